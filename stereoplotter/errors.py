@@ -1,0 +1,32 @@
+"""Domain exceptions. All subclass :class:`ValueError` so callers may catch them generically."""
+
+from __future__ import annotations
+
+__all__ = ["ConfigError", "GeometryError", "StereoplotterError"]
+
+
+class StereoplotterError(ValueError):
+    """Base class of every error stereoplotter raises on purpose."""
+
+
+class ConfigError(StereoplotterError):
+    """A scenario or instrument file is invalid.
+
+    The message names the file, the field (as a dotted path), what was expected and what was
+    found. The same pieces are kept as attributes for programs that want them.
+    """
+
+    def __init__(self, source: str, field: str, expected: str, found: object, hint: str = ""):
+        self.source = source
+        self.field = field
+        self.expected = expected
+        self.found = found
+        self.hint = hint
+        message = f"{source}: {field}: expected {expected}, found {found!r}"
+        if hint:
+            message += f" ({hint})"
+        super().__init__(message)
+
+
+class GeometryError(StereoplotterError):
+    """The geometry is degenerate: too few points, collinear points, rays that do not meet."""
