@@ -22,7 +22,8 @@ class ConfigError(StereoplotterError):
         self.expected = expected
         self.found = found
         self.hint = hint
-        message = f"{source}: {field}: expected {expected}, found {found!r}"
+        found_text = found if isinstance(found, str) else repr(found)
+        message = f"{source}: {field}: expected {expected}, found {found_text}"
         if hint:
             message += f" ({hint})"
         super().__init__(message)

@@ -212,7 +212,7 @@ def _model_and_jacobian(
     delta = points - centre
     u = delta @ m  # u = Mᵀ·Δ, Eq. (2.49)
     du_angles = np.einsum("kji,nj->nki", dm, delta)  # (n, 3 angles, 3)
-    du_centre = -np.broadcast_to(m.T, (points.shape[0], 3, 3))  # (n, 3 coords, 3)
+    du_centre = -np.broadcast_to(m, (points.shape[0], 3, 3))  # ∂u_i/∂S_k = −M_ki
     du = np.concatenate([du_angles, du_centre], axis=1)  # (n, 6, 3)
     if np.any(u[:, 2] >= 0.0):
         bad = np.nonzero(u[:, 2] >= 0.0)[0].tolist()
@@ -372,4 +372,3 @@ def space_resection(
         iterations=iterations,
         converged=converged,
     )
-
