@@ -13,9 +13,9 @@ __all__ = [
     "ARCSEC_PER_RAD",
     "DEG_PER_RAD",
     "KRASOVSKY",
-    "Ellipsoid",
     "MM_PER_M",
     "UM_PER_MM",
+    "Ellipsoid",
 ]
 
 #: Arc-seconds per radian, 648000/π. The book rounds to ρ″ = 206 265″ (OCR L364); the relative

@@ -5,9 +5,9 @@ Reference
 .. [1] Kushtin & Lyskov, *Фотограмметрия снимка и стереоскопических моделей*, Nedra, 1984, ch. 5,
    §22, pp. 118–132 (OCR L2836–3100): the pair of collinearity conditions (2.52) of a stereopair.
 
-Each ray is S + λ·d with d = M·(x − x₀, y − y₀, −f)ᵀ (Eq. (2.52)). The point returned is the midpoint
-of the shortest segment between the two rays; the segment itself (the *miss*) is the object-space
-image of the residual y-parallax and is returned so a caller can judge the pair.
+Each ray is S + λ·d with d = M·(x − x₀, y − y₀, −f)ᵀ (Eq. (2.52)). The point returned is the
+midpoint of the shortest segment between the two rays; the segment itself (the *miss*) is the
+object-space image of the residual y-parallax and is returned so a caller can judge the pair.
 """
 
 from __future__ import annotations

@@ -2,15 +2,15 @@ r"""The α-ω-κ rotation matrix of Eq. (2.50) and its alternative angles t, α�
 
 Reference
 ---------
-.. [1] Кущин (Kushtin) & Лысков (Lyskov), *Фотограмметрия снимка и стереоскопических моделей*,
+.. [1] Куштин (Kushtin) & Лысков (Lyskov), *Фотограмметрия снимка и стереоскопических моделей*,
    Moscow: Nedra, 1984, ch. 2, §12–§13, pp. 52–62 (OCR L1340–1500).
 
 Conventions (``docs/conventions.md`` §4)
 ----------------------------------------
 * α (longitudinal tilt) turns about the Y axis, first; ω (transverse tilt) about the new X′ axis;
   κ (swing) about the new Z″ axis: the φ-ω-κ family, **not** the ω-φ-κ order of most Western texts.
-* M = R_Y(−α)·R_X(ω)·R_Z(κ), with the standard right-handed *active* rotations R. The columns of M are
-  the photo axes x, y, z expressed in the object system X, Y, Z (Z up).
+* M = R_Y(−α)·R_X(ω)·R_Z(κ), with the standard right-handed *active* rotations R. The columns of
+  M are the photo axes x, y, z expressed in the object system X, Y, Z (Z up).
 * α > 0 tilts the optical axis towards +X, ω > 0 towards +Y, κ > 0 turns the photo axes
   counter-clockwise seen from +Z.
 
@@ -172,7 +172,8 @@ def alternative_angles_from_matrix(
     Returns
     -------
     direction_t, tilt, kappa0 : ndarray
-        tan t = b₃/a₃ (quadrant from a₃ = −sin α₀ cos t, b₃ = −sin α₀ sin t), sin α₀ = √(c₁² + c₂²) (α₀ from atan2 with c₃), tan κ₀ = c₁/c₂. [rad]
+        tan t = b₃/a₃ (quadrant from a₃ = −sin α₀ cos t, b₃ = −sin α₀ sin t);
+        sin α₀ = √(c₁² + c₂²) (α₀ from atan2 with c₃); tan κ₀ = c₁/c₂. [rad]
 
     Notes
     -----

@@ -1,0 +1,331 @@
+"""Command-line interface: ``stereoplotter`` and ``python -m stereoplotter``.
+
+Thin: each subcommand parses, calls one library function and formats the result. Every expected
+failure (bad input file, degenerate geometry) is printed as one ``error:`` line and exit code 1;
+a usage error exits with 2. No traceback reaches the user.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import platform
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stereoplotter import __version__
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.paths import DEFAULT_SCENARIO, data_dir, list_data_files
+from stereoplotter.yamlio import atomic_write_text
+
+__all__ = ["main"]
+
+
+def _json(data: Any) -> str:
+    return json.dumps(data, indent=2, ensure_ascii=False, default=_json_default) + "\n"
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+# --- info -------------------------------------------------------------------------------------
+
+
+def _versions() -> dict[str, str]:
+    import matplotlib
+    import pymunk
+    import pyproj
+    import scipy
+    import yaml
+
+    return {
+        "stereoplotter": __version__,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "pymunk": pymunk.version,
+        "matplotlib": matplotlib.__version__,
+        "pyyaml": yaml.__version__,
+        "pyproj": pyproj.__version__,
+        "proj": pyproj.proj_version_str,
+    }
+
+
+def _count_status(node: Any, counts: dict[str, int]) -> None:
+    if isinstance(node, dict):
+        status = node.get("status")
+        if status in ("documented", "assumed"):
+            counts[status] += 1
+        for value in node.values():
+            _count_status(value, counts)
+    elif isinstance(node, list):
+        for value in node:
+            _count_status(value, counts)
+
+
+def _info() -> dict[str, Any]:
+    from stereoplotter.scenario import load_scenario
+    from stereoplotter.yamlio import load_yaml_mapping
+
+    instruments = []
+    for path in list_data_files("instruments"):
+        counts = {"documented": 0, "assumed": 0}
+        entry: dict[str, Any] = {"file": str(path)}
+        try:
+            data, _ = load_yaml_mapping(path)
+            _count_status(data, counts)
+            entry.update(values_documented=counts["documented"],
+                         values_assumed=counts["assumed"])
+        except StereoplotterError as exc:
+            entry["error"] = str(exc)
+        instruments.append(entry)
+    scenarios = []
+    for path in list_data_files("scenarios"):
+        entry = {"file": str(path)}
+        try:
+            s = load_scenario(path)
+            entry.update(name=s.name, photos=len(s.photos), points=len(s.points))
+        except StereoplotterError as exc:
+            entry["error"] = str(exc)
+        scenarios.append(entry)
+    folders = {kind: str(data_dir(kind)) if data_dir(kind) else None
+               for kind in ("instruments", "scenarios")}
+    return {"versions": _versions(), "data_folders": folders, "instruments": instruments,
+            "scenarios": scenarios}
+
+
+def _format_info(info: dict[str, Any]) -> str:
+    lines = ["stereoplotter " + info["versions"]["stereoplotter"], "", "versions:"]
+    lines += [f"  {k:<14}{v}" for k, v in info["versions"].items()]
+    lines += ["", "instruments (" + (info["data_folders"]["instruments"] or "folder not found")
+              + "):"]
+    if not info["instruments"]:
+        lines.append("  none yet")
+    for entry in info["instruments"]:
+        if "error" in entry:
+            lines.append(f"  {entry['file']}: INVALID: {entry['error']}")
+        else:
+            lines.append(f"  {entry['file']}: {entry['values_documented']} documented, "
+                         f"{entry['values_assumed']} assumed values")
+    lines += ["", "scenarios (" + (info["data_folders"]["scenarios"] or "folder not found")
+              + "):"]
+    for entry in info["scenarios"]:
+        if "error" in entry:
+            lines.append(f"  {entry['file']}: INVALID: {entry['error']}")
+        else:
+            lines.append(f"  {entry['file']}: {entry['name']} ({entry['photos']} photo(s), "
+                         f"{entry['points']} points)")
+    return "\n".join(lines) + "\n"
+
+
+# --- scenario check --------------------------------------------------------------------------
+
+
+def _format_summary(s: dict[str, Any]) -> str:
+    lines = [f"scenario {s['name']} ({s['file']}): valid", f"  {s['description']}".rstrip(), ""]
+    cam = s["camera"]
+    lines.append(f"camera: f = {cam['focal_length_mm']} mm, format {cam['format_mm']} mm, "
+                 f"principal point {cam['principal_point_mm']} mm, fiducials given as "
+                 f"{cam['fiducials_given_as']}")
+    lines.append(f"frame: {s['frame']}")
+    for p in s["photos"]:
+        lines.append(
+            f"photo {p['name']}: S = {p['projection_centre_m']} m, α = {p['alpha_deg']}°, "
+            f"ω = {p['omega_deg']}°, κ = {p['kappa_deg']}° ({p['exterior_source']}); "
+            f"H = {p['flying_height_m']} m, photo scale 1:{p['photo_scale_denominator']:.0f}; "
+            f"{p['points_imaged']} points imaged")
+    if "base" in s:
+        b = s["base"]
+        lines.append(f"base: B = {b['horizontal_m']} m (components {b['components_m']} m), "
+                     f"B/H = {b['base_to_height']}, overlap {b['overlap_percent']} %")
+    r = s["relief"]
+    lines.append(f"relief: {r['working_area_min_m']} … {r['working_area_max_m']} m over the "
+                 f"working area ({r['working_area_range_m']} m = "
+                 f"{r['range_over_flying_height'] * 100:.1f} % of H); points "
+                 f"{r['points_min_m']} … {r['points_max_m']} m")
+    pts = s["points"]
+    lines.append("points: control " + ", ".join(f"{v} {k}" for k, v in pts["control"].items())
+                 + "; check " + str(sum(pts["check"].values())))
+    if "map_sheet" in s:
+        m = s["map_sheet"]
+        lines.append(f"map sheet: 1:{m['scale_denominator']}"
+                     + (f" {m['nomenclature']}" if m["nomenclature"] else " (corners given)"))
+    return "\n".join(lines) + "\n"
+
+
+# --- demo ------------------------------------------------------------------------------------
+
+
+def _measurements_csv(scenario, measurements) -> str:
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(["photo", "kind", "id", "x_true_mm", "y_true_mm", "x_mm", "y_mm"])
+    for pm in measurements.photos:
+        for name, t, m in zip(("1", "2", "3", "4"), pm.fiducials_true_mm, pm.fiducials_mm,
+                              strict=True):
+            writer.writerow([pm.photo, "fiducial", name, *(f"{v:.6f}" for v in (*t, *m))])
+        for pid, t, m, ok in zip(measurements.point_ids, pm.points_true_mm, pm.points_mm,
+                                 pm.points_imaged, strict=True):
+            if ok:
+                role = scenario.points[measurements.point_ids.index(pid)].role
+                writer.writerow([pm.photo, role, pid, *(f"{v:.6f}" for v in (*t, *m))])
+        for i, (t, m) in enumerate(zip(pm.grid_true_mm, pm.grid_mm, strict=True)):
+            writer.writerow([pm.photo, "grid", f"G{i + 1}", *(f"{v:.6f}" for v in (*t, *m))])
+    return out.getvalue()
+
+
+def _format_demo(result: dict[str, Any]) -> str:
+    s = result["summary"]
+    lines = [f"# stereoplotter demo: {s['name']}", "", _format_summary(s).rstrip(), "",
+             f"f′ of the pair from the measured fiducials: "
+             f"{result['focal_length_corrected_mm']} mm "
+             f"(per photo {result['focal_length_corrected_per_photo_mm']} mm)", ""]
+    for e in result["exterior"]:
+        lines.append(f"photo {e['photo']}: exterior orientation {e['source']}; error against "
+                     f"the truth: angles {e['error_angles_arcsec']}″, centre "
+                     f"{e['error_centre_m']} m")
+    inter = result.get("intersection")
+    if inter:
+        lines += ["", "space intersection of the measured points (error = intersected − true):",
+                  "", "| point | role | dX m | dY m | dZ m | dZ ‰H | ray miss m |",
+                  "|---|---|---|---|---|---|---|"]
+        for row in inter["points"]:
+            dx, dy, dz = row["error_m"]
+            lines.append(f"| {row['id']} | {row['role']} | {dx:+.3f} | {dy:+.3f} | {dz:+.3f} | "
+                         f"{row['error_height_permille_H']:+.3f} | {row['ray_miss_m']:.3f} |")
+        lines.append("")
+        for role, st in inter["statistics"].items():
+            lines.append(f"{role} points ({st['count']}): RMS plan {st['rms_plan_m']} m, "
+                         f"RMS height {st['rms_height_m']} m, max |dZ| {st['max_abs_height_m']} m")
+    sim = result.get("similarity")
+    if sim:
+        lines += ["", f"similarity (6.8) Gauss–Krüger → photogrammetric: a = {sim['a']:.9f}, "
+                  f"b = {sim['b']:.9f}, c_X = {sim['cx_m']:.3f} m, c_Y = {sim['cy_m']:.3f} m, "
+                  f"det = {sim['determinant']:.9f}; RMS residual {sim['rms_m']} m"]
+    return "\n".join(lines) + "\n"
+
+
+def _demo(args: argparse.Namespace) -> int:
+    from stereoplotter.foundation import run_foundation
+    from stereoplotter.plotting import plot_scenario_layout
+    from stereoplotter.scenario import load_scenario
+
+    path = Path(args.scenario) if args.scenario else None
+    if path is None:
+        folder = data_dir("scenarios")
+        if folder is None or not (folder / DEFAULT_SCENARIO).exists():
+            raise StereoplotterError(
+                f"the default scenario {DEFAULT_SCENARIO} was not found (searched "
+                "$STEREOPLOTTER_DATA, the current directory and the source tree); run from the "
+                "repository or pass --scenario FILE")
+        path = folder / DEFAULT_SCENARIO
+    scenario = load_scenario(path)
+    seed = scenario.seed if args.seed is None else args.seed
+    result = run_foundation(scenario, np.random.default_rng(seed))
+    measurements = result.pop("measurements")
+    result["seed"] = seed
+    out = Path(args.output)
+    text = _format_demo(result)
+    figure = plot_scenario_layout(scenario, result)
+    png = io.BytesIO()
+    figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
+    files = {
+        "result.json": _json(result),
+        "summary.md": text,
+        "measurements.csv": _measurements_csv(scenario, measurements),
+    }
+    for name, content in files.items():
+        atomic_write_text(out / name, content)
+    _atomic_write_bytes(out / "layout.png", png.getvalue())
+    if args.json:
+        sys.stdout.write(_json(result))
+    else:
+        sys.stdout.write(text)
+        sys.stdout.write(f"\nwritten: {', '.join(sorted([*files, 'layout.png']))} in {out}\n")
+    return 0
+
+
+def _atomic_write_bytes(path: Path, data: bytes) -> None:
+    import os
+    import tempfile
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+# --- parser ----------------------------------------------------------------------------------
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="stereoplotter",
+        description="Virtual SC-1, SPR-3 and SD-3 stereoplotters and their setup data "
+                    "(Kushtin & Lyskov 1984, ch. 6).")
+    parser.add_argument("--version", action="version", version=f"stereoplotter {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("info", help="versions, instruments and scenarios found")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+    p = sub.add_parser("scenario", help="work with scenario files")
+    scen = p.add_subparsers(dest="scenario_command", required=True, metavar="ACTION")
+    c = scen.add_parser("check", help="validate a scenario file and summarise it: photo scale, "
+                                      "overlap, base, B/H, relief")
+    c.add_argument("file", help="a scenarios/*.yaml file")
+    c.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+    p = sub.add_parser("demo", help="run the main job on the default scenario (or --scenario) "
+                                    "and write its results into a folder")
+    p.add_argument("-o", "--output", default="stereoplotter-demo",
+                   help="output folder (default: %(default)s)")
+    p.add_argument("--scenario", help=f"scenario file (default: scenarios/{DEFAULT_SCENARIO})")
+    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``stereoplotter`` command. Returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "info":
+            info = _info()
+            sys.stdout.write(_json(info) if args.json else _format_info(info))
+            return 0
+        if args.command == "scenario":
+            from stereoplotter.scenario import load_scenario, summarize_scenario
+
+            summary = summarize_scenario(load_scenario(args.file))
+            sys.stdout.write(_json(summary) if args.json else _format_summary(summary))
+            return 0
+        if args.command == "demo":
+            return _demo(args)
+    except StereoplotterError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    return 2  # pragma: no cover - argparse requires a command
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())

@@ -1,0 +1,45 @@
+"""Scenarios: the ground truth of a photo or a stereopair, loaded from ``scenarios/*.yaml``, and
+the synthetic measurements made from it."""
+
+from __future__ import annotations
+
+from stereoplotter.scenario.loader import load_scenario, scenario_from_mapping
+from stereoplotter.scenario.model import (
+    Camera,
+    ErrorSettings,
+    ExteriorOrientation,
+    Frame,
+    Hill,
+    MapSheet,
+    Photo,
+    Point,
+    Scenario,
+    Terrain,
+)
+from stereoplotter.scenario.summary import summarize_scenario
+from stereoplotter.scenario.synthetic import (
+    Measurements,
+    PhotoMeasurements,
+    synthesize_measurements,
+    working_area_grid_m,
+)
+
+__all__ = [
+    "Camera",
+    "ErrorSettings",
+    "ExteriorOrientation",
+    "Frame",
+    "Hill",
+    "MapSheet",
+    "Measurements",
+    "Photo",
+    "PhotoMeasurements",
+    "Point",
+    "Scenario",
+    "Terrain",
+    "load_scenario",
+    "scenario_from_mapping",
+    "summarize_scenario",
+    "synthesize_measurements",
+    "working_area_grid_m",
+]

@@ -1,0 +1,215 @@
+"""Reading YAML input with clear errors, and writing output files whole or not at all.
+
+Every problem in an input file becomes one :class:`~stereoplotter.errors.ConfigError` whose
+message names the file, the field (a dotted path such as ``photos[1].exterior.alpha_deg``), what
+was expected and what was found.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from stereoplotter.errors import ConfigError
+
+__all__ = ["Fields", "atomic_write_text", "load_yaml_mapping"]
+
+_MISSING = object()
+
+
+def load_yaml_mapping(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
+    """Read a YAML file whose top level is a mapping.
+
+    Returns
+    -------
+    data, source : dict, str
+        The parsed mapping and the path as given (for messages).
+
+    Raises
+    ------
+    ConfigError
+        The file is missing, unreadable, not valid YAML, or not a mapping.
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(source, "(file)", "an existing file", "no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(source, "(file)", "a readable UTF-8 text file", str(exc)) from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown place"
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ConfigError(source, "(file)", "valid YAML", f"{problem} at {where}") from None
+    if not isinstance(data, dict):
+        raise ConfigError(source, "(top level)", "a mapping of fields", type(data).__name__)
+    return data, source
+
+
+class Fields:
+    """Typed, range-checked access to a parsed YAML document, with messages that name the field.
+
+    Parameters
+    ----------
+    source : str
+        The file name, for messages.
+    """
+
+    def __init__(self, source: str):
+        self.source = source
+
+    def error(self, path: str, expected: str, found: object, hint: str = "") -> ConfigError:
+        """A :class:`ConfigError` for this file."""
+        return ConfigError(self.source, path, expected, found, hint)
+
+    @staticmethod
+    def join(path: str, key: str | int) -> str:
+        """Dotted path of a child: ``camera`` + ``focal_length_mm``, or ``photos`` + 1."""
+        if isinstance(key, int):
+            return f"{path}[{key}]"
+        return f"{path}.{key}" if path else key
+
+    def mapping(self, value: Any, path: str, allowed: Iterable[str] | None = None,
+                required: Iterable[str] = ()) -> dict[str, Any]:
+        """Check ``value`` is a mapping with only ``allowed`` keys and the ``required`` ones."""
+        if not isinstance(value, dict):
+            raise self.error(path or "(top level)", "a mapping", _describe(value))
+        for key in value:
+            if not isinstance(key, str):
+                raise self.error(path, "text keys", key)
+        if allowed is not None:
+            allowed = list(allowed)
+            unknown = [k for k in value if k not in allowed]
+            if unknown:
+                raise self.error(self.join(path, unknown[0]), "no such field",
+                                 unknown[0], "allowed here: " + ", ".join(allowed))
+        for key in required:
+            if key not in value:
+                raise self.error(self.join(path, key), "a value (the field is required)",
+                                 "nothing")
+        return value
+
+    def get(self, node: Mapping[str, Any], key: str, path: str, default: Any = _MISSING) -> Any:
+        """``node[key]``, or ``default``; a missing required field is an error."""
+        if key in node and node[key] is not None:
+            return node[key]
+        if default is _MISSING:
+            raise self.error(self.join(path, key), "a value (the field is required)", "nothing")
+        return default
+
+    def number(self, node: Mapping[str, Any], key: str, path: str, *, unit: str,
+               low: float = -math.inf, high: float = math.inf, low_open: bool = False,
+               high_open: bool = False, default: Any = _MISSING, basis: str = "") -> float:
+        """A finite real number inside [low, high] (ends open where asked)."""
+        value = self.get(node, key, path, default)
+        return self.check_number(value, self.join(path, key), unit=unit, low=low, high=high,
+                                 low_open=low_open, high_open=high_open, basis=basis)
+
+    def check_number(self, value: Any, path: str, *, unit: str, low: float = -math.inf,
+                     high: float = math.inf, low_open: bool = False, high_open: bool = False,
+                     basis: str = "") -> float:
+        """Validate one number already taken from the document."""
+        expected = _range_text(unit, low, high, low_open, high_open)
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.error(path, f"a number {expected}", _describe(value))
+        value = float(value)
+        too_low = value < low or (low_open and value == low)
+        too_high = value > high or (high_open and value == high)
+        if not math.isfinite(value) or too_low or too_high:
+            raise self.error(path, f"a number {expected}", value, basis)
+        return value
+
+    def integer(self, node: Mapping[str, Any], key: str, path: str, *, low: int, high: int,
+                default: Any = _MISSING) -> int:
+        """An integer inside [low, high]."""
+        value = self.get(node, key, path, default)
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+            raise self.error(self.join(path, key), f"an integer in [{low}, {high}]",
+                             _describe(value))
+        return value
+
+    def text(self, node: Mapping[str, Any], key: str, path: str, default: Any = _MISSING) -> str:
+        """A non-empty string (numbers are accepted and turned into text, as for point ids)."""
+        value = self.get(node, key, path, default)
+        if isinstance(value, bool) or not isinstance(value, str | int) or str(value) == "":
+            raise self.error(self.join(path, key), "a non-empty text", _describe(value))
+        return str(value)
+
+    def choice(self, node: Mapping[str, Any], key: str, path: str, choices: Iterable[str],
+               default: Any = _MISSING) -> str:
+        """One of a fixed set of words."""
+        choices = list(choices)
+        value = self.get(node, key, path, default)
+        if value not in choices:
+            raise self.error(self.join(path, key), "one of " + ", ".join(choices),
+                             _describe(value))
+        return value
+
+    def vector(self, node: Mapping[str, Any], key: str, path: str, length: int, *, unit: str,
+               low: float = -math.inf, high: float = math.inf,
+               default: Any = _MISSING) -> tuple[float, ...]:
+        """A list of ``length`` numbers, each inside [low, high]."""
+        value = self.get(node, key, path, default)
+        full = self.join(path, key)
+        if not isinstance(value, list | tuple) or len(value) != length:
+            raise self.error(full, f"a list of {length} numbers [{unit}]", _describe(value))
+        return tuple(self.check_number(v, self.join(full, i), unit=unit, low=low, high=high)
+                     for i, v in enumerate(value))
+
+    def sequence(self, node: Mapping[str, Any], key: str, path: str, *, min_length: int = 0,
+                 default: Any = _MISSING) -> list[Any]:
+        """A list with at least ``min_length`` entries."""
+        value = self.get(node, key, path, default)
+        if not isinstance(value, list):
+            raise self.error(self.join(path, key), "a list", _describe(value))
+        if len(value) < min_length:
+            raise self.error(self.join(path, key), f"a list of at least {min_length} entries",
+                             f"{len(value)} entries")
+        return value
+
+
+def _range_text(unit: str, low: float, high: float, low_open: bool, high_open: bool) -> str:
+    unit_text = f" {unit}" if unit and unit != "—" else ""
+    if math.isinf(low) and math.isinf(high):
+        return f"[{unit}]" if unit_text else ""
+    left = "(" if low_open or math.isinf(low) else "["
+    right = ")" if high_open or math.isinf(high) else "]"
+    lo = "-inf" if math.isinf(low) else f"{low:g}"
+    hi = "inf" if math.isinf(high) else f"{high:g}"
+    return f"in {left}{lo}, {hi}{right}{unit_text}"
+
+
+def _describe(value: Any) -> str:
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, list):
+        return f"a list of {len(value)}"
+    if value is None:
+        return "nothing"
+    if isinstance(value, str):
+        return f"the text {value!r}"
+    return repr(value)
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
+    """Write ``text`` to ``path`` whole or not at all (temporary file in the same folder, then
+    :func:`os.replace`)."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

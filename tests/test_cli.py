@@ -1,0 +1,86 @@
+"""The command line: info, scenario check, demo; errors without tracebacks."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from stereoplotter.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+PAIR60 = str(ROOT / "scenarios" / "pair60.yaml")
+
+
+def test_info_lists_versions_and_scenarios(capsys):
+    assert main(["info", "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert {"stereoplotter", "numpy", "pymunk", "matplotlib", "pyproj"} <= set(info["versions"])
+    assert any(s.get("name") == "pair60" for s in info["scenarios"])
+    assert main(["info"]) == 0
+    assert "scenarios (" in capsys.readouterr().out
+
+
+def test_scenario_check_text_and_json(capsys):
+    assert main(["scenario", "check", PAIR60]) == 0
+    text = capsys.readouterr().out
+    assert "valid" in text and "overlap" in text and "B/H" in text and "relief" in text
+    assert main(["scenario", "check", PAIR60, "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["base"]["horizontal_m"] == pytest.approx(1440.078, abs=0.001)
+    assert summary["photos"][0]["photo_scale_denominator"] == pytest.approx(19901, abs=1)
+
+
+def test_bad_scenario_is_one_error_line_exit_1(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(Path(PAIR60).read_text(encoding="utf-8").replace(
+        "focal_length_mm: 70.0", "focal_length_mm: -70.0"), encoding="utf-8")
+    assert main(["scenario", "check", str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "camera.focal_length_mm" in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_missing_file_exit_1(capsys):
+    assert main(["scenario", "check", "does-not-exist.yaml"]) == 1
+    assert "expected an existing file" in capsys.readouterr().err
+
+
+def test_usage_error_exits_2(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["scenario"])
+    assert exc.value.code == 2
+
+
+def test_demo_writes_files_reproducibly(tmp_path, capsys):
+    out1, out2 = tmp_path / "a", tmp_path / "b"
+    assert main(["demo", "-o", str(out1), "--scenario", PAIR60]) == 0
+    assert "space intersection" in capsys.readouterr().out
+    assert main(["demo", "-o", str(out2), "--scenario", PAIR60]) == 0
+    names = {"result.json", "summary.md", "measurements.csv", "layout.png"}
+    assert {p.name for p in out1.iterdir()} == names
+    for name in names:  # same seed → byte-identical output files
+        assert (out1 / name).read_bytes() == (out2 / name).read_bytes(), name
+    result = json.loads((out1 / "result.json").read_text(encoding="utf-8"))
+    # 3 µm measurement noise at 1:20 000 gives decimetre errors, not metres
+    assert result["intersection"]["statistics"]["check"]["rms_height_m"] < 0.3
+    assert result["similarity"]["determinant"] < 0
+
+
+def test_demo_resection_scenario(tmp_path, capsys):
+    scenario = str(ROOT / "scenarios" / "book_resection_table7.yaml")
+    assert main(["demo", "-o", str(tmp_path), "--scenario", scenario, "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    (ext,) = result["exterior"]
+    assert ext["source"] == "resection"
+    assert max(abs(v) for v in ext["error_angles_arcsec"]) < 0.1
+    assert max(abs(v) for v in ext["error_centre_m"]) < 0.001
+
+
+def test_python_dash_m_runs():
+    done = subprocess.run([sys.executable, "-m", "stereoplotter", "--version"],
+                          capture_output=True, text=True, check=False)
+    assert done.returncode == 0 and done.stdout.startswith("stereoplotter ")
