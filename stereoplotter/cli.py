@@ -85,8 +85,7 @@ def _info() -> dict[str, Any]:
         try:
             data, _ = load_yaml_mapping(path)
             _count_status(data, counts)
-            entry.update(values_documented=counts["documented"],
-                         values_assumed=counts["assumed"])
+            entry.update(values_documented=counts["documented"], values_assumed=counts["assumed"])
         except StereoplotterError as exc:
             entry["error"] = str(exc)
         instruments.append(entry)
@@ -99,33 +98,44 @@ def _info() -> dict[str, Any]:
         except StereoplotterError as exc:
             entry["error"] = str(exc)
         scenarios.append(entry)
-    folders = {kind: str(data_dir(kind)) if data_dir(kind) else None
-               for kind in ("instruments", "scenarios")}
-    return {"versions": _versions(), "data_folders": folders, "instruments": instruments,
-            "scenarios": scenarios}
+    folders = {
+        kind: str(data_dir(kind)) if data_dir(kind) else None
+        for kind in ("instruments", "scenarios")
+    }
+    return {
+        "versions": _versions(),
+        "data_folders": folders,
+        "instruments": instruments,
+        "scenarios": scenarios,
+    }
 
 
 def _format_info(info: dict[str, Any]) -> str:
     lines = ["stereoplotter " + info["versions"]["stereoplotter"], "", "versions:"]
     lines += [f"  {k:<14}{v}" for k, v in info["versions"].items()]
-    lines += ["", "instruments (" + (info["data_folders"]["instruments"] or "folder not found")
-              + "):"]
+    lines += [
+        "",
+        "instruments (" + (info["data_folders"]["instruments"] or "folder not found") + "):",
+    ]
     if not info["instruments"]:
         lines.append("  none yet")
     for entry in info["instruments"]:
         if "error" in entry:
             lines.append(f"  {entry['file']}: INVALID: {entry['error']}")
         else:
-            lines.append(f"  {entry['file']}: {entry['values_documented']} documented, "
-                         f"{entry['values_assumed']} assumed values")
-    lines += ["", "scenarios (" + (info["data_folders"]["scenarios"] or "folder not found")
-              + "):"]
+            lines.append(
+                f"  {entry['file']}: {entry['values_documented']} documented, "
+                f"{entry['values_assumed']} assumed values"
+            )
+    lines += ["", "scenarios (" + (info["data_folders"]["scenarios"] or "folder not found") + "):"]
     for entry in info["scenarios"]:
         if "error" in entry:
             lines.append(f"  {entry['file']}: INVALID: {entry['error']}")
         else:
-            lines.append(f"  {entry['file']}: {entry['name']} ({entry['photos']} photo(s), "
-                         f"{entry['points']} points)")
+            lines.append(
+                f"  {entry['file']}: {entry['name']} ({entry['photos']} photo(s), "
+                f"{entry['points']} points)"
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -135,32 +145,45 @@ def _format_info(info: dict[str, Any]) -> str:
 def _format_summary(s: dict[str, Any]) -> str:
     lines = [f"scenario {s['name']} ({s['file']}): valid", f"  {s['description']}".rstrip(), ""]
     cam = s["camera"]
-    lines.append(f"camera: f = {cam['focal_length_mm']} mm, format {cam['format_mm']} mm, "
-                 f"principal point {cam['principal_point_mm']} mm, fiducials given as "
-                 f"{cam['fiducials_given_as']}")
+    lines.append(
+        f"camera: f = {cam['focal_length_mm']} mm, format {cam['format_mm']} mm, "
+        f"principal point {cam['principal_point_mm']} mm, fiducials given as "
+        f"{cam['fiducials_given_as']}"
+    )
     lines.append(f"frame: {s['frame']}")
     for p in s["photos"]:
         lines.append(
             f"photo {p['name']}: S = {p['projection_centre_m']} m, α = {p['alpha_deg']}°, "
             f"ω = {p['omega_deg']}°, κ = {p['kappa_deg']}° ({p['exterior_source']}); "
             f"H = {p['flying_height_m']} m, photo scale 1:{p['photo_scale_denominator']:.0f}; "
-            f"{p['points_imaged']} points imaged")
+            f"{p['points_imaged']} points imaged"
+        )
     if "base" in s:
         b = s["base"]
-        lines.append(f"base: B = {b['horizontal_m']} m (components {b['components_m']} m), "
-                     f"B/H = {b['base_to_height']}, overlap {b['overlap_percent']} %")
+        lines.append(
+            f"base: B = {b['horizontal_m']} m (components {b['components_m']} m), "
+            f"B/H = {b['base_to_height']}, overlap {b['overlap_percent']} %"
+        )
     r = s["relief"]
-    lines.append(f"relief: {r['working_area_min_m']} … {r['working_area_max_m']} m over the "
-                 f"working area ({r['working_area_range_m']} m = "
-                 f"{r['range_over_flying_height'] * 100:.1f} % of H); points "
-                 f"{r['points_min_m']} … {r['points_max_m']} m")
+    lines.append(
+        f"relief: {r['working_area_min_m']} … {r['working_area_max_m']} m over the "
+        f"working area ({r['working_area_range_m']} m = "
+        f"{r['range_over_flying_height'] * 100:.1f} % of H); points "
+        f"{r['points_min_m']} … {r['points_max_m']} m"
+    )
     pts = s["points"]
-    lines.append("points: control " + ", ".join(f"{v} {k}" for k, v in pts["control"].items())
-                 + "; check " + str(sum(pts["check"].values())))
+    lines.append(
+        "points: control "
+        + ", ".join(f"{v} {k}" for k, v in pts["control"].items())
+        + "; check "
+        + str(sum(pts["check"].values()))
+    )
     if "map_sheet" in s:
         m = s["map_sheet"]
-        lines.append(f"map sheet: 1:{m['scale_denominator']}"
-                     + (f" {m['nomenclature']}" if m["nomenclature"] else " (corners given)"))
+        lines.append(
+            f"map sheet: 1:{m['scale_denominator']}"
+            + (f" {m['nomenclature']}" if m["nomenclature"] else " (corners given)")
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -172,11 +195,13 @@ def _measurements_csv(scenario, measurements) -> str:
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(["photo", "kind", "id", "x_true_mm", "y_true_mm", "x_mm", "y_mm"])
     for pm in measurements.photos:
-        for name, t, m in zip(("1", "2", "3", "4"), pm.fiducials_true_mm, pm.fiducials_mm,
-                              strict=True):
+        for name, t, m in zip(
+            ("1", "2", "3", "4"), pm.fiducials_true_mm, pm.fiducials_mm, strict=True
+        ):
             writer.writerow([pm.photo, "fiducial", name, *(f"{v:.6f}" for v in (*t, *m))])
-        for pid, t, m, ok in zip(measurements.point_ids, pm.points_true_mm, pm.points_mm,
-                                 pm.points_imaged, strict=True):
+        for pid, t, m, ok in zip(
+            measurements.point_ids, pm.points_true_mm, pm.points_mm, pm.points_imaged, strict=True
+        ):
             if ok:
                 role = scenario.points[measurements.point_ids.index(pid)].role
                 writer.writerow([pm.photo, role, pid, *(f"{v:.6f}" for v in (*t, *m))])
@@ -187,32 +212,51 @@ def _measurements_csv(scenario, measurements) -> str:
 
 def _format_demo(result: dict[str, Any]) -> str:
     s = result["summary"]
-    lines = [f"# stereoplotter demo: {s['name']}", "", _format_summary(s).rstrip(), "",
-             f"f′ of the pair from the measured fiducials: "
-             f"{result['focal_length_corrected_mm']} mm "
-             f"(per photo {result['focal_length_corrected_per_photo_mm']} mm)", ""]
+    lines = [
+        f"# stereoplotter demo: {s['name']}",
+        "",
+        _format_summary(s).rstrip(),
+        "",
+        f"f′ of the pair from the measured fiducials: "
+        f"{result['focal_length_corrected_mm']} mm "
+        f"(per photo {result['focal_length_corrected_per_photo_mm']} mm)",
+        "",
+    ]
     for e in result["exterior"]:
-        lines.append(f"photo {e['photo']}: exterior orientation {e['source']}; error against "
-                     f"the truth: angles {e['error_angles_arcsec']}″, centre "
-                     f"{e['error_centre_m']} m")
+        lines.append(
+            f"photo {e['photo']}: exterior orientation {e['source']}; error against "
+            f"the truth: angles {e['error_angles_arcsec']}″, centre "
+            f"{e['error_centre_m']} m"
+        )
     inter = result.get("intersection")
     if inter:
-        lines += ["", "space intersection of the measured points (error = intersected − true):",
-                  "", "| point | role | dX m | dY m | dZ m | dZ ‰H | ray miss m |",
-                  "|---|---|---|---|---|---|---|"]
+        lines += [
+            "",
+            "space intersection of the measured points (error = intersected − true):",
+            "",
+            "| point | role | dX m | dY m | dZ m | dZ ‰H | ray miss m |",
+            "|---|---|---|---|---|---|---|",
+        ]
         for row in inter["points"]:
             dx, dy, dz = row["error_m"]
-            lines.append(f"| {row['id']} | {row['role']} | {dx:+.3f} | {dy:+.3f} | {dz:+.3f} | "
-                         f"{row['error_height_permille_H']:+.3f} | {row['ray_miss_m']:.3f} |")
+            lines.append(
+                f"| {row['id']} | {row['role']} | {dx:+.3f} | {dy:+.3f} | {dz:+.3f} | "
+                f"{row['error_height_permille_H']:+.3f} | {row['ray_miss_m']:.3f} |"
+            )
         lines.append("")
         for role, st in inter["statistics"].items():
-            lines.append(f"{role} points ({st['count']}): RMS plan {st['rms_plan_m']} m, "
-                         f"RMS height {st['rms_height_m']} m, max |dZ| {st['max_abs_height_m']} m")
+            lines.append(
+                f"{role} points ({st['count']}): RMS plan {st['rms_plan_m']} m, "
+                f"RMS height {st['rms_height_m']} m, max |dZ| {st['max_abs_height_m']} m"
+            )
     sim = result.get("similarity")
     if sim:
-        lines += ["", f"similarity (6.8) Gauss–Krüger → photogrammetric: a = {sim['a']:.9f}, "
-                  f"b = {sim['b']:.9f}, c_X = {sim['cx_m']:.3f} m, c_Y = {sim['cy_m']:.3f} m, "
-                  f"det = {sim['determinant']:.9f}; RMS residual {sim['rms_m']} m"]
+        lines += [
+            "",
+            f"similarity (6.8) Gauss–Krüger → photogrammetric: a = {sim['a']:.9f}, "
+            f"b = {sim['b']:.9f}, c_X = {sim['cx_m']:.3f} m, c_Y = {sim['cy_m']:.3f} m, "
+            f"det = {sim['determinant']:.9f}; RMS residual {sim['rms_m']} m",
+        ]
     return "\n".join(lines) + "\n"
 
 
@@ -228,7 +272,8 @@ def _demo(args: argparse.Namespace) -> int:
             raise StereoplotterError(
                 f"the default scenario {DEFAULT_SCENARIO} was not found (searched "
                 "$STEREOPLOTTER_DATA, the current directory and the source tree); run from the "
-                "repository or pass --scenario FILE")
+                "repository or pass --scenario FILE"
+            )
         path = folder / DEFAULT_SCENARIO
     scenario = load_scenario(path)
     seed = scenario.seed if args.seed is None else args.seed
@@ -278,7 +323,8 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="stereoplotter",
         description="Virtual SC-1, SPR-3 and SD-3 stereoplotters and their setup data "
-                    "(Kushtin & Lyskov 1984, ch. 6).")
+        "(Kushtin & Lyskov 1984, ch. 6).",
+    )
     parser.add_argument("--version", action="version", version=f"stereoplotter {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -287,15 +333,21 @@ def _parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("scenario", help="work with scenario files")
     scen = p.add_subparsers(dest="scenario_command", required=True, metavar="ACTION")
-    c = scen.add_parser("check", help="validate a scenario file and summarise it: photo scale, "
-                                      "overlap, base, B/H, relief")
+    c = scen.add_parser(
+        "check",
+        help="validate a scenario file and summarise it: photo scale, overlap, base, B/H, relief",
+    )
     c.add_argument("file", help="a scenarios/*.yaml file")
     c.add_argument("--json", action="store_true", help="print JSON instead of text")
 
-    p = sub.add_parser("demo", help="run the main job on the default scenario (or --scenario) "
-                                    "and write its results into a folder")
-    p.add_argument("-o", "--output", default="stereoplotter-demo",
-                   help="output folder (default: %(default)s)")
+    p = sub.add_parser(
+        "demo",
+        help="run the main job on the default scenario (or --scenario) "
+        "and write its results into a folder",
+    )
+    p.add_argument(
+        "-o", "--output", default="stereoplotter-demo", help="output folder (default: %(default)s)"
+    )
     p.add_argument("--scenario", help=f"scenario file (default: scenarios/{DEFAULT_SCENARIO})")
     p.add_argument("--seed", type=int, help="override the scenario's seed")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")

@@ -80,5 +80,6 @@ class Ellipsoid:
 
 #: The Krasovsky (1940) ellipsoid of the SK-42 system: a from the constant term of N in (2.10) and
 #: (2.16) (OCR L947, L1021); 1/f = 298.3, the standard value, consistent with the printed e′².
-KRASOVSKY = Ellipsoid(name="Krasovsky 1940", a_m=6378245.0, inverse_flattening=298.3,
-                      proj_name="krass")
+KRASOVSKY = Ellipsoid(
+    name="Krasovsky 1940", a_m=6378245.0, inverse_flattening=298.3, proj_name="krass"
+)

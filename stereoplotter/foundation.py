@@ -40,8 +40,12 @@ def _exterior(scenario: Scenario, measurements: Measurements) -> list[dict[str, 
         record: dict[str, Any] = {"photo": photo.name, "source": truth.source}
         if truth.source == "resection":
             pm = measurements.photo(photo.name)
-            use = np.array([pm.points_imaged[i] and p.role == "control" and p.kind == "full"
-                            for i, p in enumerate(scenario.points)])
+            use = np.array(
+                [
+                    pm.points_imaged[i] and p.role == "control" and p.kind == "full"
+                    for i, p in enumerate(scenario.points)
+                ]
+            )
             pts = np.array([p.local_m for p in scenario.points])[use]
             result = space_resection(pm.points_mm[use], pts, f, scenario.camera.principal_point_mm)
             angles = result.angles
@@ -69,17 +73,22 @@ def _exterior(scenario: Scenario, measurements: Measurements) -> list[dict[str, 
     return out
 
 
-def _intersection(scenario: Scenario, measurements: Measurements,
-                  exterior: list[dict[str, Any]]) -> dict[str, Any]:
+def _intersection(
+    scenario: Scenario, measurements: Measurements, exterior: list[dict[str, Any]]
+) -> dict[str, Any]:
     left, right = (measurements.photo(n) for n in ("left", "right"))
     el, er = exterior
     both = left.points_imaged & right.points_imaged
     pts = np.array([p.local_m for p in scenario.points])
     result = space_intersection(
-        left.points_mm[both], right.points_mm[both],
-        el["_centre"], rotation_matrix(*el["_angles"]),
-        er["_centre"], rotation_matrix(*er["_angles"]),
-        measurements.focal_length_corrected_mm, scenario.camera.principal_point_mm,
+        left.points_mm[both],
+        right.points_mm[both],
+        el["_centre"],
+        rotation_matrix(*el["_angles"]),
+        er["_centre"],
+        rotation_matrix(*er["_angles"]),
+        measurements.focal_length_corrected_mm,
+        scenario.camera.principal_point_mm,
     )
     errors = result.points_m - pts[both]
     height = scenario.photos[0].exterior.projection_centre_m[2] - float(pts[:, 2].mean())
@@ -87,12 +96,17 @@ def _intersection(scenario: Scenario, measurements: Measurements,
     rows = []
     ids = [p for p, b in zip(scenario.points, both, strict=True) if b]
     for p, e, miss in zip(ids, errors, result.miss_distance_m, strict=True):
-        row = {"id": p.id, "role": p.role, "error_m": _rounded(e, 4),
-               "error_height_permille_H": round(float(e[2]) / height * 1000.0, 4),
-               "ray_miss_m": round(float(miss), 4)}
+        row = {
+            "id": p.id,
+            "role": p.role,
+            "error_m": _rounded(e, 4),
+            "error_height_permille_H": round(float(e[2]) / height * 1000.0, 4),
+            "ray_miss_m": round(float(miss), 4),
+        }
         if sheet:
             row["plan_error_mm_at_map_scale"] = round(
-                float(np.hypot(e[0], e[1])) * MM_PER_M / sheet, 4)
+                float(np.hypot(e[0], e[1])) * MM_PER_M / sheet, 4
+            )
         rows.append(row)
     stats = {}
     for role in ("control", "check"):
@@ -105,13 +119,20 @@ def _intersection(scenario: Scenario, measurements: Measurements,
                 "rms_height_m": round(float(np.sqrt(np.mean(e[:, 2] ** 2))), 4),
                 "max_abs_height_m": round(float(np.max(np.abs(e[:, 2]))), 4),
             }
-    return {"points": rows, "statistics": stats, "flying_height_m": round(height, 2),
-            "not_in_overlap": [p.id for p, b in zip(scenario.points, both, strict=True) if not b]}
+    return {
+        "points": rows,
+        "statistics": stats,
+        "flying_height_m": round(height, 2),
+        "not_in_overlap": [p.id for p, b in zip(scenario.points, both, strict=True) if not b],
+    }
 
 
 def _similarity(scenario: Scenario) -> dict[str, Any] | None:
-    plan = [p for p in scenario.points
-            if p.role == "control" and p.kind in ("full", "plan") and p.sk42_m is not None]
+    plan = [
+        p
+        for p in scenario.points
+        if p.role == "control" and p.kind in ("full", "plan") and p.sk42_m is not None
+    ]
     if scenario.map_sheet is None or len(plan) < 2:
         return None
     north = np.array([p.sk42_m[0] for p in plan])
@@ -125,8 +146,12 @@ def _similarity(scenario: Scenario) -> dict[str, Any] | None:
     corners = apply_similarity(fit, *scenario.map_sheet.corners_sk42_m.T)
     return {
         "equation": "(6.8)",
-        "a": fit.a, "b": fit.b, "cx_m": fit.cx_m, "cy_m": fit.cy_m,
-        "scale": fit.scale, "determinant": fit.determinant,
+        "a": fit.a,
+        "b": fit.b,
+        "cx_m": fit.cx_m,
+        "cy_m": fit.cy_m,
+        "scale": fit.scale,
+        "determinant": fit.determinant,
         "residuals_m": {p.id: _rounded(r, 4) for p, r in zip(plan, fit.residuals_m, strict=True)},
         "rms_m": round(fit.rms_m, 4),
         "sheet_corners_photogrammetric_m": [_rounded(c, 3) for c in corners],
@@ -156,7 +181,8 @@ def run_foundation(scenario: Scenario, rng: np.random.Generator) -> dict[str, An
         "summary": summarize_scenario(scenario),
         "focal_length_corrected_mm": round(measurements.focal_length_corrected_mm, 6),
         "focal_length_corrected_per_photo_mm": _rounded(
-            measurements.focal_length_corrected_per_photo_mm, 6),
+            measurements.focal_length_corrected_per_photo_mm, 6
+        ),
         "exterior": [{k: v for k, v in e.items() if not k.startswith("_")} for e in exterior],
     }
     if scenario.is_stereopair:

@@ -40,7 +40,10 @@ _QUARTERS_LOWER = {"а": 0, "б": 1, "в": 2, "г": 3, "a": 0, "b": 1, "v": 2, "
 _NINTHS = {c: i for i, c in enumerate("абвгдежзи")}
 _NINTHS.update({c: i for i, c in enumerate(["a", "b", "v", "g", "d", "e", "zh", "z", "i"])})
 _ROMAN = {
-    "I": 1, "V": 5, "X": 10, "L": 50,
+    "I": 1,
+    "V": 5,
+    "X": 10,
+    "L": 50,
 }
 
 
@@ -68,8 +71,12 @@ class SheetBounds:
 
     def corners_deg(self) -> list[tuple[float, float]]:
         """Corners (latitude, longitude) NW, NE, SE, SW. [deg]"""
-        return [(self.north_deg, self.west_deg), (self.north_deg, self.east_deg),
-                (self.south_deg, self.east_deg), (self.south_deg, self.west_deg)]
+        return [
+            (self.north_deg, self.west_deg),
+            (self.north_deg, self.east_deg),
+            (self.south_deg, self.east_deg),
+            (self.south_deg, self.west_deg),
+        ]
 
 
 def _roman(text: str) -> int | None:
@@ -146,8 +153,10 @@ def sheet_bounds(nomenclature: str) -> SheetBounds:
     def take_quarter(part: str, table: dict[str, int], new_scale: int):
         nonlocal south, west, height, width, scale
         if part not in table:
-            raise _fail(nomenclature, f"{part!r} is not one of {'/'.join(table)} "
-                                      f"for 1:{new_scale:,}".replace(",", " "))
+            raise _fail(
+                nomenclature,
+                f"{part!r} is not one of {'/'.join(table)} for 1:{new_scale:,}".replace(",", " "),
+            )
         south, west, height, width = _part(south, west, height, width, 2, 2, table[part])
         scale = new_scale
 
@@ -164,22 +173,23 @@ def sheet_bounds(nomenclature: str) -> SheetBounds:
         else:
             if not first.isdigit() or not 1 <= int(first) <= 144:
                 raise _fail(nomenclature, f"1:100 000 part {first!r} is not a number 1–144")
-            south, west, height, width = _part(south, west, height, width, 12, 12,
-                                               int(first) - 1)
+            south, west, height, width = _part(south, west, height, width, 12, 12, int(first) - 1)
             scale = 100_000
     if rest and rest[0].startswith("("):
         m = re.fullmatch(r"\((\d+)(?:-(\w+))?\)", rest.pop(0))
         if m is None or not 1 <= int(m.group(1)) <= 256 or rest:
-            raise _fail(nomenclature, "1:5 000 part must be '(n)' with n in 1–256, "
-                                      "or '(n-x)' for 1:2 000, and come last")
-        south, west, height, width = _part(south, west, height, width, 16, 16,
-                                           int(m.group(1)) - 1)
+            raise _fail(
+                nomenclature,
+                "1:5 000 part must be '(n)' with n in 1–256, or '(n-x)' for 1:2 000, and come last",
+            )
+        south, west, height, width = _part(south, west, height, width, 16, 16, int(m.group(1)) - 1)
         scale = 5_000
         if m.group(2) is not None:
             if m.group(2) not in _NINTHS:
                 raise _fail(nomenclature, f"1:2 000 part {m.group(2)!r} is not one of а–и")
-            south, west, height, width = _part(south, west, height, width, 3, 3,
-                                               _NINTHS[m.group(2)])
+            south, west, height, width = _part(
+                south, west, height, width, 3, 3, _NINTHS[m.group(2)]
+            )
             scale = 2_000
     if rest and scale == 100_000:
         take_quarter(rest.pop(0), _QUARTERS_UPPER, 50_000)
@@ -193,8 +203,9 @@ def sheet_bounds(nomenclature: str) -> SheetBounds:
         scale = 10_000
     if rest:
         raise _fail(nomenclature, f"unexpected part {rest[0]!r} after the 1:{scale} sheet")
-    return SheetBounds(text, scale, float(south), float(south + height), float(west),
-                       float(west + width), zone)
+    return SheetBounds(
+        text, scale, float(south), float(south + height), float(west), float(west + width), zone
+    )
 
 
 def zone_of_longitude(longitude_deg: float) -> int:

@@ -20,8 +20,9 @@ from stereoplotter.scenario.synthetic import footprint_m
 __all__ = ["plot_scenario_layout"]
 
 
-def plot_scenario_layout(scenario: Scenario, result: dict[str, Any] | None = None,
-                         ax: Any = None) -> Any:
+def plot_scenario_layout(
+    scenario: Scenario, result: dict[str, Any] | None = None, ax: Any = None
+) -> Any:
     """Plan view of a scenario: photo footprints on the mean point height, projection centres,
     control (triangles) and check (circles) points, the map sheet frame (from the fit (6.8)) and,
     with ``result`` from :func:`stereoplotter.foundation.run_foundation`, the plan errors of the
@@ -45,9 +46,16 @@ def plot_scenario_layout(scenario: Scenario, result: dict[str, Any] | None = Non
     for role, marker in (("control", "^"), ("check", "o")):
         sel = np.array([p.role == role for p in scenario.points])
         if sel.any():
-            ax.scatter(pts[sel, 0], pts[sel, 1], marker=marker, s=40, zorder=3,
-                       label=f"{role} points", edgecolor="k", facecolor="none" if
-                       role == "check" else "gold")
+            ax.scatter(
+                pts[sel, 0],
+                pts[sel, 1],
+                marker=marker,
+                s=40,
+                zorder=3,
+                label=f"{role} points",
+                edgecolor="k",
+                facecolor="none" if role == "check" else "gold",
+            )
     for p in scenario.points:
         ax.annotate(p.id, p.local_m[:2], textcoords="offset points", xytext=(4, 4), fontsize=8)
     if result is not None:
@@ -62,8 +70,9 @@ def plot_scenario_layout(scenario: Scenario, result: dict[str, Any] | None = Non
             for row in inter["points"]:
                 x, y = by_id[row["id"]].local_m[:2]
                 dx, dy = np.array(row["error_m"][:2]) * 1000.0
-                ax.annotate("", (x + dx, y + dy), (x, y),
-                            arrowprops={"arrowstyle": "->", "color": "purple"})
+                ax.annotate(
+                    "", (x + dx, y + dy), (x, y), arrowprops={"arrowstyle": "->", "color": "purple"}
+                )
             ax.plot([], [], color="purple", label="plan error ×1000")
     ax.set_aspect("equal")
     ax.set_xlabel("X [m]")

@@ -78,8 +78,13 @@ class Fields:
             return f"{path}[{key}]"
         return f"{path}.{key}" if path else key
 
-    def mapping(self, value: Any, path: str, allowed: Iterable[str] | None = None,
-                required: Iterable[str] = ()) -> dict[str, Any]:
+    def mapping(
+        self,
+        value: Any,
+        path: str,
+        allowed: Iterable[str] | None = None,
+        required: Iterable[str] = (),
+    ) -> dict[str, Any]:
         """Check ``value`` is a mapping with only ``allowed`` keys and the ``required`` ones."""
         if not isinstance(value, dict):
             raise self.error(path or "(top level)", "a mapping", _describe(value))
@@ -90,12 +95,15 @@ class Fields:
             allowed = list(allowed)
             unknown = [k for k in value if k not in allowed]
             if unknown:
-                raise self.error(self.join(path, unknown[0]), "no such field",
-                                 unknown[0], "allowed here: " + ", ".join(allowed))
+                raise self.error(
+                    self.join(path, unknown[0]),
+                    "no such field",
+                    unknown[0],
+                    "allowed here: " + ", ".join(allowed),
+                )
         for key in required:
             if key not in value:
-                raise self.error(self.join(path, key), "a value (the field is required)",
-                                 "nothing")
+                raise self.error(self.join(path, key), "a value (the field is required)", "nothing")
         return value
 
     def get(self, node: Mapping[str, Any], key: str, path: str, default: Any = _MISSING) -> Any:
@@ -106,17 +114,45 @@ class Fields:
             raise self.error(self.join(path, key), "a value (the field is required)", "nothing")
         return default
 
-    def number(self, node: Mapping[str, Any], key: str, path: str, *, unit: str,
-               low: float = -math.inf, high: float = math.inf, low_open: bool = False,
-               high_open: bool = False, default: Any = _MISSING, basis: str = "") -> float:
+    def number(
+        self,
+        node: Mapping[str, Any],
+        key: str,
+        path: str,
+        *,
+        unit: str,
+        low: float = -math.inf,
+        high: float = math.inf,
+        low_open: bool = False,
+        high_open: bool = False,
+        default: Any = _MISSING,
+        basis: str = "",
+    ) -> float:
         """A finite real number inside [low, high] (ends open where asked)."""
         value = self.get(node, key, path, default)
-        return self.check_number(value, self.join(path, key), unit=unit, low=low, high=high,
-                                 low_open=low_open, high_open=high_open, basis=basis)
+        return self.check_number(
+            value,
+            self.join(path, key),
+            unit=unit,
+            low=low,
+            high=high,
+            low_open=low_open,
+            high_open=high_open,
+            basis=basis,
+        )
 
-    def check_number(self, value: Any, path: str, *, unit: str, low: float = -math.inf,
-                     high: float = math.inf, low_open: bool = False, high_open: bool = False,
-                     basis: str = "") -> float:
+    def check_number(
+        self,
+        value: Any,
+        path: str,
+        *,
+        unit: str,
+        low: float = -math.inf,
+        high: float = math.inf,
+        low_open: bool = False,
+        high_open: bool = False,
+        basis: str = "",
+    ) -> float:
         """Validate one number already taken from the document."""
         expected = _range_text(unit, low, high, low_open, high_open)
         if isinstance(value, bool) or not isinstance(value, int | float):
@@ -128,13 +164,22 @@ class Fields:
             raise self.error(path, f"a number {expected}", value, basis)
         return value
 
-    def integer(self, node: Mapping[str, Any], key: str, path: str, *, low: int, high: int,
-                default: Any = _MISSING) -> int:
+    def integer(
+        self,
+        node: Mapping[str, Any],
+        key: str,
+        path: str,
+        *,
+        low: int,
+        high: int,
+        default: Any = _MISSING,
+    ) -> int:
         """An integer inside [low, high]."""
         value = self.get(node, key, path, default)
         if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-            raise self.error(self.join(path, key), f"an integer in [{low}, {high}]",
-                             _describe(value))
+            raise self.error(
+                self.join(path, key), f"an integer in [{low}, {high}]", _describe(value)
+            )
         return value
 
     def text(self, node: Mapping[str, Any], key: str, path: str, default: Any = _MISSING) -> str:
@@ -144,36 +189,62 @@ class Fields:
             raise self.error(self.join(path, key), "a non-empty text", _describe(value))
         return str(value)
 
-    def choice(self, node: Mapping[str, Any], key: str, path: str, choices: Iterable[str],
-               default: Any = _MISSING) -> str:
+    def choice(
+        self,
+        node: Mapping[str, Any],
+        key: str,
+        path: str,
+        choices: Iterable[str],
+        default: Any = _MISSING,
+    ) -> str:
         """One of a fixed set of words."""
         choices = list(choices)
         value = self.get(node, key, path, default)
         if value not in choices:
-            raise self.error(self.join(path, key), "one of " + ", ".join(choices),
-                             _describe(value))
+            raise self.error(self.join(path, key), "one of " + ", ".join(choices), _describe(value))
         return value
 
-    def vector(self, node: Mapping[str, Any], key: str, path: str, length: int, *, unit: str,
-               low: float = -math.inf, high: float = math.inf,
-               default: Any = _MISSING) -> tuple[float, ...]:
+    def vector(
+        self,
+        node: Mapping[str, Any],
+        key: str,
+        path: str,
+        length: int,
+        *,
+        unit: str,
+        low: float = -math.inf,
+        high: float = math.inf,
+        default: Any = _MISSING,
+    ) -> tuple[float, ...]:
         """A list of ``length`` numbers, each inside [low, high]."""
         value = self.get(node, key, path, default)
         full = self.join(path, key)
         if not isinstance(value, list | tuple) or len(value) != length:
             raise self.error(full, f"a list of {length} numbers [{unit}]", _describe(value))
-        return tuple(self.check_number(v, self.join(full, i), unit=unit, low=low, high=high)
-                     for i, v in enumerate(value))
+        return tuple(
+            self.check_number(v, self.join(full, i), unit=unit, low=low, high=high)
+            for i, v in enumerate(value)
+        )
 
-    def sequence(self, node: Mapping[str, Any], key: str, path: str, *, min_length: int = 0,
-                 default: Any = _MISSING) -> list[Any]:
+    def sequence(
+        self,
+        node: Mapping[str, Any],
+        key: str,
+        path: str,
+        *,
+        min_length: int = 0,
+        default: Any = _MISSING,
+    ) -> list[Any]:
         """A list with at least ``min_length`` entries."""
         value = self.get(node, key, path, default)
         if not isinstance(value, list):
             raise self.error(self.join(path, key), "a list", _describe(value))
         if len(value) < min_length:
-            raise self.error(self.join(path, key), f"a list of at least {min_length} entries",
-                             f"{len(value)} entries")
+            raise self.error(
+                self.join(path, key),
+                f"a list of at least {min_length} entries",
+                f"{len(value)} entries",
+            )
         return value
 
 

@@ -36,8 +36,12 @@ def test_scenario_check_text_and_json(capsys):
 
 def test_bad_scenario_is_one_error_line_exit_1(tmp_path, capsys):
     bad = tmp_path / "bad.yaml"
-    bad.write_text(Path(PAIR60).read_text(encoding="utf-8").replace(
-        "focal_length_mm: 70.0", "focal_length_mm: -70.0"), encoding="utf-8")
+    bad.write_text(
+        Path(PAIR60)
+        .read_text(encoding="utf-8")
+        .replace("focal_length_mm: 70.0", "focal_length_mm: -70.0"),
+        encoding="utf-8",
+    )
     assert main(["scenario", "check", str(bad)]) == 1
     err = capsys.readouterr().err
     assert err.startswith("error: ") and "camera.focal_length_mm" in err
@@ -81,6 +85,10 @@ def test_demo_resection_scenario(tmp_path, capsys):
 
 
 def test_python_dash_m_runs():
-    done = subprocess.run([sys.executable, "-m", "stereoplotter", "--version"],
-                          capture_output=True, text=True, check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "stereoplotter", "--version"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert done.returncode == 0 and done.stdout.startswith("stereoplotter ")

@@ -46,8 +46,14 @@ def test_rotation_is_orthonormal_with_det_plus_one(alpha, omega, kappa):
 @given(tilt, tilt, swing)
 def test_rotation_elements_match_printed_formulas_2_50(alpha, omega, kappa):
     # Independent: the element formulas of (2.50) typed from the book (conventions.md §4).
-    sa, ca, so, co, sk, ck = (np.sin(alpha), np.cos(alpha), np.sin(omega), np.cos(omega),
-                              np.sin(kappa), np.cos(kappa))
+    sa, ca, so, co, sk, ck = (
+        np.sin(alpha),
+        np.cos(alpha),
+        np.sin(omega),
+        np.cos(omega),
+        np.sin(kappa),
+        np.cos(kappa),
+    )
     expected = [
         [ca * ck - sa * so * sk, -ca * sk - sa * so * ck, -sa * co],
         [co * sk, co * ck, -so],
@@ -58,8 +64,9 @@ def test_rotation_elements_match_printed_formulas_2_50(alpha, omega, kappa):
 
 @given(tilt, tilt, swing)
 def test_angles_round_trip(alpha, omega, kappa):
-    assert_allclose(angles_from_matrix(rotation_matrix(alpha, omega, kappa)),
-                    [alpha, omega, kappa], atol=1e-12)
+    assert_allclose(
+        angles_from_matrix(rotation_matrix(alpha, omega, kappa)), [alpha, omega, kappa], atol=1e-12
+    )
 
 
 @given(tilt, tilt, swing)
@@ -73,8 +80,11 @@ def test_alternative_angles_2_51_2_55_round_trip_and_relations(alpha, omega, kap
 
 
 def test_alternative_angles_zero_is_kappa_minus_90():
-    assert_allclose(rotation_matrix_from_alternative_angles(0, 0, 0),
-                    rotation_matrix(0, 0, -np.pi / 2), atol=1e-16)
+    assert_allclose(
+        rotation_matrix_from_alternative_angles(0, 0, 0),
+        rotation_matrix(0, 0, -np.pi / 2),
+        atol=1e-16,
+    )
 
 
 def test_rotation_broadcasts_and_scalar_agrees():
@@ -103,8 +113,11 @@ def test_omega_positive_tilts_axis_towards_plus_y():
 
 def test_viewing_direction_formula():
     a, o = 2 * deg, -1.5 * deg
-    assert_allclose(rotation_matrix(a, o, 0.7) @ [0, 0, -1],
-                    [np.sin(a) * np.cos(o), np.sin(o), -np.cos(a) * np.cos(o)], atol=1e-16)
+    assert_allclose(
+        rotation_matrix(a, o, 0.7) @ [0, 0, -1],
+        [np.sin(a) * np.cos(o), np.sin(o), -np.cos(a) * np.cos(o)],
+        atol=1e-16,
+    )
 
 
 def test_kappa_positive_turns_photo_axes_counter_clockwise():
@@ -181,10 +194,11 @@ def test_single_axis_form_is_approximate_with_two_tilts():
 def test_first_order_3_22():
     # (3.22): x⁰ = x + (f + x²/f)α + (xy/f)ω − yκ, y⁰ = y + (xy/f)α + (f + y²/f)ω + xκ
     x, y, a, o, k = 60.0, -40.0, 1e-6, 2e-6, -1.5e-6
-    first = [x + (F + x * x / F) * a + x * y / F * o - y * k,
-             y + x * y / F * a + (F + y * y / F) * o + x * k]
-    assert_allclose(transformed_coordinates([x, y], rotation_matrix(a, o, k), F), first,
-                    atol=1e-9)
+    first = [
+        x + (F + x * x / F) * a + x * y / F * o - y * k,
+        y + x * y / F * a + (F + y * y / F) * o + x * k,
+    ]
+    assert_allclose(transformed_coordinates([x, y], rotation_matrix(a, o, k), F), first, atol=1e-9)
 
 
 # --- intersection --------------------------------------------------------------------------
@@ -234,8 +248,11 @@ def test_similarity_axis_swap_and_residuals():
     fit = fit_similarity_with_reflection(north, east, X, north)
     assert_allclose(fit.residuals_m.sum(axis=0), 0, atol=1e-9)
     assert np.argmax(np.linalg.norm(fit.residuals_m, axis=1)) == 3
-    assert_allclose(apply_similarity(fit, north, east) - np.column_stack([X, north]),
-                    fit.residuals_m, atol=1e-12)
+    assert_allclose(
+        apply_similarity(fit, north, east) - np.column_stack([X, north]),
+        fit.residuals_m,
+        atol=1e-12,
+    )
 
 
 @pytest.mark.parametrize(
@@ -260,13 +277,17 @@ def test_corrected_focal_length_uniform_shrinkage():
     measured = calibrated * (1 - 2e-4)
     # a uniform scale change s equals a change of f by the same s ((1.22)): f′ = f(1 − 2e-4)
     assert float(corrected_focal_length(70.0, measured, calibrated)) == pytest.approx(
-        70.0 * (1 - 2e-4), abs=1e-12)
+        70.0 * (1 - 2e-4), abs=1e-12
+    )
     # And it is exactly what keeps (3.17) invariant: scaled photo coordinates with scaled f
     m = rotation_matrix(0.03, 0.02, 0.1)
     xy = np.array([40.0, -60.0])
     s = 1 - 2e-4
-    assert_allclose(transformed_coordinates(xy * s, m, 70.0 * s),
-                    s * transformed_coordinates(xy, m, 70.0), atol=1e-3 * um)
+    assert_allclose(
+        transformed_coordinates(xy * s, m, 70.0 * s),
+        s * transformed_coordinates(xy, m, 70.0),
+        atol=1e-3 * um,
+    )
 
 
 def test_corrected_focal_length_refuses_non_positive_span():

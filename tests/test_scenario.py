@@ -74,7 +74,8 @@ def test_summary_overlap_and_scale_for_vertical_photos():
     scale = 1400.0 * 1000.0 / 70.0
     assert summary["photos"][0]["photo_scale_denominator"] == pytest.approx(scale)
     assert summary["base"]["overlap_percent"] == pytest.approx(
-        100 * (1 - 1440.0 / (0.180 * scale)), abs=0.05)
+        100 * (1 - 1440.0 / (0.180 * scale)), abs=0.05
+    )
     assert summary["base"]["base_to_height"] == pytest.approx(1440.0 / 1400.0, abs=1e-4)
 
 
@@ -161,39 +162,81 @@ def _mutate(path: str, value):
 @pytest.mark.parametrize(
     ("path", "value", "message"),
     [
-        ("camera.focal_length_mm", KeyError,
-         r"bad\.yaml: camera\.focal_length_mm: expected a value \(the field is required\)"),
-        ("camera.focal_length_mm", "seventy",
-         r"camera\.focal_length_mm: expected a number in \(0, 1000\] mm, found the text "
-         r"'seventy'"),
-        ("camera.focal_lenght_mm", 70.0,
-         r"camera\.focal_lenght_mm: expected no such field, found focal_lenght_mm \(allowed "
-         r"here: focal_length_mm"),
-        ("photos.0.exterior.alpha_deg", 25.0,
-         r"photos\[0\]\.exterior\.alpha_deg: expected a number in \[-15, 15\] °, found 25\.0 "
-         r"\(near-vertical"),
-        ("photos.1.exterior.kappa_deg", 270,
-         r"photos\[1\]\.exterior\.kappa_deg: expected a number in \[-180, 180\] °, found 270"),
-        ("photos.1.name", "second",
-         r"photos: expected two photos named left and right, in that order, found "
-         r"\['left', 'second'\]"),
-        ("photos.0.exterior.Z_m", 100.0,
-         r"photos\[0\]\.exterior\.Z_m: expected a projection centre above every point"),
-        ("photos.1.exterior", pair60()["photos"][0]["exterior"],
-         r"photos\[1\]\.exterior: expected a horizontal base of at least 1 m"),
-        ("camera.fiducials.coordinates_mm.1", [85.0, 0.0],
-         r"coordinates_mm\.1: expected mark 1 on the −x side"),
-        ("frame.origin.east_m", 352300.0,
-         r"frame\.origin\.east_m: expected a number in \[1e\+06, 6\.1e\+07\] m \(conventional"),
-        ("map_sheet.nomenclature", "N-35-145",
-         r"map_sheet\.nomenclature: expected a valid SK-42 nomenclature, found N-35-145 "
-         r"\(map sheet nomenclature 'N-35-145': 1:100 000 part '145'"),
-        ("map_sheet.scale", 25000,
-         r"map_sheet\.scale: expected 10000 \(the scale of sheet N-35-14-А-б-3\), found 25000"),
-        ("errors.photo_point_sigma_um", -1.0,
-         r"errors\.photo_point_sigma_um: expected a number in \[0, 1000\] µm, found -1\.0"),
-        ("points.0.role", "maybe",
-         r"points\[0\]\.role: expected one of control, check, found the text 'maybe'"),
+        (
+            "camera.focal_length_mm",
+            KeyError,
+            r"bad\.yaml: camera\.focal_length_mm: expected a value \(the field is required\)",
+        ),
+        (
+            "camera.focal_length_mm",
+            "seventy",
+            r"camera\.focal_length_mm: expected a number in \(0, 1000\] mm, found the text "
+            r"'seventy'",
+        ),
+        (
+            "camera.focal_lenght_mm",
+            70.0,
+            r"camera\.focal_lenght_mm: expected no such field, found focal_lenght_mm \(allowed "
+            r"here: focal_length_mm",
+        ),
+        (
+            "photos.0.exterior.alpha_deg",
+            25.0,
+            r"photos\[0\]\.exterior\.alpha_deg: expected a number in \[-15, 15\] °, found 25\.0 "
+            r"\(near-vertical",
+        ),
+        (
+            "photos.1.exterior.kappa_deg",
+            270,
+            r"photos\[1\]\.exterior\.kappa_deg: expected a number in \[-180, 180\] °, found 270",
+        ),
+        (
+            "photos.1.name",
+            "second",
+            r"photos: expected two photos named left and right, in that order, found "
+            r"\['left', 'second'\]",
+        ),
+        (
+            "photos.0.exterior.Z_m",
+            100.0,
+            r"photos\[0\]\.exterior\.Z_m: expected a projection centre above every point",
+        ),
+        (
+            "photos.1.exterior",
+            pair60()["photos"][0]["exterior"],
+            r"photos\[1\]\.exterior: expected a horizontal base of at least 1 m",
+        ),
+        (
+            "camera.fiducials.coordinates_mm.1",
+            [85.0, 0.0],
+            r"coordinates_mm\.1: expected mark 1 on the −x side",
+        ),
+        (
+            "frame.origin.east_m",
+            352300.0,
+            r"frame\.origin\.east_m: expected a number in \[1e\+06, 6\.1e\+07\] m \(conventional",
+        ),
+        (
+            "map_sheet.nomenclature",
+            "N-35-145",
+            r"map_sheet\.nomenclature: expected a valid SK-42 nomenclature, found N-35-145 "
+            r"\(map sheet nomenclature 'N-35-145': 1:100 000 part '145'",
+        ),
+        (
+            "map_sheet.scale",
+            25000,
+            r"map_sheet\.scale: expected 10000 \(the scale of sheet N-35-14-А-б-3\), found 25000",
+        ),
+        (
+            "errors.photo_point_sigma_um",
+            -1.0,
+            r"errors\.photo_point_sigma_um: expected a number in \[0, 1000\] µm, found -1\.0",
+        ),
+        (
+            "points.0.role",
+            "maybe",
+            r"points\[0\]\.role: expected one of control, check, found the text 'maybe'",
+        ),
         ("points.1.id", "1", r"points\[1\]\.id: expected a unique point id, found 1"),
         ("seed", -3, r"seed: expected an integer in \[0, 9223372036854775807\], found -3"),
     ],
@@ -208,8 +251,10 @@ def test_too_few_control_points_for_the_sheet_fit():
     for p in d["points"]:
         if p["id"] in ("2", "3", "4"):
             p["role"] = "check"
-    message = (r"points: expected at least 2 control points of kind full or plan for the sheet "
-               r"fit \(6\.8\), found 1 \(1\)")
+    message = (
+        r"points: expected at least 2 control points of kind full or plan for the sheet "
+        r"fit \(6\.8\), found 1 \(1\)"
+    )
     with pytest.raises(ConfigError, match=message):
         scenario_from_mapping(d, "few.yaml")
 
@@ -217,8 +262,11 @@ def test_too_few_control_points_for_the_sheet_fit():
 def test_too_few_control_points_for_a_resection():
     d = yaml.safe_load((SCENARIOS / "book_resection_table7.yaml").read_text(encoding="utf-8"))
     d["points"] = d["points"][:2]
-    with pytest.raises(ConfigError, match=r"photos\[0\]\.exterior\.source: expected at least 3 "
-                                          r"full control points imaged on photo 'single'"):
+    with pytest.raises(
+        ConfigError,
+        match=r"photos\[0\]\.exterior\.source: expected at least 3 "
+        r"full control points imaged on photo 'single'",
+    ):
         scenario_from_mapping(d, "t7.yaml")
 
 
@@ -234,12 +282,18 @@ def test_file_errors(tmp_path):
         load_scenario(tmp_path / "nope.yaml")
     bad = tmp_path / "bad.yaml"
     bad.write_text("name: [unclosed\n", encoding="utf-8")
-    with pytest.raises(ConfigError, match=r"bad\.yaml: \(file\): expected valid YAML, found .*"
-                                          r"line 2"):
+    with pytest.raises(
+        ConfigError,
+        match=r"bad\.yaml: \(file\): expected valid YAML, found .*"
+        r"line 2",
+    ):
         load_scenario(bad)
     bad.write_text("- a list\n", encoding="utf-8")
-    with pytest.raises(ConfigError, match=r"\(top level\): expected a mapping of fields, found "
-                                          r"list"):
+    with pytest.raises(
+        ConfigError,
+        match=r"\(top level\): expected a mapping of fields, found "
+        r"list",
+    ):
         load_scenario(bad)
 
 
@@ -259,10 +313,15 @@ def _collect(node, path=()):
 
 
 _collect(pair60())
-_JUNK = st.one_of(st.none(), st.booleans(), st.integers(-10**7, 10**7),
-                  st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=8),
-                  st.lists(st.floats(-1e3, 1e3), max_size=4),
-                  st.dictionaries(st.text(max_size=4), st.integers(), max_size=2))
+_JUNK = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(-(10**7), 10**7),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=8),
+    st.lists(st.floats(-1e3, 1e3), max_size=4),
+    st.dictionaries(st.text(max_size=4), st.integers(), max_size=2),
+)
 
 
 @given(st.sampled_from(_LEAVES[:-1]), _JUNK)

@@ -53,8 +53,9 @@ def fiducial_spans_mm(fiducials_mm: Mapping[str, ArrayLike]) -> NDArray[np.float
     array([170., 170.])
     """
     spans = [
-        np.linalg.norm(np.asarray(fiducials_mm[j], float) - np.asarray(fiducials_mm[i], float),
-                       axis=-1)
+        np.linalg.norm(
+            np.asarray(fiducials_mm[j], float) - np.asarray(fiducials_mm[i], float), axis=-1
+        )
         for i, j in FIDUCIAL_SPANS
     ]
     return np.stack(spans, axis=-1)

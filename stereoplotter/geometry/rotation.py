@@ -186,6 +186,7 @@ def alternative_angles_from_matrix(
     tilt = np.arctan2(np.hypot(c1, c2), c3)
     vertical = np.hypot(a3, b3) < 1e-15
     direction_t = np.where(vertical, 0.0, np.arctan2(-b3, -a3))
-    kappa0 = np.where(vertical, np.arctan2(m[..., 1, 0], m[..., 1, 1]) + np.pi / 2,
-                      np.arctan2(c1, c2))
+    kappa0 = np.where(
+        vertical, np.arctan2(m[..., 1, 0], m[..., 1, 1]) + np.pi / 2, np.arctan2(c1, c2)
+    )
     return direction_t, tilt, kappa0

@@ -88,5 +88,3 @@ def sheet_corners_sk42(nomenclature: str) -> tuple[NDArray[np.float64], int]:
     lat, lon = np.radians(np.array(bounds.corners_deg())).T
     north, east = conventional_from_geographic(lat, lon, bounds.zone)
     return np.column_stack([north, east]), bounds.scale_denominator
-
-

@@ -38,8 +38,18 @@ MAX_FILM_DEFORMATION_PPM = 5000.0  # 0.5 %: beyond any usable film base
 MIN_RESECTION_POINTS = 3
 MIN_SIMILARITY_POINTS = 2
 
-_TOP = ("name", "description", "seed", "camera", "frame", "terrain", "photos", "points",
-        "map_sheet", "errors")
+_TOP = (
+    "name",
+    "description",
+    "seed",
+    "camera",
+    "frame",
+    "terrain",
+    "photos",
+    "points",
+    "map_sheet",
+    "errors",
+)
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:
@@ -102,29 +112,38 @@ def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> S
 
 def _camera(fields: Fields, node: Any) -> Camera:
     path = "camera"
-    fields.mapping(node, path, ("focal_length_mm", "principal_point_mm", "format_mm",
-                                "fiducials"), required=("focal_length_mm", "fiducials"))
-    f = fields.number(node, "focal_length_mm", path, unit="mm", low=0.0, high=1000.0,
-                      low_open=True)
-    pp = fields.vector(node, "principal_point_mm", path, 2, unit="mm", low=-5.0, high=5.0,
-                       default=[0.0, 0.0])
-    fmt = fields.number(node, "format_mm", path, unit="mm", low=50.0, high=300.0,
-                        default=180.0)
+    fields.mapping(
+        node,
+        path,
+        ("focal_length_mm", "principal_point_mm", "format_mm", "fiducials"),
+        required=("focal_length_mm", "fiducials"),
+    )
+    f = fields.number(node, "focal_length_mm", path, unit="mm", low=0.0, high=1000.0, low_open=True)
+    pp = fields.vector(
+        node, "principal_point_mm", path, 2, unit="mm", low=-5.0, high=5.0, default=[0.0, 0.0]
+    )
+    fmt = fields.number(node, "format_mm", path, unit="mm", low=50.0, high=300.0, default=180.0)
     fid_path = fields.join(path, "fiducials")
-    fid = fields.mapping(fields.get(node, "fiducials", path), fid_path,
-                         ("coordinates_mm", "distances_mm"))
+    fid = fields.mapping(
+        fields.get(node, "fiducials", path), fid_path, ("coordinates_mm", "distances_mm")
+    )
     half = fmt / 2.0
     if ("coordinates_mm" in fid) == ("distances_mm" in fid):
-        raise fields.error(fid_path, "exactly one of coordinates_mm, distances_mm",
-                           ", ".join(fid) or "neither")
+        raise fields.error(
+            fid_path, "exactly one of coordinates_mm, distances_mm", ", ".join(fid) or "neither"
+        )
     marks: dict[str, tuple[float, float]] = {}
     if "coordinates_mm" in fid:
         given_as = "coordinates"
         cpath = fields.join(fid_path, "coordinates_mm")
-        coords = fields.mapping({str(k): v for k, v in (fid["coordinates_mm"] or {}).items()}
-                                if isinstance(fid["coordinates_mm"], dict)
-                                else fid["coordinates_mm"], cpath, FIDUCIAL_NAMES,
-                                required=FIDUCIAL_NAMES)
+        coords = fields.mapping(
+            {str(k): v for k, v in (fid["coordinates_mm"] or {}).items()}
+            if isinstance(fid["coordinates_mm"], dict)
+            else fid["coordinates_mm"],
+            cpath,
+            FIDUCIAL_NAMES,
+            required=FIDUCIAL_NAMES,
+        )
         for name in FIDUCIAL_NAMES:
             marks[name] = fields.vector(coords, name, cpath, 2, unit="mm", low=-half, high=half)
         # Numbering (docs/conventions.md §2): 1 at −x, 2 at +x, 3 at +y, 4 at −y.
@@ -134,16 +153,21 @@ def _camera(fields: Fields, node: Any) -> Camera:
                 raise fields.error(
                     fields.join(cpath, name),
                     f"mark {name} on the {'+' if sign > 0 else '−'}{'xy'[axis]} side "
-                    "(numbering: 1 at −x, 2 at +x, 3 at +y, 4 at −y)", list(marks[name]))
+                    "(numbering: 1 at −x, 2 at +x, 3 at +y, 4 at −y)",
+                    list(marks[name]),
+                )
     else:
         given_as = "distances"
         dpath = fields.join(fid_path, "distances_mm")
-        dist = fields.mapping(fid["distances_mm"], dpath, ("1-2", "3-4"),
-                              required=("1-2", "3-4"))
+        dist = fields.mapping(fid["distances_mm"], dpath, ("1-2", "3-4"), required=("1-2", "3-4"))
         d12 = fields.number(dist, "1-2", dpath, unit="mm", low=0.0, high=fmt, low_open=True)
         d34 = fields.number(dist, "3-4", dpath, unit="mm", low=0.0, high=fmt, low_open=True)
-        marks = {"1": (-d12 / 2, 0.0), "2": (d12 / 2, 0.0), "3": (0.0, d34 / 2),
-                 "4": (0.0, -d34 / 2)}
+        marks = {
+            "1": (-d12 / 2, 0.0),
+            "2": (d12 / 2, 0.0),
+            "3": (0.0, d34 / 2),
+            "4": (0.0, -d34 / 2),
+        }
     return Camera(f, (pp[0], pp[1]), fmt, marks, given_as)
 
 
@@ -153,27 +177,39 @@ def _frame(fields: Fields, node: Any) -> Frame:
     kind = fields.choice(node, "kind", path, ("local", "sk42"), default="local")
     if kind == "local":
         if "origin" in node:
-            raise fields.error(fields.join(path, "origin"), "no origin for kind local",
-                               "an origin", "set kind: sk42 to tie the frame to SK-42")
+            raise fields.error(
+                fields.join(path, "origin"),
+                "no origin for kind local",
+                "an origin",
+                "set kind: sk42 to tie the frame to SK-42",
+            )
         return Frame("local", None)
     opath = fields.join(path, "origin")
     origin = _sk42_triplet(fields, fields.get(node, "origin", path), opath)
     return Frame("sk42", origin)
 
 
-def _sk42_triplet(fields: Fields, node: Any, path: str,
-                  height: bool = True) -> tuple[float, ...]:
+def _sk42_triplet(fields: Fields, node: Any, path: str, height: bool = True) -> tuple[float, ...]:
     keys = ("north_m", "east_m", "height_m") if height else ("north_m", "east_m")
     fields.mapping(node, path, keys, required=keys)
     north = fields.number(node, "north_m", path, unit="m", low=0.0, high=1.0e7)
-    east = fields.number(node, "east_m", path, unit="m (conventional ordinate: zone × 10⁶ + "
-                         "500 000 + y)", low=1.0e6, high=61.0e6)
+    east = fields.number(
+        node,
+        "east_m",
+        path,
+        unit="m (conventional ordinate: zone × 10⁶ + 500 000 + y)",
+        low=1.0e6,
+        high=61.0e6,
+    )
     try:
         frame_tie.check_conventional_ordinate(east)
     except StereoplotterError as exc:
-        raise fields.error(fields.join(path, "east_m"),
-                           "a conventional ordinate zone·10⁶ + 500 000 + y, |y| < 400 km",
-                           east, str(exc)) from None
+        raise fields.error(
+            fields.join(path, "east_m"),
+            "a conventional ordinate zone·10⁶ + 500 000 + y, |y| < 400 km",
+            east,
+            str(exc),
+        ) from None
     if not height:
         return (north, east)
     h = fields.number(node, "height_m", path, unit="m", low=-500.0, high=9000.0)
@@ -183,60 +219,100 @@ def _sk42_triplet(fields: Fields, node: Any, path: str,
 def _terrain(fields: Fields, node: Any) -> Terrain:
     path = "terrain"
     fields.mapping(node, path, ("base_height_m", "slope", "hills"))
-    base = fields.number(node, "base_height_m", path, unit="m", low=-500.0, high=9000.0,
-                         default=0.0)
-    slope = fields.vector(node, "slope", path, 2, unit="—", low=-1.0, high=1.0,
-                          default=[0.0, 0.0])
+    base = fields.number(
+        node, "base_height_m", path, unit="m", low=-500.0, high=9000.0, default=0.0
+    )
+    slope = fields.vector(node, "slope", path, 2, unit="—", low=-1.0, high=1.0, default=[0.0, 0.0])
     hills = []
     for i, hill in enumerate(fields.sequence(node, "hills", path, default=[])):
         hpath = fields.join(fields.join(path, "hills"), i)
-        fields.mapping(hill, hpath, ("X_m", "Y_m", "height_m", "radius_m"),
-                       required=("X_m", "Y_m", "height_m", "radius_m"))
-        hills.append(Hill(
-            fields.number(hill, "X_m", hpath, unit="m", low=-1.0e7, high=1.0e7),
-            fields.number(hill, "Y_m", hpath, unit="m", low=-1.0e7, high=1.0e7),
-            fields.number(hill, "height_m", hpath, unit="m", low=-3000.0, high=3000.0),
-            fields.number(hill, "radius_m", hpath, unit="m", low=1.0, high=1.0e6),
-        ))
+        fields.mapping(
+            hill,
+            hpath,
+            ("X_m", "Y_m", "height_m", "radius_m"),
+            required=("X_m", "Y_m", "height_m", "radius_m"),
+        )
+        hills.append(
+            Hill(
+                fields.number(hill, "X_m", hpath, unit="m", low=-1.0e7, high=1.0e7),
+                fields.number(hill, "Y_m", hpath, unit="m", low=-1.0e7, high=1.0e7),
+                fields.number(hill, "height_m", hpath, unit="m", low=-3000.0, high=3000.0),
+                fields.number(hill, "radius_m", hpath, unit="m", low=1.0, high=1.0e6),
+            )
+        )
     return Terrain(base, (slope[0], slope[1]), tuple(hills))
 
 
 def _photos(fields: Fields, node: Any) -> tuple[Photo, ...]:
     path = "photos"
     if not isinstance(node, list) or not 1 <= len(node) <= 2:
-        raise fields.error(path, "a list of 1 photo or 2 photos named left and right",
-                           f"a list of {len(node)}" if isinstance(node, list) else node)
+        raise fields.error(
+            path,
+            "a list of 1 photo or 2 photos named left and right",
+            f"a list of {len(node)}" if isinstance(node, list) else node,
+        )
     photos = []
     for i, item in enumerate(node):
         ppath = fields.join(path, i)
-        fields.mapping(item, ppath, ("name", "exterior", "film_deformation_ppm"),
-                       required=("name", "exterior"))
+        fields.mapping(
+            item, ppath, ("name", "exterior", "film_deformation_ppm"), required=("name", "exterior")
+        )
         name = fields.text(item, "name", ppath)
         epath = fields.join(ppath, "exterior")
-        ext = fields.mapping(item["exterior"], epath,
-                             ("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg",
-                              "source"),
-                             required=("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg",
-                                       "kappa_deg"))
-        centre = tuple(fields.number(ext, k, epath, unit="m", low=-1.0e7, high=1.0e7)
-                       for k in ("X_m", "Y_m"))
+        ext = fields.mapping(
+            item["exterior"],
+            epath,
+            ("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg", "source"),
+            required=("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg"),
+        )
+        centre = tuple(
+            fields.number(ext, k, epath, unit="m", low=-1.0e7, high=1.0e7) for k in ("X_m", "Y_m")
+        )
         z = fields.number(ext, "Z_m", epath, unit="m", low=-500.0, high=50000.0)
         tilt_basis = f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°"
-        alpha = fields.number(ext, "alpha_deg", epath, unit="°", low=-MAX_TILT_DEG,
-                              high=MAX_TILT_DEG, basis=tilt_basis)
-        omega = fields.number(ext, "omega_deg", epath, unit="°", low=-MAX_TILT_DEG,
-                              high=MAX_TILT_DEG, basis=tilt_basis)
+        alpha = fields.number(
+            ext,
+            "alpha_deg",
+            epath,
+            unit="°",
+            low=-MAX_TILT_DEG,
+            high=MAX_TILT_DEG,
+            basis=tilt_basis,
+        )
+        omega = fields.number(
+            ext,
+            "omega_deg",
+            epath,
+            unit="°",
+            low=-MAX_TILT_DEG,
+            high=MAX_TILT_DEG,
+            basis=tilt_basis,
+        )
         kappa = fields.number(ext, "kappa_deg", epath, unit="°", low=-180.0, high=180.0)
         source = fields.choice(ext, "source", epath, ("given", "resection"), default="given")
-        film = fields.vector(item, "film_deformation_ppm", ppath, 2, unit="ppm",
-                             low=-MAX_FILM_DEFORMATION_PPM, high=MAX_FILM_DEFORMATION_PPM,
-                             default=[0.0, 0.0])
-        photos.append(Photo(
-            name,
-            ExteriorOrientation((centre[0], centre[1], z), math.radians(alpha),
-                                math.radians(omega), math.radians(kappa), source),
-            (film[0], film[1]),
-        ))
+        film = fields.vector(
+            item,
+            "film_deformation_ppm",
+            ppath,
+            2,
+            unit="ppm",
+            low=-MAX_FILM_DEFORMATION_PPM,
+            high=MAX_FILM_DEFORMATION_PPM,
+            default=[0.0, 0.0],
+        )
+        photos.append(
+            Photo(
+                name,
+                ExteriorOrientation(
+                    (centre[0], centre[1], z),
+                    math.radians(alpha),
+                    math.radians(omega),
+                    math.radians(kappa),
+                    source,
+                ),
+                (film[0], film[1]),
+            )
+        )
     names = [p.name for p in photos]
     if len(photos) == 2 and names != ["left", "right"]:
         raise fields.error(path, "two photos named left and right, in that order", names)
@@ -258,26 +334,33 @@ def _points(fields: Fields, node: Any, frame: Frame, terrain: Terrain) -> tuple[
         role = fields.choice(item, "role", ppath, ("control", "check"), default="control")
         kind = fields.choice(item, "kind", ppath, ("full", "plan", "height"), default="full")
         if ("local" in item) == ("sk42" in item):
-            raise fields.error(ppath, "exactly one of local, sk42",
-                               "both" if "local" in item else "neither")
+            raise fields.error(
+                ppath, "exactly one of local, sk42", "both" if "local" in item else "neither"
+            )
         if "local" in item:
             lpath = fields.join(ppath, "local")
-            local = fields.mapping(item["local"], lpath, ("X_m", "Y_m", "Z_m"),
-                                   required=("X_m", "Y_m"))
+            local = fields.mapping(
+                item["local"], lpath, ("X_m", "Y_m", "Z_m"), required=("X_m", "Y_m")
+            )
             X = fields.number(local, "X_m", lpath, unit="m", low=-1.0e7, high=1.0e7)
             Y = fields.number(local, "Y_m", lpath, unit="m", low=-1.0e7, high=1.0e7)
             if local.get("Z_m", "terrain") == "terrain":
                 Z = float(terrain.height_m(X, Y))
             else:
-                Z = fields.number(local, "Z_m", lpath, unit="m (or the word terrain)",
-                                  low=-500.0, high=9000.0)
+                Z = fields.number(
+                    local, "Z_m", lpath, unit="m (or the word terrain)", low=-500.0, high=9000.0
+                )
             sk42 = frame_tie.sk42_from_local(frame, (X, Y, Z)) if frame.kind == "sk42" else None
             points.append(Point(pid, role, kind, (X, Y, Z), sk42))
         else:
             spath = fields.join(ppath, "sk42")
             if frame.kind != "sk42":
-                raise fields.error(spath, "local coordinates (the frame has no SK-42 tie)",
-                                   "sk42 coordinates", "set frame.kind: sk42 with an origin")
+                raise fields.error(
+                    spath,
+                    "local coordinates (the frame has no SK-42 tie)",
+                    "sk42 coordinates",
+                    "set frame.kind: sk42 with an origin",
+                )
             sk42 = _sk42_triplet(fields, item["sk42"], spath)
             local = frame_tie.local_from_sk42(frame, sk42)
             points.append(Point(pid, role, kind, local, sk42))
@@ -288,29 +371,40 @@ def _map_sheet(fields: Fields, node: Any, frame: Frame) -> MapSheet:
     path = "map_sheet"
     fields.mapping(node, path, ("scale", "nomenclature", "corners"), required=("scale",))
     if frame.kind != "sk42":
-        raise fields.error(path, "a frame tied to SK-42 (frame.kind: sk42)", "frame.kind: local",
-                           "a map sheet is defined in Gauss–Krüger coordinates")
+        raise fields.error(
+            path,
+            "a frame tied to SK-42 (frame.kind: sk42)",
+            "frame.kind: local",
+            "a map sheet is defined in Gauss–Krüger coordinates",
+        )
     scale = fields.integer(node, "scale", path, low=100, high=1_000_000)
     if ("nomenclature" in node) == ("corners" in node):
-        raise fields.error(path, "exactly one of nomenclature, corners",
-                           "both" if "corners" in node else "neither")
+        raise fields.error(
+            path, "exactly one of nomenclature, corners", "both" if "corners" in node else "neither"
+        )
     if "corners" in node:
         cpath = fields.join(path, "corners")
         items = fields.sequence(node, "corners", path, min_length=4)
         if len(items) != 4:
             raise fields.error(cpath, "4 corners (NW, NE, SE, SW)", f"{len(items)} corners")
-        corners = np.array([_sk42_triplet(fields, c, fields.join(cpath, i), height=False)
-                            for i, c in enumerate(items)])
+        corners = np.array(
+            [
+                _sk42_triplet(fields, c, fields.join(cpath, i), height=False)
+                for i, c in enumerate(items)
+            ]
+        )
         return MapSheet(scale, corners, None)
     name = fields.text(node, "nomenclature", path)
     try:
         corners, sheet_scale = frame_tie.sheet_corners_sk42(name)
     except StereoplotterError as exc:
-        raise fields.error(fields.join(path, "nomenclature"), "a valid SK-42 nomenclature",
-                           name, str(exc)) from None
+        raise fields.error(
+            fields.join(path, "nomenclature"), "a valid SK-42 nomenclature", name, str(exc)
+        ) from None
     if sheet_scale != scale:
-        raise fields.error(fields.join(path, "scale"),
-                           f"{sheet_scale} (the scale of sheet {name})", scale)
+        raise fields.error(
+            fields.join(path, "scale"), f"{sheet_scale} (the scale of sheet {name})", scale
+        )
     return MapSheet(scale, corners, name)
 
 
@@ -318,10 +412,24 @@ def _errors(fields: Fields, node: Any) -> ErrorSettings:
     path = "errors"
     fields.mapping(node, path, ("photo_point_sigma_um", "fiducial_sigma_um"))
     return ErrorSettings(
-        fields.number(node, "photo_point_sigma_um", path, unit="µm", low=0.0, high=1000.0,
-                      default=ErrorSettings.photo_point_sigma_um),
-        fields.number(node, "fiducial_sigma_um", path, unit="µm", low=0.0, high=1000.0,
-                      default=ErrorSettings.fiducial_sigma_um),
+        fields.number(
+            node,
+            "photo_point_sigma_um",
+            path,
+            unit="µm",
+            low=0.0,
+            high=1000.0,
+            default=ErrorSettings.photo_point_sigma_um,
+        ),
+        fields.number(
+            node,
+            "fiducial_sigma_um",
+            path,
+            unit="µm",
+            low=0.0,
+            high=1000.0,
+            default=ErrorSettings.fiducial_sigma_um,
+        ),
     )
 
 
@@ -336,31 +444,49 @@ def _check_geometry(fields: Fields, scenario: Scenario) -> None:
         lowest_clearance = ext.projection_centre_m[2] - pts[:, 2].max()
         if lowest_clearance <= 0:
             top = scenario.points[int(np.argmax(pts[:, 2]))]
-            raise fields.error(fields.join(epath, "Z_m"),
-                               f"a projection centre above every point (point {top.id} is at "
-                               f"Z = {top.local_m[2]:g} m)", ext.projection_centre_m[2])
+            raise fields.error(
+                fields.join(epath, "Z_m"),
+                f"a projection centre above every point (point {top.id} is at "
+                f"Z = {top.local_m[2]:g} m)",
+                ext.projection_centre_m[2],
+            )
         if ext.source == "resection":
-            xy = object_to_photo(pts, ext.centre, ext.rotation, scenario.camera.focal_length_mm,
-                                 scenario.camera.principal_point_mm)
+            xy = object_to_photo(
+                pts,
+                ext.centre,
+                ext.rotation,
+                scenario.camera.focal_length_mm,
+                scenario.camera.principal_point_mm,
+            )
             inside = np.all(np.abs(xy) <= half, axis=-1)
-            usable = [p.id for p, ok in zip(scenario.points, inside, strict=True)
-                      if ok and p.role == "control" and p.kind == "full"]
+            usable = [
+                p.id
+                for p, ok in zip(scenario.points, inside, strict=True)
+                if ok and p.role == "control" and p.kind == "full"
+            ]
             if len(usable) < MIN_RESECTION_POINTS:
                 raise fields.error(
                     fields.join(epath, "source"),
                     f"at least {MIN_RESECTION_POINTS} full control points imaged on photo "
-                    f"{photo.name!r} for a resection", f"{len(usable)} ({', '.join(usable)})")
+                    f"{photo.name!r} for a resection",
+                    f"{len(usable)} ({', '.join(usable)})",
+                )
     if len(scenario.photos) == 2:
         left, right = (p.exterior.centre for p in scenario.photos)
         base = float(np.linalg.norm(right[:2] - left[:2]))
         if base < 1.0:
-            raise fields.error("photos[1].exterior", "a horizontal base of at least 1 m",
-                               f"{base:.3g} m", "the two stations coincide")
+            raise fields.error(
+                "photos[1].exterior",
+                "a horizontal base of at least 1 m",
+                f"{base:.3g} m",
+                "the two stations coincide",
+            )
     if scenario.map_sheet is not None:
         plan = [p.id for p in scenario.points if p.role == "control" and p.kind in ("full", "plan")]
         if len(plan) < MIN_SIMILARITY_POINTS:
-            raise fields.error("points", f"at least {MIN_SIMILARITY_POINTS} control points of "
-                               "kind full or plan for the sheet fit (6.8)",
-                               f"{len(plan)} ({', '.join(plan)})")
-
-
+            raise fields.error(
+                "points",
+                f"at least {MIN_SIMILARITY_POINTS} control points of "
+                "kind full or plan for the sheet fit (6.8)",
+                f"{len(plan)} ({', '.join(plan)})",
+            )

@@ -245,8 +245,10 @@ class Scenario:
         for p in self.photos:
             if p.name == name:
                 return p
-        raise KeyError(f"scenario {self.name!r} has no photo {name!r}; it has "
-                       + ", ".join(p.name for p in self.photos))
+        raise KeyError(
+            f"scenario {self.name!r} has no photo {name!r}; it has "
+            + ", ".join(p.name for p in self.photos)
+        )
 
     def points_with_role(self, role: str) -> tuple[Point, ...]:
         """The control (``"control"``) or check (``"check"``) points."""

@@ -48,18 +48,20 @@ def summarize_scenario(scenario: Scenario) -> dict[str, Any]:
         ext = photo.exterior
         height = ext.projection_centre_m[2] - z_mean
         imaged = _imaged(scenario, photo, pts)
-        photos.append({
-            "name": photo.name,
-            "projection_centre_m": [_r(v) for v in ext.projection_centre_m],
-            "alpha_deg": _r(math.degrees(ext.alpha), 4),
-            "omega_deg": _r(math.degrees(ext.omega), 4),
-            "kappa_deg": _r(math.degrees(ext.kappa), 4),
-            "exterior_source": ext.source,
-            "flying_height_m": _r(height, 1),
-            "photo_scale_denominator": _r(height * MM_PER_M / cam.focal_length_mm, 0),
-            "film_deformation_ppm": list(photo.film_deformation_ppm),
-            "points_imaged": int(imaged.sum()),
-        })
+        photos.append(
+            {
+                "name": photo.name,
+                "projection_centre_m": [_r(v) for v in ext.projection_centre_m],
+                "alpha_deg": _r(math.degrees(ext.alpha), 4),
+                "omega_deg": _r(math.degrees(ext.omega), 4),
+                "kappa_deg": _r(math.degrees(ext.kappa), 4),
+                "exterior_source": ext.source,
+                "flying_height_m": _r(height, 1),
+                "photo_scale_denominator": _r(height * MM_PER_M / cam.focal_length_mm, 0),
+                "film_deformation_ppm": list(photo.film_deformation_ppm),
+                "points_imaged": int(imaged.sum()),
+            }
+        )
     flying_height = float(np.mean([p["flying_height_m"] for p in photos]))
     relief = float(terrain_z.max() - terrain_z.min())
     summary: dict[str, Any] = {
@@ -85,8 +87,10 @@ def summarize_scenario(scenario: Scenario) -> dict[str, Any]:
             "range_over_flying_height": _r(relief / flying_height, 4),
         },
         "points": {
-            role: {kind: sum(1 for p in scenario.points if p.role == role and p.kind == kind)
-                   for kind in ("full", "plan", "height")}
+            role: {
+                kind: sum(1 for p in scenario.points if p.role == role and p.kind == kind)
+                for kind in ("full", "plan", "height")
+            }
             for role in ("control", "check")
         },
     }

@@ -101,12 +101,19 @@ def footprint_m(scenario: Scenario, photo: Photo, Z_m: float) -> NDArray[np.floa
     h = scenario.camera.format_mm / 2.0
     corners = np.array([[h, h], [-h, h], [-h, -h], [h, -h]])
     ext = photo.exterior
-    return photo_to_object(corners, Z_m, ext.centre, ext.rotation,
-                           scenario.camera.focal_length_mm, scenario.camera.principal_point_mm)
+    return photo_to_object(
+        corners,
+        Z_m,
+        ext.centre,
+        ext.rotation,
+        scenario.camera.focal_length_mm,
+        scenario.camera.principal_point_mm,
+    )
 
 
-def working_area_grid_m(scenario: Scenario, shape: tuple[int, int] = (7, 7),
-                        margin: float = 0.05) -> NDArray[np.float64]:
+def working_area_grid_m(
+    scenario: Scenario, shape: tuple[int, int] = (7, 7), margin: float = 0.05
+) -> NDArray[np.float64]:
     """Regular ground grid over the working area: the overlap of the photos' footprints (or the
     single photo's footprint), at the mean terrain height, shrunk by ``margin`` of its size on each
     side; heights from the terrain. Points not imaged on every photo are dropped.
@@ -121,8 +128,10 @@ def working_area_grid_m(scenario: Scenario, shape: tuple[int, int] = (7, 7),
     lo = np.max([b[:, :2].min(axis=0) for b in boxes], axis=0)
     hi = np.min([b[:, :2].max(axis=0) for b in boxes], axis=0)
     pad = margin * (hi - lo)
-    X, Y = np.meshgrid(np.linspace(lo[0] + pad[0], hi[0] - pad[0], shape[1]),
-                       np.linspace(lo[1] + pad[1], hi[1] - pad[1], shape[0]))
+    X, Y = np.meshgrid(
+        np.linspace(lo[0] + pad[0], hi[0] - pad[0], shape[1]),
+        np.linspace(lo[1] + pad[1], hi[1] - pad[1], shape[0]),
+    )
     grid = np.column_stack([X.ravel(), Y.ravel(), scenario.terrain.height_m(X, Y).ravel()])
     keep = np.ones(len(grid), bool)
     for photo in scenario.photos:
@@ -132,8 +141,13 @@ def working_area_grid_m(scenario: Scenario, shape: tuple[int, int] = (7, 7),
 
 def _project(scenario: Scenario, photo: Photo, points_m: NDArray) -> NDArray[np.float64]:
     ext = photo.exterior
-    return object_to_photo(points_m, ext.centre, ext.rotation, scenario.camera.focal_length_mm,
-                           scenario.camera.principal_point_mm)
+    return object_to_photo(
+        points_m,
+        ext.centre,
+        ext.rotation,
+        scenario.camera.focal_length_mm,
+        scenario.camera.principal_point_mm,
+    )
 
 
 def _imaged(scenario: Scenario, photo: Photo, points_m: NDArray) -> NDArray[np.bool_]:
@@ -193,13 +207,11 @@ def synthesize_measurements(
         xy_meas = xy + rng.normal(0.0, 1.0, xy.shape) * sig_p
         g = _deform(photo, _project(scenario, photo, grid))
         g_meas = g + rng.normal(0.0, 1.0, g.shape) * sig_p
-        photos.append(PhotoMeasurements(photo.name, fid_true, fid, xy, xy_meas, imaged, g,
-                                        g_meas))
+        photos.append(PhotoMeasurements(photo.name, fid_true, fid, xy, xy_meas, imaged, g, g_meas))
         spans = fiducial_spans_mm(dict(zip(FIDUCIAL_NAMES, fid, strict=True)))
         ratios.append(spans / fiducial_spans_mm(cam.fiducials_mm))
     f = cam.focal_length_mm
     per_photo = tuple(float(f * np.mean(r)) for r in ratios)
     # One f′ per pair: the mean ratio over all spans of all photos (docs/conventions.md §7).
     pair = float(corrected_focal_length(f, np.concatenate(ratios), np.ones(2 * len(ratios))))
-    return Measurements(tuple(photos), tuple(p.id for p in scenario.points), grid, pair,
-                        per_photo)
+    return Measurements(tuple(photos), tuple(p.id for p in scenario.points), grid, pair, per_photo)
