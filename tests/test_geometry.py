@@ -293,3 +293,56 @@ def test_corrected_focal_length_uniform_shrinkage():
 def test_corrected_focal_length_refuses_non_positive_span():
     with pytest.raises(GeometryError, match="positive finite measured"):
         corrected_focal_length(70.0, [0.0, 170.0], [170.0, 170.0])
+
+
+# --- fiducial system ---------------------------------------------------------------------------
+
+
+def test_fiducial_system_recovers_a_rotated_shifted_frame():
+    from stereoplotter.geometry.fiducial import to_fiducial_system
+
+    marks = np.array([[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]])
+    pts = np.array([[10.0, 20.0], [-60.0, 45.0]])
+    theta, shift = 0.03, np.array([101.0, 99.0])
+    r = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    for origin in ("intersection", "mean_of_marks"):
+        back = to_fiducial_system(pts @ r.T + shift, marks @ r.T + shift, origin)
+        assert_allclose(back, pts, atol=1e-12)
+
+
+def test_fiducial_origins_differ_for_asymmetric_marks():
+    from stereoplotter.geometry.fiducial import fiducial_frame
+
+    marks = [[-85.0, 0.0], [85.0, 0.0], [1.0, 86.0], [1.0, -80.0]]
+    o_int, _ = fiducial_frame(marks, "intersection")
+    o_mean, _ = fiducial_frame(marks, "mean_of_marks")
+    assert_allclose(o_int, [1.0, 0.0], atol=1e-12)  # lines 1–2 (y = 0) and 3–4 (x = 1)
+    assert_allclose(o_mean, [0.5, 1.5], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("marks", "origin", "message"),
+    [
+        ([[0, 0], [0, 0], [0, 85], [0, -85]], "intersection", "marks 1 and 2 coincide"),
+        ([[-85, 0], [85, 0], [-50, 1], [50, 1]], "intersection", "nearly\\) parallel"),
+        ([[-85, 0], [85, 0], [0, 85], [0, -85]], "centroid", "expected one of intersection"),
+    ],
+)
+def test_fiducial_frame_errors(marks, origin, message):
+    from stereoplotter.geometry.fiducial import fiducial_frame
+
+    with pytest.raises(GeometryError, match=message):
+        fiducial_frame(marks, origin)
+
+
+def test_transformed_and_single_tilt_scalar_and_array_calls_agree():
+    xs = np.array([-80.0, -10.0, 35.0, 85.0])
+    alphas = np.array([-0.05, 0.0, 0.02, 0.05])
+    batch = transformed_x_single_tilt(xs, alphas, F)
+    for x, a, b in zip(xs, alphas, batch, strict=True):
+        assert transformed_x_single_tilt(x, a, F) == b
+    m = rotation_matrix(alphas, -alphas, 0.1)
+    pts = np.column_stack([xs, xs[::-1]])
+    batch = transformed_coordinates(pts, m, F)
+    for i in range(4):
+        assert_allclose(transformed_coordinates(pts[i], m[i], F), batch[i], atol=0)
