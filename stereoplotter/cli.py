@@ -11,6 +11,7 @@ import argparse
 import csv
 import io
 import json
+import os
 import platform
 import sys
 from collections.abc import Sequence
@@ -253,7 +254,7 @@ def _format_demo(result: dict[str, Any]) -> str:
     if sim:
         lines += [
             "",
-            f"similarity (6.8) Gauss–Krüger → photogrammetric: a = {sim['a']:.9f}, "
+            f"similarity (6.8) Gauss–Krüger → photogrammetric: a = {sim['a']:.4e}, "
             f"b = {sim['b']:.9f}, c_X = {sim['cx_m']:.3f} m, c_Y = {sim['cy_m']:.3f} m, "
             f"det = {sim['determinant']:.9f}; RMS residual {sim['rms_m']} m",
         ]
@@ -302,7 +303,6 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _atomic_write_bytes(path: Path, data: bytes) -> None:
-    import os
     import tempfile
 
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -376,6 +376,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
+    except Exception as exc:  # a bug: say so in one line, the traceback only on request
+        if os.environ.get("STEREOPLOTTER_DEBUG"):
+            raise
+        print(
+            f"error: internal error ({type(exc).__name__}: {exc}); this is a bug in "
+            "stereoplotter: please report it with the command you ran (set "
+            "STEREOPLOTTER_DEBUG=1 to see the traceback)",
+            file=sys.stderr,
+        )
+        return 3
     return 2  # pragma: no cover - argparse requires a command
 
 

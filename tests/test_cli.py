@@ -92,3 +92,17 @@ def test_python_dash_m_runs():
         check=False,
     )
     assert done.returncode == 0 and done.stdout.startswith("stereoplotter ")
+
+
+def test_unexpected_error_is_one_line_exit_3(monkeypatch, capsys):
+    import stereoplotter.cli as cli
+
+    def broken():
+        raise ZeroDivisionError("boom")
+
+    monkeypatch.delenv("STEREOPLOTTER_DEBUG", raising=False)
+    monkeypatch.setattr(cli, "_info", broken)
+    assert cli.main(["info"]) == 3
+    err = capsys.readouterr().err
+    assert err.startswith("error: internal error (ZeroDivisionError: boom)")
+    assert "Traceback" not in err
