@@ -23,7 +23,7 @@ import numpy as np
 from stereoplotter import __version__
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.paths import DEFAULT_SCENARIO, data_dir, list_data_files
-from stereoplotter.yamlio import atomic_write_text
+from stereoplotter.yamlio import atomic_write_bytes, atomic_write_text
 
 __all__ = ["main"]
 
@@ -293,27 +293,13 @@ def _demo(args: argparse.Namespace) -> int:
     }
     for name, content in files.items():
         atomic_write_text(out / name, content)
-    _atomic_write_bytes(out / "layout.png", png.getvalue())
+    atomic_write_bytes(out / "layout.png", png.getvalue())
     if args.json:
         sys.stdout.write(_json(result))
     else:
         sys.stdout.write(text)
         sys.stdout.write(f"\nwritten: {', '.join(sorted([*files, 'layout.png']))} in {out}\n")
     return 0
-
-
-def _atomic_write_bytes(path: Path, data: bytes) -> None:
-    import tempfile
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 # --- parser ----------------------------------------------------------------------------------

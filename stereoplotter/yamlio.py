@@ -18,7 +18,7 @@ import yaml
 
 from stereoplotter.errors import ConfigError
 
-__all__ = ["Fields", "atomic_write_text", "load_yaml_mapping"]
+__all__ = ["Fields", "atomic_write_bytes", "atomic_write_text", "load_yaml_mapping"]
 
 _MISSING = object()
 
@@ -271,16 +271,21 @@ def _describe(value: Any) -> str:
     return repr(value)
 
 
-def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
-    """Write ``text`` to ``path`` whole or not at all (temporary file in the same folder, then
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
+    """Write ``data`` to ``path`` whole or not at all (temporary file in the same folder, then
     :func:`os.replace`)."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
         os.replace(tmp, target)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
+    """Write UTF-8 ``text`` to ``path`` whole or not at all."""
+    atomic_write_bytes(path, text.encode("utf-8"))

@@ -106,3 +106,19 @@ def test_unexpected_error_is_one_line_exit_3(monkeypatch, capsys):
     err = capsys.readouterr().err
     assert err.startswith("error: internal error (ZeroDivisionError: boom)")
     assert "Traceback" not in err
+
+
+def test_atomic_write_leaves_old_file_when_writing_fails(tmp_path, monkeypatch):
+    import stereoplotter.yamlio as yamlio
+
+    target = tmp_path / "out.txt"
+    yamlio.atomic_write_text(target, "old")
+
+    def failing_replace(src, dst):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(yamlio.os, "replace", failing_replace)
+    with pytest.raises(OSError, match="disk full"):
+        yamlio.atomic_write_text(target, "new")
+    assert target.read_text(encoding="utf-8") == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]  # no temporary file left
