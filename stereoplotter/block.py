@@ -1,0 +1,1265 @@
+r"""Block mode of the setup-data computer: one setup sheet per model of a block, vectorised.
+
+A *block file* (YAML, ``docs/scenarios.md``) lists many stereopairs of one camera, each with its
+exterior orientation, the lowest and highest ground of its working area and optional height control
+points. :func:`compute_block` computes the Table 24 values of every pair in one pass of numpy
+broadcasting over the N pairs (and over the (M_г, M_в) candidate grid of the scale choice); a pair
+the instrument cannot take gets NaN and a reason code instead of raising (``style.md`` §10).
+:func:`per_pair_loop` computes the same with a plain Python loop over the pairs: it is the test
+oracle and the benchmark's comparison (``benchmarks/bench_setup_block.py``).
+
+Reference
+---------
+.. [1] Kushtin I. F. & Lyskov G. A., *Фотограмметрия снимка и стереоскопических моделей*,
+   Moscow: Nedra, 1984, ch. 6, §26, pp. 153–158 (OCR L3682–3826): Eqs. (6.1)–(6.6), Table 24.
+
+Equations chained (each lives in one place: :mod:`stereoplotter.setup_data`,
+:mod:`stereoplotter.geometry.transformed`, :mod:`stereoplotter.geometry.rotation`):
+
+* frame: θ = atan2(ΔY_S, ΔX_S), M′ = R_Z(−θ)·M, α, ω, κ from M′ (inverse of (2.50));
+* item 1: the scale choice, f_пр = f′·M_г/M_в, b_x, b_y, b_z′;
+* (6.3) n_л, (6.4) n_п; (6.1)/(6.2) x⁰, y⁰ of the marks (n-free) and (3.17) with κ = 0;
+* (6.5) L_л, L_п; decentrations f′·tan α, f′·tan ω; (6.6) Z_i of the height points.
+
+**Not in block mode:** the sheet corners (6.7) and the similarity (6.8) need the map sheet and
+plan control of each model; compute those per model with
+:func:`stereoplotter.setup_sheet.compute_setup_sheet`. Likewise the X, Y travel of the model
+(``model_x_offset_range_mm``) is not checked here, since a block file gives no plan extent of the
+working area; the single-pair sheet checks it.
+
+Shapes: N pairs; photo axis 0 = left, 1 = right; C scale candidates; P height points (padded with
+NaN). Units: ground m, model and photo mm, angles rad.
+
+Decisions (``docs/setup-data.md``): f′ is the camera's calibrated f unless the caller passes a
+corrected one (a block file has no measured fiducial spans); the marks of (6.1)/(6.2) are the
+calibrated ones, taken relative to the principal point.
+"""
+
+from __future__ import annotations
+
+import csv
+import enum
+import io
+import math
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from numpy.typing import ArrayLike, NDArray
+
+from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix, rotation_z
+from stereoplotter.geometry.transformed import (
+    transformed_coordinates,
+    transformed_x_single_tilt,
+    transformed_y_single_tilt,
+)
+from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
+from stereoplotter.scenario.loader import MAX_TILT_DEG, _camera
+from stereoplotter.scenario.model import Camera
+from stereoplotter.setup_data import (
+    base_components,
+    counter_scale_left,
+    counter_scale_right,
+    decentration,
+    instrument_principal_distance,
+    mark_span,
+    model_height,
+    projection_distance,
+    transformation_coefficient,
+)
+from stereoplotter.yamlio import Fields, atomic_write_text, load_yaml_mapping
+
+__all__ = [
+    "Block",
+    "BlockResult",
+    "Refusal",
+    "compute_block",
+    "load_block",
+    "model_sheet",
+    "per_pair_loop",
+    "run_block",
+    "write_block",
+]
+
+_EO_KEYS = ("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg")
+_TOP = ("name", "description", "camera", "map_scale", "scales", "models", "models_csv")
+_MODEL = ("name", "left", "right", "terrain_m", "height_points")
+#: Columns of a ``models_csv`` file; ``height_points`` ("id=Z_m;id=Z_m", may be empty) is optional.
+CSV_COLUMNS = (
+    "name",
+    *(f"left_{k}" for k in _EO_KEYS),
+    *(f"right_{k}" for k in _EO_KEYS),
+    "terrain_lowest_m",
+    "terrain_highest_m",
+)
+_NAME_RE = re.compile(r"^[\w][\w.+-]*$")
+#: Marks used per photo (Table 24 reading, docs/setup-data.md): left x of mark 2, right x of mark 1,
+#: both y of marks 3 and 4. Indices into marks 1..4.
+_X_MARK = (1, 0)
+_X_MARK_NAME = ("2", "1")
+
+
+class Refusal(enum.IntFlag):
+    """Reason codes of a refused pair (bit flags; 0 = accepted).
+
+    The scale-dependent codes (``F_INSTRUMENT`` … ``BASE_Z``) are those of the *closest* (M_г,
+    M_в) candidate when no candidate is feasible: fewest violated conditions, then the largest
+    model scale, as :mod:`stereoplotter.setup_sheet` reports it.
+    """
+
+    NONE = 0
+    INVALID_INPUT = 1  #: a non-finite input or terrain lowest > highest
+    F_INSTRUMENT = 2  #: f_пр outside f_instrument_range_mm
+    PROJECTION_DISTANCE = 4  #: depth of the working area (and + b_z′) outside [D_min, D_max]
+    BASE_X = 8  #: b_x outside base_x_range_mm
+    BASE_Y = 16  #: b_y outside base_y_range_mm
+    BASE_Z = 32  #: b_z′ outside base_z_range_mm
+    KAPPA = 64  #: κ of a photo (instrument frame) outside kappa_range
+    TILT = 128  #: |α| or |ω| above tilt_max
+    DECENTRATION = 256  #: f′·tan α or f′·tan ω outside decentration_range_mm
+
+
+_SCALE_FLAGS = (
+    Refusal.F_INSTRUMENT,
+    Refusal.PROJECTION_DISTANCE,
+    Refusal.BASE_X,
+    Refusal.BASE_Y,
+    Refusal.BASE_Z,
+)
+
+
+# --- the block file ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class Block:
+    """A validated block file: N stereopairs of one camera.
+
+    Attributes
+    ----------
+    name, source : str
+        Block name; the file it was read from.
+    camera : Camera
+        The camera (same schema as a scenario's camera).
+    map_scale_denominator : int
+        M_map. [—]
+    horizontal_scale_denominator, vertical_scale_denominator : int or None
+        Forced M_г, M_в (``scales:``), else None (chosen per pair).
+    model_names : tuple of str
+    centre_left_m, centre_right_m : ndarray, shape (N, 3)
+        X_S, Y_S, Z_S of the left and right photo. [m]
+    angles_left, angles_right : ndarray, shape (N, 3)
+        α, ω, κ of Eq. (2.50). [rad]
+    terrain_m : ndarray, shape (N, 2)
+        Lowest and highest ground height of each model's working area. [m]
+    height_point_ids : tuple of tuple of str
+        Ids of the height points of each model.
+    height_points_m : ndarray, shape (N, P)
+        Their Z, padded with NaN. [m]
+    """
+
+    name: str
+    source: str
+    camera: Camera
+    map_scale_denominator: int
+    horizontal_scale_denominator: int | None
+    vertical_scale_denominator: int | None
+    model_names: tuple[str, ...]
+    centre_left_m: NDArray[np.float64]
+    angles_left: NDArray[np.float64]
+    centre_right_m: NDArray[np.float64]
+    angles_right: NDArray[np.float64]
+    terrain_m: NDArray[np.float64]
+    height_point_ids: tuple[tuple[str, ...], ...]
+    height_points_m: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return len(self.model_names)
+
+
+def load_block(path: str | os.PathLike[str]) -> Block:
+    """Read and validate a block file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A YAML file with ``name``, ``camera``, ``map_scale``, optional ``scales: {horizontal,
+        vertical}`` and exactly one of ``models`` (a list) or ``models_csv`` (a CSV file relative
+        to the YAML, columns :data:`CSV_COLUMNS` plus an optional ``height_points`` column
+        ``"id=Z_m;id=Z_m"``).
+
+    Returns
+    -------
+    Block
+
+    Raises
+    ------
+    ConfigError
+        "FILE: FIELD: expected …, found …" for the first problem found (for a CSV row the field
+        is ``line L: column``).
+
+    Examples
+    --------
+    >>> from stereoplotter.paths import data_dir
+    >>> block = load_block(data_dir("scenarios") / "blocks" / "strip60.yaml")
+    >>> len(block), block.camera.focal_length_mm
+    (8, 70.0)
+    """
+    data, source = load_yaml_mapping(path)
+    fields = Fields(source)
+    fields.mapping(data, "", _TOP, required=("name", "camera", "map_scale"))
+    name = fields.text(data, "name", "")
+    camera = _camera(fields, fields.get(data, "camera", ""))
+    map_scale = fields.integer(data, "map_scale", "", low=100, high=1_000_000)
+    forced: dict[str, int | None] = {"horizontal": None, "vertical": None}
+    if data.get("scales") is not None:
+        node = fields.mapping(data["scales"], "scales", ("horizontal", "vertical"))
+        for key in forced:
+            if node.get(key) is not None:
+                forced[key] = fields.integer(node, key, "scales", low=100, high=1_000_000)
+    if ("models" in data) == ("models_csv" in data):
+        raise fields.error(
+            "models", "exactly one of models, models_csv", "both" if "models" in data else "neither"
+        )
+    if "models" in data:
+        rows, where = _models_yaml(fields, data)
+        csv_fields = fields
+    else:
+        csv_name = fields.text(data, "models_csv", "")
+        csv_path = Path(source).parent / csv_name
+        csv_fields = Fields(str(csv_path))
+        rows, where = _models_csv(csv_fields, csv_path)
+    names, eo_l, eo_r, terrain, points = zip(*rows, strict=True) if rows else ((),) * 5
+    if not names:
+        raise fields.error("models", "a list of at least 1 model", "0 models")
+    eo_l, eo_r = np.array(eo_l), np.array(eo_r)
+    terrain = np.array(terrain)
+    n_points = max((len(p) for p in points), default=0)
+    heights = np.full((len(names), n_points), np.nan)
+    for i, p in enumerate(points):
+        heights[i, : len(p)] = [z for _, z in p]
+    block = Block(
+        name=name,
+        source=source,
+        camera=camera,
+        map_scale_denominator=map_scale,
+        horizontal_scale_denominator=forced["horizontal"],
+        vertical_scale_denominator=forced["vertical"],
+        model_names=tuple(names),
+        centre_left_m=eo_l[:, :3],
+        angles_left=np.radians(eo_l[:, 3:]),
+        centre_right_m=eo_r[:, :3],
+        angles_right=np.radians(eo_r[:, 3:]),
+        terrain_m=terrain,
+        height_point_ids=tuple(tuple(pid for pid, _ in p) for p in points),
+        height_points_m=heights,
+    )
+    _check_block_geometry(csv_fields, block, where)
+    return block
+
+
+def _eo_limits(key: str) -> dict[str, Any]:
+    if key in ("X_m", "Y_m"):
+        return {"unit": "m", "low": -1.0e7, "high": 1.0e7}
+    if key == "Z_m":
+        return {"unit": "m", "low": -500.0, "high": 50000.0}
+    if key == "kappa_deg":
+        return {"unit": "°", "low": -180.0, "high": 180.0}
+    return {
+        "unit": "°",
+        "low": -MAX_TILT_DEG,
+        "high": MAX_TILT_DEG,
+        "basis": f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°",
+    }
+
+
+def _check_name(fields: Fields, name: str, path: str, seen: set[str]) -> str:
+    if not _NAME_RE.match(name) or name in (".", ".."):
+        raise fields.error(
+            path,
+            "a model name usable as a folder name (letters, digits, _ . + -)",
+            name,
+        )
+    if name in seen:
+        raise fields.error(path, "a unique model name", name)
+    seen.add(name)
+    return name
+
+
+def _models_yaml(fields: Fields, data: dict[str, Any]) -> tuple[list[tuple], list[str]]:
+    rows, where, seen = [], [], set()
+    for i, item in enumerate(fields.sequence(data, "models", "", min_length=1)):
+        mpath = fields.join("models", i)
+        fields.mapping(item, mpath, _MODEL, required=("name", "left", "right", "terrain_m"))
+        name = _check_name(
+            fields, fields.text(item, "name", mpath), fields.join(mpath, "name"), seen
+        )
+        eos = []
+        for side in ("left", "right"):
+            epath = fields.join(mpath, side)
+            node = fields.mapping(item[side], epath, _EO_KEYS, required=_EO_KEYS)
+            eos.append(tuple(fields.number(node, k, epath, **_eo_limits(k)) for k in _EO_KEYS))
+        terrain = fields.vector(item, "terrain_m", mpath, 2, unit="m", low=-500.0, high=9000.0)
+        points, ids = [], set()
+        for j, p in enumerate(fields.sequence(item, "height_points", mpath, default=[])):
+            ppath = fields.join(fields.join(mpath, "height_points"), j)
+            fields.mapping(p, ppath, ("id", "Z_m"), required=("id", "Z_m"))
+            pid = fields.text(p, "id", ppath)
+            if pid in ids:
+                raise fields.error(fields.join(ppath, "id"), "a unique point id", pid)
+            ids.add(pid)
+            points.append((pid, fields.number(p, "Z_m", ppath, unit="m", low=-500.0, high=9000.0)))
+        rows.append((name, eos[0], eos[1], terrain, tuple(points)))
+        where.append(mpath)
+    return rows, where
+
+
+def _models_csv(fields: Fields, path: Path) -> tuple[list[tuple], list[str]]:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise fields.error("(file)", "an existing CSV file (models_csv)", "no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise fields.error("(file)", "a readable UTF-8 CSV file", str(exc)) from None
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    reader = csv.DictReader(io.StringIO("\n".join(lines)))
+    header = reader.fieldnames or []
+    missing = [c for c in CSV_COLUMNS if c not in header]
+    if missing:
+        raise fields.error(
+            "header", "the columns " + ", ".join(CSV_COLUMNS), "no column " + missing[0]
+        )
+    unknown = [c for c in header if c not in (*CSV_COLUMNS, "height_points")]
+    if unknown:
+        raise fields.error(
+            "header",
+            "no such column",
+            unknown[0],
+            "allowed: " + ", ".join((*CSV_COLUMNS, "height_points")),
+        )
+    rows, where, seen = [], [], set()
+    for line, row in enumerate(reader, start=2):
+        at = f"line {line}"
+
+        def number(column: str, limits: dict[str, Any], at: str = at, row: dict = row) -> float:
+            raw = (row.get(column) or "").strip()
+            try:
+                value: Any = float(raw)
+            except ValueError:
+                value = raw
+            return fields.check_number(value, f"{at}: {column}", **limits)
+
+        name = _check_name(fields, (row.get("name") or "").strip(), f"{at}: name", seen)
+        eos = [
+            tuple(number(f"{side}_{k}", _eo_limits(k)) for k in _EO_KEYS)
+            for side in ("left", "right")
+        ]
+        ground = {"unit": "m", "low": -500.0, "high": 9000.0}
+        terrain = (number("terrain_lowest_m", ground), number("terrain_highest_m", ground))
+        points = []
+        for item in (row.get("height_points") or "").split(";"):
+            if not item.strip():
+                continue
+            pid, sep, z = item.partition("=")
+            if not sep or not pid.strip():
+                raise fields.error(f"{at}: height_points", "entries id=Z_m separated by ;", item)
+            points.append(
+                (pid.strip(), number("", ground, row={"": z}, at=f"{at}: height_points.{pid}"))
+            )
+        rows.append((name, eos[0], eos[1], terrain, tuple(points)))
+        where.append(at)
+    return rows, where
+
+
+def _check_block_geometry(fields: Fields, block: Block, where: list[str]) -> None:
+    """Refuse degenerate models at load time: terrain lowest > highest, a station at or below the
+    highest ground or a height point, a horizontal base under 1 m."""
+    sep = "." if where and where[0].startswith("models") else ": "
+    low, high = block.terrain_m[:, 0], block.terrain_m[:, 1]
+    bad = np.flatnonzero(low > high)
+    if bad.size:
+        i = int(bad[0])
+        raise fields.error(
+            f"{where[i]}{sep}terrain" + ("_m" if sep == "." else "_lowest_m"),
+            "lowest ≤ highest ground height",
+            [float(low[i]), float(high[i])],
+        )
+    top = np.fmax(high, np.nanmax(block.height_points_m, axis=1, initial=-np.inf))
+    for side, centre in (("left", block.centre_left_m), ("right", block.centre_right_m)):
+        bad = np.flatnonzero(centre[:, 2] <= top)
+        if bad.size:
+            i = int(bad[0])
+            raise fields.error(
+                f"{where[i]}{sep}{side}" + (".Z_m" if sep == "." else "_Z_m"),
+                f"a projection centre above the model's highest ground ({top[i]:g} m)",
+                float(centre[i, 2]),
+            )
+    base = np.hypot(*(block.centre_right_m - block.centre_left_m)[:, :2].T)
+    bad = np.flatnonzero(base < 1.0)
+    if bad.size:
+        i = int(bad[0])
+        raise fields.error(
+            f"{where[i]}{sep}right", "a horizontal base of at least 1 m", f"{base[i]:.3g} m"
+        )
+
+
+# --- the result -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class BlockResult:
+    """Setup data of N pairs (Table 24 without (6.7)/(6.8)). Refused pairs hold NaN.
+
+    Attributes
+    ----------
+    name, instrument : str
+        Block name; instrument key.
+    model_names : tuple of str
+    spec : InstrumentSpec
+        The instrument (for the refusal messages).
+    map_scale_denominator : int or None
+    focal_length_corrected_mm : float
+        f′. [mm]
+    book_sign : bool
+        (6.4) with the printed sign.
+    candidate_scales : ndarray, shape (C, 2)
+        The (M_г, M_в) grid of the scale choice. [—]
+    feasible_candidates : ndarray of bool, shape (N, C)
+    candidate_index : ndarray of int, shape (N,)
+        The chosen candidate, or the closest one of a pair with no feasible candidate.
+    reason_code : ndarray of int, shape (N,)
+        :class:`Refusal` flags; 0 = accepted.
+    frame_rotation : ndarray, shape (N,)
+        θ, azimuth of the horizontal base. [rad]
+    base_ground_m : ndarray, shape (N, 3)
+        S_п − S_л in the instrument frame (X along the base). [m]
+    depth_ground_m : ndarray, shape (N, 2)
+        Z_Sл − highest, Z_Sл − lowest ground. [m]
+    angles : ndarray, shape (N, 2, 3)
+        α, ω, κ of the left, right photo in the instrument frame. [rad]
+    horizontal_scale_denominator, vertical_scale_denominator : ndarray, shape (N,)
+        M_г, M_в (float, NaN when refused). [—]
+    f_instrument_mm, transformation_coefficient, n_left, n_right : ndarray, shape (N,)
+        f_пр [mm], k [—], n_л, n_п [—].
+    base_mm : ndarray, shape (N, 3)
+        b_x, b_y, b_z′. [mm]
+    fiducials_transformed_mm : ndarray, shape (N, 2, 3)
+        Per photo: x⁰ of its x mark (left 2, right 1), y⁰₃, y⁰₄, from (6.1)/(6.2) without n. [mm]
+    fiducials_rigorous_mm : ndarray, shape (N, 2, 3, 2)
+        (3.17) x⁰, y⁰ of the same marks with κ = 0. [mm]
+    mark_span_mm : ndarray, shape (N, 2)
+        L_л, L_п of (6.5). [mm]
+    decentration_mm : ndarray, shape (N, 2, 2)
+        Per photo f′·tan α, f′·tan ω. [mm]
+    depth_range_mm : ndarray, shape (N, 2)
+        Projection distances of the highest and lowest ground at M_в. [mm]
+    height_point_ids : tuple of tuple of str
+    control_heights_model_mm : ndarray, shape (N, P)
+        Z_i of (6.6), NaN-padded. [mm]
+    """
+
+    name: str
+    instrument: str
+    model_names: tuple[str, ...]
+    spec: InstrumentSpec = field(repr=False)
+    map_scale_denominator: int | None
+    focal_length_corrected_mm: float
+    book_sign: bool
+    candidate_scales: NDArray[np.float64]
+    feasible_candidates: NDArray[np.bool_]
+    candidate_index: NDArray[np.int64]
+    reason_code: NDArray[np.int64]
+    frame_rotation: NDArray[np.float64]
+    base_ground_m: NDArray[np.float64]
+    depth_ground_m: NDArray[np.float64]
+    angles: NDArray[np.float64]
+    horizontal_scale_denominator: NDArray[np.float64]
+    vertical_scale_denominator: NDArray[np.float64]
+    f_instrument_mm: NDArray[np.float64]
+    transformation_coefficient: NDArray[np.float64]
+    n_left: NDArray[np.float64]
+    n_right: NDArray[np.float64]
+    base_mm: NDArray[np.float64]
+    fiducials_transformed_mm: NDArray[np.float64]
+    fiducials_rigorous_mm: NDArray[np.float64]
+    mark_span_mm: NDArray[np.float64]
+    decentration_mm: NDArray[np.float64]
+    depth_range_mm: NDArray[np.float64]
+    height_point_ids: tuple[tuple[str, ...], ...]
+    control_heights_model_mm: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return len(self.model_names)
+
+    @property
+    def accepted(self) -> NDArray[np.bool_]:
+        """True where the instrument takes the pair."""
+        return self.reason_code == 0
+
+    def reason(self, i: int) -> str:
+        """The refusal of pair ``i`` in words ("" when accepted): values, ranges, way out."""
+        return _reason_text(self, int(i))
+
+
+_ARRAY_FIELDS = tuple(
+    f
+    for f in BlockResult.__slots__
+    if f
+    not in (
+        "name",
+        "instrument",
+        "model_names",
+        "spec",
+        "map_scale_denominator",
+        "focal_length_corrected_mm",
+        "book_sign",
+        "candidate_scales",
+        "height_point_ids",
+    )
+)
+
+
+# --- computation ------------------------------------------------------------------------------
+
+
+def _candidate_grid(
+    spec: InstrumentSpec, map_scale: int | None, horizontal: int | None, vertical: int | None
+) -> NDArray[np.float64]:
+    """(M_г, M_в) candidates in the order of ``setup_sheet._choose_scales``: shape (C, 2)."""
+    if horizontal is not None:
+        hs = [int(horizontal)]
+    elif map_scale is None:
+        raise ValueError(
+            "map_scale is needed to choose M_г (or force horizontal_scale_denominator)"
+        )
+    else:
+        hs = [round(r * map_scale) for r in spec.coordinatograph_ratios]
+    vs = [int(vertical)] if vertical is not None else list(spec.vertical_scale_denominators)
+    return np.array([(mg, mv) for mg in hs for mv in vs], dtype=float)
+
+
+def _inside_with_slack(v: NDArray, lo: float, hi: float) -> NDArray[np.bool_]:
+    """lo ≤ v ≤ hi with the 1e-9 relative slack of ``instrument.spec.check_in_range``."""
+    eps = 1e-9 * max(1.0, abs(lo), abs(hi))
+    with np.errstate(invalid="ignore"):
+        return (v >= lo - eps) & (v <= hi + eps)
+
+
+def _prepare(
+    focal_length_corrected_mm: float,
+    fiducials_mm: ArrayLike,
+    principal_point_mm: ArrayLike,
+    centre_left_m: ArrayLike,
+    angles_left: ArrayLike,
+    centre_right_m: ArrayLike,
+    angles_right: ArrayLike,
+    terrain_m: ArrayLike,
+    height_points_m: ArrayLike | None,
+) -> tuple[float, NDArray, NDArray, NDArray, NDArray, NDArray]:
+    f = float(focal_length_corrected_mm)
+    marks = np.asarray(fiducials_mm, float) - np.asarray(principal_point_mm, float)
+    if marks.shape != (4, 2):
+        raise ValueError(f"fiducials_mm: expected shape (4, 2) (marks 1–4), found {marks.shape}")
+    centres = np.stack(
+        [np.asarray(centre_left_m, float), np.asarray(centre_right_m, float)], axis=1
+    )
+    angles = np.stack([np.asarray(angles_left, float), np.asarray(angles_right, float)], axis=1)
+    if centres.ndim != 3 or centres.shape[2] != 3 or angles.shape != centres.shape:
+        raise ValueError(
+            "centre_*_m and angles_* must have shape (N, 3); found "
+            f"{centres.shape[::2]} and {angles.shape[::2]}"
+        )
+    n = centres.shape[0]
+    terrain = np.asarray(terrain_m, float)
+    if terrain.shape != (n, 2):
+        raise ValueError(f"terrain_m: expected shape ({n}, 2), found {terrain.shape}")
+    heights = np.zeros((n, 0)) if height_points_m is None else np.asarray(height_points_m, float)
+    if heights.ndim != 2 or heights.shape[0] != n:
+        raise ValueError(f"height_points_m: expected shape ({n}, P), found {heights.shape}")
+    return f, marks, centres, angles, terrain, heights
+
+
+def compute_block(
+    focal_length_corrected_mm: float,
+    fiducials_mm: ArrayLike,
+    centre_left_m: ArrayLike,
+    angles_left: ArrayLike,
+    centre_right_m: ArrayLike,
+    angles_right: ArrayLike,
+    terrain_m: ArrayLike,
+    spec: InstrumentSpec,
+    map_scale_denominator: int | None,
+    *,
+    principal_point_mm: ArrayLike = (0.0, 0.0),
+    height_points_m: ArrayLike | None = None,
+    horizontal_scale_denominator: int | None = None,
+    vertical_scale_denominator: int | None = None,
+    book_sign: bool = False,
+    model_names: tuple[str, ...] | None = None,
+    height_point_ids: tuple[tuple[str, ...], ...] | None = None,
+    name: str = "block",
+) -> BlockResult:
+    r"""Setup data of N stereopairs of one camera, vectorised over the pairs.
+
+    Parameters
+    ----------
+    focal_length_corrected_mm : float
+        f′ (the calibrated f when no film deformation is known). [mm]
+    fiducials_mm : array_like, shape (4, 2)
+        Calibrated marks 1–4 (1 at −x, 2 at +x, 3 at +y, 4 at −y). [mm]
+    centre_left_m, centre_right_m : array_like, shape (N, 3)
+        X_S, Y_S, Z_S of the left and right photo, in any photogrammetric system with Z up. [m]
+    angles_left, angles_right : array_like, shape (N, 3)
+        α, ω, κ of Eq. (2.50) in that system. [rad]
+    terrain_m : array_like, shape (N, 2)
+        Lowest and highest ground height of each model's working area. [m]
+    spec : InstrumentSpec
+        The instrument (ranges, gear sets, D_max).
+    map_scale_denominator : int or None
+        M_map; M_г = r·M_map for the coordinatograph ratios r. [—]
+    principal_point_mm : array_like, shape (2,)
+        x₀, y₀; the marks are taken relative to it. [mm]
+    height_points_m : array_like, shape (N, P), optional
+        Z of the height control points of each model, NaN-padded. [m]
+    horizontal_scale_denominator, vertical_scale_denominator : int, optional
+        Force M_г and/or M_в (still range-checked). [—]
+    book_sign : bool
+        (6.4) with the printed sign (Z_Sл − Z_Sп).
+    model_names, height_point_ids, name
+        Labels carried into the result.
+
+    Returns
+    -------
+    BlockResult
+        Pairs with no feasible scale pair, or a tilt, κ or decentration beyond a stop, hold NaN in
+        every sheet value and a :class:`Refusal` code; nothing raises mid-batch.
+
+    Notes
+    -----
+    Chains, per pair and all at once: the frame rotation θ = atan2(ΔY_S, ΔX_S),
+    M′ = R_Z(−θ)·M and α, ω, κ from M′ (``docs/setup-data.md``, Frame); the scale choice of item 1
+    of [1]_ on the (pair × candidate) grid — feasible when f_пр = f′·M_г/M_в is in range, the
+    projection distances (Z_Sл − Z)·1000/M_в of the lowest and highest ground, and the same plus
+    b_z′ for the right rod, are inside [D_min, D_max], and b_x, b_y, b_z′ are in range; the largest
+    model scale (smallest M_г) wins, then the smallest M_в, as in
+    :func:`stereoplotter.setup_sheet.compute_setup_sheet`; then Eqs. (6.3), (6.4), (6.1)/(6.2)
+    (n-free) and (3.17) with κ = 0 for the marks, (6.5), the decentrations and (6.6).
+
+    (6.7)/(6.8) — the sheet corners — are **not** computed in block mode (they need a map sheet
+    and plan control per model), nor is the X, Y travel of the model checked.
+
+    Examples
+    --------
+    The model of the book's §27 setting (f = 70 mm, 60 % overlap, photo scale 1:20 000):
+
+    >>> import numpy as np
+    >>> from stereoplotter.instrument.spec import load_instrument
+    >>> marks = [[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]]
+    >>> r = compute_block(70.0, marks, [[-720.0, 0.0, 1550.0]], [[0.0, 0.0, 0.0]],
+    ...                   [[720.0, 0.0, 1560.0]], [[0.0, 0.0, 0.0]], [[120.0, 210.0]],
+    ...                   load_instrument("sc1"), 10000)
+    >>> float(r.horizontal_scale_denominator[0]), float(r.vertical_scale_denominator[0])
+    (12500.0, 8000.0)
+    >>> round(float(r.n_left[0]), 5), round(float(r.base_mm[0, 0]), 3)
+    (1.69143, 115.2)
+    """
+    f, marks, centres, angles, terrain, heights = _prepare(
+        focal_length_corrected_mm,
+        fiducials_mm,
+        principal_point_mm,
+        centre_left_m,
+        angles_left,
+        centre_right_m,
+        angles_right,
+        terrain_m,
+        height_points_m,
+    )
+    n = centres.shape[0]
+    invalid = ~(
+        np.isfinite(centres).all(axis=(1, 2))
+        & np.isfinite(angles).all(axis=(1, 2))
+        & np.isfinite(terrain).all(axis=1)
+    )
+    with np.errstate(invalid="ignore"):
+        invalid |= terrain[:, 0] > terrain[:, 1]
+
+    # Frame: base along +X, origin S_л (docs/setup-data.md, Inputs, "Frame").
+    base_vector = centres[:, 1] - centres[:, 0]
+    theta = np.arctan2(base_vector[:, 1], base_vector[:, 0])
+    turn = rotation_z(-theta)  # (N, 3, 3)
+    rotations = turn[:, None] @ rotation_matrix(angles[..., 0], angles[..., 1], angles[..., 2])
+    alpha, omega, kappa = angles_from_matrix(rotations)  # (N, 2) each
+    base_m = np.einsum("nij,nj->ni", turn, base_vector)
+    depth_m = centres[:, 0, 2:3] - terrain[:, ::-1]  # (N, 2): Z_Sл − highest, Z_Sл − lowest
+
+    # Item 1: scale choice on the (pair × candidate) grid.
+    grid = _candidate_grid(
+        spec, map_scale_denominator, horizontal_scale_denominator, vertical_scale_denominator
+    )
+    mg_c, mv_c = grid[:, 0], grid[:, 1]
+    lo, hi = spec.f_instrument_range_mm
+    f_c = instrument_principal_distance(f, mg_c, mv_c)  # (C,)
+    bad = {Refusal.F_INSTRUMENT: np.broadcast_to(~((lo <= f_c) & (f_c <= hi)), (n, len(grid)))}
+    b_c = base_components(np.zeros(3), base_m[:, None, :], mg_c, mv_c)  # (N, C, 3)
+    near = projection_distance(depth_m[:, 0:1], mv_c)  # (N, C)
+    far = projection_distance(depth_m[:, 1:2], mv_c)
+    d_lo, d_hi = spec.projection_distance_range_mm
+    with np.errstate(invalid="ignore"):
+        vmin = np.minimum(near, near + b_c[..., 2])
+        vmax = np.maximum(far, far + b_c[..., 2])
+        bad[Refusal.PROJECTION_DISTANCE] = ~((vmin >= d_lo) & (vmax <= d_hi))
+        for flag, j, attribute in (
+            (Refusal.BASE_X, 0, "base_x_range_mm"),
+            (Refusal.BASE_Y, 1, "base_y_range_mm"),
+            (Refusal.BASE_Z, 2, "base_z_range_mm"),
+        ):
+            b_lo, b_hi = getattr(spec, attribute)
+            bad[flag] = ~((b_c[..., j] >= b_lo) & (b_c[..., j] <= b_hi))
+    flags_c = np.zeros((n, len(grid)), dtype=np.int64)
+    count_c = np.zeros((n, len(grid)), dtype=np.int64)
+    for flag, mask in bad.items():
+        flags_c |= np.where(mask, int(flag), 0)
+        count_c += mask
+    feasible = flags_c == 0
+    order = np.lexsort((mv_c, mg_c))  # largest model scale first, then the smallest M_в
+    any_ok = feasible.any(axis=1)
+    first = order[np.argmax(feasible[:, order], axis=1)]
+    rank = np.empty(len(grid), dtype=np.int64)
+    rank[np.lexsort((np.arange(len(grid)), mg_c))] = np.arange(len(grid))
+    closest = np.argmin(count_c * len(grid) + rank, axis=1)  # fewest failures, then smallest M_г
+    chosen = np.where(any_ok, first, closest)
+    reason = np.where(any_ok, 0, flags_c[np.arange(n), chosen])
+
+    # Settings that do not depend on the scale: κ, tilts, decentrations (the stops).
+    dec = np.stack([decentration(f, alpha), decentration(f, omega)], axis=-1)  # (N, 2, 2)
+    k_lo, k_hi = spec.kappa_range
+    reason |= np.where(~_inside_with_slack(kappa, k_lo, k_hi).all(axis=1), int(Refusal.KAPPA), 0)
+    tilts = np.concatenate([alpha, omega], axis=1)
+    t_ok = _inside_with_slack(tilts, -spec.tilt_max, spec.tilt_max).all(axis=1)
+    reason |= np.where(~t_ok, int(Refusal.TILT), 0)
+    dc_ok = _inside_with_slack(dec, *spec.decentration_range_mm).all(axis=(1, 2))
+    reason |= np.where(~dc_ok, int(Refusal.DECENTRATION), 0)
+    reason = np.where(invalid, int(Refusal.INVALID_INPUT), reason)
+    ok = reason == 0
+
+    mg = np.where(ok, mg_c[chosen], np.nan)
+    mv = np.where(ok, mv_c[chosen], np.nan)
+    f_pr = instrument_principal_distance(f, mg, mv)
+    k = transformation_coefficient(f_pr, f)
+    n_left = counter_scale_left(d_hi, f_pr)  # (6.3)
+    n_right = counter_scale_right(n_left, 0.0, base_m[:, 2], f_pr, mv, book_sign=book_sign)  # (6.4)
+    b = base_components(np.zeros(3), base_m, mg, mv)
+    mask2 = np.where(ok, 1.0, np.nan)[:, None]
+    x0 = transformed_x_single_tilt(marks[list(_X_MARK), 0], alpha, f) * mask2  # (6.1)
+    y3 = transformed_y_single_tilt(marks[2, 1], omega, f) * mask2  # (6.2)
+    y4 = transformed_y_single_tilt(marks[3, 1], omega, f) * mask2
+    rig_marks = marks[[[1, 2, 3], [0, 2, 3]]]  # (2, 3, 2)
+    untwisted = rotation_matrix(alpha, omega, 0.0)  # the cassette κ is 0 in stage 2
+    rigorous = transformed_coordinates(rig_marks, untwisted[:, :, None], f)  # (3.17)
+    rigorous = rigorous * mask2[..., None, None]
+    spans = mark_span(np.stack([n_left, n_right], axis=1), y3, y4)  # (6.5)
+    flying = centres[:, 0, 2:3] - heights  # H_Фi = Z_Sл − Z_Фi
+    control = model_height(flying, mv[:, None])  # (6.6)
+    depth_used = projection_distance(depth_m, mv[:, None])
+
+    names = tuple(model_names) if model_names is not None else tuple(f"{i + 1}" for i in range(n))
+    ids = (
+        height_point_ids
+        if height_point_ids is not None
+        else tuple(tuple(str(j + 1) for j in range(heights.shape[1])) for _ in range(n))
+    )
+    return BlockResult(
+        name=name,
+        instrument=spec.key,
+        model_names=names,
+        spec=spec,
+        map_scale_denominator=map_scale_denominator,
+        focal_length_corrected_mm=f,
+        book_sign=book_sign,
+        candidate_scales=grid,
+        feasible_candidates=feasible,
+        candidate_index=chosen,
+        reason_code=reason.astype(np.int64),
+        frame_rotation=theta,
+        base_ground_m=base_m,
+        depth_ground_m=depth_m,
+        angles=np.stack([alpha, omega, kappa], axis=-1),
+        horizontal_scale_denominator=mg,
+        vertical_scale_denominator=mv,
+        f_instrument_mm=f_pr,
+        transformation_coefficient=k,
+        n_left=n_left,
+        n_right=n_right,
+        base_mm=b,
+        fiducials_transformed_mm=np.stack([x0, y3, y4], axis=-1),
+        fiducials_rigorous_mm=rigorous,
+        mark_span_mm=spans,
+        decentration_mm=dec * mask2[..., None],
+        depth_range_mm=depth_used,
+        height_point_ids=ids,
+        control_heights_model_mm=control,
+    )
+
+
+def per_pair_loop(
+    focal_length_corrected_mm: float,
+    fiducials_mm: ArrayLike,
+    centre_left_m: ArrayLike,
+    angles_left: ArrayLike,
+    centre_right_m: ArrayLike,
+    angles_right: ArrayLike,
+    terrain_m: ArrayLike,
+    spec: InstrumentSpec,
+    map_scale_denominator: int | None,
+    **options: Any,
+) -> BlockResult:
+    """The same as :func:`compute_block`, one pair at a time (a plain Python loop on scalars).
+
+    Parameters
+    ----------
+    focal_length_corrected_mm, fiducials_mm, centre_left_m, angles_left, centre_right_m, \
+angles_right, terrain_m, spec, map_scale_denominator, **options
+        As for :func:`compute_block`. [mm, m, rad]
+
+    Returns
+    -------
+    BlockResult
+        Equal to :func:`compute_block` to rounding (the test oracle and the benchmark's
+        comparison; not meant for production use).
+
+    Notes
+    -----
+    Calls the same equation functions — frame rotation, item 1 of [1]_, (6.1)–(6.6), (3.17) —
+    with scalars, and chooses the scales by a loop over the candidates written after
+    ``setup_sheet._choose_scales``.
+    """
+    f, marks, centres, angles, terrain, heights = _prepare(
+        focal_length_corrected_mm,
+        fiducials_mm,
+        options.get("principal_point_mm", (0.0, 0.0)),
+        centre_left_m,
+        angles_left,
+        centre_right_m,
+        angles_right,
+        terrain_m,
+        options.get("height_points_m"),
+    )
+    grid = _candidate_grid(
+        spec,
+        map_scale_denominator,
+        options.get("horizontal_scale_denominator"),
+        options.get("vertical_scale_denominator"),
+    )
+    book_sign = bool(options.get("book_sign", False))
+    rows = [
+        _one_pair(f, marks, centres[i], angles[i], terrain[i], heights[i], grid, spec, book_sign)
+        for i in range(centres.shape[0])
+    ]
+    n = len(rows)
+    stacked = {key: np.array([r[key] for r in rows]) for key in rows[0]} if rows else {}
+    names = options.get("model_names") or tuple(f"{i + 1}" for i in range(n))
+    ids = options.get("height_point_ids") or tuple(
+        tuple(str(j + 1) for j in range(heights.shape[1])) for _ in range(n)
+    )
+    return BlockResult(
+        name=options.get("name", "block"),
+        instrument=spec.key,
+        model_names=tuple(names),
+        spec=spec,
+        map_scale_denominator=map_scale_denominator,
+        focal_length_corrected_mm=f,
+        book_sign=book_sign,
+        candidate_scales=grid,
+        height_point_ids=ids,
+        **stacked,
+    )
+
+
+def _one_pair(
+    f: float,
+    marks: NDArray,
+    centres: NDArray,
+    angles: NDArray,
+    terrain: NDArray,
+    heights: NDArray,
+    grid: NDArray,
+    spec: InstrumentSpec,
+    book_sign: bool,
+) -> dict[str, Any]:
+    """One pair with scalars: the oracle of :func:`compute_block`."""
+    c_left, c_right = centres
+    invalid = not (
+        np.isfinite(centres).all() and np.isfinite(angles).all() and np.isfinite(terrain).all()
+    ) or bool(terrain[0] > terrain[1])
+    base_vector = c_right - c_left
+    theta = math.atan2(base_vector[1], base_vector[0])
+    turn = rotation_z(-theta)
+    photo_angles = []
+    for a in angles:
+        rot = turn @ rotation_matrix(a[0], a[1], a[2])
+        photo_angles.append(tuple(float(v) for v in angles_from_matrix(rot)))
+    base_m = turn @ base_vector
+    depth = [float(c_left[2] - terrain[1]), float(c_left[2] - terrain[0])]
+
+    # Item 1, as setup_sheet._candidate / _choose_scales.
+    candidates = []
+    for index, (mg, mv) in enumerate(grid):
+        failed = []
+        f_pr = float(instrument_principal_distance(f, mg, mv))
+        lo, hi = spec.f_instrument_range_mm
+        if not lo <= f_pr <= hi:
+            failed.append(Refusal.F_INSTRUMENT)
+        b = base_components(np.zeros(3), base_m, mg, mv)
+        d = [float(projection_distance(v, mv)) for v in depth]
+        values = [d[0], d[1], d[0] + b[2], d[1] + b[2]]
+        d_lo, d_hi = spec.projection_distance_range_mm
+        if min(values) < d_lo or max(values) > d_hi or any(math.isnan(v) for v in values):
+            failed.append(Refusal.PROJECTION_DISTANCE)
+        for flag, j, attribute in (
+            (Refusal.BASE_X, 0, "base_x_range_mm"),
+            (Refusal.BASE_Y, 1, "base_y_range_mm"),
+            (Refusal.BASE_Z, 2, "base_z_range_mm"),
+        ):
+            b_lo, b_hi = getattr(spec, attribute)
+            if not b_lo <= b[j] <= b_hi:
+                failed.append(flag)
+        candidates.append((index, float(mg), float(mv), failed))
+    feasible = [c for c in candidates if not c[3]]
+    if feasible:
+        chosen = min(feasible, key=lambda c: (c[1], c[2]))
+        reason = 0
+    else:
+        chosen = min(candidates, key=lambda c: (len(c[3]), c[1]))
+        reason = int(sum(chosen[3]))
+
+    decs = [(float(decentration(f, a)), float(decentration(f, w))) for a, w, _ in photo_angles]
+    for (a, w, kap), dxy in zip(photo_angles, decs, strict=True):
+        for value, attribute, flag in (
+            (kap, "kappa_range", Refusal.KAPPA),
+            (a, "tilt_max", Refusal.TILT),
+            (w, "tilt_max", Refusal.TILT),
+            (dxy[0], "decentration_range_mm", Refusal.DECENTRATION),
+            (dxy[1], "decentration_range_mm", Refusal.DECENTRATION),
+        ):
+            try:
+                check_in_range(spec, attribute, value, "")
+            except RangeRefusal:
+                reason |= int(flag)
+    if invalid:
+        reason = int(Refusal.INVALID_INPUT)
+    ok = reason == 0
+    nan = math.nan
+    mg, mv = (chosen[1], chosen[2]) if ok else (nan, nan)
+    f_pr = float(instrument_principal_distance(f, mg, mv))
+    n_left = float(counter_scale_left(spec.projection_distance_range_mm[1], f_pr))  # (6.3)
+    n_right = float(
+        counter_scale_right(n_left, c_left[2], c_right[2], f_pr, mv, book_sign=book_sign)
+    )  # (6.4)
+    fid, rig, spans = [], [], []
+    for p, ((a, w, _), n) in enumerate(zip(photo_angles, (n_left, n_right), strict=True)):
+        x_mark = marks[_X_MARK[p]]
+        x0 = float(transformed_x_single_tilt(x_mark[0], a, f))  # (6.1)
+        y3 = float(transformed_y_single_tilt(marks[2, 1], w, f))  # (6.2)
+        y4 = float(transformed_y_single_tilt(marks[3, 1], w, f))
+        fid.append([x0, y3, y4] if ok else [nan] * 3)
+        untwisted = rotation_matrix(a, w, 0.0)
+        rig.append(
+            [
+                transformed_coordinates(m, untwisted, f) if ok else [nan, nan]
+                for m in (x_mark, marks[2], marks[3])
+            ]
+        )  # (3.17)
+        spans.append(float(mark_span(n, y3, y4)))  # (6.5)
+    return {
+        "feasible_candidates": np.array([not c[3] for c in candidates]),
+        "candidate_index": chosen[0],
+        "reason_code": reason,
+        "frame_rotation": theta,
+        "base_ground_m": base_m,
+        "depth_ground_m": depth,
+        "angles": photo_angles,
+        "horizontal_scale_denominator": mg,
+        "vertical_scale_denominator": mv,
+        "f_instrument_mm": f_pr,
+        "transformation_coefficient": float(transformation_coefficient(f_pr, f)),
+        "n_left": n_left,
+        "n_right": n_right,
+        "base_mm": base_components(np.zeros(3), base_m, mg, mv),
+        "fiducials_transformed_mm": fid,
+        "fiducials_rigorous_mm": rig,
+        "mark_span_mm": spans,
+        "decentration_mm": decs if ok else [[nan, nan], [nan, nan]],
+        "depth_range_mm": [float(projection_distance(v, mv)) for v in depth],
+        "control_heights_model_mm": [
+            float(model_height(c_left[2] - z, mv)) for z in heights
+        ],  # (6.6)
+    }
+
+
+# --- refusal messages -------------------------------------------------------------------------
+
+
+def _reason_text(result: BlockResult, i: int) -> str:
+    code = Refusal(int(result.reason_code[i]))
+    if not code:
+        return ""
+    spec = result.spec
+    if Refusal.INVALID_INPUT in code:
+        return "invalid input: a non-finite value, or terrain lowest > highest"
+    parts = []
+    if code & sum(_SCALE_FLAGS):
+        mg, mv = result.candidate_scales[result.candidate_index[i]]
+        f = result.focal_length_corrected_mm
+        b = base_components(np.zeros(3), result.base_ground_m[i], mg, mv)
+        d = projection_distance(result.depth_ground_m[i], mv)
+        checks = {
+            Refusal.F_INSTRUMENT: [
+                ("f_instrument_range_mm", instrument_principal_distance(f, mg, mv), "f_пр")
+            ],
+            Refusal.PROJECTION_DISTANCE: [
+                ("projection_distance_range_mm", v, "projection distance D")
+                for v in (d[0], d[1], d[0] + b[2], d[1] + b[2])
+            ],
+            Refusal.BASE_X: [("base_x_range_mm", b[0], "b_x")],
+            Refusal.BASE_Y: [("base_y_range_mm", b[1], "b_y")],
+            Refusal.BASE_Z: [("base_z_range_mm", b[2], "b_z′")],
+        }
+        texts = []
+        for flag in _SCALE_FLAGS:
+            if flag in code:
+                texts.append(_first_refusal(spec, checks[flag], flag.name or ""))
+        parts.append(
+            f"none of the {len(result.candidate_scales)} scale pairs fits (way out: another "
+            f"instrument or map scale); closest M_г = 1:{mg:.0f}, M_в = 1:{mv:.0f}: "
+            + "; ".join(texts)
+        )
+    names = ("left", "right")
+    for flag, attribute, getter in (
+        (Refusal.KAPPA, "kappa_range", lambda p: [(result.angles[i, p, 2], f"κ_{names[p]}")]),
+        (
+            Refusal.TILT,
+            "tilt_max",
+            lambda p: [
+                (result.angles[i, p, 0], f"α_{names[p]}"),
+                (result.angles[i, p, 1], f"ω_{names[p]}"),
+            ],
+        ),
+        (
+            Refusal.DECENTRATION,
+            "decentration_range_mm",
+            lambda p: [
+                (
+                    decentration(result.focal_length_corrected_mm, result.angles[i, p, j]),
+                    f"decentration d_{'xy'[j]},{names[p]}",
+                )
+                for j in (0, 1)
+            ],
+        ),
+    ):
+        if flag in code:
+            checks = [(attribute, v, w) for p in (0, 1) for v, w in getter(p)]
+            parts.append(_first_refusal(spec, checks, flag.name or ""))
+    return "; ".join(parts)
+
+
+def _first_refusal(spec: InstrumentSpec, checks: list[tuple[str, Any, str]], name: str) -> str:
+    for attribute, value, what in checks:
+        try:
+            check_in_range(spec, attribute, float(value), what)
+        except RangeRefusal as exc:
+            return str(exc)
+    return name.lower()  # within the slack of check_in_range: name the condition only
+
+
+# --- running a block file and writing the sheets ---------------------------------------------
+
+
+def run_block(
+    path: str | os.PathLike[str],
+    spec: InstrumentSpec,
+    output_dir: str | os.PathLike[str] | None = None,
+    book_sign: bool = False,
+) -> BlockResult:
+    """Load a block file, compute every model (:func:`compute_block`) and optionally write it.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The block YAML (:func:`load_block`).
+    spec : InstrumentSpec
+    output_dir : str or path-like, optional
+        Where to write ``<model>/sheet.yaml`` and ``block.csv`` (:func:`write_block`).
+    book_sign : bool
+        (6.4) with the printed sign.
+
+    Returns
+    -------
+    BlockResult
+
+    Notes
+    -----
+    Eqs. (6.1)–(6.6) of [1]_ via :func:`compute_block`; (6.7)/(6.8) are not part of block mode.
+    """
+    block = load_block(path)
+    result = compute_block(
+        block.camera.focal_length_mm,
+        block.camera.fiducial_array_mm(),
+        block.centre_left_m,
+        block.angles_left,
+        block.centre_right_m,
+        block.angles_right,
+        block.terrain_m,
+        spec,
+        block.map_scale_denominator,
+        principal_point_mm=block.camera.principal_point_mm,
+        height_points_m=block.height_points_m,
+        horizontal_scale_denominator=block.horizontal_scale_denominator,
+        vertical_scale_denominator=block.vertical_scale_denominator,
+        book_sign=book_sign,
+        model_names=block.model_names,
+        height_point_ids=block.height_point_ids,
+        name=block.name,
+    )
+    if output_dir is not None:
+        write_block(result, output_dir)
+    return result
+
+
+def _num(value: float, digits: int = 6) -> float | None:
+    v = float(value)
+    return None if math.isnan(v) else round(v, digits) + 0.0  # + 0.0: no "-0.0" on the sheet
+
+
+def _int(value: float) -> int | None:
+    v = float(value)
+    return None if math.isnan(v) else round(v)
+
+
+def model_sheet(result: BlockResult, i: int) -> dict[str, Any]:
+    """The sheet of model ``i`` as plain data, with the keys of the single-pair ``--json``.
+
+    Parameters
+    ----------
+    result : BlockResult
+    i : int
+        Model index.
+
+    Returns
+    -------
+    dict
+        ``status`` ("ok" or "refused"), ``reason``, and the values of Eqs. (6.1)–(6.6) of [1]_
+        (None where refused). [mm, —]
+    """
+    ok = bool(result.accepted[i])
+    fid = result.fiducials_transformed_mm[i]
+    rig = result.fiducials_rigorous_mm[i]
+    photos = ("left", "right")
+    return {
+        "block": result.name,
+        "model": result.model_names[i],
+        "instrument": result.instrument,
+        "status": "ok" if ok else "refused",
+        "reason": result.reason(i),
+        "reason_code": int(result.reason_code[i]),
+        "scale_horizontal": _int(result.horizontal_scale_denominator[i]),
+        "scale_vertical": _int(result.vertical_scale_denominator[i]),
+        "scale_map": result.map_scale_denominator,
+        "f_instrument_mm": _num(result.f_instrument_mm[i]),
+        "transformation_coefficient": _num(result.transformation_coefficient[i]),
+        "focal_length_corrected_mm": _num(result.focal_length_corrected_mm),
+        "n_left": _num(result.n_left[i]),
+        "n_right": _num(result.n_right[i]),
+        "base_mm": dict(zip(("bx", "by", "bz"), map(_num, result.base_mm[i]), strict=True)),
+        "fiducials_transformed_mm": {
+            p: {
+                f"x{_X_MARK_NAME[j]}": _num(fid[j, 0]),
+                "y3": _num(fid[j, 1]),
+                "y4": _num(fid[j, 2]),
+            }
+            for j, p in enumerate(photos)
+        },
+        "fiducials_rigorous_mm": {
+            p: {
+                key: [_num(rig[j, m, 0]), _num(rig[j, m, 1])]
+                for m, key in enumerate((_X_MARK_NAME[j], "3", "4"))
+            }
+            for j, p in enumerate(photos)
+        },
+        "L_mm": {"left": _num(result.mark_span_mm[i, 0]), "right": _num(result.mark_span_mm[i, 1])},
+        "decentrations_mm": {
+            p: {
+                "x": _num(result.decentration_mm[i, j, 0]),
+                "y": _num(result.decentration_mm[i, j, 1]),
+            }
+            for j, p in enumerate(photos)
+        },
+        "angles_deg": {
+            p: {
+                a: _num(math.degrees(result.angles[i, j, m]), 7)
+                for m, a in enumerate(("alpha", "omega", "kappa"))
+            }
+            for j, p in enumerate(photos)
+        },
+        "control_heights_model_mm": {
+            pid: _num(result.control_heights_model_mm[i, j])
+            for j, pid in enumerate(result.height_point_ids[i])
+        },
+        "depth_range_used_mm": [_num(v, 3) for v in result.depth_range_mm[i]],
+        "frame": {
+            "rotation_deg": _num(math.degrees(result.frame_rotation[i]), 7),
+            "note": "the photogrammetric system is turned about Z by −rotation so that X runs "
+            "along the base, origin S_л (docs/setup-data.md)",
+        },
+        "options": {"book_sign_n_right": result.book_sign},
+        "not_in_block_mode": "sheet corners (6.7), similarity (6.8) and the model X, Y travel: "
+        "compute the single-pair sheet for them",
+    }
+
+
+_CSV_OUT = (
+    "model", "status", "reason_code", "scale_horizontal", "scale_vertical", "f_instrument_mm",
+    "transformation_coefficient", "n_left", "n_right", "bx_mm", "by_mm", "bz_mm",
+    "left_x2_mm", "left_y3_mm", "left_y4_mm", "right_x1_mm", "right_y3_mm", "right_y4_mm",
+    "L_left_mm", "L_right_mm", "frame_rotation_deg", "reason",
+)  # fmt: skip
+
+
+def write_block(result: BlockResult, output_dir: str | os.PathLike[str]) -> None:
+    """Write ``<output_dir>/<model>/sheet.yaml`` for every model and ``<output_dir>/block.csv``.
+
+    Parameters
+    ----------
+    result : BlockResult
+    output_dir : str or path-like
+        Created if needed. Each file is written whole or not at all.
+
+    Notes
+    -----
+    The sheet keys are those of the single-pair ``--json`` output where they exist
+    (:func:`model_sheet`); values of Eqs. (6.1)–(6.6) of [1]_.
+    """
+    out = Path(output_dir)
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(_CSV_OUT)
+    for i, model in enumerate(result.model_names):
+        sheet = model_sheet(result, i)
+        text = yaml.dump(sheet, Dumper=dumper, sort_keys=False, allow_unicode=True, width=100)
+        atomic_write_text(out / model / "sheet.yaml", text)
+        fid = sheet["fiducials_transformed_mm"]
+        writer.writerow(
+            [
+                model, sheet["status"], sheet["reason_code"], sheet["scale_horizontal"],
+                sheet["scale_vertical"], sheet["f_instrument_mm"],
+                sheet["transformation_coefficient"], sheet["n_left"], sheet["n_right"],
+                *sheet["base_mm"].values(), *fid["left"].values(), *fid["right"].values(),
+                sheet["L_mm"]["left"], sheet["L_mm"]["right"], sheet["frame"]["rotation_deg"],
+                sheet["reason"],
+            ]
+        )  # fmt: skip
+    atomic_write_text(out / "block.csv", buffer.getvalue())

@@ -1,0 +1,33 @@
+"""Instruments: the specification of SC-1, SPR-3 and SD-3 read from ``instruments/*.yaml``.
+
+Every value carries its status (documented by a source, or assumed with a basis); see
+``docs/instruments.md``.
+"""
+
+from __future__ import annotations
+
+from stereoplotter.instrument.spec import (
+    STATUSES,
+    InstrumentSpec,
+    Parameter,
+    RangeRefusal,
+    check_in_range,
+    format_instrument,
+    instrument_from_mapping,
+    instrument_to_dict,
+    list_instruments,
+    load_instrument,
+)
+
+__all__ = [
+    "STATUSES",
+    "InstrumentSpec",
+    "Parameter",
+    "RangeRefusal",
+    "check_in_range",
+    "format_instrument",
+    "instrument_from_mapping",
+    "instrument_to_dict",
+    "list_instruments",
+    "load_instrument",
+]

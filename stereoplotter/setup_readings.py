@@ -1,0 +1,280 @@
+"""The readings each of the five stages asks for, as zero reading (MO) + signed value.
+
+Eqs. (6.11)–(6.18) of the book (ch. 6, §26, OCR L3735–3823) read as in ``docs/setup-data.md``:
+* readings are MO + **signed** value; the book's MO − (y⁰₄) and MO − (x⁰₁) treat the negative-side
+  marks as magnitudes — the same number (``book_form`` is reported beside);
+* the right photo's targets use its own zero reading MO_п = MO + (b_x, b_y) and n_п (decision D6);
+* (6.16)–(6.18) reuse the names O_X1, O_Y3, O_Y4 for the sheet corners: they are kept apart here
+  under the names ``corner 1`` … ``corner 4``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from stereoplotter.setup_data import height_scale_reading
+
+if TYPE_CHECKING:  # pragma: no cover
+    from stereoplotter.setup_sheet import SetupSheet
+
+__all__ = ["stage_readings"]
+
+
+def _r(
+    stage: int,
+    step: str,
+    name: str,
+    zero: str,
+    value: float,
+    unit: str,
+    equation: str,
+    tolerance: float | None = None,
+    note: str = "",
+    **extra: Any,
+) -> dict[str, Any]:
+    value = 0.0 if abs(value) < 5e-7 else value  # no "−0.000"
+    relation = extra.pop("relation", "=")
+    if zero:
+        formula = f"{name} = {zero} {'+' if value >= 0 else '−'} {abs(value):.3f} {unit}"
+    else:
+        formula = f"{name} {relation} {value:.4g} {unit}" if relation != "=" else (
+            f"{name} = {value:.3f} {unit}")
+    row = {
+        "stage": stage,
+        "step": step,
+        "reading": name,
+        "zero_reading": zero,
+        "value": value,
+        "unit": unit,
+        "equation": equation,
+        "formula": formula,
+    }
+    if tolerance is not None:
+        row["tolerance"] = tolerance
+    if note:
+        row["note"] = note
+    row.update(extra)
+    return row
+
+
+def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
+    """All readings of stages 1–5 for a sheet, in the order the operator sets them.
+
+    Returns
+    -------
+    tuple of dict
+        ``stage``, ``step``, ``reading``, ``zero_reading`` (the MO it is added to, or "" for an
+        absolute value), ``value`` (signed), ``unit``, ``equation``, ``formula`` (text),
+        ``tolerance`` where the book gives one, ``note``.
+    """
+    tol = sheet.tolerances
+    bx, by, bz = sheet.base_mm
+    left, right = sheet.photos
+    n_l, n_r = sheet.n_left, sheet.n_right
+    rows = [
+        _r(
+            1,
+            "set the instrument principal distance",
+            "f_пр",
+            "",
+            sheet.f_instrument_mm,
+            "mm",
+            "item 1",
+        ),
+        _r(1, "base carriage", "O_bx", "MO_bx", bx, "mm", "item 1"),
+        _r(
+            1,
+            "base carriage (MO_by from the two cassette centres)",
+            "O_by",
+            "MO_by",
+            by,
+            "mm",
+            "item 1",
+        ),
+        _r(
+            1,
+            "lower the base carriage (foot wheel): absolute height counter",
+            "O_Z",
+            "",
+            n_l * sheet.f_instrument_mm,
+            "mm",
+            "(6.3)",
+            note="D = n_л·f_пр = D_max",
+        ),
+        _r(
+            1,
+            "check the span of marks 3–4, left photo",
+            "L_л",
+            "",
+            left.mark_span_mm,
+            "mm",
+            "(6.5)",
+            tolerance=tol["mark_span_mm"],
+            note="correct with ΔZ (6.9) and repeat until |L − L′| ≤ tolerance",
+        ),
+        _r(
+            1,
+            "check the span of marks 3–4, right photo",
+            "L_п",
+            "",
+            right.mark_span_mm,
+            "mm",
+            "(6.5)",
+            tolerance=tol["mark_span_mm"],
+            note="correct with Δb_z (6.10), O′_bz = O_bz + Δb_z (6.11, b_z scale sense +1)",
+        ),
+        _r(
+            1,
+            "record the zero readings",
+            "MO_bz",
+            "O_bz",
+            -bz,
+            "mm",
+            "decision D7",
+            note="MO_bz = (b_z reading) − b_z′; MO_Z = height-scale reading [m]",
+        ),
+    ]
+    for photo, n, zero_x, zero_y, x_mark in (
+        (left, n_l, "MO_X", "MO_Y", "2"),
+        (right, n_r, "MO_X,п", "MO_Y,п", "1"),
+    ):
+        side = "л" if photo.name == "left" else "п"
+        t = photo.transformed_book_mm
+        extra = (
+            {}
+            if photo.name == "left"
+            else {
+                "zero_reading_definition": f"MO_X,п = MO_X + b_x = MO_X + {bx:.3f}; "
+                f"MO_Y,п = MO_Y + b_y = MO_Y + {by:.3f}"
+            }
+        )
+        rows += [
+            _r(
+                2,
+                f"{photo.name} photo: k_ω on mark 3",
+                f"O_Y3,{side}",
+                zero_y,
+                n * t["y3"],
+                "mm",
+                "(6.12)",
+                **extra,
+            ),
+            _r(
+                2,
+                f"{photo.name} photo: check mark 4",
+                f"O_Y4,{side}",
+                zero_y,
+                n * t["y4"],
+                "mm",
+                "(6.12)",
+                tolerance=tol["mark_fit_mm"],
+                book_form=f"{zero_y} − {abs(n * t['y4']):.3f}",
+            ),
+            _r(
+                2,
+                f"{photo.name} photo: k_α on mark {x_mark}",
+                f"O_X{x_mark},{side}",
+                zero_x,
+                n * t[f"x{x_mark}"],
+                "mm",
+                "(6.13)",
+                **({"book_form": f"{zero_x} − {abs(n * t['x1']):.3f}"} if x_mark == "1" else {}),
+            ),
+        ]
+    for photo in (left, right):
+        side = "л" if photo.name == "left" else "п"
+        rows += [
+            _r(
+                2,
+                f"{photo.name} photo: decentration scale x",
+                f"d_x,{side}",
+                "MO_dx",
+                photo.decentration_mm[0],
+                "mm",
+                "f′·tan α (kinematics §2.4)",
+            ),
+            _r(
+                2,
+                f"{photo.name} photo: decentration scale y",
+                f"d_y,{side}",
+                "MO_dy",
+                photo.decentration_mm[1],
+                "mm",
+                "f′·tan ω (kinematics §2.4)",
+            ),
+        ]
+    rows += [
+        _r(
+            2,
+            "vertical base",
+            "O_bz",
+            "MO_bz",
+            bz,
+            "mm",
+            "(6.14)",
+            note="b_z′ = k·b_z; under D7 a re-set of the stage-1 value",
+        ),
+        _r(
+            2,
+            "κ_л, κ_п by the initial directions; residual y-parallax",
+            "residual q",
+            "",
+            tol["residual_y_parallax_mm"],
+            "mm",
+            "stage 2",
+            tolerance=tol["residual_y_parallax_mm"],
+            note="residual y-parallax ≤ ¼ of the mark diameter",
+            relation="≤",
+        ),
+    ]
+    for h in sheet.control_heights:
+        value = float(
+            height_scale_reading(
+                0.0,
+                h["model_height_mm"],
+                n_l,
+                sheet.f_instrument_mm,
+                sheet.vertical_scale_denominator,
+            )
+        )
+        rows.append(
+            _r(
+                3,
+                f"height control point {h['id']}: fuse the mark with b_x",
+                f"O_Z{h['id']}",
+                "MO_Z",
+                value,
+                "m",
+                "(6.15)",
+                tolerance=tol["control_height_m"],
+                note=f"Z_{h['id']} = {h['model_height_mm']:.3f} mm (6.6)",
+            )
+        )
+    for corner in sheet.corners:
+        stage = 5 if corner["corner"] == "4" else 4
+        equation = {"1": "(6.16)", "3": "(6.17)", "4": "(6.18)"}.get(corner["corner"], "(6.7)")
+        tolerance = tol["corner_mm"] if corner["corner"] == "4" else None
+        c = corner["corner"]
+        rows += [
+            _r(
+                stage,
+                f"sheet corner {c} ({corner['position']})",
+                f"corner {c}: O_X",
+                "MO_X",
+                corner["x_mm"],
+                "mm",
+                equation,
+                tolerance=tolerance,
+            ),
+            _r(
+                stage,
+                f"sheet corner {c} ({corner['position']})",
+                f"corner {c}: O_Y",
+                "MO_Y",
+                corner["y_mm"],
+                "mm",
+                equation,
+                tolerance=tolerance,
+            ),
+        ]
+    return tuple(rows)

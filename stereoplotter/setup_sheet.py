@@ -1,0 +1,585 @@
+"""The setup sheet (Table 24 of the book): everything an operator needs to build an oriented,
+scaled model on the instrument without plotting control first.
+
+Orchestration only: the equations live in :mod:`stereoplotter.setup_data` and
+:mod:`stereoplotter.geometry`; the decisions behind them in ``docs/setup-data.md``. The sheet is
+computed from the scenario *as measured*: f′ from the measured fiducial spans, the measured mark
+coordinates, and the exterior orientation as given (aerotriangulation) or by resection from the
+measured control — with the scenario's seed, so a sheet is reproducible.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.constants import MM_PER_M
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.geometry.resection import space_resection
+from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix, rotation_z
+from stereoplotter.geometry.similarity import SimilarityFit, fit_similarity_with_reflection
+from stereoplotter.geometry.transformed import (
+    transformed_coordinates,
+    transformed_x_single_tilt,
+    transformed_y_single_tilt,
+)
+from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
+from stereoplotter.scenario.model import Scenario
+from stereoplotter.scenario.synthetic import (
+    Measurements,
+    synthesize_measurements,
+    working_area_grid_m,
+)
+from stereoplotter.setup_data import (
+    base_components,
+    correction_inclination,
+    counter_scale_left,
+    counter_scale_right,
+    decentration,
+    instrument_principal_distance,
+    mark_span,
+    model_height,
+    sheet_corner_instrument_coordinates,
+    sheet_corner_instrument_coordinates_book_form,
+)
+
+__all__ = [
+    "CORNER_ORDER",
+    "ScaleCandidate",
+    "SetupOptions",
+    "SetupRefusal",
+    "SetupSheet",
+    "compute_setup_sheet",
+]
+
+#: Sheet-corner numbering (decision, docs/setup-data.md): 1 = lower left, then counter-clockwise
+#: in map view, north up. The scenario stores corners NW, NE, SE, SW; this maps 1..4 to them.
+CORNER_ORDER = {"1": 3, "2": 2, "3": 1, "4": 0}
+CORNER_NAMES = {"1": "SW", "2": "SE", "3": "NE", "4": "NW"}
+
+
+class SetupRefusal(StereoplotterError):
+    """The instrument cannot take the scenario (no feasible scale pair, a setting beyond a stop)."""
+
+
+@dataclass(frozen=True, slots=True)
+class SetupOptions:
+    """Choices behind the sheet; the defaults are the decisions of ``docs/setup-data.md``.
+
+    Attributes
+    ----------
+    book_sign_n_right : bool
+        Use the printed sign of (6.4) (n_п < n_л for a higher right station).
+    horizontal_scale_denominator, vertical_scale_denominator : int or None
+        Force M_г and/or M_в instead of choosing them (still range-checked).
+    book_corner_form : bool
+        Also report the corners by the printed (6.7) (n·1000/M_photo); the values coincide.
+    """
+
+    book_sign_n_right: bool = False
+    horizontal_scale_denominator: int | None = None
+    vertical_scale_denominator: int | None = None
+    book_corner_form: bool = True
+
+
+@dataclass(frozen=True, slots=True)
+class ScaleCandidate:
+    """One (M_г, M_в) pair considered by the scale choice, with why it was refused ("" = ok)."""
+
+    horizontal: int
+    vertical: int
+    ratio: float
+    f_instrument_mm: float
+    reasons: tuple[str, ...]
+
+    @property
+    def feasible(self) -> bool:
+        return not self.reasons
+
+
+@dataclass(frozen=True, slots=True)
+class PhotoSetup:
+    """Per-photo settings of the sheet (angles in the instrument frame)."""
+
+    name: str
+    alpha: float
+    omega: float
+    kappa: float
+    marks_measured_mm: dict[str, tuple[float, float]]
+    transformed_book_mm: dict[str, float]
+    transformed_rigorous_mm: dict[str, tuple[float, float]]
+    mark_span_mm: float
+    decentration_mm: tuple[float, float]
+    correction_inclination: tuple[float, float]
+    n: float
+
+
+@dataclass(frozen=True, slots=True)
+class SetupSheet:
+    """The computed setup sheet (Table 24 plus the readings of the five stages)."""
+
+    scenario: str
+    instrument: str
+    instrument_title: str
+    frame_rotation: float
+    frame_origin_m: tuple[float, float, float]
+    focal_length_corrected_mm: float
+    focal_length_corrected_per_photo_mm: tuple[float, ...]
+    map_scale_denominator: int | None
+    horizontal_scale_denominator: int
+    vertical_scale_denominator: int
+    f_instrument_mm: float
+    transformation_coefficient: float
+    n_left: float
+    n_right: float
+    base_mm: tuple[float, float, float]
+    photos: tuple[PhotoSetup, ...]
+    control_heights: tuple[dict[str, Any], ...]
+    similarity: SimilarityFit | None
+    similarity_point_ids: tuple[str, ...]
+    corners: tuple[dict[str, Any], ...]
+    readings: tuple[dict[str, Any], ...]
+    tolerances: dict[str, float]
+    candidates: tuple[ScaleCandidate, ...]
+    assumed: dict[str, tuple[str, ...]]
+    options: SetupOptions = field(default_factory=SetupOptions)
+    depth_range_used_mm: tuple[float, float] = (math.nan, math.nan)
+    exterior_sources: tuple[str, ...] = ()
+    points_model_mm: tuple[dict[str, Any], ...] = ()
+
+
+# --- helpers --------------------------------------------------------------------------------
+
+
+def _exterior(scenario: Scenario, measurements: Measurements) -> list[tuple[NDArray, NDArray]]:
+    """(centre, rotation) of each photo as the setup computation knows it."""
+    out = []
+    pts = np.array([p.local_m for p in scenario.points])
+    for photo in scenario.photos:
+        ext = photo.exterior
+        if ext.source == "resection":
+            pm = measurements.photo(photo.name)
+            use = np.array(
+                [
+                    pm.points_imaged[i] and p.role == "control" and p.kind == "full"
+                    for i, p in enumerate(scenario.points)
+                ]
+            )
+            r = space_resection(
+                pm.points_mm[use],
+                pts[use],
+                measurements.focal_length_corrected_mm,
+                scenario.camera.principal_point_mm,
+            )
+            out.append((r.projection_centre_m, r.rotation))
+        else:
+            out.append((ext.centre, ext.rotation))
+    return out
+
+
+def _to_instrument_frame(points_m: NDArray, origin_m: NDArray, theta: float) -> NDArray:
+    """Rotate about Z by −θ (base along +X) after moving the origin to S_л."""
+    return (np.asarray(points_m, float) - origin_m) @ rotation_z(-theta).T
+
+
+def _sheet_corners_gk(scenario: Scenario) -> NDArray:
+    sheet = scenario.map_sheet
+    return np.array([sheet.corners_sk42_m[CORNER_ORDER[k]] for k in ("1", "2", "3", "4")])
+
+
+def _range_reason(
+    spec: InstrumentSpec, attribute: str, values: NDArray, what: str, unit: str = "mm"
+) -> str:
+    lo, hi = getattr(spec, attribute)
+    v = np.asarray(values, float)
+    if v.size == 0:
+        return ""
+    vmin, vmax = float(v.min()), float(v.max())
+    if vmin < lo or vmax > hi:
+        status = "assumed" if spec.is_assumed(spec.key_of(attribute)) else "documented"
+        return (
+            f"{what} {vmin:.3f} … {vmax:.3f} {unit} outside the {status} range "
+            f"[{lo:g}, {hi:g}] {unit}"
+        )
+    return ""
+
+
+def _candidate(
+    spec: InstrumentSpec,
+    f_prime: float,
+    mg: int,
+    mv: int,
+    ratio: float,
+    depths_m: NDArray,
+    base_m: NDArray,
+    offsets_m: NDArray,
+) -> ScaleCandidate:
+    f_pr = float(instrument_principal_distance(f_prime, mg, mv))
+    reasons = []
+    lo, hi = spec.f_instrument_range_mm
+    if not lo <= f_pr <= hi:
+        reasons.append(f"f_пр = {f_pr:.2f} mm outside [{lo:g}, {hi:g}] mm")
+    depth_left = depths_m * MM_PER_M / mv
+    bz = base_m[2] * MM_PER_M / mv
+    reasons.append(
+        _range_reason(
+            spec,
+            "projection_distance_range_mm",
+            np.concatenate([depth_left, depth_left + bz]),
+            "projection distance D of the working area",
+        )
+    )
+    b = base_components(np.zeros(3), base_m, mg, mv)
+    for attribute, value, name in (
+        ("base_x_range_mm", b[0], "b_x"),
+        ("base_y_range_mm", b[1], "b_y"),
+        ("base_z_range_mm", b[2], "b_z′"),
+    ):
+        reasons.append(_range_reason(spec, attribute, np.array([value]), name))
+    model = offsets_m * MM_PER_M / mg
+    reasons.append(
+        _range_reason(
+            spec, "model_x_offset_range_mm", model[:, 0], "X offsets of the model and sheet corners"
+        )
+    )
+    reasons.append(
+        _range_reason(
+            spec, "model_y_offset_range_mm", model[:, 1], "Y offsets of the model and sheet corners"
+        )
+    )
+    return ScaleCandidate(mg, mv, ratio, f_pr, tuple(r for r in reasons if r))
+
+
+def _choose_scales(
+    spec: InstrumentSpec,
+    options: SetupOptions,
+    map_scale: int | None,
+    f_prime: float,
+    depths_m: NDArray,
+    base_m: NDArray,
+    offsets_m: NDArray,
+) -> tuple[ScaleCandidate, tuple[ScaleCandidate, ...]]:
+    if options.horizontal_scale_denominator is not None:
+        horizontals = [
+            (
+                options.horizontal_scale_denominator,
+                options.horizontal_scale_denominator / map_scale if map_scale else math.nan,
+            )
+        ]
+    elif map_scale is None:
+        raise SetupRefusal(
+            "the scenario has no map sheet, so the horizontal model scale cannot be chosen from "
+            "the coordinatograph gears: add map_sheet to the scenario or force M_г "
+            "(--horizontal-scale)"
+        )
+    else:
+        horizontals = [(round(r * map_scale), r) for r in spec.coordinatograph_ratios]
+    verticals = (
+        [options.vertical_scale_denominator]
+        if options.vertical_scale_denominator is not None
+        else list(spec.vertical_scale_denominators)
+    )
+    candidates = [
+        _candidate(spec, f_prime, mg, mv, r, depths_m, base_m, offsets_m)
+        for mg, r in horizontals
+        for mv in verticals
+    ]
+    feasible = sorted(
+        (c for c in candidates if c.feasible), key=lambda c: (c.horizontal, c.vertical)
+    )
+    if not feasible:
+
+        def badness(c: ScaleCandidate) -> tuple[int, int]:
+            return (len(c.reasons), c.horizontal)
+
+        best = min(candidates, key=badness)
+        raise SetupRefusal(
+            f"instrument {spec.key} cannot take this stereopair: none of the "
+            f"{len(candidates)} scale pairs (M_г = r·M_map for the coordinatograph ratios r, "
+            "M_в from the height-counter gears) fits every range. Closest: "
+            f"M_г = 1:{best.horizontal}, M_в = 1:{best.vertical}: "
+            + "; ".join(best.reasons)
+            + ". Way out: another instrument, another map scale, or widen the assumed ranges "
+            f"in {spec.source}."
+        )
+    return feasible[0], tuple(candidates)
+
+
+def _check_tilt(spec: InstrumentSpec, value: float, what: str) -> None:
+    """Refuse a tilt the correction mechanisms cannot take (|α|, |ω| ≤ tilt_max)."""
+    if abs(value) > spec.tilt_max:
+        key = spec.key_of("tilt_max")
+        status = "assumed" if spec.is_assumed(key) else "documented"
+        raise SetupRefusal(
+            f"{what} = {math.degrees(value):.4f}° is beyond the {status} correction range "
+            f"±{math.degrees(spec.tilt_max):g}° of {spec.source}: {key} (the correction mechanism "
+            "stops there); such a photo needs another instrument or rectification first"
+        )
+
+
+def _assumed(spec: InstrumentSpec, *attributes: str) -> tuple[str, ...]:
+    keys = [spec.key_of(a) for a in attributes]
+    return tuple(k for k in keys if spec.is_assumed(k))
+
+
+# --- the computation ----------------------------------------------------------------------------
+
+
+def compute_setup_sheet(
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    options: SetupOptions | None = None,
+    rng: np.random.Generator | None = None,
+) -> SetupSheet:
+    """Compute the setup sheet of a stereopair for an instrument.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A stereopair (photos "left" and "right").
+    spec : InstrumentSpec
+    options : SetupOptions, optional
+    rng : numpy.random.Generator, optional
+        Noise of the synthetic measurements the sheet is computed from; by default
+        ``numpy.random.default_rng(scenario.seed)``.
+
+    Returns
+    -------
+    SetupSheet
+
+    Raises
+    ------
+    SetupRefusal
+        Not a stereopair, no feasible scale pair, or a setting outside an instrument range
+        (the message names the value, the range and the way out).
+    """
+    options = options or SetupOptions()
+    if not scenario.is_stereopair:
+        raise SetupRefusal(
+            f"scenario {scenario.name!r} is not a stereopair (photos left and right)"
+        )
+    rng = np.random.default_rng(scenario.seed) if rng is None else rng
+    measurements = synthesize_measurements(scenario, rng)
+    f_prime = measurements.focal_length_corrected_mm
+    (c_left, m_left), (c_right, m_right) = _exterior(scenario, measurements)
+
+    # Frame: base along +X, origin at S_л (docs/setup-data.md, Inputs, "Frame").
+    base_vector = c_right - c_left
+    theta = float(math.atan2(base_vector[1], base_vector[0]))
+    turn = rotation_z(-theta)
+    rotations = [turn @ m_left, turn @ m_right]
+    base_m = turn @ base_vector
+    points_local = np.array([p.local_m for p in scenario.points])
+    points_m = _to_instrument_frame(points_local, c_left, theta)
+    grid_m = _to_instrument_frame(working_area_grid_m(scenario, (15, 15)), c_left, theta)
+    ground = np.vstack([grid_m, points_m])
+    depths_m = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
+
+    corners_gk = _sheet_corners_gk(scenario) if scenario.map_sheet is not None else None
+    plan = [
+        i
+        for i, p in enumerate(scenario.points)
+        if p.role == "control" and p.kind in ("full", "plan") and p.sk42_m is not None
+    ]
+    fit = None
+    corners_m = np.zeros((0, 2))
+    if corners_gk is not None and len(plan) >= 2:
+        north = np.array([scenario.points[i].sk42_m[0] for i in plan])
+        east = np.array([scenario.points[i].sk42_m[1] for i in plan])
+        fit = fit_similarity_with_reflection(north, east, points_m[plan, 0], points_m[plan, 1])
+        corners_m = sheet_corner_instrument_coordinates(
+            fit, corners_gk[:, 0], corners_gk[:, 1], MM_PER_M
+        )  # metres (scale 1:1000 → m)
+    offsets_m = np.vstack([ground[:, :2], corners_m])
+    map_scale = scenario.map_sheet.scale_denominator if scenario.map_sheet else None
+    chosen, candidates = _choose_scales(
+        spec, options, map_scale, f_prime, depths_m, base_m, offsets_m
+    )
+    mg, mv, f_pr = chosen.horizontal, chosen.vertical, chosen.f_instrument_mm
+    k = f_pr / f_prime
+
+    # (6.3), (6.4)
+    n_left = float(counter_scale_left(spec.projection_distance_max_mm, f_pr))
+    n_right = float(
+        counter_scale_right(n_left, 0.0, base_m[2], f_pr, mv, book_sign=options.book_sign_n_right)
+    )
+    b = base_components(np.zeros(3), base_m, mg, mv)
+
+    photos = []
+    for name, rot, n in (("left", rotations[0], n_left), ("right", rotations[1], n_right)):
+        alpha, omega, kappa = (float(v) for v in angles_from_matrix(rot))
+        check_in_range(spec, "kappa_range", kappa, f"κ_{name} (cassette rotation)")
+        for value, what in ((alpha, f"α_{name}"), (omega, f"ω_{name}")):
+            _check_tilt(spec, value, what)
+        marks = measurements.photo(name).fiducials_mm - scenario.camera.principal_point_mm
+        marks_d = {str(i + 1): (float(m[0]), float(m[1])) for i, m in enumerate(marks)}
+        x_mark = "2" if name == "left" else "1"
+        book = {  # (6.1)/(6.2) without n
+            f"x{x_mark}": float(transformed_x_single_tilt(marks_d[x_mark][0], alpha, f_prime)),
+            "y3": float(transformed_y_single_tilt(marks_d["3"][1], omega, f_prime)),
+            "y4": float(transformed_y_single_tilt(marks_d["4"][1], omega, f_prime)),
+        }
+        untwisted = rotation_matrix(alpha, omega, 0.0)  # the cassette κ is 0 in stage 2
+        rigorous = {
+            key: tuple(float(v) for v in transformed_coordinates(marks_d[key], untwisted, f_prime))
+            for key in (x_mark, "3", "4")
+        }
+        d = (float(decentration(f_prime, alpha)), float(decentration(f_prime, omega)))
+        for value, what in zip(
+            d, (f"decentration d_x,{name}", f"decentration d_y,{name}"), strict=True
+        ):
+            check_in_range(spec, "decentration_range_mm", value, what)
+        photos.append(
+            PhotoSetup(
+                name,
+                alpha,
+                omega,
+                kappa,
+                marks_d,
+                book,
+                rigorous,
+                float(mark_span(n, book["y3"], book["y4"])),
+                d,
+                (float(correction_inclination(k, alpha)), float(correction_inclination(k, omega))),
+                n,
+            )
+        )
+    for value, attribute, what in (
+        (b[0], "base_x_range_mm", "b_x"),
+        (b[1], "base_y_range_mm", "b_y"),
+        (b[2], "base_z_range_mm", "b_z′"),
+    ):
+        check_in_range(spec, attribute, float(value), what)
+
+    # (6.6) model heights over height control
+    heights = []
+    for i, p in enumerate(scenario.points):
+        if p.role == "control" and p.kind in ("full", "height"):
+            flying = -float(points_m[i, 2])
+            heights.append(
+                {
+                    "id": p.id,
+                    "Z_m": p.local_m[2],
+                    "flying_height_m": flying,
+                    "model_height_mm": float(model_height(flying, mv)),
+                }
+            )
+
+    # (6.7) corners
+    corners = []
+    if fit is not None:
+        xy = sheet_corner_instrument_coordinates(fit, corners_gk[:, 0], corners_gk[:, 1], mg)
+        photo_scale = n_left * mg
+        xy_book = sheet_corner_instrument_coordinates_book_form(
+            fit, corners_gk[:, 0], corners_gk[:, 1], n_left, photo_scale
+        )
+        for j, key in enumerate(("1", "2", "3", "4")):
+            corners.append(
+                {
+                    "corner": key,
+                    "position": CORNER_NAMES[key],
+                    "gk_north_m": float(corners_gk[j, 0]),
+                    "gk_east_m": float(corners_gk[j, 1]),
+                    "x_mm": float(xy[j, 0]),
+                    "y_mm": float(xy[j, 1]),
+                    "x_book_form_mm": float(xy_book[j, 0]),
+                    "y_book_form_mm": float(xy_book[j, 1]),
+                }
+            )
+
+    tolerances = {
+        "mark_span_mm": spec.tolerance_L_numerator_mm / n_left,
+        "mark_fit_mm": spec.tolerance_mark_fit_per_n_mm * n_left,
+        "residual_y_parallax_mm": spec.residual_q_fraction_of_mark * spec.mark_diameter_mm,
+        "control_height_m": spec.control_height_fraction_of_H * float(np.mean(depths_m)),
+        "corner_mm": spec.corner_tolerance_mm,
+    }
+    sheet = SetupSheet(
+        scenario=scenario.name,
+        instrument=spec.key,
+        instrument_title=spec.title,
+        frame_rotation=theta,
+        frame_origin_m=tuple(float(v) for v in c_left),
+        focal_length_corrected_mm=f_prime,
+        focal_length_corrected_per_photo_mm=measurements.focal_length_corrected_per_photo_mm,
+        map_scale_denominator=map_scale,
+        horizontal_scale_denominator=mg,
+        vertical_scale_denominator=mv,
+        f_instrument_mm=f_pr,
+        transformation_coefficient=k,
+        n_left=n_left,
+        n_right=n_right,
+        base_mm=tuple(float(v) for v in b),
+        photos=tuple(photos),
+        control_heights=tuple(heights),
+        similarity=fit,
+        similarity_point_ids=tuple(scenario.points[i].id for i in plan),
+        corners=tuple(corners),
+        readings=(),
+        tolerances=tolerances,
+        candidates=candidates,
+        assumed=_assumed_map(spec),
+        options=options,
+        depth_range_used_mm=(
+            float(depths_m.min() * MM_PER_M / mv),
+            float(depths_m.max() * MM_PER_M / mv),
+        ),
+        exterior_sources=tuple(p.exterior.source for p in scenario.photos),
+        points_model_mm=tuple(
+            {
+                "id": p.id,
+                "role": p.role,
+                "kind": p.kind,
+                "x_mm": float(points_m[i, 0] * MM_PER_M / mg),
+                "y_mm": float(points_m[i, 1] * MM_PER_M / mg),
+            }
+            for i, p in enumerate(scenario.points)
+        ),
+    )
+    from stereoplotter.setup_readings import stage_readings
+
+    return _replace_readings(sheet, stage_readings(sheet))
+
+
+def _replace_readings(sheet: SetupSheet, readings: tuple[dict[str, Any], ...]) -> SetupSheet:
+    from dataclasses import replace
+
+    return replace(sheet, readings=readings)
+
+
+def _assumed_map(spec: InstrumentSpec) -> dict[str, tuple[str, ...]]:
+    """For each sheet quantity, the assumed instrument parameters it rests on."""
+    scales = _assumed(
+        spec,
+        "coordinatograph_ratios",
+        "vertical_scale_denominators",
+        "f_instrument_range_mm",
+        "projection_distance_range_mm",
+        "model_x_offset_range_mm",
+        "model_y_offset_range_mm",
+    )
+    d_max = _assumed(spec, "projection_distance_max_mm")
+    return {
+        "scale_horizontal": scales,
+        "scale_vertical": scales,
+        "f_instrument_mm": scales,
+        "n_left": tuple(sorted(set(scales) | set(d_max))),
+        "n_right": tuple(sorted(set(scales) | set(d_max))),
+        "base_mm": scales,
+        "L_mm": tuple(sorted(set(scales) | set(d_max))),
+        "control_heights_model_mm": scales,
+        "sheet_corners_mm": scales,
+        "tolerances": _assumed(
+            spec,
+            "mark_diameter_mm",
+            "tolerance_L_numerator_mm",
+            "tolerance_mark_fit_per_n_mm",
+            "residual_q_fraction_of_mark",
+            "control_height_fraction_of_H",
+            "corner_tolerance_mm",
+        ),
+    }
