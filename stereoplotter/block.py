@@ -750,7 +750,7 @@ def compute_block(
     mv = np.where(ok, mv_c[chosen], np.nan)
     f_pr = instrument_principal_distance(f, mg, mv)
     k = transformation_coefficient(f_pr, f)
-    n_left = counter_scale_left(d_hi, f_pr)  # (6.3)
+    n_left = counter_scale_left(spec.projection_distance_max_mm, f_pr)  # (6.3)
     n_right = counter_scale_right(n_left, 0.0, base_m[:, 2], f_pr, mv, book_sign=book_sign)  # (6.4)
     b = base_components(np.zeros(3), base_m, mg, mv)
     mask2 = np.where(ok, 1.0, np.nan)[:, None]
@@ -955,7 +955,7 @@ def _one_pair(
     nan = math.nan
     mg, mv = (chosen[1], chosen[2]) if ok else (nan, nan)
     f_pr = float(instrument_principal_distance(f, mg, mv))
-    n_left = float(counter_scale_left(spec.projection_distance_range_mm[1], f_pr))  # (6.3)
+    n_left = float(counter_scale_left(spec.projection_distance_max_mm, f_pr))  # (6.3)
     n_right = float(
         counter_scale_right(n_left, c_left[2], c_right[2], f_pr, mv, book_sign=book_sign)
     )  # (6.4)

@@ -37,8 +37,11 @@ def _r(
     if zero:
         formula = f"{name} = {zero} {'+' if value >= 0 else '−'} {abs(value):.3f} {unit}"
     else:
-        formula = f"{name} {relation} {value:.4g} {unit}" if relation != "=" else (
-            f"{name} = {value:.3f} {unit}")
+        formula = (
+            f"{name} {relation} {value:.4g} {unit}"
+            if relation != "="
+            else (f"{name} = {value:.3f} {unit}")
+        )
     row = {
         "stage": stage,
         "step": step,

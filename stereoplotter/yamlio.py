@@ -160,8 +160,9 @@ class Fields:
         try:
             value = float(value)
         except OverflowError:  # an integer beyond the float range
-            raise self.error(path, f"a number {expected}", "an integer too large for a float",
-                             basis) from None
+            raise self.error(
+                path, f"a number {expected}", "an integer too large for a float", basis
+            ) from None
         too_low = value < low or (low_open and value == low)
         too_high = value > high or (high_open and value == high)
         if not math.isfinite(value) or too_low or too_high:

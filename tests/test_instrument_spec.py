@@ -453,7 +453,8 @@ BAD = [
     ),
     (
         lambda d: d["mark"]["diameter_mm"].__setitem__("value", 10**400),
-        r"mark\.diameter_mm\.value: expected a number \[mm\], found an integer too large",
+        r"mark\.diameter_mm\.value: expected a number in \(0, 5\] mm, found an integer too large "
+        r"for a float",
     ),
 ]
 

@@ -182,8 +182,9 @@ def test_6_7_model_scale_form_equals_book_form_with_photo_scale():
     corners_n, corners_e = north[:4], east[:4]
     n_l, mg = 1.6914, 12500
     model = sheet_corner_instrument_coordinates(fit, corners_n, corners_e, mg, (-720.0, 0.0))
-    book = sheet_corner_instrument_coordinates_book_form(fit, corners_n, corners_e, n_l,
-                                                         n_l * mg, (-720.0, 0.0))
+    book = sheet_corner_instrument_coordinates_book_form(
+        fit, corners_n, corners_e, n_l, n_l * mg, (-720.0, 0.0)
+    )
     assert_allclose(model, book, atol=1e-12)
     # and the model coordinate is the ground offset from S_л at 1:M_г
     assert_allclose(model[:, 0], (X[:4] + 720.0) * 1000 / mg, atol=1e-6)

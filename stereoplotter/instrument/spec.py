@@ -750,11 +750,8 @@ def _value(fields: Fields, node: Mapping[str, Any], leaf: _Leaf) -> Any:
 
 
 def _number(fields: Fields, value: Any, path: str, limits: Mapping[str, Any]) -> float:
-    """:meth:`Fields.check_number`, also for integers too large for a float."""
-    try:
-        return fields.check_number(value, path, **limits)
-    except OverflowError:
-        raise fields.error(path, f"a number [{limits['unit']}]", "an integer too large") from None
+    """:meth:`Fields.check_number` with the limits of a parameter."""
+    return fields.check_number(value, path, **limits)
 
 
 def _cross_check(
