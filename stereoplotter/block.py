@@ -51,6 +51,7 @@ import numpy as np
 import yaml
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.errors import StereoplotterError
 from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix, rotation_z
 from stereoplotter.geometry.transformed import (
     transformed_coordinates,
@@ -58,6 +59,12 @@ from stereoplotter.geometry.transformed import (
     transformed_y_single_tilt,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
+from stereoplotter.scale_choice import (
+    candidate_flags,
+    candidate_scales,
+    choose_candidates,
+    describe_candidate,
+)
 from stereoplotter.scenario.loader import MAX_TILT_DEG, _camera
 from stereoplotter.scenario.model import Camera
 from stereoplotter.setup_data import (
@@ -529,17 +536,11 @@ _ARRAY_FIELDS = tuple(
 def _candidate_grid(
     spec: InstrumentSpec, map_scale: int | None, horizontal: int | None, vertical: int | None
 ) -> NDArray[np.float64]:
-    """(M_г, M_в) candidates in the order of ``setup_sheet._choose_scales``: shape (C, 2)."""
-    if horizontal is not None:
-        hs = [int(horizontal)]
-    elif map_scale is None:
-        raise ValueError(
-            "map_scale is needed to choose M_г (or force horizontal_scale_denominator)"
-        )
-    else:
-        hs = [round(r * map_scale) for r in spec.coordinatograph_ratios]
-    vs = [int(vertical)] if vertical is not None else list(spec.vertical_scale_denominators)
-    return np.array([(mg, mv) for mg in hs for mv in vs], dtype=float)
+    """(M_г, M_в) candidates of :func:`stereoplotter.scale_choice.candidate_scales`: (C, 2)."""
+    try:
+        return candidate_scales(spec, map_scale, horizontal, vertical)
+    except StereoplotterError as exc:
+        raise ValueError(str(exc)) from None
 
 
 def _inside_with_slack(v: NDArray, lo: float, hi: float) -> NDArray[np.bool_]:
@@ -701,37 +702,9 @@ def compute_block(
         spec, map_scale_denominator, horizontal_scale_denominator, vertical_scale_denominator
     )
     mg_c, mv_c = grid[:, 0], grid[:, 1]
-    lo, hi = spec.f_instrument_range_mm
-    f_c = instrument_principal_distance(f, mg_c, mv_c)  # (C,)
-    bad = {Refusal.F_INSTRUMENT: np.broadcast_to(~((lo <= f_c) & (f_c <= hi)), (n, len(grid)))}
-    b_c = base_components(np.zeros(3), base_m[:, None, :], mg_c, mv_c)  # (N, C, 3)
-    near = projection_distance(depth_m[:, 0:1], mv_c)  # (N, C)
-    far = projection_distance(depth_m[:, 1:2], mv_c)
-    d_lo, d_hi = spec.projection_distance_range_mm
-    with np.errstate(invalid="ignore"):
-        vmin = np.minimum(near, near + b_c[..., 2])
-        vmax = np.maximum(far, far + b_c[..., 2])
-        bad[Refusal.PROJECTION_DISTANCE] = ~((vmin >= d_lo) & (vmax <= d_hi))
-        for flag, j, attribute in (
-            (Refusal.BASE_X, 0, "base_x_range_mm"),
-            (Refusal.BASE_Y, 1, "base_y_range_mm"),
-            (Refusal.BASE_Z, 2, "base_z_range_mm"),
-        ):
-            b_lo, b_hi = getattr(spec, attribute)
-            bad[flag] = ~((b_c[..., j] >= b_lo) & (b_c[..., j] <= b_hi))
-    flags_c = np.zeros((n, len(grid)), dtype=np.int64)
-    count_c = np.zeros((n, len(grid)), dtype=np.int64)
-    for flag, mask in bad.items():
-        flags_c |= np.where(mask, int(flag), 0)
-        count_c += mask
+    flags_c = candidate_flags(spec, f, grid, depth_m, base_m)  # (N, C)
     feasible = flags_c == 0
-    order = np.lexsort((mv_c, mg_c))  # largest model scale first, then the smallest M_в
-    any_ok = feasible.any(axis=1)
-    first = order[np.argmax(feasible[:, order], axis=1)]
-    rank = np.empty(len(grid), dtype=np.int64)
-    rank[np.lexsort((np.arange(len(grid)), mg_c))] = np.arange(len(grid))
-    closest = np.argmin(count_c * len(grid) + rank, axis=1)  # fewest failures, then smallest M_г
-    chosen = np.where(any_ok, first, closest)
+    chosen, any_ok = choose_candidates(flags_c, grid)
     reason = np.where(any_ok, 0, flags_c[np.arange(n), chosen])
 
     # Settings that do not depend on the scale: κ, tilts, decentrations (the stops).
@@ -1012,30 +985,19 @@ def _reason_text(result: BlockResult, i: int) -> str:
         return "invalid input: a non-finite value, or terrain lowest > highest"
     parts = []
     if code & sum(_SCALE_FLAGS):
-        mg, mv = result.candidate_scales[result.candidate_index[i]]
-        f = result.focal_length_corrected_mm
-        b = base_components(np.zeros(3), result.base_ground_m[i], mg, mv)
-        d = projection_distance(result.depth_ground_m[i], mv)
-        checks = {
-            Refusal.F_INSTRUMENT: [
-                ("f_instrument_range_mm", instrument_principal_distance(f, mg, mv), "f_пр")
-            ],
-            Refusal.PROJECTION_DISTANCE: [
-                ("projection_distance_range_mm", v, "projection distance D")
-                for v in (d[0], d[1], d[0] + b[2], d[1] + b[2])
-            ],
-            Refusal.BASE_X: [("base_x_range_mm", b[0], "b_x")],
-            Refusal.BASE_Y: [("base_y_range_mm", b[1], "b_y")],
-            Refusal.BASE_Z: [("base_z_range_mm", b[2], "b_z′")],
-        }
-        texts = []
-        for flag in _SCALE_FLAGS:
-            if flag in code:
-                texts.append(_first_refusal(spec, checks[flag], flag.name or ""))
+        candidate = result.candidate_scales[result.candidate_index[i]]
+        texts = describe_candidate(
+            spec,
+            result.focal_length_corrected_mm,
+            candidate,
+            int(code & sum(_SCALE_FLAGS)),
+            result.depth_ground_m[i],
+            result.base_ground_m[i],
+        )
         parts.append(
             f"none of the {len(result.candidate_scales)} scale pairs fits (way out: another "
-            f"instrument or map scale); closest M_г = 1:{mg:.0f}, M_в = 1:{mv:.0f}: "
-            + "; ".join(texts)
+            f"instrument or map scale); closest M_г = 1:{candidate[0]:.0f}, "
+            f"M_в = 1:{candidate[1]:.0f}: " + "; ".join(texts)
         )
     names = ("left", "right")
     for flag, attribute, getter in (

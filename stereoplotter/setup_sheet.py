@@ -28,6 +28,13 @@ from stereoplotter.geometry.transformed import (
     transformed_y_single_tilt,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
+from stereoplotter.scale_choice import (
+    ScaleCheck,
+    candidate_flags,
+    candidate_scales,
+    choose_candidates,
+    describe_candidate,
+)
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import (
     Measurements,
@@ -88,7 +95,8 @@ class SetupOptions:
 
 @dataclass(frozen=True, slots=True)
 class ScaleCandidate:
-    """One (M_г, M_в) pair considered by the scale choice, with why it was refused ("" = ok)."""
+    """One (M_г, M_в) pair considered by the scale choice, with the conditions it fails
+    (:class:`~stereoplotter.scale_choice.ScaleCheck` names; empty = feasible)."""
 
     horizontal: int
     vertical: int
@@ -191,69 +199,6 @@ def _sheet_corners_gk(scenario: Scenario) -> NDArray:
     return np.array([sheet.corners_sk42_m[CORNER_ORDER[k]] for k in ("1", "2", "3", "4")])
 
 
-def _range_reason(
-    spec: InstrumentSpec, attribute: str, values: NDArray, what: str, unit: str = "mm"
-) -> str:
-    lo, hi = getattr(spec, attribute)
-    v = np.asarray(values, float)
-    if v.size == 0:
-        return ""
-    vmin, vmax = float(v.min()), float(v.max())
-    if vmin < lo or vmax > hi:
-        status = "assumed" if spec.is_assumed(spec.key_of(attribute)) else "documented"
-        return (
-            f"{what} {vmin:.3f} … {vmax:.3f} {unit} outside the {status} range "
-            f"[{lo:g}, {hi:g}] {unit}"
-        )
-    return ""
-
-
-def _candidate(
-    spec: InstrumentSpec,
-    f_prime: float,
-    mg: int,
-    mv: int,
-    ratio: float,
-    depths_m: NDArray,
-    base_m: NDArray,
-    offsets_m: NDArray,
-) -> ScaleCandidate:
-    f_pr = float(instrument_principal_distance(f_prime, mg, mv))
-    reasons = []
-    lo, hi = spec.f_instrument_range_mm
-    if not lo <= f_pr <= hi:
-        reasons.append(f"f_пр = {f_pr:.2f} mm outside [{lo:g}, {hi:g}] mm")
-    depth_left = depths_m * MM_PER_M / mv
-    bz = base_m[2] * MM_PER_M / mv
-    reasons.append(
-        _range_reason(
-            spec,
-            "projection_distance_range_mm",
-            np.concatenate([depth_left, depth_left + bz]),
-            "projection distance D of the working area",
-        )
-    )
-    b = base_components(np.zeros(3), base_m, mg, mv)
-    for attribute, value, name in (
-        ("base_x_range_mm", b[0], "b_x"),
-        ("base_y_range_mm", b[1], "b_y"),
-        ("base_z_range_mm", b[2], "b_z′"),
-    ):
-        reasons.append(_range_reason(spec, attribute, np.array([value]), name))
-    model = offsets_m * MM_PER_M / mg
-    reasons.append(
-        _range_reason(
-            spec, "model_x_offset_range_mm", model[:, 0], "X offsets of the model and sheet corners"
-        )
-    )
-    reasons.append(
-        _range_reason(
-            spec, "model_y_offset_range_mm", model[:, 1], "Y offsets of the model and sheet corners"
-        )
-    )
-    return ScaleCandidate(mg, mv, ratio, f_pr, tuple(r for r in reasons if r))
-
-
 def _choose_scales(
     spec: InstrumentSpec,
     options: SetupOptions,
@@ -263,50 +208,52 @@ def _choose_scales(
     base_m: NDArray,
     offsets_m: NDArray,
 ) -> tuple[ScaleCandidate, tuple[ScaleCandidate, ...]]:
-    if options.horizontal_scale_denominator is not None:
-        horizontals = [
-            (
-                options.horizontal_scale_denominator,
-                options.horizontal_scale_denominator / map_scale if map_scale else math.nan,
-            )
+    """Item 1 of §26 through :mod:`stereoplotter.scale_choice`, for one pair."""
+    try:
+        grid = candidate_scales(
+            spec,
+            map_scale,
+            options.horizontal_scale_denominator,
+            options.vertical_scale_denominator,
+        )
+    except StereoplotterError as exc:
+        raise SetupRefusal(f"{exc} (--horizontal-scale)") from None
+    depth = np.array([[depths_m.min(), depths_m.max()]])
+    extent = np.array(
+        [
+            [
+                [offsets_m[:, 0].min(), offsets_m[:, 0].max()],
+                [offsets_m[:, 1].min(), offsets_m[:, 1].max()],
+            ]
         ]
-    elif map_scale is None:
-        raise SetupRefusal(
-            "the scenario has no map sheet, so the horizontal model scale cannot be chosen from "
-            "the coordinatograph gears: add map_sheet to the scenario or force M_г "
-            "(--horizontal-scale)"
-        )
-    else:
-        horizontals = [(round(r * map_scale), r) for r in spec.coordinatograph_ratios]
-    verticals = (
-        [options.vertical_scale_denominator]
-        if options.vertical_scale_denominator is not None
-        else list(spec.vertical_scale_denominators)
     )
-    candidates = [
-        _candidate(spec, f_prime, mg, mv, r, depths_m, base_m, offsets_m)
-        for mg, r in horizontals
-        for mv in verticals
-    ]
-    feasible = sorted(
-        (c for c in candidates if c.feasible), key=lambda c: (c.horizontal, c.vertical)
-    )
-    if not feasible:
-
-        def badness(c: ScaleCandidate) -> tuple[int, int]:
-            return (len(c.reasons), c.horizontal)
-
-        best = min(candidates, key=badness)
-        raise SetupRefusal(
-            f"instrument {spec.key} cannot take this stereopair: none of the "
-            f"{len(candidates)} scale pairs (M_г = r·M_map for the coordinatograph ratios r, "
-            "M_в from the height-counter gears) fits every range. Closest: "
-            f"M_г = 1:{best.horizontal}, M_в = 1:{best.vertical}: "
-            + "; ".join(best.reasons)
-            + ". Way out: another instrument, another map scale, or widen the assumed ranges "
-            f"in {spec.source}."
+    flags = candidate_flags(spec, f_prime, grid, depth, base_m[None], extent)
+    chosen, feasible = choose_candidates(flags, grid)
+    best = int(chosen[0])
+    if not feasible[0]:
+        reasons = describe_candidate(
+            spec, f_prime, grid[best], int(flags[0, best]), depth[0], base_m, extent[0]
         )
-    return feasible[0], tuple(candidates)
+        raise SetupRefusal(
+            f"instrument {spec.key} cannot take this stereopair: none of the {len(grid)} scale "
+            "pairs (M_г = r·M_map for the coordinatograph ratios r, M_в from the height-counter "
+            f"gears) fits every range. Closest: M_г = 1:{grid[best, 0]:.0f}, "
+            f"M_в = 1:{grid[best, 1]:.0f}: "
+            + "; ".join(reasons)
+            + ". Way out: another instrument, another map scale or forced scales, or widen the "
+            f"assumed ranges in {spec.source}."
+        )
+    candidates = tuple(
+        ScaleCandidate(
+            int(mg),
+            int(mv),
+            mg / map_scale if map_scale else math.nan,
+            float(instrument_principal_distance(f_prime, mg, mv)),
+            tuple((flag.name or "").lower() for flag in ScaleCheck if flag and code & int(flag)),
+        )
+        for (mg, mv), code in zip(grid, flags[0], strict=True)
+    )
+    return candidates[best], candidates
 
 
 def _check_tilt(spec: InstrumentSpec, value: float, what: str) -> None:
