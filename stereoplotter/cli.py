@@ -23,7 +23,7 @@ import numpy as np
 from stereoplotter import __version__
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.paths import DEFAULT_SCENARIO, data_dir, list_data_files
-from stereoplotter.yamlio import atomic_write_bytes, atomic_write_text
+from stereoplotter.yamlio import atomic_write_bytes, atomic_write_text, load_yaml_mapping
 
 __all__ = ["main"]
 
@@ -77,7 +77,6 @@ def _count_status(node: Any, counts: dict[str, int]) -> None:
 
 def _info() -> dict[str, Any]:
     from stereoplotter.scenario import load_scenario
-    from stereoplotter.yamlio import load_yaml_mapping
 
     instruments = []
     for path in list_data_files("instruments"):
@@ -322,8 +321,11 @@ def _setup(args: argparse.Namespace) -> int:
     from stereoplotter.setup_sheet import SetupOptions, compute_setup_sheet
     from stereoplotter.sheet_report import sheet_markdown, sheet_to_dict
 
-    scenario = load_scenario(args.scenario)
     spec = load_instrument(args.instrument)
+    data, _ = load_yaml_mapping(args.scenario)
+    if "models" in data or "models_csv" in data:
+        return _setup_block(args, spec)
+    scenario = load_scenario(args.scenario)
     options = SetupOptions(
         book_sign_n_right=args.book_sign,
         horizontal_scale_denominator=args.horizontal_scale,
@@ -362,6 +364,39 @@ def _setup(args: argparse.Namespace) -> int:
     return 0
 
 
+def _setup_block(args: argparse.Namespace, spec: Any) -> int:
+    """Block mode: one sheet per model of a block file (``stereoplotter.block``)."""
+    from stereoplotter.block import model_sheet, run_block
+
+    if args.horizontal_scale is not None or args.vertical_scale is not None or args.seed:
+        raise StereoplotterError(
+            f"{args.scenario}: a block file sets its scales in its own 'scales' field; "
+            "--horizontal-scale, --vertical-scale and --seed apply to single pairs only"
+        )
+    out = (
+        None if (args.json and args.output is None) else Path(args.output or "stereoplotter-setup")
+    )
+    result = run_block(args.scenario, spec, out, book_sign=args.book_sign)
+    sheets = [model_sheet(result, i) for i in range(len(result))]
+    if args.json:
+        sys.stdout.write(_json({"block": result.name, "instrument": spec.key, "models": sheets}))
+        return 0
+    accepted = int(np.sum(result.accepted))
+    lines = [f"block {result.name} on {spec.title}: {accepted} of {len(result)} models set up"]
+    for i, sheet in enumerate(sheets):
+        if result.accepted[i]:
+            lines.append(
+                f"  {result.model_names[i]}: M_г = 1:{sheet['scale_horizontal']}, "
+                f"M_в = 1:{sheet['scale_vertical']}, n_л = {sheet['n_left']:.5f}, "
+                f"n_п = {sheet['n_right']:.5f}"
+            )
+        else:
+            lines.append(f"  {result.model_names[i]}: REFUSED: {result.reason(i)}")
+    lines.append(f"written: <model>/sheet.yaml and block.csv in {out}")
+    sys.stdout.write("\n".join(lines) + "\n")
+    return 0
+
+
 # --- parser ----------------------------------------------------------------------------------
 
 
@@ -393,7 +428,11 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print JSON instead of text")
 
     p = sub.add_parser("setup", help="compute the setup sheet (Table 24) of a stereopair")
-    p.add_argument("scenario", help="a scenarios/*.yaml stereopair")
+    p.add_argument(
+        "scenario",
+        help="a scenarios/*.yaml stereopair, or a block file listing "
+        "many stereopairs of one camera (one sheet per model)",
+    )
     p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
     p.add_argument(
         "-o",

@@ -271,3 +271,16 @@ def test_fuzzed_scenarios_give_a_sheet_or_a_clear_refusal(mutations):
         assert str(exc)
     else:
         assert np.isfinite(sheet.n_left) and np.isfinite(sheet.n_right)
+
+
+def test_cli_setup_block_mode(tmp_path, capsys):
+    block = str(SCENARIOS / "blocks" / "strip60.yaml")
+    assert main(["setup", block, "--instrument", "sc1", "-o", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("block strip60 on") and "8 of 8 models set up" in out
+    assert (tmp_path / "block.csv").exists() and (tmp_path / "101-102" / "sheet.yaml").exists()
+    assert main(["setup", block, "--instrument", "sd3", "--json"]) == 0
+    models = json.loads(capsys.readouterr().out)["models"]
+    assert len(models) == 8 and all(m["status"] == "ok" for m in models)
+    assert main(["setup", block, "--instrument", "sc1", "--horizontal-scale", "12500"]) == 1
+    assert "apply to single pairs only" in capsys.readouterr().err
