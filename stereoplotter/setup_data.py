@@ -202,7 +202,7 @@ def mark_span(
 
     Notes
     -----
-    Implements Eq. (6.5) of [1]_ (OCR L3723). The printed (6.1)/(6.2) already contain n and (6.5)
+    Implements Eq. (6.5) of [1]_ (OCR L3725). The printed (6.1)/(6.2) already contain n and (6.5)
     multiplies by n again; n is applied exactly once here (``docs/setup-data.md``).
     """
     return _a(n) * (_a(y3_transformed_mm) - _a(y4_transformed_mm))
@@ -227,7 +227,7 @@ def model_height(
 
     Notes
     -----
-    Implements Eq. (6.6) of [1]_ (OCR L3727).
+    Implements Eq. (6.6) of [1]_ (OCR L3731).
 
     Examples
     --------
@@ -293,7 +293,7 @@ def decentration(focal_length_corrected_mm: ArrayLike, tilt: ArrayLike) -> NDArr
 
     Notes
     -----
-    The book gives no formula ("по общеизвестным формулам", item 3 of [1]_, OCR L3725). The
+    The book gives no formula ("по общеизвестным формулам", item 3 of [1]_, OCR L3727). The
     exact value follows from the correction-plane geometry (``kinematics.md`` §2.4,
     e = c = f·tan α); to first order it is the book's fα = Δx (OCR L3843).
     """
@@ -346,7 +346,7 @@ def height_correction(
 
     Notes
     -----
-    Implements Eq. (6.9) of [1]_ (OCR L3769). ΔL > 0 means the photo must go deeper: on the
+    Implements Eq. (6.9) of [1]_ (OCR L3765). ΔL > 0 means the photo must go deeper: on the
     absolute counter D′ = D + D·ΔL_л/L_л (6.11); on the metre height scale the reading *decreases*
     by ΔZ (``docs/setup-data.md``, stage readings).
     """
@@ -381,7 +381,7 @@ def base_z_correction(
 
     Notes
     -----
-    Implements Eq. (6.10) of [1]_ (OCR L3773). With a b_z scale that increases when the right
+    Implements Eq. (6.10) of [1]_ (OCR L3767). With a b_z scale that increases when the right
     pivot rises, the new reading is O′_bz = O_bz **+** Δb_z; the printed minus of (6.11) belongs
     to a scale counting the other way (option ``bz_scale_sense = -1``, ``docs/setup-data.md``).
     """
@@ -413,7 +413,7 @@ def height_scale_reading(
 
     Notes
     -----
-    Implements Eq. (6.15) of [1]_ (OCR L3797); the OCR's "n_p f′" is n_л·f_пр
+    Implements Eq. (6.15) of [1]_ (OCR L3799); the OCR's "n_p f′" is n_л·f_пр
     (``docs/setup-data.md``). The height scale reads const − D·M_в/1000, hence the minus.
     """
     return (
@@ -452,7 +452,7 @@ def sheet_corner_instrument_coordinates(
 
     Notes
     -----
-    Implements Eq. (6.7) of [1]_ (OCR L3731–3735) with the model scale and without n
+    Implements Eq. (6.7) of [1]_ (OCR L3735) with the model scale and without n
     (decision, ``docs/setup-data.md``):
 
     .. math::
@@ -474,7 +474,7 @@ def sheet_corner_instrument_coordinates_book_form(
     photo_scale_denominator: float,
     origin_m: ArrayLike = (0.0, 0.0),
 ) -> NDArray[np.float64]:
-    r"""Eq. (6.7) as printed: x′ = n·(a X_г + b Y_г + c_X)·1000/M (OCR L3731–3735).
+    r"""Eq. (6.7) as printed: x′ = n·(a X_г + b Y_г + c_X)·1000/M (OCR L3735).
 
     With M the photo-scale denominator at the plane of n (M_photo = n_л·M_г) it gives the same x′
     as :func:`sheet_corner_instrument_coordinates`; with the model M_г it would be n times too

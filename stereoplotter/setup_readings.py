@@ -1,6 +1,6 @@
 """The readings each of the five stages asks for, as zero reading (MO) + signed value.
 
-Eqs. (6.11)–(6.18) of the book (ch. 6, §26, OCR L3735–3823) read as in ``docs/setup-data.md``:
+Eqs. (6.11)–(6.18) of the book (ch. 6, §26, OCR L3773–3821) read as in ``docs/setup-data.md``:
 * readings are MO + **signed** value; the book's MO − (y⁰₄) and MO − (x⁰₁) treat the negative-side
   marks as magnitudes — the same number (``book_form`` is reported beside);
 * the right photo's targets use its own zero reading MO_п = MO + (b_x, b_y) and n_п (decision D6);
