@@ -23,7 +23,7 @@ import numpy as np
 from stereoplotter import __version__
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.paths import DEFAULT_SCENARIO, data_dir, list_data_files
-from stereoplotter.yamlio import atomic_write_bytes, atomic_write_text, load_yaml_mapping
+from stereoplotter.yamlio import atomic_write_bytes, load_yaml_mapping
 
 __all__ = ["main"]
 
@@ -262,8 +262,11 @@ def _format_demo(result: dict[str, Any]) -> str:
 
 def _demo(args: argparse.Namespace) -> int:
     from stereoplotter.foundation import run_foundation
+    from stereoplotter.instrument.spec import load_instrument
     from stereoplotter.plotting import plot_scenario_layout
     from stereoplotter.scenario import load_scenario
+    from stereoplotter.setup_sheet import SetupRefusal, compute_setup_sheet
+    from stereoplotter.sheet_report import sheet_to_dict
 
     path = Path(args.scenario) if args.scenario else None
     if path is None:
@@ -276,28 +279,43 @@ def _demo(args: argparse.Namespace) -> int:
             )
         path = folder / DEFAULT_SCENARIO
     scenario = load_scenario(path)
+    spec = load_instrument(args.instrument)
     seed = scenario.seed if args.seed is None else args.seed
     result = run_foundation(scenario, np.random.default_rng(seed))
     measurements = result.pop("measurements")
     result["seed"] = seed
-    out = Path(args.output)
     text = _format_demo(result)
+    files: dict[str, bytes] = {}
+    try:
+        sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(seed))
+    except SetupRefusal as exc:
+        result["setup_sheet"] = {"refused": str(exc)}
+        text += f"\nsetup sheet on {spec.title}: refused: {exc}\n"
+    else:
+        data = sheet_to_dict(sheet)
+        data["seed"] = seed
+        result["setup_sheet"] = data
+        files.update(_sheet_files(sheet, data))
+        text += f"\n{_sheet_summary(sheet)} (sheet.md, sheet.pdf)\n"
     figure = plot_scenario_layout(scenario, result)
     png = io.BytesIO()
     figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
-    files = {
-        "result.json": _json(result),
-        "summary.md": text,
-        "measurements.csv": _measurements_csv(scenario, measurements),
-    }
+    files.update(
+        {
+            "result.json": _json(result).encode("utf-8"),
+            "summary.md": text.encode("utf-8"),
+            "measurements.csv": _measurements_csv(scenario, measurements).encode("utf-8"),
+            "layout.png": png.getvalue(),
+        }
+    )
+    out = Path(args.output)
     for name, content in files.items():
-        atomic_write_text(out / name, content)
-    atomic_write_bytes(out / "layout.png", png.getvalue())
+        atomic_write_bytes(out / name, content)
     if args.json:
         sys.stdout.write(_json(result))
     else:
         sys.stdout.write(text)
-        sys.stdout.write(f"\nwritten: {', '.join(sorted([*files, 'layout.png']))} in {out}\n")
+        sys.stdout.write(f"\nwritten: {', '.join(sorted(files))} in {out}\n")
     return 0
 
 
@@ -312,14 +330,42 @@ def _instrument(args: argparse.Namespace) -> int:
     return 0
 
 
-def _setup(args: argparse.Namespace) -> int:
+def _sheet_files(sheet: Any, data: dict[str, Any]) -> dict[str, bytes]:
+    """sheet.yaml, sheet.md, sheet.pdf and sheet.png of a setup sheet, rendered in memory."""
     import yaml
 
-    from stereoplotter.instrument.spec import load_instrument
     from stereoplotter.plotting import plot_setup_sheet
+    from stereoplotter.sheet_report import sheet_markdown
+
+    text = yaml.safe_dump(json.loads(_json(data)), sort_keys=False, allow_unicode=True, width=100)
+    figure = plot_setup_sheet(sheet)
+    pdf, png = io.BytesIO(), io.BytesIO()
+    figure.savefig(
+        pdf, format="pdf", metadata={"Creator": None, "Producer": None, "CreationDate": None}
+    )
+    figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
+    return {
+        "sheet.yaml": text.encode("utf-8"),
+        "sheet.md": sheet_markdown(sheet).encode("utf-8"),
+        "sheet.pdf": pdf.getvalue(),
+        "sheet.png": png.getvalue(),
+    }
+
+
+def _sheet_summary(sheet: Any) -> str:
+    return (
+        f"setup sheet of {sheet.scenario} on {sheet.instrument_title}: M_г = "
+        f"1:{sheet.horizontal_scale_denominator}, M_в = 1:{sheet.vertical_scale_denominator}, "
+        f"f_пр = {sheet.f_instrument_mm:.3f} mm, n_л = {sheet.n_left:.5f}, "
+        f"n_п = {sheet.n_right:.5f}"
+    )
+
+
+def _setup(args: argparse.Namespace) -> int:
+    from stereoplotter.instrument.spec import load_instrument
     from stereoplotter.scenario import load_scenario
     from stereoplotter.setup_sheet import SetupOptions, compute_setup_sheet
-    from stereoplotter.sheet_report import sheet_markdown, sheet_to_dict
+    from stereoplotter.sheet_report import sheet_to_dict
 
     spec = load_instrument(args.instrument)
     data, _ = load_yaml_mapping(args.scenario)
@@ -340,27 +386,11 @@ def _setup(args: argparse.Namespace) -> int:
     if args.output is None and args.json:
         return 0
     out = Path(args.output or "stereoplotter-setup")
-    # Render everything in memory first: the files are written whole or not at all.
-    markdown = sheet_markdown(sheet)
-    text = yaml.safe_dump(json.loads(_json(data)), sort_keys=False, allow_unicode=True, width=100)
-    figure = plot_setup_sheet(sheet)
-    pdf, png = io.BytesIO(), io.BytesIO()
-    figure.savefig(
-        pdf, format="pdf", metadata={"Creator": None, "Producer": None, "CreationDate": None}
-    )
-    figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
-    atomic_write_text(out / "sheet.yaml", text)
-    atomic_write_text(out / "sheet.md", markdown)
-    atomic_write_bytes(out / "sheet.pdf", pdf.getvalue())
-    atomic_write_bytes(out / "sheet.png", png.getvalue())
+    files = _sheet_files(sheet, data)  # everything rendered before anything is written
+    for name, content in files.items():
+        atomic_write_bytes(out / name, content)
     if not args.json:
-        sys.stdout.write(
-            f"setup sheet of {sheet.scenario} on {sheet.instrument_title}: M_г = "
-            f"1:{sheet.horizontal_scale_denominator}, M_в = 1:{sheet.vertical_scale_denominator}, "
-            f"f_пр = {sheet.f_instrument_mm:.3f} mm, n_л = {sheet.n_left:.5f}, "
-            f"n_п = {sheet.n_right:.5f}\n"
-            f"written: sheet.yaml, sheet.md, sheet.pdf, sheet.png in {out}\n"
-        )
+        sys.stdout.write(f"{_sheet_summary(sheet)}\nwritten: {', '.join(files)} in {out}\n")
     return 0
 
 
@@ -461,6 +491,9 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--scenario", help=f"scenario file (default: scenarios/{DEFAULT_SCENARIO})")
     p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument(
+        "--instrument", default="sc1", help="instrument of the setup sheet (default: %(default)s)"
+    )
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     return parser
 

@@ -11,7 +11,7 @@ measured control — with the scenario's seed, so a sheet is reproducible.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -21,7 +21,11 @@ from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.geometry.resection import space_resection
 from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix, rotation_z
-from stereoplotter.geometry.similarity import SimilarityFit, fit_similarity_with_reflection
+from stereoplotter.geometry.similarity import (
+    SimilarityFit,
+    apply_similarity,
+    fit_similarity_with_reflection,
+)
 from stereoplotter.geometry.transformed import (
     transformed_coordinates,
     transformed_x_single_tilt,
@@ -53,6 +57,7 @@ from stereoplotter.setup_data import (
     sheet_corner_instrument_coordinates,
     sheet_corner_instrument_coordinates_book_form,
 )
+from stereoplotter.setup_readings import stage_readings
 
 __all__ = [
     "CORNER_ORDER",
@@ -338,9 +343,7 @@ def compute_setup_sheet(
         north = np.array([scenario.points[i].sk42_m[0] for i in plan])
         east = np.array([scenario.points[i].sk42_m[1] for i in plan])
         fit = fit_similarity_with_reflection(north, east, points_m[plan, 0], points_m[plan, 1])
-        corners_m = sheet_corner_instrument_coordinates(
-            fit, corners_gk[:, 0], corners_gk[:, 1], MM_PER_M
-        )  # metres (scale 1:1000 → m)
+        corners_m = apply_similarity(fit, corners_gk[:, 0], corners_gk[:, 1])  # (6.8), ground m
     offsets_m = np.vstack([ground[:, :2], corners_m])
     map_scale = scenario.map_sheet.scale_denominator if scenario.map_sheet else None
     chosen, candidates = _choose_scales(
@@ -395,13 +398,6 @@ def compute_setup_sheet(
                 n,
             )
         )
-    for value, attribute, what in (
-        (b[0], "base_x_range_mm", "b_x"),
-        (b[1], "base_y_range_mm", "b_y"),
-        (b[2], "base_z_range_mm", "b_z′"),
-    ):
-        check_in_range(spec, attribute, float(value), what)
-
     # (6.6) model heights over height control
     heights = []
     for i, p in enumerate(scenario.points):
@@ -487,15 +483,7 @@ def compute_setup_sheet(
             for i, p in enumerate(scenario.points)
         ),
     )
-    from stereoplotter.setup_readings import stage_readings
-
-    return _replace_readings(sheet, stage_readings(sheet))
-
-
-def _replace_readings(sheet: SetupSheet, readings: tuple[dict[str, Any], ...]) -> SetupSheet:
-    from dataclasses import replace
-
-    return replace(sheet, readings=readings)
+    return replace(sheet, readings=stage_readings(sheet))
 
 
 def _assumed_map(spec: InstrumentSpec) -> dict[str, tuple[str, ...]]:

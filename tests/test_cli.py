@@ -64,7 +64,16 @@ def test_demo_writes_files_reproducibly(tmp_path, capsys):
     assert main(["demo", "-o", str(out1), "--scenario", PAIR60]) == 0
     assert "space intersection" in capsys.readouterr().out
     assert main(["demo", "-o", str(out2), "--scenario", PAIR60]) == 0
-    names = {"result.json", "summary.md", "measurements.csv", "layout.png"}
+    names = {
+        "result.json",
+        "summary.md",
+        "measurements.csv",
+        "layout.png",
+        "sheet.yaml",
+        "sheet.md",
+        "sheet.pdf",
+        "sheet.png",
+    }
     assert {p.name for p in out1.iterdir()} == names
     for name in names:  # same seed → byte-identical output files
         assert (out1 / name).read_bytes() == (out2 / name).read_bytes(), name
@@ -72,12 +81,14 @@ def test_demo_writes_files_reproducibly(tmp_path, capsys):
     # 3 µm measurement noise at 1:20 000 gives decimetre errors, not metres
     assert result["intersection"]["statistics"]["check"]["rms_height_m"] < 0.3
     assert result["similarity"]["determinant"] < 0
+    assert result["setup_sheet"]["scale_horizontal"] == 12500  # the sheet on the default SC-1
 
 
 def test_demo_resection_scenario(tmp_path, capsys):
     scenario = str(ROOT / "scenarios" / "book_resection_table7.yaml")
     assert main(["demo", "-o", str(tmp_path), "--scenario", scenario, "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
+    assert "not a stereopair" in result["setup_sheet"]["refused"]
     (ext,) = result["exterior"]
     assert ext["source"] == "resection"
     assert max(abs(v) for v in ext["error_angles_arcsec"]) < 0.1
