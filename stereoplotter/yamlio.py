@@ -18,7 +18,13 @@ import yaml
 
 from stereoplotter.errors import ConfigError
 
-__all__ = ["Fields", "atomic_write_bytes", "atomic_write_text", "load_yaml_mapping"]
+__all__ = [
+    "Fields",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "describe_value",
+    "load_yaml_mapping",
+]
 
 _MISSING = object()
 
@@ -87,7 +93,7 @@ class Fields:
     ) -> dict[str, Any]:
         """Check ``value`` is a mapping with only ``allowed`` keys and the ``required`` ones."""
         if not isinstance(value, dict):
-            raise self.error(path or "(top level)", "a mapping", _describe(value))
+            raise self.error(path or "(top level)", "a mapping", describe_value(value))
         for key in value:
             if not isinstance(key, str):
                 raise self.error(path, "text keys", key)
@@ -156,7 +162,7 @@ class Fields:
         """Validate one number already taken from the document."""
         expected = _range_text(unit, low, high, low_open, high_open)
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.error(path, f"a number {expected}", _describe(value))
+            raise self.error(path, f"a number {expected}", describe_value(value))
         try:
             value = float(value)
         except OverflowError:  # an integer beyond the float range
@@ -183,7 +189,7 @@ class Fields:
         value = self.get(node, key, path, default)
         if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
             raise self.error(
-                self.join(path, key), f"an integer in [{low}, {high}]", _describe(value)
+                self.join(path, key), f"an integer in [{low}, {high}]", describe_value(value)
             )
         return value
 
@@ -191,7 +197,7 @@ class Fields:
         """A non-empty string (numbers are accepted and turned into text, as for point ids)."""
         value = self.get(node, key, path, default)
         if isinstance(value, bool) or not isinstance(value, str | int) or str(value) == "":
-            raise self.error(self.join(path, key), "a non-empty text", _describe(value))
+            raise self.error(self.join(path, key), "a non-empty text", describe_value(value))
         return str(value)
 
     def choice(
@@ -206,7 +212,9 @@ class Fields:
         choices = list(choices)
         value = self.get(node, key, path, default)
         if value not in choices:
-            raise self.error(self.join(path, key), "one of " + ", ".join(choices), _describe(value))
+            raise self.error(
+                self.join(path, key), "one of " + ", ".join(choices), describe_value(value)
+            )
         return value
 
     def vector(
@@ -225,7 +233,7 @@ class Fields:
         value = self.get(node, key, path, default)
         full = self.join(path, key)
         if not isinstance(value, list | tuple) or len(value) != length:
-            raise self.error(full, f"a list of {length} numbers [{unit}]", _describe(value))
+            raise self.error(full, f"a list of {length} numbers [{unit}]", describe_value(value))
         return tuple(
             self.check_number(v, self.join(full, i), unit=unit, low=low, high=high)
             for i, v in enumerate(value)
@@ -243,7 +251,7 @@ class Fields:
         """A list with at least ``min_length`` entries."""
         value = self.get(node, key, path, default)
         if not isinstance(value, list):
-            raise self.error(self.join(path, key), "a list", _describe(value))
+            raise self.error(self.join(path, key), "a list", describe_value(value))
         if len(value) < min_length:
             raise self.error(
                 self.join(path, key),
@@ -264,7 +272,8 @@ def _range_text(unit: str, low: float, high: float, low_open: bool, high_open: b
     return f"in {left}{lo}, {hi}{right}{unit_text}"
 
 
-def _describe(value: Any) -> str:
+def describe_value(value: Any) -> str:
+    """How a YAML value is named in an error message ("a mapping", "the text 'x'", …)."""
     if isinstance(value, dict):
         return "a mapping"
     if isinstance(value, list):

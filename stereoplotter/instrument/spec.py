@@ -30,7 +30,7 @@ import yaml
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.paths import data_dir, list_data_files
-from stereoplotter.yamlio import Fields, load_yaml_mapping
+from stereoplotter.yamlio import Fields, describe_value, load_yaml_mapping
 
 __all__ = [
     "STATUSES",
@@ -634,7 +634,7 @@ def _parameter(fields: Fields, node: Any, leaf: _Leaf, origin: str) -> Parameter
         raise fields.error(
             path,
             "a leaf {value, status, src | basis, note?}",
-            _describe(node),
+            describe_value(node),
             "every value says whether a source documents it (see docs/instruments.md)",
         )
     fields.mapping(node, path, _LEAF_KEYS)
@@ -643,7 +643,7 @@ def _parameter(fields: Fields, node: Any, leaf: _Leaf, origin: str) -> Parameter
         raise fields.error(
             fields.join(path, "status"),
             "documented or assumed",
-            _describe(status),
+            describe_value(status),
             "every value says whether a source documents it; an inferred value is assumed, "
             "with a basis",
         )
@@ -680,7 +680,7 @@ def _sources(fields: Fields, node: Mapping[str, Any], path: str) -> tuple[str, .
     items = raw if isinstance(raw, list) else [raw]
     if not items or any(not isinstance(s, str) or not s.strip() for s in items):
         raise fields.error(
-            fields.join(path, "src"), "a source key or a list of source keys", _describe(raw)
+            fields.join(path, "src"), "a source key or a list of source keys", describe_value(raw)
         )
     return tuple(s.strip() for s in items)
 
@@ -690,7 +690,7 @@ def _optional_text(fields: Fields, node: Mapping[str, Any], key: str, path: str)
     if raw is None:
         return ""
     if not isinstance(raw, str) or not raw.strip():
-        raise fields.error(fields.join(path, key), "a non-empty text", _describe(raw))
+        raise fields.error(fields.join(path, key), "a non-empty text", describe_value(raw))
     return raw.strip()
 
 
@@ -704,7 +704,7 @@ def _value(fields: Fields, node: Mapping[str, Any], leaf: _Leaf) -> Any:
         return fields.text(node, "value", path)
     if kind == "bool":
         if not isinstance(raw, bool):
-            raise fields.error(vpath, "true or false", _describe(raw))
+            raise fields.error(vpath, "true or false", describe_value(raw))
         return raw
     if kind == "int":
         return fields.integer(node, "value", path, low=int(leaf.low), high=int(leaf.high))
@@ -714,7 +714,7 @@ def _value(fields: Fields, node: Mapping[str, Any], leaf: _Leaf) -> Any:
         length = 3 if kind == "triple" else 2
         if not isinstance(raw, list) or len(raw) != length:
             what = "[lo, hi]" if kind == "range" else f"{length} numbers"
-            raise fields.error(vpath, f"a list of {what} [{leaf.unit}]", _describe(raw))
+            raise fields.error(vpath, f"a list of {what} [{leaf.unit}]", describe_value(raw))
         numbers = tuple(
             _number(fields, v, fields.join(vpath, i), limits) for i, v in enumerate(raw)
         )
@@ -739,7 +739,7 @@ def _value(fields: Fields, node: Mapping[str, Any], leaf: _Leaf) -> Any:
         if kind == "int_list":
             if isinstance(v, bool) or not isinstance(v, int) or not leaf.low <= v <= leaf.high:
                 raise fields.error(
-                    ipath, f"an integer in [{leaf.low:g}, {leaf.high:g}]", _describe(v)
+                    ipath, f"an integer in [{leaf.low:g}, {leaf.high:g}]", describe_value(v)
                 )
             out.append(v)
         else:
@@ -767,18 +767,6 @@ def _cross_check(
                 d_max.value,
                 "D_max is the deepest position of the carriage; change both together",
             )
-
-
-def _describe(value: Any) -> str:
-    if isinstance(value, dict):
-        return "a mapping"
-    if isinstance(value, list):
-        return f"a list of {len(value)}"
-    if value is None:
-        return "nothing"
-    if isinstance(value, str):
-        return f"the text {value!r}"
-    return repr(value)
 
 
 def list_instruments() -> list[str]:
