@@ -199,6 +199,22 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("errors.backlash_xy_mm", "number", "mm", 0.0, 1.0),
     _Leaf("errors.backlash_z_mm", "number", "mm", 0.0, 1.0),
     _Leaf("errors.zero_reading_scatter_mm", "number", "mm", 0.0, 100.0),
+    _Leaf("errors.counter_scale_error_ppm", "number", "ppm", 0.0, 1.0e4),
+    _Leaf("errors.f_instrument_setting_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("errors.base_setting_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("errors.kappa_setting_arcmin", "number", "′", 0.0, 600.0),
+    _Leaf("errors.decentration_setting_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("errors.correction_setting_arcmin", "number", "′", 0.0, 600.0),
+    _Leaf("errors.coordinatograph_nonorthogonality_arcsec", "number", "″", 0.0, 3600.0),
+    _Leaf("errors.pen_play_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("errors.sheet_placement_mm", "number", "mm", 0.0, 100.0),
+    _Leaf("mechanics.carriage_mass_kg", "number", "kg", high=1000.0, **_POS),
+    _Leaf("mechanics.z_carriage_mass_kg", "number", "kg", high=1000.0, **_POS),
+    _Leaf("mechanics.friction_coefficient", "number", "—", 0.0, 2.0),
+    _Leaf("mechanics.screw_stiffness_N_per_um", "number", "N/µm", high=1.0e4, **_POS),
+    _Leaf("mechanics.bridge_mass_kg", "number", "kg", high=1000.0, **_POS),
+    _Leaf("mechanics.pen_carriage_mass_kg", "number", "kg", high=1000.0, **_POS),
+    _Leaf("mechanics.sheet_friction_torque_Nm", "number", "N·m", 0.0, 1000.0),
     _Leaf("accuracy.height_error_fraction_of_H", "number", "—", high=1.0, required=False, **_POS),
     _Leaf("facts.n_formula", "text", required=False),
     _Leaf("facts.n_example", "number", "—", high=100.0, required=False, **_POS),
@@ -273,6 +289,25 @@ _ATTRIBUTES: dict[str, tuple[str, Callable[[Any], Any]]] = {
     "backlash_xy_mm": ("errors.backlash_xy_mm", _same),
     "backlash_z_mm": ("errors.backlash_z_mm", _same),
     "zero_reading_scatter_mm": ("errors.zero_reading_scatter_mm", _same),
+    "counter_scale_error_ppm": ("errors.counter_scale_error_ppm", _same),
+    "f_instrument_setting_sigma_mm": ("errors.f_instrument_setting_mm", _same),
+    "base_setting_sigma_mm": ("errors.base_setting_mm", _same),
+    "kappa_setting_sigma": ("errors.kappa_setting_arcmin", lambda v: v * _RAD / 60.0),
+    "decentration_setting_sigma_mm": ("errors.decentration_setting_mm", _same),
+    "correction_setting_sigma": ("errors.correction_setting_arcmin", lambda v: v * _RAD / 60.0),
+    "coordinatograph_nonorthogonality_sigma": (
+        "errors.coordinatograph_nonorthogonality_arcsec",
+        lambda v: v * _RAD / 3600.0,
+    ),
+    "pen_play_mm": ("errors.pen_play_mm", _same),
+    "sheet_placement_sigma_mm": ("errors.sheet_placement_mm", _same),
+    "carriage_mass_kg": ("mechanics.carriage_mass_kg", _same),
+    "z_carriage_mass_kg": ("mechanics.z_carriage_mass_kg", _same),
+    "friction_coefficient": ("mechanics.friction_coefficient", _same),
+    "screw_stiffness_N_per_um": ("mechanics.screw_stiffness_N_per_um", _same),
+    "bridge_mass_kg": ("mechanics.bridge_mass_kg", _same),
+    "pen_carriage_mass_kg": ("mechanics.pen_carriage_mass_kg", _same),
+    "sheet_friction_torque_Nm": ("mechanics.sheet_friction_torque_Nm", _same),
     "height_error_fraction_of_H": ("accuracy.height_error_fraction_of_H", _same),
 }
 
@@ -383,6 +418,22 @@ class InstrumentSpec:
     backlash_xy_mm: float
     backlash_z_mm: float
     zero_reading_scatter_mm: float
+    counter_scale_error_ppm: float
+    f_instrument_setting_sigma_mm: float
+    base_setting_sigma_mm: float
+    kappa_setting_sigma: float
+    decentration_setting_sigma_mm: float
+    correction_setting_sigma: float
+    coordinatograph_nonorthogonality_sigma: float
+    pen_play_mm: float
+    sheet_placement_sigma_mm: float
+    carriage_mass_kg: float
+    z_carriage_mass_kg: float
+    friction_coefficient: float
+    screw_stiffness_N_per_um: float
+    bridge_mass_kg: float
+    pen_carriage_mass_kg: float
+    sheet_friction_torque_Nm: float
     height_error_fraction_of_H: float | None
     parameters: Mapping[str, Parameter] = field(repr=False)
 

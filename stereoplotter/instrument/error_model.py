@@ -1,0 +1,315 @@
+"""Injected instrument errors: every error is a named term with a distribution and a source.
+
+The defaults come from the instrument YAML (``errors.*``; all *assumed*, since no data sheet of
+SC-1, SPR-3 or SD-3 was found — ``docs/instruments.md``). A run draws all terms at once from an
+explicit :class:`numpy.random.Generator`, vectorised over trials, in a fixed term-major order
+(term 1 for all trials, then term 2, …), so a seed reproduces a run; a per-trial oracle takes
+trial t from the same arrays.
+
+Units inside: mm, rad, relative (ppm/10⁶); the YAML and reports use ′, ″ and ppm at the edges.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.errors import ConfigError
+from stereoplotter.instrument.spec import InstrumentSpec
+
+__all__ = ["DISTRIBUTIONS", "ErrorModel", "ErrorTerm", "error_model_from_spec"]
+
+#: normal: σ; uniform: half-width a (values in [−a, a]); constant: the value itself.
+DISTRIBUTIONS = ("normal", "uniform", "constant")
+
+
+@dataclass(frozen=True, slots=True)
+class ErrorTerm:
+    """One injected error.
+
+    Attributes
+    ----------
+    name : str
+        Dotted name, e.g. ``"zero_reading.X"`` or ``"setting.kappa_left"``.
+    distribution : str
+        One of :data:`DISTRIBUTIONS`.
+    scale : float
+        σ, half-width or value, in internal units (mm, rad, or relative for scale errors).
+    unit : str
+        Internal unit of ``scale`` ("mm", "rad" or "—").
+    source_key : str
+        The YAML key the default comes from.
+    assumed : bool
+        Whether that default is assumed.
+    meaning : str
+        What the term perturbs.
+    """
+
+    name: str
+    distribution: str
+    scale: float
+    unit: str
+    source_key: str
+    assumed: bool
+    meaning: str
+
+    def draw(self, rng: np.random.Generator, trials: int | None) -> NDArray[np.float64] | float:
+        """Values of this term: a float for ``trials=None``, an array of shape (trials,)."""
+        size = None if trials is None else (trials,)
+        if self.distribution == "normal":
+            return rng.normal(0.0, self.scale, size) if self.scale else _zeros(size)
+        if self.distribution == "uniform":
+            return rng.uniform(-self.scale, self.scale, size) if self.scale else _zeros(size)
+        return _zeros(size) + self.scale
+
+
+def _zeros(size: tuple[int] | None) -> NDArray[np.float64] | float:
+    return 0.0 if size is None else np.zeros(size)
+
+
+_ARCMIN = np.pi / 180.0 / 60.0
+
+
+def _terms(spec: InstrumentSpec) -> list[ErrorTerm]:
+    def term(name, dist, attribute, meaning, unit="mm", factor=1.0):
+        key = spec.key_of(attribute)
+        return ErrorTerm(
+            name,
+            dist,
+            float(getattr(spec, attribute)) * factor,
+            unit,
+            key,
+            spec.is_assumed(key),
+            meaning,
+        )
+
+    terms = []
+    for scale in ("X", "Y", "Z", "bx", "by", "bz", "dx_left", "dy_left", "dx_right", "dy_right"):
+        terms.append(
+            term(
+                f"zero_reading.{scale}",
+                "normal",
+                "zero_reading_scatter_mm",
+                f"error of the zero reading (место нуля) of the {scale} scale",
+            )
+        )
+    for counter in ("X", "Y", "Z"):
+        terms.append(
+            term(
+                f"counter_scale.{counter}",
+                "normal",
+                "counter_scale_error_ppm",
+                f"relative gear/scale ratio error of the {counter} counter",
+                unit="—",
+                factor=1e-6,
+            )
+        )
+    for axis, attribute in (
+        ("X", "backlash_xy_mm"),
+        ("Y", "backlash_xy_mm"),
+        ("Z", "backlash_z_mm"),
+        ("bx", "backlash_xy_mm"),
+        ("by", "backlash_xy_mm"),
+        ("bz", "backlash_z_mm"),
+    ):
+        terms.append(
+            term(
+                f"backlash.{axis}",
+                "constant",
+                attribute,
+                f"backlash (мёртвый ход) of the {axis} screw",
+            )
+        )
+    terms.append(
+        term(
+            "setting.f_instrument",
+            "normal",
+            "f_instrument_setting_sigma_mm",
+            "error of setting f_пр on its scale",
+        )
+    )
+    for b in ("bx", "by", "bz"):
+        terms.append(
+            term(
+                f"setting.{b}",
+                "normal",
+                "base_setting_sigma_mm",
+                f"error of setting {b} on its scale",
+            )
+        )
+    for side in ("left", "right"):
+        terms.append(
+            term(
+                f"setting.kappa_{side}",
+                "normal",
+                "kappa_setting_sigma",
+                f"error of setting κ of the {side} cassette",
+                unit="rad",
+            )
+        )
+        for d in ("dx", "dy"):
+            terms.append(
+                term(
+                    f"setting.{d}_{side}",
+                    "normal",
+                    "decentration_setting_sigma_mm",
+                    f"error of setting the decentration {d} of the {side} photo",
+                )
+            )
+        for c in ("alpha", "omega"):
+            terms.append(
+                term(
+                    f"setting.correction_{c}_{side}",
+                    "normal",
+                    "correction_setting_sigma",
+                    f"error of a k_{c} setting of the {side} correction mechanism",
+                    unit="rad",
+                )
+            )
+    terms.append(
+        term(
+            "coordinatograph.nonorthogonality",
+            "normal",
+            "coordinatograph_nonorthogonality_sigma",
+            "angle error between the coordinatograph X and Y rails",
+            unit="rad",
+        )
+    )
+    terms.append(
+        term(
+            "coordinatograph.pen_play",
+            "uniform",
+            "pen_play_mm",
+            "play of the needle in its holder (half-width = play/2)",
+            factor=0.5,
+        )
+    )
+    for axis in ("x", "y"):
+        terms.append(
+            term(
+                f"coordinatograph.sheet_placement_{axis}",
+                "normal",
+                "sheet_placement_sigma_mm",
+                f"hand placement error of a sheet corner under the needle, {axis}",
+            )
+        )
+    return terms
+
+
+@dataclass(frozen=True, slots=True)
+class ErrorModel:
+    """The set of injected error terms of one instrument.
+
+    Build with :func:`error_model_from_spec`; :meth:`zero` switches everything off (the
+    error-free instrument), :meth:`with_overrides` changes single terms.
+    """
+
+    instrument: str
+    terms: tuple[ErrorTerm, ...]
+
+    def term(self, name: str) -> ErrorTerm:
+        """The term called ``name``."""
+        for t in self.terms:
+            if t.name == name:
+                return t
+        raise KeyError(f"no error term {name!r}; known: {', '.join(self.names)}")
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(t.name for t in self.terms)
+
+    def zero(self) -> ErrorModel:
+        """The same terms with every scale 0: an error-free instrument."""
+        return replace(self, terms=tuple(replace(t, scale=0.0) for t in self.terms))
+
+    def scaled(self, factor: float) -> ErrorModel:
+        """Every scale multiplied by ``factor`` (e.g. 0 for error-free, 2 for a worn one)."""
+        return replace(self, terms=tuple(replace(t, scale=t.scale * factor) for t in self.terms))
+
+    def with_overrides(self, overrides: Mapping[str, Any], source: str = "<errors>") -> ErrorModel:
+        """Terms changed by a mapping ``name → scale`` or ``name → {distribution, scale}``.
+
+        A group prefix ("backlash", "zero_reading", …) sets every term of the group. Values are
+        in internal units (mm, rad, relative). Unknown names or bad values raise
+        :class:`~stereoplotter.errors.ConfigError` naming the file and the field.
+        """
+        terms = {t.name: t for t in self.terms}
+        groups = {n.split(".")[0] for n in terms}
+        for key, value in overrides.items():
+            names = [n for n in terms if n == key or (key in groups and n.startswith(key + "."))]
+            if not names:
+                raise ConfigError(
+                    source,
+                    str(key),
+                    "an error term or group: " + ", ".join(sorted(groups | set(terms))),
+                    key,
+                )
+            dist = None
+            if isinstance(value, Mapping):
+                dist = value.get("distribution")
+                value = value.get("scale")
+                if dist is not None and dist not in DISTRIBUTIONS:
+                    raise ConfigError(
+                        source, f"{key}.distribution", "one of " + ", ".join(DISTRIBUTIONS), dist
+                    )
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, int | float)
+                or not (np.isfinite(value) and value >= 0)
+            ):
+                raise ConfigError(source, f"{key}", "a finite number ≥ 0 (internal units)", value)
+            for name in names:
+                terms[name] = replace(
+                    terms[name],
+                    scale=float(value),
+                    distribution=dist or terms[name].distribution,
+                    assumed=True,
+                )
+        return replace(self, terms=tuple(terms.values()))
+
+    def draw(
+        self, rng: np.random.Generator, trials: int | None = None
+    ) -> dict[str, NDArray[np.float64] | float]:
+        """All terms at once, in the fixed order of :attr:`terms`.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+        trials : int, optional
+            None → floats (one instrument); T → arrays of shape (T,).
+        """
+        return {t.name: t.draw(rng, trials) for t in self.terms}
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready description: every term with its distribution, scale, unit and status."""
+        return {
+            t.name: {
+                "distribution": t.distribution,
+                "scale": t.scale,
+                "unit": t.unit,
+                "source": t.source_key,
+                "assumed": t.assumed,
+                "meaning": t.meaning,
+            }
+            for t in self.terms
+        }
+
+
+def error_model_from_spec(spec: InstrumentSpec) -> ErrorModel:
+    """The default error model of an instrument, from its YAML ``errors.*`` parameters.
+
+    Examples
+    --------
+    >>> from stereoplotter.instrument.spec import load_instrument
+    >>> model = error_model_from_spec(load_instrument("sc1"))
+    >>> model.term("backlash.X").scale, model.term("backlash.X").assumed
+    (0.005, True)
+    >>> import numpy as np
+    >>> model.zero().draw(np.random.default_rng(1))["zero_reading.X"]
+    0.0
+    """
+    return ErrorModel(spec.key, tuple(_terms(spec)))
