@@ -78,6 +78,7 @@ from stereoplotter.setup_data import (
     projection_distance,
     transformation_coefficient,
 )
+from stereoplotter.setup_sheet import assumed_parameters
 from stereoplotter.yamlio import Fields, atomic_write_text, load_yaml_mapping
 
 __all__ = [
@@ -1127,6 +1128,9 @@ def model_sheet(result: BlockResult, i: int) -> dict[str, Any]:
         "status": "ok" if ok else "refused",
         "reason": result.reason(i),
         "reason_code": int(result.reason_code[i]),
+        "assumed": {
+            key: list(params) for key, params in assumed_parameters(result.spec).items() if params
+        },
         "scale_horizontal": _int(result.horizontal_scale_denominator[i]),
         "scale_vertical": _int(result.vertical_scale_denominator[i]),
         "scale_map": result.map_scale_denominator,

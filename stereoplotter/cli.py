@@ -376,6 +376,7 @@ def _setup(args: argparse.Namespace) -> int:
         book_sign_n_right=args.book_sign,
         horizontal_scale_denominator=args.horizontal_scale,
         vertical_scale_denominator=args.vertical_scale,
+        bz_scale_sense=args.bz_scale_sense,
     )
     seed = scenario.seed if args.seed is None else args.seed
     sheet = compute_setup_sheet(scenario, spec, options, np.random.default_rng(seed))
@@ -475,6 +476,14 @@ def _parser() -> argparse.ArgumentParser:
         "--book-sign",
         action="store_true",
         help="use the printed sign of (6.4) for n_п (default: the geometric sign)",
+    )
+    p.add_argument(
+        "--bz-scale-sense",
+        type=int,
+        choices=(1, -1),
+        default=1,
+        help="+1: the b_z scale grows when the right pivot rises (default); -1: the other way, "
+        "as the printed minus of (6.11) implies",
     )
     p.add_argument("--horizontal-scale", type=int, metavar="M", help="force M_г = M")
     p.add_argument("--vertical-scale", type=int, metavar="M", help="force M_в = M")

@@ -71,6 +71,7 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
         ``tolerance`` where the book gives one, ``note``.
     """
     tol = sheet.tolerances
+    sense = sheet.options.bz_scale_sense
     bx, by, bz = sheet.base_mm
     left, right = sheet.photos
     n_l, n_r = sheet.n_left, sheet.n_right
@@ -124,17 +125,21 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
             "mm",
             "(6.5)",
             tolerance=tol["mark_span_mm"],
-            note="correct with Δb_z (6.10), O′_bz = O_bz + Δb_z (6.11, b_z scale sense +1)",
+            note=(
+                f"correct with Δb_z (6.10): O′_bz = O_bz {'+' if sense > 0 else '−'} Δb_z "
+                f"(6.11, b_z scale sense {sense:+d})"
+            ),
         ),
         _r(
             1,
             "record the zero readings",
             "MO_bz",
             "O_bz",
-            -bz,
+            -sense * bz,
             "mm",
             "decision D7",
-            note="MO_bz = (b_z reading) − b_z′; MO_Z = height-scale reading [m]",
+            note="MO_bz = (b_z reading) ∓ b_z′ (by the scale sense); MO_Z = height-scale "
+            "reading [m]",
         ),
     ]
     for photo, n, zero_x, zero_y, x_mark in (
@@ -212,7 +217,7 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
             "vertical base",
             "O_bz",
             "MO_bz",
-            bz,
+            sense * bz,
             "mm",
             "(6.14)",
             note="b_z′ = k·b_z; under D7 a re-set of the stage-1 value",

@@ -65,6 +65,7 @@ __all__ = [
     "SetupOptions",
     "SetupRefusal",
     "SetupSheet",
+    "assumed_parameters",
     "compute_setup_sheet",
 ]
 
@@ -88,14 +89,22 @@ class SetupOptions:
         Use the printed sign of (6.4) (n_п < n_л for a higher right station).
     horizontal_scale_denominator, vertical_scale_denominator : int or None
         Force M_г and/or M_в instead of choosing them (still range-checked).
-    book_corner_form : bool
-        Also report the corners by the printed (6.7) (n·1000/M_photo); the values coincide.
+    bz_scale_sense : int
+        +1 (default): the b_z scale grows when the right pivot rises, so (6.11) reads
+        O′_bz = O_bz + Δb_z and (6.14) O_bz = MO_bz + b_z′. −1: a scale counting the other way,
+        which makes the printed minus of (6.11) right and turns (6.14) into MO_bz − b_z′.
     """
 
     book_sign_n_right: bool = False
     horizontal_scale_denominator: int | None = None
     vertical_scale_denominator: int | None = None
-    book_corner_form: bool = True
+    bz_scale_sense: int = 1
+
+    def __post_init__(self) -> None:
+        if self.bz_scale_sense not in (1, -1):
+            raise StereoplotterError(
+                f"bz_scale_sense: expected +1 or -1, found {self.bz_scale_sense!r}"
+            )
 
 
 @dataclass(frozen=True, slots=True)
@@ -465,7 +474,7 @@ def compute_setup_sheet(
         readings=(),
         tolerances=tolerances,
         candidates=candidates,
-        assumed=_assumed_map(spec),
+        assumed=assumed_parameters(spec),
         options=options,
         depth_range_used_mm=(
             float(depths_m.min() * MM_PER_M / mv),
@@ -486,8 +495,11 @@ def compute_setup_sheet(
     return replace(sheet, readings=stage_readings(sheet))
 
 
-def _assumed_map(spec: InstrumentSpec) -> dict[str, tuple[str, ...]]:
-    """For each sheet quantity, the assumed instrument parameters it rests on."""
+def assumed_parameters(spec: InstrumentSpec) -> dict[str, tuple[str, ...]]:
+    """For each sheet quantity (the ``--json`` key), the assumed instrument parameters it rests on.
+
+    Shared by the single-pair sheet and block mode.
+    """
     scales = _assumed(
         spec,
         "coordinatograph_ratios",

@@ -77,6 +77,9 @@ def sheet_to_dict(sheet: SetupSheet) -> dict[str, Any]:
         "f_instrument_mm": _round(sheet.f_instrument_mm),
         "transformation_coefficient": _round(sheet.transformation_coefficient),
         "focal_length_corrected_mm": _round(sheet.focal_length_corrected_mm),
+        "focal_length_corrected_per_photo_mm": [
+            _round(v) for v in sheet.focal_length_corrected_per_photo_mm
+        ],
         "n_left": _round(sheet.n_left),
         "n_right": _round(sheet.n_right),
         "base_mm": dict(zip(("bx", "by", "bz"), (_round(v) for v in sheet.base_mm), strict=True)),
@@ -106,7 +109,13 @@ def sheet_to_dict(sheet: SetupSheet) -> dict[str, Any]:
             h["id"]: _round(h["model_height_mm"]) for h in sheet.control_heights
         },
         "sheet_corners_mm": {
-            c["corner"]: {"position": c["position"], "x": _round(c["x_mm"]), "y": _round(c["y_mm"])}
+            c["corner"]: {
+                "position": c["position"],
+                "x": _round(c["x_mm"]),
+                "y": _round(c["y_mm"]),
+                "x_book_form": _round(c["x_book_form_mm"]),
+                "y_book_form": _round(c["y_book_form_mm"]),
+            }
             for c in sheet.corners
         },
         "similarity": similarity,
@@ -126,15 +135,12 @@ def sheet_to_dict(sheet: SetupSheet) -> dict[str, Any]:
         "scale_choice": {
             "chosen": [sheet.horizontal_scale_denominator, sheet.vertical_scale_denominator],
             "feasible": [[c.horizontal, c.vertical] for c in sheet.candidates if c.feasible],
-            "refused_larger_scales": [
-                {"horizontal": c.horizontal, "vertical": c.vertical, "reasons": list(c.reasons)}
-                for c in sheet.candidates
-                if not c.feasible
-                and c.horizontal < sheet.horizontal_scale_denominator
-                and c.f_instrument_mm > 0
-            ][:12],
+            "refused_larger_scales": _refused_larger_scales(sheet),
         },
-        "options": {"book_sign_n_right": sheet.options.book_sign_n_right},
+        "options": {
+            "book_sign_n_right": sheet.options.book_sign_n_right,
+            "bz_scale_sense": sheet.options.bz_scale_sense,
+        },
         "assumed": assumed,
         "annotations": {
             k: {"unit": u, "equation": e, "meaning": m, "assumed": bool(sheet.assumed.get(k))}
@@ -142,6 +148,25 @@ def sheet_to_dict(sheet: SetupSheet) -> dict[str, Any]:
         },
     }
     return data
+
+
+def _refused_larger_scales(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """For every horizontal scale larger than the chosen one, its closest M_в and why it fails."""
+    rows = []
+    for mg in sorted({c.horizontal for c in sheet.candidates}):
+        if mg >= sheet.horizontal_scale_denominator:
+            break
+        options = [c for c in sheet.candidates if c.horizontal == mg]
+        best = min(options, key=lambda c: (len(c.reasons), c.vertical))
+        rows.append(
+            {
+                "horizontal": mg,
+                "closest_vertical": best.vertical,
+                "f_instrument_mm": _round(best.f_instrument_mm, 3),
+                "fails": list(best.reasons),
+            }
+        )
+    return rows
 
 
 def _fmt(value: float, digits: int = 3) -> str:

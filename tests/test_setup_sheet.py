@@ -284,3 +284,32 @@ def test_cli_setup_block_mode(tmp_path, capsys):
     assert len(models) == 8 and all(m["status"] == "ok" for m in models)
     assert main(["setup", block, "--instrument", "sc1", "--horizontal-scale", "12500"]) == 1
     assert "apply to single pairs only" in capsys.readouterr().err
+
+
+def test_corner_readings_6_16_to_6_18_and_zero_reading_of_bz():
+    s = load_scenario(SCENARIOS / "pair60.yaml")
+    sheet = compute_setup_sheet(s, load_instrument("sc1"))
+    rows = {r["reading"]: r for r in sheet.readings}
+    for corner, equation in (("1", "(6.16)"), ("3", "(6.17)"), ("4", "(6.18)")):
+        c = next(c for c in sheet.corners if c["corner"] == corner)
+        assert rows[f"corner {corner}: O_X"]["value"] == pytest.approx(c["x_mm"])
+        assert rows[f"corner {corner}: O_Y"]["value"] == pytest.approx(c["y_mm"])
+        assert rows[f"corner {corner}: O_X"]["equation"] == equation
+        assert rows[f"corner {corner}: O_X"]["zero_reading"] == "MO_X"  # the left plumb
+    # D7: MO_bz = stage-1 reading − b_z′, and (6.14) re-sets MO_bz + b_z′: the same b_z reading
+    assert rows["MO_bz"]["value"] + rows["O_bz"]["value"] == pytest.approx(0.0)
+    other = compute_setup_sheet(s, load_instrument("sc1"), SetupOptions(bz_scale_sense=-1))
+    rows_other = {r["reading"]: r for r in other.readings}
+    assert rows_other["O_bz"]["value"] == pytest.approx(-rows["O_bz"]["value"])
+    with pytest.raises(StereoplotterError, match="bz_scale_sense: expected"):
+        SetupOptions(bz_scale_sense=0)
+
+
+def test_scale_choice_reports_why_larger_scales_fail():
+    sheet = compute_setup_sheet(load_scenario(SCENARIOS / "pair60.yaml"), load_instrument("sc1"))
+    refused = sheet_to_dict(sheet)["scale_choice"]["refused_larger_scales"]
+    assert [r["horizontal"] for r in refused] == [5000, 6300, 8000, 10000]
+    assert all(r["fails"] for r in refused)
+    # 1:10 000 fails on depth: D_max = 185 mm needs M_в ≥ 1425 m·1000/185 = 7703, and then
+    # f_пр = 70·10000/M_в < 100 mm; its closest pair is limited by the projection distance
+    assert refused[-1]["fails"] == ["projection_distance"]

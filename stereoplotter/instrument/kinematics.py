@@ -1,0 +1,832 @@
+r"""Pure kinematics of a transformed-bundle stereoplotter (SC-1, SPR-3, SD-3).
+
+The correction unit of each photo (correction plane + decentration + cassette rotation) and the
+instrument's two rods, as closed-form, vectorised maps between counter readings, rod coordinates
+and photo coordinates. The model is fixed by ``kinematics.md`` (design decision, §2–§4 and §8);
+this module implements its §3.3 (forward map) and §3.4 (inverse maps) and the knob semantics of
+decision D1 (§4.1, §8).
+
+Reference
+---------
+.. [1] Kushtin I. F. & Lyskov G. A., *Фотограмметрия снимка и стереоскопических моделей*,
+   Moscow: Nedra, 1984, ch. 6, §26–§27, pp. 153–163 (OCR L3680–4030).
+.. [2] F. V. Drobyshev, "Soviet stereophotogrammetric instruments", ISP Congress 1960,
+   Comm. II, pp. 767–773 (transformed bundles, k = F/f_k, planes at kα, kω).
+
+Frames and conventions (``kinematics.md`` §3.1)
+-----------------------------------------------
+* Counters X, Y [mm] along the instrument guides; D [mm] = reading of the absolute height counter
+  = depth of the model point below the left pivot S_л. The counters read MO_X, MO_Y with the left
+  mark on the plumb of S_л. The right pivot is S_п = S_л + (b_x, b_y, b_z′), b_z′ = k·b_z.
+* Rod coordinates (ξ, η) [mm] of a photo: the horizontal offset of the model point from the
+  pivot's plumb divided by n = D_j / f_пр, i.e. the book's x⁰/n, y⁰/n: nadir-referenced
+  rectified coordinates at the camera principal distance f′.
+* Photo coordinates (x, y) [mm] in the fiducial system, principal point at the origin, positive
+  plane. κ turns the cassette about its centre, innermost (after the tilts).
+* Tilts are represented by T_α = tan θ_α / k, T_ω = tan θ_ω / k: the tangent of the tilt that the
+  correction plane of inclination θ represents (tan θ = k tan α, [2] eq. (4)).
+
+Shapes: every function broadcasts. A point argument has shape ``(..., 2)``; the fields of a
+:class:`CorrectionUnit` or :class:`InstrumentSetting` and the counters are scalars or arrays that
+broadcast against the leading dimensions ``...`` of the points (e.g. one row per trial and one
+column per point).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.setup_data import correction_inclination, decentration
+
+__all__ = [
+    "DECENTRATION_VARIANTS",
+    "LINKAGES",
+    "CorrectionUnit",
+    "DecentrationVariant",
+    "InstrumentSetting",
+    "StereoReading",
+    "correction_angle",
+    "counters_from_homologous_points",
+    "counters_from_photo",
+    "decentration_variant",
+    "dependent_decentration_change",
+    "marks_from_counters",
+    "photo_from_rod",
+    "represented_tilt_tangent",
+    "rod_from_counters",
+    "rod_from_photo",
+    "rods_intersection",
+    "set_decentrations",
+    "turn_correction_knob",
+    "unit_for_orientation",
+]
+
+#: Allowed linkages between a correction knob and the decentrations (``kinematics.md`` §4.1):
+#: "L" both the photo decentration e and the plane decentration c follow the knob (D1),
+#: "A" only the photo decentration follows, "B" the decentrations are independent.
+LINKAGES = ("L", "A", "B")
+
+
+@dataclass(frozen=True, slots=True)
+class DecentrationVariant:
+    """A named decentration variant of the instrument model (``kinematics.md`` §4.1, §5).
+
+    Attributes
+    ----------
+    name : str
+        "L", "A", "B", "B2" or "S".
+    linkage : str
+        How turning a correction knob moves the decentrations, one of :data:`LINKAGES`.
+    decentrations_first : bool
+        The computed decentrations are set before the k_ω, k_α fits (B2) instead of after them.
+    strict_per_axis : bool
+        The correction unit is the strict per-axis mechanism (α only in x, ω only in y).
+    description : str
+        One line for tables.
+    """
+
+    name: str
+    linkage: str
+    decentrations_first: bool
+    strict_per_axis: bool
+    description: str
+
+
+#: The variants compared in ``kinematics.md`` §5 [1]; "L" is the canonical one (decision D1).
+DECENTRATION_VARIANTS: dict[str, DecentrationVariant] = {
+    v.name: v
+    for v in (
+        DecentrationVariant("L", "L", False, False, "canonical: dependent decentration (D1)"),
+        DecentrationVariant("A", "A", False, False, "only the photo decentration follows"),
+        DecentrationVariant("B", "B", False, False, "book order, independent decentrations"),
+        DecentrationVariant("B2", "B", True, False, "independent, decentrations set first"),
+        DecentrationVariant("S", "L", False, True, "strict per-axis unit, linkage as L"),
+    )
+}
+
+
+def decentration_variant(name: str) -> DecentrationVariant:
+    """The :class:`DecentrationVariant` called ``name``.
+
+    Raises
+    ------
+    StereoplotterError
+        ``name`` is not one of :data:`DECENTRATION_VARIANTS`.
+
+    Examples
+    --------
+    >>> decentration_variant("B2").decentrations_first
+    True
+    """
+    try:
+        return DECENTRATION_VARIANTS[name]
+    except KeyError:
+        raise StereoplotterError(
+            f"unknown decentration variant {name!r}; expected one of "
+            f"{', '.join(DECENTRATION_VARIANTS)}"
+        ) from None
+
+
+def _a(v: ArrayLike) -> NDArray[np.float64]:
+    return np.asarray(v, dtype=float)
+
+
+@dataclass(frozen=True, slots=True)
+class CorrectionUnit:
+    r"""State of the correction unit of one photo (``kinematics.md`` §3.2).
+
+    Every field is a scalar or an array; arrays broadcast against the leading dimensions of the
+    points passed to :func:`photo_from_rod` and :func:`rod_from_photo`.
+
+    Attributes
+    ----------
+    focal_length_mm : float or ndarray
+        f′, the camera principal distance known to the unit (decision D3). [mm]
+    tan_alpha, tan_omega : float or ndarray
+        T_α = tan θ_α / k, T_ω = tan θ_ω / k: the tangent of the tilt represented by the
+        correction-plane settings "k_α", "k_ω". [—]
+    decentration_x_mm, decentration_y_mm : float or ndarray
+        e = (e_x, e_y): the photo decentration. [mm]
+    kappa : float or ndarray
+        κ, the cassette rotation about its centre. [rad]
+    plane_decentration_x_mm, plane_decentration_y_mm : float, ndarray or None
+        c = (c_x, c_y): the decentration of the correction plane. None (default) means c = e,
+        the merged pair of decision D2; separate values are needed for variant "A". [mm]
+    strict_per_axis : bool
+        Use the strict per-axis mechanism (α only in x, ω only in y, no common change of F;
+        ``kinematics.md`` §3.3, last paragraph) instead of the correction plane.
+    """
+
+    focal_length_mm: ArrayLike
+    tan_alpha: ArrayLike = 0.0
+    tan_omega: ArrayLike = 0.0
+    decentration_x_mm: ArrayLike = 0.0
+    decentration_y_mm: ArrayLike = 0.0
+    kappa: ArrayLike = 0.0
+    plane_decentration_x_mm: ArrayLike | None = None
+    plane_decentration_y_mm: ArrayLike | None = None
+    strict_per_axis: bool = False
+
+    @property
+    def plane_decentration_mm(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(c_x, c_y), with the D2 default c = e resolved. [mm]"""
+        cx = self.decentration_x_mm
+        cy = self.decentration_y_mm
+        if self.plane_decentration_x_mm is not None:
+            cx = self.plane_decentration_x_mm
+        if self.plane_decentration_y_mm is not None:
+            cy = self.plane_decentration_y_mm
+        return _a(cx), _a(cy)
+
+
+@dataclass(frozen=True, slots=True)
+class InstrumentSetting:
+    r"""Global state of the instrument apart from the counters (``kinematics.md`` §3.2).
+
+    The counters X, Y and the absolute height counter D are passed to the functions as arrays (one
+    value per point or per trial), so that one setting serves many points.
+
+    Attributes
+    ----------
+    f_instrument_mm : float or ndarray
+        f_пр, the instrument principal distance. [mm]
+    base_x_mm, base_y_mm : float or ndarray
+        b_x, b_y at the horizontal model scale. [mm]
+    base_z_mm : float or ndarray
+        b_z′ = k·b_z, the vertical base component as set (positive: right pivot higher). [mm]
+    model_origin_x_mm, model_origin_y_mm : float or ndarray
+        MO_X, MO_Y: the counter readings with the left mark on the plumb of S_л. [mm]
+    """
+
+    f_instrument_mm: ArrayLike
+    base_x_mm: ArrayLike = 0.0
+    base_y_mm: ArrayLike = 0.0
+    base_z_mm: ArrayLike = 0.0
+    model_origin_x_mm: ArrayLike = 0.0
+    model_origin_y_mm: ArrayLike = 0.0
+
+    def pivot(self, side: str) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray]:
+        """Plumb position (S_x, S_y) [mm] and height above S_л [mm] of the "left"/"right" pivot."""
+        if side == "left":
+            return _a(self.model_origin_x_mm), _a(self.model_origin_y_mm), _a(0.0)
+        if side == "right":
+            return (
+                _a(self.model_origin_x_mm) + _a(self.base_x_mm),
+                _a(self.model_origin_y_mm) + _a(self.base_y_mm),
+                _a(self.base_z_mm),
+            )
+        raise StereoplotterError(f"side must be 'left' or 'right', found {side!r}")
+
+
+class StereoReading(NamedTuple):
+    """Counters of a model point seen in both photos, and the y-parallax left there.
+
+    Attributes
+    ----------
+    x_mm, y_mm : ndarray
+        X, Y counters. [mm]
+    depth_mm : ndarray
+        D, the absolute height counter (depth below S_л). [mm]
+    y_parallax_mm : ndarray
+        q, the y-parallax in photo mm (n·q in model mm). [mm]
+    """
+
+    x_mm: NDArray[np.float64]
+    y_mm: NDArray[np.float64]
+    depth_mm: NDArray[np.float64]
+    y_parallax_mm: NDArray[np.float64]
+
+
+# --------------------------------------------------------------------------------------------
+# The correction unit: rod coordinates <-> photo coordinates
+# --------------------------------------------------------------------------------------------
+
+
+def photo_from_rod(rod_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.float64]:
+    r"""Photo point under the mark for given rod coordinates (the correction unit's forward map).
+
+    Parameters
+    ----------
+    rod_mm : array_like, shape (..., 2)
+        Rod coordinates (ξ, η) = ((X − S_x)/n, (Y − S_y)/n), the book's x⁰/n, y⁰/n. [mm]
+    unit : CorrectionUnit
+        State of the photo's correction unit.
+
+    Returns
+    -------
+    ndarray, shape (..., 2)
+        (x, y), photo coordinates in the fiducial system. [mm]
+
+    Notes
+    -----
+    Implements ``kinematics.md`` §3.3 (correction plane with common change of F, then photo
+    decentration, then the cassette rotation):
+
+    .. math::
+        \tau = \frac{f' + c_x T_\alpha + c_y T_\omega}{f' + \xi T_\alpha + \eta T_\omega},\quad
+        (u, v) = \tau\,(\xi, \eta) - (e_x, e_y),\quad
+        (x, y)^T = R_2(\kappa)^T (u, v)^T
+
+    with R₂(κ) = [[cos κ, −sin κ], [sin κ, cos κ]]. With e = c = f′(T_α, T_ω) and κ = 0 a point
+    on a fiducial axis obeys Eq. (6.1) (x axis) or Eq. (6.2) (y axis) of [1]_ exactly, for any
+    combination of α and ω; off the axes the unit is the per-axis approximation (§3.3, §6).
+
+    With ``unit.strict_per_axis`` the plane is replaced by two independent single-axis units,
+    u = ξ (f′ + c_x T_α)/(f′ + ξ T_α) − e_x and v = η (f′ + c_y T_ω)/(f′ + η T_ω) − e_y
+    (§3.3, last paragraph; with e = c = f′T this is x = f′(ξ − f′T_α)/(f′ + ξT_α)).
+
+    Examples
+    --------
+    The principal point of a photo tilted by α = 3° lies under the rod at x⁰ = f′ tan α:
+
+    >>> import numpy as np
+    >>> unit = unit_for_orientation(np.radians(3.0), 0.0, 0.0, 100.0)
+    >>> np.round(photo_from_rod([100.0 * np.tan(np.radians(3.0)), 0.0], unit), 12) + 0.0
+    array([0., 0.])
+    """
+    rod = _a(rod_mm)
+    xi, eta = rod[..., 0], rod[..., 1]
+    f = _a(unit.focal_length_mm)
+    ta, to = _a(unit.tan_alpha), _a(unit.tan_omega)
+    cx, cy = unit.plane_decentration_mm
+    if unit.strict_per_axis:
+        u = xi * (f + cx * ta) / (f + xi * ta)
+        v = eta * (f + cy * to) / (f + eta * to)
+    else:
+        tau = (f + cx * ta + cy * to) / (f + xi * ta + eta * to)
+        u, v = tau * xi, tau * eta
+    u = u - _a(unit.decentration_x_mm)
+    v = v - _a(unit.decentration_y_mm)
+    c, s = np.cos(_a(unit.kappa)), np.sin(_a(unit.kappa))
+    return np.stack(np.broadcast_arrays(c * u + s * v, -s * u + c * v), axis=-1)
+
+
+def rod_from_photo(photo_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.float64]:
+    r"""Rod coordinates that bring the mark onto a photo point (inverse of :func:`photo_from_rod`).
+
+    Parameters
+    ----------
+    photo_mm : array_like, shape (..., 2)
+        (x, y), photo coordinates in the fiducial system. [mm]
+    unit : CorrectionUnit
+        State of the photo's correction unit.
+
+    Returns
+    -------
+    ndarray, shape (..., 2)
+        (ξ, η), rod coordinates (the book's x⁰/n, y⁰/n). [mm]
+
+    Notes
+    -----
+    Implements ``kinematics.md`` §3.4, closed form:
+
+    .. math::
+        (u, v)^T = R_2(\kappa)(x, y)^T,\quad P = (u + e_x, v + e_y),\quad
+        \tau = \frac{f' + c_x T_\alpha + c_y T_\omega - P_x T_\alpha - P_y T_\omega}{f'},\quad
+        (\xi, \eta) = P / \tau
+
+    On the fiducial axes, with the true settings (e = c = f′ tan α, f′ tan ω; κ = 0), ξ of a
+    point (x, 0) is Eq. (6.1) and η of a point (0, y) is Eq. (6.2) of [1]_, n-free (the counters
+    apply n once). The strict per-axis unit inverts each axis separately.
+
+    Examples
+    --------
+    Eq. (6.1) at the fiducial x = 85 mm of a photo with α = 1°, ω = −2°, f′ = 100 mm:
+
+    >>> import numpy as np
+    >>> from stereoplotter.geometry.transformed import transformed_x_single_tilt
+    >>> unit = unit_for_orientation(np.radians(1.0), np.radians(-2.0), 0.0, 100.0)
+    >>> xi = rod_from_photo([85.0, 0.0], unit)[0]
+    >>> bool(abs(xi - transformed_x_single_tilt(85.0, np.radians(1.0), 100.0)) < 1e-12)
+    True
+    """
+    p = _a(photo_mm)
+    x, y = p[..., 0], p[..., 1]
+    c, s = np.cos(_a(unit.kappa)), np.sin(_a(unit.kappa))
+    px = c * x - s * y + _a(unit.decentration_x_mm)
+    py = s * x + c * y + _a(unit.decentration_y_mm)
+    f = _a(unit.focal_length_mm)
+    ta, to = _a(unit.tan_alpha), _a(unit.tan_omega)
+    cx, cy = unit.plane_decentration_mm
+    if unit.strict_per_axis:
+        xi = px * f / (f + cx * ta - px * ta)
+        eta = py * f / (f + cy * to - py * to)
+    else:
+        tau = (f + cx * ta + cy * to - px * ta - py * to) / f
+        xi, eta = px / tau, py / tau
+    return np.stack(np.broadcast_arrays(xi, eta), axis=-1)
+
+
+# --------------------------------------------------------------------------------------------
+# The instrument: counters <-> rods <-> photos
+# --------------------------------------------------------------------------------------------
+
+
+def _depth(setting: InstrumentSetting, side: str, depth_mm: ArrayLike):
+    sx, sy, sz = setting.pivot(side)
+    return sx, sy, _a(depth_mm) + sz
+
+
+def rod_from_counters(
+    x_mm: ArrayLike,
+    y_mm: ArrayLike,
+    depth_mm: ArrayLike,
+    setting: InstrumentSetting,
+    side: str = "left",
+) -> NDArray[np.float64]:
+    r"""Rod coordinates (ξ, η) of one photo for given counter readings.
+
+    Parameters
+    ----------
+    x_mm, y_mm : float or ndarray
+        X, Y counters. [mm]
+    depth_mm : float or ndarray
+        D, the absolute height counter (depth below S_л). [mm]
+    setting : InstrumentSetting
+        f_пр, base and MO.
+    side : {"left", "right"}
+        Which rod.
+
+    Returns
+    -------
+    ndarray, shape (..., 2)
+        (ξ, η) = ((X − S_x)/n_j, (Y − S_y)/n_j), n_j = D_j/f_пр, D_л = D, D_п = D + b_z′. [mm]
+
+    Notes
+    -----
+    ``kinematics.md`` §3.3, first two lines; n_л is Eq. (6.3) of [1]_ when D = D_max, and n_п the
+    geometric reading of Eq. (6.4) (D_п = D + b_z′).
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(130.0, base_x_mm=100.0, base_z_mm=2.0)
+    >>> rod_from_counters(100.0 + 1.5 * 10.0, 0.0, 1.5 * 130.0 - 2.0, setting, "right")
+    array([10.,  0.])
+    """
+    sx, sy, dj = _depth(setting, side, depth_mm)
+    n = dj / _a(setting.f_instrument_mm)
+    return np.stack(np.broadcast_arrays((_a(x_mm) - sx) / n, (_a(y_mm) - sy) / n), axis=-1)
+
+
+def counters_from_photo(
+    photo_mm: ArrayLike,
+    depth_mm: ArrayLike,
+    unit: CorrectionUnit,
+    setting: InstrumentSetting,
+    side: str = "left",
+) -> NDArray[np.float64]:
+    r"""Monocular setting: the X, Y counters that put one mark on a photo point at a given D.
+
+    Parameters
+    ----------
+    photo_mm : array_like, shape (..., 2)
+        (x, y) on the photo of ``side``. [mm]
+    depth_mm : float or ndarray
+        D, the absolute height counter. [mm]
+    unit : CorrectionUnit
+        The correction unit of that photo.
+    setting : InstrumentSetting
+        f_пр, base and MO.
+    side : {"left", "right"}
+        Which photo.
+
+    Returns
+    -------
+    ndarray, shape (..., 2)
+        (X, Y) = S_j + n_j·(ξ, η). [mm]
+
+    Notes
+    -----
+    ``kinematics.md`` §3.4, "monocular". With the true unit and κ = 0 these are the book's
+    fiducial targets MO + n·x⁰, MO + n·y⁰ of Eqs. (6.12)/(6.13) of [1]_ (with per-photo MO,
+    decision D6).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> unit = unit_for_orientation(0.0, np.radians(1.0), 0.0, 100.0)
+    >>> xy = counters_from_photo([0.0, 85.0], 185.0, unit, InstrumentSetting(130.0))
+    >>> np.round(xy, 4) + 0.0
+    array([  0.    , 125.3046])
+    """
+    sx, sy, dj = _depth(setting, side, depth_mm)
+    n = dj / _a(setting.f_instrument_mm)
+    rod = rod_from_photo(photo_mm, unit)
+    return np.stack(np.broadcast_arrays(sx + n * rod[..., 0], sy + n * rod[..., 1]), axis=-1)
+
+
+def marks_from_counters(
+    x_mm: ArrayLike,
+    y_mm: ArrayLike,
+    depth_mm: ArrayLike,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    r"""Photo points under the left and the right mark for given counters.
+
+    Parameters
+    ----------
+    x_mm, y_mm, depth_mm : float or ndarray
+        X, Y counters and the absolute height counter D. [mm]
+    setting : InstrumentSetting
+        f_пр, base and MO.
+    left, right : CorrectionUnit
+        The correction units of the two photos.
+
+    Returns
+    -------
+    photo_left, photo_right : ndarray, shape (..., 2)
+        (x, y) under each mark. [mm]
+
+    Notes
+    -----
+    ``kinematics.md`` §3.3: :func:`rod_from_counters` followed by :func:`photo_from_rod` for each
+    photo. On the fiducial axes the relation is Eqs. (6.1)/(6.2) of [1]_ scaled by n.
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(130.0, base_x_mm=90.0)
+    >>> unit = CorrectionUnit(100.0)
+    >>> pl, pr = marks_from_counters(45.0, 0.0, 130.0, setting, unit, unit)
+    >>> pl.tolist(), pr.tolist()
+    ([45.0, 0.0], [-45.0, 0.0])
+    """
+    pl = photo_from_rod(rod_from_counters(x_mm, y_mm, depth_mm, setting, "left"), left)
+    pr = photo_from_rod(rod_from_counters(x_mm, y_mm, depth_mm, setting, "right"), right)
+    return pl, pr
+
+
+def rods_intersection(
+    rod_left_mm: ArrayLike, rod_right_mm: ArrayLike, setting: InstrumentSetting
+) -> StereoReading:
+    r"""Counters and y-parallax where the two rods meet in the XZ plane (x-parallax cleared).
+
+    Parameters
+    ----------
+    rod_left_mm, rod_right_mm : array_like, shape (..., 2)
+        (ξ, η) of the left and the right rod. [mm]
+    setting : InstrumentSetting
+        f_пр, base and MO.
+
+    Returns
+    -------
+    StereoReading
+        X, Y, D [mm] and q [mm, photo scale].
+
+    Notes
+    -----
+    ``kinematics.md`` §3.4, "stereo": rays S_j + t_j (ξ_j, η_j, −f_пр) with
+    t_л ξ_л − t_п ξ_п = b_x and t_п − t_л = b_z′/f_пр; then X = MO_X + t_л ξ_л, D = t_л f_пр,
+    Y = MO_Y + ½(t_л η_л + b_y + t_п η_п) and
+
+    .. math:: q = \frac{t_л \eta_л - (b_y + t_п \eta_п)}{t_л}
+
+    (t_л = n_л, so n·q is the parallax in model mm). Rods parallel in X give inf/NaN.
+    """
+    rl, rr = _a(rod_left_mm), _a(rod_right_mm)
+    f = _a(setting.f_instrument_mm)
+    bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
+    xi_l, eta_l = rl[..., 0], rl[..., 1]
+    xi_r, eta_r = rr[..., 0], rr[..., 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_l = (bx + xi_r * bz / f) / (xi_l - xi_r)
+        t_r = t_l + bz / f
+        y_l = t_l * eta_l
+        y_r = by + t_r * eta_r
+        q = (y_l - y_r) / t_l
+    x = _a(setting.model_origin_x_mm) + t_l * xi_l
+    y = _a(setting.model_origin_y_mm) + 0.5 * (y_l + y_r)
+    return StereoReading(*np.broadcast_arrays(x, y, t_l * f, q))
+
+
+def counters_from_homologous_points(
+    photo_left_mm: ArrayLike,
+    photo_right_mm: ArrayLike,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+) -> StereoReading:
+    r"""Counters X, Y, D of the model point of two homologous photo points, and its y-parallax q.
+
+    Parameters
+    ----------
+    photo_left_mm, photo_right_mm : array_like, shape (..., 2)
+        (x, y) of the point on the left and on the right photo. [mm]
+    setting : InstrumentSetting
+        f_пр, base and MO.
+    left, right : CorrectionUnit
+        The correction units of the two photos.
+
+    Returns
+    -------
+    StereoReading
+        X, Y, D [mm] and q [mm, photo scale].
+
+    Notes
+    -----
+    ``kinematics.md`` §3.4: :func:`rod_from_photo` for each photo, then
+    :func:`rods_intersection`. It inverts :func:`marks_from_counters` (q = 0 then).
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(130.0, base_x_mm=90.0)
+    >>> unit = CorrectionUnit(100.0)
+    >>> r = counters_from_homologous_points([45.0, 0.0], [-45.0, 0.0], setting, unit, unit)
+    >>> [float(v) for v in r]
+    [45.0, 0.0, 130.0, 0.0]
+    """
+    return rods_intersection(
+        rod_from_photo(photo_left_mm, left), rod_from_photo(photo_right_mm, right), setting
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Settings and knob semantics (decision D1)
+# --------------------------------------------------------------------------------------------
+
+
+def unit_for_orientation(
+    alpha: ArrayLike,
+    omega: ArrayLike,
+    kappa: ArrayLike,
+    focal_length_mm: ArrayLike,
+    *,
+    strict_per_axis: bool = False,
+) -> CorrectionUnit:
+    r"""The correction unit at the true settings for a photo of tilts α, ω and swing κ.
+
+    Parameters
+    ----------
+    alpha, omega, kappa : float or ndarray
+        α, ω, κ of Eq. (2.50) of [1]_ (M = R_Y(−α)·R_X(ω)·R_Z(κ)). [rad]
+    focal_length_mm : float or ndarray
+        f′. [mm]
+    strict_per_axis : bool
+        Build the strict per-axis unit instead of the correction plane.
+
+    Returns
+    -------
+    CorrectionUnit
+        T_α = tan α, T_ω = tan ω, e = c = (f′ tan α, f′ tan ω) (``setup_data.decentration``), κ.
+
+    Notes
+    -----
+    ``kinematics.md`` §2.4 and §3.6: the decentrations the computer provides and the plane
+    inclinations tan θ = k tan α ([2]_ eq. (4)) expressed as T = tan θ/k.
+
+    Examples
+    --------
+    >>> unit = unit_for_orientation(0.01, 0.0, 0.0, 100.0)
+    >>> round(float(unit.decentration_x_mm), 6)
+    1.000033
+    """
+    return CorrectionUnit(
+        focal_length_mm=focal_length_mm,
+        tan_alpha=np.tan(_a(alpha)),
+        tan_omega=np.tan(_a(omega)),
+        decentration_x_mm=decentration(focal_length_mm, alpha),
+        decentration_y_mm=decentration(focal_length_mm, omega),
+        kappa=_a(kappa),
+        strict_per_axis=strict_per_axis,
+    )
+
+
+def represented_tilt_tangent(
+    plane_inclination: ArrayLike, transformation_coefficient_k: ArrayLike
+) -> NDArray[np.float64]:
+    r"""T = tan θ / k: the tangent of the tilt represented by a correction plane at θ.
+
+    Parameters
+    ----------
+    plane_inclination : float or ndarray
+        θ_α or θ_ω, the inclination of the correction plane. [rad]
+    transformation_coefficient_k : float or ndarray
+        k = f_пр / f′. [—]
+
+    Returns
+    -------
+    ndarray
+        T. [—]
+
+    Notes
+    -----
+    Inverse of tan θ = k tan α ([2]_ eq. (4); ``kinematics.md`` §3.2). The forward relation is
+    :func:`correction_angle` (which uses ``setup_data.correction_inclination``).
+
+    Examples
+    --------
+    >>> theta = correction_angle(0.05, 1.3)
+    >>> round(float(represented_tilt_tangent(theta, 1.3)), 12)
+    0.05
+    """
+    return np.tan(_a(plane_inclination)) / _a(transformation_coefficient_k)
+
+
+def correction_angle(
+    tan_tilt: ArrayLike, transformation_coefficient_k: ArrayLike
+) -> NDArray[np.float64]:
+    r"""θ = atan(k·T), the plane inclination that represents a tilt of tangent T.
+
+    Parameters
+    ----------
+    tan_tilt : float or ndarray
+        T_α or T_ω. [—]
+    transformation_coefficient_k : float or ndarray
+        k = f_пр / f′. [—]
+
+    Returns
+    -------
+    ndarray
+        θ. [rad]
+
+    Notes
+    -----
+    [2]_ eq. (4), tan θ = k tan α, via ``setup_data.correction_inclination``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> round(float(np.degrees(correction_angle(np.tan(np.radians(1.0)), 1.3))), 4)
+    1.2999
+    """
+    return correction_inclination(transformation_coefficient_k, np.arctan(_a(tan_tilt)))
+
+
+def dependent_decentration_change(
+    focal_length_mm: ArrayLike,
+    plane_inclination_before: ArrayLike,
+    plane_inclination_after: ArrayLike,
+    transformation_coefficient_k: ArrayLike,
+) -> NDArray[np.float64]:
+    r"""Change of the decentration dragged by turning a correction knob (decision D1).
+
+    Parameters
+    ----------
+    focal_length_mm : float or ndarray
+        f′. [mm]
+    plane_inclination_before, plane_inclination_after : float or ndarray
+        θ before and after the turn. [rad]
+    transformation_coefficient_k : float or ndarray
+        k = f_пр / f′. [—]
+
+    Returns
+    -------
+    ndarray
+        Δd = f′·Δ(tan θ / k) = f′·ΔT. [mm]
+
+    Notes
+    -----
+    ``kinematics.md`` §4.1 and §8: the θ_α knob changes tan θ_α by Δ and d_x by f′·Δ/k; the
+    θ_ω knob acts likewise on d_y. Starting from d = 0 at θ = 0 it keeps d = f′ T, the value
+    f′ tan α of the computed decentration.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> theta = correction_angle(np.tan(np.radians(1.0)), 1.3)
+    >>> round(float(dependent_decentration_change(100.0, 0.0, theta, 1.3)), 6)
+    1.745506
+    """
+    k = _a(transformation_coefficient_k)
+    return (
+        _a(focal_length_mm)
+        * (np.tan(_a(plane_inclination_after)) - np.tan(_a(plane_inclination_before)))
+        / k
+    )
+
+
+def turn_correction_knob(
+    unit: CorrectionUnit, axis: str, tan_tilt: ArrayLike, linkage: str = "L"
+) -> CorrectionUnit:
+    r"""The unit after turning the k_α or k_ω knob to represent the tilt tangent ``tan_tilt``.
+
+    Parameters
+    ----------
+    unit : CorrectionUnit
+        The unit before the turn.
+    axis : {"alpha", "omega"}
+        "alpha" turns θ_α (moves T_α, drags d_x), "omega" turns θ_ω (T_ω, d_y).
+    tan_tilt : float or ndarray
+        The new T = tan θ / k. [—]
+    linkage : {"L", "A", "B"}
+        "L" (default, D1): photo and plane decentrations move by f′·ΔT; "A": only the photo
+        decentration moves; "B": the decentrations stay (independent).
+
+    Returns
+    -------
+    CorrectionUnit
+        A new unit (the argument is frozen).
+
+    Notes
+    -----
+    ``kinematics.md`` §4.1 (variants) and §8 (knob semantics); the drag is
+    :func:`dependent_decentration_change` written in T.
+
+    Examples
+    --------
+    >>> u = turn_correction_knob(CorrectionUnit(100.0), "omega", 0.02)
+    >>> float(u.tan_omega), float(u.decentration_y_mm), u.plane_decentration_mm[1].item()
+    (0.02, 2.0, 2.0)
+    >>> u = turn_correction_knob(CorrectionUnit(100.0), "omega", 0.02, linkage="A")
+    >>> float(u.decentration_y_mm), u.plane_decentration_mm[1].item()
+    (2.0, 0.0)
+    """
+    if linkage not in LINKAGES:
+        raise StereoplotterError(f"linkage must be one of {LINKAGES}, found {linkage!r}")
+    if axis == "alpha":
+        t_name, e_name, c_index = "tan_alpha", "decentration_x_mm", 0
+    elif axis == "omega":
+        t_name, e_name, c_index = "tan_omega", "decentration_y_mm", 1
+    else:
+        raise StereoplotterError(f"axis must be 'alpha' or 'omega', found {axis!r}")
+    t_new = _a(tan_tilt)
+    delta = _a(unit.focal_length_mm) * (t_new - _a(getattr(unit, t_name)))
+    c = list(unit.plane_decentration_mm)
+    e = _a(getattr(unit, e_name))
+    changes: dict[str, object] = {t_name: t_new}
+    if linkage in ("L", "A"):
+        changes[e_name] = e + delta
+    if linkage == "L":
+        c[c_index] = c[c_index] + delta
+    changes["plane_decentration_x_mm"] = c[0]
+    changes["plane_decentration_y_mm"] = c[1]
+    return replace(unit, **changes)
+
+
+def set_decentrations(
+    unit: CorrectionUnit, decentration_x_mm: ArrayLike, decentration_y_mm: ArrayLike
+) -> CorrectionUnit:
+    r"""The unit after setting the computed decentrations on the scales (photo and plane).
+
+    Parameters
+    ----------
+    unit : CorrectionUnit
+        The unit before.
+    decentration_x_mm, decentration_y_mm : float or ndarray
+        d_x = f′ tan α, d_y = f′ tan ω from the computer (``setup_data.decentration``). [mm]
+
+    Returns
+    -------
+    CorrectionUnit
+        e = c = (d_x, d_y): "set the computed decentrations" overrides the dependent value
+        (``kinematics.md`` §4.1, decision D1; D2 merges e and c).
+
+    Examples
+    --------
+    >>> u = set_decentrations(CorrectionUnit(100.0, tan_alpha=0.01), 1.0, 0.0)
+    >>> float(u.decentration_x_mm), u.plane_decentration_mm[0].item()
+    (1.0, 1.0)
+    """
+    return replace(
+        unit,
+        decentration_x_mm=_a(decentration_x_mm),
+        decentration_y_mm=_a(decentration_y_mm),
+        plane_decentration_x_mm=None,
+        plane_decentration_y_mm=None,
+    )

@@ -1,0 +1,268 @@
+"""Closed-form back-end: the play operator, vectorised over trials.
+
+In the quasi-static regime a lead-screw axis with backlash b, Coulomb friction F = μ·m·g and axial
+stiffness k is a *play* (backlash) operator on the nut command s (``mechanics.md`` §2, §8)::
+
+    x = clip(x_prev, s + c − h, s + c + h),   h = b/2 + F/k,   c = 0
+
+For a vertical column under gravity (§7) the load keeps the carriage on the lower flank, so the
+play shows as a constant sag c = −(b/2 + (m + m_f)·g/k) and only friction is left as a dead band,
+h = F/k. pymunk reproduces this to about 0.5 µm for slow approaches; the operator is the test
+oracle and the fast path for bulk Monte Carlo.
+
+Shape layout: every function broadcasts; :class:`PlayAxis` keeps one state per trial, arrays of
+shape (T,). A single axis is T = 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.mechanics.base import (
+    G_MM_S2,
+    AxisParams,
+    Side,
+    check_side,
+    check_travel,
+    pre_position,
+)
+
+__all__ = ["PlayAxis", "half_play_mm", "play", "play_offset_mm"]
+
+
+def half_play_mm(
+    backlash_mm: ArrayLike,
+    friction: ArrayLike,
+    mass_kg: ArrayLike,
+    stiffness_kg_s2: ArrayLike,
+    *,
+    vertical: bool = False,
+    g_mm_s2: float = G_MM_S2,
+) -> np.ndarray:
+    """Half-width h of the dead band of a lead-screw axis.
+
+    Parameters
+    ----------
+    backlash_mm : array_like
+        Axial play b. [mm]
+    friction : array_like
+        Coulomb coefficient μ. [—]
+    mass_kg : array_like
+        Carriage mass m. [kg]
+    stiffness_kg_s2 : array_like
+        Axial stiffness k, ``inf`` for a rigid screw (1 N/µm = 10⁶). [kg/s²]
+    vertical : bool
+        A column under gravity: the play is taken up by the load (see :func:`play_offset_mm`).
+    g_mm_s2 : float
+        Gravity. [mm/s²]
+
+    Returns
+    -------
+    numpy.ndarray
+        h = b/2 + μ·m·g/k, or μ·m·g/k for a vertical column. [mm]
+
+    Examples
+    --------
+    >>> round(float(half_play_mm(0.020, 0.1, 2.0, 1e6)) * 1e3, 4)  # µm, mechanics.md §8
+    11.962
+    >>> half_play_mm([0.02, 0.03], 0.1, 2.0, np.inf)
+    array([0.01 , 0.015])
+    """
+    f_over_k = np.asarray(friction, float) * np.asarray(mass_kg, float) * g_mm_s2
+    f_over_k = f_over_k / np.asarray(stiffness_kg_s2, float)
+    if vertical:
+        return f_over_k + 0.0 * np.asarray(backlash_mm, float)
+    return 0.5 * np.asarray(backlash_mm, float) + f_over_k
+
+
+def play_offset_mm(
+    backlash_mm: ArrayLike,
+    mass_kg: ArrayLike,
+    stiffness_kg_s2: ArrayLike,
+    follower_mass_kg: ArrayLike = 0.5,
+    *,
+    vertical: bool = False,
+    g_mm_s2: float = G_MM_S2,
+) -> np.ndarray:
+    """Centre c of the dead band relative to the nut: 0, or the sag of a vertical column.
+
+    Parameters
+    ----------
+    backlash_mm, mass_kg, stiffness_kg_s2 : array_like
+        b [mm], m [kg], k [kg/s²] as in :func:`half_play_mm`.
+    follower_mass_kg : array_like
+        Mass m_f hanging on the spring with the carriage (none for a rigid screw). [kg]
+    vertical : bool
+        A column with gravity along −axis.
+    g_mm_s2 : float
+        Gravity. [mm/s²]
+
+    Returns
+    -------
+    numpy.ndarray
+        0 for a horizontal axis; −(b/2 + (m + m_f)·g/k) for a vertical one. [mm]
+
+    Examples
+    --------
+    >>> round(float(play_offset_mm(0.020, 3.0, 1e6, 0.5, vertical=True)) * 1e3, 2)  # §7, µm
+    -44.34
+    """
+    b = np.asarray(backlash_mm, float)
+    if not vertical:
+        return 0.0 * b
+    k = np.asarray(stiffness_kg_s2, float)
+    load = (np.asarray(mass_kg, float) + np.where(np.isinf(k), 0.0, follower_mass_kg)) * g_mm_s2
+    return -(0.5 * b + load / k)
+
+
+def play(x_prev: ArrayLike, s: ArrayLike, h: ArrayLike, c: ArrayLike = 0.0) -> np.ndarray:
+    """The play operator: the carriage after a monotone move of the nut to ``s``.
+
+    Parameters
+    ----------
+    x_prev : array_like
+        Carriage position before the move. [mm]
+    s : array_like
+        Nut position at the end of the move. [mm]
+    h : array_like
+        Half-width of the dead band, h ≥ 0. [mm]
+    c : array_like
+        Centre offset of the dead band (sag of a vertical column). [mm]
+
+    Returns
+    -------
+    numpy.ndarray
+        x = clip(x_prev, s + c − h, s + c + h), broadcast over all inputs. [mm]
+
+    Examples
+    --------
+    >>> play([0.0, 10.0, 10.02], 10.0, 0.01)
+    array([ 9.99, 10.  , 10.01])
+    """
+    centre = np.asarray(s, float) + np.asarray(c, float)
+    h = np.asarray(h, float)
+    return np.minimum(np.maximum(np.asarray(x_prev, float), centre - h), centre + h)
+
+
+class PlayAxis:
+    """T independent copies of one axis under the play operator (closed form, vectorised).
+
+    Parameters
+    ----------
+    params : AxisParams
+        The axis: range stops, overtravel and, unless ``half_play_mm`` is given, b, μ, m, k.
+    half_play_mm : array_like, optional
+        Per-trial dead-band half-width h, shape (T,) (e.g. from :func:`half_play_mm` on sampled
+        parameters). Default: ``params.half_play_mm`` for every trial. [mm]
+    offset_mm : array_like, optional
+        Per-trial centre offset c. Default: ``params.offset_mm``. [mm]
+    trials : int, optional
+        T when both h and c are scalars. Default 1.
+
+    Attributes
+    ----------
+    h, c : numpy.ndarray
+        Shape (T,). [mm]
+
+    Examples
+    --------
+    >>> axis = PlayAxis(AxisParams(name="X", stiffness_kg_s2=np.inf), trials=3)
+    >>> axis.place(0.0, "below")
+    >>> axis.approach([5.0, 5.0, -5.0])
+    array([ 4.99,  4.99, -4.99])
+    >>> axis.approach(5.0, side="below")
+    array([4.99, 4.99, 4.99])
+    """
+
+    def __init__(
+        self,
+        params: AxisParams,
+        half_play_mm: ArrayLike | None = None,
+        offset_mm: ArrayLike | None = None,
+        trials: int | None = None,
+    ):
+        self.params = params
+        h = np.asarray(params.half_play_mm if half_play_mm is None else half_play_mm, float)
+        c = np.asarray(params.offset_mm if offset_mm is None else offset_mm, float)
+        shape = np.broadcast_shapes(h.shape, c.shape, (1,) if trials is None else (trials,))
+        if len(shape) != 1:
+            raise StereoplotterError(
+                f"axis {params.name}: per-trial parameters must have shape (T,), found {shape}"
+            )
+        if np.any(~(h >= 0.0)):
+            raise StereoplotterError(f"axis {params.name}: half_play_mm must be ≥ 0, found {h}")
+        self.h = np.broadcast_to(h, shape).copy()
+        self.c = np.broadcast_to(c, shape).copy()
+        self._nut = np.zeros(shape)
+        self._car = self.c.copy()
+
+    @property
+    def trials(self) -> int:
+        """Number of trials T."""
+        return self.h.shape[0]
+
+    @property
+    def nut(self) -> np.ndarray:
+        """Nut (command) positions, shape (T,). [mm]"""
+        return self._nut.copy()
+
+    @property
+    def position(self) -> np.ndarray:
+        """Carriage positions, shape (T,). [mm]"""
+        return self._car.copy()
+
+    def place(self, nut_mm: ArrayLike, side: Side = None) -> None:
+        """Put every trial at rest as a long monotone move from ``side`` leaves it.
+
+        Parameters
+        ----------
+        nut_mm : float or array_like of shape (T,)
+            Nut setting. [mm]
+        side : {None, "below", "above"}
+            ``None`` centres the carriage in the dead band.
+
+        Raises
+        ------
+        TravelRefusal
+            A setting beyond the range stops.
+        """
+        check_side(side)
+        check_travel(self.params, nut_mm)
+        s = np.broadcast_to(np.asarray(nut_mm, float), self.h.shape)
+        sign = {None: 0.0, "below": -1.0, "above": 1.0}[side]
+        self._nut = s.copy()
+        self._car = s + self.c + sign * self.h
+
+    def approach(self, target: ArrayLike, side: Side = None) -> np.ndarray:
+        """Drive every nut to ``target``, finishing from ``side``; return the carriages.
+
+        Parameters
+        ----------
+        target : float or array_like of shape (T,)
+            Nut target. [mm]
+        side : {None, "below", "above"}
+            ``None``: straight there. ``"below"`` / ``"above"``: the last stroke is monotone
+            and ``params.overtravel_mm`` long (a pre-position beyond the target if needed).
+
+        Returns
+        -------
+        numpy.ndarray
+            Carriage positions, shape (T,). [mm]
+
+        Raises
+        ------
+        TravelRefusal
+            If the target or a needed pre-position is beyond the range stops (nothing moves).
+        """
+        check_side(side)
+        check_travel(self.params, target, "target")
+        s = np.broadcast_to(np.asarray(target, float), self.h.shape)
+        pre = pre_position(self._nut, s, side, self.params.overtravel_mm)
+        detour = ~np.isnan(pre)
+        check_travel(self.params, pre[detour], "pre-position")
+        x = np.where(detour, play(self._car, pre, self.h, self.c), self._car)
+        self._car = play(x, s, self.h, self.c)
+        self._nut = s.copy()
+        return self._car.copy()
