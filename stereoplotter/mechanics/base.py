@@ -125,6 +125,11 @@ class AxisParams:
     overtravel_mm : float
         Length of the final monotone stroke of the unidirectional strategy; must exceed the dead
         band 2h. [mm]
+    simulate_last_mm : float
+        pymunk only: a monotone stroke longer than this starts with :meth:`place` at this
+        distance before its end (the state a long move leaves) and only the rest is simulated
+        (``mechanics.md`` §4: 0.012 µm from the full simulation). ``math.inf``: simulate all.
+        [mm]
     """
 
     name: str = "axis"
@@ -145,6 +150,7 @@ class AxisParams:
     stair_s: float = 0.01
     settle_s: float = 0.05
     overtravel_mm: float = 0.5
+    simulate_last_mm: float = 2.0
 
     def __post_init__(self) -> None:
         def need(ok: bool, what: str, value: object) -> None:
@@ -167,6 +173,8 @@ class AxisParams:
         need(self.accel_mm_s2 > 0.0, "accel_mm_s2 > 0", self.accel_mm_s2)
         need(self.stair_s > 0.0 and self.settle_s >= 0.0, "stair_s > 0 and settle_s ≥ 0",
              (self.stair_s, self.settle_s))  # fmt: skip
+        need(self.simulate_last_mm > self.creep_distance_mm, "simulate_last_mm > creep_distance_mm",
+             self.simulate_last_mm)  # fmt: skip
         need(self.overtravel_mm > 2.0 * self.dead_band_mm, "overtravel_mm > the dead band 2h",
              (self.overtravel_mm, 2.0 * self.dead_band_mm))  # fmt: skip
 

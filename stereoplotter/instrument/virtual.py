@@ -1,0 +1,432 @@
+"""The virtual instrument: an SC-1, SPR-3 or SD-3 an operator can work on.
+
+:class:`Instrument` holds the physical state — carriages, base carriage, cassettes, correction
+mechanisms, decentration scales, counters with their zero readings, the coordinatograph — and
+exposes only what an operator can do: turn a control to a scale reading (:meth:`set`), turn a
+correction knob (:meth:`turn_knob`), read a scale (:meth:`read`), and look through the eyepieces
+(:meth:`marks`, :meth:`mark_offsets`). Every formula it needs lives in the pure layer:
+the kinematics in :mod:`stereoplotter.instrument.kinematics`, the backlash in
+:mod:`stereoplotter.mechanics`.
+
+Frames (``kinematics.md`` §3.1): X, Y, D are physical model coordinates [mm] with the left pivot's
+plumb at X = Y = 0; a counter reads ``zero + (1 + e)·nut`` (its zero reading, место нуля, is
+the reading at the plumb, the book's MO; ``e`` its gear/scale ratio error). The carriage follows the
+nut through the backlash of its screw. Injected errors come from an
+:class:`~stereoplotter.instrument.error_model.ErrorModel`, drawn once per instrument (or per trial,
+vectorised: every state is an array of shape (T,) when ``trials`` is given).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
+from stereoplotter.instrument.kinematics import (
+    CorrectionUnit,
+    InstrumentSetting,
+    decentration_variant,
+    marks_from_counters,
+    turn_correction_knob,
+)
+from stereoplotter.instrument.spec import InstrumentSpec, check_in_range, load_instrument
+from stereoplotter.mechanics.base import N_PER_UM, AxisParams
+from stereoplotter.mechanics.play import PlayAxis
+
+__all__ = ["BACKENDS", "CONTROLS", "Instrument", "Scale"]
+
+#: Mechanics back-ends of the lead-screw axes.
+BACKENDS = ("closed-form", "pymunk")
+
+#: Lead-screw axes with a counter or scale: the carriages and the base carriage.
+_SCREWS = ("X", "Y", "Z", "bx", "by", "bz")
+#: Controls set on a scale: f_пр, the cassette rotations and the decentrations.
+_SET = ("f_instrument", "kappa_left", "kappa_right", "dx_left", "dy_left", "dx_right", "dy_right")
+#: Every control an operator can turn to a reading.
+CONTROLS = _SCREWS + _SET
+#: Nominal zero readings of the scales (arbitrary instrument constants). [mm]
+_NOMINAL_ZERO = {
+    "X": 200.0,
+    "Y": 200.0,
+    "Z": 0.0,
+    "bx": 0.0,
+    "by": 50.0,
+    "bz": 50.0,
+    "dx_left": 20.0,
+    "dy_left": 20.0,
+    "dx_right": 20.0,
+    "dy_right": 20.0,
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Scale:
+    """A counter or scale: reading = zero + sense·(1 + ratio_error)·position.
+
+    Attributes
+    ----------
+    name : str
+    zero : float or ndarray
+        Reading at position 0 (the place of zero, место нуля, including its error). [mm]
+    ratio_error : float or ndarray
+        Relative gear/scale ratio error e. [—]
+    least_count : float
+        Resolution of the reading (vernier). [mm]
+    sense : int
+        Direction switch: +1 readings grow with the position (the book's setting, L3779).
+    """
+
+    name: str
+    zero: Any
+    ratio_error: Any
+    least_count: float
+    sense: int = 1
+
+    def reading(self, position: ArrayLike) -> NDArray[np.float64]:
+        """The exact reading of a position. [mm]"""
+        return np.asarray(
+            self.zero + self.sense * (1.0 + self.ratio_error) * np.asarray(position, float)
+        )
+
+    def position(self, reading: ArrayLike) -> NDArray[np.float64]:
+        """The position that shows a reading. [mm]"""
+        return (np.asarray(reading, float) - self.zero) / (self.sense * (1.0 + self.ratio_error))
+
+    def rounded(self, reading: ArrayLike) -> NDArray[np.float64]:
+        """A reading as the operator sees it: to the least count."""
+        return np.round(np.asarray(reading, float) / self.least_count) * self.least_count
+
+
+class Instrument:
+    """A virtual SC-1, SPR-3 or SD-3.
+
+    Parameters
+    ----------
+    spec : InstrumentSpec
+    focal_length_mm : float
+        f′ of the photos in the cassettes (decision D3: the units work with it). [mm]
+    errors : ErrorModel, optional
+        Injected errors; default the instrument's own (:func:`error_model_from_spec`).
+        ``errors.zero()`` gives an error-free instrument.
+    rng : numpy.random.Generator, optional
+        Draws the injected errors; required unless the error model is all zero.
+    variant : str
+        Decentration variant of the correction mechanisms: "L" (default), "A", "B", "B2", "S".
+    backend : {"closed-form", "pymunk"}
+        Mechanics of the lead-screw axes X, Y, Z.
+    trials : int, optional
+        Vectorise over T independent instruments (closed-form back-end only).
+    ideal_mechanics : bool
+        Rigid, frictionless screws without backlash (the kinematic instrument); otherwise the
+        friction, compliance and masses of the YAML ``mechanics.*`` apply.
+
+    Notes
+    -----
+    Ranges are stops: a setting outside the instrument's range raises
+    :class:`~stereoplotter.instrument.spec.RangeRefusal` or
+    :class:`~stereoplotter.mechanics.base.TravelRefusal`; nothing is clipped.
+    """
+
+    def __init__(
+        self,
+        spec: InstrumentSpec,
+        focal_length_mm: float,
+        *,
+        errors: ErrorModel | None = None,
+        rng: np.random.Generator | None = None,
+        variant: str = "L",
+        backend: str = "closed-form",
+        trials: int | None = None,
+        ideal_mechanics: bool = False,
+    ):
+        if backend not in BACKENDS:
+            raise StereoplotterError(
+                f"backend: expected one of {', '.join(BACKENDS)}, found {backend!r}"
+            )
+        if backend == "pymunk" and trials is not None:
+            raise StereoplotterError(
+                "the pymunk back-end runs single instruments; use backend='closed-form' for trials"
+            )
+        self.spec = spec
+        self.variant = decentration_variant(variant)
+        self.backend = backend
+        self.trials = trials
+        self.ideal_mechanics = ideal_mechanics
+        self.errors = errors if errors is not None else error_model_from_spec(spec)
+        if rng is None:
+            if any(t.scale for t in self.errors.terms if t.distribution != "constant"):
+                raise StereoplotterError(
+                    "an instrument with random injected errors needs an "
+                    "explicit numpy.random.Generator (rng)"
+                )
+            rng = np.random.default_rng(0)
+        self.injected = self.errors.draw(rng, trials)
+        e = self.injected
+        shape = () if trials is None else (trials,)
+
+        def full(v: Any) -> NDArray[np.float64]:
+            return np.broadcast_to(np.asarray(v, float), shape).copy()
+
+        least = {
+            "X": spec.xy_least_count_mm,
+            "Y": spec.xy_least_count_mm,
+            "Z": spec.z_least_count_mm,
+        }
+        self._scales: dict[str, Scale] = {}
+        for name, nominal in _NOMINAL_ZERO.items():
+            ratio = e.get(f"counter_scale.{name}", 0.0)
+            self._scales[name] = Scale(
+                name,
+                full(nominal + e[f"zero_reading.{name}"]),
+                full(ratio),
+                least.get(name, spec.xy_least_count_mm),
+            )
+        self._axes = {name: self._make_axis(name) for name in _SCREWS}
+        self.focal_length_mm = float(focal_length_mm)
+        self._f_instrument = full(math.nan)
+        self._kappa = {"left": full(0.0), "right": full(0.0)}
+        self._units = {
+            side: CorrectionUnit(
+                self.focal_length_mm,
+                full(0.0),
+                full(0.0),
+                full(0.0),
+                full(0.0),
+                full(0.0),
+                strict_per_axis=self.variant.strict_per_axis,
+            )
+            for side in ("left", "right")
+        }
+
+    # --- construction --------------------------------------------------------------------
+
+    @classmethod
+    def from_yaml(cls, name_or_path: str, focal_length_mm: float, **kwargs: Any) -> Instrument:
+        """An instrument from ``instruments/NAME.yaml`` (or a path)."""
+        return cls(load_instrument(name_or_path), focal_length_mm, **kwargs)
+
+    @classmethod
+    def error_free(cls, spec: InstrumentSpec, focal_length_mm: float, **kwargs: Any) -> Instrument:
+        """The kinematic instrument: no injected errors, ideal screws."""
+        return cls(
+            spec,
+            focal_length_mm,
+            errors=error_model_from_spec(spec).zero(),
+            ideal_mechanics=True,
+            **kwargs,
+        )
+
+    def _axis_params(self, name: str) -> AxisParams:
+        spec = self.spec
+        ranges = {
+            "X": "model_x_offset_range_mm",
+            "Y": "model_y_offset_range_mm",
+            "Z": "projection_distance_range_mm",
+            "bx": "base_x_range_mm",
+            "by": "base_y_range_mm",
+            "bz": "base_z_range_mm",
+        }
+        key = spec.key_of(ranges[name])
+        parameter = spec.parameters[key]
+        ideal = self.ideal_mechanics
+        return AxisParams(
+            name=f"{spec.key} {name}",
+            backlash_mm=0.0 if ideal else float(np.mean(self.injected[f"backlash.{name}"])),
+            friction=0.0 if ideal else spec.friction_coefficient,
+            mass_kg=spec.z_carriage_mass_kg if name == "Z" else spec.carriage_mass_kg,
+            stiffness_kg_s2=math.inf if ideal else spec.screw_stiffness_N_per_um * N_PER_UM,
+            range_mm=tuple(float(v) for v in getattr(spec, ranges[name])),
+            range_source=f"{parameter.file}: {key} ({parameter.status})",
+            vertical=name == "Z",
+        )
+
+    def _make_axis(self, name: str) -> Any:
+        params = self._axis_params(name)
+        if self.backend == "pymunk" and name in ("X", "Y", "Z"):
+            from stereoplotter.mechanics.pymunk_axis import PymunkAxis
+
+            return PymunkAxis(params)
+        return PlayAxis(params, trials=self.trials if self.trials is not None else 1)
+
+    # --- what an operator can do ---------------------------------------------------------------
+
+    def read(self, control: str, exact: bool = False) -> NDArray[np.float64] | float:
+        """The reading of a counter or scale (X, Y, Z (= D), bx, by, bz, dx/dy_left/right).
+
+        Parameters
+        ----------
+        control : str
+        exact : bool
+            Return the exact reading instead of the one rounded to the least count.
+        """
+        if control not in self._scales:
+            raise StereoplotterError(f"no scale {control!r}; scales: {', '.join(self._scales)}")
+        scale = self._scales[control]
+        if control in self._axes:
+            reading = scale.reading(self._axes[control].nut)
+        else:
+            side = control.split("_")[1]
+            unit = self._units[side]
+            value = unit.decentration_x_mm if control.startswith("dx") else unit.decentration_y_mm
+            reading = scale.reading(value)
+        out = reading if exact else scale.rounded(reading)
+        return self._out(out)
+
+    def set(self, control: str, reading: ArrayLike, side: str | None = None) -> None:
+        """Turn a control until its scale shows ``reading``.
+
+        Lead screws (X, Y, Z, bx, by, bz) move their nut there; the carriage follows through the
+        backlash, finishing from ``side`` ("below", "above" or None). f_пр and κ are set on their
+        scales with their setting errors [mm, rad]; a decentration is set on its scale (the
+        scale's zero-reading error stays in the physical decentration).
+
+        Raises
+        ------
+        RangeRefusal, TravelRefusal
+            A setting beyond the instrument's range: refused like the real stop.
+        """
+        if control in self._axes:
+            nut = self._scales[control].position(reading)
+            self._axes[control].approach(self._arg(nut), side)
+            return
+        value = np.asarray(reading, float)
+        if control == "f_instrument":
+            check_in_range(self.spec, "f_instrument_range_mm", float(np.max(value)), "f_пр")
+            check_in_range(self.spec, "f_instrument_range_mm", float(np.min(value)), "f_пр")
+            self._f_instrument = value + self.injected["setting.f_instrument"]
+        elif control.startswith("kappa_"):
+            side_name = control.split("_")[1]
+            for v in (np.min(value), np.max(value)):
+                check_in_range(self.spec, "kappa_range", float(v), f"κ_{side_name}")
+            self._kappa[side_name] = value + self.injected[f"setting.kappa_{side_name}"]
+            self._units[side_name] = _replace(self._units[side_name], kappa=self._kappa[side_name])
+        elif control in ("dx_left", "dy_left", "dx_right", "dy_right"):
+            axis, side_name = control.split("_")
+            d = self._scales[control].position(value) + self.injected[f"setting.{control}"]
+            for v in (np.min(d), np.max(d)):
+                check_in_range(
+                    self.spec, "decentration_range_mm", float(v), f"decentration {axis},{side_name}"
+                )
+            unit = self._units[side_name]
+            cx, cy = unit.plane_decentration_mm
+            if axis == "dx":
+                unit = _replace(
+                    unit, decentration_x_mm=d, plane_decentration_x_mm=d, plane_decentration_y_mm=cy
+                )
+            else:
+                unit = _replace(
+                    unit, decentration_y_mm=d, plane_decentration_y_mm=d, plane_decentration_x_mm=cx
+                )
+            self._units[side_name] = unit
+        else:
+            raise StereoplotterError(f"no control {control!r}; controls: {', '.join(CONTROLS)}")
+
+    def turn_knob(self, knob: str, tan_tilt: ArrayLike) -> None:
+        """Turn a correction mechanism (k_α or k_ω of the left or right photo) to represent the
+        tilt tangent ``tan_tilt`` (T = tan θ / k, ``kinematics.md`` §3.2).
+
+        The knob has no usable zero place (it is fitted on the fiducials, stage 2), so it is set
+        by what it represents; its setting error is added. Under variant L the decentration
+        follows (D1); "A" drags only the photo decentration; "B", "B2" none.
+
+        Raises
+        ------
+        RangeRefusal
+            |tilt| beyond the correction range.
+        """
+        try:
+            axis, side = {
+                "k_alpha_left": ("alpha", "left"),
+                "k_omega_left": ("omega", "left"),
+                "k_alpha_right": ("alpha", "right"),
+                "k_omega_right": ("omega", "right"),
+            }[knob]
+        except KeyError:
+            raise StereoplotterError(
+                f"no correction knob {knob!r}; knobs: k_alpha_left, k_omega_left, "
+                "k_alpha_right, k_omega_right"
+            ) from None
+        t = np.asarray(tan_tilt, float) + np.tan(self.injected[f"setting.correction_{axis}_{side}"])
+        for v in (np.min(t), np.max(t)):
+            check_in_range(self.spec, "tilt_max", math.atan(float(v)), f"k_{axis},{side}")
+        self._units[side] = turn_correction_knob(
+            self._units[side], axis, t, linkage=self.variant.linkage
+        )
+
+    # --- looking through the eyepieces ---------------------------------------------------------
+
+    @property
+    def setting(self) -> InstrumentSetting:
+        """The physical setting: f_пр, base and the plumb of S_л at X = Y = 0."""
+        if np.any(np.isnan(self._f_instrument)):
+            raise StereoplotterError("f_пр has not been set (set('f_instrument', …) first)")
+        return InstrumentSetting(
+            self._f_instrument, self._pos("bx"), self._pos("by"), self._pos("bz"), 0.0, 0.0
+        )
+
+    def _pos(self, name: str) -> NDArray[np.float64]:
+        return self._out(self._axes[name].position)
+
+    def marks(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Photo points under the left and right measuring marks for the present carriages. [mm]
+
+        ``kinematics.md`` §3.3 through
+        :func:`~stereoplotter.instrument.kinematics.marks_from_counters`.
+        """
+        return marks_from_counters(
+            self._pos("X"),
+            self._pos("Y"),
+            self._pos("Z"),
+            self.setting,
+            self._units["left"],
+            self._units["right"],
+        )
+
+    def mark_offsets(
+        self, left_point_mm: ArrayLike | None = None, right_point_mm: ArrayLike | None = None
+    ) -> dict[str, NDArray[np.float64]]:
+        """Where each mark sits relative to a photo point, as seen in the eyepieces. [photo mm]
+
+        Returns ``{"left": mark − point, "right": mark − point}`` for the points given.
+        """
+        pl, pr = self.marks()
+        out = {}
+        if left_point_mm is not None:
+            out["left"] = pl - np.asarray(left_point_mm, float)
+        if right_point_mm is not None:
+            out["right"] = pr - np.asarray(right_point_mm, float)
+        return out
+
+    # --- state for tests and reports (not an operator's view) ---------------------------------
+
+    def state(self) -> dict[str, Any]:
+        """The physical state (what the operator cannot see): for tests, transcripts, reports."""
+        return {
+            "carriages_mm": {n: self._pos(n) for n in ("X", "Y", "Z")},
+            "base_mm": {n: self._pos(n) for n in ("bx", "by", "bz")},
+            "f_instrument_mm": self._out(self._f_instrument),
+            "units": {side: u for side, u in self._units.items()},
+            "zero_readings": {n: self._out(s.zero) for n, s in self._scales.items()},
+        }
+
+    def _arg(self, value: NDArray) -> Any:
+        if self.backend == "pymunk":
+            return float(value)
+        return np.broadcast_to(np.asarray(value, float), (self.trials or 1,))
+
+    def _out(self, value: Any) -> Any:
+        v = np.asarray(value, float)
+        if self.trials is None and v.size == 1:
+            return float(v.reshape(-1)[0])
+        return v
+
+
+def _replace(unit: CorrectionUnit, **changes: Any) -> CorrectionUnit:
+    from dataclasses import replace
+
+    return replace(unit, **changes)

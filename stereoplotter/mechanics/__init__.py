@@ -1,0 +1,1 @@
+"""Hand-driven mechanics (placeholder during development)."""
