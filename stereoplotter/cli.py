@@ -11,6 +11,7 @@ import argparse
 import csv
 import io
 import json
+import math
 import os
 import platform
 import sys
@@ -326,6 +327,14 @@ def _instrument(args: argparse.Namespace) -> int:
     from stereoplotter.instrument.spec import format_instrument, instrument_to_dict, load_instrument
 
     spec = load_instrument(args.name)
+    if args.instrument_command == "test":
+        from stereoplotter.instrument.selftest import format_selftest, run_kinematic_selftest
+
+        tilts = [math.radians(t) for t in args.tilts]
+        result = run_kinematic_selftest(tilts=tilts, variants=tuple(args.variants), instrument=spec)
+        result["instrument"] = spec.key
+        sys.stdout.write(_json(result) if args.json else format_selftest(result))
+        return 0
     sys.stdout.write(_json(instrument_to_dict(spec)) if args.json else format_instrument(spec))
     return 0
 
@@ -457,6 +466,28 @@ def _parser() -> argparse.ArgumentParser:
     s = inst.add_parser("show", help="print an instrument's parameters, documented or assumed")
     s.add_argument("name", help="sc1, spr3, sd3 or a path to an instrument YAML")
     s.add_argument("--json", action="store_true", help="print JSON instead of text")
+    t = inst.add_parser(
+        "test",
+        help="kinematic acceptance on a synthetic grid pair (kinematics.md §5–§6): residual "
+        "y-parallax per decentration variant and tilt",
+    )
+    t.add_argument("name", help="sc1, spr3, sd3 or a path to an instrument YAML")
+    t.add_argument(
+        "--tilts",
+        type=float,
+        nargs="+",
+        default=[0.5, 1.0, 3.0],
+        metavar="DEG",
+        help="tilt magnitudes [deg] (default: 0.5 1 3)",
+    )
+    t.add_argument(
+        "--variants",
+        nargs="+",
+        default=["L", "A", "B", "B2", "S"],
+        choices=["L", "A", "B", "B2", "S"],
+        help="decentration variants",
+    )
+    t.add_argument("--json", action="store_true", help="print JSON instead of text")
 
     p = sub.add_parser("setup", help="compute the setup sheet (Table 24) of a stereopair")
     p.add_argument(

@@ -1,4 +1,4 @@
-"""The virtual instrument: controls, scales, stops, and the sheet set on an error-free instrument."""
+"""The virtual instrument: controls, scales, stops, and a setup sheet set on it."""
 
 from __future__ import annotations
 
@@ -102,7 +102,7 @@ def test_same_seed_same_instrument_and_trials_vectorise():
     assert many.state()["zero_readings"]["X"].shape == (50,)
     many.set("Z", many.state()["zero_readings"]["Z"] + 150.0)
     assert many.state()["carriages_mm"]["Z"].shape == (50,)
-    with pytest.raises(StereoplotterError, match="needs an explicit numpy.random.Generator"):
+    with pytest.raises(StereoplotterError, match=r"needs an explicit numpy\.random\.Generator"):
         Instrument(spec, 70.0)
 
 

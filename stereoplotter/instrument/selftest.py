@@ -533,12 +533,14 @@ def stage2_setting(
 
     Examples
     --------
-    Variant B at 1°: the fit returns about 2.4 times the true ω and mark 4 misses by 0.12 mm.
+    Variant B at ω = 1°: the fit returns about 2.3 times the true ω, and mark 4 misses by
+    0.12 mm against the tolerance 0.02·n_л = 0.028 mm.
 
     >>> import numpy as np
     >>> r = stage2_setting(0.0, np.radians(1.0), 1.0, "B")
-    >>> round(float(np.degrees(np.arctan(r.unit.tan_omega))), 2), round(float(r.mark4_mismatch_mm), 3)
-    (2.43, 0.123)
+    >>> omega_fitted_deg = np.degrees(np.arctan(r.unit.tan_omega))
+    >>> round(float(omega_fitted_deg), 2), round(float(r.mark4_mismatch_mm), 3)
+    (2.34, 0.123)
     """
     pair = pair or SyntheticPair()
     v = decentration_variant(variant)
@@ -744,7 +746,7 @@ def run_kinematic_selftest(
         pair = replace(
             pair, projection_distance_max_mm=float(instrument.projection_distance_max_mm)
         )
-    tilts_deg = [float(t) * DEG_PER_RAD for t in tilts]
+    tilts_deg = [round(float(t) * DEG_PER_RAD, 9) for t in tilts]
     return {
         "data": {
             "focal_length_mm": pair.focal_length_mm,
@@ -779,8 +781,8 @@ def format_selftest(result: dict[str, Any]) -> str:
     Examples
     --------
     >>> r = run_kinematic_selftest(tilts=[0.00872665], variants=("B",))
-    >>> print(format_selftest(r).splitlines()[0])
-    Kinematic self-test (kinematics.md §5, §6): f' = 100 mm, f_pr = 130 mm, D_max = 185 mm, 49 points
+    >>> print(format_selftest(r).splitlines()[-1])
+    B       0.5    +0.6798    -0.7043   0.0309  0.028    2587.7    999.2     725.7 FAIL
     """
     d = result["data"]
     s = result["sanity"]
@@ -824,4 +826,4 @@ def format_selftest(result: dict[str, Any]) -> str:
             f"{r['mark4_tolerance_mm']:>7.3f}{r['max_q_um']:>10.1f}{r['rms_q_um']:>9.1f}"
             f"{r['max_q_after_touch_up_um']:>10.1f}{flag}"
         )
-    return "\n".join(lines)
+    return "\n".join(lines) + "\n"

@@ -159,7 +159,9 @@ class AxisParams:
 
         need(self.backlash_mm >= 0.0 and math.isfinite(self.backlash_mm), "backlash_mm ≥ 0",
              self.backlash_mm)  # fmt: skip
-        need(0.0 <= self.friction < 1.0, "friction μ in [0, 1)", self.friction)
+        need(self.friction >= 0.0 and math.isfinite(self.friction), "friction μ ≥ 0", self.friction)
+        need(not self.vertical or self.friction < 1.0, "friction μ < 1 on a vertical axis "
+             "(the load must keep the carriage on its lower flank)", self.friction)  # fmt: skip
         need(0.0 < self.mass_kg < math.inf, "mass_kg > 0", self.mass_kg)
         need(self.stiffness_kg_s2 > 0.0, "stiffness_kg_s2 > 0 (inf: rigid)", self.stiffness_kg_s2)
         need(0.0 < self.follower_mass_kg < math.inf, "follower_mass_kg > 0", self.follower_mass_kg)
@@ -227,15 +229,17 @@ class AxisParams:
     def from_instrument(
         cls, spec: InstrumentSpec, axis: Literal["X", "Y", "Z"], **overrides: object
     ) -> AxisParams:
-        """The plotter axis X, Y or Z of an instrument: its backlash and its travel.
+        """The plotter axis X, Y or Z of an instrument: backlash, travel and ``mechanics.*``.
 
         Parameters
         ----------
         spec : InstrumentSpec
             The instrument (``load_instrument("sc1")``).
         axis : {"X", "Y", "Z"}
-            X and Y take ``errors.backlash_xy_mm`` and the model offset ranges; Z takes
-            ``errors.backlash_z_mm``, the projection-distance range and ``vertical=True``.
+            X and Y take ``errors.backlash_xy_mm``, the model offset ranges and
+            ``mechanics.carriage_mass_kg``; Z takes ``errors.backlash_z_mm``, the
+            projection-distance range, ``mechanics.z_carriage_mass_kg`` and ``vertical=True``.
+            All take ``mechanics.friction_coefficient`` and ``mechanics.screw_stiffness_N_per_um``.
         **overrides
             Any other :class:`AxisParams` field (friction, mass_kg, …; all **assumed**).
 
@@ -247,8 +251,8 @@ class AxisParams:
         --------
         >>> from stereoplotter.instrument.spec import load_instrument
         >>> p = AxisParams.from_instrument(load_instrument("sc1"), "X")
-        >>> p.backlash_mm, p.range_mm
-        (0.005, (-150.0, 150.0))
+        >>> p.backlash_mm, p.range_mm, p.friction, p.mass_kg, p.stiffness_kg_s2
+        (0.005, (-250.0, 450.0), 0.1, 2.0, 1000000.0)
         """
         if axis not in ("X", "Y", "Z"):
             raise StereoplotterError(f"axis must be 'X', 'Y' or 'Z', found {axis!r}")
@@ -266,6 +270,9 @@ class AxisParams:
             "range_mm": tuple(float(v) for v in getattr(spec, attribute)),
             "range_source": f"{parameter.file}: {key} ({parameter.status})",
             "vertical": axis == "Z",
+            "friction": spec.friction_coefficient,
+            "mass_kg": spec.z_carriage_mass_kg if axis == "Z" else spec.carriage_mass_kg,
+            "stiffness_kg_s2": spec.screw_stiffness_N_per_um * N_PER_UM,
         }
         fields.update(overrides)
         return cls(**fields)  # type: ignore[arg-type]

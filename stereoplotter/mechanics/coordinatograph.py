@@ -64,7 +64,12 @@ class CoordinatographParams:
 
     @classmethod
     def from_instrument(cls, spec: InstrumentSpec, **overrides: object) -> CoordinatographParams:
-        """Travel from ``coordinatograph.table_mm``; the rest from :data:`BRIDGE`/:data:`PEN_CARRIAGE`.
+        """The chains of an instrument's coordinatograph.
+
+        Travel from ``coordinatograph.table_mm``; masses from ``mechanics.bridge_mass_kg`` and
+        ``mechanics.pen_carriage_mass_kg``; μ from ``mechanics.friction_coefficient``. Backlash
+        and stiffness have no instrument key and stay as in :data:`BRIDGE` and
+        :data:`PEN_CARRIAGE` (``mechanics.md`` §5, assumed).
 
         Parameters
         ----------
@@ -83,8 +88,14 @@ class CoordinatographParams:
         parameter = spec.parameters[key]
         source = f"{parameter.file}: {key} ({parameter.status})"
         width, height = spec.coordinatograph_table_mm
-        x = replace(BRIDGE, range_mm=(0.0, float(width)), range_source=source, **overrides)
-        y = replace(PEN_CARRIAGE, range_mm=(0.0, float(height)), range_source=source, **overrides)
+        common = {"range_source": source, "friction": spec.friction_coefficient}
+        x = replace(BRIDGE, range_mm=(0.0, float(width)), mass_kg=spec.bridge_mass_kg, **common)
+        y = replace(
+            PEN_CARRIAGE, range_mm=(0.0, float(height)), mass_kg=spec.pen_carriage_mass_kg,
+            **common,
+        )  # fmt: skip
+        if overrides:
+            x, y = replace(x, **overrides), replace(y, **overrides)
         return cls(x, y)
 
 
@@ -111,7 +122,7 @@ class Coordinatograph:
     >>> c.place((100.0, 200.0), "below")
     >>> err = (c.move_pen((101.0, 201.0)) - (101.0, 201.0)) * 1e3  # µm
     >>> [round(float(e), 1) for e in err]  # dead bands ±19.66, ±11.47 µm, less relaxation
-    [-19.3, -11.3]
+    [-19.3, -11.2]
     """
 
     def __init__(
