@@ -133,3 +133,12 @@ def test_atomic_write_leaves_old_file_when_writing_fails(tmp_path, monkeypatch):
         yamlio.atomic_write_text(target, "new")
     assert target.read_text(encoding="utf-8") == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]  # no temporary file left
+
+
+def test_instrument_test_cli(capsys):
+    assert main(["instrument", "test", "sc1", "--tilts", "1", "--variants", "L", "B"]) == 0
+    text = capsys.readouterr().out
+    assert "§6 Residual y-parallax" in text and "FAIL" in text  # variant B fails mark 4
+    assert main(["instrument", "test", "sd3", "--tilts", "0.5", "--variants", "L", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["instrument"] == "sd3" and data["residuals"][0]["unit"] == "canonical"
