@@ -121,3 +121,33 @@ def test_error_free_model_zero_terms():
     model = error_model_from_spec(spec).zero()
     inst = Instrument(spec, 70.0, errors=model)  # no rng needed: nothing random
     assert all(v == 0 for v in inst.injected.values())
+
+
+def test_coordinatograph_follows_the_carriages_through_the_gears():
+    spec = load_instrument("sc1")
+    inst = Instrument.error_free(spec, 70.0)
+    inst.connect_coordinatograph(1.25, origin_table_mm=(400.0, 400.0))
+    zero = inst.state()["zero_readings"]
+    inst.set("X", zero["X"] + 100.0)
+    inst.set("Y", zero["Y"] - 50.0)
+    np.testing.assert_allclose(inst.needle(), [400.0 + 125.0, 400.0 - 62.5], atol=1e-9)
+    with pytest.raises(RangeRefusal, match="coordinatograph ratio = 1.300"):
+        inst.connect_coordinatograph(1.3)
+
+
+def test_back_ends_agree_within_half_a_micrometre():
+    # mechanics.md: pymunk and the play operator agree within 0.5 µm for slow approaches; here
+    # through the instrument, for a script of moves with reversals and one-sided finishes.
+    spec = load_instrument("sc1")
+    carriages = {}
+    for backend in ("pymunk", "closed-form"):
+        inst = Instrument(spec, 70.0, rng=np.random.default_rng(1), backend=backend)
+        zero = inst.state()["zero_readings"]
+        for target, side in ((100.0, "below"), (99.5, None), (100.0, "above"), (20.0, "below")):
+            inst.set("X", zero["X"] + target, side=side)
+            inst.set("Z", zero["Z"] + 170.0 + target / 100.0, side=side)
+        carriages[backend] = inst.state()["carriages_mm"]
+    for axis in ("X", "Z"):
+        assert abs(carriages["pymunk"][axis] - carriages["closed-form"][axis]) < 0.5e-3
+    with pytest.raises(StereoplotterError, match="pymunk back-end runs single instruments"):
+        Instrument(spec, 70.0, rng=np.random.default_rng(1), backend="pymunk", trials=3)

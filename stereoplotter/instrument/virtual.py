@@ -19,7 +19,7 @@ vectorised: every state is an array of shape (T,) when ``trials`` is given).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -246,12 +246,18 @@ class Instrument:
         )
 
     def _make_axis(self, name: str) -> Any:
+        """A lead-screw axis at rest at its start: 0 (the plumb, no base) when 0 is inside its
+        range, else the middle of the range (Z: half-way down)."""
         params = self._axis_params(name)
+        lo, hi = params.range_mm
+        start = 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi)
         if self.backend == "pymunk" and name in ("X", "Y", "Z"):
             from stereoplotter.mechanics.pymunk_axis import PymunkAxis
 
-            return PymunkAxis(params)
-        return PlayAxis(params, trials=self.trials if self.trials is not None else 1)
+            return PymunkAxis(params, start_mm=start)
+        axis = PlayAxis(params, trials=self.trials if self.trials is not None else 1)
+        axis.place(start)
+        return axis
 
     # --- what an operator can do ---------------------------------------------------------------
 
@@ -402,6 +408,79 @@ class Instrument:
             out["right"] = pr - np.asarray(right_point_mm, float)
         return out
 
+    # --- the coordinatograph ------------------------------------------------------------------
+
+    def connect_coordinatograph(
+        self, ratio: float, origin_table_mm: tuple[float, float] | None = None
+    ) -> None:
+        """Couple the coordinatograph to the X, Y carriages through the gear ``ratio``.
+
+        Parameters
+        ----------
+        ratio : float
+            r = M_г / M_map, one of the instrument's coordinatograph gears: the needle moves
+            r·ΔX, r·ΔY on the table. [—]
+        origin_table_mm : (float, float), optional
+            Table position of the needle when the carriages are on the plumb of S_л
+            (X = Y = 0). Default: the table centre. [mm]
+
+        Raises
+        ------
+        RangeRefusal
+            A ratio that is not one of the gears.
+        """
+        from stereoplotter.mechanics.coordinatograph import (
+            Coordinatograph,
+            CoordinatographParams,
+        )
+
+        check_in_range(self.spec, "coordinatograph_ratios", float(ratio), "coordinatograph ratio")
+        params = CoordinatographParams.from_instrument(self.spec)
+        if self.ideal_mechanics:
+            ideal = {"backlash_mm": 0.0, "friction": 0.0, "stiffness_kg_s2": math.inf}
+            params = CoordinatographParams(replace(params.x, **ideal), replace(params.y, **ideal))
+        if origin_table_mm is None:
+            origin_table_mm = (0.5 * sum(params.x.range_mm), 0.5 * sum(params.y.range_mm))
+        self._cg_ratio = float(ratio)
+        self._cg_origin = np.asarray(origin_table_mm, float)
+        if self.trials is None:
+            self._cg = Coordinatograph(
+                params, start_mm=tuple(self._cg_origin), fast=self.backend == "closed-form"
+            )
+            self._cg_axes = (self._cg.x, self._cg.y)
+        else:
+            self._cg_axes = (
+                PlayAxis(params.x, trials=self.trials),
+                PlayAxis(params.y, trials=self.trials),
+            )
+            for axis, start in zip(self._cg_axes, self._cg_origin, strict=True):
+                axis.place(start)
+
+    def needle(self, side: str | None = None) -> NDArray[np.float64]:
+        """Table position of the needle for the present carriages. [mm]
+
+        The bridge and pen-carriage screws follow r·(X, Y) (gears), finishing from ``side``; the
+        rails' non-orthogonality ε turns the pen carriage's axis (x += y·sin ε) and the needle has
+        its play in the holder (``errors.*``).
+        """
+        if not hasattr(self, "_cg_axes"):
+            raise StereoplotterError(
+                "the coordinatograph is not connected (connect_coordinatograph(ratio) first)"
+            )
+        target_x = self._cg_origin[0] + self._cg_ratio * np.asarray(self._pos("X"))
+        target_y = self._cg_origin[1] + self._cg_ratio * np.asarray(self._pos("Y"))
+        x_axis, y_axis = self._cg_axes
+        x = np.asarray(x_axis.approach(self._arg(target_x), side), float)
+        y = np.asarray(y_axis.approach(self._arg(target_y), side), float)
+        eps = self.injected["coordinatograph.nonorthogonality"]
+        play = self.injected["coordinatograph.pen_play"]
+        x = x + (y - self._cg_origin[1]) * np.sin(eps) + play
+        return (
+            self._out(np.stack([x, y], axis=-1))
+            if self.trials
+            else np.array([float(np.squeeze(x)), float(np.squeeze(y))])
+        )
+
     # --- state for tests and reports (not an operator's view) ---------------------------------
 
     def state(self) -> dict[str, Any]:
@@ -427,6 +506,4 @@ class Instrument:
 
 
 def _replace(unit: CorrectionUnit, **changes: Any) -> CorrectionUnit:
-    from dataclasses import replace
-
     return replace(unit, **changes)
