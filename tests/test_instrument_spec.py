@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import deg
+from conftest import deg, node_paths
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -533,21 +533,7 @@ def test_inherits_errors_name_the_right_file(tmp_path):
 # --- fuzzing: a mutated file never produces anything but a StereoplotterError -----------------
 
 _SC1 = raw("sc1")
-_PATHS: list[tuple] = []
-
-
-def _collect(node, path=()):
-    if isinstance(node, dict):
-        for k, v in node.items():
-            _collect(v, (*path, k))
-    elif isinstance(node, list):
-        for i, v in enumerate(node):
-            _collect(v, (*path, i))
-    if path:
-        _PATHS.append(path)
-
-
-_collect(_SC1)
+_PATHS = node_paths(_SC1)
 _JUNK = st.one_of(
     st.none(),
     st.booleans(),

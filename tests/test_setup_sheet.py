@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from conftest import node_paths, value_at
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
@@ -231,21 +232,11 @@ def test_cli_instrument_show(capsys):
 # --- fuzz: odd but valid scenarios never give anything but a StereoplotterError ----------------
 
 _BASE = _noise_free("pair60")
-_NUMERIC = []
-
-
-def _collect(node, path=()):
-    if isinstance(node, dict):
-        for k, v in node.items():
-            _collect(v, (*path, k))
-    elif isinstance(node, list):
-        for i, v in enumerate(node):
-            _collect(v, (*path, i))
-    elif isinstance(node, int | float) and not isinstance(node, bool):
-        _NUMERIC.append(path)
-
-
-_collect(_BASE)
+_NUMERIC = [
+    p
+    for p in node_paths(_BASE)
+    if isinstance(value_at(_BASE, p), int | float) and not isinstance(value_at(_BASE, p), bool)
+]
 
 
 @settings(max_examples=40, deadline=None)
