@@ -17,9 +17,9 @@ import numpy as np
 from stereoplotter.constants import ARCSEC_PER_RAD, MM_PER_M, UM_PER_MM
 from stereoplotter.errors import GeometryError
 from stereoplotter.geometry.intersection import space_intersection
-from stereoplotter.geometry.resection import space_resection
-from stereoplotter.geometry.rotation import rotation_matrix
+from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix
 from stereoplotter.geometry.similarity import apply_similarity, fit_similarity_with_reflection
+from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.summary import summarize_scenario
 from stereoplotter.scenario.synthetic import Measurements, synthesize_measurements
@@ -32,42 +32,30 @@ def _rounded(values, digits: int) -> list[float]:
 
 
 def _exterior(scenario: Scenario, measurements: Measurements) -> list[dict[str, Any]]:
-    """EO used downstream, per photo: the given one, or a resection from measured control."""
+    """EO used downstream, per photo (given, or by resection), with its error against the truth."""
     out = []
-    f = measurements.focal_length_corrected_mm
-    for photo in scenario.photos:
+    for known, photo in zip(
+        known_exterior_orientation(scenario, measurements), scenario.photos, strict=True
+    ):
         truth = photo.exterior
-        record: dict[str, Any] = {"photo": photo.name, "source": truth.source}
-        if truth.source == "resection":
-            pm = measurements.photo(photo.name)
-            use = np.array(
-                [
-                    pm.points_imaged[i] and p.role == "control" and p.kind == "full"
-                    for i, p in enumerate(scenario.points)
-                ]
-            )
-            pts = np.array([p.local_m for p in scenario.points])[use]
-            result = space_resection(pm.points_mm[use], pts, f, scenario.camera.principal_point_mm)
-            angles = result.angles
-            centre = result.projection_centre_m
+        angles = np.array(angles_from_matrix(known.rotation))
+        record: dict[str, Any] = {"photo": photo.name, "source": known.source}
+        if known.resection is not None:
             record.update(
-                points_used=[p.id for p, u in zip(scenario.points, use, strict=True) if u],
-                iterations=result.iterations,
-                rms_residual_um=round(result.rms_residual_mm * UM_PER_MM, 4),
+                points_used=list(known.point_ids),
+                iterations=known.resection.iterations,
+                rms_residual_um=round(known.resection.rms_residual_mm * UM_PER_MM, 4),
             )
-        else:
-            angles = np.array([truth.alpha, truth.omega, truth.kappa])
-            centre = truth.centre
         d_angles = (angles - [truth.alpha, truth.omega, truth.kappa]) * ARCSEC_PER_RAD
         record.update(
             alpha_deg=round(math.degrees(angles[0]), 7),
             omega_deg=round(math.degrees(angles[1]), 7),
             kappa_deg=round(math.degrees(angles[2]), 7),
-            projection_centre_m=_rounded(centre, 4),
+            projection_centre_m=_rounded(known.centre_m, 4),
             error_angles_arcsec=_rounded(d_angles, 3),
-            error_centre_m=_rounded(np.asarray(centre) - truth.centre, 4),
+            error_centre_m=_rounded(np.asarray(known.centre_m) - truth.centre, 4),
             _angles=angles,
-            _centre=np.asarray(centre, float),
+            _centre=np.asarray(known.centre_m, float),
         )
         out.append(record)
     return out

@@ -19,7 +19,6 @@ from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.geometry.resection import space_resection
 from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix, rotation_z
 from stereoplotter.geometry.similarity import (
     SimilarityFit,
@@ -39,9 +38,9 @@ from stereoplotter.scale_choice import (
     choose_candidates,
     describe_candidate,
 )
+from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import (
-    Measurements,
     synthesize_measurements,
     working_area_grid_m,
 )
@@ -177,32 +176,6 @@ class SetupSheet:
 # --- helpers --------------------------------------------------------------------------------
 
 
-def _exterior(scenario: Scenario, measurements: Measurements) -> list[tuple[NDArray, NDArray]]:
-    """(centre, rotation) of each photo as the setup computation knows it."""
-    out = []
-    pts = np.array([p.local_m for p in scenario.points])
-    for photo in scenario.photos:
-        ext = photo.exterior
-        if ext.source == "resection":
-            pm = measurements.photo(photo.name)
-            use = np.array(
-                [
-                    pm.points_imaged[i] and p.role == "control" and p.kind == "full"
-                    for i, p in enumerate(scenario.points)
-                ]
-            )
-            r = space_resection(
-                pm.points_mm[use],
-                pts[use],
-                measurements.focal_length_corrected_mm,
-                scenario.camera.principal_point_mm,
-            )
-            out.append((r.projection_centre_m, r.rotation))
-        else:
-            out.append((ext.centre, ext.rotation))
-    return out
-
-
 def _to_instrument_frame(points_m: NDArray, origin_m: NDArray, theta: float) -> NDArray:
     """Rotate about Z by −θ (base along +X) after moving the origin to S_л."""
     return (np.asarray(points_m, float) - origin_m) @ rotation_z(-theta).T
@@ -326,7 +299,8 @@ def compute_setup_sheet(
     rng = np.random.default_rng(scenario.seed) if rng is None else rng
     measurements = synthesize_measurements(scenario, rng)
     f_prime = measurements.focal_length_corrected_mm
-    (c_left, m_left), (c_right, m_right) = _exterior(scenario, measurements)
+    known = known_exterior_orientation(scenario, measurements)
+    (c_left, m_left), (c_right, m_right) = ((k.centre_m, k.rotation) for k in known)
 
     # Frame: base along +X, origin at S_л (docs/setup-data.md, Inputs, "Frame").
     base_vector = c_right - c_left
