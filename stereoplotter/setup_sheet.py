@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
@@ -66,6 +66,7 @@ __all__ = [
     "SetupSheet",
     "assumed_parameters",
     "compute_setup_sheet",
+    "instrument_frame_m",
 ]
 
 #: Sheet-corner numbering (decision, docs/setup-data.md): 1 = lower left, then counter-clockwise
@@ -176,9 +177,47 @@ class SetupSheet:
 # --- helpers --------------------------------------------------------------------------------
 
 
-def _to_instrument_frame(points_m: NDArray, origin_m: NDArray, theta: float) -> NDArray:
-    """Rotate about Z by −θ (base along +X) after moving the origin to S_л."""
-    return (np.asarray(points_m, float) - origin_m) @ rotation_z(-theta).T
+def instrument_frame_m(
+    points_m: ArrayLike, frame_origin_m: ArrayLike, frame_rotation: float, *, inverse: bool = False
+) -> NDArray[np.float64]:
+    r"""Ground points in the instrument frame of the setup sheet (or back).
+
+    Parameters
+    ----------
+    points_m : array_like, shape (..., 3)
+        X, Y, Z in the photogrammetric frame of the scenario (``inverse=False``) or in the
+        instrument frame (``inverse=True``). [m]
+    frame_origin_m : array_like, shape (3,)
+        S_л, the origin of the instrument frame in the photogrammetric frame. [m]
+    frame_rotation : float
+        θ, the azimuth of the horizontal base in the photogrammetric frame. [rad]
+    inverse : bool
+        Map instrument-frame points back to the photogrammetric frame.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        The points in the other frame. [m]
+
+    Notes
+    -----
+    ``docs/setup-data.md``, "The frame turn": the photogrammetric frame moved to S_л and turned
+    by −θ about Z, p = R_Z(−θ)(P − S_л), so that the base runs along +X.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p = instrument_frame_m([10.0, 10.0, 0.0], [0.0, 0.0, 100.0], np.pi / 4)
+    >>> (np.round(p, 6) + 0.0).tolist()
+    [14.142136, 0.0, -100.0]
+    >>> back = instrument_frame_m(p, [0.0, 0.0, 100.0], np.pi / 4, inverse=True)
+    >>> (np.round(back, 9) + 0.0).tolist()
+    [10.0, 10.0, 0.0]
+    """
+    origin = np.asarray(frame_origin_m, float)
+    if inverse:
+        return np.asarray(points_m, float) @ rotation_z(frame_rotation).T + origin
+    return (np.asarray(points_m, float) - origin) @ rotation_z(-frame_rotation).T
 
 
 def _sheet_corners_gk(scenario: Scenario) -> NDArray:
@@ -309,8 +348,8 @@ def compute_setup_sheet(
     rotations = [turn @ m_left, turn @ m_right]
     base_m = turn @ base_vector
     points_local = np.array([p.local_m for p in scenario.points])
-    points_m = _to_instrument_frame(points_local, c_left, theta)
-    grid_m = _to_instrument_frame(working_area_grid_m(scenario, (15, 15)), c_left, theta)
+    points_m = instrument_frame_m(points_local, c_left, theta)
+    grid_m = instrument_frame_m(working_area_grid_m(scenario, (15, 15)), c_left, theta)
     ground = np.vstack([grid_m, points_m])
     depths_m = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
 

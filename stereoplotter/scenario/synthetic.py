@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.constants import UM_PER_MM
 from stereoplotter.geometry.collinearity import object_to_photo, photo_to_object
@@ -24,6 +24,7 @@ from stereoplotter.scenario.model import FIDUCIAL_NAMES, Photo, Scenario
 __all__ = [
     "Measurements",
     "PhotoMeasurements",
+    "film_deformed",
     "footprint_m",
     "synthesize_measurements",
     "working_area_grid_m",
@@ -156,8 +157,13 @@ def _imaged(scenario: Scenario, photo: Photo, points_m: NDArray) -> NDArray[np.b
         return np.all(np.abs(xy) <= scenario.camera.format_mm / 2.0, axis=-1)
 
 
-def _deform(photo: Photo, xy: NDArray) -> NDArray[np.float64]:
-    return xy * (1.0 + 1e-6 * np.asarray(photo.film_deformation_ppm))
+def film_deformed(photo: Photo, xy: ArrayLike) -> NDArray[np.float64]:
+    """Fiducial-system coordinates on the deformed film: (1 + s_x·10⁻⁶)·x, (1 + s_y·10⁻⁶)·y.
+
+    The uniform film deformation of ``photo`` (``docs/conventions.md`` §7), for marks and points.
+    [mm]
+    """
+    return np.asarray(xy, float) * (1.0 + 1e-6 * np.asarray(photo.film_deformation_ppm, float))
 
 
 def synthesize_measurements(
@@ -199,13 +205,13 @@ def synthesize_measurements(
     photos = []
     ratios = []
     for photo in scenario.photos:
-        fid_true = _deform(photo, fid_cal)
+        fid_true = film_deformed(photo, fid_cal)
         fid = fid_true + rng.normal(0.0, 1.0, fid_true.shape) * sig_f
         xy = _project(scenario, photo, pts)
         imaged = np.all(np.abs(xy) <= cam.format_mm / 2.0, axis=-1)
-        xy = np.where(imaged[:, None], _deform(photo, xy), np.nan)
+        xy = np.where(imaged[:, None], film_deformed(photo, xy), np.nan)
         xy_meas = xy + rng.normal(0.0, 1.0, xy.shape) * sig_p
-        g = _deform(photo, _project(scenario, photo, grid))
+        g = film_deformed(photo, _project(scenario, photo, grid))
         g_meas = g + rng.normal(0.0, 1.0, g.shape) * sig_p
         photos.append(PhotoMeasurements(photo.name, fid_true, fid, xy, xy_meas, imaged, g, g_meas))
         spans = fiducial_spans_mm(dict(zip(FIDUCIAL_NAMES, fid, strict=True)))
