@@ -437,6 +437,79 @@ def _setup_block(args: argparse.Namespace, spec: Any) -> int:
     return 0
 
 
+def _simulate(args: argparse.Namespace) -> int:
+    from stereoplotter.procedure.simulate import run_simulation_command
+
+    text, summary = run_simulation_command(
+        args.scenario,
+        instrument=args.instrument,
+        method=args.method,
+        errors=args.errors,
+        seed=args.seed,
+        trials=args.trials,
+        backend=args.backend,
+        output=args.output,
+    )
+    sys.stdout.write(_json(summary) if args.json else text)
+    return 0
+
+
+def _verify(args: argparse.Namespace) -> int:
+    from stereoplotter.accuracy.verification import verify
+
+    def progress(done: int, total: int, eq: str) -> None:
+        if args.json or not sys.stderr.isatty():
+            return
+        bar = "#" * (30 * done // total)
+        sys.stderr.write(f"\r[{bar:<30}] {done}/{total} {eq:<12}")
+        if done == total:
+            sys.stderr.write("\n")
+
+    rows, seconds = verify(trials=args.trials, seed=args.seed, out_dir=None, progress=progress)
+    if args.output:
+        from stereoplotter.accuracy.verification import write_verification
+
+        out = Path(args.output)
+        # Figures first, in memory: every file is written whole or not at all.
+        from stereoplotter.accuracy_plot import plot_error_maps, plot_verification_chart
+
+        figures = {}
+        for name, figure in (
+            ("error_maps.png", plot_error_maps()),
+            ("verification_chart.png", plot_verification_chart(rows).figure),
+        ):
+            buffer = io.BytesIO()
+            figure.savefig(buffer, format="png", dpi=100, metadata={"Software": None})
+            figures[name] = buffer.getvalue()
+        write_verification(rows, out, trials=args.trials, seed=args.seed, seconds=seconds)
+        for name, content in figures.items():
+            atomic_write_bytes(out / name, content)
+    if args.json:
+        sys.stdout.write(_json(rows))
+        return 0
+    lines = [
+        f"verification of Eqs. (6.28)–(6.61): {len(rows)} rows, {args.trials} trials, "
+        f"seed {args.seed}, {seconds:.1f} s",
+        "",
+        f"{'eq':<14}{'printed':>10}{'rigorous':>10}{'MC':>10}  verdict",
+    ]
+    for r in rows:
+
+        def f(v):
+            return f"{v:10.4g}" if isinstance(v, int | float) else f"{'—':>10}"
+
+        lines.append(
+            f"{r['eq']:<14}{f(r['printed'])}{f(r['rigorous'])}{f(r['mc_linear'])}  {r['verdict']}"
+        )
+    if args.output:
+        lines.append(
+            f"\nwritten: verification.md, .csv, .json, closing_comparison.json, "
+            f"error_maps.png, verification_chart.png in {args.output}"
+        )
+    sys.stdout.write("\n".join(lines) + "\n")
+    return 0
+
+
 # --- parser ----------------------------------------------------------------------------------
 
 
@@ -522,6 +595,43 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the sheet as JSON")
 
     p = sub.add_parser(
+        "simulate",
+        help="run the simulated operator on a virtual instrument and evaluate the model",
+    )
+    p.add_argument("scenario", help="a scenarios/*.yaml stereopair")
+    p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
+    p.add_argument(
+        "--method",
+        choices=("setup", "conventional"),
+        default="setup",
+        help="the setup-data method (five stages) or the conventional method",
+    )
+    p.add_argument(
+        "--errors",
+        help="injected errors: a YAML of overrides, or 'zero' "
+        "(default: the instrument's own, all assumed)",
+    )
+    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument("--trials", type=int, help="run T trials at once (closed-form back-end)")
+    p.add_argument("--backend", choices=("closed-form", "pymunk"), default="closed-form")
+    p.add_argument(
+        "-o",
+        "--output",
+        default="stereoplotter-simulate",
+        help="output folder (default: %(default)s)",
+    )
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+
+    p = sub.add_parser(
+        "verify",
+        help="verify the accuracy formulas (6.28)–(6.61) against rigorous forms and Monte Carlo",
+    )
+    p.add_argument("--trials", type=int, default=60000, help="Monte Carlo trials per row")
+    p.add_argument("--seed", type=int, default=20240601, help="seed of the Monte Carlo")
+    p.add_argument("-o", "--output", help="write Markdown, CSV, JSON and plots into this folder")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON")
+
+    p = sub.add_parser(
         "demo",
         help="run the main job on the default scenario (or --scenario) "
         "and write its results into a folder",
@@ -558,6 +668,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _instrument(args)
         if args.command == "setup":
             return _setup(args)
+        if args.command == "simulate":
+            return _simulate(args)
+        if args.command == "verify":
+            return _verify(args)
     except StereoplotterError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

@@ -142,3 +142,35 @@ def test_instrument_test_cli(capsys):
     assert main(["instrument", "test", "sd3", "--tilts", "0.5", "--variants", "L", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["instrument"] == "sd3" and data["residuals"][0]["unit"] == "canonical"
+
+
+def test_verify_cli(tmp_path, capsys):
+    assert main(["verify", "--trials", "2000", "-o", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "(6.43)" in out and "verdict" in out
+    names = {p.name for p in tmp_path.iterdir()}
+    assert {
+        "verification.md",
+        "verification.csv",
+        "verification.json",
+        "closing_comparison.json",
+        "error_maps.png",
+        "verification_chart.png",
+    } <= names
+    assert main(["verify", "--trials", "2000", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    keys = {
+        "eq",
+        "quantity",
+        "printed",
+        "book",
+        "rigorous",
+        "mc_linear",
+        "mc_linear_ci",
+        "mc_procedure",
+        "mc_procedure_ci",
+        "verdict",
+        "note",
+    }
+    assert all(keys <= set(r) for r in rows)
+    assert {r["eq"] for r in rows} >= {f"(6.{i})" for i in range(28, 62)}

@@ -88,7 +88,7 @@ def _terms(spec: InstrumentSpec) -> list[ErrorTerm]:
         )
 
     terms = []
-    for scale in ("X", "Y", "Z", "bx", "by", "bz", "dx_left", "dy_left", "dx_right", "dy_right"):
+    for scale in ("X", "Y", "bx", "by", "bz", "dx_left", "dy_left", "dx_right", "dy_right"):
         terms.append(
             term(
                 f"zero_reading.{scale}",
@@ -97,6 +97,17 @@ def _terms(spec: InstrumentSpec) -> list[ErrorTerm]:
                 f"error of the zero reading (место нуля) of the {scale} scale",
             )
         )
+    # The absolute height counter reads D itself (stage 1 sets O_Z = n_л·f_пр on it): its zero
+    # is a factory calibration, assumed good to one least count, not an unknown place of zero.
+    terms.insert(
+        2,
+        term(
+            "zero_reading.Z",
+            "normal",
+            "z_least_count_mm",
+            "calibration error of the absolute height counter (reads D), one least count",
+        ),
+    )
     for counter in ("X", "Y", "Z"):
         terms.append(
             term(

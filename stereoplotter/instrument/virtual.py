@@ -38,7 +38,7 @@ from stereoplotter.instrument.spec import InstrumentSpec, check_in_range, load_i
 from stereoplotter.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.mechanics.play import PlayAxis
 
-__all__ = ["BACKENDS", "CONTROLS", "Instrument", "Scale"]
+__all__ = ["BACKENDS", "CONTROLS", "HEIGHT_SCALE", "NOMINAL_ZERO", "Instrument", "Scale"]
 
 #: Mechanics back-ends of the lead-screw axes.
 BACKENDS = ("closed-form", "pymunk")
@@ -49,6 +49,10 @@ _SCREWS = ("X", "Y", "Z", "bx", "by", "bz")
 _SET = ("f_instrument", "kappa_left", "kappa_right", "dx_left", "dy_left", "dx_right", "dy_right")
 #: Every control an operator can turn to a reading.
 CONTROLS = _SCREWS + _SET
+#: The metre height scale geared to the Z screw: reading = slip − D·M_в/1000 [m].
+HEIGHT_SCALE = "H"
+#: Reading of the height scale at D = 0 before the operator slips it (arbitrary constant). [m]
+_HEIGHT_SLIP_NOMINAL = 2000.0
 #: Nominal zero readings of the scales (arbitrary instrument constants). [mm]
 _NOMINAL_ZERO = {
     "X": 200.0,
@@ -62,6 +66,9 @@ _NOMINAL_ZERO = {
     "dx_right": 20.0,
     "dy_right": 20.0,
 }
+#: The nominal zero readings an operator finds on the instrument's scales (the place of zero
+#: engraved; the injected zero-reading error is what differs from it). [mm]
+NOMINAL_ZERO = dict(_NOMINAL_ZERO)
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,6 +131,9 @@ class Instrument:
     ideal_mechanics : bool
         Rigid, frictionless screws without backlash (the kinematic instrument); otherwise the
         friction, compliance and masses of the YAML ``mechanics.*`` apply.
+    injected : mapping, optional
+        Already drawn injected errors (``ErrorModel.draw`` output, or one trial of it) instead of
+        drawing them from ``rng``: lets a per-trial loop rebuild trial t of a vectorised run.
 
     Notes
     -----
@@ -143,6 +153,7 @@ class Instrument:
         backend: str = "closed-form",
         trials: int | None = None,
         ideal_mechanics: bool = False,
+        injected: dict[str, Any] | None = None,
     ):
         if backend not in BACKENDS:
             raise StereoplotterError(
@@ -158,14 +169,16 @@ class Instrument:
         self.trials = trials
         self.ideal_mechanics = ideal_mechanics
         self.errors = errors if errors is not None else error_model_from_spec(spec)
-        if rng is None:
+        if injected is not None:
+            rng = np.random.default_rng(0)
+        elif rng is None:
             if any(t.scale for t in self.errors.terms if t.distribution != "constant"):
                 raise StereoplotterError(
                     "an instrument with random injected errors needs an "
                     "explicit numpy.random.Generator (rng)"
                 )
             rng = np.random.default_rng(0)
-        self.injected = self.errors.draw(rng, trials)
+        self.injected = dict(injected) if injected is not None else self.errors.draw(rng, trials)
         e = self.injected
         shape = () if trials is None else (trials,)
 
@@ -190,6 +203,8 @@ class Instrument:
         self.focal_length_mm = float(focal_length_mm)
         self._f_instrument = full(math.nan)
         self._kappa = {"left": full(0.0), "right": full(0.0)}
+        self._height_gear: float | None = None
+        self._height_slip = full(_HEIGHT_SLIP_NOMINAL)
         self._units = {
             side: CorrectionUnit(
                 self.focal_length_mm,
@@ -270,6 +285,10 @@ class Instrument:
         exact : bool
             Return the exact reading instead of the one rounded to the least count.
         """
+        if control == HEIGHT_SCALE:
+            reading = self._height_reading()
+            out = reading if exact else self._round_height(reading)
+            return self._out(out)
         if control not in self._scales:
             raise StereoplotterError(f"no scale {control!r}; scales: {', '.join(self._scales)}")
         scale = self._scales[control]
@@ -296,6 +315,11 @@ class Instrument:
         RangeRefusal, TravelRefusal
             A setting beyond the instrument's range: refused like the real stop.
         """
+        if control == HEIGHT_SCALE:
+            gear = self._gear()
+            depth_reading = (self._height_slip - np.asarray(reading, float)) * 1000.0 / gear
+            self.set("Z", depth_reading, side)
+            return
         if control in self._axes:
             nut = self._scales[control].position(reading)
             self._axes[control].approach(self._arg(nut), side)
@@ -363,6 +387,70 @@ class Instrument:
         self._units[side] = turn_correction_knob(
             self._units[side], axis, t, linkage=self.variant.linkage
         )
+
+    def travel_mm(self, control: str) -> tuple[float, float]:
+        """The range stops of a lead-screw axis (nut positions). [mm]
+
+        Examples
+        --------
+        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> Instrument.error_free(load_instrument("sc1"), 70.0).travel_mm("Z")
+        (110.0, 185.0)
+        """
+        return tuple(float(v) for v in self._axis_params(control).range_mm)
+
+    def reading_of(self, control: str, nut_mm: ArrayLike) -> NDArray[np.float64]:
+        """The exact reading a counter shows with its nut at ``nut_mm`` (counter arithmetic)."""
+        return np.asarray(self._scales[control].reading(nut_mm))
+
+    # --- the metre height scale (stage 1 MO_Z, stage 3 (6.15)) ----------------------------------
+
+    def gear_height_counter(self, vertical_scale_denominator: int) -> None:
+        """Put the height-counter gear for M_в: the metre scale then moves D·M_в/1000.
+
+        Raises
+        ------
+        RangeRefusal
+            An M_в that is not one of the instrument's gears.
+
+        Examples
+        --------
+        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> inst = Instrument.error_free(load_instrument("sc1"), 70.0)
+        >>> inst.gear_height_counter(8000)
+        >>> inst.set("Z", 175.0)
+        >>> round(inst.read("H", exact=True), 6)  # 2000 m − 175 mm · 8000 / 1000
+        600.0
+        >>> inst.slip_height_scale(143.4)
+        >>> inst.set("H", 135.4)  # 8 m lower: 1 mm deeper
+        >>> round(inst.read("Z", exact=True), 6)
+        176.0
+        """
+        check_in_range(
+            self.spec, "vertical_scale_denominators", float(vertical_scale_denominator), "M_в"
+        )
+        self._height_gear = float(vertical_scale_denominator)
+
+    def slip_height_scale(self, reading_m: ArrayLike) -> None:
+        """Slip the metre height scale (friction coupling) so that it shows ``reading_m`` now."""
+        self._height_slip = self._height_slip + (
+            np.asarray(reading_m, float) - self._height_reading()
+        )
+
+    def _gear(self) -> float:
+        if self._height_gear is None:
+            raise StereoplotterError(
+                "the height counter is not geared (gear_height_counter(M_в) first)"
+            )
+        return self._height_gear
+
+    def _height_reading(self) -> NDArray[np.float64]:
+        depth = np.asarray(self._scales["Z"].reading(self._axes["Z"].nut), float)
+        return self._height_slip - depth * self._gear() / 1000.0
+
+    def _round_height(self, reading: NDArray) -> NDArray[np.float64]:
+        lc = self.spec.height_scale_least_count_m
+        return np.round(np.asarray(reading, float) / lc) * lc
 
     # --- looking through the eyepieces ---------------------------------------------------------
 

@@ -1,0 +1,483 @@
+"""The simulated operator: acts only through the instrument's controls, with judgment errors.
+
+``procedure.md`` §The operator model. The operator sees counter and scale readings and, in the
+eyepieces, where each measuring mark sits relative to image detail. "Turn a control until X" is a
+1-D solve on the instrument model (:mod:`stereoplotter.instrument.kinematics`, closed form or a
+fixed number of Newton steps, vectorised over trials), then the judgment error, then the
+mechanics: the operator turns the handwheel while looking, so the final *carriage* position is
+the target plus the judgment error whatever the backlash (a fixed number of look-and-correct
+passes, always finishing from the same side by default); a computed value is *set on its scale*,
+so the backlash and the scale errors stay in the result.
+
+Randomness comes only from :class:`Noise`: keyed streams (one per act and iteration) derived from
+one seed, so that a vectorised run and a per-trial loop draw identical numbers for each trial.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.kinematics import (
+    counters_from_homologous_points,
+    counters_from_photo,
+    marks_from_counters,
+    turn_correction_knob,
+)
+from stereoplotter.instrument.virtual import HEIGHT_SCALE, Instrument
+from stereoplotter.procedure.transcript import Transcript
+from stereoplotter.scenario.model import Scenario
+from stereoplotter.scenario.synthetic import synthesize_measurements
+
+__all__ = ["Noise", "Operator", "OperatorModel", "Scene", "solve_1d"]
+
+_SCREWS = ("X", "Y", "Z", "bx", "by", "bz")
+_KNOBS = ("k_alpha_left", "k_omega_left", "k_alpha_right", "k_omega_right")
+
+
+@dataclass(frozen=True, slots=True)
+class OperatorModel:
+    """Judgment errors and habits of the operator (all **assumed**, ``procedure.md`` table).
+
+    Attributes
+    ----------
+    monocular_sigma_mm : float
+        σ_mono, mark on a point of one photo, per axis, photo scale. [mm]
+    stereo_sigma_mm : float
+        σ_p, x-parallax judged zero (mark "on the ground"), photo scale. [mm]
+    y_parallax_sigma_mm : float
+        σ_q, y-parallax judged zero (Table 18 of the book uses m_q = 0.015 mm). [mm]
+    reading_sigma_lc : float
+        σ_read in least counts of the scale read, before rounding to the least count. [—]
+    setting_sigma_lc : float
+        σ_set in least counts of the scale set. [—]
+    quantise : bool
+        Readings are rounded to the least count.
+    finish_side : {"below", "above", None}
+        Habit: always finish a setting from this side (default "below"); None: straight there.
+    max_iterations : int
+        Bound of every tolerance loop (reported when reached, never silent).
+    assumed : bool
+        Always True: none of these values is documented for the instruments.
+    """
+
+    monocular_sigma_mm: float = 0.010
+    stereo_sigma_mm: float = 0.010
+    y_parallax_sigma_mm: float = 0.010
+    reading_sigma_lc: float = 0.2
+    setting_sigma_lc: float = 0.2
+    quantise: bool = True
+    finish_side: str | None = "below"
+    max_iterations: int = 6
+    assumed: bool = field(default=True, init=False)
+
+    def zero(self) -> OperatorModel:
+        """The same habits with no judgment error and exact readings.
+
+        Examples
+        --------
+        >>> OperatorModel().zero().stereo_sigma_mm
+        0.0
+        """
+        return replace(
+            self,
+            monocular_sigma_mm=0.0,
+            stereo_sigma_mm=0.0,
+            y_parallax_sigma_mm=0.0,
+            reading_sigma_lc=0.0,
+            setting_sigma_lc=0.0,
+            quantise=False,
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready parameters with their status."""
+        out = {k: getattr(self, k) for k in self.__slots__ if k != "assumed"}
+        out["status"] = "assumed"
+        return out
+
+
+class Noise:
+    """Keyed normal streams: the draw for an act depends on (seed, key) only.
+
+    Parameters
+    ----------
+    seed : int
+    trials : int or None
+        T of the run (None: a single run).
+    trial : int, optional
+        Return only this trial's value (the per-trial oracle of a vectorised run).
+
+    Examples
+    --------
+    >>> a = Noise(7, 4).normal("stage 1/L/1", 1.0)
+    >>> b = Noise(7, 4, trial=2).normal("stage 1/L/1", 1.0)
+    >>> bool(a[2] == b)
+    True
+    """
+
+    def __init__(self, seed: int, trials: int | None, trial: int | None = None):
+        self.seed = int(seed)
+        self.trials = trials
+        self.trial = trial
+
+    def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
+        """σ·z for the act ``key``: shape (T,), or () for a single run or a per-trial oracle."""
+        size = self.trials or 1
+        if sigma == 0.0:
+            z = np.zeros(size)
+        else:
+            rng = np.random.default_rng([self.seed, zlib.crc32(key.encode("utf-8"))])
+            z = sigma * rng.standard_normal(size)
+        if self.trial is not None:
+            return np.asarray(z[self.trial])
+        return z if self.trials else np.asarray(z[0])
+
+
+def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: float = 1e-6):
+    """x with fun(x) = target by a fixed number of Newton steps (central differences).
+
+    A fixed count (no early exit) keeps a vectorised run and a per-trial loop bit-identical.
+
+    Examples
+    --------
+    >>> float(solve_1d(lambda x: x**3, 1.0, 8.0, iterations=12))
+    2.0
+    """
+    x = np.asarray(x0, float) + 0.0
+    t = np.asarray(target, float)
+    for _ in range(iterations):
+        r = fun(x) - t
+        d = (fun(x + h) - fun(x - h)) / (2.0 * h)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = np.where(d != 0.0, r / d, 0.0)
+        x = x - step
+    return x
+
+
+@dataclass(frozen=True)
+class Scene:
+    """What lies in the cassettes and on the ground: the physical photos and the truth.
+
+    Attributes
+    ----------
+    scenario : Scenario
+    fiducials_mm : dict
+        "left"/"right" → (4, 2) fiducial marks 1–4 on the (deformed) film. [mm]
+    standard_points_m : ndarray, shape (6, 3)
+        Ground points of the six standard points (Fig. 39): 1, 2 below the principal points,
+        3, 4 at +c and 5, 6 at −c on the photo y axis of photos 1, 2 (local frame). [m]
+    c_mm : float
+        c of the standard points on the photo. [mm]
+    """
+
+    scenario: Scenario
+    fiducials_mm: dict[str, NDArray[np.float64]]
+    standard_points_m: NDArray[np.float64]
+    c_mm: float
+
+    @classmethod
+    def build(
+        cls,
+        scenario: Scenario,
+        frame_origin_m: ArrayLike,
+        frame_rotation: float,
+        c_mm: float,
+    ) -> Scene:
+        """Photos of ``scenario`` and its six standard points (c from the instrument spec).
+
+        The standard points are those of ``stereoplotter.evaluation.standard_points_m``
+        (Fig. 39: nadirs ± c·H̄/f), H̄ the flying height of S_л over the mean control height.
+        """
+        from stereoplotter.evaluation import instrument_frame_m, standard_points_m
+
+        m = synthesize_measurements(scenario, np.random.default_rng(0), noise=False)
+        fid = {p.photo: p.fiducials_true_mm for p in m.photos}
+        z0 = float(np.mean([p.local_m[2] for p in scenario.points]))
+        h = float(scenario.photo("left").exterior.centre[2]) - z0
+        frame = standard_points_m(scenario, frame_origin_m, frame_rotation, h, c_mm)
+        local = instrument_frame_m(frame, frame_origin_m, frame_rotation, inverse=True)
+        return cls(scenario, fid, local, c_mm)
+
+    def images(self, points_m: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """True images of ground points on the left and right photo (fiducial system). [mm]"""
+        from stereoplotter.evaluation import film_points_mm
+
+        pts = np.asarray(points_m, float)
+        return film_points_mm(self.scenario, "left", pts), film_points_mm(
+            self.scenario, "right", pts
+        )
+
+
+class Operator:
+    """An operator at one instrument (or at T instruments at once).
+
+    Parameters
+    ----------
+    instrument : Instrument
+    model : OperatorModel
+    noise : Noise
+    transcript : Transcript
+    """
+
+    def __init__(
+        self, instrument: Instrument, model: OperatorModel, noise: Noise, transcript: Transcript
+    ):
+        self.inst = instrument
+        self.model = model
+        self.noise = noise
+        self.log = transcript
+        self.trials = instrument.trials
+        self.commanded: dict[str, NDArray[np.float64]] = {}
+        self.passes = 3 if instrument.backend == "pymunk" else 2
+        #: Per control, the trials whose handwheel was turned against its stop.
+        self.stopped: dict[str, NDArray[np.bool_]] = {}
+
+    # --- shapes -------------------------------------------------------------------------------
+
+    def v(self, x: ArrayLike) -> NDArray[np.float64]:
+        """A value in the run's shape: (T,) or ()."""
+        a = np.asarray(x, float)
+        if self.trials:
+            return np.broadcast_to(a, (self.trials,)).copy()
+        return a.reshape(-1)[0] + np.zeros(()) if a.size == 1 else a
+
+    def all(self) -> NDArray[np.bool_]:
+        """An all-true mask."""
+        return np.ones(self.trials, bool) if self.trials else np.array(True)
+
+    # --- least counts -------------------------------------------------------------------------
+
+    def least_count(self, control: str) -> float:
+        spec = self.inst.spec
+        if control == HEIGHT_SCALE:
+            return spec.height_scale_least_count_m
+        if control == "Z":
+            return spec.z_least_count_mm
+        return spec.xy_least_count_mm
+
+    # --- reading and setting ------------------------------------------------------------------
+
+    def read(self, control: str, key: str) -> NDArray[np.float64]:
+        """Read a counter or scale: exact value + σ_read, rounded to the least count."""
+        lc = self.least_count(control)
+        exact = self.v(self.inst.read(control, exact=True))
+        seen = exact + self.noise.normal(f"read/{key}", self.model.reading_sigma_lc * lc)
+        if self.model.quantise:
+            seen = np.round(seen / lc) * lc
+        return seen
+
+    def set(
+        self,
+        control: str,
+        value: ArrayLike,
+        key: str,
+        active: NDArray[np.bool_] | None = None,
+    ) -> NDArray[np.float64]:
+        """Set a computed value on a scale (σ_set); backlash and scale errors stay in."""
+        active = self.all() if active is None else active
+        if not np.any(active):
+            return self.v(value)
+        value = self.v(value)
+        if control in _SCREWS or control == HEIGHT_SCALE:
+            lc = self.least_count(control)
+            cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
+            prev = self.v(self.inst.read(control, exact=True))
+            cmd = self._at_stop(control, cmd)
+            self.inst.set(control, np.where(active, cmd, prev), side=self.model.finish_side)
+        else:
+            lc = self.inst.spec.xy_least_count_mm if control.startswith(("d", "f_")) else 0.0
+            cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
+            prev = self.commanded.get(control, cmd)
+            cmd = np.where(active, cmd, prev)
+            self.inst.set(control, cmd)
+            self.commanded[control] = cmd
+        return cmd
+
+    def _at_stop(self, control: str, reading: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The operator turns no further than the stop (the instrument would refuse): a reading
+        beyond it becomes the stop's reading, and the trial is flagged in :attr:`stopped`."""
+        if control == HEIGHT_SCALE:
+            return reading
+        lo, hi = self.inst.travel_mm(control)
+        margin = 1e-9
+        r_lo, r_hi = (self.v(self.inst.reading_of(control, v)) for v in (lo + margin, hi - margin))
+        low, high = np.minimum(r_lo, r_hi), np.maximum(r_lo, r_hi)
+        beyond = (reading < low) | (reading > high)
+        if np.any(beyond):
+            self.stopped[control] = self.stopped.get(control, np.zeros_like(beyond)) | beyond
+        return np.clip(reading, low, high)
+
+    # --- turning while looking ---------------------------------------------------------------
+
+    def physical(self, control: str) -> NDArray[np.float64]:
+        """Where a control physically is (what the eye judges in the eyepiece)."""
+        st = self.inst.state()
+        if control in ("X", "Y", "Z"):
+            return self.v(st["carriages_mm"][control])
+        if control in ("bx", "by", "bz"):
+            return self.v(st["base_mm"][control])
+        if control.startswith("kappa_"):
+            return self.v(st["units"][control.split("_")[1]].kappa)
+        if control in _KNOBS:
+            _, axis, side = control.split("_")
+            unit = st["units"][side]
+            return self.v(unit.tan_alpha if axis == "alpha" else unit.tan_omega)
+        raise StereoplotterError(f"cannot drive {control!r}")
+
+    def drive(
+        self,
+        control: str,
+        target: ArrayLike,
+        active: NDArray[np.bool_] | None = None,
+    ) -> None:
+        """Turn a handwheel, knob or cassette until the control is physically at ``target``.
+
+        A fixed number of look-and-correct passes: with the habit of finishing from one side
+        the backlash is a constant offset, removed by the second pass.
+        """
+        active = self.all() if active is None else active
+        if not np.any(active):
+            return
+        target = self.v(target)
+        for _ in range(self.passes):
+            now = self.physical(control)
+            err = np.where(active, target - now, 0.0)
+            if control in _SCREWS:
+                cmd = self._at_stop(control, self.v(self.inst.read(control, exact=True)) + err)
+                self.inst.set(control, cmd, side=self.model.finish_side)
+            elif control in _KNOBS:
+                cmd = self.commanded.get(control, now) + err
+                self.inst.turn_knob(control, cmd)
+                self.commanded[control] = cmd
+            else:
+                cmd = self.commanded.get(control, now) + err
+                self.inst.set(control, cmd)
+                self.commanded[control] = cmd
+
+    # --- looking ------------------------------------------------------------------------------
+
+    def units(self):
+        st = self.inst.state()
+        return st["units"]["left"], st["units"]["right"]
+
+    def mark_on(
+        self,
+        side: str,
+        photo_point_mm: ArrayLike,
+        key: str,
+        active: NDArray[np.bool_] | None = None,
+        free: str = "XY",
+    ) -> NDArray[np.float64]:
+        """Monocular pointing: move X and/or Y until the mark of ``side`` is on a photo point.
+
+        ``free`` names the handwheels turned ("XY", "X": onto the fiducial line x = const with
+        Y as set, "Y": onto y = const). Returns the judgment error drawn, shape (..., 2). [mm]
+        """
+        e = np.stack(
+            [
+                self.noise.normal(f"mono/{key}/x", self.model.monocular_sigma_mm),
+                self.noise.normal(f"mono/{key}/y", self.model.monocular_sigma_mm),
+            ],
+            axis=-1,
+        )
+        target = np.asarray(photo_point_mm, float) + e
+        left, right = self.units()
+        setting = self.inst.setting
+        car = {c: self.physical(c) for c in ("X", "Y", "Z")}
+        index = 0 if side == "left" else 1
+        if free == "XY":  # both handwheels: the closed-form monocular setting (§3.4)
+            xy = counters_from_photo(
+                target, car["Z"], left if side == "left" else right, setting, side
+            )
+            car["X"], car["Y"] = xy[..., 0], xy[..., 1]
+            free_solve = ""
+        else:
+            free_solve = free
+        for axis in free_solve:
+            comp = 0 if axis == "X" else 1
+
+            def seen(value, axis=axis, comp=comp):
+                xy = dict(car)
+                xy[axis] = value
+                marks = marks_from_counters(xy["X"], xy["Y"], xy["Z"], setting, left, right)
+                return marks[index][..., comp]
+
+            car[axis] = solve_1d(seen, car[axis], target[..., comp], iterations=4, h=1e-3)
+        for axis in free:
+            self.drive(axis, car[axis], active)
+        return e
+
+    def fuse(
+        self,
+        points_m: ArrayLike,
+        images: tuple[NDArray, NDArray],
+        key: str,
+        active: NDArray[np.bool_] | None = None,
+        move: bool = True,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Stereo pointing on a ground point: clear the x-parallax (σ_p) with the floating mark
+        on the point (σ_mono); return the y-parallax seen there (σ_q) and the true one. [mm]"""
+        pl, pr = images
+        ex = self.noise.normal(f"mono/{key}/x", self.model.monocular_sigma_mm)
+        ey = self.noise.normal(f"mono/{key}/y", self.model.monocular_sigma_mm)
+        ep = self.noise.normal(f"stereo/{key}", self.model.stereo_sigma_mm)
+        eq = self.noise.normal(f"q/{key}", self.model.y_parallax_sigma_mm)
+        shift = np.stack([ex, ey], axis=-1)
+        pl = np.asarray(pl, float) + shift + np.stack([ep, 0.0 * ep], axis=-1)
+        pr = np.asarray(pr, float) + shift
+        left, right = self.units()
+        r = counters_from_homologous_points(pl, pr, self.inst.setting, left, right)
+        if move:
+            for axis, value in (("X", r.x_mm), ("Y", r.y_mm), ("Z", r.depth_mm)):
+                self.drive(axis, value, active)
+        return r.y_parallax_mm + eq, r.y_parallax_mm
+
+    def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):
+        """The true y-parallax of the present model at ground points (no judgment). [mm]"""
+        left, right = self.units()
+        setting = self.inst.setting
+        if self.trials:  # one row per trial, one column per point
+            left, right, setting = (_column(o) for o in (left, right, setting))
+        return counters_from_homologous_points(
+            images[0], images[1], setting, left, right
+        ).y_parallax_mm
+
+    def knob_for(self, knob: str, unit, photo_point, rod, comp: int, target) -> NDArray:
+        """T of ``knob`` that puts ``photo_point`` under the rod coordinate ``rod`` (axis comp).
+
+        A 1-D Newton solve on the unit model with the instrument's own linkage (D1).
+        """
+        from stereoplotter.instrument.kinematics import photo_from_rod
+
+        axis = knob.split("_")[1]
+        linkage = self.inst.variant.linkage
+
+        def seen(t):
+            u = turn_correction_knob(unit, axis, t, linkage=linkage)
+            return photo_from_rod(rod, u)[..., comp]
+
+        t0 = self.physical(knob)
+        return solve_1d(seen, t0, target, iterations=6, h=1e-6)
+
+
+def _column(obj):
+    """A frozen unit/setting with every per-trial field (T,) turned into a column (T, 1)."""
+    from dataclasses import fields
+
+    changes = {}
+    for f in fields(obj):
+        v = getattr(obj, f.name)
+        if isinstance(v, np.ndarray) and v.ndim == 1:
+            changes[f.name] = v[:, None]
+    return replace(obj, **changes)
+
+
+def degrees(value: float) -> float:
+    """Radians to degrees (for messages)."""
+    return math.degrees(value)

@@ -1,0 +1,781 @@
+"""The setup-data method of §26: stages 1–5 on a virtual instrument (``procedure.md``).
+
+Each stage is a function of a :class:`Run` (instrument, sheet, operator, scene) that changes the
+instrument only through the operator and appends to the transcript. Every tolerance loop is
+bounded by ``OperatorModel.max_iterations``; its iteration count and its last residual are
+returned per trial (never silent). All arithmetic is vectorised over the trials of the run; a
+trial whose loop has passed is left alone (``active`` masks), so a vectorised run and a per-trial
+loop give the same numbers.
+
+Reference
+---------
+.. [1] Kushtin I. F. & Lyskov G. A., *Фотограмметрия снимка и стереоскопических моделей*,
+   Moscow: Nedra, 1984, ch. 6, §26, Eqs. (6.9)–(6.18) (OCR L3753–3826).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.instrument.kinematics import rod_from_counters, rod_from_photo
+from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.procedure.operator import Operator, Scene
+from stereoplotter.setup_data import (
+    base_z_correction,
+    height_correction,
+    height_scale_reading,
+    sheet_corner_instrument_coordinates,
+)
+from stereoplotter.setup_sheet import SetupSheet
+
+__all__ = [
+    "Run",
+    "check_standard_points",
+    "clear_kappa",
+    "run_setup_method",
+    "stage1_scale_coefficient",
+    "stage2_transform",
+    "stage3_scale_model",
+    "stage4_orient_sheet",
+    "stage5_check",
+]
+
+_SIDE = {"left": "л", "right": "п"}
+
+
+@dataclass
+class Run:
+    """Everything a procedure works on, and what it found.
+
+    Attributes
+    ----------
+    op : Operator
+    sheet : SetupSheet
+    scene : Scene
+    zero : dict
+        Zero readings the operator has determined (MO_X, MO_Y, MO_X,п, MO_Y,п, MO_by, MO_bz,
+        MO_Z), arrays over the trials. [mm, m for MO_Z]
+    results : dict
+        Checks: name → {"residual", "tolerance", "passed", "iterations", "unit"}, arrays.
+    iterations : dict
+        Stage → iterations used (arrays over the trials).
+    """
+
+    op: Operator
+    sheet: SetupSheet
+    scene: Scene
+    zero: dict[str, NDArray[np.float64]] = field(default_factory=dict)
+    results: dict[str, dict[str, Any]] = field(default_factory=dict)
+    iterations: dict[str, NDArray[np.int64]] = field(default_factory=dict)
+    sheet_pose: dict[str, Any] = field(default_factory=dict)
+
+    def check(
+        self, name: str, residual, tolerance, unit: str = "mm", iterations=None
+    ) -> NDArray[np.bool_]:
+        """Record a tolerance check (|residual| ≤ tolerance) and return pass/fail per trial."""
+        residual = self.op.v(residual)
+        tol = self.op.v(tolerance) if tolerance is not None else None
+        passed = np.abs(residual) <= tol if tol is not None else None
+        self.results[name] = {
+            "residual": residual,
+            "tolerance": tol,
+            "passed": passed,
+            "unit": unit,
+            "iterations": None if iterations is None else self.op.v(iterations).astype(int),
+        }
+        return passed
+
+
+def _fid(run: Run, side: str, mark: str) -> NDArray[np.float64]:
+    return run.scene.fiducials_mm[side][int(mark) - 1]
+
+
+# --- stage 1 ---------------------------------------------------------------------------------
+
+
+def _measure_span(run: Run, side: str, key: str, active) -> NDArray[np.float64]:
+    """L′: the mark on fiducial 3 then 4 of ``side``, Y read at each."""
+    op = run.op
+    ys = []
+    for mark in ("3", "4"):
+        op.mark_on(side, _fid(run, side, mark), f"{key}/{side}/{mark}", active)
+        ys.append(op.read("Y", f"{key}/{side}/{mark}"))
+    return ys[0] - ys[1]
+
+
+def _spans(sheet: SetupSheet, units_at_zero: bool) -> tuple[float, float]:
+    """The L to compare with: (6.5), or with the units at zero n·(y₃ − y₄) of the measured
+    marks (decision D5, ``kinematics.md`` §4.3: the literal (6.5) would bias n by
+    tan²ω(1 + l²/f′²) and can drive D beyond D_max)."""
+    out = []
+    for photo in sheet.photos:
+        if units_at_zero:
+            m = photo.marks_measured_mm
+            out.append(photo.n * (m["3"][1] - m["4"][1]))
+        else:
+            out.append(photo.mark_span_mm)
+    return out[0], out[1]
+
+
+def _span_loop(
+    run: Run, stage: str, key: str, units_at_zero: bool = False, active=None
+) -> tuple[NDArray, NDArray, NDArray]:
+    """The L-check loop (6.9)–(6.11) until |L − L′| ≤ 0.03/n_л for both photos."""
+    op, sheet = run.op, run.sheet
+    tol = sheet.tolerances["mark_span_mm"]
+    span_l, span_r = _spans(sheet, units_at_zero)
+    sense = sheet.options.bz_scale_sense
+    active = op.all() if active is None else active.copy()
+    its = np.zeros(np.shape(active), int)
+    dl = dr = op.v(np.nan)
+    for it in range(1, op.model.max_iterations + 1):
+        its = np.where(active, it, its)
+        k = f"{key}/{it}"
+        meas_l = _measure_span(run, "left", k, active)
+        meas_r = _measure_span(run, "right", k, active)
+        dl = np.where(active, span_l - meas_l, dl)
+        dr = np.where(active, span_r - meas_r, dr)
+        ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
+        for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
+            op.log.add(
+                stage,
+                f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} "
+                f"= {span:.3f} mm",
+                "Y",
+                reading=meas,
+                residual=d,
+                tolerance=tol,
+                passed=np.abs(d) <= tol,
+                iteration=it,
+                equation="(6.5)" if not units_at_zero else "(6.5), decision D5",
+            )
+        active = active & ~ok
+        if not np.any(active):
+            break
+        depth = op.read("Z", f"{k}/Z")
+        dz_m = height_correction(depth, dl, span_l, sheet.vertical_scale_denominator)
+        dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
+        # Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a
+        # correction that asks for a deeper carriage cannot be set there. The operator reaches
+        # the same n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
+        stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
+        beyond = active & (depth + dz_mm > stop)
+        if np.any(beyond):
+            f_set = op.commanded["f_instrument"]
+            f_new = f_set * depth / (depth + dz_mm)
+            op.set("f_instrument", f_new, f"{k}/setf", beyond)
+            op.log.add(
+                stage,
+                "the carriage is at its bottom stop: n = D/f_пр reached by f_пр instead, "
+                "f′_пр = f_пр·D/(D + ΔD)",
+                "f_instrument",
+                before=f_set,
+                after=f_new,
+                reading=f_new,
+                iteration=it,
+                equation="(6.3), (6.9)",
+            )
+            dz_mm = np.where(beyond, 0.0, dz_mm)
+        op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
+        op.log.add(
+            stage,
+            f"ΔZ = {float(np.ravel(dz_m)[op.log.shown if dz_m.size > 1 else 0]):+.3f} m "
+            "(6.9): lower the carriage, O′_Z = O_Z + ΔZ",
+            "Z",
+            before=depth,
+            after=depth + dz_mm,
+            reading=depth + dz_mm,
+            iteration=it,
+            equation="(6.9), (6.11)",
+        )
+        bz = op.read("bz", f"{k}/bz")
+        dbz = base_z_correction(depth, dr, span_r)
+        op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
+        op.log.add(
+            stage,
+            "Δb_z (6.10): O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
+            "bz",
+            before=bz,
+            after=bz + sense * dbz,
+            reading=bz + sense * dbz,
+            iteration=it,
+            equation="(6.10), (6.11)",
+        )
+    ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
+    return its, ok, np.maximum(np.abs(dl), np.abs(dr))
+
+
+def stage1_scale_coefficient(run: Run) -> None:
+    """Stage 1: interior settings, base, D = n_л f_пр, the L-check loop, MO_Z and MO_bz (D7)."""
+    op, sheet = run.op, run.sheet
+    log = op.log
+    op.inst.gear_height_counter(sheet.vertical_scale_denominator)
+    op.set("f_instrument", sheet.f_instrument_mm, "1/f")
+    log.add(
+        "1",
+        "set the instrument principal distance f_пр",
+        "f_instrument",
+        reading=sheet.f_instrument_mm,
+        equation="item 1",
+    )
+    for side in ("left", "right"):
+        op.drive(f"kappa_{side}", 0.0)
+        log.add(
+            "1",
+            f"turn the {side} cassette: fiducial lines parallel to the axes",
+            f"kappa_{side}",
+            reading=0.0,
+            unit="rad",
+            equation="stage 1",
+        )
+        for axis in ("alpha", "omega"):
+            op.drive(f"k_{axis}_{side}", 0.0)
+        for d in ("dx", "dy"):
+            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], f"1/{d}_{side}")
+    log.add(
+        "1", "correction mechanisms and decentrations to their zero places", "", equation="stage 1"
+    )
+    bx, by, _ = sheet.base_mm
+    op.set("bx", NOMINAL_ZERO["bx"] + bx, "1/bx")
+    log.add(
+        "1",
+        "base carriage: O_bx = MO_bx + b_x",
+        "bx",
+        reading=NOMINAL_ZERO["bx"] + bx,
+        equation="item 1",
+    )
+    op.set("bz", NOMINAL_ZERO["bz"], "1/bz0")
+    depth = sheet.n_left * sheet.f_instrument_mm
+    op.set("Z", NOMINAL_ZERO["Z"] + depth, "1/Z")
+    log.add(
+        "1",
+        "lower the carriage to O_Z = n_л·f_пр (absolute height counter)",
+        "Z",
+        reading=depth,
+        equation="(6.3)",
+    )
+    # MO_by: left mark on the left cassette centre, then b_y until the right mark is on the
+    # right cassette centre's line.
+    centre = np.zeros(2)
+    op.mark_on("left", centre, "1/MOby/left")
+    _, right_u = op.units()
+    setting = op.inst.setting
+    car = {c: op.physical(c) for c in ("X", "Y", "Z")}
+    e = op.noise.normal("mono/1/MOby/right", op.model.monocular_sigma_mm)
+    eta = rod_from_photo(np.stack([0.0 * e, e], axis=-1), right_u)[..., 1]
+    n_r = (car["Z"] + op.physical("bz")) / setting.f_instrument_mm
+    op.drive("by", car["Y"] - n_r * eta)
+    mo_by = op.read("by", "1/MOby")
+    run.zero["MO_by"] = mo_by
+    log.add(
+        "1",
+        "MO_by: right mark on the right cassette centre (by turning b_y)",
+        "by",
+        reading=mo_by,
+        judgment_error=e,
+        equation="stage 1",
+    )
+    op.set("by", mo_by + by, "1/by")
+    log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="item 1")
+    its, _, res = _span_loop(run, "1", "1/L", units_at_zero=True)
+    run.iterations["1"] = its
+    run.check("stage 1: |L − L′|", res, sheet.tolerances["mark_span_mm"], iterations=its)
+    _record_stage1_zeros(run)
+
+
+def _record_stage1_zeros(run: Run) -> None:
+    op, sheet = run.op, run.sheet
+    run.zero["MO_Z"] = op.read(HEIGHT_SCALE, "1/MOZ")
+    run.zero["D_MO_Z"] = op.read("Z", "1/MOZ/D")
+    bzr = op.read("bz", "1/MObz")
+    run.zero["MO_bz"] = bzr - sheet.options.bz_scale_sense * sheet.base_mm[2]
+    op.log.add(
+        "1",
+        "record MO_Z on the height scale",
+        HEIGHT_SCALE,
+        reading=run.zero["MO_Z"],
+        unit="m",
+        equation="stage 1",
+    )
+    op.log.add(
+        "1",
+        "record MO_bz = (b_z reading) − b_z′",
+        "bz",
+        reading=run.zero["MO_bz"],
+        equation="decision D7",
+    )
+
+
+# --- stage 2 ---------------------------------------------------------------------------------
+
+
+def _zero_readings(run: Run, key: str) -> None:
+    op = run.op
+    for side, names in (("left", ("MO_X", "MO_Y")), ("right", ("MO_X,п", "MO_Y,п"))):
+        e = op.mark_on(side, np.zeros(2), f"{key}/{side}")
+        run.zero[names[0]] = op.read("X", f"{key}/{side}/X")
+        run.zero[names[1]] = op.read("Y", f"{key}/{side}/Y")
+        op.log.add(
+            "2",
+            f"{side} mark on the {side} cassette centre → {names[0]}",
+            "X",
+            reading=run.zero[names[0]],
+            judgment_error=e[..., 0],
+            equation="decision D6",
+        )
+        op.log.add(
+            "2",
+            f"… and {names[1]}",
+            "Y",
+            reading=run.zero[names[1]],
+            judgment_error=e[..., 1],
+            equation="decision D6",
+        )
+
+
+def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> None:
+    """Set the counter to MO + n·(x⁰ or y⁰), the other handwheel onto the fiducial line, turn
+    the knob until the fiducial is under the mark ((6.12) or (6.13))."""
+    op, sheet = run.op, run.sheet
+    photo = sheet.photos[0 if side == "left" else 1]
+    n = sheet.n_left if side == "left" else sheet.n_right
+    sfx = "" if side == "left" else ",п"
+    fid = _fid(run, side, mark)
+    if axis == "omega":
+        counter, free, comp = "Y", "X", 1
+        value = run.zero["MO_Y" + sfx] + n * photo.transformed_book_mm[f"y{mark}"]
+        eq = "(6.12)"
+    else:
+        counter, free, comp = "X", "Y", 0
+        value = run.zero["MO_X" + sfx] + n * photo.transformed_book_mm[f"x{mark}"]
+        eq = "(6.13)"
+    op.set(counter, value, f"{key}/set", active)
+    op.mark_on(side, fid, f"{key}/line", active, free=free)
+    e = op.noise.normal(f"mono/{key}/knob", op.model.monocular_sigma_mm)
+    left_u, right_u = op.units()
+    unit = left_u if side == "left" else right_u
+    rod = rod_from_counters(
+        op.physical("X"), op.physical("Y"), op.physical("Z"), op.inst.setting, side
+    )
+    knob = f"k_{axis}_{side}"
+    t = op.knob_for(knob, unit, fid, rod, comp, fid[comp] + e)
+    before = op.physical(knob)
+    op.drive(knob, t, active)
+    op.log.add(
+        "2",
+        f"{side} photo: counter {counter} = {'MO' + sfx} + n·{axis[0]}⁰, turn {knob} "
+        f"until mark {mark} is under the measuring mark",
+        knob,
+        before=before,
+        after=op.physical(knob),
+        reading=value,
+        unit="—",
+        judgment_error=e,
+        equation=eq,
+    )
+
+
+def _mark4(run: Run, side: str, key: str, active) -> NDArray[np.float64]:
+    """Check mark 4 at MO_Y + n·y⁰₄ (6.12): the offset of the mark from fiducial 4 seen."""
+    op, sheet = run.op, run.sheet
+    photo = sheet.photos[0 if side == "left" else 1]
+    n = sheet.n_left if side == "left" else sheet.n_right
+    sfx = "" if side == "left" else ",п"
+    fid = _fid(run, side, "4")
+    value = run.zero["MO_Y" + sfx] + n * photo.transformed_book_mm["y4"]
+    op.set("Y", value, f"{key}/set", active)
+    op.mark_on(side, fid, f"{key}/line", active, free="X")
+    off = op.inst.mark_offsets(**{f"{side}_point_mm": fid})[side]
+    e = op.noise.normal(f"mono/{key}/seen", op.model.monocular_sigma_mm)
+    return np.abs(np.asarray(off)[..., 1]) + e
+
+
+def stage2_transform(run: Run) -> None:
+    """Stage 2: zero readings, k_ω with the mark-4 check (iterated with the stage-1 L-check,
+    decision D5), k_α, computed decentrations, O_bz (6.14), κ (D8), residual y-parallax."""
+    op, sheet = run.op, run.sheet
+    tol4 = sheet.tolerances["mark_fit_mm"]
+    active = op.all()
+    its = np.zeros(np.shape(active), int)
+    worst = op.v(np.nan)
+    for it in range(1, op.model.max_iterations + 1):
+        its = np.where(active, it, its)
+        if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
+            l_its, _, _ = _span_loop(run, "2", f"2/L{it}", active=active)
+            run.iterations["1"] = run.iterations["1"] + np.where(active, l_its, 0)
+        else:  # with the correction units still at zero the cassette centre is on the plumb
+            _zero_readings(run, "2/MO")
+        seen = []
+        for side in ("left", "right"):
+            _fit_knob(run, side, "omega", "3", f"2/{it}/{side}/omega", active)
+            m4 = _mark4(run, side, f"2/{it}/{side}/m4", active)
+            seen.append(m4)
+            op.log.add(
+                "2",
+                f"{side} photo: check mark 4 at MO_Y + n·y⁰₄",
+                "Y",
+                residual=m4,
+                tolerance=tol4,
+                passed=np.abs(m4) <= tol4,
+                iteration=it,
+                equation="(6.12)",
+            )
+        new = np.maximum(np.abs(seen[0]), np.abs(seen[1]))
+        worst = np.where(active, new, worst)
+        active = active & ~(worst <= tol4)
+        if not np.any(active):
+            break
+    run.iterations["2"] = its
+    run.check("stage 2: mark 4", worst, tol4, iterations=its)
+    for side, mark in (("left", "2"), ("right", "1")):
+        _fit_knob(run, side, "alpha", mark, f"2/{side}/alpha", op.all())
+    for photo in sheet.photos:
+        for d, value in zip(("dx", "dy"), photo.decentration_mm, strict=True):
+            control = f"{d}_{photo.name}"
+            op.set(control, NOMINAL_ZERO[control] + value, f"2/{control}")
+            op.log.add(
+                "2",
+                f"set the computed decentration {control}",
+                control,
+                reading=NOMINAL_ZERO[control] + value,
+                equation="f′·tan α (§2.4)",
+            )
+    bz = run.zero["MO_bz"] + sheet.options.bz_scale_sense * sheet.base_mm[2]
+    op.set("bz", bz, "2/bz")
+    op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
+    clear_kappa(run, "2")
+    check_standard_points(run, "2")
+
+
+def clear_kappa(run: Run, stage: str) -> None:
+    """κ by the initial directions (decision D8): q at standard point 1 with κ_п, at point 2
+    with κ_л, repeated until both are within ¼ mark (bounded)."""
+    op = run.op
+    tol = run.sheet.tolerances["residual_y_parallax_mm"]
+    pts = run.scene.standard_points_m
+    imgs = run.scene.images(pts)
+    active = op.all()
+    its = np.zeros(np.shape(active), int)
+    for it in range(1, op.model.max_iterations + 1):
+        its = np.where(active, it, its)
+        qs = []
+        for idx, side in ((0, "right"), (1, "left")):
+            key = f"{stage}/kappa/{it}/{idx + 1}"
+            img = (imgs[0][idx], imgs[1][idx])
+            q_seen, _ = op.fuse(pts[idx], img, key, active)
+            qs.append(q_seen)
+            control = f"kappa_{side}"
+            target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+
+            def q_of(kappa, side=side, img=img):
+                from dataclasses import replace
+
+                left_u, right_u = op.units()
+                if side == "left":
+                    left_u = replace(left_u, kappa=kappa)
+                else:
+                    right_u = replace(right_u, kappa=kappa)
+                from stereoplotter.instrument.kinematics import counters_from_homologous_points
+
+                return counters_from_homologous_points(
+                    img[0], img[1], op.inst.setting, left_u, right_u
+                ).y_parallax_mm
+
+            ok_here = np.abs(q_seen) <= tol
+            move = active & ~ok_here if it > 1 else active
+            kappa = op.physical(control)
+            new = _solve_kappa(q_of, kappa, target)
+            op.drive(control, new, move)
+            op.log.add(
+                stage,
+                f"standard point {idx + 1}: clear the y-parallax with κ_{_SIDE[side]}",
+                control,
+                before=kappa,
+                after=op.physical(control),
+                unit="rad",
+                residual=q_seen,
+                tolerance=tol,
+                passed=ok_here,
+                iteration=it,
+                equation="decision D8",
+            )
+        ok = (np.abs(qs[0]) <= tol) & (np.abs(qs[1]) <= tol)
+        active = active & ~ok
+        if it > 1 and not np.any(active):
+            break
+    run.iterations[f"{stage}/kappa"] = its
+
+
+def _solve_kappa(q_of, kappa0, target):
+    from stereoplotter.procedure.operator import solve_1d
+
+    return solve_1d(q_of, kappa0, target, iterations=4, h=1e-6)
+
+
+def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
+    """The residual y-parallax at the six standard points, judged by the operator."""
+    op = run.op
+    tol = run.sheet.tolerances["residual_y_parallax_mm"]
+    pts = run.scene.standard_points_m
+    imgs = run.scene.images(pts)
+    seen = []
+    for i in range(6):
+        q, _ = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{stage}/std/{i + 1}", move=True)
+        seen.append(q)
+        op.log.add(
+            stage,
+            f"residual y-parallax at standard point {i + 1}",
+            "",
+            residual=q,
+            tolerance=tol,
+            passed=np.abs(q) <= tol,
+            equation="≤ ¼ mark",
+        )
+    worst = np.max(np.abs(np.stack(seen, axis=-1)), axis=-1)
+    run.check(f"stage {stage}: residual y-parallax (6 points)", worst, tol)
+    return worst
+
+
+# --- stage 3 ---------------------------------------------------------------------------------
+
+
+def _heights(run: Run):
+    sc = run.scene.scenario
+    rows = []
+    for h in run.sheet.control_heights:
+        p = next(p for p in sc.points if p.id == h["id"])
+        rows.append((h, np.asarray(p.local_m, float)))
+    return rows
+
+
+def stage3_scale_model(run: Run) -> None:
+    """Stage 3: (6.15) at a height control point, b_x until the mark fuses, slip the height
+    scale, check the other control heights (H/3000), re-check κ and the residual y-parallax."""
+    op, sheet = run.op, run.sheet
+    rows = _heights(run)
+    tol = sheet.tolerances["control_height_m"]
+    (h0, p0) = rows[0]
+    o_z = height_scale_reading(
+        run.zero["MO_Z"],
+        h0["model_height_mm"],
+        sheet.n_left,
+        sheet.f_instrument_mm,
+        sheet.vertical_scale_denominator,
+    )
+    op.set(HEIGHT_SCALE, o_z, "3/OZ")
+    op.log.add(
+        "3",
+        f"height scale to O_Z{h0['id']} for control point {h0['id']}",
+        HEIGHT_SCALE,
+        reading=o_z,
+        unit="m",
+        equation="(6.15)",
+    )
+    pl, pr = run.scene.images(p0[None, :])
+    op.mark_on("left", pl[0], "3/left")
+    e = op.noise.normal("stereo/3/bx", op.model.stereo_sigma_mm)
+    _, right_u = op.units()
+    xi_r = rod_from_photo(pr[0] + np.stack([e, 0.0 * e], axis=-1), right_u)[..., 0]
+    n_r = (op.physical("Z") + op.physical("bz")) / op.inst.setting.f_instrument_mm
+    before = op.read("bx", "3/bx/before")
+    op.drive("bx", op.physical("X") - n_r * xi_r)
+    after = op.read("bx", "3/bx/after")
+    op.log.add(
+        "3",
+        f"fuse the mark on point {h0['id']} by turning b_x",
+        "bx",
+        before=before,
+        after=after,
+        reading=after,
+        judgment_error=e,
+        equation="stage 3",
+    )
+    op.inst.slip_height_scale(p0[2])
+    op.log.add(
+        "3",
+        f"slip the height scale to H = {p0[2]:.2f} m",
+        HEIGHT_SCALE,
+        reading=p0[2],
+        unit="m",
+        equation="stage 3",
+    )
+    errs = []
+    for h, p in rows[1:]:
+        img = run.scene.images(p[None, :])
+        op.fuse(p, (img[0][0], img[1][0]), f"3/h/{h['id']}")
+        read = op.read(HEIGHT_SCALE, f"3/h/{h['id']}")
+        errs.append(read - p[2])
+        op.log.add(
+            "3",
+            f"control point {h['id']}: fuse, read the height",
+            HEIGHT_SCALE,
+            reading=read,
+            unit="m",
+            residual=read - p[2],
+            tolerance=tol,
+            passed=np.abs(read - p[2]) <= tol,
+            equation="H/3000",
+        )
+    worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1) if errs else op.v(0.0)
+    run.check("stage 3: control heights", worst, tol, unit="m")
+    clear_kappa(run, "3")
+    check_standard_points(run, "3")
+
+
+# --- stages 4 and 5: the sheet on the coordinatograph ----------------------------------------
+
+
+def _table(run: Run, xy_mm) -> NDArray[np.float64]:
+    """Ideal table position of a model position (x′, y′) for the coordinatograph's origin."""
+    inst = run.op.inst
+    return inst._cg_origin + inst._cg_ratio * np.asarray(xy_mm, float)
+
+
+def _needle_at(run: Run, xy_mm, key: str) -> NDArray[np.float64]:
+    op = run.op
+    op.set("X", run.zero["MO_X"] + xy_mm[0], f"{key}/X")
+    op.set("Y", run.zero["MO_Y"] + xy_mm[1], f"{key}/Y")
+    return np.asarray(op.inst.needle(op.model.finish_side), float)
+
+
+def _rot(phi):
+    c, s = np.cos(phi), np.sin(phi)
+    return c, s
+
+
+def _apply_pose(pose, p):
+    """Table position of a sheet point p (sheet frame = ideal table frame)."""
+    c, s = _rot(pose["angle"])
+    pivot_sheet, pivot_table = pose["pivot_sheet"], pose["pivot_table"]
+    d = np.asarray(p, float) - pivot_sheet
+    x = c * d[..., 0] - s * d[..., 1]
+    y = s * d[..., 0] + c * d[..., 1]
+    return pivot_table + np.stack([x, y], axis=-1)
+
+
+def stage4_orient_sheet(run: Run) -> None:
+    """Stage 4: corner 1 under the needle (6.16), rotate about it to corner 3 (6.17), repeat.
+
+    Closed form (the sheet is rigid): the pin pierces mark 1 + placement error (injected
+    ``coordinatograph.sheet_placement_*`` plus σ_mono at map scale); the operator turns the
+    sheet until mark 3 lies on the needle's ray from the pin (σ_mono across it).
+    """
+    op, sheet = run.op, run.sheet
+    if not sheet.corners:
+        run.sheet_pose = {}
+        return
+    ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
+    op.inst.connect_coordinatograph(ratio)
+    corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
+    ideal = {k: _table(run, v) for k, v in corners.items()}
+    inj = op.inst.injected
+    place = np.stack(
+        [
+            op.v(inj["coordinatograph.sheet_placement_x"]),
+            op.v(inj["coordinatograph.sheet_placement_y"]),
+        ],
+        axis=-1,
+    )
+    pose = None
+    for it in (1, 2):
+        n1 = _needle_at(run, corners["1"], f"4/{it}/c1")
+        e = np.stack(
+            [op.noise.normal(f"mono/4/{it}/pin/{a}", op.model.monocular_sigma_mm) for a in "xy"],
+            axis=-1,
+        )
+        pin_sheet = ideal["1"] + (place if it == 1 else 0.0) + e
+        pose = {
+            "angle": op.v(0.0) if pose is None else pose["angle"],
+            "pivot_sheet": pin_sheet,
+            "pivot_table": n1,
+        }
+        op.log.add(
+            "4",
+            "counters to corner 1, pin the sheet's corner 1 under the needle",
+            "X",
+            reading=run.zero["MO_X"] + corners["1"][0],
+            iteration=it,
+            equation="(6.16)",
+        )
+        n3 = _needle_at(run, corners["3"], f"4/{it}/c3")
+        e3 = op.noise.normal(f"mono/4/{it}/c3", op.model.monocular_sigma_mm)
+        a_needle = np.arctan2(n3[..., 1] - n1[..., 1], n3[..., 0] - n1[..., 0])
+        d = ideal["3"] - pin_sheet
+        a_mark = np.arctan2(d[..., 1], d[..., 0])
+        pose["angle"] = a_needle - a_mark + e3 / np.hypot(d[..., 0], d[..., 1])
+        op.log.add(
+            "4",
+            "counters to corner 3, rotate the sheet about corner 1 until the needle meets corner 3",
+            "",
+            reading=None,
+            judgment_error=e3,
+            iteration=it,
+            equation="(6.17)",
+        )
+    run.sheet_pose = pose
+    run.iterations["4"] = op.v(2).astype(int)
+
+
+def stage5_check(run: Run) -> None:
+    """Stage 5: counters to corner 4 (6.18), misclosure ≤ 0.3 mm; plotted control points."""
+    op, sheet = run.op, run.sheet
+    if not run.sheet_pose:
+        return
+    corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
+    n4 = _needle_at(run, corners["4"], "5/c4")
+    mark4 = _apply_pose(run.sheet_pose, _table(run, corners["4"]))
+    mis = np.hypot(*np.moveaxis(mark4 - n4, -1, 0))
+    tol = sheet.tolerances["corner_mm"]
+    op.log.add(
+        "5",
+        "counters to corner 4: misclosure of needle and corner 4",
+        "",
+        residual=mis,
+        tolerance=tol,
+        passed=mis <= tol,
+        equation="(6.18)",
+    )
+    run.check("stage 5: corner 4", mis, tol)
+    run.iterations["5"] = op.v(1).astype(int)
+    # plotted plan control points: fuse on the point, compare the needle with the plotted point
+    sc = run.scene.scenario
+    if sheet.similarity is None:
+        return
+    errs = []
+    for pid in sheet.similarity_point_ids:
+        p = next(q for q in sc.points if q.id == pid)
+        xy = sheet_corner_instrument_coordinates(
+            sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
+        )
+        img = run.scene.images(np.asarray(p.local_m, float)[None, :])
+        op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
+        needle = np.asarray(op.inst.needle(op.model.finish_side), float)
+        plotted = _apply_pose(run.sheet_pose, _table(run, np.asarray(xy, float).reshape(2)))
+        err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
+        errs.append(err)
+        op.log.add(
+            "5",
+            f"plan control point {pid}: fuse, needle against the plotted point",
+            "",
+            residual=err,
+            equation="stage 5",
+        )
+    run.check(
+        "stage 5: plan control points (needle − plotted)",
+        np.max(np.stack(errs, axis=-1), axis=-1),
+        None,
+    )
+
+
+def run_setup_method(run: Run) -> Run:
+    """Stages 1–5 in order."""
+    stage1_scale_coefficient(run)
+    stage2_transform(run)
+    stage3_scale_model(run)
+    stage4_orient_sheet(run)
+    stage5_check(run)
+    return run

@@ -1,0 +1,182 @@
+"""The transcript of a simulated procedure: one record per operator action.
+
+A record carries what a trainee must see (``procedure.md`` §What a run returns): stage, step,
+control, value before and after, the reading, the judgment error drawn, the residual seen, the
+tolerance, pass/fail and the iteration. Vectorised runs record trial ``shown`` only (default 0);
+the arrays of all trials live in the result, not in the transcript.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Record", "Transcript"]
+
+
+def _f(value: Any, trial: int) -> float | None:
+    if value is None:
+        return None
+    v = np.asarray(value, float)
+    v = v.reshape(-1)[trial] if v.size > 1 else v.reshape(-1)[0]
+    return None if math.isnan(float(v)) else float(v)
+
+
+@dataclass(frozen=True, slots=True)
+class Record:
+    """One operator action.
+
+    Attributes
+    ----------
+    number : int
+        Running number (1, 2, …).
+    stage : str
+        "1" … "5" (setup-data method) or "C1" … "C4" (conventional method).
+    step : str
+        What the operator does, in words.
+    control : str
+        The control turned or the scale read ("" for a look).
+    before, after : float or None
+        Value of the control before and after (reading units: mm, m, rad). [unit]
+    reading : float or None
+        The value the operator reads or sets. [unit]
+    unit : str
+    judgment_error : float or None
+        The judgment error drawn for this act (pointing, y-parallax, reading, setting). [unit]
+    residual : float or None
+        The residual the operator sees after the act (e.g. |L − L′|, q, misclosure). [mm or m]
+    tolerance : float or None
+        The tolerance the residual is checked against. [same unit as residual]
+    passed : bool or None
+        residual ≤ tolerance, where a tolerance applies.
+    iteration : int
+        Iteration of the enclosing tolerance loop (1 for a single pass).
+    equation : str
+        The book equation or design decision behind the act.
+    """
+
+    number: int
+    stage: str
+    step: str
+    control: str
+    before: float | None
+    after: float | None
+    reading: float | None
+    unit: str
+    judgment_error: float | None
+    residual: float | None
+    tolerance: float | None
+    passed: bool | None
+    iteration: int
+    equation: str
+
+
+class Transcript:
+    """Ordered records of one procedure run (trial ``shown`` of a vectorised run)."""
+
+    def __init__(self, shown: int = 0, enabled: bool = True):
+        self.shown = shown
+        self.enabled = enabled
+        self.records: list[Record] = []
+
+    def add(
+        self,
+        stage: str,
+        step: str,
+        control: str = "",
+        *,
+        before: Any = None,
+        after: Any = None,
+        reading: Any = None,
+        unit: str = "mm",
+        judgment_error: Any = None,
+        residual: Any = None,
+        tolerance: Any = None,
+        passed: Any = None,
+        iteration: int = 1,
+        equation: str = "",
+    ) -> None:
+        """Append a record (array arguments are taken at trial ``shown``)."""
+        if not self.enabled:
+            return
+        t = self.shown
+        ok = None
+        if passed is not None:
+            p = np.asarray(passed).reshape(-1)
+            ok = bool(p[t] if p.size > 1 else p[0])
+        self.records.append(
+            Record(
+                len(self.records) + 1,
+                str(stage),
+                step,
+                control,
+                _f(before, t),
+                _f(after, t),
+                _f(reading, t),
+                unit,
+                _f(judgment_error, t),
+                _f(residual, t),
+                _f(tolerance, t),
+                ok,
+                int(iteration),
+                equation,
+            )
+        )
+
+    def to_jsonl(self) -> str:
+        """JSON lines, one record per line (keys as in :class:`Record`)."""
+        return "".join(
+            json.dumps(asdict(r), ensure_ascii=False, sort_keys=False) + "\n" for r in self.records
+        )
+
+    def to_text(self) -> str:
+        """Numbered steps for a trainee: what to set, what was read and seen, pass/fail.
+
+        Examples
+        --------
+        >>> t = Transcript()
+        >>> t.add("1", "set f_пр", "f_instrument", reading=109.375, equation="item 1")
+        >>> print(t.to_text().splitlines()[-1])
+        1. [stage 1] set f_пр — f_instrument: 109.3750 mm  (item 1)
+        """
+        lines = []
+        stage = None
+        for r in self.records:
+            if r.stage != stage:
+                stage = r.stage
+                lines.append(f"## Stage {stage}")
+            parts = [f"{r.number}. [stage {r.stage}]"]
+            if r.iteration > 1:
+                parts.append(f"(iteration {r.iteration})")
+            parts.append(r.step)
+            text = " ".join(parts)
+            if r.control:
+                text += f" — {r.control}"
+                if r.reading is not None:
+                    text += f": {_num(r.reading, r.unit)}"
+                if r.before is not None and r.after is not None:
+                    text += f" (from {_num(r.before, r.unit)} to {_num(r.after, r.unit)})"
+            if r.judgment_error is not None and r.judgment_error != 0.0:
+                text += f"; judgment error {r.judgment_error * 1e3:+.1f} µm"
+            if r.residual is not None:
+                text += f"; seen {r.residual:+.4f}"
+                if r.tolerance is not None:
+                    text += f" (tolerance {r.tolerance:.4f}: {'pass' if r.passed else 'FAIL'})"
+            if r.equation:
+                text += f"  ({r.equation})"
+            lines.append(text)
+        return "\n".join(lines) + "\n"
+
+
+def _num(value: float, unit: str) -> str:
+    if unit == "rad":
+        return f"{math.degrees(value) * 60:+.2f}′"
+    if unit == "m":
+        return f"{value:.2f} m"
+    if unit == "—":
+        return f"{value:.6f}"
+    return f"{value:.4f} {unit}"
