@@ -298,6 +298,14 @@ def _demo(args: argparse.Namespace) -> int:
         result["setup_sheet"] = data
         files.update(_sheet_files(sheet, data))
         text += f"\n{_sheet_summary(sheet)} (sheet.md, sheet.pdf)\n"
+    if scenario.is_stereopair and "refused" not in result["setup_sheet"]:
+        from stereoplotter.procedure.simulate import run_simulation_command
+
+        sim_text, sim_summary = run_simulation_command(
+            path, instrument=args.instrument, seed=seed, output=Path(args.output) / "simulate"
+        )
+        result["simulation"] = sim_summary
+        text += "\n" + sim_text
     figure = plot_scenario_layout(scenario, result)
     png = io.BytesIO()
     figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
