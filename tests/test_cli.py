@@ -74,7 +74,16 @@ def test_demo_writes_files_reproducibly(tmp_path, capsys):
         "sheet.pdf",
         "sheet.png",
     }
-    assert {p.name for p in out1.iterdir()} == names
+    assert {p.name for p in out1.iterdir()} == names | {"simulate"}
+    simulated = {
+        "transcript.txt",
+        "transcript.jsonl",
+        "evaluation.yaml",
+        "evaluation.md",
+        "parallax.png",
+    }
+    assert {p.name for p in (out1 / "simulate").iterdir()} == simulated
+    names |= {f"simulate/{n}" for n in simulated}
     for name in names:  # same seed → byte-identical output files
         assert (out1 / name).read_bytes() == (out2 / name).read_bytes(), name
     result = json.loads((out1 / "result.json").read_text(encoding="utf-8"))
