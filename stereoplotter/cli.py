@@ -305,7 +305,8 @@ def _demo(args: argparse.Namespace) -> int:
             path, instrument=args.instrument, seed=seed, output=Path(args.output) / "simulate"
         )
         result["simulation"] = sim_summary
-        text += "\n" + sim_text
+        # name the sub-folder, not the output path: the summary stays the same wherever written
+        text += "\n" + sim_text.replace(str(Path(args.output) / "simulate"), "simulate/")
     figure = plot_scenario_layout(scenario, result)
     png = io.BytesIO()
     figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
