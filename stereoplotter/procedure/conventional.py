@@ -1,30 +1,68 @@
 r"""The conventional method: relative orientation by the six standard points (ch. 5, §22).
 
-This module holds the pure equations the conventional procedure needs: the first-order
-y-parallax equation (5.10) in the basis system and its solution (5.11) for the six standard
-points of Fig. 39. The operator procedures (element by element with over-correction, by measured
-q with (5.11), absolute orientation by control points) are **not implemented yet**
-(:func:`run_conventional_method` refuses with a clear message).
+The pure equations the conventional procedure needs: the first-order y-parallax equation
+(5.10) in the basis system, its solution (5.11) for the six standard points of Fig. 39 and the
+over-correction factor of the element-by-element method; and the procedure itself on a virtual
+instrument (:func:`run_conventional_method`, stages C1–C4, ``docs/procedure.md``, "The
+conventional method"):
+
+* C1 interior orientation as in stage 1 of the setup-data method, without computed data;
+* C2 relative orientation at the six standard points, element by element with over-correction
+  (``relative="elements"``) or by the six measured q and (5.11) (``relative="equations"``);
+* C3 absolute orientation by control points: scale with b_x, levelling by a common tilt;
+* C4 the sheet on the coordinatograph and its checks (stages 4–5 of the setup-data method).
+
+The mapping between the book's dependent elements α′₁, α′₂, ω′₂, κ′₁, κ′₂ and the instrument's
+controls is found numerically (:func:`calibrate`), never by hand.
 
 Reference
 ---------
 .. [1] Kushtin I. F. & Lyskov G. A., *Фотограмметрия снимка и стереоскопических моделей*,
-   Moscow: Nedra, 1984, ch. 5, §22, Eqs. (5.10)–(5.11), Fig. 39 (OCR L2928–3010).
+   Moscow: Nedra, 1984, ch. 5, §22, Eqs. (5.10)–(5.11), Fig. 39 (OCR L2928–3010); ch. 6, §26
+   (stage 1, stage 3 H/3000, stages 4–5, OCR L3753–3826).
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.kinematics import (
+    CorrectionUnit,
+    InstrumentSetting,
+    counters_from_homologous_points,
+    rod_from_photo,
+    turn_correction_knob,
+)
+from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 
 __all__ = [
+    "ELEMENTS",
+    "RELATIVE_OPTIONS",
+    "Calibration",
+    "calibrate",
+    "control_sensitivity",
     "overcorrection_factor",
     "relative_orientation_from_standard_points",
     "run_conventional_method",
     "y_parallax_first_order",
 ]
+
+#: The two ways of relative orientation offered (``procedure.md``, the conventional method).
+RELATIVE_OPTIONS = ("elements", "equations")
+
+#: Book element (basis system, (5.10)) → the instrument control that realises it.
+ELEMENTS = {
+    "alpha1": "k_alpha_left",
+    "alpha2": "k_alpha_right",
+    "omega2": "k_omega_right",
+    "kappa1": "kappa_left",
+    "kappa2": "kappa_right",
+}
 
 
 def _a(v: ArrayLike) -> NDArray[np.float64]:
@@ -169,9 +207,697 @@ def overcorrection_factor(focal_length_mm: ArrayLike, c_mm: ArrayLike) -> NDArra
     return 0.5 * (_a(focal_length_mm) ** 2 / _a(c_mm) ** 2 - 1.0)
 
 
-def run_conventional_method(run) -> None:
-    """The conventional procedure on a virtual instrument — not implemented yet."""
-    raise StereoplotterError(
-        "method 'conventional': the operator procedure is not implemented yet (only the "
-        "equations (5.10)/(5.11) are); use method 'setup'"
+# --------------------------------------------------------------------------------------------
+# Sensitivities: the book's elements on the instrument's controls (found numerically)
+# --------------------------------------------------------------------------------------------
+
+#: Controls whose sensitivity :func:`control_sensitivity` knows.
+_CONTROLS = (
+    "kappa_left",
+    "kappa_right",
+    "k_alpha_left",
+    "k_alpha_right",
+    "k_omega_left",
+    "k_omega_right",
+    "by",
+    "bz",
+)
+
+
+def _perturb(
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+    changes: dict[str, Any],
+    linkage: str,
+) -> tuple[InstrumentSetting, CorrectionUnit, CorrectionUnit]:
+    """The instrument state after adding ``changes`` (control → increment) to it."""
+    units = {"left": left, "right": right}
+    for control, delta in changes.items():
+        if control in ("by", "bz"):
+            name = "base_y_mm" if control == "by" else "base_z_mm"
+            setting = replace(setting, **{name: np.asarray(getattr(setting, name)) + delta})
+        elif control.startswith("kappa_"):
+            side = control.split("_")[1]
+            units[side] = replace(units[side], kappa=np.asarray(units[side].kappa) + delta)
+        elif control.startswith("k_"):
+            _, axis, side = control.split("_")
+            now = units[side].tan_alpha if axis == "alpha" else units[side].tan_omega
+            units[side] = turn_correction_knob(
+                units[side], axis, np.asarray(now) + delta, linkage=linkage
+            )
+        else:
+            raise StereoplotterError(f"no sensitivity for control {control!r}")
+    return setting, units["left"], units["right"]
+
+
+def control_sensitivity(
+    images: tuple[ArrayLike, ArrayLike],
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+    changes: dict[str, float],
+    *,
+    linkage: str = "L",
+    step: float = 1e-5,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    r"""Change of q and D at homologous points per unit of a combined turn of controls.
+
+    Parameters
+    ----------
+    images : (ndarray, ndarray), shapes (n, 2)
+        The points on the left and right photo. [mm]
+    setting : InstrumentSetting
+        f_пр and base (scalar fields).
+    left, right : CorrectionUnit
+        The units (scalar fields).
+    changes : dict
+        Control → increment per unit of the combined turn: "kappa_left", "kappa_right" [rad],
+        "k_alpha_left", … "k_omega_right" (the represented tangent T) [—], "by", "bz" [mm].
+    linkage : {"L", "A", "B"}
+        How the decentrations follow a knob (``kinematics.md`` §4.1).
+    step : float
+        Central-difference step of the unit turn.
+
+    Returns
+    -------
+    dq, dD : ndarray, shape (n,)
+        ∂q [mm, photo] and ∂D [mm, model] per unit turn, q of
+        :func:`~stereoplotter.instrument.kinematics.counters_from_homologous_points`.
+
+    Examples
+    --------
+    Turning κ_п by 1 mrad on a point at x₂ = −90 mm gives q = ±0.09 mm:
+
+    >>> s = InstrumentSetting(130.0, base_x_mm=90.0)
+    >>> u = CorrectionUnit(100.0)
+    >>> imgs = (np.array([[0.0, 0.0]]), np.array([[-90.0, 0.0]]))
+    >>> dq, dd = control_sensitivity(imgs, s, u, u, {"kappa_right": 1.0})
+    >>> round(abs(float(dq[0])), 6)
+    90.0
+    """
+    pl, pr = (np.asarray(v, float) for v in images)
+    out = []
+    for sign in (1.0, -1.0):
+        ch = {k: sign * step * v for k, v in changes.items()}
+        s, lu, ru = _perturb(setting, left, right, ch, linkage)
+        out.append(counters_from_homologous_points(pl, pr, s, lu, ru))
+    dq = (out[0].y_parallax_mm - out[1].y_parallax_mm) / (2.0 * step)
+    dd = (out[0].depth_mm - out[1].depth_mm) / (2.0 * step)
+    return dq, dd
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """What the operator knows of the instrument's response (one table for all trials).
+
+    Attributes
+    ----------
+    mapping : dict
+        Book element → control turn per radian of the element (``ELEMENTS``): turning the
+        control by ``mapping[e]·ε`` makes the q of the element ε in (5.10) at the six standard
+        points, in the instrument's sign of q. [rad⁻¹·control unit]
+    fit : dict
+        Book element → relative misfit ‖J m − g‖/‖g‖ of that column. [—]
+    common_alpha, common_omega : dict
+        Control → turn per radian of a common tilt of the model about the Y / X axis (both photos
+        and the base, q unchanged to first order).
+    level_design : ndarray, shape (n, 3)
+        Columns 1, ∂H/∂φ_α, ∂H/∂φ_ω at the levelling points. [m, m/rad]
+    level_weights : ndarray, shape (3, n)
+        Least-squares pseudo-inverse of ``level_design``.
+    """
+
+    mapping: dict[str, float]
+    fit: dict[str, float]
+    common_alpha: dict[str, float]
+    common_omega: dict[str, float]
+    level_design: NDArray[np.float64]
+    level_weights: NDArray[np.float64]
+
+
+def _dot(a, b) -> float:
+    return float(np.dot(np.asarray(a, float), np.asarray(b, float)))
+
+
+def _null_q(j, fixed: dict[str, float], free: tuple[str, ...]) -> dict[str, float]:
+    """Turns of the ``free`` controls that cancel the q of the ``fixed`` turns (least squares)."""
+    rhs = -sum(j[k] * v for k, v in fixed.items())
+    a = np.column_stack([j[k] for k in free])
+    sol = np.linalg.lstsq(a, rhs, rcond=None)[0]
+    return {**fixed, **{k: float(v) for k, v in zip(free, sol, strict=True)}}
+
+
+def calibrate(run, level_ids: tuple[str, ...]) -> Calibration:
+    """The numerical sensitivities of the nominal instrument (sheet f_пр, b_x, b_y; b_z′ = 0;
+    units at zero) at the six standard points and at the levelling points.
+
+    Turning each control by a small amount and observing q at the six points gives a column J;
+    the element's column g of (5.10) (:func:`y_parallax_first_order` at the photo images of the
+    points, f = f′) gives the mapping m = J·g/J·J. A common tilt of the model is a turn of one
+    photo's knob with the other photo's knob and b_z′ (α), or the other photo's knob and b_z′ (ω),
+    chosen so that q stays zero to first order.
+    """
+    op, sheet, scene = run.op, run.sheet, run.scene
+    inst = op.inst
+    bx, by, _ = sheet.base_mm
+    setting = InstrumentSetting(sheet.f_instrument_mm, bx, by, 0.0)
+    unit = CorrectionUnit(
+        sheet.focal_length_corrected_mm, strict_per_axis=inst.variant.strict_per_axis
     )
+    linkage = inst.variant.linkage
+    pts = scene.standard_points_m
+    imgs = scene.images(pts)
+    f = sheet.focal_length_corrected_mm
+    j = {
+        c: control_sensitivity(imgs, setting, unit, unit, {c: 1.0}, linkage=linkage)[0]
+        for c in _CONTROLS
+    }
+    mapping, fit = {}, {}
+    for k, (element, control) in enumerate(ELEMENTS.items()):
+        unit_el = np.eye(5)[k]
+        g = y_parallax_first_order(
+            imgs[0][:, 0], imgs[0][:, 1], imgs[1][:, 0], imgs[1][:, 1], f, *unit_el
+        )
+        m = _dot(j[control], g) / _dot(j[control], j[control])
+        mapping[element] = m
+        fit[element] = float(np.linalg.norm(j[control] * m - g) / np.linalg.norm(g))
+    common_alpha = _null_q(
+        j, {"k_alpha_left": mapping["alpha1"]}, ("k_alpha_right", "bz", "kappa_left", "kappa_right")
+    )
+    common_omega = _null_q(
+        j, {"k_omega_right": mapping["omega2"]}, ("k_omega_left", "bz", "kappa_left", "kappa_right")
+    )
+    rows = _height_points(run, level_ids)
+    lp = np.array([p for _, p in rows])
+    limgs = scene.images(lp)
+    mv = sheet.vertical_scale_denominator
+    cols = [np.ones(len(rows))]
+    for combo in (common_alpha, common_omega):
+        _, dd = control_sensitivity(limgs, setting, unit, unit, combo, linkage=linkage)
+        cols.append(-dd * mv / 1000.0)
+    design = np.column_stack(cols)
+    return Calibration(mapping, fit, common_alpha, common_omega, design, np.linalg.pinv(design))
+
+
+# --------------------------------------------------------------------------------------------
+# The procedure
+# --------------------------------------------------------------------------------------------
+
+_SIDE = {"left": "л", "right": "п"}
+_BOOK = {"alpha1": "α′₁", "alpha2": "α′₂", "omega2": "ω′₂", "kappa1": "κ′₁", "kappa2": "κ′₂"}
+
+
+def _psum(values) -> NDArray[np.float64]:
+    """A sum over points in a fixed order (a vectorised run and a per-trial loop agree)."""
+    total = None
+    for v in values:
+        total = v if total is None else total + v
+    return total
+
+
+def _worst(values) -> NDArray[np.float64]:
+    return np.max(np.abs(np.stack(values, axis=-1)), axis=-1)
+
+
+def c1_interior(run) -> None:
+    """C1: interior orientation as in stage 1, without computed setup data.
+
+    f_пр, M_в (height-counter gear) and b_x, b_y are those of the setup sheet (one instrument and
+    scenario for the comparison); cassettes parallel (κ = 0), correction knobs and decentrations
+    at their zero places, b_z′ = 0 (decision: the conventional operator does not know the
+    exterior orientation; the levelling in C3 finds b_z′), D = n_л·f_пр, MO_b_y by the right mark
+    on the right cassette centre as in stage 1, MO_X, MO_Y with the left mark on the left cassette
+    centre (units at zero).
+    """
+    from stereoplotter.procedure.setup_method import interior_orientation
+
+    op, sheet = run.op, run.sheet
+    log = op.log
+    interior_orientation(run, "C1")
+    bx, by, _ = sheet.base_mm
+    op.set("bx", NOMINAL_ZERO["bx"] + bx, "C1/bx")
+    log.add(
+        "C1",
+        "base carriage: b_x of the sheet",
+        "bx",
+        reading=NOMINAL_ZERO["bx"] + bx,
+        equation="stage 1",
+    )
+    op.set("bz", NOMINAL_ZERO["bz"], "C1/bz")
+    log.add(
+        "C1",
+        "b_z′ = 0 (found by the levelling, C3)",
+        "bz",
+        reading=NOMINAL_ZERO["bz"],
+        equation="assumption",
+    )
+    depth = sheet.n_left * sheet.f_instrument_mm
+    op.set("Z", NOMINAL_ZERO["Z"] + depth, "C1/Z")
+    log.add(
+        "C1",
+        "lower the carriage to D = n_л·f_пр",
+        "Z",
+        reading=NOMINAL_ZERO["Z"] + depth,
+        equation="(6.3)",
+    )
+    # MO_by exactly as stage 1: left mark on the left centre, b_y until the right mark is on
+    # the right cassette centre's line
+    op.mark_on("left", np.zeros(2), "C1/MOby/left")
+    _, right_u = op.units()
+    car = {c: op.physical(c) for c in ("X", "Y", "Z")}
+    e = op.noise.normal("mono/C1/MOby/right", op.model.monocular_sigma_mm)
+    eta = rod_from_photo(np.stack([0.0 * e, e], axis=-1), right_u)[..., 1]
+    n_r = (car["Z"] + op.physical("bz")) / op.inst.setting.f_instrument_mm
+    op.drive("by", car["Y"] - n_r * eta)
+    mo_by = op.read("by", "C1/MOby")
+    run.zero["MO_by"] = mo_by
+    log.add(
+        "C1",
+        "MO_by: right mark on the right cassette centre (by turning b_y)",
+        "by",
+        reading=mo_by,
+        judgment_error=e,
+        equation="stage 1",
+    )
+    op.set("by", mo_by + by, "C1/by")
+    log.add("C1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="stage 1")
+    e = op.mark_on("left", np.zeros(2), "C1/MO")
+    run.zero["MO_X"] = op.read("X", "C1/MO/X")
+    run.zero["MO_Y"] = op.read("Y", "C1/MO/Y")
+    log.add(
+        "C1",
+        "left mark on the left cassette centre → MO_X",
+        "X",
+        reading=run.zero["MO_X"],
+        judgment_error=e[..., 0],
+        equation="decision D6",
+    )
+    log.add(
+        "C1",
+        "… and MO_Y",
+        "Y",
+        reading=run.zero["MO_Y"],
+        judgment_error=e[..., 1],
+        equation="decision D6",
+    )
+
+
+def _turn(op, control: str, target, active) -> None:
+    """Turn a knob or cassette while looking, no further than its stop (2 % short of the
+    tilt limit, 1 % of the κ range): a trial that needed more is flagged in ``op.stopped``."""
+    spec = op.inst.spec
+    if control.startswith("kappa_"):
+        lo, hi = spec.kappa_range
+        lo, hi = lo + 0.01 * (hi - lo), hi - 0.01 * (hi - lo)
+    else:
+        hi = 0.98 * float(np.tan(spec.tilt_max))
+        lo = -hi
+    target = op.v(target)
+    beyond = (target < lo) | (target > hi)
+    if np.any(beyond & active):
+        op.stopped[control] = op.stopped.get(control, np.zeros_like(beyond)) | (beyond & active)
+    op.drive(control, np.clip(target, lo, hi), active)
+
+
+def _six_q(run, key: str, active, it: int, stage: str = "C2") -> list[NDArray[np.float64]]:
+    """Fuse on the six standard points and judge q at each (σ_q)."""
+    op = run.op
+    tol = run.sheet.tolerances["residual_y_parallax_mm"]
+    pts = run.scene.standard_points_m
+    imgs = run.scene.images(pts)
+    seen = []
+    for i in range(6):
+        q, _ = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
+        seen.append(q)
+        op.log.add(
+            stage,
+            f"standard point {i + 1}: fuse, judge the y-parallax",
+            "",
+            residual=q,
+            tolerance=tol,
+            passed=np.abs(q) <= tol,
+            iteration=it,
+            equation="≤ ¼ mark",
+        )
+    return seen
+
+
+def _q_after(op, control: str, value, img) -> NDArray[np.float64]:
+    """q at a point with ``control`` physically at ``value`` (the operator's 1-D look)."""
+    left_u, right_u = op.units()
+    units = {"left": left_u, "right": right_u}
+    side = control.split("_")[-1]
+    if control.startswith("kappa_"):
+        units[side] = replace(units[side], kappa=value)
+    else:
+        axis = control.split("_")[1]
+        units[side] = turn_correction_knob(
+            units[side], axis, value, linkage=op.inst.variant.linkage
+        )
+    return counters_from_homologous_points(
+        img[0], img[1], op.inst.setting, units["left"], units["right"]
+    ).y_parallax_mm
+
+
+#: The classic sequence (``instruments.md`` §6.1): point index, control, book element.
+_SEQUENCE = (
+    (0, "kappa_right", "kappa2"),
+    (1, "kappa_left", "kappa1"),
+    (3, "k_alpha_left", "alpha1"),
+    (2, "k_alpha_right", "alpha2"),
+    (4, "k_omega_right", "omega2"),
+)
+
+
+def c2_relative_by_elements(
+    run, cal: Calibration | None = None, stage: str = "C2", key0: str = "C2"
+):
+    """C2 (a): element by element — point 1 → κ_п, 2 → κ_л, 4 → α_л, 3 → α_п, 5 → ω_п with the
+    over-correction ½(f′²/c² − 1); repeat until q ≤ ¼ mark at all six points (bounded).
+
+    Returns the iterations and the worst |q| seen at the last check, arrays over the trials.
+    """
+    from stereoplotter.procedure.operator import solve_1d
+
+    op, sheet = run.op, run.sheet
+    tol = sheet.tolerances["residual_y_parallax_mm"]
+    over = float(overcorrection_factor(sheet.focal_length_corrected_mm, run.scene.c_mm))
+    pts = run.scene.standard_points_m
+    imgs = run.scene.images(pts)
+    active = op.all()
+    its = np.zeros(np.shape(active), int)
+    worst = op.v(np.nan)
+    for it in range(1, op.model.max_iterations + 1):
+        its = np.where(active, it, its)
+        for idx, control, element in _SEQUENCE:
+            key = f"{key0}/a/{it}/{idx + 1}"
+            img = (imgs[0][idx], imgs[1][idx])
+            q_seen, _ = op.fuse(pts[idx], img, key, active)
+            target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+            before = op.physical(control)
+            clear = solve_1d(
+                lambda v, c=control, i=img: _q_after(op, c, v, i), before, target, 4, 1e-6
+            )
+            extra = ""
+            if element == "omega2":
+                clear = before + (1.0 + over) * (clear - before)
+                extra = f" and over-correct by {over:+.4f} of the turn"
+            _turn(op, control, clear, active)
+            op.log.add(
+                stage,
+                f"standard point {idx + 1}: clear the y-parallax with {control} "
+                f"({_BOOK[element]}){extra}",
+                control,
+                before=before,
+                after=op.physical(control),
+                unit="rad" if control.startswith("kappa") else "—",
+                judgment_error=target,
+                residual=q_seen,
+                tolerance=tol,
+                passed=np.abs(q_seen) <= tol,
+                iteration=it,
+                equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
+            )
+        seen = _six_q(run, f"{key0}/a/{it}/check", active, it, stage)
+        worst = np.where(active, _worst(seen), worst)
+        active = active & ~(worst <= tol)
+        if not np.any(active):
+            break
+    return its, worst
+
+
+def c2_relative_by_equations(run, cal: Calibration, stage: str = "C2", key0: str = "C2"):
+    """C2 (b): measure the six q, solve (5.11), turn the five controls by the result through the
+    numerical mapping; repeat until q ≤ ¼ mark at all six points (bounded).
+
+    Returns the iterations and the worst |q| seen at the last measurement, arrays over the trials.
+    """
+    op, sheet = run.op, run.sheet
+    tol = sheet.tolerances["residual_y_parallax_mm"]
+    imgs = run.scene.images(run.scene.standard_points_m)
+    x11, x12 = imgs[0][0, 0], imgs[0][1, 0]
+    x21, x22 = imgs[1][0, 0], imgs[1][1, 0]
+    active = op.all()
+    its = np.zeros(np.shape(active), int)
+    worst = op.v(np.nan)
+    for it in range(1, op.model.max_iterations + 1):
+        its = np.where(active, it, its)
+        seen = _six_q(run, f"{key0}/b/{it}", active, it, stage)
+        worst = np.where(active, _worst(seen), worst)
+        active = active & ~(worst <= tol)
+        if not np.any(active) or it == op.model.max_iterations:
+            break
+        el = relative_orientation_from_standard_points(
+            np.stack(seen, axis=-1),
+            x11,
+            x12,
+            x21,
+            x22,
+            run.scene.c_mm,
+            sheet.focal_length_corrected_mm,
+        )
+        for element, control in ELEMENTS.items():
+            before = op.physical(control)
+            _turn(op, control, before - cal.mapping[element] * el[element], active)
+            op.log.add(
+                stage,
+                f"{_BOOK[element]} = {float(np.ravel(el[element])[0]) * 1e3:+.4f} mrad (5.11): "
+                f"turn {control} by −m·{_BOOK[element]}",
+                control,
+                before=before,
+                after=op.physical(control),
+                unit="rad" if control.startswith("kappa") else "—",
+                iteration=it,
+                equation="(5.11)",
+            )
+    return its, worst
+
+
+def _height_points(run, ids) -> list[tuple[str, NDArray[np.float64]]]:
+    sc = run.scene.scenario
+    return [(i, np.asarray(next(p for p in sc.points if p.id == i).local_m, float)) for i in ids]
+
+
+def levelling_points(run) -> tuple[str, ...]:
+    """The height control points nearest (in plan) to standard points 3, 4, 5, 6, distinct."""
+    rows = _height_points(run, [h["id"] for h in run.sheet.control_heights])
+    out: list[str] = []
+    for std in run.scene.standard_points_m[2:6]:
+        free = [(float(np.hypot(*(p[:2] - std[:2]))), i) for i, p in rows if i not in out]
+        if free:
+            out.append(min(free)[1])
+    return tuple(out)
+
+
+def _scale_pair(run) -> tuple[str, str]:
+    """The two plan control points farthest apart (the scale is taken between them)."""
+    ids = run.sheet.similarity_point_ids or tuple(h["id"] for h in run.sheet.control_heights)
+    rows = _height_points(run, ids)
+    best = max(
+        (float(np.hypot(*(a[1][:2] - b[1][:2]))), a[0], b[0])
+        for k, a in enumerate(rows)
+        for b in rows[k + 1 :]
+    )
+    return best[1], best[2]
+
+
+def _fuse_read(run, pid: str, p, key: str, active, read: tuple[str, ...]):
+    op = run.op
+    img = run.scene.images(p[None, :])
+    op.fuse(p, (img[0][0], img[1][0]), key, active)
+    return {c: op.read(c, f"{key}/{c}") for c in read}
+
+
+def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=None) -> None:
+    """C3: absolute orientation by control points, iterated until the levelling points agree in
+    height within H/3000 with the first of them (where the height scale is slipped); then slip
+    the height scale there and check all control heights, and the six standard points again.
+
+    Each iteration: (1) scale — fuse on the two plan control points farthest apart, compare the
+    model distance from the X, Y counters with the ground distance/M_г, turn b_x in proportion;
+    (2) level — fuse on the four control points nearest standard points 3–6, read the heights,
+    fit offset + common tilts φ_α, φ_ω (:class:`Calibration` ``level_design``) and turn the
+    knobs of both photos, the cassettes and b_z′ by −φ (assumption: the common tilt of
+    ``instruments.md`` §6.1); (3) clear the y-parallax the common tilt leaves (the relative
+    orientation of C2 again, bounded): on this instrument the common tilt is q-neutral only to
+    a few per cent.
+    """
+    op, sheet = run.op, run.sheet
+    tol = sheet.tolerances["control_height_m"]
+    tol_q = sheet.tolerances["residual_y_parallax_mm"]
+    mg = sheet.horizontal_scale_denominator
+    a_id, b_id = _scale_pair(run)
+    (_, pa), (_, pb) = _height_points(run, (a_id, b_id))
+    d_true = float(np.hypot(*(pa[:2] - pb[:2]))) * 1000.0 / mg
+    rows = _height_points(run, level_ids)
+    active = op.all()
+    its = np.zeros(np.shape(active), int)
+    ro_its = np.zeros(np.shape(active), int)
+    worst = op.v(np.nan)
+    for it in range(1, op.model.max_iterations + 1):
+        its = np.where(active, it, its)
+        ra = _fuse_read(run, a_id, pa, f"C3/{it}/scale/{a_id}", active, ("X", "Y"))
+        rb = _fuse_read(run, b_id, pb, f"C3/{it}/scale/{b_id}", active, ("X", "Y"))
+        d_model = np.hypot(ra["X"] - rb["X"], ra["Y"] - rb["Y"])
+        with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest read d = 0
+            ratio = np.where(active, d_true / d_model, 1.0)
+        bx = op.read("bx", f"C3/{it}/bx")
+        new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio
+        op.set("bx", new, f"C3/{it}/setbx", active)
+        op.log.add(
+            "C3",
+            f"scale: fuse on {a_id} and {b_id}, model distance against {d_true:.3f} mm; "
+            "turn b_x in proportion",
+            "bx",
+            before=bx,
+            after=new,
+            reading=new,
+            residual=d_model - d_true,
+            iteration=it,
+            equation="scale by b_x",
+        )
+        errs = []
+        for pid, p in rows:
+            h = _fuse_read(run, pid, p, f"C3/{it}/level/{pid}", active, (HEIGHT_SCALE,))
+            errs.append(h[HEIGHT_SCALE] - p[2])
+        resid = [e - errs[0] for e in errs]
+        for (pid, _), r, e in zip(rows, resid, errs, strict=True):
+            op.log.add(
+                "C3",
+                f"level: control point {pid}, height error against point {rows[0][0]}",
+                HEIGHT_SCALE,
+                reading=e,
+                unit="m",
+                residual=r,
+                tolerance=tol,
+                passed=np.abs(r) <= tol,
+                iteration=it,
+                equation="H/3000",
+            )
+        worst = np.where(active, _worst(resid), worst)
+        active = active & ~(worst <= tol)
+        if not np.any(active) or it == op.model.max_iterations:
+            break
+        w = cal.level_weights
+        phi_a = -_psum(w[1, i] * e for i, e in enumerate(errs))
+        phi_o = -_psum(w[2, i] * e for i, e in enumerate(errs))
+        for name, phi, combo in (("α", phi_a, cal.common_alpha), ("ω", phi_o, cal.common_omega)):
+            for control, rate in combo.items():
+                if control in ("by", "bz"):
+                    before = op.read(control, f"C3/{it}/{name}/{control}")
+                    op.set(control, before + rate * phi, f"C3/{it}/{name}/set{control}", active)
+                    after = before + rate * phi
+                else:
+                    before = op.physical(control)
+                    _turn(op, control, before + rate * phi, active)
+                    after = op.physical(control)
+                op.log.add(
+                    "C3",
+                    f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: "
+                    f"turn {control}",
+                    control,
+                    before=before,
+                    after=after,
+                    unit="mm" if control in ("by", "bz") else "—",
+                    iteration=it,
+                    equation="levelling (assumption)",
+                )
+        if relative_fn is not None:
+            r_its, _ = _masked(run, active, relative_fn, cal, f"C3/{it}/ro")
+            ro_its = ro_its + np.where(active, r_its, 0)
+    run.iterations["C3"] = its
+    run.iterations["C3/relative"] = ro_its
+    run.check("C3: levelling points (against the first)", worst, tol, unit="m", iterations=its)
+    # slip the height scale at the first levelling point, check all control heights
+    heights = _height_points(run, [h["id"] for h in sheet.control_heights])
+    pid0, p0 = rows[0]
+    _fuse_read(run, pid0, p0, f"C3/slip/{pid0}", None, ())
+    op.inst.slip_height_scale(p0[2])
+    op.log.add(
+        "C3",
+        f"fuse on {pid0}, slip the height scale to H = {p0[2]:.2f} m",
+        HEIGHT_SCALE,
+        reading=p0[2],
+        unit="m",
+        equation="stage 3",
+    )
+    errs = []
+    for pid, p in heights:
+        if pid == pid0:
+            continue
+        read = _fuse_read(run, pid, p, f"C3/h/{pid}", None, (HEIGHT_SCALE,))[HEIGHT_SCALE]
+        errs.append(read - p[2])
+        op.log.add(
+            "C3",
+            f"control point {pid}: fuse, read the height",
+            HEIGHT_SCALE,
+            reading=read,
+            unit="m",
+            residual=read - p[2],
+            tolerance=tol,
+            passed=np.abs(read - p[2]) <= tol,
+            equation="H/3000",
+        )
+    run.check("C3: control heights", _worst(errs) if errs else op.v(0.0), tol, unit="m")
+    seen = _six_q(run, "C3/std", None, 1, stage="C3")
+    run.check("C3: residual y-parallax (6 points)", _worst(seen), tol_q)
+
+
+def _masked(run, active, relative_fn, cal, key0):
+    """The relative orientation for the trials still ``active`` only (the others stay)."""
+    op = run.op
+    saved = op.all
+    op.all = lambda: active.copy()
+    try:
+        return relative_fn(run, cal, stage="C3", key0=key0)
+    finally:
+        op.all = saved
+
+
+def c4_sheet(run) -> None:
+    """C4: the sheet on the coordinatograph, corner 4 and the plotted plan control — stages 4–5
+    of the setup-data method reused, with the corner coordinates of the setup sheet."""
+    from stereoplotter.procedure.setup_method import stage4_orient_sheet, stage5_check
+
+    log = run.op.log
+    start = len(log.records)
+    stage4_orient_sheet(run)
+    stage5_check(run)
+    log.records[start:] = [replace(r, stage="C4") for r in log.records[start:]]
+    for old, new in (("4", "C4"), ("5", "C4/check")):
+        if old in run.iterations:
+            run.iterations[new] = run.iterations.pop(old)
+
+
+def run_conventional_method(run, relative: str = "elements"):
+    """The conventional method on a virtual instrument: C1–C4 in order.
+
+    Parameters
+    ----------
+    run : stereoplotter.procedure.setup_method.Run
+        Instrument, sheet, operator and scene; receives results, iterations, zero readings.
+    relative : {"elements", "equations"}
+        Relative orientation element by element with over-correction, or by the six measured
+        q and (5.11).
+
+    Returns
+    -------
+    Run
+    """
+    if relative not in RELATIVE_OPTIONS:
+        raise StereoplotterError(
+            f"relative: expected one of {', '.join(RELATIVE_OPTIONS)}, found {relative!r}"
+        )
+    c1_interior(run)
+    level_ids = levelling_points(run)
+    cal = calibrate(run, level_ids)
+    run.calibration = cal
+    relative_fn = c2_relative_by_elements if relative == "elements" else c2_relative_by_equations
+    its, worst = relative_fn(run, cal)
+    run.iterations["C2"] = its
+    tol = run.sheet.tolerances["residual_y_parallax_mm"]
+    run.check("C2: residual y-parallax (6 points)", worst, tol, iterations=its)
+    c3_absolute(run, cal, level_ids, relative_fn)
+    c4_sheet(run)
+    return run

@@ -209,14 +209,16 @@ def _span_loop(
     return its, ok, np.maximum(np.abs(dl), np.abs(dr))
 
 
-def stage1_scale_coefficient(run: Run) -> None:
-    """Stage 1: interior settings, base, D = n_л f_пр, the L-check loop, MO_Z and MO_bz (D7)."""
+def interior_orientation(run: Run, stage: str) -> None:
+    """Interior settings common to stage 1 and the conventional method's C1: the height-counter
+    gear M_в, f_пр, the cassettes parallel to the axes, the correction mechanisms and the
+    decentrations at their zero places (OCR L3755–3759)."""
     op, sheet = run.op, run.sheet
     log = op.log
     op.inst.gear_height_counter(sheet.vertical_scale_denominator)
-    op.set("f_instrument", sheet.f_instrument_mm, "1/f")
+    op.set("f_instrument", sheet.f_instrument_mm, f"{stage}/f")
     log.add(
-        "1",
+        stage,
         "set the instrument principal distance f_пр",
         "f_instrument",
         reading=sheet.f_instrument_mm,
@@ -225,7 +227,7 @@ def stage1_scale_coefficient(run: Run) -> None:
     for side in ("left", "right"):
         op.drive(f"kappa_{side}", 0.0)
         log.add(
-            "1",
+            stage,
             f"turn the {side} cassette: fiducial lines parallel to the axes",
             f"kappa_{side}",
             reading=0.0,
@@ -235,10 +237,20 @@ def stage1_scale_coefficient(run: Run) -> None:
         for axis in ("alpha", "omega"):
             op.drive(f"k_{axis}_{side}", 0.0)
         for d in ("dx", "dy"):
-            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], f"1/{d}_{side}")
+            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], f"{stage}/{d}_{side}")
     log.add(
-        "1", "correction mechanisms and decentrations to their zero places", "", equation="stage 1"
+        stage,
+        "correction mechanisms and decentrations to their zero places",
+        "",
+        equation="stage 1",
     )
+
+
+def stage1_scale_coefficient(run: Run) -> None:
+    """Stage 1: interior settings, base, D = n_л f_пр, the L-check loop, MO_Z and MO_bz (D7)."""
+    op, sheet = run.op, run.sheet
+    log = op.log
+    interior_orientation(run, "1")
     bx, by, _ = sheet.base_mm
     op.set("bx", NOMINAL_ZERO["bx"] + bx, "1/bx")
     log.add(

@@ -130,6 +130,7 @@ def _run_one(
     variant,
     transcript=True,
     noise_trials=None,
+    relative="elements",
 ):
     inst = Instrument(
         spec,
@@ -149,7 +150,7 @@ def _run_one(
     elif method == "conventional":
         from stereoplotter.procedure.conventional import run_conventional_method
 
-        run_conventional_method(run)
+        run_conventional_method(run, relative)
     else:
         raise StereoplotterError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
     q_std = op.y_parallax(scene.standard_points_m, scene.images(scene.standard_points_m))
@@ -177,6 +178,7 @@ def simulate(
     ideal_mechanics: bool = False,
     variant: str = "L",
     evaluate: bool = True,
+    relative: str = "elements",
 ) -> SimulationResult:
     """Run the setup-data or the conventional method on a virtual instrument.
 
@@ -200,6 +202,9 @@ def simulate(
         Decentration linkage variant of the instrument ("L" canonical).
     evaluate : bool
         Call ``stereoplotter.evaluation.evaluate_model`` (if the module exists).
+    relative : {"elements", "equations"}
+        Conventional method only: relative orientation element by element with over-correction,
+        or by the six measured q and (5.11).
 
     Returns
     -------
@@ -223,6 +228,7 @@ def simulate(
         ideal_mechanics,
         method,
         variant,
+        relative=relative,
     )
     evaluation = _evaluate(scenario, sheet, run) if evaluate else None
     return SimulationResult(
@@ -256,6 +262,7 @@ def simulate_per_trial(
     operator: OperatorModel | None = None,
     ideal_mechanics: bool = False,
     variant: str = "L",
+    relative: str = "elements",
 ) -> dict[str, Any]:
     """The test oracle: trial t of ``simulate(..., trials=T)`` run alone, for t = 0 … T−1.
 
@@ -286,6 +293,7 @@ def simulate_per_trial(
             variant,
             transcript=False,
             noise_trials=trials,
+            relative=relative,
         )
         rows.append((run, q_std, q_grid))
     # the noise of a per-trial run must see T: rebuilt with trial index (see _run_one)
