@@ -136,6 +136,14 @@ def _a(v: ArrayLike) -> NDArray[np.float64]:
     return np.asarray(v, dtype=float)
 
 
+def _pair(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Stack two broadcastable arrays along a new last axis (..., 2), without broadcast views."""
+    out = np.empty((*np.broadcast_shapes(np.shape(a), np.shape(b)), 2))
+    out[..., 0] = a
+    out[..., 1] = b
+    return out
+
+
 @dataclass(frozen=True, slots=True)
 class CorrectionUnit:
     r"""State of the correction unit of one photo (``kinematics.md`` §3.2).
@@ -303,7 +311,7 @@ def photo_from_rod(rod_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.float6
     u = u - _a(unit.decentration_x_mm)
     v = v - _a(unit.decentration_y_mm)
     c, s = np.cos(_a(unit.kappa)), np.sin(_a(unit.kappa))
-    return np.stack(np.broadcast_arrays(c * u + s * v, -s * u + c * v), axis=-1)
+    return _pair(c * u + s * v, -s * u + c * v)
 
 
 def rod_from_photo(photo_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.float64]:
@@ -359,7 +367,7 @@ def rod_from_photo(photo_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.floa
     else:
         tau = (f + cx * ta + cy * to - px * ta - py * to) / f
         xi, eta = px / tau, py / tau
-    return np.stack(np.broadcast_arrays(xi, eta), axis=-1)
+    return _pair(xi, eta)
 
 
 # --------------------------------------------------------------------------------------------
