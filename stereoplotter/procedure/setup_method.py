@@ -170,8 +170,8 @@ def _span_loop(
             op.set("f_instrument", f_new, f"{k}/setf", beyond)
             op.log.add(
                 stage,
-                "the carriage is at its bottom stop: n = D/f_пр reached by f_пр instead, "
-                "f′_пр = f_пр·D/(D + ΔD)",
+                "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
+                "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
                 "f_instrument",
                 before=f_set,
                 after=f_new,
@@ -181,17 +181,19 @@ def _span_loop(
             )
             dz_mm = np.where(beyond, 0.0, dz_mm)
         op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
-        op.log.add(
-            stage,
-            f"ΔZ = {float(np.ravel(dz_m)[op.log.shown if dz_m.size > 1 else 0]):+.3f} m "
-            "(6.9): lower the carriage, O′_Z = O_Z + ΔZ",
-            "Z",
-            before=depth,
-            after=depth + dz_mm,
-            reading=depth + dz_mm,
-            iteration=it,
-            equation="(6.9), (6.11)",
-        )
+        shown = op.log.shown if np.ndim(beyond) else 0
+        if not np.ravel(beyond)[shown]:
+            op.log.add(
+                stage,
+                f"ΔZ = {float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]):+.3f} m "
+                "(6.9): lower the carriage, O′_Z = O_Z + ΔZ",
+                "Z",
+                before=depth,
+                after=depth + dz_mm,
+                reading=depth + dz_mm,
+                iteration=it,
+                equation="(6.9), (6.11)",
+            )
         bz = op.read("bz", f"{k}/bz")
         dbz = base_z_correction(depth, dr, span_r)
         op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
