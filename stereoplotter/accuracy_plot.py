@@ -3,6 +3,8 @@
 * :func:`plot_error_maps` — RMS x-parallax error over the working area per error source
   (like Fig. 40 of the book), from exact covariance propagation;
 * :func:`plot_mc_histogram` — per-trial RMS of a Monte Carlo row against the formula's σ;
+* :func:`plot_mc_histograms` — the figure ``verify -o`` writes: per-trial RMS of the procedure
+  MC (setup data, conventional; 60 %, 80 %) and of two linear-MC rows against the formulas;
 * :func:`plot_verification_chart` — printed / book / rigorous / MC per row.
 """
 
@@ -16,7 +18,7 @@ import numpy as np
 
 from stereoplotter.accuracy import montecarlo as mc
 
-__all__ = ["plot_error_maps", "plot_mc_histogram", "plot_verification_chart"]
+__all__ = ["plot_error_maps", "plot_mc_histogram", "plot_mc_histograms", "plot_verification_chart"]
 
 
 def plot_error_maps(
@@ -101,3 +103,65 @@ def plot_verification_chart(rows, ax=None):
     ax.set_ylabel("value / rigorous")
     ax.legend()
     return ax
+
+
+def plot_mc_histograms(rows, procedure=None, trials=4000, seed=0):
+    """Histograms of per-trial RMS / σ for representative rows.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Verification rows (for the formula values).
+    procedure : dict, optional
+        :func:`~stereoplotter.accuracy.verification.run_procedure_mc` output; one panel per
+        (overlap, method) with the per-trial coefficient, the procedure-MC RMS and the formula.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from stereoplotter.accuracy import setup_accuracy as sa
+    from stereoplotter.accuracy.verification import BOOK, _both
+
+    by = {r["eq"]: r for r in rows}
+    panels = []
+    g = BOOK
+    sb = _both(sa.setup_element_sigmas(g["f"], g["l"], g["n"], 1.0))
+    for eq, p, a in (("(6.43)", g["p60"], g["a60"]), ("(6.44)", g["p80"], g["a80"])):
+        m = mc.setup_model(g["f"], p, a, g["c"], sb, levelled=False)
+        panels.append(("linear", eq, m, by[eq]["rigorous"]))
+    for (slot, method), res in sorted((procedure or {}).items()):
+        eq = {"setup": "(6.43)", "conventional": "(6.60)"}[method]
+        if slot == "80":
+            eq = {"(6.43)": "(6.44)", "(6.60)": "(6.61)"}[eq]
+        panels.append(("procedure", eq, res, by[eq]["rigorous"]))
+    cols = 3 if len(panels) > 4 else 2
+    fig, axes = plt.subplots(
+        (len(panels) + cols - 1) // cols,
+        cols,
+        figsize=(5 * cols, 3.2 * ((len(panels) + 1) // cols)),
+        squeeze=False,
+    )
+    for ax, (kind, eq, obj, formula) in zip(axes.ravel(), panels, strict=False):
+        if kind == "linear":
+            plot_mc_histogram(obj, formula, trials=trials, seed=seed, ax=ax)
+            ax.set_title(f"{eq} linear MC, per m_xy", fontsize=9)
+        else:
+            ax.hist(obj["per_trial"], bins=50, color="0.7")
+            ax.axvline(formula, color="r", label=f"rigorous (book geometry) {formula:.3g}")
+            ax.axvline(
+                obj["coefficient"],
+                color="b",
+                ls="--",
+                label=f"procedure MC {obj['coefficient']:.3g} ± {obj['ci']:.2g}",
+            )
+            unit = "m_xy = n_л σ" if obj["method"] == "setup" else "m_p = m_q = σ"
+            ax.set_title(
+                f"{eq} procedure MC {obj['scenario']}, {obj['method']}, per {unit}", fontsize=9
+            )
+            ax.legend(fontsize=7)
+        ax.set_xlabel("per-trial RMS of δp / σ")
+    for ax in axes.ravel()[len(panels) :]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    return fig

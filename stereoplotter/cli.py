@@ -474,23 +474,53 @@ def _verify(args: argparse.Namespace) -> int:
         if done == total:
             sys.stderr.write("\n")
 
-    rows, seconds = verify(trials=args.trials, seed=args.seed, out_dir=None, progress=progress)
+    from stereoplotter.accuracy.verification import geometry_from_file, run_procedure_mc
+
+    geometry, scenarios = None, None
+    if args.geometry:
+        geometry, scenarios = geometry_from_file(args.geometry)
+    # the procedure MC once, shared by the table and the histograms
+    proc = run_procedure_mc(args.procedure_trials, args.seed, scenarios, progress=progress)
+    rows, seconds = verify(
+        trials=args.trials,
+        seed=args.seed,
+        out_dir=None,
+        geometry=geometry,
+        progress=progress,
+        procedure_trials=0,
+    )
+    if proc:
+        from stereoplotter.accuracy.verification import attach_procedure_mc
+
+        attach_procedure_mc(rows, proc)
     if args.output:
         from stereoplotter.accuracy.verification import write_verification
 
         out = Path(args.output)
         # Figures first, in memory: every file is written whole or not at all.
-        from stereoplotter.accuracy_plot import plot_error_maps, plot_verification_chart
+        from stereoplotter.accuracy_plot import (
+            plot_error_maps,
+            plot_mc_histograms,
+            plot_verification_chart,
+        )
 
         figures = {}
         for name, figure in (
             ("error_maps.png", plot_error_maps()),
             ("verification_chart.png", plot_verification_chart(rows).figure),
+            ("mc_histograms.png", plot_mc_histograms(rows, proc, seed=args.seed)),
         ):
             buffer = io.BytesIO()
             figure.savefig(buffer, format="png", dpi=100, metadata={"Software": None})
             figures[name] = buffer.getvalue()
-        write_verification(rows, out, trials=args.trials, seed=args.seed, seconds=seconds)
+        write_verification(
+            rows,
+            out,
+            trials=args.trials,
+            seed=args.seed,
+            seconds=seconds,
+            procedure_trials=args.procedure_trials,
+        )
         for name, content in figures.items():
             atomic_write_bytes(out / name, content)
     if args.json:
@@ -500,7 +530,7 @@ def _verify(args: argparse.Namespace) -> int:
         f"verification of Eqs. (6.28)–(6.61): {len(rows)} rows, {args.trials} trials, "
         f"seed {args.seed}, {seconds:.1f} s",
         "",
-        f"{'eq':<14}{'printed':>10}{'rigorous':>10}{'MC':>10}  verdict",
+        f"{'eq':<14}{'printed':>10}{'rigorous':>10}{'MC':>10}{'proc. MC':>10}  verdict",
     ]
     for r in rows:
 
@@ -508,12 +538,13 @@ def _verify(args: argparse.Namespace) -> int:
             return f"{v:10.4g}" if isinstance(v, int | float) else f"{'—':>10}"
 
         lines.append(
-            f"{r['eq']:<14}{f(r['printed'])}{f(r['rigorous'])}{f(r['mc_linear'])}  {r['verdict']}"
+            f"{r['eq']:<14}{f(r['printed'])}{f(r['rigorous'])}{f(r['mc_linear'])}"
+            f"{f(r['mc_procedure'])}  {r['verdict']}"
         )
     if args.output:
         lines.append(
             f"\nwritten: verification.md, .csv, .json, closing_comparison.json, "
-            f"error_maps.png, verification_chart.png in {args.output}"
+            f"error_maps.png, verification_chart.png, mc_histograms.png in {args.output}"
         )
     sys.stdout.write("\n".join(lines) + "\n")
     return 0
@@ -639,6 +670,18 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=20240601, help="seed of the Monte Carlo")
     p.add_argument("-o", "--output", help="write Markdown, CSV, JSON and plots into this folder")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
+    p.add_argument(
+        "--procedure-trials",
+        type=int,
+        default=1500,
+        help="trials of the procedure MC (simulated operator) per overlap and method; 0 disables",
+    )
+    p.add_argument(
+        "--geometry",
+        metavar="FILE",
+        help="YAML: a scenario (f, l, n, photo base p, overlap; also runs the procedure MC on it) "
+        "or a mapping of f, l, n, c, p60, a60, p80, a80",
+    )
 
     p = sub.add_parser(
         "demo",

@@ -1,0 +1,253 @@
+"""Procedure Monte Carlo: the formulas of §27 against the simulated operator (``accuracy.md`` 4).
+
+:func:`procedure_mc` runs the real stages on the virtual SC-1 (``procedure.simulate``, closed-form
+back-end, vectorised over trials) twice with the same seed — once with the operator's pointing
+errors of the formula switched on, once with every error zero — and takes the x-parallax error
+field δp of the built model (photo mm, at the ideal model position, :mod:`stereoplotter.evaluation`)
+on the formula's own integration domain. The difference of the two runs is the error the
+pointing caused (the zero run carries the deterministic residue of the sheet's approximations,
+reported as ``bias``). The statistic is the protocol's: sqrt(mean over trials and a uniform
+midpoint grid of δp²), with a CI half-width of ``CI_Z`` standard errors from the per-trial mean
+squares.
+
+Configurations (chosen to match the formulas' assumptions as far as the model allows):
+
+* ``method="setup"`` — (6.39)/(6.40) → (6.43)/(6.44): only the monocular pointing error σ of the
+  operator (photo scale; the fiducial settings of stages 1–2); no injected instrument errors,
+  ideal mechanics, exact counter reading and setting, no stereo / y-parallax judgment error.
+  Coefficient = RMS / m_xy with m_xy = n_л·σ (the book's m_x is a counter error, (6.31)
+  m_Δx = m_x/n). Domain of (6.27): x_л ∈ [0, c], y ∈ [−c, c]; no plane removal.
+* ``method="conventional"`` — (6.45)/(6.46) = (6.60)/(6.61): y-parallax judgment σ_q = σ and
+  stereo (x-parallax) judgment σ_p = σ (m_q = m_p), relative orientation by the six measured q and
+  (5.11) (``relative="equations"``, least squares as (5.54) assumes), levelling on the scenario's
+  four control points by the procedure itself; coefficient = RMS / σ. Domain of chapter 5:
+  x_п ∈ [−c, 0], y ∈ [−c, c] (x_л = x_п + p).
+
+The standard points of the simulated instrument are on the two nadirs (the book's a = 0); their
+ordinate is set to c (``spec.standard_points_c_mm``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from stereoplotter.accuracy.montecarlo import CI_Z
+
+__all__ = ["PROCEDURE_ROWS", "procedure_mc", "scenario_geometry"]
+
+ROOT = Path(__file__).resolve().parents[2]
+#: Row → (scenario file, method); the scenarios are the book's §27 setting.
+PROCEDURE_ROWS = {
+    "(6.43)": ("pair60.yaml", "setup"),
+    "(6.44)": ("pair80.yaml", "setup"),
+    "(6.39)": ("pair60.yaml", "setup"),
+    "(6.40)": ("pair80.yaml", "setup"),
+    "(6.45)": ("pair60.yaml", "conventional"),
+    "(6.46)": ("pair80.yaml", "conventional"),
+    "(6.60)": ("pair60.yaml", "conventional"),
+    "(6.61)": ("pair80.yaml", "conventional"),
+}
+
+
+def _load(scenario):
+    from stereoplotter.scenario import load_scenario
+
+    if isinstance(scenario, str | Path):
+        path = Path(scenario)
+        if not path.exists():
+            path = ROOT / "scenarios" / str(scenario)
+        return load_scenario(path)
+    return scenario
+
+
+@lru_cache(maxsize=8)
+def _geometry_cached(path: str, instrument: str):
+    return _scenario_geometry(_load(path), instrument)
+
+
+def scenario_geometry(scenario, instrument: str = "sc1") -> dict:
+    """f, l, n_л, f_пр, photo base p = B·f/H̄, overlap and the book's c of a scenario.
+
+    c follows the book's §27 convention: c = p below 70 % overlap (60 %: a = 0), c = 2p above
+    (80 %: a = p).
+
+    Examples
+    --------
+    >>> g = scenario_geometry("pair60.yaml")
+    >>> round(g["f"]), round(g["l"]), g["overlap"] < 0.7
+    (70, 85, True)
+    """
+    if isinstance(scenario, str | Path):
+        return dict(_geometry_cached(str(scenario), instrument))
+    return _scenario_geometry(scenario, instrument)
+
+
+def _scenario_geometry(scenario, instrument):
+    from stereoplotter.evaluation import instrument_frame_m
+    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.scenario.synthetic import working_area_grid_m
+    from stereoplotter.setup_sheet import compute_setup_sheet
+
+    spec = load_instrument(instrument)
+    sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
+    f = float(scenario.camera.focal_length_mm)
+    pts = np.asarray(scenario.camera.fiducial_array_mm(), float)
+    ll = float(np.mean(np.hypot(pts[:, 0], pts[:, 1])))  # mark distance l from the centre
+    origin = np.asarray(sheet.frame_origin_m, float)
+    theta = float(sheet.frame_rotation)
+    grid = instrument_frame_m(working_area_grid_m(scenario, (9, 9)), origin, theta)
+    height = float(-np.mean(grid[:, 2]))
+    right = instrument_frame_m(
+        np.asarray(scenario.photo("right").exterior.centre, float)[None], origin, theta
+    )[0]
+    p = float(right[0]) * f / height
+    fmt = float(scenario.camera.format_mm)
+    overlap = 1.0 - p / fmt
+    c = p if overlap < 0.7 else 2.0 * p
+    return {
+        "f": f,
+        "l": ll,
+        "n": float(sheet.n_left),
+        "f_instrument": float(sheet.f_instrument_mm),
+        "p": p,
+        "c": c,
+        "a": c - p,
+        "overlap": overlap,
+        "flying_height_m": height,
+    }
+
+
+def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
+    """Ground points (instrument frame) under a midpoint grid of left-photo (x_л, y) [mm]."""
+    from stereoplotter.evaluation import instrument_frame_m
+
+    nx, ny = grid
+    x0, x1 = x_left_range
+    xs = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
+    ys = -c + (np.arange(ny) + 0.5) * 2 * c / ny
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    scale = height / f  # ground m per photo mm
+    plan = np.column_stack([X.ravel() * scale, Y.ravel() * scale])
+    origin = np.asarray(sheet.frame_origin_m, float)
+    theta = float(sheet.frame_rotation)
+    local = instrument_frame_m(
+        np.column_stack([plan, np.zeros(len(plan))]), origin, theta, inverse=True
+    )
+    local[:, 2] = scenario.terrain.height_m(local[:, 0], local[:, 1])
+    return instrument_frame_m(local, origin, theta)
+
+
+def _dp(scenario, sheet, inst, frame_pts):
+    from stereoplotter import evaluation as ev
+
+    origin = np.asarray(sheet.frame_origin_m, float)
+    theta = float(sheet.frame_rotation)
+    local = ev.instrument_frame_m(frame_pts, origin, theta, inverse=True)
+    gl = ev.film_points_mm(scenario, "left", local)
+    gr = ev.film_points_mm(scenario, "right", local)
+    model = ev.ideal_model_mm(
+        frame_pts, sheet.horizontal_scale_denominator, sheet.vertical_scale_denominator
+    )
+    units = inst.state()["units"]
+    setting, left, right = inst.setting, units["left"], units["right"]
+    if ev._trial_count(setting, (left, right)) is not None:
+        setting = ev._with_point_axis(setting)
+        left, right = ev._with_point_axis(left), ev._with_point_axis(right)
+    dp, _ = ev.parallax_errors_at_ideal(model, gl, gr, setting, left, right)
+    return np.asarray(dp, float)
+
+
+def procedure_mc(
+    scenario="pair60.yaml",
+    method: str = "setup",
+    *,
+    trials: int = 600,
+    seed: int = 20240601,
+    sigma_mm: float = 0.01,
+    instrument: str = "sc1",
+    grid=(16, 32),
+) -> dict:
+    """Run the procedure MC for one scenario and method (see the module docstring).
+
+    Returns
+    -------
+    dict
+        ``coefficient`` (RMS of δp per m_xy for "setup", per m_p = m_q for "conventional"),
+        ``ci`` (half-width, same units), ``rms_mm``, ``bias_mm`` (RMS δp of the error-free run on
+        the same domain), ``per_trial`` (per-trial RMS / unit, for histograms), the geometry
+        used (f, l, n, f_instrument, p, c, a, overlap) and ``seconds``.
+
+    Examples
+    --------
+    >>> r = procedure_mc("pair60.yaml", "setup", trials=20, seed=1)
+    >>> 0.3 < r["coefficient"] < 3.0
+    True
+    """
+    import time
+
+    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.procedure.operator import OperatorModel
+    from stereoplotter.procedure.simulate import simulate
+
+    t0 = time.perf_counter()
+    sc = _load(scenario)
+    g = scenario_geometry(scenario if isinstance(scenario, str | Path) else sc, instrument)
+    f, p, c, n = g["f"], g["p"], g["c"], g["n"]
+    spec = load_instrument(instrument)
+    spec = replace(spec, standard_points_c_mm=c)
+    zero = OperatorModel().zero()
+    if method == "setup":
+        op = replace(zero, monocular_sigma_mm=sigma_mm)
+        xr = (0.0, c)  # (6.27)
+        unit = n * sigma_mm
+        kw = {}
+    elif method == "conventional":
+        op = replace(zero, stereo_sigma_mm=sigma_mm, y_parallax_sigma_mm=sigma_mm)
+        xr = (p - c, p)  # x_п ∈ [−c, 0]
+        unit = sigma_mm
+        kw = {"relative": "equations"}
+    else:
+        raise ValueError(f"method: expected 'setup' or 'conventional', found {method!r}")
+    runs = []
+    for o, t in ((op, int(trials)), (zero, None)):
+        r = simulate(
+            sc,
+            spec,
+            method,
+            errors="zero",
+            seed=seed,
+            trials=t,
+            operator=o,
+            ideal_mechanics=True,
+            evaluate=False,
+            **kw,
+        )
+        runs.append(r)
+    pts = _domain_points(sc, runs[0].sheet, xr, c, p, f, g["flying_height_m"], grid)
+    d_noisy = _dp(sc, runs[0].sheet, runs[0].instrument, pts)
+    d_zero = _dp(sc, runs[1].sheet, runs[1].instrument, pts)
+    d = d_noisy - d_zero
+    ms = np.mean(d**2, axis=-1)  # per trial
+    mean_ms = float(np.mean(ms))
+    rms = math.sqrt(mean_ms)
+    se_ms = float(np.std(ms, ddof=1)) / math.sqrt(len(ms))
+    half = CI_Z * rms * se_ms / (2.0 * mean_ms)
+    return {
+        "method": method,
+        "scenario": sc.name,
+        "trials": int(trials),
+        "seed": int(seed),
+        "sigma_mm": sigma_mm,
+        "coefficient": rms / unit,
+        "ci": half / unit,
+        "rms_mm": rms,
+        "bias_mm": float(np.sqrt(np.mean(d_zero**2))),
+        "per_trial": np.sqrt(ms) / unit,
+        "seconds": time.perf_counter() - t0,
+        **g,
+    }
