@@ -50,6 +50,7 @@ __all__ = [
     "DecentrationVariant",
     "InstrumentSetting",
     "StereoReading",
+    "UnitMap",
     "correction_angle",
     "counters_from_homologous_points",
     "counters_from_photo",
@@ -58,9 +59,11 @@ __all__ = [
     "marks_from_counters",
     "photo_from_rod",
     "represented_tilt_tangent",
+    "rod_frame",
     "rod_from_counters",
     "rod_from_photo",
     "rods_intersection",
+    "rods_y_parallax",
     "set_decentrations",
     "turn_correction_knob",
     "unit_for_orientation",
@@ -297,21 +300,7 @@ def photo_from_rod(rod_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.float6
     >>> np.round(photo_from_rod([100.0 * np.tan(np.radians(3.0)), 0.0], unit), 12) + 0.0
     array([0., 0.])
     """
-    rod = _a(rod_mm)
-    xi, eta = rod[..., 0], rod[..., 1]
-    f = _a(unit.focal_length_mm)
-    ta, to = _a(unit.tan_alpha), _a(unit.tan_omega)
-    cx, cy = unit.plane_decentration_mm
-    if unit.strict_per_axis:
-        u = xi * (f + cx * ta) / (f + xi * ta)
-        v = eta * (f + cy * to) / (f + eta * to)
-    else:
-        tau = (f + cx * ta + cy * to) / (f + xi * ta + eta * to)
-        u, v = tau * xi, tau * eta
-    u = u - _a(unit.decentration_x_mm)
-    v = v - _a(unit.decentration_y_mm)
-    c, s = np.cos(_a(unit.kappa)), np.sin(_a(unit.kappa))
-    return _pair(c * u + s * v, -s * u + c * v)
+    return UnitMap(unit).photo_from_rod(rod_mm)
 
 
 def rod_from_photo(photo_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.float64]:
@@ -353,21 +342,111 @@ def rod_from_photo(photo_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.floa
     >>> bool(abs(xi - transformed_x_single_tilt(85.0, np.radians(1.0), 100.0)) < 1e-12)
     True
     """
-    p = _a(photo_mm)
-    x, y = p[..., 0], p[..., 1]
-    c, s = np.cos(_a(unit.kappa)), np.sin(_a(unit.kappa))
-    px = c * x - s * y + _a(unit.decentration_x_mm)
-    py = s * x + c * y + _a(unit.decentration_y_mm)
-    f = _a(unit.focal_length_mm)
-    ta, to = _a(unit.tan_alpha), _a(unit.tan_omega)
-    cx, cy = unit.plane_decentration_mm
-    if unit.strict_per_axis:
-        xi = px * f / (f + cx * ta - px * ta)
-        eta = py * f / (f + cy * to - py * to)
-    else:
-        tau = (f + cx * ta + cy * to - px * ta - py * to) / f
-        xi, eta = px / tau, py / tau
-    return _pair(xi, eta)
+    return UnitMap(unit).rod_from_photo(photo_mm)
+
+
+class UnitMap:
+    r"""The maps of one :class:`CorrectionUnit` with its invariants computed once.
+
+    :func:`photo_from_rod` and :func:`rod_from_photo` are this class applied once; an operator
+    that evaluates the same unit many times (a 1-D solve, a look per pass) keeps a
+    :class:`UnitMap` and saves cos κ, sin κ and the plane's numerator f′ + c_x T_α + c_y T_ω
+    (``kinematics.md`` §3.3, §3.4). The arithmetic is the same, in the same order, so the
+    results are bit-identical to the functions.
+
+    Parameters
+    ----------
+    unit : CorrectionUnit
+    trig : (ndarray, ndarray), optional
+        (cos κ, sin κ) of ``unit.kappa`` when already known (e.g. after a knob turn, which
+        leaves κ alone).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> unit = unit_for_orientation(0.02, -0.01, 0.003, 100.0)
+    >>> m = UnitMap(unit)
+    >>> bool(np.array_equal(m.rod_from_photo([40.0, 30.0]), rod_from_photo([40.0, 30.0], unit)))
+    True
+    """
+
+    __slots__ = ("c", "ex", "ey", "f", "kx", "ky", "ms", "num", "s", "strict", "ta", "to", "unit")
+
+    def __init__(
+        self,
+        unit: CorrectionUnit,
+        trig: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    ):
+        self.unit = unit
+        f = _a(unit.focal_length_mm)
+        ta, to = _a(unit.tan_alpha), _a(unit.tan_omega)
+        cx, cy = unit.plane_decentration_mm
+        self.strict = bool(unit.strict_per_axis)
+        self.f, self.ta, self.to = f, ta, to
+        if self.strict:
+            self.kx, self.ky = f + cx * ta, f + cy * to
+            self.num = None
+        else:
+            self.num = f + cx * ta + cy * to
+            self.kx = self.ky = None
+        self.ex = _a(unit.decentration_x_mm)
+        self.ey = _a(unit.decentration_y_mm)
+        if trig is None:
+            kappa = _a(unit.kappa)
+            trig = (np.cos(kappa), np.sin(kappa))
+        self.c, self.s = trig
+        self.ms = -self.s
+
+    @property
+    def trig(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(cos κ, sin κ)."""
+        return self.c, self.s
+
+    def with_kappa(self, kappa: ArrayLike) -> UnitMap:
+        """The map of the same unit with the cassette turned to ``kappa`` (only κ recomputed)."""
+        out = object.__new__(UnitMap)
+        for name in UnitMap.__slots__:
+            setattr(out, name, getattr(self, name))
+        out.unit = None
+        k = _a(kappa)
+        out.c, out.s = np.cos(k), np.sin(k)
+        out.ms = -out.s
+        return out
+
+    def photo_xy(self, xi: ArrayLike, eta: ArrayLike) -> tuple[NDArray, NDArray]:
+        """:func:`photo_from_rod` on separate ξ, η arrays, returning (x, y) separately."""
+        f, ta, to = self.f, self.ta, self.to
+        if self.strict:
+            u = xi * self.kx / (f + xi * ta)
+            v = eta * self.ky / (f + eta * to)
+        else:
+            tau = self.num / (f + xi * ta + eta * to)
+            u, v = tau * xi, tau * eta
+        u = u - self.ex
+        v = v - self.ey
+        c = self.c
+        return c * u + self.s * v, self.ms * u + c * v
+
+    def photo_from_rod(self, rod_mm: ArrayLike) -> NDArray[np.float64]:
+        """See :func:`photo_from_rod`."""
+        rod = _a(rod_mm)
+        return _pair(*self.photo_xy(rod[..., 0], rod[..., 1]))
+
+    def rod_xy(self, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
+        """:func:`rod_from_photo` on separate x, y arrays, returning (ξ, η) separately."""
+        c, s = self.c, self.s
+        px = c * x - s * y + self.ex
+        py = s * x + c * y + self.ey
+        f, ta, to = self.f, self.ta, self.to
+        if self.strict:
+            return px * f / (self.kx - px * ta), py * f / (self.ky - py * to)
+        tau = (self.num - px * ta - py * to) / f
+        return px / tau, py / tau
+
+    def rod_from_photo(self, photo_mm: ArrayLike) -> NDArray[np.float64]:
+        """See :func:`rod_from_photo`."""
+        p = _a(photo_mm)
+        return _pair(*self.rod_xy(p[..., 0], p[..., 1]))
 
 
 # --------------------------------------------------------------------------------------------
@@ -378,6 +457,22 @@ def rod_from_photo(photo_mm: ArrayLike, unit: CorrectionUnit) -> NDArray[np.floa
 def _depth(setting: InstrumentSetting, side: str, depth_mm: ArrayLike):
     sx, sy, sz = setting.pivot(side)
     return sx, sy, _a(depth_mm) + sz
+
+
+def rod_frame(
+    setting: InstrumentSetting, side: str, depth_mm: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    r"""(S_x, S_y, n_j) of one rod at the absolute height counter D: ξ = (X − S_x)/n_j,
+    η = (Y − S_y)/n_j, n_j = D_j/f_пр (:func:`rod_from_counters` split for reuse).
+
+    Examples
+    --------
+    >>> sx, sy, n = rod_frame(InstrumentSetting(130.0, base_x_mm=100.0), "right", 260.0)
+    >>> float(sx), float(sy), float(n)
+    (100.0, 0.0, 2.0)
+    """
+    sx, sy, dj = _depth(setting, side, depth_mm)
+    return sx, sy, dj / _a(setting.f_instrument_mm)
 
 
 def rod_from_counters(
@@ -416,9 +511,8 @@ def rod_from_counters(
     >>> rod_from_counters(100.0 + 1.5 * 10.0, 0.0, 1.5 * 130.0 - 2.0, setting, "right")
     array([10.,  0.])
     """
-    sx, sy, dj = _depth(setting, side, depth_mm)
-    n = dj / _a(setting.f_instrument_mm)
-    return np.stack(np.broadcast_arrays((_a(x_mm) - sx) / n, (_a(y_mm) - sy) / n), axis=-1)
+    sx, sy, n = rod_frame(setting, side, depth_mm)
+    return _pair((_a(x_mm) - sx) / n, (_a(y_mm) - sy) / n)
 
 
 def counters_from_photo(
@@ -462,10 +556,9 @@ def counters_from_photo(
     >>> np.round(xy, 4) + 0.0
     array([  0.    , 125.3046])
     """
-    sx, sy, dj = _depth(setting, side, depth_mm)
-    n = dj / _a(setting.f_instrument_mm)
+    sx, sy, n = rod_frame(setting, side, depth_mm)
     rod = rod_from_photo(photo_mm, unit)
-    return np.stack(np.broadcast_arrays(sx + n * rod[..., 0], sy + n * rod[..., 1]), axis=-1)
+    return _pair(sx + n * rod[..., 0], sy + n * rod[..., 1])
 
 
 def marks_from_counters(
@@ -539,18 +632,45 @@ def rods_intersection(
     """
     rl, rr = _a(rod_left_mm), _a(rod_right_mm)
     f = _a(setting.f_instrument_mm)
-    bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
     xi_l, eta_l = rl[..., 0], rl[..., 1]
-    xi_r, eta_r = rr[..., 0], rr[..., 1]
+    t_l, y_l, y_r, q = _rays(xi_l, eta_l, rr[..., 0], rr[..., 1], setting)
+    x = _a(setting.model_origin_x_mm) + t_l * xi_l
+    y = _a(setting.model_origin_y_mm) + 0.5 * (y_l + y_r)
+    return StereoReading(*np.broadcast_arrays(x, y, t_l * f, q))
+
+
+def _rays(xi_l, eta_l, xi_r, eta_r, setting: InstrumentSetting):
+    """t_л, the two ray heights y_л, y_п and q of :func:`rods_intersection` (§3.4, "stereo")."""
+    f = _a(setting.f_instrument_mm)
+    bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
     with np.errstate(divide="ignore", invalid="ignore"):
         t_l = (bx + xi_r * bz / f) / (xi_l - xi_r)
         t_r = t_l + bz / f
         y_l = t_l * eta_l
         y_r = by + t_r * eta_r
         q = (y_l - y_r) / t_l
-    x = _a(setting.model_origin_x_mm) + t_l * xi_l
-    y = _a(setting.model_origin_y_mm) + 0.5 * (y_l + y_r)
-    return StereoReading(*np.broadcast_arrays(x, y, t_l * f, q))
+    return t_l, y_l, y_r, q
+
+
+def rods_y_parallax(
+    rod_left: tuple[ArrayLike, ArrayLike],
+    rod_right: tuple[ArrayLike, ArrayLike],
+    setting: InstrumentSetting,
+) -> NDArray[np.float64]:
+    r"""Only q of :func:`rods_intersection`, with the rods as (ξ, η) pairs of arrays. [mm]
+
+    The same arithmetic as :func:`rods_intersection` (bit-identical q), without X, Y, D.
+
+    Examples
+    --------
+    >>> s = InstrumentSetting(130.0, base_x_mm=90.0, base_y_mm=0.5)
+    >>> r = rods_intersection([45.0, 3.0], [-45.0, 2.0], s)
+    >>> bool(rods_y_parallax((45.0, 3.0), (-45.0, 2.0), s) == r.y_parallax_mm)
+    True
+    """
+    xi_l, eta_l = (_a(v) for v in rod_left)
+    xi_r, eta_r = (_a(v) for v in rod_right)
+    return _rays(xi_l, eta_l, xi_r, eta_r, setting)[3]
 
 
 def counters_from_homologous_points(

@@ -30,6 +30,7 @@ from stereoplotter.instrument.error_model import ErrorModel, error_model_from_sp
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
+    UnitMap,
     decentration_variant,
     marks_from_counters,
     turn_correction_knob,
@@ -217,6 +218,9 @@ class Instrument:
             )
             for side in ("left", "right")
         }
+        #: Per side, the UnitMap of the present unit (rebuilt when the unit is replaced).
+        self._unit_maps: dict[str, UnitMap] = {}
+        self._travel: dict[str, tuple[float, float]] = {}
 
     # --- construction --------------------------------------------------------------------
 
@@ -397,7 +401,11 @@ class Instrument:
         >>> Instrument.error_free(load_instrument("sc1"), 70.0).travel_mm("Z")
         (110.0, 185.0)
         """
-        return tuple(float(v) for v in self._axis_params(control).range_mm)
+        travel = self._travel.get(control)
+        if travel is None:
+            travel = tuple(float(v) for v in self._axis_params(control).range_mm)
+            self._travel[control] = travel
+        return travel
 
     def reading_of(self, control: str, nut_mm: ArrayLike) -> NDArray[np.float64]:
         """The exact reading a counter shows with its nut at ``nut_mm`` (counter arithmetic)."""
@@ -465,6 +473,27 @@ class Instrument:
 
     def _pos(self, name: str) -> NDArray[np.float64]:
         return self._out(self._axes[name].position)
+
+    def position(self, name: str) -> NDArray[np.float64] | float:
+        """Physical position of a lead-screw axis (X, Y, Z, bx, by, bz): ``state()`` for one
+        axis (not an operator's view). [mm]"""
+        return self._pos(name)
+
+    def unit(self, side: str) -> CorrectionUnit:
+        """The present correction unit of ``side`` ("left"/"right"): ``state()["units"][side]``."""
+        return self._units[side]
+
+    def unit_map(self, side: str) -> UnitMap:
+        """The :class:`~stereoplotter.instrument.kinematics.UnitMap` of the present unit of
+        ``side``, kept until the unit changes (cos κ, sin κ kept while κ stays)."""
+        unit = self._units[side]
+        cached = self._unit_maps.get(side)
+        if cached is not None and cached.unit is unit:
+            return cached
+        trig = cached.trig if cached is not None and cached.unit.kappa is unit.kappa else None
+        cached = UnitMap(unit, trig)
+        self._unit_maps[side] = cached
+        return cached
 
     def marks(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Photo points under the left and right measuring marks for the present carriages. [mm]

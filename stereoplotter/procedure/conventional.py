@@ -35,7 +35,6 @@ from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
     counters_from_homologous_points,
-    rod_from_photo,
     turn_correction_knob,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
@@ -467,7 +466,7 @@ def c1_interior(run) -> None:
     _, right_u = op.units()
     car = {c: op.physical(c) for c in ("X", "Y", "Z")}
     e = op.noise.normal("mono/C1/MOby/right", op.model.monocular_sigma_mm)
-    eta = rod_from_photo(np.stack([0.0 * e, e], axis=-1), right_u)[..., 1]
+    eta = op.unit_map("right", right_u).rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
     n_r = (car["Z"] + op.physical("bz")) / op.inst.setting.f_instrument_mm
     op.drive("by", car["Y"] - n_r * eta)
     mo_by = op.read("by", "C1/MOby")
@@ -543,23 +542,6 @@ def _six_q(run, key: str, active, it: int, stage: str = "C2") -> list[NDArray[np
     return seen
 
 
-def _q_after(op, control: str, value, img) -> NDArray[np.float64]:
-    """q at a point with ``control`` physically at ``value`` (the operator's 1-D look)."""
-    left_u, right_u = op.units()
-    units = {"left": left_u, "right": right_u}
-    side = control.split("_")[-1]
-    if control.startswith("kappa_"):
-        units[side] = replace(units[side], kappa=value)
-    else:
-        axis = control.split("_")[1]
-        units[side] = turn_correction_knob(
-            units[side], axis, value, linkage=op.inst.variant.linkage
-        )
-    return counters_from_homologous_points(
-        img[0], img[1], op.inst.setting, units["left"], units["right"]
-    ).y_parallax_mm
-
-
 #: The classic sequence (``instruments.md`` §6.1): point index, control, book element.
 _SEQUENCE = (
     (0, "kappa_right", "kappa2"),
@@ -596,9 +578,7 @@ def c2_relative_by_elements(
             q_seen, _ = op.fuse(pts[idx], img, key, active)
             target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
             before = op.physical(control)
-            clear = solve_1d(
-                lambda v, c=control, i=img: _q_after(op, c, v, i), before, target, 4, 1e-6
-            )
+            clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
             extra = ""
             if element == "omega2":
                 clear = before + (1.0 + over) * (clear - before)

@@ -25,9 +25,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.kinematics import (
-    counters_from_homologous_points,
-    counters_from_photo,
-    marks_from_counters,
+    CorrectionUnit,
+    UnitMap,
+    rod_frame,
+    rods_intersection,
+    rods_y_parallax,
     turn_correction_knob,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, Instrument
@@ -133,7 +135,8 @@ class Noise:
             z = np.zeros(size)
         else:
             rng = np.random.default_rng([self.seed, zlib.crc32(key.encode("utf-8"))])
-            z = sigma * rng.standard_normal(size)
+            z = rng.standard_normal(size)
+            z *= sigma
         if self.trial is not None:
             return np.asarray(z[self.trial])
         return z if self.trials else np.asarray(z[0])
@@ -237,6 +240,8 @@ class Operator:
         self.passes = 3 if instrument.backend == "pymunk" else 2
         #: Per control, the trials whose handwheel was turned against its stop.
         self.stopped: dict[str, NDArray[np.bool_]] = {}
+        #: Per lead screw, the readings of its two stops (the scales never change).
+        self._stops: dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
 
     # --- shapes -------------------------------------------------------------------------------
 
@@ -304,10 +309,16 @@ class Operator:
         beyond it becomes the stop's reading, and the trial is flagged in :attr:`stopped`."""
         if control == HEIGHT_SCALE:
             return reading
-        lo, hi = self.inst.travel_mm(control)
-        margin = 1e-9
-        r_lo, r_hi = (self.v(self.inst.reading_of(control, v)) for v in (lo + margin, hi - margin))
-        low, high = np.minimum(r_lo, r_hi), np.maximum(r_lo, r_hi)
+        stops = self._stops.get(control)
+        if stops is None:
+            lo, hi = self.inst.travel_mm(control)
+            margin = 1e-9
+            r_lo, r_hi = (
+                self.v(self.inst.reading_of(control, v)) for v in (lo + margin, hi - margin)
+            )
+            stops = np.minimum(r_lo, r_hi), np.maximum(r_lo, r_hi)
+            self._stops[control] = stops
+        low, high = stops
         beyond = (reading < low) | (reading > high)
         if np.any(beyond):
             self.stopped[control] = self.stopped.get(control, np.zeros_like(beyond)) | beyond
@@ -317,16 +328,13 @@ class Operator:
 
     def physical(self, control: str) -> NDArray[np.float64]:
         """Where a control physically is (what the eye judges in the eyepiece)."""
-        st = self.inst.state()
-        if control in ("X", "Y", "Z"):
-            return self.v(st["carriages_mm"][control])
-        if control in ("bx", "by", "bz"):
-            return self.v(st["base_mm"][control])
+        if control in _SCREWS:
+            return self.v(self.inst.position(control))
         if control.startswith("kappa_"):
-            return self.v(st["units"][control.split("_")[1]].kappa)
+            return self.v(self.inst.unit(control.split("_")[1]).kappa)
         if control in _KNOBS:
             _, axis, side = control.split("_")
-            unit = st["units"][side]
+            unit = self.inst.unit(side)
             return self.v(unit.tan_alpha if axis == "alpha" else unit.tan_omega)
         raise StereoplotterError(f"cannot drive {control!r}")
 
@@ -363,8 +371,14 @@ class Operator:
     # --- looking ------------------------------------------------------------------------------
 
     def units(self):
-        st = self.inst.state()
-        return st["units"]["left"], st["units"]["right"]
+        return self.inst.unit("left"), self.inst.unit("right")
+
+    def unit_map(self, side: str, unit: CorrectionUnit | None = None) -> UnitMap:
+        """The UnitMap of ``unit`` (default: the present unit of ``side``), cached by the
+        instrument while that unit is in place."""
+        if unit is None or unit is self.inst.unit(side):
+            return self.inst.unit_map(side)
+        return UnitMap(unit)
 
     def mark_on(
         self,
@@ -387,26 +401,30 @@ class Operator:
             axis=-1,
         )
         target = np.asarray(photo_point_mm, float) + e
-        left, right = self.units()
+        umap = self.unit_map(side)
         setting = self.inst.setting
         car = {c: self.physical(c) for c in ("X", "Y", "Z")}
-        index = 0 if side == "left" else 1
+        # the rod of ``side`` (kinematics.rod_from_counters / counters_from_photo, split so that
+        # the unit's invariants and the rod frame are computed once per pointing)
+        sx, sy, n = rod_frame(setting, side, car["Z"])
         if free == "XY":  # both handwheels: the closed-form monocular setting (§3.4)
-            xy = counters_from_photo(
-                target, car["Z"], left if side == "left" else right, setting, side
-            )
-            car["X"], car["Y"] = xy[..., 0], xy[..., 1]
+            xi, eta = umap.rod_xy(target[..., 0], target[..., 1])
+            car["X"], car["Y"] = sx + n * xi, sy + n * eta
             free_solve = ""
         else:
             free_solve = free
         for axis in free_solve:
             comp = 0 if axis == "X" else 1
+            if axis == "X":
+                eta = (np.asarray(car["Y"], float) - sy) / n
 
-            def seen(value, axis=axis, comp=comp):
-                xy = dict(car)
-                xy[axis] = value
-                marks = marks_from_counters(xy["X"], xy["Y"], xy["Z"], setting, left, right)
-                return marks[index][..., comp]
+                def seen(value, eta=eta, comp=comp):
+                    return umap.photo_xy((np.asarray(value, float) - sx) / n, eta)[comp]
+            else:
+                xi = (np.asarray(car["X"], float) - sx) / n
+
+                def seen(value, xi=xi, comp=comp):
+                    return umap.photo_xy(xi, (np.asarray(value, float) - sy) / n)[comp]
 
             car[axis] = solve_1d(seen, car[axis], target[..., comp], iterations=4, h=1e-3)
         for axis in free:
@@ -431,12 +449,51 @@ class Operator:
         shift = np.stack([ex, ey], axis=-1)
         pl = np.asarray(pl, float) + shift + np.stack([ep, 0.0 * ep], axis=-1)
         pr = np.asarray(pr, float) + shift
-        left, right = self.units()
-        r = counters_from_homologous_points(pl, pr, self.inst.setting, left, right)
+        r = rods_intersection(
+            self.unit_map("left").rod_from_photo(pl),
+            self.unit_map("right").rod_from_photo(pr),
+            self.inst.setting,
+        )
         if move:
             for axis, value in (("X", r.x_mm), ("Y", r.y_mm), ("Z", r.depth_mm)):
                 self.drive(axis, value, active)
         return r.y_parallax_mm + eq, r.y_parallax_mm
+
+    def q_turning(self, control: str, images: tuple[ArrayLike, ArrayLike]):
+        """q at homologous points as a function of where ``control`` (a cassette κ or a
+        correction knob) would be, the rest of the instrument as it is now: the operator's 1-D
+        look for :func:`solve_1d`.
+
+        The same arithmetic as ``counters_from_homologous_points(...).y_parallax_mm`` on the
+        units with the control turned; the other photo's rod and cos κ, sin κ of a knob's unit
+        are computed once.
+        """
+        side = control.split("_")[-1]
+        other = "right" if side == "left" else "left"
+        pts = {"left": np.asarray(images[0], float), "right": np.asarray(images[1], float)}
+        setting = self.inst.setting
+        fixed = self.unit_map(other).rod_xy(pts[other][..., 0], pts[other][..., 1])
+        base = self.unit_map(side)
+        x, y = pts[side][..., 0], pts[side][..., 1]
+        if control.startswith("kappa_"):
+
+            def turned(value):
+                return base.with_kappa(value)
+        else:
+            unit = self.inst.unit(side)
+            axis = control.split("_")[1]
+            linkage = self.inst.variant.linkage
+
+            def turned(value):
+                return UnitMap(turn_correction_knob(unit, axis, value, linkage=linkage), base.trig)
+
+        def q(value):
+            moving = turned(value).rod_xy(x, y)
+            if side == "left":
+                return rods_y_parallax(moving, fixed, setting)
+            return rods_y_parallax(fixed, moving, setting)
+
+        return q
 
     def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):
         """The true y-parallax of the present model at ground points (no judgment). [mm]"""
@@ -444,23 +501,27 @@ class Operator:
         setting = self.inst.setting
         if self.trials:  # one row per trial, one column per point
             left, right, setting = (_column(o) for o in (left, right, setting))
-        return counters_from_homologous_points(
-            images[0], images[1], setting, left, right
-        ).y_parallax_mm
+        pl, pr = (np.asarray(p, float) for p in images)
+        return rods_y_parallax(
+            UnitMap(left).rod_xy(pl[..., 0], pl[..., 1]),
+            UnitMap(right).rod_xy(pr[..., 0], pr[..., 1]),
+            setting,
+        )
 
     def knob_for(self, knob: str, unit, photo_point, rod, comp: int, target) -> NDArray:
         """T of ``knob`` that puts ``photo_point`` under the rod coordinate ``rod`` (axis comp).
 
         A 1-D Newton solve on the unit model with the instrument's own linkage (D1).
         """
-        from stereoplotter.instrument.kinematics import photo_from_rod
-
-        axis = knob.split("_")[1]
+        _, axis, side = knob.split("_")
         linkage = self.inst.variant.linkage
+        trig = self.unit_map(side, unit).trig  # κ stays while the knob turns
+        rod = np.asarray(rod, float)
+        xi, eta = rod[..., 0], rod[..., 1]
 
         def seen(t):
             u = turn_correction_knob(unit, axis, t, linkage=linkage)
-            return photo_from_rod(rod, u)[..., comp]
+            return UnitMap(u, trig).photo_xy(xi, eta)[comp]
 
         t0 = self.physical(knob)
         return solve_1d(seen, t0, target, iterations=6, h=1e-6)

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.instrument.kinematics import rod_from_counters, rod_from_photo
+from stereoplotter.instrument.kinematics import rod_from_counters
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 from stereoplotter.procedure.operator import Operator, Scene
 from stereoplotter.setup_data import (
@@ -276,11 +276,11 @@ def stage1_scale_coefficient(run: Run) -> None:
     # right cassette centre's line.
     centre = np.zeros(2)
     op.mark_on("left", centre, "1/MOby/left")
-    _, right_u = op.units()
+    right_map = op.unit_map("right")  # kinematics.rod_from_photo with the unit's cos κ kept
     setting = op.inst.setting
     car = {c: op.physical(c) for c in ("X", "Y", "Z")}
     e = op.noise.normal("mono/1/MOby/right", op.model.monocular_sigma_mm)
-    eta = rod_from_photo(np.stack([0.0 * e, e], axis=-1), right_u)[..., 1]
+    eta = right_map.rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
     n_r = (car["Z"] + op.physical("bz")) / setting.f_instrument_mm
     op.drive("by", car["Y"] - n_r * eta)
     mo_by = op.read("by", "1/MOby")
@@ -484,21 +484,7 @@ def clear_kappa(run: Run, stage: str) -> None:
             qs.append(q_seen)
             control = f"kappa_{side}"
             target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
-
-            def q_of(kappa, side=side, img=img):
-                from dataclasses import replace
-
-                left_u, right_u = op.units()
-                if side == "left":
-                    left_u = replace(left_u, kappa=kappa)
-                else:
-                    right_u = replace(right_u, kappa=kappa)
-                from stereoplotter.instrument.kinematics import counters_from_homologous_points
-
-                return counters_from_homologous_points(
-                    img[0], img[1], op.inst.setting, left_u, right_u
-                ).y_parallax_mm
-
+            q_of = op.q_turning(control, img)  # q with κ turned, the rest as it is now
             ok_here = np.abs(q_seen) <= tol
             move = active & ~ok_here if it > 1 else active
             kappa = op.physical(control)
@@ -592,8 +578,8 @@ def stage3_scale_model(run: Run) -> None:
     pl, pr = run.scene.images(p0[None, :])
     op.mark_on("left", pl[0], "3/left")
     e = op.noise.normal("stereo/3/bx", op.model.stereo_sigma_mm)
-    _, right_u = op.units()
-    xi_r = rod_from_photo(pr[0] + np.stack([e, 0.0 * e], axis=-1), right_u)[..., 0]
+    right_map = op.unit_map("right")
+    xi_r = right_map.rod_from_photo(pr[0] + np.stack([e, 0.0 * e], axis=-1))[..., 0]
     n_r = (op.physical("Z") + op.physical("bz")) / op.inst.setting.f_instrument_mm
     before = op.read("bx", "3/bx/before")
     op.drive("bx", op.physical("X") - n_r * xi_r)
