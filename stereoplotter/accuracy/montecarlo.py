@@ -29,6 +29,7 @@ from stereoplotter.accuracy.chapter5 import (
     relative_orientation_design,
     standard_points,
 )
+from stereoplotter.accuracy.setup_accuracy import SETUP_SOURCES
 
 __all__ = [
     "CI_Z",
@@ -44,17 +45,6 @@ __all__ = [
 ]
 
 CI_Z = 3.29  # two-sided 99.9 % normal quantile
-
-SETUP_SOURCES = (
-    "base_x",
-    "alpha_left",
-    "alpha_right",
-    "omega_left",
-    "omega_right",
-    "kappa_left",
-    "kappa_right",
-    "base_z",
-)
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,18 @@ from stereoplotter.accuracy.chapter5 import (
     relative_orientation_parallax_rms,
 )
 
+#: The setup-element error sources of (6.21)/(6.22), in the order of every error vector here.
+SETUP_SOURCES = (
+    "base_x",
+    "alpha_left",
+    "alpha_right",
+    "omega_left",
+    "omega_right",
+    "kappa_left",
+    "kappa_right",
+    "base_z",
+)
+
 __all__ = [
     "conventional_parallax_rms",
     "height_from_parallax",
@@ -107,19 +119,7 @@ def parallax_error_field_setup(
     y = np.asarray(y_mm, float)
     x_r = x_l - x_parallax_mm
     f = focal_length_mm
-    e = {
-        k: errors.get(k, 0.0)
-        for k in (
-            "base_x",
-            "alpha_left",
-            "alpha_right",
-            "omega_left",
-            "omega_right",
-            "kappa_left",
-            "kappa_right",
-            "base_z",
-        )
-    }
+    e = {k: errors.get(k, 0.0) for k in SETUP_SOURCES}
     s = 1.0 if omega_sign == "3.22" else -1.0
     return (
         e["base_x"]
