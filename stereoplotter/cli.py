@@ -23,7 +23,15 @@ import numpy as np
 
 from stereoplotter import __version__
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.paths import DEFAULT_SCENARIO, data_dir, list_data_files
+from stereoplotter.paths import (
+    DEFAULT_SCENARIO,
+    DataFile,
+    data_files,
+    resolve_data_file,
+    set_user_folders,
+    shipped_root,
+    user_folders,
+)
 from stereoplotter.yamlio import atomic_write_bytes, load_yaml_mapping
 
 __all__ = ["main"]
@@ -76,33 +84,40 @@ def _count_status(node: Any, counts: dict[str, int]) -> None:
             _count_status(value, counts)
 
 
+def _data_entry(found: DataFile) -> dict[str, Any]:
+    """The name, file and origin of a data file for ``info``."""
+    entry: dict[str, Any] = {"key": found.name, "file": str(found.path), "from": found.origin}
+    if found.hides:
+        entry["hides"] = [str(p) for p in found.hides]
+    return entry
+
+
 def _info() -> dict[str, Any]:
     from stereoplotter.scenario import load_scenario
 
     instruments = []
-    for path in list_data_files("instruments"):
+    for found in data_files("instruments"):
         counts = {"documented": 0, "assumed": 0}
-        entry: dict[str, Any] = {"file": str(path)}
+        entry = _data_entry(found)
         try:
-            data, _ = load_yaml_mapping(path)
+            data, _ = load_yaml_mapping(found.path)
             _count_status(data, counts)
             entry.update(values_documented=counts["documented"], values_assumed=counts["assumed"])
         except StereoplotterError as exc:
             entry["error"] = str(exc)
         instruments.append(entry)
     scenarios = []
-    for path in list_data_files("scenarios"):
-        entry = {"file": str(path)}
+    for found in data_files("scenarios"):
+        entry = _data_entry(found)
         try:
-            s = load_scenario(path)
+            s = load_scenario(found.path)
             entry.update(name=s.name, photos=len(s.photos), points=len(s.points))
         except StereoplotterError as exc:
             entry["error"] = str(exc)
         scenarios.append(entry)
-    folders = {
-        kind: str(data_dir(kind)) if data_dir(kind) else None
-        for kind in ("instruments", "scenarios")
-    }
+    # in the order names are looked up: user folders first, the shipped data last
+    folders = [{"folder": str(f.path), "from": f.origin} for f in user_folders()]
+    folders.append({"folder": str(shipped_root()), "from": "shipped"})
     return {
         "versions": _versions(),
         "data_folders": folders,
@@ -114,29 +129,29 @@ def _info() -> dict[str, Any]:
 def _format_info(info: dict[str, Any]) -> str:
     lines = ["stereoplotter " + info["versions"]["stereoplotter"], "", "versions:"]
     lines += [f"  {k:<14}{v}" for k, v in info["versions"].items()]
-    lines += [
-        "",
-        "instruments (" + (info["data_folders"]["instruments"] or "folder not found") + "):",
-    ]
-    if not info["instruments"]:
-        lines.append("  none yet")
-    for entry in info["instruments"]:
-        if "error" in entry:
-            lines.append(f"  {entry['file']}: INVALID: {entry['error']}")
-        else:
-            lines.append(
-                f"  {entry['file']}: {entry['values_documented']} documented, "
-                f"{entry['values_assumed']} assumed values"
-            )
-    lines += ["", "scenarios (" + (info["data_folders"]["scenarios"] or "folder not found") + "):"]
-    for entry in info["scenarios"]:
-        if "error" in entry:
-            lines.append(f"  {entry['file']}: INVALID: {entry['error']}")
-        else:
-            lines.append(
-                f"  {entry['file']}: {entry['name']} ({entry['photos']} photo(s), "
-                f"{entry['points']} points)"
-            )
+    lines += ["", "data folders (a name is looked up in this order):"]
+    lines += [f"  {f['from']:<20}{f['folder']}" for f in info["data_folders"]]
+    for kind in ("instruments", "scenarios"):
+        lines += ["", f"{kind} ({len(info[kind])} found):"]
+        if not info[kind]:
+            lines.append("  none")
+        width = max((len(e["key"]) for e in info[kind]), default=0) + 2
+        for entry in info[kind]:
+            head = f"  {entry['key']:<{width}}[{entry['from']}] {entry['file']}"
+            if "error" in entry:
+                lines.append(f"{head}: INVALID: {entry['error']}")
+            elif kind == "instruments":
+                lines.append(
+                    f"{head}: {entry['values_documented']} documented, "
+                    f"{entry['values_assumed']} assumed values"
+                )
+            else:
+                lines.append(
+                    f"{head}: {entry['name']} ({entry['photos']} photo(s), "
+                    f"{entry['points']} points)"
+                )
+            if "hides" in entry:
+                lines.append(f"  {'':<{width}}hides {', '.join(entry['hides'])}")
     return "\n".join(lines) + "\n"
 
 
@@ -269,16 +284,7 @@ def _demo(args: argparse.Namespace) -> int:
     from stereoplotter.setup_sheet import SetupRefusal, compute_setup_sheet
     from stereoplotter.sheet_report import sheet_to_dict
 
-    path = Path(args.scenario) if args.scenario else None
-    if path is None:
-        folder = data_dir("scenarios")
-        if folder is None or not (folder / DEFAULT_SCENARIO).exists():
-            raise StereoplotterError(
-                f"the default scenario {DEFAULT_SCENARIO} was not found (searched "
-                "$STEREOPLOTTER_DATA, the current directory and the source tree); run from the "
-                "repository or pass --scenario FILE"
-            )
-        path = folder / DEFAULT_SCENARIO
+    path = Path(args.scenario)  # main() has resolved a name (default: the shipped pair60)
     scenario = load_scenario(path)
     spec = load_instrument(args.instrument)
     seed = scenario.seed if args.seed is None else args.seed
@@ -560,6 +566,14 @@ def _parser() -> argparse.ArgumentParser:
         "(Kushtin & Lyskov 1984, ch. 6).",
     )
     parser.add_argument("--version", action="version", version=f"stereoplotter {__version__}")
+    parser.add_argument(
+        "--data",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder of your own instruments/ and scenarios/, searched by name before the "
+        "shipped ones (may be repeated; also $STEREOPLOTTER_DATA, separated by os.pathsep)",
+    )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("info", help="versions, instruments and scenarios found")
@@ -571,7 +585,7 @@ def _parser() -> argparse.ArgumentParser:
         "check",
         help="validate a scenario file and summarise it: photo scale, overlap, base, B/H, relief",
     )
-    c.add_argument("file", help="a scenarios/*.yaml file")
+    c.add_argument("file", help="a scenario name (pair60) or YAML file")
     c.add_argument("--json", action="store_true", help="print JSON instead of text")
 
     p = sub.add_parser("instrument", help="instrument specifications")
@@ -605,8 +619,8 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("setup", help="compute the setup sheet (Table 24) of a stereopair")
     p.add_argument(
         "scenario",
-        help="a scenarios/*.yaml stereopair, or a block file listing "
-        "many stereopairs of one camera (one sheet per model)",
+        help="a stereopair scenario (a name such as pair60, or a YAML file), or a block file "
+        "listing many stereopairs of one camera (one sheet per model)",
     )
     p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
     p.add_argument(
@@ -638,7 +652,7 @@ def _parser() -> argparse.ArgumentParser:
         "simulate",
         help="run the simulated operator on a virtual instrument and evaluate the model",
     )
-    p.add_argument("scenario", help="a scenarios/*.yaml stereopair")
+    p.add_argument("scenario", help="a stereopair scenario: a name (pair60) or a YAML file")
     p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
     p.add_argument(
         "--method",
@@ -691,7 +705,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "-o", "--output", default="stereoplotter-demo", help="output folder (default: %(default)s)"
     )
-    p.add_argument("--scenario", help=f"scenario file (default: scenarios/{DEFAULT_SCENARIO})")
+    p.add_argument(
+        "--scenario",
+        default=DEFAULT_SCENARIO,
+        help="scenario name or file (default: the shipped %(default)s)",
+    )
     p.add_argument("--seed", type=int, help="override the scenario's seed")
     p.add_argument(
         "--instrument", default="sc1", help="instrument of the setup sheet (default: %(default)s)"
@@ -700,10 +718,20 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _resolve_data_arguments(args: argparse.Namespace) -> None:
+    """Apply ``--data`` and turn scenario names (``pair60``) into files; instrument names are
+    resolved by :func:`~stereoplotter.instrument.spec.load_instrument` itself."""
+    set_user_folders(args.data)
+    for attribute in ("scenario", "file", "geometry"):  # setup/simulate/demo, check, verify
+        if getattr(args, attribute, None):
+            setattr(args, attribute, str(resolve_data_file("scenarios", getattr(args, attribute))))
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``stereoplotter`` command. Returns the exit code."""
     args = _parser().parse_args(argv)
     try:
+        _resolve_data_arguments(args)
         if args.command == "info":
             info = _info()
             sys.stdout.write(_json(info) if args.json else _format_info(info))

@@ -29,7 +29,7 @@ from typing import Any, ClassVar
 import yaml
 
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.paths import data_dir, list_data_files
+from stereoplotter.paths import data_dir, find_data_file, list_data_files
 from stereoplotter.yamlio import Fields, describe_value, load_yaml_mapping
 
 __all__ = [
@@ -520,9 +520,9 @@ def load_instrument(name_or_path: str | os.PathLike[str]) -> InstrumentSpec:
     Parameters
     ----------
     name_or_path : str or path-like
-        A bare name is looked up as ``<name>.yaml`` in the ``instruments`` data folder
-        (:func:`stereoplotter.paths.data_dir`); anything with a folder part or a ``.yaml``/``.yml``
-        suffix is used as a path.
+        A bare name is looked up as ``<name>.yaml`` in the user data folders, then the shipped
+        ones (:func:`stereoplotter.paths.find_data_file`); anything with a folder part, or an
+        existing ``.yaml``/``.yml`` file, is used as a path.
 
     Returns
     -------
@@ -597,11 +597,15 @@ def _resolve(name_or_path: str | os.PathLike[str]) -> Path:
     text = os.fspath(name_or_path)
     if isinstance(name_or_path, os.PathLike) or os.sep in text or "/" in text:
         return Path(text)
-    if text.endswith((".yaml", ".yml")):
+    is_file_name = text.endswith((".yaml", ".yml"))
+    if is_file_name and Path(text).exists():
         return Path(text)
+    # user folders (--data, STEREOPLOTTER_DATA) first, then the shipped data
+    candidate = find_data_file("instruments", text)
+    if candidate is None and is_file_name:
+        return Path(text)  # reading it reports the missing file
     folder = data_dir("instruments")
-    candidate = folder / f"{text}.yaml" if folder else None
-    if candidate is None or not candidate.is_file():
+    if candidate is None:
         available = ", ".join(list_instruments()) or "none found"
         raise ConfigError(
             _display(folder) if folder else "instruments/",
