@@ -15,9 +15,9 @@ import math
 import os
 import platform
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -558,9 +558,68 @@ def _verify(args: argparse.Namespace) -> int:
 
 # --- parser ----------------------------------------------------------------------------------
 
+#: The largest seed, as in scenario files (``seed``); numpy itself takes any integer ≥ 0.
+MAX_SEED = 2**63 - 1
+#: Trials of one verification row are held in memory at once (8 bytes each, per row).
+MAX_VERIFY_TRIALS = 1_000_000
+#: Scale denominators as the instrument gear sets allow (``gears.vertical_scale_denominators``).
+MAX_SCALE_DENOMINATOR = 10_000_000
+#: Tilts of the kinematic self-test: near-vertical photos, as in scenario files.
+MAX_TILT_DEG = 15.0
+
+
+def bounded_int(low: int, high: int | None = None) -> Callable[[str], int]:
+    """An argparse ``type=``: an integer in [low, high] (``high=None``: no upper end).
+
+    The message names what was expected and what was found; argparse adds the option.
+    """
+    expected = f"an integer ≥ {low}" if high is None else f"an integer in [{low}, {high}]"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text, 10)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {expected}, found {text!r}") from None
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"expected {expected}, found {value}")
+        return value
+
+    parse.__name__ = f"integer in [{low}, {high}]"
+    return parse
+
+
+def bounded_float(low: float, high: float) -> Callable[[str], float]:
+    """An argparse ``type=``: a finite number in [low, high]."""
+    expected = f"a number in [{low:g}, {high:g}]"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {expected}, found {text!r}") from None
+        if not (math.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(f"expected {expected}, found {text}")
+        return value
+
+    parse.__name__ = f"number in [{low:g}, {high:g}]"
+    return parse
+
+
+positive_int = bounded_int(1)
+non_negative_int = bounded_int(0)
+seed_int = bounded_int(0, MAX_SEED)
+scale_denominator = bounded_int(1, MAX_SCALE_DENOMINATOR)
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line, ``error: …``, exit code 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="stereoplotter",
         description="Virtual SC-1, SPR-3 and SD-3 stereoplotters and their setup data "
         "(Kushtin & Lyskov 1984, ch. 6).",
@@ -601,7 +660,7 @@ def _parser() -> argparse.ArgumentParser:
     t.add_argument("name", help="sc1, spr3, sd3 or a path to an instrument YAML")
     t.add_argument(
         "--tilts",
-        type=float,
+        type=bounded_float(-MAX_TILT_DEG, MAX_TILT_DEG),
         nargs="+",
         default=[0.5, 1.0, 3.0],
         metavar="DEG",
@@ -643,9 +702,9 @@ def _parser() -> argparse.ArgumentParser:
         help="+1: the b_z scale grows when the right pivot rises (default); -1: the other way, "
         "as the printed minus of (6.11) implies",
     )
-    p.add_argument("--horizontal-scale", type=int, metavar="M", help="force M_г = M")
-    p.add_argument("--vertical-scale", type=int, metavar="M", help="force M_в = M")
-    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument("--horizontal-scale", type=scale_denominator, metavar="M", help="force M_г = M")
+    p.add_argument("--vertical-scale", type=scale_denominator, metavar="M", help="force M_в = M")
+    p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument("--json", action="store_true", help="print the sheet as JSON")
 
     p = sub.add_parser(
@@ -665,8 +724,10 @@ def _parser() -> argparse.ArgumentParser:
         help="injected errors: a YAML of overrides, or 'zero' "
         "(default: the instrument's own, all assumed)",
     )
-    p.add_argument("--seed", type=int, help="override the scenario's seed")
-    p.add_argument("--trials", type=int, help="run T trials at once (closed-form back-end)")
+    p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
+    p.add_argument(
+        "--trials", type=positive_int, help="run T trials at once (closed-form back-end)"
+    )
     p.add_argument("--backend", choices=("closed-form", "pymunk"), default="closed-form")
     p.add_argument(
         "-o",
@@ -680,13 +741,18 @@ def _parser() -> argparse.ArgumentParser:
         "verify",
         help="verify the accuracy formulas (6.28)–(6.61) against rigorous forms and Monte Carlo",
     )
-    p.add_argument("--trials", type=int, default=60000, help="Monte Carlo trials per row")
-    p.add_argument("--seed", type=int, default=20240601, help="seed of the Monte Carlo")
+    p.add_argument(
+        "--trials",
+        type=bounded_int(2, MAX_VERIFY_TRIALS),
+        default=60000,
+        help=f"Monte Carlo trials per row, 2 to {MAX_VERIFY_TRIALS} (default: %(default)s)",
+    )
+    p.add_argument("--seed", type=seed_int, default=20240601, help="seed of the Monte Carlo")
     p.add_argument("-o", "--output", help="write Markdown, CSV, JSON and plots into this folder")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.add_argument(
         "--procedure-trials",
-        type=int,
+        type=bounded_int(0, MAX_VERIFY_TRIALS),
         default=1500,
         help="trials of the procedure MC (simulated operator) per overlap and method; 0 disables",
     )
@@ -710,7 +776,7 @@ def _parser() -> argparse.ArgumentParser:
         default=DEFAULT_SCENARIO,
         help="scenario name or file (default: the shipped %(default)s)",
     )
-    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument(
         "--instrument", default="sc1", help="instrument of the setup sheet (default: %(default)s)"
     )

@@ -2,11 +2,23 @@
 
 from __future__ import annotations
 
+import re
+
 __all__ = ["ConfigError", "GeometryError", "StereoplotterError"]
+
+#: Control characters and line breaks: a message quoting user text stays one printable line.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 
 
 class StereoplotterError(ValueError):
-    """Base class of every error stereoplotter raises on purpose."""
+    """Base class of every error stereoplotter raises on purpose.
+
+    Its text is one line: control characters and line breaks of quoted user text (a name with
+    a newline, say) are shown as escapes (``\\n``).
+    """
+
+    def __str__(self) -> str:
+        return _CONTROL.sub(lambda m: repr(m.group())[1:-1], super().__str__())
 
 
 class ConfigError(StereoplotterError):

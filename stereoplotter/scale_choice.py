@@ -240,6 +240,10 @@ def describe_candidate(
             except RangeRefusal as exc:
                 texts.append(str(exc))
                 break
-        else:  # within check_in_range's slack at a boundary: name the condition
-            texts.append(f"{flag.name.lower().replace('_', ' ')} at the edge of its range")
+        else:  # within check_in_range's slack at a boundary: name the condition and its range
+            key = spec.key_of(items[0][0])
+            texts.append(
+                f"{flag.name.lower().replace('_', ' ')} at the edge of its range (of "
+                f"{spec.parameters[key].file}: {key})"
+            )
     return texts

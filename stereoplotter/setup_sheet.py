@@ -333,7 +333,9 @@ def compute_setup_sheet(
     options = options or SetupOptions()
     if not scenario.is_stereopair:
         raise SetupRefusal(
-            f"scenario {scenario.name!r} is not a stereopair (photos left and right)"
+            f"{scenario.source}: photos: expected two photos named left and right, found "
+            f"{', '.join(p.name for p in scenario.photos)}: scenario {scenario.name!r} is not a "
+            "stereopair"
         )
     rng = np.random.default_rng(scenario.seed) if rng is None else rng
     measurements = synthesize_measurements(scenario, rng)
@@ -368,6 +370,12 @@ def compute_setup_sheet(
         corners_m = apply_similarity(fit, corners_gk[:, 0], corners_gk[:, 1])  # (6.8), ground m
     offsets_m = np.vstack([ground[:, :2], corners_m])
     map_scale = scenario.map_sheet.scale_denominator if scenario.map_sheet else None
+    if map_scale is None and options.horizontal_scale_denominator is None:
+        raise SetupRefusal(
+            f"{scenario.source}: map_sheet: expected a map sheet, whose scale chooses the "
+            "horizontal model scale M_г from the coordinatograph gears, found nothing (or force "
+            "M_г with --horizontal-scale)"
+        )
     chosen, candidates = _choose_scales(
         spec, options, map_scale, f_prime, depths_m, base_m, offsets_m
     )

@@ -7,6 +7,7 @@ was expected and what was found.
 
 from __future__ import annotations
 
+import difflib
 import math
 import os
 import secrets
@@ -23,10 +24,18 @@ __all__ = [
     "atomic_write_bytes",
     "atomic_write_text",
     "describe_value",
+    "did_you_mean",
     "load_yaml_mapping",
 ]
 
 _MISSING = object()
+
+
+#: Bounds of an input document, far above any real scenario, instrument or block file. A
+#: document beyond them is refused before anything walks it: YAML aliases let a few hundred bytes
+#: stand for billions of nodes ("billion laughs"), and deep nesting exhausts Python's stack.
+MAX_YAML_NODES = 1_000_000  # after expanding aliases
+MAX_YAML_DEPTH = 64
 
 
 def load_yaml_mapping(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
@@ -40,7 +49,9 @@ def load_yaml_mapping(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str
     Raises
     ------
     ConfigError
-        The file is missing, unreadable, not valid YAML, or not a mapping.
+        The file is missing, unreadable, not valid YAML, or not a mapping; a key is given twice
+        in one mapping; the document nests deeper than :data:`MAX_YAML_DEPTH`, refers to itself
+        through an alias, or expands (through aliases) to more than :data:`MAX_YAML_NODES` nodes.
     """
     source = str(path)
     try:
@@ -49,16 +60,178 @@ def load_yaml_mapping(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str
         raise ConfigError(source, "(file)", "an existing file", "no such file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(source, "(file)", "a readable UTF-8 text file", str(exc)) from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown place"
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ConfigError(source, "(file)", "valid YAML", f"{problem} at {where}") from None
+    data = _parse_yaml(text, source)
+    if data is None:
+        raise ConfigError(source, "(top level)", "a mapping of fields", "an empty document")
     if not isinstance(data, dict):
         raise ConfigError(source, "(top level)", "a mapping of fields", type(data).__name__)
     return data, source
+
+
+class _TooDeep(Exception):
+    def __init__(self, mark: Any):
+        self.mark = mark
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """:class:`yaml.SafeLoader` that stops composing at :data:`MAX_YAML_DEPTH` levels, before
+    PyYAML's recursive composer exhausts the stack."""
+
+    _depth = 0
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        self._depth += 1
+        try:
+            if self._depth > MAX_YAML_DEPTH + 1:
+                raise _TooDeep(self.peek_event().start_mark)
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+
+def _parse_yaml(text: str, source: str) -> Any:
+    """``yaml.safe_load`` with the document checked (:func:`_check_document`) before it is
+    constructed, and every failure as a :class:`ConfigError`."""
+    try:
+        loader = _BoundedLoader(text)  # the reader refuses control characters here
+    except yaml.YAMLError as exc:
+        raise _yaml_error(source, exc) from None
+    try:
+        try:
+            node = loader.get_single_node()
+        except yaml.YAMLError as exc:
+            raise _yaml_error(source, exc) from None
+        except _TooDeep as exc:
+            raise ConfigError(
+                source,
+                "(file)",
+                f"YAML nested at most {MAX_YAML_DEPTH} levels deep",
+                f"deeper nesting (line {exc.mark.line + 1}, column {exc.mark.column + 1})",
+            ) from None
+        if node is None:
+            return None
+        _check_document(node, source)
+        try:
+            return loader.construct_document(node)
+        except yaml.YAMLError as exc:
+            raise _yaml_error(source, exc) from None
+        except Exception as exc:  # PyYAML's own constructors: dates, !!int, !!timestamp, …
+            raise ConfigError(
+                source,
+                "(file)",
+                "valid YAML values",
+                f"a value YAML cannot construct ({type(exc).__name__}: {exc})",
+            ) from None
+    finally:
+        loader.dispose()
+
+
+def _yaml_error(source: str, exc: yaml.YAMLError) -> ConfigError:
+    mark = getattr(exc, "problem_mark", None)
+    if mark is not None:
+        where = f"line {mark.line + 1}, column {mark.column + 1}"
+    elif isinstance(exc, yaml.reader.ReaderError):
+        where = f"character {exc.position + 1}"
+    else:
+        where = "unknown place"
+    problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+    return ConfigError(source, "(file)", "valid YAML", f"{problem} at {where}")
+
+
+def _node_line(node: yaml.Node) -> str:
+    return f"line {node.start_mark.line + 1}"
+
+
+def _check_document(root: yaml.Node, source: str) -> None:
+    """Refuse what :func:`yaml.safe_load` would build without complaint but no input file needs:
+    a key given twice in one mapping (the last would silently win), text with lone surrogates
+    (it cannot be printed), nesting deeper than :data:`MAX_YAML_DEPTH`, an alias to an enclosing
+    node (a cycle), and more than :data:`MAX_YAML_NODES` nodes once aliases are expanded.
+
+    One pass over the composed nodes, each node once (aliased nodes are shared, so the expanded
+    size is summed without expanding anything): time and memory grow with the file, not with
+    what its aliases stand for.
+    """
+    expanded: dict[int, int] = {}  # id(node) -> node count with aliases expanded
+    open_nodes: set[int] = set()  # nodes whose children are being walked
+    # (node, field path, depth, children done?)
+    stack: list[tuple[yaml.Node, str, int, bool]] = [(root, "", 0, False)]
+    while stack:
+        node, path, depth, done = stack.pop()
+        key = id(node)
+        if done:
+            open_nodes.discard(key)
+            total = 1 + sum(expanded[id(child)] for child in _children(node))
+            if total > MAX_YAML_NODES:
+                raise ConfigError(
+                    source,
+                    path or "(top level)",
+                    f"at most {MAX_YAML_NODES:,} YAML nodes with aliases (*name) expanded",
+                    f"more than {MAX_YAML_NODES:,} from {_node_line(node)} on",
+                    "a YAML alias bomb?",
+                )
+            expanded[key] = total
+            continue
+        if key in expanded:
+            continue  # an alias to a node already walked
+        if key in open_nodes:
+            raise ConfigError(
+                source,
+                path or "(top level)",
+                "no alias to an enclosing node",
+                f"an alias that makes the document contain itself ({_node_line(node)})",
+            )
+        if depth > MAX_YAML_DEPTH:
+            raise ConfigError(
+                source,
+                path[:40] + "…" if len(path) > 40 else path or "(top level)",
+                f"YAML nested at most {MAX_YAML_DEPTH} levels deep",
+                f"deeper nesting ({_node_line(node)})",
+            )
+        if isinstance(node, yaml.ScalarNode):
+            if _has_surrogate(node.value):
+                raise ConfigError(
+                    source,
+                    path or "(top level)",
+                    "text without lone surrogates (\\ud800–\\udfff escapes)",
+                    f"a lone surrogate ({_node_line(node)})",
+                )
+            expanded[key] = 1
+            continue
+        open_nodes.add(key)
+        stack.append((node, path, depth, True))
+        if isinstance(node, yaml.SequenceNode):
+            for i, child in enumerate(node.value):
+                stack.append((child, f"{path}[{i}]", depth + 1, False))
+            continue
+        seen: dict[tuple[str, str], yaml.Node] = {}
+        for k, v in node.value:
+            name = k.value if isinstance(k, yaml.ScalarNode) else None
+            if name is not None and k.tag != "tag:yaml.org,2002:merge":
+                first = seen.setdefault((k.tag, name), k)
+                if first is not k:
+                    raise ConfigError(
+                        source,
+                        f"{path}.{name}" if path else name,
+                        "each key once in a mapping",
+                        f"it twice ({_node_line(first)} and {_node_line(k)})",
+                        "the second would silently replace the first",
+                    )
+            child_path = (f"{path}.{name}" if path else name) if name is not None else path
+            stack.append((k, path, depth + 1, False))
+            stack.append((v, child_path, depth + 1, False))
+
+
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.SequenceNode):
+        return node.value
+    if isinstance(node, yaml.MappingNode):
+        return [n for pair in node.value for n in pair]
+    return []
+
+
+def _has_surrogate(text: str) -> bool:
+    return not text.isascii() and any("\ud800" <= ch <= "\udfff" for ch in text)
 
 
 class Fields:
@@ -101,11 +274,13 @@ class Fields:
             allowed = list(allowed)
             unknown = [k for k in value if k not in allowed]
             if unknown:
+                hint = "allowed here: " + ", ".join(allowed)
+                suggestion = did_you_mean(unknown[0], allowed)
                 raise self.error(
                     self.join(path, unknown[0]),
                     "no such field",
                     unknown[0],
-                    "allowed here: " + ", ".join(allowed),
+                    f"{hint}; {suggestion}" if suggestion else hint,
                 )
         for key in required:
             if key not in value:
@@ -270,6 +445,30 @@ def _range_text(unit: str, low: float, high: float, low_open: bool, high_open: b
     lo = "-inf" if math.isinf(low) else f"{low:g}"
     hi = "inf" if math.isinf(high) else f"{high:g}"
     return f"in {left}{lo}, {hi}{right}{unit_text}"
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """``"did you mean NAME?"`` for the one choice closest to a mistyped ``word``, or ``""``
+    when none is close (:func:`difflib.get_close_matches`, case ignored) or two are equally
+    close (then the list of choices says more than a guess).
+
+    Examples
+    --------
+    >>> did_you_mean("focal_lenght_mm", ["focal_length_mm", "format_mm"])
+    'did you mean focal_length_mm?'
+    >>> did_you_mean("w_mm", ["x_mm", "y_mm", "z_mm"])
+    ''
+    """
+    choices = [str(c) for c in choices]
+    lowered = {c.lower(): c for c in choices}
+    matches = difflib.get_close_matches(str(word).lower(), list(lowered), n=2, cutoff=0.6)
+    if not matches:
+        return ""
+    if len(matches) == 2:
+        ratio = [difflib.SequenceMatcher(None, str(word).lower(), m).ratio() for m in matches]
+        if ratio[0] == ratio[1]:
+            return ""
+    return f"did you mean {lowered[matches[0]]}?"
 
 
 def describe_value(value: Any) -> str:

@@ -684,6 +684,21 @@ def _levelling_point_model(a, c, p, f, pt):
     return mc.LinearModel(G, np.zeros((1, 1)), np.zeros((1, 4)), Hg @ np.linalg.pinv(Ac), 1.0)
 
 
+#: Accepted values of a flat ``--geometry`` mapping (keys of :data:`BOOK`), in mm or [—]: wide
+#: round bounds around the book's setting that keep every formula finite.
+_MM_POSITIVE = {"unit": "mm", "low": 1.0, "high": 500.0}
+_GEOMETRY_LIMITS = {
+    "f": {"unit": "mm", "low": 1.0, "high": 1000.0},
+    "l": _MM_POSITIVE,
+    "n": {"unit": "—", "low": 0.01, "high": 100.0},
+    "c": _MM_POSITIVE,
+    "p60": _MM_POSITIVE,
+    "a60": {"unit": "mm", "low": -500.0, "high": 500.0},
+    "p80": _MM_POSITIVE,
+    "a80": {"unit": "mm", "low": -500.0, "high": 500.0},
+}
+
+
 def geometry_from_file(path) -> tuple[dict, dict]:
     """Geometry overrides from a YAML file: a scenario (has ``camera``) or a flat mapping.
 
@@ -699,21 +714,86 @@ def geometry_from_file(path) -> tuple[dict, dict]:
     procedure_scenarios : dict
         ``{"60": path or None, "80": path or None}`` for the procedure MC.
     """
-    from stereoplotter.yamlio import load_yaml_mapping
+    from stereoplotter.errors import ConfigError
+    from stereoplotter.yamlio import Fields, load_yaml_mapping
 
-    data, _ = load_yaml_mapping(path)
+    data, source = load_yaml_mapping(path)
     if "camera" not in data:
-        return {k: float(v) for k, v in data.items()}, {"60": None, "80": None}
+        fields = Fields(source)
+        fields.mapping(data, "", tuple(BOOK))
+        geometry = {k: fields.number(data, k, "", **_GEOMETRY_LIMITS[k]) for k in data}
+        _check_geometry(fields, geometry)
+        return geometry, {"60": None, "80": None}
     from stereoplotter.accuracy.procedure_mc import scenario_geometry
+    from stereoplotter.scenario import load_scenario
 
+    scenario = load_scenario(path)  # every problem of the file as one ConfigError
+    if not scenario.is_stereopair:
+        raise ConfigError(
+            source,
+            "photos",
+            "a stereopair (photos left and right) for --geometry",
+            f"{len(scenario.photos)} photo(s)",
+        )
     sg = scenario_geometry(str(path))
     p = sg["p"]
     g = {"f": sg["f"], "l": sg["l"], "n": sg["n"]}
     if sg["overlap"] < 0.7:
         g.update(c=p, p60=p, a60=0.0, p80=p / 2, a80=p / 2)
+        _check_geometry(Fields(source), g)
         return g, {"60": str(path), "80": None}
     g.update(c=2 * p, p60=2 * p, a60=0.0, p80=p, a80=p)
+    _check_geometry(Fields(source), g)
     return g, {"60": None, "80": str(path)}
+
+
+def _check_geometry(fields, geometry: dict) -> None:
+    """Refuse a geometry outside the domain of the table's formulas, naming the field.
+
+    The standard and control points sit at x_п = −c, a and −(p + a): they must be distinct
+    (a > −c, a > −p/2), and the root of (5.54) must be real (it is for a = c − p, the default).
+    Last, every formula is evaluated with floating-point errors raised, so nothing undefined
+    reaches the Monte Carlo.
+    """
+    import warnings
+
+    g = _normalise_geometry(geometry)
+    for ov in ("60", "80"):
+        a, c, p = g[f"a{ov}"], g["c"], g[f"p{ov}"]
+        name = next((k for k in (f"a{ov}", f"p{ov}", "c") if k in geometry), f"a{ov}")
+        found = f"a{ov} = {a:g}, c = {c:g}, p{ov} = {p:g} mm"
+        if not (a + c > 0 and p + 2 * a > 0):
+            raise fields.error(
+                name,
+                f"a{ov} > −c and a{ov} > −p{ov}/2 (distinct points x_п = −c, a, −(p + a))",
+                found,
+            )
+        if not 1 / 48 + (6 * c**2 + 10 * a * c - 5 * p * (2 * a + c)) / (30 * (a + c) ** 2) > 0:
+            raise fields.error(
+                name,
+                f"a geometry where the root of (5.54) is real, as it is for a{ov} = c − p{ov} "
+                f"with p{ov} < 2c",
+                found,
+            )
+    try:
+        with np.errstate(all="raise"), warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
+            specs = _row_specs(g)
+    except (ArithmeticError, ValueError, np.linalg.LinAlgError, RuntimeWarning) as exc:
+        raise fields.error(
+            "(geometry)",
+            "values of " + ", ".join(BOOK) + " for which every formula of the table is defined",
+            f"{type(exc).__name__}: {exc}",
+        ) from None
+    for spec in specs:
+        values = [v for v in spec[2:5] if isinstance(v, int | float)]
+        if not all(math.isfinite(v) for v in values):
+            raise fields.error(
+                "(geometry)",
+                "values of " + ", ".join(BOOK) + " for which every formula of the table is "
+                "finite",
+                f"{spec[0]} {spec[1]}: {values}",
+            )
 
 
 def _normalise_geometry(geometry) -> dict:

@@ -11,6 +11,7 @@ Units inside: mm, rad, relative (ppm/10⁶); the YAML and reports use ′, ″ a
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
@@ -20,6 +21,7 @@ from numpy.typing import NDArray
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.instrument.spec import InstrumentSpec
+from stereoplotter.yamlio import describe_value, did_you_mean
 
 __all__ = ["DISTRIBUTIONS", "ErrorModel", "ErrorTerm", "error_model_from_spec"]
 
@@ -72,6 +74,18 @@ def _zeros(size: tuple[int] | None) -> NDArray[np.float64] | float:
 
 
 _ARCMIN = np.pi / 180.0 / 60.0
+
+#: Largest override of a term per internal unit: the largest ``errors.*`` value the instrument
+#: schema accepts (100 mm of zero-reading scatter or sheet placement, 600′ of a setting angle,
+#: 10⁴ ppm of counter scale error); a backlash at most 0.2 mm (``errors.backlash_*``: the 0.5 mm
+#: overtravel of the unidirectional approach must clear the dead band).
+_MAX_OVERRIDE = {"mm": 100.0, "rad": 600.0 * _ARCMIN, "—": 1.0e-2}
+_MAX_OVERRIDE_GROUP = {"backlash": 0.2}
+_UNIT_WORDS = {"mm": "mm", "rad": "rad", "—": "(relative)"}
+#: Groups whose distribution an override may not change, and why.
+_FIXED_DISTRIBUTION = {
+    "backlash": ("constant", "a backlash is the size of the dead travel, never negative"),
+}
 
 
 def _terms(spec: InstrumentSpec) -> list[ErrorTerm]:
@@ -258,21 +272,43 @@ class ErrorModel:
                     str(key),
                     "an error term or group: " + ", ".join(sorted(groups | set(terms))),
                     key,
+                    did_you_mean(str(key), sorted(groups | set(terms))),
                 )
             dist = None
+            path = str(key)
             if isinstance(value, Mapping):
+                unknown = [k for k in value if k not in ("distribution", "scale")]
+                if unknown:
+                    raise ConfigError(
+                        source,
+                        f"{key}.{unknown[0]}",
+                        "no such field",
+                        unknown[0],
+                        "allowed here: distribution, scale",
+                    )
                 dist = value.get("distribution")
                 value = value.get("scale")
+                path = f"{key}.scale"
                 if dist is not None and dist not in DISTRIBUTIONS:
                     raise ConfigError(
                         source, f"{key}.distribution", "one of " + ", ".join(DISTRIBUTIONS), dist
                     )
-            if (
-                isinstance(value, bool)
-                or not isinstance(value, int | float)
-                or not (np.isfinite(value) and value >= 0)
-            ):
-                raise ConfigError(source, f"{key}", "a finite number ≥ 0 (internal units)", value)
+                fixed = _FIXED_DISTRIBUTION.get(names[0].split(".")[0])
+                if dist is not None and fixed is not None and dist != fixed[0]:
+                    raise ConfigError(
+                        source, f"{key}.distribution", f"{fixed[0]} ({fixed[1]})", dist
+                    )
+            # the same unit for every term of a group: mm, rad or relative
+            unit = terms[names[0]].unit
+            high = _MAX_OVERRIDE_GROUP.get(names[0].split(".")[0], _MAX_OVERRIDE[unit])
+            expected = (
+                f"a finite number ≥ 0 and ≤ {high:g} {_UNIT_WORDS[unit]} (internal units; the "
+                "largest the instrument files allow)"
+            )
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ConfigError(source, path, expected, describe_value(value))
+            if not (-math.inf < value <= high and value >= 0):  # NaN fails; big ints compare
+                raise ConfigError(source, path, expected, value)
             for name in names:
                 terms[name] = replace(
                     terms[name],

@@ -30,7 +30,7 @@ import yaml
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.paths import data_dir, find_data_file, list_data_files
-from stereoplotter.yamlio import Fields, describe_value, load_yaml_mapping
+from stereoplotter.yamlio import Fields, describe_value, did_you_mean, load_yaml_mapping
 
 __all__ = [
     "STATUSES",
@@ -196,8 +196,9 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("tolerances.corner4_mm", "number", "mm", high=100.0, **_POS),
     _Leaf("tolerances.m_q_typical_mm", "number", "mm", high=1.0, **_POS),
     _Leaf("tolerances.standard_points_c_mm", "number", "mm", high=500.0, **_POS),
-    _Leaf("errors.backlash_xy_mm", "number", "mm", 0.0, 1.0),
-    _Leaf("errors.backlash_z_mm", "number", "mm", 0.0, 1.0),
+    # at most 0.2 mm: the unidirectional approach overtravels by 0.5 mm > the dead band 2h
+    _Leaf("errors.backlash_xy_mm", "number", "mm", 0.0, 0.2),
+    _Leaf("errors.backlash_z_mm", "number", "mm", 0.0, 0.2),
     _Leaf("errors.zero_reading_scatter_mm", "number", "mm", 0.0, 100.0),
     _Leaf("errors.counter_scale_error_ppm", "number", "ppm", 0.0, 1.0e4),
     _Leaf("errors.f_instrument_setting_mm", "number", "mm", 0.0, 10.0),
@@ -208,12 +209,13 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("errors.coordinatograph_nonorthogonality_arcsec", "number", "″", 0.0, 3600.0),
     _Leaf("errors.pen_play_mm", "number", "mm", 0.0, 10.0),
     _Leaf("errors.sheet_placement_mm", "number", "mm", 0.0, 100.0),
-    _Leaf("mechanics.carriage_mass_kg", "number", "kg", high=1000.0, **_POS),
-    _Leaf("mechanics.z_carriage_mass_kg", "number", "kg", high=1000.0, **_POS),
+    _Leaf("mechanics.carriage_mass_kg", "number", "kg", 0.001, 1000.0),
+    _Leaf("mechanics.z_carriage_mass_kg", "number", "kg", 0.001, 1000.0),
     _Leaf("mechanics.friction_coefficient", "number", "—", 0.0, 2.0),
-    _Leaf("mechanics.screw_stiffness_N_per_um", "number", "N/µm", high=1.0e4, **_POS),
-    _Leaf("mechanics.bridge_mass_kg", "number", "kg", high=1000.0, **_POS),
-    _Leaf("mechanics.pen_carriage_mass_kg", "number", "kg", high=1000.0, **_POS),
+    # no smaller masses and stiffness: F/k stays finite, the dead band measurable
+    _Leaf("mechanics.screw_stiffness_N_per_um", "number", "N/µm", 0.001, 1.0e4),
+    _Leaf("mechanics.bridge_mass_kg", "number", "kg", 0.001, 1000.0),
+    _Leaf("mechanics.pen_carriage_mass_kg", "number", "kg", 0.001, 1000.0),
     _Leaf("mechanics.sheet_friction_torque_Nm", "number", "N·m", 0.0, 1000.0),
     _Leaf("accuracy.height_error_fraction_of_H", "number", "—", high=1.0, required=False, **_POS),
     _Leaf("facts.n_formula", "text", required=False),
@@ -585,12 +587,84 @@ def instrument_from_mapping(
         values[attribute] = convert(params[dotted].value) if dotted in params else None
     if values["projection_distance_max_mm"] is None:
         values["projection_distance_max_mm"] = values["projection_distance_range_mm"][1]
-    return InstrumentSpec(
+    spec = InstrumentSpec(
         key=key or Path(source).stem,
         source=source,
         parameters=MappingProxyType(params),
         **values,
     )
+    _check_mechanics(spec)
+    return spec
+
+
+def _check_mechanics(spec: InstrumentSpec) -> None:
+    """Refuse ``mechanics.*`` and ``errors.backlash_*`` values that give no working screw axis
+    (``mechanics.md``): μ ≥ 1 on the vertical Z axis, or a dead band 2h = b + 2μmg/k that the
+    0.5 mm overtravel of the unidirectional approach does not clear. The axes are built as the
+    virtual instrument builds them, so a file that loads also runs."""
+    from stereoplotter.mechanics.base import N_PER_UM, AxisParams
+    from stereoplotter.mechanics.coordinatograph import CoordinatographParams
+
+    def refuse(key: str, exc: StereoplotterError, hint: str = "") -> ConfigError:
+        return ConfigError(
+            spec.parameters[key].file,
+            f"{key}.value",
+            "a value that gives a working screw axis (mechanics.md: μ < 1 on the vertical "
+            "axis, dead band 2h = backlash b + 2μmg/k below the 0.5 mm overtravel)",
+            str(exc),
+            hint,
+        )
+
+    overtravel = AxisParams.__dataclass_fields__["overtravel_mm"].default
+    # as Instrument._axis_params builds them: (axis, range, backlash, mass)
+    axes = [
+        ("X", "model_x_offset_range_mm", "backlash_xy_mm", "carriage_mass_kg"),
+        ("Y", "model_y_offset_range_mm", "backlash_xy_mm", "carriage_mass_kg"),
+        ("Z", "projection_distance_range_mm", "backlash_z_mm", "z_carriage_mass_kg"),
+        ("bx", "base_x_range_mm", "backlash_xy_mm", "carriage_mass_kg"),
+        ("by", "base_y_range_mm", "backlash_xy_mm", "carriage_mass_kg"),
+        ("bz", "base_z_range_mm", "backlash_z_mm", "carriage_mass_kg"),
+    ]
+    for name, range_attribute, backlash_attribute, mass_attribute in axes:
+        backlash = float(getattr(spec, backlash_attribute))
+        vertical = name == "Z"
+        backlash_key, mass_key = (spec.key_of(a) for a in (backlash_attribute, mass_attribute))
+        lo, hi = getattr(spec, range_attribute)
+        try:
+            AxisParams(
+                name=f"{spec.key} {name}",
+                backlash_mm=backlash,
+                friction=spec.friction_coefficient,
+                mass_kg=getattr(spec, mass_attribute),
+                stiffness_kg_s2=spec.screw_stiffness_N_per_um * N_PER_UM,
+                range_mm=(float(lo), float(hi)),
+                vertical=vertical,
+            )
+        except StereoplotterError as exc:
+            # the key to change: a range without travel; μ on the vertical axis; b where it
+            # alone fills half the overtravel; else the 2μmg/k part, named by its mass
+            if not lo < hi:
+                raise ConfigError(
+                    spec.parameters[spec.key_of(range_attribute)].file,
+                    f"{spec.key_of(range_attribute)}.value",
+                    "a range [lo, hi] with lo < hi (the axis must travel)",
+                    [lo, hi],
+                ) from None
+            if vertical and spec.friction_coefficient >= 1.0:
+                key = "mechanics.friction_coefficient"
+            elif 2.0 * backlash >= 0.5 * overtravel:
+                key = backlash_key
+            else:
+                key = mass_key
+            hint = "or lower μ, or raise the screw stiffness k" if key == mass_key else ""
+            raise refuse(key, exc, hint) from None
+    try:
+        CoordinatographParams.from_instrument(spec)
+    except StereoplotterError as exc:
+        mass_key = "mechanics.pen_carriage_mass_kg" if " Y:" in str(exc) else (
+            "mechanics.bridge_mass_kg"
+        )
+        raise refuse(mass_key, exc, "or lower mechanics.friction_coefficient") from None
 
 
 def _resolve(name_or_path: str | os.PathLike[str]) -> Path:
@@ -606,12 +680,14 @@ def _resolve(name_or_path: str | os.PathLike[str]) -> Path:
         return Path(text)  # reading it reports the missing file
     folder = data_dir("instruments")
     if candidate is None:
-        available = ", ".join(list_instruments()) or "none found"
+        names = list_instruments()
+        available = ", ".join(names) or "none found"
         raise ConfigError(
             _display(folder) if folder else "instruments/",
             text,
             f"the name of an instrument ({available}) or a path to a YAML file",
             "no such instrument file",
+            did_you_mean(text, names),
         )
     return Path(_display(candidate))
 

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from stereoplotter.errors import StereoplotterError
+from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -253,16 +253,29 @@ class Instrument:
         key = spec.key_of(ranges[name])
         parameter = spec.parameters[key]
         ideal = self.ideal_mechanics
-        return AxisParams(
-            name=f"{spec.key} {name}",
-            backlash_mm=0.0 if ideal else float(np.mean(self.injected[f"backlash.{name}"])),
-            friction=0.0 if ideal else spec.friction_coefficient,
-            mass_kg=spec.z_carriage_mass_kg if name == "Z" else spec.carriage_mass_kg,
-            stiffness_kg_s2=math.inf if ideal else spec.screw_stiffness_N_per_um * N_PER_UM,
-            range_mm=tuple(float(v) for v in getattr(spec, ranges[name])),
-            range_source=f"{parameter.file}: {key} ({parameter.status})",
-            vertical=name == "Z",
-        )
+        backlash = 0.0 if ideal else float(np.mean(self.injected[f"backlash.{name}"]))
+        try:
+            return AxisParams(
+                name=f"{spec.key} {name}",
+                backlash_mm=backlash,
+                friction=0.0 if ideal else spec.friction_coefficient,
+                mass_kg=spec.z_carriage_mass_kg if name == "Z" else spec.carriage_mass_kg,
+                stiffness_kg_s2=math.inf if ideal else spec.screw_stiffness_N_per_um * N_PER_UM,
+                range_mm=tuple(float(v) for v in getattr(spec, ranges[name])),
+                range_source=f"{parameter.file}: {key} ({parameter.status})",
+                vertical=name == "Z",
+            )
+        except StereoplotterError as exc:
+            # the instrument file passed the same check when loaded (spec._check_mechanics): the
+            # backlash comes from the error model, i.e. from an --errors file
+            backlash_key = spec.key_of("backlash_z_mm" if name in ("Z", "bz") else "backlash_xy_mm")
+            raise ConfigError(
+                spec.parameters[backlash_key].file,
+                f"{backlash_key}.value",
+                "a backlash that leaves the axis a dead band below its 0.5 mm overtravel",
+                f"{backlash:g} mm: {exc}",
+                "the backlash in use may come from the overrides of an --errors file",
+            ) from None
 
     def _make_axis(self, name: str) -> Any:
         """A lead-screw axis at rest at its start: 0 (the plumb, no base) when 0 is inside its

@@ -38,6 +38,12 @@ MAX_FILM_DEFORMATION_PPM = 5000.0  # 0.5 %: beyond any usable film base
 MIN_RESECTION_POINTS = 3
 MIN_SIMILARITY_POINTS = 2
 
+#: The defaults of the optional ``errors`` section. (Not ``ErrorSettings.photo_point_sigma_um``:
+#: on a dataclass with slots that is the slot descriptor, not the default value.)
+_DEFAULT_ERRORS = ErrorSettings()
+#: Top-level fields that only a block file has (``stereoplotter.block``).
+_BLOCK_FIELDS = ("models", "models_csv")
+
 _TOP = (
     "name",
     "description",
@@ -84,6 +90,15 @@ def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> S
         Name of the file, for messages.
     """
     fields = Fields(source)
+    block_fields = [k for k in _BLOCK_FIELDS if isinstance(data, dict) and k in data]
+    if block_fields:
+        raise fields.error(
+            block_fields[0],
+            "a scenario (one photo or one stereopair: fields photos, points)",
+            "a block file (it has " + ", ".join(block_fields) + ")",
+            "a block file is set up model by model with: stereoplotter setup FILE --instrument "
+            "NAME",
+        )
     fields.mapping(data, "", _TOP, required=("name", "camera", "photos", "points"))
     camera = _camera(fields, fields.get(data, "camera", ""))
     frame = _frame(fields, data.get("frame", {}) or {})
@@ -186,7 +201,14 @@ def _frame(fields: Fields, node: Any) -> Frame:
         return Frame("local", None)
     opath = fields.join(path, "origin")
     origin = _sk42_triplet(fields, fields.get(node, "origin", path), opath)
-    return Frame("sk42", origin)
+    frame = Frame("sk42", origin)
+    try:
+        frame_tie.local_frame(frame)
+    except StereoplotterError as exc:  # e.g. a latitude beyond the geodesy's range
+        raise fields.error(
+            opath, "an origin inside the SK-42 Gauss–Krüger domain", list(origin), str(exc)
+        ) from None
+    return frame
 
 
 def _sk42_triplet(fields: Fields, node: Any, path: str, height: bool = True) -> tuple[float, ...]:
@@ -350,7 +372,17 @@ def _points(fields: Fields, node: Any, frame: Frame, terrain: Terrain) -> tuple[
                 Z = fields.number(
                     local, "Z_m", lpath, unit="m (or the word terrain)", low=-500.0, high=9000.0
                 )
-            sk42 = frame_tie.sk42_from_local(frame, (X, Y, Z)) if frame.kind == "sk42" else None
+            sk42 = None
+            if frame.kind == "sk42":
+                try:
+                    sk42 = frame_tie.sk42_from_local(frame, (X, Y, Z))
+                except StereoplotterError as exc:  # far outside the origin's zone
+                    raise fields.error(
+                        lpath,
+                        f"a point inside the zone of frame.origin (point {pid})",
+                        [X, Y, Z],
+                        str(exc),
+                    ) from None
             points.append(Point(pid, role, kind, (X, Y, Z), sk42))
         else:
             spath = fields.join(ppath, "sk42")
@@ -362,7 +394,15 @@ def _points(fields: Fields, node: Any, frame: Frame, terrain: Terrain) -> tuple[
                     "set frame.kind: sk42 with an origin",
                 )
             sk42 = _sk42_triplet(fields, item["sk42"], spath)
-            local = frame_tie.local_from_sk42(frame, sk42)
+            try:
+                local = frame_tie.local_from_sk42(frame, sk42)
+            except StereoplotterError as exc:  # e.g. the point lies in another zone
+                raise fields.error(
+                    fields.join(spath, "east_m"),
+                    f"a point in the zone of frame.origin (point {pid})",
+                    sk42[1],
+                    str(exc),
+                ) from None
             points.append(Point(pid, role, kind, local, sk42))
     return tuple(points)
 
@@ -419,7 +459,7 @@ def _errors(fields: Fields, node: Any) -> ErrorSettings:
             unit="µm",
             low=0.0,
             high=1000.0,
-            default=ErrorSettings.photo_point_sigma_um,
+            default=_DEFAULT_ERRORS.photo_point_sigma_um,
         ),
         fields.number(
             node,
@@ -428,7 +468,7 @@ def _errors(fields: Fields, node: Any) -> ErrorSettings:
             unit="µm",
             low=0.0,
             high=1000.0,
-            default=ErrorSettings.fiducial_sigma_um,
+            default=_DEFAULT_ERRORS.fiducial_sigma_um,
         ),
     )
 
