@@ -32,6 +32,8 @@ from stereoplotter.paths import (
     shipped_root,
     user_folders,
 )
+from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB
+from stereoplotter.progress import configure_logging
 from stereoplotter.yamlio import atomic_write_bytes, load_yaml_mapping
 
 __all__ = ["main"]
@@ -277,6 +279,14 @@ def _format_demo(result: dict[str, Any]) -> str:
 
 
 def _demo(args: argparse.Namespace) -> int:
+    from stereoplotter.progress import step_progress
+
+    with step_progress("demo") as step:
+        return _demo_steps(args, step)
+
+
+def _demo_steps(args: argparse.Namespace, step) -> int:
+    """The demo's work, reporting ``step(done, 4, what)`` as it goes."""
     from stereoplotter.foundation import run_foundation
     from stereoplotter.instrument.spec import load_instrument
     from stereoplotter.plotting import plot_scenario_layout
@@ -292,6 +302,7 @@ def _demo(args: argparse.Namespace) -> int:
     measurements = result.pop("measurements")
     result["seed"] = seed
     text = _format_demo(result)
+    step(1, 4, "setup sheet")
     files: dict[str, bytes] = {}
     try:
         sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(seed))
@@ -304,18 +315,21 @@ def _demo(args: argparse.Namespace) -> int:
         result["setup_sheet"] = data
         files.update(_sheet_files(sheet, data))
         text += f"\n{_sheet_summary(sheet)} (sheet.md, sheet.pdf)\n"
+    step(2, 4, "simulated operator")
     if scenario.is_stereopair and "refused" not in result["setup_sheet"]:
-        from stereoplotter.procedure.simulate import run_simulation_command
+        from stereoplotter.simulation_output import run_simulation_command
 
-        sim_text, sim_summary = run_simulation_command(
+        sim = run_simulation_command(
             path, instrument=args.instrument, seed=seed, output=Path(args.output) / "simulate"
         )
-        result["simulation"] = sim_summary
+        result["simulation"] = sim.summary
         # name the sub-folder, not the output path: the summary stays the same wherever written
-        text += "\n" + sim_text.replace(str(Path(args.output) / "simulate"), "simulate/")
+        text += "\n" + sim.text.replace(str(Path(args.output) / "simulate"), "simulate/")
+    step(3, 4, "figures")
     figure = plot_scenario_layout(scenario, result)
     png = io.BytesIO()
     figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
+    step(4, 4, "done")
     files.update(
         {
             "result.json": _json(result).encode("utf-8"),
@@ -453,48 +467,45 @@ def _setup_block(args: argparse.Namespace, spec: Any) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from stereoplotter.procedure.simulate import run_simulation_command
+    from stereoplotter.progress import progress_bar
+    from stereoplotter.simulation_output import run_simulation_command
 
-    text, summary = run_simulation_command(
-        args.scenario,
-        instrument=args.instrument,
-        method=args.method,
-        errors=args.errors,
-        seed=args.seed,
-        trials=args.trials,
-        backend=args.backend,
-        output=args.output,
-    )
-    sys.stdout.write(_json(summary) if args.json else text)
+    with progress_bar(args.trials or 1, "simulate") as advance:
+        outcome = run_simulation_command(
+            args.scenario,
+            instrument=args.instrument,
+            method=args.method,
+            errors=args.errors,
+            seed=args.seed,
+            trials=args.trials,
+            backend=args.backend,
+            output=args.output,
+            memory_mb=args.memory_mb,
+            progress=advance,
+        )
+    sys.stdout.write(_json(outcome.summary) if args.json else outcome.text)
     return 0
 
 
 def _verify(args: argparse.Namespace) -> int:
-    from stereoplotter.accuracy.verification import verify
-
-    def progress(done: int, total: int, eq: str) -> None:
-        if args.json or not sys.stderr.isatty():
-            return
-        bar = "#" * (30 * done // total)
-        sys.stderr.write(f"\r[{bar:<30}] {done}/{total} {eq:<12}")
-        if done == total:
-            sys.stderr.write("\n")
-
-    from stereoplotter.accuracy.verification import geometry_from_file, run_procedure_mc
+    from stereoplotter.accuracy.verification import geometry_from_file, run_procedure_mc, verify
+    from stereoplotter.progress import step_progress
 
     geometry, scenarios = None, None
     if args.geometry:
         geometry, scenarios = geometry_from_file(args.geometry)
     # the procedure MC once, shared by the table and the histograms
-    proc = run_procedure_mc(args.procedure_trials, args.seed, scenarios, progress=progress)
-    rows, seconds = verify(
-        trials=args.trials,
-        seed=args.seed,
-        out_dir=None,
-        geometry=geometry,
-        progress=progress,
-        procedure_trials=0,
-    )
+    with step_progress("procedure MC") as progress:
+        proc = run_procedure_mc(args.procedure_trials, args.seed, scenarios, progress=progress)
+    with step_progress("verify") as progress:
+        rows, seconds = verify(
+            trials=args.trials,
+            seed=args.seed,
+            out_dir=None,
+            geometry=geometry,
+            progress=progress,
+            procedure_trials=0,
+        )
     if proc:
         from stereoplotter.accuracy.verification import attach_procedure_mc
 
@@ -618,6 +629,7 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
 
 
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="stereoplotter",
@@ -633,6 +645,7 @@ def _parser() -> argparse.ArgumentParser:
         help="a folder of your own instruments/ and scenarios/, searched by name before the "
         "shipped ones (may be repeated; also $STEREOPLOTTER_DATA, separated by os.pathsep)",
     )
+    _add_verbosity(parser, argparse.SUPPRESS)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("info", help="versions, instruments and scenarios found")
@@ -732,8 +745,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "-o",
         "--output",
-        default="stereoplotter-simulate",
-        help="output folder (default: %(default)s)",
+        help="write the transcript, the evaluation, a parallax map and (with --trials) the "
+        "per-trial measures trials.npz into this folder (default: write nothing)",
+    )
+    p.add_argument(
+        "--memory-mb",
+        type=bounded_float(16.0, 1e6),  # below 16 MB no useful chunk fits
+        default=DEFAULT_MEMORY_BUDGET_MB,
+        metavar="MB",
+        help="memory budget of one chunk of trials (default: %(default)s MB)",
     )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
@@ -793,9 +813,44 @@ def _resolve_data_arguments(args: argparse.Namespace) -> None:
             setattr(args, attribute, str(resolve_data_file("scenarios", getattr(args, attribute))))
 
 
+def _add_verbosity(parser: argparse.ArgumentParser, default: Any) -> None:
+    parser.add_argument(
+        "-v",
+        "--verbose",
+        action="count",
+        default=default,
+        help="log what is done on stderr (-v: steps, -vv: details)",
+    )
+    parser.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        default=default,
+        help="no progress bar, warnings and errors only",
+    )
+
+
+def _all_subparsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
+    found = []
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child in action.choices.values():
+                found += [child, *_all_subparsers(child)]
+    return found
+
+
+def _full_parser() -> argparse.ArgumentParser:
+    """The parser with -v/--quiet accepted before or after the command."""
+    parser = _parser()
+    for child in _all_subparsers(parser):
+        _add_verbosity(child, argparse.SUPPRESS)
+    return parser
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``stereoplotter`` command. Returns the exit code."""
-    args = _parser().parse_args(argv)
+    args = _full_parser().parse_args(argv)
+    configure_logging(getattr(args, "verbose", 0), getattr(args, "quiet", False))
     try:
         _resolve_data_arguments(args)
         if args.command == "info":

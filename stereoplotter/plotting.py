@@ -14,10 +14,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from stereoplotter.procedure.simulate import residual_grid_m
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import footprint_m
 
-__all__ = ["plot_scenario_layout"]
+__all__ = ["plot_residual_y_parallax", "plot_scenario_layout"]
 
 
 def plot_scenario_layout(
@@ -216,4 +217,34 @@ def plot_setup_sheet(sheet: Any, figure: Any = None) -> Any:
         )
         ax.set_xlabel("x [mm]")
         ax.legend(fontsize=6, loc="upper right")
+    return fig
+
+
+def plot_residual_y_parallax(result: Any, ax: Any = None) -> Any:
+    """The true residual y-parallax q of a built model over the working-area grid (trial 0 of a
+    vectorised run) and the six standard points, from a ``SimulationResult``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6, 5))
+    else:
+        fig = ax.figure
+    grid = residual_grid_m(result.scene.scenario)
+    q = np.asarray(result.q_grid_mm)
+    q = q[0] if q.ndim > 1 else q
+    sc = ax.scatter(grid[:, 0], grid[:, 1], c=q * 1e3, cmap="RdBu_r", s=80)
+    std = result.scene.standard_points_m
+    ax.plot(std[:, 0], std[:, 1], "k+", ms=10)
+    for i, p in enumerate(std):
+        ax.annotate(str(i + 1), p[:2], textcoords="offset points", xytext=(4, 4))
+    fig.colorbar(sc, ax=ax, label="residual y-parallax q [µm, photo]")
+    ax.set_xlabel("X [m]")
+    ax.set_ylabel("Y [m]")
+    ax.set_title(
+        f"{result.method} method, {result.sheet.instrument}, seed {result.seed} (trial 0)"
+    )
+    ax.set_aspect("equal")
     return fig

@@ -11,9 +11,10 @@ import difflib
 import math
 import os
 import secrets
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import yaml
 
@@ -485,26 +486,31 @@ def describe_value(value: Any) -> str:
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
-    """Write ``data`` to ``path`` whole or not at all.
+    """Write ``data`` to ``path`` whole or not at all (:func:`atomic_stream`)."""
+    with atomic_stream(path) as f:
+        f.write(data)
 
-    The bytes go to a new temporary file in the same folder (``.NAME.XXXXXXXXXXXX.tmp``), are
-    flushed to disk, and the file is renamed onto ``path`` (:func:`os.replace`, atomic on one
-    file system). The temporary file is created with mode 0o666, which the kernel reduces by the
-    process umask as for any ``open``: 0644 under umask 022, 0600 under 077 (and a default ACL of
-    the folder applies as usual). On any exception, ``KeyboardInterrupt`` included, the
-    temporary file is removed and ``path`` is left as it was.
+
+@contextmanager
+def atomic_stream(path: str | os.PathLike[str]) -> Iterator[BinaryIO]:
+    """A binary file that appears under ``path`` whole or not at all, for streamed writing.
+
+    The bytes go to a new temporary file in the same folder (``.NAME.XXXXXXXXXXXX.tmp``); when
+    the ``with`` block ends without an exception they are flushed to disk and the file is renamed
+    onto ``path`` (:func:`os.replace`, atomic on one file system). The temporary file is created
+    with mode 0o666, which the kernel reduces by the process umask as for any ``open``: 0644
+    under umask 022, 0600 under 077 (and a default ACL of the folder applies as usual). On any
+    exception, ``KeyboardInterrupt`` included, the temporary file is removed and ``path`` is left
+    as it was.
     """
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp, fd = _create_temporary(target)
     try:
-        try:
-            view = memoryview(data)
-            while view:
-                view = view[os.write(fd, view) :]
-            os.fsync(fd)
-        finally:
-            os.close(fd)
+        with os.fdopen(fd, "wb") as f:
+            yield f
+            f.flush()
+            os.fsync(f.fileno())
         os.replace(tmp, target)
     except BaseException:
         tmp.unlink(missing_ok=True)

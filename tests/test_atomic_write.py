@@ -47,20 +47,13 @@ def test_setup_sheet_files_are_0644_under_umask_022(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("interruption", [KeyboardInterrupt, OSError])
-def test_interrupted_write_leaves_no_file_under_the_final_name(tmp_path, monkeypatch, interruption):
-    real_write = os.write
-    calls = []
-
-    def write_then_fail(fd, data):
-        if calls:
-            raise interruption("interrupted mid-write")
-        calls.append(1)
-        return real_write(fd, bytes(data[:10]))  # a partial write: the rest is pending
-
-    monkeypatch.setattr(yamlio.os, "write", write_then_fail)
+def test_interrupted_write_leaves_no_file_under_the_final_name(tmp_path, interruption):
     with pytest.raises(interruption, match="mid-write"):
-        yamlio.atomic_write_bytes(tmp_path / "sheet.pdf", b"%PDF" + b"x" * 1000)
-    assert calls == [1]  # it did fail in the middle, after 10 bytes
+        with yamlio.atomic_stream(tmp_path / "sheet.pdf") as f:
+            f.write(b"%PDF" + b"x" * 10)
+            f.flush()  # part of the file is on disk under the temporary name
+            assert len(list(tmp_path.iterdir())) == 1
+            raise interruption("interrupted mid-write")
     assert list(tmp_path.iterdir()) == []  # neither the final name nor the temporary file
 
 

@@ -14,13 +14,13 @@ from stereoplotter.procedure import (
     Transcript,
     simulate,
     simulate_per_trial,
-    write_simulation,
 )
 from stereoplotter.procedure.conventional import (
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
 from stereoplotter.scenario import load_scenario
+from stereoplotter.simulation_output import write_simulation
 
 
 @pytest.fixture(scope="module")

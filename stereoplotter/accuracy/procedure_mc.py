@@ -192,7 +192,12 @@ def procedure_mc(
 
     from stereoplotter.instrument.spec import load_instrument
     from stereoplotter.procedure.operator import OperatorModel
-    from stereoplotter.procedure.simulate import simulate
+    from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
+    from stereoplotter.procedure.trials import (
+        DEFAULT_MEMORY_BUDGET_MB,
+        chunk_trials_for,
+        iter_trial_chunks,
+    )
 
     t0 = time.perf_counter()
     sc = _load(scenario)
@@ -213,26 +218,21 @@ def procedure_mc(
         kw = {"relative": "equations"}
     else:
         raise ValueError(f"method: expected 'setup' or 'conventional', found {method!r}")
-    runs = []
-    for o, t in ((op, int(trials)), (zero, None)):
-        r = simulate(
-            sc,
-            spec,
-            method,
-            errors="zero",
-            seed=seed,
-            trials=t,
-            operator=o,
-            ideal_mechanics=True,
-            evaluate=False,
-            **kw,
-        )
-        runs.append(r)
-    pts = _domain_points(sc, runs[0].sheet, xr, c, p, f, g["flying_height_m"], grid)
-    d_noisy = _dp(sc, runs[0].sheet, runs[0].instrument, pts)
-    d_zero = _dp(sc, runs[1].sheet, runs[1].instrument, pts)
-    d = d_noisy - d_zero
-    ms = np.mean(d**2, axis=-1)  # per trial
+    # the error-free run once; the noisy trials in chunks under the memory budget
+    # (the random draws are keyed by trial, so the chunk size changes no result)
+    zero_prep = prepare_run(
+        sc, spec, method, "zero", seed, operator=zero, ideal_mechanics=True, **kw
+    )
+    zero_run = run_trials_chunk(zero_prep, 0, None, evaluate=False, transcript=False)
+    pts = _domain_points(sc, zero_run.sheet, xr, c, p, f, g["flying_height_m"], grid)
+    d_zero = _dp(sc, zero_run.sheet, zero_run.instrument, pts)
+    prep = prepare_run(sc, spec, method, "zero", seed, operator=op, ideal_mechanics=True, **kw)
+    chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, method)
+    ms = np.empty(int(trials))
+    for result in iter_trial_chunks(prep, int(trials), chunk, evaluate=False):
+        d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
+        first = result.first_trial
+        ms[first : first + len(d)] = np.mean(d**2, axis=-1)  # per trial
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(mean_ms)
     se_ms = float(np.std(ms, ddof=1)) / math.sqrt(len(ms))

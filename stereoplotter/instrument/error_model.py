@@ -3,8 +3,9 @@
 The defaults come from the instrument YAML (``errors.*``; all *assumed*, since no data sheet of
 SC-1, SPR-3 or SD-3 was found — ``docs/instruments.md``). A run draws all terms at once from an
 explicit :class:`numpy.random.Generator`, vectorised over trials, in a fixed term-major order
-(term 1 for all trials, then term 2, …), so a seed reproduces a run; a per-trial oracle takes
-trial t from the same arrays.
+(term 1 for all trials, then term 2, …), so a seed reproduces a run. A procedure run draws them
+from keyed streams instead (:meth:`ErrorModel.draw_keyed`: one stream per term), so trial t has
+the same errors whichever chunk of a long run it falls in, and a per-trial oracle draws it alone.
 
 Units inside: mm, rad, relative (ppm/10⁶); the YAML and reports use ′, ″ and ppm at the edges.
 """
@@ -21,6 +22,7 @@ from numpy.typing import NDArray
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.instrument.spec import InstrumentSpec
+from stereoplotter.random_streams import keyed_draws
 from stereoplotter.yamlio import describe_value, did_you_mean
 
 __all__ = ["DISTRIBUTIONS", "ErrorModel", "ErrorTerm", "error_model_from_spec"]
@@ -67,6 +69,18 @@ class ErrorTerm:
         if self.distribution == "uniform":
             return rng.uniform(-self.scale, self.scale, size) if self.scale else _zeros(size)
         return _zeros(size) + self.scale
+
+    def draw_keyed(self, seed: int, start: int, stop: int) -> NDArray[np.float64]:
+        """Trials ``start … stop−1`` of this term from its keyed stream ``"injected/" + name``."""
+        n = stop - start
+        if self.distribution == "constant" or not self.scale:
+            return np.zeros(n) + (self.scale if self.distribution == "constant" else 0.0)
+        key = "injected/" + self.name
+        if self.distribution == "normal":
+            z = keyed_draws(seed, key, start, stop, lambda rng, k: rng.standard_normal(k))
+        else:
+            z = keyed_draws(seed, key, start, stop, lambda rng, k: rng.uniform(-1.0, 1.0, k))
+        return z * self.scale
 
 
 def _zeros(size: tuple[int] | None) -> NDArray[np.float64] | float:
@@ -330,6 +344,32 @@ class ErrorModel:
             None → floats (one instrument); T → arrays of shape (T,).
         """
         return {t.name: t.draw(rng, trials) for t in self.terms}
+
+    def draw_keyed(
+        self, seed: int, start: int = 0, stop: int | None = None
+    ) -> dict[str, NDArray[np.float64] | float]:
+        """Trials ``start … stop−1`` of every term from keyed streams (one stream per term).
+
+        The value of trial t does not depend on how a run is cut into chunks
+        (:func:`stereoplotter.random_streams.keyed_draws`); ``stop=None`` gives one instrument
+        (trial ``start``) as floats.
+
+        Examples
+        --------
+        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> model = error_model_from_spec(load_instrument("sc1"))
+        >>> a = model.draw_keyed(3, 0, 10)["backlash.X"]
+        >>> b = model.draw_keyed(3, 7)["backlash.X"]
+        >>> bool(a[7] == b)
+        True
+        """
+        single = stop is None
+        stop = start + 1 if single else stop
+        out: dict[str, NDArray[np.float64] | float] = {}
+        for t in self.terms:
+            values = t.draw_keyed(seed, start, stop)
+            out[t.name] = float(values[0]) if single else values
+        return out
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready description: every term with its distribution, scale, unit and status."""

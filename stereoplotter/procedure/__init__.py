@@ -4,7 +4,8 @@
 * :mod:`~stereoplotter.procedure.setup_method` — the setup-data method, stages 1–5 (§26);
 * :mod:`~stereoplotter.procedure.conventional` — relative orientation by the six standard points
   and absolute orientation by control points (§22, ch. 6);
-* :mod:`~stereoplotter.procedure.simulate` — whole runs, vectorised, and their files.
+* :mod:`~stereoplotter.procedure.simulate` — whole runs, vectorised;
+* :mod:`~stereoplotter.procedure.trials` — long runs in chunks under a memory budget, summarised.
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ from stereoplotter.procedure.simulate import (
     SimulationResult,
     simulate,
     simulate_per_trial,
-    write_simulation,
 )
 from stereoplotter.procedure.transcript import Record, Transcript
 
@@ -30,5 +30,4 @@ __all__ = [
     "Transcript",
     "simulate",
     "simulate_per_trial",
-    "write_simulation",
 ]

@@ -16,7 +16,6 @@ one seed, so that a vectorised run and a per-trial loop draw identical numbers f
 from __future__ import annotations
 
 import math
-import zlib
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -34,6 +33,7 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, Instrument
 from stereoplotter.procedure.transcript import Transcript
+from stereoplotter.random_streams import keyed_draws
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import synthesize_measurements
 
@@ -105,41 +105,55 @@ class OperatorModel:
 
 
 class Noise:
-    """Keyed normal streams: the draw for an act depends on (seed, key) only.
+    """Keyed normal streams: the draw for an act depends on (seed, key, trial index) only.
 
     Parameters
     ----------
     seed : int
     trials : int or None
-        T of the run (None: a single run).
+        Trials of this run or chunk (None: a single run, which is trial ``first_trial``).
     trial : int, optional
         Return only this trial's value (the per-trial oracle of a vectorised run).
+    first_trial : int
+        Index of the chunk's first trial in the whole run (chunked runs, ``procedure.trials``).
 
     Examples
     --------
     >>> a = Noise(7, 4).normal("stage 1/L/1", 1.0)
     >>> b = Noise(7, 4, trial=2).normal("stage 1/L/1", 1.0)
-    >>> bool(a[2] == b)
+    >>> c = Noise(7, 2, first_trial=2).normal("stage 1/L/1", 1.0)
+    >>> bool(a[2] == b == c[0])
     True
     """
 
-    def __init__(self, seed: int, trials: int | None, trial: int | None = None):
+    def __init__(
+        self, seed: int, trials: int | None, trial: int | None = None, first_trial: int = 0
+    ):
         self.seed = int(seed)
         self.trials = trials
         self.trial = trial
+        self.first_trial = int(first_trial)
 
     def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
         """σ·z for the act ``key``: shape (T,), or () for a single run or a per-trial oracle."""
-        size = self.trials or 1
-        if sigma == 0.0:
-            z = np.zeros(size)
-        else:
-            rng = np.random.default_rng([self.seed, zlib.crc32(key.encode("utf-8"))])
-            z = rng.standard_normal(size)
-            z *= sigma
         if self.trial is not None:
-            return np.asarray(z[self.trial])
-        return z if self.trials else np.asarray(z[0])
+            start = self.first_trial + self.trial
+            stop = start + 1
+        else:
+            start = self.first_trial
+            stop = start + (self.trials or 1)
+        if sigma == 0.0:
+            z = np.zeros(stop - start)
+        else:
+            z = keyed_draws(self.seed, key, start, stop, _standard_normal)
+            z *= sigma
+        if self.trial is not None or not self.trials:
+            return np.asarray(z[0])
+        return z
+
+
+def _standard_normal(rng: np.random.Generator, n: int) -> NDArray[np.float64]:
+    return rng.standard_normal(n)
 
 
 def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: float = 1e-6):

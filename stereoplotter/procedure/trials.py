@@ -1,0 +1,221 @@
+"""Many trials of a procedure in chunks under a memory budget, summarised per measure.
+
+A run of T trials is cut into chunks of :func:`chunk_trials_for` trials (from a memory budget);
+:func:`iter_trial_chunks` runs them one after another on one :class:`PreparedRun`. Every random
+draw is keyed by the trial index, so the results do not depend on the chunk size.
+
+Each chunk is reduced at once to *columns*: one value per trial and measure
+(:func:`trial_columns`: every check's residual, tolerance, pass flag and iterations, the
+iterations per stage, the zero readings, the true residual y-parallax, and the evaluation's max
+and RMS errors per point set in base units). Columns are what a long run keeps (the caller
+spools them, ``stereoplotter.trial_store``); :func:`summarise_columns` turns them into the
+summary that ``simulate --json`` prints: pass rates, means, RMS and quantiles with their Monte
+Carlo standard errors (:mod:`stereoplotter.statistics`), never per-trial arrays.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.constants import MM_PER_M, UM_PER_MM
+from stereoplotter.procedure.simulate import (
+    PreparedRun,
+    SimulationResult,
+    run_header,
+    run_trials_chunk,
+)
+from stereoplotter.statistics import scale_summary, summarise_flags, summarise_values
+
+__all__ = [
+    "BYTES_PER_TRIAL",
+    "DEFAULT_MEMORY_BUDGET_MB",
+    "RunInfo",
+    "chunk_trials_for",
+    "iter_trial_chunks",
+    "run_info",
+    "summarise_columns",
+    "summarise_result",
+    "trial_columns",
+]
+
+#: Peak working memory per trial of one chunk (simulation and evaluation), measured with
+#: ``benchmarks/bench_simulate_scale.py`` on pair60 (setup ≈ 20 kB, conventional ≈ 25 kB) and
+#: rounded up for safety. [bytes]
+BYTES_PER_TRIAL = {"setup": 32_000, "conventional": 40_000}
+
+#: Default memory budget of one chunk (a convention: leaves room on a 1 GiB allowance for the
+#: interpreter, the libraries and the columns of the current chunk). [MB]
+DEFAULT_MEMORY_BUDGET_MB = 256
+
+#: Smallest chunk (below it the per-chunk Python overhead dominates). [trials]
+MIN_CHUNK = 256
+
+
+def chunk_trials_for(memory_budget_mb: float, method: str) -> int:
+    """Trials per chunk so that one chunk stays within the memory budget.
+
+    Examples
+    --------
+    >>> chunk_trials_for(256, "setup")
+    8000
+    """
+    if not memory_budget_mb > 0:
+        raise ValueError(f"memory budget: expected > 0 MB, found {memory_budget_mb}")
+    per_trial = BYTES_PER_TRIAL.get(method, max(BYTES_PER_TRIAL.values()))
+    return max(MIN_CHUNK, int(memory_budget_mb * 1e6 // per_trial))
+
+
+def iter_trial_chunks(
+    prep: PreparedRun,
+    trials: int,
+    chunk_trials: int,
+    *,
+    evaluate: bool = True,
+    progress: Callable[[int], None] | None = None,
+) -> Iterator[SimulationResult]:
+    """Run trials 0 … T−1 in chunks; yield each chunk's result (the first with its transcript).
+
+    ``progress(n)`` is called after each chunk with the number of trials it ran.
+    """
+    if trials < 1:
+        raise ValueError(f"trials: expected ≥ 1, found {trials}")
+    if chunk_trials < 1:
+        raise ValueError(f"chunk_trials: expected ≥ 1, found {chunk_trials}")
+    for first in range(0, trials, chunk_trials):
+        n = min(chunk_trials, trials - first)
+        result = run_trials_chunk(prep, first, n, evaluate=evaluate, transcript=first == 0)
+        yield result
+        if progress is not None:
+            progress(n)
+
+
+def _full(value: Any, trials: int, dtype: type = float) -> NDArray[Any]:
+    return np.broadcast_to(np.asarray(value, dtype), (trials,)).copy()
+
+
+#: Evaluation keys kept per trial: base units only (‰ H and map mm are derived in the summary).
+_BASE_UNITS = ("_mm", "_m")
+
+
+def trial_columns(result: SimulationResult) -> dict[str, NDArray[Any]]:
+    """One value per trial and measure of a vectorised result, shape (T,) each.
+
+    Names: ``check/<check>/{residual,tolerance,passed,iterations}``, ``iterations/<stage>``,
+    ``zero_reading/<scale>``, ``residual_y_parallax/{standard_points_max,grid_max,grid_rms}_um``
+    and ``evaluation/<point set>/<measure>`` (max and RMS errors in mm or m).
+    """
+    t = result.trials
+    if t is None:
+        raise ValueError("trial_columns needs a vectorised result (trials = T)")
+    cols: dict[str, NDArray[Any]] = {}
+    for name, c in result.checks.items():
+        cols[f"check/{name}/residual"] = _full(c["residual"], t)
+        if c["tolerance"] is not None:
+            cols[f"check/{name}/tolerance"] = _full(c["tolerance"], t)
+            cols[f"check/{name}/passed"] = _full(c["passed"], t, bool)
+        if c["iterations"] is not None:
+            cols[f"check/{name}/iterations"] = _full(c["iterations"], t)
+    for name, v in result.iterations.items():
+        cols[f"iterations/{name}"] = _full(v, t)
+    for name, v in result.zero_readings.items():
+        cols[f"zero_reading/{name}"] = _full(v, t)
+    q_std = np.abs(np.asarray(result.q_standard_mm, float)).reshape(t, -1)
+    q_grid = np.asarray(result.q_grid_mm, float).reshape(t, -1)
+    cols["residual_y_parallax/standard_points_max_um"] = np.max(q_std, axis=1) * UM_PER_MM
+    cols["residual_y_parallax/grid_max_um"] = np.max(np.abs(q_grid), axis=1) * UM_PER_MM
+    cols["residual_y_parallax/grid_rms_um"] = np.sqrt(np.mean(q_grid**2, axis=1)) * UM_PER_MM
+    if result.evaluation is not None:
+        for set_name, measures in result.evaluation.summary().items():
+            for key, v in measures.items():
+                if key == "n_points" or not key.endswith(_BASE_UNITS):
+                    continue
+                cols[f"evaluation/{set_name}/{key}"] = _full(v, t)
+    return cols
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """What the summary needs besides the columns (from any chunk of the run)."""
+
+    header: dict[str, Any]
+    check_units: dict[str, str]
+    flying_height_m: float | None
+    map_scale_denominator: int | None
+    points_per_set: dict[str, int]
+
+
+def run_info(result: SimulationResult, trials: int) -> RunInfo:
+    """The :class:`RunInfo` of a run of ``trials`` trials from one of its chunks."""
+    header = run_header(result)
+    header["trials"] = int(trials)
+    ev = result.evaluation
+    return RunInfo(
+        header,
+        {name: c["unit"] for name, c in result.checks.items()},
+        None if ev is None else float(ev.flying_height_m),
+        None if ev is None else ev.map_scale_denominator,
+        {} if ev is None else {n: len(s.ids) for n, s in ev.sets().items()},
+    )
+
+
+def _derived(key: str, summary: dict[str, Any], info: RunInfo) -> dict[str, dict[str, Any]]:
+    """The same measure in ‰ H (heights) or map mm (plan), from its metre summary."""
+    out = {}
+    if key.endswith("_m") and key.startswith("height_error") and info.flying_height_m:
+        out[key[:-2] + "_permille"] = scale_summary(summary, MM_PER_M / info.flying_height_m)
+    if key.endswith("_m") and key.startswith("plan_error") and info.map_scale_denominator:
+        out[key[:-2] + "_map_mm"] = scale_summary(summary, MM_PER_M / info.map_scale_denominator)
+    return out
+
+
+def summarise_columns(
+    info: RunInfo, columns: Iterable[tuple[str, NDArray[Any]]], extra: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """The JSON-ready summary of a run from its whole columns (one at a time is enough).
+
+    Per check: pass rate, residual, tolerance and iterations; per stage: iterations; the true
+    residual y-parallax; per point set of the evaluation: each max/RMS error (and in ‰ H or map
+    mm). Every figure with its Monte Carlo standard error or 95 % interval.
+    """
+    out: dict[str, Any] = {**info.header, **(extra or {})}
+    checks: dict[str, dict[str, Any]] = {}
+    groups: dict[str, dict[str, Any]] = {
+        "iterations": {},
+        "zero_reading": {},
+        "residual_y_parallax": {},
+    }
+    evaluation: dict[str, dict[str, Any]] = {}
+    for name, values in columns:
+        kind, _, rest = name.partition("/")
+        if kind == "check":
+            check, _, field = rest.rpartition("/")
+            entry = checks.setdefault(check, {"unit": info.check_units.get(check)})
+            if field == "passed":
+                entry["pass_rate"] = summarise_flags(values)
+            else:
+                entry[field] = summarise_values(values)
+        elif kind == "evaluation":
+            set_name, _, key = rest.partition("/")
+            s = evaluation.setdefault(set_name, {"n_points": info.points_per_set.get(set_name)})
+            s[key] = summarise_values(values)
+            s.update(_derived(key, s[key], info))
+        elif kind in groups:
+            groups[kind][rest] = summarise_values(values)
+        else:  # pragma: no cover - trial_columns makes only these kinds
+            raise ValueError(f"unknown column {name!r}")
+    out["checks"] = checks
+    out.update(groups)
+    out["evaluation"] = evaluation or None
+    return out
+
+
+def summarise_result(result: SimulationResult) -> dict[str, Any]:
+    """The summary of a vectorised result held in memory (one chunk)."""
+    return summarise_columns(
+        run_info(result, result.trials or 1), trial_columns(result).items()
+    )

@@ -1,0 +1,272 @@
+"""What ``stereoplotter simulate`` prints and writes.
+
+One procedure (no ``--trials``): the transcript, the evaluation of the built model (values and
+per point), a Markdown summary and a parallax map. ``--trials T``: the trials run in chunks
+under a memory budget (``procedure.trials``); their per-trial measures are spooled to disk
+(``trial_store``) and summarised per measure with Monte Carlo standard errors; with an output
+folder the per-trial columns go to ``trials.npz``, the transcript and the map are of trial 0.
+
+Every file is written whole or not at all; the same seed gives byte-identical files.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
+from stereoplotter.procedure.trials import (
+    DEFAULT_MEMORY_BUDGET_MB,
+    chunk_trials_for,
+    iter_trial_chunks,
+    run_info,
+    summarise_columns,
+    trial_columns,
+)
+from stereoplotter.trial_store import TrialStore
+from stereoplotter.yamlio import atomic_write_bytes
+
+__all__ = ["SimulationOutcome", "run_simulation_command", "simulation_markdown", "write_simulation"]
+
+log = logging.getLogger(__name__)
+
+
+def _plain(v: Any) -> Any:
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, np.generic):
+        return v.item()
+    return str(v)
+
+
+def json_ready(data: Any) -> Any:
+    """Plain lists, floats and strings only."""
+    return json.loads(json.dumps(data, default=_plain))
+
+
+def _yaml(data: Any) -> str:
+    import yaml
+
+    return yaml.safe_dump(json_ready(data), sort_keys=False, allow_unicode=True)
+
+
+def _g(v: Any) -> str:
+    return "—" if v is None else f"{v:.4g}"
+
+
+def _stat(s: dict[str, Any] | None, key: str = "mean") -> str:
+    """``mean ± SE`` of a value summary (or the plain value of a single run)."""
+    if s is None:
+        return "—"
+    if not isinstance(s, dict):
+        return _g(s)
+    if "constant" in s:
+        return _g(s["constant"])
+    v, se = s.get(key), s.get(f"{key}_se")
+    if v is None:
+        return "—"
+    return _g(v) if se is None else f"{v:.4g} ± {se:.2g}"
+
+
+def _p95(s: dict[str, Any] | None) -> str:
+    if isinstance(s, dict) and "constant" in s:
+        return _g(s["constant"])
+    if not isinstance(s, dict) or "quantiles" not in s:
+        return "—"
+    return _g(s["quantiles"]["p95"]["value"])
+
+
+def simulation_markdown(s: dict[str, Any]) -> str:
+    """The Markdown summary of a run (one procedure, or statistics over trials)."""
+    trials = s.get("trials")
+    lines = [
+        f"# Simulated {s['method']} procedure: {s['scenario']} on {s['instrument']}",
+        "",
+    ]
+    if trials is None:
+        lines += [
+            f"back-end {s['backend']}, seed {s['seed']}, one procedure; operator judgment "
+            "errors are assumed values.",
+            "",
+            "| check | residual | tolerance | passed | iterations |",
+            "|---|---|---|---|---|",
+        ]
+        for name, c in s["checks"].items():
+            label = name.replace("|", "\\|")
+            lines.append(
+                f"| {label} | {_g(c['residual'])} {c['unit']} | {_g(c.get('tolerance'))} | "
+                f"{c.get('passed', '—')} | {_g(c.get('iterations'))} |"
+            )
+        q = s["residual_y_parallax_um"]
+        lines += [
+            "",
+            f"Residual y-parallax of the built model (truth): max {_g(q['standard_points_max'])} "
+            f"µm at the six standard points; over the grid max {_g(q['grid_max'])} µm, "
+            f"RMS {_g(q['grid_rms'])} µm.",
+            "",
+            "Iterations per stage: "
+            + ", ".join(f"{k}: {_g(v)}" for k, v in s["iterations"].items()),
+            "",
+        ]
+        return "\n".join(lines)
+    chunks = s.get("chunks", {})
+    lines += [
+        f"back-end {s['backend']}, seed {s['seed']}, {trials} trials"
+        + (f" in {chunks['count']} chunk(s) of ≤ {chunks['trials']}" if chunks else "")
+        + "; operator judgment errors are assumed values. Figures: mean ± Monte Carlo standard "
+        "error; p95 the 95th percentile over the trials.",
+        "",
+        "| check | passed (rate ± SE) | residual mean | residual p95 | tolerance | iterations |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, c in s["checks"].items():
+        label = name.replace("|", "\\|")
+        rate = c.get("pass_rate")
+        passed = "—" if rate is None else f"{rate['rate']:.3f} ± {rate['rate_se']:.3f}"
+        lines.append(
+            f"| {label} | {passed} | {_stat(c.get('residual'))} {c['unit']} | "
+            f"{_p95(c.get('residual'))} | {_stat(c.get('tolerance'))} | "
+            f"{_stat(c.get('iterations'))} |"
+        )
+    q = s["residual_y_parallax"]
+    lines += [
+        "",
+        "Residual y-parallax of the built model (truth), µm: grid RMS "
+        f"{_stat(q['grid_rms_um'])} (p95 {_p95(q['grid_rms_um'])}); grid max "
+        f"{_stat(q['grid_max_um'])}; six standard points max {_stat(q['standard_points_max_um'])}.",
+        "",
+    ]
+    ev = s.get("evaluation") or {}
+    rows = []
+    for set_name in ("control", "check", "grid"):
+        e = ev.get(set_name) or {}
+        h = e.get("height_error_rms_permille")
+        p = e.get("plan_error_rms_map_mm")
+        if h or p:
+            rows.append(
+                f"| {set_name} ({e.get('n_points')}) | {_stat(h)} | {_p95(h)} | {_stat(p)} | "
+                f"{_p95(p)} |"
+            )
+    if rows:
+        lines += [
+            "| points | height RMS, ‰ H | p95 | plan RMS, mm on the map | p95 |",
+            "|---|---|---|---|---|",
+            *rows,
+            "",
+        ]
+    return "\n".join(lines)
+
+
+def _parallax_png(result: SimulationResult) -> bytes:
+    """The true residual y-parallax over the working-area grid (trial 0) as a PNG."""
+    from stereoplotter.plotting import plot_residual_y_parallax
+
+    fig = plot_residual_y_parallax(result)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def _trial0_files(result: SimulationResult) -> dict[str, bytes]:
+    return {
+        "transcript.txt": result.transcript.to_text().encode("utf-8"),
+        "transcript.jsonl": result.transcript.to_jsonl().encode("utf-8"),
+        "parallax.png": _parallax_png(result),
+    }
+
+
+def write_simulation(result: SimulationResult, out_dir: str | Path) -> dict[str, Path]:
+    """Write one run's transcript.txt, transcript.jsonl, evaluation.yaml, evaluation.md,
+    parallax.png (a vectorised result: the summary over its trials, trial 0's transcript)."""
+    s = result.summary()
+    files = _trial0_files(result)
+    files["evaluation.yaml"] = _yaml(s).encode("utf-8")
+    files["evaluation.md"] = simulation_markdown(s).encode("utf-8")
+    return _write_all(Path(out_dir), files)
+
+
+def _write_all(out: Path, files: dict[str, bytes]) -> dict[str, Path]:
+    paths = {}
+    for name, data in files.items():
+        atomic_write_bytes(out / name, data)
+        paths[name] = out / name
+    log.info("wrote %s in %s", ", ".join(sorted(files)), out)
+    return paths
+
+
+@dataclass
+class SimulationOutcome:
+    """What the command produced: the summary, its Markdown, the files written."""
+
+    summary: dict[str, Any]
+    text: str
+    files: dict[str, Path]
+
+
+def run_simulation_command(
+    scenario_path: str | Path,
+    instrument: str = "sc1",
+    method: str = "setup",
+    errors: str | None = None,
+    seed: int | None = None,
+    trials: int | None = None,
+    backend: str = "closed-form",
+    output: str | Path | None = None,
+    *,
+    memory_mb: float = DEFAULT_MEMORY_BUDGET_MB,
+    progress: Callable[[int], None] | None = None,
+) -> SimulationOutcome:
+    """What ``stereoplotter simulate`` does: run, summarise, write the files if ``output``.
+
+    ``seed`` defaults to the scenario's seed; ``errors`` is None (instrument defaults), "zero" or
+    an errors YAML path. ``trials`` runs in chunks that fit ``memory_mb``; the summary holds
+    statistics, never per-trial arrays (those go to ``trials.npz`` in ``output``).
+    ``progress(n)`` is told the trials each finished chunk ran.
+    """
+    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.scenario import load_scenario
+
+    scenario = load_scenario(scenario_path)
+    spec = load_instrument(instrument)
+    seed = scenario.seed if seed is None else seed
+    prep = prepare_run(scenario, spec, method, errors, seed, backend)
+    out = None if output is None else Path(output)
+    if trials is None:
+        result = run_trials_chunk(prep, 0, None)
+        summary = json_ready(result.summary())
+        files = {} if out is None else write_simulation(result, out)
+        if progress is not None:
+            progress(1)
+    else:
+        chunk = chunk_trials_for(memory_mb, method)
+        log.info("%d trials in chunks of %d (memory budget %g MB)", trials, chunk, memory_mb)
+        info = None
+        with TrialStore() as store:
+            for result in iter_trial_chunks(prep, trials, chunk, progress=progress):
+                if info is None:  # the first chunk: trial 0's transcript and map
+                    info = run_info(result, trials)
+                    trial0 = _trial0_files(result) if out is not None else {}
+                store.append(trial_columns(result))
+            extra = {"chunks": {"trials": chunk, "count": -(-trials // chunk)}}
+            summary = json_ready(summarise_columns(info, store.columns(), extra))
+            files = {}
+            if out is not None:
+                trial0["evaluation.yaml"] = _yaml(summary).encode("utf-8")
+                trial0["evaluation.md"] = simulation_markdown(summary).encode("utf-8")
+                files = _write_all(out, trial0)
+                store.write_npz(out / "trials.npz")
+                files["trials.npz"] = out / "trials.npz"
+    text = simulation_markdown(summary)
+    if files:
+        text += f"\nwritten: {', '.join(sorted(files))} in {out}\n"
+    return SimulationOutcome(summary, text, files)
