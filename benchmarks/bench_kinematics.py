@@ -9,7 +9,7 @@ Times, best of ``--repeat``:
   (counters → both photo points) on N counter triples;
 * the inverse :func:`~stereoplotter.instrument.kinematics.counters_from_homologous_points`
   (both photo points → X, Y, D, q) on N pairs;
-* :func:`~stereoplotter.instrument.selftest.run_kinematic_selftest` (``kinematics.md`` §5, §6:
+* :func:`~stereoplotter.procedure.selftest.run_kinematic_selftest` (``kinematics.md`` §5, §6:
   the CLI-facing acceptance, goal < 10 s).
 
 Prints points per second, the wall times, ``os.cpu_count()`` and the numpy version. Speed is
@@ -33,7 +33,7 @@ from stereoplotter.instrument.kinematics import (
     photo_from_rod,
     unit_for_orientation,
 )
-from stereoplotter.instrument.selftest import run_kinematic_selftest
+from stereoplotter.procedure.selftest import run_kinematic_selftest
 
 
 def best_of(repeat: int, fn) -> float:

@@ -9,7 +9,7 @@ Prints, best of ``--repeat``:
 * bare ``space.step`` rate of one axis (3 bodies, 6 constraints), in steps/s;
 * one coordinatograph setting (both chains) and one sheet orientation (ideal drives, acuity 0);
 * the play operator over N trials (``PlayAxis.approach`` with a unidirectional finish, and the
-  bare :func:`~stereoplotter.mechanics.play`), in trials/s.
+  bare :func:`~stereoplotter.instrument.mechanics.play`), in trials/s.
 
 Speed is measured here, never asserted in the test suite.
 """
@@ -27,7 +27,7 @@ from dataclasses import replace
 import numpy as np
 import pymunk
 
-from stereoplotter.mechanics import (
+from stereoplotter.instrument.mechanics import (
     AxisParams,
     Coordinatograph,
     PlayAxis,

@@ -14,7 +14,7 @@ import numpy as np
 
 from stereoplotter.instrument.spec import load_instrument
 from stereoplotter.procedure import simulate, simulate_per_trial
-from stereoplotter.scenario import load_scenario
+from stereoplotter.io.scenario_file import load_scenario
 
 
 def main() -> None:

@@ -9,8 +9,8 @@ import time
 
 import numpy as np
 
-from stereoplotter.accuracy import montecarlo as mc
-from stereoplotter.accuracy import verification as v
+from stereoplotter.verification import linear_mc as mc
+from stereoplotter.verification import table as v
 
 
 def main():

@@ -23,7 +23,7 @@ import numpy as np
 
 from stereoplotter import __version__
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.paths import (
+from stereoplotter.io.paths import (
     DEFAULT_SCENARIO,
     DataFile,
     data_files,
@@ -34,7 +34,7 @@ from stereoplotter.paths import (
 )
 from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB
 from stereoplotter.progress import configure_logging
-from stereoplotter.yamlio import atomic_write_bytes, load_yaml_mapping
+from stereoplotter.io.yaml_files import atomic_write_bytes, load_yaml_mapping
 
 __all__ = ["main"]
 
@@ -95,7 +95,7 @@ def _data_entry(found: DataFile) -> dict[str, Any]:
 
 
 def _info() -> dict[str, Any]:
-    from stereoplotter.scenario import load_scenario
+    from stereoplotter.io.scenario_file import load_scenario
 
     instruments = []
     for found in data_files("instruments"):
@@ -287,12 +287,12 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _demo_steps(args: argparse.Namespace, step) -> int:
     """The demo's work, reporting ``step(done, 4, what)`` as it goes."""
-    from stereoplotter.foundation import run_foundation
+    from stereoplotter.scenario.foundation import run_foundation
     from stereoplotter.instrument.spec import load_instrument
-    from stereoplotter.plotting import plot_scenario_layout
-    from stereoplotter.scenario import load_scenario
-    from stereoplotter.setup_sheet import SetupRefusal, compute_setup_sheet
-    from stereoplotter.sheet_report import sheet_to_dict
+    from stereoplotter.plotting.figures import plot_scenario_layout
+    from stereoplotter.io.scenario_file import load_scenario
+    from stereoplotter.setup.sheet import SetupRefusal, compute_setup_sheet
+    from stereoplotter.report.sheet import sheet_to_dict
 
     path = Path(args.scenario)  # main() has resolved a name (default: the shipped pair60)
     scenario = load_scenario(path)
@@ -317,7 +317,7 @@ def _demo_steps(args: argparse.Namespace, step) -> int:
         text += f"\n{_sheet_summary(sheet)} (sheet.md, sheet.pdf)\n"
     step(2, 4, "simulated operator")
     if scenario.is_stereopair and "refused" not in result["setup_sheet"]:
-        from stereoplotter.simulation_output import run_simulation_command
+        from stereoplotter.report.simulation import run_simulation_command
 
         sim = run_simulation_command(
             path, instrument=args.instrument, seed=seed, output=Path(args.output) / "simulate"
@@ -357,7 +357,7 @@ def _instrument(args: argparse.Namespace) -> int:
 
     spec = load_instrument(args.name)
     if args.instrument_command == "test":
-        from stereoplotter.instrument.selftest import format_selftest, run_kinematic_selftest
+        from stereoplotter.procedure.selftest import format_selftest, run_kinematic_selftest
 
         tilts = [math.radians(t) for t in args.tilts]
         result = run_kinematic_selftest(tilts=tilts, variants=tuple(args.variants), instrument=spec)
@@ -372,8 +372,8 @@ def _sheet_files(sheet: Any, data: dict[str, Any]) -> dict[str, bytes]:
     """sheet.yaml, sheet.md, sheet.pdf and sheet.png of a setup sheet, rendered in memory."""
     import yaml
 
-    from stereoplotter.plotting import plot_setup_sheet
-    from stereoplotter.sheet_report import sheet_markdown
+    from stereoplotter.plotting.figures import plot_setup_sheet
+    from stereoplotter.report.sheet import sheet_markdown
 
     text = yaml.safe_dump(json.loads(_json(data)), sort_keys=False, allow_unicode=True, width=100)
     figure = plot_setup_sheet(sheet)
@@ -401,9 +401,9 @@ def _sheet_summary(sheet: Any) -> str:
 
 def _setup(args: argparse.Namespace) -> int:
     from stereoplotter.instrument.spec import load_instrument
-    from stereoplotter.scenario import load_scenario
-    from stereoplotter.setup_sheet import SetupOptions, compute_setup_sheet
-    from stereoplotter.sheet_report import sheet_to_dict
+    from stereoplotter.io.scenario_file import load_scenario
+    from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
+    from stereoplotter.report.sheet import sheet_to_dict
 
     spec = load_instrument(args.instrument)
     data, _ = load_yaml_mapping(args.scenario)
@@ -434,8 +434,8 @@ def _setup(args: argparse.Namespace) -> int:
 
 
 def _setup_block(args: argparse.Namespace, spec: Any) -> int:
-    """Block mode: one sheet per model of a block file (``stereoplotter.block``)."""
-    from stereoplotter.block import model_sheet, run_block
+    """Block mode: one sheet per model of a block file (``stereoplotter.setup.block``)."""
+    from stereoplotter.setup.block import model_sheet, run_block
 
     if args.horizontal_scale is not None or args.vertical_scale is not None or args.seed:
         raise StereoplotterError(
@@ -468,7 +468,7 @@ def _setup_block(args: argparse.Namespace, spec: Any) -> int:
 
 def _simulate(args: argparse.Namespace) -> int:
     from stereoplotter.progress import progress_bar
-    from stereoplotter.simulation_output import run_simulation_command
+    from stereoplotter.report.simulation import run_simulation_command
 
     with progress_bar(args.trials or 1, "simulate") as advance:
         outcome = run_simulation_command(
@@ -488,7 +488,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _verify(args: argparse.Namespace) -> int:
-    from stereoplotter.accuracy.verification import geometry_from_file, run_procedure_mc, verify
+    from stereoplotter.verification.table import geometry_from_file, run_procedure_mc, verify
     from stereoplotter.progress import step_progress
 
     geometry, scenarios = None, None
@@ -507,15 +507,15 @@ def _verify(args: argparse.Namespace) -> int:
             procedure_trials=0,
         )
     if proc:
-        from stereoplotter.accuracy.verification import attach_procedure_mc
+        from stereoplotter.verification.table import attach_procedure_mc
 
         attach_procedure_mc(rows, proc)
     if args.output:
-        from stereoplotter.accuracy.verification import write_verification
+        from stereoplotter.verification.table import write_verification
 
         out = Path(args.output)
         # Figures first, in memory: every file is written whole or not at all.
-        from stereoplotter.accuracy_plot import (
+        from stereoplotter.plotting.accuracy import (
             plot_error_maps,
             plot_mc_histograms,
             plot_verification_chart,
@@ -858,7 +858,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             sys.stdout.write(_json(info) if args.json else _format_info(info))
             return 0
         if args.command == "scenario":
-            from stereoplotter.scenario import load_scenario, summarize_scenario
+            from stereoplotter.io.scenario_file import load_scenario
+            from stereoplotter.scenario import summarize_scenario
 
             summary = summarize_scenario(load_scenario(args.file))
             sys.stdout.write(_json(summary) if args.json else _format_summary(summary))

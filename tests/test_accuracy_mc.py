@@ -10,8 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from stereoplotter.accuracy import ROW_KEYS, VERDICTS, run_verification, write_verification
-from stereoplotter.accuracy import montecarlo as mc
+from stereoplotter.verification import ROW_KEYS, VERDICTS, run_verification, write_verification
+from stereoplotter.verification import linear_mc as mc
 
 TRIALS = 3000  # per row; CI half-width ≈ 3.29/√(2·3000) = 4.2 % for one source
 
@@ -70,7 +70,7 @@ def test_geometry_override_rejects_unknown_key():
 
 
 def test_plots_have_data(rows):
-    from stereoplotter import accuracy_plot as ap
+    from stereoplotter.plotting import accuracy as ap
 
     ax = ap.plot_verification_chart(rows)
     assert len(ax.lines) >= 3
@@ -88,7 +88,7 @@ def test_plots_have_data(rows):
 
 def test_procedure_mc_setup_matches_formula_at_simulated_geometry():
     from stereoplotter.accuracy import setup_accuracy as sa
-    from stereoplotter.accuracy.procedure_mc import procedure_mc
+    from stereoplotter.verification.procedure_mc import procedure_mc
 
     r = procedure_mc("pair60.yaml", "setup", trials=400, seed=3)
     ref = sa.setup_parallax_rms_from_pointing(r["f"], r["p"], r["c"], r["l"], r["n"], 1.0)
@@ -98,7 +98,7 @@ def test_procedure_mc_setup_matches_formula_at_simulated_geometry():
 
 
 def test_procedure_columns_filled_and_disabled():
-    from stereoplotter.accuracy.verification import PROCEDURE_ROWS
+    from stereoplotter.verification.table import PROCEDURE_ROWS
 
     rows = run_verification(trials=200, seed=2, procedure_trials=150)
     for r in rows:
@@ -112,7 +112,7 @@ def test_procedure_columns_filled_and_disabled():
 
 
 def test_geometry_book_explicit_equals_default():
-    from stereoplotter.accuracy.verification import BOOK
+    from stereoplotter.verification.table import BOOK
 
     a = run_verification(trials=300, seed=4, procedure_trials=0)
     b = run_verification(trials=300, seed=4, geometry=dict(BOOK), procedure_trials=0)
@@ -137,7 +137,7 @@ def test_other_geometry_rigorous_and_mc_agree(geometry):
 
 
 def test_geometry_from_scenario_file():
-    from stereoplotter.accuracy.verification import geometry_from_file
+    from stereoplotter.verification.table import geometry_from_file
 
     g, scen = geometry_from_file("scenarios/pair80.yaml")
     assert g["p80"] == pytest.approx(36.1, abs=0.1) and g["c"] == pytest.approx(2 * g["p80"])

@@ -8,7 +8,7 @@ from contextlib import contextmanager
 
 import pytest
 
-from stereoplotter import yamlio
+from stereoplotter.io import yaml_files as yamlio
 from stereoplotter.cli import main
 
 

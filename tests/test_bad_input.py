@@ -17,14 +17,14 @@ import yaml
 
 from stereoplotter.cli import _parser, main
 from stereoplotter.errors import ConfigError
-from stereoplotter.scenario import load_scenario
+from stereoplotter.io.scenario_file import load_scenario
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
 def _shipped(kind: str, name: str) -> Path:
     try:
-        from stereoplotter.paths import data_dir
+        from stereoplotter.io.paths import data_dir
 
         folder = data_dir(kind)
         if folder is not None and (Path(folder) / name).is_file():
@@ -196,14 +196,14 @@ def test_geometry_file_with_a_typo_names_file_and_field(tmp_path, capsys):
     ],
 )
 def test_geometry_file_values_are_checked(tmp_path, text, message):
-    from stereoplotter.accuracy.verification import geometry_from_file
+    from stereoplotter.verification.table import geometry_from_file
 
     with pytest.raises(ConfigError, match=r"geometry\.yaml: " + message):
         geometry_from_file(_write(tmp_path, text, "geometry.yaml"))
 
 
 def test_geometry_from_a_single_photo_scenario_is_refused(capsys):
-    from stereoplotter.accuracy.verification import geometry_from_file
+    from stereoplotter.verification.table import geometry_from_file
 
     with pytest.raises(ConfigError, match=r"photos: expected a stereopair .*found 1 photo"):
         geometry_from_file(SINGLE)
@@ -298,7 +298,7 @@ def test_setup_refusals_name_the_scenario_file(tmp_path, capsys):
     ],
 )
 def test_yaml_problems_are_config_errors(tmp_path, text, message):
-    from stereoplotter.yamlio import load_yaml_mapping
+    from stereoplotter.io.yaml_files import load_yaml_mapping
 
     path = _write(tmp_path, text, "doc.yaml")
     t0 = time.perf_counter()

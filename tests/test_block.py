@@ -1,4 +1,4 @@
-"""Block mode (stereoplotter.block): vectorised setup data of many stereopairs.
+"""Block mode (stereoplotter.setup.block): vectorised setup data of many stereopairs.
 
 The references here are independent computations: the per-pair Python loop (scalars through the
 same equation functions, scales chosen by a loop written after setup_sheet._choose_scales) and the
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from stereoplotter.block import (
+from stereoplotter.setup.block import (
     CSV_COLUMNS,
     BlockResult,
     Refusal,
@@ -28,10 +28,10 @@ from stereoplotter.block import (
 )
 from stereoplotter.errors import ConfigError
 from stereoplotter.instrument.spec import load_instrument
-from stereoplotter.paths import data_dir
-from stereoplotter.scenario.loader import scenario_from_mapping
+from stereoplotter.io.paths import data_dir
+from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.scenario.synthetic import working_area_grid_m
-from stereoplotter.setup_sheet import SetupOptions, compute_setup_sheet
+from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
 
 STRIP = data_dir("scenarios") / "blocks" / "strip60.yaml"
 MARKS = np.array([[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]])

@@ -129,7 +129,7 @@ def test_unexpected_error_is_one_line_exit_3(monkeypatch, capsys):
 
 
 def test_atomic_write_leaves_old_file_when_writing_fails(tmp_path, monkeypatch):
-    import stereoplotter.yamlio as yamlio
+    import stereoplotter.io.yaml_files as yamlio
 
     target = tmp_path / "out.txt"
     yamlio.atomic_write_text(target, "old")

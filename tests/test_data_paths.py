@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from stereoplotter import paths
+from stereoplotter.io import paths
 from stereoplotter.cli import main
 from stereoplotter.instrument.spec import load_instrument
 
@@ -39,7 +39,7 @@ def _user_folder(root: Path, files: dict[str, str]) -> Path:
 
 def test_shipped_data_are_package_data_inside_the_package():
     root = paths.shipped_root()
-    assert root == Path(paths.__file__).parent / "data"
+    assert root == Path(paths.__file__).parent.parent / "data"
     assert paths.available_names("instruments") == ["sc1", "sd3", "spr3"]
     assert paths.available_names("scenarios") == [
         "book_resection_table7",
@@ -79,7 +79,7 @@ def test_user_folder_adds_an_instrument_and_a_scenario(tmp_path, capsys, caplog)
         tmp_path / "mine",
         {"instruments/my_sd3.yaml": sd3, "scenarios/my_pair80.yaml": pair80},
     )
-    with caplog.at_level(logging.WARNING, logger="stereoplotter.paths"):
+    with caplog.at_level(logging.WARNING, logger="stereoplotter.io.paths"):
         assert main(["--data", str(user), "instrument", "show", "my_sd3", "--json"]) == 0
         shown = json.loads(capsys.readouterr().out)
         assert Path(shown["file"]).resolve() == user / "instruments" / "my_sd3.yaml"
@@ -116,7 +116,7 @@ def test_a_user_file_hiding_a_shipped_one_is_used_with_a_warning(tmp_path, capsy
     user = _user_folder(
         tmp_path / "mine", {"instruments/sc1.yaml": text.replace("[-40, 40]", "[-30, 30]")}
     )
-    with caplog.at_level(logging.WARNING, logger="stereoplotter.paths"):
+    with caplog.at_level(logging.WARNING, logger="stereoplotter.io.paths"):
         assert main(["--data", str(user), "instrument", "show", "sc1", "--json"]) == 0
     shown = json.loads(capsys.readouterr().out)
     assert shown["parameters"]["base.z_mm"]["value"] == [-30.0, 30.0]  # the user's file
@@ -128,11 +128,11 @@ def test_a_user_file_hiding_a_shipped_one_is_used_with_a_warning(tmp_path, capsy
 
 
 def test_a_checkout_named_as_user_folder_hides_nothing(caplog):
-    checkout = Path(paths.__file__).resolve().parent.parent
+    checkout = Path(paths.__file__).resolve().parents[2]
     if not (checkout / "instruments").is_dir():
         pytest.skip("not a checkout: no instruments link beside the package")
     paths.set_user_folders([checkout])
-    with caplog.at_level(logging.WARNING, logger="stereoplotter.paths"):
+    with caplog.at_level(logging.WARNING, logger="stereoplotter.io.paths"):
         assert paths.find_data_file("instruments", "sc1") == SHIPPED / "sc1.yaml"
     assert {f.origin for f in paths.data_files("instruments")} == {"shipped"}
     assert caplog.records == []

@@ -1,4 +1,4 @@
-"""Tests of the evaluation of a built model against the ground truth (``stereoplotter.evaluation``).
+"""Tests of the evaluation of a built model against the ground truth (``stereoplotter.procedure.evaluation``).
 
 References for the tolerances: ``kinematics.md`` §3.3 (per-axis approximation at the fiducials)
 and §6 (residual y-parallax and height deformation of the canonical unit at the true settings).
@@ -18,7 +18,7 @@ from conftest import m, mm, um
 from numpy.testing import assert_allclose, assert_array_equal
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.evaluation import (
+from stereoplotter.procedure.evaluation import (
     evaluate_instrument,
     evaluate_model,
     film_points_mm,
@@ -27,10 +27,10 @@ from stereoplotter.evaluation import (
 )
 from stereoplotter.instrument.kinematics import InstrumentSetting, unit_for_orientation
 from stereoplotter.instrument.spec import load_instrument
-from stereoplotter.scenario import load_scenario
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.scenario.synthetic import synthesize_measurements
-from stereoplotter.setup_data import instrument_principal_distance
-from stereoplotter.setup_sheet import compute_setup_sheet
+from stereoplotter.setup.equations import instrument_principal_distance
+from stereoplotter.setup.sheet import compute_setup_sheet
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
 
@@ -354,7 +354,7 @@ def test_parallax_error_map_has_the_expected_artists(trials):
     from matplotlib.collections import PathCollection
     from matplotlib.contour import ContourSet
 
-    from stereoplotter.evaluation_plot import plot_parallax_error_map
+    from stereoplotter.plotting.evaluation import plot_parallax_error_map
 
     if trials is None:
         scenario, sheet, setting, units = _case("pair60")

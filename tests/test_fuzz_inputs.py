@@ -67,10 +67,10 @@ _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 def _shipped_dir(kind: str) -> Path:
-    """The shipped ``kind`` folder: through :mod:`stereoplotter.paths` where it says, else the
+    """The shipped ``kind`` folder: through :mod:`stereoplotter.io.paths` where it says, else the
     checkout's ``kind/`` folder."""
     try:
-        from stereoplotter.paths import data_dir
+        from stereoplotter.io.paths import data_dir
 
         folder = data_dir(kind)
         if folder is not None and Path(folder).is_dir():
@@ -109,8 +109,8 @@ def corpus() -> dict[str, list[Seed]]:
     global _CORPUS
     if _CORPUS is not None:
         return _CORPUS
-    from stereoplotter.accuracy.verification import BOOK
-    from stereoplotter.block import CSV_COLUMNS
+    from stereoplotter.verification.table import BOOK
+    from stereoplotter.setup.block import CSV_COLUMNS
     from stereoplotter.instrument.error_model import error_model_from_spec
     from stereoplotter.instrument.spec import load_instrument
 
@@ -477,13 +477,14 @@ class Outcome:
 def _load(kind: str, path: Path) -> Any:
     """The library loader of a kind, and everything derived from what it loaded."""
     if kind == "scenario":
-        from stereoplotter.scenario import load_scenario, summarize_scenario
+        from stereoplotter.io.scenario_file import load_scenario
+        from stereoplotter.scenario import summarize_scenario
 
         scenario = load_scenario(path)
         json.dumps(summarize_scenario(scenario), default=float)
         return scenario
     if kind in ("block", "block_csv", "csv"):
-        from stereoplotter.block import load_block
+        from stereoplotter.setup.block import load_block
 
         return load_block(path)
     if kind == "instrument":
@@ -500,7 +501,7 @@ def _load(kind: str, path: Path) -> Any:
     if kind == "errors":
         from stereoplotter.instrument.error_model import error_model_from_spec
         from stereoplotter.instrument.spec import load_instrument
-        from stereoplotter.yamlio import load_yaml_mapping
+        from stereoplotter.io.yaml_files import load_yaml_mapping
 
         data, source = load_yaml_mapping(path)
         base = error_model_from_spec(load_instrument(_shipped_dir("instruments") / "sc1.yaml"))
@@ -509,7 +510,7 @@ def _load(kind: str, path: Path) -> Any:
         assert all(np.all(np.isfinite(v)) for v in draws.values()), "non-finite draw"
         return model
     if kind == "geometry":
-        from stereoplotter.accuracy.verification import geometry_from_file
+        from stereoplotter.verification.table import geometry_from_file
 
         return geometry_from_file(path)
     raise AssertionError(kind)
@@ -725,7 +726,7 @@ def test_mutated_inputs_never_crash(tmp_path, monkeypatch):
 @pytest.mark.parametrize("raw", [_bomb_flow(), _bomb_flow(12, 6), _CLASSIC_BOMB])
 def test_alias_bombs_are_refused_quickly(tmp_path, raw):
     from stereoplotter.errors import ConfigError
-    from stereoplotter.yamlio import MAX_YAML_NODES, load_yaml_mapping
+    from stereoplotter.io.yaml_files import MAX_YAML_NODES, load_yaml_mapping
 
     path = tmp_path / "bomb.yaml"
     path.write_text(raw if raw.startswith("a0:") else f"name: x\nvalue: {raw}\n", encoding="utf-8")

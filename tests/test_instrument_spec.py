@@ -30,7 +30,7 @@ from stereoplotter.instrument import (
     list_instruments,
     load_instrument,
 )
-from stereoplotter.paths import data_dir
+from stereoplotter.io.paths import data_dir
 
 NAMES = ("sc1", "spr3", "sd3")
 _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)

@@ -39,7 +39,7 @@ from stereoplotter.instrument.kinematics import (
     turn_correction_knob,
     unit_for_orientation,
 )
-from stereoplotter.instrument.selftest import SyntheticPair, sanity_checks
+from stereoplotter.procedure.selftest import SyntheticPair, sanity_checks
 
 tilts = st.floats(-5.0, 5.0).map(lambda t: t * deg)
 kappas = st.floats(-10.0, 10.0).map(lambda t: t * deg)

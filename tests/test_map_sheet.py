@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.map_sheet import sheet_bounds, zone_of_longitude
+from stereoplotter.geodesy.map_sheet import sheet_bounds, zone_of_longitude
 
 
 def minutes(deg):

@@ -24,7 +24,7 @@ import pytest
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.spec import load_instrument
-from stereoplotter.mechanics import (
+from stereoplotter.instrument.mechanics import (
     BRIDGE,
     G_MM_S2,
     N_PER_UM,

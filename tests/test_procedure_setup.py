@@ -19,8 +19,8 @@ from stereoplotter.procedure.conventional import (
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
-from stereoplotter.scenario import load_scenario
-from stereoplotter.simulation_output import write_simulation
+from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.report.simulation import write_simulation
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,7 @@ import pytest
 
 from stereoplotter.instrument.spec import load_instrument
 from stereoplotter.procedure import simulate
-from stereoplotter.scenario import load_scenario
+from stereoplotter.io.scenario_file import load_scenario
 
 
 @pytest.fixture(scope="module")

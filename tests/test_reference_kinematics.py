@@ -22,7 +22,7 @@ import pytest
 from conftest import deg, mm, um
 from scipy.optimize import least_squares
 
-from stereoplotter.instrument.selftest import (
+from stereoplotter.procedure.selftest import (
     SyntheticPair,
     _apply_touch_up,
     _true_units,

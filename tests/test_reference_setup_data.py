@@ -18,7 +18,7 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
-from stereoplotter.setup_data import (
+from stereoplotter.setup.equations import (
     base_components,
     base_z_correction,
     counter_scale_left,

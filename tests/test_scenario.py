@@ -16,12 +16,8 @@ from numpy.testing import assert_allclose
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.geometry.collinearity import object_to_photo
-from stereoplotter.scenario import (
-    load_scenario,
-    scenario_from_mapping,
-    summarize_scenario,
-    synthesize_measurements,
-)
+from stereoplotter.io.scenario_file import load_scenario, scenario_from_mapping
+from stereoplotter.scenario import summarize_scenario, synthesize_measurements
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 SHIPPED = sorted(SCENARIOS.glob("*.yaml"))

@@ -21,9 +21,9 @@ from stereoplotter.procedure.trials import (
     trial_columns,
 )
 from stereoplotter.random_streams import BLOCK, keyed_draws
-from stereoplotter.scenario import load_scenario
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.statistics import scale_summary, summarise_flags, summarise_values
-from stereoplotter.trial_store import TrialStore
+from stereoplotter.io.trial_store import TrialStore
 
 
 @pytest.fixture(scope="module")

@@ -13,9 +13,9 @@ from stereoplotter.instrument.error_model import error_model_from_spec
 from stereoplotter.instrument.kinematics import counters_from_photo
 from stereoplotter.instrument.spec import RangeRefusal, load_instrument
 from stereoplotter.instrument.virtual import Instrument
-from stereoplotter.mechanics.base import TravelRefusal
-from stereoplotter.scenario import scenario_from_mapping
-from stereoplotter.setup_sheet import compute_setup_sheet
+from stereoplotter.instrument.mechanics.base import TravelRefusal
+from stereoplotter.io.scenario_file import scenario_from_mapping
+from stereoplotter.setup.sheet import compute_setup_sheet
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -1,26 +1,6 @@
-"""Accuracy of model building, Kushtin & Lyskov 1984, ch. 5 §22-§24 and ch. 6 §27.
+"""Accuracy formulas of model building, Kushtin & Lyskov 1984, ch. 5 §22–§24 and ch. 6 §27.
 
-Formulas (:mod:`.chapter5`, :mod:`.setup_accuracy`), their linear Monte Carlo and covariance
-propagation (:mod:`.montecarlo`) and the verification table (:mod:`.verification`).
-Figures are in :mod:`stereoplotter.accuracy_plot` (matplotlib is imported only there).
+Layer: pure. Formulas only — book and rigorous form of each — in :mod:`.chapter5` and
+:mod:`.setup_accuracy`; imports numpy and the base modules, nothing else of the package. Their
+Monte Carlo verification is :mod:`stereoplotter.verification`.
 """
-
-from stereoplotter.accuracy.verification import (
-    BOOK,
-    ROW_KEYS,
-    VERDICTS,
-    closing_comparison,
-    run_verification,
-    verify,
-    write_verification,
-)
-
-__all__ = [
-    "BOOK",
-    "ROW_KEYS",
-    "VERDICTS",
-    "closing_comparison",
-    "run_verification",
-    "verify",
-    "write_verification",
-]

@@ -12,7 +12,7 @@ Two problems (OCR L3829-3831):
    chapter 5, x_п ∈ [−c, 0], y ∈ [−c, +c] (see :mod:`stereoplotter.accuracy.chapter5`).
 
 The ω sign of (6.20) is opposite to (3.22) (``conventions.md`` §6 caveat 2); it does not
-affect any variance here. The simulator (:mod:`stereoplotter.accuracy.montecarlo`) uses (3.22).
+affect any variance here. The simulator (:mod:`stereoplotter.verification.linear_mc`) uses (3.22).
 
 References
 ----------

@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.setup_data import correction_inclination, decentration
+from stereoplotter.setup.equations import correction_inclination, decentration
 
 __all__ = [
     "DECENTRATION_VARIANTS",

@@ -29,8 +29,8 @@ from typing import Any, ClassVar
 import yaml
 
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.paths import data_dir, find_data_file, list_data_files
-from stereoplotter.yamlio import Fields, describe_value, did_you_mean, load_yaml_mapping
+from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
+from stereoplotter.io.yaml_files import Fields, describe_value, did_you_mean, load_yaml_mapping
 
 __all__ = [
     "STATUSES",
@@ -523,7 +523,7 @@ def load_instrument(name_or_path: str | os.PathLike[str]) -> InstrumentSpec:
     ----------
     name_or_path : str or path-like
         A bare name is looked up as ``<name>.yaml`` in the user data folders, then the shipped
-        ones (:func:`stereoplotter.paths.find_data_file`); anything with a folder part, or an
+        ones (:func:`stereoplotter.io.paths.find_data_file`); anything with a folder part, or an
         existing ``.yaml``/``.yml`` file, is used as a path.
 
     Returns
@@ -602,8 +602,8 @@ def _check_mechanics(spec: InstrumentSpec) -> None:
     (``mechanics.md``): μ ≥ 1 on the vertical Z axis, or a dead band 2h = b + 2μmg/k that the
     0.5 mm overtravel of the unidirectional approach does not clear. The axes are built as the
     virtual instrument builds them, so a file that loads also runs."""
-    from stereoplotter.mechanics.base import N_PER_UM, AxisParams
-    from stereoplotter.mechanics.coordinatograph import CoordinatographParams
+    from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
+    from stereoplotter.instrument.mechanics.coordinatograph import CoordinatographParams
 
     def refuse(key: str, exc: StereoplotterError, hint: str = "") -> ConfigError:
         return ConfigError(

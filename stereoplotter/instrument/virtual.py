@@ -6,7 +6,7 @@ exposes only what an operator can do: turn a control to a scale reading (:meth:`
 correction knob (:meth:`turn_knob`), read a scale (:meth:`read`), and look through the eyepieces
 (:meth:`marks`, :meth:`mark_offsets`). Every formula it needs lives in the pure layer:
 the kinematics in :mod:`stereoplotter.instrument.kinematics`, the backlash in
-:mod:`stereoplotter.mechanics`.
+:mod:`stereoplotter.instrument.mechanics`.
 
 Frames (``kinematics.md`` §3.1): X, Y, D are physical model coordinates [mm] with the left pivot's
 plumb at X = Y = 0; a counter reads ``zero + (1 + e)·nut`` (its zero reading, место нуля, is
@@ -36,8 +36,8 @@ from stereoplotter.instrument.kinematics import (
     turn_correction_knob,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, check_in_range, load_instrument
-from stereoplotter.mechanics.base import N_PER_UM, AxisParams
-from stereoplotter.mechanics.play import PlayAxis
+from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
+from stereoplotter.instrument.mechanics.play import PlayAxis
 
 __all__ = ["BACKENDS", "CONTROLS", "HEIGHT_SCALE", "NOMINAL_ZERO", "Instrument", "Scale"]
 
@@ -140,7 +140,7 @@ class Instrument:
     -----
     Ranges are stops: a setting outside the instrument's range raises
     :class:`~stereoplotter.instrument.spec.RangeRefusal` or
-    :class:`~stereoplotter.mechanics.base.TravelRefusal`; nothing is clipped.
+    :class:`~stereoplotter.instrument.mechanics.base.TravelRefusal`; nothing is clipped.
     """
 
     def __init__(
@@ -284,7 +284,7 @@ class Instrument:
         lo, hi = params.range_mm
         start = 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi)
         if self.backend == "pymunk" and name in ("X", "Y", "Z"):
-            from stereoplotter.mechanics.pymunk_axis import PymunkAxis
+            from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis
 
             return PymunkAxis(params, start_mm=start)
         axis = PlayAxis(params, trials=self.trials if self.trials is not None else 1)
@@ -559,7 +559,7 @@ class Instrument:
         RangeRefusal
             A ratio that is not one of the gears.
         """
-        from stereoplotter.mechanics.coordinatograph import (
+        from stereoplotter.instrument.mechanics.coordinatograph import (
             Coordinatograph,
             CoordinatographParams,
         )

@@ -208,10 +208,10 @@ class Scene:
     ) -> Scene:
         """Photos of ``scenario`` and its six standard points (c from the instrument spec).
 
-        The standard points are those of ``stereoplotter.evaluation.standard_points_m``
+        The standard points are those of ``stereoplotter.procedure.evaluation.standard_points_m``
         (Fig. 39: nadirs ± c·H̄/f), H̄ the flying height of S_л over the mean control height.
         """
-        from stereoplotter.evaluation import instrument_frame_m, standard_points_m
+        from stereoplotter.procedure.evaluation import instrument_frame_m, standard_points_m
 
         m = synthesize_measurements(scenario, np.random.default_rng(0), noise=False)
         fid = {p.photo: p.fiducials_true_mm for p in m.photos}
@@ -223,7 +223,7 @@ class Scene:
 
     def images(self, points_m: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """True images of ground points on the left and right photo (fiducial system). [mm]"""
-        from stereoplotter.evaluation import film_points_mm
+        from stereoplotter.procedure.evaluation import film_points_mm
 
         pts = np.asarray(points_m, float)
         return film_points_mm(self.scenario, "left", pts), film_points_mm(

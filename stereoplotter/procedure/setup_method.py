@@ -24,13 +24,13 @@ from numpy.typing import NDArray
 from stereoplotter.instrument.kinematics import rod_from_counters
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 from stereoplotter.procedure.operator import Operator, Scene
-from stereoplotter.setup_data import (
+from stereoplotter.setup.equations import (
     base_z_correction,
     height_correction,
     height_scale_reading,
     sheet_corner_instrument_coordinates,
 )
-from stereoplotter.setup_sheet import SetupSheet
+from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = [
     "Run",

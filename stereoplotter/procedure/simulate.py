@@ -4,7 +4,7 @@
 seed), the operator and the scene, runs the setup-data method (stages 1–5) or the conventional
 method, vectorised over ``trials`` on the closed-form back-end, and evaluates the model.
 :func:`simulate_per_trial` is the test oracle: the same procedure one trial at a time.
-:mod:`stereoplotter.simulation_output` writes the files; :mod:`stereoplotter.procedure.trials`
+:mod:`stereoplotter.report.simulation` writes the files; :mod:`stereoplotter.procedure.trials`
 runs long runs in chunks.
 """
 
@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.evaluation import ModelEvaluation, evaluate_model
+from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.instrument.virtual import Instrument
@@ -27,7 +27,7 @@ from stereoplotter.procedure.setup_method import Run, run_setup_method
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import working_area_grid_m
-from stereoplotter.setup_sheet import SetupSheet, compute_setup_sheet
+from stereoplotter.setup.sheet import SetupSheet, compute_setup_sheet
 
 __all__ = [
     "METHODS",
@@ -106,7 +106,7 @@ def _errors(spec: InstrumentSpec, errors: ErrorModel | str | None) -> ErrorModel
         return errors
     if errors == "zero":
         return error_model_from_spec(spec).zero()
-    from stereoplotter.yamlio import load_yaml_mapping
+    from stereoplotter.io.yaml_files import load_yaml_mapping
 
     data, source = load_yaml_mapping(errors)
     return error_model_from_spec(spec).with_overrides(data, source)

@@ -8,7 +8,7 @@ Each chunk is reduced at once to *columns*: one value per trial and measure
 (:func:`trial_columns`: every check's residual, tolerance, pass flag and iterations, the
 iterations per stage, the zero readings, the true residual y-parallax, and the evaluation's max
 and RMS errors per point set in base units). Columns are what a long run keeps (the caller
-spools them, ``stereoplotter.trial_store``); :func:`summarise_columns` turns them into the
+spools them, ``stereoplotter.io.trial_store``); :func:`summarise_columns` turns them into the
 summary that ``simulate --json`` prints: pass rates, means, RMS and quantiles with their Monte
 Carlo standard errors (:mod:`stereoplotter.statistics`), never per-trial arrays.
 """

@@ -1,9 +1,8 @@
-"""Scenarios: the ground truth of a photo or a stereopair, loaded from ``scenarios/*.yaml``, and
-the synthetic measurements made from it."""
+"""Scenarios: the ground truth of a photo or a stereopair and the synthetic measurements made
+from it (pure layer; files are read by :mod:`stereoplotter.io.scenario_file`)."""
 
 from __future__ import annotations
 
-from stereoplotter.scenario.loader import load_scenario, scenario_from_mapping
 from stereoplotter.scenario.model import (
     Camera,
     ErrorSettings,
@@ -37,8 +36,6 @@ __all__ = [
     "Point",
     "Scenario",
     "Terrain",
-    "load_scenario",
-    "scenario_from_mapping",
     "summarize_scenario",
     "synthesize_measurements",
     "working_area_grid_m",

@@ -24,7 +24,7 @@ from stereoplotter.geodesy.photogrammetric import (
     gauss_kruger_from_local,
     local_from_gauss_kruger,
 )
-from stereoplotter.map_sheet import sheet_bounds
+from stereoplotter.geodesy.map_sheet import sheet_bounds
 from stereoplotter.scenario.model import Frame
 
 __all__ = [

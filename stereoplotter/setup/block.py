@@ -13,7 +13,7 @@ Reference
 .. [1] Kushtin I. F. & Lyskov G. A., *Фотограмметрия снимка и стереоскопических моделей*,
    Moscow: Nedra, 1984, ch. 6, §26, pp. 153–158 (OCR L3682–3826): Eqs. (6.1)–(6.6), Table 24.
 
-Equations chained (each lives in one place: :mod:`stereoplotter.setup_data`,
+Equations chained (each lives in one place: :mod:`stereoplotter.setup.equations`,
 :mod:`stereoplotter.geometry.transformed`, :mod:`stereoplotter.geometry.rotation`):
 
 * frame: θ = atan2(ΔY_S, ΔX_S), M′ = R_Z(−θ)·M, α, ω, κ from M′ (inverse of (2.50));
@@ -23,7 +23,7 @@ Equations chained (each lives in one place: :mod:`stereoplotter.setup_data`,
 
 **Not in block mode:** the sheet corners (6.7) and the similarity (6.8) need the map sheet and
 plan control of each model; compute those per model with
-:func:`stereoplotter.setup_sheet.compute_setup_sheet`. Likewise the X, Y travel of the model
+:func:`stereoplotter.setup.sheet.compute_setup_sheet`. Likewise the X, Y travel of the model
 (``model_x_offset_range_mm``) is not checked here, since a block file gives no plan extent of the
 working area; the single-pair sheet checks it.
 
@@ -59,15 +59,15 @@ from stereoplotter.geometry.transformed import (
     transformed_y_single_tilt,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
-from stereoplotter.scale_choice import (
+from stereoplotter.setup.scale_choice import (
     candidate_flags,
     candidate_scales,
     choose_candidates,
     describe_candidate,
 )
-from stereoplotter.scenario.loader import MAX_TILT_DEG, _camera
+from stereoplotter.io.scenario_file import MAX_TILT_DEG, _camera
 from stereoplotter.scenario.model import Camera
-from stereoplotter.setup_data import (
+from stereoplotter.setup.equations import (
     base_components,
     counter_scale_left,
     counter_scale_right,
@@ -78,8 +78,8 @@ from stereoplotter.setup_data import (
     projection_distance,
     transformation_coefficient,
 )
-from stereoplotter.setup_sheet import assumed_parameters
-from stereoplotter.yamlio import Fields, atomic_write_text, load_yaml_mapping
+from stereoplotter.setup.sheet import assumed_parameters
+from stereoplotter.io.yaml_files import Fields, atomic_write_text, load_yaml_mapping
 
 __all__ = [
     "Block",
@@ -116,7 +116,7 @@ class Refusal(enum.IntFlag):
 
     The scale-dependent codes (``F_INSTRUMENT`` … ``BASE_Z``) are those of the *closest* (M_г,
     M_в) candidate when no candidate is feasible: fewest violated conditions, then the largest
-    model scale, as :mod:`stereoplotter.setup_sheet` reports it.
+    model scale, as :mod:`stereoplotter.setup.sheet` reports it.
     """
 
     NONE = 0
@@ -212,7 +212,7 @@ def load_block(path: str | os.PathLike[str]) -> Block:
 
     Examples
     --------
-    >>> from stereoplotter.paths import data_dir
+    >>> from stereoplotter.io.paths import data_dir
     >>> block = load_block(data_dir("scenarios") / "blocks" / "strip60.yaml")
     >>> len(block), block.camera.focal_length_mm
     (8, 70.0)
@@ -537,7 +537,7 @@ _ARRAY_FIELDS = tuple(
 def _candidate_grid(
     spec: InstrumentSpec, map_scale: int | None, horizontal: int | None, vertical: int | None
 ) -> NDArray[np.float64]:
-    """(M_г, M_в) candidates of :func:`stereoplotter.scale_choice.candidate_scales`: (C, 2)."""
+    """(M_г, M_в) candidates of :func:`stereoplotter.setup.scale_choice.candidate_scales`: (C, 2)."""
     try:
         return candidate_scales(spec, map_scale, horizontal, vertical)
     except StereoplotterError as exc:
@@ -648,7 +648,7 @@ def compute_block(
     projection distances (Z_Sл − Z)·1000/M_в of the lowest and highest ground, and the same plus
     b_z′ for the right rod, are inside [D_min, D_max], and b_x, b_y, b_z′ are in range; the largest
     model scale (smallest M_г) wins, then the smallest M_в, as in
-    :func:`stereoplotter.setup_sheet.compute_setup_sheet`; then Eqs. (6.3), (6.4), (6.1)/(6.2)
+    :func:`stereoplotter.setup.sheet.compute_setup_sheet`; then Eqs. (6.3), (6.4), (6.1)/(6.2)
     (n-free) and (3.17) with κ = 0 for the marks, (6.5), the decentrations and (6.6).
 
     (6.7)/(6.8) — the sheet corners — are **not** computed in block mode (they need a map sheet

@@ -16,7 +16,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from stereoplotter.accuracy import montecarlo as mc
+from stereoplotter.verification import linear_mc as mc
 
 __all__ = ["plot_error_maps", "plot_mc_histogram", "plot_mc_histograms", "plot_verification_chart"]
 
@@ -38,7 +38,7 @@ def plot_error_maps(
     matplotlib.figure.Figure
     """
     from stereoplotter.accuracy.setup_accuracy import setup_element_sigmas
-    from stereoplotter.accuracy.verification import _both
+    from stereoplotter.verification.table import _both
 
     if sigmas is None:
         sigmas = _both(setup_element_sigmas(focal_length_mm, 85.0, 1.42, 0.01))
@@ -113,7 +113,7 @@ def plot_mc_histograms(rows, procedure=None, trials=4000, seed=0):
     rows : list of dict
         Verification rows (for the formula values).
     procedure : dict, optional
-        :func:`~stereoplotter.accuracy.verification.run_procedure_mc` output; one panel per
+        :func:`~stereoplotter.verification.table.run_procedure_mc` output; one panel per
         (overlap, method) with the per-trial coefficient, the procedure-MC RMS and the formula.
 
     Returns
@@ -121,7 +121,7 @@ def plot_mc_histograms(rows, procedure=None, trials=4000, seed=0):
     matplotlib.figure.Figure
     """
     from stereoplotter.accuracy import setup_accuracy as sa
-    from stereoplotter.accuracy.verification import BOOK, _both
+    from stereoplotter.verification.table import BOOK, _both
 
     by = {r["eq"]: r for r in rows}
     panels = []

@@ -26,7 +26,7 @@ def plot_scenario_layout(
 ) -> Any:
     """Plan view of a scenario: photo footprints on the mean point height, projection centres,
     control (triangles) and check (circles) points, the map sheet frame (from the fit (6.8)) and,
-    with ``result`` from :func:`stereoplotter.foundation.run_foundation`, the plan errors of the
+    with ``result`` from :func:`stereoplotter.scenario.foundation.run_foundation`, the plan errors of the
     intersected points as arrows exaggerated ×1000.
 
     Returns
@@ -91,13 +91,13 @@ def plot_setup_sheet(sheet: Any, figure: Any = None) -> Any:
 
     Parameters
     ----------
-    sheet : stereoplotter.setup_sheet.SetupSheet
+    sheet : stereoplotter.setup.sheet.SetupSheet
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    from stereoplotter.sheet_report import sheet_to_dict
+    from stereoplotter.report.sheet import sheet_to_dict
 
     fig = figure or plt.figure(figsize=(11.69, 8.27), layout="constrained")  # A4 landscape
     grid = fig.add_gridspec(2, 3, height_ratios=[1.0, 1.0], width_ratios=[1.1, 1.0, 1.0])

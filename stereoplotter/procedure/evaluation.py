@@ -19,7 +19,7 @@ Frame
 Ideal model
     The affine image of the ground (``kinematics.md`` §2.1, §3.5), in counter terms:
     X = MO_X + X_g·1000/M_г, Y = MO_Y + Y_g·1000/M_г, D = (Z_Sл − Z)·1000/M_в (Eq. (6.6) of [1]_,
-    :func:`~stereoplotter.setup_data.model_height`), with M_в = M_г/k.
+    :func:`~stereoplotter.setup.equations.model_height`), with M_в = M_г/k.
 Parallax errors (at the ideal position)
     The counters are put on the ideal model point, the photo points under the marks are taken
     (:func:`~stereoplotter.instrument.kinematics.marks_from_counters`, ``kinematics.md`` §3.3)
@@ -34,7 +34,7 @@ Built model
     cleared, Y as the mean of the two rays). Plan errors are (built − ideal)·M_г/1000 [m] along
     the instrument-frame axes, and ×1000/M_map in mm on the map. The height of the built point is
     read as the metre height scale shows it, height_zero − D·M_в/1000 (the scale of (6.15),
-    :func:`~stereoplotter.setup_data.height_scale_reading`); ΔH = built − true [m], positive when
+    :func:`~stereoplotter.setup.equations.height_scale_reading`); ΔH = built − true [m], positive when
     the built point is too high; in ‰ of the mean flying height H̄ = Z_Sл − mean Z of the
     working-area grid.
 After plane removal
@@ -78,8 +78,8 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import film_deformed, working_area_grid_m
-from stereoplotter.setup_data import height_scale_reading, model_height
-from stereoplotter.setup_sheet import instrument_frame_m
+from stereoplotter.setup.equations import height_scale_reading, model_height
+from stereoplotter.setup.sheet import instrument_frame_m
 
 __all__ = [
     "STANDARD_POINTS_C_MM",
@@ -129,7 +129,7 @@ def ideal_model_mm(
     Notes
     -----
     ``kinematics.md`` §2.1 (the model is A(X, Y, Z) = (X/M_г, Y/M_г, Z/M_в)) and §3.5 (counters ↔
-    ground); the depth is Eq. (6.6) of [1]_ (:func:`~stereoplotter.setup_data.model_height`).
+    ground); the depth is Eq. (6.6) of [1]_ (:func:`~stereoplotter.setup.equations.model_height`).
 
     Examples
     --------
@@ -822,7 +822,7 @@ def evaluate_instrument(scenario: Scenario, sheet: Any, instrument: Any, **kwarg
 
 
 def parallax_map_data(evaluation: ModelEvaluation, *, after_plane: bool = False) -> dict[str, Any]:
-    r"""The data of the x-parallax error map (for :mod:`stereoplotter.evaluation_plot`).
+    r"""The data of the x-parallax error map (for :mod:`stereoplotter.plotting.evaluation`).
 
     Parameters
     ----------

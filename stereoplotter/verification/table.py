@@ -24,9 +24,9 @@ from pathlib import Path
 import numpy as np
 
 from stereoplotter.accuracy import chapter5 as c5
-from stereoplotter.accuracy import montecarlo as mc
+from stereoplotter.verification import linear_mc as mc
 from stereoplotter.accuracy import setup_accuracy as sa
-from stereoplotter.yamlio import atomic_write_bytes
+from stereoplotter.io.yaml_files import atomic_write_bytes
 
 __all__ = [
     "BOOK",
@@ -715,7 +715,7 @@ def geometry_from_file(path) -> tuple[dict, dict]:
         ``{"60": path or None, "80": path or None}`` for the procedure MC.
     """
     from stereoplotter.errors import ConfigError
-    from stereoplotter.yamlio import Fields, load_yaml_mapping
+    from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
 
     data, source = load_yaml_mapping(path)
     if "camera" not in data:
@@ -724,8 +724,8 @@ def geometry_from_file(path) -> tuple[dict, dict]:
         geometry = {k: fields.number(data, k, "", **_GEOMETRY_LIMITS[k]) for k in data}
         _check_geometry(fields, geometry)
         return geometry, {"60": None, "80": None}
-    from stereoplotter.accuracy.procedure_mc import scenario_geometry
-    from stereoplotter.scenario import load_scenario
+    from stereoplotter.verification.procedure_mc import scenario_geometry
+    from stereoplotter.io.scenario_file import load_scenario
 
     scenario = load_scenario(path)  # every problem of the file as one ConfigError
     if not scenario.is_stereopair:
@@ -824,16 +824,16 @@ PROCEDURE_ROWS = {
 
 
 def run_procedure_mc(trials=PROCEDURE_TRIALS, seed=20240601, scenarios=None, progress=None):
-    """The procedure MC of :mod:`stereoplotter.accuracy.procedure_mc` for the setup-data and the
+    """The procedure MC of :mod:`stereoplotter.verification.procedure_mc` for the setup-data and the
     conventional method at each overlap slot; ``scenarios`` maps "60"/"80" to a scenario file
     (None: skip); default the book's ``pair60.yaml`` and ``pair80.yaml``.
 
     Returns
     -------
     dict
-        (slot, method) → :func:`~stereoplotter.accuracy.procedure_mc.procedure_mc` result.
+        (slot, method) → :func:`~stereoplotter.verification.procedure_mc.procedure_mc` result.
     """
-    from stereoplotter.accuracy.procedure_mc import procedure_mc
+    from stereoplotter.verification.procedure_mc import procedure_mc
 
     if scenarios is None:
         scenarios = {"60": "pair60.yaml", "80": "pair80.yaml"}

@@ -6,9 +6,9 @@ axial play (backlash) b and an axial compliance k, and the carriage slides on it
 Coulomb friction F = μ·m·g (``docs/design/mechanics.md`` §4). Two back-ends implement
 :class:`LinearAxis`:
 
-* :class:`~stereoplotter.mechanics.play.PlayAxis`: the closed-form play operator, vectorised over
+* :class:`~stereoplotter.instrument.mechanics.play.PlayAxis`: the closed-form play operator, vectorised over
   trials (the test oracle and the fast path for bulk Monte Carlo);
-* :class:`~stereoplotter.mechanics.pymunk_axis.PymunkAxis`: the time-domain pymunk model.
+* :class:`~stereoplotter.instrument.mechanics.pymunk_axis.PymunkAxis`: the time-domain pymunk model.
 
 Units (``mechanics.md`` §3): mm, s, kg. Hence force in mN (kg·mm/s²), stiffness in kg/s²
 (1 N/µm = 10⁶ kg/s², :data:`N_PER_UM`), torque in kg·mm²/s² (1 N·m = 10⁶, :data:`N_M`).
@@ -193,7 +193,7 @@ class AxisParams:
     @property
     def half_play_mm(self) -> float:
         """Half-width h of the play operator's dead band (see :func:`~.play.half_play_mm`). [mm]"""
-        from stereoplotter.mechanics.play import half_play_mm
+        from stereoplotter.instrument.mechanics.play import half_play_mm
 
         return float(
             half_play_mm(
@@ -208,7 +208,7 @@ class AxisParams:
     @property
     def offset_mm(self) -> float:
         """Centre offset c of the dead band (see :func:`~.play.play_offset_mm`). [mm]"""
-        from stereoplotter.mechanics.play import play_offset_mm
+        from stereoplotter.instrument.mechanics.play import play_offset_mm
 
         return float(
             play_offset_mm(
@@ -301,7 +301,7 @@ def check_travel(params: AxisParams, value: ArrayLike, what: str = "setting") ->
     >>> check_travel(AxisParams(name="X", range_mm=(-150.0, 150.0)), 151.0)
     Traceback (most recent call last):
     ...
-    stereoplotter.mechanics.base.TravelRefusal: axis X: setting 151.000000 mm is beyond the range stops [-150, 150] mm (the stop refuses it; nothing is clipped)
+    stereoplotter.instrument.mechanics.base.TravelRefusal: axis X: setting 151.000000 mm is beyond the range stops [-150, 150] mm (the stop refuses it; nothing is clipped)
     """  # noqa: E501
     lo, hi = params.range_mm
     v = np.asarray(value, dtype=float)

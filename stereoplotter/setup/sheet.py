@@ -1,7 +1,7 @@
 """The setup sheet (Table 24 of the book): everything an operator needs to build an oriented,
 scaled model on the instrument without plotting control first.
 
-Orchestration only: the equations live in :mod:`stereoplotter.setup_data` and
+Orchestration only: the equations live in :mod:`stereoplotter.setup.equations` and
 :mod:`stereoplotter.geometry`; the decisions behind them in ``docs/setup-data.md``. The sheet is
 computed from the scenario *as measured*: f′ from the measured fiducial spans, the measured mark
 coordinates, and the exterior orientation as given (aerotriangulation) or by resection from the
@@ -31,7 +31,7 @@ from stereoplotter.geometry.transformed import (
     transformed_y_single_tilt,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
-from stereoplotter.scale_choice import (
+from stereoplotter.setup.scale_choice import (
     ScaleCheck,
     candidate_flags,
     candidate_scales,
@@ -44,7 +44,7 @@ from stereoplotter.scenario.synthetic import (
     synthesize_measurements,
     working_area_grid_m,
 )
-from stereoplotter.setup_data import (
+from stereoplotter.setup.equations import (
     base_components,
     correction_inclination,
     counter_scale_left,
@@ -56,7 +56,7 @@ from stereoplotter.setup_data import (
     sheet_corner_instrument_coordinates,
     sheet_corner_instrument_coordinates_book_form,
 )
-from stereoplotter.setup_readings import stage_readings
+from stereoplotter.setup.readings import stage_readings
 
 __all__ = [
     "CORNER_ORDER",
@@ -110,7 +110,7 @@ class SetupOptions:
 @dataclass(frozen=True, slots=True)
 class ScaleCandidate:
     """One (M_г, M_в) pair considered by the scale choice, with the conditions it fails
-    (:class:`~stereoplotter.scale_choice.ScaleCheck` names; empty = feasible)."""
+    (:class:`~stereoplotter.setup.scale_choice.ScaleCheck` names; empty = feasible)."""
 
     horizontal: int
     vertical: int
@@ -234,7 +234,7 @@ def _choose_scales(
     base_m: NDArray,
     offsets_m: NDArray,
 ) -> tuple[ScaleCandidate, tuple[ScaleCandidate, ...]]:
-    """Item 1 of §26 through :mod:`stereoplotter.scale_choice`, for one pair."""
+    """Item 1 of §26 through :mod:`stereoplotter.setup.scale_choice`, for one pair."""
     try:
         grid = candidate_scales(
             spec,

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from stereoplotter.setup_data import height_scale_reading
+from stereoplotter.setup.equations import height_scale_reading
 
 if TYPE_CHECKING:  # pragma: no cover
-    from stereoplotter.setup_sheet import SetupSheet
+    from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = ["stage_readings"]
 

@@ -1,7 +1,7 @@
 """Figure of the evaluation of a built model: the x-parallax error map over the working area.
 
 Plotting at the edge (``style.md`` §13): the data come from the pure
-:func:`stereoplotter.evaluation.parallax_map_data`; this module only draws (non-interactive Agg
+:func:`stereoplotter.procedure.evaluation.parallax_map_data`; this module only draws (non-interactive Agg
 backend). The function takes an optional ``ax`` and returns the Figure, so tests can inspect the
 artists.
 """
@@ -17,7 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from stereoplotter.evaluation import ModelEvaluation, parallax_map_data
+from stereoplotter.procedure.evaluation import ModelEvaluation, parallax_map_data
 
 __all__ = ["plot_parallax_error_map"]
 
@@ -35,7 +35,7 @@ def plot_parallax_error_map(
 
     Parameters
     ----------
-    evaluation : stereoplotter.evaluation.ModelEvaluation
+    evaluation : stereoplotter.procedure.evaluation.ModelEvaluation
     ax : matplotlib.axes.Axes, optional
         Draw into this axes; by default a new figure.
     after_plane : bool

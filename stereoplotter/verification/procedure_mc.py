@@ -3,7 +3,7 @@
 :func:`procedure_mc` runs the real stages on the virtual SC-1 (``procedure.simulate``, closed-form
 back-end, vectorised over trials) twice with the same seed — once with the operator's pointing
 errors of the formula switched on, once with every error zero — and takes the x-parallax error
-field δp of the built model (photo mm, at the ideal model position, :mod:`stereoplotter.evaluation`)
+field δp of the built model (photo mm, at the ideal model position, :mod:`stereoplotter.procedure.evaluation`)
 on the formula's own integration domain. The difference of the two runs is the error the
 pointing caused (the zero run carries the deterministic residue of the sheet's approximations,
 reported as ``bias``). The statistic is the protocol's: sqrt(mean over trials and a uniform
@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stereoplotter.accuracy.montecarlo import CI_Z
+from stereoplotter.verification.linear_mc import CI_Z
 
 __all__ = ["PROCEDURE_ROWS", "procedure_mc", "scenario_geometry"]
 
@@ -55,7 +55,7 @@ PROCEDURE_ROWS = {
 
 
 def _load(scenario):
-    from stereoplotter.scenario import load_scenario
+    from stereoplotter.io.scenario_file import load_scenario
 
     if isinstance(scenario, str | Path):
         path = Path(scenario)
@@ -88,10 +88,10 @@ def scenario_geometry(scenario, instrument: str = "sc1") -> dict:
 
 
 def _scenario_geometry(scenario, instrument):
-    from stereoplotter.evaluation import instrument_frame_m
+    from stereoplotter.procedure.evaluation import instrument_frame_m
     from stereoplotter.instrument.spec import load_instrument
     from stereoplotter.scenario.synthetic import working_area_grid_m
-    from stereoplotter.setup_sheet import compute_setup_sheet
+    from stereoplotter.setup.sheet import compute_setup_sheet
 
     spec = load_instrument(instrument)
     sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
@@ -124,7 +124,7 @@ def _scenario_geometry(scenario, instrument):
 
 def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
     """Ground points (instrument frame) under a midpoint grid of left-photo (x_л, y) [mm]."""
-    from stereoplotter.evaluation import instrument_frame_m
+    from stereoplotter.procedure.evaluation import instrument_frame_m
 
     nx, ny = grid
     x0, x1 = x_left_range
@@ -143,7 +143,7 @@ def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)
 
 
 def _dp(scenario, sheet, inst, frame_pts):
-    from stereoplotter import evaluation as ev
+    from stereoplotter.procedure import evaluation as ev
 
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)

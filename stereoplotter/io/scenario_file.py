@@ -28,7 +28,7 @@ from stereoplotter.scenario.model import (
     Scenario,
     Terrain,
 )
-from stereoplotter.yamlio import Fields, load_yaml_mapping
+from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
 
 __all__ = ["load_scenario", "scenario_from_mapping"]
 
@@ -41,7 +41,7 @@ MIN_SIMILARITY_POINTS = 2
 #: The defaults of the optional ``errors`` section. (Not ``ErrorSettings.photo_point_sigma_um``:
 #: on a dataclass with slots that is the slot descriptor, not the default value.)
 _DEFAULT_ERRORS = ErrorSettings()
-#: Top-level fields that only a block file has (``stereoplotter.block``).
+#: Top-level fields that only a block file has (``stereoplotter.setup.block``).
 _BLOCK_FIELDS = ("models", "models_csv")
 
 _TOP = (

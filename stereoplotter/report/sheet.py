@@ -1,6 +1,6 @@
 """The setup sheet as data (JSON/YAML) and as Markdown: Table 24 and the readings of each stage.
 
-Pure formatting of a :class:`~stereoplotter.setup_sheet.SetupSheet`; the figure is in
+Pure formatting of a :class:`~stereoplotter.setup.sheet.SetupSheet`; the figure is in
 ``plotting.py``. Every value carries its unit, equation and, where it rests on an assumed
 instrument parameter, the list of those parameters (shown as ASSUMED).
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stereoplotter.setup_sheet import SetupSheet
+from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = ["sheet_markdown", "sheet_to_dict"]
 

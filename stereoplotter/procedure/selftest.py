@@ -56,7 +56,7 @@ from stereoplotter.instrument.kinematics import (
     turn_correction_knob,
     unit_for_orientation,
 )
-from stereoplotter.setup_data import (
+from stereoplotter.setup.equations import (
     base_components,
     counter_scale_left,
     decentration,

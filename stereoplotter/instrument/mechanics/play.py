@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.mechanics.base import (
+from stereoplotter.instrument.mechanics.base import (
     G_MM_S2,
     AxisParams,
     Side,

@@ -30,7 +30,7 @@ import numpy as np
 import pymunk
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.mechanics.base import (
+from stereoplotter.instrument.mechanics.base import (
     G_MM_S2,
     AxisParams,
     Side,

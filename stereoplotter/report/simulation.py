@@ -30,8 +30,8 @@ from stereoplotter.procedure.trials import (
     summarise_columns,
     trial_columns,
 )
-from stereoplotter.trial_store import TrialStore
-from stereoplotter.yamlio import atomic_write_bytes
+from stereoplotter.io.trial_store import TrialStore
+from stereoplotter.io.yaml_files import atomic_write_bytes
 
 __all__ = ["SimulationOutcome", "run_simulation_command", "simulation_markdown", "write_simulation"]
 
@@ -166,7 +166,7 @@ def simulation_markdown(s: dict[str, Any]) -> str:
 
 def _parallax_png(result: SimulationResult) -> bytes:
     """The true residual y-parallax over the working-area grid (trial 0) as a PNG."""
-    from stereoplotter.plotting import plot_residual_y_parallax
+    from stereoplotter.plotting.figures import plot_residual_y_parallax
 
     fig = plot_residual_y_parallax(result)
     buf = io.BytesIO()
@@ -234,7 +234,7 @@ def run_simulation_command(
     ``progress(n)`` is told the trials each finished chunk ran.
     """
     from stereoplotter.instrument.spec import load_instrument
-    from stereoplotter.scenario import load_scenario
+    from stereoplotter.io.scenario_file import load_scenario
 
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)

@@ -13,7 +13,7 @@ sheet turned about a pinned corner). Units: mm, s, kg; randomness only through a
 ``numpy.random.Generator``.
 """
 
-from stereoplotter.mechanics.base import (
+from stereoplotter.instrument.mechanics.base import (
     G_MM_S2,
     N_M,
     N_PER_UM,
@@ -23,15 +23,15 @@ from stereoplotter.mechanics.base import (
     TravelRefusal,
     check_travel,
 )
-from stereoplotter.mechanics.coordinatograph import (
+from stereoplotter.instrument.mechanics.coordinatograph import (
     BRIDGE,
     PEN_CARRIAGE,
     Coordinatograph,
     CoordinatographParams,
 )
-from stereoplotter.mechanics.play import PlayAxis, half_play_mm, play, play_offset_mm
-from stereoplotter.mechanics.pymunk_axis import PymunkAxis, new_space, velocity_plan
-from stereoplotter.mechanics.sheet import (
+from stereoplotter.instrument.mechanics.play import PlayAxis, half_play_mm, play, play_offset_mm
+from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis, new_space, velocity_plan
+from stereoplotter.instrument.mechanics.sheet import (
     OperatorParams,
     SheetOnTable,
     SheetOrientation,

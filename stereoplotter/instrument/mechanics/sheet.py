@@ -25,14 +25,14 @@ import numpy as np
 import pymunk
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.mechanics.base import N_M, Side
-from stereoplotter.mechanics.pymunk_axis import new_space
+from stereoplotter.instrument.mechanics.base import N_M, Side
+from stereoplotter.instrument.mechanics.pymunk_axis import new_space
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from stereoplotter.instrument.spec import InstrumentSpec
-    from stereoplotter.mechanics.coordinatograph import Coordinatograph
+    from stereoplotter.instrument.mechanics.coordinatograph import Coordinatograph
 
 __all__ = [
     "OperatorParams",
