@@ -13,8 +13,8 @@ import time
 import numpy as np
 
 from stereoplotter.instrument.spec import load_instrument
-from stereoplotter.procedure import simulate, simulate_per_trial
 from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.procedure import simulate, simulate_per_trial
 
 
 def main() -> None:

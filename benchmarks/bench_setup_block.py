@@ -1,10 +1,10 @@
 """Benchmark: setup data of a block of stereopairs, vectorised vs one pair at a time.
 
 Run ``python benchmarks/bench_setup_block.py`` (optionally ``--pairs 10000 --loop-pairs 300``).
-Times the numeric part only — :func:`stereoplotter.setup.block.compute_block` on N pairs (best of 5) and
-:func:`stereoplotter.setup.block.per_pair_loop` on a subset — and prints pairs per second, their ratio
-and the machine. Goal (issue "block mode"): ≥ 10⁴ pairs/s vectorised on a 2-core machine. Speed is
-measured here, never asserted in the test suite.
+Times the numeric part only — :func:`stereoplotter.setup.block.compute_block` on N pairs (best of
+5) and :func:`stereoplotter.setup.block.per_pair_loop` on a subset — and prints pairs per second,
+their ratio and the machine. Goal (issue "block mode"): ≥ 10⁴ pairs/s vectorised on a 2-core
+machine. Speed is measured here, never asserted in the test suite.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ import time
 
 import numpy as np
 
-from stereoplotter.setup.block import compute_block, per_pair_loop
 from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.setup.block import compute_block, per_pair_loop
 
 MARKS = np.array([[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]])
 

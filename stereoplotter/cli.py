@@ -32,9 +32,9 @@ from stereoplotter.io.paths import (
     shipped_root,
     user_folders,
 )
+from stereoplotter.io.yaml_files import atomic_write_bytes, load_yaml_mapping
 from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB
 from stereoplotter.progress import configure_logging
-from stereoplotter.io.yaml_files import atomic_write_bytes, load_yaml_mapping
 
 __all__ = ["main"]
 
@@ -287,12 +287,12 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _demo_steps(args: argparse.Namespace, step) -> int:
     """The demo's work, reporting ``step(done, 4, what)`` as it goes."""
-    from stereoplotter.scenario.foundation import run_foundation
     from stereoplotter.instrument.spec import load_instrument
-    from stereoplotter.plotting.figures import plot_scenario_layout
     from stereoplotter.io.scenario_file import load_scenario
-    from stereoplotter.setup.sheet import SetupRefusal, compute_setup_sheet
+    from stereoplotter.plotting.figures import plot_scenario_layout
     from stereoplotter.report.sheet import sheet_to_dict
+    from stereoplotter.scenario.foundation import run_foundation
+    from stereoplotter.setup.sheet import SetupRefusal, compute_setup_sheet
 
     path = Path(args.scenario)  # main() has resolved a name (default: the shipped pair60)
     scenario = load_scenario(path)
@@ -402,8 +402,8 @@ def _sheet_summary(sheet: Any) -> str:
 def _setup(args: argparse.Namespace) -> int:
     from stereoplotter.instrument.spec import load_instrument
     from stereoplotter.io.scenario_file import load_scenario
-    from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
     from stereoplotter.report.sheet import sheet_to_dict
+    from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
 
     spec = load_instrument(args.instrument)
     data, _ = load_yaml_mapping(args.scenario)
@@ -488,8 +488,8 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _verify(args: argparse.Namespace) -> int:
-    from stereoplotter.verification.table import geometry_from_file, run_procedure_mc, verify
     from stereoplotter.progress import step_progress
+    from stereoplotter.verification.table import geometry_from_file, run_procedure_mc, verify
 
     geometry, scenarios = None, None
     if args.geometry:

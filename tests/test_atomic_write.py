@@ -8,8 +8,8 @@ from contextlib import contextmanager
 
 import pytest
 
-from stereoplotter.io import yaml_files as yamlio
 from stereoplotter.cli import main
+from stereoplotter.io import yaml_files as yamlio
 
 
 @contextmanager

@@ -16,6 +16,11 @@ import numpy as np
 import pytest
 import yaml
 
+from stereoplotter.errors import ConfigError
+from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.paths import data_dir
+from stereoplotter.io.scenario_file import scenario_from_mapping
+from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.block import (
     CSV_COLUMNS,
     BlockResult,
@@ -26,11 +31,6 @@ from stereoplotter.setup.block import (
     run_block,
     write_block,
 )
-from stereoplotter.errors import ConfigError
-from stereoplotter.instrument.spec import load_instrument
-from stereoplotter.io.paths import data_dir
-from stereoplotter.io.scenario_file import scenario_from_mapping
-from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
 
 STRIP = data_dir("scenarios") / "blocks" / "strip60.yaml"

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from stereoplotter.io import paths
 from stereoplotter.cli import main
 from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io import paths
 
 SHIPPED = Path(paths.data_dir("instruments"))
 

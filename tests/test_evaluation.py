@@ -1,4 +1,5 @@
-"""Tests of the evaluation of a built model against the ground truth (``stereoplotter.procedure.evaluation``).
+"""Tests of the evaluation of a built model against the ground truth
+(``stereoplotter.procedure.evaluation``).
 
 References for the tolerances: ``kinematics.md`` §3.3 (per-axis approximation at the fiducials)
 and §6 (residual y-parallax and height deformation of the canonical unit at the true settings).
@@ -18,6 +19,9 @@ from conftest import m, mm, um
 from numpy.testing import assert_allclose, assert_array_equal
 
 from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.kinematics import InstrumentSetting, unit_for_orientation
+from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure.evaluation import (
     evaluate_instrument,
     evaluate_model,
@@ -25,9 +29,6 @@ from stereoplotter.procedure.evaluation import (
     instrument_frame_m,
     parallax_map_data,
 )
-from stereoplotter.instrument.kinematics import InstrumentSetting, unit_for_orientation
-from stereoplotter.instrument.spec import load_instrument
-from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.scenario.synthetic import synthesize_measurements
 from stereoplotter.setup.equations import instrument_principal_distance
 from stereoplotter.setup.sheet import compute_setup_sheet

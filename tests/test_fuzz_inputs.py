@@ -109,10 +109,10 @@ def corpus() -> dict[str, list[Seed]]:
     global _CORPUS
     if _CORPUS is not None:
         return _CORPUS
-    from stereoplotter.verification.table import BOOK
-    from stereoplotter.setup.block import CSV_COLUMNS
     from stereoplotter.instrument.error_model import error_model_from_spec
     from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.setup.block import CSV_COLUMNS
+    from stereoplotter.verification.table import BOOK
 
     scenarios, instruments = _shipped_dir("scenarios"), _shipped_dir("instruments")
     out: dict[str, list[Seed]] = {k: [] for k in ("scenario", "block", "instrument")}

@@ -8,9 +8,9 @@ import pytest
 from conftest import um
 
 from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import OperatorModel, simulate, simulate_per_trial
 from stereoplotter.procedure.conventional import overcorrection_factor
-from stereoplotter.io.scenario_file import load_scenario
 
 SPEC = load_instrument("sc1")
 

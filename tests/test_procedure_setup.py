@@ -8,6 +8,7 @@ from conftest import um
 
 from stereoplotter.instrument.spec import load_instrument
 from stereoplotter.instrument.virtual import Instrument
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import (
     Noise,
     OperatorModel,
@@ -19,7 +20,6 @@ from stereoplotter.procedure.conventional import (
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
-from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.report.simulation import write_simulation
 
 

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from stereoplotter.instrument.spec import load_instrument
-from stereoplotter.procedure import simulate
 from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.procedure import simulate
 
 
 @pytest.fixture(scope="module")

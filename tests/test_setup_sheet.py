@@ -20,9 +20,9 @@ from stereoplotter.errors import StereoplotterError
 from stereoplotter.geometry.rotation import rotation_z
 from stereoplotter.instrument.spec import load_instrument
 from stereoplotter.io.scenario_file import load_scenario, scenario_from_mapping
+from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.scenario.frame import local_from_sk42
 from stereoplotter.setup.sheet import SetupOptions, SetupRefusal, compute_setup_sheet
-from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = ROOT / "scenarios"

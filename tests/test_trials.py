@@ -13,6 +13,8 @@ import pytest
 
 from stereoplotter.cli import main
 from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.io.trial_store import TrialStore
 from stereoplotter.procedure.simulate import prepare_run, simulate
 from stereoplotter.procedure.trials import (
     chunk_trials_for,
@@ -21,9 +23,7 @@ from stereoplotter.procedure.trials import (
     trial_columns,
 )
 from stereoplotter.random_streams import BLOCK, keyed_draws
-from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.statistics import scale_summary, summarise_flags, summarise_values
-from stereoplotter.io.trial_store import TrialStore
 
 
 @pytest.fixture(scope="module")

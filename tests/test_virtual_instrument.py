@@ -11,9 +11,9 @@ import yaml
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.error_model import error_model_from_spec
 from stereoplotter.instrument.kinematics import counters_from_photo
+from stereoplotter.instrument.mechanics.base import TravelRefusal
 from stereoplotter.instrument.spec import RangeRefusal, load_instrument
 from stereoplotter.instrument.virtual import Instrument
-from stereoplotter.instrument.mechanics.base import TravelRefusal
 from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.setup.sheet import compute_setup_sheet
 

@@ -22,8 +22,8 @@ from numpy.typing import NDArray
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.instrument.spec import InstrumentSpec
-from stereoplotter.random_streams import keyed_draws
 from stereoplotter.io.yaml_files import describe_value, did_you_mean
+from stereoplotter.random_streams import keyed_draws
 
 __all__ = ["DISTRIBUTIONS", "ErrorModel", "ErrorTerm", "error_model_from_spec"]
 

@@ -35,9 +35,9 @@ from stereoplotter.instrument.kinematics import (
     marks_from_counters,
     turn_correction_knob,
 )
-from stereoplotter.instrument.spec import InstrumentSpec, check_in_range, load_instrument
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.instrument.mechanics.play import PlayAxis
+from stereoplotter.instrument.spec import InstrumentSpec, check_in_range, load_instrument
 
 __all__ = ["BACKENDS", "CONTROLS", "HEIGHT_SCALE", "NOMINAL_ZERO", "Instrument", "Scale"]
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.geometry.collinearity import object_to_photo
+from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.scenario.model import (
     FIDUCIAL_NAMES,
@@ -28,7 +29,6 @@ from stereoplotter.scenario.model import (
     Scenario,
     Terrain,
 )
-from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
 
 __all__ = ["load_scenario", "scenario_from_mapping"]
 

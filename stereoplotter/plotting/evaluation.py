@@ -1,7 +1,8 @@
 """Figure of the evaluation of a built model: the x-parallax error map over the working area.
 
 Plotting at the edge (``style.md`` §13): the data come from the pure
-:func:`stereoplotter.procedure.evaluation.parallax_map_data`; this module only draws (non-interactive Agg
+:func:`stereoplotter.procedure.evaluation.parallax_map_data`; this module only draws
+(non-interactive Agg
 backend). The function takes an optional ``ax`` and returns the Figure, so tests can inspect the
 artists.
 """

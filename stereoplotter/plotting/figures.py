@@ -26,7 +26,8 @@ def plot_scenario_layout(
 ) -> Any:
     """Plan view of a scenario: photo footprints on the mean point height, projection centres,
     control (triangles) and check (circles) points, the map sheet frame (from the fit (6.8)) and,
-    with ``result`` from :func:`stereoplotter.scenario.foundation.run_foundation`, the plan errors of the
+    with ``result`` from :func:`stereoplotter.scenario.foundation.run_foundation`, the plan errors
+    of the
     intersected points as arrows exaggerated ×1000.
 
     Returns

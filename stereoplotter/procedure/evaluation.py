@@ -34,7 +34,8 @@ Built model
     cleared, Y as the mean of the two rays). Plan errors are (built − ideal)·M_г/1000 [m] along
     the instrument-frame axes, and ×1000/M_map in mm on the map. The height of the built point is
     read as the metre height scale shows it, height_zero − D·M_в/1000 (the scale of (6.15),
-    :func:`~stereoplotter.setup.equations.height_scale_reading`); ΔH = built − true [m], positive when
+    :func:`~stereoplotter.setup.equations.height_scale_reading`); ΔH = built − true [m], positive
+    when
     the built point is too high; in ‰ of the mean flying height H̄ = Z_Sл − mean Z of the
     working-area grid.
 After plane removal

@@ -17,11 +17,11 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
+from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
 from stereoplotter.procedure.setup_method import Run, run_setup_method
 from stereoplotter.procedure.transcript import Transcript

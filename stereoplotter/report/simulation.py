@@ -21,6 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from stereoplotter.io.trial_store import TrialStore
+from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import (
     DEFAULT_MEMORY_BUDGET_MB,
@@ -30,8 +32,6 @@ from stereoplotter.procedure.trials import (
     summarise_columns,
     trial_columns,
 )
-from stereoplotter.io.trial_store import TrialStore
-from stereoplotter.io.yaml_files import atomic_write_bytes
 
 __all__ = ["SimulationOutcome", "run_simulation_command", "simulation_markdown", "write_simulation"]
 

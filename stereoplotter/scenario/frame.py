@@ -19,12 +19,12 @@ from stereoplotter.geodesy import (
     conventional_ordinate,
     split_conventional_ordinate,
 )
+from stereoplotter.geodesy.map_sheet import sheet_bounds
 from stereoplotter.geodesy.photogrammetric import (
     LocalFrame,
     gauss_kruger_from_local,
     local_from_gauss_kruger,
 )
-from stereoplotter.geodesy.map_sheet import sheet_bounds
 from stereoplotter.scenario.model import Frame
 
 __all__ = [

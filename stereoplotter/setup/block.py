@@ -59,13 +59,8 @@ from stereoplotter.geometry.transformed import (
     transformed_y_single_tilt,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
-from stereoplotter.setup.scale_choice import (
-    candidate_flags,
-    candidate_scales,
-    choose_candidates,
-    describe_candidate,
-)
 from stereoplotter.io.scenario_file import MAX_TILT_DEG, _camera
+from stereoplotter.io.yaml_files import Fields, atomic_write_text, load_yaml_mapping
 from stereoplotter.scenario.model import Camera
 from stereoplotter.setup.equations import (
     base_components,
@@ -78,8 +73,13 @@ from stereoplotter.setup.equations import (
     projection_distance,
     transformation_coefficient,
 )
+from stereoplotter.setup.scale_choice import (
+    candidate_flags,
+    candidate_scales,
+    choose_candidates,
+    describe_candidate,
+)
 from stereoplotter.setup.sheet import assumed_parameters
-from stereoplotter.io.yaml_files import Fields, atomic_write_text, load_yaml_mapping
 
 __all__ = [
     "Block",
@@ -537,7 +537,8 @@ _ARRAY_FIELDS = tuple(
 def _candidate_grid(
     spec: InstrumentSpec, map_scale: int | None, horizontal: int | None, vertical: int | None
 ) -> NDArray[np.float64]:
-    """(M_г, M_в) candidates of :func:`stereoplotter.setup.scale_choice.candidate_scales`: (C, 2)."""
+    """(M_г, M_в) candidates, shape (C, 2)
+    (:func:`stereoplotter.setup.scale_choice.candidate_scales`)."""
     try:
         return candidate_scales(spec, map_scale, horizontal, vertical)
     except StereoplotterError as exc:

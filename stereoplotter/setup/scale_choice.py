@@ -1,7 +1,8 @@
 """The choice of the model scales M_г, M_в (item 1 of §26), vectorised over stereopairs.
 
 One implementation serves the single-pair sheet (:mod:`stereoplotter.setup.sheet`) and block mode
-(:mod:`stereoplotter.setup.block`). Candidates are M_г = r·M_map for the coordinatograph ratios r and
+(:mod:`stereoplotter.setup.block`). Candidates are M_г = r·M_map for the coordinatograph ratios r
+and
 M_в from the height-counter gears (or forced values); a candidate is feasible when every
 condition below holds, and the chosen one has the largest model scale (smallest M_г), then the
 smallest M_в (``docs/setup-data.md``, item 1):

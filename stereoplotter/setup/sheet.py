@@ -31,13 +31,6 @@ from stereoplotter.geometry.transformed import (
     transformed_y_single_tilt,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
-from stereoplotter.setup.scale_choice import (
-    ScaleCheck,
-    candidate_flags,
-    candidate_scales,
-    choose_candidates,
-    describe_candidate,
-)
 from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import (
@@ -57,6 +50,13 @@ from stereoplotter.setup.equations import (
     sheet_corner_instrument_coordinates_book_form,
 )
 from stereoplotter.setup.readings import stage_readings
+from stereoplotter.setup.scale_choice import (
+    ScaleCheck,
+    candidate_flags,
+    candidate_scales,
+    choose_candidates,
+    describe_candidate,
+)
 
 __all__ = [
     "CORNER_ORDER",

@@ -3,7 +3,8 @@
 :func:`procedure_mc` runs the real stages on the virtual SC-1 (``procedure.simulate``, closed-form
 back-end, vectorised over trials) twice with the same seed — once with the operator's pointing
 errors of the formula switched on, once with every error zero — and takes the x-parallax error
-field δp of the built model (photo mm, at the ideal model position, :mod:`stereoplotter.procedure.evaluation`)
+field δp of the built model (photo mm, at the ideal model position,
+:mod:`stereoplotter.procedure.evaluation`)
 on the formula's own integration domain. The difference of the two runs is the error the
 pointing caused (the zero run carries the deterministic residue of the sheet's approximations,
 reported as ``bias``). The statistic is the protocol's: sqrt(mean over trials and a uniform
@@ -88,8 +89,8 @@ def scenario_geometry(scenario, instrument: str = "sc1") -> dict:
 
 
 def _scenario_geometry(scenario, instrument):
-    from stereoplotter.procedure.evaluation import instrument_frame_m
     from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.procedure.evaluation import instrument_frame_m
     from stereoplotter.scenario.synthetic import working_area_grid_m
     from stereoplotter.setup.sheet import compute_setup_sheet
 

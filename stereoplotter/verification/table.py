@@ -24,9 +24,9 @@ from pathlib import Path
 import numpy as np
 
 from stereoplotter.accuracy import chapter5 as c5
-from stereoplotter.verification import linear_mc as mc
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.io.yaml_files import atomic_write_bytes
+from stereoplotter.verification import linear_mc as mc
 
 __all__ = [
     "BOOK",
@@ -724,8 +724,8 @@ def geometry_from_file(path) -> tuple[dict, dict]:
         geometry = {k: fields.number(data, k, "", **_GEOMETRY_LIMITS[k]) for k in data}
         _check_geometry(fields, geometry)
         return geometry, {"60": None, "80": None}
-    from stereoplotter.verification.procedure_mc import scenario_geometry
     from stereoplotter.io.scenario_file import load_scenario
+    from stereoplotter.verification.procedure_mc import scenario_geometry
 
     scenario = load_scenario(path)  # every problem of the file as one ConfigError
     if not scenario.is_stereopair:

@@ -6,7 +6,8 @@ axial play (backlash) b and an axial compliance k, and the carriage slides on it
 Coulomb friction F = μ·m·g (``docs/design/mechanics.md`` §4). Two back-ends implement
 :class:`LinearAxis`:
 
-* :class:`~stereoplotter.instrument.mechanics.play.PlayAxis`: the closed-form play operator, vectorised over
+* :class:`~stereoplotter.instrument.mechanics.play.PlayAxis`: the closed-form play operator,
+vectorised over
   trials (the test oracle and the fast path for bulk Monte Carlo);
 * :class:`~stereoplotter.instrument.mechanics.pymunk_axis.PymunkAxis`: the time-domain pymunk model.
 

@@ -14,7 +14,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams, Side, check_travel, pre_position
+from stereoplotter.instrument.mechanics.base import (
+    N_PER_UM,
+    AxisParams,
+    Side,
+    check_travel,
+    pre_position,
+)
 from stereoplotter.instrument.mechanics.play import PlayAxis
 from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis, new_space, run_programs
 

@@ -31,8 +31,8 @@ from stereoplotter.instrument.mechanics.pymunk_axis import new_space
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-    from stereoplotter.instrument.spec import InstrumentSpec
     from stereoplotter.instrument.mechanics.coordinatograph import Coordinatograph
+    from stereoplotter.instrument.spec import InstrumentSpec
 
 __all__ = [
     "OperatorParams",
