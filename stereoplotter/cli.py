@@ -435,7 +435,7 @@ def _setup(args: argparse.Namespace) -> int:
 
 def _setup_block(args: argparse.Namespace, spec: Any) -> int:
     """Block mode: one sheet per model of a block file (``stereoplotter.setup.block``)."""
-    from stereoplotter.setup.block import model_sheet, run_block
+    from stereoplotter.report.block import model_sheet, run_block
 
     if args.horizontal_scale is not None or args.vertical_scale is not None or args.seed:
         raise StereoplotterError(

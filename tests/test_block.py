@@ -18,19 +18,12 @@ import yaml
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.block_file import CSV_COLUMNS, load_block
 from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import scenario_from_mapping
+from stereoplotter.report.block import run_block, write_block
 from stereoplotter.scenario.synthetic import working_area_grid_m
-from stereoplotter.setup.block import (
-    CSV_COLUMNS,
-    BlockResult,
-    Refusal,
-    compute_block,
-    load_block,
-    per_pair_loop,
-    run_block,
-    write_block,
-)
+from stereoplotter.setup.block import BlockResult, Refusal, compute_block, per_pair_loop
 from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
 
 STRIP = data_dir("scenarios") / "blocks" / "strip60.yaml"

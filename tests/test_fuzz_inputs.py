@@ -111,7 +111,7 @@ def corpus() -> dict[str, list[Seed]]:
         return _CORPUS
     from stereoplotter.instrument.error_model import error_model_from_spec
     from stereoplotter.instrument.spec import load_instrument
-    from stereoplotter.setup.block import CSV_COLUMNS
+    from stereoplotter.io.block_file import CSV_COLUMNS
     from stereoplotter.verification.table import BOOK
 
     scenarios, instruments = _shipped_dir("scenarios"), _shipped_dir("instruments")
@@ -484,7 +484,7 @@ def _load(kind: str, path: Path) -> Any:
         json.dumps(summarize_scenario(scenario), default=float)
         return scenario
     if kind in ("block", "block_csv", "csv"):
-        from stereoplotter.setup.block import load_block
+        from stereoplotter.io.block_file import load_block
 
         return load_block(path)
     if kind == "instrument":

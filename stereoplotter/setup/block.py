@@ -37,18 +37,12 @@ calibrated ones, taken relative to the principal point.
 
 from __future__ import annotations
 
-import csv
 import enum
-import io
 import math
-import os
-import re
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
@@ -59,9 +53,6 @@ from stereoplotter.geometry.transformed import (
     transformed_y_single_tilt,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
-from stereoplotter.io.scenario_file import MAX_TILT_DEG, _camera
-from stereoplotter.io.yaml_files import Fields, atomic_write_text, load_yaml_mapping
-from stereoplotter.scenario.model import Camera
 from stereoplotter.setup.equations import (
     base_components,
     counter_scale_left,
@@ -79,36 +70,20 @@ from stereoplotter.setup.scale_choice import (
     choose_candidates,
     describe_candidate,
 )
-from stereoplotter.setup.sheet import assumed_parameters
 
 __all__ = [
-    "Block",
+    "X_MARK_NAME",
     "BlockResult",
     "Refusal",
     "compute_block",
-    "load_block",
-    "model_sheet",
     "per_pair_loop",
-    "run_block",
-    "write_block",
+    "reason_text",
 ]
 
-_EO_KEYS = ("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg")
-_TOP = ("name", "description", "camera", "map_scale", "scales", "models", "models_csv")
-_MODEL = ("name", "left", "right", "terrain_m", "height_points")
-#: Columns of a ``models_csv`` file; ``height_points`` ("id=Z_m;id=Z_m", may be empty) is optional.
-CSV_COLUMNS = (
-    "name",
-    *(f"left_{k}" for k in _EO_KEYS),
-    *(f"right_{k}" for k in _EO_KEYS),
-    "terrain_lowest_m",
-    "terrain_highest_m",
-)
-_NAME_RE = re.compile(r"^[\w][\w.+-]*$")
 #: Marks used per photo (Table 24 reading, docs/setup-data.md): left x of mark 2, right x of mark 1,
 #: both y of marks 3 and 4. Indices into marks 1..4.
 _X_MARK = (1, 0)
-_X_MARK_NAME = ("2", "1")
+X_MARK_NAME = ("2", "1")
 
 
 class Refusal(enum.IntFlag):
@@ -138,281 +113,6 @@ _SCALE_FLAGS = (
     Refusal.BASE_Y,
     Refusal.BASE_Z,
 )
-
-
-# --- the block file ---------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class Block:
-    """A validated block file: N stereopairs of one camera.
-
-    Attributes
-    ----------
-    name, source : str
-        Block name; the file it was read from.
-    camera : Camera
-        The camera (same schema as a scenario's camera).
-    map_scale_denominator : int
-        M_map. [—]
-    horizontal_scale_denominator, vertical_scale_denominator : int or None
-        Forced M_г, M_в (``scales:``), else None (chosen per pair).
-    model_names : tuple of str
-    centre_left_m, centre_right_m : ndarray, shape (N, 3)
-        X_S, Y_S, Z_S of the left and right photo. [m]
-    angles_left, angles_right : ndarray, shape (N, 3)
-        α, ω, κ of Eq. (2.50). [rad]
-    terrain_m : ndarray, shape (N, 2)
-        Lowest and highest ground height of each model's working area. [m]
-    height_point_ids : tuple of tuple of str
-        Ids of the height points of each model.
-    height_points_m : ndarray, shape (N, P)
-        Their Z, padded with NaN. [m]
-    """
-
-    name: str
-    source: str
-    camera: Camera
-    map_scale_denominator: int
-    horizontal_scale_denominator: int | None
-    vertical_scale_denominator: int | None
-    model_names: tuple[str, ...]
-    centre_left_m: NDArray[np.float64]
-    angles_left: NDArray[np.float64]
-    centre_right_m: NDArray[np.float64]
-    angles_right: NDArray[np.float64]
-    terrain_m: NDArray[np.float64]
-    height_point_ids: tuple[tuple[str, ...], ...]
-    height_points_m: NDArray[np.float64]
-
-    def __len__(self) -> int:
-        return len(self.model_names)
-
-
-def load_block(path: str | os.PathLike[str]) -> Block:
-    """Read and validate a block file.
-
-    Parameters
-    ----------
-    path : str or path-like
-        A YAML file with ``name``, ``camera``, ``map_scale``, optional ``scales: {horizontal,
-        vertical}`` and exactly one of ``models`` (a list) or ``models_csv`` (a CSV file relative
-        to the YAML, columns :data:`CSV_COLUMNS` plus an optional ``height_points`` column
-        ``"id=Z_m;id=Z_m"``).
-
-    Returns
-    -------
-    Block
-
-    Raises
-    ------
-    ConfigError
-        "FILE: FIELD: expected …, found …" for the first problem found (for a CSV row the field
-        is ``line L: column``).
-
-    Examples
-    --------
-    >>> from stereoplotter.io.paths import data_dir
-    >>> block = load_block(data_dir("scenarios") / "blocks" / "strip60.yaml")
-    >>> len(block), block.camera.focal_length_mm
-    (8, 70.0)
-    """
-    data, source = load_yaml_mapping(path)
-    fields = Fields(source)
-    fields.mapping(data, "", _TOP, required=("name", "camera", "map_scale"))
-    name = fields.text(data, "name", "")
-    camera = _camera(fields, fields.get(data, "camera", ""))
-    map_scale = fields.integer(data, "map_scale", "", low=100, high=1_000_000)
-    forced: dict[str, int | None] = {"horizontal": None, "vertical": None}
-    if data.get("scales") is not None:
-        node = fields.mapping(data["scales"], "scales", ("horizontal", "vertical"))
-        for key in forced:
-            if node.get(key) is not None:
-                forced[key] = fields.integer(node, key, "scales", low=100, high=1_000_000)
-    if ("models" in data) == ("models_csv" in data):
-        raise fields.error(
-            "models", "exactly one of models, models_csv", "both" if "models" in data else "neither"
-        )
-    if "models" in data:
-        rows, where = _models_yaml(fields, data)
-        csv_fields = fields
-    else:
-        csv_name = fields.text(data, "models_csv", "")
-        csv_path = Path(source).parent / csv_name
-        csv_fields = Fields(str(csv_path))
-        rows, where = _models_csv(csv_fields, csv_path)
-    names, eo_l, eo_r, terrain, points = zip(*rows, strict=True) if rows else ((),) * 5
-    if not names:
-        raise fields.error("models", "a list of at least 1 model", "0 models")
-    eo_l, eo_r = np.array(eo_l), np.array(eo_r)
-    terrain = np.array(terrain)
-    n_points = max((len(p) for p in points), default=0)
-    heights = np.full((len(names), n_points), np.nan)
-    for i, p in enumerate(points):
-        heights[i, : len(p)] = [z for _, z in p]
-    block = Block(
-        name=name,
-        source=source,
-        camera=camera,
-        map_scale_denominator=map_scale,
-        horizontal_scale_denominator=forced["horizontal"],
-        vertical_scale_denominator=forced["vertical"],
-        model_names=tuple(names),
-        centre_left_m=eo_l[:, :3],
-        angles_left=np.radians(eo_l[:, 3:]),
-        centre_right_m=eo_r[:, :3],
-        angles_right=np.radians(eo_r[:, 3:]),
-        terrain_m=terrain,
-        height_point_ids=tuple(tuple(pid for pid, _ in p) for p in points),
-        height_points_m=heights,
-    )
-    _check_block_geometry(csv_fields, block, where)
-    return block
-
-
-def _eo_limits(key: str) -> dict[str, Any]:
-    if key in ("X_m", "Y_m"):
-        return {"unit": "m", "low": -1.0e7, "high": 1.0e7}
-    if key == "Z_m":
-        return {"unit": "m", "low": -500.0, "high": 50000.0}
-    if key == "kappa_deg":
-        return {"unit": "°", "low": -180.0, "high": 180.0}
-    return {
-        "unit": "°",
-        "low": -MAX_TILT_DEG,
-        "high": MAX_TILT_DEG,
-        "basis": f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°",
-    }
-
-
-def _check_name(fields: Fields, name: str, path: str, seen: set[str]) -> str:
-    if not _NAME_RE.match(name) or name in (".", ".."):
-        raise fields.error(
-            path,
-            "a model name usable as a folder name (letters, digits, _ . + -)",
-            name,
-        )
-    if name in seen:
-        raise fields.error(path, "a unique model name", name)
-    seen.add(name)
-    return name
-
-
-def _models_yaml(fields: Fields, data: dict[str, Any]) -> tuple[list[tuple], list[str]]:
-    rows, where, seen = [], [], set()
-    for i, item in enumerate(fields.sequence(data, "models", "", min_length=1)):
-        mpath = fields.join("models", i)
-        fields.mapping(item, mpath, _MODEL, required=("name", "left", "right", "terrain_m"))
-        name = _check_name(
-            fields, fields.text(item, "name", mpath), fields.join(mpath, "name"), seen
-        )
-        eos = []
-        for side in ("left", "right"):
-            epath = fields.join(mpath, side)
-            node = fields.mapping(item[side], epath, _EO_KEYS, required=_EO_KEYS)
-            eos.append(tuple(fields.number(node, k, epath, **_eo_limits(k)) for k in _EO_KEYS))
-        terrain = fields.vector(item, "terrain_m", mpath, 2, unit="m", low=-500.0, high=9000.0)
-        points, ids = [], set()
-        for j, p in enumerate(fields.sequence(item, "height_points", mpath, default=[])):
-            ppath = fields.join(fields.join(mpath, "height_points"), j)
-            fields.mapping(p, ppath, ("id", "Z_m"), required=("id", "Z_m"))
-            pid = fields.text(p, "id", ppath)
-            if pid in ids:
-                raise fields.error(fields.join(ppath, "id"), "a unique point id", pid)
-            ids.add(pid)
-            points.append((pid, fields.number(p, "Z_m", ppath, unit="m", low=-500.0, high=9000.0)))
-        rows.append((name, eos[0], eos[1], terrain, tuple(points)))
-        where.append(mpath)
-    return rows, where
-
-
-def _models_csv(fields: Fields, path: Path) -> tuple[list[tuple], list[str]]:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise fields.error("(file)", "an existing CSV file (models_csv)", "no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise fields.error("(file)", "a readable UTF-8 CSV file", str(exc)) from None
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    reader = csv.DictReader(io.StringIO("\n".join(lines)))
-    header = reader.fieldnames or []
-    missing = [c for c in CSV_COLUMNS if c not in header]
-    if missing:
-        raise fields.error(
-            "header", "the columns " + ", ".join(CSV_COLUMNS), "no column " + missing[0]
-        )
-    unknown = [c for c in header if c not in (*CSV_COLUMNS, "height_points")]
-    if unknown:
-        raise fields.error(
-            "header",
-            "no such column",
-            unknown[0],
-            "allowed: " + ", ".join((*CSV_COLUMNS, "height_points")),
-        )
-    rows, where, seen = [], [], set()
-    for line, row in enumerate(reader, start=2):
-        at = f"line {line}"
-
-        def number(column: str, limits: dict[str, Any], at: str = at, row: dict = row) -> float:
-            raw = (row.get(column) or "").strip()
-            try:
-                value: Any = float(raw)
-            except ValueError:
-                value = raw
-            return fields.check_number(value, f"{at}: {column}", **limits)
-
-        name = _check_name(fields, (row.get("name") or "").strip(), f"{at}: name", seen)
-        eos = [
-            tuple(number(f"{side}_{k}", _eo_limits(k)) for k in _EO_KEYS)
-            for side in ("left", "right")
-        ]
-        ground = {"unit": "m", "low": -500.0, "high": 9000.0}
-        terrain = (number("terrain_lowest_m", ground), number("terrain_highest_m", ground))
-        points = []
-        for item in (row.get("height_points") or "").split(";"):
-            if not item.strip():
-                continue
-            pid, sep, z = item.partition("=")
-            if not sep or not pid.strip():
-                raise fields.error(f"{at}: height_points", "entries id=Z_m separated by ;", item)
-            points.append(
-                (pid.strip(), number("", ground, row={"": z}, at=f"{at}: height_points.{pid}"))
-            )
-        rows.append((name, eos[0], eos[1], terrain, tuple(points)))
-        where.append(at)
-    return rows, where
-
-
-def _check_block_geometry(fields: Fields, block: Block, where: list[str]) -> None:
-    """Refuse degenerate models at load time: terrain lowest > highest, a station at or below the
-    highest ground or a height point, a horizontal base under 1 m."""
-    sep = "." if where and where[0].startswith("models") else ": "
-    low, high = block.terrain_m[:, 0], block.terrain_m[:, 1]
-    bad = np.flatnonzero(low > high)
-    if bad.size:
-        i = int(bad[0])
-        raise fields.error(
-            f"{where[i]}{sep}terrain" + ("_m" if sep == "." else "_lowest_m"),
-            "lowest ≤ highest ground height",
-            [float(low[i]), float(high[i])],
-        )
-    top = np.fmax(high, np.nanmax(block.height_points_m, axis=1, initial=-np.inf))
-    for side, centre in (("left", block.centre_left_m), ("right", block.centre_right_m)):
-        bad = np.flatnonzero(centre[:, 2] <= top)
-        if bad.size:
-            i = int(bad[0])
-            raise fields.error(
-                f"{where[i]}{sep}{side}" + (".Z_m" if sep == "." else "_Z_m"),
-                f"a projection centre above the model's highest ground ({top[i]:g} m)",
-                float(centre[i, 2]),
-            )
-    base = np.hypot(*(block.centre_right_m - block.centre_left_m)[:, :2].T)
-    bad = np.flatnonzero(base < 1.0)
-    if bad.size:
-        i = int(bad[0])
-        raise fields.error(
-            f"{where[i]}{sep}right", "a horizontal base of at least 1 m", f"{base[i]:.3g} m"
-        )
 
 
 # --- the result -------------------------------------------------------------------------------
@@ -510,7 +210,7 @@ class BlockResult:
 
     def reason(self, i: int) -> str:
         """The refusal of pair ``i`` in words ("" when accepted): values, ranges, way out."""
-        return _reason_text(self, int(i))
+        return reason_text(self, int(i))
 
 
 _ARRAY_FIELDS = tuple(
@@ -978,7 +678,7 @@ def _one_pair(
 # --- refusal messages -------------------------------------------------------------------------
 
 
-def _reason_text(result: BlockResult, i: int) -> str:
+def reason_text(result: BlockResult, i: int) -> str:
     code = Refusal(int(result.reason_code[i]))
     if not code:
         return ""
@@ -1039,194 +739,3 @@ def _first_refusal(spec: InstrumentSpec, checks: list[tuple[str, Any, str]], nam
     return name.lower()  # within the slack of check_in_range: name the condition only
 
 
-# --- running a block file and writing the sheets ---------------------------------------------
-
-
-def run_block(
-    path: str | os.PathLike[str],
-    spec: InstrumentSpec,
-    output_dir: str | os.PathLike[str] | None = None,
-    book_sign: bool = False,
-) -> BlockResult:
-    """Load a block file, compute every model (:func:`compute_block`) and optionally write it.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The block YAML (:func:`load_block`).
-    spec : InstrumentSpec
-    output_dir : str or path-like, optional
-        Where to write ``<model>/sheet.yaml`` and ``block.csv`` (:func:`write_block`).
-    book_sign : bool
-        (6.4) with the printed sign.
-
-    Returns
-    -------
-    BlockResult
-
-    Notes
-    -----
-    Eqs. (6.1)–(6.6) of [1]_ via :func:`compute_block`; (6.7)/(6.8) are not part of block mode.
-    """
-    block = load_block(path)
-    result = compute_block(
-        block.camera.focal_length_mm,
-        block.camera.fiducial_array_mm(),
-        block.centre_left_m,
-        block.angles_left,
-        block.centre_right_m,
-        block.angles_right,
-        block.terrain_m,
-        spec,
-        block.map_scale_denominator,
-        principal_point_mm=block.camera.principal_point_mm,
-        height_points_m=block.height_points_m,
-        horizontal_scale_denominator=block.horizontal_scale_denominator,
-        vertical_scale_denominator=block.vertical_scale_denominator,
-        book_sign=book_sign,
-        model_names=block.model_names,
-        height_point_ids=block.height_point_ids,
-        name=block.name,
-    )
-    if output_dir is not None:
-        write_block(result, output_dir)
-    return result
-
-
-def _num(value: float, digits: int = 6) -> float | None:
-    v = float(value)
-    return None if math.isnan(v) else round(v, digits) + 0.0  # + 0.0: no "-0.0" on the sheet
-
-
-def _int(value: float) -> int | None:
-    v = float(value)
-    return None if math.isnan(v) else round(v)
-
-
-def model_sheet(result: BlockResult, i: int) -> dict[str, Any]:
-    """The sheet of model ``i`` as plain data, with the keys of the single-pair ``--json``.
-
-    Parameters
-    ----------
-    result : BlockResult
-    i : int
-        Model index.
-
-    Returns
-    -------
-    dict
-        ``status`` ("ok" or "refused"), ``reason``, and the values of Eqs. (6.1)–(6.6) of [1]_
-        (None where refused). [mm, —]
-    """
-    ok = bool(result.accepted[i])
-    fid = result.fiducials_transformed_mm[i]
-    rig = result.fiducials_rigorous_mm[i]
-    photos = ("left", "right")
-    return {
-        "block": result.name,
-        "model": result.model_names[i],
-        "instrument": result.instrument,
-        "status": "ok" if ok else "refused",
-        "reason": result.reason(i),
-        "reason_code": int(result.reason_code[i]),
-        "assumed": {
-            key: list(params) for key, params in assumed_parameters(result.spec).items() if params
-        },
-        "scale_horizontal": _int(result.horizontal_scale_denominator[i]),
-        "scale_vertical": _int(result.vertical_scale_denominator[i]),
-        "scale_map": result.map_scale_denominator,
-        "f_instrument_mm": _num(result.f_instrument_mm[i]),
-        "transformation_coefficient": _num(result.transformation_coefficient[i]),
-        "focal_length_corrected_mm": _num(result.focal_length_corrected_mm),
-        "n_left": _num(result.n_left[i]),
-        "n_right": _num(result.n_right[i]),
-        "base_mm": dict(zip(("bx", "by", "bz"), map(_num, result.base_mm[i]), strict=True)),
-        "fiducials_transformed_mm": {
-            p: {
-                f"x{_X_MARK_NAME[j]}": _num(fid[j, 0]),
-                "y3": _num(fid[j, 1]),
-                "y4": _num(fid[j, 2]),
-            }
-            for j, p in enumerate(photos)
-        },
-        "fiducials_rigorous_mm": {
-            p: {
-                key: [_num(rig[j, m, 0]), _num(rig[j, m, 1])]
-                for m, key in enumerate((_X_MARK_NAME[j], "3", "4"))
-            }
-            for j, p in enumerate(photos)
-        },
-        "L_mm": {"left": _num(result.mark_span_mm[i, 0]), "right": _num(result.mark_span_mm[i, 1])},
-        "decentrations_mm": {
-            p: {
-                "x": _num(result.decentration_mm[i, j, 0]),
-                "y": _num(result.decentration_mm[i, j, 1]),
-            }
-            for j, p in enumerate(photos)
-        },
-        "angles_deg": {
-            p: {
-                a: _num(math.degrees(result.angles[i, j, m]), 7)
-                for m, a in enumerate(("alpha", "omega", "kappa"))
-            }
-            for j, p in enumerate(photos)
-        },
-        "control_heights_model_mm": {
-            pid: _num(result.control_heights_model_mm[i, j])
-            for j, pid in enumerate(result.height_point_ids[i])
-        },
-        "depth_range_used_mm": [_num(v, 3) for v in result.depth_range_mm[i]],
-        "frame": {
-            "rotation_deg": _num(math.degrees(result.frame_rotation[i]), 7),
-            "note": "the photogrammetric system is turned about Z by −rotation so that X runs "
-            "along the base, origin S_л (docs/setup-data.md)",
-        },
-        "options": {"book_sign_n_right": result.book_sign},
-        "not_in_block_mode": "sheet corners (6.7), similarity (6.8) and the model X, Y travel: "
-        "compute the single-pair sheet for them",
-    }
-
-
-_CSV_OUT = (
-    "model", "status", "reason_code", "scale_horizontal", "scale_vertical", "f_instrument_mm",
-    "transformation_coefficient", "n_left", "n_right", "bx_mm", "by_mm", "bz_mm",
-    "left_x2_mm", "left_y3_mm", "left_y4_mm", "right_x1_mm", "right_y3_mm", "right_y4_mm",
-    "L_left_mm", "L_right_mm", "frame_rotation_deg", "reason",
-)  # fmt: skip
-
-
-def write_block(result: BlockResult, output_dir: str | os.PathLike[str]) -> None:
-    """Write ``<output_dir>/<model>/sheet.yaml`` for every model and ``<output_dir>/block.csv``.
-
-    Parameters
-    ----------
-    result : BlockResult
-    output_dir : str or path-like
-        Created if needed. Each file is written whole or not at all.
-
-    Notes
-    -----
-    The sheet keys are those of the single-pair ``--json`` output where they exist
-    (:func:`model_sheet`); values of Eqs. (6.1)–(6.6) of [1]_.
-    """
-    out = Path(output_dir)
-    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(_CSV_OUT)
-    for i, model in enumerate(result.model_names):
-        sheet = model_sheet(result, i)
-        text = yaml.dump(sheet, Dumper=dumper, sort_keys=False, allow_unicode=True, width=100)
-        atomic_write_text(out / model / "sheet.yaml", text)
-        fid = sheet["fiducials_transformed_mm"]
-        writer.writerow(
-            [
-                model, sheet["status"], sheet["reason_code"], sheet["scale_horizontal"],
-                sheet["scale_vertical"], sheet["f_instrument_mm"],
-                sheet["transformation_coefficient"], sheet["n_left"], sheet["n_right"],
-                *sheet["base_mm"].values(), *fid["left"].values(), *fid["right"].values(),
-                sheet["L_mm"]["left"], sheet["L_mm"]["right"], sheet["frame"]["rotation_deg"],
-                sheet["reason"],
-            ]
-        )  # fmt: skip
-    atomic_write_text(out / "block.csv", buffer.getvalue())

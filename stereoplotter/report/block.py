@@ -1,0 +1,213 @@
+"""Block mode at the edge: run a block file and write one sheet per model plus ``block.csv``."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from stereoplotter.instrument.spec import InstrumentSpec
+from stereoplotter.io.block_file import load_block
+from stereoplotter.io.yaml_files import atomic_write_text
+from stereoplotter.setup.block import X_MARK_NAME, BlockResult, compute_block
+from stereoplotter.setup.sheet import assumed_parameters
+
+__all__ = ["model_sheet", "run_block", "write_block"]
+
+# --- running a block file and writing the sheets ---------------------------------------------
+
+
+def run_block(
+    path: str | os.PathLike[str],
+    spec: InstrumentSpec,
+    output_dir: str | os.PathLike[str] | None = None,
+    book_sign: bool = False,
+) -> BlockResult:
+    """Load a block file, compute every model (:func:`compute_block`) and optionally write it.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The block YAML (:func:`load_block`).
+    spec : InstrumentSpec
+    output_dir : str or path-like, optional
+        Where to write ``<model>/sheet.yaml`` and ``block.csv`` (:func:`write_block`).
+    book_sign : bool
+        (6.4) with the printed sign.
+
+    Returns
+    -------
+    BlockResult
+
+    Notes
+    -----
+    Eqs. (6.1)–(6.6) of [1]_ via :func:`compute_block`; (6.7)/(6.8) are not part of block mode.
+    """
+    block = load_block(path)
+    result = compute_block(
+        block.camera.focal_length_mm,
+        block.camera.fiducial_array_mm(),
+        block.centre_left_m,
+        block.angles_left,
+        block.centre_right_m,
+        block.angles_right,
+        block.terrain_m,
+        spec,
+        block.map_scale_denominator,
+        principal_point_mm=block.camera.principal_point_mm,
+        height_points_m=block.height_points_m,
+        horizontal_scale_denominator=block.horizontal_scale_denominator,
+        vertical_scale_denominator=block.vertical_scale_denominator,
+        book_sign=book_sign,
+        model_names=block.model_names,
+        height_point_ids=block.height_point_ids,
+        name=block.name,
+    )
+    if output_dir is not None:
+        write_block(result, output_dir)
+    return result
+
+
+def _num(value: float, digits: int = 6) -> float | None:
+    v = float(value)
+    return None if math.isnan(v) else round(v, digits) + 0.0  # + 0.0: no "-0.0" on the sheet
+
+
+def _int(value: float) -> int | None:
+    v = float(value)
+    return None if math.isnan(v) else round(v)
+
+
+def model_sheet(result: BlockResult, i: int) -> dict[str, Any]:
+    """The sheet of model ``i`` as plain data, with the keys of the single-pair ``--json``.
+
+    Parameters
+    ----------
+    result : BlockResult
+    i : int
+        Model index.
+
+    Returns
+    -------
+    dict
+        ``status`` ("ok" or "refused"), ``reason``, and the values of Eqs. (6.1)–(6.6) of [1]_
+        (None where refused). [mm, —]
+    """
+    ok = bool(result.accepted[i])
+    fid = result.fiducials_transformed_mm[i]
+    rig = result.fiducials_rigorous_mm[i]
+    photos = ("left", "right")
+    return {
+        "block": result.name,
+        "model": result.model_names[i],
+        "instrument": result.instrument,
+        "status": "ok" if ok else "refused",
+        "reason": result.reason(i),
+        "reason_code": int(result.reason_code[i]),
+        "assumed": {
+            key: list(params) for key, params in assumed_parameters(result.spec).items() if params
+        },
+        "scale_horizontal": _int(result.horizontal_scale_denominator[i]),
+        "scale_vertical": _int(result.vertical_scale_denominator[i]),
+        "scale_map": result.map_scale_denominator,
+        "f_instrument_mm": _num(result.f_instrument_mm[i]),
+        "transformation_coefficient": _num(result.transformation_coefficient[i]),
+        "focal_length_corrected_mm": _num(result.focal_length_corrected_mm),
+        "n_left": _num(result.n_left[i]),
+        "n_right": _num(result.n_right[i]),
+        "base_mm": dict(zip(("bx", "by", "bz"), map(_num, result.base_mm[i]), strict=True)),
+        "fiducials_transformed_mm": {
+            p: {
+                f"x{X_MARK_NAME[j]}": _num(fid[j, 0]),
+                "y3": _num(fid[j, 1]),
+                "y4": _num(fid[j, 2]),
+            }
+            for j, p in enumerate(photos)
+        },
+        "fiducials_rigorous_mm": {
+            p: {
+                key: [_num(rig[j, m, 0]), _num(rig[j, m, 1])]
+                for m, key in enumerate((X_MARK_NAME[j], "3", "4"))
+            }
+            for j, p in enumerate(photos)
+        },
+        "L_mm": {"left": _num(result.mark_span_mm[i, 0]), "right": _num(result.mark_span_mm[i, 1])},
+        "decentrations_mm": {
+            p: {
+                "x": _num(result.decentration_mm[i, j, 0]),
+                "y": _num(result.decentration_mm[i, j, 1]),
+            }
+            for j, p in enumerate(photos)
+        },
+        "angles_deg": {
+            p: {
+                a: _num(math.degrees(result.angles[i, j, m]), 7)
+                for m, a in enumerate(("alpha", "omega", "kappa"))
+            }
+            for j, p in enumerate(photos)
+        },
+        "control_heights_model_mm": {
+            pid: _num(result.control_heights_model_mm[i, j])
+            for j, pid in enumerate(result.height_point_ids[i])
+        },
+        "depth_range_used_mm": [_num(v, 3) for v in result.depth_range_mm[i]],
+        "frame": {
+            "rotation_deg": _num(math.degrees(result.frame_rotation[i]), 7),
+            "note": "the photogrammetric system is turned about Z by −rotation so that X runs "
+            "along the base, origin S_л (docs/setup-data.md)",
+        },
+        "options": {"book_sign_n_right": result.book_sign},
+        "not_in_block_mode": "sheet corners (6.7), similarity (6.8) and the model X, Y travel: "
+        "compute the single-pair sheet for them",
+    }
+
+
+_CSV_OUT = (
+    "model", "status", "reason_code", "scale_horizontal", "scale_vertical", "f_instrument_mm",
+    "transformation_coefficient", "n_left", "n_right", "bx_mm", "by_mm", "bz_mm",
+    "left_x2_mm", "left_y3_mm", "left_y4_mm", "right_x1_mm", "right_y3_mm", "right_y4_mm",
+    "L_left_mm", "L_right_mm", "frame_rotation_deg", "reason",
+)  # fmt: skip
+
+
+def write_block(result: BlockResult, output_dir: str | os.PathLike[str]) -> None:
+    """Write ``<output_dir>/<model>/sheet.yaml`` for every model and ``<output_dir>/block.csv``.
+
+    Parameters
+    ----------
+    result : BlockResult
+    output_dir : str or path-like
+        Created if needed. Each file is written whole or not at all.
+
+    Notes
+    -----
+    The sheet keys are those of the single-pair ``--json`` output where they exist
+    (:func:`model_sheet`); values of Eqs. (6.1)–(6.6) of [1]_.
+    """
+    out = Path(output_dir)
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(_CSV_OUT)
+    for i, model in enumerate(result.model_names):
+        sheet = model_sheet(result, i)
+        text = yaml.dump(sheet, Dumper=dumper, sort_keys=False, allow_unicode=True, width=100)
+        atomic_write_text(out / model / "sheet.yaml", text)
+        fid = sheet["fiducials_transformed_mm"]
+        writer.writerow(
+            [
+                model, sheet["status"], sheet["reason_code"], sheet["scale_horizontal"],
+                sheet["scale_vertical"], sheet["f_instrument_mm"],
+                sheet["transformation_coefficient"], sheet["n_left"], sheet["n_right"],
+                *sheet["base_mm"].values(), *fid["left"].values(), *fid["right"].values(),
+                sheet["L_mm"]["left"], sheet["L_mm"]["right"], sheet["frame"]["rotation_deg"],
+                sheet["reason"],
+            ]
+        )  # fmt: skip
+    atomic_write_text(out / "block.csv", buffer.getvalue())
+
