@@ -488,8 +488,10 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _verify(args: argparse.Namespace) -> int:
+    from stereoplotter.io.geometry_file import geometry_from_file
     from stereoplotter.progress import step_progress
-    from stereoplotter.verification.table import geometry_from_file, run_procedure_mc, verify
+    from stereoplotter.report.verification import verify
+    from stereoplotter.verification.table import run_procedure_mc
 
     geometry, scenarios = None, None
     if args.geometry:
@@ -511,7 +513,7 @@ def _verify(args: argparse.Namespace) -> int:
 
         attach_procedure_mc(rows, proc)
     if args.output:
-        from stereoplotter.verification.table import write_verification
+        from stereoplotter.report.verification import write_verification
 
         out = Path(args.output)
         # Figures first, in memory: every file is written whole or not at all.

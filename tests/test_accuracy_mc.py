@@ -10,7 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from stereoplotter.verification import ROW_KEYS, VERDICTS, run_verification, write_verification
+from stereoplotter.report.verification import write_verification
+from stereoplotter.verification import ROW_KEYS, VERDICTS, run_verification
 from stereoplotter.verification import linear_mc as mc
 
 TRIALS = 3000  # per row; CI half-width ≈ 3.29/√(2·3000) = 4.2 % for one source
@@ -137,7 +138,7 @@ def test_other_geometry_rigorous_and_mc_agree(geometry):
 
 
 def test_geometry_from_scenario_file():
-    from stereoplotter.verification.table import geometry_from_file
+    from stereoplotter.io.geometry_file import geometry_from_file
 
     g, scen = geometry_from_file("scenarios/pair80.yaml")
     assert g["p80"] == pytest.approx(36.1, abs=0.1) and g["c"] == pytest.approx(2 * g["p80"])

@@ -196,14 +196,14 @@ def test_geometry_file_with_a_typo_names_file_and_field(tmp_path, capsys):
     ],
 )
 def test_geometry_file_values_are_checked(tmp_path, text, message):
-    from stereoplotter.verification.table import geometry_from_file
+    from stereoplotter.io.geometry_file import geometry_from_file
 
     with pytest.raises(ConfigError, match=r"geometry\.yaml: " + message):
         geometry_from_file(_write(tmp_path, text, "geometry.yaml"))
 
 
 def test_geometry_from_a_single_photo_scenario_is_refused(capsys):
-    from stereoplotter.verification.table import geometry_from_file
+    from stereoplotter.io.geometry_file import geometry_from_file
 
     with pytest.raises(ConfigError, match=r"photos: expected a stereopair .*found 1 photo"):
         geometry_from_file(SINGLE)

@@ -510,7 +510,7 @@ def _load(kind: str, path: Path) -> Any:
         assert all(np.all(np.isfinite(v)) for v in draws.values()), "non-finite draw"
         return model
     if kind == "geometry":
-        from stereoplotter.verification.table import geometry_from_file
+        from stereoplotter.io.geometry_file import geometry_from_file
 
         return geometry_from_file(path)
     raise AssertionError(kind)

@@ -13,8 +13,6 @@ from stereoplotter.verification.table import (
     VERDICTS,
     closing_comparison,
     run_verification,
-    verify,
-    write_verification,
 )
 
 __all__ = [
@@ -23,6 +21,4 @@ __all__ = [
     "VERDICTS",
     "closing_comparison",
     "run_verification",
-    "verify",
-    "write_verification",
 ]

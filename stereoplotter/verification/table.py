@@ -13,19 +13,13 @@ m_q = m_p = 1 (and m_xy = √2 m_p) for (6.45)-(6.61).
 
 from __future__ import annotations
 
-import csv
-import io
-import json
 import math
-import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 
 from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.accuracy import setup_accuracy as sa
-from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.verification import linear_mc as mc
 
 __all__ = [
@@ -33,11 +27,10 @@ __all__ = [
     "ROW_KEYS",
     "VERDICTS",
     "attach_procedure_mc",
+    "check_geometry",
     "closing_comparison",
-    "geometry_from_file",
     "run_procedure_mc",
     "run_verification",
-    "write_verification",
 ]
 
 BOOK = {
@@ -686,68 +679,7 @@ def _levelling_point_model(a, c, p, f, pt):
 
 #: Accepted values of a flat ``--geometry`` mapping (keys of :data:`BOOK`), in mm or [—]: wide
 #: round bounds around the book's setting that keep every formula finite.
-_MM_POSITIVE = {"unit": "mm", "low": 1.0, "high": 500.0}
-_GEOMETRY_LIMITS = {
-    "f": {"unit": "mm", "low": 1.0, "high": 1000.0},
-    "l": _MM_POSITIVE,
-    "n": {"unit": "—", "low": 0.01, "high": 100.0},
-    "c": _MM_POSITIVE,
-    "p60": _MM_POSITIVE,
-    "a60": {"unit": "mm", "low": -500.0, "high": 500.0},
-    "p80": _MM_POSITIVE,
-    "a80": {"unit": "mm", "low": -500.0, "high": 500.0},
-}
-
-
-def geometry_from_file(path) -> tuple[dict, dict]:
-    """Geometry overrides from a YAML file: a scenario (has ``camera``) or a flat mapping.
-
-    A scenario gives f (camera), l (mean fiducial distance), n = n_л of the SC-1 sheet and its
-    photo base p = B·f/H̄ at the scenario's photo scale; below 70 % overlap p is the 60 % slot
-    (c = p, a = 0, and the 80 % slot the book's relation p/2, a = c − p/2), above it the 80 % slot
-    (c = 2p, a = p; 60 % slot p = c, a = 0). A flat mapping gives keys of :data:`BOOK`.
-
-    Returns
-    -------
-    geometry : dict
-        Keys of :data:`BOOK`.
-    procedure_scenarios : dict
-        ``{"60": path or None, "80": path or None}`` for the procedure MC.
-    """
-    from stereoplotter.errors import ConfigError
-    from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
-
-    data, source = load_yaml_mapping(path)
-    if "camera" not in data:
-        fields = Fields(source)
-        fields.mapping(data, "", tuple(BOOK))
-        geometry = {k: fields.number(data, k, "", **_GEOMETRY_LIMITS[k]) for k in data}
-        _check_geometry(fields, geometry)
-        return geometry, {"60": None, "80": None}
-    from stereoplotter.io.scenario_file import load_scenario
-    from stereoplotter.verification.procedure_mc import scenario_geometry
-
-    scenario = load_scenario(path)  # every problem of the file as one ConfigError
-    if not scenario.is_stereopair:
-        raise ConfigError(
-            source,
-            "photos",
-            "a stereopair (photos left and right) for --geometry",
-            f"{len(scenario.photos)} photo(s)",
-        )
-    sg = scenario_geometry(str(path))
-    p = sg["p"]
-    g = {"f": sg["f"], "l": sg["l"], "n": sg["n"]}
-    if sg["overlap"] < 0.7:
-        g.update(c=p, p60=p, a60=0.0, p80=p / 2, a80=p / 2)
-        _check_geometry(Fields(source), g)
-        return g, {"60": str(path), "80": None}
-    g.update(c=2 * p, p60=2 * p, a60=0.0, p80=p, a80=p)
-    _check_geometry(Fields(source), g)
-    return g, {"60": None, "80": str(path)}
-
-
-def _check_geometry(fields, geometry: dict) -> None:
+def check_geometry(fields, geometry: dict) -> None:
     """Refuse a geometry outside the domain of the table's formulas, naming the field.
 
     The standard and control points sit at x_п = −c, a and −(p + a): they must be distinct
@@ -1003,141 +935,3 @@ def closing_comparison(rows: list[dict]) -> list[dict]:
             row[f"gain_{key}"] = None if a is None or b is None else 1.0 - a / b
         out.append(row)
     return out
-
-
-def _fmt(v, digits=4):
-    if v is None:
-        return "—"
-    if isinstance(v, float):
-        return f"{v:.{digits}g}" if abs(v) < 1e-3 or abs(v) >= 1e4 else f"{v:.{digits}f}"
-    return str(v)
-
-
-def _proc(r):
-    if r.get("mc_procedure") is None:
-        return "—"
-    return f"{_fmt(r['mc_procedure'])} ± {r['mc_procedure_ci']:.2g}"
-
-
-def _markdown(rows, closing, meta):
-    lines = [
-        "# Verification of Kushtin & Lyskov 1984, §27 and chapter 5",
-        "",
-        f"trials = {meta['trials']}, seed = {meta['seed']}, CI = ±{mc.CI_Z} s.e. (99.9 %),"
-        f" runtime {meta['seconds']:.1f} s"
-        + (
-            f", procedure MC trials = {meta['procedure_trials']}"
-            if meta.get("procedure_trials")
-            else ""
-        ),
-        "",
-        "| eq | quantity | printed | book | rigorous | covariance | linear MC ± CI | "
-        "procedure MC | verdict | note |",
-        "|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    for r in rows:
-        lines.append(
-            f"| {r['eq']} | {r['quantity']} | {_fmt(r['printed'])} | {_fmt(r['book'])} | "
-            f"{_fmt(r['rigorous'])} | {_fmt(r['covariance'])} | {_fmt(r['mc_linear'])} ± "
-            f"{r['mc_linear_ci']:.2g} | {_proc(r)} | {r['verdict']} | {r['note']} |"
-        )
-    lines += [
-        "",
-        "## Closing comparison (setup data vs conventional method)",
-        "",
-        "| overlap | book claim | printed setup/conv | book setup/conv (gain) | "
-        "rigorous setup/conv (gain) | MC setup/conv |",
-        "|---|---|---|---|---|---|",
-    ]
-    for c in closing:
-        lines.append(
-            f"| {c['overlap']} | {c['book_claim']} | {_fmt(c['setup_printed'], 2)} / "
-            f"{_fmt(c['conventional_printed'], 2)} | {_fmt(c['setup_book'])} / "
-            f"{_fmt(c['conventional_book'])} ({c['gain_book']:+.0%}) | "
-            f"{_fmt(c['setup_rigorous'])} / {_fmt(c['conventional_rigorous'])} "
-            f"({c['gain_rigorous']:+.0%}) | {_fmt(c['setup_mc_linear'])} / "
-            f"{_fmt(c['conventional_mc_linear'])} |"
-        )
-    return "\n".join(lines) + "\n"
-
-
-def write_verification(
-    rows: list[dict], out_dir, *, trials=None, seed=None, seconds=0.0, procedure_trials=None
-):
-    """Write ``verification.md``, ``verification.csv``, ``verification.json`` and
-    ``closing_comparison.json`` to ``out_dir``, each whole or not at all.
-
-    Returns
-    -------
-    list of pathlib.Path
-        The files written.
-    """
-    out = Path(out_dir)
-    closing = closing_comparison(rows)
-    meta = {
-        "trials": trials,
-        "seed": seed,
-        "seconds": seconds,
-        "procedure_trials": procedure_trials,
-    }
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=list(ROW_KEYS), extrasaction="ignore")
-    w.writeheader()
-    for r in rows:
-        w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in ROW_KEYS})
-    files = {
-        "verification.md": _markdown(rows, closing, meta),
-        "verification.csv": buf.getvalue(),
-        "verification.json": json.dumps(rows, ensure_ascii=False, indent=1),
-        "closing_comparison.json": json.dumps(closing, ensure_ascii=False, indent=1),
-    }
-    paths = []
-    for name, text in files.items():
-        atomic_write_bytes(out / name, text.encode("utf-8"))
-        paths.append(out / name)
-    return paths
-
-
-def verify(
-    trials: int = 60000,
-    seed: int = 20240601,
-    out_dir=None,
-    geometry=None,
-    progress=None,
-    procedure_trials: int = PROCEDURE_TRIALS,
-    procedure_scenarios=None,
-):
-    """Run and optionally write the verification (the entry point for ``stereoplotter verify``).
-
-    ``geometry`` is a mapping of :data:`BOOK` keys or the path of a YAML file
-    (:func:`geometry_from_file`: a scenario also becomes the procedure MC's scenario).
-
-    Returns
-    -------
-    rows : list of dict
-    seconds : float
-    """
-    if isinstance(geometry, str | Path):
-        geometry, scen = geometry_from_file(geometry)
-        if procedure_scenarios is None:
-            procedure_scenarios = scen
-    t0 = time.perf_counter()
-    rows = run_verification(
-        trials=trials,
-        seed=seed,
-        geometry=geometry,
-        progress=progress,
-        procedure_trials=procedure_trials,
-        procedure_scenarios=procedure_scenarios,
-    )
-    seconds = time.perf_counter() - t0
-    if out_dir is not None:
-        write_verification(
-            rows,
-            out_dir,
-            trials=trials,
-            seed=seed,
-            seconds=seconds,
-            procedure_trials=procedure_trials,
-        )
-    return rows, seconds
