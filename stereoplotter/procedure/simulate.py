@@ -106,10 +106,10 @@ def _errors(spec: InstrumentSpec, errors: ErrorModel | str | None) -> ErrorModel
         return errors
     if errors == "zero":
         return error_model_from_spec(spec).zero()
-    from stereoplotter.io.yaml_files import load_yaml_mapping
-
-    data, source = load_yaml_mapping(errors)
-    return error_model_from_spec(spec).with_overrides(data, source)
+    raise StereoplotterError(
+        f"errors: expected an ErrorModel, 'zero' or None, found {errors!r} (an errors file is "
+        "read by stereoplotter.io.errors_file.load_error_model)"
+    )
 
 
 @dataclass(frozen=True)
@@ -275,8 +275,9 @@ def simulate(
     scenario : Scenario
     spec : InstrumentSpec
     method : {"setup", "conventional"}
-    errors : ErrorModel, "zero", path of an errors YAML, or None
-        Injected instrument errors; None: the instrument's defaults; "zero": none.
+    errors : ErrorModel, "zero" or None
+        Injected instrument errors; None: the instrument's defaults; "zero": none (an errors
+        file: :func:`stereoplotter.io.errors_file.load_error_model`).
     seed : int
         Seeds the injected errors and every judgment of the operator.
     trials : int, optional

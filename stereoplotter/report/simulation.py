@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from stereoplotter.io.errors_file import load_error_model
 from stereoplotter.io.trial_store import TrialStore
 from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
@@ -239,7 +240,7 @@ def run_simulation_command(
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
     seed = scenario.seed if seed is None else seed
-    prep = prepare_run(scenario, spec, method, errors, seed, backend)
+    prep = prepare_run(scenario, spec, method, load_error_model(errors, spec), seed, backend)
     out = None if output is None else Path(output)
     if trials is None:
         result = run_trials_chunk(prep, 0, None)
