@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.setup.equations import correction_inclination, decentration
+from stereoplotter.geometry.tilt_correction import correction_inclination, decentration
 
 __all__ = [
     "DECENTRATION_VARIANTS",
@@ -741,7 +741,7 @@ def unit_for_orientation(
     Returns
     -------
     CorrectionUnit
-        T_α = tan α, T_ω = tan ω, e = c = (f′ tan α, f′ tan ω) (``setup_data.decentration``), κ.
+        T_α = tan α, T_ω = tan ω, e = c = (f′ tan α, f′ tan ω) (``decentration``), κ.
 
     Notes
     -----
@@ -785,7 +785,7 @@ def represented_tilt_tangent(
     Notes
     -----
     Inverse of tan θ = k tan α ([2]_ eq. (4); ``kinematics.md`` §3.2). The forward relation is
-    :func:`correction_angle` (which uses ``setup_data.correction_inclination``).
+    :func:`correction_angle` (which uses ``geometry.tilt_correction.correction_inclination``).
 
     Examples
     --------
@@ -815,7 +815,7 @@ def correction_angle(
 
     Notes
     -----
-    [2]_ eq. (4), tan θ = k tan α, via ``setup_data.correction_inclination``.
+    [2]_ eq. (4), tan θ = k tan α, via ``geometry.tilt_correction.correction_inclination``.
 
     Examples
     --------
@@ -937,7 +937,7 @@ def set_decentrations(
     unit : CorrectionUnit
         The unit before.
     decentration_x_mm, decentration_y_mm : float or ndarray
-        d_x = f′ tan α, d_y = f′ tan ω from the computer (``setup_data.decentration``). [mm]
+        d_x = f′ tan α, d_y = f′ tan ω from the computer (``tilt_correction.decentration``). [mm]
 
     Returns
     -------
