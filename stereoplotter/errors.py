@@ -1,10 +1,19 @@
-"""Domain exceptions. All subclass :class:`ValueError` so callers may catch them generically."""
+"""Domain exceptions (all subclass :class:`ValueError`) and the helpers of their messages."""
 
 from __future__ import annotations
 
+import difflib
 import re
+from collections.abc import Iterable
+from typing import Any
 
-__all__ = ["ConfigError", "GeometryError", "StereoplotterError"]
+__all__ = [
+    "ConfigError",
+    "GeometryError",
+    "StereoplotterError",
+    "describe_value",
+    "did_you_mean",
+]
 
 #: Control characters and line breaks: a message quoting user text stays one printable line.
 _CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
@@ -43,3 +52,43 @@ class ConfigError(StereoplotterError):
 
 class GeometryError(StereoplotterError):
     """The geometry is degenerate: too few points, collinear points, rays that do not meet."""
+
+
+# --- helpers of the messages -----------------------------------------------------------------
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """``"did you mean NAME?"`` for the one choice closest to a mistyped ``word``, or ``""``
+    when none is close (:func:`difflib.get_close_matches`, case ignored) or two are equally
+    close (then the list of choices says more than a guess).
+
+    Examples
+    --------
+    >>> did_you_mean("focal_lenght_mm", ["focal_length_mm", "format_mm"])
+    'did you mean focal_length_mm?'
+    >>> did_you_mean("w_mm", ["x_mm", "y_mm", "z_mm"])
+    ''
+    """
+    choices = [str(c) for c in choices]
+    lowered = {c.lower(): c for c in choices}
+    matches = difflib.get_close_matches(str(word).lower(), list(lowered), n=2, cutoff=0.6)
+    if not matches:
+        return ""
+    if len(matches) == 2:
+        ratio = [difflib.SequenceMatcher(None, str(word).lower(), m).ratio() for m in matches]
+        if ratio[0] == ratio[1]:
+            return ""
+    return f"did you mean {lowered[matches[0]]}?"
+
+
+def describe_value(value: Any) -> str:
+    """How a YAML value is named in an error message ("a mapping", "the text 'x'", …)."""
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, list):
+        return f"a list of {len(value)}"
+    if value is None:
+        return "nothing"
+    if isinstance(value, str):
+        return f"the text {value!r}"
+    return repr(value)

@@ -20,9 +20,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.errors import ConfigError
+from stereoplotter.errors import ConfigError, describe_value, did_you_mean
 from stereoplotter.instrument.spec import InstrumentSpec
-from stereoplotter.io.yaml_files import describe_value, did_you_mean
 from stereoplotter.random_streams import keyed_draws
 
 __all__ = ["DISTRIBUTIONS", "ErrorModel", "ErrorTerm", "error_model_from_spec"]

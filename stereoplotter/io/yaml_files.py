@@ -7,7 +7,6 @@ was expected and what was found.
 
 from __future__ import annotations
 
-import difflib
 import math
 import os
 import secrets
@@ -18,7 +17,7 @@ from typing import Any, BinaryIO
 
 import yaml
 
-from stereoplotter.errors import ConfigError
+from stereoplotter.errors import ConfigError, describe_value, did_you_mean
 
 __all__ = [
     "Fields",
@@ -446,43 +445,6 @@ def _range_text(unit: str, low: float, high: float, low_open: bool, high_open: b
     lo = "-inf" if math.isinf(low) else f"{low:g}"
     hi = "inf" if math.isinf(high) else f"{high:g}"
     return f"in {left}{lo}, {hi}{right}{unit_text}"
-
-
-def did_you_mean(word: str, choices: Iterable[str]) -> str:
-    """``"did you mean NAME?"`` for the one choice closest to a mistyped ``word``, or ``""``
-    when none is close (:func:`difflib.get_close_matches`, case ignored) or two are equally
-    close (then the list of choices says more than a guess).
-
-    Examples
-    --------
-    >>> did_you_mean("focal_lenght_mm", ["focal_length_mm", "format_mm"])
-    'did you mean focal_length_mm?'
-    >>> did_you_mean("w_mm", ["x_mm", "y_mm", "z_mm"])
-    ''
-    """
-    choices = [str(c) for c in choices]
-    lowered = {c.lower(): c for c in choices}
-    matches = difflib.get_close_matches(str(word).lower(), list(lowered), n=2, cutoff=0.6)
-    if not matches:
-        return ""
-    if len(matches) == 2:
-        ratio = [difflib.SequenceMatcher(None, str(word).lower(), m).ratio() for m in matches]
-        if ratio[0] == ratio[1]:
-            return ""
-    return f"did you mean {lowered[matches[0]]}?"
-
-
-def describe_value(value: Any) -> str:
-    """How a YAML value is named in an error message ("a mapping", "the text 'x'", …)."""
-    if isinstance(value, dict):
-        return "a mapping"
-    if isinstance(value, list):
-        return f"a list of {len(value)}"
-    if value is None:
-        return "nothing"
-    if isinstance(value, str):
-        return f"the text {value!r}"
-    return repr(value)
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:

@@ -10,7 +10,6 @@ runs long runs in chunks.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -35,7 +34,6 @@ __all__ = [
     "SimulationResult",
     "prepare_run",
     "residual_grid_m",
-    "run_header",
     "run_trials_chunk",
     "simulate",
     "simulate_per_trial",
@@ -93,10 +91,6 @@ class SimulationResult:
     operator_model: OperatorModel
     sheet_pose: dict[str, Any] = field(default_factory=dict)
     first_trial: int = 0
-
-    def summary(self) -> dict[str, Any]:
-        """JSON-ready figures: one procedure's values, or per-measure statistics over trials."""
-        return _summary(self)
 
 
 def _errors(spec: InstrumentSpec, errors: ErrorModel | str | None) -> ErrorModel:
@@ -386,55 +380,3 @@ def _evaluate(scenario, sheet, run: Run) -> ModelEvaluation:
         standard_points_c_mm=inst.spec.standard_points_c_mm,
         corner4_misclosure_mm=None if corner is None else corner["residual"],
     )
-
-
-# --- summary and files -----------------------------------------------------------------------
-
-
-def _value(v) -> Any:
-    a = np.asarray(v, float)
-    x = float(a.reshape(-1)[0])
-    return None if math.isnan(x) else x
-
-
-def _summary(r: SimulationResult) -> dict[str, Any]:
-    """The summary of one procedure (``trials`` None); trial runs: :func:`trials.summarise_run`."""
-    if r.trials is not None:
-        from stereoplotter.procedure.trials import summarise_result
-
-        return summarise_result(r)
-    checks = {}
-    for name, c in r.checks.items():
-        entry = {"residual": _value(c["residual"]), "unit": c["unit"]}
-        if c["tolerance"] is not None:
-            entry["tolerance"] = _value(c["tolerance"])
-            entry["passed"] = bool(np.asarray(c["passed"]).reshape(-1)[0])
-        if c["iterations"] is not None:
-            entry["iterations"] = _value(c["iterations"])
-        checks[name] = entry
-    q_std = np.abs(np.asarray(r.q_standard_mm))
-    q_grid = np.asarray(r.q_grid_mm)
-    return {
-        **run_header(r),
-        "iterations": {k: _value(v) for k, v in r.iterations.items()},
-        "checks": checks,
-        "residual_y_parallax_um": {
-            "standard_points_max": _value(np.max(q_std) * 1e3),
-            "grid_max": _value(np.max(np.abs(q_grid)) * 1e3),
-            "grid_rms": _value(np.sqrt(np.mean(q_grid**2)) * 1e3),
-        },
-        "evaluation": None if r.evaluation is None else r.evaluation.to_dict(),
-    }
-
-
-def run_header(r: SimulationResult) -> dict[str, Any]:
-    """What a run was: method, back-end, seed, trials, scenario, instrument, operator."""
-    return {
-        "method": r.method,
-        "backend": r.backend,
-        "seed": r.seed,
-        "trials": r.trials,
-        "scenario": r.sheet.scenario,
-        "instrument": r.sheet.instrument,
-        "operator": r.operator_model.to_dict(),
-    }

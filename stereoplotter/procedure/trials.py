@@ -15,6 +15,7 @@ Carlo standard errors (:mod:`stereoplotter.statistics`), never per-trial arrays.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -23,12 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M, UM_PER_MM
-from stereoplotter.procedure.simulate import (
-    PreparedRun,
-    SimulationResult,
-    run_header,
-    run_trials_chunk,
-)
+from stereoplotter.procedure.simulate import PreparedRun, SimulationResult, run_trials_chunk
 from stereoplotter.statistics import scale_summary, summarise_flags, summarise_values
 
 __all__ = [
@@ -37,6 +33,7 @@ __all__ = [
     "RunInfo",
     "chunk_trials_for",
     "iter_trial_chunks",
+    "run_header",
     "run_info",
     "summarise_columns",
     "summarise_result",
@@ -215,7 +212,53 @@ def summarise_columns(
 
 
 def summarise_result(result: SimulationResult) -> dict[str, Any]:
-    """The summary of a vectorised result held in memory (one chunk)."""
-    return summarise_columns(
-        run_info(result, result.trials or 1), trial_columns(result).items()
-    )
+    """JSON-ready summary of a result in memory: one procedure's values, or the per-measure
+    statistics over the trials of a vectorised result (one chunk)."""
+    if result.trials is None:
+        return _single_summary(result)
+    return summarise_columns(run_info(result, result.trials), trial_columns(result).items())
+
+
+def _value(v) -> Any:
+    a = np.asarray(v, float)
+    x = float(a.reshape(-1)[0])
+    return None if math.isnan(x) else x
+
+
+def _single_summary(r: SimulationResult) -> dict[str, Any]:
+    """The summary of one procedure (``trials`` None): its values and the evaluation per point."""
+    checks = {}
+    for name, c in r.checks.items():
+        entry = {"residual": _value(c["residual"]), "unit": c["unit"]}
+        if c["tolerance"] is not None:
+            entry["tolerance"] = _value(c["tolerance"])
+            entry["passed"] = bool(np.asarray(c["passed"]).reshape(-1)[0])
+        if c["iterations"] is not None:
+            entry["iterations"] = _value(c["iterations"])
+        checks[name] = entry
+    q_std = np.abs(np.asarray(r.q_standard_mm))
+    q_grid = np.asarray(r.q_grid_mm)
+    return {
+        **run_header(r),
+        "iterations": {k: _value(v) for k, v in r.iterations.items()},
+        "checks": checks,
+        "residual_y_parallax_um": {
+            "standard_points_max": _value(np.max(q_std) * 1e3),
+            "grid_max": _value(np.max(np.abs(q_grid)) * 1e3),
+            "grid_rms": _value(np.sqrt(np.mean(q_grid**2)) * 1e3),
+        },
+        "evaluation": None if r.evaluation is None else r.evaluation.to_dict(),
+    }
+
+
+def run_header(r: SimulationResult) -> dict[str, Any]:
+    """What a run was: method, back-end, seed, trials, scenario, instrument, operator."""
+    return {
+        "method": r.method,
+        "backend": r.backend,
+        "seed": r.seed,
+        "trials": r.trials,
+        "scenario": r.sheet.scenario,
+        "instrument": r.sheet.instrument,
+        "operator": r.operator_model.to_dict(),
+    }

@@ -31,6 +31,7 @@ from stereoplotter.procedure.trials import (
     iter_trial_chunks,
     run_info,
     summarise_columns,
+    summarise_result,
     trial_columns,
 )
 
@@ -189,7 +190,7 @@ def _trial0_files(result: SimulationResult) -> dict[str, bytes]:
 def write_simulation(result: SimulationResult, out_dir: str | Path) -> dict[str, Path]:
     """Write one run's transcript.txt, transcript.jsonl, evaluation.yaml, evaluation.md,
     parallax.png (a vectorised result: the summary over its trials, trial 0's transcript)."""
-    s = result.summary()
+    s = summarise_result(result)
     files = _trial0_files(result)
     files["evaluation.yaml"] = _yaml(s).encode("utf-8")
     files["evaluation.md"] = simulation_markdown(s).encode("utf-8")
@@ -244,7 +245,7 @@ def run_simulation_command(
     out = None if output is None else Path(output)
     if trials is None:
         result = run_trials_chunk(prep, 0, None)
-        summary = json_ready(result.summary())
+        summary = json_ready(summarise_result(result))
         files = {} if out is None else write_simulation(result, out)
         if progress is not None:
             progress(1)

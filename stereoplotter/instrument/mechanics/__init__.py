@@ -29,7 +29,8 @@ from stereoplotter.instrument.mechanics.coordinatograph import (
     Coordinatograph,
     CoordinatographParams,
 )
-from stereoplotter.instrument.mechanics.play import PlayAxis, half_play_mm, play, play_offset_mm
+from stereoplotter.instrument.mechanics.dead_band import half_play_mm, play_offset_mm
+from stereoplotter.instrument.mechanics.play import PlayAxis, play
 from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis, new_space, velocity_plan
 from stereoplotter.instrument.mechanics.sheet import (
     OperatorParams,

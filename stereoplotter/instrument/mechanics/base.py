@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Literal, Protocol, runtime_checkable
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.mechanics.dead_band import G_MM_S2, half_play_mm, play_offset_mm
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -47,8 +48,6 @@ __all__ = [
     "pre_position",
 ]
 
-#: Standard gravity in the mechanics units. [mm/s²]
-G_MM_S2: float = 9810.0
 #: One N/µm in the mechanics stiffness unit. [kg/s² per N/µm]
 N_PER_UM: float = 1.0e6
 #: One N·m in the mechanics torque unit. [kg·mm²/s² per N·m]
@@ -193,9 +192,7 @@ class AxisParams:
 
     @property
     def half_play_mm(self) -> float:
-        """Half-width h of the play operator's dead band (see :func:`~.play.half_play_mm`). [mm]"""
-        from stereoplotter.instrument.mechanics.play import half_play_mm
-
+        """Half-width h of the play operator's dead band (:func:`~.dead_band.half_play_mm`). [mm]"""
         return float(
             half_play_mm(
                 self.backlash_mm,
@@ -208,9 +205,7 @@ class AxisParams:
 
     @property
     def offset_mm(self) -> float:
-        """Centre offset c of the dead band (see :func:`~.play.play_offset_mm`). [mm]"""
-        from stereoplotter.instrument.mechanics.play import play_offset_mm
-
+        """Centre offset c of the dead band (:func:`~.dead_band.play_offset_mm`). [mm]"""
         return float(
             play_offset_mm(
                 self.backlash_mm,
