@@ -19,7 +19,7 @@ from stereoplotter.cli import _parser, main
 from stereoplotter.errors import ConfigError
 from stereoplotter.io.scenario_file import load_scenario
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _shipped(kind: str, name: str) -> Path:

@@ -41,7 +41,7 @@ um = 1e-3 * mm
 m = 1.0  # internal length unit of object coordinates
 arcsec = 1.0 / ARCSEC_PER_RAD  # radians
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 def _load(name: str) -> list[dict[str, str]]:

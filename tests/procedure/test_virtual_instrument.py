@@ -17,7 +17,7 @@ from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.setup.sheet import compute_setup_sheet
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

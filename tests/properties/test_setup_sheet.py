@@ -24,7 +24,7 @@ from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.scenario.frame import local_from_sk42
 from stereoplotter.setup.sheet import SetupOptions, SetupRefusal, compute_setup_sheet
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = ROOT / "scenarios"
 PAIRS = ("pair60", "pair80", "mountain60")
 INSTRUMENTS = ("sc1", "spr3", "sd3")

@@ -11,7 +11,7 @@ import pytest
 
 from stereoplotter.cli import main
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 PAIR60 = str(ROOT / "scenarios" / "pair60.yaml")
 
 

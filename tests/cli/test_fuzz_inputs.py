@@ -49,7 +49,7 @@ from conftest import node_paths, value_at
 
 from stereoplotter.errors import StereoplotterError
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SEED = int(os.environ.get("STEREOPLOTTER_FUZZ_SEED", "20240607"))
 CASES = int(os.environ.get("STEREOPLOTTER_FUZZ_CASES", "2000"))
 ONLY = os.environ.get("STEREOPLOTTER_FUZZ_ONLY")

@@ -33,7 +33,7 @@ from stereoplotter.scenario.synthetic import synthesize_measurements
 from stereoplotter.setup.equations import instrument_principal_distance
 from stereoplotter.setup.sheet import compute_setup_sheet
 
-SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
 # kinematics.md §6, canonical unit, worst case over the tilt signs, f′ = 100 mm, §5 grid
 # (photo coordinates up to 80 mm, tan of the half field ≈ 0.8): tilt [deg] ->

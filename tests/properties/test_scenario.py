@@ -19,7 +19,7 @@ from stereoplotter.geometry.collinearity import object_to_photo
 from stereoplotter.io.scenario_file import load_scenario, scenario_from_mapping
 from stereoplotter.scenario import summarize_scenario, synthesize_measurements
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SHIPPED = sorted(SCENARIOS.glob("*.yaml"))
 
 
