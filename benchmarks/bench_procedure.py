@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import simulate, simulate_per_trial
 

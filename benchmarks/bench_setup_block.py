@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.setup.block import compute_block, per_pair_loop
 
 MARKS = np.array([[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]])

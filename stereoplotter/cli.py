@@ -287,7 +287,7 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _demo_steps(args: argparse.Namespace, step) -> int:
     """The demo's work, reporting ``step(done, 4, what)`` as it goes."""
-    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.io.scenario_file import load_scenario
     from stereoplotter.plotting.figures import plot_scenario_layout
     from stereoplotter.report.sheet import sheet_to_dict
@@ -353,7 +353,8 @@ def _demo_steps(args: argparse.Namespace, step) -> int:
 
 
 def _instrument(args: argparse.Namespace) -> int:
-    from stereoplotter.instrument.spec import format_instrument, instrument_to_dict, load_instrument
+    from stereoplotter.instrument.spec import format_instrument, instrument_to_dict
+    from stereoplotter.io.instrument_file import load_instrument
 
     spec = load_instrument(args.name)
     if args.instrument_command == "test":
@@ -400,7 +401,7 @@ def _sheet_summary(sheet: Any) -> str:
 
 
 def _setup(args: argparse.Namespace) -> int:
-    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.io.scenario_file import load_scenario
     from stereoplotter.report.sheet import sheet_to_dict
     from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
@@ -808,7 +809,7 @@ def _parser() -> argparse.ArgumentParser:
 
 def _resolve_data_arguments(args: argparse.Namespace) -> None:
     """Apply ``--data`` and turn scenario names (``pair60``) into files; instrument names are
-    resolved by :func:`~stereoplotter.instrument.spec.load_instrument` itself."""
+    resolved by :func:`~stereoplotter.io.instrument_file.load_instrument` itself."""
     set_user_folders(args.data)
     for attribute in ("scenario", "file", "geometry"):  # setup/simulate/demo, check, verify
         if getattr(args, attribute, None):

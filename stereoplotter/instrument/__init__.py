@@ -1,4 +1,5 @@
-"""Instruments: the specification of SC-1, SPR-3 and SD-3 read from ``instruments/*.yaml``.
+"""Instruments: the specification of SC-1, SPR-3 and SD-3 (read from ``instruments/*.yaml`` by
+:mod:`stereoplotter.io.instrument_file`), their kinematics, mechanics and error model.
 
 Every value carries its status (documented by a source, or assumed with a basis); see
 ``docs/instruments.md``.
@@ -13,10 +14,7 @@ from stereoplotter.instrument.spec import (
     RangeRefusal,
     check_in_range,
     format_instrument,
-    instrument_from_mapping,
     instrument_to_dict,
-    list_instruments,
-    load_instrument,
 )
 
 __all__ = [
@@ -26,8 +24,5 @@ __all__ = [
     "RangeRefusal",
     "check_in_range",
     "format_instrument",
-    "instrument_from_mapping",
     "instrument_to_dict",
-    "list_instruments",
-    "load_instrument",
 ]

@@ -355,7 +355,7 @@ class ErrorModel:
 
         Examples
         --------
-        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> from stereoplotter.io.instrument_file import load_instrument
         >>> model = error_model_from_spec(load_instrument("sc1"))
         >>> a = model.draw_keyed(3, 0, 10)["backlash.X"]
         >>> b = model.draw_keyed(3, 7)["backlash.X"]
@@ -390,7 +390,7 @@ def error_model_from_spec(spec: InstrumentSpec) -> ErrorModel:
 
     Examples
     --------
-    >>> from stereoplotter.instrument.spec import load_instrument
+    >>> from stereoplotter.io.instrument_file import load_instrument
     >>> model = error_model_from_spec(load_instrument("sc1"))
     >>> model.term("backlash.X").scale, model.term("backlash.X").assumed
     (0.005, True)

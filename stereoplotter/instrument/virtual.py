@@ -37,7 +37,7 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.instrument.mechanics.play import PlayAxis
-from stereoplotter.instrument.spec import InstrumentSpec, check_in_range, load_instrument
+from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
 
 __all__ = ["BACKENDS", "CONTROLS", "HEIGHT_SCALE", "NOMINAL_ZERO", "Instrument", "Scale"]
 
@@ -225,11 +225,6 @@ class Instrument:
     # --- construction --------------------------------------------------------------------
 
     @classmethod
-    def from_yaml(cls, name_or_path: str, focal_length_mm: float, **kwargs: Any) -> Instrument:
-        """An instrument from ``instruments/NAME.yaml`` (or a path)."""
-        return cls(load_instrument(name_or_path), focal_length_mm, **kwargs)
-
-    @classmethod
     def error_free(cls, spec: InstrumentSpec, focal_length_mm: float, **kwargs: Any) -> Instrument:
         """The kinematic instrument: no injected errors, ideal screws."""
         return cls(
@@ -266,8 +261,9 @@ class Instrument:
                 vertical=name == "Z",
             )
         except StereoplotterError as exc:
-            # the instrument file passed the same check when loaded (spec._check_mechanics): the
-            # backlash comes from the error model, i.e. from an --errors file
+            # the instrument file passed the same check when loaded
+            # (io.instrument_file._check_mechanics): the backlash comes from the error model,
+            # i.e. from an --errors file
             backlash_key = spec.key_of("backlash_z_mm" if name in ("Z", "bz") else "backlash_xy_mm")
             raise ConfigError(
                 spec.parameters[backlash_key].file,
@@ -410,7 +406,7 @@ class Instrument:
 
         Examples
         --------
-        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> from stereoplotter.io.instrument_file import load_instrument
         >>> Instrument.error_free(load_instrument("sc1"), 70.0).travel_mm("Z")
         (110.0, 185.0)
         """
@@ -436,7 +432,7 @@ class Instrument:
 
         Examples
         --------
-        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> from stereoplotter.io.instrument_file import load_instrument
         >>> inst = Instrument.error_free(load_instrument("sc1"), 70.0)
         >>> inst.gear_height_counter(8000)
         >>> inst.set("Z", 175.0)

@@ -235,7 +235,7 @@ def run_simulation_command(
     statistics, never per-trial arrays (those go to ``trials.npz`` in ``output``).
     ``progress(n)`` is told the trials each finished chunk ran.
     """
-    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.io.scenario_file import load_scenario
 
     scenario = load_scenario(scenario_path)

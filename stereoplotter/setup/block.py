@@ -360,7 +360,7 @@ def compute_block(
     The model of the book's §27 setting (f = 70 mm, 60 % overlap, photo scale 1:20 000):
 
     >>> import numpy as np
-    >>> from stereoplotter.instrument.spec import load_instrument
+    >>> from stereoplotter.io.instrument_file import load_instrument
     >>> marks = [[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]]
     >>> r = compute_block(70.0, marks, [[-720.0, 0.0, 1550.0]], [[0.0, 0.0, 0.0]],
     ...                   [[720.0, 0.0, 1560.0]], [[0.0, 0.0, 0.0]], [[120.0, 210.0]],

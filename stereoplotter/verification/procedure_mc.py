@@ -89,7 +89,7 @@ def scenario_geometry(scenario, instrument: str = "sc1") -> dict:
 
 
 def _scenario_geometry(scenario, instrument):
-    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.procedure.evaluation import instrument_frame_m
     from stereoplotter.scenario.synthetic import working_area_grid_m
     from stereoplotter.setup.sheet import compute_setup_sheet
@@ -191,7 +191,7 @@ def procedure_mc(
     """
     import time
 
-    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.procedure.operator import OperatorModel
     from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
     from stereoplotter.procedure.trials import (

@@ -211,7 +211,7 @@ def test_geometry_from_a_single_photo_scenario_is_refused(capsys):
 
 def test_errors_file_unknown_term_and_bad_values(tmp_path):
     from stereoplotter.instrument.error_model import error_model_from_spec
-    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.io.instrument_file import load_instrument
 
     model = error_model_from_spec(load_instrument("sc1"))
     with pytest.raises(ConfigError, match=r"e\.yaml: backlash\.x: expected an error term .*"
@@ -341,7 +341,7 @@ def _doc_bytes(path: Path) -> bytes:
     ],
 )
 def test_instrument_mechanics_that_cannot_run_are_refused(tmp_path, section, key, value, message):
-    from stereoplotter.instrument.spec import load_instrument
+    from stereoplotter.io.instrument_file import load_instrument
 
     doc = _doc(_shipped("instruments", "sc1.yaml"))
     doc[section][key]["value"] = value

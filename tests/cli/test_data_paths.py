@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 from stereoplotter.cli import main
-from stereoplotter.instrument.spec import load_instrument
 from stereoplotter.io import paths
+from stereoplotter.io.instrument_file import load_instrument
 
 SHIPPED = Path(paths.data_dir("instruments"))
 

@@ -110,8 +110,8 @@ def corpus() -> dict[str, list[Seed]]:
     if _CORPUS is not None:
         return _CORPUS
     from stereoplotter.instrument.error_model import error_model_from_spec
-    from stereoplotter.instrument.spec import load_instrument
     from stereoplotter.io.block_file import CSV_COLUMNS
+    from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.verification.table import BOOK
 
     scenarios, instruments = _shipped_dir("scenarios"), _shipped_dir("instruments")
@@ -488,11 +488,8 @@ def _load(kind: str, path: Path) -> Any:
 
         return load_block(path)
     if kind == "instrument":
-        from stereoplotter.instrument.spec import (
-            format_instrument,
-            instrument_to_dict,
-            load_instrument,
-        )
+        from stereoplotter.instrument.spec import format_instrument, instrument_to_dict
+        from stereoplotter.io.instrument_file import load_instrument
 
         spec = load_instrument(path)
         format_instrument(spec).encode("utf-8")
@@ -500,7 +497,7 @@ def _load(kind: str, path: Path) -> Any:
         return spec
     if kind == "errors":
         from stereoplotter.instrument.error_model import error_model_from_spec
-        from stereoplotter.instrument.spec import load_instrument
+        from stereoplotter.io.instrument_file import load_instrument
         from stereoplotter.io.yaml_files import load_yaml_mapping
 
         data, source = load_yaml_mapping(path)

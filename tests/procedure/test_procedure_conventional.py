@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from conftest import um
 
-from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import OperatorModel, simulate, simulate_per_trial
 from stereoplotter.procedure.conventional import overcorrection_factor

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from conftest import um
 
-from stereoplotter.instrument.spec import load_instrument
 from stereoplotter.instrument.virtual import Instrument
+from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import (
     Noise,

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from stereoplotter.cli import main
-from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.trial_store import TrialStore
 from stereoplotter.procedure.simulate import prepare_run, simulate

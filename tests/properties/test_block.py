@@ -17,8 +17,8 @@ import pytest
 import yaml
 
 from stereoplotter.errors import ConfigError
-from stereoplotter.instrument.spec import load_instrument
 from stereoplotter.io.block_file import CSV_COLUMNS, load_block
+from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.report.block import run_block, write_block

@@ -7,7 +7,7 @@ import pytest
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.instrument.error_model import error_model_from_spec
-from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.instrument_file import load_instrument
 
 
 @pytest.fixture(scope="module")

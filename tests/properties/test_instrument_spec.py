@@ -25,8 +25,10 @@ from stereoplotter.instrument import (
     RangeRefusal,
     check_in_range,
     format_instrument,
-    instrument_from_mapping,
     instrument_to_dict,
+)
+from stereoplotter.io.instrument_file import (
+    instrument_from_mapping,
     list_instruments,
     load_instrument,
 )

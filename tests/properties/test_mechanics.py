@@ -42,7 +42,7 @@ from stereoplotter.instrument.mechanics import (
     play,
     velocity_plan,
 )
-from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.instrument_file import load_instrument
 from tests.conftest import arcsec, um
 
 REF = AxisParams(name="X")  # §8 defaults: b = 20 µm, μ = 0.1, 2 kg, k = 1 N/µm, dt = 1 ms

@@ -18,7 +18,7 @@ from numpy.testing import assert_allclose
 from stereoplotter.cli import main
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.geometry.rotation import rotation_z
-from stereoplotter.instrument.spec import load_instrument
+from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario, scenario_from_mapping
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.scenario.frame import local_from_sk42

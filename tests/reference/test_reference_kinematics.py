@@ -223,7 +223,7 @@ def test_result_is_json_ready_and_formatted(selftest):
 
 
 def test_instrument_spec_supplies_d_max():
-    from stereoplotter.instrument import load_instrument
+    from stereoplotter.io.instrument_file import load_instrument
 
     spec = load_instrument("sc1")
     r = run_kinematic_selftest(tilts=[1.0 * deg], variants=("L",), instrument=spec)

@@ -245,7 +245,7 @@ class AxisParams:
 
         Examples
         --------
-        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> from stereoplotter.io.instrument_file import load_instrument
         >>> p = AxisParams.from_instrument(load_instrument("sc1"), "X")
         >>> p.backlash_mm, p.range_mm, p.friction, p.mass_kg, p.stiffness_kg_s2
         (0.005, (-250.0, 450.0), 0.1, 2.0, 1000000.0)

@@ -86,7 +86,7 @@ class CoordinatographParams:
 
         Examples
         --------
-        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> from stereoplotter.io.instrument_file import load_instrument
         >>> CoordinatographParams.from_instrument(load_instrument("sc1")).x.range_mm
         (0.0, 800.0)
         """

@@ -83,7 +83,7 @@ class SheetParams:
 
         Examples
         --------
-        >>> from stereoplotter.instrument.spec import load_instrument
+        >>> from stereoplotter.io.instrument_file import load_instrument
         >>> SheetParams.from_instrument(load_instrument("sc1")).friction_torque  # 0.2 N·m
         200000.0
         """

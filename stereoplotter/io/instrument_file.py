@@ -1,0 +1,548 @@
+"""Reading instrument files (``instruments/*.yaml``) into a frozen
+:class:`~stereoplotter.instrument.spec.InstrumentSpec`: name resolution, ``inherits``, the leaf
+schema, validation and the mechanics feasibility check.
+
+Every value in an instrument file is a *leaf* ``{value, status, src | basis, note?}``
+(``docs/instruments.md``). ``status: documented`` needs ``src``; ``status: assumed`` needs
+``basis``. An instrument file may start with ``inherits: family.yaml`` (a file in the same
+folder): its sections are merged key by key, the instrument's own leaves win.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import yaml
+
+from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.instrument.spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
+from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
+from stereoplotter.io.yaml_files import Fields, describe_value, did_you_mean, load_yaml_mapping
+
+__all__ = ["instrument_from_mapping", "list_instruments", "load_instrument"]
+
+_LEAF_KEYS = ("value", "status", "src", "basis", "note")
+_MAX_INHERITANCE_DEPTH = 4
+
+# --- schema -----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class _Leaf:
+    key: str
+    kind: str  # text, bool, int, number, range, pair, triple, int_list, number_list
+    unit: str = ""
+    low: float = -math.inf
+    high: float = math.inf
+    low_open: bool = False
+    required: bool = True
+    contains_zero: bool = False
+
+
+_POS = {"low": 0.0, "low_open": True}
+
+_SCHEMA: tuple[_Leaf, ...] = (
+    _Leaf("name", "text"),
+    _Leaf("principle", "text"),
+    _Leaf("photo.format_mm", "pair", "mm", high=500.0, **_POS),
+    _Leaf("photo.camera_f_mm", "range", "mm", high=1000.0, **_POS),
+    _Leaf("projection.distance_mm", "range", "mm", high=2000.0, **_POS),
+    _Leaf("projection.distance_max_mm", "number", "mm", high=2000.0, required=False, **_POS),
+    _Leaf("projection.f_instrument_mm", "range", "mm", high=1000.0, **_POS),
+    _Leaf("model.x_offset_mm", "range", "mm", -5000.0, 5000.0, contains_zero=True),
+    _Leaf("model.y_offset_mm", "range", "mm", -5000.0, 5000.0, contains_zero=True),
+    _Leaf("base.x_mm", "range", "mm", -1000.0, 1000.0),
+    _Leaf("base.y_mm", "range", "mm", -1000.0, 1000.0, contains_zero=True),
+    _Leaf("base.z_mm", "range", "mm", -1000.0, 1000.0, contains_zero=True),
+    _Leaf("orientation.kappa_deg", "range", "deg", -180.0, 180.0, contains_zero=True),
+    _Leaf("correction.tilt_max_deg", "number", "deg", high=45.0, **_POS),
+    _Leaf("correction.decentration_mm", "range", "mm", -200.0, 200.0, contains_zero=True),
+    _Leaf("counters.present", "bool"),
+    _Leaf("counters.direction_switches", "bool"),
+    _Leaf("counters.xy_least_count_mm", "number", "mm", high=1.0, **_POS),
+    _Leaf("counters.z_abs_least_count_mm", "number", "mm", high=1.0, **_POS),
+    _Leaf("counters.height_scale_least_count_m", "number", "m", high=100.0, **_POS),
+    _Leaf("gears.vertical_scale_denominators", "int_list", "—", 1, 10_000_000),
+    _Leaf("gears.coordinatograph_ratios", "number_list", "—", high=100.0, **_POS),
+    _Leaf("gears.max_photo_to_map_enlargement", "number", "—", high=100.0, required=False, **_POS),
+    _Leaf(
+        "gears.max_photo_to_map_enlargement_automatic",
+        "number",
+        "—",
+        high=100.0,
+        required=False,
+        **_POS,
+    ),
+    _Leaf("gears.photo_to_map_scale_ratio", "range", "—", high=100.0, required=False, **_POS),
+    _Leaf("gears.model_to_photo_scale", "range", "—", high=100.0, required=False, **_POS),
+    _Leaf("coordinatograph.present", "bool"),
+    _Leaf("coordinatograph.automatic_variant", "bool", required=False),
+    _Leaf("coordinatograph.table_mm", "pair", "mm", high=5000.0, **_POS),
+    _Leaf("coordinatograph.plotting_sigma_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("mark.diameter_mm", "number", "mm", high=5.0, **_POS),
+    _Leaf("tolerances.L_check_times_n_mm", "number", "mm", high=10.0, **_POS),
+    _Leaf("tolerances.mark_fit_per_n_mm", "number", "mm", high=10.0, **_POS),
+    _Leaf("tolerances.residual_q_fraction_of_mark", "number", "—", high=10.0, **_POS),
+    _Leaf("tolerances.control_height_denominator", "number", "—", 1.0, 1.0e7),
+    _Leaf("tolerances.corner4_mm", "number", "mm", high=100.0, **_POS),
+    _Leaf("tolerances.m_q_typical_mm", "number", "mm", high=1.0, **_POS),
+    _Leaf("tolerances.standard_points_c_mm", "number", "mm", high=500.0, **_POS),
+    # at most 0.2 mm: the unidirectional approach overtravels by 0.5 mm > the dead band 2h
+    _Leaf("errors.backlash_xy_mm", "number", "mm", 0.0, 0.2),
+    _Leaf("errors.backlash_z_mm", "number", "mm", 0.0, 0.2),
+    _Leaf("errors.zero_reading_scatter_mm", "number", "mm", 0.0, 100.0),
+    _Leaf("errors.counter_scale_error_ppm", "number", "ppm", 0.0, 1.0e4),
+    _Leaf("errors.f_instrument_setting_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("errors.base_setting_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("errors.kappa_setting_arcmin", "number", "′", 0.0, 600.0),
+    _Leaf("errors.decentration_setting_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("errors.correction_setting_arcmin", "number", "′", 0.0, 600.0),
+    _Leaf("errors.coordinatograph_nonorthogonality_arcsec", "number", "″", 0.0, 3600.0),
+    _Leaf("errors.pen_play_mm", "number", "mm", 0.0, 10.0),
+    _Leaf("errors.sheet_placement_mm", "number", "mm", 0.0, 100.0),
+    _Leaf("mechanics.carriage_mass_kg", "number", "kg", 0.001, 1000.0),
+    _Leaf("mechanics.z_carriage_mass_kg", "number", "kg", 0.001, 1000.0),
+    _Leaf("mechanics.friction_coefficient", "number", "—", 0.0, 2.0),
+    # no smaller masses and stiffness: F/k stays finite, the dead band measurable
+    _Leaf("mechanics.screw_stiffness_N_per_um", "number", "N/µm", 0.001, 1.0e4),
+    _Leaf("mechanics.bridge_mass_kg", "number", "kg", 0.001, 1000.0),
+    _Leaf("mechanics.pen_carriage_mass_kg", "number", "kg", 0.001, 1000.0),
+    _Leaf("mechanics.sheet_friction_torque_Nm", "number", "N·m", 0.0, 1000.0),
+    _Leaf("accuracy.height_error_fraction_of_H", "number", "—", high=1.0, required=False, **_POS),
+    _Leaf("facts.n_formula", "text", required=False),
+    _Leaf("facts.n_example", "number", "—", high=100.0, required=False, **_POS),
+    _Leaf("facts.fiducial_distance_l_mm", "number", "mm", high=500.0, required=False, **_POS),
+    _Leaf("facts.error_correction_unit_range_um", "number", "µm", 0.0, 1.0e4, required=False),
+    _Leaf("facts.error_correction_unit_rms_um", "number", "µm", 0.0, 1.0e4, required=False),
+    _Leaf("facts.photos_move_under_fixed_marks", "bool", required=False),
+    _Leaf("facts.base_on_z_carriage", "text", required=False),
+    _Leaf("facts.phi_omega_dependent_settings", "int", "—", 0, 100, required=False),
+    _Leaf("facts.max_relief_fraction_of_H", "number", "—", high=1.0, required=False, **_POS),
+    _Leaf("facts.correction_plane_tilt", "text", required=False),
+    _Leaf("facts.mass_kg", "number", "kg", high=1.0e5, required=False, **_POS),
+    _Leaf("facts.footprint_cm", "triple", "cm", high=1.0e4, required=False, **_POS),
+)
+_BY_KEY = {leaf.key: leaf for leaf in _SCHEMA}
+_SECTIONS: dict[str, tuple[str, ...]] = {}
+for _leaf in _SCHEMA:
+    if "." in _leaf.key:
+        _section, _name = _leaf.key.split(".", 1)
+        _SECTIONS.setdefault(_section, ())
+        _SECTIONS[_section] += (_name,)
+_TOP_LEAVES = tuple(leaf.key for leaf in _SCHEMA if "." not in leaf.key)
+_TOP = ("inherits", *_TOP_LEAVES, *_SECTIONS)
+
+
+# --- loading ----------------------------------------------------------------------------------
+
+
+def load_instrument(name_or_path: str | os.PathLike[str]) -> InstrumentSpec:
+    """Load an instrument file by short name (``"sc1"``) or by path.
+
+    Parameters
+    ----------
+    name_or_path : str or path-like
+        A bare name is looked up as ``<name>.yaml`` in the user data folders, then the shipped
+        ones (:func:`stereoplotter.io.paths.find_data_file`); anything with a folder part, or an
+        existing ``.yaml``/``.yml`` file, is used as a path.
+
+    Returns
+    -------
+    InstrumentSpec
+
+    Raises
+    ------
+    ConfigError
+        No such instrument, or the file is invalid; the message names the file, the field, what
+        was expected and what was found.
+
+    Examples
+    --------
+    >>> spec = load_instrument("sc1")
+    >>> spec.projection_distance_max_mm, spec.status("projection_distance_max_mm")
+    (185.0, 'documented')
+    >>> spec.base_z_range_mm, spec.is_assumed("base_z_range_mm")
+    ((-40.0, 40.0), True)
+    """
+    path = _resolve(name_or_path)
+    data, source = load_yaml_mapping(path)
+    return instrument_from_mapping(data, source)
+
+
+def instrument_from_mapping(
+    data: dict[str, Any], source: str = "<instrument>", *, key: str | None = None
+) -> InstrumentSpec:
+    """Validate a parsed instrument document and build the :class:`InstrumentSpec`.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed YAML.
+    source : str
+        The file name: used in messages, for the default ``key`` (its stem) and to find an
+        ``inherits`` file (in the same folder).
+    key : str, optional
+        Short name; default the stem of ``source``.
+    """
+    fields = Fields(source)
+    merged, origins = _merge_inherited(fields, data, source, chain=(_norm(source),))
+    params: dict[str, Parameter] = {}
+    for leaf in _SCHEMA:
+        section, _, name = leaf.key.rpartition(".")
+        node = merged.get(section, {}) if section else merged
+        if name not in node:
+            if leaf.required:
+                raise fields.error(
+                    leaf.key,
+                    "a value {value, status, src | basis} (the field is required)",
+                    "nothing",
+                    _inherit_hint(data),
+                )
+            continue
+        origin = origins.get(leaf.key, source)
+        params[leaf.key] = _parameter(Fields(origin), node[name], leaf, origin)
+    _cross_check(fields, params, origins, source)
+    values: dict[str, Any] = {}
+    for attribute, (dotted, convert) in _ATTRIBUTES.items():
+        values[attribute] = convert(params[dotted].value) if dotted in params else None
+    if values["projection_distance_max_mm"] is None:
+        values["projection_distance_max_mm"] = values["projection_distance_range_mm"][1]
+    spec = InstrumentSpec(
+        key=key or Path(source).stem,
+        source=source,
+        parameters=MappingProxyType(params),
+        **values,
+    )
+    _check_mechanics(spec)
+    return spec
+
+
+def _check_mechanics(spec: InstrumentSpec) -> None:
+    """Refuse ``mechanics.*`` and ``errors.backlash_*`` values that give no working screw axis
+    (``mechanics.md``): μ ≥ 1 on the vertical Z axis, or a dead band 2h = b + 2μmg/k that the
+    0.5 mm overtravel of the unidirectional approach does not clear. The axes are built as the
+    virtual instrument builds them, so a file that loads also runs."""
+    from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
+    from stereoplotter.instrument.mechanics.coordinatograph import CoordinatographParams
+
+    def refuse(key: str, exc: StereoplotterError, hint: str = "") -> ConfigError:
+        return ConfigError(
+            spec.parameters[key].file,
+            f"{key}.value",
+            "a value that gives a working screw axis (mechanics.md: μ < 1 on the vertical "
+            "axis, dead band 2h = backlash b + 2μmg/k below the 0.5 mm overtravel)",
+            str(exc),
+            hint,
+        )
+
+    overtravel = AxisParams.__dataclass_fields__["overtravel_mm"].default
+    # as Instrument._axis_params builds them: (axis, range, backlash, mass)
+    axes = [
+        ("X", "model_x_offset_range_mm", "backlash_xy_mm", "carriage_mass_kg"),
+        ("Y", "model_y_offset_range_mm", "backlash_xy_mm", "carriage_mass_kg"),
+        ("Z", "projection_distance_range_mm", "backlash_z_mm", "z_carriage_mass_kg"),
+        ("bx", "base_x_range_mm", "backlash_xy_mm", "carriage_mass_kg"),
+        ("by", "base_y_range_mm", "backlash_xy_mm", "carriage_mass_kg"),
+        ("bz", "base_z_range_mm", "backlash_z_mm", "carriage_mass_kg"),
+    ]
+    for name, range_attribute, backlash_attribute, mass_attribute in axes:
+        backlash = float(getattr(spec, backlash_attribute))
+        vertical = name == "Z"
+        backlash_key, mass_key = (spec.key_of(a) for a in (backlash_attribute, mass_attribute))
+        lo, hi = getattr(spec, range_attribute)
+        try:
+            AxisParams(
+                name=f"{spec.key} {name}",
+                backlash_mm=backlash,
+                friction=spec.friction_coefficient,
+                mass_kg=getattr(spec, mass_attribute),
+                stiffness_kg_s2=spec.screw_stiffness_N_per_um * N_PER_UM,
+                range_mm=(float(lo), float(hi)),
+                vertical=vertical,
+            )
+        except StereoplotterError as exc:
+            # the key to change: a range without travel; μ on the vertical axis; b where it
+            # alone fills half the overtravel; else the 2μmg/k part, named by its mass
+            if not lo < hi:
+                raise ConfigError(
+                    spec.parameters[spec.key_of(range_attribute)].file,
+                    f"{spec.key_of(range_attribute)}.value",
+                    "a range [lo, hi] with lo < hi (the axis must travel)",
+                    [lo, hi],
+                ) from None
+            if vertical and spec.friction_coefficient >= 1.0:
+                key = "mechanics.friction_coefficient"
+            elif 2.0 * backlash >= 0.5 * overtravel:
+                key = backlash_key
+            else:
+                key = mass_key
+            hint = "or lower μ, or raise the screw stiffness k" if key == mass_key else ""
+            raise refuse(key, exc, hint) from None
+    try:
+        CoordinatographParams.from_instrument(spec)
+    except StereoplotterError as exc:
+        mass_key = "mechanics.pen_carriage_mass_kg" if " Y:" in str(exc) else (
+            "mechanics.bridge_mass_kg"
+        )
+        raise refuse(mass_key, exc, "or lower mechanics.friction_coefficient") from None
+
+
+def _resolve(name_or_path: str | os.PathLike[str]) -> Path:
+    text = os.fspath(name_or_path)
+    if isinstance(name_or_path, os.PathLike) or os.sep in text or "/" in text:
+        return Path(text)
+    is_file_name = text.endswith((".yaml", ".yml"))
+    if is_file_name and Path(text).exists():
+        return Path(text)
+    # user folders (--data, STEREOPLOTTER_DATA) first, then the shipped data
+    candidate = find_data_file("instruments", text)
+    if candidate is None and is_file_name:
+        return Path(text)  # reading it reports the missing file
+    folder = data_dir("instruments")
+    if candidate is None:
+        names = list_instruments()
+        available = ", ".join(names) or "none found"
+        raise ConfigError(
+            _display(folder) if folder else "instruments/",
+            text,
+            f"the name of an instrument ({available}) or a path to a YAML file",
+            "no such instrument file",
+            did_you_mean(text, names),
+        )
+    return Path(_display(candidate))
+
+
+def _display(path: Path) -> str:
+    """A path relative to the current folder when it lies inside it (shorter messages)."""
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+def _norm(source: str) -> str:
+    try:
+        return str(Path(source).resolve())
+    except (OSError, RuntimeError):
+        return source
+
+
+def _inherit_hint(data: Mapping[str, Any]) -> str:
+    if "inherits" in data:
+        return f"not in this file nor in {data['inherits']}"
+    return ""
+
+
+def _check_structure(fields: Fields, data: Mapping[str, Any]) -> None:
+    fields.mapping(data, "", _TOP)
+    for section, names in _SECTIONS.items():
+        if section in data:
+            fields.mapping(data[section], section, names)
+
+
+def _merge_inherited(
+    fields: Fields, data: dict[str, Any], source: str, chain: tuple[str, ...]
+) -> tuple[dict[str, Any], dict[str, str]]:
+    """The document with its ``inherits`` file merged in, and the file each leaf came from."""
+    _check_structure(fields, data)
+    merged: dict[str, Any] = {}
+    origins: dict[str, str] = {}
+    if "inherits" in data:
+        name = fields.text(data, "inherits", "")
+        parent_path = Path(source).parent / name
+        if not parent_path.is_file():
+            raise fields.error("inherits", "the name of an existing file in the same folder", name)
+        if _norm(str(parent_path)) in chain or len(chain) > _MAX_INHERITANCE_DEPTH:
+            raise fields.error(
+                "inherits",
+                f"a chain of at most {_MAX_INHERITANCE_DEPTH} files without a loop",
+                name,
+                "files: " + " → ".join(Path(c).name for c in chain),
+            )
+        parent, parent_source = load_yaml_mapping(parent_path)
+        merged, origins = _merge_inherited(
+            Fields(parent_source), parent, parent_source, (*chain, _norm(parent_source))
+        )
+    for top, value in data.items():
+        if top == "inherits":
+            continue
+        if top in _SECTIONS and isinstance(merged.get(top), dict):
+            merged[top] = {**merged[top], **value}
+            for name in value:
+                origins[f"{top}.{name}"] = source
+        else:
+            merged[top] = value
+            if top in _SECTIONS:
+                origins.update({f"{top}.{name}": source for name in value})
+            else:
+                origins[top] = source
+    return merged, origins
+
+
+def _parameter(fields: Fields, node: Any, leaf: _Leaf, origin: str) -> Parameter:
+    path = leaf.key
+    if not isinstance(node, dict) or "value" not in node:
+        raise fields.error(
+            path,
+            "a leaf {value, status, src | basis, note?}",
+            describe_value(node),
+            "every value says whether a source documents it (see docs/instruments.md)",
+        )
+    fields.mapping(node, path, _LEAF_KEYS)
+    status = node.get("status")
+    if status not in STATUSES:
+        raise fields.error(
+            fields.join(path, "status"),
+            "documented or assumed",
+            describe_value(status),
+            "every value says whether a source documents it; an inferred value is assumed, "
+            "with a basis",
+        )
+    sources = _sources(fields, node, path)
+    basis = _optional_text(fields, node, "basis", path)
+    note = _optional_text(fields, node, "note", path)
+    if status == "documented" and not sources:
+        raise fields.error(
+            fields.join(path, "src"),
+            "the source key(s) of a documented value (e.g. SEED6)",
+            "nothing",
+            "a value without a source must be status: assumed with a basis",
+        )
+    if status == "documented" and basis:
+        raise fields.error(
+            fields.join(path, "basis"),
+            "no basis for a documented value (basis is for assumed ones; use note)",
+            basis,
+        )
+    if status == "assumed" and not basis:
+        raise fields.error(
+            fields.join(path, "basis"),
+            "a basis for an assumed value (why this value was chosen)",
+            "nothing",
+        )
+    value = _value(fields, node, leaf)
+    return Parameter(value, leaf.unit, status, sources, basis, note, origin)
+
+
+def _sources(fields: Fields, node: Mapping[str, Any], path: str) -> tuple[str, ...]:
+    raw = node.get("src")
+    if raw is None:
+        return ()
+    items = raw if isinstance(raw, list) else [raw]
+    if not items or any(not isinstance(s, str) or not s.strip() for s in items):
+        raise fields.error(
+            fields.join(path, "src"), "a source key or a list of source keys", describe_value(raw)
+        )
+    return tuple(s.strip() for s in items)
+
+
+def _optional_text(fields: Fields, node: Mapping[str, Any], key: str, path: str) -> str:
+    raw = node.get(key)
+    if raw is None:
+        return ""
+    if not isinstance(raw, str) or not raw.strip():
+        raise fields.error(fields.join(path, key), "a non-empty text", describe_value(raw))
+    return raw.strip()
+
+
+def _value(fields: Fields, node: Mapping[str, Any], leaf: _Leaf) -> Any:
+    path = leaf.key
+    vpath = fields.join(path, "value")
+    limits = {"unit": leaf.unit, "low": leaf.low, "high": leaf.high, "low_open": leaf.low_open}
+    kind = leaf.kind
+    raw = node["value"]
+    if kind == "text":
+        return fields.text(node, "value", path)
+    if kind == "bool":
+        if not isinstance(raw, bool):
+            raise fields.error(vpath, "true or false", describe_value(raw))
+        return raw
+    if kind == "int":
+        return fields.integer(node, "value", path, low=int(leaf.low), high=int(leaf.high))
+    if kind == "number":
+        return _number(fields, raw, vpath, limits)
+    if kind in ("range", "pair", "triple"):
+        length = 3 if kind == "triple" else 2
+        if not isinstance(raw, list) or len(raw) != length:
+            what = "[lo, hi]" if kind == "range" else f"{length} numbers"
+            raise fields.error(vpath, f"a list of {what} [{leaf.unit}]", describe_value(raw))
+        numbers = tuple(
+            _number(fields, v, fields.join(vpath, i), limits) for i, v in enumerate(raw)
+        )
+        if kind == "range" and numbers[0] > numbers[1]:
+            raise fields.error(
+                vpath, "a range [lo, hi] with lo ≤ hi", list(numbers), "the ends are reversed"
+            )
+        if leaf.contains_zero and not numbers[0] <= 0.0 <= numbers[1]:
+            raise fields.error(
+                vpath,
+                "a range that contains 0",
+                list(numbers),
+                "the zero position (scales near their zeros, mark on the left plumb point) "
+                "must be reachable",
+            )
+        return numbers
+    # int_list, number_list: gear sets, strictly increasing
+    items = fields.sequence(node, "value", path, min_length=1)
+    out: list[Any] = []
+    for i, v in enumerate(items):
+        ipath = fields.join(vpath, i)
+        if kind == "int_list":
+            if isinstance(v, bool) or not isinstance(v, int) or not leaf.low <= v <= leaf.high:
+                raise fields.error(
+                    ipath, f"an integer in [{leaf.low:g}, {leaf.high:g}]", describe_value(v)
+                )
+            out.append(v)
+        else:
+            out.append(_number(fields, v, ipath, limits))
+        if i and out[-1] <= out[-2]:
+            raise fields.error(ipath, f"a value above the previous one ({out[-2]:g})", v)
+    return tuple(out)
+
+
+def _number(fields: Fields, value: Any, path: str, limits: Mapping[str, Any]) -> float:
+    """:meth:`Fields.check_number` with the limits of a parameter."""
+    return fields.check_number(value, path, **limits)
+
+
+def _cross_check(
+    fields: Fields, params: Mapping[str, Parameter], origins: Mapping[str, str], source: str
+) -> None:
+    d_max = params.get("projection.distance_max_mm")
+    if d_max is not None:
+        hi = params["projection.distance_mm"].value[1]
+        if not math.isclose(d_max.value, hi, rel_tol=0.0, abs_tol=1e-9):
+            raise Fields(origins.get("projection.distance_max_mm", source)).error(
+                "projection.distance_max_mm.value",
+                f"the upper end of projection.distance_mm ({hi:g} mm)",
+                d_max.value,
+                "D_max is the deepest position of the carriage; change both together",
+            )
+
+
+def list_instruments() -> list[str]:
+    """Short names of the instrument files in the ``instruments`` data folder.
+
+    Files without a top-level ``name`` (shared family files meant for ``inherits``) are not
+    instruments and are left out.
+
+    Examples
+    --------
+    >>> {"sc1", "spr3", "sd3"} <= set(list_instruments())
+    True
+    """
+    names = []
+    for path in list_data_files("instruments"):
+        try:
+            data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, yaml.YAMLError):
+            data = {"name": None}  # list it: loading it reports the problem
+        if isinstance(data, dict) and "name" in data:
+            names.append(path.stem)
+    return names
