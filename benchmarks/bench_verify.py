@@ -1,4 +1,5 @@
-"""Time `run_verification` (default settings) and its parts.
+"""Time `run_verification` (default settings, the book's scenarios in the procedure MC) and its
+parts.
 
 python benchmarks/bench_verify.py [--trials T] [--repeat R]
 """
@@ -9,6 +10,7 @@ import time
 
 import numpy as np
 
+from stereoplotter.report.verification import book_instrument, book_scenarios
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification import table as v
 
@@ -18,18 +20,20 @@ def main():
     ap.add_argument("--trials", type=int, default=60000)
     ap.add_argument("--repeat", type=int, default=3)
     a = ap.parse_args()
-    best = min(_timed(lambda: v.run_verification(trials=a.trials)) for _ in range(a.repeat))
+    scenarios, spec = book_scenarios(), book_instrument()
+    best = min(
+        _timed(
+            lambda: v.run_verification(
+                trials=a.trials, procedure_scenarios=scenarios, instrument=spec
+            )
+        )
+        for _ in range(a.repeat)
+    )
     specs = v._row_specs(dict(v.BOOK))
     t_spec = _timed(lambda: v._row_specs(dict(v.BOOK)))
-    t_cov = _timed(
-        lambda: [mc.covariance_rms(s[5][1] if isinstance(s[5], tuple) else s[5]) for s in specs]
-    )
+    t_cov = _timed(lambda: [mc.covariance_rms(e.model) for e in specs])
     rng = np.random.default_rng(0)
-    t_mc = _timed(
-        lambda: [
-            mc.mc_rms(s[5][1] if isinstance(s[5], tuple) else s[5], a.trials, rng) for s in specs
-        ]
-    )
+    t_mc = _timed(lambda: [mc.mc_rms(e.model, a.trials, rng) for e in specs])
     print(f"cpu_count={os.cpu_count()} numpy={np.__version__} rows={len(specs)} trials={a.trials}")
     print(f"run_verification best of {a.repeat}: {best:.2f} s")
     print(

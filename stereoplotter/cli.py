@@ -491,15 +491,20 @@ def _simulate(args: argparse.Namespace) -> int:
 def _verify(args: argparse.Namespace) -> int:
     from stereoplotter.io.geometry_file import geometry_from_file
     from stereoplotter.progress import step_progress
-    from stereoplotter.report.verification import verify
+    from stereoplotter.report.verification import book_instrument, book_scenarios, verify
     from stereoplotter.verification.table import run_procedure_mc
 
     geometry, scenarios = None, None
     if args.geometry:
         geometry, scenarios = geometry_from_file(args.geometry)
+    elif args.procedure_trials:
+        scenarios = book_scenarios()  # the book's pair60/pair80
+    instrument = book_instrument() if scenarios and args.procedure_trials else None
     # the procedure MC once, shared by the table and the histograms
     with step_progress("procedure MC") as progress:
-        proc = run_procedure_mc(args.procedure_trials, args.seed, scenarios, progress=progress)
+        proc = run_procedure_mc(
+            args.procedure_trials, args.seed, scenarios, progress=progress, instrument=instrument
+        )
     with step_progress("verify") as progress:
         rows, seconds = verify(
             trials=args.trials,

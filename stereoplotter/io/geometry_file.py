@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from stereoplotter.errors import ConfigError
+from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
 from stereoplotter.verification.procedure_mc import scenario_geometry
@@ -37,7 +38,8 @@ def geometry_from_file(path) -> tuple[dict, dict]:
     geometry : dict
         Keys of :data:`BOOK`.
     procedure_scenarios : dict
-        ``{"60": path or None, "80": path or None}`` for the procedure MC.
+        ``{"60": Scenario or None, "80": Scenario or None}`` for the procedure MC (the loaded
+        scenario in its slot).
     """
     data, source = load_yaml_mapping(path)
     if "camera" not in data:
@@ -54,13 +56,13 @@ def geometry_from_file(path) -> tuple[dict, dict]:
             "a stereopair (photos left and right) for --geometry",
             f"{len(scenario.photos)} photo(s)",
         )
-    sg = scenario_geometry(str(path))
+    sg = scenario_geometry(scenario, load_instrument("sc1"))
     p = sg["p"]
     g = {"f": sg["f"], "l": sg["l"], "n": sg["n"]}
     if sg["overlap"] < 0.7:
         g.update(c=p, p60=p, a60=0.0, p80=p / 2, a80=p / 2)
         check_geometry(Fields(source), g)
-        return g, {"60": str(path), "80": None}
+        return g, {"60": scenario, "80": None}
     g.update(c=2 * p, p60=2 * p, a60=0.0, p80=p, a80=p)
     check_geometry(Fields(source), g)
-    return g, {"60": None, "80": str(path)}
+    return g, {"60": None, "80": scenario}

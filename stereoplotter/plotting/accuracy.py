@@ -38,7 +38,7 @@ def plot_error_maps(
     matplotlib.figure.Figure
     """
     from stereoplotter.accuracy.setup_accuracy import setup_element_sigmas
-    from stereoplotter.verification.table import _both
+    from stereoplotter.verification.entry import both_photos as _both
 
     if sigmas is None:
         sigmas = _both(setup_element_sigmas(focal_length_mm, 85.0, 1.42, 0.01))
@@ -121,7 +121,8 @@ def plot_mc_histograms(rows, procedure=None, trials=4000, seed=0):
     matplotlib.figure.Figure
     """
     from stereoplotter.accuracy import setup_accuracy as sa
-    from stereoplotter.verification.table import BOOK, _both
+    from stereoplotter.verification.entry import BOOK
+    from stereoplotter.verification.entry import both_photos as _both
 
     by = {r["eq"]: r for r in rows}
     panels = []

@@ -9,6 +9,9 @@ import time
 from pathlib import Path
 
 from stereoplotter.io.geometry_file import geometry_from_file
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.paths import data_dir
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.table import (
@@ -18,7 +21,25 @@ from stereoplotter.verification.table import (
     run_verification,
 )
 
-__all__ = ["verify", "write_verification"]
+__all__ = ["book_instrument", "book_scenarios", "verify", "write_verification"]
+
+#: The book's §27 setting: the shipped scenarios of the procedure MC per overlap slot, and SC-1.
+BOOK_SCENARIOS = {"60": "pair60.yaml", "80": "pair80.yaml"}
+BOOK_INSTRUMENT = "sc1"
+
+
+def book_scenarios() -> dict:
+    """The shipped ``pair60``/``pair80`` scenarios, loaded, as "60"/"80" slots of the procedure MC.
+
+    Always the shipped files (never a user folder's file of the same name): they are the book's.
+    """
+    folder = data_dir("scenarios")
+    return {slot: load_scenario(folder / name) for slot, name in BOOK_SCENARIOS.items()}
+
+
+def book_instrument():
+    """The instrument of the procedure MC, the book's SC-1 (``sc1``, by name as ever)."""
+    return load_instrument(BOOK_INSTRUMENT)
 
 
 def _fmt(v, digits=4):
@@ -126,7 +147,9 @@ def verify(
     """Run and optionally write the verification (the entry point for ``stereoplotter verify``).
 
     ``geometry`` is a mapping of :data:`BOOK` keys or the path of a YAML file
-    (:func:`geometry_from_file`: a scenario also becomes the procedure MC's scenario).
+    (:func:`geometry_from_file`: a scenario also becomes the procedure MC's scenario). Without a
+    geometry the procedure MC runs on the book's scenarios (:func:`book_scenarios`); with a
+    mapping it is skipped unless ``procedure_scenarios`` (loaded scenarios) are given.
 
     Returns
     -------
@@ -137,6 +160,9 @@ def verify(
         geometry, scen = geometry_from_file(geometry)
         if procedure_scenarios is None:
             procedure_scenarios = scen
+    elif procedure_scenarios is None and not geometry and procedure_trials:
+        procedure_scenarios = book_scenarios()
+    instrument = book_instrument() if procedure_scenarios and procedure_trials else None
     t0 = time.perf_counter()
     rows = run_verification(
         trials=trials,
@@ -145,6 +171,7 @@ def verify(
         progress=progress,
         procedure_trials=procedure_trials,
         procedure_scenarios=procedure_scenarios,
+        instrument=instrument,
     )
     seconds = time.perf_counter() - t0
     if out_dir is not None:

@@ -32,17 +32,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from functools import lru_cache
-from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from stereoplotter.verification.linear_mc import CI_Z
 
+if TYPE_CHECKING:
+    from stereoplotter.instrument.spec import InstrumentSpec
+    from stereoplotter.scenario.model import Scenario
+
 __all__ = ["PROCEDURE_ROWS", "procedure_mc", "scenario_geometry"]
 
-ROOT = Path(__file__).resolve().parents[2]
-#: Row → (scenario file, method); the scenarios are the book's §27 setting.
+#: Row → (book scenario, method); the scenarios are the book's §27 setting (shipped ``pair60``,
+#: ``pair80``), loaded by the caller (:func:`stereoplotter.report.verification.book_scenarios`).
 PROCEDURE_ROWS = {
     "(6.43)": ("pair60.yaml", "setup"),
     "(6.44)": ("pair80.yaml", "setup"),
@@ -55,46 +58,31 @@ PROCEDURE_ROWS = {
 }
 
 
-def _load(scenario):
-    from stereoplotter.io.scenario_file import load_scenario
-
-    if isinstance(scenario, str | Path):
-        path = Path(scenario)
-        if not path.exists():
-            path = ROOT / "scenarios" / str(scenario)
-        return load_scenario(path)
-    return scenario
-
-
-@lru_cache(maxsize=8)
-def _geometry_cached(path: str, instrument: str):
-    return _scenario_geometry(_load(path), instrument)
-
-
-def scenario_geometry(scenario, instrument: str = "sc1") -> dict:
+def scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict:
     """f, l, n_л, f_пр, photo base p = B·f/H̄, overlap and the book's c of a scenario.
 
     c follows the book's §27 convention: c = p below 70 % overlap (60 %: a = 0), c = 2p above
-    (80 %: a = p).
+    (80 %: a = p). ``spec`` is the instrument whose setup sheet gives n_л and f_пр (the book's
+    SC-1).
 
     Examples
     --------
-    >>> g = scenario_geometry("pair60.yaml")
+    >>> from stereoplotter.io.paths import data_dir
+    >>> from stereoplotter.io.scenario_file import load_scenario
+    >>> from stereoplotter.io.instrument_file import load_instrument
+    >>> sc = load_scenario(data_dir("scenarios") / "pair60.yaml")
+    >>> g = scenario_geometry(sc, load_instrument("sc1"))
     >>> round(g["f"]), round(g["l"]), g["overlap"] < 0.7
     (70, 85, True)
     """
-    if isinstance(scenario, str | Path):
-        return dict(_geometry_cached(str(scenario), instrument))
-    return _scenario_geometry(scenario, instrument)
+    return _scenario_geometry(scenario, spec)
 
 
-def _scenario_geometry(scenario, instrument):
-    from stereoplotter.io.instrument_file import load_instrument
+def _scenario_geometry(scenario, spec):
     from stereoplotter.procedure.evaluation import instrument_frame_m
     from stereoplotter.scenario.synthetic import working_area_grid_m
     from stereoplotter.setup.sheet import compute_setup_sheet
 
-    spec = load_instrument(instrument)
     sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
     f = float(scenario.camera.focal_length_mm)
     pts = np.asarray(scenario.camera.fiducial_array_mm(), float)
@@ -163,36 +151,26 @@ def _dp(scenario, sheet, inst, frame_pts):
     return np.asarray(dp, float)
 
 
-def procedure_mc(
-    scenario="pair60.yaml",
-    method: str = "setup",
-    *,
-    trials: int = 600,
-    seed: int = 20240601,
-    sigma_mm: float = 0.01,
-    instrument: str = "sc1",
-    grid=(16, 32),
-) -> dict:
-    """Run the procedure MC for one scenario and method (see the module docstring).
-
-    Returns
-    -------
-    dict
-        ``coefficient`` (RMS of δp per m_xy for "setup", per m_p = m_q for "conventional"),
-        ``ci`` (half-width, same units), ``rms_mm``, ``bias_mm`` (RMS δp of the error-free run on
-        the same domain), ``per_trial`` (per-trial RMS / unit, for histograms), the geometry
-        used (f, l, n, f_instrument, p, c, a, overlap) and ``seconds``.
-
-    Examples
-    --------
-    >>> r = procedure_mc("pair60.yaml", "setup", trials=20, seed=1)
-    >>> 0.3 < r["coefficient"] < 3.0
-    True
-    """
-    import time
-
-    from stereoplotter.io.instrument_file import load_instrument
+def _configuration(method, sigma_mm, c, p, n):
+    """Operator errors, domain x_л-range, unit and run options of ``method`` (module docstring)."""
     from stereoplotter.procedure.operator import OperatorModel
+
+    zero = OperatorModel().zero()
+    if method == "setup":
+        op = replace(zero, monocular_sigma_mm=sigma_mm)
+        return zero, op, (0.0, c), n * sigma_mm, {}  # domain of (6.27)
+    if method == "conventional":
+        op = replace(zero, stereo_sigma_mm=sigma_mm, y_parallax_sigma_mm=sigma_mm)
+        return zero, op, (p - c, p), sigma_mm, {"relative": "equations"}  # x_п ∈ [−c, 0]
+    raise ValueError(f"method: expected 'setup' or 'conventional', found {method!r}")
+
+
+def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw):
+    """Per-trial mean square of δp on the domain, and the error-free run's δp.
+
+    The error-free run once; the noisy trials in chunks under the memory budget (the random
+    draws are keyed by trial, so the chunk size changes no result).
+    """
     from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
     from stereoplotter.procedure.trials import (
         DEFAULT_MEMORY_BUDGET_MB,
@@ -200,27 +178,7 @@ def procedure_mc(
         iter_trial_chunks,
     )
 
-    t0 = time.perf_counter()
-    sc = _load(scenario)
-    g = scenario_geometry(scenario if isinstance(scenario, str | Path) else sc, instrument)
-    f, p, c, n = g["f"], g["p"], g["c"], g["n"]
-    spec = load_instrument(instrument)
-    spec = replace(spec, standard_points_c_mm=c)
-    zero = OperatorModel().zero()
-    if method == "setup":
-        op = replace(zero, monocular_sigma_mm=sigma_mm)
-        xr = (0.0, c)  # (6.27)
-        unit = n * sigma_mm
-        kw = {}
-    elif method == "conventional":
-        op = replace(zero, stereo_sigma_mm=sigma_mm, y_parallax_sigma_mm=sigma_mm)
-        xr = (p - c, p)  # x_п ∈ [−c, 0]
-        unit = sigma_mm
-        kw = {"relative": "equations"}
-    else:
-        raise ValueError(f"method: expected 'setup' or 'conventional', found {method!r}")
-    # the error-free run once; the noisy trials in chunks under the memory budget
-    # (the random draws are keyed by trial, so the chunk size changes no result)
+    f, p, c = g["f"], g["p"], g["c"]
     zero_prep = prepare_run(
         sc, spec, method, "zero", seed, operator=zero, ideal_mechanics=True, **kw
     )
@@ -234,13 +192,56 @@ def procedure_mc(
         d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
         first = result.first_trial
         ms[first : first + len(d)] = np.mean(d**2, axis=-1)  # per trial
+    return ms, d_zero
+
+
+def procedure_mc(
+    scenario: Scenario,
+    method: str = "setup",
+    *,
+    spec: InstrumentSpec,
+    trials: int = 600,
+    seed: int = 20240601,
+    sigma_mm: float = 0.01,
+    grid=(16, 32),
+) -> dict:
+    """Run the procedure MC for one scenario and method (see the module docstring).
+
+    ``scenario`` and ``spec`` (the instrument, the book's SC-1) are loaded by the caller; this
+    layer reads no files.
+
+    Returns
+    -------
+    dict
+        ``coefficient`` (RMS of δp per m_xy for "setup", per m_p = m_q for "conventional"),
+        ``ci`` (half-width, same units), ``rms_mm``, ``bias_mm`` (RMS δp of the error-free run on
+        the same domain), ``per_trial`` (per-trial RMS / unit, for histograms), the geometry
+        used (f, l, n, f_instrument, p, c, a, overlap) and ``seconds``.
+
+    Examples
+    --------
+    >>> from stereoplotter.io.paths import data_dir
+    >>> from stereoplotter.io.scenario_file import load_scenario
+    >>> from stereoplotter.io.instrument_file import load_instrument
+    >>> sc = load_scenario(data_dir("scenarios") / "pair60.yaml")
+    >>> r = procedure_mc(sc, "setup", spec=load_instrument("sc1"), trials=20, seed=1)
+    >>> 0.3 < r["coefficient"] < 3.0
+    True
+    """
+    import time
+
+    t0 = time.perf_counter()
+    g = scenario_geometry(scenario, spec)
+    zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"])
+    spec = replace(spec, standard_points_c_mm=g["c"])
+    ms, d_zero = _mean_squares(scenario, spec, method, seed, trials, zero, op, xr, g, grid, kw)
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(mean_ms)
     se_ms = float(np.std(ms, ddof=1)) / math.sqrt(len(ms))
     half = CI_Z * rms * se_ms / (2.0 * mean_ms)
     return {
         "method": method,
-        "scenario": sc.name,
+        "scenario": scenario.name,
         "trials": int(trials),
         "seed": int(seed),
         "sigma_mm": sigma_mm,

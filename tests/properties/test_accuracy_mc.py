@@ -89,9 +89,11 @@ def test_plots_have_data(rows):
 
 def test_procedure_mc_setup_matches_formula_at_simulated_geometry():
     from stereoplotter.accuracy import setup_accuracy as sa
+    from stereoplotter.report.verification import book_instrument, book_scenarios
     from stereoplotter.verification.procedure_mc import procedure_mc
 
-    r = procedure_mc("pair60.yaml", "setup", trials=400, seed=3)
+    sc = book_scenarios()["60"]
+    r = procedure_mc(sc, "setup", spec=book_instrument(), trials=400, seed=3)
     ref = sa.setup_parallax_rms_from_pointing(r["f"], r["p"], r["c"], r["l"], r["n"], 1.0)
     # first-order formula within the CI plus 10 % (model mismatches stated in the note)
     assert abs(r["coefficient"] - ref) < r["ci"] + 0.1 * ref
@@ -99,9 +101,16 @@ def test_procedure_mc_setup_matches_formula_at_simulated_geometry():
 
 
 def test_procedure_columns_filled_and_disabled():
+    from stereoplotter.report.verification import book_instrument, book_scenarios
     from stereoplotter.verification.table import PROCEDURE_ROWS
 
-    rows = run_verification(trials=200, seed=2, procedure_trials=150)
+    rows = run_verification(
+        trials=200,
+        seed=2,
+        procedure_trials=150,
+        procedure_scenarios=book_scenarios(),
+        instrument=book_instrument(),
+    )
     for r in rows:
         if r["eq"] in PROCEDURE_ROWS:
             assert r["mc_procedure"] > 0 and r["mc_procedure_ci"] > 0, r["eq"]
@@ -110,6 +119,18 @@ def test_procedure_columns_filled_and_disabled():
             assert r["mc_procedure"] is None
     off = run_verification(trials=200, seed=2, procedure_trials=0)
     assert all(r["mc_procedure"] is None for r in off)
+
+
+def test_procedure_mc_needs_loaded_inputs():
+    # the verification layer reads no files: no scenarios, no procedure MC; a scenario without
+    # its instrument is refused
+    from stereoplotter.report.verification import book_scenarios
+    from stereoplotter.verification.table import run_procedure_mc
+
+    rows = run_verification(trials=50, seed=2, procedure_trials=50)
+    assert all(r["mc_procedure"] is None for r in rows)
+    with pytest.raises(ValueError, match="instrument"):
+        run_procedure_mc(50, 2, book_scenarios())
 
 
 def test_geometry_book_explicit_equals_default():
@@ -142,7 +163,7 @@ def test_geometry_from_scenario_file():
 
     g, scen = geometry_from_file("scenarios/pair80.yaml")
     assert g["p80"] == pytest.approx(36.1, abs=0.1) and g["c"] == pytest.approx(2 * g["p80"])
-    assert scen == {"60": None, "80": "scenarios/pair80.yaml"}
+    assert scen["60"] is None and scen["80"].source == "scenarios/pair80.yaml"
 
 
 def test_cli_verify_geometry_and_histograms(tmp_path):

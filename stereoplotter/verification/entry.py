@@ -1,0 +1,142 @@
+"""One row of the verification table as data (:class:`Entry`) and the geometry the rows are
+computed at (:class:`Setting`), shared by the row modules ``rows_*``.
+
+Book geometry (§27): f = 70 mm, l = 85 mm, n = 1.42 (SC-1), c = 70 mm; 60 %: p = 70, a = 0;
+80 %: p = 35, a = 35.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from stereoplotter.accuracy import chapter5 as c5
+from stereoplotter.accuracy import setup_accuracy as sa
+from stereoplotter.verification import linear_mc as mc
+
+__all__ = ["BOOK", "GENERIC_SIGMAS", "Entry", "Setting", "both_photos"]
+
+BOOK = {
+    "f": 70.0,
+    "l": 85.0,
+    "n": 1.42,
+    "c": 70.0,
+    "p60": 70.0,
+    "a60": 0.0,
+    "p80": 35.0,
+    "a80": 35.0,
+}
+#: σ's of the setup elements for (6.28)–(6.30) (the book gives the formula, not the σ's).
+GENERIC_SIGMAS = {
+    "base_x": 0.005,
+    "alpha": 1.0e-4,
+    "omega": 1.5e-4,
+    "kappa": 1.0e-4,
+    "base_z": 0.02,
+}
+
+
+@dataclass(frozen=True)
+class Entry:
+    """A row of the table before its Monte Carlo: the formula values and the linear model.
+
+    ``model`` is a :class:`~stereoplotter.verification.linear_mc.LinearModel`; its MC and
+    covariance RMS are multiplied by ``scale``. ``squared``: the row reports a cofactor (the
+    square of the model's σ), not a σ.
+    """
+
+    eq: str
+    quantity: str
+    printed: float | None
+    book: float
+    rigorous: float
+    model: mc.LinearModel
+    verdict: str
+    note: str
+    scale: float = 1.0
+    squared: bool = False
+
+    def __post_init__(self):
+        object.__setattr__(self, "book", float(self.book))
+        object.__setattr__(self, "rigorous", float(self.rigorous))
+
+
+def both_photos(s: dict) -> dict:
+    """Setup-element σ's of one photo (keys of :data:`GENERIC_SIGMAS`) for both photos."""
+    return {
+        "base_x": s["base_x"],
+        "base_z": s["base_z"],
+        "alpha_left": s["alpha"],
+        "alpha_right": s["alpha"],
+        "omega_left": s["omega"],
+        "omega_right": s["omega"],
+        "kappa_left": s["kappa"],
+        "kappa_right": s["kappa"],
+    }
+
+
+@dataclass(frozen=True)
+class Setting:
+    """The table's geometry (keys of :data:`BOOK`) and the models every topic shares."""
+
+    f: float
+    l: float  # noqa: E741 (the book's l)
+    n: float
+    c: float
+    p60: float
+    a60: float
+    p80: float
+    a80: float
+
+    @classmethod
+    def from_mapping(cls, g: dict) -> Setting:
+        return cls(**{k: g[k] for k in BOOK})
+
+    @property
+    def r2(self) -> float:
+        return math.sqrt(2.0)
+
+    def slot(self, overlap: str) -> tuple[float, float]:
+        """(a, p) of the "60" or "80" % slot."""
+        return (self.a60, self.p60) if overlap == "60" else (self.a80, self.p80)
+
+    def setup_sigmas(self, m_xy: float = 1.0) -> dict:
+        """Book-mode σ's of the setup elements (6.31)–(6.38) per m_xy."""
+        return sa.setup_element_sigmas(self.f, self.l, self.n, m_xy, mode="book")
+
+    def unadjusted(self, a: float, p: float, sigmas: dict) -> mc.LinearModel:
+        """Setup data without levelling, both photos' element errors (problem 1)."""
+        return mc.setup_model(self.f, p, a, self.c, both_photos(sigmas), levelled=False)
+
+    def levelled(self, a: float, p: float, sigmas: dict, control: float = 0.0) -> mc.LinearModel:
+        """Setup data after levelling on control with σ ``control`` [mm] (problem 2)."""
+        return mc.setup_model(
+            self.f,
+            p,
+            a,
+            self.c,
+            both_photos(sigmas),
+            levelled=True,
+            sigma_control_mm=control,
+        )
+
+    def conventional(self, a: float, p: float, sq: float = 1.0, sc: float = 1.0):
+        """Conventional method: relative orientation (σ_q = ``sq``) and levelling (σ = ``sc``)."""
+        return mc.relative_orientation_model(a, self.c, p, self.f, sq, sigma_control_mm=sc)
+
+    def conventional_values(self, a: float, p: float) -> list[float]:
+        """printed, book, rigorous of the conventional M_p/m_p (m_q = m_p = 1)."""
+        return [
+            sa.conventional_parallax_rms(a, self.c, p, self.f, 1.0, 1.0, m)
+            for m in ("printed", "book", "rigorous")
+        ]
+
+    def single_model(self, a: float, p: float) -> mc.LinearModel:
+        """Relative orientation with m_q = m_p/√2, control and white error m_p = 1 ((5.56))."""
+        return mc.relative_orientation_model(
+            a, self.c, p, self.f, 1 / self.r2, sigma_control_mm=1.0, sigma_white_mm=1.0
+        )
+
+    def geodetic(self, a: float, p: float, mode: str) -> float:
+        """(5.55) m_p,г/m_p over the pair in ``mode``."""
+        return c5.geodetic_orientation_parallax_rms(a, self.c, p, self.f, 1.0, mode)

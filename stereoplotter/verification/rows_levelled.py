@@ -1,0 +1,280 @@
+"""Rows of §27 problem 2, setup data with levelling against the conventional method:
+(6.47)–(6.50) the relative residual of setup data, (6.51)–(6.57) the conventional terms, and the
+closing pair (6.58)–(6.61) (m_q = m_p = 1, m_xy = √2 m_p)."""
+
+from __future__ import annotations
+
+import math
+
+from stereoplotter.accuracy import chapter5 as c5
+from stereoplotter.accuracy import setup_accuracy as sa
+from stereoplotter.verification.entry import Entry, Setting
+
+__all__ = ["closing_entries", "conventional_term_entries", "setup_residual_entries"]
+
+
+def _residual(s: Setting, overlap: str, mode: str, m_xy: float = 1.0) -> float:
+    a, _ = s.slot(overlap)
+    return sa.setup_relative_residual_rms(a, s.c, s.f, s.l, s.n, m_xy, mode)
+
+
+def _residual_printed(s: Setting, overlap: str) -> float:
+    a, _ = s.slot(overlap)
+    return sa.setup_relative_residual_rms_printed(a, s.c, s.l, s.n, 1.0)
+
+
+def _residual_entry(s: Setting, eq, overlap, quantity, printed, verdict, note) -> Entry:
+    a, p = s.slot(overlap)
+    return Entry(
+        eq,
+        quantity,
+        printed,
+        _residual(s, overlap, "book"),
+        _residual(s, overlap, "rigorous"),
+        s.levelled(a, p, s.setup_sigmas()),
+        verdict,
+        note,
+    )
+
+
+def eq_6_47(s: Setting) -> Entry:
+    return _residual_entry(
+        s,
+        "(6.47)",
+        "60",
+        "m_p,во/m_xy setup data after levelling, 60 %",
+        None,
+        "book misprint",
+        "(6.47) carries one m_α, m_ω; both photos' errors enter (residual ∝ α_л − α_п, "
+        "ω_л − ω_п): variance ×2",
+    )
+
+
+def eq_6_48(s: Setting) -> Entry:
+    return _residual_entry(
+        s,
+        "(6.48)",
+        "80",
+        "m_p,во/m_xy, formula at 80 %",
+        _residual_printed(s, "80"),
+        "book misprint",
+        "integral of (6.47) gives (…)/(15c²) not /21; with (6.35) corrected 1/24 not 1/48; "
+        "rigorous adds the second photo and the exact ω residual",
+    )
+
+
+def eq_6_49(s: Setting) -> Entry:
+    return _residual_entry(
+        s,
+        "(6.49)",
+        "60",
+        "m_p,во/m_xy, 60 %",
+        0.12,
+        "book misprint",
+        f"printed (6.48) gives {_residual_printed(s, '60'):.4f} (truncated 0.12); its "
+        "coefficients are wrong, see (6.48)",
+    )
+
+
+def eq_6_50(s: Setting) -> Entry:
+    return _residual_entry(
+        s,
+        "(6.50)",
+        "80",
+        "m_p,во/m_xy, 80 %",
+        0.12,
+        "not reproducible",
+        f"printed (6.48) gives {_residual_printed(s, '80'):.4f} at 80 %; 0.12 repeats the 60 % "
+        "value",
+    )
+
+
+def setup_residual_entries(s: Setting) -> list[Entry]:
+    """(6.47)–(6.50)."""
+    return [eq_6_47(s), eq_6_48(s), eq_6_49(s), eq_6_50(s)]
+
+
+def _relative(s: Setting, overlap: str, mode: str) -> float:
+    a, p = s.slot(overlap)
+    return c5.relative_orientation_parallax_rms(a, s.c, p, 1.0, mode)
+
+
+def _relative_entry(s: Setting, eq, overlap, printed, verdict, note) -> Entry:
+    """m_p,во/m_q of the conventional method ((5.54)), relative orientation only."""
+    a, p = s.slot(overlap)
+    return Entry(
+        eq,
+        f"m_p,во/m_q conventional, {overlap} %",
+        printed,
+        _relative(s, overlap, "book"),
+        _relative(s, overlap, "rigorous" if overlap == "80" else "book"),
+        s.conventional(a, p, sc=0.0),
+        verdict,
+        note,
+    )
+
+
+def eq_6_51(s: Setting) -> Entry:
+    ro6 = _relative(s, "60", "book")
+    return _relative_entry(
+        s,
+        "(6.51)",
+        "60",
+        0.24,
+        "book misprint",
+        f"(5.54) gives {ro6:.4f}; the book's own (6.56) prints 0.23",
+    )
+
+
+def eq_6_52(s: Setting) -> Entry:
+    ro8b, ro8r = _relative(s, "80", "book"), _relative(s, "80", "rigorous")
+    return _relative_entry(
+        s,
+        "(6.52)",
+        "80",
+        0.33,
+        "reproduces",
+        f"(5.54) {ro8b:.4f}; rigorous (exact plane residual) {ro8r:.4f}",
+    )
+
+
+def eq_6_53(s: Setting) -> Entry:
+    _, bk, rg = s.conventional_values(s.a80, s.p80)
+    return Entry(
+        "(6.53)",
+        "M_p/m_p = √(m²_во + m²_го), conventional 80 %",
+        None,
+        bk,
+        rg,
+        s.conventional(s.a80, s.p80),
+        "reproduces",
+        "independent sources: MC of the summed fields has no cross term",
+    )
+
+
+def eq_6_54(s: Setting) -> Entry:
+    g6 = [s.geodetic(s.a60, s.p60, m) for m in ("printed", "book", "rigorous")]
+    return Entry(
+        "(6.54)",
+        f"coefficient k of (k·p/f)·m_p, 60 %, p = {s.p60:g}",
+        0.95,
+        g6[1],
+        g6[2],
+        s.conventional(s.a60, s.p60, sq=0.0),
+        "book misprint",
+        f"from the printed (5.55): {g6[0]:.4f} (truncated); (5.55) is not its integral, "
+        "see (5.55) 60 %; 0.12 m_xy as (6.49)",
+    )
+
+
+def eq_6_55(s: Setting) -> Entry:
+    f, p8 = s.f, s.p80
+    g8 = [s.geodetic(s.a80, p8, m) * f / p8 for m in ("printed", "book", "rigorous")]
+    return Entry(
+        "(6.55)",
+        "coefficient k of (k·p/f)·m_p, 80 %",
+        0.63,
+        g8[1],
+        g8[2],
+        s.conventional(s.a80, p8, sq=0.0),
+        "reproduces",
+        "√(43/108) = 0.6310; rigorous (control heights with parallax error m_p) is k·f/p",
+        scale=f / p8,
+    )
+
+
+def eq_6_56(s: Setting) -> Entry:
+    ro6 = _relative(s, "60", "book")
+    return _relative_entry(
+        s, "(6.56)", "60", 0.23, "reproduces", f"(5.54) {ro6:.4f}; 0.95 term as (6.54)"
+    )
+
+
+def eq_6_57(s: Setting) -> Entry:
+    return _relative_entry(s, "(6.57)", "80", 0.33, "reproduces", "as (6.52); 0.63 term as (6.55)")
+
+
+def conventional_term_entries(s: Setting) -> list[Entry]:
+    """(6.51)–(6.57)."""
+    return [eq_6_51(s), eq_6_52(s), eq_6_53(s), eq_6_54(s), eq_6_55(s), eq_6_56(s), eq_6_57(s)]
+
+
+def _label(s: Setting, p: float) -> str:
+    """The overlap named in (6.58)–(6.61): "60" whenever p is the 60 % slot's p."""
+    return "60" if p == s.p60 else "80"
+
+
+def _setup_levelled(s: Setting, eq: str, overlap: str, printed: float, chain: float) -> Entry:
+    """(6.58)/(6.59): setup data + levelling, M_p/m_p with m_p = m_q = m_xy/√2."""
+    a, p = s.slot(overlap)
+    r2 = s.r2
+    bk = math.hypot(_residual(s, overlap, "book", r2), s.geodetic(a, p, "book"))
+    rg = math.hypot(_residual(s, overlap, "rigorous", r2), s.geodetic(a, p, "rigorous"))
+    return Entry(
+        eq,
+        f"M_p/m_p setup data + levelling, {_label(s, p)} %, f = {s.f:g}, m_p = m_q = m_xy/√2",
+        printed,
+        bk,
+        rg,
+        s.levelled(a, p, s.setup_sigmas(r2), control=1.0),
+        "book misprint",
+        f"arithmetic from the printed intermediates gives {chain:.4f} (truncated "
+        f"{math.floor(chain * 100) / 100:.2f}); inherits (6.49)/(6.50) and "
+        + ("(6.54)" if eq == "(6.58)" else "the p/f scale of (5.55)"),
+    )
+
+
+def eq_6_58(s: Setting) -> Entry:
+    return _setup_levelled(s, "(6.58)", "60", 0.96, math.hypot(0.12 * s.r2, 0.95))
+
+
+def eq_6_59(s: Setting) -> Entry:
+    chain = math.hypot(0.12 * s.r2, 0.63 * s.p80 / s.f)
+    return _setup_levelled(s, "(6.59)", "80", 0.35, chain)
+
+
+def _conventional_total(s: Setting, eq, overlap, printed, verdict, note) -> Entry:
+    a, p = s.slot(overlap)
+    _, bk, rg = s.conventional_values(a, p)
+    return Entry(
+        eq,
+        f"M_p/m_p conventional, {_label(s, p)} %, f = {s.f:g}",
+        printed,
+        bk,
+        rg,
+        s.conventional(a, p),
+        verdict,
+        note,
+    )
+
+
+def eq_6_60(s: Setting) -> Entry:
+    chain = math.hypot(0.23, 0.95)
+    return _conventional_total(
+        s,
+        "(6.60)",
+        "60",
+        0.96,
+        "not reproducible",
+        f"√(0.23² + 0.95²) = {chain:.4f} → 0.97/0.98; m_q = m_p/√2 gives 0.964 but then "
+        "(6.61) would be 0.39; book-mode value from the correct (5.55)",
+    )
+
+
+def eq_6_61(s: Setting) -> Entry:
+    chain = math.hypot(0.33, 0.63 * s.p80 / s.f)
+    _, bk, rg = s.conventional_values(s.a80, s.p80)
+    return _conventional_total(
+        s,
+        "(6.61)",
+        "80",
+        0.45,
+        "rounding",
+        f"√(0.33² + (0.63/2)²) = {chain:.4f}, truncated to 0.45 (book mode "
+        f"{bk:.4f}); rigorous {rg:.4f} (control heights with parallax error m_p)",
+    )
+
+
+def closing_entries(s: Setting) -> list[Entry]:
+    """(6.58)–(6.61): the closing comparison's rows."""
+    return [eq_6_58(s), eq_6_59(s), eq_6_60(s), eq_6_61(s)]

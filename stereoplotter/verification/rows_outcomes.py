@@ -1,0 +1,128 @@
+"""Rows of the outcomes of §27 problem 1: (6.39)–(6.44) the parallax of unadjusted setup data
+from the pointing error m_xy, (6.45)/(6.46) the conventional method it is compared with."""
+
+from __future__ import annotations
+
+from stereoplotter.accuracy import setup_accuracy as sa
+from stereoplotter.verification.entry import Entry, Setting
+
+__all__ = ["conventional_entries", "setup_outcome_entries"]
+
+
+def _from_pointing(s: Setting, overlap: str) -> float:
+    _, p = s.slot(overlap)
+    return sa.setup_parallax_rms_from_pointing(s.f, p, s.c, s.l, s.n, 1.0)
+
+
+def _outcome(s: Setting, eq: str, overlap: str, quantity: str, printed, verdict, note) -> Entry:
+    """A row of m_p⁰/m_xy of unadjusted setup data at ``overlap`` (book σ's of (6.31)–(6.38))."""
+    a, p = s.slot(overlap)
+    v = _from_pointing(s, overlap)
+    return Entry(
+        eq, quantity, printed, v, v, s.unadjusted(a, p, s.setup_sigmas()), verdict, note
+    )
+
+
+def eq_6_39(s: Setting) -> Entry:
+    return _outcome(
+        s,
+        "(6.39)",
+        "60",
+        f"m_p⁰/m_xy, 60 %, l = {s.l:g}, n = {s.n:g}",
+        sa.setup_parallax_rms_printed_60(s.p60, s.l, s.n, 1.0),
+        "reproduces",
+        "with the least-squares m_ω (not the printed (6.35)) and f_пр = f in (6.37)",
+    )
+
+
+def eq_6_40(s: Setting) -> Entry:
+    return _outcome(
+        s,
+        "(6.40)",
+        "80",
+        f"m_p⁰/m_xy, 80 %, l = {s.l:g}, n = {s.n:g}",
+        sa.setup_parallax_rms_printed_80(s.p80, s.l, s.n, 1.0),
+        "reproduces",
+        "as (6.39)",
+    )
+
+
+def eq_6_41(s: Setting) -> Entry:
+    return _outcome(
+        s,
+        "(6.41)",
+        "60",
+        f"m_p⁰/m_xy, 60 %, n = {s.n:g}, rounded coefficients",
+        sa.setup_parallax_rms_rounded_60(s.n, 1.0),
+        "rounding",
+        "124 ← 123.63, 10 ← 10.17, 6.7 ← 3√5 = 6.708",
+    )
+
+
+def eq_6_42(s: Setting) -> Entry:
+    return _outcome(
+        s,
+        "(6.42)",
+        "80",
+        f"m_p⁰/m_xy, 80 %, n = {s.n:g}, rounded coefficients",
+        sa.setup_parallax_rms_rounded_80(s.n, 1.0),
+        "rounding",
+        "113 ← 113.28, 2.5 ← 2.54",
+    )
+
+
+def eq_6_43(s: Setting) -> Entry:
+    return _outcome(s, "(6.43)", "60", "m_p⁰/m_xy, 60 %, SC-1", 1.26, "reproduces", "1.2604")
+
+
+def eq_6_44(s: Setting) -> Entry:
+    return _outcome(
+        s,
+        "(6.44)",
+        "80",
+        "m_p⁰/m_xy, 80 %, SC-1",
+        1.11,
+        "book misprint",
+        "the book's own (6.42) gives 1.142 (and (6.40) 1.1424); 1.11 not reached by any "
+        "reading of (6.40)",
+    )
+
+
+def setup_outcome_entries(s: Setting) -> list[Entry]:
+    """(6.39)–(6.44), in the table's order."""
+    return [eq_6_39(s), eq_6_40(s), eq_6_41(s), eq_6_42(s), eq_6_43(s), eq_6_44(s)]
+
+
+def eq_6_45(s: Setting) -> Entry:
+    pr, bk, rg = s.conventional_values(s.a60, s.p60)
+    return Entry(
+        "(6.45)",
+        f"m_p⁰/m_p conventional, 60 %, p = {s.p60:g}, m_q = m_p",
+        0.98,
+        bk,
+        rg,
+        s.conventional(s.a60, s.p60),
+        "book misprint",
+        f"printed (5.54), (5.55) give {pr:.4f} (truncated 0.98); the correct "
+        "integral of (5.53) gives the book value",
+    )
+
+
+def eq_6_46(s: Setting) -> Entry:
+    pr, bk, rg = s.conventional_values(s.a80, s.p80)
+    return Entry(
+        "(6.46)",
+        f"m_p⁰/m_p conventional, 80 %, p = {s.p80:g}, m_q = m_p",
+        0.67,
+        bk,
+        rg,
+        s.conventional(s.a80, s.p80),
+        "not reproducible",
+        f"printed (5.54)/(5.55) give {pr:.4f}; √(0.63² + 0.23²) = 0.671 (p/f dropped and the "
+        "60 % m_p,в used) is the only reading found that gives 0.67",
+    )
+
+
+def conventional_entries(s: Setting) -> list[Entry]:
+    """(6.45), (6.46)."""
+    return [eq_6_45(s), eq_6_46(s)]
