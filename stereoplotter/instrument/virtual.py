@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Final, Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,19 +39,60 @@ from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.instrument.mechanics.play import PlayAxis
 from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
 
-__all__ = ["BACKENDS", "CONTROLS", "HEIGHT_SCALE", "NOMINAL_ZERO", "Instrument", "Scale"]
+__all__ = [
+    "BACKENDS",
+    "CASSETTES",
+    "CONTROLS",
+    "DECENTRATIONS",
+    "HEIGHT_SCALE",
+    "KNOBS",
+    "NOMINAL_ZERO",
+    "SCREWS",
+    "CassetteName",
+    "Control",
+    "DecentrationName",
+    "HeightScaleName",
+    "Instrument",
+    "KnobName",
+    "Scale",
+    "ScaleName",
+    "ScrewName",
+    "SetControl",
+    "Side",
+]
 
 #: Mechanics back-ends of the lead-screw axes.
 BACKENDS = ("closed-form", "pymunk")
 
+#: The two photos / projectors.
+Side = Literal["left", "right"]
 #: Lead-screw axes with a counter or scale: the carriages and the base carriage.
-_SCREWS = ("X", "Y", "Z", "bx", "by", "bz")
+ScrewName = Literal["X", "Y", "Z", "bx", "by", "bz"]
+#: Cassette rotations κ, set on their scales [rad].
+CassetteName = Literal["kappa_left", "kappa_right"]
+#: Decentration scales of the correction units [mm].
+DecentrationName = Literal["dx_left", "dy_left", "dx_right", "dy_right"]
+#: Correction knobs k_α, k_ω, turned to the tilt tangent they represent (:meth:`turn_knob`).
+KnobName = Literal["k_alpha_left", "k_omega_left", "k_alpha_right", "k_omega_right"]
+#: The metre height scale geared to the Z screw.
+HeightScaleName = Literal["H"]
 #: Controls set on a scale: f_пр, the cassette rotations and the decentrations.
-_SET = ("f_instrument", "kappa_left", "kappa_right", "dx_left", "dy_left", "dx_right", "dy_right")
+SetControl = Literal["f_instrument", CassetteName, DecentrationName]
+#: Every counter or scale that can be read (:meth:`Instrument.read`).
+ScaleName = Literal[ScrewName, DecentrationName, HeightScaleName]
+#: Every control of the instrument (what an operator turns or sets).
+Control = Literal[ScrewName, SetControl, KnobName, HeightScaleName]
+
+SCREWS: Final[tuple[ScrewName, ...]] = get_args(ScrewName)
+CASSETTES: Final[tuple[CassetteName, ...]] = get_args(CassetteName)
+DECENTRATIONS: Final[tuple[DecentrationName, ...]] = get_args(DecentrationName)
+KNOBS: Final[tuple[KnobName, ...]] = get_args(KnobName)
+_SCREWS = SCREWS
+_SET: tuple[SetControl, ...] = get_args(SetControl)
 #: Every control an operator can turn to a reading.
 CONTROLS = _SCREWS + _SET
 #: The metre height scale geared to the Z screw: reading = slip − D·M_в/1000 [m].
-HEIGHT_SCALE = "H"
+HEIGHT_SCALE: Final[HeightScaleName] = "H"
 #: Reading of the height scale at D = 0 before the operator slips it (arbitrary constant). [m]
 _HEIGHT_SLIP_NOMINAL = 2000.0
 #: Nominal zero readings of the scales (arbitrary instrument constants). [mm]
@@ -289,7 +330,7 @@ class Instrument:
 
     # --- what an operator can do ---------------------------------------------------------------
 
-    def read(self, control: str, exact: bool = False) -> NDArray[np.float64] | float:
+    def read(self, control: ScaleName, exact: bool = False) -> NDArray[np.float64] | float:
         """The reading of a counter or scale (X, Y, Z (= D), bx, by, bz, dx/dy_left/right).
 
         Parameters
@@ -315,7 +356,12 @@ class Instrument:
         out = reading if exact else scale.rounded(reading)
         return self._out(out)
 
-    def set(self, control: str, reading: ArrayLike, side: str | None = None) -> None:
+    def set(
+        self,
+        control: ScrewName | SetControl | HeightScaleName,
+        reading: ArrayLike,
+        side: str | None = None,
+    ) -> None:
         """Turn a control until its scale shows ``reading``.
 
         Lead screws (X, Y, Z, bx, by, bz) move their nut there; the carriage follows through the
@@ -369,7 +415,7 @@ class Instrument:
         else:
             raise StereoplotterError(f"no control {control!r}; controls: {', '.join(CONTROLS)}")
 
-    def turn_knob(self, knob: str, tan_tilt: ArrayLike) -> None:
+    def turn_knob(self, knob: KnobName, tan_tilt: ArrayLike) -> None:
         """Turn a correction mechanism (k_α or k_ω of the left or right photo) to represent the
         tilt tangent ``tan_tilt`` (T = tan θ / k, ``kinematics.md`` §3.2).
 
@@ -401,7 +447,7 @@ class Instrument:
             self._units[side], axis, t, linkage=self.variant.linkage
         )
 
-    def travel_mm(self, control: str) -> tuple[float, float]:
+    def travel_mm(self, control: ScrewName) -> tuple[float, float]:
         """The range stops of a lead-screw axis (nut positions). [mm]
 
         Examples
@@ -416,7 +462,9 @@ class Instrument:
             self._travel[control] = travel
         return travel
 
-    def reading_of(self, control: str, nut_mm: ArrayLike) -> NDArray[np.float64]:
+    def reading_of(
+        self, control: ScrewName | DecentrationName, nut_mm: ArrayLike
+    ) -> NDArray[np.float64]:
         """The exact reading a counter shows with its nut at ``nut_mm`` (counter arithmetic)."""
         return np.asarray(self._scales[control].reading(nut_mm))
 
@@ -483,16 +531,16 @@ class Instrument:
     def _pos(self, name: str) -> NDArray[np.float64]:
         return self._out(self._axes[name].position)
 
-    def position(self, name: str) -> NDArray[np.float64] | float:
+    def position(self, name: ScrewName) -> NDArray[np.float64] | float:
         """Physical position of a lead-screw axis (X, Y, Z, bx, by, bz): ``state()`` for one
         axis (not an operator's view). [mm]"""
         return self._pos(name)
 
-    def unit(self, side: str) -> CorrectionUnit:
+    def unit(self, side: Side) -> CorrectionUnit:
         """The present correction unit of ``side`` ("left"/"right"): ``state()["units"][side]``."""
         return self._units[side]
 
-    def unit_map(self, side: str) -> UnitMap:
+    def unit_map(self, side: Side) -> UnitMap:
         """The :class:`~stereoplotter.instrument.kinematics.UnitMap` of the present unit of
         ``side``, kept until the unit changes (cos κ, sin κ kept while κ stays)."""
         unit = self._units[side]
@@ -581,6 +629,21 @@ class Instrument:
             )
             for axis, start in zip(self._cg_axes, self._cg_origin, strict=True):
                 axis.place(start)
+
+    def table_position_mm(self, model_xy_mm: ArrayLike) -> NDArray[np.float64]:
+        """Ideal table position of a model position (X, Y): origin + r·(X, Y), the gears
+        without the mechanics' errors (where a sheet point belongs on the table). [mm]
+
+        Raises
+        ------
+        StereoplotterError
+            The coordinatograph is not connected.
+        """
+        if not hasattr(self, "_cg_axes"):
+            raise StereoplotterError(
+                "the coordinatograph is not connected (connect_coordinatograph(ratio) first)"
+            )
+        return self._cg_origin + self._cg_ratio * np.asarray(model_xy_mm, float)
 
     def needle(self, side: str | None = None) -> NDArray[np.float64]:
         """Table position of the needle for the present carriages. [mm]

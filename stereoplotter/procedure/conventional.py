@@ -429,6 +429,8 @@ def c1_interior(run) -> None:
     on the right cassette centre as in stage 1, MO_X, MO_Y with the left mark on the left cassette
     centre (units at zero).
     """
+    # Over 80 lines with its docstring (71 of code): the book's C1 items in their order, each
+    # act followed by its transcript entry; splitting would scatter one sequence of settings.
     from stereoplotter.procedure.setup_method import interior_orientation
 
     op, sheet = run.op, run.sheet
@@ -703,6 +705,9 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     orientation of C2 again, bounded): on this instrument the common tilt is q-neutral only to
     a few per cent.
     """
+    # Long (119 lines of code): one bounded loop whose masks (active, its, ro_its, worst) are
+    # updated together per iteration, then the slip and the checks on the same state. Kept whole
+    # so the vectorised masks stay in one place; a split is left for the next redesign step.
     op, sheet = run.op, run.sheet
     tol = sheet.tolerances["control_height_m"]
     tol_q = sheet.tolerances["residual_y_parallax_mm"]
@@ -786,8 +791,8 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
         if relative_fn is not None:
             r_its, _ = _masked(run, active, relative_fn, cal, f"C3/{it}/ro")
             ro_its = ro_its + np.where(active, r_its, 0)
-    run.iterations["C3"] = its
-    run.iterations["C3/relative"] = ro_its
+    run.record_stage("C3", its)
+    run.record_stage("C3/relative", ro_its)
     run.check("C3: levelling points (against the first)", worst, tol, unit="m", iterations=its)
     # slip the height scale at the first levelling point, check all control heights
     heights = _height_points(run, [h["id"] for h in sheet.control_heights])
@@ -846,8 +851,8 @@ def c4_sheet(run) -> None:
     stage5_check(run)
     log.records[start:] = [replace(r, stage="C4") for r in log.records[start:]]
     for old, new in (("4", "C4"), ("5", "C4/check")):
-        if old in run.iterations:
-            run.iterations[new] = run.iterations.pop(old)
+        if old in run.stages:
+            run.record_stage(new, run.stages.pop(old).iterations)
 
 
 def run_conventional_method(run, relative: str = "elements"):
@@ -875,7 +880,7 @@ def run_conventional_method(run, relative: str = "elements"):
     run.calibration = cal
     relative_fn = c2_relative_by_elements if relative == "elements" else c2_relative_by_equations
     its, worst = relative_fn(run, cal)
-    run.iterations["C2"] = its
+    run.record_stage("C2", its)
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     run.check("C2: residual y-parallax (6 points)", worst, tol, iterations=its)
     c3_absolute(run, cal, level_ids, relative_fn)

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -31,16 +31,42 @@ from stereoplotter.instrument.kinematics import (
     rods_y_parallax,
     turn_correction_knob,
 )
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, Instrument
+from stereoplotter.instrument.virtual import (
+    HEIGHT_SCALE,
+    KNOBS,
+    SCREWS,
+    CassetteName,
+    HeightScaleName,
+    Instrument,
+    KnobName,
+    ScaleName,
+    ScrewName,
+    SetControl,
+    Side,
+)
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.random_streams import keyed_draws
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import synthesize_measurements
 
-__all__ = ["Noise", "Operator", "OperatorModel", "Scene", "solve_1d"]
+__all__ = [
+    "DrivenControl",
+    "Noise",
+    "Operator",
+    "OperatorModel",
+    "Scene",
+    "SetControlName",
+    "solve_1d",
+]
 
-_SCREWS = ("X", "Y", "Z", "bx", "by", "bz")
-_KNOBS = ("k_alpha_left", "k_omega_left", "k_alpha_right", "k_omega_right")
+#: Controls the operator turns while looking until they are physically at a target
+#: (:meth:`Operator.drive`): the lead screws, the cassettes, the correction knobs.
+DrivenControl = Literal[ScrewName, CassetteName, KnobName]
+#: Controls the operator sets to a computed reading on their scale (:meth:`Operator.set`).
+SetControlName = Literal[ScrewName, SetControl, HeightScaleName]
+
+_SCREWS = SCREWS
+_KNOBS = KNOBS
 
 
 @dataclass(frozen=True, slots=True)
@@ -272,7 +298,7 @@ class Operator:
 
     # --- least counts -------------------------------------------------------------------------
 
-    def least_count(self, control: str) -> float:
+    def least_count(self, control: ScaleName) -> float:
         spec = self.inst.spec
         if control == HEIGHT_SCALE:
             return spec.height_scale_least_count_m
@@ -282,7 +308,7 @@ class Operator:
 
     # --- reading and setting ------------------------------------------------------------------
 
-    def read(self, control: str, key: str) -> NDArray[np.float64]:
+    def read(self, control: ScaleName, key: str) -> NDArray[np.float64]:
         """Read a counter or scale: exact value + σ_read, rounded to the least count."""
         lc = self.least_count(control)
         exact = self.v(self.inst.read(control, exact=True))
@@ -293,7 +319,7 @@ class Operator:
 
     def set(
         self,
-        control: str,
+        control: SetControlName,
         value: ArrayLike,
         key: str,
         active: NDArray[np.bool_] | None = None,
@@ -318,7 +344,9 @@ class Operator:
             self.commanded[control] = cmd
         return cmd
 
-    def _at_stop(self, control: str, reading: NDArray[np.float64]) -> NDArray[np.float64]:
+    def _at_stop(
+        self, control: ScrewName | HeightScaleName, reading: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
         """The operator turns no further than the stop (the instrument would refuse): a reading
         beyond it becomes the stop's reading, and the trial is flagged in :attr:`stopped`."""
         if control == HEIGHT_SCALE:
@@ -340,7 +368,7 @@ class Operator:
 
     # --- turning while looking ---------------------------------------------------------------
 
-    def physical(self, control: str) -> NDArray[np.float64]:
+    def physical(self, control: DrivenControl) -> NDArray[np.float64]:
         """Where a control physically is (what the eye judges in the eyepiece)."""
         if control in _SCREWS:
             return self.v(self.inst.position(control))
@@ -354,7 +382,7 @@ class Operator:
 
     def drive(
         self,
-        control: str,
+        control: DrivenControl,
         target: ArrayLike,
         active: NDArray[np.bool_] | None = None,
     ) -> None:
@@ -387,7 +415,7 @@ class Operator:
     def units(self):
         return self.inst.unit("left"), self.inst.unit("right")
 
-    def unit_map(self, side: str, unit: CorrectionUnit | None = None) -> UnitMap:
+    def unit_map(self, side: Side, unit: CorrectionUnit | None = None) -> UnitMap:
         """The UnitMap of ``unit`` (default: the present unit of ``side``), cached by the
         instrument while that unit is in place."""
         if unit is None or unit is self.inst.unit(side):
@@ -396,7 +424,7 @@ class Operator:
 
     def mark_on(
         self,
-        side: str,
+        side: Side,
         photo_point_mm: ArrayLike,
         key: str,
         active: NDArray[np.bool_] | None = None,
@@ -473,7 +501,7 @@ class Operator:
                 self.drive(axis, value, active)
         return r.y_parallax_mm + eq, r.y_parallax_mm
 
-    def q_turning(self, control: str, images: tuple[ArrayLike, ArrayLike]):
+    def q_turning(self, control: CassetteName | KnobName, images: tuple[ArrayLike, ArrayLike]):
         """q at homologous points as a function of where ``control`` (a cassette κ or a
         correction knob) would be, the rest of the instrument as it is now: the operator's 1-D
         look for :func:`solve_1d`.
@@ -522,7 +550,7 @@ class Operator:
             setting,
         )
 
-    def knob_for(self, knob: str, unit, photo_point, rod, comp: int, target) -> NDArray:
+    def knob_for(self, knob: KnobName, unit, photo_point, rod, comp: int, target) -> NDArray:
         """T of ``knob`` that puts ``photo_point`` under the rod coordinate ``rod`` (axis comp).
 
         A 1-D Newton solve on the unit model with the instrument's own linkage (D1).

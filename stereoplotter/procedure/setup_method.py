@@ -16,18 +16,23 @@ Reference
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.instrument.kinematics import rod_from_counters
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
 from stereoplotter.procedure.operator import Operator, Scene
+from stereoplotter.procedure.records import (
+    Check,
+    ControlHeight,
+    SheetPose,
+    SheetReadings,
+    StageRecord,
+)
 from stereoplotter.setup.equations import (
     base_z_correction,
     height_correction,
-    height_scale_reading,
     sheet_corner_instrument_coordinates,
 )
 from stereoplotter.setup.sheet import SetupSheet
@@ -44,7 +49,7 @@ __all__ = [
     "stage5_check",
 ]
 
-_SIDE = {"left": "л", "right": "п"}
+_SIDE: dict[Side, str] = {"left": "л", "right": "п"}
 
 
 @dataclass
@@ -57,21 +62,29 @@ class Run:
     sheet : SetupSheet
     scene : Scene
     zero : dict
-        Zero readings the operator has determined (MO_X, MO_Y, MO_X,п, MO_Y,п, MO_by, MO_bz,
-        MO_Z), arrays over the trials. [mm, m for MO_Z]
+        Zero readings the operator has determined, by the sheet's names (MO_X, MO_Y, MO_X,п,
+        MO_Y,п, MO_by, MO_bz, MO_Z), arrays over the trials. [mm, m for MO_Z]
     results : dict
-        Checks: name → {"residual", "tolerance", "passed", "iterations", "unit"}, arrays.
-    iterations : dict
-        Stage → iterations used (arrays over the trials).
+        Check name → :class:`~stereoplotter.procedure.records.Check`.
+    stages : dict
+        Stage → :class:`~stereoplotter.procedure.records.StageRecord` (iterations used).
+    sheet_pose : SheetPose or None
+        Stages 4–5: the sheet on the coordinatograph (None without a map sheet).
+    readings : SheetReadings
+        The sheet's printed readings: every target reading the operator sets comes from here.
     """
 
     op: Operator
     sheet: SetupSheet
     scene: Scene
     zero: dict[str, NDArray[np.float64]] = field(default_factory=dict)
-    results: dict[str, dict[str, Any]] = field(default_factory=dict)
-    iterations: dict[str, NDArray[np.int64]] = field(default_factory=dict)
-    sheet_pose: dict[str, Any] = field(default_factory=dict)
+    results: dict[str, Check] = field(default_factory=dict)
+    stages: dict[str, StageRecord] = field(default_factory=dict)
+    sheet_pose: SheetPose | None = None
+    readings: SheetReadings = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.readings = SheetReadings.of(self.sheet)
 
     def check(
         self, name: str, residual, tolerance, unit: str = "mm", iterations=None
@@ -80,14 +93,29 @@ class Run:
         residual = self.op.v(residual)
         tol = self.op.v(tolerance) if tolerance is not None else None
         passed = np.abs(residual) <= tol if tol is not None else None
-        self.results[name] = {
-            "residual": residual,
-            "tolerance": tol,
-            "passed": passed,
-            "unit": unit,
-            "iterations": None if iterations is None else self.op.v(iterations).astype(int),
-        }
+        its = None if iterations is None else self.op.v(iterations).astype(int)
+        self.results[name] = Check(name, residual, tol, passed, its, unit)
         return passed
+
+    def record_stage(self, stage: str, iterations: ArrayLike) -> None:
+        """Record the iterations a stage (or loop) used, per trial."""
+        self.stages[stage] = StageRecord(stage, np.asarray(iterations).astype(int))
+
+    def stage_iterations(self, stage: str) -> NDArray[np.int64]:
+        """The iterations recorded for ``stage``."""
+        return self.stages[stage].iterations
+
+    def target(self, reading: str, zero: ArrayLike | None = None):
+        """The sheet's reading ``reading`` as set: its zero reading + the printed value.
+
+        ``zero`` defaults to the zero reading the operator has determined (``self.zero``, by
+        the sheet's name); the instrument's nominal zero places (MO_bx, MO_dx, MO_dy) are
+        passed by the caller.
+        """
+        r = self.readings[reading]
+        if r.zero_reading and zero is None:
+            zero = self.zero[r.zero_reading]
+        return r.target(zero)
 
 
 def _fid(run: Run, side: str, mark: str) -> NDArray[np.float64]:
@@ -107,17 +135,20 @@ def _measure_span(run: Run, side: str, key: str, active) -> NDArray[np.float64]:
     return ys[0] - ys[1]
 
 
-def _spans(sheet: SetupSheet, units_at_zero: bool) -> tuple[float, float]:
-    """The L to compare with: (6.5), or with the units at zero n·(y₃ − y₄) of the measured
-    marks (decision D5, ``kinematics.md`` §4.3: the literal (6.5) would bias n by
-    tan²ω(1 + l²/f′²) and can drive D beyond D_max)."""
+def _spans(run: Run, units_at_zero: bool) -> tuple[float, float]:
+    """The L to compare with: the sheet's L_л, L_п (6.5), or with the units at zero
+    n·(y₃ − y₄) of the measured marks (decision D5, ``kinematics.md`` §4.3: the literal (6.5)
+    would bias n by tan²ω(1 + l²/f′²) and can drive D beyond D_max).
+
+    The D5 span is a comparison value, not a reading set on a scale; the sheet does not print
+    it, so it is formed here from the sheet's measured marks and n.
+    """
+    if not units_at_zero:
+        return run.readings["L_л"].value, run.readings["L_п"].value
     out = []
-    for photo in sheet.photos:
-        if units_at_zero:
-            m = photo.marks_measured_mm
-            out.append(photo.n * (m["3"][1] - m["4"][1]))
-        else:
-            out.append(photo.mark_span_mm)
+    for photo in run.sheet.photos:
+        m = photo.marks_measured_mm
+        out.append(photo.n * (m["3"][1] - m["4"][1]))
     return out[0], out[1]
 
 
@@ -127,8 +158,7 @@ def _span_loop(
     """The L-check loop (6.9)–(6.11) until |L − L′| ≤ 0.03/n_л for both photos."""
     op, sheet = run.op, run.sheet
     tol = sheet.tolerances["mark_span_mm"]
-    span_l, span_r = _spans(sheet, units_at_zero)
-    sense = sheet.options.bz_scale_sense
+    span_l, span_r = _spans(run, units_at_zero)
     active = op.all() if active is None else active.copy()
     its = np.zeros(np.shape(active), int)
     dl = dr = op.v(np.nan)
@@ -156,59 +186,69 @@ def _span_loop(
         active = active & ~ok
         if not np.any(active):
             break
-        depth = op.read("Z", f"{k}/Z")
-        dz_m = height_correction(depth, dl, span_l, sheet.vertical_scale_denominator)
-        dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
-        # Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a
-        # correction that asks for a deeper carriage cannot be set there. The operator reaches
-        # the same n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
-        stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
-        beyond = active & (depth + dz_mm > stop)
-        if np.any(beyond):
-            f_set = op.commanded["f_instrument"]
-            f_new = f_set * depth / (depth + dz_mm)
-            op.set("f_instrument", f_new, f"{k}/setf", beyond)
-            op.log.add(
-                stage,
-                "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
-                "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
-                "f_instrument",
-                before=f_set,
-                after=f_new,
-                reading=f_new,
-                iteration=it,
-                equation="(6.3), (6.9)",
-            )
-            dz_mm = np.where(beyond, 0.0, dz_mm)
-        op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
-        shown = op.log.shown if np.ndim(beyond) else 0
-        if not np.ravel(beyond)[shown]:
-            op.log.add(
-                stage,
-                f"ΔZ = {float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]):+.3f} m "
-                "(6.9): lower the carriage, O′_Z = O_Z + ΔZ",
-                "Z",
-                before=depth,
-                after=depth + dz_mm,
-                reading=depth + dz_mm,
-                iteration=it,
-                equation="(6.9), (6.11)",
-            )
-        bz = op.read("bz", f"{k}/bz")
-        dbz = base_z_correction(depth, dr, span_r)
-        op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
-        op.log.add(
-            stage,
-            "Δb_z (6.10): O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
-            "bz",
-            before=bz,
-            after=bz + sense * dbz,
-            reading=bz + sense * dbz,
-            iteration=it,
-            equation="(6.10), (6.11)",
-        )
+        _correct_span(run, stage, k, it, active, (dl, dr), (span_l, span_r))
     ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
     return its, ok, np.maximum(np.abs(dl), np.abs(dr))
+
+
+def _correct_span(run: Run, stage: str, k: str, it: int, active, diffs, spans) -> None:
+    """One correction of the L-check: ΔZ (6.9) from the left photo (or f_пр at the bottom
+    stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11)."""
+    op, sheet = run.op, run.sheet
+    dl, dr = diffs
+    span_l, span_r = spans
+    sense = sheet.options.bz_scale_sense
+    depth = op.read("Z", f"{k}/Z")
+    dz_m = height_correction(depth, dl, span_l, sheet.vertical_scale_denominator)
+    dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
+    # Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a
+    # correction that asks for a deeper carriage cannot be set there. The operator reaches
+    # the same n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
+    stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
+    beyond = active & (depth + dz_mm > stop)
+    if np.any(beyond):
+        f_set = op.commanded["f_instrument"]
+        f_new = f_set * depth / (depth + dz_mm)
+        op.set("f_instrument", f_new, f"{k}/setf", beyond)
+        op.log.add(
+            stage,
+            "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
+            "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
+            "f_instrument",
+            before=f_set,
+            after=f_new,
+            reading=f_new,
+            iteration=it,
+            equation="(6.3), (6.9)",
+        )
+        dz_mm = np.where(beyond, 0.0, dz_mm)
+    op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
+    shown = op.log.shown if np.ndim(beyond) else 0
+    if not np.ravel(beyond)[shown]:
+        op.log.add(
+            stage,
+            f"ΔZ = {float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]):+.3f} m "
+            "(6.9): lower the carriage, O′_Z = O_Z + ΔZ",
+            "Z",
+            before=depth,
+            after=depth + dz_mm,
+            reading=depth + dz_mm,
+            iteration=it,
+            equation="(6.9), (6.11)",
+        )
+    bz = op.read("bz", f"{k}/bz")
+    dbz = base_z_correction(depth, dr, span_r)
+    op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
+    op.log.add(
+        stage,
+        "Δb_z (6.10): O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
+        "bz",
+        before=bz,
+        after=bz + sense * dbz,
+        reading=bz + sense * dbz,
+        iteration=it,
+        equation="(6.10), (6.11)",
+    )
 
 
 def interior_orientation(run: Run, stage: str) -> None:
@@ -218,12 +258,13 @@ def interior_orientation(run: Run, stage: str) -> None:
     op, sheet = run.op, run.sheet
     log = op.log
     op.inst.gear_height_counter(sheet.vertical_scale_denominator)
-    op.set("f_instrument", sheet.f_instrument_mm, f"{stage}/f")
+    f_instrument = run.target("f_пр")
+    op.set("f_instrument", f_instrument, f"{stage}/f")
     log.add(
         stage,
         "set the instrument principal distance f_пр",
         "f_instrument",
-        reading=sheet.f_instrument_mm,
+        reading=f_instrument,
         equation="item 1",
     )
     for side in ("left", "right"):
@@ -253,18 +294,18 @@ def stage1_scale_coefficient(run: Run) -> None:
     op, sheet = run.op, run.sheet
     log = op.log
     interior_orientation(run, "1")
-    bx, by, _ = sheet.base_mm
-    op.set("bx", NOMINAL_ZERO["bx"] + bx, "1/bx")
+    o_bx = run.target("O_bx", NOMINAL_ZERO["bx"])  # MO_bx: the scale's place of zero
+    op.set("bx", o_bx, "1/bx")
     log.add(
         "1",
         "base carriage: O_bx = MO_bx + b_x",
         "bx",
-        reading=NOMINAL_ZERO["bx"] + bx,
+        reading=o_bx,
         equation="item 1",
     )
     op.set("bz", NOMINAL_ZERO["bz"], "1/bz0")
-    depth = sheet.n_left * sheet.f_instrument_mm
-    op.set("Z", NOMINAL_ZERO["Z"] + depth, "1/Z")
+    depth = run.target("O_Z")  # absolute height counter: D = n_л·f_пр
+    op.set("Z", depth, "1/Z")
     log.add(
         "1",
         "lower the carriage to O_Z = n_л·f_пр (absolute height counter)",
@@ -293,20 +334,21 @@ def stage1_scale_coefficient(run: Run) -> None:
         judgment_error=e,
         equation="stage 1",
     )
-    op.set("by", mo_by + by, "1/by")
-    log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="item 1")
+    o_by = run.target("O_by")
+    op.set("by", o_by, "1/by")
+    log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=o_by, equation="item 1")
     its, _, res = _span_loop(run, "1", "1/L", units_at_zero=True)
-    run.iterations["1"] = its
+    run.record_stage("1", its)
     run.check("stage 1: |L − L′|", res, sheet.tolerances["mark_span_mm"], iterations=its)
     _record_stage1_zeros(run)
 
 
 def _record_stage1_zeros(run: Run) -> None:
-    op, sheet = run.op, run.sheet
+    op = run.op
     run.zero["MO_Z"] = op.read(HEIGHT_SCALE, "1/MOZ")
     run.zero["D_MO_Z"] = op.read("Z", "1/MOZ/D")
     bzr = op.read("bz", "1/MObz")
-    run.zero["MO_bz"] = bzr - sheet.options.bz_scale_sense * sheet.base_mm[2]
+    run.zero["MO_bz"] = run.target("MO_bz", bzr)  # (b_z reading) ∓ b_z′ (D7)
     op.log.add(
         "1",
         "record MO_Z on the height scale",
@@ -354,19 +396,16 @@ def _zero_readings(run: Run, key: str) -> None:
 def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> None:
     """Set the counter to MO + n·(x⁰ or y⁰), the other handwheel onto the fiducial line, turn
     the knob until the fiducial is under the mark ((6.12) or (6.13))."""
-    op, sheet = run.op, run.sheet
-    photo = sheet.photos[0 if side == "left" else 1]
-    n = sheet.n_left if side == "left" else sheet.n_right
+    op = run.op
     sfx = "" if side == "left" else ",п"
     fid = _fid(run, side, mark)
     if axis == "omega":
         counter, free, comp = "Y", "X", 1
-        value = run.zero["MO_Y" + sfx] + n * photo.transformed_book_mm[f"y{mark}"]
         eq = "(6.12)"
     else:
         counter, free, comp = "X", "Y", 0
-        value = run.zero["MO_X" + sfx] + n * photo.transformed_book_mm[f"x{mark}"]
         eq = "(6.13)"
+    value = run.target(f"O_{counter}{mark},{_SIDE[side]}")  # MO (+ ,п) + n·x⁰ or n·y⁰
     op.set(counter, value, f"{key}/set", active)
     op.mark_on(side, fid, f"{key}/line", active, free=free)
     e = op.noise.normal(f"mono/{key}/knob", op.model.monocular_sigma_mm)
@@ -395,12 +434,9 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
 
 def _mark4(run: Run, side: str, key: str, active) -> NDArray[np.float64]:
     """Check mark 4 at MO_Y + n·y⁰₄ (6.12): the offset of the mark from fiducial 4 seen."""
-    op, sheet = run.op, run.sheet
-    photo = sheet.photos[0 if side == "left" else 1]
-    n = sheet.n_left if side == "left" else sheet.n_right
-    sfx = "" if side == "left" else ",п"
+    op = run.op
     fid = _fid(run, side, "4")
-    value = run.zero["MO_Y" + sfx] + n * photo.transformed_book_mm["y4"]
+    value = run.target(f"O_Y4,{_SIDE[side]}")
     op.set("Y", value, f"{key}/set", active)
     op.mark_on(side, fid, f"{key}/line", active, free="X")
     off = op.inst.mark_offsets(**{f"{side}_point_mm": fid})[side]
@@ -420,7 +456,7 @@ def stage2_transform(run: Run) -> None:
         its = np.where(active, it, its)
         if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
             l_its, _, _ = _span_loop(run, "2", f"2/L{it}", active=active)
-            run.iterations["1"] = run.iterations["1"] + np.where(active, l_its, 0)
+            run.record_stage("1", run.stage_iterations("1") + np.where(active, l_its, 0))
         else:  # with the correction units still at zero the cassette centre is on the plumb
             _zero_readings(run, "2/MO")
         seen = []
@@ -443,22 +479,24 @@ def stage2_transform(run: Run) -> None:
         active = active & ~(worst <= tol4)
         if not np.any(active):
             break
-    run.iterations["2"] = its
+    run.record_stage("2", its)
     run.check("stage 2: mark 4", worst, tol4, iterations=its)
     for side, mark in (("left", "2"), ("right", "1")):
         _fit_knob(run, side, "alpha", mark, f"2/{side}/alpha", op.all())
-    for photo in sheet.photos:
-        for d, value in zip(("dx", "dy"), photo.decentration_mm, strict=True):
-            control = f"{d}_{photo.name}"
-            op.set(control, NOMINAL_ZERO[control] + value, f"2/{control}")
+    for side in ("left", "right"):
+        for d in ("dx", "dy"):
+            control = f"{d}_{side}"
+            # MO_dx, MO_dy: the decentration scale's place of zero
+            value = run.target(f"d_{d[1]},{_SIDE[side]}", NOMINAL_ZERO[control])
+            op.set(control, value, f"2/{control}")
             op.log.add(
                 "2",
                 f"set the computed decentration {control}",
                 control,
-                reading=NOMINAL_ZERO[control] + value,
+                reading=value,
                 equation="f′·tan α (§2.4)",
             )
-    bz = run.zero["MO_bz"] + sheet.options.bz_scale_sense * sheet.base_mm[2]
+    bz = run.target("O_bz")
     op.set("bz", bz, "2/bz")
     op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
     clear_kappa(run, "2")
@@ -507,7 +545,7 @@ def clear_kappa(run: Run, stage: str) -> None:
         active = active & ~ok
         if it > 1 and not np.any(active):
             break
-    run.iterations[f"{stage}/kappa"] = its
+    run.record_stage(f"{stage}/kappa", its)
 
 
 def _solve_kappa(q_of, kappa0, target):
@@ -543,12 +581,15 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
 # --- stage 3 ---------------------------------------------------------------------------------
 
 
-def _heights(run: Run):
+def control_heights(run: Run) -> list[ControlHeight]:
+    """The sheet's height control points with their ground points (the scene's truth)."""
     sc = run.scene.scenario
     rows = []
     for h in run.sheet.control_heights:
         p = next(p for p in sc.points if p.id == h["id"])
-        rows.append((h, np.asarray(p.local_m, float)))
+        rows.append(
+            ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
+        )
     return rows
 
 
@@ -556,20 +597,15 @@ def stage3_scale_model(run: Run) -> None:
     """Stage 3: (6.15) at a height control point, b_x until the mark fuses, slip the height
     scale, check the other control heights (H/3000), re-check κ and the residual y-parallax."""
     op, sheet = run.op, run.sheet
-    rows = _heights(run)
+    rows = control_heights(run)
     tol = sheet.tolerances["control_height_m"]
-    (h0, p0) = rows[0]
-    o_z = height_scale_reading(
-        run.zero["MO_Z"],
-        h0["model_height_mm"],
-        sheet.n_left,
-        sheet.f_instrument_mm,
-        sheet.vertical_scale_denominator,
-    )
+    h0 = rows[0]
+    p0 = h0.ground_m
+    o_z = run.target(f"O_Z{h0.id}")  # MO_Z + (6.15)
     op.set(HEIGHT_SCALE, o_z, "3/OZ")
     op.log.add(
         "3",
-        f"height scale to O_Z{h0['id']} for control point {h0['id']}",
+        f"height scale to O_Z{h0.id} for control point {h0.id}",
         HEIGHT_SCALE,
         reading=o_z,
         unit="m",
@@ -586,7 +622,7 @@ def stage3_scale_model(run: Run) -> None:
     after = op.read("bx", "3/bx/after")
     op.log.add(
         "3",
-        f"fuse the mark on point {h0['id']} by turning b_x",
+        f"fuse the mark on point {h0.id} by turning b_x",
         "bx",
         before=before,
         after=after,
@@ -604,14 +640,15 @@ def stage3_scale_model(run: Run) -> None:
         equation="stage 3",
     )
     errs = []
-    for h, p in rows[1:]:
+    for h in rows[1:]:
+        p = h.ground_m
         img = run.scene.images(p[None, :])
-        op.fuse(p, (img[0][0], img[1][0]), f"3/h/{h['id']}")
-        read = op.read(HEIGHT_SCALE, f"3/h/{h['id']}")
+        op.fuse(p, (img[0][0], img[1][0]), f"3/h/{h.id}")
+        read = op.read(HEIGHT_SCALE, f"3/h/{h.id}")
         errs.append(read - p[2])
         op.log.add(
             "3",
-            f"control point {h['id']}: fuse, read the height",
+            f"control point {h.id}: fuse, read the height",
             HEIGHT_SCALE,
             reading=read,
             unit="m",
@@ -631,30 +668,15 @@ def stage3_scale_model(run: Run) -> None:
 
 def _table(run: Run, xy_mm) -> NDArray[np.float64]:
     """Ideal table position of a model position (x′, y′) for the coordinatograph's origin."""
-    inst = run.op.inst
-    return inst._cg_origin + inst._cg_ratio * np.asarray(xy_mm, float)
+    return run.op.inst.table_position_mm(xy_mm)
 
 
-def _needle_at(run: Run, xy_mm, key: str) -> NDArray[np.float64]:
+def _needle_at(run: Run, corner: str, key: str) -> NDArray[np.float64]:
+    """Counters to the sheet's readings of ``corner`` (MO_X, MO_Y + x′, y′): the needle."""
     op = run.op
-    op.set("X", run.zero["MO_X"] + xy_mm[0], f"{key}/X")
-    op.set("Y", run.zero["MO_Y"] + xy_mm[1], f"{key}/Y")
+    op.set("X", run.target(f"corner {corner}: O_X"), f"{key}/X")
+    op.set("Y", run.target(f"corner {corner}: O_Y"), f"{key}/Y")
     return np.asarray(op.inst.needle(op.model.finish_side), float)
-
-
-def _rot(phi):
-    c, s = np.cos(phi), np.sin(phi)
-    return c, s
-
-
-def _apply_pose(pose, p):
-    """Table position of a sheet point p (sheet frame = ideal table frame)."""
-    c, s = _rot(pose["angle"])
-    pivot_sheet, pivot_table = pose["pivot_sheet"], pose["pivot_table"]
-    d = np.asarray(p, float) - pivot_sheet
-    x = c * d[..., 0] - s * d[..., 1]
-    y = s * d[..., 0] + c * d[..., 1]
-    return pivot_table + np.stack([x, y], axis=-1)
 
 
 def stage4_orient_sheet(run: Run) -> None:
@@ -666,7 +688,7 @@ def stage4_orient_sheet(run: Run) -> None:
     """
     op, sheet = run.op, run.sheet
     if not sheet.corners:
-        run.sheet_pose = {}
+        run.sheet_pose = None
         return
     ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
     op.inst.connect_coordinatograph(ratio)
@@ -680,33 +702,28 @@ def stage4_orient_sheet(run: Run) -> None:
         ],
         axis=-1,
     )
-    pose = None
+    angle = op.v(0.0)
     for it in (1, 2):
-        n1 = _needle_at(run, corners["1"], f"4/{it}/c1")
+        n1 = _needle_at(run, "1", f"4/{it}/c1")
         e = np.stack(
             [op.noise.normal(f"mono/4/{it}/pin/{a}", op.model.monocular_sigma_mm) for a in "xy"],
             axis=-1,
         )
         pin_sheet = ideal["1"] + (place if it == 1 else 0.0) + e
-        pose = {
-            "angle": op.v(0.0) if pose is None else pose["angle"],
-            "pivot_sheet": pin_sheet,
-            "pivot_table": n1,
-        }
         op.log.add(
             "4",
             "counters to corner 1, pin the sheet's corner 1 under the needle",
             "X",
-            reading=run.zero["MO_X"] + corners["1"][0],
+            reading=run.target("corner 1: O_X"),
             iteration=it,
             equation="(6.16)",
         )
-        n3 = _needle_at(run, corners["3"], f"4/{it}/c3")
+        n3 = _needle_at(run, "3", f"4/{it}/c3")
         e3 = op.noise.normal(f"mono/4/{it}/c3", op.model.monocular_sigma_mm)
         a_needle = np.arctan2(n3[..., 1] - n1[..., 1], n3[..., 0] - n1[..., 0])
         d = ideal["3"] - pin_sheet
         a_mark = np.arctan2(d[..., 1], d[..., 0])
-        pose["angle"] = a_needle - a_mark + e3 / np.hypot(d[..., 0], d[..., 1])
+        angle = a_needle - a_mark + e3 / np.hypot(d[..., 0], d[..., 1])
         op.log.add(
             "4",
             "counters to corner 3, rotate the sheet about corner 1 until the needle meets corner 3",
@@ -716,18 +733,19 @@ def stage4_orient_sheet(run: Run) -> None:
             iteration=it,
             equation="(6.17)",
         )
-    run.sheet_pose = pose
-    run.iterations["4"] = op.v(2).astype(int)
+    run.sheet_pose = SheetPose(angle, pin_sheet, n1)
+    run.record_stage("4", op.v(2).astype(int))
 
 
 def stage5_check(run: Run) -> None:
     """Stage 5: counters to corner 4 (6.18), misclosure ≤ 0.3 mm; plotted control points."""
     op, sheet = run.op, run.sheet
-    if not run.sheet_pose:
+    pose = run.sheet_pose
+    if pose is None:
         return
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
-    n4 = _needle_at(run, corners["4"], "5/c4")
-    mark4 = _apply_pose(run.sheet_pose, _table(run, corners["4"]))
+    n4 = _needle_at(run, "4", "5/c4")
+    mark4 = pose.table_of(_table(run, corners["4"]))
     mis = np.hypot(*np.moveaxis(mark4 - n4, -1, 0))
     tol = sheet.tolerances["corner_mm"]
     op.log.add(
@@ -740,7 +758,7 @@ def stage5_check(run: Run) -> None:
         equation="(6.18)",
     )
     run.check("stage 5: corner 4", mis, tol)
-    run.iterations["5"] = op.v(1).astype(int)
+    run.record_stage("5", op.v(1).astype(int))
     # plotted plan control points: fuse on the point, compare the needle with the plotted point
     sc = run.scene.scenario
     if sheet.similarity is None:
@@ -754,7 +772,7 @@ def stage5_check(run: Run) -> None:
         img = run.scene.images(np.asarray(p.local_m, float)[None, :])
         op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
         needle = np.asarray(op.inst.needle(op.model.finish_side), float)
-        plotted = _apply_pose(run.sheet_pose, _table(run, np.asarray(xy, float).reshape(2)))
+        plotted = pose.table_of(_table(run, np.asarray(xy, float).reshape(2)))
         err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
         errs.append(err)
         op.log.add(

@@ -10,7 +10,7 @@ runs long runs in chunks.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -22,6 +22,7 @@ from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
 from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
+from stereoplotter.procedure.records import Check, SheetPose, StageRecord
 from stereoplotter.procedure.setup_method import Run, run_setup_method
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
@@ -55,9 +56,10 @@ class SimulationResult:
     transcript : Transcript
         Trial 0 of the run.
     checks : dict
-        Every tolerance check: residual, tolerance, passed, iterations (arrays over trials).
-    iterations : dict
-        Stage → iterations used (arrays).
+        Check name → :class:`~stereoplotter.procedure.records.Check` (arrays over trials).
+    stages : dict
+        Stage → :class:`~stereoplotter.procedure.records.StageRecord` (iterations used);
+        :attr:`iterations` gives the arrays by stage.
     zero_readings : dict
         The zero readings the operator determined.
     q_standard_mm, q_grid_mm : ndarray
@@ -68,7 +70,7 @@ class SimulationResult:
     instrument : Instrument
     scene : Scene
     operator_model : OperatorModel
-    sheet_pose : dict
+    sheet_pose : SheetPose or None
         Stages 4–5: the sheet's placement on the coordinatograph.
     first_trial : int
         Index of the first trial of this result in the whole run (chunked runs).
@@ -80,8 +82,8 @@ class SimulationResult:
     trials: int | None
     sheet: SetupSheet
     transcript: Transcript
-    checks: dict[str, dict[str, Any]]
-    iterations: dict[str, Any]
+    checks: dict[str, Check]
+    stages: dict[str, StageRecord]
     zero_readings: dict[str, Any]
     q_standard_mm: np.ndarray
     q_grid_mm: np.ndarray
@@ -89,8 +91,13 @@ class SimulationResult:
     instrument: Instrument
     scene: Scene
     operator_model: OperatorModel
-    sheet_pose: dict[str, Any] = field(default_factory=dict)
+    sheet_pose: SheetPose | None = None
     first_trial: int = 0
+
+    @property
+    def iterations(self) -> dict[str, np.ndarray]:
+        """Stage → iterations used (arrays over the trials)."""
+        return {name: s.iterations for name, s in self.stages.items()}
 
 
 def _errors(spec: InstrumentSpec, errors: ErrorModel | str | None) -> ErrorModel:
@@ -233,7 +240,7 @@ def run_trials_chunk(
         prep.sheet,
         run.op.log,
         run.results,
-        run.iterations,
+        run.stages,
         run.zero,
         q_std,
         q_grid,
@@ -326,8 +333,8 @@ def simulate_per_trial(
 ) -> dict[str, Any]:
     """The test oracle: trial t of ``simulate(..., trials=T)`` run alone, for t = 0 … T−1.
 
-    Returns the checks, iterations, zero readings and q arrays stacked over the trials, in the
-    layout of :class:`SimulationResult` (no evaluation, no transcript).
+    Returns the checks (:class:`Check` with fields stacked over the trials), iterations, zero
+    readings and q arrays stacked over the trials (no evaluation, no transcript).
     """
     prep = prepare_run(
         scenario,
@@ -348,12 +355,22 @@ def simulate_per_trial(
     out: dict[str, Any] = {"checks": {}, "iterations": {}, "zero_readings": {}}
     first = rows[0][0]
     for name, c in first.results.items():
-        out["checks"][name] = {
-            k: (None if c[k] is None else np.array([r[0].results[name][k] for r in rows]))
-            for k in ("residual", "tolerance", "passed", "iterations")
-        }
-    for name in first.iterations:
-        out["iterations"][name] = np.array([r[0].iterations[name] for r in rows])
+
+        def stacked(attr: str, name: str = name, c: Check = c):
+            if getattr(c, attr) is None:
+                return None
+            return np.array([getattr(r[0].results[name], attr) for r in rows])
+
+        out["checks"][name] = Check(
+            name,
+            stacked("residual"),
+            stacked("tolerance"),
+            stacked("passed"),
+            stacked("iterations"),
+            c.unit,
+        )
+    for name in first.stages:
+        out["iterations"][name] = np.array([r[0].stage_iterations(name) for r in rows])
     for name in first.zero:
         out["zero_readings"][name] = np.array([r[0].zero[name] for r in rows])
     out["q_standard_mm"] = np.array([r[1] for r in rows])
@@ -378,5 +395,5 @@ def _evaluate(scenario, sheet, run: Run) -> ModelEvaluation:
         units["right"],
         height_zero=zero,
         standard_points_c_mm=inst.spec.standard_points_c_mm,
-        corner4_misclosure_mm=None if corner is None else corner["residual"],
+        corner4_misclosure_mm=None if corner is None else corner.residual,
     )

@@ -111,12 +111,12 @@ def trial_columns(result: SimulationResult) -> dict[str, NDArray[Any]]:
         raise ValueError("trial_columns needs a vectorised result (trials = T)")
     cols: dict[str, NDArray[Any]] = {}
     for name, c in result.checks.items():
-        cols[f"check/{name}/residual"] = _full(c["residual"], t)
-        if c["tolerance"] is not None:
-            cols[f"check/{name}/tolerance"] = _full(c["tolerance"], t)
-            cols[f"check/{name}/passed"] = _full(c["passed"], t, bool)
-        if c["iterations"] is not None:
-            cols[f"check/{name}/iterations"] = _full(c["iterations"], t)
+        cols[f"check/{name}/residual"] = _full(c.residual, t)
+        if c.tolerance is not None:
+            cols[f"check/{name}/tolerance"] = _full(c.tolerance, t)
+            cols[f"check/{name}/passed"] = _full(c.passed, t, bool)
+        if c.iterations is not None:
+            cols[f"check/{name}/iterations"] = _full(c.iterations, t)
     for name, v in result.iterations.items():
         cols[f"iterations/{name}"] = _full(v, t)
     for name, v in result.zero_readings.items():
@@ -153,7 +153,7 @@ def run_info(result: SimulationResult, trials: int) -> RunInfo:
     ev = result.evaluation
     return RunInfo(
         header,
-        {name: c["unit"] for name, c in result.checks.items()},
+        {name: c.unit for name, c in result.checks.items()},
         None if ev is None else float(ev.flying_height_m),
         None if ev is None else ev.map_scale_denominator,
         {} if ev is None else {n: len(s.ids) for n, s in ev.sets().items()},
@@ -229,12 +229,12 @@ def _single_summary(r: SimulationResult) -> dict[str, Any]:
     """The summary of one procedure (``trials`` None): its values and the evaluation per point."""
     checks = {}
     for name, c in r.checks.items():
-        entry = {"residual": _value(c["residual"]), "unit": c["unit"]}
-        if c["tolerance"] is not None:
-            entry["tolerance"] = _value(c["tolerance"])
-            entry["passed"] = bool(np.asarray(c["passed"]).reshape(-1)[0])
-        if c["iterations"] is not None:
-            entry["iterations"] = _value(c["iterations"])
+        entry = {"residual": _value(c.residual), "unit": c.unit}
+        if c.tolerance is not None:
+            entry["tolerance"] = _value(c.tolerance)
+            entry["passed"] = bool(np.asarray(c.passed).reshape(-1)[0])
+        if c.iterations is not None:
+            entry["iterations"] = _value(c.iterations)
         checks[name] = entry
     q_std = np.abs(np.asarray(r.q_standard_mm))
     q_grid = np.asarray(r.q_grid_mm)

@@ -41,8 +41,8 @@ def test_overcorrection_factor():
 def test_zero_errors_relative_orientation_converges(ideal60):
     tol = ideal60.sheet.tolerances["residual_y_parallax_mm"]
     c2 = ideal60.checks["C2: residual y-parallax (6 points)"]
-    assert bool(c2["passed"])
-    assert int(c2["iterations"]) <= 4
+    assert bool(c2.passed)
+    assert int(c2.iterations) <= 4
     # the setup method leaves 5.4 µm here (kinematics.md §6); the conventional method stops
     # at ¼ mark = 12.5 µm and ends below 10 µm
     assert np.max(np.abs(ideal60.q_standard_mm)) < 10 * um < tol
@@ -52,18 +52,18 @@ def test_zero_errors_relative_orientation_converges(ideal60):
 def test_zero_errors_absolute_orientation_within_h_over_3000(ideal60):
     tol = ideal60.sheet.tolerances["control_height_m"]
     c3 = ideal60.checks["C3: control heights"]
-    assert bool(c3["passed"])
-    assert float(c3["residual"]) <= tol
-    assert bool(ideal60.checks["C3: levelling points (against the first)"]["passed"])
-    assert float(ideal60.checks["stage 5: corner 4"]["residual"]) < 1e-9
+    assert bool(c3.passed)
+    assert float(c3.residual) <= tol
+    assert bool(ideal60.checks["C3: levelling points (against the first)"].passed)
+    assert float(ideal60.checks["stage 5: corner 4"].residual) < 1e-9
     stages = {r.stage for r in ideal60.transcript.records}
     assert {"C1", "C2", "C3", "C4"} <= stages
 
 
 def test_zero_errors_pair80_elements_converges():
     r = _ideal("pair80", "elements")
-    assert bool(r.checks["C2: residual y-parallax (6 points)"]["passed"])
-    assert bool(r.checks["C3: control heights"]["passed"])
+    assert bool(r.checks["C2: residual y-parallax (6 points)"].passed)
+    assert bool(r.checks["C3: control heights"].passed)
 
 
 @pytest.mark.parametrize("relative", ["elements", "equations"])
@@ -72,7 +72,7 @@ def test_vectorised_equals_per_trial_oracle(relative):
     vec = simulate(sc, SPEC, "conventional", seed=5, trials=3, evaluate=False, relative=relative)
     one = simulate_per_trial(sc, SPEC, "conventional", seed=5, trials=3, relative=relative)
     for name, c in vec.checks.items():
-        np.testing.assert_array_equal(c["residual"], one["checks"][name]["residual"])
+        np.testing.assert_array_equal(c.residual, one["checks"][name].residual)
     for name, its in vec.iterations.items():
         np.testing.assert_array_equal(its, one["iterations"][name])
     np.testing.assert_array_equal(vec.q_grid_mm, one["q_grid_mm"])

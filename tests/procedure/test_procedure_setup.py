@@ -43,15 +43,15 @@ def test_zero_errors_converge_in_fewest_iterations(ideal):
     assert ideal.iterations["2"] == 1
     assert ideal.iterations["2/kappa"] == 2
     for name, c in ideal.checks.items():
-        if c["passed"] is not None:
-            assert bool(c["passed"]), name
+        if c.passed is not None:
+            assert bool(c.passed), name
 
 
 def test_zero_errors_reach_the_approximation_level(ideal):
     # kinematics.md §6: the canonical unit leaves a few µm of y-parallax at tilts < 1°
     assert np.max(np.abs(ideal.q_grid_mm)) < 6 * um
     assert np.max(np.abs(ideal.q_standard_mm)) < 6 * um
-    assert ideal.checks["stage 5: corner 4"]["residual"] < 1e-9
+    assert ideal.checks["stage 5: corner 4"].residual < 1e-9
 
 
 def test_default_errors_evaluate_every_tolerance(pair):
@@ -66,7 +66,7 @@ def test_default_errors_evaluate_every_tolerance(pair):
         "stage 5: corner 4",
     ):
         assert expected in names
-        assert r.checks[expected]["passed"] is not None
+        assert r.checks[expected].passed is not None
     assert any(rec.tolerance is not None for rec in r.transcript.records)
 
 
@@ -75,7 +75,7 @@ def test_vectorised_equals_per_trial_oracle(pair):
     vec = simulate(sc, spec, seed=5, trials=3, evaluate=False)
     one = simulate_per_trial(sc, spec, seed=5, trials=3)
     for name, c in vec.checks.items():
-        np.testing.assert_array_equal(c["residual"], one["checks"][name]["residual"])
+        np.testing.assert_array_equal(c.residual, one["checks"][name].residual)
     for name, its in vec.iterations.items():
         np.testing.assert_array_equal(its, one["iterations"][name])
     np.testing.assert_array_equal(vec.q_grid_mm, one["q_grid_mm"])

@@ -64,7 +64,7 @@ def test_single_run_is_trial_zero_of_a_vectorised_run(pair):
     single = simulate(sc, spec, seed=6, evaluate=False)
     many = simulate(sc, spec, seed=6, trials=3, evaluate=False)
     for name, c in single.checks.items():
-        assert float(c["residual"]) == pytest.approx(float(many.checks[name]["residual"][0]))
+        assert float(c.residual) == pytest.approx(float(many.checks[name].residual[0]))
 
 
 def test_chunk_size_follows_the_memory_budget():

@@ -88,7 +88,7 @@ def _value(r, name: str) -> float:
     base, index = name[:-1].rsplit("[", 1)
     if base in r.zero_readings:
         return float(r.zero_readings[base][int(index)])
-    return float(r.checks[base]["residual"][int(index)])
+    return float(r.checks[base].residual[int(index)])
 
 
 @pytest.mark.parametrize("method", ["setup", "conventional"])
@@ -97,7 +97,7 @@ def test_seeded_vectorised_run_matches_the_recorded_values(runs, method):
     for name, want in PINNED[method].items():
         assert _value(r, name) == pytest.approx(want, rel=RTOL, abs=1e-12), name
     for name, total in ITERATION_SUMS[method].items():
-        assert int(r.checks[name]["iterations"].sum()) == total, name
+        assert int(r.checks[name].iterations.sum()) == total, name
 
 
 @pytest.mark.parametrize("control", ["kappa_left", "kappa_right", "k_alpha_left", "k_omega_right"])
