@@ -2,7 +2,8 @@
 
 Run ``python benchmarks/bench_setup_block.py`` (optionally ``--pairs 10000 --loop-pairs 300``).
 Times the numeric part only — :func:`stereoplotter.setup.block.compute_block` on N pairs (best of
-5) and :func:`stereoplotter.setup.block.per_pair_loop` on a subset — and prints pairs per second,
+5) and the per-pair scalar oracle ``per_pair_loop`` of ``tests/oracles/setup_pair_oracle.py`` on a
+subset — and prints pairs per second,
 their ratio and the machine. Goal (issue "block mode"): ≥ 10⁴ pairs/s vectorised on a 2-core
 machine. Speed is measured here, never asserted in the test suite.
 """
@@ -14,11 +15,15 @@ import os
 import platform
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.setup.block import compute_block, per_pair_loop
+from stereoplotter.setup.block import compute_block
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from oracles.setup_pair_oracle import per_pair_loop  # the tests' scalar oracle
 
 MARKS = np.array([[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]])
 

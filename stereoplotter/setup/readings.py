@@ -10,12 +10,10 @@ Eqs. (6.11)–(6.18) of the book (ch. 6, §26, OCR L3773–3821) read as in ``do
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from stereoplotter.setup.equations import height_scale_reading
-
-if TYPE_CHECKING:  # pragma: no cover
-    from stereoplotter.setup.sheet import SetupSheet
+from stereoplotter.setup.records import SetupSheet
 
 __all__ = ["stage_readings"]
 

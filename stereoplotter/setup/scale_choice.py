@@ -21,6 +21,8 @@ the largest model scale.
 from __future__ import annotations
 
 import enum
+import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,11 +36,13 @@ from stereoplotter.setup.equations import (
 )
 
 __all__ = [
+    "ScaleCandidate",
     "ScaleCheck",
     "candidate_flags",
     "candidate_scales",
     "choose_candidates",
     "describe_candidate",
+    "scale_candidates",
 ]
 
 
@@ -53,6 +57,53 @@ class ScaleCheck(enum.IntFlag):
     BASE_Z = 32  #: b_z′ outside base_z_range_mm
     MODEL_X = 512  #: X extent of the model or sheet corners outside model_x_offset_range_mm
     MODEL_Y = 1024  #: Y extent outside model_y_offset_range_mm
+
+
+@dataclass(frozen=True, slots=True)
+class ScaleCandidate:
+    """One (M_г, M_в) pair considered by the scale choice, with the conditions it fails
+    (:class:`ScaleCheck` names; empty = feasible)."""
+
+    horizontal: int
+    vertical: int
+    ratio: float
+    f_instrument_mm: float
+    reasons: tuple[str, ...]
+
+    @property
+    def feasible(self) -> bool:
+        return not self.reasons
+
+
+def scale_candidates(
+    focal_length_corrected_mm: float,
+    candidates: ArrayLike,
+    flags: ArrayLike,
+    map_scale_denominator: int | None,
+) -> tuple[ScaleCandidate, ...]:
+    """The candidates of one pair as :class:`ScaleCandidate` records.
+
+    Parameters
+    ----------
+    focal_length_corrected_mm : float
+        f′. [mm]
+    candidates : array_like, shape (C, 2)
+        (M_г, M_в) from :func:`candidate_scales`.
+    flags : array_like of int, shape (C,)
+        This pair's row of :func:`candidate_flags`.
+    map_scale_denominator : int or None
+        M_map, for the coordinatograph ratio M_г/M_map (NaN without a map).
+    """
+    return tuple(
+        ScaleCandidate(
+            int(mg),
+            int(mv),
+            mg / map_scale_denominator if map_scale_denominator else math.nan,
+            float(instrument_principal_distance(focal_length_corrected_mm, mg, mv)),
+            tuple((flag.name or "").lower() for flag in ScaleCheck if flag and code & int(flag)),
+        )
+        for (mg, mv), code in zip(np.asarray(candidates, float), np.asarray(flags), strict=True)
+    )
 
 
 def candidate_scales(

@@ -1,34 +1,32 @@
 """The setup sheet (Table 24 of the book): everything an operator needs to build an oriented,
 scaled model on the instrument without plotting control first.
 
-Orchestration only: the equations live in :mod:`stereoplotter.setup.equations` and
-:mod:`stereoplotter.geometry`; the decisions behind them in ``docs/setup-data.md``. The sheet is
-computed from the scenario *as measured*: f′ from the measured fiducial spans, the measured mark
-coordinates, and the exterior orientation as given (aerotriangulation) or by resection from the
-measured control — with the scenario's seed, so a sheet is reproducible.
+Orchestration only: the Table 24 values come from the one vectorised computation,
+:func:`stereoplotter.setup.table24.compute_table24`, called with a block of one; this module adds
+what a single scenario allows beyond a block: f′ from the measured fiducial spans, the measured
+marks, the ground of the whole working area, plan control and the sheet corners (6.7)/(6.8), the
+carriage travel, the tolerances and the stage readings (:mod:`stereoplotter.setup.readings`). The
+decisions behind it are in ``docs/setup-data.md``. The sheet is computed from the scenario *as
+measured*: f′ from the measured fiducial spans, the measured mark coordinates, and the exterior
+orientation as given (aerotriangulation) or by resection from the measured control — with the
+scenario's seed, so a sheet is reproducible.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
-from typing import Any
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix, rotation_z
+from stereoplotter.geometry.rotation import rotation_z
 from stereoplotter.geometry.similarity import (
     SimilarityFit,
     apply_similarity,
     fit_similarity_with_reflection,
-)
-from stereoplotter.geometry.transformed import (
-    transformed_coordinates,
-    transformed_x_single_tilt,
-    transformed_y_single_tilt,
 )
 from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
 from stereoplotter.scenario.exterior import known_exterior_orientation
@@ -38,28 +36,32 @@ from stereoplotter.scenario.synthetic import (
     working_area_grid_m,
 )
 from stereoplotter.setup.equations import (
-    base_components,
-    correction_inclination,
-    counter_scale_left,
-    counter_scale_right,
     decentration,
-    instrument_principal_distance,
-    mark_span,
-    model_height,
     sheet_corner_instrument_coordinates,
     sheet_corner_instrument_coordinates_book_form,
 )
 from stereoplotter.setup.readings import stage_readings
-from stereoplotter.setup.scale_choice import (
-    ScaleCheck,
-    candidate_flags,
-    candidate_scales,
-    choose_candidates,
-    describe_candidate,
+from stereoplotter.setup.records import (
+    PhotoSetup,
+    ScaleCandidate,
+    SetupOptions,
+    SetupRefusal,
+    SetupSheet,
+)
+from stereoplotter.setup.scale_choice import candidate_scales, describe_candidate
+from stereoplotter.setup.table24 import (
+    SCALE_FLAGS,
+    X_MARK_NAME,
+    BlockResult,
+    Refusal,
+    candidates_of,
+    compute_table24,
+    instrument_frames,
 )
 
 __all__ = [
     "CORNER_ORDER",
+    "PhotoSetup",
     "ScaleCandidate",
     "SetupOptions",
     "SetupRefusal",
@@ -73,105 +75,6 @@ __all__ = [
 #: in map view, north up. The scenario stores corners NW, NE, SE, SW; this maps 1..4 to them.
 CORNER_ORDER = {"1": 3, "2": 2, "3": 1, "4": 0}
 CORNER_NAMES = {"1": "SW", "2": "SE", "3": "NE", "4": "NW"}
-
-
-class SetupRefusal(StereoplotterError):
-    """The instrument cannot take the scenario (no feasible scale pair, a setting beyond a stop)."""
-
-
-@dataclass(frozen=True, slots=True)
-class SetupOptions:
-    """Choices behind the sheet; the defaults are the decisions of ``docs/setup-data.md``.
-
-    Attributes
-    ----------
-    book_sign_n_right : bool
-        Use the printed sign of (6.4) (n_п < n_л for a higher right station).
-    horizontal_scale_denominator, vertical_scale_denominator : int or None
-        Force M_г and/or M_в instead of choosing them (still range-checked).
-    bz_scale_sense : int
-        +1 (default): the b_z scale grows when the right pivot rises, so (6.11) reads
-        O′_bz = O_bz + Δb_z and (6.14) O_bz = MO_bz + b_z′. −1: a scale counting the other way,
-        which makes the printed minus of (6.11) right and turns (6.14) into MO_bz − b_z′.
-    """
-
-    book_sign_n_right: bool = False
-    horizontal_scale_denominator: int | None = None
-    vertical_scale_denominator: int | None = None
-    bz_scale_sense: int = 1
-
-    def __post_init__(self) -> None:
-        if self.bz_scale_sense not in (1, -1):
-            raise StereoplotterError(
-                f"bz_scale_sense: expected +1 or -1, found {self.bz_scale_sense!r}"
-            )
-
-
-@dataclass(frozen=True, slots=True)
-class ScaleCandidate:
-    """One (M_г, M_в) pair considered by the scale choice, with the conditions it fails
-    (:class:`~stereoplotter.setup.scale_choice.ScaleCheck` names; empty = feasible)."""
-
-    horizontal: int
-    vertical: int
-    ratio: float
-    f_instrument_mm: float
-    reasons: tuple[str, ...]
-
-    @property
-    def feasible(self) -> bool:
-        return not self.reasons
-
-
-@dataclass(frozen=True, slots=True)
-class PhotoSetup:
-    """Per-photo settings of the sheet (angles in the instrument frame)."""
-
-    name: str
-    alpha: float
-    omega: float
-    kappa: float
-    marks_measured_mm: dict[str, tuple[float, float]]
-    transformed_book_mm: dict[str, float]
-    transformed_rigorous_mm: dict[str, tuple[float, float]]
-    mark_span_mm: float
-    decentration_mm: tuple[float, float]
-    correction_inclination: tuple[float, float]
-    n: float
-
-
-@dataclass(frozen=True, slots=True)
-class SetupSheet:
-    """The computed setup sheet (Table 24 plus the readings of the five stages)."""
-
-    scenario: str
-    instrument: str
-    instrument_title: str
-    frame_rotation: float
-    frame_origin_m: tuple[float, float, float]
-    focal_length_corrected_mm: float
-    focal_length_corrected_per_photo_mm: tuple[float, ...]
-    map_scale_denominator: int | None
-    horizontal_scale_denominator: int
-    vertical_scale_denominator: int
-    f_instrument_mm: float
-    transformation_coefficient: float
-    n_left: float
-    n_right: float
-    base_mm: tuple[float, float, float]
-    photos: tuple[PhotoSetup, ...]
-    control_heights: tuple[dict[str, Any], ...]
-    similarity: SimilarityFit | None
-    similarity_point_ids: tuple[str, ...]
-    corners: tuple[dict[str, Any], ...]
-    readings: tuple[dict[str, Any], ...]
-    tolerances: dict[str, float]
-    candidates: tuple[ScaleCandidate, ...]
-    assumed: dict[str, tuple[str, ...]]
-    options: SetupOptions = field(default_factory=SetupOptions)
-    depth_range_used_mm: tuple[float, float] = (math.nan, math.nan)
-    exterior_sources: tuple[str, ...] = ()
-    points_model_mm: tuple[dict[str, Any], ...] = ()
 
 
 # --- helpers --------------------------------------------------------------------------------
@@ -225,18 +128,12 @@ def _sheet_corners_gk(scenario: Scenario) -> NDArray:
     return np.array([sheet.corners_sk42_m[CORNER_ORDER[k]] for k in ("1", "2", "3", "4")])
 
 
-def _choose_scales(
-    spec: InstrumentSpec,
-    options: SetupOptions,
-    map_scale: int | None,
-    f_prime: float,
-    depths_m: NDArray,
-    base_m: NDArray,
-    offsets_m: NDArray,
-) -> tuple[ScaleCandidate, tuple[ScaleCandidate, ...]]:
-    """Item 1 of §26 through :mod:`stereoplotter.setup.scale_choice`, for one pair."""
+def _candidate_grid(
+    spec: InstrumentSpec, options: SetupOptions, map_scale: int | None
+) -> NDArray[np.float64]:
+    """Item 1 of §26: the (M_г, M_в) candidates (:mod:`stereoplotter.setup.scale_choice`)."""
     try:
-        grid = candidate_scales(
+        return candidate_scales(
             spec,
             map_scale,
             options.horizontal_scale_denominator,
@@ -244,42 +141,30 @@ def _choose_scales(
         )
     except StereoplotterError as exc:
         raise SetupRefusal(f"{exc} (--horizontal-scale)") from None
-    depth = np.array([[depths_m.min(), depths_m.max()]])
-    extent = np.array(
-        [
-            [
-                [offsets_m[:, 0].min(), offsets_m[:, 0].max()],
-                [offsets_m[:, 1].min(), offsets_m[:, 1].max()],
-            ]
-        ]
+
+
+def _refuse_scales(table: BlockResult, extent_m: NDArray) -> None:
+    """Raise the refusal of a pair with no feasible (M_г, M_в), naming the closest one."""
+    spec, grid = table.spec, table.candidate_scales
+    best = int(table.candidate_index[0])
+    reasons = describe_candidate(
+        spec,
+        table.focal_length_corrected_mm,
+        grid[best],
+        int(table.candidate_flags[0, best]),
+        table.depth_ground_m[0],
+        table.base_ground_m[0],
+        extent_m[0],
     )
-    flags = candidate_flags(spec, f_prime, grid, depth, base_m[None], extent)
-    chosen, feasible = choose_candidates(flags, grid)
-    best = int(chosen[0])
-    if not feasible[0]:
-        reasons = describe_candidate(
-            spec, f_prime, grid[best], int(flags[0, best]), depth[0], base_m, extent[0]
-        )
-        raise SetupRefusal(
-            f"instrument {spec.key} cannot take this stereopair: none of the {len(grid)} scale "
-            "pairs (M_г = r·M_map for the coordinatograph ratios r, M_в from the height-counter "
-            f"gears) fits every range. Closest: M_г = 1:{grid[best, 0]:.0f}, "
-            f"M_в = 1:{grid[best, 1]:.0f}: "
-            + "; ".join(reasons)
-            + ". Way out: another instrument, another map scale or forced scales, or widen the "
-            f"assumed ranges in {spec.source}."
-        )
-    candidates = tuple(
-        ScaleCandidate(
-            int(mg),
-            int(mv),
-            mg / map_scale if map_scale else math.nan,
-            float(instrument_principal_distance(f_prime, mg, mv)),
-            tuple((flag.name or "").lower() for flag in ScaleCheck if flag and code & int(flag)),
-        )
-        for (mg, mv), code in zip(grid, flags[0], strict=True)
+    raise SetupRefusal(
+        f"instrument {spec.key} cannot take this stereopair: none of the {len(grid)} scale "
+        "pairs (M_г = r·M_map for the coordinatograph ratios r, M_в from the height-counter "
+        f"gears) fits every range. Closest: M_г = 1:{grid[best, 0]:.0f}, "
+        f"M_в = 1:{grid[best, 1]:.0f}: "
+        + "; ".join(reasons)
+        + ". Way out: another instrument, another map scale or forced scales, or widen the "
+        f"assumed ranges in {spec.source}."
     )
-    return candidates[best], candidates
 
 
 def _check_tilt(spec: InstrumentSpec, value: float, what: str) -> None:
@@ -297,6 +182,108 @@ def _check_tilt(spec: InstrumentSpec, value: float, what: str) -> None:
 def _assumed(spec: InstrumentSpec, *attributes: str) -> tuple[str, ...]:
     keys = [spec.key_of(a) for a in attributes]
     return tuple(k for k in keys if spec.is_assumed(k))
+
+
+def _check_settings(table: BlockResult) -> None:
+    """Refuse a pair :func:`compute_table24` refused, with the message of the first setting
+    beyond a stop (scale choice, then κ, tilts and decentrations, left photo first)."""
+    code = int(table.reason_code[0])
+    if code & Refusal.INVALID_INPUT:
+        raise SetupRefusal(
+            "the exterior orientation or the working area of this stereopair is not finite"
+        )
+    spec, f_prime = table.spec, table.focal_length_corrected_mm
+    for j, name in enumerate(("left", "right")):
+        alpha, omega, kappa = (float(v) for v in table.angles[0, j])
+        check_in_range(spec, "kappa_range", kappa, f"κ_{name} (cassette rotation)")
+        for value, what in ((alpha, f"α_{name}"), (omega, f"ω_{name}")):
+            _check_tilt(spec, value, what)
+        for value, what in (
+            (float(decentration(f_prime, alpha)), f"decentration d_x,{name}"),
+            (float(decentration(f_prime, omega)), f"decentration d_y,{name}"),
+        ):
+            check_in_range(spec, "decentration_range_mm", value, what)
+
+
+def _photo_setups(table: BlockResult, marks_mm: NDArray) -> tuple[PhotoSetup, ...]:
+    """The per-photo settings of pair 0 of ``table``; ``marks_mm`` shape (2, 4, 2)."""
+    photos = []
+    for j, (name, n) in enumerate((("left", table.n_left[0]), ("right", table.n_right[0]))):
+        x_mark = X_MARK_NAME[j]
+        fid = table.fiducials_transformed_mm[0, j]
+        photos.append(
+            PhotoSetup(
+                name,
+                *(float(v) for v in table.angles[0, j]),
+                {str(i + 1): (float(m[0]), float(m[1])) for i, m in enumerate(marks_mm[j])},
+                {f"x{x_mark}": float(fid[0]), "y3": float(fid[1]), "y4": float(fid[2])},
+                {
+                    key: tuple(float(v) for v in table.fiducials_rigorous_mm[0, j, m])
+                    for m, key in enumerate((x_mark, "3", "4"))
+                },
+                float(table.mark_span_mm[0, j]),
+                tuple(float(v) for v in table.decentration_mm[0, j]),
+                tuple(float(v) for v in table.correction_inclination[0, j]),
+                float(n),
+            )
+        )
+    return tuple(photos)
+
+
+def _plan_control(
+    scenario: Scenario, points_m: NDArray
+) -> tuple[SimilarityFit | None, list[int], NDArray | None, NDArray]:
+    """(6.8): the similarity from Gauss–Krüger to the instrument frame over the plan control, and
+    the sheet corners on the ground (empty without a map sheet or two plan points)."""
+    corners_gk = _sheet_corners_gk(scenario) if scenario.map_sheet is not None else None
+    plan = [
+        i
+        for i, p in enumerate(scenario.points)
+        if p.role == "control" and p.kind in ("full", "plan") and p.sk42_m is not None
+    ]
+    fit = None
+    corners_m = np.zeros((0, 2))
+    if corners_gk is not None and len(plan) >= 2:
+        north = np.array([scenario.points[i].sk42_m[0] for i in plan])
+        east = np.array([scenario.points[i].sk42_m[1] for i in plan])
+        fit = fit_similarity_with_reflection(north, east, points_m[plan, 0], points_m[plan, 1])
+        corners_m = apply_similarity(fit, corners_gk[:, 0], corners_gk[:, 1])  # (6.8), ground m
+    return fit, plan, corners_gk, corners_m
+
+
+def _corners(
+    fit: SimilarityFit | None, corners_gk: NDArray | None, mg: int, n_left: float
+) -> tuple[dict[str, object], ...]:
+    """(6.7): the sheet corners in instrument coordinates from the left plumb."""
+    if fit is None or corners_gk is None:
+        return ()
+    xy = sheet_corner_instrument_coordinates(fit, corners_gk[:, 0], corners_gk[:, 1], mg)
+    xy_book = sheet_corner_instrument_coordinates_book_form(
+        fit, corners_gk[:, 0], corners_gk[:, 1], n_left, n_left * mg
+    )
+    return tuple(
+        {
+            "corner": key,
+            "position": CORNER_NAMES[key],
+            "gk_north_m": float(corners_gk[j, 0]),
+            "gk_east_m": float(corners_gk[j, 1]),
+            "x_mm": float(xy[j, 0]),
+            "y_mm": float(xy[j, 1]),
+            "x_book_form_mm": float(xy_book[j, 0]),
+            "y_book_form_mm": float(xy_book[j, 1]),
+        }
+        for j, key in enumerate(("1", "2", "3", "4"))
+    )
+
+
+def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[str, float]:
+    return {
+        "mark_span_mm": spec.tolerance_L_numerator_mm / n_left,
+        "mark_fit_mm": spec.tolerance_mark_fit_per_n_mm * n_left,
+        "residual_y_parallax_mm": spec.residual_q_fraction_of_mark * spec.mark_diameter_mm,
+        "control_height_m": spec.control_height_fraction_of_H * float(np.mean(depths_m)),
+        "corner_mm": spec.corner_tolerance_mm,
+    }
 
 
 # --- the computation ----------------------------------------------------------------------------
@@ -339,35 +326,15 @@ def compute_setup_sheet(
         )
     rng = np.random.default_rng(scenario.seed) if rng is None else rng
     measurements = synthesize_measurements(scenario, rng)
-    f_prime = measurements.focal_length_corrected_mm
     known = known_exterior_orientation(scenario, measurements)
-    (c_left, m_left), (c_right, m_right) = ((k.centre_m, k.rotation) for k in known)
-
-    # Frame: base along +X, origin at S_л (docs/setup-data.md, Inputs, "Frame").
-    base_vector = c_right - c_left
-    theta = float(math.atan2(base_vector[1], base_vector[0]))
-    turn = rotation_z(-theta)
-    rotations = [turn @ m_left, turn @ m_right]
-    base_m = turn @ base_vector
-    points_local = np.array([p.local_m for p in scenario.points])
-    points_m = instrument_frame_m(points_local, c_left, theta)
-    grid_m = instrument_frame_m(working_area_grid_m(scenario, (15, 15)), c_left, theta)
+    centres = np.array([[k.centre_m for k in known]])  # (1, 2, 3)
+    rotations = np.array([[k.rotation for k in known]])  # (1, 2, 3, 3)
+    theta = float(instrument_frames(centres, rotations)[0][0])
+    points_m = instrument_frame_m([p.local_m for p in scenario.points], centres[0, 0], theta)
+    grid_m = instrument_frame_m(working_area_grid_m(scenario, (15, 15)), centres[0, 0], theta)
     ground = np.vstack([grid_m, points_m])
     depths_m = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
-
-    corners_gk = _sheet_corners_gk(scenario) if scenario.map_sheet is not None else None
-    plan = [
-        i
-        for i, p in enumerate(scenario.points)
-        if p.role == "control" and p.kind in ("full", "plan") and p.sk42_m is not None
-    ]
-    fit = None
-    corners_m = np.zeros((0, 2))
-    if corners_gk is not None and len(plan) >= 2:
-        north = np.array([scenario.points[i].sk42_m[0] for i in plan])
-        east = np.array([scenario.points[i].sk42_m[1] for i in plan])
-        fit = fit_similarity_with_reflection(north, east, points_m[plan, 0], points_m[plan, 1])
-        corners_m = apply_similarity(fit, corners_gk[:, 0], corners_gk[:, 1])  # (6.8), ground m
+    fit, plan, corners_gk, corners_m = _plan_control(scenario, points_m)
     offsets_m = np.vstack([ground[:, :2], corners_m])
     map_scale = scenario.map_sheet.scale_denominator if scenario.map_sheet else None
     if map_scale is None and options.horizontal_scale_denominator is None:
@@ -376,131 +343,69 @@ def compute_setup_sheet(
             "horizontal model scale M_г from the coordinatograph gears, found nothing (or force "
             "M_г with --horizontal-scale)"
         )
-    chosen, candidates = _choose_scales(
-        spec, options, map_scale, f_prime, depths_m, base_m, offsets_m
+    heights = [
+        p for p in scenario.points if p.role == "control" and p.kind in ("full", "height")
+    ]
+    marks = np.array(
+        [[measurements.photo(n).fiducials_mm for n in ("left", "right")]]
+    ) - np.asarray(scenario.camera.principal_point_mm, float)
+    extent = np.array([[[offsets_m[:, j].min(), offsets_m[:, j].max()] for j in (0, 1)]])
+    table = compute_table24(
+        measurements.focal_length_corrected_mm,
+        marks,
+        centres,
+        rotations,
+        np.array([[depths_m.min(), depths_m.max()]]),
+        _candidate_grid(spec, options, map_scale),
+        spec,
+        heights_m=np.array([[p.local_m[2] for p in heights]], float).reshape(1, -1),
+        extent_m=extent,
+        map_scale_denominator=map_scale,
+        book_sign=options.book_sign_n_right,
+        model_names=(scenario.name,),
+        height_point_ids=(tuple(p.id for p in heights),),
+        name=scenario.name,
     )
-    mg, mv, f_pr = chosen.horizontal, chosen.vertical, chosen.f_instrument_mm
-    k = f_pr / f_prime
-
-    # (6.3), (6.4)
-    n_left = float(counter_scale_left(spec.projection_distance_max_mm, f_pr))
-    n_right = float(
-        counter_scale_right(n_left, 0.0, base_m[2], f_pr, mv, book_sign=options.book_sign_n_right)
-    )
-    b = base_components(np.zeros(3), base_m, mg, mv)
-
-    photos = []
-    for name, rot, n in (("left", rotations[0], n_left), ("right", rotations[1], n_right)):
-        alpha, omega, kappa = (float(v) for v in angles_from_matrix(rot))
-        check_in_range(spec, "kappa_range", kappa, f"κ_{name} (cassette rotation)")
-        for value, what in ((alpha, f"α_{name}"), (omega, f"ω_{name}")):
-            _check_tilt(spec, value, what)
-        marks = measurements.photo(name).fiducials_mm - scenario.camera.principal_point_mm
-        marks_d = {str(i + 1): (float(m[0]), float(m[1])) for i, m in enumerate(marks)}
-        x_mark = "2" if name == "left" else "1"
-        book = {  # (6.1)/(6.2) without n
-            f"x{x_mark}": float(transformed_x_single_tilt(marks_d[x_mark][0], alpha, f_prime)),
-            "y3": float(transformed_y_single_tilt(marks_d["3"][1], omega, f_prime)),
-            "y4": float(transformed_y_single_tilt(marks_d["4"][1], omega, f_prime)),
-        }
-        untwisted = rotation_matrix(alpha, omega, 0.0)  # the cassette κ is 0 in stage 2
-        rigorous = {
-            key: tuple(float(v) for v in transformed_coordinates(marks_d[key], untwisted, f_prime))
-            for key in (x_mark, "3", "4")
-        }
-        d = (float(decentration(f_prime, alpha)), float(decentration(f_prime, omega)))
-        for value, what in zip(
-            d, (f"decentration d_x,{name}", f"decentration d_y,{name}"), strict=True
-        ):
-            check_in_range(spec, "decentration_range_mm", value, what)
-        photos.append(
-            PhotoSetup(
-                name,
-                alpha,
-                omega,
-                kappa,
-                marks_d,
-                book,
-                rigorous,
-                float(mark_span(n, book["y3"], book["y4"])),
-                d,
-                (float(correction_inclination(k, alpha)), float(correction_inclination(k, omega))),
-                n,
-            )
-        )
-    # (6.6) model heights over height control
-    heights = []
-    for i, p in enumerate(scenario.points):
-        if p.role == "control" and p.kind in ("full", "height"):
-            flying = -float(points_m[i, 2])
-            heights.append(
-                {
-                    "id": p.id,
-                    "Z_m": p.local_m[2],
-                    "flying_height_m": flying,
-                    "model_height_mm": float(model_height(flying, mv)),
-                }
-            )
-
-    # (6.7) corners
-    corners = []
-    if fit is not None:
-        xy = sheet_corner_instrument_coordinates(fit, corners_gk[:, 0], corners_gk[:, 1], mg)
-        photo_scale = n_left * mg
-        xy_book = sheet_corner_instrument_coordinates_book_form(
-            fit, corners_gk[:, 0], corners_gk[:, 1], n_left, photo_scale
-        )
-        for j, key in enumerate(("1", "2", "3", "4")):
-            corners.append(
-                {
-                    "corner": key,
-                    "position": CORNER_NAMES[key],
-                    "gk_north_m": float(corners_gk[j, 0]),
-                    "gk_east_m": float(corners_gk[j, 1]),
-                    "x_mm": float(xy[j, 0]),
-                    "y_mm": float(xy[j, 1]),
-                    "x_book_form_mm": float(xy_book[j, 0]),
-                    "y_book_form_mm": float(xy_book[j, 1]),
-                }
-            )
-
-    tolerances = {
-        "mark_span_mm": spec.tolerance_L_numerator_mm / n_left,
-        "mark_fit_mm": spec.tolerance_mark_fit_per_n_mm * n_left,
-        "residual_y_parallax_mm": spec.residual_q_fraction_of_mark * spec.mark_diameter_mm,
-        "control_height_m": spec.control_height_fraction_of_H * float(np.mean(depths_m)),
-        "corner_mm": spec.corner_tolerance_mm,
-    }
+    if int(table.reason_code[0]) & SCALE_FLAGS:
+        _refuse_scales(table, extent)
+    _check_settings(table)
+    mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
+    n_left = float(table.n_left[0])
     sheet = SetupSheet(
         scenario=scenario.name,
         instrument=spec.key,
         instrument_title=spec.title,
-        frame_rotation=theta,
-        frame_origin_m=tuple(float(v) for v in c_left),
-        focal_length_corrected_mm=f_prime,
+        frame_rotation=float(table.frame_rotation[0]),
+        frame_origin_m=tuple(float(v) for v in table.frame_origin_m[0]),
+        focal_length_corrected_mm=table.focal_length_corrected_mm,
         focal_length_corrected_per_photo_mm=measurements.focal_length_corrected_per_photo_mm,
         map_scale_denominator=map_scale,
         horizontal_scale_denominator=mg,
         vertical_scale_denominator=mv,
-        f_instrument_mm=f_pr,
-        transformation_coefficient=k,
+        f_instrument_mm=float(table.f_instrument_mm[0]),
+        transformation_coefficient=float(table.transformation_coefficient[0]),
         n_left=n_left,
-        n_right=n_right,
-        base_mm=tuple(float(v) for v in b),
-        photos=tuple(photos),
-        control_heights=tuple(heights),
+        n_right=float(table.n_right[0]),
+        base_mm=tuple(float(v) for v in table.base_mm[0]),
+        photos=_photo_setups(table, marks[0]),
+        control_heights=tuple(
+            {
+                "id": p.id,
+                "Z_m": p.local_m[2],
+                "flying_height_m": float(centres[0, 0, 2] - p.local_m[2]),
+                "model_height_mm": float(z),
+            }
+            for p, z in zip(heights, table.control_heights_model_mm[0], strict=True)
+        ),  # (6.6)
         similarity=fit,
         similarity_point_ids=tuple(scenario.points[i].id for i in plan),
-        corners=tuple(corners),
+        corners=_corners(fit, corners_gk, mg, n_left),
         readings=(),
-        tolerances=tolerances,
-        candidates=candidates,
+        tolerances=_tolerances(spec, n_left, depths_m),
+        candidates=candidates_of(table, 0),
         assumed=assumed_parameters(spec),
         options=options,
-        depth_range_used_mm=(
-            float(depths_m.min() * MM_PER_M / mv),
-            float(depths_m.max() * MM_PER_M / mv),
-        ),
+        depth_range_used_mm=tuple(float(v) for v in table.depth_range_mm[0]),
         exterior_sources=tuple(p.exterior.source for p in scenario.photos),
         points_model_mm=tuple(
             {
@@ -512,6 +417,7 @@ def compute_setup_sheet(
             }
             for i, p in enumerate(scenario.points)
         ),
+        table24=table,
     )
     return replace(sheet, readings=stage_readings(sheet))
 

@@ -1,8 +1,9 @@
 """Block mode (stereoplotter.setup.block): vectorised setup data of many stereopairs.
 
-The references here are independent computations: the per-pair Python loop (scalars through the
-same equation functions, scales chosen by a loop written after setup_sheet._choose_scales) and the
-single-pair sheet (compute_setup_sheet) of an equivalent scenario.
+The references here are independent computations: the per-pair Python loop of
+tests/oracles/setup_pair_oracle.py (scalars through the same equation functions, scales chosen by
+a loop over the candidates) and the single-pair sheet (compute_setup_sheet) of an equivalent
+scenario.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from oracles.setup_pair_oracle import per_pair_loop
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.io.block_file import CSV_COLUMNS, load_block
@@ -23,7 +25,7 @@ from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.report.block import run_block, write_block
 from stereoplotter.scenario.synthetic import working_area_grid_m
-from stereoplotter.setup.block import BlockResult, Refusal, compute_block, per_pair_loop
+from stereoplotter.setup.block import BlockResult, Refusal, compute_block
 from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
 
 STRIP = data_dir("scenarios") / "blocks" / "strip60.yaml"

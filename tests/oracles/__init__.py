@@ -1,0 +1,1 @@
+"""Independent reference computations (oracles) used by the tests and benchmarks."""
