@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.io.scenario_file import MAX_TILT_DEG, _camera
+from stereoplotter.io.scenario_file import MAX_TILT_DEG, CameraModel, camera_from_model
+from stereoplotter.io.validation import validate
 from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
 from stereoplotter.scenario.model import Camera
 
@@ -118,7 +119,8 @@ def load_block(path: str | os.PathLike[str]) -> Block:
     fields = Fields(source)
     fields.mapping(data, "", _TOP, required=("name", "camera", "map_scale"))
     name = fields.text(data, "name", "")
-    camera = _camera(fields, fields.get(data, "camera", ""))
+    camera_model = validate(CameraModel, fields.get(data, "camera", ""), source, prefix=("camera",))
+    camera = camera_from_model(fields, camera_model)
     map_scale = fields.integer(data, "map_scale", "", low=100, high=1_000_000)
     forced: dict[str, int | None] = {"horizontal": None, "vertical": None}
     if data.get("scales") is not None:

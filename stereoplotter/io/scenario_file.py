@@ -6,14 +6,28 @@ was expected and what was found. The schema is documented in ``docs/scenarios.md
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import BeforeValidator, ConfigDict, Field, field_validator, model_validator
 
-from stereoplotter.errors import StereoplotterError
+from stereoplotter.errors import StereoplotterError, describe_value
 from stereoplotter.geometry.collinearity import object_to_photo
+from stereoplotter.io.validation import (
+    FileModel,
+    _fail,
+    check_number,
+    integer,
+    number,
+    one_of,
+    sequence,
+    text,
+    validate,
+    vector,
+)
 from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.scenario.model import (
@@ -30,7 +44,13 @@ from stereoplotter.scenario.model import (
     Terrain,
 )
 
-__all__ = ["load_scenario", "scenario_from_mapping"]
+__all__ = [
+    "CameraModel",
+    "ScenarioFile",
+    "camera_from_model",
+    "load_scenario",
+    "scenario_from_mapping",
+]
 
 #: Limits of the input, with their basis (shown in the messages).
 MAX_TILT_DEG = 15.0  # near-vertical aerial photography; the instruments correct far less
@@ -38,24 +58,9 @@ MAX_FILM_DEFORMATION_PPM = 5000.0  # 0.5 %: beyond any usable film base
 MIN_RESECTION_POINTS = 3
 MIN_SIMILARITY_POINTS = 2
 
-#: The defaults of the optional ``errors`` section. (Not ``ErrorSettings.photo_point_sigma_um``:
-#: on a dataclass with slots that is the slot descriptor, not the default value.)
-_DEFAULT_ERRORS = ErrorSettings()
 #: Top-level fields that only a block file has (``stereoplotter.setup.block``).
 _BLOCK_FIELDS = ("models", "models_csv")
 
-_TOP = (
-    "name",
-    "description",
-    "seed",
-    "camera",
-    "frame",
-    "terrain",
-    "photos",
-    "points",
-    "map_sheet",
-    "errors",
-)
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:
@@ -82,6 +87,10 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
 def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> Scenario:
     """Validate a parsed scenario document and build the :class:`Scenario`.
 
+    The document is validated by :class:`ScenarioFile` (types, ranges, unknown keys); then the
+    checks that span fields run here: the fiducial numbering, the SK-42 tie of the frame and the
+    points, the map sheet and the geometry (:func:`_check_geometry`).
+
     Parameters
     ----------
     data : dict
@@ -99,18 +108,21 @@ def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> S
             "a block file is set up model by model with: stereoplotter setup FILE --instrument "
             "NAME",
         )
-    fields.mapping(data, "", _TOP, required=("name", "camera", "photos", "points"))
-    camera = _camera(fields, fields.get(data, "camera", ""))
-    frame = _frame(fields, data.get("frame", {}) or {})
-    terrain = _terrain(fields, data.get("terrain", {}) or {})
-    photos = _photos(fields, fields.get(data, "photos", ""))
-    points = _points(fields, fields.get(data, "points", ""), frame, terrain)
-    map_sheet = _map_sheet(fields, data["map_sheet"], frame) if data.get("map_sheet") else None
-    errors = _errors(fields, data.get("errors", {}) or {})
-    seed = fields.integer(data, "seed", "", low=0, high=2**63 - 1, default=0)
+    doc = validate(ScenarioFile, _drop_nulls(data, _NULLABLE_TOP), source)
+    camera = camera_from_model(fields, doc.camera)
+    frame = _frame(fields, doc.frame)
+    terrain = Terrain(
+        doc.terrain.base_height_m,
+        doc.terrain.slope,
+        tuple(Hill(h.X_m, h.Y_m, h.height_m, h.radius_m) for h in doc.terrain.hills),
+    )
+    photos = _photos(fields, doc.photos)
+    points = _points(fields, doc.points, frame, terrain)
+    map_sheet = _map_sheet(fields, doc.map_sheet, frame) if doc.map_sheet else None
+    errors = ErrorSettings(doc.errors.photo_point_sigma_um, doc.errors.fiducial_sigma_um)
     scenario = Scenario(
-        name=fields.text(data, "name", ""),
-        description=str(data.get("description", "") or ""),
+        name=doc.name,
+        description=doc.description or "",
         source=source,
         camera=camera,
         photos=photos,
@@ -119,259 +131,351 @@ def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> S
         frame=frame,
         map_sheet=map_sheet,
         errors=errors,
-        seed=seed,
+        seed=doc.seed,
     )
     _check_geometry(fields, scenario)
     return scenario
 
 
-def _camera(fields: Fields, node: Any) -> Camera:
-    path = "camera"
-    fields.mapping(
-        node,
-        path,
-        ("focal_length_mm", "principal_point_mm", "format_mm", "fiducials"),
-        required=("focal_length_mm", "fiducials"),
+def _drop_nulls(data: Any, keys: tuple[str, ...]) -> Any:
+    """The document without the optional sections written empty (``terrain:`` with nothing)."""
+    if not isinstance(data, dict):
+        return data
+    return {k: v for k, v in data.items() if not (k in keys and v in (None, {}))}
+
+
+_NULLABLE_TOP = ("frame", "terrain", "map_sheet", "errors", "seed", "description")
+
+
+# --- the models -------------------------------------------------------------------------------
+
+_TILT_BASIS = f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°"
+_EAST_UNIT = "m (conventional ordinate: zone × 10⁶ + 500 000 + y)"
+_XY = number("m", -1.0e7, 1.0e7)
+_GROUND = number("m", -500.0, 9000.0)
+
+
+def _present(v: Any) -> Any:
+    """A mapping without its keys written with no value (they count as absent)."""
+    return {k: x for k, x in v.items() if x is not None} if isinstance(v, dict) else v
+
+
+class Distances(FileModel):
+    """Distances between opposite fiducial marks; the marks sit symmetrically on the axes."""
+
+    d12: float = Field(alias="1-2", json_schema_extra={"description": "[mm]"})
+    d34: float = Field(alias="3-4", json_schema_extra={"description": "[mm]"})
+
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=False)
+
+    @field_validator("d12", "d34", mode="before")
+    @classmethod
+    def _positive(cls, v: Any) -> float:
+        return check_number(v, unit="mm", low=0.0, high=300.0, low_open=True)
+
+
+class Coordinates(FileModel):
+    """x, y of the four fiducial marks (1 at −x, 2 at +x, 3 at +y, 4 at −y)."""
+
+    m1: vector(2, "mm", -150.0, 150.0) = Field(alias="1")  # type: ignore[valid-type]
+    m2: vector(2, "mm", -150.0, 150.0) = Field(alias="2")  # type: ignore[valid-type]
+    m3: vector(2, "mm", -150.0, 150.0) = Field(alias="3")  # type: ignore[valid-type]
+    m4: vector(2, "mm", -150.0, 150.0) = Field(alias="4")  # type: ignore[valid-type]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _text_keys(cls, v: Any) -> Any:
+        return {str(k): x for k, x in v.items()} if isinstance(v, dict) else v
+
+
+class Fiducials(FileModel):
+    """Exactly one of ``coordinates_mm``, ``distances_mm``."""
+
+    coordinates_mm: Coordinates | None = None
+    distances_mm: Distances | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _exactly_one(cls, v: Any) -> Any:
+        v = _present(v)
+        if isinstance(v, dict) and not set(v) - {"coordinates_mm", "distances_mm"}:
+            if ("coordinates_mm" in v) == ("distances_mm" in v):
+                found = ", ".join(v) or "neither"
+                raise _fail("exactly one of coordinates_mm, distances_mm", found)
+        return v
+
+
+class CameraModel(FileModel):
+    focal_length_mm: number("mm", 0.0, 1000.0, low_open=True)  # type: ignore[valid-type]
+    principal_point_mm: vector(2, "mm", -5.0, 5.0) = (0.0, 0.0)  # type: ignore[valid-type]
+    format_mm: number("mm", 50.0, 300.0) = 180.0  # type: ignore[valid-type]
+    fiducials: Fiducials
+
+
+class Origin(FileModel):
+    north_m: number("m", 0.0, 1.0e7)  # type: ignore[valid-type]
+    east_m: number(_EAST_UNIT, 1.0e6, 61.0e6)  # type: ignore[valid-type]
+    height_m: _GROUND  # type: ignore[valid-type]
+
+
+class Corner(FileModel):
+    north_m: number("m", 0.0, 1.0e7)  # type: ignore[valid-type]
+    east_m: number(_EAST_UNIT, 1.0e6, 61.0e6)  # type: ignore[valid-type]
+
+
+class FrameModel(FileModel):
+    kind: one_of("local", "sk42") = "local"  # type: ignore[valid-type]
+    origin: Origin | None = None
+
+
+class HillModel(FileModel):
+    X_m: _XY  # type: ignore[valid-type]
+    Y_m: _XY  # type: ignore[valid-type]
+    height_m: number("m", -3000.0, 3000.0)  # type: ignore[valid-type]
+    radius_m: number("m", 1.0, 1.0e6)  # type: ignore[valid-type]
+
+
+class TerrainModel(FileModel):
+    base_height_m: _GROUND = 0.0  # type: ignore[valid-type]
+    slope: vector(2, "—", -1.0, 1.0) = (0.0, 0.0)  # type: ignore[valid-type]
+    hills: sequence(HillModel) = Field(default_factory=list)  # type: ignore[valid-type]
+
+
+class Exterior(FileModel):
+    X_m: _XY  # type: ignore[valid-type]
+    Y_m: _XY  # type: ignore[valid-type]
+    Z_m: number("m", -500.0, 50000.0)  # type: ignore[valid-type]
+    alpha_deg: number("°", -MAX_TILT_DEG, MAX_TILT_DEG, basis=_TILT_BASIS)  # type: ignore[valid-type]
+    omega_deg: number("°", -MAX_TILT_DEG, MAX_TILT_DEG, basis=_TILT_BASIS)  # type: ignore[valid-type]
+    kappa_deg: number("°", -180.0, 180.0)  # type: ignore[valid-type]
+    source: one_of("given", "resection") = "given"  # type: ignore[valid-type]
+
+
+_FILM = number("ppm", -MAX_FILM_DEFORMATION_PPM, MAX_FILM_DEFORMATION_PPM)
+
+
+class PhotoModel(FileModel):
+    name: text  # type: ignore[valid-type]
+    exterior: Exterior
+    film_deformation_ppm: vector(  # type: ignore[valid-type]
+        2, "ppm", -MAX_FILM_DEFORMATION_PPM, MAX_FILM_DEFORMATION_PPM
+    ) = (0.0, 0.0)
+
+
+def _z_or_terrain(v: Any) -> Any:
+    if v == "terrain":
+        return v
+    return check_number(v, unit="m (or the word terrain)", low=-500.0, high=9000.0)
+
+
+class Local(FileModel):
+    X_m: _XY  # type: ignore[valid-type]
+    Y_m: _XY  # type: ignore[valid-type]
+    Z_m: Annotated[  # type: ignore[valid-type]
+        float | Literal["terrain"],
+        BeforeValidator(_z_or_terrain),
+        Field(description="[m] or the word terrain (the height of the terrain there)"),
+    ] = "terrain"
+
+
+class PointModel(FileModel):
+    id: text  # type: ignore[valid-type]
+    role: one_of("control", "check") = "control"  # type: ignore[valid-type]
+    kind: one_of("full", "plan", "height") = "full"  # type: ignore[valid-type]
+    local: Local | None = None
+    sk42: Origin | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _exactly_one(cls, v: Any) -> Any:
+        v = _present(v)
+        if isinstance(v, dict) and ("local" in v) == ("sk42" in v):
+            if not set(v) - {"id", "role", "kind", "local", "sk42"} and "id" in v:
+                raise _fail("exactly one of local, sk42", "both" if "local" in v else "neither")
+        return v
+
+
+class MapSheetModel(FileModel):
+    scale: integer(100, 1_000_000)  # type: ignore[valid-type]
+    nomenclature: text | None = None  # type: ignore[valid-type]
+    corners: sequence(Corner, min_length=4) | None = None  # type: ignore[valid-type]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _exactly_one(cls, v: Any) -> Any:
+        v = _present(v)
+        if isinstance(v, dict) and not set(v) - {"scale", "nomenclature", "corners"}:
+            if "scale" in v and ("nomenclature" in v) == ("corners" in v):
+                raise _fail(
+                    "exactly one of nomenclature, corners",
+                    "both" if "corners" in v else "neither",
+                )
+        return v
+
+
+#: The defaults of the optional ``errors`` section, from the dataclass fields (not from
+#: ``ErrorSettings.photo_point_sigma_um``: on a dataclass with slots that is a slot descriptor).
+_ERROR_DEFAULTS = {f.name: f.default for f in dataclasses.fields(ErrorSettings)}
+
+
+class ErrorsModel(FileModel):
+    photo_point_sigma_um: number("µm", 0.0, 1000.0) = _ERROR_DEFAULTS[  # type: ignore[valid-type]
+        "photo_point_sigma_um"
+    ]
+    fiducial_sigma_um: number("µm", 0.0, 1000.0) = _ERROR_DEFAULTS[  # type: ignore[valid-type]
+        "fiducial_sigma_um"
+    ]
+
+
+class ScenarioFile(FileModel):
+    """A scenario file (``docs/scenarios.md``)."""
+
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, title="stereoplotter scenario file"
     )
-    f = fields.number(node, "focal_length_mm", path, unit="mm", low=0.0, high=1000.0, low_open=True)
-    pp = fields.vector(
-        node, "principal_point_mm", path, 2, unit="mm", low=-5.0, high=5.0, default=[0.0, 0.0]
-    )
-    fmt = fields.number(node, "format_mm", path, unit="mm", low=50.0, high=300.0, default=180.0)
-    fid_path = fields.join(path, "fiducials")
-    fid = fields.mapping(
-        fields.get(node, "fiducials", path), fid_path, ("coordinates_mm", "distances_mm")
-    )
+
+    name: text  # type: ignore[valid-type]
+    description: str | None = None
+    seed: integer(0, 2**63 - 1) = 0  # type: ignore[valid-type]
+    camera: CameraModel
+    frame: FrameModel = FrameModel()
+    terrain: TerrainModel = TerrainModel()
+    photos: list[PhotoModel]
+    points: sequence(PointModel, min_length=1)  # type: ignore[valid-type]
+    map_sheet: MapSheetModel | None = None
+    errors: ErrorsModel = ErrorsModel()
+
+    @field_validator("photos", mode="before")
+    @classmethod
+    def _one_or_two(cls, v: Any) -> Any:
+        if not isinstance(v, list) or not 1 <= len(v) <= 2:
+            raise _fail(
+                "a list of 1 photo or 2 photos named left and right",
+                f"a list of {len(v)}" if isinstance(v, list) else describe_value(v),
+            )
+        return v
+
+
+# --- from the models to the domain ----------------------------------------------------------
+
+
+def camera_from_model(fields: Fields, model: CameraModel) -> Camera:
+    """The :class:`Camera` of a validated camera section; checks the marks against the format
+    and their numbering (``docs/conventions.md`` §2: 1 at −x, 2 at +x, 3 at +y, 4 at −y)."""
+    fmt = model.format_mm
     half = fmt / 2.0
-    if ("coordinates_mm" in fid) == ("distances_mm" in fid):
-        raise fields.error(
-            fid_path, "exactly one of coordinates_mm, distances_mm", ", ".join(fid) or "neither"
-        )
+    fid_path = "camera.fiducials"
     marks: dict[str, tuple[float, float]] = {}
-    if "coordinates_mm" in fid:
+    if model.fiducials.coordinates_mm is not None:
         given_as = "coordinates"
-        cpath = fields.join(fid_path, "coordinates_mm")
-        coords = fields.mapping(
-            {str(k): v for k, v in (fid["coordinates_mm"] or {}).items()}
-            if isinstance(fid["coordinates_mm"], dict)
-            else fid["coordinates_mm"],
-            cpath,
-            FIDUCIAL_NAMES,
-            required=FIDUCIAL_NAMES,
-        )
+        cpath = f"{fid_path}.coordinates_mm"
+        c = model.fiducials.coordinates_mm
+        given = {"1": c.m1, "2": c.m2, "3": c.m3, "4": c.m4}
         for name in FIDUCIAL_NAMES:
-            marks[name] = fields.vector(coords, name, cpath, 2, unit="mm", low=-half, high=half)
-        # Numbering (docs/conventions.md §2): 1 at −x, 2 at +x, 3 at +y, 4 at −y.
+            for i, v in enumerate(given[name]):
+                fields.check_number(v, f"{cpath}.{name}[{i}]", unit="mm", low=-half, high=half)
+            marks[name] = (given[name][0], given[name][1])
         expected_side = {"1": (0, -1), "2": (0, 1), "3": (1, 1), "4": (1, -1)}
         for name, (axis, sign) in expected_side.items():
             if marks[name][axis] * sign <= 0:
                 raise fields.error(
-                    fields.join(cpath, name),
+                    f"{cpath}.{name}",
                     f"mark {name} on the {'+' if sign > 0 else '−'}{'xy'[axis]} side "
                     "(numbering: 1 at −x, 2 at +x, 3 at +y, 4 at −y)",
                     list(marks[name]),
                 )
     else:
         given_as = "distances"
-        dpath = fields.join(fid_path, "distances_mm")
-        dist = fields.mapping(fid["distances_mm"], dpath, ("1-2", "3-4"), required=("1-2", "3-4"))
-        d12 = fields.number(dist, "1-2", dpath, unit="mm", low=0.0, high=fmt, low_open=True)
-        d34 = fields.number(dist, "3-4", dpath, unit="mm", low=0.0, high=fmt, low_open=True)
-        marks = {
-            "1": (-d12 / 2, 0.0),
-            "2": (d12 / 2, 0.0),
-            "3": (0.0, d34 / 2),
-            "4": (0.0, -d34 / 2),
-        }
-    return Camera(f, (pp[0], pp[1]), fmt, marks, given_as)
+        dpath = f"{fid_path}.distances_mm"
+        d = model.fiducials.distances_mm
+        assert d is not None  # the model has exactly one of the two
+        d12 = fields.check_number(d.d12, f"{dpath}.1-2", unit="mm", low=0.0, high=fmt,
+                                  low_open=True)
+        d34 = fields.check_number(d.d34, f"{dpath}.3-4", unit="mm", low=0.0, high=fmt,
+                                  low_open=True)
+        marks = {"1": (-d12 / 2, 0.0), "2": (d12 / 2, 0.0), "3": (0.0, d34 / 2),
+                 "4": (0.0, -d34 / 2)}
+    pp = model.principal_point_mm
+    return Camera(model.focal_length_mm, (pp[0], pp[1]), fmt, marks, given_as)
 
 
-def _frame(fields: Fields, node: Any) -> Frame:
-    path = "frame"
-    fields.mapping(node, path, ("kind", "origin"))
-    kind = fields.choice(node, "kind", path, ("local", "sk42"), default="local")
-    if kind == "local":
-        if "origin" in node:
+def _frame(fields: Fields, model: FrameModel) -> Frame:
+    if model.kind == "local":
+        if model.origin is not None:
             raise fields.error(
-                fields.join(path, "origin"),
+                "frame.origin",
                 "no origin for kind local",
                 "an origin",
                 "set kind: sk42 to tie the frame to SK-42",
             )
         return Frame("local", None)
-    opath = fields.join(path, "origin")
-    origin = _sk42_triplet(fields, fields.get(node, "origin", path), opath)
+    if model.origin is None:
+        raise fields.error("frame.origin", "a value (the field is required)", "nothing")
+    origin = _sk42(fields, model.origin, "frame.origin")
     frame = Frame("sk42", origin)
     try:
         frame_tie.local_frame(frame)
     except StereoplotterError as exc:  # e.g. a latitude beyond the geodesy's range
         raise fields.error(
-            opath, "an origin inside the SK-42 Gauss–Krüger domain", list(origin), str(exc)
+            "frame.origin", "an origin inside the SK-42 Gauss–Krüger domain", list(origin), str(exc)
         ) from None
     return frame
 
 
-def _sk42_triplet(fields: Fields, node: Any, path: str, height: bool = True) -> tuple[float, ...]:
-    keys = ("north_m", "east_m", "height_m") if height else ("north_m", "east_m")
-    fields.mapping(node, path, keys, required=keys)
-    north = fields.number(node, "north_m", path, unit="m", low=0.0, high=1.0e7)
-    east = fields.number(
-        node,
-        "east_m",
-        path,
-        unit="m (conventional ordinate: zone × 10⁶ + 500 000 + y)",
-        low=1.0e6,
-        high=61.0e6,
-    )
+def _sk42(fields: Fields, model: Origin | Corner, path: str) -> tuple[float, ...]:
     try:
-        frame_tie.check_conventional_ordinate(east)
+        frame_tie.check_conventional_ordinate(model.east_m)
     except StereoplotterError as exc:
         raise fields.error(
-            fields.join(path, "east_m"),
+            f"{path}.east_m",
             "a conventional ordinate zone·10⁶ + 500 000 + y, |y| < 400 km",
-            east,
+            model.east_m,
             str(exc),
         ) from None
-    if not height:
-        return (north, east)
-    h = fields.number(node, "height_m", path, unit="m", low=-500.0, high=9000.0)
-    return (north, east, h)
+    if isinstance(model, Origin):
+        return (model.north_m, model.east_m, model.height_m)
+    return (model.north_m, model.east_m)
 
 
-def _terrain(fields: Fields, node: Any) -> Terrain:
-    path = "terrain"
-    fields.mapping(node, path, ("base_height_m", "slope", "hills"))
-    base = fields.number(
-        node, "base_height_m", path, unit="m", low=-500.0, high=9000.0, default=0.0
-    )
-    slope = fields.vector(node, "slope", path, 2, unit="—", low=-1.0, high=1.0, default=[0.0, 0.0])
-    hills = []
-    for i, hill in enumerate(fields.sequence(node, "hills", path, default=[])):
-        hpath = fields.join(fields.join(path, "hills"), i)
-        fields.mapping(
-            hill,
-            hpath,
-            ("X_m", "Y_m", "height_m", "radius_m"),
-            required=("X_m", "Y_m", "height_m", "radius_m"),
-        )
-        hills.append(
-            Hill(
-                fields.number(hill, "X_m", hpath, unit="m", low=-1.0e7, high=1.0e7),
-                fields.number(hill, "Y_m", hpath, unit="m", low=-1.0e7, high=1.0e7),
-                fields.number(hill, "height_m", hpath, unit="m", low=-3000.0, high=3000.0),
-                fields.number(hill, "radius_m", hpath, unit="m", low=1.0, high=1.0e6),
-            )
-        )
-    return Terrain(base, (slope[0], slope[1]), tuple(hills))
-
-
-def _photos(fields: Fields, node: Any) -> tuple[Photo, ...]:
-    path = "photos"
-    if not isinstance(node, list) or not 1 <= len(node) <= 2:
-        raise fields.error(
-            path,
-            "a list of 1 photo or 2 photos named left and right",
-            f"a list of {len(node)}" if isinstance(node, list) else node,
-        )
+def _photos(fields: Fields, models: list[PhotoModel]) -> tuple[Photo, ...]:
     photos = []
-    for i, item in enumerate(node):
-        ppath = fields.join(path, i)
-        fields.mapping(
-            item, ppath, ("name", "exterior", "film_deformation_ppm"), required=("name", "exterior")
-        )
-        name = fields.text(item, "name", ppath)
-        epath = fields.join(ppath, "exterior")
-        ext = fields.mapping(
-            item["exterior"],
-            epath,
-            ("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg", "source"),
-            required=("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg"),
-        )
-        centre = tuple(
-            fields.number(ext, k, epath, unit="m", low=-1.0e7, high=1.0e7) for k in ("X_m", "Y_m")
-        )
-        z = fields.number(ext, "Z_m", epath, unit="m", low=-500.0, high=50000.0)
-        tilt_basis = f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°"
-        alpha = fields.number(
-            ext,
-            "alpha_deg",
-            epath,
-            unit="°",
-            low=-MAX_TILT_DEG,
-            high=MAX_TILT_DEG,
-            basis=tilt_basis,
-        )
-        omega = fields.number(
-            ext,
-            "omega_deg",
-            epath,
-            unit="°",
-            low=-MAX_TILT_DEG,
-            high=MAX_TILT_DEG,
-            basis=tilt_basis,
-        )
-        kappa = fields.number(ext, "kappa_deg", epath, unit="°", low=-180.0, high=180.0)
-        source = fields.choice(ext, "source", epath, ("given", "resection"), default="given")
-        film = fields.vector(
-            item,
-            "film_deformation_ppm",
-            ppath,
-            2,
-            unit="ppm",
-            low=-MAX_FILM_DEFORMATION_PPM,
-            high=MAX_FILM_DEFORMATION_PPM,
-            default=[0.0, 0.0],
-        )
+    for p in models:
+        e = p.exterior
         photos.append(
             Photo(
-                name,
+                p.name,
                 ExteriorOrientation(
-                    (centre[0], centre[1], z),
-                    math.radians(alpha),
-                    math.radians(omega),
-                    math.radians(kappa),
-                    source,
+                    (e.X_m, e.Y_m, e.Z_m),
+                    math.radians(e.alpha_deg),
+                    math.radians(e.omega_deg),
+                    math.radians(e.kappa_deg),
+                    e.source,
                 ),
-                (film[0], film[1]),
+                (p.film_deformation_ppm[0], p.film_deformation_ppm[1]),
             )
         )
     names = [p.name for p in photos]
     if len(photos) == 2 and names != ["left", "right"]:
-        raise fields.error(path, "two photos named left and right, in that order", names)
+        raise fields.error("photos", "two photos named left and right, in that order", names)
     return tuple(photos)
 
 
-def _points(fields: Fields, node: Any, frame: Frame, terrain: Terrain) -> tuple[Point, ...]:
-    path = "points"
-    items = fields.sequence({"points": node}, "points", "", min_length=1)
+def _points(
+    fields: Fields, models: list[PointModel], frame: Frame, terrain: Terrain
+) -> tuple[Point, ...]:
     points: list[Point] = []
     seen: set[str] = set()
-    for i, item in enumerate(items):
-        ppath = fields.join(path, i)
-        fields.mapping(item, ppath, ("id", "role", "kind", "local", "sk42"), required=("id",))
-        pid = fields.text(item, "id", ppath)
+    for i, item in enumerate(models):
+        ppath = f"points[{i}]"
+        pid = item.id
         if pid in seen:
-            raise fields.error(fields.join(ppath, "id"), "a unique point id", pid)
+            raise fields.error(f"{ppath}.id", "a unique point id", pid)
         seen.add(pid)
-        role = fields.choice(item, "role", ppath, ("control", "check"), default="control")
-        kind = fields.choice(item, "kind", ppath, ("full", "plan", "height"), default="full")
-        if ("local" in item) == ("sk42" in item):
-            raise fields.error(
-                ppath, "exactly one of local, sk42", "both" if "local" in item else "neither"
-            )
-        if "local" in item:
-            lpath = fields.join(ppath, "local")
-            local = fields.mapping(
-                item["local"], lpath, ("X_m", "Y_m", "Z_m"), required=("X_m", "Y_m")
-            )
-            X = fields.number(local, "X_m", lpath, unit="m", low=-1.0e7, high=1.0e7)
-            Y = fields.number(local, "Y_m", lpath, unit="m", low=-1.0e7, high=1.0e7)
-            if local.get("Z_m", "terrain") == "terrain":
-                Z = float(terrain.height_m(X, Y))
-            else:
-                Z = fields.number(
-                    local, "Z_m", lpath, unit="m (or the word terrain)", low=-500.0, high=9000.0
-                )
+        if item.local is not None:
+            lpath = f"{ppath}.local"
+            X, Y = item.local.X_m, item.local.Y_m
+            z = item.local.Z_m
+            Z = float(terrain.height_m(X, Y)) if z == "terrain" else float(z)
             sk42 = None
             if frame.kind == "sk42":
                 try:
@@ -383,33 +487,33 @@ def _points(fields: Fields, node: Any, frame: Frame, terrain: Terrain) -> tuple[
                         [X, Y, Z],
                         str(exc),
                     ) from None
-            points.append(Point(pid, role, kind, (X, Y, Z), sk42))
-        else:
-            spath = fields.join(ppath, "sk42")
-            if frame.kind != "sk42":
-                raise fields.error(
-                    spath,
-                    "local coordinates (the frame has no SK-42 tie)",
-                    "sk42 coordinates",
-                    "set frame.kind: sk42 with an origin",
-                )
-            sk42 = _sk42_triplet(fields, item["sk42"], spath)
-            try:
-                local = frame_tie.local_from_sk42(frame, sk42)
-            except StereoplotterError as exc:  # e.g. the point lies in another zone
-                raise fields.error(
-                    fields.join(spath, "east_m"),
-                    f"a point in the zone of frame.origin (point {pid})",
-                    sk42[1],
-                    str(exc),
-                ) from None
-            points.append(Point(pid, role, kind, local, sk42))
+            points.append(Point(pid, item.role, item.kind, (X, Y, Z), sk42))
+            continue
+        spath = f"{ppath}.sk42"
+        if frame.kind != "sk42":
+            raise fields.error(
+                spath,
+                "local coordinates (the frame has no SK-42 tie)",
+                "sk42 coordinates",
+                "set frame.kind: sk42 with an origin",
+            )
+        assert item.sk42 is not None  # the model has exactly one of local, sk42
+        sk42 = _sk42(fields, item.sk42, spath)
+        try:
+            local = frame_tie.local_from_sk42(frame, sk42)
+        except StereoplotterError as exc:  # e.g. the point lies in another zone
+            raise fields.error(
+                f"{spath}.east_m",
+                f"a point in the zone of frame.origin (point {pid})",
+                sk42[1],
+                str(exc),
+            ) from None
+        points.append(Point(pid, item.role, item.kind, local, sk42))
     return tuple(points)
 
 
-def _map_sheet(fields: Fields, node: Any, frame: Frame) -> MapSheet:
+def _map_sheet(fields: Fields, model: MapSheetModel, frame: Frame) -> MapSheet:
     path = "map_sheet"
-    fields.mapping(node, path, ("scale", "nomenclature", "corners"), required=("scale",))
     if frame.kind != "sk42":
         raise fields.error(
             path,
@@ -417,60 +521,24 @@ def _map_sheet(fields: Fields, node: Any, frame: Frame) -> MapSheet:
             "frame.kind: local",
             "a map sheet is defined in Gauss–Krüger coordinates",
         )
-    scale = fields.integer(node, "scale", path, low=100, high=1_000_000)
-    if ("nomenclature" in node) == ("corners" in node):
-        raise fields.error(
-            path, "exactly one of nomenclature, corners", "both" if "corners" in node else "neither"
-        )
-    if "corners" in node:
-        cpath = fields.join(path, "corners")
-        items = fields.sequence(node, "corners", path, min_length=4)
-        if len(items) != 4:
-            raise fields.error(cpath, "4 corners (NW, NE, SE, SW)", f"{len(items)} corners")
-        corners = np.array(
-            [
-                _sk42_triplet(fields, c, fields.join(cpath, i), height=False)
-                for i, c in enumerate(items)
-            ]
-        )
+    scale = model.scale
+    if model.corners is not None:
+        cpath = f"{path}.corners"
+        if len(model.corners) != 4:
+            raise fields.error(cpath, "4 corners (NW, NE, SE, SW)", f"{len(model.corners)} corners")
+        corners = np.array([_sk42(fields, c, f"{cpath}[{i}]") for i, c in enumerate(model.corners)])
         return MapSheet(scale, corners, None)
-    name = fields.text(node, "nomenclature", path)
+    name = model.nomenclature
+    assert name is not None  # the model has exactly one of nomenclature, corners
     try:
         corners, sheet_scale = frame_tie.sheet_corners_sk42(name)
     except StereoplotterError as exc:
         raise fields.error(
-            fields.join(path, "nomenclature"), "a valid SK-42 nomenclature", name, str(exc)
+            f"{path}.nomenclature", "a valid SK-42 nomenclature", name, str(exc)
         ) from None
     if sheet_scale != scale:
-        raise fields.error(
-            fields.join(path, "scale"), f"{sheet_scale} (the scale of sheet {name})", scale
-        )
+        raise fields.error(f"{path}.scale", f"{sheet_scale} (the scale of sheet {name})", scale)
     return MapSheet(scale, corners, name)
-
-
-def _errors(fields: Fields, node: Any) -> ErrorSettings:
-    path = "errors"
-    fields.mapping(node, path, ("photo_point_sigma_um", "fiducial_sigma_um"))
-    return ErrorSettings(
-        fields.number(
-            node,
-            "photo_point_sigma_um",
-            path,
-            unit="µm",
-            low=0.0,
-            high=1000.0,
-            default=_DEFAULT_ERRORS.photo_point_sigma_um,
-        ),
-        fields.number(
-            node,
-            "fiducial_sigma_um",
-            path,
-            unit="µm",
-            low=0.0,
-            high=1000.0,
-            default=_DEFAULT_ERRORS.fiducial_sigma_um,
-        ),
-    )
 
 
 def _check_geometry(fields: Fields, scenario: Scenario) -> None:
