@@ -132,6 +132,58 @@ def sheet_bounds(nomenclature: str) -> SheetBounds:
     """
     text = nomenclature.strip()
     parts = re.split(r"-(?![^(]*\))", text)
+    frame, zone = _million_sheet(nomenclature, parts)
+    rest = parts[2:]
+    if rest:
+        _second_part(frame, rest)
+    if rest and rest[0].startswith("("):
+        _plan_parts(frame, rest)
+    if rest and frame.scale == 100_000:
+        frame.quarter(rest.pop(0), _QUARTERS_UPPER, 50_000)
+    if rest and frame.scale == 50_000:
+        frame.quarter(rest.pop(0), _QUARTERS_LOWER, 25_000)
+    if rest and frame.scale == 25_000:
+        part = rest.pop(0)
+        if part not in {"1", "2", "3", "4"}:
+            raise _fail(nomenclature, f"1:10 000 part {part!r} is not one of 1/2/3/4")
+        frame.divide(2, 2, int(part) - 1, 10_000)
+    if rest:
+        raise _fail(nomenclature, f"unexpected part {rest[0]!r} after the 1:{frame.scale} sheet")
+    south, west = frame.south, frame.west
+    north, east = south + frame.height, west + frame.width
+    return SheetBounds(
+        text, frame.scale, float(south), float(north), float(west), float(east), zone
+    )
+
+
+@dataclass
+class _Frame:
+    """The sheet being subdivided: exact south, west, height, width [°] and its scale."""
+
+    nomenclature: str
+    south: Fraction
+    west: Fraction
+    height: Fraction
+    width: Fraction
+    scale: int
+
+    def divide(self, rows: int, cols: int, index: int, new_scale: int) -> None:
+        self.south, self.west, self.height, self.width = _part(
+            self.south, self.west, self.height, self.width, rows, cols, index
+        )
+        self.scale = new_scale
+
+    def quarter(self, part: str, table: dict[str, int], new_scale: int) -> None:
+        if part not in table:
+            raise _fail(
+                self.nomenclature,
+                f"{part!r} is not one of {'/'.join(table)} for 1:{new_scale:,}".replace(",", " "),
+            )
+        self.divide(2, 2, table[part], new_scale)
+
+
+def _million_sheet(nomenclature: str, parts: list[str]) -> tuple[_Frame, int]:
+    """The 1:1 000 000 sheet of the band letter and column, and its 6° zone."""
     if len(parts) < 2:
         raise _fail(nomenclature, "too few parts")
     band = parts[0].upper()
@@ -145,67 +197,42 @@ def sheet_bounds(nomenclature: str) -> SheetBounds:
         raise _fail(nomenclature, f"column {column} is outside 1–60")
     south = Fraction(4 * _BAND_LETTERS.index(band))
     west = Fraction(6 * (column - 31))
-    height, width = Fraction(4), Fraction(6)
     zone = column - 30 if column > 30 else column + 30
-    scale = 1_000_000
-    rest = parts[2:]
+    return _Frame(nomenclature, south, west, Fraction(4), Fraction(6), 1_000_000), zone
 
-    def take_quarter(part: str, table: dict[str, int], new_scale: int):
-        nonlocal south, west, height, width, scale
-        if part not in table:
-            raise _fail(
-                nomenclature,
-                f"{part!r} is not one of {'/'.join(table)} for 1:{new_scale:,}".replace(",", " "),
-            )
-        south, west, height, width = _part(south, west, height, width, 2, 2, table[part])
-        scale = new_scale
 
-    if rest:
-        first = rest.pop(0)
-        roman = _roman(first)
-        if first in _QUARTERS_UPPER and not rest:
-            take_quarter(first, _QUARTERS_UPPER, 500_000)
-        elif roman is not None and not rest:
-            if not 1 <= roman <= 36:
-                raise _fail(nomenclature, f"1:200 000 part {first} is outside I–XXXVI")
-            south, west, height, width = _part(south, west, height, width, 6, 6, roman - 1)
-            scale = 200_000
-        else:
-            if not first.isdigit() or not 1 <= int(first) <= 144:
-                raise _fail(nomenclature, f"1:100 000 part {first!r} is not a number 1–144")
-            south, west, height, width = _part(south, west, height, width, 12, 12, int(first) - 1)
-            scale = 100_000
-    if rest and rest[0].startswith("("):
-        m = re.fullmatch(r"\((\d+)(?:-(\w+))?\)", rest.pop(0))
-        if m is None or not 1 <= int(m.group(1)) <= 256 or rest:
-            raise _fail(
-                nomenclature,
-                "1:5 000 part must be '(n)' with n in 1–256, or '(n-x)' for 1:2 000, and come last",
-            )
-        south, west, height, width = _part(south, west, height, width, 16, 16, int(m.group(1)) - 1)
-        scale = 5_000
-        if m.group(2) is not None:
-            if m.group(2) not in _NINTHS:
-                raise _fail(nomenclature, f"1:2 000 part {m.group(2)!r} is not one of а–и")
-            south, west, height, width = _part(
-                south, west, height, width, 3, 3, _NINTHS[m.group(2)]
-            )
-            scale = 2_000
-    if rest and scale == 100_000:
-        take_quarter(rest.pop(0), _QUARTERS_UPPER, 50_000)
-    if rest and scale == 50_000:
-        take_quarter(rest.pop(0), _QUARTERS_LOWER, 25_000)
-    if rest and scale == 25_000:
-        part = rest.pop(0)
-        if part not in {"1", "2", "3", "4"}:
-            raise _fail(nomenclature, f"1:10 000 part {part!r} is not one of 1/2/3/4")
-        south, west, height, width = _part(south, west, height, width, 2, 2, int(part) - 1)
-        scale = 10_000
-    if rest:
-        raise _fail(nomenclature, f"unexpected part {rest[0]!r} after the 1:{scale} sheet")
-    return SheetBounds(
-        text, scale, float(south), float(south + height), float(west), float(west + width), zone
-    )
+def _second_part(frame: _Frame, rest: list[str]) -> None:
+    """The part after the column: 1:500 000 (А–Г alone), 1:200 000 (I–XXXVI alone) or
+    1:100 000 (1–144); consumed from ``rest``."""
+    nomenclature = frame.nomenclature
+    first = rest.pop(0)
+    roman = _roman(first)
+    if first in _QUARTERS_UPPER and not rest:
+        frame.quarter(first, _QUARTERS_UPPER, 500_000)
+    elif roman is not None and not rest:
+        if not 1 <= roman <= 36:
+            raise _fail(nomenclature, f"1:200 000 part {first} is outside I–XXXVI")
+        frame.divide(6, 6, roman - 1, 200_000)
+    else:
+        if not first.isdigit() or not 1 <= int(first) <= 144:
+            raise _fail(nomenclature, f"1:100 000 part {first!r} is not a number 1–144")
+        frame.divide(12, 12, int(first) - 1, 100_000)
+
+
+def _plan_parts(frame: _Frame, rest: list[str]) -> None:
+    """The last part "(n)" (1:5 000) or "(n-x)" (1:2 000); consumed from ``rest``."""
+    nomenclature = frame.nomenclature
+    m = re.fullmatch(r"\((\d+)(?:-(\w+))?\)", rest.pop(0))
+    if m is None or not 1 <= int(m.group(1)) <= 256 or rest:
+        raise _fail(
+            nomenclature,
+            "1:5 000 part must be '(n)' with n in 1–256, or '(n-x)' for 1:2 000, and come last",
+        )
+    frame.divide(16, 16, int(m.group(1)) - 1, 5_000)
+    if m.group(2) is not None:
+        if m.group(2) not in _NINTHS:
+            raise _fail(nomenclature, f"1:2 000 part {m.group(2)!r} is not one of а–и")
+        frame.divide(3, 3, _NINTHS[m.group(2)], 2_000)
 
 
 def zone_of_longitude(longitude_deg: float) -> int:

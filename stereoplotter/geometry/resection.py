@@ -227,6 +227,7 @@ def _model_and_jacobian(
     return xy, np.stack([jx, jy], axis=1)
 
 
+# long: the docstring (parameters, Eqs. (3.6)–(3.11), a Table 7 example) is 70 lines; code ~27
 def space_resection(
     photo_mm: ArrayLike,
     points_m: ArrayLike,
@@ -305,34 +306,11 @@ def space_resection(
     if not f > 0.0:
         raise GeometryError(f"focal_length_mm must be positive, got {focal_length_mm!r}")
     pp = np.asarray(principal_point_mm, dtype=float)
-    if initial is None:
-        params = initial_exterior_orientation(photo, points, f, pp)
-    else:
-        params = np.asarray(initial, dtype=float).copy()
-        if params.shape != (6,):
-            raise GeometryError(
-                f"initial must be (alpha, omega, kappa, X_S, Y_S, Z_S), got shape {params.shape}"
-            )
-    n = photo.shape[0]
+    params = _initial_params(photo, points, f, pp, initial)
     converged = False
     iterations = 0
     for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported after the loop)
-        computed, jac = _model_and_jacobian(params, points, f, pp)
-        v = (photo - computed).reshape(-1)
-        a = jac.reshape(-1, 6)
-        # Column scaling: angles (rad) and positions (m) differ by orders of magnitude.
-        scale = np.sqrt(np.sum(a**2, axis=0))
-        if np.any(scale == 0.0):
-            raise GeometryError("the Jacobian has a zero column: the geometry fixes no element")
-        a_scaled = a / scale
-        s = np.linalg.svd(a_scaled, compute_uv=False)
-        if s[-1] <= 1e-10 * s[0]:
-            raise GeometryError(
-                "the normal equations are singular (condition "
-                f"{s[0] / s[-1]:.3g}): the control points do not determine all six elements"
-            )
-        delta_scaled, *_ = np.linalg.lstsq(a_scaled, v, rcond=None)
-        delta = delta_scaled / scale
+        delta = _gauss_newton_step(params, photo, points, f, pp)
         params = params + delta  # Eq. (3.7)
         if np.all(np.abs(delta[:3]) <= angle_tolerance) and np.all(
             np.abs(delta[3:]) <= position_tolerance_m
@@ -346,6 +324,44 @@ def space_resection(
             f"{np.abs(delta[3:]).max():.3g} m); give a better `initial` or check the point "
             "identification"
         )
+    return _resection_result(params, photo, points, f, pp, iterations, converged)
+
+
+def _initial_params(photo, points, f, pp, initial) -> NDArray[np.float64]:
+    """The starting (α, ω, κ, X_S, Y_S, Z_S): ``initial`` checked, or the vertical-photo guess."""
+    if initial is None:
+        return initial_exterior_orientation(photo, points, f, pp)
+    params = np.asarray(initial, dtype=float).copy()
+    if params.shape != (6,):
+        raise GeometryError(
+            f"initial must be (alpha, omega, kappa, X_S, Y_S, Z_S), got shape {params.shape}"
+        )
+    return params
+
+
+def _gauss_newton_step(params, photo, points, f, pp) -> NDArray[np.float64]:
+    """The least-squares correction of the linearised system (3.6) at ``params``."""
+    computed, jac = _model_and_jacobian(params, points, f, pp)
+    v = (photo - computed).reshape(-1)
+    a = jac.reshape(-1, 6)
+    # Column scaling: angles (rad) and positions (m) differ by orders of magnitude.
+    scale = np.sqrt(np.sum(a**2, axis=0))
+    if np.any(scale == 0.0):
+        raise GeometryError("the Jacobian has a zero column: the geometry fixes no element")
+    a_scaled = a / scale
+    s = np.linalg.svd(a_scaled, compute_uv=False)
+    if s[-1] <= 1e-10 * s[0]:
+        raise GeometryError(
+            "the normal equations are singular (condition "
+            f"{s[0] / s[-1]:.3g}): the control points do not determine all six elements"
+        )
+    delta_scaled, *_ = np.linalg.lstsq(a_scaled, v, rcond=None)
+    return delta_scaled / scale
+
+
+def _resection_result(params, photo, points, f, pp, iterations, converged) -> ResectionResult:
+    """Residuals and precision (Eqs. (3.10)–(3.11)) at the final ``params``."""
+    n = photo.shape[0]
     # Re-express the angles in their principal range via the matrix (α, κ in (−π, π]).
     alpha, omega, kappa = (float(t) for t in angles_from_matrix(rotation_matrix(*params[:3])))
     params[:3] = (alpha, omega, kappa)

@@ -137,6 +137,7 @@ class LineCoefficients:
     free_term: NDArray[np.float64]
 
 
+# long: the docstring (Eqs. (3.23)–(3.24) and a Table 8 example) is 65 lines; code ~28
 def line_coefficients(
     photo_mm: ArrayLike,
     points_m: ArrayLike,

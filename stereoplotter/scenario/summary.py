@@ -43,25 +43,7 @@ def summarize_scenario(scenario: Scenario) -> dict[str, Any]:
     z_mean = float(pts[:, 2].mean())
     grid = working_area_grid_m(scenario, (15, 15))
     terrain_z = grid[:, 2] if len(grid) else pts[:, 2]
-    photos = []
-    for photo in scenario.photos:
-        ext = photo.exterior
-        height = ext.projection_centre_m[2] - z_mean
-        imaged = _imaged(scenario, photo, pts)
-        photos.append(
-            {
-                "name": photo.name,
-                "projection_centre_m": [_r(v) for v in ext.projection_centre_m],
-                "alpha_deg": _r(math.degrees(ext.alpha), 4),
-                "omega_deg": _r(math.degrees(ext.omega), 4),
-                "kappa_deg": _r(math.degrees(ext.kappa), 4),
-                "exterior_source": ext.source,
-                "flying_height_m": _r(height, 1),
-                "photo_scale_denominator": _r(height * MM_PER_M / cam.focal_length_mm, 0),
-                "film_deformation_ppm": list(photo.film_deformation_ppm),
-                "points_imaged": int(imaged.sum()),
-            }
-        )
+    photos = [_photo_summary(scenario, photo, pts, z_mean) for photo in scenario.photos]
     flying_height = float(np.mean([p["flying_height_m"] for p in photos]))
     relief = float(terrain_z.max() - terrain_z.min())
     summary: dict[str, Any] = {
@@ -95,22 +77,7 @@ def summarize_scenario(scenario: Scenario) -> dict[str, Any]:
         },
     }
     if scenario.is_stereopair:
-        left, right = scenario.photos
-        b = right.exterior.centre - left.exterior.centre
-        horizontal = float(np.hypot(b[0], b[1]))
-        direction = b[:2] / horizontal
-        spans = []
-        for photo in (left, right):
-            along = footprint_m(scenario, photo, z_mean)[:, :2] @ direction
-            spans.append((along.min(), along.max()))
-        common = min(spans[0][1], spans[1][1]) - max(spans[0][0], spans[1][0])
-        summary["base"] = {
-            "components_m": [_r(v) for v in b],
-            "horizontal_m": _r(horizontal),
-            "azimuth_from_X_deg": _r(math.degrees(math.atan2(b[1], b[0])), 4),
-            "base_to_height": _r(horizontal / flying_height, 4),
-            "overlap_percent": _r(100.0 * max(common, 0.0) / (spans[0][1] - spans[0][0]), 1),
-        }
+        summary["base"] = _base_summary(scenario, z_mean, flying_height)
     if scenario.map_sheet is not None:
         sheet = scenario.map_sheet
         summary["map_sheet"] = {
@@ -119,3 +86,42 @@ def summarize_scenario(scenario: Scenario) -> dict[str, Any]:
             "corners_sk42_m": [[_r(v) for v in c] for c in sheet.corners_sk42_m],
         }
     return summary
+
+
+def _photo_summary(scenario: Scenario, photo, pts, z_mean: float) -> dict[str, Any]:
+    """One photo's entry of ``photos`` (see :func:`summarize_scenario`)."""
+    ext = photo.exterior
+    height = ext.projection_centre_m[2] - z_mean
+    imaged = _imaged(scenario, photo, pts)
+    return {
+        "name": photo.name,
+        "projection_centre_m": [_r(v) for v in ext.projection_centre_m],
+        "alpha_deg": _r(math.degrees(ext.alpha), 4),
+        "omega_deg": _r(math.degrees(ext.omega), 4),
+        "kappa_deg": _r(math.degrees(ext.kappa), 4),
+        "exterior_source": ext.source,
+        "flying_height_m": _r(height, 1),
+        "photo_scale_denominator": _r(height * MM_PER_M / scenario.camera.focal_length_mm, 0),
+        "film_deformation_ppm": list(photo.film_deformation_ppm),
+        "points_imaged": int(imaged.sum()),
+    }
+
+
+def _base_summary(scenario: Scenario, z_mean: float, flying_height: float) -> dict[str, Any]:
+    """``base`` of a stereopair: components, B/H and the overlap on the plane Z_mean."""
+    left, right = scenario.photos
+    b = right.exterior.centre - left.exterior.centre
+    horizontal = float(np.hypot(b[0], b[1]))
+    direction = b[:2] / horizontal
+    spans = []
+    for photo in (left, right):
+        along = footprint_m(scenario, photo, z_mean)[:, :2] @ direction
+        spans.append((along.min(), along.max()))
+    common = min(spans[0][1], spans[1][1]) - max(spans[0][0], spans[1][0])
+    return {
+        "components_m": [_r(v) for v in b],
+        "horizontal_m": _r(horizontal),
+        "azimuth_from_X_deg": _r(math.degrees(math.atan2(b[1], b[0])), 4),
+        "base_to_height": _r(horizontal / flying_height, 4),
+        "overlap_percent": _r(100.0 * max(common, 0.0) / (spans[0][1] - spans[0][0]), 1),
+    }
