@@ -1,0 +1,44 @@
+"""List functions longer than a limit (default 80 lines, def to last line) via ``ast``.
+
+A function counts as justified when one of the two lines above its ``def`` (or its first
+decorator) is a comment starting ``# long:`` that says why.
+
+python benchmarks/long_functions.py stereoplotter/geometry stereoplotter/accuracy [--limit 80]
+"""
+
+import argparse
+import ast
+import pathlib
+
+
+def scan(paths, limit):
+    out = []
+    for root in paths:
+        p = pathlib.Path(root)
+        files = [p] if p.is_file() else sorted(p.rglob("*.py"))
+        for f in files:
+            text = f.read_text().splitlines()
+            for node in ast.walk(ast.parse("\n".join(text))):
+                if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                    n = node.end_lineno - node.lineno + 1
+                    if n > limit:
+                        top = min([node.lineno] + [d.lineno for d in node.decorator_list])
+                        above = text[max(0, top - 3) : top - 1]
+                        why = any(line.strip().startswith("# long:") for line in above)
+                        out.append((str(f), node.lineno, node.name, n, why))
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("paths", nargs="+")
+    ap.add_argument("--limit", type=int, default=80)
+    a = ap.parse_args()
+    rows = scan(a.paths, a.limit)
+    for f, ln, name, n, why in rows:
+        print(f"{f}:{ln}: {name} {n} lines" + ("  (justified)" if why else ""))
+    print(f"total {len(rows)}, unjustified {sum(not r[4] for r in rows)}")
+
+
+if __name__ == "__main__":
+    main()
