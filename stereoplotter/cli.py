@@ -491,20 +491,14 @@ def _simulate(args: argparse.Namespace) -> int:
 def _verify(args: argparse.Namespace) -> int:
     from stereoplotter.io.geometry_file import geometry_from_file
     from stereoplotter.progress import step_progress
-    from stereoplotter.report.verification import book_instrument, book_scenarios, verify
-    from stereoplotter.verification.table import run_procedure_mc
+    from stereoplotter.report.verification import run_procedure_mc, verify
 
     geometry, scenarios = None, None
     if args.geometry:
         geometry, scenarios = geometry_from_file(args.geometry)
-    elif args.procedure_trials:
-        scenarios = book_scenarios()  # the book's pair60/pair80
-    instrument = book_instrument() if scenarios and args.procedure_trials else None
     # the procedure MC once, shared by the table and the histograms
     with step_progress("procedure MC") as progress:
-        proc = run_procedure_mc(
-            args.procedure_trials, args.seed, scenarios, progress=progress, instrument=instrument
-        )
+        proc = run_procedure_mc(args.procedure_trials, args.seed, scenarios, progress=progress)
     with step_progress("verify") as progress:
         rows, seconds = verify(
             trials=args.trials,

@@ -14,6 +14,7 @@ from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.verification import linear_mc as mc
+from stereoplotter.verification import table
 from stereoplotter.verification.table import (
     PROCEDURE_TRIALS,
     ROW_KEYS,
@@ -21,7 +22,13 @@ from stereoplotter.verification.table import (
     run_verification,
 )
 
-__all__ = ["book_instrument", "book_scenarios", "verify", "write_verification"]
+__all__ = [
+    "book_instrument",
+    "book_scenarios",
+    "run_procedure_mc",
+    "verify",
+    "write_verification",
+]
 
 #: The book's §27 setting: the shipped scenarios of the procedure MC per overlap slot, and SC-1.
 BOOK_SCENARIOS = {"60": "pair60.yaml", "80": "pair80.yaml"}
@@ -40,6 +47,18 @@ def book_scenarios() -> dict:
 def book_instrument():
     """The instrument of the procedure MC, the book's SC-1 (``sc1``, by name as ever)."""
     return load_instrument(BOOK_INSTRUMENT)
+
+
+def run_procedure_mc(trials=PROCEDURE_TRIALS, seed=20240601, scenarios=None, progress=None):
+    """:func:`stereoplotter.verification.table.run_procedure_mc` with the files loaded here:
+    ``scenarios`` (loaded, "60"/"80" → Scenario or None) default to the book's
+    (:func:`book_scenarios`), the instrument is the book's SC-1 (:func:`book_instrument`)."""
+    if not trials:
+        return {}
+    if scenarios is None:
+        scenarios = book_scenarios()
+    instrument = book_instrument() if any(scenarios.values()) else None
+    return table.run_procedure_mc(trials, seed, scenarios, progress, instrument=instrument)
 
 
 def _fmt(v, digits=4):
