@@ -105,11 +105,12 @@ def check_number(
 
 
 def _bounds(low: float, high: float, low_open: bool, high_open: bool) -> dict[str, float]:
+    """JSON Schema keywords of a range (the check itself is :func:`check_number`)."""
     out: dict[str, float] = {}
     if math.isfinite(low):
-        out["gt" if low_open else "ge"] = low
+        out["exclusiveMinimum" if low_open else "minimum"] = low
     if math.isfinite(high):
-        out["lt" if high_open else "le"] = high
+        out["exclusiveMaximum" if high_open else "maximum"] = high
     return out
 
 
@@ -136,9 +137,8 @@ def number(
         float,
         BeforeValidator(check),
         Field(
-            allow_inf_nan=False,
             description=text or None,
-            **_bounds(low, high, low_open, high_open),
+            json_schema_extra=_bounds(low, high, low_open, high_open),
         ),
     ]
 
@@ -152,7 +152,9 @@ def integer(low: int, high: int, description: str = "") -> Any:
         return v
 
     return Annotated[
-        int, BeforeValidator(check), Field(ge=low, le=high, description=description or None)
+        int,
+        BeforeValidator(check),
+        Field(description=description or None, json_schema_extra={"minimum": low, "maximum": high}),
     ]
 
 
