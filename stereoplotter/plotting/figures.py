@@ -98,41 +98,51 @@ def plot_setup_sheet(sheet: Any, figure: Any = None) -> Any:
     -------
     matplotlib.figure.Figure
     """
-    from stereoplotter.report.sheet import sheet_to_dict
-
     fig = figure or plt.figure(figsize=(11.69, 8.27), layout="constrained")  # A4 landscape
     grid = fig.add_gridspec(2, 3, height_ratios=[1.0, 1.0], width_ratios=[1.1, 1.0, 1.0])
     ax_table = fig.add_subplot(grid[:, 0])
     ax_sheet = fig.add_subplot(grid[0, 1:])
     ax_left = fig.add_subplot(grid[1, 1])
     ax_right = fig.add_subplot(grid[1, 2])
-    d = sheet_to_dict(sheet)
     mark = " *" if any(sheet.assumed.values()) else ""
+
+    def r6(value: float) -> float:  # the 6-decimal rounding of sheet.yaml, then the format
+        return round(float(value), 6) + 0.0
+
+    bx, by, bz = (r6(v) for v in sheet.base_mm)
     rows = [
-        ("M_г", f"1:{d['scale_horizontal']}{mark}"),
-        ("M_в", f"1:{d['scale_vertical']}{mark}"),
-        ("f_пр, mm", f"{d['f_instrument_mm']:.3f}{mark}"),
-        ("k", f"{d['transformation_coefficient']:.5f}"),
-        ("b_x, mm", f"{d['base_mm']['bx']:.3f}{mark}"),
-        ("b_y, mm", f"{d['base_mm']['by']:.3f}{mark}"),
-        ("b_z′, mm", f"{d['base_mm']['bz']:.3f}{mark}"),
-        ("n_л", f"{d['n_left']:.5f}{mark}"),
-        ("n_п", f"{d['n_right']:.5f}{mark}"),
+        ("M_г", f"1:{sheet.horizontal_scale_denominator}{mark}"),
+        ("M_в", f"1:{sheet.vertical_scale_denominator}{mark}"),
+        ("f_пр, mm", f"{r6(sheet.f_instrument_mm):.3f}{mark}"),
+        ("k", f"{r6(sheet.transformation_coefficient):.5f}"),
+        ("b_x, mm", f"{bx:.3f}{mark}"),
+        ("b_y, mm", f"{by:.3f}{mark}"),
+        ("b_z′, mm", f"{bz:.3f}{mark}"),
+        ("n_л", f"{r6(sheet.n_left):.5f}{mark}"),
+        ("n_п", f"{r6(sheet.n_right):.5f}{mark}"),
     ]
-    for name, values in d["fiducials_transformed_mm"].items():
-        side = "л" if name == "left" else "п"
-        rows += [(f"({k[0]}⁰{k[1:]})_{side}, mm", f"{v:.3f}") for k, v in values.items()]
+    for photo in sheet.photos:
+        side = "л" if photo.name == "left" else "п"
+        rows += [
+            (f"({k[0]}⁰{k[1:]})_{side}, mm", f"{r6(v):.3f}")
+            for k, v in photo.transformed_book_mm.items()
+        ]
+    left, right = sheet.photos
     rows += [
-        ("L_л, mm", f"{d['L_mm']['left']:.3f}{mark}"),
-        ("L_п, mm", f"{d['L_mm']['right']:.3f}{mark}"),
+        ("L_л, mm", f"{r6(left.mark_span_mm):.3f}{mark}"),
+        ("L_п, mm", f"{r6(right.mark_span_mm):.3f}{mark}"),
     ]
-    for name, dec in d["decentrations_mm"].items():
-        side = "л" if name == "left" else "п"
-        rows.append((f"d_x, d_y {side}, mm", f"{dec['x']:.3f}, {dec['y']:.3f}"))
-    rows += [(f"Z_{pid}, mm", f"{z:.3f}{mark}") for pid, z in d["control_heights_model_mm"].items()]
+    for photo in sheet.photos:
+        side = "л" if photo.name == "left" else "п"
+        dx, dy = (r6(v) for v in photo.decentration_mm)
+        rows.append((f"d_x, d_y {side}, mm", f"{dx:.3f}, {dy:.3f}"))
     rows += [
-        (f"x′{c}, y′{c}, mm", f"{v['x']:.2f}, {v['y']:.2f}{mark}")
-        for c, v in d["sheet_corners_mm"].items()
+        (f"Z_{h['id']}, mm", f"{r6(h['model_height_mm']):.3f}{mark}")
+        for h in sheet.control_heights
+    ]
+    rows += [
+        (f"x′{c['corner']}, y′{c['corner']}, mm", f"{r6(c['x_mm']):.2f}, {r6(c['y_mm']):.2f}{mark}")
+        for c in sheet.corners
     ]
     ax_table.axis("off")
     table = ax_table.table(

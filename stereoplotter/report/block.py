@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 import os
 from pathlib import Path
 from typing import Any
@@ -14,8 +13,8 @@ import yaml
 from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.io.block_file import load_block
 from stereoplotter.io.yaml_files import atomic_write_text
-from stereoplotter.setup.block import X_MARK_NAME, BlockResult, compute_block
-from stereoplotter.setup.sheet import assumed_parameters
+from stereoplotter.report.sheet import setup_dict
+from stereoplotter.setup.block import BlockResult, compute_block
 
 __all__ = ["model_sheet", "run_block", "write_block"]
 
@@ -73,98 +72,11 @@ def run_block(
     return result
 
 
-def _num(value: float, digits: int = 6) -> float | None:
-    v = float(value)
-    return None if math.isnan(v) else round(v, digits) + 0.0  # + 0.0: no "-0.0" on the sheet
-
-
-def _int(value: float) -> int | None:
-    v = float(value)
-    return None if math.isnan(v) else round(v)
-
-
 def model_sheet(result: BlockResult, i: int) -> dict[str, Any]:
-    """The sheet of model ``i`` as plain data, with the keys of the single-pair ``--json``.
-
-    Parameters
-    ----------
-    result : BlockResult
-    i : int
-        Model index.
-
-    Returns
-    -------
-    dict
-        ``status`` ("ok" or "refused"), ``reason``, and the values of Eqs. (6.1)–(6.6) of [1]_
-        (None where refused). [mm, —]
-    """
-    ok = bool(result.accepted[i])
-    fid = result.fiducials_transformed_mm[i]
-    rig = result.fiducials_rigorous_mm[i]
-    photos = ("left", "right")
-    return {
-        "block": result.name,
-        "model": result.model_names[i],
-        "instrument": result.instrument,
-        "status": "ok" if ok else "refused",
-        "reason": result.reason(i),
-        "reason_code": int(result.reason_code[i]),
-        "assumed": {
-            key: list(params) for key, params in assumed_parameters(result.spec).items() if params
-        },
-        "scale_horizontal": _int(result.horizontal_scale_denominator[i]),
-        "scale_vertical": _int(result.vertical_scale_denominator[i]),
-        "scale_map": result.map_scale_denominator,
-        "f_instrument_mm": _num(result.f_instrument_mm[i]),
-        "transformation_coefficient": _num(result.transformation_coefficient[i]),
-        "focal_length_corrected_mm": _num(result.focal_length_corrected_mm),
-        "n_left": _num(result.n_left[i]),
-        "n_right": _num(result.n_right[i]),
-        "base_mm": dict(zip(("bx", "by", "bz"), map(_num, result.base_mm[i]), strict=True)),
-        "fiducials_transformed_mm": {
-            p: {
-                f"x{X_MARK_NAME[j]}": _num(fid[j, 0]),
-                "y3": _num(fid[j, 1]),
-                "y4": _num(fid[j, 2]),
-            }
-            for j, p in enumerate(photos)
-        },
-        "fiducials_rigorous_mm": {
-            p: {
-                key: [_num(rig[j, m, 0]), _num(rig[j, m, 1])]
-                for m, key in enumerate((X_MARK_NAME[j], "3", "4"))
-            }
-            for j, p in enumerate(photos)
-        },
-        "L_mm": {"left": _num(result.mark_span_mm[i, 0]), "right": _num(result.mark_span_mm[i, 1])},
-        "decentrations_mm": {
-            p: {
-                "x": _num(result.decentration_mm[i, j, 0]),
-                "y": _num(result.decentration_mm[i, j, 1]),
-            }
-            for j, p in enumerate(photos)
-        },
-        "angles_deg": {
-            p: {
-                a: _num(math.degrees(result.angles[i, j, m]), 7)
-                for m, a in enumerate(("alpha", "omega", "kappa"))
-            }
-            for j, p in enumerate(photos)
-        },
-        "control_heights_model_mm": {
-            pid: _num(result.control_heights_model_mm[i, j])
-            for j, pid in enumerate(result.height_point_ids[i])
-        },
-        "depth_range_used_mm": [_num(v, 3) for v in result.depth_range_mm[i]],
-        "frame": {
-            "rotation_deg": _num(math.degrees(result.frame_rotation[i]), 7),
-            "note": "the photogrammetric system is turned about Z by −rotation so that X runs "
-            "along the base, origin S_л (docs/setup-data.md)",
-        },
-        "options": {"book_sign_n_right": result.book_sign},
-        "not_in_block_mode": "sheet corners (6.7), similarity (6.8) and the model X, Y travel: "
-        "compute the single-pair sheet for them",
-    }
+    """The sheet of model ``i`` as plain data: :func:`stereoplotter.report.sheet.setup_dict`,
+    the keys of the single-pair ``--json`` (None where a block model has no value; the key
+    ``not_in_block_mode`` says why). ``status`` is "ok" or "refused", ``reason`` the refusal."""
+    return setup_dict(result, i)
 
 
 _CSV_OUT = (

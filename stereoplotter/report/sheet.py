@@ -1,8 +1,11 @@
 """The setup sheet as data (JSON/YAML) and as Markdown: Table 24 and the readings of each stage.
 
-Pure formatting of a :class:`~stereoplotter.setup.sheet.SetupSheet`; the figure is in
-``plotting.py``. Every value carries its unit, equation and, where it rests on an assumed
-instrument parameter, the list of those parameters (shown as ASSUMED).
+Pure formatting. :func:`setup_dict` is the one serialiser of a setup sheet, for the single-pair
+:class:`~stereoplotter.setup.sheet.SetupSheet` (:func:`sheet_to_dict`) and for a model of a block
+(:func:`stereoplotter.report.block.model_sheet`): the same keys, the block model holding None where
+it cannot have a value. The figure is in ``plotting/figures.py``. Every value carries its unit,
+equation and, where it rests on an assumed instrument parameter, the list of those parameters
+(shown as ASSUMED).
 """
 
 from __future__ import annotations
@@ -10,9 +13,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stereoplotter.setup.sheet import SetupSheet
+from stereoplotter.setup.sheet import SetupSheet, assumed_parameters
+from stereoplotter.setup.table24 import X_MARK_NAME, BlockResult, candidates_of
 
-__all__ = ["sheet_markdown", "sheet_to_dict"]
+__all__ = ["NOT_IN_BLOCK_MODE", "setup_dict", "sheet_markdown", "sheet_to_dict"]
 
 #: Unit, equation and meaning of each top-level value of the sheet.
 ANNOTATIONS: dict[str, tuple[str, str, str]] = {
@@ -34,139 +38,213 @@ ANNOTATIONS: dict[str, tuple[str, str, str]] = {
 }
 
 
-def _round(value: float, digits: int = 6) -> float:
-    return round(float(value), digits) + 0.0  # + 0.0 turns −0.0 into 0.0
+def _num(value: float, digits: int = 6) -> float | None:
+    v = float(value)
+    return None if math.isnan(v) else round(v, digits) + 0.0  # + 0.0 turns −0.0 into 0.0
 
 
-def sheet_to_dict(sheet: SetupSheet) -> dict[str, Any]:
-    """The sheet as plain data: the keys of the ``--json`` output and of ``sheet.yaml``."""
-    left, right = sheet.photos
-    fiducials = {
-        p.name: {k: _round(v) for k, v in p.transformed_book_mm.items()} for p in sheet.photos
+def _int(value: float) -> int | None:
+    v = float(value)
+    return None if math.isnan(v) else round(v)
+
+
+#: What a block model cannot have, and why (the keys are present, with the value None).
+NOT_IN_BLOCK_MODE = {
+    "scenario": "a block model is named by block and model",
+    "focal_length_corrected_per_photo_mm": "a block file has no measured fiducial spans",
+    "sheet_corners_mm": "(6.7) needs the map sheet and plan control of the model",
+    "similarity": "(6.8) needs the plan control of the model",
+    "readings": "the stage readings need the corners and the tolerances of a single-pair sheet",
+    "tolerances": "the control-height tolerance needs the working area of a single-pair sheet",
+    "exterior_orientation": "given in the block file",
+    "options.bz_scale_sense": "a single-pair option",
+    "model X, Y travel": "a block file gives no plan extent of the working area",
+}
+
+
+def setup_dict(table: BlockResult, i: int, sheet: SetupSheet | None = None) -> dict[str, Any]:
+    """Pair ``i`` of a Table 24 computation as plain data: the one serialiser of setup sheets.
+
+    Parameters
+    ----------
+    table : BlockResult
+        :func:`stereoplotter.setup.table24.compute_table24` of a block, or the block of one of a
+        single-pair sheet (``sheet.table24``).
+    i : int
+        The pair.
+    sheet : SetupSheet, optional
+        The single-pair sheet, for what only a sheet has (corners, similarity, readings,
+        tolerances, …); without it those keys hold None and ``not_in_block_mode`` says why.
+
+    Returns
+    -------
+    dict
+        The keys of ``sheet.yaml`` and of the ``--json`` output, the same for both. [mm, —, °]
+    """
+    ok = bool(table.accepted[i])
+    photos = ("left", "right")
+    fid, rig = table.fiducials_transformed_mm[i], table.fiducials_rigorous_mm[i]
+    assumed = sheet.assumed if sheet is not None else assumed_parameters(table.spec)
+    data: dict[str, Any] = {
+        "scenario": sheet.scenario if sheet is not None else None,
+        "block": None if sheet is not None else table.name,
+        "model": None if sheet is not None else table.model_names[i],
+        "instrument": table.instrument,
+        "instrument_title": table.spec.title,
+        "status": "ok" if ok else "refused",
+        "reason": table.reason(i),
+        "reason_code": int(table.reason_code[i]),
+        "scale_horizontal": _int(table.horizontal_scale_denominator[i]),
+        "scale_vertical": _int(table.vertical_scale_denominator[i]),
+        "scale_map": table.map_scale_denominator,
+        "f_instrument_mm": _num(table.f_instrument_mm[i]),
+        "transformation_coefficient": _num(table.transformation_coefficient[i]),
+        "focal_length_corrected_mm": _num(table.focal_length_corrected_mm),
+        "focal_length_corrected_per_photo_mm": None
+        if sheet is None
+        else [_num(v) for v in sheet.focal_length_corrected_per_photo_mm],
+        "n_left": _num(table.n_left[i]),
+        "n_right": _num(table.n_right[i]),
+        "base_mm": dict(zip(("bx", "by", "bz"), map(_num, table.base_mm[i]), strict=True)),
+        "fiducials_transformed_mm": {
+            p: {f"x{X_MARK_NAME[j]}": _num(fid[j, 0]), "y3": _num(fid[j, 1]), "y4": _num(fid[j, 2])}
+            for j, p in enumerate(photos)
+        },
+        "fiducials_rigorous_mm": {
+            p: {
+                key: [_num(rig[j, m, 0]), _num(rig[j, m, 1])]
+                for m, key in enumerate((X_MARK_NAME[j], "3", "4"))
+            }
+            for j, p in enumerate(photos)
+        },
+        "L_mm": dict(zip(photos, map(_num, table.mark_span_mm[i]), strict=True)),
+        "decentrations_mm": {
+            p: dict(zip("xy", map(_num, table.decentration_mm[i, j]), strict=True))
+            for j, p in enumerate(photos)
+        },
+        "correction_inclinations_deg": {
+            p: dict(
+                zip(
+                    ("alpha", "omega"),
+                    (_num(math.degrees(v)) for v in table.correction_inclination[i, j]),
+                    strict=True,
+                )
+            )
+            for j, p in enumerate(photos)
+        },
+        "angles_deg": {
+            p: {
+                a: _num(math.degrees(table.angles[i, j, m]), 7)
+                for m, a in enumerate(("alpha", "omega", "kappa"))
+            }
+            for j, p in enumerate(photos)
+        },
+        "control_heights_model_mm": {
+            pid: _num(table.control_heights_model_mm[i, j])
+            for j, pid in enumerate(table.height_point_ids[i])
+        },
+        **_single_pair_only(sheet),
+        "frame": {
+            "rotation_deg": _num(math.degrees(table.frame_rotation[i]), 7),
+            "origin_m": [_num(v, 4) for v in table.frame_origin_m[i]],
+            "note": "the photogrammetric system is moved to S_л and turned about Z by "
+            "−rotation so that X runs along the base (docs/setup-data.md)",
+        },
+        "exterior_orientation": None if sheet is None else list(sheet.exterior_sources),
+        "depth_range_used_mm": [_num(v, 3) for v in table.depth_range_mm[i]],
+        "scale_choice": _scale_choice(table, i),
+        "options": {
+            "book_sign_n_right": table.book_sign,
+            "bz_scale_sense": None if sheet is None else sheet.options.bz_scale_sense,
+        },
+        "assumed": {key: list(params) for key, params in assumed.items() if params},
+        "annotations": {
+            k: {"unit": u, "equation": e, "meaning": m, "assumed": bool(assumed.get(k))}
+            for k, (u, e, m) in ANNOTATIONS.items()
+        },
+        "not_in_block_mode": {} if sheet is not None else dict(NOT_IN_BLOCK_MODE),
     }
-    rigorous = {
-        p.name: {k: [_round(v[0]), _round(v[1])] for k, v in p.transformed_rigorous_mm.items()}
-        for p in sheet.photos
-    }
+    return data
+
+
+def _single_pair_only(sheet: SetupSheet | None) -> dict[str, Any]:
+    """Corners (6.7), similarity (6.8), readings and tolerances: None for a block model."""
+    if sheet is None:
+        return dict.fromkeys(("sheet_corners_mm", "similarity", "readings", "tolerances"))
     similarity = None
     if sheet.similarity is not None:
         fit = sheet.similarity
         similarity = {
             "a": fit.a,
             "b": fit.b,
-            "cx_m": _round(fit.cx_m, 4),
-            "cy_m": _round(fit.cy_m, 4),
+            "cx_m": _num(fit.cx_m, 4),
+            "cy_m": _num(fit.cy_m, 4),
             "scale": fit.scale,
             "determinant": fit.determinant,
-            "rms_m": _round(fit.rms_m, 4),
+            "rms_m": _num(fit.rms_m, 4),
             "redundancy": fit.redundancy,
             "residuals_m": {
-                pid: [_round(r[0], 4), _round(r[1], 4)]
+                pid: [_num(r[0], 4), _num(r[1], 4)]
                 for pid, r in zip(sheet.similarity_point_ids, fit.residuals_m, strict=True)
             },
             "frame": "photogrammetric X, Y rotated so that X runs along the base, origin S_л",
         }
-    assumed = {key: list(params) for key, params in sheet.assumed.items() if params}
-    data: dict[str, Any] = {
-        "scenario": sheet.scenario,
-        "instrument": sheet.instrument,
-        "instrument_title": sheet.instrument_title,
-        "scale_horizontal": sheet.horizontal_scale_denominator,
-        "scale_vertical": sheet.vertical_scale_denominator,
-        "scale_map": sheet.map_scale_denominator,
-        "f_instrument_mm": _round(sheet.f_instrument_mm),
-        "transformation_coefficient": _round(sheet.transformation_coefficient),
-        "focal_length_corrected_mm": _round(sheet.focal_length_corrected_mm),
-        "focal_length_corrected_per_photo_mm": [
-            _round(v) for v in sheet.focal_length_corrected_per_photo_mm
-        ],
-        "n_left": _round(sheet.n_left),
-        "n_right": _round(sheet.n_right),
-        "base_mm": dict(zip(("bx", "by", "bz"), (_round(v) for v in sheet.base_mm), strict=True)),
-        "fiducials_transformed_mm": fiducials,
-        "fiducials_rigorous_mm": rigorous,
-        "L_mm": {"left": _round(left.mark_span_mm), "right": _round(right.mark_span_mm)},
-        "decentrations_mm": {
-            p.name: {"x": _round(p.decentration_mm[0]), "y": _round(p.decentration_mm[1])}
-            for p in sheet.photos
-        },
-        "correction_inclinations_deg": {
-            p.name: {
-                "alpha": _round(math.degrees(p.correction_inclination[0])),
-                "omega": _round(math.degrees(p.correction_inclination[1])),
-            }
-            for p in sheet.photos
-        },
-        "angles_deg": {
-            p.name: {
-                "alpha": _round(math.degrees(p.alpha), 7),
-                "omega": _round(math.degrees(p.omega), 7),
-                "kappa": _round(math.degrees(p.kappa), 7),
-            }
-            for p in sheet.photos
-        },
-        "control_heights_model_mm": {
-            h["id"]: _round(h["model_height_mm"]) for h in sheet.control_heights
-        },
+    return {
         "sheet_corners_mm": {
             c["corner"]: {
                 "position": c["position"],
-                "x": _round(c["x_mm"]),
-                "y": _round(c["y_mm"]),
-                "x_book_form": _round(c["x_book_form_mm"]),
-                "y_book_form": _round(c["y_book_form_mm"]),
+                "x": _num(c["x_mm"]),
+                "y": _num(c["y_mm"]),
+                "x_book_form": _num(c["x_book_form_mm"]),
+                "y_book_form": _num(c["y_book_form_mm"]),
             }
             for c in sheet.corners
         },
         "similarity": similarity,
         "readings": [
-            {k: (_round(v) if isinstance(v, float) else v) for k, v in r.items()}
+            {k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()}
             for r in sheet.readings
         ],
-        "tolerances": {k: _round(v) for k, v in sheet.tolerances.items()},
-        "frame": {
-            "rotation_deg": _round(math.degrees(sheet.frame_rotation), 7),
-            "origin_m": [_round(v, 4) for v in sheet.frame_origin_m],
-            "note": "the photogrammetric system is moved to S_л and turned about Z by "
-            "−rotation so that X runs along the base (docs/setup-data.md)",
-        },
-        "exterior_orientation": list(sheet.exterior_sources),
-        "depth_range_used_mm": [_round(v, 3) for v in sheet.depth_range_used_mm],
-        "scale_choice": {
-            "chosen": [sheet.horizontal_scale_denominator, sheet.vertical_scale_denominator],
-            "feasible": [[c.horizontal, c.vertical] for c in sheet.candidates if c.feasible],
-            "refused_larger_scales": _refused_larger_scales(sheet),
-        },
-        "options": {
-            "book_sign_n_right": sheet.options.book_sign_n_right,
-            "bz_scale_sense": sheet.options.bz_scale_sense,
-        },
-        "assumed": assumed,
-        "annotations": {
-            k: {"unit": u, "equation": e, "meaning": m, "assumed": bool(sheet.assumed.get(k))}
-            for k, (u, e, m) in ANNOTATIONS.items()
-        },
+        "tolerances": {k: _num(v) for k, v in sheet.tolerances.items()},
     }
-    return data
 
 
-def _refused_larger_scales(sheet: SetupSheet) -> list[dict[str, Any]]:
-    """For every horizontal scale larger than the chosen one, its closest M_в and why it fails."""
+def sheet_to_dict(sheet: SetupSheet) -> dict[str, Any]:
+    """The sheet as plain data: the keys of the ``--json`` output and of ``sheet.yaml``
+    (:func:`setup_dict` of its block of one)."""
+    if sheet.table24 is None:
+        raise ValueError("sheet_to_dict: expected a sheet from compute_setup_sheet")
+    return setup_dict(sheet.table24, 0, sheet)
+
+
+def _scale_choice(table: BlockResult, i: int) -> dict[str, Any]:
+    """The chosen (M_г, M_в), the feasible ones, and for every horizontal scale larger than the
+    chosen one (every one, for a refused pair) its closest M_в and why it fails."""
+    candidates = candidates_of(table, i)
+    chosen = [
+        _int(table.horizontal_scale_denominator[i]),
+        _int(table.vertical_scale_denominator[i]),
+    ]
+    limit = chosen[0] if chosen[0] is not None else math.inf
     rows = []
-    for mg in sorted({c.horizontal for c in sheet.candidates}):
-        if mg >= sheet.horizontal_scale_denominator:
+    for mg in sorted({c.horizontal for c in candidates}):
+        if mg >= limit:
             break
-        options = [c for c in sheet.candidates if c.horizontal == mg]
-        best = min(options, key=lambda c: (len(c.reasons), c.vertical))
+        same = [c for c in candidates if c.horizontal == mg]
+        best = min(same, key=lambda c: (len(c.reasons), c.vertical))
         rows.append(
             {
                 "horizontal": mg,
                 "closest_vertical": best.vertical,
-                "f_instrument_mm": _round(best.f_instrument_mm, 3),
+                "f_instrument_mm": _num(best.f_instrument_mm, 3),
                 "fails": list(best.reasons),
             }
         )
-    return rows
+    return {
+        "chosen": chosen,
+        "feasible": [[c.horizontal, c.vertical] for c in candidates if c.feasible],
+        "refused_larger_scales": rows,
+    }
 
 
 def _fmt(value: float, digits: int = 3) -> str:
