@@ -99,6 +99,8 @@ def prepare_block_arrays(
     return f, marks, centres, angles, terrain, heights
 
 
+# Over 80 lines by its numpydoc docstring and doctest alone; the body checks the arguments and
+# makes one call to compute_table24.
 def compute_block(
     focal_length_corrected_mm: float,
     fiducials_mm: ArrayLike,

@@ -58,6 +58,8 @@ def _r(
     return row
 
 
+# Over 80 lines: a table of reading rows in the order the operator sets them (one _r call a row);
+# splitting it by stage would scatter the order the sheet prints.
 def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
     """All readings of stages 1–5 for a sheet, in the order the operator sets them.
 

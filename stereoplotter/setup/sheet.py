@@ -289,6 +289,8 @@ def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[
 # --- the computation ----------------------------------------------------------------------------
 
 
+# Over 80 lines: after the one compute_table24 call the rest is the SetupSheet constructor (28
+# named fields); the steps that compute something are the helpers above.
 def compute_setup_sheet(
     scenario: Scenario,
     spec: InstrumentSpec,
