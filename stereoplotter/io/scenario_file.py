@@ -16,6 +16,7 @@ from pydantic import BeforeValidator, ConfigDict, Field, field_validator, model_
 
 from stereoplotter.errors import StereoplotterError, describe_value
 from stereoplotter.geometry.collinearity import object_to_photo
+from stereoplotter.io.paths import resolve_data_file
 from stereoplotter.io.validation import (
     FileModel,
     _fail,
@@ -69,7 +70,8 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     Parameters
     ----------
     path : str or path-like
-        A ``scenarios/*.yaml`` file.
+        A scenario YAML file, or the name of a shipped or user scenario (``"pair60"``,
+        :func:`stereoplotter.io.paths.resolve_data_file`).
 
     Returns
     -------
@@ -80,7 +82,7 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     ConfigError
         With the file, field, expected and found values in the message.
     """
-    data, source = load_yaml_mapping(path)
+    data, source = load_yaml_mapping(resolve_data_file("scenarios", path))
     return scenario_from_mapping(data, source)
 
 
