@@ -30,7 +30,7 @@ from stereoplotter.geometry.similarity import (
 )
 from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
 from stereoplotter.scenario.exterior import known_exterior_orientation
-from stereoplotter.scenario.model import Scenario
+from stereoplotter.scenario.model import MapSheet, Point, Scenario
 from stereoplotter.scenario.synthetic import (
     synthesize_measurements,
     working_area_grid_m,
@@ -68,6 +68,7 @@ __all__ = [
     "SetupSheet",
     "assumed_parameters",
     "compute_setup_sheet",
+    "compute_sheet_from_measurements",
     "instrument_frame_m",
 ]
 
@@ -123,8 +124,7 @@ def instrument_frame_m(
     return (np.asarray(points_m, float) - origin) @ rotation_z(-frame_rotation).T
 
 
-def _sheet_corners_gk(scenario: Scenario) -> NDArray:
-    sheet = scenario.map_sheet
+def _sheet_corners_gk(sheet: MapSheet) -> NDArray:
     return np.array([sheet.corners_sk42_m[CORNER_ORDER[k]] for k in ("1", "2", "3", "4")])
 
 
@@ -231,21 +231,21 @@ def _photo_setups(table: BlockResult, marks_mm: NDArray) -> tuple[PhotoSetup, ..
 
 
 def _plan_control(
-    scenario: Scenario, points_m: NDArray
+    points: tuple[Point, ...], map_sheet: MapSheet | None, points_m: NDArray
 ) -> tuple[SimilarityFit | None, list[int], NDArray | None, NDArray]:
     """(6.8): the similarity from Gauss–Krüger to the instrument frame over the plan control, and
     the sheet corners on the ground (empty without a map sheet or two plan points)."""
-    corners_gk = _sheet_corners_gk(scenario) if scenario.map_sheet is not None else None
+    corners_gk = _sheet_corners_gk(map_sheet) if map_sheet is not None else None
     plan = [
         i
-        for i, p in enumerate(scenario.points)
+        for i, p in enumerate(points)
         if p.role == "control" and p.kind in ("full", "plan") and p.sk42_m is not None
     ]
     fit = None
     corners_m = np.zeros((0, 2))
     if corners_gk is not None and len(plan) >= 2:
-        north = np.array([scenario.points[i].sk42_m[0] for i in plan])
-        east = np.array([scenario.points[i].sk42_m[1] for i in plan])
+        north = np.array([points[i].sk42_m[0] for i in plan])
+        east = np.array([points[i].sk42_m[1] for i in plan])
         fit = fit_similarity_with_reflection(north, east, points_m[plan, 0], points_m[plan, 1])
         corners_m = apply_similarity(fit, corners_gk[:, 0], corners_gk[:, 1])  # (6.8), ground m
     return fit, plan, corners_gk, corners_m
@@ -289,8 +289,6 @@ def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[
 # --- the computation ----------------------------------------------------------------------------
 
 
-# Over 80 lines: after the one compute_table24 call the rest is the SetupSheet constructor (28
-# named fields); the steps that compute something are the helpers above.
 def compute_setup_sheet(
     scenario: Scenario,
     spec: InstrumentSpec,
@@ -329,31 +327,100 @@ def compute_setup_sheet(
     rng = np.random.default_rng(scenario.seed) if rng is None else rng
     measurements = synthesize_measurements(scenario, rng)
     known = known_exterior_orientation(scenario, measurements)
-    centres = np.array([[k.centre_m for k in known]])  # (1, 2, 3)
-    rotations = np.array([[k.rotation for k in known]])  # (1, 2, 3, 3)
+    marks = np.array(
+        [measurements.photo(n).fiducials_mm for n in ("left", "right")]
+    ) - np.asarray(scenario.camera.principal_point_mm, float)
+    return compute_sheet_from_measurements(
+        name=scenario.name,
+        source=scenario.source,
+        spec=spec,
+        options=options,
+        focal_length_corrected_mm=measurements.focal_length_corrected_mm,
+        focal_length_corrected_per_photo_mm=measurements.focal_length_corrected_per_photo_mm,
+        marks_mm=marks,
+        centres_m=np.array([k.centre_m for k in known]),
+        rotations=np.array([k.rotation for k in known]),
+        points=scenario.points,
+        working_area_m=working_area_grid_m(scenario, (15, 15)),
+        map_sheet=scenario.map_sheet,
+        exterior_sources=tuple(p.exterior.source for p in scenario.photos),
+    )
+
+
+# Over 80 lines: after the one compute_table24 call the rest is the SetupSheet constructor (28
+# named fields); the steps that compute something are the helpers above.
+def compute_sheet_from_measurements(
+    *,
+    name: str,
+    source: str,
+    spec: InstrumentSpec,
+    options: SetupOptions,
+    focal_length_corrected_mm: float,
+    focal_length_corrected_per_photo_mm: tuple[float, ...],
+    marks_mm: NDArray,
+    centres_m: NDArray,
+    rotations: NDArray,
+    points: tuple[Point, ...],
+    working_area_m: NDArray,
+    map_sheet: MapSheet | None,
+    exterior_sources: tuple[str, ...],
+) -> SetupSheet:
+    """The setup sheet of one stereopair from what was measured, not from a ground truth.
+
+    :func:`compute_setup_sheet` calls it with the synthetic measurements of a scenario; a
+    production job (``stereoplotter.io.job_file``) with the measured fiducial spans and the
+    exterior orientation of the aerotriangulation. No random numbers: the same inputs give the
+    same sheet.
+
+    Parameters
+    ----------
+    name, source : str
+        The pair's name (``SetupSheet.scenario``) and the file named in refusals.
+    spec : InstrumentSpec
+    options : SetupOptions
+    focal_length_corrected_mm : float
+        f′ of the pair. [mm]
+    focal_length_corrected_per_photo_mm : tuple of float
+        f′ of each photo. [mm]
+    marks_mm : ndarray, shape (2, 4, 2)
+        Measured marks 1–4 of the left and right photo, relative to the principal point. [mm]
+    centres_m : ndarray, shape (2, 3)
+        S_л, S_п in the photogrammetric frame. [m]
+    rotations : ndarray, shape (2, 3, 3)
+        M of Eq. (2.50) of the left and right photo in that frame. [—]
+    points : tuple of Point
+        Control and check points of the pair (``local_m`` in the same frame; ``sk42_m`` for
+        the plan control of (6.8)).
+    working_area_m : ndarray, shape (g, 3)
+        Ground samples of the working area (with the points: the depth range and the plan
+        extent of the model). [m]
+    map_sheet : MapSheet or None
+    exterior_sources : tuple of str
+        Where each photo's exterior orientation came from (printed on the sheet).
+    """
+    centres = np.asarray(centres_m, float)[None]  # (1, 2, 3)
+    rotations = np.asarray(rotations, float)[None]  # (1, 2, 3, 3)
     theta = float(instrument_frames(centres, rotations)[0][0])
-    points_m = instrument_frame_m([p.local_m for p in scenario.points], centres[0, 0], theta)
-    grid_m = instrument_frame_m(working_area_grid_m(scenario, (15, 15)), centres[0, 0], theta)
+    points_m = instrument_frame_m(
+        np.array([p.local_m for p in points], float).reshape(-1, 3), centres[0, 0], theta
+    )
+    grid_m = instrument_frame_m(working_area_m, centres[0, 0], theta)
     ground = np.vstack([grid_m, points_m])
     depths_m = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
-    fit, plan, corners_gk, corners_m = _plan_control(scenario, points_m)
+    fit, plan, corners_gk, corners_m = _plan_control(points, map_sheet, points_m)
     offsets_m = np.vstack([ground[:, :2], corners_m])
-    map_scale = scenario.map_sheet.scale_denominator if scenario.map_sheet else None
+    map_scale = map_sheet.scale_denominator if map_sheet else None
     if map_scale is None and options.horizontal_scale_denominator is None:
         raise SetupRefusal(
-            f"{scenario.source}: map_sheet: expected a map sheet, whose scale chooses the "
+            f"{source}: map_sheet: expected a map sheet, whose scale chooses the "
             "horizontal model scale M_г from the coordinatograph gears, found nothing (or force "
             "M_г with --horizontal-scale)"
         )
-    heights = [
-        p for p in scenario.points if p.role == "control" and p.kind in ("full", "height")
-    ]
-    marks = np.array(
-        [[measurements.photo(n).fiducials_mm for n in ("left", "right")]]
-    ) - np.asarray(scenario.camera.principal_point_mm, float)
+    heights = [p for p in points if p.role == "control" and p.kind in ("full", "height")]
+    marks = np.asarray(marks_mm, float)[None]
     extent = np.array([[[offsets_m[:, j].min(), offsets_m[:, j].max()] for j in (0, 1)]])
     table = compute_table24(
-        measurements.focal_length_corrected_mm,
+        focal_length_corrected_mm,
         marks,
         centres,
         rotations,
@@ -364,9 +431,9 @@ def compute_setup_sheet(
         extent_m=extent,
         map_scale_denominator=map_scale,
         book_sign=options.book_sign_n_right,
-        model_names=(scenario.name,),
+        model_names=(name,),
         height_point_ids=(tuple(p.id for p in heights),),
-        name=scenario.name,
+        name=name,
     )
     if int(table.reason_code[0]) & SCALE_FLAGS:
         _refuse_scales(table, extent)
@@ -374,13 +441,13 @@ def compute_setup_sheet(
     mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
     n_left = float(table.n_left[0])
     sheet = SetupSheet(
-        scenario=scenario.name,
+        scenario=name,
         instrument=spec.key,
         instrument_title=spec.title,
         frame_rotation=float(table.frame_rotation[0]),
         frame_origin_m=tuple(float(v) for v in table.frame_origin_m[0]),
         focal_length_corrected_mm=table.focal_length_corrected_mm,
-        focal_length_corrected_per_photo_mm=measurements.focal_length_corrected_per_photo_mm,
+        focal_length_corrected_per_photo_mm=tuple(focal_length_corrected_per_photo_mm),
         map_scale_denominator=map_scale,
         horizontal_scale_denominator=mg,
         vertical_scale_denominator=mv,
@@ -400,7 +467,7 @@ def compute_setup_sheet(
             for p, z in zip(heights, table.control_heights_model_mm[0], strict=True)
         ),  # (6.6)
         similarity=fit,
-        similarity_point_ids=tuple(scenario.points[i].id for i in plan),
+        similarity_point_ids=tuple(points[i].id for i in plan),
         corners=_corners(fit, corners_gk, mg, n_left),
         readings=(),
         tolerances=_tolerances(spec, n_left, depths_m),
@@ -408,7 +475,7 @@ def compute_setup_sheet(
         assumed=assumed_parameters(spec),
         options=options,
         depth_range_used_mm=tuple(float(v) for v in table.depth_range_mm[0]),
-        exterior_sources=tuple(p.exterior.source for p in scenario.photos),
+        exterior_sources=tuple(exterior_sources),
         points_model_mm=tuple(
             {
                 "id": p.id,
@@ -417,7 +484,7 @@ def compute_setup_sheet(
                 "x_mm": float(points_m[i, 0] * MM_PER_M / mg),
                 "y_mm": float(points_m[i, 1] * MM_PER_M / mg),
             }
-            for i, p in enumerate(scenario.points)
+            for i, p in enumerate(points)
         ),
         table24=table,
     )
