@@ -14,18 +14,23 @@ import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Annotated, Any
 
 import yaml
+from pydantic import BeforeValidator, ConfigDict, Field, WithJsonSchema, create_model
+from pydantic import model_validator as _model_validator
+from pydantic_core import PydanticCustomError
 
-from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.errors import ConfigError, StereoplotterError, describe_value, did_you_mean
 from stereoplotter.instrument.spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
 from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
-from stereoplotter.io.yaml_files import Fields, describe_value, did_you_mean, load_yaml_mapping
+from stereoplotter.io.validation import FileModel, _bounds, _fail, check_number, text, validate
+from stereoplotter.io.yaml_files import load_yaml_mapping
 
-__all__ = ["instrument_from_mapping", "list_instruments", "load_instrument"]
+__all__ = ["InstrumentFile", "instrument_from_mapping", "list_instruments", "load_instrument"]
 
 _LEAF_KEYS = ("value", "status", "src", "basis", "note")
 _MAX_INHERITANCE_DEPTH = 4
@@ -136,7 +141,274 @@ for _leaf in _SCHEMA:
         _SECTIONS.setdefault(_section, ())
         _SECTIONS[_section] += (_name,)
 _TOP_LEAVES = tuple(leaf.key for leaf in _SCHEMA if "." not in leaf.key)
-_TOP = ("inherits", *_TOP_LEAVES, *_SECTIONS)
+
+# --- the pydantic models: one leaf model per parameter, one model per section ---------------
+#
+# They validate ONE file as written: every leaf is optional here (a file with ``inherits`` omits
+# the inherited ones, a family file has no name); which leaves an instrument must have is
+# checked after the merge (:func:`instrument_from_mapping`). The JSON Schema says the same with
+# ``if name and no inherits then required``.
+
+_LEAF_SHAPE = "a leaf {value, status, src | basis, note?}"
+_STATUS_HINT = (
+    "every value says whether a source documents it; an inferred value is assumed, with a basis"
+)
+
+
+def _at(exc: PydanticCustomError, at: tuple[str | int, ...]) -> PydanticCustomError:
+    """The same error one level down (``value[3]``)."""
+    ctx = exc.context or {}
+    return _fail(ctx["expected"], ctx["found"], ctx.get("hint", ""), at)
+
+
+def _number(value: Any, leaf: _Leaf, at: tuple[str | int, ...] = ()) -> float:
+    try:
+        return check_number(
+            value, unit=leaf.unit, low=leaf.low, high=leaf.high, low_open=leaf.low_open
+        )
+    except PydanticCustomError as exc:
+        raise _at(exc, at) from None
+
+
+def _check_value(leaf: _Leaf, raw: Any) -> Any:
+    """The ``value`` of one leaf, by its kind (raises the error of :mod:`.validation`)."""
+    kind = leaf.kind
+    if kind == "text":
+        if isinstance(raw, bool) or not isinstance(raw, str | int) or str(raw) == "":
+            raise _fail("a non-empty text", describe_value(raw))
+        return str(raw)
+    if kind == "bool":
+        if not isinstance(raw, bool):
+            raise _fail("true or false", describe_value(raw))
+        return raw
+    if kind == "int":
+        lo, hi = int(leaf.low), int(leaf.high)
+        if isinstance(raw, bool) or not isinstance(raw, int) or not lo <= raw <= hi:
+            raise _fail(f"an integer in [{lo}, {hi}]", describe_value(raw))
+        return raw
+    if kind == "number":
+        return _number(raw, leaf)
+    if kind in ("range", "pair", "triple"):
+        return _check_tuple(leaf, raw)
+    return _check_gear_set(leaf, raw)
+
+
+def _check_tuple(leaf: _Leaf, raw: Any) -> tuple[float, ...]:
+    kind = leaf.kind
+    length = 3 if kind == "triple" else 2
+    if not isinstance(raw, list) or len(raw) != length:
+        what = "[lo, hi]" if kind == "range" else f"{length} numbers"
+        raise _fail(f"a list of {what} [{leaf.unit}]", describe_value(raw))
+    numbers = tuple(_number(v, leaf, (i,)) for i, v in enumerate(raw))
+    if kind == "range" and numbers[0] > numbers[1]:
+        raise _fail("a range [lo, hi] with lo ≤ hi", list(numbers), "the ends are reversed")
+    if leaf.contains_zero and not numbers[0] <= 0.0 <= numbers[1]:
+        raise _fail(
+            "a range that contains 0",
+            list(numbers),
+            "the zero position (scales near their zeros, mark on the left plumb point) "
+            "must be reachable",
+        )
+    return numbers
+
+
+def _check_gear_set(leaf: _Leaf, raw: Any) -> tuple[Any, ...]:
+    """int_list, number_list: gear sets, at least one entry, strictly increasing."""
+    if not isinstance(raw, list):
+        raise _fail("a list", describe_value(raw))
+    if not raw:
+        raise _fail("a list of at least 1 entries", "0 entries")
+    out: list[Any] = []
+    for i, v in enumerate(raw):
+        if leaf.kind == "int_list":
+            if isinstance(v, bool) or not isinstance(v, int) or not leaf.low <= v <= leaf.high:
+                raise _fail(
+                    f"an integer in [{leaf.low:g}, {leaf.high:g}]", describe_value(v), at=(i,)
+                )
+            out.append(v)
+        else:
+            out.append(_number(v, leaf, (i,)))
+        if i and out[-1] <= out[-2]:
+            raise _fail(f"a value above the previous one ({out[-2]:g})", v, at=(i,))
+    return tuple(out)
+
+
+def _value_schema(leaf: _Leaf) -> dict[str, Any]:
+    """The JSON Schema of the ``value`` of one leaf (the check is :func:`_check_value`)."""
+    unit = f"[{leaf.unit}]" if leaf.unit and leaf.unit != "—" else None
+    bounds = _bounds(leaf.low, leaf.high, leaf.low_open, False)
+    number: dict[str, Any] = {"type": "number", **bounds}
+    kind = leaf.kind
+    if kind == "text":
+        out: dict[str, Any] = {"type": ["string", "integer"], "minLength": 1}
+    elif kind == "bool":
+        out = {"type": "boolean"}
+    elif kind == "int":
+        out = {"type": "integer", "minimum": int(leaf.low), "maximum": int(leaf.high)}
+    elif kind == "number":
+        out = number
+    elif kind in ("range", "pair", "triple"):
+        n = 3 if kind == "triple" else 2
+        out = {"type": "array", "items": number, "minItems": n, "maxItems": n}
+        if kind == "range":
+            zero = ", containing 0" if leaf.contains_zero else ""
+            out["description"] = f"[lo, hi], lo ≤ hi{zero}"
+    else:
+        item = number if kind == "number_list" else {
+            "type": "integer", "minimum": int(leaf.low), "maximum": int(leaf.high)
+        }
+        out = {"type": "array", "items": item, "minItems": 1, "description": "increasing"}
+    if unit:
+        out["description"] = f"{out.get('description', '')} {unit}".strip()
+    return out
+
+
+def _check_status(v: Any) -> str:
+    if v not in STATUSES:
+        raise _fail("documented or assumed", describe_value(v), _STATUS_HINT)
+    return v
+
+
+def _check_sources(raw: Any) -> tuple[str, ...]:
+    items = raw if isinstance(raw, list) else [raw]
+    if not items or any(not isinstance(s, str) or not s.strip() for s in items):
+        raise _fail("a source key or a list of source keys", describe_value(raw))
+    return tuple(s.strip() for s in items)
+
+
+def _check_note(raw: Any) -> str:
+    if not isinstance(raw, str) or not raw.strip():
+        raise _fail("a non-empty text", describe_value(raw))
+    return raw.strip()
+
+
+_NOTE = Annotated[
+    str, BeforeValidator(_check_note), WithJsonSchema({"type": "string", "pattern": r"\S"})
+]
+_SOURCE_KEY = {"type": "string", "pattern": r"\S"}
+
+
+class LeafBase(FileModel):
+    """``{value, status, src | basis, note?}``: documented values name their source keys
+    (``src``), assumed ones say why (``basis``)."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        frozen=True,
+        json_schema_extra={
+            "if": {"properties": {"status": {"const": "documented"}}},
+            "then": {"required": ["src"], "not": {"required": ["basis"]}},
+            "else": {"required": ["basis"]},
+        },
+    )
+
+    status: Annotated[
+        str, BeforeValidator(_check_status), WithJsonSchema({"enum": list(STATUSES)})
+    ]
+    src: Annotated[
+        tuple[str, ...],
+        BeforeValidator(_check_sources),
+        WithJsonSchema(
+            {"anyOf": [_SOURCE_KEY, {"type": "array", "items": _SOURCE_KEY, "minItems": 1}]}
+        ),
+    ] = ()
+    basis: _NOTE = ""  # type: ignore[valid-type]
+    note: _NOTE = ""  # type: ignore[valid-type]
+
+    @_model_validator(mode="before")
+    @classmethod
+    def _shape(cls, v: Any) -> Any:
+        if not isinstance(v, dict) or v.get("value") is None:
+            raise _fail(
+                _LEAF_SHAPE,
+                describe_value(v),
+                "every value says whether a source documents it (see docs/instruments.md)",
+            )
+        if v.get("status") is None and set(v) <= set(_LEAF_KEYS):
+            raise _fail("documented or assumed", "nothing", _STATUS_HINT, at=("status",))
+        return v
+
+    @_model_validator(mode="after")
+    def _provenance(self) -> LeafBase:
+        if self.status == "documented" and not self.src:
+            raise _fail(
+                "the source key(s) of a documented value (e.g. SEED6)",
+                "nothing",
+                "a value without a source must be status: assumed with a basis",
+                at=("src",),
+            )
+        if self.status == "documented" and self.basis:
+            raise _fail(
+                "no basis for a documented value (basis is for assumed ones; use note)",
+                self.basis,
+                at=("basis",),
+            )
+        if self.status == "assumed" and not self.basis:
+            raise _fail(
+                "a basis for an assumed value (why this value was chosen)", "nothing", at=("basis",)
+            )
+        return self
+
+
+def _leaf_model(leaf: _Leaf) -> type[LeafBase]:
+    value = Annotated[
+        Any, BeforeValidator(partial(_check_value, leaf)), WithJsonSchema(_value_schema(leaf))
+    ]
+    name = "".join(part[:1].upper() + part[1:] for part in leaf.key.replace(".", "_").split("_"))
+    return create_model(name, __base__=LeafBase, value=(value, ...))  # type: ignore[call-overload]
+
+
+_LEAF_MODELS = {leaf.key: _leaf_model(leaf) for leaf in _SCHEMA}
+
+
+class _SectionBase(FileModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, protected_namespaces=())
+
+
+def _section_model(section: str) -> type[FileModel]:
+    leaves = {
+        name: (_LEAF_MODELS[f"{section}.{name}"] | None, None) for name in _SECTIONS[section]
+    }
+    return create_model(  # type: ignore[call-overload]
+        section.capitalize() + "Section", __base__=_SectionBase, **leaves
+    )
+
+
+def _required_when_complete() -> dict[str, Any]:
+    """JSON Schema: a file with a name and no ``inherits`` is a whole instrument."""
+    sections: dict[str, list[str]] = {}
+    for leaf in _SCHEMA:
+        if leaf.required and "." in leaf.key:
+            section, name = leaf.key.split(".", 1)
+            sections.setdefault(section, []).append(name)
+    top = [leaf.key for leaf in _SCHEMA if leaf.required and "." not in leaf.key]
+    return {
+        "if": {"required": ["name"], "not": {"required": ["inherits"]}},
+        "then": {
+            "required": [*top, *sections],
+            "properties": {s: {"required": names} for s, names in sections.items()},
+        },
+    }
+
+
+class _InstrumentBase(FileModel):
+    model_config = ConfigDict(
+        extra="forbid",
+        frozen=True,
+        protected_namespaces=(),
+        title="stereoplotter instrument file",
+        json_schema_extra=_required_when_complete(),
+    )
+
+
+#: One instrument file as written (``docs/instruments.md``).
+InstrumentFile: type[FileModel] = create_model(  # type: ignore[call-overload]
+    "InstrumentFile",
+    __base__=_InstrumentBase,
+    inherits=(text | None, Field(None, description="a file in the same folder to start from")),
+    **{name: (_LEAF_MODELS[name] | None, None) for name in _TOP_LEAVES},
+    **{section: (_section_model(section) | None, None) for section in _SECTIONS},
+)
 
 
 # --- loading ----------------------------------------------------------------------------------
@@ -190,24 +462,30 @@ def instrument_from_mapping(
     key : str, optional
         Short name; default the stem of ``source``.
     """
-    fields = Fields(source)
-    merged, origins = _merge_inherited(fields, data, source, chain=(_norm(source),))
+    leaves, origins = _merge_inherited(data, source, chain=(_norm(source),))
     params: dict[str, Parameter] = {}
     for leaf in _SCHEMA:
-        section, _, name = leaf.key.rpartition(".")
-        node = merged.get(section, {}) if section else merged
-        if name not in node:
+        node = leaves.get(leaf.key)
+        if node is None:
             if leaf.required:
-                raise fields.error(
+                raise ConfigError(
+                    source,
                     leaf.key,
                     "a value {value, status, src | basis} (the field is required)",
                     "nothing",
                     _inherit_hint(data),
                 )
             continue
-        origin = origins.get(leaf.key, source)
-        params[leaf.key] = _parameter(Fields(origin), node[name], leaf, origin)
-    _cross_check(fields, params, origins, source)
+        params[leaf.key] = Parameter(
+            node.value,  # type: ignore[attr-defined]
+            leaf.unit,
+            node.status,
+            node.src,
+            node.basis,
+            node.note,
+            origins[leaf.key],
+        )
+    _cross_check(params, source)
     values: dict[str, Any] = {}
     for attribute, (dotted, convert) in _ATTRIBUTES.items():
         values[attribute] = convert(params[dotted].value) if dotted in params else None
@@ -334,197 +612,71 @@ def _norm(source: str) -> str:
 
 
 def _inherit_hint(data: Mapping[str, Any]) -> str:
-    if "inherits" in data:
+    if isinstance(data.get("inherits"), str):
         return f"not in this file nor in {data['inherits']}"
     return ""
 
 
-def _check_structure(fields: Fields, data: Mapping[str, Any]) -> None:
-    fields.mapping(data, "", _TOP)
+def _leaves(doc: FileModel) -> dict[str, LeafBase]:
+    """The leaves a validated file gives, by dotted key."""
+    out: dict[str, LeafBase] = {}
+    for name in _TOP_LEAVES:
+        if getattr(doc, name) is not None:
+            out[name] = getattr(doc, name)
     for section, names in _SECTIONS.items():
-        if section in data:
-            fields.mapping(data[section], section, names)
+        node = getattr(doc, section)
+        if node is None:
+            continue
+        for name in names:
+            if getattr(node, name) is not None:
+                out[f"{section}.{name}"] = getattr(node, name)
+    return out
 
 
 def _merge_inherited(
-    fields: Fields, data: dict[str, Any], source: str, chain: tuple[str, ...]
-) -> tuple[dict[str, Any], dict[str, str]]:
-    """The document with its ``inherits`` file merged in, and the file each leaf came from."""
-    _check_structure(fields, data)
-    merged: dict[str, Any] = {}
+    data: dict[str, Any], source: str, chain: tuple[str, ...]
+) -> tuple[dict[str, LeafBase], dict[str, str]]:
+    """The leaves of the file and of its ``inherits`` chain (its own win), and the file each
+    leaf came from. Each file is validated as written before the merge, so an error names the
+    file that has it."""
+    doc = validate(InstrumentFile, data, source)
+    leaves: dict[str, LeafBase] = {}
     origins: dict[str, str] = {}
-    if "inherits" in data:
-        name = fields.text(data, "inherits", "")
+    name = doc.inherits  # type: ignore[attr-defined]
+    if name is not None:
         parent_path = Path(source).parent / name
         if not parent_path.is_file():
-            raise fields.error("inherits", "the name of an existing file in the same folder", name)
+            raise ConfigError(
+                source, "inherits", "the name of an existing file in the same folder", name
+            )
         if _norm(str(parent_path)) in chain or len(chain) > _MAX_INHERITANCE_DEPTH:
-            raise fields.error(
+            raise ConfigError(
+                source,
                 "inherits",
                 f"a chain of at most {_MAX_INHERITANCE_DEPTH} files without a loop",
                 name,
                 "files: " + " → ".join(Path(c).name for c in chain),
             )
         parent, parent_source = load_yaml_mapping(parent_path)
-        merged, origins = _merge_inherited(
-            Fields(parent_source), parent, parent_source, (*chain, _norm(parent_source))
-        )
-    for top, value in data.items():
-        if top == "inherits":
-            continue
-        if top in _SECTIONS and isinstance(merged.get(top), dict):
-            merged[top] = {**merged[top], **value}
-            for name in value:
-                origins[f"{top}.{name}"] = source
-        else:
-            merged[top] = value
-            if top in _SECTIONS:
-                origins.update({f"{top}.{name}": source for name in value})
-            else:
-                origins[top] = source
-    return merged, origins
+        leaves, origins = _merge_inherited(parent, parent_source, (*chain, _norm(parent_source)))
+    own = _leaves(doc)
+    leaves.update(own)
+    origins.update(dict.fromkeys(own, source))
+    return leaves, origins
 
 
-def _parameter(fields: Fields, node: Any, leaf: _Leaf, origin: str) -> Parameter:
-    path = leaf.key
-    if not isinstance(node, dict) or "value" not in node:
-        raise fields.error(
-            path,
-            "a leaf {value, status, src | basis, note?}",
-            describe_value(node),
-            "every value says whether a source documents it (see docs/instruments.md)",
-        )
-    fields.mapping(node, path, _LEAF_KEYS)
-    status = node.get("status")
-    if status not in STATUSES:
-        raise fields.error(
-            fields.join(path, "status"),
-            "documented or assumed",
-            describe_value(status),
-            "every value says whether a source documents it; an inferred value is assumed, "
-            "with a basis",
-        )
-    sources = _sources(fields, node, path)
-    basis = _optional_text(fields, node, "basis", path)
-    note = _optional_text(fields, node, "note", path)
-    if status == "documented" and not sources:
-        raise fields.error(
-            fields.join(path, "src"),
-            "the source key(s) of a documented value (e.g. SEED6)",
-            "nothing",
-            "a value without a source must be status: assumed with a basis",
-        )
-    if status == "documented" and basis:
-        raise fields.error(
-            fields.join(path, "basis"),
-            "no basis for a documented value (basis is for assumed ones; use note)",
-            basis,
-        )
-    if status == "assumed" and not basis:
-        raise fields.error(
-            fields.join(path, "basis"),
-            "a basis for an assumed value (why this value was chosen)",
-            "nothing",
-        )
-    value = _value(fields, node, leaf)
-    return Parameter(value, leaf.unit, status, sources, basis, note, origin)
-
-
-def _sources(fields: Fields, node: Mapping[str, Any], path: str) -> tuple[str, ...]:
-    raw = node.get("src")
-    if raw is None:
-        return ()
-    items = raw if isinstance(raw, list) else [raw]
-    if not items or any(not isinstance(s, str) or not s.strip() for s in items):
-        raise fields.error(
-            fields.join(path, "src"), "a source key or a list of source keys", describe_value(raw)
-        )
-    return tuple(s.strip() for s in items)
-
-
-def _optional_text(fields: Fields, node: Mapping[str, Any], key: str, path: str) -> str:
-    raw = node.get(key)
-    if raw is None:
-        return ""
-    if not isinstance(raw, str) or not raw.strip():
-        raise fields.error(fields.join(path, key), "a non-empty text", describe_value(raw))
-    return raw.strip()
-
-
-def _value(fields: Fields, node: Mapping[str, Any], leaf: _Leaf) -> Any:
-    path = leaf.key
-    vpath = fields.join(path, "value")
-    limits = {"unit": leaf.unit, "low": leaf.low, "high": leaf.high, "low_open": leaf.low_open}
-    kind = leaf.kind
-    raw = node["value"]
-    if kind == "text":
-        return fields.text(node, "value", path)
-    if kind == "bool":
-        if not isinstance(raw, bool):
-            raise fields.error(vpath, "true or false", describe_value(raw))
-        return raw
-    if kind == "int":
-        return fields.integer(node, "value", path, low=int(leaf.low), high=int(leaf.high))
-    if kind == "number":
-        return _number(fields, raw, vpath, limits)
-    if kind in ("range", "pair", "triple"):
-        length = 3 if kind == "triple" else 2
-        if not isinstance(raw, list) or len(raw) != length:
-            what = "[lo, hi]" if kind == "range" else f"{length} numbers"
-            raise fields.error(vpath, f"a list of {what} [{leaf.unit}]", describe_value(raw))
-        numbers = tuple(
-            _number(fields, v, fields.join(vpath, i), limits) for i, v in enumerate(raw)
-        )
-        if kind == "range" and numbers[0] > numbers[1]:
-            raise fields.error(
-                vpath, "a range [lo, hi] with lo ≤ hi", list(numbers), "the ends are reversed"
-            )
-        if leaf.contains_zero and not numbers[0] <= 0.0 <= numbers[1]:
-            raise fields.error(
-                vpath,
-                "a range that contains 0",
-                list(numbers),
-                "the zero position (scales near their zeros, mark on the left plumb point) "
-                "must be reachable",
-            )
-        return numbers
-    # int_list, number_list: gear sets, strictly increasing
-    items = fields.sequence(node, "value", path, min_length=1)
-    out: list[Any] = []
-    for i, v in enumerate(items):
-        ipath = fields.join(vpath, i)
-        if kind == "int_list":
-            if isinstance(v, bool) or not isinstance(v, int) or not leaf.low <= v <= leaf.high:
-                raise fields.error(
-                    ipath, f"an integer in [{leaf.low:g}, {leaf.high:g}]", describe_value(v)
-                )
-            out.append(v)
-        else:
-            out.append(_number(fields, v, ipath, limits))
-        if i and out[-1] <= out[-2]:
-            raise fields.error(ipath, f"a value above the previous one ({out[-2]:g})", v)
-    return tuple(out)
-
-
-def _number(fields: Fields, value: Any, path: str, limits: Mapping[str, Any]) -> float:
-    """:meth:`Fields.check_number` with the limits of a parameter."""
-    return fields.check_number(value, path, **limits)
-
-
-def _cross_check(
-    fields: Fields, params: Mapping[str, Parameter], origins: Mapping[str, str], source: str
-) -> None:
+def _cross_check(params: Mapping[str, Parameter], source: str) -> None:
     d_max = params.get("projection.distance_max_mm")
     if d_max is not None:
         hi = params["projection.distance_mm"].value[1]
         if not math.isclose(d_max.value, hi, rel_tol=0.0, abs_tol=1e-9):
-            raise Fields(origins.get("projection.distance_max_mm", source)).error(
+            raise ConfigError(
+                d_max.file or source,
                 "projection.distance_max_mm.value",
                 f"the upper end of projection.distance_mm ({hi:g} mm)",
                 d_max.value,
                 "D_max is the deepest position of the carriage; change both together",
             )
-
 
 def list_instruments() -> list[str]:
     """Short names of the instrument files in the ``instruments`` data folder.

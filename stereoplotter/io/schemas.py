@@ -3,8 +3,7 @@
 ``python -m stereoplotter.io.schemas [FOLDER]`` writes ``FOLDER/KIND.schema.json`` (default
 ``docs/schemas``); editors that read JSON Schema (VS Code's YAML extension, JetBrains) can then
 check a file as it is typed. ``tests/cli/test_schemas.py`` keeps the published files equal to
-the generated ones. So far the scenario file has a model; the instrument, block, injected-errors
-and geometry files are still checked by :class:`~stereoplotter.io.yaml_files.Fields`.
+the generated ones. ``docs/input-files.md`` says how to point an editor at them.
 """
 
 from __future__ import annotations
@@ -17,13 +16,17 @@ from typing import Any
 
 from pydantic import BaseModel
 
+from stereoplotter.io.instrument_file import InstrumentFile
 from stereoplotter.io.scenario_file import ScenarioFile
 from stereoplotter.io.yaml_files import atomic_write_text
 
 __all__ = ["MODELS", "schema", "schema_text", "write_schemas"]
 
 #: File kind → its model.
-MODELS: dict[str, type[BaseModel]] = {"scenario": ScenarioFile}
+MODELS: dict[str, type[BaseModel]] = {
+    "scenario": ScenarioFile,
+    "instrument": InstrumentFile,
+}
 
 
 def schema(kind: str) -> dict[str, Any]:

@@ -34,8 +34,11 @@ from stereoplotter.errors import ConfigError, describe_value, did_you_mean
 
 __all__ = [
     "FileModel",
+    "check_number",
+    "field_path",
     "integer",
     "number",
+    "number_at",
     "one_of",
     "sequence",
     "text",
@@ -61,10 +64,30 @@ class FileModel(BaseModel):
         return v
 
 
-def _fail(expected: str, found: object, hint: str = "") -> PydanticCustomError:
-    # the braces of the expected text must not be read as a template: escape them
-    template = expected.replace("{", "{{").replace("}", "}}")
-    return PydanticCustomError("stereoplotter", template, {"found": found, "hint": hint})
+def _fail(
+    expected: str, found: object, hint: str = "", at: tuple[str | int, ...] = ()
+) -> PydanticCustomError:
+    """The error a check raises: ``expected``, ``found`` and a ``hint``; ``at`` is the place of
+    the bad value below the field being checked (a list index, or a key of a model whose
+    cross-field check failed)."""
+    # the expected text goes through the context: its braces are not read as a template
+    return PydanticCustomError(
+        "stereoplotter",
+        "{expected}",
+        {"expected": expected, "found": found, "hint": hint, "at": at},
+    )
+
+
+def number_at(source: str, path: str, value: Any, **limits: Any) -> float:
+    """:func:`check_number` for a value already validated once (a cross-field limit, such as a
+    fiducial mark inside the format), its failure as the :class:`ConfigError` of ``path``."""
+    try:
+        return check_number(value, **limits)
+    except PydanticCustomError as exc:
+        ctx = exc.context or {}
+        raise ConfigError(
+            source, path, ctx["expected"], ctx.get("found"), ctx.get("hint", "")
+        ) from None
 
 
 def range_text(unit: str, low: float, high: float, low_open: bool, high_open: bool) -> str:
@@ -294,8 +317,11 @@ def config_error(
     kind = err["type"]
     ctx = err.get("ctx") or {}
     if kind == "stereoplotter":
-        return ConfigError(where, field_path(loc) or "(top level)", err["msg"], ctx["found"],
-                           ctx.get("hint", ""))
+        loc = (*loc, *ctx.get("at", ()))
+        return ConfigError(
+            where, field_path(loc) or "(top level)", ctx["expected"], ctx["found"],
+            ctx.get("hint", ""),
+        )
     if kind == "extra_forbidden":
         key = str(loc[-1])
         owner = _model_at(model, owner_loc)

@@ -14,7 +14,11 @@ from stereoplotter.io.paths import data_dir
 from stereoplotter.io.schemas import MODELS, schema_text, write_schemas
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "schemas"
-SHIPPED = {"scenario": sorted(data_dir("scenarios").glob("*.yaml"))}
+SHIPPED = {
+    "scenario": sorted(data_dir("scenarios").glob("*.yaml")),
+    "instrument": sorted(data_dir("instruments").glob("*.yaml")),
+}
+COUNTS = {"scenario": 4, "instrument": 3}
 
 
 @pytest.mark.parametrize("kind", list(MODELS))
@@ -32,7 +36,7 @@ def test_shipped_files_validate_against_their_schema(kind):
     validator = jsonschema.Draft202012Validator(
         json.loads((DOCS / f"{kind}.schema.json").read_text(encoding="utf-8"))
     )
-    assert len(SHIPPED[kind]) == 4
+    assert len(SHIPPED[kind]) == COUNTS[kind]
     for path in SHIPPED[kind]:
         doc = yaml.safe_load(path.read_text(encoding="utf-8"))
         assert [e.message for e in validator.iter_errors(doc)] == [], path.name
@@ -47,3 +51,50 @@ def test_schema_refuses_what_the_loader_refuses():
     doc["camera"]["focal_length_mm"] = doc["camera"].pop("focal_lenght_mm")
     doc["photos"][0]["exterior"]["alpha_deg"] = 25.0  # |tilt| ≤ 15°
     assert [e.validator for e in validator.iter_errors(doc)] == ["maximum"]
+
+
+def _validator(kind):
+    return jsonschema.Draft202012Validator(json.loads(schema_text(kind)))
+
+
+def _leaf_errors(errors):
+    """The innermost errors (an optional section is ``anyOf: [{$ref}, {type: null}]``), without
+    the "is not null" branch."""
+    for e in errors:
+        if e.context:
+            yield from _leaf_errors(e.context)
+        elif e.validator_value != "null":
+            yield e
+
+
+def _sc1():
+    return yaml.safe_load((data_dir("instruments") / "sc1.yaml").read_text(encoding="utf-8"))
+
+
+def test_instrument_schema_refuses_what_the_loader_refuses():
+    validator = _validator("instrument")
+    doc = _sc1()
+    doc["base"]["z_mm"].pop("basis")  # assumed needs a basis
+    doc["mark"]["diameter_mm"]["value"] = 7.0  # (0, 5] mm
+    doc["counters"]["present"]["value"] = "yes"
+    doc["tolerances"]["corner4_mm"]["basis"] = "why"  # documented: src, no basis
+    errors = sorted(
+        (list(e.absolute_path), e.validator) for e in _leaf_errors(validator.iter_errors(doc))
+    )
+    assert errors == [
+        (["base", "z_mm"], "required"),
+        (["counters", "present", "value"], "type"),
+        (["mark", "diameter_mm", "value"], "maximum"),
+        (["tolerances", "corner4_mm"], "not"),
+    ]
+
+
+def test_instrument_schema_lets_a_file_with_inherits_omit_leaves():
+    validator = _validator("instrument")
+    doc = _sc1()
+    thin = {"inherits": "family.yaml", "name": doc["name"], "mark": doc["mark"]}
+    assert list(validator.iter_errors(thin)) == []
+    family = {k: v for k, v in doc.items() if k not in ("name", "principle")}
+    assert list(validator.iter_errors(family)) == []  # no name: a family file
+    del doc["mark"]  # a whole instrument (a name, no inherits) must have every required leaf
+    assert [e.message for e in validator.iter_errors(doc)] == ["'mark' is a required property"]
