@@ -17,17 +17,26 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from pydantic import ConfigDict, Field, field_validator, model_validator
 
+from stereoplotter.errors import ConfigError
 from stereoplotter.io.scenario_file import MAX_TILT_DEG, CameraModel, camera_from_model
-from stereoplotter.io.validation import validate
-from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
+from stereoplotter.io.validation import (
+    FileModel,
+    _fail,
+    integer,
+    number,
+    sequence,
+    text,
+    validate,
+    vector,
+)
+from stereoplotter.io.yaml_files import load_yaml_mapping
 from stereoplotter.scenario.model import Camera
 
-__all__ = ["CSV_COLUMNS", "Block", "load_block"]
+__all__ = ["CSV_COLUMNS", "Block", "BlockFile", "load_block"]
 
 _EO_KEYS = ("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg")
-_TOP = ("name", "description", "camera", "map_scale", "scales", "models", "models_csv")
-_MODEL = ("name", "left", "right", "terrain_m", "height_points")
 #: Columns of a ``models_csv`` file; ``height_points`` ("id=Z_m;id=Z_m", may be empty) is optional.
 CSV_COLUMNS = (
     "name",
@@ -87,6 +96,108 @@ class Block:
         return len(self.model_names)
 
 
+
+# --- the models -------------------------------------------------------------------------------
+
+_TILT_BASIS = f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°"
+_XY = number("m", -1.0e7, 1.0e7)
+_TILT = number("°", -MAX_TILT_DEG, MAX_TILT_DEG, basis=_TILT_BASIS)
+_GROUND = number("m", -500.0, 9000.0)
+_SCALE = integer(100, 1_000_000)
+
+
+class Station(FileModel):
+    """The exterior orientation of one photo of a model (Eq. (2.50) angles)."""
+
+    X_m: _XY  # type: ignore[valid-type]
+    Y_m: _XY  # type: ignore[valid-type]
+    Z_m: number("m", -500.0, 50000.0)  # type: ignore[valid-type]
+    alpha_deg: _TILT  # type: ignore[valid-type]
+    omega_deg: _TILT  # type: ignore[valid-type]
+    kappa_deg: number("°", -180.0, 180.0)  # type: ignore[valid-type]
+
+
+class HeightPoint(FileModel):
+    id: text  # type: ignore[valid-type]
+    Z_m: _GROUND  # type: ignore[valid-type]
+
+
+class ModelEntry(FileModel):
+    """One stereopair of the block (an entry of ``models``, or a row of ``models_csv``)."""
+
+    name: text = Field(  # type: ignore[valid-type]
+        description="usable as a folder name: letters, digits, _ . + -",
+        json_schema_extra={"pattern": _NAME_RE.pattern},
+    )
+    left: Station
+    right: Station
+    terrain_m: vector(2, "m", -500.0, 9000.0) = Field(  # type: ignore[valid-type]
+        description="lowest and highest ground of the working area [m]"
+    )
+    height_points: sequence(HeightPoint) = Field(default_factory=list)  # type: ignore[valid-type]
+
+    @field_validator("name")
+    @classmethod
+    def _folder_name(cls, name: str) -> str:
+        if not _NAME_RE.match(name) or name in (".", ".."):
+            raise _fail("a model name usable as a folder name (letters, digits, _ . + -)", name)
+        return name
+
+    @model_validator(mode="after")
+    def _unique_ids(self) -> ModelEntry:
+        seen: set[str] = set()
+        for j, p in enumerate(self.height_points):
+            if p.id in seen:
+                raise _fail("a unique point id", p.id, at=("height_points", j, "id"))
+            seen.add(p.id)
+        return self
+
+
+class Scales(FileModel):
+    horizontal: _SCALE | None = None  # type: ignore[valid-type]
+    vertical: _SCALE | None = None  # type: ignore[valid-type]
+
+
+class BlockFile(FileModel):
+    """A block file (``docs/scenarios.md``): exactly one of ``models``, ``models_csv``."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        frozen=True,
+        title="stereoplotter block file",
+        json_schema_extra={"oneOf": [{"required": ["models"]}, {"required": ["models_csv"]}]},
+    )
+
+    name: text  # type: ignore[valid-type]
+    description: str | None = None
+    camera: CameraModel
+    map_scale: _SCALE  # type: ignore[valid-type]
+    scales: Scales | None = None
+    models: sequence(ModelEntry, min_length=1) | None = None  # type: ignore[valid-type]
+    models_csv: text | None = Field(  # type: ignore[valid-type]
+        None, description="a CSV file next to this one (columns: docs/scenarios.md)"
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _exactly_one(cls, v: Any) -> Any:
+        if isinstance(v, dict) and not set(v) - set(cls.model_fields):
+            given = [k for k in ("models", "models_csv") if v.get(k) is not None]
+            if len(given) != 1:
+                found = "both" if given else "neither"
+                raise _fail("exactly one of models, models_csv", found, at=("models",))
+        return v
+
+    @model_validator(mode="after")
+    def _unique_names(self) -> BlockFile:
+        seen: set[str] = set()
+        for i, m in enumerate(self.models or ()):
+            if m.name in seen:
+                raise _fail("a unique model name", m.name, at=("models", i, "name"))
+            seen.add(m.name)
+        return self
+
+
 def load_block(path: str | os.PathLike[str]) -> Block:
     """Read and validate a block file.
 
@@ -116,173 +227,144 @@ def load_block(path: str | os.PathLike[str]) -> Block:
     (8, 70.0)
     """
     data, source = load_yaml_mapping(path)
-    fields = Fields(source)
-    fields.mapping(data, "", _TOP, required=("name", "camera", "map_scale"))
-    name = fields.text(data, "name", "")
-    camera_model = validate(CameraModel, fields.get(data, "camera", ""), source, prefix=("camera",))
-    camera = camera_from_model(fields, camera_model)
-    map_scale = fields.integer(data, "map_scale", "", low=100, high=1_000_000)
-    forced: dict[str, int | None] = {"horizontal": None, "vertical": None}
-    if data.get("scales") is not None:
-        node = fields.mapping(data["scales"], "scales", ("horizontal", "vertical"))
-        for key in forced:
-            if node.get(key) is not None:
-                forced[key] = fields.integer(node, key, "scales", low=100, high=1_000_000)
-    if ("models" in data) == ("models_csv" in data):
-        raise fields.error(
-            "models", "exactly one of models, models_csv", "both" if "models" in data else "neither"
-        )
-    if "models" in data:
-        rows, where = _models_yaml(fields, data)
-        csv_fields = fields
+    doc = validate(BlockFile, data, source)
+    camera = camera_from_model(source, doc.camera)
+    if doc.models is not None:
+        models, rows_source = list(doc.models), source
+        where = [f"models[{i}]" for i in range(len(models))]
     else:
-        csv_name = fields.text(data, "models_csv", "")
-        csv_path = Path(source).parent / csv_name
-        csv_fields = Fields(str(csv_path))
-        rows, where = _models_csv(csv_fields, csv_path)
-    names, eo_l, eo_r, terrain, points = zip(*rows, strict=True) if rows else ((),) * 5
-    if not names:
-        raise fields.error("models", "a list of at least 1 model", "0 models")
-    eo_l, eo_r = np.array(eo_l), np.array(eo_r)
-    terrain = np.array(terrain)
-    n_points = max((len(p) for p in points), default=0)
-    heights = np.full((len(names), n_points), np.nan)
-    for i, p in enumerate(points):
-        heights[i, : len(p)] = [z for _, z in p]
+        assert doc.models_csv is not None  # the model has exactly one of the two
+        csv_path = Path(source).parent / doc.models_csv
+        rows_source = str(csv_path)
+        models, where = _models_csv(csv_path)
+        if not models:
+            raise ConfigError(source, "models", "a list of at least 1 model", "0 models")
+        seen: set[str] = set()
+        for m, at in zip(models, where, strict=True):
+            if m.name in seen:
+                raise ConfigError(rows_source, f"{at}: name", "a unique model name", m.name)
+            seen.add(m.name)
+    eo = {
+        side: np.array([[getattr(getattr(m, side), k) for k in _EO_KEYS] for m in models])
+        for side in ("left", "right")
+    }
+    n_points = max((len(m.height_points) for m in models), default=0)
+    heights = np.full((len(models), n_points), np.nan)
+    for i, m in enumerate(models):
+        heights[i, : len(m.height_points)] = [p.Z_m for p in m.height_points]
+    scales = doc.scales or Scales()
     block = Block(
-        name=name,
+        name=doc.name,
         source=source,
         camera=camera,
-        map_scale_denominator=map_scale,
-        horizontal_scale_denominator=forced["horizontal"],
-        vertical_scale_denominator=forced["vertical"],
-        model_names=tuple(names),
-        centre_left_m=eo_l[:, :3],
-        angles_left=np.radians(eo_l[:, 3:]),
-        centre_right_m=eo_r[:, :3],
-        angles_right=np.radians(eo_r[:, 3:]),
-        terrain_m=terrain,
-        height_point_ids=tuple(tuple(pid for pid, _ in p) for p in points),
+        map_scale_denominator=doc.map_scale,
+        horizontal_scale_denominator=scales.horizontal,
+        vertical_scale_denominator=scales.vertical,
+        model_names=tuple(m.name for m in models),
+        centre_left_m=eo["left"][:, :3],
+        angles_left=np.radians(eo["left"][:, 3:]),
+        centre_right_m=eo["right"][:, :3],
+        angles_right=np.radians(eo["right"][:, 3:]),
+        terrain_m=np.array([m.terrain_m for m in models]),
+        height_point_ids=tuple(tuple(p.id for p in m.height_points) for m in models),
         height_points_m=heights,
     )
-    _check_block_geometry(csv_fields, block, where)
+    _check_block_geometry(rows_source, block, where)
     return block
 
 
-def _eo_limits(key: str) -> dict[str, Any]:
-    if key in ("X_m", "Y_m"):
-        return {"unit": "m", "low": -1.0e7, "high": 1.0e7}
-    if key == "Z_m":
-        return {"unit": "m", "low": -500.0, "high": 50000.0}
-    if key == "kappa_deg":
-        return {"unit": "°", "low": -180.0, "high": 180.0}
+def _csv_column(field: str, pid: str) -> str:
+    """The CSV column of a field of :class:`ModelEntry` (``left.Z_m`` → ``left_Z_m``)."""
+    if field.startswith("height_points"):
+        return f"height_points.{pid}" if field.endswith("Z_m") else "height_points"
     return {
-        "unit": "°",
-        "low": -MAX_TILT_DEG,
-        "high": MAX_TILT_DEG,
-        "basis": f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°",
-    }
+        "terrain_m[0]": "terrain_lowest_m",
+        "terrain_m[1]": "terrain_highest_m",
+    }.get(field, field.replace(".", "_"))
 
 
-def _check_name(fields: Fields, name: str, path: str, seen: set[str]) -> str:
-    if not _NAME_RE.match(name) or name in (".", ".."):
-        raise fields.error(
-            path,
-            "a model name usable as a folder name (letters, digits, _ . + -)",
-            name,
-        )
-    if name in seen:
-        raise fields.error(path, "a unique model name", name)
-    seen.add(name)
-    return name
-
-
-def _models_yaml(fields: Fields, data: dict[str, Any]) -> tuple[list[tuple], list[str]]:
-    rows, where, seen = [], [], set()
-    for i, item in enumerate(fields.sequence(data, "models", "", min_length=1)):
-        mpath = fields.join("models", i)
-        fields.mapping(item, mpath, _MODEL, required=("name", "left", "right", "terrain_m"))
-        name = _check_name(
-            fields, fields.text(item, "name", mpath), fields.join(mpath, "name"), seen
-        )
-        eos = []
-        for side in ("left", "right"):
-            epath = fields.join(mpath, side)
-            node = fields.mapping(item[side], epath, _EO_KEYS, required=_EO_KEYS)
-            eos.append(tuple(fields.number(node, k, epath, **_eo_limits(k)) for k in _EO_KEYS))
-        terrain = fields.vector(item, "terrain_m", mpath, 2, unit="m", low=-500.0, high=9000.0)
-        points, ids = [], set()
-        for j, p in enumerate(fields.sequence(item, "height_points", mpath, default=[])):
-            ppath = fields.join(fields.join(mpath, "height_points"), j)
-            fields.mapping(p, ppath, ("id", "Z_m"), required=("id", "Z_m"))
-            pid = fields.text(p, "id", ppath)
-            if pid in ids:
-                raise fields.error(fields.join(ppath, "id"), "a unique point id", pid)
-            ids.add(pid)
-            points.append((pid, fields.number(p, "Z_m", ppath, unit="m", low=-500.0, high=9000.0)))
-        rows.append((name, eos[0], eos[1], terrain, tuple(points)))
-        where.append(mpath)
-    return rows, where
-
-
-def _models_csv(fields: Fields, path: Path) -> tuple[list[tuple], list[str]]:
+def _models_csv(path: Path) -> tuple[list[ModelEntry], list[str]]:
+    """The rows of a ``models_csv`` file, each validated by :class:`ModelEntry`; the field of an
+    error is ``line L: column``."""
+    source = str(path)
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise fields.error("(file)", "an existing CSV file (models_csv)", "no such file") from None
+        raise ConfigError(
+            source, "(file)", "an existing CSV file (models_csv)", "no such file"
+        ) from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise fields.error("(file)", "a readable UTF-8 CSV file", str(exc)) from None
+        raise ConfigError(source, "(file)", "a readable UTF-8 CSV file", str(exc)) from None
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     reader = csv.DictReader(io.StringIO("\n".join(lines)))
     header = reader.fieldnames or []
     missing = [c for c in CSV_COLUMNS if c not in header]
     if missing:
-        raise fields.error(
-            "header", "the columns " + ", ".join(CSV_COLUMNS), "no column " + missing[0]
+        raise ConfigError(
+            source, "header", "the columns " + ", ".join(CSV_COLUMNS), "no column " + missing[0]
         )
     unknown = [c for c in header if c not in (*CSV_COLUMNS, "height_points")]
     if unknown:
-        raise fields.error(
+        raise ConfigError(
+            source,
             "header",
             "no such column",
             unknown[0],
             "allowed: " + ", ".join((*CSV_COLUMNS, "height_points")),
         )
-    rows, where, seen = [], [], set()
+    models: list[ModelEntry] = []
+    where: list[str] = []
     for line, row in enumerate(reader, start=2):
         at = f"line {line}"
-
-        def number(column: str, limits: dict[str, Any], at: str = at, row: dict = row) -> float:
-            raw = (row.get(column) or "").strip()
-            try:
-                value: Any = float(raw)
-            except ValueError:
-                value = raw
-            return fields.check_number(value, f"{at}: {column}", **limits)
-
-        name = _check_name(fields, (row.get("name") or "").strip(), f"{at}: name", seen)
-        eos = [
-            tuple(number(f"{side}_{k}", _eo_limits(k)) for k in _EO_KEYS)
-            for side in ("left", "right")
-        ]
-        ground = {"unit": "m", "low": -500.0, "high": 9000.0}
-        terrain = (number("terrain_lowest_m", ground), number("terrain_highest_m", ground))
-        points = []
-        for item in (row.get("height_points") or "").split(";"):
-            if not item.strip():
-                continue
-            pid, sep, z = item.partition("=")
-            if not sep or not pid.strip():
-                raise fields.error(f"{at}: height_points", "entries id=Z_m separated by ;", item)
-            points.append(
-                (pid.strip(), number("", ground, row={"": z}, at=f"{at}: height_points.{pid}"))
-            )
-        rows.append((name, eos[0], eos[1], terrain, tuple(points)))
+        entry, pids = _csv_entry(source, at, row)
+        try:
+            models.append(validate(ModelEntry, entry, source))
+        except ConfigError as exc:
+            pid = next((p for j, p in enumerate(pids) if f"[{j}]" in exc.field), "")
+            raise ConfigError(
+                source, f"{at}: {_csv_column(exc.field, pid)}", exc.expected, exc.found, exc.hint
+            ) from None
         where.append(at)
-    return rows, where
+    return models, where
 
 
-def _check_block_geometry(fields: Fields, block: Block, where: list[str]) -> None:
+def _csv_entry(source: str, at: str, row: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
+    """One CSV row as the mapping :class:`ModelEntry` validates (numbers where they parse)."""
+
+    def cell(column: str) -> Any:
+        raw = (row.get(column) or "").strip()
+        try:
+            return float(raw)
+        except ValueError:
+            return raw
+
+    points, pids = [], []
+    for item in (row.get("height_points") or "").split(";"):
+        if not item.strip():
+            continue
+        pid, sep, z = item.partition("=")
+        if not sep or not pid.strip():
+            raise ConfigError(source, f"{at}: height_points", "entries id=Z_m separated by ;", item)
+        pids.append(pid.strip())
+        points.append({"id": pid.strip(), "Z_m": _parse(z)})
+    entry = {
+        "name": (row.get("name") or "").strip(),
+        "left": {k: cell(f"left_{k}") for k in _EO_KEYS},
+        "right": {k: cell(f"right_{k}") for k in _EO_KEYS},
+        "terrain_m": [cell("terrain_lowest_m"), cell("terrain_highest_m")],
+        "height_points": points,
+    }
+    return entry, pids
+
+
+def _parse(raw: str) -> Any:
+    try:
+        return float(raw.strip())
+    except ValueError:
+        return raw.strip()
+
+
+def _check_block_geometry(source: str, block: Block, where: list[str]) -> None:
     """Refuse degenerate models at load time: terrain lowest > highest, a station at or below the
     highest ground or a height point, a horizontal base under 1 m."""
     sep = "." if where and where[0].startswith("models") else ": "
@@ -290,7 +372,8 @@ def _check_block_geometry(fields: Fields, block: Block, where: list[str]) -> Non
     bad = np.flatnonzero(low > high)
     if bad.size:
         i = int(bad[0])
-        raise fields.error(
+        raise ConfigError(
+            source,
             f"{where[i]}{sep}terrain" + ("_m" if sep == "." else "_lowest_m"),
             "lowest ≤ highest ground height",
             [float(low[i]), float(high[i])],
@@ -300,7 +383,8 @@ def _check_block_geometry(fields: Fields, block: Block, where: list[str]) -> Non
         bad = np.flatnonzero(centre[:, 2] <= top)
         if bad.size:
             i = int(bad[0])
-            raise fields.error(
+            raise ConfigError(
+                source,
                 f"{where[i]}{sep}{side}" + (".Z_m" if sep == "." else "_Z_m"),
                 f"a projection centre above the model's highest ground ({top[i]:g} m)",
                 float(centre[i, 2]),
@@ -309,8 +393,6 @@ def _check_block_geometry(fields: Fields, block: Block, where: list[str]) -> Non
     bad = np.flatnonzero(base < 1.0)
     if bad.size:
         i = int(bad[0])
-        raise fields.error(
-            f"{where[i]}{sep}right", "a horizontal base of at least 1 m", f"{base[i]:.3g} m"
+        raise ConfigError(
+            source, f"{where[i]}{sep}right", "a horizontal base of at least 1 m", f"{base[i]:.3g} m"
         )
-
-

@@ -14,7 +14,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BeforeValidator, ConfigDict, Field, field_validator, model_validator
 
-from stereoplotter.errors import StereoplotterError, describe_value
+from stereoplotter.errors import ConfigError, StereoplotterError, describe_value
 from stereoplotter.geometry.collinearity import object_to_photo
 from stereoplotter.io.paths import resolve_data_file
 from stereoplotter.io.validation import (
@@ -23,13 +23,14 @@ from stereoplotter.io.validation import (
     check_number,
     integer,
     number,
+    number_at,
     one_of,
     sequence,
     text,
     validate,
     vector,
 )
-from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
+from stereoplotter.io.yaml_files import load_yaml_mapping
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.scenario.model import (
     FIDUCIAL_NAMES,
@@ -100,10 +101,10 @@ def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> S
     source : str
         Name of the file, for messages.
     """
-    fields = Fields(source)
     block_fields = [k for k in _BLOCK_FIELDS if isinstance(data, dict) and k in data]
     if block_fields:
-        raise fields.error(
+        raise ConfigError(
+            source,
             block_fields[0],
             "a scenario (one photo or one stereopair: fields photos, points)",
             "a block file (it has " + ", ".join(block_fields) + ")",
@@ -111,16 +112,16 @@ def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> S
             "NAME",
         )
     doc = validate(ScenarioFile, _drop_nulls(data, _NULLABLE_TOP), source)
-    camera = camera_from_model(fields, doc.camera)
-    frame = _frame(fields, doc.frame)
+    camera = camera_from_model(source, doc.camera)
+    frame = _frame(source, doc.frame)
     terrain = Terrain(
         doc.terrain.base_height_m,
         doc.terrain.slope,
         tuple(Hill(h.X_m, h.Y_m, h.height_m, h.radius_m) for h in doc.terrain.hills),
     )
-    photos = _photos(fields, doc.photos)
-    points = _points(fields, doc.points, frame, terrain)
-    map_sheet = _map_sheet(fields, doc.map_sheet, frame) if doc.map_sheet else None
+    photos = _photos(source, doc.photos)
+    points = _points(source, doc.points, frame, terrain)
+    map_sheet = _map_sheet(source, doc.map_sheet, frame) if doc.map_sheet else None
     errors = ErrorSettings(doc.errors.photo_point_sigma_um, doc.errors.fiducial_sigma_um)
     scenario = Scenario(
         name=doc.name,
@@ -135,7 +136,7 @@ def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> S
         errors=errors,
         seed=doc.seed,
     )
-    _check_geometry(fields, scenario)
+    _check_geometry(source, scenario)
     return scenario
 
 
@@ -361,7 +362,7 @@ class ScenarioFile(FileModel):
 # --- from the models to the domain ----------------------------------------------------------
 
 
-def camera_from_model(fields: Fields, model: CameraModel) -> Camera:
+def camera_from_model(source: str, model: CameraModel) -> Camera:
     """The :class:`Camera` of a validated camera section; checks the marks against the format
     and their numbering (``docs/conventions.md`` §2: 1 at −x, 2 at +x, 3 at +y, 4 at −y)."""
     fmt = model.format_mm
@@ -375,12 +376,13 @@ def camera_from_model(fields: Fields, model: CameraModel) -> Camera:
         given = {"1": c.m1, "2": c.m2, "3": c.m3, "4": c.m4}
         for name in FIDUCIAL_NAMES:
             for i, v in enumerate(given[name]):
-                fields.check_number(v, f"{cpath}.{name}[{i}]", unit="mm", low=-half, high=half)
+                number_at(source, f"{cpath}.{name}[{i}]", v, unit="mm", low=-half, high=half)
             marks[name] = (given[name][0], given[name][1])
         expected_side = {"1": (0, -1), "2": (0, 1), "3": (1, 1), "4": (1, -1)}
         for name, (axis, sign) in expected_side.items():
             if marks[name][axis] * sign <= 0:
-                raise fields.error(
+                raise ConfigError(
+                    source,
                     f"{cpath}.{name}",
                     f"mark {name} on the {'+' if sign > 0 else '−'}{'xy'[axis]} side "
                     "(numbering: 1 at −x, 2 at +x, 3 at +y, 4 at −y)",
@@ -391,9 +393,9 @@ def camera_from_model(fields: Fields, model: CameraModel) -> Camera:
         dpath = f"{fid_path}.distances_mm"
         d = model.fiducials.distances_mm
         assert d is not None  # the model has exactly one of the two
-        d12 = fields.check_number(d.d12, f"{dpath}.1-2", unit="mm", low=0.0, high=fmt,
+        d12 = number_at(source, f"{dpath}.1-2", d.d12, unit="mm", low=0.0, high=fmt,
                                   low_open=True)
-        d34 = fields.check_number(d.d34, f"{dpath}.3-4", unit="mm", low=0.0, high=fmt,
+        d34 = number_at(source, f"{dpath}.3-4", d.d34, unit="mm", low=0.0, high=fmt,
                                   low_open=True)
         marks = {"1": (-d12 / 2, 0.0), "2": (d12 / 2, 0.0), "3": (0.0, d34 / 2),
                  "4": (0.0, -d34 / 2)}
@@ -401,10 +403,11 @@ def camera_from_model(fields: Fields, model: CameraModel) -> Camera:
     return Camera(model.focal_length_mm, (pp[0], pp[1]), fmt, marks, given_as)
 
 
-def _frame(fields: Fields, model: FrameModel) -> Frame:
+def _frame(source: str, model: FrameModel) -> Frame:
     if model.kind == "local":
         if model.origin is not None:
-            raise fields.error(
+            raise ConfigError(
+                source,
                 "frame.origin",
                 "no origin for kind local",
                 "an origin",
@@ -412,23 +415,25 @@ def _frame(fields: Fields, model: FrameModel) -> Frame:
             )
         return Frame("local", None)
     if model.origin is None:
-        raise fields.error("frame.origin", "a value (the field is required)", "nothing")
-    origin = _sk42(fields, model.origin, "frame.origin")
+        raise ConfigError(source, "frame.origin", "a value (the field is required)", "nothing")
+    origin = _sk42(source, model.origin, "frame.origin")
     frame = Frame("sk42", origin)
     try:
         frame_tie.local_frame(frame)
     except StereoplotterError as exc:  # e.g. a latitude beyond the geodesy's range
-        raise fields.error(
+        raise ConfigError(
+            source,
             "frame.origin", "an origin inside the SK-42 Gauss–Krüger domain", list(origin), str(exc)
         ) from None
     return frame
 
 
-def _sk42(fields: Fields, model: Origin | Corner, path: str) -> tuple[float, ...]:
+def _sk42(source: str, model: Origin | Corner, path: str) -> tuple[float, ...]:
     try:
         frame_tie.check_conventional_ordinate(model.east_m)
     except StereoplotterError as exc:
-        raise fields.error(
+        raise ConfigError(
+            source,
             f"{path}.east_m",
             "a conventional ordinate zone·10⁶ + 500 000 + y, |y| < 400 km",
             model.east_m,
@@ -439,7 +444,7 @@ def _sk42(fields: Fields, model: Origin | Corner, path: str) -> tuple[float, ...
     return (model.north_m, model.east_m)
 
 
-def _photos(fields: Fields, models: list[PhotoModel]) -> tuple[Photo, ...]:
+def _photos(source: str, models: list[PhotoModel]) -> tuple[Photo, ...]:
     photos = []
     for p in models:
         e = p.exterior
@@ -458,12 +463,12 @@ def _photos(fields: Fields, models: list[PhotoModel]) -> tuple[Photo, ...]:
         )
     names = [p.name for p in photos]
     if len(photos) == 2 and names != ["left", "right"]:
-        raise fields.error("photos", "two photos named left and right, in that order", names)
+        raise ConfigError(source, "photos", "two photos named left and right, in that order", names)
     return tuple(photos)
 
 
 def _points(
-    fields: Fields, models: list[PointModel], frame: Frame, terrain: Terrain
+    source: str, models: list[PointModel], frame: Frame, terrain: Terrain
 ) -> tuple[Point, ...]:
     points: list[Point] = []
     seen: set[str] = set()
@@ -471,7 +476,7 @@ def _points(
         ppath = f"points[{i}]"
         pid = item.id
         if pid in seen:
-            raise fields.error(f"{ppath}.id", "a unique point id", pid)
+            raise ConfigError(source, f"{ppath}.id", "a unique point id", pid)
         seen.add(pid)
         if item.local is not None:
             lpath = f"{ppath}.local"
@@ -483,7 +488,8 @@ def _points(
                 try:
                     sk42 = frame_tie.sk42_from_local(frame, (X, Y, Z))
                 except StereoplotterError as exc:  # far outside the origin's zone
-                    raise fields.error(
+                    raise ConfigError(
+                        source,
                         lpath,
                         f"a point inside the zone of frame.origin (point {pid})",
                         [X, Y, Z],
@@ -493,18 +499,20 @@ def _points(
             continue
         spath = f"{ppath}.sk42"
         if frame.kind != "sk42":
-            raise fields.error(
+            raise ConfigError(
+                source,
                 spath,
                 "local coordinates (the frame has no SK-42 tie)",
                 "sk42 coordinates",
                 "set frame.kind: sk42 with an origin",
             )
         assert item.sk42 is not None  # the model has exactly one of local, sk42
-        sk42 = _sk42(fields, item.sk42, spath)
+        sk42 = _sk42(source, item.sk42, spath)
         try:
             local = frame_tie.local_from_sk42(frame, sk42)
         except StereoplotterError as exc:  # e.g. the point lies in another zone
-            raise fields.error(
+            raise ConfigError(
+                source,
                 f"{spath}.east_m",
                 f"a point in the zone of frame.origin (point {pid})",
                 sk42[1],
@@ -514,10 +522,11 @@ def _points(
     return tuple(points)
 
 
-def _map_sheet(fields: Fields, model: MapSheetModel, frame: Frame) -> MapSheet:
+def _map_sheet(source: str, model: MapSheetModel, frame: Frame) -> MapSheet:
     path = "map_sheet"
     if frame.kind != "sk42":
-        raise fields.error(
+        raise ConfigError(
+            source,
             path,
             "a frame tied to SK-42 (frame.kind: sk42)",
             "frame.kind: local",
@@ -527,23 +536,28 @@ def _map_sheet(fields: Fields, model: MapSheetModel, frame: Frame) -> MapSheet:
     if model.corners is not None:
         cpath = f"{path}.corners"
         if len(model.corners) != 4:
-            raise fields.error(cpath, "4 corners (NW, NE, SE, SW)", f"{len(model.corners)} corners")
-        corners = np.array([_sk42(fields, c, f"{cpath}[{i}]") for i, c in enumerate(model.corners)])
+            raise ConfigError(
+                source, cpath, "4 corners (NW, NE, SE, SW)", f"{len(model.corners)} corners"
+            )
+        corners = np.array([_sk42(source, c, f"{cpath}[{i}]") for i, c in enumerate(model.corners)])
         return MapSheet(scale, corners, None)
     name = model.nomenclature
     assert name is not None  # the model has exactly one of nomenclature, corners
     try:
         corners, sheet_scale = frame_tie.sheet_corners_sk42(name)
     except StereoplotterError as exc:
-        raise fields.error(
+        raise ConfigError(
+            source,
             f"{path}.nomenclature", "a valid SK-42 nomenclature", name, str(exc)
         ) from None
     if sheet_scale != scale:
-        raise fields.error(f"{path}.scale", f"{sheet_scale} (the scale of sheet {name})", scale)
+        raise ConfigError(
+            source, f"{path}.scale", f"{sheet_scale} (the scale of sheet {name})", scale
+        )
     return MapSheet(scale, corners, name)
 
 
-def _check_geometry(fields: Fields, scenario: Scenario) -> None:
+def _check_geometry(source: str, scenario: Scenario) -> None:
     """Refuse degenerate geometry: a station at or below the ground, a zero base, too few
     control points for a resection or for the sheet fit (6.8)."""
     pts = np.array([p.local_m for p in scenario.points])
@@ -554,8 +568,9 @@ def _check_geometry(fields: Fields, scenario: Scenario) -> None:
         lowest_clearance = ext.projection_centre_m[2] - pts[:, 2].max()
         if lowest_clearance <= 0:
             top = scenario.points[int(np.argmax(pts[:, 2]))]
-            raise fields.error(
-                fields.join(epath, "Z_m"),
+            raise ConfigError(
+                source,
+                f"{epath}.Z_m",
                 f"a projection centre above every point (point {top.id} is at "
                 f"Z = {top.local_m[2]:g} m)",
                 ext.projection_centre_m[2],
@@ -575,8 +590,9 @@ def _check_geometry(fields: Fields, scenario: Scenario) -> None:
                 if ok and p.role == "control" and p.kind == "full"
             ]
             if len(usable) < MIN_RESECTION_POINTS:
-                raise fields.error(
-                    fields.join(epath, "source"),
+                raise ConfigError(
+                    source,
+                    f"{epath}.source",
                     f"at least {MIN_RESECTION_POINTS} full control points imaged on photo "
                     f"{photo.name!r} for a resection",
                     f"{len(usable)} ({', '.join(usable)})",
@@ -585,7 +601,8 @@ def _check_geometry(fields: Fields, scenario: Scenario) -> None:
         left, right = (p.exterior.centre for p in scenario.photos)
         base = float(np.linalg.norm(right[:2] - left[:2]))
         if base < 1.0:
-            raise fields.error(
+            raise ConfigError(
+                source,
                 "photos[1].exterior",
                 "a horizontal base of at least 1 m",
                 f"{base:.3g} m",
@@ -594,7 +611,8 @@ def _check_geometry(fields: Fields, scenario: Scenario) -> None:
     if scenario.map_sheet is not None:
         plan = [p.id for p in scenario.points if p.role == "control" and p.kind in ("full", "plan")]
         if len(plan) < MIN_SIMILARITY_POINTS:
-            raise fields.error(
+            raise ConfigError(
+                source,
                 "points",
                 f"at least {MIN_SIMILARITY_POINTS} control points of "
                 "kind full or plan for the sheet fit (6.8)",

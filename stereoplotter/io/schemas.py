@@ -16,6 +16,7 @@ from typing import Any
 
 from pydantic import BaseModel
 
+from stereoplotter.io.block_file import BlockFile
 from stereoplotter.io.instrument_file import InstrumentFile
 from stereoplotter.io.scenario_file import ScenarioFile
 from stereoplotter.io.yaml_files import atomic_write_text
@@ -26,6 +27,7 @@ __all__ = ["MODELS", "schema", "schema_text", "write_schemas"]
 MODELS: dict[str, type[BaseModel]] = {
     "scenario": ScenarioFile,
     "instrument": InstrumentFile,
+    "block": BlockFile,
 }
 
 

@@ -17,8 +17,9 @@ DOCS = Path(__file__).resolve().parents[2] / "docs" / "schemas"
 SHIPPED = {
     "scenario": sorted(data_dir("scenarios").glob("*.yaml")),
     "instrument": sorted(data_dir("instruments").glob("*.yaml")),
+    "block": sorted((data_dir("scenarios") / "blocks").glob("*.yaml")),
 }
-COUNTS = {"scenario": 4, "instrument": 3}
+COUNTS = {"scenario": 4, "instrument": 3, "block": 1}
 
 
 @pytest.mark.parametrize("kind", list(MODELS))
@@ -98,3 +99,19 @@ def test_instrument_schema_lets_a_file_with_inherits_omit_leaves():
     assert list(validator.iter_errors(family)) == []  # no name: a family file
     del doc["mark"]  # a whole instrument (a name, no inherits) must have every required leaf
     assert [e.message for e in validator.iter_errors(doc)] == ["'mark' is a required property"]
+
+
+def test_block_schema_refuses_what_the_loader_refuses():
+    validator = _validator("block")
+    doc = yaml.safe_load(SHIPPED["block"][0].read_text(encoding="utf-8"))
+    doc["models"][0]["left"]["alpha_deg"] = 22.0  # |tilt| ≤ 15°
+    doc["models"][1]["name"] = "../evil"  # usable as a folder name
+    doc["models_csv"] = "m.csv"  # exactly one of models, models_csv
+    errors = sorted(
+        (list(e.absolute_path), e.validator) for e in _leaf_errors(validator.iter_errors(doc))
+    )
+    assert errors == [
+        ([], "oneOf"),
+        (["models", 0, "left", "alpha_deg"], "maximum"),
+        (["models", 1, "name"], "pattern"),
+    ]
