@@ -42,7 +42,13 @@ if TYPE_CHECKING:
     from stereoplotter.instrument.spec import InstrumentSpec
     from stereoplotter.scenario.model import Scenario
 
-__all__ = ["PROCEDURE_ROWS", "procedure_mc", "scenario_geometry"]
+__all__ = [
+    "PROCEDURE_ROWS",
+    "idealised_geometry",
+    "procedure_mc",
+    "relative_orientation_mc",
+    "scenario_geometry",
+]
 
 #: Row → (book scenario, method); the scenarios are the book's §27 setting (shipped ``pair60``,
 #: ``pair80``), loaded by the caller (:func:`stereoplotter.report.verification.book_scenarios`).
@@ -250,6 +256,193 @@ def procedure_mc(
         "rms_mm": rms,
         "bias_mm": float(np.sqrt(np.mean(d_zero**2))),
         "per_trial": np.sqrt(ms) / unit,
+        "seconds": time.perf_counter() - t0,
+        **g,
+    }
+
+
+# --------------------------------------------------------------------------------------------
+# The conventional relative orientation alone against (5.54)
+# --------------------------------------------------------------------------------------------
+
+
+def idealised_geometry(scenario: Scenario) -> Scenario:
+    """``scenario`` with vertical photos at the left photo's height, flat terrain at the base
+    height and no film deformation: the geometry (5.54) assumes (points exactly at Fig. 39)."""
+    from stereoplotter.scenario.model import Terrain
+
+    z = float(scenario.photo("left").exterior.centre[2])
+    photos = tuple(
+        replace(
+            ph,
+            exterior=replace(
+                ph.exterior,
+                alpha=0.0,
+                omega=0.0,
+                kappa=0.0,
+                projection_centre_m=(*ph.exterior.projection_centre_m[:2], z),
+            ),
+            film_deformation_ppm=(0.0, 0.0),
+        )
+        for ph in scenario.photos
+    )
+    return replace(scenario, terrain=Terrain(scenario.terrain.base_height_m), photos=photos)
+
+
+def _standard_points_at_a(prep, g):
+    """The prepared run with standard points 1, 3, 5 moved by −a and 2, 4, 6 by +a along the
+    base (Fig. 39, x_л ∈ {−a, p + a}, a = c − p) and the C2 tolerance 0, so every trial makes
+    the same number of passes (no 'stop when satisfied' selection, which (5.54) does not model)."""
+    from stereoplotter.procedure.evaluation import instrument_frame_m
+
+    sc, sheet, scene = prep.scenario, prep.sheet, prep.scene
+    origin = np.asarray(sheet.frame_origin_m, float)
+    theta = float(sheet.frame_rotation)
+    frame = instrument_frame_m(scene.standard_points_m, origin, theta)
+    a_m = g["a"] * g["flying_height_m"] / g["f"]
+    frame[:, 0] += np.array([-a_m, a_m] * 3)
+    local = instrument_frame_m(frame, origin, theta, inverse=True)
+    local[:, 2] = sc.terrain.height_m(local[:, 0], local[:, 1])
+    tol = {**sheet.tolerances, "residual_y_parallax_mm": 0.0}
+    return replace(
+        prep,
+        scene=replace(scene, standard_points_m=local),
+        sheet=replace(sheet, tolerances=tol),
+    )
+
+
+def _control_frame_points(scenario, sheet, g):
+    """The four levelling control points of (5.54), x_п ∈ {−c, a}, y = ±c, on the ground; with
+    their (x_п, y) [mm]."""
+    from stereoplotter.procedure.evaluation import instrument_frame_m
+
+    c, p, a = g["c"], g["p"], g["a"]
+    xr = np.array([-c, a, -c, a])
+    y = np.array([c, c, -c, -c])
+    scale = g["flying_height_m"] / g["f"]
+    origin = np.asarray(sheet.frame_origin_m, float)
+    theta = float(sheet.frame_rotation)
+    local = instrument_frame_m(
+        np.column_stack([(xr + p) * scale, y * scale, np.zeros(4)]), origin, theta, inverse=True
+    )
+    local[:, 2] = scenario.terrain.height_m(local[:, 0], local[:, 1])
+    return instrument_frame_m(local, origin, theta), xr, y
+
+
+def _relative_only(prep, first, trials):
+    """C1, the calibration and C2 by (5.11) on trials ``first … first + trials − 1`` (None: one
+    error-free trial); returns the run."""
+    from stereoplotter.instrument.virtual import Instrument
+    from stereoplotter.procedure import conventional as cv
+    from stereoplotter.procedure.operator import Noise, Operator
+    from stereoplotter.procedure.setup_method import Run
+    from stereoplotter.procedure.transcript import Transcript
+
+    stop = None if trials is None else first + trials
+    inst = Instrument(
+        prep.spec,
+        prep.sheet.focal_length_corrected_mm,
+        errors=prep.model,
+        injected=prep.model.draw_keyed(prep.seed, first, stop),
+        variant=prep.variant,
+        backend=prep.backend,
+        trials=trials,
+        ideal_mechanics=True,
+    )
+    noise = Noise(prep.seed, trials, None, first)
+    op = Operator(inst, prep.operator, noise, Transcript(enabled=False))
+    run = Run(op, prep.sheet, prep.scene)
+    cv.c1_interior(run)
+    cal = cv.calibrate(run, cv.levelling_points(run))
+    cv.c2_relative_by_equations(run, cal)
+    return run
+
+
+def relative_orientation_mc(
+    scenario: Scenario,
+    *,
+    spec: InstrumentSpec,
+    trials: int = 2000,
+    seed: int = 20240601,
+    sigma_mm: float = 0.01,
+    ideal_geometry: bool = False,
+    chunk: int = 2000,
+    grid=(16, 32),
+) -> dict:
+    """Procedure MC of the conventional relative orientation alone, the quantity of (5.54).
+
+    The simulated operator runs C1 and C2 by the six measured q and (5.11) on an ideal instrument
+    (no injected errors, ideal mechanics, exact counters) with only the y-parallax judgment
+    error σ_q; standard points at Fig. 39 with a = c − p and ordinate c; a fixed number of passes
+    (``OperatorModel.max_iterations``). The statistic: RMS over trials and the midpoint grid of
+    x_п ∈ [−c, 0], y ∈ [−c, c] of δp (this run minus the error-free run) after removing the
+    least-squares plane through δp at the four control points x_п ∈ {−c, a}, y = ±c (the
+    error-free levelling (5.54) assumes), per m_q = σ_q. CI: ``CI_Z`` standard errors.
+
+    ``ideal_geometry``: run on :func:`idealised_geometry` (vertical photos, flat terrain).
+
+    Returns
+    -------
+    dict
+        ``coefficient``, ``ci``, ``formula`` ((5.54) rigorous at the simulated a, c, p),
+        ``unlevelled`` (RMS/σ_q without the plane removal), ``trials``, geometry, ``seconds``.
+    """
+    import time
+
+    from stereoplotter.accuracy.chapter5 import (
+        levelling_design,
+        relative_orientation_parallax_rms,
+    )
+    from stereoplotter.procedure.operator import OperatorModel
+    from stereoplotter.procedure.simulate import prepare_run
+
+    t0 = time.perf_counter()
+    sc = idealised_geometry(scenario) if ideal_geometry else scenario
+    g = scenario_geometry(sc, spec)
+    spec = replace(spec, standard_points_c_mm=g["c"])
+    zero = OperatorModel().zero()
+    preps = [
+        _standard_points_at_a(
+            prepare_run(sc, spec, "conventional", "zero", seed, operator=o, ideal_mechanics=True),
+            g,
+        )
+        for o in (zero, replace(zero, y_parallax_sigma_mm=sigma_mm))
+    ]
+    run0 = _relative_only(preps[0], 0, None)
+    sheet = run0.sheet
+    pts = _domain_points(
+        sc, sheet, (g["p"] - g["c"], g["p"]), g["c"], g["p"], g["f"], g["flying_height_m"], grid
+    )
+    cpts, xc, yc = _control_frame_points(sc, sheet, g)
+    d0, d0c = (_dp(sc, sheet, run0.op.inst, q) for q in (pts, cpts))
+    nx, ny = grid
+    xs = -g["c"] + (np.arange(nx) + 0.5) * g["c"] / nx
+    ys = -g["c"] + (np.arange(ny) + 0.5) * 2 * g["c"] / ny
+    xg, yg = (v.ravel() for v in np.meshgrid(xs, ys, indexing="ij"))
+    plane = levelling_design(xg, yg) @ np.linalg.pinv(levelling_design(xc, yc))
+    ms = np.empty(int(trials))
+    raw = np.empty(int(trials))
+    for first in range(0, int(trials), int(chunk)):
+        n = min(int(chunk), int(trials) - first)
+        run = _relative_only(preps[1], first, n)
+        d = _dp(sc, sheet, run.op.inst, pts) - d0
+        dc = _dp(sc, sheet, run.op.inst, cpts) - d0c
+        ms[first : first + n] = np.mean((d - dc @ plane.T) ** 2, axis=-1)
+        raw[first : first + n] = np.mean(d**2, axis=-1)
+    mean_ms = float(np.mean(ms))
+    rms = math.sqrt(mean_ms)
+    half = CI_Z * rms * (float(np.std(ms, ddof=1)) / math.sqrt(len(ms))) / (2.0 * mean_ms)
+    formula = float(relative_orientation_parallax_rms(g["a"], g["c"], g["p"], 1.0, "rigorous"))
+    return {
+        "scenario": scenario.name,
+        "ideal_geometry": bool(ideal_geometry),
+        "trials": int(trials),
+        "seed": int(seed),
+        "sigma_mm": sigma_mm,
+        "coefficient": rms / sigma_mm,
+        "ci": half / sigma_mm,
+        "formula": formula,
+        "unlevelled": math.sqrt(float(np.mean(raw))) / sigma_mm,
         "seconds": time.perf_counter() - t0,
         **g,
     }
