@@ -1,28 +1,48 @@
-"""The ``verify --geometry`` file: a scenario, or a flat mapping of the table's geometry."""
+"""The ``verify --geometry`` file: a scenario, or a flat mapping of the table's geometry
+(:class:`GeometryFile`)."""
 
 from __future__ import annotations
+
+from functools import partial
+from types import SimpleNamespace
+
+from pydantic import ConfigDict
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
-from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
+from stereoplotter.io.validation import FileModel, number, validate
+from stereoplotter.io.yaml_files import load_yaml_mapping
 from stereoplotter.verification.procedure_mc import scenario_geometry
-from stereoplotter.verification.table import BOOK, check_geometry
+from stereoplotter.verification.table import check_geometry
 
-__all__ = ["geometry_from_file"]
+__all__ = ["GeometryFile", "geometry_from_file"]
+
+_MM_POSITIVE = number("mm", 1.0, 500.0)
+_MM = number("mm", -500.0, 500.0)
 
 
-_MM_POSITIVE = {"unit": "mm", "low": 1.0, "high": 500.0}
-_GEOMETRY_LIMITS = {
-    "f": {"unit": "mm", "low": 1.0, "high": 1000.0},
-    "l": _MM_POSITIVE,
-    "n": {"unit": "—", "low": 0.01, "high": 100.0},
-    "c": _MM_POSITIVE,
-    "p60": _MM_POSITIVE,
-    "a60": {"unit": "mm", "low": -500.0, "high": 500.0},
-    "p80": _MM_POSITIVE,
-    "a80": {"unit": "mm", "low": -500.0, "high": 500.0},
-}
+class GeometryFile(FileModel):
+    """The flat form of a ``verify --geometry`` file: any of the table's geometry values (the
+    others keep the book's setting); a file with ``camera`` is a scenario instead."""
+
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, title="stereoplotter verify --geometry file (flat form)"
+    )
+
+    f: number("mm", 1.0, 1000.0, description="focal length f") | None = None  # type: ignore[valid-type]
+    l: _MM_POSITIVE | None = None  # type: ignore[valid-type]  # noqa: E741
+    n: number("—", 0.01, 100.0) | None = None  # type: ignore[valid-type]
+    c: _MM_POSITIVE | None = None  # type: ignore[valid-type]
+    p60: _MM_POSITIVE | None = None  # type: ignore[valid-type]
+    a60: _MM | None = None  # type: ignore[valid-type]
+    p80: _MM_POSITIVE | None = None  # type: ignore[valid-type]
+    a80: _MM | None = None  # type: ignore[valid-type]
+
+
+def _errors(source: str) -> SimpleNamespace:
+    """What :func:`check_geometry` reports through: ``.error(field, expected, found)``."""
+    return SimpleNamespace(error=partial(ConfigError, source))
 
 
 def geometry_from_file(path) -> tuple[dict, dict]:
@@ -43,10 +63,9 @@ def geometry_from_file(path) -> tuple[dict, dict]:
     """
     data, source = load_yaml_mapping(path)
     if "camera" not in data:
-        fields = Fields(source)
-        fields.mapping(data, "", tuple(BOOK))
-        geometry = {k: fields.number(data, k, "", **_GEOMETRY_LIMITS[k]) for k in data}
-        check_geometry(fields, geometry)
+        doc = validate(GeometryFile, data, source)
+        geometry = {k: v for k, v in doc.model_dump().items() if v is not None}
+        check_geometry(_errors(source), geometry)
         return geometry, {"60": None, "80": None}
     scenario = load_scenario(path)  # every problem of the file as one ConfigError
     if not scenario.is_stereopair:
@@ -61,8 +80,8 @@ def geometry_from_file(path) -> tuple[dict, dict]:
     g = {"f": sg["f"], "l": sg["l"], "n": sg["n"]}
     if sg["overlap"] < 0.7:
         g.update(c=p, p60=p, a60=0.0, p80=p / 2, a80=p / 2)
-        check_geometry(Fields(source), g)
+        check_geometry(_errors(source), g)
         return g, {"60": scenario, "80": None}
     g.update(c=2 * p, p60=2 * p, a60=0.0, p80=p, a80=p)
-    check_geometry(Fields(source), g)
+    check_geometry(_errors(source), g)
     return g, {"60": None, "80": scenario}

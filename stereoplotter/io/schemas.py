@@ -17,6 +17,8 @@ from typing import Any
 from pydantic import BaseModel
 
 from stereoplotter.io.block_file import BlockFile
+from stereoplotter.io.errors_file import ErrorsFile
+from stereoplotter.io.geometry_file import GeometryFile
 from stereoplotter.io.instrument_file import InstrumentFile
 from stereoplotter.io.scenario_file import ScenarioFile
 from stereoplotter.io.yaml_files import atomic_write_text
@@ -28,6 +30,8 @@ MODELS: dict[str, type[BaseModel]] = {
     "scenario": ScenarioFile,
     "instrument": InstrumentFile,
     "block": BlockFile,
+    "errors": ErrorsFile,
+    "geometry": GeometryFile,
 }
 
 

@@ -237,6 +237,10 @@ def _has_surrogate(text: str) -> bool:
 class Fields:
     """Typed, range-checked access to a parsed YAML document, with messages that name the field.
 
+    Superseded by the pydantic models of :mod:`stereoplotter.io.validation` (scenario,
+    instrument, block, injected-errors and geometry files no longer use it); kept only until
+    ``io/job_file.py`` moves over, then to be removed.
+
     Parameters
     ----------
     source : str

@@ -10,8 +10,10 @@ import jsonschema
 import pytest
 import yaml
 
+from stereoplotter.io.geometry_file import GeometryFile
 from stereoplotter.io.paths import data_dir
 from stereoplotter.io.schemas import MODELS, schema_text, write_schemas
+from stereoplotter.verification.table import BOOK
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "schemas"
 SHIPPED = {
@@ -114,4 +116,25 @@ def test_block_schema_refuses_what_the_loader_refuses():
         ([], "oneOf"),
         (["models", 0, "left", "alpha_deg"], "maximum"),
         (["models", 1, "name"], "pattern"),
+    ]
+
+
+def test_errors_and_geometry_schemas():
+    errors = _validator("errors")
+    good = {"backlash": 0.02, "setting.bx": {"distribution": "uniform", "scale": 0.1}}
+    assert list(errors.iter_errors(good)) == []
+    bad = {"backlash": -1, "setting.bx": {"sigma": 0.1, "scale": 0.1}}
+    found = sorted((*e.absolute_path, e.validator) for e in _leaf_errors(errors.iter_errors(bad)))
+    assert found == [  # each value fails both branches: a scale, {distribution, scale}
+        ("backlash", "minimum"),
+        ("backlash", "type"),
+        ("setting.bx", "additionalProperties"),
+        ("setting.bx", "type"),
+    ]
+    geometry = _validator("geometry")
+    assert list(GeometryFile.model_fields) == list(BOOK)  # the keys of the table's setting
+    assert list(geometry.iter_errors({"f": 70.0, "p60": 90.0})) == []
+    assert [e.validator for e in _leaf_errors(geometry.iter_errors({"f": 0.5, "q": 1}))] == [
+        "additionalProperties",
+        "minimum",
     ]
