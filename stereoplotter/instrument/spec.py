@@ -448,24 +448,8 @@ def check_in_range(spec: InstrumentSpec, attribute_name: str, value: float, what
         else f"the limit is documented ({', '.join(parameter.source)})"
     )
     if attribute_name in _SETS:
-        entries = tuple(limit)
-        if any(math.isclose(value, e, rel_tol=1e-9, abs_tol=0.0) for e in entries):
-            return
-        listed = ", ".join(f"{e:g}" for e in entries)
-        advice = (
-            "add the gear to the YAML if your instrument has it" if status == "assumed" else advice
-        )
-        raise RangeRefusal(
-            f"{what} = {shown:g} is not in the {status} gear set [{listed}] of {file}: {key} "
-            f"(no such gear; {advice})",
-            what=what,
-            value=shown,
-            low=min(entries),
-            high=max(entries),
-            status=status,
-            file=file,
-            key=key,
-        )
+        _check_in_gear_set(parameter, key, tuple(limit), value, what, advice)
+        return
     if attribute_name in _MAXIMA:
         lo, hi = -limit, limit
     elif (
@@ -506,6 +490,34 @@ def check_in_range(spec: InstrumentSpec, attribute_name: str, value: float, what
         value=shown,
         low=lo_y,
         high=hi_y,
+        status=status,
+        file=file,
+        key=key,
+    )
+
+
+def _check_in_gear_set(
+    parameter: Parameter,
+    key: str,
+    entries: tuple[float, ...],
+    value: float,
+    what: str,
+    advice: str,
+) -> None:
+    """The gear-set case of :func:`check_in_range`: the value must be one of the entries."""
+    if any(math.isclose(value, e, rel_tol=1e-9, abs_tol=0.0) for e in entries):
+        return
+    status, file = parameter.status, parameter.file
+    listed = ", ".join(f"{e:g}" for e in entries)
+    if status == "assumed":
+        advice = "add the gear to the YAML if your instrument has it"
+    raise RangeRefusal(
+        f"{what} = {float(value):g} is not in the {status} gear set [{listed}] of {file}: {key} "
+        f"(no such gear; {advice})",
+        what=what,
+        value=float(value),
+        low=min(entries),
+        high=max(entries),
         status=status,
         file=file,
         key=key,
