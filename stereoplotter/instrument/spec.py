@@ -403,6 +403,8 @@ _MAXIMA = ("tilt_max",)
 _UPPER_END = {"projection_distance_range_mm": "projection.distance_max_mm"}
 
 
+# long: the docstring (parameters, the refusal, a doctest) is 32 lines; code ~55 (range, maximum,
+# documented upper end: one message each); the gear-set case is _check_in_gear_set
 def check_in_range(spec: InstrumentSpec, attribute_name: str, value: float, what: str) -> None:
     """Refuse a setting outside the instrument's range, as a mechanical stop would.
 
