@@ -23,6 +23,7 @@ import numpy as np
 
 from stereoplotter import __version__
 from stereoplotter.errors import StereoplotterError
+from stereoplotter.io.job_file import is_job_file
 from stereoplotter.io.paths import (
     DEFAULT_SCENARIO,
     DataFile,
@@ -406,8 +407,15 @@ def _setup(args: argparse.Namespace) -> int:
     from stereoplotter.report.sheet import sheet_to_dict
     from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
 
-    spec = load_instrument(args.instrument)
     data, _ = load_yaml_mapping(args.scenario)
+    if is_job_file(data):
+        return _setup_job(args)
+    if args.instrument is None:
+        raise StereoplotterError(
+            f"{args.scenario}: --instrument: expected sc1, spr3, sd3 or a YAML path, found "
+            "nothing (only a job file names its own instrument)"
+        )
+    spec = load_instrument(args.instrument)
     if "models" in data or "models_csv" in data:
         return _setup_block(args, spec)
     scenario = load_scenario(args.scenario)
@@ -431,6 +439,48 @@ def _setup(args: argparse.Namespace) -> int:
         atomic_write_bytes(out / name, content)
     if not args.json:
         sys.stdout.write(f"{_sheet_summary(sheet)}\nwritten: {', '.join(files)} in {out}\n")
+    return 0
+
+
+def _setup_job(args: argparse.Namespace) -> int:
+    """A production job: every pair's sheet and printable form (``stereoplotter.report.job``)."""
+    from stereoplotter.io.instrument_file import load_instrument
+    from stereoplotter.io.job_file import load_job
+    from stereoplotter.report.job import compute_job, pair_dict, write_job
+
+    given = [o for o, v in (("--seed", args.seed), ("--horizontal-scale", args.horizontal_scale),
+                            ("--vertical-scale", args.vertical_scale)) if v is not None]
+    if given:
+        raise StereoplotterError(
+            f"{args.scenario}: {given[0]}: expected nothing for a job file, found a value (a job "
+            "draws no random numbers and sets its scales in its own 'scales' field)"
+        )
+    job = load_job(args.scenario)
+    result = compute_job(job, load_instrument(args.instrument) if args.instrument else None)
+    if args.json:
+        pairs = [pair_dict(job, p) for p in result.pairs]
+        sys.stdout.write(_json({"job": job.name, "instrument": result.spec.key, "pairs": pairs}))
+        if args.output is None:
+            return 0
+    out = Path(args.output or "stereoplotter-setup")
+    names = write_job(result, out)
+    if args.json:
+        return 0
+    accepted = sum(p.accepted for p in result.pairs)
+    lines = [f"job {job.name} on {result.spec.title}: {accepted} of {len(result.pairs)} pairs "
+             "set up"]
+    for p in result.pairs:
+        s = p.sheet
+        lines.append(
+            f"  {p.pair.name}: M_г = 1:{s.horizontal_scale_denominator}, M_в = "
+            f"1:{s.vertical_scale_denominator}, f_пр = {s.f_instrument_mm:.3f} mm, n_л = "
+            f"{s.n_left:.5f}, n_п = {s.n_right:.5f}" if s is not None
+            else f"  {p.pair.name}: REFUSED: {p.reason}"
+        )
+    pdfs = sum(n.endswith("/sheet.pdf") for n in names)
+    lines.append(f"written: <pair>/sheet.yaml, sheet.md, sheet.pdf ({pdfs} forms), forms.pdf, "
+                 f"block.csv, refused.md in {out}")
+    sys.stdout.write("\n".join(lines) + "\n")
     return 0
 
 
@@ -693,10 +743,15 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("setup", help="compute the setup sheet (Table 24) of a stereopair")
     p.add_argument(
         "scenario",
-        help="a stereopair scenario (a name such as pair60, or a YAML file), or a block file "
-        "listing many stereopairs of one camera (one sheet per model)",
+        help="a stereopair scenario (a name such as pair60, or a YAML file), a block file "
+        "listing many stereopairs of one camera (one sheet per model), or a production job file "
+        "(format: stereoplotter-job/1: one sheet and printable form per pair)",
     )
-    p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
+    p.add_argument(
+        "--instrument",
+        help="sc1, spr3, sd3 or a YAML path (required, except for a job file, which names its "
+        "own instrument; given, it overrides the job's)",
+    )
     p.add_argument(
         "-o",
         "--output",

@@ -1,0 +1,685 @@
+"""The production job file ``stereoplotter-job/1``: the setup sheets of a block from real data.
+
+A *job* holds what a production office has, not a ground truth (``docs/production.md``): the
+camera's calibration certificate, the exterior orientation of every photo by number from the
+aerotriangulation, the fiducial distances measured on each diapositive, the control and check
+points of the catalogue, the map sheets, the stereopairs as pairs of photo numbers and the
+instrument. :func:`load_job` validates it (pydantic models on :mod:`stereoplotter.io.validation`;
+JSON Schema ``docs/schemas/job.schema.json``) into a frozen :class:`Job`; :func:`measured_pair`
+turns one pair into the measured inputs of
+:func:`stereoplotter.setup.sheet.compute_sheet_from_measurements`. Nothing here draws a random
+number: the same job gives the same sheets.
+
+The passage to the photogrammetric frame (``frame.kind``)
+--------------------------------------------------------
+* ``sk42``: centres and points are SK-42 Gauss–Krüger (x north, conventional ordinate ȳ with the
+  zone, geodetic height H). Every pair is computed in its own local system of §10
+  (:mod:`stereoplotter.geodesy.photogrammetric`) with the origin ``frame.origin`` when given,
+  else at the midpoint of the pair's two stations (whole metres) at H = 0. The angles α, ω, κ
+  of Eq. (2.50) are given relative to the grid axes at the photo's nadir (X grid east, Y grid
+  north, Z along the normal, up); they are carried into the local system by the rotation R whose
+  columns are the local directions of grid east, grid north and up at the nadir
+  (:func:`grid_to_local_rotation`): M_local = R·M_grid.
+* ``local``: centres, angles and points are already in one photogrammetric system; with
+  ``frame.origin`` that system is the §10 system at that SK-42 origin (then map sheets and the
+  similarity (6.8) are available), without it there is no geodetic tie (no sheet corners).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import ConfigDict, Field, field_validator
+
+from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.geodesy import split_conventional_ordinate
+from stereoplotter.geodesy.photogrammetric import local_from_gauss_kruger
+from stereoplotter.geometry.collinearity import object_to_photo, photo_to_object
+from stereoplotter.geometry.film import corrected_focal_length, fiducial_spans_mm
+from stereoplotter.geometry.rotation import rotation_matrix
+from stereoplotter.io.scenario_file import (
+    Corner,
+    Distances,
+    Fiducials,
+    MapSheetModel,
+    Origin,
+    camera_from_model,
+)
+from stereoplotter.io.validation import (
+    FileModel,
+    _fail,
+    integer,
+    number,
+    one_of,
+    sequence,
+    text,
+    validate,
+    vector,
+)
+from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
+from stereoplotter.scenario import frame as frame_tie
+from stereoplotter.scenario.model import Camera, Frame, MapSheet, Point
+
+__all__ = [
+    "FORMAT",
+    "Job",
+    "JobFile",
+    "JobPair",
+    "JobPhoto",
+    "MeasuredPair",
+    "grid_to_local_rotation",
+    "is_job_file",
+    "load_job",
+    "measured_pair",
+]
+
+#: The value of the ``format`` key that marks a job file.
+FORMAT = "stereoplotter-job/1"
+MAX_TILT_DEG = 15.0
+_TILT_BASIS = f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°"
+_EAST = "m (conventional ordinate: zone × 10⁶ + 500 000 + y)"
+#: Margin of the working area inside the overlap of the two footprints (as for a scenario).
+WORKING_AREA_MARGIN = 0.05
+
+
+# --- the models -------------------------------------------------------------------------------
+
+
+def _check_date(v: Any) -> str:
+    if not isinstance(v, str) or not re.fullmatch(r"\d{4}-\d{2}-\d{2}", v):
+        raise _fail("a date YYYY-MM-DD (printed on the forms; the clock is never read)", repr(v))
+    return v
+
+
+class Certificate(FileModel):
+    """The camera's calibration certificate."""
+
+    camera: text | None = None  # type: ignore[valid-type]
+    focal_length_mm: number("mm", 0.0, 1000.0, low_open=True)  # type: ignore[valid-type]
+    principal_point_mm: vector(2, "mm", -5.0, 5.0) = (0.0, 0.0)  # type: ignore[valid-type]
+    format_mm: number("mm", 50.0, 300.0) = 180.0  # type: ignore[valid-type]
+    fiducials: Fiducials
+    distortion: sequence(  # type: ignore[valid-type]
+        vector(2, "mm, µm", -1000.0, 1000.0, "r [mm], Δr [µm]")
+    ) | None = None
+
+
+class FrameModel(FileModel):
+    kind: one_of("sk42", "local")  # type: ignore[valid-type]
+    origin: Origin | None = None
+
+
+class PhotoModel(FileModel):
+    """One photo: its number and exterior orientation (SK-42 or local by ``frame.kind``)."""
+
+    number: integer(0, 10**9)  # type: ignore[valid-type]
+    north_m: number("m", 0.0, 1.0e7) | None = None  # type: ignore[valid-type]
+    east_m: number(_EAST, 1.0e6, 61.0e6) | None = None  # type: ignore[valid-type]
+    height_m: number("m", -500.0, 50000.0) | None = None  # type: ignore[valid-type]
+    X_m: number("m", -1.0e7, 1.0e7) | None = None  # type: ignore[valid-type]
+    Y_m: number("m", -1.0e7, 1.0e7) | None = None  # type: ignore[valid-type]
+    Z_m: number("m", -500.0, 50000.0) | None = None  # type: ignore[valid-type]
+    alpha_deg: number("°", -MAX_TILT_DEG, MAX_TILT_DEG, basis=_TILT_BASIS)  # type: ignore[valid-type]
+    omega_deg: number("°", -MAX_TILT_DEG, MAX_TILT_DEG, basis=_TILT_BASIS)  # type: ignore[valid-type]
+    kappa_deg: number("°", -180.0, 180.0)  # type: ignore[valid-type]
+    fiducial_distances_mm: Distances | None = None
+
+
+class FiducialRow(FileModel):
+    """A row of the fiducial-distance CSV: photo number, measured 1–2 and 3–4."""
+
+    photo: integer(0, 10**9)  # type: ignore[valid-type]
+    d12_mm: number("mm", 0.0, 300.0, low_open=True)  # type: ignore[valid-type]
+    d34_mm: number("mm", 0.0, 300.0, low_open=True)  # type: ignore[valid-type]
+
+
+class PointModel(FileModel):
+    """A control or check point (SK-42 or local coordinates, by ``frame.kind``)."""
+
+    id: text  # type: ignore[valid-type]
+    role: one_of("control", "check") = "control"  # type: ignore[valid-type]
+    kind: one_of("full", "plan", "height") = "full"  # type: ignore[valid-type]
+    north_m: number("m", 0.0, 1.0e7) | None = None  # type: ignore[valid-type]
+    east_m: number(_EAST, 1.0e6, 61.0e6) | None = None  # type: ignore[valid-type]
+    height_m: number("m", -500.0, 9000.0) | None = None  # type: ignore[valid-type]
+    X_m: number("m", -1.0e7, 1.0e7) | None = None  # type: ignore[valid-type]
+    Y_m: number("m", -1.0e7, 1.0e7) | None = None  # type: ignore[valid-type]
+    Z_m: number("m", -500.0, 9000.0) | None = None  # type: ignore[valid-type]
+
+
+class NamedSheet(MapSheetModel):
+    """A map sheet: scale and nomenclature, or scale and corners NW, NE, SE, SW (then a name)."""
+
+    name: text | None = None  # type: ignore[valid-type]
+
+
+class WorkingArea(FileModel):
+    lowest_m: number("m", -500.0, 9000.0)  # type: ignore[valid-type]
+    highest_m: number("m", -500.0, 9000.0)  # type: ignore[valid-type]
+
+
+class PairModel(FileModel):
+    left: integer(0, 10**9)  # type: ignore[valid-type]
+    right: integer(0, 10**9)  # type: ignore[valid-type]
+    map_sheet: text | None = None  # type: ignore[valid-type]
+    working_area: WorkingArea | None = None
+
+
+class ScalesModel(FileModel):
+    horizontal: integer(100, 10_000_000) | None = None  # type: ignore[valid-type]
+    vertical: integer(100, 10_000_000) | None = None  # type: ignore[valid-type]
+
+
+class OptionsModel(FileModel):
+    book_sign: bool = False
+    bz_scale_sense: integer(-1, 1) = 1  # type: ignore[valid-type]
+
+
+class JobFile(FileModel):
+    """A production job file (``docs/production.md``)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, title="stereoplotter job file")
+
+    format: one_of(FORMAT, expected=f"the text {FORMAT}")  # type: ignore[valid-type]
+    name: text  # type: ignore[valid-type]
+    date: str = Field(description="YYYY-MM-DD, printed on the forms")
+    description: str | None = None
+    instrument: text  # type: ignore[valid-type]
+    camera: Certificate
+    frame: FrameModel
+    photos: sequence(PhotoModel, min_length=2)  # type: ignore[valid-type]
+    fiducial_distances_csv: text | None = None  # type: ignore[valid-type]
+    points: sequence(PointModel) = Field(default_factory=list)  # type: ignore[valid-type]
+    points_csv: sequence(text) = Field(default_factory=list)  # type: ignore[valid-type]
+    map_sheets: sequence(NamedSheet) = Field(default_factory=list)  # type: ignore[valid-type]
+    pairs: sequence(PairModel, min_length=1)  # type: ignore[valid-type]
+    scales: ScalesModel = ScalesModel()
+    options: OptionsModel = OptionsModel()
+
+    @field_validator("date", mode="before")
+    @classmethod
+    def _date(cls, v: Any) -> str:
+        return _check_date(v)
+
+
+# --- the job as data ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class JobPhoto:
+    """One photo of a job.
+
+    ``centre`` is (x north, ȳ, H) for an SK-42 job, (X, Y, Z) for a local one [m]; the angles
+    are α, ω, κ of Eq. (2.50) [rad] (relative to the grid axes at the nadir for SK-42);
+    ``fiducial_distances_mm`` the measured 1–2 and 3–4 [mm].
+    """
+
+    number: int
+    centre: tuple[float, float, float]
+    angles: tuple[float, float, float]
+    fiducial_distances_mm: tuple[float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class JobPair:
+    """A stereopair by photo numbers, its map sheet and optional working-area heights [m]."""
+
+    left: int
+    right: int
+    map_sheet: MapSheet | None
+    working_area_m: tuple[float, float] | None
+
+    @property
+    def name(self) -> str:
+        return f"{self.left}-{self.right}"
+
+
+@dataclass(frozen=True, slots=True)
+class Job:
+    """A validated job file."""
+
+    name: str
+    date: str
+    description: str
+    source: str
+    instrument: str
+    camera: Camera
+    camera_name: str
+    distortion: tuple[tuple[float, float], ...]
+    frame_kind: str
+    origin_sk42_m: tuple[float, float, float] | None
+    photos: dict[int, JobPhoto]
+    points: tuple[Point, ...]
+    pairs: tuple[JobPair, ...]
+    horizontal_scale: int | None
+    vertical_scale: int | None
+    book_sign: bool
+    bz_scale_sense: int
+
+
+def is_job_file(data: Any) -> bool:
+    """True when a parsed YAML document declares ``format: stereoplotter-job/…``."""
+    return isinstance(data, dict) and str(data.get("format", "")).startswith("stereoplotter-job")
+
+
+def load_job(path: str | os.PathLike[str]) -> Job:
+    """Read and validate a job file (CSV files relative to it).
+
+    Raises
+    ------
+    ConfigError
+        One line: file (or CSV file and line), field, expected, found.
+    """
+    data, source = load_yaml_mapping(path)
+    doc = validate(JobFile, data, source)
+    fields = Fields(source)
+    folder = Path(path).parent
+    camera = camera_from_model(fields, doc.camera)  # type: ignore[arg-type]
+    origin = _origin(fields, doc.frame)
+    distances = (
+        _fiducial_csv(folder, doc.fiducial_distances_csv) if doc.fiducial_distances_csv else {}
+    )
+    photos = _photos(fields, doc, distances)
+    rows = [(source, f"points[{i}]", p) for i, p in enumerate(doc.points)]
+    for name in doc.points_csv:
+        rows += _csv_rows(folder / name, PointModel)
+    points = _points(doc.frame.kind, origin, rows)
+    sheets = _map_sheets(fields, doc.map_sheets)
+    pairs = _pairs(fields, doc, photos, sheets)
+    return Job(
+        name=doc.name,
+        date=doc.date,
+        description=(doc.description or "").strip(),
+        source=source,
+        instrument=doc.instrument,
+        camera=camera,
+        camera_name=doc.camera.camera or "",
+        distortion=tuple((float(r), float(d)) for r, d in doc.camera.distortion or ()),
+        frame_kind=doc.frame.kind,
+        origin_sk42_m=origin,
+        photos=photos,
+        points=points,
+        pairs=pairs,
+        horizontal_scale=doc.scales.horizontal,
+        vertical_scale=doc.scales.vertical,
+        book_sign=doc.options.book_sign,
+        bz_scale_sense=doc.options.bz_scale_sense,
+    )
+
+
+def _origin(fields: Fields, model: FrameModel) -> tuple[float, float, float] | None:
+    if model.origin is None:
+        return None
+    o = model.origin
+    try:
+        frame_tie.local_frame(Frame("sk42", (o.north_m, o.east_m, o.height_m)))
+    except StereoplotterError as exc:
+        raise fields.error(
+            "frame.origin", "an origin inside the SK-42 Gauss–Krüger domain",
+            [o.north_m, o.east_m, o.height_m], str(exc),
+        ) from None  # fmt: skip
+    return (o.north_m, o.east_m, o.height_m)
+
+
+def _csv_rows(path: Path, model: type[FileModel]) -> list[tuple[str, str, Any]]:
+    """Validated rows of a CSV file with a header line; numbers written as numbers."""
+    source = str(path)
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            lines = [row for row in csv.reader(f) if row and not row[0].startswith("#")]
+    except OSError as exc:
+        found = exc.strerror or str(exc)
+        raise ConfigError(source, "(file)", "a readable CSV file", found) from None
+    if not lines:
+        raise ConfigError(source, "(header)", "a header line and rows", "an empty file")
+    header = [h.strip() for h in lines[0]]
+    out = []
+    for n, row in enumerate(lines[1:], start=2):
+        if len(row) != len(header):
+            raise ConfigError(
+                f"{source}:{n}", "(row)", f"{len(header)} values ({', '.join(header)})",
+                f"{len(row)} values",
+            )  # fmt: skip
+        item = {h: _csv_value(v) for h, v in zip(header, row, strict=True) if v.strip() != ""}
+        out.append((f"{source}:{n}", "", validate(model, item, f"{source}:{n}")))
+    return out
+
+
+def _csv_value(v: str) -> Any:
+    v = v.strip()
+    for kind in (int, float):
+        try:
+            return kind(v)
+        except ValueError:
+            pass
+    return v
+
+
+def _fiducial_csv(folder: Path, name: str) -> dict[int, tuple[str, tuple[float, float]]]:
+    out: dict[int, tuple[str, tuple[float, float]]] = {}
+    for where, _, row in _csv_rows(folder / name, FiducialRow):
+        if row.photo in out:
+            raise ConfigError(where, "photo", "each photo once", row.photo)
+        out[row.photo] = (where, (row.d12_mm, row.d34_mm))
+    return out
+
+
+def _coordinates(
+    where: str, path: str, model: PhotoModel | PointModel, kind: str
+) -> tuple[float, float, float]:
+    names = ("north_m", "east_m", "height_m") if kind == "sk42" else ("X_m", "Y_m", "Z_m")
+    other = ("X_m", "Y_m", "Z_m") if kind == "sk42" else ("north_m", "east_m", "height_m")
+    values = [getattr(model, n) for n in names]
+    wrong = [n for n in other if getattr(model, n) is not None]
+    if wrong or any(v is None for v in values):
+        missing = [n for n, v in zip(names, values, strict=True) if v is None]
+        raise ConfigError(
+            where, path or "(row)", f"the coordinates {', '.join(names)} (frame.kind: {kind})",
+            ("also " + ", ".join(wrong)) if wrong else "no " + ", ".join(missing),
+        )  # fmt: skip
+    if kind == "sk42":
+        try:
+            frame_tie.check_conventional_ordinate(values[1])
+        except StereoplotterError as exc:
+            raise ConfigError(where, f"{path}.east_m".lstrip("."), "a conventional ordinate",
+                              values[1], str(exc)) from None
+    return (float(values[0]), float(values[1]), float(values[2]))
+
+
+def _photos(
+    fields: Fields, doc: JobFile, csv_distances: dict[int, tuple[str, tuple[float, float]]]
+) -> dict[int, JobPhoto]:
+    photos: dict[int, JobPhoto] = {}
+    for i, p in enumerate(doc.photos):
+        path = f"photos[{i}]"
+        if p.number in photos:
+            raise fields.error(f"{path}.number", "a photo number used once", p.number)
+        centre = _coordinates(fields.source, path, p, doc.frame.kind)
+        if p.fiducial_distances_mm is not None and p.number in csv_distances:
+            raise fields.error(
+                f"{path}.fiducial_distances_mm", "the measured distances in one place",
+                "them here and in " + csv_distances[p.number][0],
+            )  # fmt: skip
+        if p.fiducial_distances_mm is not None:
+            d = (p.fiducial_distances_mm.d12, p.fiducial_distances_mm.d34)
+        elif p.number in csv_distances:
+            d = csv_distances[p.number][1]
+        else:
+            raise fields.error(
+                f"{path}.fiducial_distances_mm",
+                "the fiducial distances 1-2, 3-4 measured on this diapositive (here or in "
+                "fiducial_distances_csv)", "nothing",
+            )  # fmt: skip
+        angles = tuple(math.radians(a) for a in (p.alpha_deg, p.omega_deg, p.kappa_deg))
+        photos[p.number] = JobPhoto(p.number, centre, angles, (float(d[0]), float(d[1])))  # type: ignore[arg-type]
+    unknown = sorted(set(csv_distances) - set(photos))
+    if unknown:
+        raise ConfigError(csv_distances[unknown[0]][0], "photo", "a photo number of the job",
+                          unknown[0])
+    return photos
+
+
+def _points(
+    kind: str, origin: tuple[float, float, float] | None, rows: list[tuple[str, str, Any]]
+) -> tuple[Point, ...]:
+    points: list[Point] = []
+    seen: set[str] = set()
+    for where, path, p in rows:
+        if p.id in seen:
+            raise ConfigError(where, f"{path}.id".lstrip("."), "a unique point id", p.id)
+        seen.add(p.id)
+        xyz = _coordinates(where, path, p, kind)
+        if kind == "sk42":  # the local coordinates depend on the pair's frame: set per pair
+            points.append(Point(p.id, p.role, p.kind, (math.nan,) * 3, xyz))
+        else:
+            sk42 = frame_tie.sk42_from_local(Frame("sk42", origin), xyz) if origin else None
+            points.append(Point(p.id, p.role, p.kind, xyz, sk42))  # type: ignore[arg-type]
+    return tuple(points)
+
+
+def _map_sheets(fields: Fields, models: list[NamedSheet]) -> dict[str, MapSheet]:
+    sheets: dict[str, MapSheet] = {}
+    for i, m in enumerate(models):
+        path = f"map_sheets[{i}]"
+        if m.corners is not None:
+            if len(m.corners) != 4:
+                raise fields.error(f"{path}.corners", "4 corners (NW, NE, SE, SW)",
+                                   f"{len(m.corners)} corners")
+            corners = np.array([_corner(fields, c, f"{path}.corners[{j}]")
+                                for j, c in enumerate(m.corners)])  # fmt: skip
+            name = m.name or f"sheet {i + 1}"
+            sheet = MapSheet(m.scale, corners, m.name)
+        else:
+            assert m.nomenclature is not None
+            try:
+                corners, scale = frame_tie.sheet_corners_sk42(m.nomenclature)
+            except StereoplotterError as exc:
+                raise fields.error(f"{path}.nomenclature", "a valid SK-42 nomenclature",
+                                   m.nomenclature, str(exc)) from None
+            if scale != m.scale:
+                raise fields.error(f"{path}.scale", f"{scale} (the scale of {m.nomenclature})",
+                                   m.scale)
+            name = m.nomenclature
+            sheet = MapSheet(m.scale, corners, m.nomenclature)
+        if name in sheets:
+            raise fields.error(path, "a map sheet listed once", name)
+        sheets[name] = sheet
+    return sheets
+
+
+def _corner(fields: Fields, c: Corner, path: str) -> tuple[float, float]:
+    try:
+        frame_tie.check_conventional_ordinate(c.east_m)
+    except StereoplotterError as exc:
+        raise fields.error(
+            f"{path}.east_m", "a conventional ordinate", c.east_m, str(exc)
+        ) from None
+    return (c.north_m, c.east_m)
+
+
+def _pairs(
+    fields: Fields, doc: JobFile, photos: dict[int, JobPhoto], sheets: dict[str, MapSheet]
+) -> tuple[JobPair, ...]:
+    pairs = []
+    for i, p in enumerate(doc.pairs):
+        path = f"pairs[{i}]"
+        for side in ("left", "right"):
+            if getattr(p, side) not in photos:
+                raise fields.error(f"{path}.{side}", "a photo number of photos",
+                                   getattr(p, side), f"photos: {sorted(photos)}")
+        if p.left == p.right:
+            raise fields.error(f"{path}.right", "another photo than the left one", p.right)
+        if p.map_sheet is not None and p.map_sheet not in sheets:
+            raise fields.error(f"{path}.map_sheet", "a sheet of map_sheets", p.map_sheet,
+                               "listed: " + (", ".join(sheets) or "none"))
+        sheet = sheets[p.map_sheet] if p.map_sheet else None
+        if sheet is None and len(sheets) == 1:
+            sheet = next(iter(sheets.values()))
+        if sheet is None and sheets:
+            raise fields.error(f"{path}.map_sheet", "the sheet of this pair (several are listed)",
+                               "nothing")
+        area = None
+        if p.working_area is not None:
+            area = (p.working_area.lowest_m, p.working_area.highest_m)
+            if area[0] > area[1]:
+                raise fields.error(f"{path}.working_area", "lowest_m ≤ highest_m", list(area))
+        pairs.append(JobPair(p.left, p.right, sheet, area))
+    if not sheets and doc.scales.horizontal is None:
+        raise fields.error("map_sheets", "a map sheet (its scale chooses M_г) or scales.horizontal",
+                           "neither")
+    return tuple(pairs)
+
+
+# --- from a pair to the measured inputs of the sheet ----------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class MeasuredPair:
+    """The measured inputs of one pair's sheet (the keyword arguments of
+    :func:`stereoplotter.setup.sheet.compute_sheet_from_measurements`) and the frame they are
+    in (``origin_sk42_m`` is None for a local job without a tie)."""
+
+    name: str
+    origin_sk42_m: tuple[float, float, float] | None
+    focal_length_corrected_mm: float
+    focal_length_corrected_per_photo_mm: tuple[float, float]
+    marks_mm: NDArray[np.float64]
+    centres_m: NDArray[np.float64]
+    rotations: NDArray[np.float64]
+    points: tuple[Point, ...]
+    working_area_m: NDArray[np.float64]
+    map_sheet: MapSheet | None
+
+    def sheet_arguments(self) -> dict[str, Any]:
+        """The keyword arguments of ``compute_sheet_from_measurements`` but spec and options."""
+        return {
+            "name": self.name,
+            "focal_length_corrected_mm": self.focal_length_corrected_mm,
+            "focal_length_corrected_per_photo_mm": self.focal_length_corrected_per_photo_mm,
+            "marks_mm": self.marks_mm,
+            "centres_m": self.centres_m,
+            "rotations": self.rotations,
+            "points": self.points,
+            "working_area_m": self.working_area_m,
+            "map_sheet": self.map_sheet,
+            "exterior_sources": ("aerotriangulation", "aerotriangulation"),
+        }
+
+
+def grid_to_local_rotation(
+    frame: Frame, north_m: float, east_m: float, height_m: float, step_m: float = 10.0
+) -> NDArray[np.float64]:
+    """R: the directions of grid east, grid north and up at a point, in the local frame.
+
+    Columns: the central differences of :func:`~stereoplotter.geodesy.photogrammetric.
+    local_from_gauss_kruger` along ȳ, x and H at the point, made orthonormal (the nearest
+    rotation, by SVD: removes the grid scale factor). M_local = R·M_grid. [—]
+    """
+    lf = frame_tie.local_frame(frame)
+    zone, y = split_conventional_ordinate(east_m)
+    if int(zone) != lf.zone:
+        raise StereoplotterError(f"a station in zone {int(zone)}, the frame in zone {lf.zone}")
+    d = np.array([-step_m, step_m])
+    zero = np.zeros(2)
+    cols = []
+    for dn, de, dh in ((zero, d, zero), (d, zero, zero), (zero, zero, d)):
+        X, Y, Z = local_from_gauss_kruger(lf, north_m + dn, float(y) + de, height_m + dh)
+        cols.append(np.array([X[1] - X[0], Y[1] - Y[0], Z[1] - Z[0]]))
+    u, _, vt = np.linalg.svd(np.column_stack(cols))
+    return u @ vt
+
+
+def _pair_frame(job: Job, left: JobPhoto, right: JobPhoto) -> Frame | None:
+    if job.origin_sk42_m is not None:
+        return Frame("sk42", job.origin_sk42_m)
+    if job.frame_kind == "local":
+        return None
+    north = round((left.centre[0] + right.centre[0]) / 2.0)
+    east = round((left.centre[1] + right.centre[1]) / 2.0)
+    return Frame("sk42", (float(north), float(east), 0.0))
+
+
+def _local_points(job: Job, frame: Frame | None) -> tuple[Point, ...]:
+    if job.frame_kind == "local":
+        return job.points
+    assert frame is not None
+    out = []
+    for p in job.points:
+        assert p.sk42_m is not None
+        out.append(Point(p.id, p.role, p.kind, frame_tie.local_from_sk42(frame, p.sk42_m),
+                         p.sk42_m))  # type: ignore[arg-type]
+    return tuple(out)
+
+
+def _station(job: Job, frame: Frame | None, photo: JobPhoto) -> tuple[NDArray, NDArray]:
+    m = rotation_matrix(*photo.angles)
+    if job.frame_kind == "local":
+        return np.array(photo.centre, float), m
+    assert frame is not None
+    centre = np.array(frame_tie.local_from_sk42(frame, photo.centre), float)
+    return centre, grid_to_local_rotation(frame, *photo.centre) @ m
+
+
+def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
+    """One pair of the job as the measured inputs of its sheet.
+
+    f′ by :mod:`stereoplotter.geometry.film` from the measured 1–2, 3–4 against the certificate
+    (one f′ per pair from all four spans; per photo for the record); the measured marks are the
+    certificate's scaled per axis by the same ratios (the uniform film deformation of
+    ``docs/conventions.md`` §7), relative to the principal point; the points of the pair are
+    those imaged on both photos; the working area is the overlap of the two footprints at the
+    mean point height, shrunk by 5 % a side, at the lowest and highest ground (``working_area``
+    of the pair, else the points' heights).
+    """
+    cam = job.camera
+    left, right = job.photos[pair.left], job.photos[pair.right]
+    frame = _pair_frame(job, left, right)
+    cal_marks = cam.fiducial_array_mm()
+    cal_spans = fiducial_spans_mm(cam.fiducials_mm)
+    ratios = [np.array(p.fiducial_distances_mm) / cal_spans for p in (left, right)]
+    f = cam.focal_length_mm
+    f_pair = float(corrected_focal_length(f, np.concatenate(ratios), np.ones(4)))
+    per_photo = (float(f * np.mean(ratios[0])), float(f * np.mean(ratios[1])))
+    marks = np.array([cal_marks * r for r in ratios]) - np.asarray(cam.principal_point_mm, float)
+    (c_l, m_l), (c_r, m_r) = _station(job, frame, left), _station(job, frame, right)
+    points = _local_points(job, frame)
+    xyz = np.array([p.local_m for p in points], float).reshape(-1, 3)
+    half = cam.format_mm / 2.0
+    inside = np.ones(len(points), bool)
+    for c, m in ((c_l, m_l), (c_r, m_r)):
+        xy = object_to_photo(xyz, c, m, f, cam.principal_point_mm)
+        with np.errstate(invalid="ignore"):
+            inside &= np.all(np.abs(xy) <= half, axis=-1)
+    points = tuple(p for p, ok in zip(points, inside, strict=True) if ok)
+    heights = [p.local_m[2] for p in points if p.kind != "plan"] or [p.local_m[2] for p in points]
+    if pair.working_area_m is not None:
+        lowest, highest = _local_heights(frame, c_l, c_r, pair.working_area_m)
+    elif heights:
+        lowest, highest = min(heights), max(heights)
+    else:
+        raise StereoplotterError(
+            f"{job.source}: pairs: pair {pair.name}: expected control points imaged on both "
+            "photos or a working_area (lowest_m, highest_m), found neither"
+        )
+    z0 = (lowest + highest) / 2.0
+    corners = np.array([[half, half], [-half, half], [-half, -half], [half, -half]])
+    boxes = [photo_to_object(corners, z0, c, m, f, cam.principal_point_mm)
+             for c, m in ((c_l, m_l), (c_r, m_r))]  # fmt: skip
+    lo = np.max([b[:, :2].min(axis=0) for b in boxes], axis=0)
+    hi = np.min([b[:, :2].max(axis=0) for b in boxes], axis=0)
+    pad = WORKING_AREA_MARGIN * (hi - lo)
+    lo, hi = lo + pad, hi - pad
+    plan = ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1]))
+    area = np.array([[x, y, z] for z in (lowest, highest) for x, y in plan])
+    return MeasuredPair(
+        name=pair.name,
+        origin_sk42_m=frame.origin_sk42_m if frame is not None else None,
+        focal_length_corrected_mm=f_pair,
+        focal_length_corrected_per_photo_mm=per_photo,
+        marks_mm=marks,
+        centres_m=np.array([c_l, c_r]),
+        rotations=np.array([m_l, m_r]),
+        points=points,
+        working_area_m=area,
+        map_sheet=pair.map_sheet,
+    )
+
+
+def _local_heights(
+    frame: Frame | None, c_l: NDArray, c_r: NDArray, heights: tuple[float, float]
+) -> tuple[float, float]:
+    """The working area's lowest and highest ground as local Z under the pair's centre."""
+    if frame is None:
+        return heights
+    centre = (c_l + c_r) / 2.0
+    north, east, _ = frame_tie.sk42_from_local(frame, (centre[0], centre[1], 0.0))
+    z = [frame_tie.local_from_sk42(frame, (north, east, h))[2] for h in heights]
+    return (float(z[0]), float(z[1]))
