@@ -527,6 +527,7 @@ def _simulate(args: argparse.Namespace) -> int:
             instrument=args.instrument,
             method=args.method,
             errors=args.errors,
+            operator=args.operator,
             seed=args.seed,
             trials=args.trials,
             backend=args.backend,
@@ -793,6 +794,11 @@ def _parser() -> argparse.ArgumentParser:
         "--errors",
         help="injected errors: a YAML of overrides, or 'zero' "
         "(default: the instrument's own, all assumed)",
+    )
+    p.add_argument(
+        "--operator",
+        help="the operator: 'zero' (no judgment, reading or setting error, no rounding) or a "
+        "YAML of OperatorModel fields (default: the assumed operator)",
     )
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument(

@@ -20,7 +20,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from stereoplotter.instrument.kinematics import rod_from_counters
+from stereoplotter.instrument.kinematics import (
+    InstrumentSetting,
+    UnitMap,
+    rod_from_counters,
+    rods_intersection,
+    unit_for_orientation,
+)
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
 from stereoplotter.procedure.operator import Operator, Scene
 from stereoplotter.procedure.records import (
@@ -35,12 +41,15 @@ from stereoplotter.setup.equations import (
     height_correction,
     sheet_corner_instrument_coordinates,
 )
+from stereoplotter.setup.records import SetupRefusal
 from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = [
     "Run",
     "check_standard_points",
     "clear_kappa",
+    "mechanism_level",
+    "refuse_beyond_mechanism",
     "run_setup_method",
     "stage1_scale_coefficient",
     "stage2_transform",
@@ -193,14 +202,26 @@ def _span_loop(
 
 def _correct_span(run: Run, stage: str, k: str, it: int, active, diffs, spans) -> None:
     """One correction of the L-check: ΔZ (6.9) from the left photo (or f_пр at the bottom
-    stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11)."""
+    stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11).
+
+    Decision D9 (``docs/procedure.md``, "The error-free floor"): (6.9) and (6.10) are applied
+    in their ratio form, which is exact for the span of a photo (L′ = n·(y₃ − y₄), n = D/f_пр):
+    ΔD = D·ΔL/L′ with the *measured* L′ in the denominator, and for the right photo its own
+    projection distance D_п = D + b_z, less the change ΔZ (or the f_пр change) that the left
+    correction makes to it. The printed first-order form D·ΔL_п/L_п under-corrects by the
+    factor L′_п/L_п ≈ D/(D + b_z′): with b_z at zero in stage 1 it leaves b_z′²/(D + b_z′) —
+    8.4 µm of b_z for pair60 (b_z′ = 1.25 mm), which the loop accepts (0.03/n_л mm of L is
+    11 µm of b_z) and which shows as 6 µm of y-parallax at the standard points.
+    """
     op, sheet = run.op, run.sheet
     dl, dr = diffs
     span_l, span_r = spans
+    meas_l, meas_r = span_l - dl, span_r - dr  # L′ as measured
     sense = sheet.options.bz_scale_sense
     depth = op.read("Z", f"{k}/Z")
-    dz_m = height_correction(depth, dl, span_l, sheet.vertical_scale_denominator)
+    dz_m = height_correction(depth, dl, meas_l, sheet.vertical_scale_denominator)
     dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
+    f_ratio = op.v(1.0)  # f′_пр/f_пр of this correction (bottom stop)
     # Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a
     # correction that asks for a deeper carriage cannot be set there. The operator reaches
     # the same n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
@@ -209,6 +230,7 @@ def _correct_span(run: Run, stage: str, k: str, it: int, active, diffs, spans) -
     if np.any(beyond):
         f_set = op.commanded["f_instrument"]
         f_new = f_set * depth / (depth + dz_mm)
+        f_ratio = np.where(beyond, depth / (depth + dz_mm), 1.0)
         op.set("f_instrument", f_new, f"{k}/setf", beyond)
         op.log.add(
             stage,
@@ -237,11 +259,17 @@ def _correct_span(run: Run, stage: str, k: str, it: int, active, diffs, spans) -
             equation="(6.9), (6.11)",
         )
     bz = op.read("bz", f"{k}/bz")
-    dbz = base_z_correction(depth, dr, span_r)
+    # D_п as the operator knows it: D + b_z from the b_z scale's nominal place of zero; scaled
+    # by f_пр/f′_пр where f_пр was changed, less the ΔZ just set (both move the right photo)
+    depth_r = (depth + sense * (bz - NOMINAL_ZERO["bz"])) * f_ratio
+    dbz = depth_r + base_z_correction(depth_r, dr, meas_r) - (depth + dz_mm) - (
+        sense * (bz - NOMINAL_ZERO["bz"])
+    )
     op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
     op.log.add(
         stage,
-        "Δb_z (6.10): O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
+        "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): "
+        "O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
         "bz",
         before=bz,
         after=bz + sense * dbz,
@@ -583,14 +611,7 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
 
 def control_heights(run: Run) -> list[ControlHeight]:
     """The sheet's height control points with their ground points (the scene's truth)."""
-    sc = run.scene.scenario
-    rows = []
-    for h in run.sheet.control_heights:
-        p = next(p for p in sc.points if p.id == h["id"])
-        rows.append(
-            ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
-        )
-    return rows
+    return control_heights_of(run.sheet, run.scene)
 
 
 def stage3_scale_model(run: Run) -> None:
@@ -630,6 +651,12 @@ def stage3_scale_model(run: Run) -> None:
         judgment_error=e,
         equation="stage 3",
     )
+    # Decision D10 (docs/procedure.md): the b_x change moves the rods' meeting depth and with it
+    # q where η_л ≠ η_п, so κ is cleared again (D8) *before* the heights are read: they are then
+    # read on the model that is kept. Read before it (pair80: b_x 57.6 mm, κ absorbing f·ω/b),
+    # they differed from the final model's by 0.14 m of the 0.465 m tolerance.
+    clear_kappa(run, "3")
+    op.fuse(p0, (pl[0], pr[0]), "3/refuse")
     op.inst.slip_height_scale(p0[2])
     op.log.add(
         "3",
@@ -659,7 +686,6 @@ def stage3_scale_model(run: Run) -> None:
         )
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1) if errs else op.v(0.0)
     run.check("stage 3: control heights", worst, tol, unit="m")
-    clear_kappa(run, "3")
     check_standard_points(run, "3")
 
 
@@ -787,6 +813,71 @@ def stage5_check(run: Run) -> None:
         np.max(np.stack(errs, axis=-1), axis=-1),
         None,
     )
+
+
+def mechanism_level(
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False
+) -> tuple[float, float]:
+    """What the correction mechanism itself leaves at the sheet's own settings (the floor).
+
+    The units at the sheet's α, ω, κ with its decentrations (``unit_for_orientation``), f_пр and
+    b = (b_x, b_y, b_z′) of the sheet, no error anywhere: the largest |q| at the six standard
+    points [mm, photo scale], and the largest control-height error relative to the first height
+    control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
+    setup-data method sets exactly these values and has no relative orientation or levelling.
+    """
+    f = sheet.focal_length_corrected_mm
+    units = [
+        UnitMap(unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis))
+        for p in sheet.photos
+    ]
+    bx, by, bz = sheet.base_mm
+    setting = InstrumentSetting(sheet.f_instrument_mm, bx, by, bz)
+
+    def reading(points_m):
+        pl, pr = scene.images(points_m)
+        return rods_intersection(units[0].rod_from_photo(pl), units[1].rod_from_photo(pr), setting)
+
+    q_max = float(np.max(np.abs(reading(scene.standard_points_m).y_parallax_mm)))
+    heights = np.array([h.ground_m for h in control_heights_of(sheet, scene)])
+    if len(heights) < 2:
+        return q_max, 0.0
+    depth = reading(heights).depth_mm
+    # deeper is lower: H_i = H_0 − (D_i − D_0)·M_в/1000 with the scale slipped at point 0
+    model_h = heights[0, 2] - (depth - depth[0]) * sheet.vertical_scale_denominator / 1000.0
+    return q_max, float(np.max(np.abs(model_h - heights[:, 2])))
+
+
+def refuse_beyond_mechanism(sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False):
+    """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
+    already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
+    no operator can then build the model by the setup-data method on this instrument."""
+    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis)
+    tol_q = sheet.tolerances["residual_y_parallax_mm"]
+    tol_h = sheet.tolerances["control_height_m"]
+    if q_max <= tol_q and h_max <= tol_h:
+        return
+    tilt = max(max(abs(p.alpha), abs(p.omega)) for p in sheet.photos)
+    raise SetupRefusal(
+        f"{sheet.scenario}: setup-data method on {sheet.instrument_title}: the correction "
+        f"mechanism at the sheet's exact settings already leaves {q_max * 1000:.1f} µm of "
+        f"y-parallax at the standard points (¼ mark {tol_q * 1000:.1f} µm) and {h_max:.2f} m "
+        f"at the control heights (H/3000 {tol_h:.2f} m): tilts up to {np.degrees(tilt):.1f}° at "
+        f"f′ = {sheet.focal_length_corrected_mm:.0f} mm are beyond its approximation "
+        "(instrument test, §6); the model needs relative orientation and levelling"
+    )
+
+
+def control_heights_of(sheet: SetupSheet, scene: Scene) -> list[ControlHeight]:
+    """The sheet's height control points with their ground points (the scene's truth)."""
+    sc = scene.scenario
+    rows = []
+    for h in sheet.control_heights:
+        p = next(p for p in sc.points if p.id == h["id"])
+        rows.append(
+            ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
+        )
+    return rows
 
 
 def run_setup_method(run: Run) -> Run:

@@ -17,13 +17,14 @@ import numpy as np
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
+from stereoplotter.instrument.kinematics import decentration_variant
 from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
 from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, SheetPose, StageRecord
-from stereoplotter.procedure.setup_method import Run, run_setup_method
+from stereoplotter.procedure.setup_method import Run, refuse_beyond_mechanism, run_setup_method
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import working_area_grid_m
@@ -155,6 +156,8 @@ def prepare_run(
     scene = Scene.build(
         scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
     )
+    if method == "setup":  # the floor: the mechanism at the sheet's own settings (D9)
+        refuse_beyond_mechanism(sheet, scene, decentration_variant(variant).strict_per_axis)
     return PreparedRun(
         scenario,
         spec,

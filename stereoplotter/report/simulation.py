@@ -21,9 +21,11 @@ from typing import Any
 
 import numpy as np
 
+from stereoplotter.errors import ConfigError, did_you_mean
 from stereoplotter.io.errors_file import load_error_model
 from stereoplotter.io.trial_store import TrialStore
 from stereoplotter.io.yaml_files import atomic_write_bytes
+from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import (
     DEFAULT_MEMORY_BUDGET_MB,
@@ -35,7 +37,13 @@ from stereoplotter.procedure.trials import (
     trial_columns,
 )
 
-__all__ = ["SimulationOutcome", "run_simulation_command", "simulation_markdown", "write_simulation"]
+__all__ = [
+    "SimulationOutcome",
+    "load_operator_model",
+    "run_simulation_command",
+    "simulation_markdown",
+    "write_simulation",
+]
 
 log = logging.getLogger(__name__)
 
@@ -206,6 +214,50 @@ def _write_all(out: Path, files: dict[str, bytes]) -> dict[str, Path]:
     return paths
 
 
+_OPERATOR_FIELDS: dict[str, tuple[str, Any]] = {
+    "monocular_sigma_mm": ("a number ≥ 0 [mm]", float),
+    "stereo_sigma_mm": ("a number ≥ 0 [mm]", float),
+    "y_parallax_sigma_mm": ("a number ≥ 0 [mm]", float),
+    "reading_sigma_lc": ("a number ≥ 0 [least counts]", float),
+    "setting_sigma_lc": ("a number ≥ 0 [least counts]", float),
+    "quantise": ("true or false", bool),
+    "finish_side": ("below, above or null", str),
+    "max_iterations": ("an integer 1 … 100", int),
+}
+
+
+def load_operator_model(value: str | Path | OperatorModel | None) -> OperatorModel | None:
+    """The operator an ``--operator`` value names: None (the defaults), "zero" (no judgment,
+    reading or setting error, no quantisation: ``OperatorModel().zero()``) or a YAML file of
+    :class:`OperatorModel` fields (the others keep their defaults); a bad entry is one
+    :class:`ConfigError` naming the file and the field."""
+    if value is None or isinstance(value, OperatorModel):
+        return value
+    if str(value) == "zero":
+        return OperatorModel().zero()
+    from stereoplotter.io.yaml_files import load_yaml_mapping  # the file reader of the io layer
+
+    data, source = load_yaml_mapping(value)
+    fields: dict[str, Any] = {}
+    for key, v in data.items():
+        if key not in _OPERATOR_FIELDS:
+            raise ConfigError(
+                source, str(key), "a field of OperatorModel", key,
+                did_you_mean(str(key), sorted(_OPERATOR_FIELDS)),
+            )
+        expected, kind = _OPERATOR_FIELDS[key]
+        ok = {
+            float: isinstance(v, int | float) and not isinstance(v, bool) and 0 <= v < float("inf"),
+            bool: isinstance(v, bool),
+            int: isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 100,
+            str: v is None or v in ("below", "above"),
+        }[kind]
+        if not ok:
+            raise ConfigError(source, str(key), expected, v)
+        fields[key] = float(v) if kind is float else v
+    return OperatorModel(**fields)
+
+
 @dataclass
 class SimulationOutcome:
     """What the command produced: the summary, its Markdown, the files written."""
@@ -227,13 +279,15 @@ def run_simulation_command(
     *,
     memory_mb: float = DEFAULT_MEMORY_BUDGET_MB,
     progress: Callable[[int], None] | None = None,
+    operator: str | Path | OperatorModel | None = None,
 ) -> SimulationOutcome:
     """What ``stereoplotter simulate`` does: run, summarise, write the files if ``output``.
 
     ``seed`` defaults to the scenario's seed; ``errors`` is None (instrument defaults), "zero" or
     an errors YAML path. ``trials`` runs in chunks that fit ``memory_mb``; the summary holds
     statistics, never per-trial arrays (those go to ``trials.npz`` in ``output``).
-    ``progress(n)`` is told the trials each finished chunk ran.
+    ``progress(n)`` is told the trials each finished chunk ran. ``operator`` is None (the
+    assumed defaults), "zero" or a YAML of OperatorModel fields (:func:`load_operator_model`).
     """
     from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.io.scenario_file import load_scenario
@@ -241,7 +295,15 @@ def run_simulation_command(
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
     seed = scenario.seed if seed is None else seed
-    prep = prepare_run(scenario, spec, method, load_error_model(errors, spec), seed, backend)
+    prep = prepare_run(
+        scenario,
+        spec,
+        method,
+        load_error_model(errors, spec),
+        seed,
+        backend,
+        operator=load_operator_model(operator),
+    )
     out = None if output is None else Path(output)
     if trials is None:
         result = run_trials_chunk(prep, 0, None)

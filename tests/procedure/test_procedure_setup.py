@@ -37,9 +37,10 @@ def ideal(pair):
 
 
 def test_zero_errors_converge_in_fewest_iterations(ideal):
-    # stage 1: first-order (6.9)/(6.10) with the coupling of ΔZ into the right photo (3 passes);
+    # stage 1: (6.9)/(6.10) in their ratio form with the ΔZ coupling (D9) land in one correction,
+    # then one confirming look (2 passes; the printed first-order form took 3);
     # stage 2: one k_ω pass, mark 4 exact; κ (D8): one clearing pass and one confirming look
-    assert ideal.iterations["1"] == 3
+    assert ideal.iterations["1"] == 2
     assert ideal.iterations["2"] == 1
     assert ideal.iterations["2/kappa"] == 2
     for name, c in ideal.checks.items():
