@@ -28,6 +28,7 @@ The passage to the photogrammetric frame (``frame.kind``)
 from __future__ import annotations
 
 import csv
+import datetime as _dt
 import math
 import os
 import re
@@ -94,6 +95,8 @@ WORKING_AREA_MARGIN = 0.05
 
 
 def _check_date(v: Any) -> str:
+    if isinstance(v, _dt.date) and not isinstance(v, _dt.datetime):  # an unquoted YAML date
+        v = v.isoformat()
     if not isinstance(v, str) or not re.fullmatch(r"\d{4}-\d{2}-\d{2}", v):
         raise _fail("a date YYYY-MM-DD (printed on the forms; the clock is never read)", repr(v))
     return v
@@ -266,8 +269,11 @@ class Job:
 
 
 def is_job_file(data: Any) -> bool:
-    """True when a parsed YAML document declares ``format: stereoplotter-job/…``."""
-    return isinstance(data, dict) and str(data.get("format", "")).startswith("stereoplotter-job")
+    """True when a parsed YAML document declares ``format: stereoplotter-job/…``, or has the
+    ``pairs`` of a job (then a missing ``format`` is reported by the job's validation)."""
+    if not isinstance(data, dict):
+        return False
+    return str(data.get("format", "")).startswith("stereoplotter-job") or "pairs" in data
 
 
 def load_job(path: str | os.PathLike[str]) -> Job:

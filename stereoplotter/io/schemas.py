@@ -20,6 +20,7 @@ from stereoplotter.io.block_file import BlockFile
 from stereoplotter.io.errors_file import ErrorsFile
 from stereoplotter.io.geometry_file import GeometryFile
 from stereoplotter.io.instrument_file import InstrumentFile
+from stereoplotter.io.job_file import JobFile
 from stereoplotter.io.scenario_file import ScenarioFile
 from stereoplotter.io.yaml_files import atomic_write_text
 
@@ -32,6 +33,7 @@ MODELS: dict[str, type[BaseModel]] = {
     "block": BlockFile,
     "errors": ErrorsFile,
     "geometry": GeometryFile,
+    "job": JobFile,
 }
 
 

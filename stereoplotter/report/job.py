@@ -202,7 +202,7 @@ def block_csv(result: JobResult) -> str:
         head = [p.pair.name, p.pair.left, p.pair.right, sheet_name]
         s = p.sheet
         if s is None:
-            writer.writerow([*head, "refused", *[""] * 12, p.reason])
+            writer.writerow([*head, "refused", *[""] * (len(_CSV) - 6), p.reason])
             continue
         writer.writerow([
             *head, "ok", s.horizontal_scale_denominator, s.vertical_scale_denominator,

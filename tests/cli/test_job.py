@@ -1,0 +1,200 @@
+"""`stereoplotter setup JOB`: the production job of issue 12 (jobs/strip8), its forms and files."""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+from pathlib import Path
+
+import numpy as np
+import pypdf
+import pytest
+import yaml
+
+from stereoplotter import __version__
+from stereoplotter.cli import main
+from stereoplotter.io.job_file import load_job
+from stereoplotter.report.job import compute_job, pair_dict
+
+ROOT = Path(__file__).resolve().parents[2]
+JOB = ROOT / "jobs" / "strip8" / "job.yaml"
+PAIRS = ["101-102", "102-103", "103-104", "104-105", "105-106", "106-107", "107-108", "108-109"]
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    out = tmp_path_factory.mktemp("strip8")
+    assert main(["setup", str(JOB), "-o", str(out)]) == 0
+    return out
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*"))
+            if p.is_file()}  # fmt: skip
+
+
+def test_strip8_writes_eight_forms_and_the_combined_pdf(written):
+    for pair in PAIRS:
+        for name in ("sheet.yaml", "sheet.md", "sheet.pdf"):
+            assert (written / pair / name).is_file(), f"{pair}/{name}"
+    forms = pypdf.PdfReader(written / "forms.pdf")
+    one = pypdf.PdfReader(written / "101-102" / "sheet.pdf")
+    assert len(forms.pages) == sum(
+        len(pypdf.PdfReader(written / p / "sheet.pdf").pages) for p in PAIRS
+    )
+    assert len(one.pages) >= 4
+    rows = list(csv.DictReader(io.StringIO((written / "block.csv").read_text("utf-8"))))
+    assert [r["pair"] for r in rows] == PAIRS
+    assert {r["status"] for r in rows} == {"ok"}
+    assert "None: all 8 pairs are set up" in (written / "refused.md").read_text("utf-8")
+
+
+def test_same_job_gives_byte_identical_files(written, tmp_path):
+    assert main(["setup", str(JOB), "-o", str(tmp_path)]) == 0
+    first, second = _files(written), _files(tmp_path)
+    assert sorted(first) == sorted(second)
+    assert len(first) == 8 * 3 + 3
+    for name in first:
+        assert first[name] == second[name], name
+
+
+def test_no_seed_reaches_a_job(capsys):
+    """A scenario's sheet is computed from seeded synthetic measurements; a job's from what was
+    measured: --seed is refused, and no global random state changes a sheet."""
+    assert main(["setup", str(JOB), "--seed", "2"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: {JOB}: --seed: expected nothing")
+    job = load_job(JOB)
+    np.random.seed(1)  # noqa: NPY002 - a hidden use of the global state would show here
+    a = [pair_dict(job, p) for p in compute_job(job).pairs]
+    np.random.seed(2)  # noqa: NPY002
+    np.random.default_rng(2).normal(size=100)
+    b = [pair_dict(job, p) for p in compute_job(job).pairs]
+    assert a == b
+
+
+def test_f_prime_is_from_the_measured_fiducial_distances(written):
+    """f′ = f·mean(l′/l) over the four spans of the pair (geometry/film.py), from fiducials.csv."""
+    text = (JOB.parent / "fiducials.csv").read_text("utf-8")
+    spans = {int(r["photo"]): (float(r["d12_mm"]), float(r["d34_mm"]))
+             for r in csv.DictReader(io.StringIO(text))}  # fmt: skip
+    for pair in PAIRS:
+        left, right = (int(n) for n in pair.split("-"))
+        expected = 70.0 * np.mean([*spans[left], *spans[right]]) / 170.0
+        sheet = yaml.safe_load((written / pair / "sheet.yaml").read_text("utf-8"))
+        assert sheet["focal_length_corrected_mm"] == pytest.approx(expected, abs=1e-6)
+        assert sheet["job"]["photos"] == {"left": left, "right": right}
+        per_photo = sheet["focal_length_corrected_per_photo_mm"]
+        assert per_photo[0] == pytest.approx(70.0 * np.mean(spans[left]) / 170.0, abs=1e-6)
+    # film shrinkage of 29–52 ppm: f′ is 2–4 µm short of f
+    assert 69.9960 < expected < 69.9982
+
+
+def test_pdf_text_has_header_photo_numbers_and_readings(written):
+    sheet = yaml.safe_load((written / "104-105" / "sheet.yaml").read_text("utf-8"))
+    reader = pypdf.PdfReader(written / "104-105" / "sheet.pdf")
+    text = "\n".join(page.extract_text() for page in reader.pages)
+    flat = re.sub(r"\s+", " ", text)
+    for expected in (
+        "Setup sheet (Table 24) — stereopair 104-105",
+        "strip8 (job.yaml)",
+        "left photo 104, right photo 105",
+        "N-35-14-А-б-3, 1:10000",
+        "СЦ-1 (SC-1)",
+        "2026-11-24 (from the job file)",
+        f"stereoplotter {__version__}",
+        "gears.coordinatograph_ratios",  # an assumed parameter
+        f"1:{sheet['scale_horizontal']}",
+        f"{sheet['f_instrument_mm']:.3f}",
+        f"{sheet['base_mm']['bx']:.3f}",
+        "horizontal model scale r·M_map: set the coordinatograph gear",  # a note
+    ):
+        assert expected in flat, expected
+    readings = sheet["readings"]
+    assert len(readings) >= 30
+    for r in readings:  # every stage reading (6.9)–(6.18) is printed as on sheet.yaml
+        assert re.sub(r"\s+", " ", r["formula"]) in flat, r["formula"]
+    for corner in sheet["sheet_corners_mm"].values():
+        assert f"{corner['x']:.3f}, {corner['y']:.3f}" in flat
+    for z in sheet["control_heights_model_mm"].values():
+        assert f"{z:.3f}" in flat
+
+
+def test_instrument_override(tmp_path, capsys):
+    assert main(["setup", str(JOB), "--instrument", "sd3", "-o", str(tmp_path)]) == 0
+    assert "SD-3" in capsys.readouterr().out.splitlines()[0]
+    sheet = yaml.safe_load((tmp_path / "101-102" / "sheet.yaml").read_text("utf-8"))
+    assert sheet["instrument"] == "sd3"
+
+
+def test_refused_pairs_are_summarised(tmp_path, capsys):
+    """Photo 105 tilted 4° (beyond the SC-1's ±3°): its two pairs are refused with the reason
+    in refused.md and block.csv, and the other six still get their forms."""
+    path = _job_with(tmp_path, lambda d, f: d["photos"][4].update(alpha_deg=4.0))
+    assert main(["setup", str(path), "-o", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert "6 of 8 pairs set up" in out
+    rows = list(csv.DictReader(io.StringIO((tmp_path / "out" / "block.csv").read_text("utf-8"))))
+    refused = {r["pair"]: r["reason"] for r in rows if r["status"] == "refused"}
+    assert sorted(refused) == ["104-105", "105-106"]
+    summary = (tmp_path / "out" / "refused.md").read_text("utf-8")
+    for pair, reason in refused.items():
+        assert "3°" in reason and f"**{pair}**" in summary
+        assert not (tmp_path / "out" / pair / "sheet.pdf").exists()
+    forms = pypdf.PdfReader(tmp_path / "out" / "forms.pdf")
+    text = " ".join(p.extract_text() for p in forms.pages)
+    assert "stereopair 103-104" in text and "stereopair 104-105" not in text
+
+
+def _job_with(tmp_path: Path, edit) -> Path:
+    doc = yaml.safe_load(JOB.read_text("utf-8"))
+    for name in ("fiducials.csv", "control.csv"):
+        (tmp_path / name).write_text((JOB.parent / name).read_text("utf-8"), "utf-8")
+    edit(doc, tmp_path)
+    path = tmp_path / "job.yaml"
+    path.write_text(yaml.safe_dump(doc, allow_unicode=True), "utf-8")
+    return path
+
+
+def _bad_csv(doc, folder):
+    text = (folder / "control.csv").read_text("utf-8").splitlines()
+    text[2] = text[2].replace(",6168", ",x6168", 1)
+    (folder / "control.csv").write_text("\n".join(text) + "\n", "utf-8")
+
+
+@pytest.mark.parametrize(
+    ("edit", "where", "field"),
+    [
+        (lambda d, f: d["pairs"][0].update(right=999), "job.yaml", "pairs[0].right"),
+        (lambda d, f: d.pop("format"), "job.yaml", "format"),
+        (lambda d, f: d.update(date="24.11.2026"), "job.yaml", "date"),
+        (lambda d, f: d["photos"][3].update(alpha_deg=25.0), "job.yaml", "photos[3].alpha_deg"),
+        (lambda d, f: d["photos"][0].update(X_m=1.0), "job.yaml", "photos[0]"),
+        (lambda d, f: d["map_sheets"][0].update(nomenclature="N-35-14-Ж"), "job.yaml",
+         "map_sheets[0].nomenclature"),
+        (_bad_csv, "control.csv:3", "north_m"),
+        (lambda d, f: d["camera"].update(focal_lenght_mm=70.0), "job.yaml",
+         "camera.focal_lenght_mm"),
+    ],
+)
+def test_bad_job_is_one_line(tmp_path, capsys, edit, where, field):
+    path = _job_with(tmp_path, edit)
+    assert main(["setup", str(path), "-o", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith("error: ") and where in err[0] and f": {field}: expected" in err[0]
+    assert "Traceback" not in err[0] and "internal error" not in err[0]
+
+
+def test_shipped_job_validates_against_its_schema():
+    import json
+
+    import jsonschema
+
+    schema = json.loads((ROOT / "docs" / "schemas" / "job.schema.json").read_text("utf-8"))
+    doc = yaml.safe_load(JOB.read_text("utf-8"))
+    validator = jsonschema.Draft202012Validator(schema)
+    assert [e.message for e in validator.iter_errors(doc)] == []
+    doc["pairs"][0]["lefft"] = 101
+    assert any("lefft" in e.message for e in validator.iter_errors(doc))
