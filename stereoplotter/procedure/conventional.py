@@ -419,6 +419,116 @@ def _worst(values) -> NDArray[np.float64]:
     return np.max(np.abs(np.stack(values, axis=-1)), axis=-1)
 
 
+def _rms(values) -> NDArray[np.float64]:
+    return np.sqrt(np.mean(np.square(np.stack(values, axis=-1)), axis=-1))
+
+
+#: C2 stopping rule: a pass whose RMS of the six looks is above this fraction of the previous
+#: pass's RMS has stopped decreasing (``procedure.md``, "When C2 stops"). Error-free passes
+#: shrink the RMS by ≈ 0.1 each (pair60/pair80, both ways of C2), so ½ never stops a converging
+#: orientation; at the operator's judgment floor the ratio of two passes is ≈ 1 ± 0.4.
+DECREASE_RATIO = 0.5
+
+
+#: The conventional loops (C2 passes, C3 iterations) are bounded by this multiple of the
+#: operator's ``max_iterations``: without setup data the orientation starts from the knobs'
+#: zero places, and a knob at its stop costs passes (mountain60 error-free: C2 needs 8 (by
+#: elements) / 10 (by (5.11)) passes and C3 7 iterations; pair60/pair80 ≤ 7 and ≤ 4).
+BOUND_FACTOR = 2
+
+
+def _bound(op) -> int:
+    """The bound of a conventional loop (:data:`BOUND_FACTOR` × ``max_iterations``)."""
+    return BOUND_FACTOR * op.model.max_iterations
+
+
+def _c2_stop(run, stage: str, it: int, seen, prev_rms, active):
+    """The operator's judgment after the six looks of pass ``it``: go on while the residual
+    y-parallax still decreases (RMS of the six looks ≤ :data:`DECREASE_RATIO` × the previous
+    pass's), stop when it no longer does — further passes would chase the judgment error or the
+    mechanism's own approximation. Bounded (:func:`_bound`); logged. Returns the RMS and the
+    trials that stop now."""
+    op = run.op
+    rms = _rms(seen)
+    if prev_rms is None:
+        done = np.zeros(np.shape(rms), bool)
+        ratio = op.v(np.nan)
+    else:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = rms / prev_rms
+        done = ratio > DECREASE_RATIO  # nan (no comparable previous pass): go on
+    bound = it == _bound(op)
+    r0, q0 = float(np.ravel(ratio)[0]), float(np.ravel(rms)[0]) * 1e3
+    if prev_rms is None:
+        what = "first pass: orient again"
+    elif not np.isfinite(r0):
+        what = "after a common tilt: orient again"
+    elif bool(np.ravel(done)[0]):
+        what = f"ratio {r0:.2f} > {DECREASE_RATIO}: no longer decreasing, stop"
+    else:
+        what = f"ratio {r0:.2f} ≤ {DECREASE_RATIO}: still decreasing"
+    if bound and not bool(np.ravel(done)[0]):
+        what += f"; bound of {it} passes reached, stop"
+    op.log.add(
+        stage,
+        f"pass {it}: RMS of the six looks {q0:.1f} µm — {what}",
+        "",
+        residual=rms,
+        iteration=it,
+        equation="stopping rule",
+    )
+    return rms, done & active
+
+
+def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
+    """A correction knob at its stop: move the model by a common tilt
+    (:class:`Calibration` ``common_alpha`` / ``common_omega``, q-neutral to first order) that
+    centres the pair of knobs of that axis, so the relative orientation has room again.
+
+    The relative elements of the basis system (ω′₁ = 0, b_z′ = 0 until C3) can exceed one knob's
+    range although each photo's own tilt is inside it: mountain60 needs ω′₂ ≈ ω₂ − ω₁ = 5.1° and
+    α′₂ ≈ α₂ − ν = −4.0° (ν = 1.1° the base inclination) against the ±2.94° stops.
+    Returns the trials moved (their next pass is not compared with this one).
+    """
+    op = run.op
+    hi = 0.98 * float(np.tan(op.inst.spec.tilt_max))
+    moved = np.zeros(np.shape(active), bool)
+    if stage != "C2":  # in C3 the knobs hold the levelling: a common tilt would undo it
+        return moved
+    for name, combo, pair in (
+        ("α", cal.common_alpha, ("k_alpha_left", "k_alpha_right")),
+        ("ω", cal.common_omega, ("k_omega_left", "k_omega_right")),
+    ):
+        now = [op.physical(c) for c in pair]
+        near = active & ((np.abs(now[0]) >= 0.999 * hi) | (np.abs(now[1]) >= 0.999 * hi))
+        if not np.any(near):
+            continue
+        moved = moved | near
+        phi = np.where(near, -(now[0] + now[1]) / (combo[pair[0]] + combo[pair[1]]), 0.0)
+        for control, rate in combo.items():
+            if control in ("by", "bz"):
+                before = op.read(control, f"{stage}/{it}/transfer{name}/{control}")
+                after = before + rate * phi
+                op.set(control, after, f"{stage}/{it}/transfer{name}/set{control}", near)
+            else:
+                before = op.physical(control)
+                _turn(op, control, before + rate * phi, near)
+                after = op.physical(control)
+            op.log.add(
+                stage,
+                f"a knob of axis {name} at its stop: common tilt "
+                f"Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad centres the pair; "
+                f"turn {control}",
+                control,
+                before=before,
+                after=after,
+                unit="mm" if control in ("by", "bz") else "—",
+                iteration=it,
+                equation="common tilt (q-neutral)",
+            )
+    return moved
+
+
 def c1_interior(run) -> None:
     """C1: interior orientation as in stage 1, without computed setup data.
 
@@ -558,7 +668,9 @@ def c2_relative_by_elements(
     run, cal: Calibration | None = None, stage: str = "C2", key0: str = "C2"
 ):
     """C2 (a): element by element — point 1 → κ_п, 2 → κ_л, 4 → α_л, 3 → α_п, 5 → ω_п with the
-    over-correction ½(f′²/c² − 1); repeat until q ≤ ¼ mark at all six points (bounded).
+    over-correction ½(f′²/c² − 1); repeat while the residual y-parallax of the six looks still
+    decreases (:func:`_c2_stop`, bounded); a knob at its stop hands its tilt to a common tilt
+    (:func:`_transfer_common_tilt`, when ``cal`` is given). The ¼-mark check is the caller's.
 
     Returns the iterations and the worst |q| seen at the last check, arrays over the trials.
     """
@@ -572,7 +684,8 @@ def c2_relative_by_elements(
     active = op.all()
     its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
-    for it in range(1, op.model.max_iterations + 1):
+    prev_rms = None
+    for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
         for idx, control, element in _SEQUENCE:
             key = f"{key0}/a/{it}/{idx + 1}"
@@ -603,32 +716,47 @@ def c2_relative_by_elements(
             )
         seen = _six_q(run, f"{key0}/a/{it}/check", active, it, stage)
         worst = np.where(active, _worst(seen), worst)
-        active = active & ~(worst <= tol)
+        rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
+        prev_rms = rms if prev_rms is None else np.where(active, rms, prev_rms)
+        active = active & ~done
         if not np.any(active):
             break
+        if cal is not None:
+            moved = _transfer_common_tilt(run, cal, active, stage, it)
+            prev_rms = np.where(moved, np.nan, prev_rms)
     return its, worst
 
 
-def c2_relative_by_equations(run, cal: Calibration, stage: str = "C2", key0: str = "C2"):
+def c2_relative_by_equations(
+    run, cal: Calibration, stage: str = "C2", key0: str = "C2", passes: int | None = None
+):
     """C2 (b): measure the six q, solve (5.11), turn the five controls by the result through the
-    numerical mapping; repeat until q ≤ ¼ mark at all six points (bounded).
+    numerical mapping; repeat while the residual still decreases (:func:`_c2_stop`, bounded); a
+    knob at its stop hands its tilt to a common tilt (:func:`_transfer_common_tilt`).
+
+    ``passes``: exactly this many measurements, no stopping rule (the fixed passes of the
+    (5.54) Monte Carlo, ``verification.procedure_mc.relative_orientation_mc``).
 
     Returns the iterations and the worst |q| seen at the last measurement, arrays over the trials.
     """
     op, sheet = run.op, run.sheet
-    tol = sheet.tolerances["residual_y_parallax_mm"]
+    bound = _bound(op) if passes is None else int(passes)
     imgs = run.scene.images(run.scene.standard_points_m)
     x11, x12 = imgs[0][0, 0], imgs[0][1, 0]
     x21, x22 = imgs[1][0, 0], imgs[1][1, 0]
     active = op.all()
     its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
-    for it in range(1, op.model.max_iterations + 1):
+    prev_rms = None
+    for it in range(1, bound + 1):
         its = np.where(active, it, its)
         seen = _six_q(run, f"{key0}/b/{it}", active, it, stage)
         worst = np.where(active, _worst(seen), worst)
-        active = active & ~(worst <= tol)
-        if not np.any(active) or it == op.model.max_iterations:
+        if passes is None:
+            rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
+            prev_rms = rms if prev_rms is None else np.where(active, rms, prev_rms)
+            active = active & ~done
+        if not np.any(active) or it == bound:
             break
         el = relative_orientation_from_standard_points(
             np.stack(seen, axis=-1),
@@ -653,6 +781,8 @@ def c2_relative_by_equations(run, cal: Calibration, stage: str = "C2", key0: str
                 iteration=it,
                 equation="(5.11)",
             )
+        moved = _transfer_common_tilt(run, cal, active, stage, it)
+        prev_rms = np.where(moved, np.nan, prev_rms)
     return its, worst
 
 
@@ -695,6 +825,9 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     """C3: absolute orientation by control points, iterated until the levelling points agree in
     height within H/3000 with the first of them (where the height scale is slipped); then slip
     the height scale there and check all control heights, and the six standard points again.
+    The levelling of the last iteration is always made (the least-squares plane on the four
+    heights, read with σ_p), with no relative orientation after it: the model is levelled last,
+    as (5.54)/(5.55) assume (before, a model inside H/3000 was accepted unlevelled).
 
     Each iteration: (1) scale — fuse on the two plan control points farthest apart, compare the
     model distance from the X, Y counters with the ground distance/M_г, turn b_x in proportion;
@@ -720,7 +853,7 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     its = np.zeros(np.shape(active), int)
     ro_its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
-    for it in range(1, op.model.max_iterations + 1):
+    for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
         ra = _fuse_read(run, a_id, pa, f"C3/{it}/scale/{a_id}", active, ("X", "Y"))
         rb = _fuse_read(run, b_id, pb, f"C3/{it}/scale/{b_id}", active, ("X", "Y"))
@@ -761,9 +894,10 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
                 equation="H/3000",
             )
         worst = np.where(active, _worst(resid), worst)
-        active = active & ~(worst <= tol)
-        if not np.any(active) or it == op.model.max_iterations:
-            break
+        # every trial still iterating levels on these heights (the least-squares plane of the
+        # four points, as (5.54)/(5.55) assume); those inside H/3000 (or at the bound) stop after
+        # it without a further relative orientation, so the model is always levelled last
+        going = active & ~(worst <= tol) & (it < _bound(op))
         w = cal.level_weights
         phi_a = -_psum(w[1, i] * e for i, e in enumerate(errs))
         phi_o = -_psum(w[2, i] * e for i, e in enumerate(errs))
@@ -788,6 +922,9 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
                     iteration=it,
                     equation="levelling (assumption)",
                 )
+        active = going
+        if not np.any(active):
+            break
         if relative_fn is not None:
             r_its, _ = _masked(run, active, relative_fn, cal, f"C3/{it}/ro")
             ro_its = ro_its + np.where(active, r_its, 0)

@@ -354,7 +354,7 @@ def _relative_only(prep, first, trials):
     run = Run(op, prep.sheet, prep.scene)
     cv.c1_interior(run)
     cal = cv.calibrate(run, cv.levelling_points(run))
-    cv.c2_relative_by_equations(run, cal)
+    cv.c2_relative_by_equations(run, cal, passes=prep.operator.max_iterations)
     return run
 
 

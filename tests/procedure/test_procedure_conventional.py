@@ -42,10 +42,13 @@ def test_zero_errors_relative_orientation_converges(ideal60):
     tol = ideal60.sheet.tolerances["residual_y_parallax_mm"]
     c2 = ideal60.checks["C2: residual y-parallax (6 points)"]
     assert bool(c2.passed)
-    assert int(c2.iterations) <= 4
-    # the setup method leaves 5.4 µm here (kinematics.md §6); the conventional method stops
-    # at ¼ mark = 12.5 µm and ends below 10 µm
-    assert np.max(np.abs(ideal60.q_standard_mm)) < 10 * um < tol
+    # the error-free operator goes on while the RMS of the six looks still falls by ½ a pass
+    # (≈ 10× per pass from ≈ 2–4 mm): the stop comes at the mechanism level in ≤ 7 passes
+    assert int(c2.iterations) <= 7
+    # the setup method leaves 5.4 µm here (kinematics.md §6); the conventional method clears
+    # q at its own six points, then the final levelling's common tilt (q-neutral to first
+    # order) leaves < 1 µm there and < 10 µm over the grid
+    assert np.max(np.abs(ideal60.q_standard_mm)) < 1 * um < tol
     assert np.max(np.abs(ideal60.q_grid_mm)) < 10 * um
 
 
