@@ -594,15 +594,25 @@ def _pair_frame(job: Job, left: JobPhoto, right: JobPhoto) -> Frame | None:
 
 
 def _local_points(job: Job, frame: Frame | None) -> tuple[Point, ...]:
-    if job.frame_kind == "local":
+    """The job's points in the pair's frame (SK-42 jobs: all points in one geodesy call)."""
+    if job.frame_kind == "local" or not job.points:
         return job.points
     assert frame is not None
-    out = []
-    for p in job.points:
-        assert p.sk42_m is not None
-        out.append(Point(p.id, p.role, p.kind, frame_tie.local_from_sk42(frame, p.sk42_m),
-                         p.sk42_m))  # type: ignore[arg-type]
-    return tuple(out)
+    lf = frame_tie.local_frame(frame)
+    sk42 = np.array([p.sk42_m for p in job.points], float)
+    zone, y = split_conventional_ordinate(sk42[:, 1])
+    far = np.flatnonzero(np.asarray(zone) != lf.zone)
+    if far.size:
+        raise StereoplotterError(
+            f"{job.source}: points: point {job.points[far[0]].id} is in zone "
+            f"{int(np.asarray(zone)[far[0]])}, the pair's frame in zone {lf.zone}: expected the "
+            "points of a job in one zone"
+        )
+    X, Y, Z = local_from_gauss_kruger(lf, sk42[:, 0], np.asarray(y, float), sk42[:, 2])
+    return tuple(
+        Point(p.id, p.role, p.kind, (float(X[i]), float(Y[i]), float(Z[i])), p.sk42_m)
+        for i, p in enumerate(job.points)
+    )
 
 
 def _station(job: Job, frame: Frame | None, photo: JobPhoto) -> tuple[NDArray, NDArray]:
