@@ -202,7 +202,7 @@ class JobFile(FileModel):
     fiducial_distances_csv: text | None = None  # type: ignore[valid-type]
     points: sequence(PointModel) = Field(default_factory=list)  # type: ignore[valid-type]
     points_csv: sequence(text) = Field(default_factory=list)  # type: ignore[valid-type]
-    map_sheets: sequence(NamedSheet) = Field(default_factory=list)  # type: ignore[valid-type]
+    map_sheets: sequence(NamedSheet, min_length=1)  # type: ignore[valid-type]
     pairs: sequence(PairModel, min_length=1)  # type: ignore[valid-type]
     scales: ScalesModel = ScalesModel()
     options: OptionsModel = OptionsModel()
@@ -518,9 +518,6 @@ def _pairs(
             if area[0] > area[1]:
                 raise fields.error(f"{path}.working_area", "lowest_m ≤ highest_m", list(area))
         pairs.append(JobPair(p.left, p.right, sheet, area))
-    if not sheets and doc.scales.horizontal is None:
-        raise fields.error("map_sheets", "a map sheet (its scale chooses M_г) or scales.horizontal",
-                           "neither")
     return tuple(pairs)
 
 

@@ -168,6 +168,7 @@ def _bad_csv(doc, folder):
     [
         (lambda d, f: d["pairs"][0].update(right=999), "job.yaml", "pairs[0].right"),
         (lambda d, f: d.pop("format"), "job.yaml", "format"),
+        (lambda d, f: d.pop("map_sheets"), "job.yaml", "map_sheets"),
         (lambda d, f: d.update(date="24.11.2026"), "job.yaml", "date"),
         (lambda d, f: d["photos"][3].update(alpha_deg=25.0), "job.yaml", "photos[3].alpha_deg"),
         (lambda d, f: d["photos"][0].update(X_m=1.0), "job.yaml", "photos[0]"),
