@@ -318,7 +318,7 @@ def _demo_steps(args: argparse.Namespace, step) -> int:
         text += f"\n{_sheet_summary(sheet)} (sheet.md, sheet.pdf)\n"
     step(2, 4, "simulated operator")
     if scenario.is_stereopair and "refused" not in result["setup_sheet"]:
-        from stereoplotter.report.simulation import run_simulation_command
+        from stereoplotter.report.simulation import run_simulation_command, tolerance_note
 
         sim = run_simulation_command(
             path, instrument=args.instrument, seed=seed, output=Path(args.output) / "simulate"
@@ -326,6 +326,7 @@ def _demo_steps(args: argparse.Namespace, step) -> int:
         result["simulation"] = sim.summary
         # name the sub-folder, not the output path: the summary stays the same wherever written
         text += "\n" + sim.text.replace(str(Path(args.output) / "simulate"), "simulate/")
+        text += "\n" + tolerance_note(sim.summary) + "\n"
     step(3, 4, "figures")
     figure = plot_scenario_layout(scenario, result)
     png = io.BytesIO()
@@ -528,6 +529,7 @@ def _simulate(args: argparse.Namespace) -> int:
             method=args.method,
             errors=args.errors,
             operator=args.operator,
+            practice=args.practice,
             seed=args.seed,
             trials=args.trials,
             backend=args.backend,
@@ -799,6 +801,15 @@ def _parser() -> argparse.ArgumentParser:
         "--operator",
         help="the operator: 'zero' (no judgment, reading or setting error, no rounding) or a "
         "YAML of OperatorModel fields (default: the assumed operator)",
+    )
+    p.add_argument(
+        "--practice",
+        choices=("operator", "book"),
+        default="operator",
+        help="'operator' (default): after a failed check the operator applies the book's "
+        "remedies (repeat the setting, refine the relative orientation), bounded and logged; "
+        "'book': §27's task 1, each element set once, failed checks only recorded "
+        "(setup-data method)",
     )
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument(

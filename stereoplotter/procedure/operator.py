@@ -73,24 +73,34 @@ _KNOBS = KNOBS
 class OperatorModel:
     """Judgment errors and habits of the operator (all **assumed**, ``procedure.md`` table).
 
+    Bases (none of these is documented for the SC-1, SPR-3, SD-3; the book's only figure is the
+    y-parallax pointing error m_q = 0.015 mm of its Table 18, ch. 5):
+
     Attributes
     ----------
     monocular_sigma_mm : float
-        σ_mono, mark on a point of one photo, per axis, photo scale. [mm]
+        σ_mono, mark on a point of one photo, per axis, photo scale. [mm] Assumed 0.010:
+        below the book's m_q = 0.015 mm (a monocular setting on a sharp fiducial is easier
+        than judging y-parallax) and of the order of the 0.01 mm least count of the counters.
     stereo_sigma_mm : float
-        σ_p, x-parallax judged zero (mark "on the ground"), photo scale. [mm]
+        σ_p, x-parallax judged zero (mark "on the ground"), photo scale. [mm] Assumed 0.010,
+        as σ_mono (no figure in the book).
     y_parallax_sigma_mm : float
-        σ_q, y-parallax judged zero (Table 18 of the book uses m_q = 0.015 mm). [mm]
+        σ_q, y-parallax judged zero. [mm] Assumed 0.010, below the book's m_q = 0.015 mm
+        (Table 18, documented) for a trained operator; with it the ¼-mark check (12.5 µm at
+        the assumed 0.05 mm mark) cannot pass reliably (``docs/procedure.md``, the sweep).
     reading_sigma_lc : float
         σ_read in least counts of the scale read, before rounding to the least count. [—]
+        Assumed 0.2: a vernier or drum read to the least count, no data.
     setting_sigma_lc : float
-        σ_set in least counts of the scale set. [—]
+        σ_set in least counts of the scale set. [—] Assumed 0.2, as σ_read.
     quantise : bool
         Readings are rounded to the least count.
     finish_side : {"below", "above", None}
         Habit: always finish a setting from this side (default "below"); None: straight there.
     max_iterations : int
-        Bound of every tolerance loop (reported when reached, never silent).
+        Bound of every tolerance loop and of every remedy's rounds (reported when reached,
+        never silent). A convention (6), not a figure of the book.
     assumed : bool
         Always True: none of these values is documented for the instruments.
     """

@@ -22,7 +22,15 @@ from stereoplotter.errors import StereoplotterError
 if TYPE_CHECKING:  # pragma: no cover
     from stereoplotter.setup.sheet import SetupSheet
 
-__all__ = ["Check", "ControlHeight", "SheetPose", "SheetReading", "SheetReadings", "StageRecord"]
+__all__ = [
+    "Check",
+    "ControlHeight",
+    "Remedy",
+    "SheetPose",
+    "SheetReading",
+    "SheetReadings",
+    "StageRecord",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,6 +60,35 @@ class Check:
     passed: NDArray[np.bool_] | None
     iterations: NDArray[np.int64] | None
     unit: str = "mm"
+
+
+@dataclass(frozen=True, slots=True)
+class Remedy:
+    """What the operator did after a check failed (``--practice operator``), per trial.
+
+    Method-neutral: the setup-data method and the conventional method record their remedies
+    the same way (the transcript logs each act with ``remedy=`` its name).
+
+    Attributes
+    ----------
+    name : str
+        E.g. ``"stage 2: refine the relative orientation"``.
+    check : str
+        The check it answers (a key of the run's checks).
+    applied : ndarray of bool, shape (T,) or ()
+        The check had failed, so the remedy was applied.
+    rounds : ndarray of int
+        Rounds of the remedy used (0 where not applied), bounded by
+        ``OperatorModel.max_iterations``.
+    passed : ndarray of bool
+        The check passed after the remedy (equal to the check's final ``passed``).
+    """
+
+    name: str
+    check: str
+    applied: NDArray[np.bool_]
+    rounds: NDArray[np.int64]
+    passed: NDArray[np.bool_]
 
 
 @dataclass(frozen=True, slots=True)

@@ -10,7 +10,7 @@ runs long runs in chunks.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -23,8 +23,13 @@ from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
 from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
-from stereoplotter.procedure.records import Check, SheetPose, StageRecord
-from stereoplotter.procedure.setup_method import Run, refuse_beyond_mechanism, run_setup_method
+from stereoplotter.procedure.records import Check, Remedy, SheetPose, StageRecord
+from stereoplotter.procedure.setup_method import (
+    PRACTICES,
+    Run,
+    refuse_beyond_mechanism,
+    run_setup_method,
+)
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import working_area_grid_m
@@ -75,6 +80,10 @@ class SimulationResult:
         Stages 4–5: the sheet's placement on the coordinatograph.
     first_trial : int
         Index of the first trial of this result in the whole run (chunked runs).
+    practice : {"operator", "book"}
+        Remedies after a failed check ("operator") or none (§27 task 1, "book").
+    remedies : dict
+        Remedy name → :class:`~stereoplotter.procedure.records.Remedy` (operator practice).
     """
 
     method: str
@@ -94,6 +103,8 @@ class SimulationResult:
     operator_model: OperatorModel
     sheet_pose: SheetPose | None = None
     first_trial: int = 0
+    practice: str = "book"
+    remedies: dict[str, Remedy] = field(default_factory=dict)
 
     @property
     def iterations(self) -> dict[str, np.ndarray]:
@@ -134,6 +145,7 @@ class PreparedRun:
     ideal_mechanics: bool = False
     variant: str = "L"
     relative: str = "elements"
+    practice: str = "operator"
 
 
 def prepare_run(
@@ -148,10 +160,15 @@ def prepare_run(
     ideal_mechanics: bool = False,
     variant: str = "L",
     relative: str = "elements",
+    practice: str = "operator",
 ) -> PreparedRun:
     """The fixed part of a run (arguments as :func:`simulate`)."""
     if method not in METHODS:
         raise StereoplotterError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
+    if practice not in PRACTICES:
+        raise StereoplotterError(
+            f"practice: expected one of {', '.join(PRACTICES)}, found {practice!r}"
+        )
     sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
     scene = Scene.build(
         scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
@@ -171,6 +188,7 @@ def prepare_run(
         ideal_mechanics,
         variant,
         relative,
+        practice,
     )
 
 
@@ -194,6 +212,7 @@ def _run_one(
     op = Operator(inst, prep.operator, noise, Transcript(enabled=transcript))
     run = Run(op, prep.sheet, prep.scene)
     if prep.method == "setup":
+        run.practice = prep.practice
         run_setup_method(run)
     else:
         run_conventional_method(run, prep.relative)
@@ -253,6 +272,8 @@ def run_trials_chunk(
         prep.operator,
         run.sheet_pose,
         first_trial,
+        run.practice,
+        run.remedies,
     )
 
 
@@ -271,6 +292,7 @@ def simulate(
     evaluate: bool = True,
     relative: str = "elements",
     first_trial: int = 0,
+    practice: str = "operator",
 ) -> SimulationResult:
     """Run the setup-data or the conventional method on a virtual instrument.
 
@@ -301,6 +323,11 @@ def simulate(
         or by the six measured q and (5.11).
     first_trial : int
         Index of the first trial in a longer run (a chunk of it); a single run is that trial.
+    practice : {"operator", "book"}
+        "operator" (default): after a failed check the operator applies the book's remedies
+        (repeat the stage-1 setting, refine the relative orientation, refine the scaling on the
+        control heights), bounded and logged; "book": §27's task 1, no remedy. The setup-data
+        method only so far (the conventional method ignores it).
 
     Returns
     -------
@@ -317,6 +344,7 @@ def simulate(
         ideal_mechanics=ideal_mechanics,
         variant=variant,
         relative=relative,
+        practice=practice,
     )
     return run_trials_chunk(prep, first_trial, trials, evaluate=evaluate)
 
@@ -333,6 +361,7 @@ def simulate_per_trial(
     ideal_mechanics: bool = False,
     variant: str = "L",
     relative: str = "elements",
+    practice: str = "operator",
 ) -> dict[str, Any]:
     """The test oracle: trial t of ``simulate(..., trials=T)`` run alone, for t = 0 … T−1.
 
@@ -349,6 +378,7 @@ def simulate_per_trial(
         ideal_mechanics=ideal_mechanics,
         variant=variant,
         relative=relative,
+        practice=practice,
     )
     rows = []
     for t in range(trials):

@@ -57,6 +57,8 @@ class Record:
         Iteration of the enclosing tolerance loop (1 for a single pass).
     equation : str
         The book equation or design decision behind the act.
+    remedy : str
+        The remedy this act belongs to (``--practice operator``, after a failed check), or "".
     """
 
     number: int
@@ -73,6 +75,7 @@ class Record:
     passed: bool | None
     iteration: int
     equation: str
+    remedy: str = ""
 
 
 class Transcript:
@@ -99,11 +102,18 @@ class Transcript:
         passed: Any = None,
         iteration: int = 1,
         equation: str = "",
+        remedy: str = "",
+        when: Any = None,
     ) -> None:
-        """Append a record (array arguments are taken at trial ``shown``)."""
+        """Append a record (array arguments are taken at trial ``shown``); ``when`` (a mask
+        over the trials) skips the record where trial ``shown`` did not do the act."""
         if not self.enabled:
             return
         t = self.shown
+        if when is not None:
+            w = np.asarray(when).reshape(-1)
+            if not bool(w[t] if w.size > 1 else w[0]):
+                return
         ok = None
         if passed is not None:
             p = np.asarray(passed).reshape(-1)
@@ -124,6 +134,7 @@ class Transcript:
                 ok,
                 int(iteration),
                 equation,
+                remedy,
             )
         )
 
@@ -150,6 +161,8 @@ class Transcript:
                 stage = r.stage
                 lines.append(f"## Stage {stage}")
             parts = [f"{r.number}. [stage {r.stage}]"]
+            if r.remedy:
+                parts.append(f"REMEDY ({r.remedy}):")
             if r.iteration > 1:
                 parts.append(f"(iteration {r.iteration})")
             parts.append(r.step)

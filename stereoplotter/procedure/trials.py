@@ -117,6 +117,13 @@ def trial_columns(result: SimulationResult) -> dict[str, NDArray[Any]]:
             cols[f"check/{name}/passed"] = _full(c.passed, t, bool)
         if c.iterations is not None:
             cols[f"check/{name}/iterations"] = _full(c.iterations, t)
+    for name, rem in result.remedies.items():
+        cols[f"remedy/{name}/applied"] = _full(rem.applied, t, bool)
+        cols[f"remedy/{name}/rounds"] = _full(rem.rounds, t)
+        # the check's pass among the trials that needed the remedy (NaN elsewhere)
+        cols[f"remedy/{name}/passed_after"] = np.where(
+            _full(rem.applied, t, bool), _full(rem.passed, t), np.nan
+        )
     for name, v in result.iterations.items():
         cols[f"iterations/{name}"] = _full(v, t)
     for name, v in result.zero_readings.items():
@@ -187,6 +194,7 @@ def summarise_columns(
         "residual_y_parallax": {},
     }
     evaluation: dict[str, dict[str, Any]] = {}
+    remedies: dict[str, dict[str, Any]] = {}
     for name, values in columns:
         kind, _, rest = name.partition("/")
         if kind == "check":
@@ -194,6 +202,17 @@ def summarise_columns(
             entry = checks.setdefault(check, {"unit": info.check_units.get(check)})
             if field == "passed":
                 entry["pass_rate"] = summarise_flags(values)
+            else:
+                entry[field] = summarise_values(values)
+        elif kind == "remedy":
+            rem, _, field = rest.rpartition("/")
+            entry = remedies.setdefault(rem, {})
+            if field == "applied":
+                entry["applied_rate"] = summarise_flags(values)
+            elif field == "passed_after":
+                done = values[~np.isnan(values)]
+                flags = done.astype(bool)
+                entry["passed_after_rate"] = summarise_flags(flags) if done.size else None
             else:
                 entry[field] = summarise_values(values)
         elif kind == "evaluation":
@@ -206,6 +225,7 @@ def summarise_columns(
         else:  # pragma: no cover - trial_columns makes only these kinds
             raise ValueError(f"unknown column {name!r}")
     out["checks"] = checks
+    out["remedies"] = remedies
     out.update(groups)
     out["evaluation"] = evaluation or None
     return out
@@ -238,10 +258,19 @@ def _single_summary(r: SimulationResult) -> dict[str, Any]:
         checks[name] = entry
     q_std = np.abs(np.asarray(r.q_standard_mm))
     q_grid = np.asarray(r.q_grid_mm)
+    remedies = {
+        name: {
+            "applied": bool(np.asarray(m.applied).reshape(-1)[0]),
+            "rounds": int(np.asarray(m.rounds).reshape(-1)[0]),
+            "passed_after": bool(np.asarray(m.passed).reshape(-1)[0]),
+        }
+        for name, m in r.remedies.items()
+    }
     return {
         **run_header(r),
         "iterations": {k: _value(v) for k, v in r.iterations.items()},
         "checks": checks,
+        "remedies": remedies,
         "residual_y_parallax_um": {
             "standard_points_max": _value(np.max(q_std) * 1e3),
             "grid_max": _value(np.max(np.abs(q_grid)) * 1e3),
@@ -258,6 +287,7 @@ def run_header(r: SimulationResult) -> dict[str, Any]:
         "backend": r.backend,
         "seed": r.seed,
         "trials": r.trials,
+        "practice": r.practice,
         "scenario": r.sheet.scenario,
         "instrument": r.sheet.instrument,
         "operator": r.operator_model.to_dict(),

@@ -29,7 +29,7 @@ SUFFIX = {"left": "", "right": ",п"}
 NOT_READINGS = (
     r"1/bz0",
     r"1/d[xy]_(left|right)",
-    r"(1/L|2/L\d+)/\d+/set(Z|bz|f)",
+    r"(1/L|1/L/R1|2/L\d+)/\d+/set(Z|bz|f)",  # R1 repeats the L-check corrections
 )
 
 
