@@ -171,12 +171,63 @@ def _configuration(method, sigma_mm, c, p, n):
     raise ValueError(f"method: expected 'setup' or 'conventional', found {method!r}")
 
 
-def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw):
+def _height_errors_parallax(sc, sheet, inst, frame_pts):
+    """The error of the height read on the slipped height scale at ``frame_pts`` (the mark
+    fused exactly on each point), converted to x-parallax (photo mm) by dp/dH = B·f/(Z_S − Z)².
+
+    This is what M_p measures ((5.42), (5.56)): the datum is carried by the height scale (its
+    slip), not by the model's position; a model scale error of b_x moves every δp at the ideal
+    model position by p·ε but a slipped height by only ε·ΔH.
+    """
+    from stereoplotter.instrument.kinematics import counters_from_homologous_points
+    from stereoplotter.instrument.virtual import HEIGHT_SCALE
+    from stereoplotter.procedure import evaluation as ev
+
+    origin = np.asarray(sheet.frame_origin_m, float)
+    theta = float(sheet.frame_rotation)
+    local = ev.instrument_frame_m(frame_pts, origin, theta, inverse=True)
+    gl = ev.film_points_mm(sc, "left", local)
+    gr = ev.film_points_mm(sc, "right", local)
+    units = inst.state()["units"]
+    setting, left, right = inst.setting, units["left"], units["right"]
+    gear = float(sheet.vertical_scale_denominator)
+    slip = np.asarray(inst.read(HEIGHT_SCALE, exact=True), float) + np.asarray(
+        inst.read("Z", exact=True), float
+    ) * gear / 1000.0
+    if ev._trial_count(setting, (left, right)) is not None:
+        setting = ev._with_point_axis(setting)
+        left, right = ev._with_point_axis(left), ev._with_point_axis(right)
+        slip = slip[:, None]
+    depth = counters_from_homologous_points(gl, gr, setting, left, right).depth_mm
+    dh = slip - depth * gear / 1000.0 - local[:, 2]
+    return dh
+
+
+def _levelling_frame_points(prep):
+    """The procedure's four levelling points (``conventional.levelling_points``) in the frame."""
+    from stereoplotter.procedure import conventional as cv
+    from stereoplotter.procedure.evaluation import instrument_frame_m
+
+    class _R:  # levelling_points reads only run.scene and run.sheet
+        scene, sheet = prep.scene, prep.sheet
+
+    ids = cv.levelling_points(_R)
+    local = np.array(
+        [next(p for p in prep.scenario.points if p.id == i).local_m for i in ids], float
+    )
+    origin = np.asarray(prep.sheet.frame_origin_m, float)
+    return ids, instrument_frame_m(local, origin, float(prep.sheet.frame_rotation))
+
+
+def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, options=None):
     """Per-trial mean square of δp on the domain, and the error-free run's δp.
 
     The error-free run once; the noisy trials in chunks under the memory budget (the random
-    draws are keyed by trial, so the chunk size changes no result).
+    draws are keyed by trial, so the chunk size changes no result). ``options`` (conventional
+    only, :func:`procedure_mc`): standard points at a = c − p, and the quantity "heights" with
+    both datums; then the return is a dict of per-trial mean squares by quantity.
     """
+    from stereoplotter.procedure.operator import Noise
     from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
     from stereoplotter.procedure.trials import (
         DEFAULT_MEMORY_BUDGET_MB,
@@ -185,20 +236,63 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw):
     )
 
     f, p, c = g["f"], g["p"], g["c"]
-    zero_prep = prepare_run(
-        sc, spec, method, "zero", seed, operator=zero, ideal_mechanics=True, **kw
-    )
+    options = options or {}
+
+    def prepared(operator):
+        prep = prepare_run(
+            sc, spec, method, "zero", seed, operator=operator, ideal_mechanics=True, **kw
+        )
+        if options.get("standard_points") == "book":
+            tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
+            prep = _standard_points_at_a(prep, g)
+            prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
+        return prep
+
+    zero_prep = prepared(zero)
     zero_run = run_trials_chunk(zero_prep, 0, None, evaluate=False, transcript=False)
     pts = _domain_points(sc, zero_run.sheet, xr, c, p, f, g["flying_height_m"], grid)
     d_zero = _dp(sc, zero_run.sheet, zero_run.instrument, pts)
-    prep = prepare_run(sc, spec, method, "zero", seed, operator=op, ideal_mechanics=True, **kw)
+    prep = prepared(op)
     chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, method)
     ms = np.empty(int(trials))
+    if not options.get("heights"):
+        for result in iter_trial_chunks(prep, int(trials), chunk, evaluate=False):
+            d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
+            first = result.first_trial
+            ms[first : first + len(d)] = np.mean(d**2, axis=-1)  # per trial
+        return ms, d_zero
+    # heights as read, in parallax units (dp/dH = B·f/(Z_S − Z)², frame origin S_л)
+    _, lev = _levelling_frame_points(zero_prep)
+    allp = np.vstack([pts, lev])
+    base_m = p * g["flying_height_m"] / f
+    k = base_m * f / allp[:, 2] ** 2  # photo mm of x-parallax per m of height
+    h_zero = _height_errors_parallax(sc, zero_run.sheet, zero_run.instrument, allp)
+    out = {name: np.empty(int(trials)) for name in ("parallax", "slip", "plane")}
+    n = len(pts)
     for result in iter_trial_chunks(prep, int(trials), chunk, evaluate=False):
-        d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
         first = result.first_trial
-        ms[first : first + len(d)] = np.mean(d**2, axis=-1)  # per trial
-    return ms, d_zero
+        m = len(result.instrument.setting.base_x_mm)
+        d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
+        e = (_height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
+        # the book's datum: the levelling plane's offset from the four levelling heights, each
+        # observed with the stereo σ_p of the formula (keyed draws, one per point and trial)
+        noise = Noise(seed, m, None, first)
+        obs = e[:, n:] + np.stack(
+            [noise.normal(f"mc/datum/{i}", op.stereo_sigma_mm) for i in range(len(lev))], -1
+        )
+        out["parallax"][first : first + m] = np.mean(d**2, axis=-1)
+        out["slip"][first : first + m] = np.mean(e[:, :n] ** 2, axis=-1)
+        plane = e[:, :n] - np.mean(obs, axis=-1, keepdims=True)
+        out["plane"][first : first + m] = np.mean(plane**2, axis=-1)
+    return out, d_zero
+
+
+def _rms_ci(ms, unit):
+    """(RMS, CI half-width) per ``unit`` from per-trial mean squares (``CI_Z`` s.e.)."""
+    mean_ms = float(np.mean(ms))
+    rms = math.sqrt(mean_ms)
+    half = CI_Z * rms * (float(np.std(ms, ddof=1)) / math.sqrt(len(ms))) / (2.0 * mean_ms)
+    return rms / unit, half / unit
 
 
 def procedure_mc(
@@ -210,8 +304,20 @@ def procedure_mc(
     seed: int = 20240601,
     sigma_mm: float = 0.01,
     grid=(16, 32),
+    quantity: str = "heights",
+    standard_points: str = "book",
+    datum: str = "plane",
 ) -> dict:
     """Run the procedure MC for one scenario and method (see the module docstring).
+
+    Conventional method only (``docs/accuracy.md``, "Why the total M_p was +54 % / +123 %"):
+    ``quantity`` "heights" (the height read on the slipped height scale, in parallax units —
+    what M_p measures) or "parallax" (δp at the ideal model position, the old quantity, which
+    counts the b_x scale error and the model's datum); ``standard_points`` "book" (Fig. 39 at
+    a = c − p, the formula's layout) or "nadirs" (a = 0, the instrument's); ``datum`` "plane"
+    (the formula's levelling offset: the four levelling heights, each with σ_p) or "slip" (the
+    procedure's: the height scale slipped at one levelling point). The result also carries
+    ``by_datum`` (coefficient, ci) for "parallax", "slip" and "plane" of the same trials.
 
     ``scenario`` and ``spec`` (the instrument, the book's SC-1) are loaded by the caller; this
     layer reads no files.
@@ -240,12 +346,32 @@ def procedure_mc(
     g = scenario_geometry(scenario, spec)
     zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"])
     spec = replace(spec, standard_points_c_mm=g["c"])
-    ms, d_zero = _mean_squares(scenario, spec, method, seed, trials, zero, op, xr, g, grid, kw)
+    options = {}
+    if method == "conventional":
+        for name, value, allowed in (
+            ("quantity", quantity, ("heights", "parallax")),
+            ("standard_points", standard_points, ("book", "nadirs")),
+            ("datum", datum, ("plane", "slip")),
+        ):
+            if value not in allowed:
+                raise ValueError(f"{name}: expected one of {allowed}, found {value!r}")
+        options = {"standard_points": standard_points, "heights": True}
+    ms, d_zero = _mean_squares(
+        scenario, spec, method, seed, trials, zero, op, xr, g, grid, kw, options
+    )
+    by = None
+    if isinstance(ms, dict):
+        by = {name: _rms_ci(v, unit) for name, v in ms.items()}
+        ms = ms["parallax" if quantity == "parallax" else datum]
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(mean_ms)
     se_ms = float(np.std(ms, ddof=1)) / math.sqrt(len(ms))
     half = CI_Z * rms * se_ms / (2.0 * mean_ms)
+    extra = {} if by is None else {
+        "by_datum": by, "quantity": quantity, "standard_points": standard_points, "datum": datum
+    }
     return {
+        **extra,
         "method": method,
         "scenario": scenario.name,
         "trials": int(trials),
