@@ -22,10 +22,15 @@ Configurations (chosen to match the formulas' assumptions as far as the model al
   stereo (x-parallax) judgment σ_p = σ (m_q = m_p), relative orientation by the six measured q and
   (5.11) (``relative="equations"``, least squares as (5.54) assumes), levelling on the scenario's
   four control points by the procedure itself; coefficient = RMS / σ. Domain of chapter 5:
-  x_п ∈ [−c, 0], y ∈ [−c, c] (x_л = x_п + p).
+  x_п ∈ [−c, 0], y ∈ [−c, c] (x_л = x_п + p). By default the measured quantity is the height
+  as read on the slipped height scale (converted to parallax units), the standard points stand
+  at a = c − p as in the formula, and the height datum is the mean of the four levelling heights
+  re-observed with σ_p (the formula's plane); ``quantity``, ``standard_points`` and ``datum``
+  select the other readings (δp at the ideal model position, the nadirs, the procedure's
+  one-point slip) — ``docs/accuracy.md`` gives the numbers of each.
 
-The standard points of the simulated instrument are on the two nadirs (the book's a = 0); their
-ordinate is set to c (``spec.standard_points_c_mm``).
+:func:`relative_orientation_mc` runs the conventional relative orientation alone (σ_q only, fixed
+passes) against (5.54).
 """
 
 from __future__ import annotations

@@ -223,12 +223,15 @@ def _procedure_note(eq, res):
     err = res["coefficient"] / ref - 1.0
     return (
         f"{head} per m_p = m_q against the rigorous formula at the simulated geometry "
-        f"(a = {a:.2f}, c = {c:.2f}, p = {p:.2f}) {ref:.3f}: ratio {err:+.0%}, far beyond a "
-        "first-order error and not yet explained (y-parallax σ alone gives ≈ 1.20, stereo σ "
-        "alone ≈ 0.87 at 60 %). Mismatches: standard points on the nadirs (a = 0) with ordinate "
-        "c, the book's 80 % case has a = p; the procedure also scales by b_x on plan control "
-        "and levels on the scenario's control points (not at x_п ∈ {−c, a}, y = ±c); "
-        f"relative orientation by (5.11); bias of the error-free run {res['bias_mm'] * 1000:.1f}"
+        f"(a = {a:.2f}, c = {c:.2f}, p = {p:.2f}) {ref:.3f}: ratio {err:+.1%}. Measured: the "
+        "heights as read on the slipped height scale, standard points at a = c − p, the height "
+        "datum the mean of the four levelling heights (the formula's plane; the procedure as "
+        "built slips at one point, which doubles the total — docs/accuracy.md); the stereo σ "
+        "part agrees with the formula at the procedure's own levelling points, the y-parallax σ "
+        "part stays above (5.54) by a remainder not yet explained. Mismatches: scaling by b_x on "
+        "plan control, levelling on the scenario's control points (not at x_п ∈ {−c, a}, "
+        f"y = ±c), relative orientation by (5.11); bias of the error-free run "
+        f"{res['bias_mm'] * 1000:.1f}"
         " µm removed"
     )
 
