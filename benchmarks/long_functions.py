@@ -1,7 +1,8 @@
 """List functions longer than a limit (default 80 lines, def to last line) via ``ast``.
 
-A function counts as justified when one of the two lines above its ``def`` (or its first
-decorator) is a comment starting ``# long:`` that says why.
+A function counts as justified when a comment says why: one of the two lines above its ``def``
+(or its first decorator), or a comment line inside the function, starting ``# long:`` or
+``# Over 80 lines``.
 
 python benchmarks/long_functions.py stereoplotter/geometry stereoplotter/accuracy [--limit 80]
 """
@@ -24,7 +25,11 @@ def scan(paths, limit):
                     if n > limit:
                         top = min([node.lineno] + [d.lineno for d in node.decorator_list])
                         above = text[max(0, top - 3) : top - 1]
-                        why = any(line.strip().startswith("# long:") for line in above)
+                        body = text[node.lineno - 1 : node.end_lineno]
+                        why = any(
+                            line.strip().startswith(("# long:", "# Over 80 lines"))
+                            for line in above + body
+                        )
                         out.append((str(f), node.lineno, node.name, n, why))
     return out
 

@@ -101,6 +101,8 @@ _FIXED_DISTRIBUTION = {
 }
 
 
+# long: one entry per injected error term, in the fixed order of the draws; a table read top to
+# bottom, which splitting would scatter.
 def _terms(spec: InstrumentSpec) -> list[ErrorTerm]:
     def term(name, dist, attribute, meaning, unit="mm", factor=1.0):
         key = spec.key_of(attribute)

@@ -821,6 +821,8 @@ def _fuse_read(run, pid: str, p, key: str, active, read: tuple[str, ...]):
     return {c: op.read(c, f"{key}/{c}") for c in read}
 
 
+# long: the book's items of absolute orientation (scale, levelling, repeated relative orientation,
+# final levelling) in their order, one bounded loop; split, the loop state would pass through each.
 def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=None) -> None:
     """C3: absolute orientation by control points, iterated until the levelling points agree in
     height within H/3000 with the first of them (where the height scale is slipped); then slip

@@ -300,6 +300,7 @@ def _rms_ci(ms, unit):
     return rms / unit, half / unit
 
 
+# long: a 32-line docstring (the options and what each measures) and 58 lines of code.
 def procedure_mc(
     scenario: Scenario,
     method: str = "setup",
@@ -489,6 +490,7 @@ def _relative_only(prep, first, trials):
     return run
 
 
+# long: an 18-line docstring and one experiment in its steps (C1, C2 by (5.11), plane removal).
 def relative_orientation_mc(
     scenario: Scenario,
     *,
