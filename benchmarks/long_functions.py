@@ -1,8 +1,8 @@
 """List functions longer than a limit (default 80 lines, def to last line) via ``ast``.
 
-A function counts as justified when a comment says why: one of the two lines above its ``def``
-(or its first decorator), or a comment line inside the function, starting ``# long:`` or
-``# Over 80 lines``.
+A function counts as justified when a comment says why: a line of the comment block right above
+its ``def`` (or its first decorator), or a comment line inside the function, starting ``# long:``
+or ``# Over 80 lines``.
 
 python benchmarks/long_functions.py stereoplotter/geometry stereoplotter/accuracy [--limit 80]
 """
@@ -24,7 +24,10 @@ def scan(paths, limit):
                     n = node.end_lineno - node.lineno + 1
                     if n > limit:
                         top = min([node.lineno] + [d.lineno for d in node.decorator_list])
-                        above = text[max(0, top - 3) : top - 1]
+                        first = top - 1  # the comment block right above the def or decorator
+                        while first > 0 and text[first - 1].lstrip().startswith("#"):
+                            first -= 1
+                        above = text[first : top - 1]
                         body = text[node.lineno - 1 : node.end_lineno]
                         why = any(
                             line.strip().startswith(("# long:", "# Over 80 lines"))
