@@ -1,8 +1,8 @@
 """A production job at the edge: every pair's sheet, its printable form, the block summary.
 
 :func:`run_job` loads a job file (:mod:`stereoplotter.io.job_file`), computes each pair's sheet
-from its *measured* inputs with the one Table 24 computation (a pair is a block of one:
-:func:`stereoplotter.setup.sheet.compute_sheet_from_measurements`), and :func:`write_job` writes
+from its *measured* inputs with the one Table 24 computation (all pairs in one vectorised call:
+:func:`stereoplotter.setup.sheet.compute_sheets_from_measurements`), and :func:`write_job` writes
 per pair ``PAIR/sheet.yaml``, ``PAIR/sheet.md`` and ``PAIR/sheet.pdf`` (the form,
 :mod:`stereoplotter.report.forms`), and for the job ``forms.pdf`` (all forms), ``block.csv`` and
 ``refused.md`` (the pairs the instrument cannot take, with the reason). No clock and no random
@@ -30,7 +30,7 @@ from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.report.forms import FormHeader, form_pdf, forms_pdf
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupOptions, SetupRefusal, SetupSheet
-from stereoplotter.setup.sheet import compute_sheet_from_measurements
+from stereoplotter.setup.sheet import compute_sheets_from_measurements
 
 __all__ = [
     "JobResult",
@@ -74,7 +74,12 @@ def _instrument(job: Job) -> InstrumentSpec:
 
 
 def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
-    """Every pair's sheet from its measured inputs; a refused pair keeps its reason."""
+    """Every pair's sheet from its measured inputs; a refused pair keeps its reason.
+
+    The pairs' Table 24 is one vectorised call (per-pair f′ and marks,
+    :func:`~stereoplotter.setup.sheet.compute_sheets_from_measurements`); each sheet is the one
+    the pair alone would give, to the bit.
+    """
     spec = spec or _instrument(job)
     options = SetupOptions(
         book_sign_n_right=job.book_sign,
@@ -82,17 +87,27 @@ def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
         vertical_scale_denominator=job.vertical_scale,
         bz_scale_sense=job.bz_scale_sense,
     )
-    out = []
+    measured: list[MeasuredPair | SetupRefusal] = []
     for pair in job.pairs:
-        measured = None
         try:
-            measured = measured_pair(job, pair)
-            sheet = compute_sheet_from_measurements(
-                spec=spec, options=options, source=job.source, **measured.sheet_arguments()
-            )
-            out.append(PairResult(pair, measured, sheet, ""))
+            measured.append(measured_pair(job, pair))
         except SetupRefusal as exc:
-            out.append(PairResult(pair, measured, None, str(exc)))
+            measured.append(exc)
+    ready = [m for m in measured if isinstance(m, MeasuredPair)]
+    sheets = iter(compute_sheets_from_measurements(
+        [m.sheet_arguments() for m in ready], spec=spec, options=options, source=job.source,
+        name=job.name,
+    ))  # fmt: skip
+    out = []
+    for pair, m in zip(job.pairs, measured, strict=True):
+        if isinstance(m, SetupRefusal):
+            out.append(PairResult(pair, None, None, str(m)))
+            continue
+        sheet = next(sheets)
+        if isinstance(sheet, SetupRefusal):
+            out.append(PairResult(pair, m, None, str(sheet)))
+        else:
+            out.append(PairResult(pair, m, sheet, ""))
     return JobResult(job, spec, tuple(out))
 
 

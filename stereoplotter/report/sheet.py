@@ -99,7 +99,7 @@ def setup_dict(table: BlockResult, i: int, sheet: SetupSheet | None = None) -> d
         "scale_map": table.map_scale_denominator,
         "f_instrument_mm": _num(table.f_instrument_mm[i]),
         "transformation_coefficient": _num(table.transformation_coefficient[i]),
-        "focal_length_corrected_mm": _num(table.focal_length_corrected_mm),
+        "focal_length_corrected_mm": _num(table.focal_length_of(i)),
         "focal_length_corrected_per_photo_mm": None
         if sheet is None
         else [_num(v) for v in sheet.focal_length_corrected_per_photo_mm],

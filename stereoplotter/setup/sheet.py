@@ -15,7 +15,9 @@ scenario's seed, so a sheet is reproducible.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -69,6 +71,7 @@ __all__ = [
     "assumed_parameters",
     "compute_setup_sheet",
     "compute_sheet_from_measurements",
+    "compute_sheets_from_measurements",
     "instrument_frame_m",
 ]
 
@@ -149,7 +152,7 @@ def _refuse_scales(table: BlockResult, extent_m: NDArray) -> None:
     best = int(table.candidate_index[0])
     reasons = describe_candidate(
         spec,
-        table.focal_length_corrected_mm,
+        table.focal_length_of(0),
         grid[best],
         int(table.candidate_flags[0, best]),
         table.depth_ground_m[0],
@@ -192,7 +195,7 @@ def _check_settings(table: BlockResult) -> None:
         raise SetupRefusal(
             "the exterior orientation or the working area of this stereopair is not finite"
         )
-    spec, f_prime = table.spec, table.focal_length_corrected_mm
+    spec, f_prime = table.spec, table.focal_length_of(0)
     for j, name in enumerate(("left", "right")):
         alpha, omega, kappa = (float(v) for v in table.angles[0, j])
         check_in_range(spec, "kappa_range", kappa, f"κ_{name} (cassette rotation)")
@@ -347,8 +350,178 @@ def compute_setup_sheet(
     )
 
 
-# Over 80 lines: after the one compute_table24 call the rest is the SetupSheet constructor (28
-# named fields); the steps that compute something are the helpers above.
+@dataclass(frozen=True, slots=True)
+class _Prepared:
+    """One pair's measured inputs turned into what Table 24 and the sheet need (no scales yet)."""
+
+    name: str
+    spec: InstrumentSpec
+    options: SetupOptions
+    focal_length_corrected_mm: float
+    focal_length_corrected_per_photo_mm: tuple[float, ...]
+    marks_mm: NDArray  # (2, 4, 2)
+    centres_m: NDArray  # (2, 3)
+    rotations: NDArray  # (2, 3, 3)
+    points: tuple[Point, ...]
+    points_m: NDArray  # (p, 3) in the instrument frame
+    heights: tuple[Point, ...]
+    depths_m: NDArray  # (g,) Z_Sл − Z of the ground samples and points
+    depth_m: NDArray  # (2,) the shallowest, deepest
+    extent_m: NDArray  # (2, 2)
+    similarity: SimilarityFit | None
+    plan: list[int]
+    corners_gk: NDArray | None
+    map_scale: int | None
+    grid: NDArray  # (C, 2)
+    exterior_sources: tuple[str, ...]
+
+
+def _prepare(
+    *,
+    name: str,
+    source: str,
+    spec: InstrumentSpec,
+    options: SetupOptions,
+    focal_length_corrected_mm: float,
+    focal_length_corrected_per_photo_mm: tuple[float, ...],
+    marks_mm: NDArray,
+    centres_m: NDArray,
+    rotations: NDArray,
+    points: tuple[Point, ...],
+    working_area_m: NDArray,
+    map_sheet: MapSheet | None,
+    exterior_sources: tuple[str, ...],
+) -> _Prepared:
+    """The frame, the ground in it, the plan control (6.8) and the scale candidates of one pair."""
+    centres = np.asarray(centres_m, float)[None]  # (1, 2, 3)
+    rots = np.asarray(rotations, float)[None]  # (1, 2, 3, 3)
+    theta = float(instrument_frames(centres, rots)[0][0])
+    points_m = instrument_frame_m(
+        np.array([p.local_m for p in points], float).reshape(-1, 3), centres[0, 0], theta
+    )
+    grid_m = instrument_frame_m(working_area_m, centres[0, 0], theta)
+    ground = np.vstack([grid_m, points_m])
+    depths_m = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
+    fit, plan, corners_gk, corners_m = _plan_control(points, map_sheet, points_m)
+    offsets_m = np.vstack([ground[:, :2], corners_m])
+    map_scale = map_sheet.scale_denominator if map_sheet else None
+    if map_scale is None and options.horizontal_scale_denominator is None:
+        raise SetupRefusal(
+            f"{source}: map_sheet: expected a map sheet, whose scale chooses the "
+            "horizontal model scale M_г from the coordinatograph gears, found nothing (or force "
+            "M_г with --horizontal-scale)"
+        )
+    return _Prepared(
+        name=name,
+        spec=spec,
+        options=options,
+        focal_length_corrected_mm=float(focal_length_corrected_mm),
+        focal_length_corrected_per_photo_mm=tuple(focal_length_corrected_per_photo_mm),
+        marks_mm=np.asarray(marks_mm, float),
+        centres_m=centres[0],
+        rotations=rots[0],
+        points=tuple(points),
+        points_m=points_m,
+        heights=tuple(
+            p for p in points if p.role == "control" and p.kind in ("full", "height")
+        ),
+        depths_m=depths_m,
+        depth_m=np.array([depths_m.min(), depths_m.max()]),
+        extent_m=np.array([[offsets_m[:, j].min(), offsets_m[:, j].max()] for j in (0, 1)]),
+        similarity=fit,
+        plan=plan,
+        corners_gk=corners_gk,
+        map_scale=map_scale,
+        grid=_candidate_grid(spec, options, map_scale),
+        exterior_sources=tuple(exterior_sources),
+    )
+
+
+def _table24(pairs: Sequence[_Prepared], name: str) -> BlockResult:
+    """Table 24 of pairs that share the instrument, the options and the scale candidates, in one
+    :func:`compute_table24` call (per-pair f′ and marks)."""
+    first = pairs[0]
+    width = max(len(p.heights) for p in pairs)
+    heights = np.full((len(pairs), width), np.nan)
+    for i, p in enumerate(pairs):
+        heights[i, : len(p.heights)] = [h.local_m[2] for h in p.heights]
+    return compute_table24(
+        np.array([p.focal_length_corrected_mm for p in pairs]),
+        np.array([p.marks_mm for p in pairs]),
+        np.array([p.centres_m for p in pairs]),
+        np.array([p.rotations for p in pairs]),
+        np.array([p.depth_m for p in pairs]),
+        first.grid,
+        first.spec,
+        heights_m=heights,
+        extent_m=np.array([p.extent_m for p in pairs]),
+        map_scale_denominator=first.map_scale,
+        book_sign=first.options.book_sign_n_right,
+        model_names=tuple(p.name for p in pairs),
+        height_point_ids=tuple(tuple(h.id for h in p.heights) for p in pairs),
+        name=name,
+    )
+
+
+def _finish(prep: _Prepared, table: BlockResult) -> SetupSheet:
+    """The sheet of a prepared pair from its Table 24 (a block of one), or its refusal."""
+    if int(table.reason_code[0]) & SCALE_FLAGS:
+        _refuse_scales(table, prep.extent_m[None])
+    _check_settings(table)
+    spec, options, points, points_m = prep.spec, prep.options, prep.points, prep.points_m
+    mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
+    n_left = float(table.n_left[0])
+    sheet = SetupSheet(
+        scenario=prep.name,
+        instrument=spec.key,
+        instrument_title=spec.title,
+        frame_rotation=float(table.frame_rotation[0]),
+        frame_origin_m=tuple(float(v) for v in table.frame_origin_m[0]),
+        focal_length_corrected_mm=table.focal_length_of(0),
+        focal_length_corrected_per_photo_mm=prep.focal_length_corrected_per_photo_mm,
+        map_scale_denominator=prep.map_scale,
+        horizontal_scale_denominator=mg,
+        vertical_scale_denominator=mv,
+        f_instrument_mm=float(table.f_instrument_mm[0]),
+        transformation_coefficient=float(table.transformation_coefficient[0]),
+        n_left=n_left,
+        n_right=float(table.n_right[0]),
+        base_mm=tuple(float(v) for v in table.base_mm[0]),
+        photos=_photo_setups(table, prep.marks_mm),
+        control_heights=tuple(
+            {
+                "id": p.id,
+                "Z_m": p.local_m[2],
+                "flying_height_m": float(prep.centres_m[0, 2] - p.local_m[2]),
+                "model_height_mm": float(z),
+            }
+            for p, z in zip(prep.heights, table.control_heights_model_mm[0], strict=True)
+        ),  # (6.6)
+        similarity=prep.similarity,
+        similarity_point_ids=tuple(points[i].id for i in prep.plan),
+        corners=_corners(prep.similarity, prep.corners_gk, mg, n_left),
+        readings=(),
+        tolerances=_tolerances(spec, n_left, prep.depths_m),
+        candidates=candidates_of(table, 0),
+        assumed=assumed_parameters(spec),
+        options=options,
+        depth_range_used_mm=tuple(float(v) for v in table.depth_range_mm[0]),
+        exterior_sources=prep.exterior_sources,
+        points_model_mm=tuple(
+            {
+                "id": p.id,
+                "role": p.role,
+                "kind": p.kind,
+                "x_mm": float(points_m[i, 0] * MM_PER_M / mg),
+                "y_mm": float(points_m[i, 1] * MM_PER_M / mg),
+            }
+            for i, p in enumerate(points)
+        ),
+        table24=table,
+    )
+    return replace(sheet, readings=stage_readings(sheet))
+
+
 def compute_sheet_from_measurements(
     *,
     name: str,
@@ -398,97 +571,70 @@ def compute_sheet_from_measurements(
     exterior_sources : tuple of str
         Where each photo's exterior orientation came from (printed on the sheet).
     """
-    centres = np.asarray(centres_m, float)[None]  # (1, 2, 3)
-    rotations = np.asarray(rotations, float)[None]  # (1, 2, 3, 3)
-    theta = float(instrument_frames(centres, rotations)[0][0])
-    points_m = instrument_frame_m(
-        np.array([p.local_m for p in points], float).reshape(-1, 3), centres[0, 0], theta
-    )
-    grid_m = instrument_frame_m(working_area_m, centres[0, 0], theta)
-    ground = np.vstack([grid_m, points_m])
-    depths_m = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
-    fit, plan, corners_gk, corners_m = _plan_control(points, map_sheet, points_m)
-    offsets_m = np.vstack([ground[:, :2], corners_m])
-    map_scale = map_sheet.scale_denominator if map_sheet else None
-    if map_scale is None and options.horizontal_scale_denominator is None:
-        raise SetupRefusal(
-            f"{source}: map_sheet: expected a map sheet, whose scale chooses the "
-            "horizontal model scale M_г from the coordinatograph gears, found nothing (or force "
-            "M_г with --horizontal-scale)"
-        )
-    heights = [p for p in points if p.role == "control" and p.kind in ("full", "height")]
-    marks = np.asarray(marks_mm, float)[None]
-    extent = np.array([[[offsets_m[:, j].min(), offsets_m[:, j].max()] for j in (0, 1)]])
-    table = compute_table24(
-        focal_length_corrected_mm,
-        marks,
-        centres,
-        rotations,
-        np.array([[depths_m.min(), depths_m.max()]]),
-        _candidate_grid(spec, options, map_scale),
-        spec,
-        heights_m=np.array([[p.local_m[2] for p in heights]], float).reshape(1, -1),
-        extent_m=extent,
-        map_scale_denominator=map_scale,
-        book_sign=options.book_sign_n_right,
-        model_names=(name,),
-        height_point_ids=(tuple(p.id for p in heights),),
+    prep = _prepare(
         name=name,
-    )
-    if int(table.reason_code[0]) & SCALE_FLAGS:
-        _refuse_scales(table, extent)
-    _check_settings(table)
-    mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
-    n_left = float(table.n_left[0])
-    sheet = SetupSheet(
-        scenario=name,
-        instrument=spec.key,
-        instrument_title=spec.title,
-        frame_rotation=float(table.frame_rotation[0]),
-        frame_origin_m=tuple(float(v) for v in table.frame_origin_m[0]),
-        focal_length_corrected_mm=table.focal_length_corrected_mm,
-        focal_length_corrected_per_photo_mm=tuple(focal_length_corrected_per_photo_mm),
-        map_scale_denominator=map_scale,
-        horizontal_scale_denominator=mg,
-        vertical_scale_denominator=mv,
-        f_instrument_mm=float(table.f_instrument_mm[0]),
-        transformation_coefficient=float(table.transformation_coefficient[0]),
-        n_left=n_left,
-        n_right=float(table.n_right[0]),
-        base_mm=tuple(float(v) for v in table.base_mm[0]),
-        photos=_photo_setups(table, marks[0]),
-        control_heights=tuple(
-            {
-                "id": p.id,
-                "Z_m": p.local_m[2],
-                "flying_height_m": float(centres[0, 0, 2] - p.local_m[2]),
-                "model_height_mm": float(z),
-            }
-            for p, z in zip(heights, table.control_heights_model_mm[0], strict=True)
-        ),  # (6.6)
-        similarity=fit,
-        similarity_point_ids=tuple(points[i].id for i in plan),
-        corners=_corners(fit, corners_gk, mg, n_left),
-        readings=(),
-        tolerances=_tolerances(spec, n_left, depths_m),
-        candidates=candidates_of(table, 0),
-        assumed=assumed_parameters(spec),
+        source=source,
+        spec=spec,
         options=options,
-        depth_range_used_mm=tuple(float(v) for v in table.depth_range_mm[0]),
-        exterior_sources=tuple(exterior_sources),
-        points_model_mm=tuple(
-            {
-                "id": p.id,
-                "role": p.role,
-                "kind": p.kind,
-                "x_mm": float(points_m[i, 0] * MM_PER_M / mg),
-                "y_mm": float(points_m[i, 1] * MM_PER_M / mg),
-            }
-            for i, p in enumerate(points)
-        ),
-        table24=table,
+        focal_length_corrected_mm=focal_length_corrected_mm,
+        focal_length_corrected_per_photo_mm=focal_length_corrected_per_photo_mm,
+        marks_mm=marks_mm,
+        centres_m=centres_m,
+        rotations=rotations,
+        points=points,
+        working_area_m=working_area_m,
+        map_sheet=map_sheet,
+        exterior_sources=exterior_sources,
     )
-    return replace(sheet, readings=stage_readings(sheet))
+    return _finish(prep, _table24([prep], name))
+
+
+def compute_sheets_from_measurements(
+    pairs: Sequence[Mapping[str, Any]],
+    *,
+    spec: InstrumentSpec,
+    options: SetupOptions,
+    source: str,
+    name: str = "job",
+) -> list[SetupSheet | SetupRefusal]:
+    """The sheets of many pairs from their measurements, Table 24 of all of them in one call.
+
+    Parameters
+    ----------
+    pairs : sequence of mapping
+        Per pair the keyword arguments of :func:`compute_sheet_from_measurements` other than
+        ``spec``, ``options`` and ``source`` (f′ and the marks are each pair's own).
+    spec, options, source
+        As for :func:`compute_sheet_from_measurements`, shared by the pairs.
+    name : str
+        The name of the block the pairs are computed in.
+
+    Returns
+    -------
+    list of SetupSheet or SetupRefusal
+        In the order of ``pairs``: the sheet, or the refusal
+        :func:`compute_sheet_from_measurements` would raise for that pair. Each sheet is the one
+        :func:`compute_sheet_from_measurements` gives for the pair alone, to the bit: the pairs
+        go through :func:`compute_table24` together (one call per set of scale candidates, i.e.
+        per map scale) and each is taken out as a block of one (:meth:`BlockResult.take`).
+    """
+    out: list[SetupSheet | SetupRefusal | None] = [None] * len(pairs)
+    groups: dict[bytes, list[tuple[int, _Prepared]]] = {}
+    for i, arguments in enumerate(pairs):
+        try:
+            prep = _prepare(spec=spec, options=options, source=source, **arguments)
+        except SetupRefusal as exc:
+            out[i] = exc
+            continue
+        groups.setdefault(prep.grid.tobytes(), []).append((i, prep))
+    for members in groups.values():
+        table = _table24([p for _, p in members], name)
+        for j, (i, prep) in enumerate(members):
+            try:
+                out[i] = _finish(prep, table.take(j))
+            except SetupRefusal as exc:
+                out[i] = exc
+    return [r for r in out if r is not None]
 
 
 def assumed_parameters(spec: InstrumentSpec) -> dict[str, tuple[str, ...]]:

@@ -29,7 +29,7 @@ Reference
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -122,8 +122,8 @@ class BlockResult:
     spec : InstrumentSpec
         The instrument (for the refusal messages).
     map_scale_denominator : int or None
-    focal_length_corrected_mm : float
-        f′. [mm]
+    focal_length_corrected_mm : ndarray, shape (N,)
+        f′ of each pair (:meth:`focal_length_of` reads one). [mm]
     book_sign : bool
         (6.4) with the printed sign.
     candidate_scales : ndarray, shape (C, 2)
@@ -173,7 +173,7 @@ class BlockResult:
     model_names: tuple[str, ...]
     spec: InstrumentSpec = field(repr=False)
     map_scale_denominator: int | None
-    focal_length_corrected_mm: float
+    focal_length_corrected_mm: NDArray[np.float64]
     book_sign: bool
     candidate_scales: NDArray[np.float64]
     candidate_flags: NDArray[np.int64]
@@ -209,9 +209,43 @@ class BlockResult:
         """True where the instrument takes the pair."""
         return self.reason_code == 0
 
+    def focal_length_of(self, i: int) -> float:
+        """f′ of pair ``i``. [mm]"""
+        return float(np.broadcast_to(self.focal_length_corrected_mm, (len(self),))[i])
+
+    def take(self, i: int) -> BlockResult:
+        """Pair ``i`` as a block of one (its height points without the padding of the block),
+        the same values as :func:`compute_table24` of that pair alone."""
+        p = len(self.height_point_ids[i])
+        one = slice(i, i + 1)
+        arrays = {
+            name: getattr(self, name)[one]
+            for name in _PER_PAIR_ARRAYS
+        }
+        arrays["control_heights_model_mm"] = self.control_heights_model_mm[one, :p]
+        return replace(
+            self,
+            model_names=self.model_names[one],
+            height_point_ids=self.height_point_ids[one],
+            focal_length_corrected_mm=np.broadcast_to(
+                self.focal_length_corrected_mm, (len(self),)
+            )[one].copy(),
+            **arrays,
+        )
+
     def reason(self, i: int) -> str:
         """The refusal of pair ``i`` in words ("" when accepted): values, ranges, way out."""
         return reason_text(self, int(i))
+
+
+#: The fields of :class:`BlockResult` with one row per pair (besides f′ and the padded Z_i).
+_PER_PAIR_ARRAYS = (
+    "candidate_flags", "feasible_candidates", "candidate_index", "reason_code", "frame_rotation",
+    "frame_origin_m", "base_ground_m", "depth_ground_m", "angles", "horizontal_scale_denominator",
+    "vertical_scale_denominator", "f_instrument_mm", "transformation_coefficient", "n_left",
+    "n_right", "base_mm", "fiducials_transformed_mm", "fiducials_rigorous_mm", "mark_span_mm",
+    "decentration_mm", "correction_inclination", "depth_range_mm",
+)  # fmt: skip
 
 
 # --- computation ------------------------------------------------------------------------------
@@ -267,16 +301,17 @@ def _stop_codes(
 
 
 def _marks(
-    f: float, marks: NDArray, alpha: NDArray, omega: NDArray, mask: NDArray
+    f: NDArray, marks: NDArray, alpha: NDArray, omega: NDArray, mask: NDArray
 ) -> tuple[NDArray, NDArray]:
     """(6.1)/(6.2) without n and (3.17) with κ = 0 for the marks of Table 24, shape (N, 2, 3) and
-    (N, 2, 3, 2); ``marks`` has shape (..., 2, 4, 2) (per photo, marks 1–4, x and y)."""
+    (N, 2, 3, 2); ``f`` has shape (N, 1) (f′ of each pair), ``marks`` shape (..., 2, 4, 2) (per
+    photo, marks 1–4, x and y)."""
     x0 = transformed_x_single_tilt(marks[..., (0, 1), _X_MARK, 0], alpha, f)  # (6.1)
     y3 = transformed_y_single_tilt(marks[..., :, 2, 1], omega, f)  # (6.2)
     y4 = transformed_y_single_tilt(marks[..., :, 3, 1], omega, f)
     rig_marks = marks[..., [[0], [1]], [[1, 2, 3], [0, 2, 3]], :]  # (..., 2, 3, 2)
     untwisted = rotation_matrix(alpha, omega, 0.0)  # the cassette κ is 0 in stage 2
-    rigorous = transformed_coordinates(rig_marks, untwisted[:, :, None], f)  # (3.17)
+    rigorous = transformed_coordinates(rig_marks, untwisted[:, :, None], f[:, :, None])  # (3.17)
     return np.stack([x0, y3, y4], axis=-1) * mask[..., None], rigorous * mask[..., None, None]
 
 
@@ -284,7 +319,7 @@ def _marks(
 # each step one equation call on (N,) arrays, ending in the one BlockResult constructor; the parts
 # that stand alone (frames, stops, marks) are helpers above.
 def compute_table24(
-    focal_length_corrected_mm: float,
+    focal_length_corrected_mm: ArrayLike,
     marks_mm: ArrayLike,
     centres_m: NDArray,
     rotations: NDArray,
@@ -305,8 +340,8 @@ def compute_table24(
 
     Parameters
     ----------
-    focal_length_corrected_mm : float
-        f′. [mm]
+    focal_length_corrected_mm : float or array_like, shape (N,)
+        f′, shared or per pair (each pair's film). [mm]
     marks_mm : array_like, shape (4, 2) or (N, 2, 4, 2)
         Marks 1–4 relative to the principal point, shared or per pair and photo. [mm]
     centres_m : ndarray, shape (N, 2, 3)
@@ -333,11 +368,13 @@ def compute_table24(
     -------
     BlockResult
     """
-    f = float(focal_length_corrected_mm)
+    n = centres_m.shape[0]
+    f_pairs = np.array(np.broadcast_to(np.asarray(focal_length_corrected_mm, float), (n,)))
+    f = f_pairs[:, None]  # (N, 1): broadcasts over the photos and the scale candidates
     marks = np.asarray(marks_mm, float)
     if marks.ndim == 2:
         marks = np.broadcast_to(marks, (2, *marks.shape))
-    n = centres_m.shape[0]
+    marks = np.broadcast_to(marks, (n, 2, 4, 2))  # f′ per pair: the marks of (3.17) per pair too
     if invalid is None:
         invalid = ~(
             np.isfinite(centres_m).all(axis=(1, 2))
@@ -349,6 +386,7 @@ def compute_table24(
     theta, base_m, (alpha, omega, kappa) = instrument_frames(centres_m, rotations)
 
     # Item 1: scale choice on the (pair × candidate) grid.
+    # f of shape (N, 1) broadcasts against the (C,) candidates in f_пр = f′·M_г/M_в.
     flags_c = candidate_flags(spec, f, grid, depth_m, base_m, extent_m)  # (N, C)
     chosen, any_ok = choose_candidates(flags_c, grid)
     reason = np.where(any_ok, 0, flags_c[np.arange(n), chosen])
@@ -359,8 +397,8 @@ def compute_table24(
 
     mg = np.where(ok, grid[chosen, 0], np.nan)
     mv = np.where(ok, grid[chosen, 1], np.nan)
-    f_pr = instrument_principal_distance(f, mg, mv)
-    k = transformation_coefficient(f_pr, f)
+    f_pr = instrument_principal_distance(f_pairs, mg, mv)
+    k = transformation_coefficient(f_pr, f_pairs)
     n_left = counter_scale_left(spec.projection_distance_max_mm, f_pr)  # (6.3)
     n_right = counter_scale_right(n_left, 0.0, base_m[:, 2], f_pr, mv, book_sign=book_sign)  # (6.4)
     mask2 = np.where(ok, 1.0, np.nan)[:, None]
@@ -376,7 +414,7 @@ def compute_table24(
         model_names=model_names,
         spec=spec,
         map_scale_denominator=map_scale_denominator,
-        focal_length_corrected_mm=f,
+        focal_length_corrected_mm=f_pairs,
         book_sign=book_sign,
         candidate_scales=grid,
         candidate_flags=flags_c,
@@ -411,7 +449,7 @@ def compute_table24(
 def candidates_of(result: BlockResult, i: int) -> tuple[ScaleCandidate, ...]:
     """Every (M_г, M_в) candidate of pair ``i`` with the conditions it fails."""
     return scale_candidates(
-        result.focal_length_corrected_mm,
+        result.focal_length_of(i),
         result.candidate_scales,
         result.candidate_flags[i],
         result.map_scale_denominator,
@@ -434,7 +472,7 @@ def reason_text(result: BlockResult, i: int) -> str:
         candidate = result.candidate_scales[result.candidate_index[i]]
         texts = describe_candidate(
             spec,
-            result.focal_length_corrected_mm,
+            result.focal_length_of(i),
             candidate,
             int(code & SCALE_FLAGS),
             result.depth_ground_m[i],
@@ -461,7 +499,7 @@ def reason_text(result: BlockResult, i: int) -> str:
             "decentration_range_mm",
             lambda p: [
                 (
-                    decentration(result.focal_length_corrected_mm, result.angles[i, p, j]),
+                    decentration(result.focal_length_of(i), result.angles[i, p, j]),
                     f"decentration d_{'xy'[j]},{names[p]}",
                 )
                 for j in (0, 1)

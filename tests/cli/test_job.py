@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,8 +15,14 @@ import yaml
 
 from stereoplotter import __version__
 from stereoplotter.cli import main
-from stereoplotter.io.job_file import load_job
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.job_file import load_job, measured_pair
 from stereoplotter.report.job import compute_job, pair_dict
+from stereoplotter.setup.records import SetupOptions, SetupRefusal
+from stereoplotter.setup.sheet import (
+    compute_sheet_from_measurements,
+    compute_sheets_from_measurements,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 JOB = ROOT / "jobs" / "strip8" / "job.yaml"
@@ -145,6 +152,41 @@ def test_refused_pairs_are_summarised(tmp_path, capsys):
     forms = pypdf.PdfReader(tmp_path / "out" / "forms.pdf")
     text = " ".join(p.extract_text() for p in forms.pages)
     assert "stereopair 103-104" in text and "stereopair 104-105" not in text
+
+
+def test_pairs_in_one_call_equal_each_pair_alone(tmp_path):
+    """A job's pairs go through Table 24 in one call (per-pair f′ and marks; a pair on a map of
+    another scale in a second call); every sheet equals the pair's own
+    compute_sheet_from_measurements to the bit, and a refusal has the same text."""
+    path = _job_with(tmp_path, lambda d, f: d["photos"][4].update(alpha_deg=4.0))
+    job = load_job(path)
+    spec, options = load_instrument(job.instrument), SetupOptions()
+    args = [measured_pair(job, p).sheet_arguments() for p in job.pairs]
+    args[6]["map_sheet"] = replace(args[6]["map_sheet"], scale_denominator=25000)
+    assert len({a["focal_length_corrected_mm"] for a in args}) > 1
+    batch = compute_sheets_from_measurements(args, spec=spec, options=options, source=job.source)
+    refused = []
+    for a, got in zip(args, batch, strict=True):
+        try:
+            alone = compute_sheet_from_measurements(
+                spec=spec, options=options, source=job.source, **a
+            )
+        except SetupRefusal as exc:
+            assert isinstance(got, SetupRefusal) and str(got) == str(exc)
+            refused.append(a["name"])
+            continue
+        assert got.readings == alone.readings and got.corners == alone.corners
+        assert got.control_heights == alone.control_heights
+        assert got.focal_length_corrected_mm == a["focal_length_corrected_mm"]
+        for name in ("n_left", "n_right", "base_mm", "fiducials_transformed_mm",
+                     "fiducials_rigorous_mm", "mark_span_mm", "decentration_mm",
+                     "control_heights_model_mm", "depth_range_mm", "candidate_flags"):  # fmt: skip
+            np.testing.assert_array_equal(
+                getattr(got.table24, name), getattr(alone.table24, name), err_msg=name
+            )
+    assert refused == ["104-105", "105-106"]
+    assert batch[6].map_scale_denominator == 25000
+    assert batch[5].horizontal_scale_denominator == 12500
 
 
 def _job_with(tmp_path: Path, edit) -> Path:

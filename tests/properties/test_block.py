@@ -19,6 +19,7 @@ import yaml
 from oracles.setup_pair_oracle import per_pair_loop
 
 from stereoplotter.errors import ConfigError
+from stereoplotter.geometry.rotation import rotation_matrix
 from stereoplotter.io.block_file import CSV_COLUMNS, load_block
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import data_dir
@@ -26,7 +27,9 @@ from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.report.block import run_block, write_block
 from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.block import BlockResult, Refusal, compute_block
+from stereoplotter.setup.scale_choice import candidate_scales
 from stereoplotter.setup.sheet import SetupOptions, compute_setup_sheet
+from stereoplotter.setup.table24 import compute_table24
 
 STRIP = data_dir("scenarios") / "blocks" / "strip60.yaml"
 MARKS = np.array([[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]])
@@ -420,3 +423,46 @@ def test_write_block_refused_sheet(tmp_path, sc1):
     assert "instruments/sc1.yaml" in sheet["reason"]
     rows = list(csv.DictReader((tmp_path / "block.csv").read_text(encoding="utf-8").splitlines()))
     assert [r["status"] for r in rows] == ["refused"] + ["ok"] * 7
+
+
+def _table24_inputs(b: dict) -> dict:
+    """compute_table24's arrays from the compute_block arguments of random_block."""
+    centres = np.stack([b["centre_left_m"], b["centre_right_m"]], axis=1)
+    angles = np.stack([b["angles_left"], b["angles_right"]], axis=1)
+    return {
+        "centres_m": centres,
+        "rotations": rotation_matrix(angles[..., 0], angles[..., 1], angles[..., 2]),
+        "depth_m": centres[:, 0, 2:3] - b["terrain_m"][:, ::-1],
+        "heights_m": b["height_points_m"],
+    }
+
+
+def test_per_pair_focal_length_equals_each_pair_alone(sc1):
+    """compute_table24 with f′ and marks per pair (each pair its own film) gives every pair,
+    to the bit, what a call with that pair's scalar f′ alone gives, refusals and their text
+    included; a scalar f′ and the array of that value give the same block."""
+    rng = np.random.default_rng(12)
+    n = 60
+    arrays = _table24_inputs(random_block(rng, n))
+    f = rng.uniform(69.95, 70.05, n)  # film shrinkage of ±700 ppm, each pair its own
+    marks = MARKS + rng.normal(0.0, 0.02, (n, 2, 4, 2))
+    grid = candidate_scales(sc1, 10000)
+    labels = {"model_names": tuple(map(str, range(n))),
+              "height_point_ids": (("1", "2", "3"),) * n}  # fmt: skip
+    whole = compute_table24(f, marks, grid=grid, spec=sc1, **arrays, **labels)
+    assert 0 < int(whole.accepted.sum()) < n  # both paths exercised
+    for i in range(n):
+        alone = compute_table24(
+            float(f[i]), marks[i : i + 1], grid=grid, spec=sc1,
+            **{k: v[i : i + 1] for k, v in arrays.items()},
+            model_names=(str(i),), height_point_ids=(("1", "2", "3"),),
+        )  # fmt: skip
+        one = whole.take(i)
+        assert one.focal_length_of(0) == f[i]
+        for name in (*FLOAT_FIELDS, "reason_code", "candidate_flags", "correction_inclination"):
+            np.testing.assert_array_equal(getattr(one, name), getattr(alone, name), err_msg=name)
+        assert one.reason(0) == alone.reason(0) == whole.reason(i)
+    shared = compute_table24(70.0, MARKS, grid=grid, spec=sc1, **arrays, **labels)
+    same = compute_table24(np.full(n, 70.0), MARKS, grid=grid, spec=sc1, **arrays, **labels)
+    for name in (*FLOAT_FIELDS, "reason_code"):
+        np.testing.assert_array_equal(getattr(shared, name), getattr(same, name), err_msg=name)
