@@ -15,16 +15,19 @@ Reference
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.instrument.kinematics import (
+    CorrectionUnit,
     InstrumentSetting,
     UnitMap,
+    counters_from_homologous_points,
     rod_from_counters,
     rods_intersection,
+    turn_correction_knob,
     unit_for_orientation,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
@@ -46,14 +49,18 @@ from stereoplotter.setup.records import SetupRefusal
 from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = [
+    "LEVEL_FREE",
+    "LEVEL_TILTS",
     "PRACTICES",
     "Q_ELEMENTS",
     "REPEAT_POINTINGS",
     "Run",
     "check_standard_points",
     "clear_kappa",
+    "level_design",
     "mechanism_level",
     "refine_relative_orientation",
+    "refine_scale_and_level",
     "refuse_beyond_mechanism",
     "run_setup_method",
     "stage1_scale_coefficient",
@@ -87,6 +94,24 @@ REPEAT_POINTINGS = 4
 #: tilt). With three elements (κ_л, κ_п, k_ω,п) and an operator without σ_q the true q at the
 #: standard points still exceeded ¼ mark in 41 % of pair60/SC-1 runs; with the five, in 0.1 %.
 Q_ELEMENTS = ("kappa_left", "kappa_right", "k_omega_right", "k_alpha_left", "k_alpha_right")
+
+#: Remedy R3 (stage 3, control heights beyond H/3000): the common tilts that level the model on
+#: a setup-data instrument. §26 refines only the *scaling* "by the heights of control points"
+#: (stage 3, b_x) and has no levelling step; the levelling here is an assumption (the §26 intro:
+#: the set orientation "most often is not accurate enough and its correction takes additional
+#: time"). A common tilt of the model turns both correction units by the same angle — k_α,л and
+#: k_α,п about the Y axis (along the base), k_ω,л and k_ω,п about the X axis — and moves the
+#: right pivot with the turned base: by the rigid rotation of b = (b_x, b_y, b_z′), Δb_z′ =
+#: −b_x·φ_α (the tilt along the base needs b_z′), and Δb_z′ = b_y·φ_ω, Δb_y = −b_z′·φ_ω, both
+#: second order here (b_y ≈ 0, b_z′ ≈ 1 mm). :data:`LEVEL_FREE` (b_z′, κ_л, κ_п) are solved by
+#: least squares on the instrument model so that q at the six standard points is unchanged to
+#: first order (:func:`level_design`; the solved Δb_z′/φ_α = −b_x within 1 % and the κ's small
+#: are tested in ``tests/procedure/test_heights_remedy.py``).
+LEVEL_TILTS = {
+    "alpha": ("k_alpha_left", "k_alpha_right"),
+    "omega": ("k_omega_left", "k_omega_right"),
+}
+LEVEL_FREE = ("bz", "kappa_left", "kappa_right")
 
 
 @dataclass
@@ -777,6 +802,311 @@ def control_heights(run: Run) -> list[ControlHeight]:
     return control_heights_of(run.sheet, run.scene)
 
 
+@dataclass(frozen=True)
+class LevelDesign:
+    """What the operator knows of levelling a model on this instrument (one table per sheet).
+
+    Attributes
+    ----------
+    combos : dict
+        "alpha"/"omega" → control → turn per radian of the common tilt (knobs in T, κ in rad,
+        ``bz`` in mm of b_z′): :data:`LEVEL_TILTS` by 1 each, :data:`LEVEL_FREE` solved so that
+        q at the six standard points is unchanged to first order.
+    q_misfit : dict
+        "alpha"/"omega" → the largest |∂q/∂φ| left at the six standard points by the combo,
+        against the largest |∂q/∂φ| of the knobs alone. [—]
+    design : ndarray, shape (n, 3)
+        Columns 1, ∂H/∂φ_α, ∂H/∂φ_ω at the sheet's control heights. [m, m/rad]
+    """
+
+    combos: dict[str, dict[str, float]]
+    q_misfit: dict[str, float]
+    design: NDArray[np.float64]
+
+
+def _nominal_state(sheet: SetupSheet, strict_per_axis: bool):
+    """The sheet's own settings (as :func:`mechanism_level`): setting and units."""
+    f = sheet.focal_length_corrected_mm
+    units = {
+        side: unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis)
+        for side, p in zip(("left", "right"), sheet.photos, strict=True)
+    }
+    bx, by, bz = sheet.base_mm
+    return InstrumentSetting(sheet.f_instrument_mm, bx, by, bz), units
+
+
+def _turned(
+    setting: InstrumentSetting, units: dict[str, CorrectionUnit], changes, linkage: str
+) -> tuple[InstrumentSetting, dict[str, CorrectionUnit]]:
+    units = dict(units)
+    for control, d in changes.items():
+        if control == "bz":
+            setting = replace(setting, base_z_mm=np.asarray(setting.base_z_mm) + d)
+        elif control.startswith("kappa_"):
+            side = control.split("_")[1]
+            units[side] = replace(units[side], kappa=np.asarray(units[side].kappa) + d)
+        else:
+            _, axis, side = control.split("_")
+            now = units[side].tan_alpha if axis == "alpha" else units[side].tan_omega
+            units[side] = turn_correction_knob(
+                units[side], axis, np.asarray(now) + d, linkage=linkage
+            )
+    return setting, units
+
+
+def _response(images, setting, units, changes, linkage: str, step: float = 1e-5):
+    """∂q [mm, photo] and ∂D [mm, model] per unit of a combined turn (central differences)."""
+    out = []
+    for sign in (1.0, -1.0):
+        ch = {k: sign * step * v for k, v in changes.items()}
+        s, u = _turned(setting, units, ch, linkage)
+        out.append(counters_from_homologous_points(images[0], images[1], s, u["left"], u["right"]))
+    dq = (out[0].y_parallax_mm - out[1].y_parallax_mm) / (2.0 * step)
+    dd = (out[0].depth_mm - out[1].depth_mm) / (2.0 * step)
+    return dq, dd
+
+
+def level_design(
+    sheet: SetupSheet, scene: Scene, linkage: str = "L", strict_per_axis: bool = False
+) -> LevelDesign:
+    """The q-neutral common tilts of remedy R3 and their height sensitivities, on the
+    instrument model at the sheet's own settings (the operator's knowledge, the same for every
+    trial)."""
+    setting, units = _nominal_state(sheet, strict_per_axis)
+    std = scene.images(scene.standard_points_m)
+    j = {
+        c: _response(std, setting, units, {c: 1.0}, linkage)[0]
+        for c in (*LEVEL_FREE, *LEVEL_TILTS["alpha"], *LEVEL_TILTS["omega"])
+    }
+    combos, misfit = {}, {}
+    for name, knobs in LEVEL_TILTS.items():
+        fixed = {k: 1.0 for k in knobs}
+        rhs = -sum(j[k] for k in knobs)
+        a = np.column_stack([j[k] for k in LEVEL_FREE])
+        sol = np.linalg.lstsq(a, rhs, rcond=None)[0]
+        combos[name] = {**fixed, **{k: float(v) for k, v in zip(LEVEL_FREE, sol, strict=True)}}
+        left = _response(std, setting, units, combos[name], linkage)[0]
+        misfit[name] = float(np.max(np.abs(left)) / np.max(np.abs(rhs)))
+    heights = np.array([h.ground_m for h in control_heights_of(sheet, scene)])
+    imgs = scene.images(heights)
+    cols = [np.ones(len(heights))]
+    for name in LEVEL_TILTS:
+        _, dd = _response(imgs, setting, units, combos[name], linkage)
+        cols.append(-dd * sheet.vertical_scale_denominator / 1000.0)  # deeper is lower
+    return LevelDesign(combos, misfit, np.column_stack(cols))
+
+
+def _scale_pair(run: Run) -> tuple[str, str]:
+    """The two plan control points of the sheet farthest apart (the scale is taken there)."""
+    sc = run.scene.scenario
+    ids = run.sheet.similarity_point_ids or tuple(h["id"] for h in run.sheet.control_heights)
+    pts = {i: np.asarray(next(p for p in sc.points if p.id == i).local_m, float) for i in ids}
+    return max(
+        ((a, b) for k, a in enumerate(ids) for b in ids[k + 1 :]),
+        key=lambda ab: float(np.hypot(*(pts[ab[0]][:2] - pts[ab[1]][:2]))),
+    )
+
+
+def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
+    """The instrument coordinates (6.7) of a plan control point (the sheet's similarity)."""
+    sheet = run.sheet
+    p = next(q for q in run.scene.scenario.points if q.id == pid)
+    xy = sheet_corner_instrument_coordinates(
+        sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
+    )
+    return np.asarray(xy, float).reshape(2)
+
+
+def _fuse_on(run: Run, p, key: str, active, read: tuple[str, ...]) -> dict[str, NDArray]:
+    op = run.op
+    img = run.scene.images(np.asarray(p, float)[None, :])
+    op.fuse(p, (img[0][0], img[1][0]), key, active)
+    return {c: op.read(c, f"{key}/{c}") for c in read}
+
+
+def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
+    """R3 (1): fuse on the two plan control points farthest apart, compare the distance of the
+    X, Y counters with that of their sheet coordinates (6.7), turn b_x in proportion."""
+    op, sheet = run.op, run.sheet
+    if sheet.similarity is None:
+        return
+    a_id, b_id = _scale_pair(run)
+    sc = run.scene.scenario
+    pts = [np.asarray(next(p for p in sc.points if p.id == i).local_m, float) for i in (a_id, b_id)]
+    ra, rb = (
+        _fuse_on(run, p, f"3/R3/{it}/scale/{i}", active, ("X", "Y"))
+        for i, p in zip((a_id, b_id), pts, strict=True)
+    )
+    d_sheet = float(np.hypot(*(_sheet_xy(run, a_id) - _sheet_xy(run, b_id))))
+    d_model = np.hypot(ra["X"] - rb["X"], ra["Y"] - rb["Y"])
+    with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
+        ratio = np.where(active, d_sheet / d_model, 1.0)
+    bx = op.read("bx", f"3/R3/{it}/bx")
+    new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio  # MO_bx + b_x·ratio
+    op.set("bx", new, f"3/R3/{it}/setbx", active)
+    op.log.add(
+        "3",
+        f"scale: fuse on {a_id} and {b_id}, counter distance against the sheet's "
+        f"{d_sheet:.3f} mm (6.7); turn b_x in proportion",
+        "bx",
+        before=bx,
+        after=new,
+        reading=new,
+        residual=d_model - d_sheet,
+        iteration=it,
+        equation="§26 stage 3: scaling refined (b_x)",
+        remedy=remedy,
+        when=active,
+    )
+
+
+def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) -> None:
+    """R3 (2): fit offset + common tilts φ_α, φ_ω to the control-height errors and turn the
+    q-neutral common tilts (:class:`LevelDesign`) by −φ."""
+    op = run.op
+    sense = run.sheet.options.bz_scale_sense
+    w = np.linalg.pinv(design.design)
+    for row, name in ((1, "alpha"), (2, "omega")):
+        phi = None
+        for i, e in enumerate(errs):  # a sum in a fixed order (vectorised = per-trial)
+            term = w[row, i] * e
+            phi = term if phi is None else phi + term
+        phi = np.where(active, -phi, 0.0)
+        for control, rate in design.combos[name].items():
+            if control == "bz":
+                before = op.read("bz", f"3/R3/{it}/{name}/bz")
+                after = before + sense * rate * phi
+                op.set("bz", after, f"3/R3/{it}/{name}/setbz", active)
+            else:
+                before = op.physical(control)
+                op.drive(control, before + rate * phi, active)
+                after = op.physical(control)
+            op.log.add(
+                "3",
+                f"level: common tilt Δφ_{name[0]} = {_shown(op, phi) * 1e3:+.4f} mrad, "
+                f"turn {control}",
+                control,
+                before=before,
+                after=after,
+                unit="mm" if control == "bz" else ("rad" if control.startswith("kappa") else "—"),
+                iteration=it,
+                equation="levelling on control (assumption, q-neutral common tilt)",
+                remedy=remedy,
+                when=active,
+            )
+
+
+def _shown(op: Operator, value) -> float:
+    """The value of the trial the transcript shows."""
+    flat = np.ravel(value)
+    return float(flat[op.log.shown if flat.size > 1 else 0])
+
+
+def _height_seen(run: Run, p, key: str, active, pointings: int) -> NDArray[np.float64]:
+    """Fuse on ``p`` and read the height scale, ``pointings`` times, averaged. [m]"""
+    total = None
+    for j in range(pointings):
+        k = key + (f"/p{j}" if j else "")
+        read = _fuse_on(run, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
+        total = read if total is None else total + read
+    return total / pointings
+
+
+def _height_seen(run: Run, p, key: str, active, pointings: int) -> NDArray[np.float64]:
+    """Fuse on ``p`` and read the height scale, ``pointings`` times, averaged. [m]"""
+    total = None
+    for j in range(pointings):
+        k = key + (f"/p{j}" if j else "")
+        read = _fuse_on(run, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
+        total = read if total is None else total + read
+    return total / pointings
+
+
+def _read_control_heights(
+    run: Run,
+    rows: list[ControlHeight],
+    key: str,
+    active,
+    remedy: str,
+    it: int,
+    pointings: int = REPEAT_POINTINGS,
+) -> list[NDArray[np.float64]]:
+    """Slip the height scale on control point 0 (the mean of ``pointings`` fusings and readings
+    there), then fuse on the others and read their heights (each the mean of ``pointings``):
+    the errors (read − truth) of points 1 … n−1. [m]"""
+    op, tol = run.op, run.sheet.tolerances["control_height_m"]
+    p0 = rows[0].ground_m
+    seen0 = _height_seen(run, p0, f"{key}/slip", active, pointings)
+    exact = op.v(op.inst.read(HEIGHT_SCALE, exact=True))
+    op.inst.slip_height_scale(np.where(active, exact + (p0[2] - seen0), exact))
+    op.log.add(
+        "3",
+        f"fuse on {rows[0].id} ({pointings} times), slip the height scale to H = {p0[2]:.2f} m",
+        HEIGHT_SCALE,
+        reading=p0[2],
+        unit="m",
+        iteration=it,
+        equation="stage 3",
+        remedy=remedy,
+        when=active,
+    )
+    errs = []
+    for h in rows[1:]:
+        p = h.ground_m
+        read = _height_seen(run, p, f"{key}/{h.id}", active, pointings)
+        errs.append(read - p[2])
+        op.log.add(
+            "3",
+            f"control point {h.id}: fuse, read the height ({pointings} times, mean)",
+            HEIGHT_SCALE,
+            reading=read,
+            unit="m",
+            residual=read - p[2],
+            tolerance=tol,
+            passed=np.abs(read - p[2]) <= tol,
+            iteration=it,
+            equation="H/3000",
+            remedy=remedy,
+            when=active,
+        )
+    return errs
+
+
+def refine_scale_and_level(
+    run: Run, rows: list[ControlHeight], errs, failed: NDArray[np.bool_]
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Remedy R3: a control height misses H/3000 after stage 3. Each round: (1) the scale by
+    b_x on the two plan control points farthest apart; (2) the levelling: read the control
+    heights, fit offset + φ_α, φ_ω (:func:`level_design`) and turn the q-neutral common tilts
+    by −φ; (3) slip the height scale again on the first control point and check all control
+    heights. Bounded by ``OperatorModel.max_iterations`` rounds.
+
+    Returns the rounds used and the worst |height error| last (per trial). [m]
+    """
+    op = run.op
+    tol = run.sheet.tolerances["control_height_m"]
+    remedy = "R3 refine scaling and levelling on control"
+    inst = op.inst
+    design = level_design(
+        run.sheet, run.scene, inst.variant.linkage, inst.variant.strict_per_axis
+    )
+    active = op.v(failed).astype(bool)
+    rounds = np.zeros(np.shape(active), int)
+    worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
+    for it in range(1, op.model.max_iterations + 1):
+        if not np.any(active):
+            break
+        rounds = np.where(active, it, rounds)
+        _refine_scale(run, it, active, remedy)
+        level = _read_control_heights(run, rows, f"3/R3/{it}/level", active, remedy, it)
+        _level(run, design, [op.v(0.0) * 0.0, *level], it, active, remedy)
+        errs = _read_control_heights(run, rows, f"3/R3/{it}/check", active, remedy, it)
+        new = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
+        worst = np.where(active, new, worst)
+        active = active & (worst > tol)
+    return rounds, worst
+
+
 def stage3_scale_model(run: Run) -> None:
     """Stage 3: (6.15) at a height control point, b_x until the mark fuses, slip the height
     scale, check the other control heights (H/3000), re-check κ and the residual y-parallax."""
@@ -848,7 +1178,15 @@ def stage3_scale_model(run: Run) -> None:
             equation="H/3000",
         )
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1) if errs else op.v(0.0)
-    run.check("stage 3: control heights", worst, tol, unit="m")
+    name = "stage 3: control heights"
+    remedial = run.remedial and bool(errs)
+    if remedial:  # R3: scaling refined "by the heights of control points", and levelling
+        failed = worst > tol
+        rounds, worst = refine_scale_and_level(run, rows, errs, failed)
+    run.check(name, worst, tol, unit="m")
+    if remedial:
+        remedy = "R3 stage 3: refine scaling and levelling on control"
+        run.record_remedy(remedy, name, failed, rounds)
     check_standard_points(run, "3")
 
 
@@ -1017,20 +1355,34 @@ def mechanism_level(
 def refuse_beyond_mechanism(sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False):
     """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
     already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
-    no operator can then build the model by the setup-data method on this instrument."""
+    no operator can then build the model by the setup-data method on this instrument.
+
+    The message names the scenario file and the field that carries the pair beyond the
+    mechanism — the largest photo tilt, ``photos[i].exterior.alpha_deg`` or ``omega_deg`` — and
+    the §26 tolerances the mechanism level exceeds.
+    """
     q_max, h_max = mechanism_level(sheet, scene, strict_per_axis)
     tol_q = sheet.tolerances["residual_y_parallax_mm"]
     tol_h = sheet.tolerances["control_height_m"]
     if q_max <= tol_q and h_max <= tol_h:
         return
-    tilt = max(max(abs(p.alpha), abs(p.omega)) for p in sheet.photos)
+    sc = scene.scenario
+    tilts = [
+        (abs(getattr(p.exterior, axis)), i, axis)
+        for i, p in enumerate(sc.photos)
+        for axis in ("alpha", "omega")
+    ]
+    _, i, axis = max(tilts, key=lambda t: t[0])  # the first of equal tilts
+    found = np.degrees(getattr(sc.photos[i].exterior, axis))
     raise SetupRefusal(
-        f"{sheet.scenario}: setup-data method on {sheet.instrument_title}: the correction "
-        f"mechanism at the sheet's exact settings already leaves {q_max * 1000:.1f} µm of "
-        f"y-parallax at the standard points (¼ mark {tol_q * 1000:.1f} µm) and {h_max:.2f} m "
-        f"at the control heights (H/3000 {tol_h:.2f} m): tilts up to {np.degrees(tilt):.1f}° at "
-        f"f′ = {sheet.focal_length_corrected_mm:.0f} mm are beyond its approximation "
-        "(instrument test, §6); the model needs relative orientation and levelling"
+        f"{sc.source}: photos[{i}].exterior.{axis}_deg: expected a tilt the setup-data method "
+        f"on {sheet.instrument_title} can carry (§26: at the sheet's exact settings the "
+        f"correction mechanism must leave ≤ ¼ mark {tol_q * 1000:.1f} µm of y-parallax at the "
+        f"standard points and ≤ H/3000 {tol_h:.2f} m at the control heights), found "
+        f"{found:+.1f}° (the largest tilt of the pair): at f′ = "
+        f"{sheet.focal_length_corrected_mm:.0f} mm the mechanism leaves {q_max * 1000:.1f} µm "
+        f"and {h_max:.2f} m (instrument test, §6); the model needs relative orientation and "
+        "levelling (--method conventional)"
     )
 
 

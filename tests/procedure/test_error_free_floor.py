@@ -111,5 +111,13 @@ def test_mountain60_is_refused_with_the_mechanism_level(instrument):
     # (instrument test §6 at 3°, f′ = 100: 22.6 µm; ×(100/70)-ish at f = 70) > ¼ mark 12.5 µm,
     # and 2 m of control heights > H/3000 = 0.57 m, which no setting of the setup-data method
     # can remove (it has no relative orientation and no levelling).
-    with pytest.raises(SetupRefusal, match=r"¼ mark 12\.5 µm.*H/3000 0\.57 m"):
+    with pytest.raises(SetupRefusal, match=r"¼ mark 12\.5 µm.*H/3000 0\.57 m") as info:
         _run("mountain60", instrument)
+    # one line naming the scenario file and the field that carries the pair beyond the
+    # mechanism: the largest tilt (left ω = −2.9°, the first of the two 2.9° tilts)
+    message = str(info.value)
+    source = load_scenario("mountain60").source
+    assert "\n" not in message
+    assert message.startswith(f"{source}: photos[0].exterior.omega_deg: expected a tilt ")
+    assert "found -2.9°" in message
+    assert "31.9 µm and 2.05 m" in message

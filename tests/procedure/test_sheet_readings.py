@@ -30,6 +30,7 @@ NOT_READINGS = (
     r"1/bz0",
     r"1/d[xy]_(left|right)",
     r"(1/L|1/L/R1|2/L\d+)/\d+/set(Z|bz|f)",  # R1 repeats the L-check corrections
+    r"3/R3/\d+/(setbx|(alpha|omega)/setbz)",  # R3: b_x, b_z′ turned from the control heights
 )
 
 

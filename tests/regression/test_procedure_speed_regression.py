@@ -19,6 +19,11 @@ failed stage-1 L-check with averaged pointings, R2 refines the relative orientat
 exceeds ¼ mark after stages 2 and 3), which legitimately changes every setup-method run;
 ``practice="book"`` gives the previous values.
 
+The setup-method values were re-recorded again (same environment) at the commit of remedy R3
+(issue 9, deliverable 3: where a stage-3 control height misses H/3000 the operator refines the
+scale by b_x and levels the model by a q-neutral common tilt), which legitimately changes every
+setup-method run whose heights failed (trial 29: 0.803 m → 0.122 m); stages 1–2 are unchanged.
+
 The conventional values were re-recorded (same environment) at the commit of issue 9's C2
 stopping rule (go on while the RMS of the six looks falls by ½ a pass), the common tilt that
 frees a knob at its stop, the loops' bound 2 × max_iterations and C3's final levelling without a
@@ -46,20 +51,20 @@ def runs():
 
 PINNED = {
     "setup": {
-        "q_standard[7, 2]": -0.013712744344872017,
-        "q_grid[13, 40]": -0.004822783921752097,
-        "sum q_grid": 2.6221940568066895,
+        "q_standard[7, 2]": -0.01371412999722037,
+        "q_grid[13, 40]": -0.0048217411465125495,
+        "sum q_grid": 1.4681253086264667,
         "MO_by[11]": 50.17,
         "MO_Z[11]": 520.2,
         "stage 1: |L − L′|[29]": 0.0016053431778004779,
         "stage 2: mark 4[29]": 0.006595123796412705,
         "stage 2: residual y-parallax (6 points)[29]": 0.02343741685755126,
-        "stage 3: control heights[29]": 0.8026792806682863,
-        "stage 3: residual y-parallax (6 points)[29]": 0.012220914992241918,
+        "stage 3: control heights[29]": 0.12176201048410462,
+        "stage 3: residual y-parallax (6 points)[29]": 0.012130085158251806,
         "stage 5: corner 4[29]": 0.0027624631174676508,
-        "stage 5: plan control points (needle − plotted)[29]": 0.10450639137801304,
+        "stage 5: plan control points (needle − plotted)[29]": 0.12857317646898742,
         "kappa_right[5]": -0.029960275881050824,
-        "Z[17]": 175.67572126477583,
+        "Z[17]": 175.66771285641335,
     },
     "conventional": {
         "q_standard[7, 2]": -0.06173781736083761,
