@@ -8,7 +8,8 @@ byte-identical for the same sheet and header: the creation date is the job's dat
 clock, and no producer version is written.
 
 Pages: (1) the header and Table 24 in the book's layout with a notes column (what each value is
-for and at which stage it is set); (2) the transformed marks, decentrations, Z_i of the height
+for and at which stage it is set) and, below it, every stage reading (6.9)–(6.18) in one row per
+stage; (2) the transformed marks, decentrations, Z_i of the height
 control, the sheet corners, the similarity (6.8) and the certificate's distortion; (3) the
 readings of stages 1–5, Eqs. (6.9)–(6.18); (4) the sheet frame and the control points in
 instrument coordinates.
@@ -18,6 +19,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import resources
@@ -149,12 +151,11 @@ def _table24_rows(sheet: SetupSheet) -> list[tuple[str, ...]]:
          f"{_f(left.mark_span_mm)}, {_f(right.mark_span_mm)}" + _flag(sheet, "L_mm"), "mm",
          "(6.5)", NOTES["L"]),
     ]  # fmt: skip
-    for j, (p, sub) in enumerate(zip(sheet.photos, ("л", "п"), strict=True)):
-        rows.append(
-            ("11" if j == 0 else "", f"decentrations, {p.name} photo", f"d_x,{sub}, d_y,{sub}",
-             f"{_f(p.decentration_mm[0])}, {_f(p.decentration_mm[1])}", "mm",
-             "f′·tan α, f′·tan ω", NOTES["d"] if j == 0 else "")
-        )  # fmt: skip
+    rows.append(
+        ("11", "decentrations, left; right photo", "d_x, d_y (л; п)",
+         "\n".join(f"{_f(p.decentration_mm[0])}, {_f(p.decentration_mm[1])}" for p in sheet.photos),
+         "mm", "f′·tan α, f′·tan ω", NOTES["d"])
+    )  # fmt: skip
     if sheet.control_heights:
         values = [f"{h['id']}: {_f(h['model_height_mm'])}" for h in sheet.control_heights]
         text = "\n".join("; ".join(values[i : i + 2]) for i in range(0, len(values), 2))
@@ -162,11 +163,11 @@ def _table24_rows(sheet: SetupSheet) -> list[tuple[str, ...]]:
             ("12", "model heights over the height control points", "Z_i",
              text + _flag(sheet, "control_heights_model_mm"), "mm", "(6.6)", NOTES["Z"])
         )  # fmt: skip
-    for j, c in enumerate(sheet.corners):
+    if sheet.corners:
         rows.append(
-            ("13" if j == 0 else "", f"sheet corner {c['corner']} ({c['position']})",
-             f"x′_{c['corner']}, y′_{c['corner']}", f"{_f(c['x_mm'])}, {_f(c['y_mm'])}"
-             + _flag(sheet, "sheet_corners_mm"), "mm", "(6.7)", NOTES["corner"] if j == 0 else "")
+            ("13", "sheet corners 1 SW, 2 SE, 3 NE, 4 NW", "x′_i, y′_i",
+             "\n".join(f"{c['corner']}: {_f(c['x_mm'])}, {_f(c['y_mm'])}" for c in sheet.corners)
+             + _flag(sheet, "sheet_corners_mm"), "mm", "(6.7)", NOTES["corner"])
         )  # fmt: skip
     return rows
 
@@ -220,18 +221,45 @@ def _header_block(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
     pdf.set_font(_FONT, "", 8)
     assumed = sorted({p for ps in sheet.assumed.values() for p in ps})
     items = [
-        ("job", f"{h.job} ({h.job_file})"),
-        ("pair", f"{h.pair}: left photo {h.left_photo}, right photo {h.right_photo}"),
-        ("map sheet", h.map_sheet),
-        ("instrument", f"{sheet.instrument_title} ({sheet.instrument})"),
+        ("job, pair", f"{h.job} ({h.job_file}) · pair {h.pair}: left photo {h.left_photo}, "
+         f"right photo {h.right_photo} · date {h.date} (from the job file) · {h.program}"),
+        ("map, instrument", f"map sheet {h.map_sheet} · {sheet.instrument_title} "
+         f"({sheet.instrument})"),
         ("camera", h.camera),
         ("frame", h.frame + f"; base azimuth θ = {math.degrees(sheet.frame_rotation):.4f}°"),
-        ("date", h.date + " (from the job file)"),
-        ("program", h.program),
         ("assumed", "values marked * rest on instrument parameters no source documents: "
          + (", ".join(assumed) if assumed else "none")),
     ]  # fmt: skip
-    _table(pdf, ("", ""), items, (22, 158), size=8)
+    _table(pdf, ("", ""), items, (24, 151), size=7.5)
+
+
+#: The stages of the setup-data method, as the compact readings of page 1 name them.
+STAGES = {
+    1: "1 · scales, base, spans",
+    2: "2 · tilts, decentrations",
+    3: "3 · height control",
+    4: "4 · sheet corners 1–3",
+    5: "5 · corner 4, check",
+}
+
+
+def _readings_rows(sheet: SetupSheet) -> list[tuple[str, str]]:
+    """Every stage reading (6.9)–(6.18) as 'reading = MO + value (± tolerance)', one row per
+    stage: the compact list of page 1 (page 3 has them one by one with a column to write in)."""
+    rows = []
+    for stage, title in STAGES.items():
+        texts, tolerances = [], {}
+        for r in sheet.readings:
+            if r["stage"] != stage:
+                continue
+            texts.append(r["formula"])
+            if "tolerance" in r and r["reading"] != "residual q":
+                name = re.sub(r"\d+", "i", r["reading"]) if stage == 3 else r["reading"]
+                tolerances.setdefault(f"±{r['tolerance']:.3g} {r['unit']}", []).append(name)
+        tol = "; ".join(f"{', '.join(dict.fromkeys(names))} {t}" for t, names in tolerances.items())
+        if texts:
+            rows.append((title, "; ".join(texts) + (f". Tolerance: {tol}" if tol else "")))
+    return rows
 
 
 def _page_table24(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
@@ -241,9 +269,12 @@ def _page_table24(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
         pdf,
         ("No.", "quantity", "symbol", "value", "unit", "equation", "notes: what for, which stage"),
         _table24_rows(sheet),
-        (7, 29, 25, 35, 8, 17, 59),
-        size=7,
+        (6, 27, 23, 33, 7, 15, 64),
+        size=6.5,
     )
+    _heading(pdf, "Readings to set, stage by stage (6.9)–(6.18): zero reading MO + value", 9)
+    _table(pdf, ("stage", "readings and tolerances; one by one with a column to write in: page 3"),
+           _readings_rows(sheet), (26, 149), size=6.5)  # fmt: skip
 
 
 def _page_details(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:

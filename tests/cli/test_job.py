@@ -128,6 +128,39 @@ def test_pdf_text_has_header_photo_numbers_and_readings(written):
         assert f"{z:.3f}" in flat
 
 
+@pytest.mark.parametrize("pair", PAIRS)
+def test_first_page_has_header_table24_and_every_reading(written, pair):
+    """Page 1 alone (what the acceptance renders): the header, the Table 24 values and every
+    stage reading (6.9)–(6.18) as sheet.yaml has it."""
+    sheet = yaml.safe_load((written / pair / "sheet.yaml").read_text("utf-8"))
+    reader = pypdf.PdfReader(written / pair / "sheet.pdf")
+    flat = re.sub(r"\s+", " ", reader.pages[0].extract_text())
+    left, right = pair.split("-")
+    for expected in (
+        f"Setup sheet (Table 24) — stereopair {pair}",
+        f"left photo {left}, right photo {right}",
+        "2026-11-24 (from the job file)",
+        f"stereoplotter {__version__}",
+        "Table 24 — setup data",
+        f"1:{sheet['scale_horizontal']}",
+        f"{sheet['n_left']:.5f}, {sheet['n_right']:.5f}",
+        "Readings to set, stage by stage (6.9)–(6.18)",
+    ):
+        assert expected in flat, expected
+    for r in sheet["readings"]:
+        assert re.sub(r"\s+", " ", r["formula"]) in flat, r["formula"]
+    for corner in sheet["sheet_corners_mm"].values():  # sheet.yaml keeps 6 decimals: ±1e-6
+        assert any(f"{_3(corner['x'], dx)}, {_3(corner['y'], dy)}" in flat
+                   for dx in (-1, 1) for dy in (-1, 1)), corner  # fmt: skip
+    for z in sheet["control_heights_model_mm"].values():
+        assert _3(z, -1) in flat or _3(z, 1) in flat
+
+
+def _3(value: float, side: int) -> str:
+    """value to 3 decimals as the form prints it, from the 6-decimal value of sheet.yaml."""
+    return f"{value + side * 6e-7:.3f}"
+
+
 def test_instrument_override(tmp_path, capsys):
     assert main(["setup", str(JOB), "--instrument", "sd3", "-o", str(tmp_path)]) == 0
     assert "SD-3" in capsys.readouterr().out.splitlines()[0]
