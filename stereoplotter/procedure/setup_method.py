@@ -1012,16 +1012,6 @@ def _height_seen(run: Run, p, key: str, active, pointings: int) -> NDArray[np.fl
     return total / pointings
 
 
-def _height_seen(run: Run, p, key: str, active, pointings: int) -> NDArray[np.float64]:
-    """Fuse on ``p`` and read the height scale, ``pointings`` times, averaged. [m]"""
-    total = None
-    for j in range(pointings):
-        k = key + (f"/p{j}" if j else "")
-        read = _fuse_on(run, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
-        total = read if total is None else total + read
-    return total / pointings
-
-
 def _read_control_heights(
     run: Run,
     rows: list[ControlHeight],
@@ -1050,26 +1040,38 @@ def _read_control_heights(
         remedy=remedy,
         when=active,
     )
-    errs = []
-    for h in rows[1:]:
-        p = h.ground_m
-        read = _height_seen(run, p, f"{key}/{h.id}", active, pointings)
-        errs.append(read - p[2])
-        op.log.add(
+    return [
+        log_control_height(
+            op,
             "3",
             f"control point {h.id}: fuse, read the height ({pointings} times, mean)",
-            HEIGHT_SCALE,
-            reading=read,
-            unit="m",
-            residual=read - p[2],
-            tolerance=tol,
-            passed=np.abs(read - p[2]) <= tol,
+            _height_seen(run, h.ground_m, f"{key}/{h.id}", active, pointings),
+            h.ground_m[2],
+            tol,
             iteration=it,
-            equation="H/3000",
             remedy=remedy,
             when=active,
         )
-    return errs
+        for h in rows[1:]
+    ]
+
+
+def log_control_height(op, stage: str, text: str, read, truth_m: float, tol, **extra):
+    """Log one control-point height read on the height scale against its truth and H/3000;
+    return the error read − truth. [m]"""
+    op.log.add(
+        stage,
+        text,
+        HEIGHT_SCALE,
+        reading=read,
+        unit="m",
+        residual=read - truth_m,
+        tolerance=tol,
+        passed=np.abs(read - truth_m) <= tol,
+        equation="H/3000",
+        **extra,
+    )
+    return read - truth_m
 
 
 def refine_scale_and_level(
@@ -1165,18 +1167,8 @@ def stage3_scale_model(run: Run) -> None:
         img = run.scene.images(p[None, :])
         op.fuse(p, (img[0][0], img[1][0]), f"3/h/{h.id}")
         read = op.read(HEIGHT_SCALE, f"3/h/{h.id}")
-        errs.append(read - p[2])
-        op.log.add(
-            "3",
-            f"control point {h.id}: fuse, read the height",
-            HEIGHT_SCALE,
-            reading=read,
-            unit="m",
-            residual=read - p[2],
-            tolerance=tol,
-            passed=np.abs(read - p[2]) <= tol,
-            equation="H/3000",
-        )
+        text = f"control point {h.id}: fuse, read the height"
+        errs.append(log_control_height(op, "3", text, read, p[2], tol))
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1) if errs else op.v(0.0)
     name = "stage 3: control heights"
     remedial = run.remedial and bool(errs)
