@@ -518,6 +518,20 @@ def _setup_block(args: argparse.Namespace, spec: Any) -> int:
     return 0
 
 
+def _job(args: argparse.Namespace) -> int:
+    """``job to-scenario``: one pair of a job as a scenario (``stereoplotter.io.job_scenario``)."""
+    from stereoplotter.io.job_file import load_job
+    from stereoplotter.io.job_scenario import write_job_scenario
+
+    doc, fit = write_job_scenario(load_job(args.job), args.pair, args.output)
+    sys.stdout.write(
+        f"scenario {doc['name']}: {len(doc['points'])} points, terrain {fit.kind} fitted to "
+        f"{fit.points} control heights (rms {fit.rms_m:.3f} m, max {fit.max_m:.3f} m)\n"
+        f"written: {args.output}\n"
+    )
+    return 0
+
+
 def _simulate(args: argparse.Namespace) -> int:
     from stereoplotter.progress import progress_bar
     from stereoplotter.report.simulation import run_simulation_command
@@ -780,6 +794,17 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument("--json", action="store_true", help="print the sheet as JSON")
 
+    p = sub.add_parser("job", help="work with production job files (docs/production.md)")
+    jobs = p.add_subparsers(dest="job_command", required=True, metavar="ACTION")
+    j = jobs.add_parser(
+        "to-scenario",
+        help="write one pair of a job as a scenario for simulation: the job's orientation, "
+        "points and map sheet, a terrain fitted to the control heights (said in the YAML)",
+    )
+    j.add_argument("job", help="a job file (format: stereoplotter-job/1)")
+    j.add_argument("pair", help="the pair as LEFT-RIGHT photo numbers, e.g. 101-102")
+    j.add_argument("-o", "--output", required=True, metavar="FILE", help="the scenario YAML")
+
     p = sub.add_parser(
         "simulate",
         help="run the simulated operator on a virtual instrument and evaluate the model",
@@ -944,6 +969,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _instrument(args)
         if args.command == "setup":
             return _setup(args)
+        if args.command == "job":
+            return _job(args)
         if args.command == "simulate":
             return _simulate(args)
         if args.command == "verify":

@@ -274,3 +274,79 @@ def test_shipped_job_validates_against_its_schema():
     assert [e.message for e in validator.iter_errors(doc)] == []
     doc["pairs"][0]["lefft"] = 101
     assert any("lefft" in e.message for e in validator.iter_errors(doc))
+
+
+# --- job to-scenario (issue 12, deliverable 3) ---------------------------------------------------
+
+
+def test_job_to_scenario_loads_simulates_and_keeps_the_pair(tmp_path, capsys):
+    """Pair 102-103 as a scenario: it loads, the zero-error simulation runs on it and sets the
+    job's scales, and the scenario's photos and points are the job's in the pair's frame (points
+    to 1 mm, centres to 1 mm, rotations to 1e-7)."""
+    import json
+
+    from stereoplotter.io.scenario_file import load_scenario
+
+    path = tmp_path / "pair.yaml"
+    assert main(["job", "to-scenario", str(JOB), "102-103", "-o", str(path)]) == 0
+    assert "terrain plane+hill fitted to 12 control heights" in capsys.readouterr().out
+    text = path.read_text("utf-8")
+    assert "# TERRAIN (fitted, not measured): plane+hill" in text
+    scenario = load_scenario(path)
+    job = load_job(JOB)
+    m = measured_pair(job, job.pairs[1])
+    mine = {p.id: p for p in scenario.points}
+    assert sorted(mine) == sorted(p.id for p in m.points) and len(mine) == 13
+    for p in m.points:
+        assert (mine[p.id].role, mine[p.id].kind) == (p.role, p.kind)
+        np.testing.assert_allclose(mine[p.id].local_m, p.local_m, rtol=0, atol=1e-3)
+    for photo, centre, rotation in zip(scenario.photos, m.centres_m, m.rotations, strict=True):
+        np.testing.assert_allclose(photo.exterior.centre, centre, rtol=0, atol=1e-3)
+        np.testing.assert_allclose(photo.exterior.rotation, rotation, rtol=0, atol=1e-7)
+    # the film deformation from the measured spans gives back the job's f′ = 70·(1 + mean ppm)
+    # (the ppm are written to 1e-4: 7e-9 mm)
+    ppm = np.mean([p.film_deformation_ppm for p in scenario.photos])
+    assert 70.0 * (1 + ppm * 1e-6) == pytest.approx(m.focal_length_corrected_mm, abs=1e-8)
+    assert scenario.map_sheet.nomenclature == "N-35-14-А-а-4"
+    # the fitted terrain meets the control heights to a few mm (strip8's ground is nearly plane)
+    heights = np.array([p.local_m for p in m.points if p.role == "control" and p.kind != "plan"])
+    misfit = scenario.terrain.height_m(heights[:, 0], heights[:, 1]) - heights[:, 2]
+    assert np.max(np.abs(misfit)) < 0.005
+
+    argv = ["simulate", str(path), "--instrument", "sc1", "--errors", "zero", "--operator",
+            "zero", "--json"]  # fmt: skip
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out)
+    sheet = pair_dict(job, compute_job(job).pairs[1])
+    assert summary["evaluation"]["horizontal_scale_denominator"] == sheet["scale_horizontal"]
+    assert summary["evaluation"]["vertical_scale_denominator"] == sheet["scale_vertical"]
+    assert all(c["passed"] for c in summary["checks"].values())
+    assert summary["residual_y_parallax_um"]["grid_max"] < 5.0  # zero errors: the mechanism's own
+
+
+def test_job_to_scenario_unknown_pair_is_one_line(tmp_path, capsys):
+    assert main(["job", "to-scenario", str(JOB), "101-109", "-o", str(tmp_path / "s.yaml")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: {JOB}: pairs: expected a pair of the job")
+    assert not (tmp_path / "s.yaml").exists()
+
+
+def test_fit_terrain_recovers_plane_and_hill():
+    """4 points of a plane: the plane exactly; 8 points of plane + the fitter's own hill shape
+    (centre at the centroid, radius 1.5 × the farthest): the hill's height; 2 points: flat."""
+    from stereoplotter.io.job_scenario import fit_terrain
+
+    xy = np.array([[-900.0, 1500.0], [900.0, 1500.0], [900.0, -1500.0], [-900.0, -1500.0]])
+    plane = np.column_stack([xy, 150.0 + 0.004 * xy[:, 0] - 0.002 * xy[:, 1]])
+    fit = fit_terrain(plane)
+    assert fit.kind == "plane" and fit.section == {"base_height_m": 150.0,
+                                                   "slope": [0.004, -0.002]}  # fmt: skip
+    xy8 = np.vstack([xy, [[-700.0, 0.0], [700.0, 0.0], [0.0, 800.0], [0.0, -800.0]]])
+    r = 1.5 * np.max(np.hypot(*(xy8 - xy8.mean(axis=0)).T))
+    z = 150.0 + 0.004 * xy8[:, 0] + 30.0 * np.exp(-0.5 * np.sum(xy8**2, axis=1) / r**2)
+    fit = fit_terrain(np.column_stack([xy8, z]))
+    assert fit.kind == "plane+hill" and fit.rms_m < 1e-4
+    assert fit.section["hills"][0]["height_m"] == pytest.approx(30.0, abs=1e-3)
+    assert fit.section["base_height_m"] == pytest.approx(150.0, abs=1e-3)
+    two = fit_terrain(np.array([[0.0, 0.0, 100.0], [10.0, 0.0, 104.0]]))
+    assert (two.kind, two.section) == ("flat", {"base_height_m": 102.0})
