@@ -27,7 +27,10 @@ Configurations (chosen to match the formulas' assumptions as far as the model al
   at a = c − p as in the formula, and the height datum is the mean of the four levelling heights
   re-observed with σ_p (the formula's plane); ``quantity``, ``standard_points`` and ``datum``
   select the other readings (δp at the ideal model position, the nadirs, the procedure's
-  one-point slip) — ``docs/accuracy.md`` gives the numbers of each.
+  one-point slip) — ``docs/accuracy.md`` gives the numbers of each. ``levelling="book"``
+  re-levels the built model at Fig. 39's control points and ``sources`` switches σ_q or σ_p
+  off; :func:`levelling_formula` is the rigorous formula with the plane at any four points (the
+  procedure levels on the scenario's control points, which moves the formula by +5 %).
 
 :func:`relative_orientation_mc` runs the conventional relative orientation alone (σ_q only, fixed
 passes) against (5.54).
@@ -49,7 +52,10 @@ if TYPE_CHECKING:
 
 __all__ = [
     "PROCEDURE_ROWS",
+    "SOURCES",
     "idealised_geometry",
+    "levelling_formula",
+    "levelling_points_photo",
     "procedure_mc",
     "relative_orientation_mc",
     "scenario_geometry",
@@ -162,8 +168,16 @@ def _dp(scenario, sheet, inst, frame_pts):
     return np.asarray(dp, float)
 
 
-def _configuration(method, sigma_mm, c, p, n):
-    """Operator errors, domain x_л-range, unit and run options of ``method`` (module docstring)."""
+#: ``procedure_mc(sources=…)`` of the conventional method: which judgment errors are on.
+SOURCES = ("both", "y_parallax", "stereo")
+
+
+def _configuration(method, sigma_mm, c, p, n, sources="both"):
+    """Operator errors, domain x_л-range, unit and run options of ``method`` (module docstring).
+
+    ``sources`` (conventional only): "both" (σ_q = σ_p = σ, the formula's m_q = m_p), or only
+    the y-parallax σ_q ("y_parallax", the relative-orientation part (5.54)) or only the stereo σ_p
+    ("stereo", the levelling part (5.55))."""
     from stereoplotter.procedure.operator import OperatorModel
 
     zero = OperatorModel().zero()
@@ -171,7 +185,9 @@ def _configuration(method, sigma_mm, c, p, n):
         op = replace(zero, monocular_sigma_mm=sigma_mm)
         return zero, op, (0.0, c), n * sigma_mm, {}  # domain of (6.27)
     if method == "conventional":
-        op = replace(zero, stereo_sigma_mm=sigma_mm, y_parallax_sigma_mm=sigma_mm)
+        sq = 0.0 if sources == "stereo" else sigma_mm
+        sp = 0.0 if sources == "y_parallax" else sigma_mm
+        op = replace(zero, stereo_sigma_mm=sp, y_parallax_sigma_mm=sq)
         return zero, op, (p - c, p), sigma_mm, {"relative": "equations"}  # x_п ∈ [−c, 0]
     raise ValueError(f"method: expected 'setup' or 'conventional', found {method!r}")
 
@@ -268,12 +284,20 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         return ms, d_zero
     # heights as read, in parallax units (dp/dH = B·f/(Z_S − Z)², frame origin S_л)
     _, lev = _levelling_frame_points(zero_prep)
-    allp = np.vstack([pts, lev])
+    book, _, _ = _control_frame_points(sc, zero_run.sheet, g)
+    allp = np.vstack([pts, lev, book])
     base_m = p * g["flying_height_m"] / f
     k = base_m * f / allp[:, 2] ** 2  # photo mm of x-parallax per m of height
     h_zero = _height_errors_parallax(sc, zero_run.sheet, zero_run.instrument, allp)
-    out = {name: np.empty(int(trials)) for name in ("parallax", "slip", "plane")}
-    n = len(pts)
+    out = {name: np.empty(int(trials)) for name in ("parallax", "slip", "plane", "book")}
+    n, nl = len(pts), len(lev)
+    # the book's levelling (mechanism off): the least-squares plane (1, X, Y) through the height
+    # errors at x_п ∈ {−c, a}, y = ±c, each observed with σ_p, removed from the built model
+    from stereoplotter.accuracy.chapter5 import levelling_design
+
+    refit = levelling_design(pts[:, 0], pts[:, 1]) @ np.linalg.pinv(
+        levelling_design(book[:, 0], book[:, 1])
+    )
     for result in iter_trial_chunks(prep, int(trials), chunk, evaluate=False):
         first = result.first_trial
         m = len(result.instrument.setting.base_x_mm)
@@ -282,14 +306,82 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         # the book's datum: the levelling plane's offset from the four levelling heights, each
         # observed with the stereo σ_p of the formula (keyed draws, one per point and trial)
         noise = Noise(seed, m, None, first)
-        obs = e[:, n:] + np.stack(
-            [noise.normal(f"mc/datum/{i}", op.stereo_sigma_mm) for i in range(len(lev))], -1
+        obs = e[:, n : n + nl] + np.stack(
+            [noise.normal(f"mc/datum/{i}", op.stereo_sigma_mm) for i in range(nl)], -1
         )
         out["parallax"][first : first + m] = np.mean(d**2, axis=-1)
         out["slip"][first : first + m] = np.mean(e[:, :n] ** 2, axis=-1)
         plane = e[:, :n] - np.mean(obs, axis=-1, keepdims=True)
         out["plane"][first : first + m] = np.mean(plane**2, axis=-1)
+        ctl = e[:, n + nl :] + np.stack(
+            [noise.normal(f"mc/book/{i}", op.stereo_sigma_mm) for i in range(len(book))], -1
+        )
+        out["book"][first : first + m] = np.mean((e[:, :n] - ctl @ refit.T) ** 2, axis=-1)
     return out, d_zero
+
+
+def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
+    """The rigorous M_p of the conventional method, (5.54) ⊕ (5.55), with the levelling plane
+    fitted at the given control points instead of Fig. 39's x_п ∈ {−c, a}, y = ±c.
+
+    The linear model of (6.60)/(6.61) (relative orientation by least squares on the six standard
+    points, the plane's error from control heights with the parallax error m_p) on the chapter-5
+    domain, propagated exactly (:func:`~stereoplotter.verification.linear_mc.covariance_rms`).
+    ``g``: :func:`scenario_geometry` (a, c, p, f). Returns the coefficients per m_q = m_p:
+    "y_parallax" (the (5.54) part), "stereo" (the (5.55) part) and "both" (their quadrature).
+
+    Examples
+    --------
+    At Fig. 39's own points it is the rigorous (6.60), 0.6862:
+
+    >>> from stereoplotter.accuracy.chapter5 import control_points
+    >>> g = {"a": 0.0, "c": 70.0, "p": 70.0, "f": 70.0}
+    >>> round(levelling_formula(g, *control_points(0.0, 70.0))["both"], 3)
+    0.686
+    """
+    from stereoplotter.accuracy.chapter5 import (
+        levelling_design,
+        relative_orientation_design,
+        standard_points,
+    )
+    from stereoplotter.verification.linear_mc import (
+        LinearModel,
+        _relative_field_basis,
+        covariance_rms,
+        grid_chapter5,
+    )
+
+    a, c, p, f = g["a"], g["c"], g["p"], g["f"]
+    _, xs, ys = standard_points(a, p, c)
+    lsq = np.linalg.pinv(relative_orientation_design(xs, ys, p, f))
+    xg, yg = grid_chapter5(c, *grid)
+    xc, yc = np.asarray(x_right_mm, float), np.asarray(y_mm, float)
+    fit = levelling_design(xg, yg) @ np.linalg.pinv(levelling_design(xc, yc))
+    out = {}
+    for name, sq, sp in (("y_parallax", 1.0, 0.0), ("stereo", 0.0, 1.0), ("both", 1.0, 1.0)):
+        model = LinearModel(
+            _relative_field_basis(xg, yg, p, f),
+            lsq * sq,
+            _relative_field_basis(xc, yc, p, f),
+            fit,
+            sp,
+            0.0,
+        )
+        out[name] = covariance_rms(model)
+    return out
+
+
+def levelling_points_photo(scenario: Scenario, spec: InstrumentSpec, g: dict):
+    """(x_п, y) [mm] of the procedure's four levelling points (the scenario's control points
+    nearest standard points 3–6, ``conventional.levelling_points``) at the mean photo scale."""
+    from stereoplotter.procedure.operator import OperatorModel
+    from stereoplotter.procedure.simulate import prepare_run
+
+    spec = replace(spec, standard_points_c_mm=g["c"])
+    prep = prepare_run(scenario, spec, "conventional", "zero", 0, operator=OperatorModel().zero())
+    _, lev = _levelling_frame_points(prep)
+    s = g["f"] / g["flying_height_m"]
+    return lev[:, 0] * s - g["p"], lev[:, 1] * s
 
 
 def _rms_ci(ms, unit):
@@ -300,7 +392,8 @@ def _rms_ci(ms, unit):
     return rms / unit, half / unit
 
 
-# long: a 32-line docstring (the options and what each measures) and 58 lines of code.
+# long: a 38-line docstring (the options and what each measures) and 63 lines of code (option
+# checks, the formula at both sets of levelling points, the run, the summary).
 def procedure_mc(
     scenario: Scenario,
     method: str = "setup",
@@ -313,6 +406,8 @@ def procedure_mc(
     quantity: str = "heights",
     standard_points: str = "book",
     datum: str = "plane",
+    levelling: str = "procedure",
+    sources: str = "both",
 ) -> dict:
     """Run the procedure MC for one scenario and method (see the module docstring).
 
@@ -322,8 +417,14 @@ def procedure_mc(
     counts the b_x scale error and the model's datum); ``standard_points`` "book" (Fig. 39 at
     a = c − p, the formula's layout) or "nadirs" (a = 0, the instrument's); ``datum`` "plane"
     (the formula's levelling offset: the four levelling heights, each with σ_p) or "slip" (the
-    procedure's: the height scale slipped at one levelling point). The result also carries
-    ``by_datum`` (coefficient, ci) for "parallax", "slip" and "plane" of the same trials.
+    procedure's: the height scale slipped at one levelling point). ``levelling`` "procedure"
+    (the model as the procedure levelled it, on the scenario's four control points nearest
+    standard points 3–6) or "book" (the built model re-levelled by the least-squares plane through
+    its height errors at Fig. 39's x_п ∈ {−c, a}, y = ±c, each observed with σ_p: the formula's
+    control points). ``sources`` "both" (σ_q = σ_p = σ), "y_parallax" (σ_q only) or "stereo"
+    (σ_p only). The result also carries ``by_datum`` (coefficient, ci) for "parallax", "slip",
+    "plane" and "book" of the same trials, and ``formula`` (:func:`levelling_formula` at the
+    procedure's levelling points, "procedure", and at Fig. 39's, "book"; the part of ``sources``).
 
     ``scenario`` and ``spec`` (the instrument, the book's SC-1) are loaded by the caller; this
     layer reads no files.
@@ -350,31 +451,49 @@ def procedure_mc(
 
     t0 = time.perf_counter()
     g = scenario_geometry(scenario, spec)
-    zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"])
-    spec = replace(spec, standard_points_c_mm=g["c"])
-    options = {}
     if method == "conventional":
         for name, value, allowed in (
             ("quantity", quantity, ("heights", "parallax")),
             ("standard_points", standard_points, ("book", "nadirs")),
             ("datum", datum, ("plane", "slip")),
+            ("levelling", levelling, ("procedure", "book")),
+            ("sources", sources, SOURCES),
         ):
             if value not in allowed:
                 raise ValueError(f"{name}: expected one of {allowed}, found {value!r}")
+    zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"], sources)
+    options, formula = {}, None
+    if method == "conventional":
+        from stereoplotter.accuracy.chapter5 import control_points
+
         options = {"standard_points": standard_points, "heights": True}
+        formula = {
+            "procedure": levelling_formula(g, *levelling_points_photo(scenario, spec, g))[sources],
+            "book": levelling_formula(g, *control_points(g["a"], g["c"]))[sources],
+        }
+    spec = replace(spec, standard_points_c_mm=g["c"])
     ms, d_zero = _mean_squares(
         scenario, spec, method, seed, trials, zero, op, xr, g, grid, kw, options
     )
     by = None
     if isinstance(ms, dict):
         by = {name: _rms_ci(v, unit) for name, v in ms.items()}
-        ms = ms["parallax" if quantity == "parallax" else datum]
+        if quantity == "parallax":
+            ms = ms["parallax"]
+        else:
+            ms = ms["book" if levelling == "book" else datum]
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(mean_ms)
     se_ms = float(np.std(ms, ddof=1)) / math.sqrt(len(ms))
     half = CI_Z * rms * se_ms / (2.0 * mean_ms)
     extra = {} if by is None else {
-        "by_datum": by, "quantity": quantity, "standard_points": standard_points, "datum": datum
+        "by_datum": by,
+        "quantity": quantity,
+        "standard_points": standard_points,
+        "datum": datum,
+        "levelling": levelling,
+        "sources": sources,
+        "formula": formula,
     }
     return {
         **extra,
