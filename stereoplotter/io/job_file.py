@@ -47,6 +47,7 @@ from stereoplotter.geometry.collinearity import object_to_photo, photo_to_object
 from stereoplotter.geometry.film import corrected_focal_length, fiducial_spans_mm
 from stereoplotter.geometry.rotation import rotation_matrix
 from stereoplotter.io.scenario_file import (
+    MAX_FILM_DEFORMATION_PPM,
     Corner,
     Distances,
     Fiducials,
@@ -288,12 +289,12 @@ def load_job(path: str | os.PathLike[str]) -> Job:
     doc = validate(JobFile, data, source)
     fields = Fields(source)
     folder = Path(path).parent
-    camera = camera_from_model(fields, doc.camera)  # type: ignore[arg-type]
+    camera = camera_from_model(source, doc.camera)  # type: ignore[arg-type]
     origin = _origin(fields, doc.frame)
     distances = (
         _fiducial_csv(folder, doc.fiducial_distances_csv) if doc.fiducial_distances_csv else {}
     )
-    photos = _photos(fields, doc, distances)
+    photos = _photos(fields, doc, distances, fiducial_spans_mm(camera.fiducials_mm))
     rows = [(source, f"points[{i}]", p) for i, p in enumerate(doc.points)]
     for name in doc.points_csv:
         rows += _csv_rows(folder / name, PointModel)
@@ -401,7 +402,10 @@ def _coordinates(
 
 
 def _photos(
-    fields: Fields, doc: JobFile, csv_distances: dict[int, tuple[str, tuple[float, float]]]
+    fields: Fields,
+    doc: JobFile,
+    csv_distances: dict[int, tuple[str, tuple[float, float]]],
+    spans: NDArray[np.float64],
 ) -> dict[int, JobPhoto]:
     photos: dict[int, JobPhoto] = {}
     for i, p in enumerate(doc.photos):
@@ -416,14 +420,18 @@ def _photos(
             )  # fmt: skip
         if p.fiducial_distances_mm is not None:
             d = (p.fiducial_distances_mm.d12, p.fiducial_distances_mm.d34)
+            where = [(fields.source, f"{path}.fiducial_distances_mm.{k}") for k in ("1-2", "3-4")]
         elif p.number in csv_distances:
             d = csv_distances[p.number][1]
+            where = [(csv_distances[p.number][0], k) for k in ("d12_mm", "d34_mm")]
         else:
             raise fields.error(
                 f"{path}.fiducial_distances_mm",
                 "the fiducial distances 1-2, 3-4 measured on this diapositive (here or in "
                 "fiducial_distances_csv)", "nothing",
             )  # fmt: skip
+        for (source, field), measured, span in zip(where, d, spans, strict=True):
+            _check_film(source, field, measured, float(span))
         angles = tuple(math.radians(a) for a in (p.alpha_deg, p.omega_deg, p.kappa_deg))
         photos[p.number] = JobPhoto(p.number, centre, angles, (float(d[0]), float(d[1])))  # type: ignore[arg-type]
     unknown = sorted(set(csv_distances) - set(photos))
@@ -431,6 +439,18 @@ def _photos(
         raise ConfigError(csv_distances[unknown[0]][0], "photo", "a photo number of the job",
                           unknown[0])
     return photos
+
+
+def _check_film(source: str, field: str, measured: float, span: float) -> None:
+    """A measured span within ±0.5 % of the certificate's (the film deformation a scenario takes:
+    beyond it no usable film base, or a typing error)."""
+    limit = MAX_FILM_DEFORMATION_PPM * 1e-6
+    ratio = measured / span if span > 0.0 else math.inf  # a certificate span that underflows
+    if not (math.isfinite(ratio) and abs(ratio - 1.0) <= limit):
+        raise ConfigError(
+            source, field, f"a measured distance within ±{limit:.1%} of the certificate's "
+            f"{span:.3f} mm (film deformation ≤ {MAX_FILM_DEFORMATION_PPM:g} ppm)", measured,
+        )  # fmt: skip
 
 
 def _points(
@@ -642,8 +662,18 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
     f_pair = float(corrected_focal_length(f, np.concatenate(ratios), np.ones(4)))
     per_photo = (float(f * np.mean(ratios[0])), float(f * np.mean(ratios[1])))
     marks = np.array([cal_marks * r for r in ratios]) - np.asarray(cam.principal_point_mm, float)
-    (c_l, m_l), (c_r, m_r) = _station(job, frame, left), _station(job, frame, right)
-    points = _local_points(job, frame)
+    try:  # the geodesy of the pair's frame: a station or point beyond its zone is bad input
+        (c_l, m_l), (c_r, m_r) = _station(job, frame, left), _station(job, frame, right)
+        points = _local_points(job, frame)
+    except StereoplotterError as exc:
+        if str(exc).startswith(f"{job.source}: "):
+            raise
+        origin = "" if frame is None or frame.origin_sk42_m is None else (
+            " at x = {:.0f} m, ȳ = {:.0f} m".format(*frame.origin_sk42_m[:2]))  # fmt: skip
+        raise StereoplotterError(
+            f"{job.source}: pairs: pair {pair.name}: expected stations and points the pair's "
+            f"frame{origin} can take (one Gauss–Krüger zone), found: {exc}"
+        ) from None
     xyz = np.array([p.local_m for p in points], float).reshape(-1, 3)
     half = cam.format_mm / 2.0
     inside = np.ones(len(points), bool)

@@ -32,6 +32,7 @@ import numpy as np
 import yaml
 
 from stereoplotter.errors import ConfigError
+from stereoplotter.geometry.film import fiducial_spans_mm
 from stereoplotter.geometry.rotation import angles_from_matrix
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair, measured_pair
 from stereoplotter.io.yaml_files import atomic_write_bytes
@@ -170,8 +171,7 @@ def job_pair_scenario(job: Job, pair_name: str) -> tuple[dict[str, Any], Terrain
     pair = _find_pair(job, pair_name)
     m = measured_pair(job, pair)
     cam = job.camera
-    spans = (cam.fiducials_mm["2"][0] - cam.fiducials_mm["1"][0],
-             cam.fiducials_mm["3"][1] - cam.fiducials_mm["4"][1])  # fmt: skip
+    spans = fiducial_spans_mm(cam.fiducials_mm)
     photos = []
     for side, number, centre, rotation in zip(("left", "right"), (pair.left, pair.right),
                                               m.centres_m, m.rotations, strict=True):  # fmt: skip
@@ -182,7 +182,7 @@ def job_pair_scenario(job: Job, pair_name: str) -> tuple[dict[str, Any], Terrain
             "exterior": {"X_m": _m(centre[0]), "Y_m": _m(centre[1]), "Z_m": _m(centre[2]),
                          "alpha_deg": round(alpha, 8) + 0.0, "omega_deg": round(omega, 8) + 0.0,
                          "kappa_deg": round(kappa, 8) + 0.0, "source": "given"},
-            "film_deformation_ppm": [round((measured[i] / spans[i] - 1.0) * 1e6, 4) + 0.0
+            "film_deformation_ppm": [round((measured[i] / float(spans[i]) - 1.0) * 1e6, 4) + 0.0
                                      for i in range(2)],
         })  # fmt: skip
     heights = np.array([p.local_m for p in m.points

@@ -23,6 +23,7 @@ import numpy as np
 import yaml
 
 from stereoplotter import __version__
+from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair, load_job, measured_pair
@@ -67,10 +68,18 @@ class JobResult:
 
 
 def _instrument(job: Job) -> InstrumentSpec:
-    """The job's instrument: a shipped name, or a YAML path relative to the job file."""
+    """The job's instrument: a shipped name, or a YAML path relative to the job file (an unknown
+    name is refused as the job's field ``instrument``; a bad YAML file names itself)."""
     beside = Path(job.source).parent / job.instrument
-    return load_instrument(beside if beside.suffix in (".yaml", ".yml") and beside.exists()
-                           else job.instrument)  # fmt: skip
+    if beside.suffix in (".yaml", ".yml") and beside.exists():
+        return load_instrument(beside)
+    try:
+        return load_instrument(job.instrument)
+    except StereoplotterError as exc:
+        if str(exc).startswith(f"{job.instrument}: "):  # a YAML path that names itself
+            raise
+        raise ConfigError(job.source, "instrument", "a shipped instrument (sc1, spr3, sd3) or "
+                          "a YAML file beside the job", job.instrument, str(exc)) from None
 
 
 def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:

@@ -1,13 +1,15 @@
 """Seeded mutation fuzzing of every input file: bad input never crashes.
 
-The shipped files (scenarios, block files, instruments) and two built ones (an errors YAML of
+The shipped files (scenarios, block files, instruments, the job ``jobs/strip8/job.yaml`` and its
+two CSV files) and two built ones (an errors YAML of
 overrides as :meth:`ErrorModel.with_overrides` accepts it, a ``verify --geometry`` mapping, a block
 file with its models in CSV) are mutated: keys deleted or misspelt, values of the wrong type,
 NaN/inf, huge and negative numbers, YAML alias bombs, cycles and deep nesting, tags PyYAML cannot
 construct, non-UTF-8 bytes, control characters, empty files, a directory in place of the file,
 truncated files and duplicated keys. Each case is loaded in-process through the library loader
 and, for a sample, through :func:`stereoplotter.cli.main` (``scenario check``, ``instrument
-show``, ``setup``, ``simulate --trials 1``, ``verify --geometry``) with stdout and stderr captured.
+show``, ``setup``, ``simulate --trials 1``, ``verify --geometry``, ``job to-scenario``) with stdout
+and stderr captured.
 
 Every case must end one of two ways:
 
@@ -84,7 +86,7 @@ def _shipped_dir(kind: str) -> Path:
 class Seed:
     """One file to mutate: its kind, name, text and parsed document."""
 
-    kind: str  # scenario, block, block_csv, csv, instrument, errors, geometry
+    kind: str  # scenario, block, block_csv, csv, instrument, errors, geometry, job, job_csv
     name: str  # the file name written into the case folder
     text: str
     doc: Any
@@ -101,6 +103,8 @@ def _dump(doc: Any) -> str:
 
 
 _CORPUS: dict[str, list[Seed]] | None = None
+JOB_DIR = ROOT / "jobs" / "strip8"
+JOB_CSV = ("control.csv", "fiducials.csv")
 _EO = ("X_m", "Y_m", "Z_m", "alpha_deg", "omega_deg", "kappa_deg")
 
 
@@ -154,6 +158,11 @@ def corpus() -> dict[str, list[Seed]]:
     yaml_doc["models_csv"] = "models.csv"
     out["block_csv"] = [_seed("block_csv", "block_csv.yaml", _dump(yaml_doc))]
     out["csv"] = [Seed("csv", "models.csv", csv_text, None)]
+
+    # the shipped production job and its CSV files (control points, fiducial distances)
+    out["job"] = [_seed("job", "job.yaml", (JOB_DIR / "job.yaml").read_text(encoding="utf-8"))]
+    out["job_csv"] = [Seed("job_csv", name, (JOB_DIR / name).read_text(encoding="utf-8"), None)
+                      for name in JOB_CSV]  # fmt: skip
     _CORPUS = out
     return out
 
@@ -289,15 +298,18 @@ MUTATIONS = {
     "inherits": 2,  # instruments only (else: wrong_type)
     "valid_edit": 4,  # a small change that keeps most files valid: numbers scaled a little
 }
-#: Kinds, with their weights.
+#: Kinds, with their weights (the job's share taken from scenarios and instruments, so the
+#: default run keeps its 2 000 cases and about its time).
 KINDS = {
-    "scenario": 32,
+    "scenario": 28,
     "block": 10,
     "block_csv": 3,
     "csv": 5,
-    "instrument": 30,
+    "instrument": 26,
     "errors": 12,
     "geometry": 8,
+    "job": 5,
+    "job_csv": 3,
 }
 
 
@@ -372,7 +384,7 @@ def _mutate_csv(rng: np.random.Generator, mutation: str, text: str) -> tuple[str
 
 def mutate(rng: np.random.Generator, seed: Seed, mutation: str) -> tuple[str, bytes | None]:
     """The mutated file as text (and bytes, where the mutation is on bytes)."""
-    if seed.kind == "csv":
+    if seed.kind in ("csv", "job_csv"):
         return _mutate_csv(rng, mutation, seed.text)
     doc = copy.deepcopy(seed.doc)
     paths = seed.paths
@@ -510,6 +522,14 @@ def _load(kind: str, path: Path) -> Any:
         from stereoplotter.io.geometry_file import geometry_from_file
 
         return geometry_from_file(path)
+    if kind in ("job", "job_csv"):
+        from stereoplotter.io.job_file import load_job
+        from stereoplotter.report.job import compute_job, pair_dict
+
+        job = load_job(path)
+        result = compute_job(job)
+        json.dumps([pair_dict(job, p) for p in result.pairs], ensure_ascii=False).encode("utf-8")
+        return result
     raise AssertionError(kind)
 
 
@@ -570,6 +590,12 @@ def _commands(rng: np.random.Generator, kind: str, path: str, shipped: dict[str,
         ]
     if kind == "geometry":
         return [["verify", "--trials", "2", "--procedure-trials", "0", "--json", "--geometry", s]]
+    if kind in ("job", "job_csv"):
+        cmds = [["setup", s, "--json"]]
+        if rng.random() < 0.5:
+            scenario = str(Path(s).parent / "pair.yaml")
+            cmds.append(["job", "to-scenario", s, "102-103", "-o", scenario])
+        return cmds
     raise AssertionError(kind)
 
 
@@ -586,6 +612,17 @@ def _names_file_and_field(message: str, files: list[str], folder: str) -> bool:
         if f"of {f}: " in message:
             return True
     return False
+
+
+def _scenario_problem(path: str) -> str:
+    """Why the scenario that ``job to-scenario`` wrote does not load ('' when it does)."""
+    from stereoplotter.io.scenario_file import load_scenario
+
+    try:
+        load_scenario(path)
+    except BaseException as exc:  # the point of the check
+        return f"{type(exc).__name__}: {str(exc)[:300]}"
+    return ""
 
 
 def run_case(case: int, folder: Path) -> Outcome:
@@ -614,6 +651,13 @@ def run_case(case: int, folder: Path) -> Outcome:
     if kind == "csv":  # the mutated CSV under the block YAML that names it
         load_path = here / "block_csv.yaml"
         load_path.write_text(corpus()["block_csv"][0].text, encoding="utf-8")
+    if kind in ("job", "job_csv"):  # the job with its CSV files, one of them mutated
+        for other in corpus()["job_csv"]:
+            if other.name != seed.name:
+                (here / other.name).write_text(other.text, encoding="utf-8")
+    if kind == "job_csv":
+        load_path = here / "job.yaml"
+        load_path.write_text(corpus()["job"][0].text, encoding="utf-8")
     files = [str(target), str(load_path)]
     shipped_files = [str(p) for p in _shipped_dir("instruments").glob("*.yaml")]
 
@@ -649,7 +693,11 @@ def run_case(case: int, folder: Path) -> Outcome:
                 outcome.problems.append(f"{where}: {err.strip()[:300]}")
             if warned:
                 outcome.problems.append(f"{where}: warned: {warned[:2]}")
-            if rc == 0:
+            if rc == 0 and argv[0] == "job":  # one pair only (another pair may be refused):
+                problem = _scenario_problem(argv[-1])  # what it wrote must be a valid scenario
+                if problem:
+                    outcome.problems.append(f"{where}: wrote an invalid scenario: {problem}")
+            elif rc == 0:
                 if outcome.library != "ok":
                     outcome.problems.append(f"{where}: exit 0 but the loader refused the file")
                 if kind in ("block", "block_csv", "csv") and argv[0] == "simulate":

@@ -252,6 +252,17 @@ def _bad_csv(doc, folder):
         (_bad_csv, "control.csv:3", "north_m"),
         (lambda d, f: d["camera"].update(focal_lenght_mm=70.0), "job.yaml",
          "camera.focal_lenght_mm"),
+        # found by the fuzzer: a span beyond the format named an internal object, not the file
+        (lambda d, f: d["camera"]["fiducials"]["distances_mm"].update({"3-4": 187.0}),
+         "job.yaml", "camera.fiducials.distances_mm.3-4"),
+        # a measured span 10 % off the certificate's (a typing error, not film deformation)
+        (lambda d, f: d["camera"]["fiducials"]["distances_mm"].update({"1-2": 153.0}),
+         "fiducials.csv:2", "d12_mm"),
+        (lambda d, f: d.update(instrument="sc9"), "job.yaml", "instrument"),
+        # photo 103 moved 535 km east: the frame of pair 102-103 leaves zone 5 (was a bare
+        # geodesy message without the file)
+        (lambda d, f: d["photos"][2].update(east_m=5884000.0), "job.yaml",
+         "pairs: pair 102-103"),
     ],
 )
 def test_bad_job_is_one_line(tmp_path, capsys, edit, where, field):
