@@ -253,11 +253,23 @@ def _fmt(value: float, digits: int = 3) -> str:
     return f"{value:.{digits}f}"
 
 
+def _pm(value: float) -> str:
+    """A signed value to 1 mm; one that rounds to zero is +0.000 (never -0.000). [m]"""
+    return f"{round(value, 3) + 0.0:+.3f}"
+
+
 def sheet_markdown(sheet: SetupSheet) -> str:
     """Table 24 and the stage-by-stage list of readings, as Markdown."""
     d = sheet_to_dict(sheet)
     flag = {k: " **(assumed)**" if params else "" for k, params in sheet.assumed.items()}
     left, right = sheet.photos
+    m_map = sheet.map_scale_denominator
+    chain = (  # no map sheet: the horizontal scale was forced, there is no coordinatograph ratio
+        f"no map sheet → horizontal model scale M_г = 1:{sheet.horizontal_scale_denominator} "
+        "(forced; no coordinatograph ratio)" if m_map is None else
+        f"map 1:{m_map} → horizontal model scale M_г = 1:{sheet.horizontal_scale_denominator} "
+        f"(coordinatograph ratio {sheet.horizontal_scale_denominator / m_map:g})"
+    )  # fmt: skip
     lines = [
         f"# Setup sheet — {sheet.scenario} on {sheet.instrument_title}",
         "",
@@ -265,9 +277,7 @@ def sheet_markdown(sheet: SetupSheet) -> str:
         "**(assumed)** rest on instrument parameters that no source documents "
         "(`docs/instruments.md`).",
         "",
-        f"Scale chain: map 1:{sheet.map_scale_denominator} → horizontal model scale "
-        f"M_г = 1:{sheet.horizontal_scale_denominator} (coordinatograph ratio "
-        f"{sheet.horizontal_scale_denominator / sheet.map_scale_denominator:g}); vertical "
+        f"Scale chain: {chain}; vertical "
         f"M_в = M_г/k = 1:{sheet.vertical_scale_denominator}; k = f_пр/f′ = "
         f"{sheet.transformation_coefficient:.5f}; n_л = D_max/f_пр = {sheet.n_left:.5f}; "
         f"projection distances of the working area {sheet.depth_range_used_mm[0]:.1f} … "
@@ -321,7 +331,7 @@ def sheet_markdown(sheet: SetupSheet) -> str:
             f"a = {s['a']:.6e}, b = {s['b']:.9f}, c_X = {s['cx_m']:.3f} m, "
             f"c_Y = {s['cy_m']:.3f} m (det {s['determinant']:.6f} < 0: reflection); "
             f"RMS residual {s['rms_m']:.3f} m; residuals "
-            + ", ".join(f"{k}: ({v[0]:+.3f}, {v[1]:+.3f})" for k, v in s["residuals_m"].items())
+            + ", ".join(f"{k}: ({_pm(v[0])}, {_pm(v[1])})" for k, v in s["residuals_m"].items())
             + " m.",
         ]
     lines += [

@@ -18,6 +18,14 @@ from stereoplotter.setup.records import SetupSheet
 __all__ = ["stage_readings"]
 
 
+def _signed(value: float, digits: int = 3) -> str:
+    """``+ 1.234`` or ``− 1.234`` [as given]; a value that rounds to zero is ``+ 0.000`` (never
+    ``+ -0.000`` or ``− 0.000``)."""
+    text = f"{abs(value):.{digits}f}"
+    negative = value < 0 and float(text) != 0.0
+    return f"{'−' if negative else '+'} {text}"
+
+
 def _r(
     stage: int,
     step: str,
@@ -33,7 +41,7 @@ def _r(
     value = 0.0 if abs(value) < 5e-7 else value  # no "−0.000"
     relation = extra.pop("relation", "=")
     if zero:
-        formula = f"{name} = {zero} {'+' if value >= 0 else '−'} {abs(value):.3f} {unit}"
+        formula = f"{name} = {zero} {_signed(value)} {unit}"
     else:
         formula = (
             f"{name} {relation} {value:.4g} {unit}"
@@ -152,8 +160,8 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
             {}
             if photo.name == "left"
             else {
-                "zero_reading_definition": f"MO_X,п = MO_X + b_x = MO_X + {bx:.3f}; "
-                f"MO_Y,п = MO_Y + b_y = MO_Y + {by:.3f}"
+                "zero_reading_definition": f"MO_X,п = MO_X + b_x = MO_X {_signed(bx)}; "
+                f"MO_Y,п = MO_Y + b_y = MO_Y {_signed(by)}"
             }
         )
         rows += [

@@ -361,3 +361,36 @@ def test_fit_terrain_recovers_plane_and_hill():
     assert fit.section["base_height_m"] == pytest.approx(150.0, abs=1e-3)
     two = fit_terrain(np.array([[0.0, 0.0, 100.0], [10.0, 0.0, 104.0]]))
     assert (two.kind, two.section) == ("flat", {"base_height_m": 102.0})
+
+
+# --- two formatting defects seen on job and scenario sheets ---------------------------------------
+
+
+def test_sheet_without_a_map_sheet_writes_its_markdown(tmp_path, capsys):
+    """`setup --horizontal-scale` on a scenario without a map sheet: sheet_markdown divided by
+    the missing map scale (TypeError, exit 3); now the scale chain says there is no map."""
+    doc = yaml.safe_load((ROOT / "stereoplotter" / "data" / "scenarios" / "pair60.yaml")
+                         .read_text("utf-8"))  # fmt: skip
+    del doc["map_sheet"]
+    path = tmp_path / "nosheet.yaml"
+    path.write_text(yaml.safe_dump(doc, allow_unicode=True), "utf-8")
+    argv = ["setup", str(path), "--instrument", "sc1", "--horizontal-scale", "12500", "-o",
+            str(tmp_path / "out")]  # fmt: skip
+    assert main(argv) == 0, capsys.readouterr().err
+    text = (tmp_path / "out" / "sheet.md").read_text("utf-8")
+    assert "Scale chain: no map sheet → horizontal model scale M_г = 1:12500 (forced" in text
+    assert "M_в = M_г/k = 1:8000" in text
+
+
+def test_no_negative_zero_in_readings_or_residuals(tmp_path):
+    """Pair 101-102 of strip8 has b_y = −0.0003 mm: its zero reading read "MO_Y + -0.000"."""
+    from stereoplotter.report.sheet import _pm, sheet_markdown
+    from stereoplotter.setup.readings import _signed
+
+    assert (_signed(-0.0004), _signed(-0.0006), _signed(2.5)) == ("+ 0.000", "− 0.001", "+ 2.500")
+    assert (_pm(-0.0004), _pm(-0.0006), _pm(0.0123)) == ("+0.000", "-0.001", "+0.012")
+    sheet = compute_job(load_job(JOB)).pairs[0].sheet
+    assert -5e-4 < sheet.base_mm[1] < 0
+    defs = [r["zero_reading_definition"] for r in sheet.readings if "zero_reading_definition" in r]
+    assert defs and all(d.endswith("MO_Y,п = MO_Y + b_y = MO_Y + 0.000") for d in defs)
+    assert not re.search(r"[-−] ?0\.0+\b(?![1-9])", sheet_markdown(sheet))
