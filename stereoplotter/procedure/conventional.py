@@ -821,6 +821,139 @@ def _fuse_read(run, pid: str, p, key: str, active, read: tuple[str, ...]):
     return {c: op.read(c, f"{key}/{c}") for c in read}
 
 
+def _height_mean(run, pid: str, p, key: str, active, pointings: int) -> NDArray[np.float64]:
+    """The height scale read after ``pointings`` fusings on ``p``, averaged (the first fusing
+    has the single reading's noise key, so ``pointings=1`` is the book's single reading). [m]"""
+    total = None
+    for j in range(pointings):
+        k = key + (f"/p{j}" if j else "")
+        read = _fuse_read(run, pid, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
+        total = read if total is None else total + read
+    return total / pointings
+
+
+def _pointings(run) -> int:
+    """Fusings per height reading in C3: the setup method's ``REPEAT_POINTINGS`` with the
+    operator's practice (remedy CR1), one with the book's."""
+    from stereoplotter.procedure.setup_method import REPEAT_POINTINGS
+
+    return REPEAT_POINTINGS if getattr(run, "remedial", False) else 1
+
+
+#: Remedy names of the conventional method (operator practice), as recorded in ``run.remedies``.
+CR1 = "CR1 C3: read the control heights as the mean of several fusings"
+CR2 = "CR2 C3: refine the relative orientation only where q fails, then check the heights again"
+
+
+def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int, remedy: str = ""):
+    """Fuse on the first levelling point, slip the height scale there (on the mean of
+    ``pointings`` readings where ``pointings`` > 1), then read every other control height (the
+    mean of ``pointings``) and log it against H/3000. Trials not ``active`` keep their scale.
+
+    Returns the errors read − truth of the other control points. [m]
+    """
+    op = run.op
+    tol = run.sheet.tolerances["control_height_m"]
+    pid0, p0 = rows[0]
+    if pointings == 1:
+        _fuse_read(run, pid0, p0, f"{key}/slip/{pid0}", active, ())
+        op.inst.slip_height_scale(p0[2])
+    else:
+        seen0 = _height_mean(run, pid0, p0, f"{key}/slip/{pid0}", active, pointings)
+        exact = op.v(op.inst.read(HEIGHT_SCALE, exact=True))
+        act = op.all() if active is None else active
+        op.inst.slip_height_scale(np.where(act, exact + (p0[2] - seen0), exact))
+    times = f" ({pointings} times, mean)" if pointings > 1 else ""
+    op.log.add(
+        "C3",
+        f"fuse on {pid0}{times}, slip the height scale to H = {p0[2]:.2f} m",
+        HEIGHT_SCALE,
+        reading=p0[2],
+        unit="m",
+        equation="stage 3",
+        remedy=remedy,
+        when=active,
+    )
+    errs = []
+    for pid, p in heights:
+        if pid == pid0:
+            continue
+        read = _height_mean(run, pid, p, f"{key}/h/{pid}", active, pointings)
+        errs.append(read - p[2])
+        op.log.add(
+            "C3",
+            f"control point {pid}: fuse, read the height{times}",
+            HEIGHT_SCALE,
+            reading=read,
+            unit="m",
+            residual=read - p[2],
+            tolerance=tol,
+            passed=np.abs(read - p[2]) <= tol,
+            equation="H/3000",
+            remedy=remedy,
+            when=active,
+        )
+    return errs
+
+
+def _level(
+    run, cal: Calibration, rows, key: str, active, pointings: int, it: int, remedy: str = ""
+):
+    """Read the levelling points' heights (each the mean of ``pointings`` fusings), log them
+    against the first, fit offset + common tilts φ_α, φ_ω (``cal.level_weights``) and turn the
+    common tilts by −φ for the ``active`` trials. Returns the heights against the first. [m]"""
+    op = run.op
+    tol = run.sheet.tolerances["control_height_m"]
+    when = active if remedy else None  # the book's loop logs every iteration as before
+    errs = [
+        _height_mean(run, pid, p, f"{key}/level/{pid}", active, pointings) - p[2]
+        for pid, p in rows
+    ]
+    resid = [e - errs[0] for e in errs]
+    for (pid, _), r, e in zip(rows, resid, errs, strict=True):
+        op.log.add(
+            "C3",
+            f"level: control point {pid}, height error against point {rows[0][0]}",
+            HEIGHT_SCALE,
+            reading=e,
+            unit="m",
+            residual=r,
+            tolerance=tol,
+            passed=np.abs(r) <= tol,
+            iteration=it,
+            equation="H/3000",
+            remedy=remedy,
+            when=when,
+        )
+    w = cal.level_weights
+    phi_a = -_psum(w[1, i] * e for i, e in enumerate(errs))
+    phi_o = -_psum(w[2, i] * e for i, e in enumerate(errs))
+    for name, phi, combo in (("α", phi_a, cal.common_alpha), ("ω", phi_o, cal.common_omega)):
+        for control, rate in combo.items():
+            if control in ("by", "bz"):
+                before = op.read(control, f"{key}/{name}/{control}")
+                op.set(control, before + rate * phi, f"{key}/{name}/set{control}", active)
+                after = before + rate * phi
+            else:
+                before = op.physical(control)
+                _turn(op, control, before + rate * phi, active)
+                after = op.physical(control)
+            op.log.add(
+                "C3",
+                f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: "
+                f"turn {control}",
+                control,
+                before=before,
+                after=after,
+                unit="mm" if control in ("by", "bz") else "—",
+                iteration=it,
+                equation="levelling (assumption)",
+                remedy=remedy,
+                when=when,
+            )
+    return resid
+
+
 # long: the book's items of absolute orientation (scale, levelling, repeated relative orientation,
 # final levelling) in their order, one bounded loop; split, the loop state would pass through each.
 def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=None) -> None:
@@ -877,53 +1010,12 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
             iteration=it,
             equation="scale by b_x",
         )
-        errs = []
-        for pid, p in rows:
-            h = _fuse_read(run, pid, p, f"C3/{it}/level/{pid}", active, (HEIGHT_SCALE,))
-            errs.append(h[HEIGHT_SCALE] - p[2])
-        resid = [e - errs[0] for e in errs]
-        for (pid, _), r, e in zip(rows, resid, errs, strict=True):
-            op.log.add(
-                "C3",
-                f"level: control point {pid}, height error against point {rows[0][0]}",
-                HEIGHT_SCALE,
-                reading=e,
-                unit="m",
-                residual=r,
-                tolerance=tol,
-                passed=np.abs(r) <= tol,
-                iteration=it,
-                equation="H/3000",
-            )
+        resid = _level(run, cal, rows, f"C3/{it}", active, 1, it)
         worst = np.where(active, _worst(resid), worst)
         # every trial still iterating levels on these heights (the least-squares plane of the
         # four points, as (5.54)/(5.55) assume); those inside H/3000 (or at the bound) stop after
         # it without a further relative orientation, so the model is always levelled last
         going = active & ~(worst <= tol) & (it < _bound(op))
-        w = cal.level_weights
-        phi_a = -_psum(w[1, i] * e for i, e in enumerate(errs))
-        phi_o = -_psum(w[2, i] * e for i, e in enumerate(errs))
-        for name, phi, combo in (("α", phi_a, cal.common_alpha), ("ω", phi_o, cal.common_omega)):
-            for control, rate in combo.items():
-                if control in ("by", "bz"):
-                    before = op.read(control, f"C3/{it}/{name}/{control}")
-                    op.set(control, before + rate * phi, f"C3/{it}/{name}/set{control}", active)
-                    after = before + rate * phi
-                else:
-                    before = op.physical(control)
-                    _turn(op, control, before + rate * phi, active)
-                    after = op.physical(control)
-                op.log.add(
-                    "C3",
-                    f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: "
-                    f"turn {control}",
-                    control,
-                    before=before,
-                    after=after,
-                    unit="mm" if control in ("by", "bz") else "—",
-                    iteration=it,
-                    equation="levelling (assumption)",
-                )
         active = going
         if not np.any(active):
             break
@@ -933,39 +1025,50 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     run.record_stage("C3", its)
     run.record_stage("C3/relative", ro_its)
     run.check("C3: levelling points (against the first)", worst, tol, unit="m", iterations=its)
-    # slip the height scale at the first levelling point, check all control heights
     heights = _height_points(run, [h["id"] for h in sheet.control_heights])
-    pid0, p0 = rows[0]
-    _fuse_read(run, pid0, p0, f"C3/slip/{pid0}", None, ())
-    op.inst.slip_height_scale(p0[2])
-    op.log.add(
-        "C3",
-        f"fuse on {pid0}, slip the height scale to H = {p0[2]:.2f} m",
-        HEIGHT_SCALE,
-        reading=p0[2],
-        unit="m",
-        equation="stage 3",
-    )
-    errs = []
-    for pid, p in heights:
-        if pid == pid0:
-            continue
-        read = _fuse_read(run, pid, p, f"C3/h/{pid}", None, (HEIGHT_SCALE,))[HEIGHT_SCALE]
-        errs.append(read - p[2])
-        op.log.add(
-            "C3",
-            f"control point {pid}: fuse, read the height",
-            HEIGHT_SCALE,
-            reading=read,
-            unit="m",
-            residual=read - p[2],
-            tolerance=tol,
-            passed=np.abs(read - p[2]) <= tol,
-            equation="H/3000",
-        )
-    run.check("C3: control heights", _worst(errs) if errs else op.v(0.0), tol, unit="m")
+    if not run.remedial:  # the book: single readings, nothing after a failed check
+        errs = _slip_and_read_heights(run, rows, heights, "C3", None, 1)
+        run.check("C3: control heights", _worst(errs) if errs else op.v(0.0), tol, unit="m")
+        seen = _six_q(run, "C3/std", None, 1, stage="C3")
+        run.check("C3: residual y-parallax (6 points)", _worst(seen), tol_q)
+        return
+    _c3_operator_checks(run, cal, rows, heights, relative_fn, _pointings(run))
+
+
+def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) -> None:
+    """The end of C3 with the operator's practice. The control heights are first read once, as
+    the book does; where one misses H/3000 the operator slips and reads them all again, each the
+    mean of ``pointings`` fusings (CR1: one reading has σ_p·H/b = 0.19 m at pair60, 0.39 m at
+    pair80). Then q at the six standard points; where it exceeds ¼ mark, one bounded refinement
+    of the relative orientation (the C2 loop, its own bound), a levelling on the levelling points
+    (averaged readings) and a final check of the control heights (averaged) (CR2)."""
+    op = run.op
+    tol = run.sheet.tolerances["control_height_m"]
+    tol_q = run.sheet.tolerances["residual_y_parallax_mm"]
+    name_h, name_q = "C3: control heights", "C3: residual y-parallax (6 points)"
+    errs = _slip_and_read_heights(run, rows, heights, "C3", None, 1)
+    h_worst = _worst(errs) if errs else op.v(0.0)
+    h_failed = h_worst > tol
+    if errs and np.any(h_failed):
+        again = _slip_and_read_heights(run, rows, heights, "C3/CR1", h_failed, pointings, CR1)
+        h_worst = np.where(h_failed, _worst(again), h_worst)
     seen = _six_q(run, "C3/std", None, 1, stage="C3")
-    run.check("C3: residual y-parallax (6 points)", _worst(seen), tol_q)
+    q_worst = _worst(seen)
+    q_failed = q_worst > tol_q
+    rounds = np.zeros(np.shape(q_failed), int)
+    if relative_fn is not None and np.any(q_failed):
+        r_its, _ = _masked(run, q_failed, relative_fn, cal, "C3/CR2/ro")
+        rounds = np.where(q_failed, r_its, 0)
+        seen = _six_q(run, "C3/CR2/std", q_failed, 1, stage="C3")
+        q_worst = np.where(q_failed, _worst(seen), q_worst)
+        _level(run, cal, rows, "C3/CR2", q_failed, pointings, 1, CR2)
+        errs = _slip_and_read_heights(run, rows, heights, "C3/CR2", q_failed, pointings, CR2)
+        if errs:
+            h_worst = np.where(q_failed, _worst(errs), h_worst)
+    run.check(name_h, h_worst, tol, unit="m")
+    run.check(name_q, q_worst, tol_q)
+    run.record_remedy(CR1, name_h, h_failed, np.where(h_failed, pointings, 0))
+    run.record_remedy(CR2, name_q, q_failed, rounds)
 
 
 def _masked(run, active, relative_fn, cal, key0):

@@ -211,8 +211,8 @@ def _run_one(
     )
     op = Operator(inst, prep.operator, noise, Transcript(enabled=transcript))
     run = Run(op, prep.sheet, prep.scene)
+    run.practice = prep.practice
     if prep.method == "setup":
-        run.practice = prep.practice
         run_setup_method(run)
     else:
         run_conventional_method(run, prep.relative)
@@ -326,8 +326,8 @@ def simulate(
     practice : {"operator", "book"}
         "operator" (default): after a failed check the operator applies the book's remedies
         (repeat the stage-1 setting, refine the relative orientation, refine the scaling on the
-        control heights), bounded and logged; "book": §27's task 1, no remedy. The setup-data
-        method only so far (the conventional method ignores it).
+        control heights), bounded and logged; "book": §27's task 1, no remedy. Both methods
+        (the conventional method's remedies CR1, CR2: ``docs/procedure.md``).
 
     Returns
     -------

@@ -17,6 +17,7 @@ import pytest
 
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.procedure.conventional import CR1, CR2
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.selftest import sanity_checks
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
@@ -38,6 +39,11 @@ def test_conventional_floor_passes_every_check(name, instrument, relative):
     r = run_trials_chunk(prep, 0, None, transcript=False)
     failed = [n for n, c in r.checks.items() if c.passed is not None and not bool(c.passed)]
     assert failed == []
+    # the default practice is the operator's: at the floor no check fails, so no remedy is
+    # applied (CR1, CR2 recorded, none applied, no rounds)
+    assert prep.practice == "operator"
+    assert set(r.remedies) == {CR1, CR2}
+    assert not any(bool(rem.applied) or int(rem.rounds) for rem in r.remedies.values())
     mechanism_um = sanity_checks(tilt_deg=3.0)["exact_rectification_max_q_um"]
     tol_q = prep.sheet.tolerances["residual_y_parallax_mm"]
     assert np.max(np.abs(r.q_grid_mm)) <= tol_q + mechanism_um * 1e-3
