@@ -29,8 +29,8 @@ stopping rule (go on while the RMS of the six looks falls by ½ a pass), the com
 frees a knob at its stop, the loops' bound 2 × max_iterations and C3's final levelling without a
 relative orientation after it: every conventional run legitimately changes.
 
-The conventional values of the default run were re-recorded (same environment) at the commit
-after 1a03db3 that gives the conventional method the operator's-practice remedies (issue 9:
+The conventional values of the default run were re-recorded (same environment) at commit
+3d03e90 that gives the conventional method the operator's-practice remedies (issue 9:
 CR1 re-reads failed control heights as the mean of 4 fusings, CR2 refines the relative
 orientation where q fails after C3 and levels again): the default practice is "operator", so
 the default run legitimately changes from C3's final checks on (trial 29's control heights
