@@ -832,9 +832,9 @@ def _parser() -> argparse.ArgumentParser:
         choices=("operator", "book"),
         default="operator",
         help="'operator' (default): after a failed check the operator applies the book's "
-        "remedies (repeat the setting, refine the relative orientation), bounded and logged; "
-        "'book': §27's task 1, each element set once, failed checks only recorded "
-        "(setup-data method)",
+        "remedies (repeat the setting, refine the relative orientation, refine scaling and "
+        "levelling on control), bounded and logged; 'book': §27's task 1, each element set "
+        "once, failed checks only recorded (both methods)",
     )
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument(
