@@ -259,9 +259,9 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
     f, p, c = g["f"], g["p"], g["c"]
     options = options or {}
 
-    # the conventional M_p of (6.60)/(6.61) is the book's procedure: no remedies (§27 task 1)
-    if method == "conventional":
-        kw = {"practice": "book", **kw}
+    # The formulas of §27 describe the book's procedure, task 1: each element set once, no
+    # remedies — for both methods (the operator's remedies would lower the setup-data value).
+    kw = {"practice": "book", **kw}
 
     def prepared(operator):
         prep = prepare_run(
