@@ -18,6 +18,7 @@ from typing import Any, BinaryIO
 import yaml
 
 from stereoplotter.errors import ConfigError, describe_value, did_you_mean
+from stereoplotter.io.validation import range_text
 
 __all__ = [
     "Fields",
@@ -339,7 +340,7 @@ class Fields:
         basis: str = "",
     ) -> float:
         """Validate one number already taken from the document."""
-        expected = _range_text(unit, low, high, low_open, high_open)
+        expected = range_text(unit, low, high, low_open, high_open)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.error(path, f"a number {expected}", describe_value(value))
         try:
@@ -438,17 +439,6 @@ class Fields:
                 f"{len(value)} entries",
             )
         return value
-
-
-def _range_text(unit: str, low: float, high: float, low_open: bool, high_open: bool) -> str:
-    unit_text = f" {unit}" if unit and unit != "—" else ""
-    if math.isinf(low) and math.isinf(high):
-        return f"[{unit}]" if unit_text else ""
-    left = "(" if low_open or math.isinf(low) else "["
-    right = ")" if high_open or math.isinf(high) else "]"
-    lo = "-inf" if math.isinf(low) else f"{low:g}"
-    hi = "inf" if math.isinf(high) else f"{high:g}"
-    return f"in {left}{lo}, {hi}{right}{unit_text}"
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
