@@ -3,6 +3,9 @@
 Thin: each subcommand parses, calls one library function and formats the result. Every expected
 failure (bad input file, degenerate geometry) is printed as one ``error:`` line and exit code 1;
 a usage error exits with 2. No traceback reaches the user.
+
+Each subcommand's handler imports the layers it needs inside the handler: `stereoplotter --help`
+and a bad argument answer without loading matplotlib or fpdf2.
 """
 
 from __future__ import annotations

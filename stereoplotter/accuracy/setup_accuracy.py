@@ -60,6 +60,7 @@ __all__ = [
     "sigma_alpha_setup",
     "sigma_base_x_setup",
     "sigma_base_z_setup",
+    "sigma_base_z_setup_photo",
     "sigma_kappa_setup",
     "sigma_omega_setup",
     "sigma_shift_y_setup",
@@ -294,14 +295,17 @@ def sigma_kappa_setup(mark_distance_mm, n, sigma_counter_mm):
 
 
 def sigma_base_z_setup(f_instrument_mm, mark_distance_mm, sigma_counter_mm):
-    r"""m_bz of the vertical base component, Eq. (6.37) [mm].
+    r"""m_bz of the vertical base component as the book prints it, Eq. (6.37) [mm, instrument].
 
     Notes
     -----
-    Implements (6.37) of [1]_, :math:`m_{b_z} = f_{пр} m_y / l_y`. The book gives no observation
-    equations; the formula is reproduced by one y reading at a mark at distance l_y
-    (b_z = f_пр δy/l_y). (6.39)-(6.42) then use f_пр = f (see
-    :func:`setup_parallax_rms_from_pointing`).
+    Implements (6.37) of [1]_, :math:`m_{b_z} = f_{пр} m_y / l_y`, in instrument units: mm of
+    the instrument's vertical at model scale, m_y the counter error (model scale). The book gives
+    no observation equations; the formula follows from one y reading at a mark at distance l_y:
+    raising the projection centre by δb_z moves the projected mark by δY = l_y δb_z/f_пр. It is
+    *not* in the photo-scale units of (6.26); for those see :func:`sigma_base_z_setup_photo`.
+    The book's (6.39)/(6.40) substitute it with f_пр = f (their 15p²n²/l² term), which is what
+    ``mode="book"`` of :func:`setup_element_sigmas` keeps.
 
     Examples
     --------
@@ -309,6 +313,31 @@ def sigma_base_z_setup(f_instrument_mm, mark_distance_mm, sigma_counter_mm):
     0.02
     """
     return f_instrument_mm / mark_distance_mm * sigma_counter_mm
+
+
+def sigma_base_z_setup_photo(focal_length_mm, mark_distance_mm, n, sigma_counter_mm):
+    r"""m_bz of (6.37) converted to photo scale, the units of (6.22)/(6.26) [mm, photo].
+
+    Notes
+    -----
+    Unit-consistent form of (6.37) of [1]_ (``docs/errata.md``). The instrument value
+    f_пр m_y/l_y (:func:`sigma_base_z_setup`) is a length of the instrument's vertical at model
+    scale. Model → instrument photo scale divides by n = D/f_пр (as every other counter row,
+    (6.31)-(6.38), divides the reading by n); the instrument's vertical f_пр → the photo's
+    vertical f multiplies by f/f_пр. Hence
+
+    .. math:: m_{b_z} = \frac{f}{f_{пр}\,n}\cdot\frac{f_{пр}}{l_y}m_y = \frac{f}{n\,l_y}m_y,
+
+    [mm] = [mm]·[mm]/[mm] with n dimensionless. Equivalently: one reading δy/n (photo scale) of
+    a mark at l_y moved by (l_y/f)δb_z. f_пр cancels; the book form differs from this one only
+    by the factor n f_пр/f.
+
+    Examples
+    --------
+    >>> round(float(sigma_base_z_setup_photo(70.0, 85.0, 1.42, 1.0)), 4)
+    0.58
+    """
+    return focal_length_mm / (n * mark_distance_mm) * sigma_counter_mm
 
 
 def sigma_base_x_setup(n, sigma_counter_mm):
@@ -325,9 +354,12 @@ def sigma_base_x_setup(n, sigma_counter_mm):
 def setup_element_sigmas(
     focal_length_mm, mark_distance_mm, n, sigma_counter_mm, f_instrument_mm=None, mode="book"
 ):
-    """The standard errors (6.32)-(6.38) of all setup elements, as a dict.
+    """The standard errors (6.32)-(6.38) of all setup elements, as a dict (photo scale).
 
-    ``f_instrument_mm`` defaults to f (the book's implicit f_пр = f in (6.39)-(6.42)).
+    ``mode="printed"``/``"book"``: m_bz is the book's (6.37) f_пр m_y/l taken as a photo-scale
+    length, ``f_instrument_mm`` defaulting to f (the book's implicit f_пр = f in
+    (6.39)-(6.42)). ``mode="rigorous"``: m_bz = f m_y/(n l) (:func:`sigma_base_z_setup_photo`,
+    ``f_instrument_mm`` is not needed) and the least-squares m_ω.
 
     Examples
     --------
@@ -340,7 +372,11 @@ def setup_element_sigmas(
         "alpha": sigma_alpha_setup(f, ll, n, m),
         "omega": sigma_omega_setup(f, ll, n, m, mode),
         "kappa": sigma_kappa_setup(ll, n, m),
-        "base_z": sigma_base_z_setup(fi, ll, m),
+        "base_z": (
+            sigma_base_z_setup_photo(f, ll, n, m)
+            if mode == "rigorous"
+            else sigma_base_z_setup(fi, ll, m)
+        ),
         "base_x": sigma_base_x_setup(n, m),
     }
 
@@ -362,12 +398,17 @@ def setup_parallax_rms_from_pointing(
     Generalises (6.39) (a = 0, c = p) and (6.40) (a = p, c = 2p) of [1]_ with l_x = l_y = l,
     m_x = m_y. With ``mode="printed"`` the printed m_ω of (6.35) is used (which the book's own
     (6.39)/(6.40) do *not* use). f_пр defaults to f, which is what reproduces the printed
-    15p²n²/l² term.
+    15p²n²/l² term. With ``mode="rigorous"`` m_bz is the photo-scale f m_y/(n l) of
+    :func:`sigma_base_z_setup_photo` and the term becomes 15p²/l² (60 %) — the (6.39)/(6.40) of
+    ``docs/errata.md``.
 
     Examples
     --------
     >>> round(float(setup_parallax_rms_from_pointing(70.0, 70.0, 70.0, 85.0, 1.42, 1.0)), 4)
     1.2604
+    >>> round(float(setup_parallax_rms_from_pointing(
+    ...     70.0, 70.0, 70.0, 85.0, 1.42, 1.0, mode="rigorous")), 4)
+    1.2143
     """
     s = setup_element_sigmas(
         focal_length_mm, mark_distance_mm, n, sigma_counter_mm, f_instrument_mm, mode

@@ -38,6 +38,8 @@ from stereoplotter.instrument.kinematics import (
     turn_correction_knob,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.procedure.operator import solve_1d
+from stereoplotter.procedure.setup_method import interior_orientation
 
 __all__ = [
     "ELEMENTS",
@@ -541,7 +543,6 @@ def c1_interior(run) -> None:
     """
     # Over 80 lines with its docstring (71 of code): the book's C1 items in their order, each
     # act followed by its transcript entry; splitting would scatter one sequence of settings.
-    from stereoplotter.procedure.setup_method import interior_orientation
 
     op, sheet = run.op, run.sheet
     log = op.log
@@ -674,7 +675,6 @@ def c2_relative_by_elements(
 
     Returns the iterations and the worst |q| seen at the last check, arrays over the trials.
     """
-    from stereoplotter.procedure.operator import solve_1d
 
     op, sheet = run.op, run.sheet
     tol = sheet.tolerances["residual_y_parallax_mm"]

@@ -31,7 +31,7 @@ from stereoplotter.instrument.kinematics import (
     unit_for_orientation,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
-from stereoplotter.procedure.operator import Operator, Scene
+from stereoplotter.procedure.operator import Operator, Scene, solve_1d
 from stereoplotter.procedure.records import (
     Check,
     ControlHeight,
@@ -682,7 +682,6 @@ def clear_kappa(run: Run, stage: str) -> None:
 
 
 def _solve_kappa(q_of, kappa0, target):
-    from stereoplotter.procedure.operator import solve_1d
 
     return solve_1d(q_of, kappa0, target, iterations=4, h=1e-6)
 

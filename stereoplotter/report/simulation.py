@@ -23,8 +23,11 @@ import numpy as np
 
 from stereoplotter.errors import ConfigError, did_you_mean
 from stereoplotter.io.errors_file import load_error_model
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.trial_store import TrialStore
-from stereoplotter.io.yaml_files import atomic_write_bytes
+from stereoplotter.io.yaml_files import atomic_write_bytes, load_yaml_mapping
+from stereoplotter.plotting.figures import plot_residual_y_parallax
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import (
@@ -226,7 +229,6 @@ def simulation_markdown(s: dict[str, Any]) -> str:
 
 def _parallax_png(result: SimulationResult) -> bytes:
     """The true residual y-parallax over the working-area grid (trial 0) as a PNG."""
-    from stereoplotter.plotting.figures import plot_residual_y_parallax
 
     fig = plot_residual_y_parallax(result)
     buf = io.BytesIO()
@@ -285,7 +287,6 @@ def load_operator_model(value: str | Path | OperatorModel | None) -> OperatorMod
         return value
     if str(value) == "zero":
         return OperatorModel().zero()
-    from stereoplotter.io.yaml_files import load_yaml_mapping  # the file reader of the io layer
 
     data, source = load_yaml_mapping(value)
     fields: dict[str, Any] = {}
@@ -341,9 +342,6 @@ def run_simulation_command(
     assumed defaults), "zero" or a YAML of OperatorModel fields (:func:`load_operator_model`).
     ``practice`` is "operator" (remedies after a failed check) or "book" (§27 task 1, none).
     """
-    from stereoplotter.io.instrument_file import load_instrument
-    from stereoplotter.io.scenario_file import load_scenario
-
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
     seed = scenario.seed if seed is None else seed

@@ -44,7 +44,37 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from stereoplotter.verification.linear_mc import CI_Z
+from stereoplotter.accuracy.chapter5 import (
+    control_points,
+    levelling_design,
+    relative_orientation_design,
+    relative_orientation_parallax_rms,
+    standard_points,
+)
+from stereoplotter.instrument.kinematics import counters_from_homologous_points
+from stereoplotter.instrument.virtual import HEIGHT_SCALE, Instrument
+from stereoplotter.procedure import conventional as cv
+from stereoplotter.procedure import evaluation as ev
+from stereoplotter.procedure.evaluation import instrument_frame_m
+from stereoplotter.procedure.operator import Noise, Operator, OperatorModel
+from stereoplotter.procedure.setup_method import Run
+from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
+from stereoplotter.procedure.transcript import Transcript
+from stereoplotter.procedure.trials import (
+    DEFAULT_MEMORY_BUDGET_MB,
+    chunk_trials_for,
+    iter_trial_chunks,
+)
+from stereoplotter.scenario.model import Terrain
+from stereoplotter.scenario.synthetic import working_area_grid_m
+from stereoplotter.setup.sheet import compute_setup_sheet
+from stereoplotter.verification.linear_mc import (
+    CI_Z,
+    LinearModel,
+    _relative_field_basis,
+    covariance_rms,
+    grid_chapter5,
+)
 
 if TYPE_CHECKING:
     from stereoplotter.instrument.spec import InstrumentSpec
@@ -96,9 +126,6 @@ def scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict:
 
 
 def _scenario_geometry(scenario, spec):
-    from stereoplotter.procedure.evaluation import instrument_frame_m
-    from stereoplotter.scenario.synthetic import working_area_grid_m
-    from stereoplotter.setup.sheet import compute_setup_sheet
 
     sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
     f = float(scenario.camera.focal_length_mm)
@@ -130,7 +157,6 @@ def _scenario_geometry(scenario, spec):
 
 def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
     """Ground points (instrument frame) under a midpoint grid of left-photo (x_л, y) [mm]."""
-    from stereoplotter.procedure.evaluation import instrument_frame_m
 
     nx, ny = grid
     x0, x1 = x_left_range
@@ -149,7 +175,6 @@ def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)
 
 
 def _dp(scenario, sheet, inst, frame_pts):
-    from stereoplotter.procedure import evaluation as ev
 
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
@@ -178,7 +203,6 @@ def _configuration(method, sigma_mm, c, p, n, sources="both"):
     ``sources`` (conventional only): "both" (σ_q = σ_p = σ, the formula's m_q = m_p), or only
     the y-parallax σ_q ("y_parallax", the relative-orientation part (5.54)) or only the stereo σ_p
     ("stereo", the levelling part (5.55))."""
-    from stereoplotter.procedure.operator import OperatorModel
 
     zero = OperatorModel().zero()
     if method == "setup":
@@ -200,9 +224,6 @@ def _height_errors_parallax(sc, sheet, inst, frame_pts):
     slip), not by the model's position; a model scale error of b_x moves every δp at the ideal
     model position by p·ε but a slipped height by only ε·ΔH.
     """
-    from stereoplotter.instrument.kinematics import counters_from_homologous_points
-    from stereoplotter.instrument.virtual import HEIGHT_SCALE
-    from stereoplotter.procedure import evaluation as ev
 
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
@@ -226,8 +247,6 @@ def _height_errors_parallax(sc, sheet, inst, frame_pts):
 
 def _levelling_frame_points(prep):
     """The procedure's four levelling points (``conventional.levelling_points``) in the frame."""
-    from stereoplotter.procedure import conventional as cv
-    from stereoplotter.procedure.evaluation import instrument_frame_m
 
     class _R:  # levelling_points reads only run.scene and run.sheet
         scene, sheet = prep.scene, prep.sheet
@@ -248,13 +267,6 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
     only, :func:`procedure_mc`): standard points at a = c − p, and the quantity "heights" with
     both datums; then the return is a dict of per-trial mean squares by quantity.
     """
-    from stereoplotter.procedure.operator import Noise
-    from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
-    from stereoplotter.procedure.trials import (
-        DEFAULT_MEMORY_BUDGET_MB,
-        chunk_trials_for,
-        iter_trial_chunks,
-    )
 
     f, p, c = g["f"], g["p"], g["c"]
     options = options or {}
@@ -297,7 +309,6 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
     n, nl = len(pts), len(lev)
     # the book's levelling (mechanism off): the least-squares plane (1, X, Y) through the height
     # errors at x_п ∈ {−c, a}, y = ±c, each observed with σ_p, removed from the built model
-    from stereoplotter.accuracy.chapter5 import levelling_design
 
     refit = levelling_design(pts[:, 0], pts[:, 1]) @ np.linalg.pinv(
         levelling_design(book[:, 0], book[:, 1])
@@ -343,17 +354,6 @@ def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
     >>> round(levelling_formula(g, *control_points(0.0, 70.0))["both"], 3)
     0.686
     """
-    from stereoplotter.accuracy.chapter5 import (
-        levelling_design,
-        relative_orientation_design,
-        standard_points,
-    )
-    from stereoplotter.verification.linear_mc import (
-        LinearModel,
-        _relative_field_basis,
-        covariance_rms,
-        grid_chapter5,
-    )
 
     a, c, p, f = g["a"], g["c"], g["p"], g["f"]
     _, xs, ys = standard_points(a, p, c)
@@ -378,8 +378,6 @@ def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
 def levelling_points_photo(scenario: Scenario, spec: InstrumentSpec, g: dict):
     """(x_п, y) [mm] of the procedure's four levelling points (the scenario's control points
     nearest standard points 3–6, ``conventional.levelling_points``) at the mean photo scale."""
-    from stereoplotter.procedure.operator import OperatorModel
-    from stereoplotter.procedure.simulate import prepare_run
 
     spec = replace(spec, standard_points_c_mm=g["c"])
     prep = prepare_run(scenario, spec, "conventional", "zero", 0, operator=OperatorModel().zero())
@@ -468,7 +466,6 @@ def procedure_mc(
     zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"], sources)
     options, formula = {}, None
     if method == "conventional":
-        from stereoplotter.accuracy.chapter5 import control_points
 
         options = {"standard_points": standard_points, "heights": True}
         formula = {
@@ -524,7 +521,6 @@ def procedure_mc(
 def idealised_geometry(scenario: Scenario) -> Scenario:
     """``scenario`` with vertical photos at the left photo's height, flat terrain at the base
     height and no film deformation: the geometry (5.54) assumes (points exactly at Fig. 39)."""
-    from stereoplotter.scenario.model import Terrain
 
     z = float(scenario.photo("left").exterior.centre[2])
     photos = tuple(
@@ -548,7 +544,6 @@ def _standard_points_at_a(prep, g):
     """The prepared run with standard points 1, 3, 5 moved by −a and 2, 4, 6 by +a along the
     base (Fig. 39, x_л ∈ {−a, p + a}, a = c − p) and the C2 tolerance 0, so every trial makes
     the same number of passes (no 'stop when satisfied' selection, which (5.54) does not model)."""
-    from stereoplotter.procedure.evaluation import instrument_frame_m
 
     sc, sheet, scene = prep.scenario, prep.sheet, prep.scene
     origin = np.asarray(sheet.frame_origin_m, float)
@@ -569,7 +564,6 @@ def _standard_points_at_a(prep, g):
 def _control_frame_points(scenario, sheet, g):
     """The four levelling control points of (5.54), x_п ∈ {−c, a}, y = ±c, on the ground; with
     their (x_п, y) [mm]."""
-    from stereoplotter.procedure.evaluation import instrument_frame_m
 
     c, p, a = g["c"], g["p"], g["a"]
     xr = np.array([-c, a, -c, a])
@@ -587,11 +581,6 @@ def _control_frame_points(scenario, sheet, g):
 def _relative_only(prep, first, trials):
     """C1, the calibration and C2 by (5.11) on trials ``first … first + trials − 1`` (None: one
     error-free trial); returns the run."""
-    from stereoplotter.instrument.virtual import Instrument
-    from stereoplotter.procedure import conventional as cv
-    from stereoplotter.procedure.operator import Noise, Operator
-    from stereoplotter.procedure.setup_method import Run
-    from stereoplotter.procedure.transcript import Transcript
 
     stop = None if trials is None else first + trials
     inst = Instrument(
@@ -645,12 +634,6 @@ def relative_orientation_mc(
     """
     import time
 
-    from stereoplotter.accuracy.chapter5 import (
-        levelling_design,
-        relative_orientation_parallax_rms,
-    )
-    from stereoplotter.procedure.operator import OperatorModel
-    from stereoplotter.procedure.simulate import prepare_run
 
     t0 = time.perf_counter()
     sc = idealised_geometry(scenario) if ideal_geometry else scenario

@@ -9,17 +9,26 @@ from stereoplotter.verification.entry import Entry, Setting
 __all__ = ["conventional_entries", "setup_outcome_entries"]
 
 
-def _from_pointing(s: Setting, overlap: str) -> float:
+def _from_pointing(s: Setting, overlap: str, mode: str = "book") -> float:
     _, p = s.slot(overlap)
-    return sa.setup_parallax_rms_from_pointing(s.f, p, s.c, s.l, s.n, 1.0)
+    return sa.setup_parallax_rms_from_pointing(s.f, p, s.c, s.l, s.n, 1.0, mode=mode)
 
 
 def _outcome(s: Setting, eq: str, overlap: str, quantity: str, printed, verdict, note) -> Entry:
-    """A row of m_p⁰/m_xy of unadjusted setup data at ``overlap`` (book σ's of (6.31)–(6.38))."""
+    """A row of m_p⁰/m_xy of unadjusted setup data at ``overlap``: book σ's of (6.31)–(6.38)
+    (m_bz = f m_y/l) and rigorous σ's (m_bz = f m_y/(n l) at photo scale, ``docs/errata.md``);
+    the linear MC propagates the rigorous σ's."""
     a, p = s.slot(overlap)
-    v = _from_pointing(s, overlap)
+    rigorous_sigmas = sa.setup_element_sigmas(s.f, s.l, s.n, 1.0, mode="rigorous")
     return Entry(
-        eq, quantity, printed, v, v, s.unadjusted(a, p, s.setup_sigmas()), verdict, note
+        eq,
+        quantity,
+        printed,
+        _from_pointing(s, overlap),
+        _from_pointing(s, overlap, "rigorous"),
+        s.unadjusted(a, p, rigorous_sigmas),
+        verdict,
+        note + "; rigorous: m_bz of (6.37) at photo scale, f m_y/(n l) (15p²/l² for 15p²n²/l²)",
     )
 
 

@@ -139,15 +139,19 @@ def eq_6_36(s: Setting) -> Entry:
 
 def eq_6_37(s: Setting) -> Entry:
     m_bz = sa.sigma_base_z_setup(s.f, s.l, 1.0)
+    m_bz_photo = sa.sigma_base_z_setup_photo(s.f, s.l, s.n, 1.0)
     return Entry(
         "(6.37)",
-        f"m_bz per m_y (f_пр = f = {s.f:g})",
+        f"m_bz per m_y, photo scale (printed/book: f_пр = f = {s.f:g}, instrument units)",
         m_bz,
         m_bz,
-        m_bz,
-        mc.least_squares_model(np.array([[s.l / s.f]]), 1.0, 0),
-        "reproduces",
-        "no equations printed; reading: one y reading at a mark at l_y, b_z = f_пр δy/l_y",
+        m_bz_photo,
+        mc.least_squares_model(np.array([[s.l / s.f]]), 1 / s.n, 0),
+        "book misprint",
+        "printed f_пр m_y/l_y is in instrument units (model scale; one y reading at a mark at "
+        "l_y, δY = l_y δb_z/f_пр); at the photo scale of (6.26) divide by n (as the other "
+        f"counter rows) and multiply by f/f_пр: f m_y/(n l_y) = {m_bz_photo:.4f} "
+        "(docs/errata.md)",
     )
 
 

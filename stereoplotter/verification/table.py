@@ -25,6 +25,7 @@ import numpy as np
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.entry import BOOK, Entry, Setting
+from stereoplotter.verification.procedure_mc import procedure_mc
 from stereoplotter.verification.rows_chapter5 import chapter5_entries
 from stereoplotter.verification.rows_levelled import (
     closing_entries,
@@ -178,7 +179,6 @@ def run_procedure_mc(
     dict
         (slot, method) → :func:`~stereoplotter.verification.procedure_mc.procedure_mc` result.
     """
-    from stereoplotter.verification.procedure_mc import procedure_mc
 
     out = {}
     if not trials or not scenarios:
