@@ -144,10 +144,75 @@ def test_632_636_638_element_errors():
     assert sa.sigma_alpha_setup(F, L, N, 1.0) == pytest.approx(F * R2 / (N * L**2))
     assert sa.sigma_kappa_setup(L, N, 1.0) == pytest.approx(1 / (L * R2 * N))
     assert sa.sigma_base_x_setup(N, 1.0) == pytest.approx(R2 / N)
-    assert sa.sigma_base_z_setup(F, L, 1.0) == pytest.approx(F / L)
+    # (6.37) as printed, f_пр m_y/l_y (instrument units), kept in the book column with f_пр = f
+    assert sa.setup_element_sigmas(F, L, N, 1.0, mode="book")["base_z"] == pytest.approx(F / L)
     # ERRATA: (6.35) prints m_ω = f√3/(2l²n)·m_y; least squares of (6.33), and the book's own
     # (6.39) (51 = 36 + 15) and (6.40) (456 = 306 + 150), need f√(3/2)/(l²n)·m_y.
     assert sa.sigma_omega_setup(F, L, N, 1.0, "book") == pytest.approx(F * 1.5**0.5 / (L**2 * N))
+
+
+def test_637_base_z_units_derived():
+    # ERRATA: (6.37) prints m_bz = f_пр m_y/l_y, a length of the instrument (model scale); (6.26)
+    # needs it at photo scale. Transformed bundle: instrument X, Y = n·(x, y), Z = n(f_пр/f)·z,
+    # n = D/f_пр. A mark at photo y = l projects to Y = l(D + B_z)/f_пр; the counter reads Y.
+    f, fpr, dist, ll, m = sp.symbols("f f_pr D l m", positive=True)
+    bz_photo, big_b = sp.symbols("b_z B_z")
+    n = dist / fpr
+    y_counter = ll * (dist + big_b) / fpr
+    m_bz_instrument = sp.simplify(m / sp.diff(y_counter, big_b))  # one reading, error m
+    # photo-scale b_z in the instrument's vertical: B_z = n (f_пр/f) b_z
+    y_photo = y_counter.subs(big_b, n * fpr / f * bz_photo)
+    m_bz_photo = sp.simplify(m / sp.diff(y_photo, bz_photo))
+    nn = sp.symbols("n", positive=True)
+    assert sp.simplify(m_bz_instrument - fpr * m / ll) == 0  # the printed (6.37)
+    assert sp.simplify(m_bz_photo.subs(dist, nn * fpr) - f * m / (nn * ll)) == 0
+    # the two differ only by n·f_пр/f
+    assert sp.simplify(m_bz_instrument / m_bz_photo - n * fpr / f) == 0
+    assert sa.sigma_base_z_setup(109.4, L, 1.0) == pytest.approx(109.4 / L)
+    assert sa.sigma_base_z_setup_photo(F, L, N, 1.0) == pytest.approx(0.5800, abs=5e-5)
+    for fpr_v in (70.0, 109.4, 170.0):
+        ratio = sa.sigma_base_z_setup(fpr_v, L, 1.0) / sa.sigma_base_z_setup_photo(F, L, N, 1.0)
+        assert ratio == pytest.approx(N * fpr_v / F, rel=1e-12)
+    assert sa.setup_element_sigmas(F, L, N, 1.0, mode="rigorous")["base_z"] == pytest.approx(
+        F / (N * L)
+    )
+
+
+def test_639_640_rigorous_unit_consistent():
+    # ERRATA: with m_bz of (6.37) at photo scale, f m/(n l), the 15p²n²/l² of (6.39)/(6.40)
+    # becomes 15p²/l²: every term carries the 1/n of the counter readings.
+    xl, y, p, c, f, ll, nn, m = sp.symbols("x_l y p c f l n m", positive=True)
+
+    def mean(expr):
+        return sp.integrate(expr, (xl, 0, c), (y, -c, c)) / (2 * c**2)
+
+    xr = xl - p
+    m_a, m_w = f * sp.sqrt(2) / (nn * ll**2) * m, f * sp.sqrt(sp.Rational(3, 2)) / (ll**2 * nn) * m
+    m_k, m_bx, m_bz = m / (ll * sp.sqrt(2) * nn), m * sp.sqrt(2) / nn, f * m / (nn * ll)
+    var = (
+        m_bx**2
+        + mean(xl**4 + xr**4) / f**2 * m_a**2
+        + mean(y**2 * (xl**2 + xr**2)) / f**2 * m_w**2
+        + 2 * mean(y**2) * m_k**2
+        + mean(xr**2) / f**2 * m_bz**2
+    )
+    r = p / ll
+    closed60 = (90 + 51 * r**4 + 30 * r**2) * m**2 / (45 * nn**2)
+    closed80 = (90 + 456 * r**4 + 75 * r**2) * m**2 / (45 * nn**2)
+    assert sp.simplify(var.subs(c, p) - closed60) == 0
+    assert sp.simplify(var.subs(c, 2 * p) - closed80) == 0
+    for pp, cc, closed in ((P60, C, closed60), (P80, 2 * P80, closed80)):
+        for n in (1.0, 1.42, 3.0):
+            v = float(sp.sqrt(closed.subs({p: pp, ll: L, nn: n, m: 1})))
+            got = sa.setup_parallax_rms_from_pointing(F, pp, cc, L, n, 1.0, mode="rigorous")
+            assert got == pytest.approx(v, rel=1e-12)
+    # book geometry: 1.2604 → 1.2143 (60 %), 1.1424 → 1.1298 (80 %)
+    assert sa.setup_parallax_rms_from_pointing(F, P60, C, L, N, 1.0, mode="rigorous") == (
+        pytest.approx(1.2143, abs=5e-5)
+    )
+    assert sa.setup_parallax_rms_from_pointing(F, P80, C, L, N, 1.0, mode="rigorous") == (
+        pytest.approx(1.1298, abs=5e-5)
+    )
 
 
 def test_639_640_coefficients_follow_from_628():
