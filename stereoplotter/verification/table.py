@@ -204,16 +204,13 @@ def _procedure_note(eq, res):
         f" photo): {res['coefficient']:.3f} ± {res['ci']:.3f}"
     )
     if res["method"] == "setup":
-        ref = float(sa.setup_parallax_rms_from_pointing(f, p, c, ll, n, 1.0))
-        ref_fi = float(
-            sa.setup_parallax_rms_from_pointing(f, p, c, ll, n, 1.0, res["f_instrument"])
-        )
+        ref = float(sa.setup_parallax_rms_from_pointing(f, p, c, ll, n, 1.0, mode="rigorous"))
         err = res["coefficient"] / ref - 1.0
         return (
-            f"{head} per m_xy = n_л·σ against the formula at the simulated geometry "
-            f"(p = {p:.2f}, c = {c:.2f}, l = {ll:g}, n_л = {n:.3f} of our SC-1 sheet, not the "
-            f"book's 1.42; f_пр = f in (6.37)) {ref:.3f}: first-order error {err:+.1%} "
-            f"(with f_пр = {res['f_instrument']:.1f} in (6.37): {ref_fi:.3f}); bias of the "
+            f"{head} per m_xy = n_л·σ against the unit-consistent formula at the simulated "
+            f"geometry (p = {p:.2f}, c = {c:.2f}, l = {ll:g}, n_л = {n:.3f} of our SC-1 sheet, "
+            f"not the book's 1.42; (6.37) at photo scale, f·m_y/(n·l_y)) {ref:.3f}: first-order "
+            f"error {err:+.1%}; bias of the "
             f"error-free run {res['bias_mm'] * 1000:.1f} µm removed. Mismatches: only the "
             "monocular pointing σ of the operator; κ is cleared by y-parallax at standard points "
             "1-2 (D8), not from the fiducial readings of (6.36); ω, α by one knob setting per "
