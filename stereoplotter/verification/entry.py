@@ -7,6 +7,7 @@ Book geometry (§27): f = 70 mm, l = 85 mm, n = 1.42 (SC-1), c = 70 mm; 60 %: p 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -14,7 +15,7 @@ from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.verification import linear_mc as mc
 
-__all__ = ["BOOK", "GENERIC_SIGMAS", "Entry", "Setting", "both_photos"]
+__all__ = ["BOOK", "CONVENTION_NOTE", "GENERIC_SIGMAS", "RULE", "Entry", "Setting", "both_photos"]
 
 BOOK = {
     "f": 70.0,
@@ -26,6 +27,15 @@ BOOK = {
     "p80": 35.0,
     "a80": 35.0,
 }
+#: Verdict of a row decided from its numbers (:mod:`stereoplotter.verification.verdicts`).
+RULE = "rule"
+#: Note of a row whose book and rigorous values differ, off the book's geometry, by the reading
+#: of the control heights' error (docs/errata.md (5.17)/(5.20)).
+CONVENTION_NOTE = (
+    "convention: two readings of the control heights' error, the book's (p/f)·m_p and the "
+    "rigorous m_p of (5.42) (k·m_p without the factor p/f); they agree only at p = f "
+    "(docs/errata.md (5.17)/(5.20))"
+)
 #: σ's of the setup elements for (6.28)–(6.30) (the book gives the formula, not the σ's).
 GENERIC_SIGMAS = {
     "base_x": 0.005,
@@ -43,6 +53,15 @@ class Entry:
     ``model`` is a :class:`~stereoplotter.verification.linear_mc.LinearModel`; its MC and
     covariance RMS are multiplied by ``scale``. ``squared``: the row reports a cofactor (the
     square of the model's σ), not a σ.
+
+    ``verdict`` is :data:`RULE` (decided from the numbers by
+    :func:`~stereoplotter.verification.verdicts.decide`) or a hand verdict (``convention``,
+    ``not reproducible``) whose ``note`` says why. ``from_printed_inputs``: the book's arithmetic
+    redone from its own printed intermediates (book geometry only). ``digits``: decimals of a
+    printed *number* (None: ``printed`` is a printed formula evaluated at the geometry; a printed
+    number exists at the book's geometry only). ``upstream``: the equation whose error the row
+    inherits when it disagrees with the rigorous value. ``book_only``: ``printed`` is a formula
+    with coefficients evaluated for the book's geometry ((6.41), (6.42)), void elsewhere.
     """
 
     eq: str
@@ -55,6 +74,10 @@ class Entry:
     note: str
     scale: float = 1.0
     squared: bool = False
+    from_printed_inputs: float | None = None
+    digits: int | None = None
+    upstream: str | None = None
+    book_only: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "book", float(self.book))
@@ -93,8 +116,20 @@ class Setting:
         return cls(**{k: g[k] for k in BOOK})
 
     @property
+    def is_book(self) -> bool:
+        """The book's geometry: only there do its printed numbers apply."""
+        return all(getattr(self, k) == v for k, v in BOOK.items())
+
+    @property
     def r2(self) -> float:
         return math.sqrt(2.0)
+
+    def convention_off_book(self, entry: Entry) -> Entry:
+        """``entry`` at the book's geometry; elsewhere its book and rigorous values differ by the
+        control-height convention: verdict ``convention``, note :data:`CONVENTION_NOTE`."""
+        if self.is_book:
+            return entry
+        return dataclasses.replace(entry, verdict="convention", note=CONVENTION_NOTE)
 
     def slot(self, overlap: str) -> tuple[float, float]:
         """(a, p) of the "60" or "80" % slot."""

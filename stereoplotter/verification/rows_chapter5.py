@@ -9,7 +9,7 @@ import numpy as np
 
 from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.verification import linear_mc as mc
-from stereoplotter.verification.entry import Entry, Setting
+from stereoplotter.verification.entry import RULE, Entry, Setting
 
 __all__ = ["chapter5_entries", "table19_entries", "table20_entries"]
 
@@ -28,7 +28,7 @@ def table19_alpha(s: Setting) -> Entry:
         q_aa,
         q_aa,
         mc.least_squares_model(_relative_design(s), 1.0, 2),
-        "reproduces",
+        RULE,
         "f/(c(a+c)); least squares on the six standard points of Fig. 39, (5.10) left system",
     )
 
@@ -43,7 +43,7 @@ def table19_omega(s: Setting) -> Entry:
         q_ww,
         q_ww,
         mc.least_squares_model(_relative_design(s), 1.0, 3),
-        "OCR damage",
+        RULE,
         "printed 3f²/(4c²) is not dimensionless; 3f²/(4c⁴) as the text's m_ω₂′ = f√3 m_q/(2c²)",
     )
 
@@ -61,7 +61,7 @@ def table20_eta(s: Setting) -> Entry:
         q_ee,
         q_ee,
         mc.least_squares_model(_levelling_design(s), 1.0, 1),
-        "reproduces",
+        RULE,
         "1/(a + c)",
     )
 
@@ -75,7 +75,7 @@ def table20_xi(s: Setting) -> Entry:
         q_xx,
         q_xx,
         mc.least_squares_model(_levelling_design(s), 1.0, 2),
-        "OCR damage",
+        RULE,
         "printed f/(4c²) (not dimensionless); least squares gives 1/(4c²)",
     )
 
@@ -112,7 +112,7 @@ def eq_5_19(s: Setting) -> Entry:
         b519,
         r519,
         _at_point(m519, a8, c, p8, f, pt),
-        "book misprint",
+        RULE,
         "(5.15) ω residual y(x_п + c/2) is the least-squares plane residual only for a = 0; "
         "exact: y(x_п + (c − a)/2)",
     )
@@ -129,7 +129,7 @@ def eq_5_20(s: Setting) -> Entry:
         lv_pt,
         lv_pt,
         _levelling_point_model(s.a80, c, pt),
-        "reproduces",
+        RULE,
         "variance of the plane fitted at 4 control points (Table 20)",
     )
 
@@ -148,8 +148,9 @@ def eq_5_54(s: Setting, overlap: str) -> Entry:
         bk,
         rg,
         mc.relative_orientation_model(a, s.c, p, s.f, 1.0),
-        "reproduces",
+        RULE,
         note,
+        upstream="(5.19)",
     )
 
 
@@ -161,9 +162,10 @@ _NOTE_5_55 = {
         "equal only for c = 2a",
     ),
     "80": (
-        "reproduces",
-        "c = 2a: printed = integral; rigorous takes the control heights with the "
-        "parallax error m_p of (5.42) (no factor p/f)",
+        "convention",
+        "c = 2a: printed = integral. Two readings of the control heights' error: the book's "
+        "(p/f)·m_p and the rigorous m_p of (5.42), which gives k·m_p without the factor p/f "
+        "(docs/errata.md (5.17)/(5.20))",
     ),
 }
 
@@ -197,7 +199,7 @@ def eq_5_57_58(s: Setting, overlap: str) -> Entry:
         c5.single_model_height_rms(a, c, p, f, 1.0, "book"),
         c5.single_model_height_rms(a, c, p, f, 1.0, "rigorous"),
         s.single_model(a, p),
-        "not reproducible" if overlap == "60" else "book misprint",
+        "not reproducible" if overlap == "60" else RULE,
         note,
     )
 
@@ -211,7 +213,7 @@ def eq_5_43(s: Setting) -> Entry:
         rg43,
         rg43,
         s.single_model(s.a60, s.p60),
-        "reproduces",
+        RULE,
         "MC of the summed fields confirms independence (no cross terms)",
     )
 

@@ -8,7 +8,7 @@ import math
 
 from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.accuracy import setup_accuracy as sa
-from stereoplotter.verification.entry import Entry, Setting
+from stereoplotter.verification.entry import RULE, Entry, Setting
 
 __all__ = ["closing_entries", "conventional_term_entries", "setup_residual_entries"]
 
@@ -23,7 +23,7 @@ def _residual_printed(s: Setting, overlap: str) -> float:
     return sa.setup_relative_residual_rms_printed(a, s.c, s.l, s.n, 1.0)
 
 
-def _residual_entry(s: Setting, eq, overlap, quantity, printed, verdict, note) -> Entry:
+def _residual_entry(s: Setting, eq, overlap, quantity, printed, verdict, note, **kw) -> Entry:
     a, p = s.slot(overlap)
     return Entry(
         eq,
@@ -34,6 +34,7 @@ def _residual_entry(s: Setting, eq, overlap, quantity, printed, verdict, note) -
         s.levelled(a, p, s.setup_sigmas()),
         verdict,
         note,
+        **kw,
     )
 
 
@@ -44,7 +45,7 @@ def eq_6_47(s: Setting) -> Entry:
         "60",
         "m_p,во/m_xy setup data after levelling, 60 %",
         None,
-        "book misprint",
+        RULE,
         "(6.47) carries one m_α, m_ω; both photos' errors enter (residual ∝ α_л − α_п, "
         "ω_л − ω_п): variance ×2",
     )
@@ -57,7 +58,7 @@ def eq_6_48(s: Setting) -> Entry:
         "80",
         "m_p,во/m_xy, formula at 80 %",
         _residual_printed(s, "80"),
-        "book misprint",
+        RULE,
         "integral of (6.47) gives (…)/(15c²) not /21; with (6.35) corrected 1/24 not 1/48; "
         "rigorous adds the second photo and the exact ω residual",
     )
@@ -70,9 +71,11 @@ def eq_6_49(s: Setting) -> Entry:
         "60",
         "m_p,во/m_xy, 60 %",
         0.12,
-        "book misprint",
-        f"printed (6.48) gives {_residual_printed(s, '60'):.4f} (truncated 0.12); its "
-        "coefficients are wrong, see (6.48)",
+        RULE,
+        "from printed inputs: the printed (6.48) at 60 %; its coefficients are wrong, see (6.48)",
+        from_printed_inputs=_residual_printed(s, "60"),
+        digits=2,
+        upstream="(6.48)",
     )
 
 
@@ -83,9 +86,11 @@ def eq_6_50(s: Setting) -> Entry:
         "80",
         "m_p,во/m_xy, 80 %",
         0.12,
-        "not reproducible",
-        f"printed (6.48) gives {_residual_printed(s, '80'):.4f} at 80 %; 0.12 repeats the 60 % "
-        "value",
+        RULE,
+        "from printed inputs: the printed (6.48) at 80 %; 0.12 repeats the 60 % value",
+        from_printed_inputs=_residual_printed(s, "80"),
+        digits=2,
+        upstream="(6.48)",
     )
 
 
@@ -100,7 +105,8 @@ def _relative(s: Setting, overlap: str, mode: str) -> float:
 
 
 def _relative_entry(s: Setting, eq, overlap, printed, verdict, note) -> Entry:
-    """m_p,во/m_q of the conventional method ((5.54)), relative orientation only."""
+    """m_p,во/m_q of the conventional method ((5.54)), relative orientation only; the printed
+    number has 2 decimals; at 80 % the rigorous value inherits the (5.19) residual."""
     a, p = s.slot(overlap)
     return Entry(
         eq,
@@ -111,6 +117,8 @@ def _relative_entry(s: Setting, eq, overlap, printed, verdict, note) -> Entry:
         s.conventional(a, p, sc=0.0),
         verdict,
         note,
+        digits=2,
+        upstream="(5.19)",
     )
 
 
@@ -121,7 +129,7 @@ def eq_6_51(s: Setting) -> Entry:
         "(6.51)",
         "60",
         0.24,
-        "book misprint",
+        RULE,
         f"(5.54) gives {ro6:.4f}; the book's own (6.56) prints 0.23",
     )
 
@@ -133,7 +141,7 @@ def eq_6_52(s: Setting) -> Entry:
         "(6.52)",
         "80",
         0.33,
-        "reproduces",
+        RULE,
         f"(5.54) {ro8b:.4f}; rigorous (exact plane residual) {ro8r:.4f}",
     )
 
@@ -147,23 +155,30 @@ def eq_6_53(s: Setting) -> Entry:
         bk,
         rg,
         s.conventional(s.a80, s.p80),
-        "reproduces",
-        "independent sources: MC of the summed fields has no cross term",
+        "convention",
+        "independent sources: MC of the summed fields has no cross term; book and rigorous "
+        "differ by the readings of (6.55) (control heights (p/f)·m_p versus k·m_p) and the "
+        "exact (5.19) residual",
     )
 
 
 def eq_6_54(s: Setting) -> Entry:
     g6 = [s.geodetic(s.a60, s.p60, m) for m in ("printed", "book", "rigorous")]
-    return Entry(
-        "(6.54)",
-        f"coefficient k of (k·p/f)·m_p, 60 %, p = {s.p60:g}",
-        0.95,
-        g6[1],
-        g6[2],
-        s.conventional(s.a60, s.p60, sq=0.0),
-        "book misprint",
-        f"from the printed (5.55): {g6[0]:.4f} (truncated); (5.55) is not its integral, "
-        "see (5.55) 60 %; 0.12 m_xy as (6.49)",
+    return s.convention_off_book(
+        Entry(
+            "(6.54)",
+            f"coefficient k of (k·p/f)·m_p, 60 %, p = {s.p60:g}",
+            0.95,
+            g6[1],
+            g6[2],
+            s.conventional(s.a60, s.p60, sq=0.0),
+            RULE,
+            "from printed inputs: the printed (5.55) at 60 %; (5.55) is not its integral, "
+            "see (5.55) 60 %; 0.12 m_xy as (6.49)",
+            from_printed_inputs=g6[0],
+            digits=2,
+            upstream="(5.55)",
+        )
     )
 
 
@@ -177,21 +192,22 @@ def eq_6_55(s: Setting) -> Entry:
         g8[1],
         g8[2],
         s.conventional(s.a80, p8, sq=0.0),
-        "reproduces",
-        "√(43/108) = 0.6310; rigorous (control heights with parallax error m_p) is k·f/p",
+        "convention",
+        "√(43/108) = 0.6310. Two readings of the 80 % control heights' error: the book's "
+        "(k·p/f)·m_p and the rigorous k·m_p (a control height measured in the model has error "
+        "(H/p)m_p, (5.42); docs/errata.md (5.17)/(5.20)), i.e. k·f/p in this row's unit",
         scale=f / p8,
+        digits=2,
     )
 
 
 def eq_6_56(s: Setting) -> Entry:
     ro6 = _relative(s, "60", "book")
-    return _relative_entry(
-        s, "(6.56)", "60", 0.23, "reproduces", f"(5.54) {ro6:.4f}; 0.95 term as (6.54)"
-    )
+    return _relative_entry(s, "(6.56)", "60", 0.23, RULE, f"(5.54) {ro6:.4f}; 0.95 term as (6.54)")
 
 
 def eq_6_57(s: Setting) -> Entry:
-    return _relative_entry(s, "(6.57)", "80", 0.33, "reproduces", "as (6.52); 0.63 term as (6.55)")
+    return _relative_entry(s, "(6.57)", "80", 0.33, RULE, "as (6.52); 0.63 term as (6.55)")
 
 
 def conventional_term_entries(s: Setting) -> list[Entry]:
@@ -204,36 +220,53 @@ def _label(s: Setting, p: float) -> str:
     return "60" if p == s.p60 else "80"
 
 
-def _setup_levelled(s: Setting, eq: str, overlap: str, printed: float, chain: float) -> Entry:
+def _setup_levelled(
+    s: Setting, eq: str, overlap: str, printed: float, chain: float, upstream: str
+) -> Entry:
     """(6.58)/(6.59): setup data + levelling, M_p/m_p with m_p = m_q = m_xy/√2."""
     a, p = s.slot(overlap)
     r2 = s.r2
     bk = math.hypot(_residual(s, overlap, "book", r2), s.geodetic(a, p, "book"))
     rg = math.hypot(_residual(s, overlap, "rigorous", r2), s.geodetic(a, p, "rigorous"))
-    return Entry(
-        eq,
-        f"M_p/m_p setup data + levelling, {_label(s, p)} %, f = {s.f:g}, m_p = m_q = m_xy/√2",
-        printed,
-        bk,
-        rg,
-        s.levelled(a, p, s.setup_sigmas(r2), control=1.0),
-        "book misprint",
-        f"arithmetic from the printed intermediates gives {chain:.4f} (truncated "
-        f"{math.floor(chain * 100) / 100:.2f}); inherits (6.49)/(6.50) and "
-        + ("(6.54)" if eq == "(6.58)" else "the p/f scale of (5.55)"),
+    return s.convention_off_book(
+        Entry(
+            eq,
+            f"M_p/m_p setup data + levelling, {_label(s, p)} %, f = {s.f:g}, m_p = m_q = m_xy/√2",
+            printed,
+            bk,
+            rg,
+            s.levelled(a, p, s.setup_sigmas(r2), control=1.0),
+            RULE,
+            "from printed inputs: √((0.12·√2)² + (k·p/f)²) with the printed 0.12 of "
+            + (
+                "(6.49) and k = 0.95 of (6.54)"
+                if eq == "(6.58)"
+                else "(6.50) and k = 0.63 of (6.55)"
+            )
+            + ", m_xy = √2 m_p"
+            + (
+                ""
+                if eq == "(6.58)"
+                else "; the rigorous value also takes the k·m_p reading of (6.55)"
+            ),
+            from_printed_inputs=chain,
+            digits=2,
+            upstream=upstream,
+        )
     )
 
 
 def eq_6_58(s: Setting) -> Entry:
-    return _setup_levelled(s, "(6.58)", "60", 0.96, math.hypot(0.12 * s.r2, 0.95))
+    chain = math.hypot(0.12 * s.r2, 0.95 * s.p60 / s.f)
+    return _setup_levelled(s, "(6.58)", "60", 0.96, chain, "(6.49), (6.54)")
 
 
 def eq_6_59(s: Setting) -> Entry:
     chain = math.hypot(0.12 * s.r2, 0.63 * s.p80 / s.f)
-    return _setup_levelled(s, "(6.59)", "80", 0.35, chain)
+    return _setup_levelled(s, "(6.59)", "80", 0.35, chain, "(6.50)")
 
 
-def _conventional_total(s: Setting, eq, overlap, printed, verdict, note) -> Entry:
+def _conventional_total(s: Setting, eq, overlap, printed, verdict, note, chain) -> Entry:
     a, p = s.slot(overlap)
     _, bk, rg = s.conventional_values(a, p)
     return Entry(
@@ -245,33 +278,39 @@ def _conventional_total(s: Setting, eq, overlap, printed, verdict, note) -> Entr
         s.conventional(a, p),
         verdict,
         note,
+        from_printed_inputs=chain,
+        digits=2,
     )
 
 
 def eq_6_60(s: Setting) -> Entry:
-    chain = math.hypot(0.23, 0.95)
-    return _conventional_total(
-        s,
-        "(6.60)",
-        "60",
-        0.96,
-        "not reproducible",
-        f"√(0.23² + 0.95²) = {chain:.4f} → 0.97/0.98; m_q = m_p/√2 gives 0.964 but then "
-        "(6.61) would be 0.39; book-mode value from the correct (5.55)",
+    chain = math.hypot(0.23, 0.95 * s.p60 / s.f)
+    return s.convention_off_book(
+        _conventional_total(
+            s,
+            "(6.60)",
+            "60",
+            0.96,
+            "not reproducible",
+            "tried: from printed inputs √(0.23² + 0.95²) with (6.56), m_q = m_p; m_q = m_p/√2 "
+            "gives 0.964 but then (6.61) would be 0.39; book-mode value from the correct (5.55)",
+            chain,
+        )
     )
 
 
 def eq_6_61(s: Setting) -> Entry:
     chain = math.hypot(0.33, 0.63 * s.p80 / s.f)
-    _, bk, rg = s.conventional_values(s.a80, s.p80)
     return _conventional_total(
         s,
         "(6.61)",
         "80",
         0.45,
-        "rounding",
-        f"√(0.33² + (0.63/2)²) = {chain:.4f}, truncated to 0.45 (book mode "
-        f"{bk:.4f}); rigorous {rg:.4f} (control heights with parallax error m_p)",
+        "convention",
+        "from printed inputs: √(0.33² + (0.63 p/f)²) with (6.57); book and rigorous differ by "
+        "the readings of (6.55): control heights (k·p/f)·m_p (book) versus k·m_p (rigorous), "
+        "and the exact (5.19) residual",
+        chain,
     )
 
 

@@ -3,8 +3,10 @@ from the pointing error m_xy, (6.45)/(6.46) the conventional method it is compar
 
 from __future__ import annotations
 
+import math
+
 from stereoplotter.accuracy import setup_accuracy as sa
-from stereoplotter.verification.entry import Entry, Setting
+from stereoplotter.verification.entry import RULE, Entry, Setting
 
 __all__ = ["conventional_entries", "setup_outcome_entries"]
 
@@ -14,7 +16,9 @@ def _from_pointing(s: Setting, overlap: str, mode: str = "book") -> float:
     return sa.setup_parallax_rms_from_pointing(s.f, p, s.c, s.l, s.n, 1.0, mode=mode)
 
 
-def _outcome(s: Setting, eq: str, overlap: str, quantity: str, printed, verdict, note) -> Entry:
+def _outcome(
+    s: Setting, eq: str, overlap: str, quantity: str, printed, verdict, note, **printed_inputs
+) -> Entry:
     """A row of m_p⁰/m_xy of unadjusted setup data at ``overlap``: book σ's of (6.31)–(6.38)
     (m_bz = f m_y/l) and rigorous σ's (m_bz = f m_y/(n l) at photo scale, ``docs/errata.md``);
     the linear MC propagates the rigorous σ's."""
@@ -29,6 +33,8 @@ def _outcome(s: Setting, eq: str, overlap: str, quantity: str, printed, verdict,
         s.unadjusted(a, p, rigorous_sigmas),
         verdict,
         note + "; rigorous: m_bz of (6.37) at photo scale, f m_y/(n l) (15p²/l² for 15p²n²/l²)",
+        upstream="(6.37)",
+        **printed_inputs,
     )
 
 
@@ -39,7 +45,7 @@ def eq_6_39(s: Setting) -> Entry:
         "60",
         f"m_p⁰/m_xy, 60 %, l = {s.l:g}, n = {s.n:g}",
         sa.setup_parallax_rms_printed_60(s.p60, s.l, s.n, 1.0),
-        "reproduces",
+        RULE,
         "with the least-squares m_ω (not the printed (6.35)) and f_пр = f in (6.37)",
     )
 
@@ -51,7 +57,7 @@ def eq_6_40(s: Setting) -> Entry:
         "80",
         f"m_p⁰/m_xy, 80 %, l = {s.l:g}, n = {s.n:g}",
         sa.setup_parallax_rms_printed_80(s.p80, s.l, s.n, 1.0),
-        "reproduces",
+        RULE,
         "as (6.39)",
     )
 
@@ -63,8 +69,9 @@ def eq_6_41(s: Setting) -> Entry:
         "60",
         f"m_p⁰/m_xy, 60 %, n = {s.n:g}, rounded coefficients",
         sa.setup_parallax_rms_rounded_60(s.n, 1.0),
-        "rounding",
-        "124 ← 123.63, 10 ← 10.17, 6.7 ← 3√5 = 6.708",
+        RULE,
+        "coefficients of (6.39) at l = 85: 124 ← 123.63, 10 ← 10.17, 6.7 ← 3√5 = 6.708",
+        book_only=True,
     )
 
 
@@ -75,13 +82,24 @@ def eq_6_42(s: Setting) -> Entry:
         "80",
         f"m_p⁰/m_xy, 80 %, n = {s.n:g}, rounded coefficients",
         sa.setup_parallax_rms_rounded_80(s.n, 1.0),
-        "rounding",
-        "113 ← 113.28, 2.5 ← 2.54",
+        RULE,
+        "coefficients of (6.40) at l = 85: 113 ← 113.28, 2.5 ← 2.54",
+        book_only=True,
     )
 
 
 def eq_6_43(s: Setting) -> Entry:
-    return _outcome(s, "(6.43)", "60", "m_p⁰/m_xy, 60 %, SC-1", 1.26, "reproduces", "1.2604")
+    return _outcome(
+        s,
+        "(6.43)",
+        "60",
+        "m_p⁰/m_xy, 60 %, SC-1",
+        1.26,
+        RULE,
+        "from printed inputs: the printed (6.41) at n = 1.42",
+        from_printed_inputs=sa.setup_parallax_rms_rounded_60(s.n, 1.0),
+        digits=2,
+    )
 
 
 def eq_6_44(s: Setting) -> Entry:
@@ -91,9 +109,11 @@ def eq_6_44(s: Setting) -> Entry:
         "80",
         "m_p⁰/m_xy, 80 %, SC-1",
         1.11,
-        "book misprint",
-        "the book's own (6.42) gives 1.142 (and (6.40) 1.1424); 1.11 not reached by any "
-        "reading of (6.40)",
+        RULE,
+        "from printed inputs: the printed (6.42) at n = 1.42; 1.11 not reached by any reading "
+        "of (6.40)",
+        from_printed_inputs=sa.setup_parallax_rms_rounded_80(s.n, 1.0),
+        digits=2,
     )
 
 
@@ -104,31 +124,42 @@ def setup_outcome_entries(s: Setting) -> list[Entry]:
 
 def eq_6_45(s: Setting) -> Entry:
     pr, bk, rg = s.conventional_values(s.a60, s.p60)
-    return Entry(
-        "(6.45)",
-        f"m_p⁰/m_p conventional, 60 %, p = {s.p60:g}, m_q = m_p",
-        0.98,
-        bk,
-        rg,
-        s.conventional(s.a60, s.p60),
-        "book misprint",
-        f"printed (5.54), (5.55) give {pr:.4f} (truncated 0.98); the correct "
-        "integral of (5.53) gives the book value",
+    return s.convention_off_book(
+        Entry(
+            "(6.45)",
+            f"m_p⁰/m_p conventional, 60 %, p = {s.p60:g}, m_q = m_p",
+            0.98,
+            bk,
+            rg,
+            s.conventional(s.a60, s.p60),
+            RULE,
+            "from printed inputs: √(0.24² + (0.95 p/f)²) with the book's (6.51) and (6.54); the "
+            f"unrounded printed (5.54), (5.55) give {pr:.4f}; the correct integral of (5.53) "
+            "gives the book value",
+            from_printed_inputs=math.hypot(0.24, 0.95 * s.p60 / s.f),
+            digits=2,
+            upstream="(6.54)",
+        )
     )
 
 
 def eq_6_46(s: Setting) -> Entry:
     pr, bk, rg = s.conventional_values(s.a80, s.p80)
-    return Entry(
-        "(6.46)",
-        f"m_p⁰/m_p conventional, 80 %, p = {s.p80:g}, m_q = m_p",
-        0.67,
-        bk,
-        rg,
-        s.conventional(s.a80, s.p80),
-        "not reproducible",
-        f"printed (5.54)/(5.55) give {pr:.4f}; √(0.63² + 0.23²) = 0.671 (p/f dropped and the "
-        "60 % m_p,в used) is the only reading found that gives 0.67",
+    return s.convention_off_book(
+        Entry(
+            "(6.46)",
+            f"m_p⁰/m_p conventional, 80 %, p = {s.p80:g}, m_q = m_p",
+            0.67,
+            bk,
+            rg,
+            s.conventional(s.a80, s.p80),
+            "not reproducible",
+            "tried: from printed inputs √(0.33² + (0.63 p/f)²) with (6.52), (6.55); printed "
+            f"(5.54)/(5.55) give {pr:.4f}; √(0.63² + 0.23²) = 0.671 (p/f dropped and the 60 % "
+            "m_p,в used) is the only reading found that gives 0.67",
+            from_printed_inputs=math.hypot(0.33, 0.63 * s.p80 / s.f),
+            digits=2,
+        )
     )
 
 

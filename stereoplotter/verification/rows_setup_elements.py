@@ -8,7 +8,7 @@ import numpy as np
 
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.verification import linear_mc as mc
-from stereoplotter.verification.entry import GENERIC_SIGMAS, Entry, Setting, both_photos
+from stereoplotter.verification.entry import GENERIC_SIGMAS, RULE, Entry, Setting, both_photos
 
 __all__ = ["setup_element_entries", "unadjusted_generic_entries"]
 
@@ -26,7 +26,7 @@ def _unadjusted_generic(s: Setting, eq: str, a: float, p: float, label: str) -> 
         bk,
         bk,
         mc.setup_model(f, p, a, cc, both_photos(gs), levelled=False),
-        "reproduces",
+        RULE,
         "integral (6.27) of (6.26) over x_л ∈ [0,c], y ∈ [−c,c]; σ's "
         + ", ".join(f"{k}={v:g}" for k, v in gs.items()),
     )
@@ -60,7 +60,7 @@ def eq_6_31(s: Setting) -> Entry:
         1 / n,
         1 / n,
         mc.least_squares_model(_design_31(s), 1 / n, 0),
-        "reproduces",
+        RULE,
         "observation equations; mark at x = l gives (l²/f)α, fα joins Δx ((3.22))",
     )
 
@@ -74,7 +74,7 @@ def eq_6_32(s: Setting) -> Entry:
         m_a,
         m_a,
         mc.least_squares_model(_design_31(s), 1 / s.n, 1),
-        "reproduces",
+        RULE,
         "f√2/(n l²)",
     )
 
@@ -88,7 +88,7 @@ def eq_6_33(s: Setting) -> Entry:
         1 / n,
         1 / n,
         mc.least_squares_model(_design_33(s), 1 / n, 0),
-        "reproduces",
+        RULE,
         "least squares of (6.33)",
     )
 
@@ -102,7 +102,7 @@ def eq_6_34(s: Setting) -> Entry:
         3 * f**2 / (2 * ll**4 * n**2),
         3 * f**2 / (2 * ll**4 * n**2),
         mc.least_squares_model(_design_33(s), 1 / n, 1),
-        "book misprint",
+        RULE,
         "least squares of (6.33) gives 3f²/(2l⁴n²), not 3f²/(4l⁴n²); Q_ΔyΔy = 1/n² reproduces",
         squared=True,
     )
@@ -117,7 +117,7 @@ def eq_6_35(s: Setting) -> Entry:
         w_b,
         w_b,
         mc.least_squares_model(_design_33(s), 1 / s.n, 1),
-        "book misprint",
+        RULE,
         "f√3/(2l²n) printed; (6.33) gives f√(3/2)/(l²n), which the book's own (6.39) (51 = "
         "36 + 15) and (6.40) (456 = 306 + 150) use",
     )
@@ -132,7 +132,7 @@ def eq_6_36(s: Setting) -> Entry:
         m_k,
         m_k,
         mc.least_squares_model(np.array([[1.0, -s.l], [1.0, s.l]]), 1 / s.n, 1),
-        "reproduces",
+        RULE,
         "x readings at marks y = ±l_y",
     )
 
@@ -147,7 +147,7 @@ def eq_6_37(s: Setting) -> Entry:
         m_bz,
         m_bz_photo,
         mc.least_squares_model(np.array([[s.l / s.f]]), 1 / s.n, 0),
-        "book misprint",
+        RULE,
         "printed f_пр m_y/l_y is in instrument units (model scale; one y reading at a mark at "
         "l_y, δY = l_y δb_z/f_пр); at the photo scale of (6.26) divide by n (as the other "
         f"counter rows) and multiply by f/f_пр: f m_y/(n l_y) = {m_bz_photo:.4f} "
@@ -164,7 +164,7 @@ def eq_6_38(s: Setting) -> Entry:
         m_bx,
         m_bx,
         mc.least_squares_model(np.array([[1.0, 0.0], [1.0, 1.0]]), 1 / s.n, 1),
-        "reproduces",
+        RULE,
         "difference of two readings",
     )
 

@@ -24,7 +24,7 @@ import numpy as np
 
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.verification import linear_mc as mc
-from stereoplotter.verification.entry import BOOK, Entry, Setting
+from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
 from stereoplotter.verification.procedure_mc import procedure_mc
 from stereoplotter.verification.rows_chapter5 import chapter5_entries
 from stereoplotter.verification.rows_levelled import (
@@ -37,6 +37,7 @@ from stereoplotter.verification.rows_setup_elements import (
     setup_element_entries,
     unadjusted_generic_entries,
 )
+from stereoplotter.verification.verdicts import VERDICTS, decide
 
 __all__ = [
     "BOOK",
@@ -49,11 +50,11 @@ __all__ = [
     "run_verification",
 ]
 
-VERDICTS = ("reproduces", "rounding", "book misprint", "OCR damage", "not reproducible")
 ROW_KEYS = (
     "eq",
     "quantity",
     "printed",
+    "from_printed_inputs",
     "book",
     "rigorous",
     "covariance",
@@ -278,7 +279,7 @@ def run_verification(
     g = _normalise_geometry(geometry)
     proc = run_procedure_mc(procedure_trials, seed, procedure_scenarios, instrument=instrument)
     specs = _row_specs(g)
-    rows = _rows(specs, trials, seed, progress)
+    rows = _rows(specs, trials, seed, progress, Setting.from_mapping(g).is_book)
     attach_procedure_mc(rows, proc)
     return rows
 
@@ -294,27 +295,49 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
     return rows
 
 
-def _rows(specs: list[Entry], trials, seed, progress):
+def _rows(specs: list[Entry], trials, seed, progress, at_book: bool = True):
     rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(specs))]
     rows = []
     for i, e in enumerate(specs):
-        rows.append(_row(e, trials, rngs[i]))
+        rows.append(_row(e, trials, rngs[i], at_book))
         if progress is not None:
             progress(i + 1, len(specs), e.eq)
     return rows
 
 
-def _row(e: Entry, trials, rng) -> dict:
+def _verdict(e: Entry, at_book: bool) -> tuple[float | None, float | None, str, str]:
+    """printed, from_printed_inputs, verdict and note of ``e``. The book's printed *numbers*
+    (``e.digits`` set) and the arithmetic on them apply only at the book's geometry; elsewhere
+    the verdict compares the book's formula with the rigorous one and the note says so."""
+    number = e.digits is not None or e.book_only
+    printed = e.printed if at_book or not number else None
+    fpi = e.from_printed_inputs if at_book else None
+    hand = None if e.verdict == RULE else e.verdict
+    verdict, check = decide(
+        printed, fpi, e.book, e.rigorous, digits=e.digits, upstream=e.upstream, hand=hand
+    )
+    if at_book:
+        return printed, fpi, verdict, f"{check}. {e.note}"
+    head = "geometry differs from the book's"
+    if number:
+        head += ": the book's printed number and its arithmetic do not apply"
+    keep = not number or hand == "convention"
+    return printed, fpi, verdict, f"{head}; {check}" + (f". {e.note}" if keep else "")
+
+
+def _row(e: Entry, trials, rng, at_book: bool = True) -> dict:
     """The row of ``e``: its linear MC (``trials``, ``rng``) and covariance RMS."""
     # a squared statistic doubles the relative CI: four times the trials keep it ≤ 1 %
     r, h, _ = mc.mc_rms(e.model, 4 * trials if e.squared else trials, rng)
     cov = mc.covariance_rms(e.model)
     if e.squared:
         r, h, cov = r**2, 2 * r * h, cov**2
+    printed, fpi, verdict, note = _verdict(e, at_book)
     return {
         "eq": e.eq,
         "quantity": e.quantity,
-        "printed": e.printed,
+        "printed": printed,
+        "from_printed_inputs": fpi,
         "book": e.book,
         "rigorous": e.rigorous,
         "covariance": cov * e.scale,
@@ -322,8 +345,8 @@ def _row(e: Entry, trials, rng) -> dict:
         "mc_linear_ci": h * e.scale,
         "mc_procedure": None,
         "mc_procedure_ci": None,
-        "verdict": e.verdict,
-        "note": e.note + "; " + PROCEDURE_NOTE,
+        "verdict": verdict,
+        "note": note + "; " + PROCEDURE_NOTE,
     }
 
 
