@@ -597,7 +597,10 @@ def _verify(args: argparse.Namespace) -> int:
         for name, figure in (
             ("error_maps.png", plot_error_maps()),
             ("verification_chart.png", plot_verification_chart(rows).figure),
-            ("mc_histograms.png", plot_mc_histograms(rows, proc, seed=args.seed)),
+            (
+                "mc_histograms.png",
+                plot_mc_histograms(rows, proc, seed=args.seed, geometry=geometry),
+            ),
         ):
             buffer = io.BytesIO()
             figure.savefig(buffer, format="png", dpi=100, metadata={"Software": None})

@@ -87,13 +87,20 @@ def _markdown(rows, closing, meta):
             else ""
         ),
         "",
-        "| eq | quantity | printed | book | rigorous | covariance | linear MC ± CI | "
-        "procedure MC | verdict | note |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "Verdicts are decided from the numbers (stereoplotter/verification/verdicts.py): a printed "
+        "number agrees when the value rounded or truncated to its decimals equals it (both are "
+        "shown), formula values within 0.5 %; `convention` and `not reproducible` are the "
+        "row's own findings (docs/errata.md). *from printed inputs*: the book's arithmetic "
+        "redone from its own printed intermediates.",
+        "",
+        "| eq | quantity | printed | from printed inputs | book | rigorous | covariance | "
+        "linear MC ± CI | procedure MC | verdict | note |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
-            f"| {r['eq']} | {r['quantity']} | {_fmt(r['printed'])} | {_fmt(r['book'])} | "
+            f"| {r['eq']} | {r['quantity']} | {_fmt(r['printed'])} | "
+            f"{_fmt(r.get('from_printed_inputs'))} | {_fmt(r['book'])} | "
             f"{_fmt(r['rigorous'])} | {_fmt(r['covariance'])} | {_fmt(r['mc_linear'])} ± "
             f"{r['mc_linear_ci']:.2g} | {_proc(r)} | {r['verdict']} | {r['note']} |"
         )
