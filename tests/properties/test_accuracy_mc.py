@@ -208,6 +208,9 @@ def test_cli_verify_geometry_and_histograms(tmp_path):
     data = json.loads((tmp_path / "verification.json").read_text())
     by = {r["eq"]: r for r in data}
     assert by["(6.43)"]["mc_procedure"] is not None and by["(6.44)"]["mc_procedure"] is None
+    # the verdicts are recomputed for the file's geometry: no printed number, no book arithmetic
+    assert by["(6.43)"]["printed"] is None and by["(6.45)"]["from_printed_inputs"] is None
+    assert "geometry differs from the book's" in by["(6.43)"]["note"]
     import matplotlib.pyplot as plt
 
     plt.close("all")
