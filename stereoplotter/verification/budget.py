@@ -319,7 +319,7 @@ def _run_group(
     progress: Callable[[int], None] | None,
 ) -> dict[str, dict[str, NDArray]]:
     """Run configurations sharing their per-run terms; label → per-trial mean squares."""
-    rounding = ROUNDING in configs[0].on
+    rounding = ROUNDING in configs[0].on and prep.operator.quantise
     prep = replace(prep, operator=replace(prep.operator, quantise=rounding))
     per_chunk = max(1, chunk_trials // n_base)
     out = {}
