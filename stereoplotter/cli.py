@@ -728,6 +728,28 @@ class _Parser(argparse.ArgumentParser):
 
 
 
+def _add_budget_parser(sub: Any) -> None:
+    """``budget``: the per-part error budget (``verification.budget``)."""
+    p = sub.add_parser(
+        "budget",
+        help="per-part error budget: each instrument and operator error's contribution to the "
+        "residual y-parallax, height and plan RMS of the simulated procedure",
+    )
+    p.add_argument("scenario", help="a stereopair scenario: a name (pair60) or a YAML file")
+    p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
+    p.add_argument("--method", choices=("setup", "conventional"), default="setup")
+    p.add_argument(
+        "--trials",
+        type=bounded_int(2, MAX_BUDGET_TRIALS),
+        default=DEFAULT_BUDGET_TRIALS,
+        help="trials per configuration, the same trials in every configuration "
+        f"(2 to {MAX_BUDGET_TRIALS}; default: %(default)s)",
+    )
+    p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
+    p.add_argument("--json", action="store_true", help="print the budget as JSON")
+    p.add_argument("-o", "--output", help="write budget.md, budget.json and budget.png here")
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="stereoplotter",
@@ -911,24 +933,7 @@ def _parser() -> argparse.ArgumentParser:
         "or a mapping of f, l, n, c, p60, a60, p80, a80",
     )
 
-    p = sub.add_parser(
-        "budget",
-        help="per-part error budget: each instrument and operator error's contribution to the "
-        "residual y-parallax, height and plan RMS of the simulated procedure",
-    )
-    p.add_argument("scenario", help="a stereopair scenario: a name (pair60) or a YAML file")
-    p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
-    p.add_argument("--method", choices=("setup", "conventional"), default="setup")
-    p.add_argument(
-        "--trials",
-        type=bounded_int(2, MAX_BUDGET_TRIALS),
-        default=DEFAULT_BUDGET_TRIALS,
-        help="trials per configuration, the same trials in every configuration "
-        f"(2 to {MAX_BUDGET_TRIALS}; default: %(default)s)",
-    )
-    p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
-    p.add_argument("--json", action="store_true", help="print the budget as JSON")
-    p.add_argument("-o", "--output", help="write budget.md, budget.json and budget.png here")
+    _add_budget_parser(sub)
 
     p = sub.add_parser(
         "demo",
