@@ -668,9 +668,9 @@ def _budget(args: argparse.Namespace) -> int:
 MAX_SEED = 2**63 - 1
 #: Trials of one verification row are held in memory at once (8 bytes each, per row).
 MAX_VERIFY_TRIALS = 1_000_000
-#: Trials per configuration of ``budget``: about 100 configurations run them each (≈ 0.25 ms a
-#: trial, ``benchmarks/bench_budget.py``), so 10⁵ is hours of work.
-MAX_BUDGET_TRIALS = 100_000
+#: Trials per configuration of ``budget``: one configuration's trials run in one chunk of the
+#: default memory budget (``procedure.trials.chunk_trials_for``: 8 000 setup, 6 400 conventional).
+MAX_BUDGET_TRIALS = 6000
 #: Scale denominators as the instrument gear sets allow (``gears.vertical_scale_denominators``).
 MAX_SCALE_DENOMINATOR = 10_000_000
 #: Tilts of the kinematic self-test: near-vertical photos, as in scenario files.

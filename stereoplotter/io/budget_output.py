@@ -2,8 +2,8 @@
 
 Not read back by the package: the model exists so that ``docs/schemas/budget.schema.json`` is
 generated like the input files' schemas (:mod:`stereoplotter.io.schemas`) and the command's
-output can be checked against it (``tests/cli/test_budget_command.py``). Numbers are floats or null (a
-measure a scenario cannot give, e.g. the plan error without a map scale).
+output can be checked against it (``tests/cli/test_budget_command.py``). Numbers are floats or
+null (a measure a scenario cannot give, e.g. the plan error without a map scale).
 """
 
 from __future__ import annotations

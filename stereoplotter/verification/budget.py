@@ -462,6 +462,8 @@ def run_budget(
     """
     if trials < 2:
         raise StereoplotterError(f"trials: expected ≥ 2 (a standard error), found {trials}")
+    if method not in ("setup", "conventional"):
+        raise StereoplotterError(f"method: expected setup or conventional, found {method!r}")
     model = error_model_from_spec(spec) if errors is None else errors
     op = OperatorModel() if operator is None else operator
     terms = budget_terms(model, op)
@@ -472,6 +474,11 @@ def run_budget(
     for c in configs:
         groups.setdefault(_run_key(c, terms), []).append(c)
     chunk = chunk_trials_for(memory_budget_mb, method)
+    if trials > chunk:
+        raise StereoplotterError(
+            f"trials: expected at most {chunk} for the {method} method (one configuration's "
+            f"trials run in one chunk of {memory_budget_mb:g} MB), found {trials}"
+        )
     cache: dict[str, NDArray] = {}
     ms: dict[str, dict[str, NDArray]] = {}
     for group in groups.values():
