@@ -7,6 +7,7 @@ intervals: 3 standard errors of the paired per-trial differences (≈ 99.7 % for
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from stereoplotter.instrument.error_model import error_model_from_spec
@@ -14,18 +15,48 @@ from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import resolve_data_file
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure.operator import OperatorModel
+from stereoplotter.procedure.simulate import simulate
 from stereoplotter.verification.budget import MEASURES, OPERATOR_TERMS, run_budget
 
 Z = 3.0  # standard errors of a Monte Carlo interval
 
 
-@pytest.fixture(scope="module")
-def budget():
+def _pair60_sc1():
     spec = load_instrument("sc1")
     scenario = load_scenario(resolve_data_file("scenarios", "pair60"))
     model = error_model_from_spec(spec).with_overrides({"zero_reading.dy_right": 0.0})
+    return scenario, spec, model
+
+
+@pytest.fixture(scope="module")
+def budget():
+    scenario, spec, model = _pair60_sc1()
     out = run_budget(scenario, spec, "setup", trials=64, seed=5, errors=model)
     return out, {r["name"]: r for r in out["terms"]}
+
+
+def test_all_on_and_all_off_are_the_ordinary_simulation(budget):
+    # The stacked, designed runs of the budget against plain `simulate` (its own keyed draws, one
+    # configuration per run): the same 64 trials give the same mean squares to rounding.
+    out, _ = budget
+    scenario, spec, model = _pair60_sc1()
+    for config, kwargs in (
+        ("all_on", {"errors": model}),
+        ("all_off", {"errors": "zero", "operator": OperatorModel().zero()}),
+    ):
+        r = simulate(scenario, spec, "setup", seed=5, trials=64, **kwargs)
+        ev = r.evaluation
+        per_h = 1000.0 / ev.flying_height_m
+        per_map = 1000.0 / ev.map_scale_denominator
+        expected = {
+            "residual_y_parallax_rms_um": np.mean((np.asarray(r.q_grid_mm) * 1000.0) ** 2),
+            "height_error_rms_permille": np.mean((ev.grid.height_error_m * per_h) ** 2),
+            "plan_error_rms_map_mm": np.mean(
+                (ev.grid.x_error_m * per_map) ** 2 + (ev.grid.y_error_m * per_map) ** 2
+            ),
+        }
+        for m, v in expected.items():
+            assert out["totals"][m][config]["ms"] == pytest.approx(v, rel=1e-12)
 
 
 def test_every_term_is_listed_with_three_contributions(budget):
