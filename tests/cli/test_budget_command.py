@@ -18,10 +18,19 @@ SCHEMA = Path(__file__).resolve().parents[2] / "docs" / "schemas" / "budget.sche
 
 
 @pytest.mark.parametrize("instrument", ["sc1", "spr3", "sd3"])
-def test_budget_json_lists_every_term_and_validates(instrument, capsys):
-    code = main(["budget", "pair60", "--instrument", instrument, "--trials", "3", "--json", "-q"])
-    out = json.loads(capsys.readouterr().out)
+def test_budget_json_lists_every_term_and_validates(instrument, capsys, tmp_path):
+    code = main(
+        ["budget", "pair60", "--instrument", instrument, "--trials", "3", "--json", "-q"]
+        + ["-o", str(tmp_path)]
+    )
+    printed = capsys.readouterr().out
+    out = json.loads(printed)
     assert code == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["budget.json", "budget.md", "budget.png"]
+    assert (tmp_path / "budget.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "budget.json").read_text(encoding="utf-8") == printed
+    md = (tmp_path / "budget.md").read_text(encoding="utf-8")
+    assert "| `zero_reading.dx_left` |" in md and md.count("\n### ") == len(MEASURES)
     validator = jsonschema.Draft202012Validator(json.loads(SCHEMA.read_text(encoding="utf-8")))
     assert [e.message for e in validator.iter_errors(out)] == []
     names = [r["name"] for r in out["terms"]]
@@ -33,19 +42,6 @@ def test_budget_json_lists_every_term_and_validates(instrument, capsys):
                 assert set(r[kind][m]) == {"rms", "se", "delta_ms", "delta_ms_se"}
         assert set(r["linear"]) == set(MEASURES)
     assert out["instrument"] == instrument and out["trials"] == 3
-
-
-def test_budget_writes_markdown_json_and_chart(tmp_path, capsys):
-    code = main(
-        ["budget", "pair60", "--instrument", "sc1", "--trials", "2", "-q", "-o", str(tmp_path)]
-    )
-    text = capsys.readouterr().out
-    assert code == 0
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["budget.json", "budget.md", "budget.png"]
-    assert (tmp_path / "budget.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    md = (tmp_path / "budget.md").read_text(encoding="utf-8")
-    assert md in text and "| `zero_reading.dx_left` |" in md
-    assert json.loads((tmp_path / "budget.json").read_text(encoding="utf-8"))["trials"] == 2
 
 
 @pytest.mark.parametrize(
