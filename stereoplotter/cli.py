@@ -39,6 +39,7 @@ from stereoplotter.io.paths import (
 from stereoplotter.io.yaml_files import atomic_write_bytes, load_yaml_mapping
 from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB
 from stereoplotter.progress import configure_logging
+from stereoplotter.verification.budget import DEFAULT_BUDGET_TRIALS
 
 __all__ = ["main"]
 
@@ -642,12 +643,37 @@ def _verify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _budget(args: argparse.Namespace) -> int:
+    from stereoplotter.progress import progress_bar
+    from stereoplotter.report.budget import (
+        budget_json,
+        budget_markdown,
+        run_budget_command,
+        write_budget,
+    )
+
+    def bar(total: int) -> Any:
+        return progress_bar(total, "budget", unit="trial")
+
+    budget = run_budget_command(
+        args.scenario, args.instrument, args.method, args.trials, args.seed, bar
+    )
+    written = write_budget(budget, args.output) if args.output else []
+    sys.stdout.write(budget_json(budget) if args.json else budget_markdown(budget))
+    if written and not args.json:
+        sys.stdout.write(f"written: {', '.join(written)} in {args.output}\n")
+    return 0
+
+
 # --- parser ----------------------------------------------------------------------------------
 
 #: The largest seed, as in scenario files (``seed``); numpy itself takes any integer ≥ 0.
 MAX_SEED = 2**63 - 1
 #: Trials of one verification row are held in memory at once (8 bytes each, per row).
 MAX_VERIFY_TRIALS = 1_000_000
+#: Trials per configuration of ``budget``: one configuration's trials run in one chunk of the
+#: default memory budget (``procedure.trials.chunk_trials_for``: 8 000 setup, 6 400 conventional).
+MAX_BUDGET_TRIALS = 6000
 #: Scale denominators as the instrument gear sets allow (``gears.vertical_scale_denominators``).
 MAX_SCALE_DENOMINATOR = 10_000_000
 #: Tilts of the kinematic self-test: near-vertical photos, as in scenario files.
@@ -703,6 +729,28 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
 
+
+
+def _add_budget_parser(sub: Any) -> None:
+    """``budget``: the per-part error budget (``verification.budget``)."""
+    p = sub.add_parser(
+        "budget",
+        help="per-part error budget: each instrument and operator error's contribution to the "
+        "residual y-parallax, height and plan RMS of the simulated procedure",
+    )
+    p.add_argument("scenario", help="a stereopair scenario: a name (pair60) or a YAML file")
+    p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
+    p.add_argument("--method", choices=("setup", "conventional"), default="setup")
+    p.add_argument(
+        "--trials",
+        type=bounded_int(2, MAX_BUDGET_TRIALS),
+        default=DEFAULT_BUDGET_TRIALS,
+        help="trials per configuration, the same trials in every configuration "
+        f"(2 to {MAX_BUDGET_TRIALS}; default: %(default)s)",
+    )
+    p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
+    p.add_argument("--json", action="store_true", help="print the budget as JSON")
+    p.add_argument("-o", "--output", help="write budget.md, budget.json and budget.png here")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -888,6 +936,8 @@ def _parser() -> argparse.ArgumentParser:
         "or a mapping of f, l, n, c, p60, a60, p80, a80",
     )
 
+    _add_budget_parser(sub)
+
     p = sub.add_parser(
         "demo",
         help="run the main job on the default scenario (or --scenario) "
@@ -981,6 +1031,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _simulate(args)
         if args.command == "verify":
             return _verify(args)
+        if args.command == "budget":
+            return _budget(args)
     except StereoplotterError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

@@ -1,4 +1,4 @@
-"""JSON Schemas of the input files, generated from their pydantic models.
+"""JSON Schemas of the input files (and of ``budget --json``), generated from pydantic models.
 
 ``python -m stereoplotter.io.schemas [FOLDER]`` writes ``FOLDER/KIND.schema.json`` (default
 ``docs/schemas``); editors that read JSON Schema (VS Code's YAML extension, JetBrains) can then
@@ -17,6 +17,7 @@ from typing import Any
 from pydantic import BaseModel
 
 from stereoplotter.io.block_file import BlockFile
+from stereoplotter.io.budget_output import BudgetOutput
 from stereoplotter.io.errors_file import ErrorsFile
 from stereoplotter.io.geometry_file import GeometryFile
 from stereoplotter.io.instrument_file import InstrumentFile
@@ -34,6 +35,7 @@ MODELS: dict[str, type[BaseModel]] = {
     "errors": ErrorsFile,
     "geometry": GeometryFile,
     "job": JobFile,
+    "budget": BudgetOutput,  # an output: the JSON of `stereoplotter budget --json`
 }
 
 

@@ -239,19 +239,25 @@ def run_trials_chunk(
     *,
     evaluate: bool = True,
     transcript: bool = True,
+    injected: dict[str, Any] | None = None,
+    noise: Noise | None = None,
 ) -> SimulationResult:
     """Trials ``first_trial … first_trial + trials − 1`` of the run (one trial for None).
 
     Every random draw is keyed by the trial index (:mod:`stereoplotter.random_streams`), so
-    trial t gives the same result in whichever chunk it runs.
+    trial t gives the same result in whichever chunk it runs. ``injected`` (arrays (T,) per
+    error term) and ``noise`` (a :class:`Noise`) replace the keyed draws of the instrument and
+    the operator: designed runs such as the error budget (``verification.budget``).
     """
     if prep.backend == "pymunk" and trials is not None:
         raise StereoplotterError(
             "the pymunk back-end runs single procedures; use --backend closed-form for --trials"
         )
     stop = None if trials is None else first_trial + trials
-    injected = prep.model.draw_keyed(prep.seed, first_trial, stop)
-    noise = Noise(prep.seed, trials, None, first_trial)
+    if injected is None:
+        injected = prep.model.draw_keyed(prep.seed, first_trial, stop)
+    if noise is None:
+        noise = Noise(prep.seed, trials, None, first_trial)
     run, q_std, q_grid = _run_one(prep, injected, trials, noise, transcript)
     evaluation = _evaluate(prep.scenario, prep.sheet, run) if evaluate else None
     return SimulationResult(
