@@ -569,7 +569,10 @@ def _verify(args: argparse.Namespace) -> int:
         geometry, scenarios = geometry_from_file(args.geometry)
     # the procedure MC once, shared by the table and the histograms
     with step_progress("procedure MC") as progress:
-        proc = run_procedure_mc(args.procedure_trials, args.seed, scenarios, progress=progress)
+        proc = run_procedure_mc(
+            args.procedure_trials, args.seed, scenarios, progress=progress,
+            instrument=args.instrument,
+        )
     with step_progress("verify") as progress:
         rows, seconds = verify(
             trials=args.trials,
@@ -926,8 +929,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--procedure-trials",
         type=bounded_int(0, MAX_VERIFY_TRIALS),
-        default=1500,
-        help="trials of the procedure MC (simulated operator) per overlap and method; 0 disables",
+        default=None,
+        help="trials of each procedure MC run (simulated operator); default: per configuration, "
+        "enough for a 1 %% CI; 0 disables",
+    )
+    p.add_argument(
+        "--instrument",
+        default="sc1",
+        help="instrument of the procedure MC, ideal and with its error terms (default: "
+        "%(default)s, the book's SC-1)",
     )
     p.add_argument(
         "--geometry",
