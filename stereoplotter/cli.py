@@ -453,8 +453,15 @@ def _setup_job(args: argparse.Namespace) -> int:
     from stereoplotter.io.job_file import load_job
     from stereoplotter.report.job import compute_job, pair_dict, write_job
 
-    given = [o for o, v in (("--seed", args.seed), ("--horizontal-scale", args.horizontal_scale),
-                            ("--vertical-scale", args.vertical_scale)) if v is not None]
+    given = [
+        o
+        for o, v in (
+            ("--seed", args.seed),
+            ("--horizontal-scale", args.horizontal_scale),
+            ("--vertical-scale", args.vertical_scale),
+        )
+        if v is not None
+    ]
     if given:
         raise StereoplotterError(
             f"{args.scenario}: {given[0]}: expected nothing for a job file, found a value (a job "
@@ -472,19 +479,23 @@ def _setup_job(args: argparse.Namespace) -> int:
     if args.json:
         return 0
     accepted = sum(p.accepted for p in result.pairs)
-    lines = [f"job {job.name} on {result.spec.title}: {accepted} of {len(result.pairs)} pairs "
-             "set up"]
+    lines = [
+        f"job {job.name} on {result.spec.title}: {accepted} of {len(result.pairs)} pairs set up"
+    ]
     for p in result.pairs:
         s = p.sheet
         lines.append(
             f"  {p.pair.name}: M_г = 1:{s.horizontal_scale_denominator}, M_в = "
             f"1:{s.vertical_scale_denominator}, f_пр = {s.f_instrument_mm:.3f} mm, n_л = "
-            f"{s.n_left:.5f}, n_п = {s.n_right:.5f}" if s is not None
+            f"{s.n_left:.5f}, n_п = {s.n_right:.5f}"
+            if s is not None
             else f"  {p.pair.name}: REFUSED: {p.reason}"
         )
     pdfs = sum(n.endswith("/sheet.pdf") for n in names)
-    lines.append(f"written: <pair>/sheet.yaml, sheet.md, sheet.pdf ({pdfs} forms), forms.pdf, "
-                 f"block.csv, refused.md in {out}")
+    lines.append(
+        f"written: <pair>/sheet.yaml, sheet.md, sheet.pdf ({pdfs} forms), forms.pdf, "
+        f"block.csv, refused.md in {out}"
+    )
     sys.stdout.write("\n".join(lines) + "\n")
     return 0
 
@@ -570,7 +581,10 @@ def _verify(args: argparse.Namespace) -> int:
     # the procedure MC once, shared by the table and the histograms
     with step_progress("procedure MC") as progress:
         proc = run_procedure_mc(
-            args.procedure_trials, args.seed, scenarios, progress=progress,
+            args.procedure_trials,
+            args.seed,
+            scenarios,
+            progress=progress,
             instrument=args.instrument,
         )
     with step_progress("verify") as progress:
@@ -731,7 +745,6 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
-
 
 
 def _add_budget_parser(sub: Any) -> None:

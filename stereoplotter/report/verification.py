@@ -93,8 +93,7 @@ def _markdown(rows, closing, meta):
         "# Verification of Kushtin & Lyskov 1984, §27 and chapter 5",
         "",
         f"trials = {meta['trials']}, seed = {meta['seed']}, CI = ±{mc.CI_Z} s.e. (99.9 %),"
-        f" runtime {meta['seconds']:.1f} s"
-        + _procedure_trials_text(meta.get("procedure_trials")),
+        f" runtime {meta['seconds']:.1f} s" + _procedure_trials_text(meta.get("procedure_trials")),
         "",
         "Verdicts are decided from the numbers (stereoplotter/verification/verdicts.py): a printed "
         "number agrees when the value rounded or truncated to its decimals equals it (both are "

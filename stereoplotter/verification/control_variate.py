@@ -35,10 +35,10 @@ from stereoplotter.instrument.error_model import ErrorModel
 from stereoplotter.procedure.operator import Noise
 
 __all__ = [
+    "STEP",
     "DesignNoise",
     "LinearControl",
     "RecordingNoise",
-    "STEP",
     "design_inputs",
     "linear_control",
     "per_trial_controlled",
@@ -138,9 +138,7 @@ def linear_control(
         else:
             injected[key] = s * model.term(key).scale
     fields = run(injected, DesignNoise(trials, steps), trials)
-    variance = np.array(
-        [1.0] * len(keys) + [_VARIANCE[t.distribution] for t in terms], float
-    )
+    variance = np.array([1.0] * len(keys) + [_VARIANCE[t.distribution] for t in terms], float)
     center, gradient, expectation = {}, {}, {}
     for name, v in fields.items():
         v = np.asarray(v, float).reshape(trials, -1)

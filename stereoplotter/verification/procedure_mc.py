@@ -239,9 +239,10 @@ def _height_errors_parallax(sc, sheet, inst, frame_pts):
     units = inst.state()["units"]
     setting, left, right = inst.setting, units["left"], units["right"]
     gear = float(sheet.vertical_scale_denominator)
-    slip = np.asarray(inst.read(HEIGHT_SCALE, exact=True), float) + np.asarray(
-        inst.read("Z", exact=True), float
-    ) * gear / 1000.0
+    slip = (
+        np.asarray(inst.read(HEIGHT_SCALE, exact=True), float)
+        + np.asarray(inst.read("Z", exact=True), float) * gear / 1000.0
+    )
     if ev._trial_count(setting, (left, right)) is not None:
         setting = ev._with_point_axis(setting)
         left, right = ev._with_point_axis(left), ev._with_point_axis(right)
@@ -516,12 +517,16 @@ def _formulas(method, scenario, spec, g, sources, control):
     """The rigorous formula at the simulated geometry for the statistic (per its unit)."""
     f, p, c, a, n, ll = g["f"], g["p"], g["c"], g["a"], g["n"], g["l"]
     if method == "setup":
-        return {"rigorous": float(sa.setup_parallax_rms_from_pointing(f, p, c, ll, n, 1.0,
-                                                                      mode="rigorous"))}
+        return {
+            "rigorous": float(
+                sa.setup_parallax_rms_from_pointing(f, p, c, ll, n, 1.0, mode="rigorous")
+            )
+        }
     if method == "setup_control":
         if control == "exact":  # (6.47)–(6.50) per m_xy
-            return {"rigorous": float(sa.setup_relative_residual_rms(a, c, f, ll, n, 1.0,
-                                                                     "rigorous"))}
+            return {
+                "rigorous": float(sa.setup_relative_residual_rms(a, c, f, ll, n, 1.0, "rigorous"))
+            }
         # (6.58)/(6.59) per m_p with m_xy = √2 m_p and control parallaxes with m_p
         residual = sa.setup_relative_residual_rms(a, c, f, ll, n, math.sqrt(2.0), "rigorous")
         geodetic = geodetic_orientation_parallax_rms(a, c, p, f, 1.0, "rigorous")
@@ -641,8 +646,11 @@ def procedure_mc(
     best = controlled or plain
     fields = {}
     if method != "conventional":  # one run, the three readings of §27 tasks 1 and 2
-        for key, m, c in (("parallax", "setup", "exact"), ("levelled", "setup_control", "exact"),
-                          ("observed", "setup_control", "observed")):
+        for key, m, c in (
+            ("parallax", "setup", "exact"),
+            ("levelled", "setup_control", "exact"),
+            ("observed", "setup_control", "observed"),
+        ):
             cf, h = _rms_ci(best[key], units[key])
             fields[key] = {
                 "coefficient": cf,
@@ -806,7 +814,6 @@ def relative_orientation_mc(
         ``unlevelled`` (RMS/σ_q without the plane removal), ``trials``, geometry, ``seconds``.
     """
     import time
-
 
     t0 = time.perf_counter()
     sc = idealised_geometry(scenario) if ideal_geometry else scenario

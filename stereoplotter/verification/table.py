@@ -24,7 +24,6 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
-from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
 from stereoplotter.verification.procedure_mc import procedure_mc
@@ -91,6 +90,8 @@ PROCEDURE_TRIALS = {"setup": 45000, "conventional": 1500, "y_parallax": 3000, "s
 #: Trials of the runs with every instrument error term at its σ (``mc_procedure_instrument``;
 #: a comparison with the ideal instrument, not held to 1 %).
 INSTRUMENT_TRIALS = {"setup": 4000, "conventional": 600, "y_parallax": 600, "stereo": 300}
+
+
 def _row_specs(g) -> list[Entry]:
     """Every row of the table as an :class:`~stereoplotter.verification.entry.Entry`, in order
     (the order fixes each row's random stream)."""
@@ -153,8 +154,7 @@ def check_geometry(fields, geometry: dict) -> None:
         if not all(math.isfinite(v) for v in values):
             raise fields.error(
                 "(geometry)",
-                "values of " + ", ".join(BOOK) + " for which every formula of the table is "
-                "finite",
+                "values of " + ", ".join(BOOK) + " for which every formula of the table is finite",
                 f"{entry.eq} {entry.quantity}: {values}",
             )
 
@@ -336,8 +336,11 @@ def _procedure_note(eq, res, field, scaled):
             "squares of (6.31)/(6.33); the loops stop when a check passes; tilted photos and "
             "relief of the scenario"
         )
-    part = {"both": "σ_q = σ_p = σ", "y_parallax": "σ_q only (the (5.54) part)",
-            "stereo": "σ_p only (the (5.55) part" + (", × f/p: k" if scaled else "") + ")"}
+    part = {
+        "both": "σ_q = σ_p = σ",
+        "y_parallax": "σ_q only (the (5.54) part)",
+        "stereo": "σ_p only (the (5.55) part" + (", × f/p: k" if scaled else "") + ")",
+    }
     return (
         f"{head}. Measured: {part[res['sources']]}, per σ; the heights as read on the slipped "
         "height scale, standard points at a = c − p, the height datum the mean of the four "
@@ -413,8 +416,9 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
         if pr is not None:
             v, h, ref = procedure_value(pr, field, scaled)
             r["mc_procedure"], r["mc_procedure_ci"], r["mc_procedure_formula"] = v, h, ref
-            r["note"] = r["note"].replace(PROCEDURE_NOTE, _procedure_note(r["eq"], pr, field,
-                                                                          scaled))
+            r["note"] = r["note"].replace(
+                PROCEDURE_NOTE, _procedure_note(r["eq"], pr, field, scaled)
+            )
         pi = proc.get((slot, config, "instrument"))
         if pi is not None:
             v, h, _ = procedure_value(pi, field, scaled)
