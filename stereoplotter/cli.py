@@ -573,20 +573,14 @@ def _simulate(args: argparse.Namespace) -> int:
 def _verify(args: argparse.Namespace) -> int:
     from stereoplotter.io.geometry_file import geometry_from_file
     from stereoplotter.progress import step_progress
-    from stereoplotter.report.verification import run_procedure_mc, verify
+    from stereoplotter.report.verification import start_procedure_mc, verify
 
     geometry, scenarios = None, None
     if args.geometry:
         geometry, scenarios = geometry_from_file(args.geometry)
-    # the procedure MC once, shared by the table and the histograms
-    with step_progress("procedure MC") as progress:
-        proc = run_procedure_mc(
-            args.procedure_trials,
-            args.seed,
-            scenarios,
-            progress=progress,
-            instrument=args.instrument,
-        )
+    # the procedure MC once, shared by the table and the histograms; its runs go on in worker
+    # processes while the linear rows are computed
+    pending = start_procedure_mc(args.procedure_trials, args.seed, scenarios, args.instrument)
     with step_progress("verify") as progress:
         rows, seconds = verify(
             trials=args.trials,
@@ -596,6 +590,8 @@ def _verify(args: argparse.Namespace) -> int:
             progress=progress,
             procedure_trials=0,
         )
+    with step_progress("procedure MC") as progress:
+        proc = pending.result(progress)
     if proc:
         from stereoplotter.verification.table import attach_procedure_mc
 

@@ -25,6 +25,7 @@ __all__ = [
     "book_instrument",
     "book_scenarios",
     "run_procedure_mc",
+    "start_procedure_mc",
     "verify",
     "write_verification",
 ]
@@ -56,12 +57,18 @@ def run_procedure_mc(
     ``scenarios`` (loaded, "60"/"80" → Scenario or None) default to the book's
     (:func:`book_scenarios`), the instrument by name (default the book's SC-1). ``trials``:
     None for the per-configuration defaults, 0 for none."""
+    return start_procedure_mc(trials, seed, scenarios, instrument).result(progress)
+
+
+def start_procedure_mc(trials=None, seed=20240601, scenarios=None, instrument=BOOK_INSTRUMENT):
+    """:func:`stereoplotter.verification.table.start_procedure_mc` with the files loaded here
+    (arguments as :func:`run_procedure_mc`): the runs start in worker processes."""
     if trials == 0:
-        return {}
+        return table.PendingProcedureMC([], [], 1)
     if scenarios is None:
         scenarios = book_scenarios()
     spec = book_instrument(instrument) if any(scenarios.values()) else None
-    return table.run_procedure_mc(trials, seed, scenarios, progress, instrument=spec)
+    return table.start_procedure_mc(trials, seed, scenarios, instrument=spec)
 
 
 def _fmt(v, digits=4):
