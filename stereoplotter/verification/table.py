@@ -339,13 +339,15 @@ class PendingProcedureMC:
 
 def procedure_value(res: dict, field: str | None, scaled: bool) -> tuple[float, float, float]:
     """(value, CI half-width, rigorous formula at the simulated geometry) of a row from its
-    procedure-MC run: the ``field`` of a setup run, or the run's coefficient; × f/p if
-    ``scaled``."""
+    procedure-MC run: the ``field`` of a setup run, or the run's coefficient (the formula then
+    with the levelling plane at the procedure's control points,
+    :func:`~stereoplotter.verification.procedure_mc.levelling_formula`);
+    × f/p if ``scaled``."""
     if field is not None:
         f = res["fields"][field]
         v, h, ref = f["coefficient"], f["ci"], f["formula"]
-    else:
-        v, h, ref = res["coefficient"], res["ci"], res["formula"]["rigorous"]
+    else:  # the conventional formula with the plane at the procedure's own levelling points
+        v, h, ref = res["coefficient"], res["ci"], res["formula"]["procedure"]
     k = res["f"] / res["p"] if scaled else 1.0
     return v * k, h * k, ref * k
 
@@ -387,9 +389,10 @@ def _procedure_note(eq, res, field, scaled):
     return (
         f"{head}. Measured: {part[res['sources']]}, per σ; the heights as read on the slipped "
         "height scale, standard points at a = c − p, the height datum the mean of the four "
-        "levelling heights (the formula's plane), every loop 3 passes. The procedure levels on "
-        "the scenario's control points, not at x_п ∈ {−c, a}, y = ±c: the formula with the plane "
-        f"at the procedure's points gives {res['formula']['procedure']:.4f}. Mismatches: scaling "
+        "levelling heights (the formula's plane), every loop 3 passes. The formula is taken with "
+        "the plane at the procedure's levelling points (the scenario's control points nearest "
+        "standard points 3–6); at Fig. 39's x_п ∈ {−c, a}, y = ±c it gives "
+        f"{res['formula']['rigorous']:.4f}. Mismatches: scaling "
         "by b_x on plan control, relative orientation by (5.11); bias of the error-free run "
         f"{res['bias_mm'] * 1000:.1f} µm removed"
     )
