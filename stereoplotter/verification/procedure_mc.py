@@ -655,6 +655,7 @@ def procedure_mc(
             fields[key] = {
                 "coefficient": cf,
                 "ci": h,
+                "plain": _rms_ci(plain[key], units[key]),
                 "formula": _formulas(m, scenario, spec, g, sources, c)["rigorous"],
             }
         unit = units[name]
