@@ -524,7 +524,9 @@ def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
                 control,
                 before=before,
                 after=after,
-                unit="mm" if control in ("by", "bz") else "—",
+                unit="mm"
+                if control in ("by", "bz")
+                else ("tan" if control.startswith("k_") else "—"),
                 iteration=it,
                 equation="common tilt (q-neutral)",
             )
@@ -706,7 +708,7 @@ def c2_relative_by_elements(
                 control,
                 before=before,
                 after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "—",
+                unit="rad" if control.startswith("kappa") else "tan",
                 judgment_error=target,
                 residual=q_seen,
                 tolerance=tol,
@@ -777,7 +779,7 @@ def c2_relative_by_equations(
                 control,
                 before=before,
                 after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "—",
+                unit="rad" if control.startswith("kappa") else "tan",
                 iteration=it,
                 equation="(5.11)",
             )
@@ -906,8 +908,7 @@ def _level(
     tol = run.sheet.tolerances["control_height_m"]
     when = active if remedy else None  # the book's loop logs every iteration as before
     errs = [
-        _height_mean(run, pid, p, f"{key}/level/{pid}", active, pointings) - p[2]
-        for pid, p in rows
+        _height_mean(run, pid, p, f"{key}/level/{pid}", active, pointings) - p[2] for pid, p in rows
     ]
     resid = [e - errs[0] for e in errs]
     for (pid, _), r, e in zip(rows, resid, errs, strict=True):
@@ -940,12 +941,13 @@ def _level(
                 after = op.physical(control)
             op.log.add(
                 "C3",
-                f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: "
-                f"turn {control}",
+                f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: turn {control}",
                 control,
                 before=before,
                 after=after,
-                unit="mm" if control in ("by", "bz") else "—",
+                unit="mm"
+                if control in ("by", "bz")
+                else ("tan" if control.startswith("k_") else "—"),
                 iteration=it,
                 equation="levelling (assumption)",
                 remedy=remedy,
