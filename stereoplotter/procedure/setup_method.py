@@ -605,7 +605,7 @@ def stage2_transform(run: Run) -> None:
             seen.append(m4)
             op.log.add(
                 "2",
-                f"{side} photo: check mark 4 at MO_Y + n·y⁰₄",
+                f"{side} photo: check mark 4 at MO_Y{',п' if side == 'right' else ''} + n·y⁰₄",
                 "Y",
                 residual=m4,
                 tolerance=tol4,
