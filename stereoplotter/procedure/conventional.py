@@ -642,13 +642,15 @@ def _six_q(run, key: str, active, it: int, stage: str = "C2") -> list[NDArray[np
     imgs = run.scene.images(pts)
     seen = []
     for i in range(6):
-        q, _ = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
+        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
         seen.append(q)
         op.log.add(
             stage,
             f"standard point {i + 1}: fuse, judge the y-parallax",
             "",
             residual=q,
+            true=q_true,
+            judgment_error=q - q_true,
             tolerance=tol,
             passed=np.abs(q) <= tol,
             iteration=it,
@@ -692,7 +694,7 @@ def c2_relative_by_elements(
         for idx, control, element in _SEQUENCE:
             key = f"{key0}/a/{it}/{idx + 1}"
             img = (imgs[0][idx], imgs[1][idx])
-            q_seen, _ = op.fuse(pts[idx], img, key, active)
+            q_seen, q_true = op.fuse(pts[idx], img, key, active)
             target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
             before = op.physical(control)
             clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
@@ -711,6 +713,7 @@ def c2_relative_by_elements(
                 unit="rad" if control.startswith("kappa") else "tan",
                 judgment_error=target,
                 residual=q_seen,
+                true=q_true,
                 tolerance=tol,
                 passed=np.abs(q_seen) <= tol,
                 iteration=it,

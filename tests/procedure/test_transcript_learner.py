@@ -79,3 +79,13 @@ def test_closing_summary_counts_the_checks(run):
         line = next(x for x in summary.splitlines() if x.startswith(f"- {name}: still"))
         assert "→" in line
     assert transcript_text(run).endswith(summary)
+
+
+def test_conventional_y_parallax_records_carry_the_true_value():
+    r = simulate(load_scenario("pair60"), load_instrument("sc1"), method="conventional", seed=3)
+    recs = [x for x in r.transcript.records if "judge the y-parallax" in x.step]
+    assert recs and all(x.true is not None for x in recs)
+    for x in recs:
+        assert x.residual == pytest.approx(x.true + x.judgment_error, abs=1e-12)
+    text = r.transcript.to_text()
+    assert "n·o⁰" not in text and re.search(r"true [+-]\d+\.\d µm", text)
