@@ -287,6 +287,24 @@ def _span_loop(
     return its, ok, np.maximum(np.abs(dl), np.abs(dr))
 
 
+def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy: str, active):
+    """Log the ΔZ (6.9) setting; the word follows the sign: the Z counter counts the projection
+    distance D, so ΔZ > 0 (a larger D) lowers the carriage and ΔZ < 0 raises it. [m, mm]"""
+    direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
+    op.log.add(
+        stage,
+        f"ΔZ = {dz_shown:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
+        "Z",
+        before=depth,
+        after=depth + dz_mm,
+        reading=depth + dz_mm,
+        iteration=it,
+        equation="(6.9), (6.11)",
+        remedy=remedy,
+        when=active if remedy else None,
+    )
+
+
 def _correct_span(
     run: Run, stage: str, k: str, it: int, active, diffs, spans, remedy: str = ""
 ) -> None:
@@ -338,20 +356,15 @@ def _correct_span(
     op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
     shown = op.log.shown if np.ndim(beyond) else 0
     if not np.ravel(beyond)[shown]:
-        dz_shown = float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0])
-        # Z counts the projection distance D: a larger D puts the carriage lower
-        direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
-        op.log.add(
+        _log_delta_z(
+            op,
             stage,
-            f"ΔZ = {dz_shown:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
-            "Z",
-            before=depth,
-            after=depth + dz_mm,
-            reading=depth + dz_mm,
-            iteration=it,
-            equation="(6.9), (6.11)",
-            remedy=remedy,
-            when=active if remedy else None,
+            float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]),
+            depth,
+            dz_mm,
+            it,
+            remedy,
+            active,
         )
     bz = op.read("bz", f"{k}/bz")
     # D_п as the operator knows it: D + b_z from the b_z scale's nominal place of zero; scaled
