@@ -406,6 +406,25 @@ def _sheet_summary(sheet: Any) -> str:
     )
 
 
+def _check_sheet(args: argparse.Namespace) -> int:
+    """check-sheet: exit 0 when every value is within its tolerance, 1 otherwise."""
+    from stereoplotter.io.instrument_file import load_instrument
+    from stereoplotter.io.scenario_file import load_scenario
+    from stereoplotter.io.trainee_sheet import load_trainee_sheet
+    from stereoplotter.report.sheet_check import check_dict, check_text
+    from stereoplotter.setup.sheet import compute_setup_sheet
+    from stereoplotter.setup.sheet_check import check_sheet
+
+    trainee = load_trainee_sheet(args.sheet)
+    spec = load_instrument(args.instrument)
+    scenario = load_scenario(args.scenario)
+    seed = scenario.seed if args.seed is None else args.seed
+    sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(seed))
+    result = check_sheet(sheet, spec, trainee)
+    sys.stdout.write(_json(check_dict(result)) if args.json else check_text(result))
+    return 0 if result.passed else 1
+
+
 def _setup(args: argparse.Namespace) -> int:
     from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.io.scenario_file import load_scenario
@@ -848,6 +867,16 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument("--json", action="store_true", help="print the sheet as JSON")
 
+    p = sub.add_parser(
+        "check-sheet",
+        help="check a trainee's own setup sheet against the program's and name the mistakes",
+    )
+    p.add_argument("sheet", help="the trainee's sheet (YAML in the layout of sheet.yaml)")
+    p.add_argument("--scenario", required=True, help="the stereopair (a name or a YAML file)")
+    p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
+    p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
+    p.add_argument("--json", action="store_true", help="print the check as JSON")
+
     p = sub.add_parser("job", help="work with production job files (docs/production.md)")
     jobs = p.add_subparsers(dest="job_command", required=True, metavar="ACTION")
     j = jobs.add_parser(
@@ -1025,6 +1054,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _instrument(args)
         if args.command == "setup":
             return _setup(args)
+        if args.command == "check-sheet":
+            return _check_sheet(args)
         if args.command == "job":
             return _job(args)
         if args.command == "simulate":

@@ -23,6 +23,7 @@ from stereoplotter.io.geometry_file import GeometryFile
 from stereoplotter.io.instrument_file import InstrumentFile
 from stereoplotter.io.job_file import JobFile
 from stereoplotter.io.scenario_file import ScenarioFile
+from stereoplotter.io.trainee_sheet import TraineeSheet
 from stereoplotter.io.yaml_files import atomic_write_text
 
 __all__ = ["MODELS", "schema", "schema_text", "write_schemas"]
@@ -36,6 +37,7 @@ MODELS: dict[str, type[BaseModel]] = {
     "geometry": GeometryFile,
     "job": JobFile,
     "budget": BudgetOutput,  # an output: the JSON of `stereoplotter budget --json`
+    "trainee-sheet": TraineeSheet,
 }
 
 
