@@ -13,6 +13,7 @@ the stages before an exercise's first stage; replayed through a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,7 +21,6 @@ import numpy as np
 
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import (
-    RELATIVE_OPTIONS,
     c1_interior,
     c2_relative_by_elements,
     c3_absolute,
@@ -40,7 +40,13 @@ from stereoplotter.procedure.setup_method import (
 from stereoplotter.procedure.simulate import PreparedRun
 from stereoplotter.procedure.transcript import Transcript
 
-__all__ = ["OperatorRun", "RecordingInstrument", "new_instrument", "operator_run"]
+__all__ = [
+    "OperatorRun",
+    "RecordingInstrument",
+    "new_instrument",
+    "operator_run",
+    "stage_functions",
+]
 
 
 def _num(value: Any) -> Any:
@@ -168,30 +174,29 @@ def _conventional_stages(run: Run):
     return {"C1": c1, "C2": c2, "C3": c3, "C4": c4}
 
 
-def operator_run(prep: PreparedRun, seed: int) -> OperatorRun:
-    """Run the simulated operator (trial 0 of seed ``seed``) stage by stage, noting its actions.
-
-    The conventional method runs its relative orientation element by element
-    (``RELATIVE_OPTIONS[0]``), as ``simulate`` does by default.
-    """
-    assert RELATIVE_OPTIONS[0] == "elements"
-    inst = new_instrument(prep, seed, RecordingInstrument)
-    assert isinstance(inst, RecordingInstrument)
-    op = Operator(inst, prep.operator, Noise(seed, None, None, 0), Transcript())
-    run = Run(op, prep.sheet, prep.scene)
-    run.practice = prep.practice
-    if prep.method == "setup":
-        stages = {
+def stage_functions(run: Run, method: str) -> dict[str, Callable[[], None]]:
+    """The method's stages as callables on ``run``, in order (the conventional method's
+    relative orientation element by element, ``RELATIVE_OPTIONS[0]``, as ``simulate`` does)."""
+    if method == "setup":
+        return {
             "1": lambda: stage1_scale_coefficient(run),
             "2": lambda: stage2_transform(run),
             "3": lambda: stage3_scale_model(run),
             "4": lambda: stage4_orient_sheet(run),
             "5": lambda: stage5_check(run),
         }
-    else:
-        stages = _conventional_stages(run)
+    return _conventional_stages(run)
+
+
+def operator_run(prep: PreparedRun, seed: int) -> OperatorRun:
+    """Run the simulated operator (trial 0 of seed ``seed``) stage by stage, noting its actions."""
+    inst = new_instrument(prep, seed, RecordingInstrument)
+    assert isinstance(inst, RecordingInstrument)
+    op = Operator(inst, prep.operator, Noise(seed, None, None, 0), Transcript())
+    run = Run(op, prep.sheet, prep.scene)
+    run.practice = prep.practice
     ends = {}
-    for name, fn in stages.items():
+    for name, fn in stage_functions(run, prep.method).items():
         inst.stage = name
         fn()
         ends[name] = len(inst.actions)

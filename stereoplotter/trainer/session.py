@@ -73,6 +73,7 @@ class _Undoable:
     records: dict[str, Any]
     stage_index: int
     claimed: list[str]
+    at_claim: dict[str, Instrument]
 
 
 class Session:
@@ -92,6 +93,8 @@ class Session:
         self.locked: list[str] = []
         self.records: dict[str, Any] = {}
         self.claimed: list[str] = []
+        #: Stage → a copy of the instrument when the trainee claimed it (graded on it).
+        self.at_claim: dict[str, Instrument] = {}
         self.stage_index = 0
         self.log: list[dict[str, Any]] = []
         self.hints_used: list[int] = []
@@ -272,7 +275,9 @@ class Session:
         il, ir = self._std_images
         pl, pr = (np.asarray(p, float).reshape(-1) for p in self.inst.marks())
         i = int(np.argmin(np.hypot(*(il - pl).T)))
-        op = Operator(self.inst, self.prep.operator, Noise(0, None, None, 0), Transcript(False))
+        op = Operator(
+            self.inst, self.prep.operator, Noise(0, None, None, 0), Transcript(enabled=False)
+        )
         q = op.y_parallax(
             self.prep.scene.standard_points_m[i : i + 1], (il[i : i + 1], ir[i : i + 1])
         )
@@ -345,6 +350,7 @@ class Session:
             copy.deepcopy(self.records),
             self.stage_index,
             list(self.claimed),
+            dict(self.at_claim),
         )
 
     def _restore(self, snap: _Undoable) -> None:
@@ -354,6 +360,7 @@ class Session:
         self.records = snap.records
         self.stage_index = snap.stage_index
         self.claimed = snap.claimed
+        self.at_claim = snap.at_claim
 
     def act(self, action: dict[str, Any]) -> dict[str, Any]:
         """Carry out one action; returns the new state (see :meth:`state`).
@@ -432,6 +439,7 @@ class Session:
                 f"action claim: step: the stage in hand is {self.stage}, found {step!r}"
             )
         self.claimed.append(step)
+        self.at_claim[step] = _copy_instrument(self.inst)
         self.stage_index += 1
         return {"claimed": step}
 
