@@ -52,8 +52,9 @@ __all__ = [
 ]
 
 #: The largest |α|, |ω| of the photos in each tilt class (assumed: the book's "small tilts"
-#: of a few tenths of a degree up to the 3° of mountain photography). [degrees]
-TILT_TARGET_DEG = {"small": 0.7, "medium": 1.5, "large": 3.0}
+#: of a few tenths of a degree up to about 2.5°, inside the ±3° correction range of the
+#: instruments after the frame rotation of the sheet). [degrees]
+TILT_TARGET_DEG = {"small": 0.7, "medium": 1.5, "large": 2.5}
 #: Relief classes by (highest − lowest hill or slope effect) / flying height (assumed, the
 #: usual split of plain, hilly and mountain terrain for stereoplotter work). [—]
 RELIEF_CLASSES = {"flat": (0.0, 0.01), "hilly": (0.01, 0.15), "mountainous": (0.15, 10.0)}
@@ -118,8 +119,9 @@ def _relief_ratio(scenario: dict[str, Any]) -> float:
     terrain = scenario.get("terrain") or {}
     hills = terrain.get("hills") or []
     heights = [0.0] + [float(h["height_m"]) for h in hills]
-    xs = [float(p["local"]["X_m"]) for p in scenario["points"]]
-    ys = [float(p["local"]["Y_m"]) for p in scenario["points"]]
+    placed = [p["local"] for p in scenario.get("points", []) if isinstance(p.get("local"), dict)]
+    xs = [float(p["X_m"]) for p in placed] or [0.0]
+    ys = [float(p["Y_m"]) for p in placed] or [0.0]
     sx, sy = (float(v) for v in terrain.get("slope", (0.0, 0.0)))
     slope = abs(sx) * (max(xs) - min(xs)) + abs(sy) * (max(ys) - min(ys))
     relief = max(heights) - min(heights) + slope

@@ -38,9 +38,9 @@ STAGES = {"setup": ("1", "2", "3", "4", "5"), "conventional": ("C1", "C2", "C3",
 TERRAINS = ("flat", "hilly", "mountainous")
 #: Injected instrument errors: none, drawn and shown to the trainee, drawn and not shown.
 ERROR_MODES = ("off", "announced", "hidden")
-#: Tilt size classes of the photos; the largest tilt of the scenario's photos must fall in the
-#: class (the exercise file is refused otherwise). [degrees]
-TILTS = {"small": (0.0, 1.0), "medium": (1.0, 2.0), "large": (2.0, 3.5)}
+#: Tilt size classes of the photos (the io loader scales the scenario's α, ω to the class:
+#: ``stereoplotter.io.exercise_file.TILT_TARGET_DEG``).
+TILTS = ("small", "medium", "large")
 MODES = ("practice", "exam")
 #: What the trainee may use: the numeric y/x-parallax read-out, undo/redo, hints.
 ASSISTS = ("parallax_readout", "undo", "hints")

@@ -35,7 +35,7 @@ from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.trainer.actions import apply
 from stereoplotter.trainer.operator_steps import new_instrument, stage_functions
 from stereoplotter.trainer.outcome import Measure, stage_measures
-from stereoplotter.trainer.session import Session
+from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session
 
 __all__ = [
     "GRADE_FORMAT",
@@ -257,6 +257,12 @@ def grade(
             if pv is not None:
                 r = pv / m.tolerance
                 pop_ratio = r if pop_ratio is None else np.maximum(pop_ratio, r)
+        if stage in SUBSTITUTE_STAGES:
+            for n in ex.unusable_points:
+                row = _substitute_row(session, n)
+                rows.append(row)
+                ratios.append(row["value"] / row["tolerance"])
+                par_ratios.append(0.0)
         stages_out[stage] = {"claimed": stage in session.claimed, "measures": rows}
     score = max(ratios) if ratios else float("inf")
     controls = {
@@ -289,6 +295,28 @@ def grade(
             "seconds": round(pop_seconds, 3),
             "same_instrument": True,
         },
+    }
+
+
+#: A substitute for a standard point may lie this fraction of c from it (assumed: the relative
+#: orientation stays well determined while the six points keep roughly their pattern). [—]
+SUBSTITUTE_FRACTION = 0.2
+
+
+def _substitute_row(session: Session, n: int) -> dict[str, Any]:
+    """The distance of the recorded substitute from standard point n on the left photo. [mm]"""
+    il = session.prep.scene.images(session.prep.scene.standard_points_m)[0]
+    value = session.records.get(f"substitute {n}")
+    tol = SUBSTITUTE_FRACTION * session.prep.scene.c_mm
+    d = float(np.hypot(*(np.asarray(value, float) - il[n - 1]))) if value else float("inf")
+    return {
+        "name": f"substitute {n}: distance from the standard point (left photo)",
+        "value": d,
+        "tolerance": tol,
+        "unit": "mm",
+        "passed": d <= tol,
+        "par": 0.0,
+        "par_passed": True,
     }
 
 

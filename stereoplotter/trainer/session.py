@@ -48,9 +48,12 @@ from stereoplotter.trainer.exercise import STAGES, Exercise, resolve_exercise
 from stereoplotter.trainer.hints import hint_text
 from stereoplotter.trainer.operator_steps import OperatorRun, new_instrument, operator_run
 
-__all__ = ["LOG_FORMAT", "Session", "state_digest"]
+__all__ = ["LOG_FORMAT", "SUBSTITUTE_STAGES", "Session", "state_digest"]
 
 LOG_FORMAT = "stereoplotter-session/1"
+#: The stages that use the six standard points: an incomplete model's substitutes are recorded
+#: before they are claimed.
+SUBSTITUTE_STAGES = ("2", "C2")
 
 
 def state_digest(state: dict[str, Any]) -> str:
@@ -274,7 +277,10 @@ class Session:
             return None
         il, ir = self._std_images
         pl, pr = (np.asarray(p, float).reshape(-1) for p in self.inst.marks())
-        i = int(np.argmin(np.hypot(*(il - pl).T)))
+        distance = np.hypot(*(il - pl).T)
+        for n in self.exercise.unusable_points:  # on water or outside the overlap: no reading
+            distance[n - 1] = np.inf
+        i = int(np.argmin(distance))
         op = Operator(
             self.inst, self.prep.operator, Noise(0, None, None, 0), Transcript(enabled=False)
         )
@@ -438,6 +444,14 @@ class Session:
             raise TrainerError(
                 f"action claim: step: the stage in hand is {self.stage}, found {step!r}"
             )
+        if step in SUBSTITUTE_STAGES:
+            for n in self.exercise.unusable_points:
+                value = self.records.get(f"substitute {n}")
+                if not _is_point(value):
+                    raise TrainerError(
+                        f"action claim: standard point {n} is unusable: record 'substitute {n}' "
+                        "as [x_mm, y_mm] on the left photo first"
+                    )
         self.claimed.append(step)
         self.at_claim[step] = _copy_instrument(self.inst)
         self.stage_index += 1
@@ -474,8 +488,21 @@ class Session:
         for stage in self.stages:
             for a in self.par.stage_actions(stage):
                 script.append({k: v for k, v in a.items() if k != "stage"})
+            if stage in SUBSTITUTE_STAGES:  # the operator's substitute: the standard point itself
+                for n in self.exercise.unusable_points:
+                    xy = [float(v) for v in self._std_images[0][n - 1]]
+                    script.append({"kind": "record", "name": f"substitute {n}", "value": xy})
             script.append({"kind": "claim", "step": stage})
         return script
+
+
+def _is_point(value: Any) -> bool:
+    return (
+        isinstance(value, list)
+        and len(value) == 2
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        and all(math.isfinite(v) for v in value)
+    )
 
 
 def _finite(value: Any) -> Any:
