@@ -35,7 +35,7 @@ from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.trainer.actions import apply
 from stereoplotter.trainer.operator_steps import new_instrument, stage_functions
 from stereoplotter.trainer.outcome import Measure, stage_measures
-from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session
+from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session, json_finite
 
 __all__ = [
     "GRADE_FORMAT",
@@ -276,26 +276,28 @@ def grade(
     }
     if pop_ratio is not None:
         overall["percentile"] = percentile(score, pop_ratio)
-    return {
-        "format": GRADE_FORMAT,
-        "exercise": ex.name,
-        "title": ex.title,
-        "trainee": session.trainee,
-        "seed": session.seed,
-        "instrument": ex.spec.key,
-        "method": ex.method,
-        "mode": ex.mode,
-        "errors": ex.errors,
-        "stages": stages_out,
-        "overall": overall,
-        "process": process_measures(session.log, controls),
-        "par_process": process_measures(script, controls),
-        "population": {
-            "operators": population,
-            "seconds": round(pop_seconds, 3),
-            "same_instrument": True,
-        },
-    }
+    return json_finite(
+        {
+            "format": GRADE_FORMAT,
+            "exercise": ex.name,
+            "title": ex.title,
+            "trainee": session.trainee,
+            "seed": session.seed,
+            "instrument": ex.spec.key,
+            "method": ex.method,
+            "mode": ex.mode,
+            "errors": ex.errors,
+            "stages": stages_out,
+            "overall": overall,
+            "process": process_measures(session.log, controls),
+            "par_process": process_measures(script, controls),
+            "population": {
+                "operators": population,
+                "seconds": round(pop_seconds, 3),
+                "same_instrument": True,
+            },
+        }
+    )
 
 
 #: A substitute for a standard point may lie this fraction of c from it (assumed: the relative

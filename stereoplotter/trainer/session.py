@@ -48,7 +48,7 @@ from stereoplotter.trainer.exercise import STAGES, Exercise, resolve_exercise
 from stereoplotter.trainer.hints import hint_text
 from stereoplotter.trainer.operator_steps import OperatorRun, new_instrument, operator_run
 
-__all__ = ["LOG_FORMAT", "SUBSTITUTE_STAGES", "Session", "state_digest"]
+__all__ = ["LOG_FORMAT", "SUBSTITUTE_STAGES", "Session", "json_finite", "state_digest"]
 
 LOG_FORMAT = "stereoplotter-session/1"
 #: The stages that use the six standard points: an incomplete model's substitutes are recorded
@@ -321,7 +321,7 @@ class Session:
     def state(self) -> dict[str, Any]:
         """What the trainee sees (JSON-serialisable; the contract's keys; a value that is not
         finite, e.g. a range without a stop, is null)."""
-        return _finite(
+        return json_finite(
             {
                 "instrument": self.exercise.spec.key,
                 "stage": self.stage,
@@ -505,12 +505,12 @@ def _is_point(value: Any) -> bool:
     )
 
 
-def _finite(value: Any) -> Any:
+def json_finite(value: Any) -> Any:
     """``value`` with every non-finite float replaced by None (JSON has no inf, nan)."""
     if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
+        return {k: json_finite(v) for k, v in value.items()}
     if isinstance(value, list):
-        return [_finite(v) for v in value]
+        return [json_finite(v) for v in value]
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value
