@@ -18,6 +18,7 @@ from pydantic import BaseModel
 
 from stereoplotter.io.block_file import BlockFile
 from stereoplotter.io.errors_file import ErrorsFile
+from stereoplotter.io.exercise_file import ExerciseFile
 from stereoplotter.io.geometry_file import GeometryFile
 from stereoplotter.io.instrument_file import InstrumentFile
 from stereoplotter.io.job_file import JobFile
@@ -34,6 +35,7 @@ MODELS: dict[str, type[BaseModel]] = {
     "errors": ErrorsFile,
     "geometry": GeometryFile,
     "job": JobFile,
+    "exercise": ExerciseFile,
 }
 
 

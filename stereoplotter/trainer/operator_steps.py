@@ -188,8 +188,9 @@ def stage_functions(run: Run, method: str) -> dict[str, Callable[[], None]]:
     return _conventional_stages(run)
 
 
-def operator_run(prep: PreparedRun, seed: int) -> OperatorRun:
-    """Run the simulated operator (trial 0 of seed ``seed``) stage by stage, noting its actions."""
+def operator_run(prep: PreparedRun, seed: int, upto: str | None = None) -> OperatorRun:
+    """Run the simulated operator (trial 0 of seed ``seed``) stage by stage, noting its actions;
+    it stops after stage ``upto`` (default: the method's last)."""
     inst = new_instrument(prep, seed, RecordingInstrument)
     assert isinstance(inst, RecordingInstrument)
     op = Operator(inst, prep.operator, Noise(seed, None, None, 0), Transcript())
@@ -200,5 +201,7 @@ def operator_run(prep: PreparedRun, seed: int) -> OperatorRun:
         inst.stage = name
         fn()
         ends[name] = len(inst.actions)
+        if name == upto:
+            break
     inst.recording = False
     return OperatorRun(inst.actions, run, inst, ends)

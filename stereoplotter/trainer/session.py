@@ -90,7 +90,7 @@ class Session:
         self.prep: PreparedRun = prepare_run(
             exercise.scenario, exercise.spec, exercise.method, errors, self.seed
         )
-        self.par: OperatorRun = operator_run(self.prep, self.seed)
+        self.par: OperatorRun = operator_run(self.prep, self.seed, exercise.stages[-1])
         self.inst = new_instrument(self.prep, self.seed)
         self.commanded: dict[str, float] = {}
         self.locked: list[str] = []

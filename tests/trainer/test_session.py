@@ -64,3 +64,63 @@ def test_replay_refuses_a_tampered_log(stage1, tmp_path):
     records[1]["action"]["delta"] = 3.0
     with pytest.raises(TrainerError, match="does not replay"):
         Session.replay(records)
+
+
+def test_exam_mode_refuses_undo_and_hints():
+    s = Session.start(load_exercise("e11-setup-exam"), trainee="ann")
+    s.act({"kind": "turn", "control": "X", "delta": 1.0})
+    for action in ({"kind": "undo"}, {"kind": "hint", "level": 1}):
+        with pytest.raises(TrainerError, match="not allowed now"):
+            s.act(action)
+    assert s.state()["parallax"] is None  # no read-out in this exam
+
+
+def test_switching_a_counter_keeps_its_reading_and_reverses_it(stage1):
+    s = Session.start(stage1)
+    y0 = s.state()["counters"]["Y"]["value"]
+    s.act({"kind": "direction", "counter": "Y", "sign": -1})
+    assert s.state()["counters"]["Y"]["value"] == y0
+    assert s.state()["counters"]["Y"]["direction"] == -1
+    # the reversed counter shows 2 mm less where the normal one shows 2 mm more: the carriage
+    # stands where it stands after the normal counter is set to y0 + 2 (a second session)
+    s.act({"kind": "set", "control": "Y", "value": y0 - 2.0})
+    t = Session.start(stage1)
+    t.act({"kind": "set", "control": "Y", "value": y0 + 2.0})
+    assert float(s.inst.position("Y")) == float(t.inst.position("Y"))
+    assert float(s.inst.position("Y")) == pytest.approx(2.0, abs=0.01)  # from the plumb (0)
+
+
+def test_a_locked_control_refuses_to_turn(stage1):
+    s = Session.start(stage1)
+    s.act({"kind": "lock", "control": "bx"})
+    with pytest.raises(TrainerError, match="locked"):
+        s.act({"kind": "turn", "control": "bx", "delta": 0.1})
+
+
+def test_show_me_does_the_stage_as_the_operator(stage1):
+    """Hint level 3 replays the simulated operator's stage on the trainee's instrument: the
+    instrument ends where the operator's ended (its own instrument, driven by the procedure)."""
+    s = Session.start(stage1)
+    result = s.act({"kind": "hint", "level": 3})
+    assert s.log[-1]["result"]["applied"] == len(s.par.stage_actions("1")) > 0
+    assert result["counters"]["Z"]["value"] == pytest.approx(
+        float(s.par.instrument.read("Z")), abs=0
+    )
+
+
+def test_parallax_read_out_after_stage_2_is_within_the_tolerance():
+    """With no injected errors, after the operator's stage 2 the true y-parallax at the six
+    standard points is the residual the operator left: below the 12.5 µm tolerance (sheet)."""
+    s = Session.start(load_exercise("e03-setup-stage2"))
+    s.act({"kind": "hint", "level": 3})
+    y = s.state()["parallax"]["y_um"]
+    assert abs(y) < 1000.0 * s.prep.sheet.tolerances["residual_y_parallax_mm"]
+
+
+def test_an_incomplete_model_needs_its_substitutes_before_the_claim():
+    s = Session.start(load_exercise("e07-setup-stage2-incomplete"))
+    with pytest.raises(TrainerError, match="substitute 5"):
+        s.act({"kind": "claim", "step": "2"})
+    s.act({"kind": "record", "name": "substitute 5", "value": [1.0, 60.0]})
+    s.act({"kind": "record", "name": "substitute 6", "value": [1.0, -60.0]})
+    assert s.act({"kind": "claim", "step": "2"})["done"]
