@@ -67,7 +67,7 @@ def test_the_scripted_trainee_gets_the_operators_grade(replayed):
 def test_trial_zero_of_the_vectorised_population_is_the_par(replayed):
     """The population runs T operators at once on one instrument; its trial 0 has the par's
     judgments (same keyed noise), so the vectorised path must give the par's measures."""
-    s, path = replayed
+    s, _ = replayed
     pop = population_measures(s.prep, s.seed, s.stages, 3, s.inst.injected)
     g = grade(s, population=0)
     for stage, values in pop.items():
