@@ -304,6 +304,13 @@ class Session:
                 out.append({"name": name, "tolerance": _f(check.tolerance), "unit": check.unit})
         return out
 
+    def _announced(self) -> dict[str, float] | None:
+        """The injected errors when the exercise announces them (internal units: mm, rad,
+        relative), else None."""
+        if self.exercise.errors != "announced":
+            return None
+        return {k: _f(v) for k, v in sorted(self.inst.injected.items()) if _f(v) != 0.0}
+
     def allowed(self) -> list[str]:
         """The action kinds allowed now."""
         if self.stage is None:
@@ -336,6 +343,7 @@ class Session:
                 "done": self.stage is None,
                 "locked": list(self.locked),
                 "records": dict(self.records),
+                "injected_errors": self._announced(),
             }
         )
 

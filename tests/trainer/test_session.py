@@ -124,3 +124,10 @@ def test_an_incomplete_model_needs_its_substitutes_before_the_claim():
     s.act({"kind": "record", "name": "substitute 5", "value": [1.0, 60.0]})
     s.act({"kind": "record", "name": "substitute 6", "value": [1.0, -60.0]})
     assert s.act({"kind": "claim", "step": "2"})["done"]
+
+
+def test_announced_errors_are_shown_and_hidden_ones_are_not():
+    announced = Session.start(load_exercise("e04-setup-stage4")).state()["injected_errors"]
+    # the SPR-3's default error model draws zero-reading errors of every counter
+    assert set(announced) >= {f"zero_reading.{c}" for c in ("X", "Y", "Z", "bx", "by", "bz")}
+    assert Session.start(load_exercise("e08-setup-full")).state()["injected_errors"] is None
