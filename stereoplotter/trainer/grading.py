@@ -113,12 +113,16 @@ def process_measures(
 ) -> dict[str, Any]:
     """Process measures of a sequence of log records (or bare actions with a ``stage``).
 
+    The final approach of a lead screw is the side its last move finished from: the ``side`` of
+    the action when given, else the direction of the move.
+
     ``stage_controls``: stage → the controls the simulated operator turns in it (for "out of
     order"). Moves are ``turn`` and ``set`` actions; a ``set`` moves by the difference from the
     control's previous value where the log knows it (its own earlier turns and sets).
     """
     moves = reversals = iterations = out_of_order = hints = undos = refused = 0
     last_dir: dict[str, int] = {}
+    approach: dict[str, str] = {}
     last_value: dict[str, float] = {}
     touched_last: str | None = None
     seen: set[str] = set()
@@ -159,19 +163,23 @@ def process_measures(
                 reversals += 1
             if d:
                 last_dir[control] = d
+            if control in SCREWS and (d or action.get("side")):
+                # the last stroke: from the side asked for (the screw pre-positions beyond the
+                # target, PlayAxis.approach), else the direction of the move
+                side = action.get("side") or ("below" if d > 0 else "above")
+                approach[control] = f"from {side}"
             if control != touched_last and control in seen:
                 iterations += 1
             seen.add(control)
             touched_last = control
             if stage_controls and stage in stage_controls and control not in stage_controls[stage]:
                 out_of_order += 1
-    finals = {c: d for c, d in last_dir.items() if c in SCREWS}
     return {
         "time_s": (max(times) - min(times)) if times else None,
         "moves": moves,
         "reversals": reversals,
-        "final_approach_one_side": len(set(finals.values())) <= 1,
-        "final_approach": {c: "from below" if d > 0 else "from above" for c, d in finals.items()},
+        "final_approach_one_side": len(set(approach.values())) <= 1,
+        "final_approach": approach,
         "iterations": iterations,
         "steps_out_of_order": out_of_order,
         "checks_skipped": sum(1 for s in claimed if reads_in.get(s, 0) == 0),
