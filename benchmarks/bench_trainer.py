@@ -51,7 +51,7 @@ def bench(name: str, population: int) -> None:
     t = time.perf_counter()
     pop = population_measures(s.prep, s.seed, ex.stages, population, s.inst.injected)
     pop_s = time.perf_counter() - t
-    assert all(np.all(np.isfinite(v)) for vs in pop.values() for v in vs)
+    assert all(np.all(np.isfinite(v)) for vs in pop.values() for v in vs.values())
     print(
         f"{name}: start {start:.2f} s; {len(script)} actions in {acts:.2f} s = "
         f"{1000 * acts / len(script):.2f} ms/act; state() {1000 * state:.2f} ms; "

@@ -65,13 +65,13 @@ def population_measures(
     injected: dict[str, Any],
     chunk: int = CHUNK,
     progress: Callable[[int], None] | None = None,
-) -> dict[str, list[np.ndarray]]:
+) -> dict[str, dict[str, np.ndarray]]:
     """The measures of ``stages`` for ``trials`` simulated operators on one instrument.
 
-    Stage → the list of its measures' values, each an array (trials,). Every trial runs the
+    Stage → measure name → its values, an array (trials,). Every trial runs the
     method from stage 1 to the last of ``stages`` (its own presets too), vectorised per chunk.
     """
-    out: dict[str, list[list[np.ndarray]]] = {s: [] for s in stages}
+    out: dict[str, list[dict[str, np.ndarray]]] = {s: [] for s in stages}
     last = stages[-1]
     for first in range(0, trials, chunk):
         n = min(chunk, trials - first)
@@ -92,14 +92,14 @@ def population_measures(
             fn()
             if name in out:
                 out[name].append(
-                    [np.asarray(m.value, float) for m in stage_measures(inst, prep, name)]
+                    {m.name: np.asarray(m.value, float) for m in stage_measures(inst, prep, name)}
                 )
             if name == last:
                 break
         if progress is not None:
             progress(n)
     return {
-        s: [np.concatenate([c[i] for c in chunks]) for i in range(len(chunks[0]))]
+        s: {k: np.concatenate([c[k] for c in chunks]) for k in chunks[0]}
         for s, chunks in out.items()
     }
 
@@ -189,16 +189,17 @@ def process_measures(
     }
 
 
-def _measure_row(m: Measure, par: Measure, pop: np.ndarray | None) -> dict[str, Any]:
+def _measure_row(m: Measure, par: Measure | None, pop: np.ndarray | None) -> dict[str, Any]:
     value = float(np.asarray(m.value, float))
+    par_value = None if par is None else float(np.asarray(par.value, float))
     row = {
         "name": m.name,
         "value": value,
         "tolerance": float(m.tolerance),
         "unit": m.unit,
         "passed": bool(value <= m.tolerance),
-        "par": float(np.asarray(par.value, float)),
-        "par_passed": bool(float(np.asarray(par.value, float)) <= m.tolerance),
+        "par": par_value,
+        "par_passed": None if par_value is None else bool(par_value <= m.tolerance),
     }
     if pop is not None:
         row["percentile"] = percentile(value, pop)
@@ -221,33 +222,32 @@ def _par_measures(session: Session) -> dict[str, list[Measure]]:
 
 
 def _outcome(
-    session: Session, par: dict[str, list[Measure]], pop: dict[str, list[np.ndarray]]
+    session: Session, par: dict[str, list[Measure]], pop: dict[str, dict[str, np.ndarray]]
 ) -> tuple[dict[str, Any], list[float], list[float], np.ndarray | None]:
-    """Rows per stage, the trainee's and par's value/tolerance ratios, and the population's
-    largest ratio per operator."""
+    """Rows per stage (matched by measure name), the trainee's and the par's value/tolerance
+    ratios, and the population's largest ratio per operator."""
     ex = session.exercise
     stages_out = {}
-    ratios, par_ratios, pop_ratio = [], [], None
+    ratios: list[float] = []
+    par_ratios = [float(np.asarray(p.ratio)) for s in ex.stages for p in par[s]]
+    pop_ratio = None
     for stage in ex.stages:
-        inst = session.at_claim.get(stage, session.inst)
-        mine = stage_measures(inst, session.prep, stage)
-        rows = []
-        for i, m in enumerate(mine):
-            p = par[stage][i] if i < len(par[stage]) else m
-            values = pop.get(stage, [None] * len(mine))
-            pv = values[i] if i < len(values) and p.name == m.name else None
-            rows.append(_measure_row(m, p, pv))
-            ratios.append(rows[-1]["value"] / m.tolerance)
-            par_ratios.append(rows[-1]["par"] / m.tolerance)
-            if pv is not None:
-                r = pv / m.tolerance
+        par_by_name = {p.name: p for p in par[stage]}
+        pop_by_name = pop.get(stage, {})
+        for p in par[stage]:
+            if p.name in pop_by_name:
+                r = pop_by_name[p.name] / p.tolerance
                 pop_ratio = r if pop_ratio is None else np.maximum(pop_ratio, r)
+        inst = session.at_claim.get(stage, session.inst)
+        rows = []
+        for m in stage_measures(inst, session.prep, stage):
+            rows.append(_measure_row(m, par_by_name.get(m.name), pop_by_name.get(m.name)))
+            ratios.append(rows[-1]["value"] / m.tolerance)
         if stage in SUBSTITUTE_STAGES:
             for n in ex.unusable_points:
                 row = _substitute_row(session, n)
                 rows.append(row)
                 ratios.append(row["value"] / row["tolerance"])
-                par_ratios.append(0.0)
         stages_out[stage] = {"claimed": stage in session.claimed, "measures": rows}
     return stages_out, ratios, par_ratios, pop_ratio
 

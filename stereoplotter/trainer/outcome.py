@@ -147,10 +147,13 @@ def stage_measures(inst: Instrument, prep: PreparedRun, stage: str) -> list[Meas
     tol = prep.sheet.tolerances
     lc = prep.spec.xy_least_count_mm
     out: list[Measure] = []
-    if stage == "1" and not np.all(np.isinf(_f_error(inst, prep))):
+    f_unset = bool(np.all(np.isinf(_f_error(inst, prep))))
+    if f_unset:  # nothing is projected yet: the stage's measures cannot be taken
+        out.append(Measure("f_пр not set", 1.0, 0.5, "—"))
+    if stage == "1" and not f_unset:
         span = _span_error(inst, prep)
         out.append(Measure("scale coefficient |L − L′| (true)", span, tol["mark_span_mm"], "mm"))
-    if stage == "C1":
+    if stage == "C1" and not f_unset:
         out.append(Measure("f_пр as set − sheet f_пр", _f_error(inst, prep), lc, "mm"))
     if stage == "1":
         geared = inst._height_gear == float(prep.sheet.vertical_scale_denominator)
@@ -158,8 +161,8 @@ def stage_measures(inst: Instrument, prep: PreparedRun, stage: str) -> list[Meas
         out.append(Measure("height counter not geared for M_в", value + (not geared), 0.5, "—"))
     if stage in ("1", "C1"):
         return out
-    if np.all(np.isinf(_f_error(inst, prep))):
-        return [Measure("f_пр not set", 1.0, 0.5, "—")]
+    if f_unset:
+        return out
     if stage not in ("2", "C2", "3", "C3", "4", "5", "C4"):
         raise ValueError(f"no stage {stage!r}")
     if stage in ("2", "C2", "3", "C3"):

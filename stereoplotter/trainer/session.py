@@ -47,6 +47,7 @@ from stereoplotter.trainer.actions import (
 from stereoplotter.trainer.exercise import STAGES, Exercise, resolve_exercise
 from stereoplotter.trainer.hints import hint_text
 from stereoplotter.trainer.operator_steps import OperatorRun, new_instrument, operator_run
+from stereoplotter.trainer.outcome import stage_measures
 
 __all__ = ["LOG_FORMAT", "SUBSTITUTE_STAGES", "Session", "json_finite", "state_digest"]
 
@@ -397,7 +398,7 @@ class Session:
         }
         try:
             check_action(action)
-            record["result"] = self._do(clean, before)
+            record["result"] = json_finite(self._do(clean, before))
         except TrainerError as exc:
             record["refused"] = str(exc)
             after = self.state()
@@ -463,7 +464,19 @@ class Session:
         self.claimed.append(step)
         self.at_claim[step] = _copy_instrument(self.inst)
         self.stage_index += 1
-        return {"claimed": step}
+        out: dict[str, Any] = {"claimed": step}
+        if self.exercise.mode == "practice":  # feedback: the stage's true outcome
+            out["measures"] = [
+                {
+                    "name": m.name,
+                    "value": _f(m.value),
+                    "tolerance": float(m.tolerance),
+                    "unit": m.unit,
+                    "passed": bool(_f(m.value) <= m.tolerance),
+                }
+                for m in stage_measures(self.inst, self.prep, step)
+            ]
+        return out
 
     def _hint(self, level: int) -> dict[str, Any]:
         stage = self.stage

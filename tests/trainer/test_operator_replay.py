@@ -71,7 +71,8 @@ def test_trial_zero_of_the_vectorised_population_is_the_par(replayed):
     pop = population_measures(s.prep, s.seed, s.stages, 3, s.inst.injected)
     g = grade(s, population=0)
     for stage, values in pop.items():
-        rows = g["stages"][stage]["measures"]
-        for row, v in zip(rows, values, strict=False):
-            assert v[0] == pytest.approx(row["par"], rel=1e-12, abs=1e-15), (stage, row["name"])
-        assert np.all(np.isfinite(np.concatenate(values)))
+        rows = {row["name"]: row for row in g["stages"][stage]["measures"]}
+        assert set(values) == set(rows)
+        for name, v in values.items():
+            assert v[0] == pytest.approx(rows[name]["par"], rel=1e-12, abs=1e-15), (stage, name)
+            assert np.all(np.isfinite(v))

@@ -131,3 +131,18 @@ def test_announced_errors_are_shown_and_hidden_ones_are_not():
     # the SPR-3's default error model draws zero-reading errors of every counter
     assert set(announced) >= {f"zero_reading.{c}" for c in ("X", "Y", "Z", "bx", "by", "bz")}
     assert Session.start(load_exercise("e08-setup-full")).state()["injected_errors"] is None
+
+
+def test_a_practice_claim_tells_the_stages_true_outcome(stage1, tmp_path):
+    s = Session.start(stage1)
+    s.act({"kind": "claim", "step": "1"})  # nothing done: f_пр not set, counter not geared
+    result = s.log[-1]["result"]
+    assert result["claimed"] == "1"
+    assert [(m["name"], m["passed"]) for m in result["measures"]] == [
+        ("f_пр not set", False),
+        ("height counter not geared for M_в", False),
+    ]
+    write_log(tmp_path / "a.jsonl", s)  # the log stays JSON (no inf, no nan)
+    exam = Session.start(load_exercise("e11-setup-exam"))
+    exam.act({"kind": "claim", "step": "1"})
+    assert "measures" not in exam.log[-1]["result"]
