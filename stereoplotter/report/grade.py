@@ -53,7 +53,8 @@ def grade_markdown(grade: dict[str, Any]) -> str:
         f"{_num(overall['score'])} (largest value/tolerance, ≤ 1 passes); par "
         f"{_num(overall['par_score'])}"
         + (
-            f"; better than or equal to {overall['percentile']:.1f} % of "
+            f"; better than or equal to {overall['percentile']:.1f} % "
+            f"(± {overall['percentile_se']:.1f} %) of "
             f"{grade['population']['operators']} simulated operators on the same instrument"
             if "percentile" in overall
             else ""

@@ -293,7 +293,12 @@ def grade(
         "par_score": max(par_ratios) if par_ratios else None,
     }
     if pop_ratio is not None:
-        overall["percentile"] = percentile(score, pop_ratio)
+        pct = percentile(score, pop_ratio)
+        overall["percentile"] = pct
+        # binomial standard error of a share estimated from N operators [%]
+        overall["percentile_se"] = 100.0 * float(
+            np.sqrt(pct / 100.0 * (1.0 - pct / 100.0) / len(pop_ratio))
+        )
     return json_finite(
         {
             "format": GRADE_FORMAT,
