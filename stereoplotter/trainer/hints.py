@@ -1,6 +1,7 @@
 """Hints to a trainee: level 1 what to do, level 2 which control (the session lists the
 controls the simulated operator turns in the stage), level 3 show me (the session lets the
-simulated operator do the stage).
+simulated operator do the stage). Every level also lists the steps of the simulated operator's
+transcript in the stage, each once, in the order first taken.
 
 The texts follow the stages of ``docs/procedure.md`` (the book's §27 for the setup-data method,
 §26 for the conventional method).

@@ -66,10 +66,15 @@ class RecordingInstrument(Instrument):
         self.stage = ""
         self.recording = True
         self._depth = 0
+        #: The operator's transcript (set by :func:`operator_run`): each action notes how many
+        #: records it held, so that the action's step is the next record's.
+        self.transcript: Transcript | None = None
+        self.record_index: list[int] = []
 
     def _note(self, action: dict[str, Any]) -> None:
         if self.recording and self._depth == 0:
             self.actions.append({**action, "stage": self.stage})
+            self.record_index.append(len(self.transcript.records) if self.transcript else 0)
 
     def set(self, control, reading, side=None) -> None:  # type: ignore[override]
         self._depth += 1  # the height scale sets Z: only the outer call is the operator's
@@ -144,10 +149,20 @@ class OperatorRun:
     run: Run
     instrument: RecordingInstrument
     stage_ends: dict[str, int] = field(default_factory=dict)
+    #: Per action, the step of the transcript it belongs to (the first record written after it).
+    steps: list[str] = field(default_factory=list)
 
     def stage_actions(self, stage: str) -> list[dict[str, Any]]:
         """The actions of one stage."""
         return [a for a in self.actions if a["stage"] == stage]
+
+    def stage_steps(self, stage: str) -> list[str]:
+        """The steps of one stage in the operator's order (repeats of a step in a row once)."""
+        out: list[str] = []
+        for action, step in zip(self.actions, self.steps, strict=True):
+            if action["stage"] == stage and step and (not out or out[-1] != step):
+                out.append(step)
+        return out
 
 
 def _conventional_stages(run: Run):
@@ -194,6 +209,7 @@ def operator_run(prep: PreparedRun, seed: int, upto: str | None = None) -> Opera
     inst = new_instrument(prep, seed, RecordingInstrument)
     assert isinstance(inst, RecordingInstrument)
     op = Operator(inst, prep.operator, Noise(seed, None, None, 0), Transcript())
+    inst.transcript = op.log
     run = Run(op, prep.sheet, prep.scene)
     run.practice = prep.practice
     ends = {}
@@ -204,4 +220,8 @@ def operator_run(prep: PreparedRun, seed: int, upto: str | None = None) -> Opera
         if name == upto:
             break
     inst.recording = False
-    return OperatorRun(inst.actions, run, inst, ends)
+    records = op.log.records
+    steps = [
+        records[min(i, len(records) - 1)].step if records else "" for i in inst.record_index
+    ]
+    return OperatorRun(inst.actions, run, inst, ends, steps)

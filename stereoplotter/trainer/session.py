@@ -487,6 +487,8 @@ class Session:
             "level": level,
             "text": hint_text(self.exercise.method, stage, level),
         }
+        # the operator's steps of the stage, each once, in the order first taken
+        out["steps"] = list(dict.fromkeys(self.par.stage_steps(stage)))
         if level == 3:  # show me: the simulated operator does the stage on this instrument
             for a in actions:
                 apply(self.inst, a, self.commanded)

@@ -146,3 +146,14 @@ def test_a_practice_claim_tells_the_stages_true_outcome(stage1, tmp_path):
     exam = Session.start(load_exercise("e11-setup-exam"))
     exam.act({"kind": "claim", "step": "1"})
     assert "measures" not in exam.log[-1]["result"]
+
+
+def test_a_hint_lists_the_operators_steps_of_the_stage(stage1):
+    s = Session.start(stage1)
+    s.act({"kind": "hint", "level": 1})
+    steps = s.log[-1]["result"]["steps"]
+    # the steps are the operator's transcript records of stage 1, each once
+    transcript = [r.step for r in s.par.run.op.log.records if r.stage == "1"]
+    assert steps == list(dict.fromkeys(s for s in transcript if s in steps))
+    assert set(steps) <= set(transcript)
+    assert steps  # (the texts are the procedure's labels: not pinned here)
