@@ -49,12 +49,22 @@ from stereoplotter.trainer.hints import hint_text
 from stereoplotter.trainer.operator_steps import OperatorRun, new_instrument, operator_run
 from stereoplotter.trainer.outcome import stage_measures
 
-__all__ = ["LOG_FORMAT", "SUBSTITUTE_STAGES", "Session", "json_finite", "state_digest"]
+__all__ = [
+    "LOG_FORMAT",
+    "SUBSTITUTE_STAGES",
+    "UNDO_DEPTH",
+    "Session",
+    "json_finite",
+    "state_digest",
+]
 
 LOG_FORMAT = "stereoplotter-session/1"
 #: The stages that use the six standard points: an incomplete model's substitutes are recorded
 #: before they are claimed.
 SUBSTITUTE_STAGES = ("2", "C2")
+#: Undo steps kept (each about 16 kB: a copy of the instrument, measured on e08); older ones
+#: are dropped (assumed: a trainee undoes a few moves, not a stage's hundreds).
+UNDO_DEPTH = 500
 
 
 def state_digest(state: dict[str, Any]) -> str:
@@ -445,6 +455,7 @@ class Session:
             result = self._claim(str(action["step"]))
         if snap is not None:
             self._undo.append(snap)
+            del self._undo[:-UNDO_DEPTH]
             self._redo.clear()
         return result
 
