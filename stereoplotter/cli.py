@@ -948,6 +948,14 @@ def _parser() -> argparse.ArgumentParser:
         default=10_000,
         help="simulated operators for the percentile (0: none; default: %(default)s)",
     )
+
+    p = sub.add_parser(
+        "trainer",
+        help="serve the browser trainer (needs the extra stereoplotter[trainer]; docs/trainer.md)",
+    )
+    p.add_argument("--host", default="127.0.0.1", help="address to listen on (default: %(default)s)")
+    p.add_argument("--port", type=non_negative_int, default=8000, help="port (default: %(default)s)")
+    p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
     return parser
 
 
@@ -1068,6 +1076,20 @@ def _grade(args: argparse.Namespace) -> int:
     return 0
 
 
+def _trainer(args: argparse.Namespace) -> int:
+    try:
+        from stereoplotter.web.server import serve
+    except ImportError as exc:
+        print(
+            f"error: the browser trainer needs the extra stereoplotter[trainer] "
+            f"(pip install 'stereoplotter[trainer]'); missing module {exc.name}",
+            file=sys.stderr,
+        )
+        return 1
+    serve(args.host, args.port, args.token)
+    return 0
+
+
 def _resolve_data_arguments(args: argparse.Namespace) -> None:
     """Apply ``--data`` and turn scenario names (``pair60``) into files; instrument names are
     resolved by :func:`~stereoplotter.io.instrument_file.load_instrument` itself."""
@@ -1146,6 +1168,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _session(args)
         if args.command == "grade":
             return _grade(args)
+        if args.command == "trainer":
+            return _trainer(args)
     except StereoplotterError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
