@@ -76,11 +76,11 @@ class GroundTexture:
         ang = self.field_angle[ci, cj]
         period = 3.0 + 3.0 * (tone - 0.35) / 0.45
         stripes = np.sin(2 * np.pi * (X * np.cos(ang) + Y * np.sin(ang)) / period)
-        v = tone + 0.06 * stripes * np.clip(1.5 - fp / period * 2.0, 0.0, 1.0)
+        v = tone + 0.035 * stripes * np.clip(1.5 - fp / period * 2.0, 0.0, 1.0)
         forest = self._noise(1, X, Y, 350.0) + 0.3 * self._noise(2, X, Y, 60.0)
         crowns = self._noise(3, X, Y, 4.0)
         wood = np.clip((forest - 0.78) / 0.05, 0.0, 1.0)
-        v = (1 - wood) * v + wood * (0.12 + 0.25 * crowns)
+        v = (1 - wood) * v + wood * (0.06 + 0.45 * crowns**2)
         for k, lam, amp in ((4, 1.5, 0.10), (5, 0.6, 0.08)):
             fade = np.clip(lam / fp - 0.5, 0.0, 1.0)  # no grain finer than the pixel (aliasing)
             v = v + amp * fade * (self._noise(k, X, Y, lam) - 0.5)
