@@ -19,6 +19,7 @@ from importlib import resources
 from typing import Any
 
 from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, PlainTextResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
@@ -31,6 +32,10 @@ from stereoplotter.web.registry import Registry
 __all__ = ["create_app"]
 
 STATIC = resources.files("stereoplotter.web") / "static"
+
+#: Side of the photo patch the page composites from [px]: three eyepiece fields (256 px) across,
+#: so the mark can travel a field before the page asks for the next patch.
+PATCH_PX = 768
 
 #: The results table the instructor downloads (one row per session).
 CSV_FIELDS = ("id", "trainee", "exercise", "mode", "stage", "done", "actions", "score", "passed",
@@ -114,6 +119,25 @@ def create_app(token: str | None = None) -> Starlette:
             headers={"Content-Disposition": f'attachment; filename="session-{live.id}.jsonl"'},
         )
 
+    async def patch_png(request: Request) -> Response:
+        live, err = live_or_404(request)
+        if err:
+            return err
+        q = request.query_params
+        try:
+            side = q["side"]
+            x, y, mag = float(q["x"]), float(q["y"]), float(q["mag"])
+            size = int(q.get("size", PATCH_PX))
+            if side not in ("left", "right") or not 0 < size <= 1024:
+                raise ValueError(side)
+        except (KeyError, ValueError):
+            return JSONResponse(
+                {"error": "patch: expected side=left|right, x, y [mm], mag, size ≤ 1024"},
+                status_code=400,
+            )
+        png = await run_in_threadpool(core.photo_patch, live.session, side, x, y, mag, size)
+        return Response(png, media_type="image/png", headers={"Cache-Control": "max-age=3600"})
+
     async def live_sessions(request: Request) -> Response:
         if not instructor(request):
             return JSONResponse({"error": "instructor token required"}, status_code=403)
@@ -151,7 +175,8 @@ def create_app(token: str | None = None) -> Starlette:
             await websocket.close()
             return
         hello = {"exercise": live.exercise, "trainee": live.trainee,
-                 "demonstration": live.demonstration, "id": live.id}
+                 "demonstration": live.demonstration, "id": live.id,
+                 "screen_pixel_mm": core.SCREEN_PIXEL_MM, "patch_px": PATCH_PX}
         await websocket.send_text(
             _message(live, {"hello": hello, "state": live.session.state(), "error": None}))
         try:
@@ -180,6 +205,7 @@ def create_app(token: str | None = None) -> Starlette:
         Route("/api/sessions/{sid}/grade", grade_json),
         Route("/api/sessions/{sid}/grade.md", grade_md),
         Route("/api/sessions/{sid}/log.jsonl", log_jsonl),
+        Route("/api/sessions/{sid}/patch.png", patch_png),
         Route("/api/instructor/sessions", live_sessions),
         Route("/api/instructor/results.csv", results_csv),
         Route("/api/instructor/replay/{sid}", replay_states),

@@ -9,7 +9,12 @@ from __future__ import annotations
 
 from typing import Any
 
+import threading
+
 from stereoplotter.errors import StereoplotterError, TrainerError
+from stereoplotter.imagery.cache import ViewCache
+from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM
+from stereoplotter.io.images import png_bytes
 from stereoplotter.io.exercise_file import load_exercise, shipped_exercises
 from stereoplotter.io.session_log import log_bytes
 from stereoplotter.report.grade import grade_markdown
@@ -24,7 +29,9 @@ __all__ = [
     "grade_of",
     "grade_text",
     "log_of",
+    "SCREEN_PIXEL_MM",
     "operator_script",
+    "photo_patch",
     "replay",
     "replay_frames",
     "log_text",
@@ -111,3 +118,28 @@ def replay_frames(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
         frames.append({"action": rec["action"], "t": rec["t"], "state": session.state(),
                        "refused": refused})
     return frames
+
+
+#: Both photos of a (scenario, seed) as the imagery's tile pyramid, built once and shared by the
+#: sessions that use them (building pair60 takes ~4 s).
+_CACHES: dict[tuple[str, int], ViewCache] = {}
+_CACHE_LOCK = threading.Lock()
+
+
+def view_cache(session: Session) -> ViewCache:
+    """The imagery view cache of the session's photos (built on first use)."""
+    key = (session.exercise.scenario_name, int(session.seed))
+    with _CACHE_LOCK:
+        if key not in _CACHES:
+            _CACHES[key] = ViewCache(session.exercise.scenario, session.seed)
+        return _CACHES[key]
+
+
+def photo_patch(
+    session: Session, side: str, x_mm: float, y_mm: float, magnification: float, size_px: int
+) -> bytes:
+    """PNG of the photo ``side`` around photo point x, y [mm], unrotated (κ = 0), one pixel
+    = SCREEN_PIXEL_MM / magnification mm of photo, x to the right, y up: the page turns and
+    places it under the mark itself, so a move needs no new image."""
+    cache = view_cache(session)
+    return png_bytes(cache.view(side, x_mm, y_mm, 0.0, magnification, size_px))

@@ -16,7 +16,7 @@ import numpy as np
 from stereoplotter.io.exercise_file import load_exercise
 from stereoplotter.trainer.grading import grade
 from stereoplotter.trainer.session import Session
-from stereoplotter.web.core import GRADE_POPULATION
+from stereoplotter.web.core import GRADE_POPULATION, SCREEN_PIXEL_MM
 
 TOKEN = "test-token"  # conftest.TOKEN
 
@@ -72,6 +72,8 @@ def test_browser_trainee_completes_stage1_like_the_core_session(page, server, ar
     page.click("tr[data-counter='X'] button.read")
     n += 1
     _settle(page, n)
+    page.wait_for_function("(window.__patches || 0) >= 2", timeout=60_000)  # both photos in
+    page.wait_for_timeout(100)
     page.screenshot(path=str(artefacts / "instrument.png"), full_page=True)
     page.click("#claim")
     n += 1
@@ -113,40 +115,57 @@ def test_browser_trainee_completes_stage1_like_the_core_session(page, server, ar
     assert md.startswith("#") and FIRST in md
 
 
-def test_anaglyph_shows_the_marks_y_offset(page, server, artefacts):
-    """A y-difference planted between the marks (left decentration dy turned, Eq.-free: the
-    page draws each photo's graticule about its own mark) appears in the anaglyph pixels as a
-    vertical shift of the red against the cyan lines of (y_left − y_right) × px/mm."""
+PROFILE_JS = """() => {
+    const c = document.getElementById('eye-stereo'); const d = c.getContext('2d')
+        .getImageData(0, 0, c.width, c.height).data;
+    const red = [], cyan = [];
+    for (let y = 0; y < c.height; y++) {
+        let r = 0, g = 0;
+        for (let x = 100; x < 140; x++) { const i = (y * c.width + x) * 4; r += d[i]; g += d[i + 1]; }
+        red.push(r); cyan.push(g);
+    }
+    return [red, cyan]; }"""
+
+
+def _row_shift(before, after, max_lag=40):
+    """Rows by which ``after`` is ``before`` moved down (cross-correlation peak)."""
+    a, b = (np.asarray(v, float) - np.mean(v) for v in (before, after))
+    lags = np.arange(-max_lag, max_lag + 1)
+    core = slice(max_lag, len(a) - max_lag)
+    corr = [np.dot(np.roll(a, k)[core], b[core]) for k in lags]
+    return int(lags[int(np.argmax(corr))])
+
+
+def test_anaglyph_pixels_show_a_planted_y_parallax(page, server, artefacts):
+    """Plant a y-parallax by turning the left decentration dy: in the anaglyph the left photo
+    (red) moves vertically by Δy_left × px/mm while the right photo (cyan) stays: the pixels, not
+    the state, are compared (page compositing of the server's photo patches)."""
     _start(page, server, FIRST, trainee="anaglyph")
     page.fill(".wheel[data-control='f_instrument'] input", "109.34")
     page.press(".wheel[data-control='f_instrument'] input", "Enter")
     _settle(page, 1)
     page.select_option("#view", "anaglyph")
+    page.select_option("#colours", "red,cyan")
     page.fill("#mag", "10")
     page.dispatch_event("#mag", "change")
+    page.wait_for_function("(window.__patches || 0) >= 4", timeout=60_000)  # both sides at ×10
+    page.wait_for_timeout(100)
+    red0, cyan0 = page.evaluate(PROFILE_JS)
+    m0 = page.evaluate("window.trainer.state().marks")
     page.locator(".wheel[data-control='dy_left']").focus()
     for _ in range(3):
         page.keyboard.press("Shift+ArrowUp")  # 3 × 10 steps of 0.01 mm
     _settle(page, 4)
-    page.wait_for_timeout(50)
-    marks = page.evaluate("window.trainer.state().marks")
-    dy = marks["left"]["y_mm"] - marks["right"]["y_mm"]
-    assert 0.2 < abs(dy) < 0.45, marks  # planted; under half the 1 mm graticule period
-    px_per_mm = 4 * 10  # eyepiece.js PX_PER_MM_AT_1X × magnification
-    cols = page.evaluate("""() => {
-        const c = document.getElementById('eye-stereo'); const d = c.getContext('2d')
-            .getImageData(0, 0, c.width, c.height).data;
-        const red = [], cyan = [];
-        for (let y = 0; y < c.height; y++) { let r = 0, g = 0;
-            for (let x = 20; x < 60; x++) { const i = (y * c.width + x) * 4; r += d[i]; g += d[i + 1]; }
-            red.push(r); cyan.push(g); }
-        return [red, cyan]; }""")
-    red, cyan = (np.asarray(v, float) - np.mean(v) for v in cols)
-    lags = np.arange(-19, 20)  # within half a period (40 px) of the graticule
-    corr = [np.dot(np.roll(cyan, k), red) for k in lags]
-    shift = lags[int(np.argmax(corr))]
-    # photo y up, rows down: a left mark higher on its photo draws the left lines lower
-    assert abs(shift - dy * px_per_mm) <= 1.5, (shift, dy * px_per_mm)
+    page.wait_for_timeout(100)
+    red1, cyan1 = page.evaluate(PROFILE_JS)
+    m1 = page.evaluate("window.trainer.state().marks")
+    dy_left = m1["left"]["y_mm"] - m0["left"]["y_mm"]
+    assert 0.2 < abs(dy_left) < 0.45, (m0, m1)  # planted
+    assert m1["right"] == m0["right"]
+    px_per_mm = 10 / SCREEN_PIXEL_MM
+    # photo y up, rows down: the mark higher on its photo moves the picture down
+    assert abs(_row_shift(red0, red1) - dy_left * px_per_mm) <= 1.5
+    assert _row_shift(cyan0, cyan1) == 0
     page.screenshot(path=str(artefacts / "anaglyph.png"), full_page=True)
 
 

@@ -3,12 +3,14 @@
 
 const COLOURS = { red: [1, 0, 0], cyan: [0, 1, 1], green: [0, 1, 0], magenta: [1, 0, 1] };
 
-// Pixels of the eyepiece canvas per mm of photo at magnification 1.
-export const PX_PER_MM_AT_1X = 4;
+// Pixels of the eyepiece canvas per mm of photo at magnification 1 (1 / the imagery's
+// SCREEN_PIXEL_MM, sent by the server in its first message).
+export const scale = { pxPerMmAt1x: 10 };
 
-// The field of one eye: a graticule of photo coordinates (1 mm, bold every 5 mm) centred on the
-// mark (x_mm, y_mm), turned by the carrier's κ, then the mark itself at the centre.
-export function drawField(ctx, mark, magnification, { ink = "#e8e4d8", back = "#101314", markColour = "#ff4030" } = {}) {
+// The field of one eye centred on the mark (x_mm, y_mm), turned by the carrier's κ: the photo
+// patch the server sent (drawn where it lies on the photo), else a graticule of photo
+// coordinates (1 mm, bold every 5 mm) while it loads; then the mark itself at the centre.
+export function drawField(ctx, mark, magnification, { ink = "#e8e4d8", back = "#101314", markColour = "#ff4030", patch = null } = {}) {
   const w = ctx.canvas.width, h = ctx.canvas.height;
   ctx.save();
   ctx.fillStyle = back; ctx.fillRect(0, 0, w, h);
@@ -17,9 +19,19 @@ export function drawField(ctx, mark, magnification, { ink = "#e8e4d8", back = "#
     ctx.fillText("no projection yet:", w / 2, h / 2 - 8); ctx.fillText("set f_пр", w / 2, h / 2 + 10);
     ctx.restore(); return;
   }
-  const s = PX_PER_MM_AT_1X * magnification;
+  const s = scale.pxPerMmAt1x * magnification;
   ctx.translate(w / 2, h / 2);
-  ctx.rotate(-mark.kappa_rad);
+  ctx.rotate(mark.kappa_rad); // a view column shows photo R(κ)·(du, dv) (imagery.eyepiece)
+  if (patch && patch.img.complete) {
+    const k = magnification / patch.mag; // canvas px per patch px
+    const n = patch.size * k;
+    const cx = (patch.x_mm - mark.x_mm) * s, cy = -(patch.y_mm - mark.y_mm) * s;
+    ctx.imageSmoothingEnabled = true;
+    ctx.drawImage(patch.img, cx - n / 2, cy - n / 2, n, n);
+    ctx.restore();
+    drawMark(ctx, w, h, markColour);
+    return;
+  }
   const half = Math.hypot(w, h) / 2 / s;
   const x0 = Math.floor(mark.x_mm - half), x1 = Math.ceil(mark.x_mm + half);
   const y0 = Math.floor(mark.y_mm - half), y1 = Math.ceil(mark.y_mm + half);
@@ -37,6 +49,10 @@ export function drawField(ctx, mark, magnification, { ink = "#e8e4d8", back = "#
     if (y % 5 === 0) ctx.fillText(`${y}`, -w / 2 + 24, py - 2);
   }
   ctx.restore();
+  drawMark(ctx, w, h, markColour);
+}
+
+function drawMark(ctx, w, h, markColour) {
   ctx.save();
   ctx.fillStyle = markColour; ctx.strokeStyle = markColour; ctx.lineWidth = 1.5;
   ctx.beginPath(); ctx.arc(w / 2, h / 2, 2.5, 0, 2 * Math.PI); ctx.fill();

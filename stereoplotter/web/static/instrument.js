@@ -1,5 +1,5 @@
 // The instrument page: WebSocket to the server (action → state), eyepieces, wheels, counters.
-import { drawField, anaglyph } from "./eyepiece.js";
+import { drawField, anaglyph, scale } from "./eyepiece.js";
 import { Wheels, LABELS, decimals } from "./wheels.js";
 
 const sid = location.pathname.split("/").pop();
@@ -26,20 +26,39 @@ const off = { left: document.createElement("canvas"), right: document.createElem
 off.left.width = off.left.height = off.right.width = off.right.height = 320;
 let flickerSide = "left";
 
+// Photo patches (one per side): fetched when the mark nears a patch's edge or the magnification
+// changes; a move only redraws from the patch in hand.
+const patches = { left: null, right: null }, loading = { left: false, right: false };
+function needPatch(side, mark, mag) {
+  const p = patches[side];
+  if (loading[side] || !hello) return;
+  const fieldMm = 320 / (scale.pxPerMmAt1x * mag);
+  const halfMm = (hello.patch_px * hello.screen_pixel_mm) / mag / 2;
+  if (p && p.mag === mag && Math.abs(mark.x_mm - p.x_mm) < halfMm - fieldMm * 0.75
+      && Math.abs(mark.y_mm - p.y_mm) < halfMm - fieldMm * 0.75) return;
+  loading[side] = true;
+  const q = { side, x_mm: mark.x_mm, y_mm: mark.y_mm, mag, size: hello.patch_px, img: new Image() };
+  q.img.onload = () => { patches[side] = q; loading[side] = false; window.__patches = (window.__patches || 0) + 1; drawEyes(); };
+  q.img.onerror = () => { loading[side] = false; };
+  q.img.src = `/api/sessions/${sid}/patch.png?side=${side}&x=${mark.x_mm.toFixed(3)}&y=${mark.y_mm.toFixed(3)}&mag=${mag}&size=${hello.patch_px}`;
+  q.x_mm = Number(mark.x_mm.toFixed(3)); q.y_mm = Number(mark.y_mm.toFixed(3));
+}
+
 function drawEyes() {
   const marks = state ? state.marks : null;
   const mag = Number($("mag").value) || 6;
   const mode = $("view").value;
+  if (marks) for (const side of ["left", "right"]) needPatch(side, marks[side], mag);
   $("eyepieces").hidden = mode !== "split";
   $("stereo").hidden = mode === "split";
   if (mode === "split") {
     for (const side of ["left", "right"]) {
-      drawField($(`eye-${side}`).getContext("2d"), marks && marks[side], mag);
+      drawField($(`eye-${side}`).getContext("2d"), marks && marks[side], mag, { patch: patches[side] });
       $(`cap-${side}`).textContent = marks
         ? `${side}: x ${marks[side].x_mm.toFixed(3)}  y ${marks[side].y_mm.toFixed(3)} mm` : `${side} photo`;
     }
   } else {
-    for (const side of ["left", "right"]) drawField(off[side].getContext("2d"), marks && marks[side], mag, { markColour: "#ffffff" });
+    for (const side of ["left", "right"]) drawField(off[side].getContext("2d"), marks && marks[side], mag, { markColour: "#ffffff", patch: patches[side] });
     const ctx = $("eye-stereo").getContext("2d");
     if (mode === "anaglyph") anaglyph(ctx, off.left, off.right, $("colours").value.split(","));
     else { ctx.drawImage(off[flickerSide], 0, 0); }
@@ -127,6 +146,7 @@ ws.onmessage = (ev) => {
   const msg = JSON.parse(ev.data);
   if (msg.hello) {
     hello = msg.hello;
+    scale.pxPerMmAt1x = 1 / hello.screen_pixel_mm;
     $("who").textContent = `${hello.trainee} · ${hello.exercise}`;
     $("title").textContent = "Stereoplotter trainer";
     fetch("/api/exercises").then((r) => r.json()).then((all) => {
