@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from scipy.ndimage import map_coordinates
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM, view_to_photo
+from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM, check_view, view_to_photo
 from stereoplotter.imagery.photo import PhotoGeometry, PhotoRaster, photo_geometry, render_region
 from stereoplotter.scenario.model import Scenario
 
@@ -139,6 +139,7 @@ class ViewCache:
         if key in self._views:
             self._views.move_to_end(key)
             return self._views[key]
+        check_view(magnification, size_px)
         if side not in self.levels:
             raise StereoplotterError(
                 f"ViewCache.view: side must be one of {self.sides}, got {side!r}"
