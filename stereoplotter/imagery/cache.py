@@ -20,7 +20,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.ndimage import map_coordinates
 
-from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM, view_to_photo
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM, check_view, view_to_photo
 from stereoplotter.imagery.photo import PhotoGeometry, PhotoRaster, photo_geometry, render_region
 from stereoplotter.scenario.model import Scenario
 
@@ -34,10 +35,17 @@ _VIEWS_KEPT = 64
 class ViewCache:
     """Both photos of ``scenario`` as a tile pyramid; :meth:`view` serves eyepiece views."""
 
-    def __init__(self, scenario: Scenario, seed: int | None = None, *, pixel_mm: float = 0.02):
+    def __init__(
+        self,
+        scenario: Scenario,
+        seed: int | None = None,
+        *,
+        pixel_mm: float = 0.02,
+        sides: tuple[str, ...] | None = None,
+    ):
         self.scenario = scenario
         self.seed = scenario.seed if seed is None else seed
-        self.sides = tuple(p.name for p in scenario.photos)
+        self.sides = tuple(p.name for p in scenario.photos) if sides is None else tuple(sides)
         self.levels: dict[str, list[PhotoGeometry]] = {}
         self._tiles: dict[tuple[str, int, int, int], NDArray[np.uint8]] = {}
         self._whole: dict[tuple[str, int], PhotoRaster] = {}
@@ -131,6 +139,11 @@ class ViewCache:
         if key in self._views:
             self._views.move_to_end(key)
             return self._views[key]
+        check_view(magnification, size_px)
+        if side not in self.levels:
+            raise StereoplotterError(
+                f"ViewCache.view: side must be one of {self.sides}, got {side!r}"
+            )
         k = self.level_for(side, magnification)
         geo = self.levels[side][k]
         grid = PhotoRaster(np.zeros((0, 0), np.uint8), geo.pixel_mm, geo.origin_mm, side)

@@ -17,7 +17,7 @@ from scipy.ndimage import map_coordinates
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.imagery.photo import PhotoRaster
 
-__all__ = ["SCREEN_PIXEL_MM", "anaglyph", "eyepiece_view", "view_to_photo"]
+__all__ = ["SCREEN_PIXEL_MM", "anaglyph", "check_view", "eyepiece_view", "view_to_photo"]
 
 SCREEN_PIXEL_MM = 0.1
 _COLOURS = {"red": (1, 0, 0), "cyan": (0, 1, 1), "green": (0, 1, 0), "blue": (0, 0, 1)}
@@ -40,6 +40,16 @@ def view_to_photo(
     return x_mm + ck * du - sk * dv, y_mm + sk * du + ck * dv
 
 
+def check_view(magnification: float, size_px: int) -> None:
+    """Refuse a magnification outside [0.5, 60] or a view size outside [8, 2048] px."""
+    if not 0.5 <= magnification <= 60.0:
+        raise StereoplotterError(
+            f"eyepiece_view: magnification must be in [0.5, 60], got {magnification}"
+        )
+    if not 8 <= size_px <= 2048:
+        raise StereoplotterError(f"eyepiece_view: size_px must be in [8, 2048], got {size_px}")
+
+
 def eyepiece_view(
     raster: PhotoRaster,
     x_mm: float,
@@ -53,12 +63,7 @@ def eyepiece_view(
 
     Bilinear interpolation of ``raster``; beyond the film it is black. The mark is not drawn.
     """
-    if not 0.5 <= magnification <= 60.0:
-        raise StereoplotterError(
-            f"eyepiece_view: magnification must be in [0.5, 60], got {magnification}"
-        )
-    if not 8 <= size_px <= 2048:
-        raise StereoplotterError(f"eyepiece_view: size_px must be in [8, 2048], got {size_px}")
+    check_view(magnification, size_px)
     v, u = np.mgrid[0:size_px, 0:size_px]
     x, y = view_to_photo(u, v, x_mm, y_mm, kappa_rad, magnification, size_px)
     col, row = raster.to_pixel(x, y)

@@ -58,7 +58,7 @@ def write_render(
         c = np.mean([p.exterior.centre for p in scenario.photos], axis=0)
         at_m = (float(c[0]), float(c[1]))
     ground = np.array([*at_m, float(scenario.terrain.height_m(*at_m))])
-    cache = ViewCache(scenario, seed)
+    cache = ViewCache(scenario, seed, sides=sides)
     written, views = [], {}
     for side in sides:
         raster = render_photo(scenario, side, pixel_mm=pixel_mm, seed=seed)

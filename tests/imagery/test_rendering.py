@@ -14,6 +14,7 @@ import hashlib
 import numpy as np
 import pytest
 
+from stereoplotter.errors import StereoplotterError
 from stereoplotter.geometry.collinearity import object_to_photo
 from stereoplotter.imagery.cache import ViewCache
 from stereoplotter.imagery.eyepiece import anaglyph, eyepiece_view, view_to_photo
@@ -187,3 +188,10 @@ def test_anaglyph_channels():
     right = np.full((4, 4), 50, np.uint8)
     rgb = anaglyph(left, right)
     assert rgb.shape == (4, 4, 3) and tuple(rgb[0, 0]) == (200, 50, 50)
+
+
+def test_settings_beyond_the_stops_are_refused(cache):
+    with pytest.raises(StereoplotterError, match=r"magnification must be in \[0.5, 60\]"):
+        cache.view("left", 0.0, 0.0, 0.0, 100.0, 64)
+    with pytest.raises(StereoplotterError, match="side must be one of"):
+        cache.view("middle", 0.0, 0.0, 0.0, 6.0, 64)
