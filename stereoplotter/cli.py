@@ -1001,8 +1001,12 @@ def _parser() -> argparse.ArgumentParser:
         "trainer",
         help="serve the browser trainer (needs the extra stereoplotter[trainer]; docs/trainer.md)",
     )
-    p.add_argument("--host", default="127.0.0.1", help="address to listen on (default: %(default)s)")
-    p.add_argument("--port", type=non_negative_int, default=8000, help="port (default: %(default)s)")
+    p.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (default: %(default)s)"
+    )
+    p.add_argument(
+        "--port", type=non_negative_int, default=8000, help="port (default: %(default)s)"
+    )
     p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
     return parser
 

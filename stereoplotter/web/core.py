@@ -7,34 +7,33 @@ Every call the server makes into :mod:`stereoplotter.trainer`, :mod:`stereoplott
 
 from __future__ import annotations
 
-from typing import Any
-
 import threading
+from typing import Any
 
 from stereoplotter.errors import StereoplotterError, TrainerError
 from stereoplotter.imagery.cache import ViewCache
 from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM
-from stereoplotter.io.images import png_bytes
 from stereoplotter.io.exercise_file import load_exercise, shipped_exercises
+from stereoplotter.io.images import png_bytes
 from stereoplotter.io.session_log import log_bytes
 from stereoplotter.report.grade import grade_markdown
-from stereoplotter.trainer.grading import grade
 from stereoplotter.trainer.exercise import resolve_exercise
+from stereoplotter.trainer.grading import grade
 from stereoplotter.trainer.session import Session
 
 __all__ = [
+    "SCREEN_PIXEL_MM",
     "CoreError",
     "TrainerError",
     "exercise_list",
     "grade_of",
     "grade_text",
     "log_of",
-    "SCREEN_PIXEL_MM",
+    "log_text",
     "operator_script",
     "photo_patch",
     "replay",
     "replay_frames",
-    "log_text",
     "start",
 ]
 

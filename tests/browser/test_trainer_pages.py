@@ -72,7 +72,7 @@ def test_browser_trainee_completes_stage1_like_the_core_session(page, server, ar
     page.click("tr[data-counter='X'] button.read")
     n += 1
     _settle(page, n)
-    page.wait_for_function("(window.__patches || 0) >= 2", timeout=60_000)  # both photos in
+    page.wait_for_function("window.trainer.photosReady()", timeout=60_000)  # both photos in
     page.wait_for_timeout(100)
     page.screenshot(path=str(artefacts / "instrument.png"), full_page=True)
     page.click("#claim")
@@ -121,7 +121,9 @@ PROFILE_JS = """() => {
     const red = [], cyan = [];
     for (let y = 0; y < c.height; y++) {
         let r = 0, g = 0;
-        for (let x = 100; x < 140; x++) { const i = (y * c.width + x) * 4; r += d[i]; g += d[i + 1]; }
+        for (let x = 100; x < 140; x++) {
+            const i = (y * c.width + x) * 4; r += d[i]; g += d[i + 1];
+        }
         red.push(r); cyan.push(g);
     }
     return [red, cyan]; }"""
@@ -148,7 +150,8 @@ def test_anaglyph_pixels_show_a_planted_y_parallax(page, server, artefacts):
     page.select_option("#colours", "red,cyan")
     page.fill("#mag", "10")
     page.dispatch_event("#mag", "change")
-    page.wait_for_function("(window.__patches || 0) >= 4", timeout=60_000)  # both sides at ×10
+    page.wait_for_function("(window.__patches || 0) >= 4 && window.trainer.photosReady()",
+                           timeout=60_000)  # both sides at ×10
     page.wait_for_timeout(100)
     red0, cyan0 = page.evaluate(PROFILE_JS)
     m0 = page.evaluate("window.trainer.state().marks")

@@ -12,7 +12,8 @@ $("overall").innerHTML = `<p style="font-size:18px"><span class="${o.passed ? "p
   <p class="meta">${grade.title}</p>`;
 $("md").href = `/api/sessions/${sid}/grade.md`;
 $("log").href = `/api/sessions/${sid}/log.jsonl`;
-const fmt = (v) => (typeof v === "number" ? (Math.abs(v) >= 1e-3 || v === 0 ? v.toFixed(4) : v.toExponential(2)) : String(v ?? "—"));
+const fmt = (v) => (typeof v !== "number" ? String(v ?? "—")
+  : Number.isInteger(v) ? String(v) : Math.abs(v) >= 1e-3 ? v.toFixed(4) : v.toExponential(2));
 for (const [stage, body] of Object.entries(grade.stages)) {
   const div = document.createElement("div");
   div.innerHTML = `<h3>Stage ${stage} ${body.claimed ? "" : "(not claimed)"}</h3>

@@ -158,7 +158,8 @@ ws.onmessage = (ev) => {
   window.__n = msg.n;
   if (state) render();
   if (msg.error) message(msg.error, "error");
-  else if (msg.result !== undefined && msg.result !== null) message(typeof msg.result === "string" ? msg.result : JSON.stringify(msg.result), "hint");
+  else if (msg.result !== undefined && msg.result !== null) message(typeof msg.result === "string" ? msg.result
+    : typeof msg.result === "number" ? `reading: ${msg.result}` : JSON.stringify(msg.result), "hint");
   else if (msg.demo) message(`operator: ${JSON.stringify(msg.demo.action)}`);
   else if (!msg.hello) message("");
   if (msg.demo) $("demo-count").textContent = `${msg.demo.done} / ${msg.demo.of}`;
@@ -182,6 +183,8 @@ $("demo-play").onclick = () => {
 // For tests and the latency benchmark: send an action, resolve with ms until its frame is drawn.
 window.trainer = {
   state: () => state,
+  // both eyepieces drawn from a photo patch that covers the current marks
+  photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right),
   actAndFrame(action) {
     const t0 = performance.now();
     const s = send(action);
