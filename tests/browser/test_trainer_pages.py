@@ -185,6 +185,23 @@ def test_exam_hides_hints_and_undo(page, server, artefacts):
     assert page.locator("#message").inner_text().strip() != ""
 
 
+def test_demonstration_plays_the_operators_actions(page, server):
+    page.goto(server + "/")
+    page.check("#demo")
+    page.click(f"button[data-exercise='{FIRST}']")
+    page.wait_for_selector("body[data-ready='1']")
+    assert page.locator("#mode").inner_text() == "demonstration"
+    assert page.locator("#claim").is_disabled()
+    for n in (1, 2, 3):
+        page.click("#demo-step")
+        _settle(page, n)
+    script = Session.start(load_exercise(FIRST)).operator_script()
+    assert page.locator("#demo-count").inner_text() == f"3 / {len(script)}"
+    # the operator's second action set f_пр: the page's knob shows it
+    shown = page.evaluate("window.trainer.state().controls.f_instrument.value")
+    assert shown == script[1]["value"]
+
+
 def test_instructor_page_lists_sessions_and_replays(page, server, artefacts):
     page.goto(f"{server}/instructor?token=wrong")
     page.wait_for_selector("section.fail")
