@@ -797,7 +797,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--side", choices=["left", "right"], help="one photo only (default: both)")
     p.add_argument(
         "--at",
-        type=float,
+        type=bounded_float(-1e7, 1e7),
         nargs=2,
         metavar=("X", "Y"),
         help="ground point [m] the views centre on (default: below the centres' midpoint)",
@@ -815,7 +815,7 @@ def _parser() -> argparse.ArgumentParser:
         metavar="MM",
         help="pixel of the photo files [mm] (default 0.08: 3.6 s a photo; 0.02 takes a minute)",
     )
-    p.add_argument("--seed", type=int, help="texture seed (default: the scenario's)")
+    p.add_argument("--seed", type=seed_int, help="texture seed (default: the scenario's)")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the PNG files")
 
     p = sub.add_parser("setup", help="compute the setup sheet (Table 24) of a stereopair")
