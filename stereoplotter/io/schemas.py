@@ -19,6 +19,7 @@ from pydantic import BaseModel
 from stereoplotter.io.block_file import BlockFile
 from stereoplotter.io.budget_output import BudgetOutput
 from stereoplotter.io.errors_file import ErrorsFile
+from stereoplotter.io.exercise_file import ExerciseFile
 from stereoplotter.io.geometry_file import GeometryFile
 from stereoplotter.io.instrument_file import InstrumentFile
 from stereoplotter.io.job_file import JobFile
@@ -38,6 +39,7 @@ MODELS: dict[str, type[BaseModel]] = {
     "job": JobFile,
     "budget": BudgetOutput,  # an output: the JSON of `stereoplotter budget --json`
     "trainee-sheet": TraineeSheet,
+    "exercise": ExerciseFile,
 }
 
 
