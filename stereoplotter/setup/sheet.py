@@ -30,9 +30,11 @@ from stereoplotter.geometry.similarity import (
     apply_similarity,
     fit_similarity_with_reflection,
 )
-from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
+from stereoplotter.instrument.limits import check_material_limits
+from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import MapSheet, Point, Scenario
+from stereoplotter.scenario.summary import summarize_scenario
 from stereoplotter.scenario.synthetic import (
     synthesize_measurements,
     working_area_grid_m,
@@ -292,6 +294,22 @@ def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[
 # --- the computation ----------------------------------------------------------------------------
 
 
+def _check_material(scenario: Scenario, spec: InstrumentSpec) -> None:
+    """Documented limits on the pair (relief/H, f_k; :mod:`stereoplotter.instrument.limits`)."""
+    summary = summarize_scenario(scenario)
+    height = float(np.mean([p["flying_height_m"] for p in summary["photos"]]))
+    try:
+        check_material_limits(
+            spec,
+            relief_m=float(summary["relief"]["working_area_range_m"]),
+            flying_height_m=height,
+            camera_f_mm=float(scenario.camera.focal_length_mm),
+            what=scenario.source,
+        )
+    except RangeRefusal as exc:
+        raise SetupRefusal(str(exc)) from exc
+
+
 def compute_setup_sheet(
     scenario: Scenario,
     spec: InstrumentSpec,
@@ -327,6 +345,7 @@ def compute_setup_sheet(
             f"{', '.join(p.name for p in scenario.photos)}: scenario {scenario.name!r} is not a "
             "stereopair"
         )
+    _check_material(scenario, spec)
     rng = np.random.default_rng(scenario.seed) if rng is None else rng
     measurements = synthesize_measurements(scenario, rng)
     known = known_exterior_orientation(scenario, measurements)
