@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
@@ -553,8 +554,9 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
     op.drive(knob, t, active)
     op.log.add(
         "2",
-        f"{side} photo: counter {counter} = {'MO' + sfx} + n·{axis[0]}⁰, turn {knob} "
-        f"until mark {mark} is under the measuring mark",
+        f"{side} photo: counter {counter} = {'MO' + sfx} + n·{axis[0]}⁰, turn "
+        f"{control_name(op.inst.spec.principle, knob)} until "
+        f"{mark_phrase(op.inst.spec.principle, mark)}",
         knob,
         before=before,
         after=op.physical(knob),
@@ -624,7 +626,7 @@ def stage2_transform(run: Run) -> None:
             op.set(control, value, f"2/{control}")
             op.log.add(
                 "2",
-                f"set the computed decentration {control}",
+                f"set the computed decentration {control_name(op.inst.spec.principle, control)}",
                 control,
                 reading=value,
                 equation="f′·tan α (§2.4)",

@@ -29,6 +29,8 @@ __all__ = [
     "LensShift",
     "MechanicalProjection",
     "PlaneFollower",
+    "control_name",
+    "mark_phrase",
     "mechanism_for_principle",
 ]
 
@@ -155,3 +157,45 @@ def mechanism_for_principle(principle: str) -> CorrectionMechanism | None:
     """The mechanism of an instrument's ``principle`` (None: the canonical unit, s = 1)."""
     cls = _BY_PRINCIPLE.get(principle)
     return cls() if cls is not None else None
+
+
+#: Each instrument's own names of the correction controls (issue 11, deliverable 6); keys are
+#: the virtual instrument's control prefixes ``k_alpha``, ``k_omega``, ``dx``, ``dy``.
+_CONTROLS: dict[str, dict[str, str]] = {
+    PlaneFollower.key: {
+        "k_alpha": "correction plane kα (follower)",
+        "k_omega": "correction plane kω (follower)",
+        "dx": "photo decentration x (from the plane settings)",
+        "dy": "photo decentration y (from the plane settings)",
+    },
+    LensShift.key: {
+        "k_alpha": "lens-shift mechanism δ_α",
+        "k_omega": "lens-shift mechanism δ_ω",
+        "dx": "photo-carriage decentration x",
+        "dy": "photo-carriage decentration y",
+    },
+    MechanicalProjection.key: {
+        "k_alpha": "photo-carrier tilt α (gimbal)",
+        "k_omega": "photo-carrier tilt ω (gimbal)",
+        "dx": "photo-carrier decentration x",
+        "dy": "photo-carrier decentration y",
+    },
+}
+
+
+def control_name(principle: str, control: str) -> str:
+    """``control`` (``k_alpha_left``, ``dx_right`` …) with the instrument's own name added."""
+    mech = mechanism_for_principle(principle)
+    if mech is None:
+        return control
+    prefix = control.rsplit("_", 1)[0]
+    own = _CONTROLS[mech.key].get(prefix)
+    return control if own is None else f"{own} ({control})"
+
+
+def mark_phrase(principle: str, mark: str) -> str:
+    """How the fiducial meets the mark: the SPR-3 moves the photo under a fixed mark."""
+    mech = mechanism_for_principle(principle)
+    if mech is not None and mech.photo_moves:
+        return f"the photo carriage brings mark {mark} under the fixed measuring mark"
+    return f"mark {mark} is under the measuring mark"
