@@ -1313,7 +1313,7 @@ def stage5_check(run: Run) -> None:
 
 
 def mechanism_level(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
 ) -> tuple[float, float]:
     """What the correction mechanism itself leaves at the sheet's own settings (the floor).
 
@@ -1322,10 +1322,17 @@ def mechanism_level(
     points [mm, photo scale], and the largest control-height error relative to the first height
     control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
     setup-data method sets exactly these values and has no relative orientation or levelling.
+    ``mechanism``: the instrument's own correction mechanism
+    (:func:`~stereoplotter.instrument.correction.mechanism_for_principle`); None: canonical unit.
     """
     f = sheet.focal_length_corrected_mm
     units = [
-        UnitMap(unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis))
+        UnitMap(
+            replace(
+                unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis),
+                mechanism=mechanism,
+            )
+        )
         for p in sheet.photos
     ]
     bx, by, bz = sheet.base_mm
@@ -1345,7 +1352,9 @@ def mechanism_level(
     return q_max, float(np.max(np.abs(model_h - heights[:, 2])))
 
 
-def refuse_beyond_mechanism(sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False):
+def refuse_beyond_mechanism(
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
+):
     """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
     already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
     no operator can then build the model by the setup-data method on this instrument.
@@ -1354,7 +1363,7 @@ def refuse_beyond_mechanism(sheet: SetupSheet, scene: Scene, strict_per_axis: bo
     mechanism — the largest photo tilt, ``photos[i].exterior.alpha_deg`` or ``omega_deg`` — and
     the §26 tolerances the mechanism level exceeds.
     """
-    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis)
+    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis, mechanism)
     tol_q = sheet.tolerances["residual_y_parallax_mm"]
     tol_h = sheet.tolerances["control_height_m"]
     if q_max <= tol_q and h_max <= tol_h:
