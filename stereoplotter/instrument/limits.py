@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 
-__all__ = ["RELIEF_KEY", "check_material_limits"]
+__all__ = ["MODEL_SCALE_KEY", "RELIEF_KEY", "check_material_limits", "check_model_to_photo_scale"]
 
 #: Key of the relief limit (relief range within a pair over the flying height, SD-3: 0.35).
 RELIEF_KEY = "facts.max_relief_fraction_of_H"
@@ -55,4 +55,35 @@ def check_material_limits(
             status=limit.status,
             file=limit.file,
             key=RELIEF_KEY,
+        )
+
+
+#: Key of the SPR-3 model-to-photo scale range (model 0.5–2 × photo scale, SPR-2 family).
+MODEL_SCALE_KEY = "gears.model_to_photo_scale"
+
+
+def check_model_to_photo_scale(
+    spec: InstrumentSpec, *, photo_scale_denominator: float, model_scale_denominator: float
+) -> None:
+    """Refuse a model scale outside ``gears.model_to_photo_scale`` (SPR-3: 0.5–2 × photo scale).
+
+    The ratio is m/M_г (photo scale denominator over the horizontal model scale denominator). [—]
+    """
+    limit = spec.parameters.get(MODEL_SCALE_KEY)
+    if limit is None:
+        return
+    low, high = (float(v) for v in limit.value)
+    ratio = photo_scale_denominator / model_scale_denominator
+    if not low <= ratio <= high:
+        raise RangeRefusal(
+            f"model scale 1:{model_scale_denominator:.0f} = {ratio:.2f} × the photo scale "
+            f"1:{photo_scale_denominator:.0f} is outside the {spec.title} range [{low:g}, "
+            f"{high:g}] ({limit.status}; {limit.file}: {MODEL_SCALE_KEY})",
+            what="model/photo scale",
+            value=ratio,
+            low=low,
+            high=high,
+            status=limit.status,
+            file=limit.file,
+            key=MODEL_SCALE_KEY,
         )

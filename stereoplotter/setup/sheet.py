@@ -30,7 +30,7 @@ from stereoplotter.geometry.similarity import (
     apply_similarity,
     fit_similarity_with_reflection,
 )
-from stereoplotter.instrument.limits import check_material_limits
+from stereoplotter.instrument.limits import check_material_limits, check_model_to_photo_scale
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import MapSheet, Point, Scenario
@@ -294,8 +294,9 @@ def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[
 # --- the computation ----------------------------------------------------------------------------
 
 
-def _check_material(scenario: Scenario, spec: InstrumentSpec) -> None:
-    """Documented limits on the pair (relief/H, f_k; :mod:`stereoplotter.instrument.limits`)."""
+def _check_material(scenario: Scenario, spec: InstrumentSpec) -> float:
+    """Documented limits on the pair (relief/H, f_k; :mod:`stereoplotter.instrument.limits`);
+    returns the mean flying height H. [m]"""
     summary = summarize_scenario(scenario)
     height = float(np.mean([p["flying_height_m"] for p in summary["photos"]]))
     try:
@@ -308,6 +309,19 @@ def _check_material(scenario: Scenario, spec: InstrumentSpec) -> None:
         )
     except RangeRefusal as exc:
         raise SetupRefusal(str(exc)) from exc
+    return height
+
+
+def _check_model_scale(scenario: Scenario, spec: InstrumentSpec, sheet, height_m: float) -> None:
+    """SPR-3: model scale within 0.5–2 × the photo scale (m = 1000·H/f_k)."""
+    try:
+        check_model_to_photo_scale(
+            spec,
+            photo_scale_denominator=MM_PER_M * height_m / float(scenario.camera.focal_length_mm),
+            model_scale_denominator=float(sheet.horizontal_scale_denominator),
+        )
+    except RangeRefusal as exc:
+        raise SetupRefusal(f"{scenario.source}: {exc}") from exc
 
 
 def compute_setup_sheet(
@@ -345,14 +359,14 @@ def compute_setup_sheet(
             f"{', '.join(p.name for p in scenario.photos)}: scenario {scenario.name!r} is not a "
             "stereopair"
         )
-    _check_material(scenario, spec)
+    height_m = _check_material(scenario, spec)
     rng = np.random.default_rng(scenario.seed) if rng is None else rng
     measurements = synthesize_measurements(scenario, rng)
     known = known_exterior_orientation(scenario, measurements)
     marks = np.array(
         [measurements.photo(n).fiducials_mm for n in ("left", "right")]
     ) - np.asarray(scenario.camera.principal_point_mm, float)
-    return compute_sheet_from_measurements(
+    sheet = compute_sheet_from_measurements(
         name=scenario.name,
         source=scenario.source,
         spec=spec,
@@ -367,6 +381,8 @@ def compute_setup_sheet(
         map_sheet=scenario.map_sheet,
         exterior_sources=tuple(p.exterior.source for p in scenario.photos),
     )
+    _check_model_scale(scenario, spec, sheet, height_m)
+    return sheet
 
 
 @dataclass(frozen=True, slots=True)

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.limits import check_material_limits
+from stereoplotter.instrument.limits import check_material_limits, check_model_to_photo_scale
 from stereoplotter.instrument.spec import RangeRefusal
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
@@ -50,3 +50,26 @@ def test_scenario_with_relief_04H_refused_on_sd3(tmp_path):
     message = str(info.value)
     assert "\n" not in message
     assert "0.40 H" in message and "0.35 H" in message and "documented" in message
+
+
+def test_spr3_model_scale_range():
+    """SPR-3: model 0.5–2 × photo scale (assumed from SPR-2, DRO60); pair60 1:20000 → 1:16000."""
+    spec = load_instrument("spr3")
+    check_model_to_photo_scale(spec, photo_scale_denominator=20000, model_scale_denominator=16000)
+    with pytest.raises(RangeRefusal, match=r"0\.44 × the photo scale .*\[0\.5, 2\]"):
+        check_model_to_photo_scale(
+            spec, photo_scale_denominator=20000, model_scale_denominator=45000
+        )
+    # SD-3 and SC-1 state no such range
+    check_model_to_photo_scale(
+        load_instrument("sd3"), photo_scale_denominator=20000, model_scale_denominator=45000
+    )
+
+
+def test_sc1_projection_distance_stops_at_documented_d_max():
+    from stereoplotter.instrument.spec import check_in_range
+
+    spec = load_instrument("sc1")
+    assert spec.projection_distance_max_mm == 185.0  # SEED6 L3715, documented
+    with pytest.raises(RangeRefusal, match="185"):
+        check_in_range(spec, "projection_distance_range_mm", 186.0, "D")
