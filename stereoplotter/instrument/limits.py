@@ -9,7 +9,14 @@ from __future__ import annotations
 
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 
-__all__ = ["MODEL_SCALE_KEY", "RELIEF_KEY", "check_material_limits", "check_model_to_photo_scale"]
+__all__ = [
+    "MAP_RATIO_KEY",
+    "MODEL_SCALE_KEY",
+    "RELIEF_KEY",
+    "check_material_limits",
+    "check_model_to_photo_scale",
+    "check_photo_to_map_ratio",
+]
 
 #: Key of the relief limit (relief range within a pair over the flying height, SD-3: 0.35).
 RELIEF_KEY = "facts.max_relief_fraction_of_H"
@@ -86,4 +93,35 @@ def check_model_to_photo_scale(
             status=limit.status,
             file=limit.file,
             key=MODEL_SCALE_KEY,
+        )
+
+
+#: Key of the SD-3 photo-to-map scale ratio (GEOGRACE: 0.5–3.0, read as map/photo scale).
+MAP_RATIO_KEY = "gears.photo_to_map_scale_ratio"
+
+
+def check_photo_to_map_ratio(
+    spec: InstrumentSpec, *, photo_scale_denominator: float, map_scale_denominator: float
+) -> None:
+    """Refuse a map scale outside ``gears.photo_to_map_scale_ratio`` (SD-3: 0.5–3.0 ×).
+
+    The ratio is m/M_map (photo scale denominator over map scale denominator). [—]
+    """
+    limit = spec.parameters.get(MAP_RATIO_KEY)
+    if limit is None:
+        return
+    low, high = (float(v) for v in limit.value)
+    ratio = photo_scale_denominator / map_scale_denominator
+    if not low <= ratio <= high:
+        raise RangeRefusal(
+            f"map scale 1:{map_scale_denominator:.0f} = {ratio:.2f} × the photo scale "
+            f"1:{photo_scale_denominator:.0f} is outside the {spec.title} photo-to-map ratio "
+            f"[{low:g}, {high:g}] ({limit.status}; {limit.file}: {MAP_RATIO_KEY})",
+            what="photo-to-map ratio",
+            value=ratio,
+            low=low,
+            high=high,
+            status=limit.status,
+            file=limit.file,
+            key=MAP_RATIO_KEY,
         )

@@ -30,7 +30,11 @@ from stereoplotter.geometry.similarity import (
     apply_similarity,
     fit_similarity_with_reflection,
 )
-from stereoplotter.instrument.limits import check_material_limits, check_model_to_photo_scale
+from stereoplotter.instrument.limits import (
+    check_material_limits,
+    check_model_to_photo_scale,
+    check_photo_to_map_ratio,
+)
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import MapSheet, Point, Scenario
@@ -313,13 +317,21 @@ def _check_material(scenario: Scenario, spec: InstrumentSpec) -> float:
 
 
 def _check_model_scale(scenario: Scenario, spec: InstrumentSpec, sheet, height_m: float) -> None:
-    """SPR-3: model scale within 0.5–2 × the photo scale (m = 1000·H/f_k)."""
+    """SPR-3: model scale 0.5–2 × photo scale; SD-3: map scale 0.5–3 × photo scale
+    (m = 1000·H/f_k; :mod:`stereoplotter.instrument.limits`)."""
+    photo = MM_PER_M * height_m / float(scenario.camera.focal_length_mm)
     try:
         check_model_to_photo_scale(
             spec,
-            photo_scale_denominator=MM_PER_M * height_m / float(scenario.camera.focal_length_mm),
+            photo_scale_denominator=photo,
             model_scale_denominator=float(sheet.horizontal_scale_denominator),
         )
+        if sheet.map_scale_denominator is not None:
+            check_photo_to_map_ratio(
+                spec,
+                photo_scale_denominator=photo,
+                map_scale_denominator=float(sheet.map_scale_denominator),
+            )
     except RangeRefusal as exc:
         raise SetupRefusal(f"{scenario.source}: {exc}") from exc
 

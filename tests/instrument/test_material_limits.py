@@ -7,7 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.limits import check_material_limits, check_model_to_photo_scale
+from stereoplotter.instrument.limits import (
+    check_material_limits,
+    check_model_to_photo_scale,
+    check_photo_to_map_ratio,
+)
 from stereoplotter.instrument.spec import RangeRefusal
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
@@ -73,3 +77,10 @@ def test_sc1_projection_distance_stops_at_documented_d_max():
     assert spec.projection_distance_max_mm == 185.0  # SEED6 L3715, documented
     with pytest.raises(RangeRefusal, match="185"):
         check_in_range(spec, "projection_distance_range_mm", 186.0, "D")
+
+
+def test_sd3_photo_to_map_ratio_documented_05_to_3():
+    spec = load_instrument("sd3")
+    check_photo_to_map_ratio(spec, photo_scale_denominator=20000, map_scale_denominator=10000)
+    with pytest.raises(RangeRefusal, match=r"4\.00 × .*\[0\.5, 3\] \(documented"):
+        check_photo_to_map_ratio(spec, photo_scale_denominator=20000, map_scale_denominator=5000)
