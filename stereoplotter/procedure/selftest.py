@@ -44,7 +44,7 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
-from stereoplotter.instrument.correction import mechanism_for_principle
+from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
@@ -737,7 +737,7 @@ def run_kinematic_selftest(
     instrument : InstrumentSpec, optional
         If given, D_max is taken from ``instrument.projection_distance_max_mm``; otherwise the §5
         data (D_max = 185 mm, the SC-1 example) are used, and its correction mechanism
-        (:func:`~stereoplotter.instrument.correction.mechanism_for_principle`) adds its own rows.
+        (:func:`~stereoplotter.instrument.correction.mechanism_for`) adds its own rows.
 
     Returns
     -------
@@ -756,7 +756,7 @@ def run_kinematic_selftest(
     pair = SyntheticPair()
     mechanism = None
     if instrument is not None:
-        mechanism = mechanism_for_principle(instrument.principle)
+        mechanism = mechanism_for(instrument)
         pair = replace(
             pair, projection_distance_max_mm=float(instrument.projection_distance_max_mm)
         )

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.instrument.correction import mechanism_for_principle
+from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import decentration_variant
 from stereoplotter.instrument.spec import InstrumentSpec
@@ -179,7 +179,7 @@ def prepare_run(
             sheet,
             scene,
             decentration_variant(variant).strict_per_axis,
-            mechanism_for_principle(spec.principle),
+            mechanism_for(spec),
         )
     return PreparedRun(
         scenario,

@@ -18,7 +18,7 @@ from stereoplotter.instrument.correction import (
     LensShift,
     MechanicalProjection,
     PlaneFollower,
-    mechanism_for_principle,
+    mechanism_for,
 )
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.procedure.selftest import SyntheticPair, residual_table
@@ -71,7 +71,7 @@ class _NumericLinkage:
 @pytest.mark.parametrize("name", ["sc1", "spr3", "sd3"])
 def test_selftest_rows_reproduced_by_numeric_linkage(name):
     spec = load_instrument(name)
-    mech = mechanism_for_principle(spec.principle)
+    mech = mechanism_for(spec)
     pair = SyntheticPair(projection_distance_max_mm=float(spec.projection_distance_max_mm))
     closed = [r for r in residual_table(pair, (0.5, 1.0, 3.0), mech) if r["unit"] == mech.key]
     numeric = [
@@ -89,7 +89,7 @@ def test_selftest_rows_reproduced_by_numeric_linkage(name):
 def test_three_instruments_give_three_tables():
     tables = []
     for name in ("sc1", "spr3", "sd3"):
-        mech = mechanism_for_principle(load_instrument(name).principle)
+        mech = mechanism_for(load_instrument(name))
         rows = residual_table(SyntheticPair(), (3.0,), mech)
         tables.append(next(r["max_q_um"] for r in rows if r["unit"] == mech.key))
     # measured at 3°: SC-1 24.09, SPR-3 25.43, SD-3 22.19 µm (canonical unit 22.58 µm)

@@ -16,7 +16,7 @@ import re
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.correction import mechanism_for_principle
+from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.kinematics import unit_for_orientation
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
@@ -33,7 +33,7 @@ UM = 1e-3  # mm
 
 def _mechanism(instrument):
     """The instrument's own correction mechanism (issue 11): the floor is its level."""
-    return mechanism_for_principle(load_instrument(instrument).principle)
+    return mechanism_for(load_instrument(instrument))
 
 
 def _differential_scale(prep, instrument):

@@ -24,6 +24,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import brentq
 
+from stereoplotter.instrument.spec import InstrumentSpec
+
 __all__ = [
     "CorrectionMechanism",
     "LensShift",
@@ -31,6 +33,7 @@ __all__ = [
     "PlaneFollower",
     "control_name",
     "mark_phrase",
+    "mechanism_for",
     "mechanism_for_principle",
 ]
 
@@ -153,10 +156,28 @@ _BY_PRINCIPLE = {
 }
 
 
+_DIMENSION_KEYS = {
+    PlaneFollower: ("correction.follower_radius_mm", "follower_radius_mm"),
+    LensShift: ("correction.lens_arm_length_mm", "arm_length_mm"),
+    MechanicalProjection: ("correction.gimbal_offset_mm", "gimbal_offset_mm"),
+}
+
+
 def mechanism_for_principle(principle: str) -> CorrectionMechanism | None:
-    """The mechanism of an instrument's ``principle`` (None: the canonical unit, s = 1)."""
+    """The mechanism of an instrument's ``principle`` with its default dimension (None: the
+    canonical unit, s = 1)."""
     cls = _BY_PRINCIPLE.get(principle)
     return cls() if cls is not None else None
+
+
+def mechanism_for(spec: InstrumentSpec) -> CorrectionMechanism | None:
+    """The instrument's mechanism, its dimension from the YAML leaf when present (assumed)."""
+    cls = _BY_PRINCIPLE.get(spec.principle)
+    if cls is None:
+        return None
+    key, field_name = _DIMENSION_KEYS[cls]
+    p = spec.parameters.get(key)
+    return cls(**{field_name: float(p.value)}) if p is not None else cls()
 
 
 #: Each instrument's own names of the correction controls (issue 11, deliverable 6); keys are
