@@ -522,6 +522,7 @@ def _finish(prep: _Prepared, table: BlockResult) -> SetupSheet:
         scenario=prep.name,
         instrument=spec.key,
         instrument_title=spec.title,
+        instrument_principle=spec.principle,
         frame_rotation=float(table.frame_rotation[0]),
         frame_origin_m=tuple(float(v) for v in table.frame_origin_m[0]),
         focal_length_corrected_mm=table.focal_length_of(0),

@@ -12,7 +12,7 @@ from stereoplotter.instrument.limits import (
     check_model_to_photo_scale,
     check_photo_to_map_ratio,
 )
-from stereoplotter.instrument.spec import RangeRefusal
+from stereoplotter.instrument.spec import RangeRefusal, check_in_range
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.setup.sheet import SetupRefusal, compute_setup_sheet
@@ -71,8 +71,6 @@ def test_spr3_model_scale_range():
 
 
 def test_sc1_projection_distance_stops_at_documented_d_max():
-    from stereoplotter.instrument.spec import check_in_range
-
     spec = load_instrument("sc1")
     assert spec.projection_distance_max_mm == 185.0  # SEED6 L3715, documented
     with pytest.raises(RangeRefusal, match="185"):
