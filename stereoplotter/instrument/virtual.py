@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -256,6 +257,7 @@ class Instrument:
                 full(0.0),
                 full(0.0),
                 strict_per_axis=self.variant.strict_per_axis,
+                mechanism=mechanism_for(spec),
             )
             for side in ("left", "right")
         }

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
@@ -573,8 +574,8 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
     op.log.add(
         "2",
         f"{side} photo: counter {counter} at {'MO_' + counter + sfx} + n·{coordinate} "
-        f"= {np.ravel(value)[0]:.2f} mm, turn {knob} (tan {_TILT[axis]}) "
-        f"until mark {mark} is under the measuring mark",
+        f"= {np.ravel(value)[0]:.2f} mm, turn {control_name(op.inst.spec.principle, knob)} "
+        f"(tan {_TILT[axis]}) until {mark_phrase(op.inst.spec.principle, mark)}",
         knob,
         before=before,
         after=op.physical(knob),
@@ -644,7 +645,8 @@ def stage2_transform(run: Run) -> None:
             tilt = "α" if d == "dx" else "ω"
             op.log.add(
                 "2",
-                f"decentration scale {control} = MO_{d} + f′·tan {tilt}_{_SIDE[side]} "
+                f"decentration {control_name(op.inst.spec.principle, control)} "
+                f"= MO_{d} + f′·tan {tilt}_{_SIDE[side]} "
                 f"(place of zero MO_{d} = {NOMINAL_ZERO[control]:g} mm)",
                 control,
                 reading=value,
@@ -1334,7 +1336,7 @@ def stage5_check(run: Run) -> None:
 
 
 def mechanism_level(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
 ) -> tuple[float, float]:
     """What the correction mechanism itself leaves at the sheet's own settings (the floor).
 
@@ -1343,10 +1345,17 @@ def mechanism_level(
     points [mm, photo scale], and the largest control-height error relative to the first height
     control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
     setup-data method sets exactly these values and has no relative orientation or levelling.
+    ``mechanism``: the instrument's own correction mechanism
+    (:func:`~stereoplotter.instrument.correction.mechanism_for`); None: canonical unit.
     """
     f = sheet.focal_length_corrected_mm
     units = [
-        UnitMap(unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis))
+        UnitMap(
+            replace(
+                unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis),
+                mechanism=mechanism,
+            )
+        )
         for p in sheet.photos
     ]
     bx, by, bz = sheet.base_mm
@@ -1366,7 +1375,9 @@ def mechanism_level(
     return q_max, float(np.max(np.abs(model_h - heights[:, 2])))
 
 
-def refuse_beyond_mechanism(sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False):
+def refuse_beyond_mechanism(
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
+):
     """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
     already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
     no operator can then build the model by the setup-data method on this instrument.
@@ -1375,7 +1386,7 @@ def refuse_beyond_mechanism(sheet: SetupSheet, scene: Scene, strict_per_axis: bo
     mechanism — the largest photo tilt, ``photos[i].exterior.alpha_deg`` or ``omega_deg`` — and
     the §26 tolerances the mechanism level exceeds.
     """
-    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis)
+    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis, mechanism)
     tol_q = sheet.tolerances["residual_y_parallax_mm"]
     tol_h = sheet.tolerances["control_height_m"]
     if q_max <= tol_q and h_max <= tol_h:
