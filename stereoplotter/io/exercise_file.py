@@ -54,7 +54,7 @@ __all__ = [
 #: The largest |α|, |ω| of the photos in each tilt class (assumed: the book's "small tilts"
 #: of a few tenths of a degree up to about 2.5°, inside the ±3° correction range of the
 #: instruments after the frame rotation of the sheet). [degrees]
-TILT_TARGET_DEG = {"small": 0.7, "medium": 1.5, "large": 2.5}
+TILT_TARGET_DEG = {"small": 0.7, "medium": 1.0, "large": 2.5}
 #: Relief classes by (highest − lowest hill or slope effect) / flying height (assumed, the
 #: usual split of plain, hilly and mountain terrain for stereoplotter work). [—]
 RELIEF_CLASSES = {"flat": (0.0, 0.01), "hilly": (0.01, 0.15), "mountainous": (0.15, 10.0)}

@@ -111,7 +111,11 @@ class LensShift(CorrectionMechanism):
         f = np.asarray(f_mm, float)
         d2 = np.asarray(ex, float) ** 2 + np.asarray(ey, float) ** 2
         big = self.arm_length_mm
-        return f / (f - (big - np.sqrt(big * big - d2)))
+        # |δ| > L: the arm cannot reach, no such state (NaN). Only trial states of a solver's
+        # search get there (budget, pair60: tan ω ≈ −7.6 inside a Newton step); the settled
+        # settings stay within the ±3° range, where |δ| ≤ 11 mm.
+        with np.errstate(invalid="ignore"):
+            return f / (f - (big - np.sqrt(big * big - d2)))
 
     def scale_numeric(self, f_mm, ta, to, ex, ey):
         d = float(np.hypot(ex, ey))
