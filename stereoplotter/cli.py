@@ -1087,7 +1087,10 @@ def _parser() -> argparse.ArgumentParser:
         "--host", default="127.0.0.1", help="address to listen on (default: %(default)s)"
     )
     p.add_argument(
-        "--port", type=non_negative_int, default=8000, help="port (default: %(default)s)"
+        "--port",
+        type=non_negative_int,
+        default=0,
+        help="port (default: 0, a free port chosen by the system; the address is printed)",
     )
     p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
     return parser
@@ -1220,7 +1223,12 @@ def _trainer(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 1
-    serve(args.host, args.port, args.token)
+    try:
+        serve(args.host, args.port, args.token)
+    except OSError as exc:
+        print(f"error: trainer: cannot listen on {args.host}:{args.port} ({exc.strerror or exc})",
+              file=sys.stderr)
+        return 1
     return 0
 
 

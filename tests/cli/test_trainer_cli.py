@@ -3,6 +3,12 @@
 from __future__ import annotations
 
 import json
+import re
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
 
 from stereoplotter.cli import main
 from stereoplotter.io.exercise_file import shipped_exercises
@@ -50,3 +56,43 @@ def test_a_refused_action_stops_the_run_but_the_log_is_written(tmp_path, capsys)
     )
     assert "beyond the range stops" in capsys.readouterr().err
     assert len(log.read_text(encoding="utf-8").splitlines()) == 2
+
+
+def test_trainer_serves_on_the_printed_free_port():
+    # `stereoplotter trainer` with the default port 0: the system picks a free port and the
+    # printed address is the one that answers (issue 14, deliverable 1)
+    with subprocess.Popen(
+        [sys.executable, "-m", "stereoplotter", "trainer", "--token", "t0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    ) as proc:
+        try:
+            first = proc.stdout.readline()
+            second = proc.stdout.readline()
+            url = re.search(r"http://localhost:(\d+)/$", first.strip())
+            assert url and int(url.group(1)) > 0, first
+            assert second.strip().endswith(f":{url.group(1)}/instructor?token=t0")
+            for _ in range(100):  # the server starts right after printing
+                try:
+                    with urllib.request.urlopen(url.group(0), timeout=2) as r:
+                        assert r.status == 200 and b"<html" in r.read().lower()
+                    break
+                except OSError:
+                    time.sleep(0.05)
+            else:
+                raise AssertionError("the printed address did not answer")
+        finally:
+            proc.terminate()
+            proc.wait(timeout=10)
+
+
+def test_trainer_on_a_busy_port_is_one_error_line(capsys):
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen(1)
+        port = busy.getsockname()[1]
+        assert main(["trainer", "--port", str(port)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: trainer: cannot listen on 127.0.0.1:{port}")
+    assert err.count("\n") == 1
