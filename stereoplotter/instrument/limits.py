@@ -76,23 +76,35 @@ def check_model_to_photo_scale(
 
     The ratio is m/M_г (photo scale denominator over the horizontal model scale denominator). [—]
     """
-    limit = spec.parameters.get(MODEL_SCALE_KEY)
+    ratio = photo_scale_denominator / model_scale_denominator
+    _refuse_ratio_outside(
+        spec,
+        MODEL_SCALE_KEY,
+        ratio,
+        "model/photo scale",
+        f"model scale 1:{model_scale_denominator:.0f} = {ratio:.2f} × the photo scale "
+        f"1:{photo_scale_denominator:.0f} is outside the {spec.title} range",
+    )
+
+
+def _refuse_ratio_outside(
+    spec: InstrumentSpec, key: str, ratio: float, what: str, text: str
+) -> None:
+    """RangeRefusal when ``ratio`` is outside the [low, high] leaf ``key`` (absent: no limit)."""
+    limit = spec.parameters.get(key)
     if limit is None:
         return
     low, high = (float(v) for v in limit.value)
-    ratio = photo_scale_denominator / model_scale_denominator
     if not low <= ratio <= high:
         raise RangeRefusal(
-            f"model scale 1:{model_scale_denominator:.0f} = {ratio:.2f} × the photo scale "
-            f"1:{photo_scale_denominator:.0f} is outside the {spec.title} range [{low:g}, "
-            f"{high:g}] ({limit.status}; {limit.file}: {MODEL_SCALE_KEY})",
-            what="model/photo scale",
+            f"{text} [{low:g}, {high:g}] ({limit.status}; {limit.file}: {key})",
+            what=what,
             value=ratio,
             low=low,
             high=high,
             status=limit.status,
             file=limit.file,
-            key=MODEL_SCALE_KEY,
+            key=key,
         )
 
 
@@ -107,21 +119,12 @@ def check_photo_to_map_ratio(
 
     The ratio is m/M_map (photo scale denominator over map scale denominator). [—]
     """
-    limit = spec.parameters.get(MAP_RATIO_KEY)
-    if limit is None:
-        return
-    low, high = (float(v) for v in limit.value)
     ratio = photo_scale_denominator / map_scale_denominator
-    if not low <= ratio <= high:
-        raise RangeRefusal(
-            f"map scale 1:{map_scale_denominator:.0f} = {ratio:.2f} × the photo scale "
-            f"1:{photo_scale_denominator:.0f} is outside the {spec.title} photo-to-map ratio "
-            f"[{low:g}, {high:g}] ({limit.status}; {limit.file}: {MAP_RATIO_KEY})",
-            what="photo-to-map ratio",
-            value=ratio,
-            low=low,
-            high=high,
-            status=limit.status,
-            file=limit.file,
-            key=MAP_RATIO_KEY,
-        )
+    _refuse_ratio_outside(
+        spec,
+        MAP_RATIO_KEY,
+        ratio,
+        "photo-to-map ratio",
+        f"map scale 1:{map_scale_denominator:.0f} = {ratio:.2f} × the photo scale "
+        f"1:{photo_scale_denominator:.0f} is outside the {spec.title} photo-to-map ratio",
+    )

@@ -11,12 +11,11 @@ from __future__ import annotations
 
 import json
 import os
-from pathlib import Path
 from typing import Any
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.io import exercise_file  # noqa: F401  (registers the exercise resolver)
-from stereoplotter.io.yaml_files import atomic_write_bytes
+from stereoplotter.io.yaml_files import atomic_write_bytes, read_text_file
 from stereoplotter.trainer.session import LOG_FORMAT, Session
 
 __all__ = ["log_bytes", "read_log", "replay_log", "write_log"]
@@ -43,12 +42,7 @@ def read_log(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
         Missing or unreadable file, a line that is not a JSON object, or no header line.
     """
     source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError(source, "(file)", "an existing file", "no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(source, "(file)", "a readable UTF-8 text file", str(exc)) from None
+    text = read_text_file(path)
     records = []
     for number, line in enumerate(text.splitlines(), 1):
         if not line.strip():
