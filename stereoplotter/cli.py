@@ -284,6 +284,26 @@ def _format_demo(result: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _render(args: argparse.Namespace) -> int:
+    from stereoplotter.io.images import write_render
+    from stereoplotter.io.scenario_file import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    sides = (args.side,) if args.side else tuple(p.name for p in scenario.photos)
+    written = write_render(
+        scenario,
+        args.output,
+        sides=sides,
+        at_m=tuple(args.at) if args.at else None,
+        magnification=args.magnification,
+        pixel_mm=args.pixel,
+        seed=args.seed,
+    )
+    for path in written:
+        print(path)
+    return 0
+
+
 def _demo(args: argparse.Namespace) -> int:
     from stereoplotter.progress import step_progress
 
@@ -405,6 +425,25 @@ def _sheet_summary(sheet: Any) -> str:
         f"f_пр = {sheet.f_instrument_mm:.3f} mm, n_л = {sheet.n_left:.5f}, "
         f"n_п = {sheet.n_right:.5f}"
     )
+
+
+def _check_sheet(args: argparse.Namespace) -> int:
+    """check-sheet: exit 0 when every value is within its tolerance, 1 otherwise."""
+    from stereoplotter.io.instrument_file import load_instrument
+    from stereoplotter.io.scenario_file import load_scenario
+    from stereoplotter.io.trainee_sheet import load_trainee_sheet
+    from stereoplotter.report.sheet_check import check_dict, check_text
+    from stereoplotter.setup.sheet import compute_setup_sheet
+    from stereoplotter.setup.sheet_check import check_sheet
+
+    trainee = load_trainee_sheet(args.sheet)
+    spec = load_instrument(args.instrument)
+    scenario = load_scenario(args.scenario)
+    seed = scenario.seed if args.seed is None else args.seed
+    sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(seed))
+    result = check_sheet(sheet, spec, trainee)
+    sys.stdout.write(_json(check_dict(result)) if args.json else check_text(result))
+    return 0 if result.passed else 1
 
 
 def _setup(args: argparse.Namespace) -> int:
@@ -826,6 +865,34 @@ def _parser() -> argparse.ArgumentParser:
     )
     t.add_argument("--json", action="store_true", help="print JSON instead of text")
 
+    p = sub.add_parser(
+        "render", help="render synthetic photos and eyepiece views as PNG (docs/imagery.md)"
+    )
+    p.add_argument("scenario", help="a scenario name (pair60) or YAML file")
+    p.add_argument("--side", choices=["left", "right"], help="one photo only (default: both)")
+    p.add_argument(
+        "--at",
+        type=bounded_float(-1e7, 1e7),
+        nargs=2,
+        metavar=("X", "Y"),
+        help="ground point [m] the views centre on (default: below the centres' midpoint)",
+    )
+    p.add_argument(
+        "--magnification",
+        type=bounded_float(0.5, 60.0),
+        default=6.0,
+        help="eyepiece magnification of the views (default: 6)",
+    )
+    p.add_argument(
+        "--pixel",
+        type=bounded_float(0.02, 0.5),
+        default=0.08,
+        metavar="MM",
+        help="pixel of the photo files [mm] (default 0.08: 3.6 s a photo; 0.02 takes a minute)",
+    )
+    p.add_argument("--seed", type=seed_int, help="texture seed (default: the scenario's)")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the PNG files")
+
     p = sub.add_parser("setup", help="compute the setup sheet (Table 24) of a stereopair")
     p.add_argument(
         "scenario",
@@ -862,6 +929,16 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--vertical-scale", type=scale_denominator, metavar="M", help="force M_в = M")
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument("--json", action="store_true", help="print the sheet as JSON")
+
+    p = sub.add_parser(
+        "check-sheet",
+        help="check a trainee's own setup sheet against the program's and name the mistakes",
+    )
+    p.add_argument("sheet", help="the trainee's sheet (YAML in the layout of sheet.yaml)")
+    p.add_argument("--scenario", required=True, help="the stereopair (a name or a YAML file)")
+    p.add_argument("--instrument", required=True, help="sc1, spr3, sd3 or a YAML path")
+    p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
+    p.add_argument("--json", action="store_true", help="print the check as JSON")
 
     p = sub.add_parser("job", help="work with production job files (docs/production.md)")
     jobs = p.add_subparsers(dest="job_command", required=True, metavar="ACTION")
@@ -978,7 +1055,193 @@ def _parser() -> argparse.ArgumentParser:
         "--instrument", default="sc1", help="instrument of the setup sheet (default: %(default)s)"
     )
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+    p = sub.add_parser("exercise", help="trainer exercises (docs/trainer.md)")
+    exs = p.add_subparsers(dest="exercise_command", required=True, metavar="ACTION")
+    e = exs.add_parser("list", help="the exercises found, easiest first")
+    e.add_argument("--json", action="store_true", help="print JSON instead of text")
+    e = exs.add_parser("show", help="an exercise's settings")
+    e.add_argument("name", help="an exercise name (e01-setup-stage1) or YAML file")
+    e.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+    p = sub.add_parser("session", help="run a trainee's session without a browser")
+    ses = p.add_subparsers(dest="session_command", required=True, metavar="ACTION")
+    r = ses.add_parser(
+        "run",
+        help="carry out the actions of a file (JSON lines or a JSON list; 'operator' for the "
+        "simulated operator's own) and write the session log",
+    )
+    r.add_argument("exercise", help="an exercise name or YAML file")
+    r.add_argument("--actions", required=True, metavar="FILE", help="actions file, or 'operator'")
+    r.add_argument("-o", "--output", required=True, metavar="LOG", help="session log to write")
+    r.add_argument("--trainee", default="trainee", help="trainee's name (per-trainee seeds)")
+    r.add_argument("--seed", type=seed_int, help="seed when the exercise has none fixed")
+    r.add_argument(
+        "--keep-going", action="store_true", help="log a refused action and go on (default: stop)"
+    )
+
+    p = sub.add_parser("grade", help="grade a session log (Markdown and JSON)")
+    p.add_argument("log", metavar="SESSION_LOG", help="a session log (JSON lines)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of Markdown")
+    p.add_argument("-o", "--output", metavar="DIR", help="also write grade.md and grade.json here")
+    p.add_argument(
+        "--population",
+        type=non_negative_int,
+        default=10_000,
+        help="simulated operators for the percentile (0: none; default: %(default)s)",
+    )
+
+    p = sub.add_parser(
+        "trainer",
+        help="serve the browser trainer (needs the extra stereoplotter[trainer]; docs/trainer.md)",
+    )
+    p.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (default: %(default)s)"
+    )
+    p.add_argument(
+        "--port",
+        type=non_negative_int,
+        default=0,
+        help="port (default: 0, a free port chosen by the system; the address is printed)",
+    )
+    p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
     return parser
+
+
+# --- trainer: exercises, sessions, grades ----------------------------------------------------
+
+
+def _exercise_row(ex: Any) -> dict[str, Any]:
+    return {
+        "name": ex.name,
+        "level": ex.level,
+        "title": ex.title,
+        "instrument": ex.instrument,
+        "scenario": ex.scenario_name,
+        "method": ex.method,
+        "stages": list(ex.stages),
+        "preset_stages": list(ex.preset_stages),
+        "terrain": ex.terrain,
+        "model": ex.model,
+        "unusable_points": list(ex.unusable_points),
+        "errors": ex.errors,
+        "tilt": ex.tilt,
+        "assists": ex.assists,
+        "mode": ex.mode,
+        "seed": ex.seed if ex.seed is not None else "per-trainee",
+        "description": ex.description,
+    }
+
+
+def _exercise(args: argparse.Namespace) -> int:
+    from stereoplotter.io.exercise_file import load_exercise, shipped_exercises
+
+    if args.exercise_command == "list":
+        rows = sorted(
+            (_exercise_row(load_exercise(p)) for p in shipped_exercises()),
+            key=lambda r: (r["level"], r["name"]),
+        )
+        if args.json:
+            sys.stdout.write(_json(rows))
+            return 0
+        for r in rows:
+            stages = ",".join(r["stages"])
+            print(
+                f"{r['level']:>2}  {r['name']:<30} {r['instrument']:<5} {r['method']:<12} "
+                f"stages {stages:<11} {r['mode']:<8} {r['title']}"
+            )
+        return 0
+    row = _exercise_row(load_exercise(args.name))
+    if args.json:
+        sys.stdout.write(_json(row))
+        return 0
+    for key, value in row.items():
+        print(f"{key}: {value}")
+    return 0
+
+
+def _read_actions(path: str) -> list[dict[str, Any]]:
+    """Actions from a JSON list or JSON lines file (one line: file, line, what is wrong)."""
+    from stereoplotter.errors import ConfigError
+
+    text = Path(path).read_text(encoding="utf-8")
+    try:
+        data = json.loads(text)
+        rows = data if isinstance(data, list) else [data]
+    except json.JSONDecodeError:
+        rows = []
+        for number, line in enumerate(text.splitlines(), 1):
+            if line.strip():
+                try:
+                    rows.append(json.loads(line))
+                except json.JSONDecodeError as exc:
+                    raise ConfigError(path, f"line {number}", "a JSON action", exc.msg) from None
+    return rows
+
+
+def _session(args: argparse.Namespace) -> int:
+    from stereoplotter.errors import TrainerError
+    from stereoplotter.io.exercise_file import load_exercise
+    from stereoplotter.io.session_log import write_log
+    from stereoplotter.trainer.session import Session
+
+    session = Session.start(load_exercise(args.exercise), trainee=args.trainee, seed=args.seed)
+    actions = (
+        session.operator_script() if args.actions == "operator" else _read_actions(args.actions)
+    )
+    refused = 0
+    try:
+        for action in actions:
+            try:
+                session.act(action)
+            except TrainerError as exc:
+                refused += 1
+                if not args.keep_going:
+                    print(f"error: {exc}", file=sys.stderr)
+                    return 1
+                print(f"refused: {exc}", file=sys.stderr)
+    finally:
+        write_log(args.output, session)
+    state = session.state()
+    print(
+        f"{len(session.log)} actions ({refused} refused), stage {state['stage'] or 'all done'}; "
+        f"log: {args.output}"
+    )
+    return 0
+
+
+def _grade(args: argparse.Namespace) -> int:
+    from stereoplotter.io.session_log import read_log
+    from stereoplotter.progress import progress_bar
+    from stereoplotter.report.grade import grade_json, grade_markdown, write_grade
+    from stereoplotter.trainer.grading import grade
+
+    records = read_log(args.log)
+    with progress_bar(args.population, "simulated operators", unit="operator") as advance:
+        result = grade(records, population=args.population, progress=advance)
+    if args.output:
+        write_grade(result, args.output)
+    sys.stdout.write(grade_json(result) if args.json else grade_markdown(result))
+    return 0
+
+
+def _trainer(args: argparse.Namespace) -> int:
+    try:
+        from stereoplotter.web.server import serve
+    except ImportError as exc:
+        print(
+            f"error: the browser trainer needs the extra stereoplotter[trainer] "
+            f"(pip install 'stereoplotter[trainer]'); missing module {exc.name}",
+            file=sys.stderr,
+        )
+        return 1
+    try:
+        serve(args.host, args.port, args.token)
+    except OSError as exc:
+        print(f"error: trainer: cannot listen on {args.host}:{args.port} ({exc.strerror or exc})",
+              file=sys.stderr)
+        return 1
+    return 0
 
 
 def _resolve_data_arguments(args: argparse.Namespace) -> None:
@@ -1047,6 +1310,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _instrument(args)
         if args.command == "setup":
             return _setup(args)
+        if args.command == "check-sheet":
+            return _check_sheet(args)
+        if args.command == "render":
+            return _render(args)
         if args.command == "job":
             return _job(args)
         if args.command == "simulate":
@@ -1055,6 +1322,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _verify(args)
         if args.command == "budget":
             return _budget(args)
+        if args.command == "exercise":
+            return _exercise(args)
+        if args.command == "session":
+            return _session(args)
+        if args.command == "grade":
+            return _grade(args)
+        if args.command == "trainer":
+            return _trainer(args)
     except StereoplotterError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

@@ -11,6 +11,7 @@ __all__ = [
     "ConfigError",
     "GeometryError",
     "StereoplotterError",
+    "TrainerError",
     "describe_value",
     "did_you_mean",
 ]
@@ -52,6 +53,10 @@ class ConfigError(StereoplotterError):
 
 class GeometryError(StereoplotterError):
     """The geometry is degenerate: too few points, collinear points, rays that do not meet."""
+
+
+class TrainerError(StereoplotterError):
+    """A trainee's action refused by the session (one line: what and why)."""
 
 
 # --- helpers of the messages -----------------------------------------------------------------

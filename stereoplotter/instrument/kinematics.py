@@ -35,7 +35,7 @@ column per point).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -171,6 +171,9 @@ class CorrectionUnit:
     strict_per_axis : bool
         Use the strict per-axis mechanism (α only in x, ω only in y, no common change of F;
         ``kinematics.md`` §3.3, last paragraph) instead of the correction plane.
+    mechanism : CorrectionMechanism or None
+        The instrument's own construction (:mod:`stereoplotter.instrument.correction`): its
+        second-order scale factor s multiplies τ·(ξ, η) before the decentration. None: s = 1.
     """
 
     focal_length_mm: ArrayLike
@@ -182,6 +185,7 @@ class CorrectionUnit:
     plane_decentration_x_mm: ArrayLike | None = None
     plane_decentration_y_mm: ArrayLike | None = None
     strict_per_axis: bool = False
+    mechanism: Any = None
 
     @property
     def plane_decentration_mm(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -370,7 +374,9 @@ class UnitMap:
     True
     """
 
-    __slots__ = ("c", "ex", "ey", "f", "kx", "ky", "ms", "num", "s", "strict", "ta", "to", "unit")
+    __slots__ = (
+        "c", "ex", "ey", "f", "kx", "ky", "mech", "ms", "num", "s", "strict", "ta", "to", "unit"
+    )
 
     def __init__(
         self,
@@ -391,6 +397,9 @@ class UnitMap:
             self.kx = self.ky = None
         self.ex = _a(unit.decentration_x_mm)
         self.ey = _a(unit.decentration_y_mm)
+        self.mech = None
+        if unit.mechanism is not None:
+            self.mech = unit.mechanism.scale(f, ta, to, self.ex, self.ey)
         if trig is None:
             kappa = _a(unit.kappa)
             trig = (np.cos(kappa), np.sin(kappa))
@@ -422,6 +431,8 @@ class UnitMap:
         else:
             tau = self.num / (f + xi * ta + eta * to)
             u, v = tau * xi, tau * eta
+        if self.mech is not None:
+            u, v = self.mech * u, self.mech * v
         u = u - self.ex
         v = v - self.ey
         c = self.c
@@ -437,6 +448,8 @@ class UnitMap:
         c, s = self.c, self.s
         px = c * x - s * y + self.ex
         py = s * x + c * y + self.ey
+        if self.mech is not None:
+            px, py = px / self.mech, py / self.mech
         f, ta, to = self.f, self.ta, self.to
         if self.strict:
             return px * f / (self.kx - px * ta), py * f / (self.ky - py * to)

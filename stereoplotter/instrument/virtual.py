@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -256,6 +257,7 @@ class Instrument:
                 full(0.0),
                 full(0.0),
                 strict_per_axis=self.variant.strict_per_axis,
+                mechanism=mechanism_for(spec),
             )
             for side in ("left", "right")
         }
@@ -446,6 +448,30 @@ class Instrument:
         self._units[side] = turn_correction_knob(
             self._units[side], axis, t, linkage=self.variant.linkage
         )
+
+    def switch_counter(self, control: ScrewName | DecentrationName, sense: int) -> None:
+        """Switch a counter's direction (+1: readings grow with the position, the book's
+        setting, L3779; −1: they fall). The reading at the present position stays; the zero
+        reading (место нуля) follows from it."""
+        if control not in self._scales:
+            raise StereoplotterError(f"no counter {control!r}; counters: {', '.join(self._scales)}")
+        if sense not in (1, -1):
+            raise StereoplotterError(f"counter direction: expected +1 or -1, found {sense!r}")
+        scale = self._scales[control]
+        if control in self._axes:
+            position = np.asarray(self._axes[control].nut, float).reshape(np.shape(scale.zero))
+        else:
+            unit = self._units[control.split("_")[1]]
+            position = (
+                unit.decentration_x_mm if control.startswith("dx") else unit.decentration_y_mm
+            )
+        now = scale.reading(position)
+        zero = now - sense * (1.0 + scale.ratio_error) * np.asarray(position, float)
+        self._scales[control] = replace(scale, zero=zero, sense=sense)
+
+    def counter_sense(self, control: ScrewName | DecentrationName) -> int:
+        """The direction of a counter (+1 or −1)."""
+        return self._scales[control].sense
 
     def travel_mm(self, control: ScrewName) -> tuple[float, float]:
         """The range stops of a lead-screw axis (nut positions). [mm]

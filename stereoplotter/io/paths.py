@@ -53,9 +53,9 @@ DEFAULT_SCENARIO = "pair60"
 ENVIRONMENT_VARIABLE = "STEREOPLOTTER_DATA"
 
 #: The kinds of data: the sub-folder names of a data folder.
-KINDS = ("instruments", "scenarios")
+KINDS = ("instruments", "scenarios", "exercises")
 
-_SINGULAR = {"instruments": "instrument", "scenarios": "scenario"}
+_SINGULAR = {"instruments": "instrument", "scenarios": "scenario", "exercises": "exercise"}
 
 _option_folders: tuple[Path, ...] = ()
 _warned: set[tuple[str, str, str]] = set()

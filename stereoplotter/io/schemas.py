@@ -19,10 +19,12 @@ from pydantic import BaseModel
 from stereoplotter.io.block_file import BlockFile
 from stereoplotter.io.budget_output import BudgetOutput
 from stereoplotter.io.errors_file import ErrorsFile
+from stereoplotter.io.exercise_file import ExerciseFile
 from stereoplotter.io.geometry_file import GeometryFile
 from stereoplotter.io.instrument_file import InstrumentFile
 from stereoplotter.io.job_file import JobFile
 from stereoplotter.io.scenario_file import ScenarioFile
+from stereoplotter.io.trainee_sheet import TraineeSheet
 from stereoplotter.io.yaml_files import atomic_write_text
 
 __all__ = ["MODELS", "schema", "schema_text", "write_schemas"]
@@ -36,6 +38,8 @@ MODELS: dict[str, type[BaseModel]] = {
     "geometry": GeometryFile,
     "job": JobFile,
     "budget": BudgetOutput,  # an output: the JSON of `stereoplotter budget --json`
+    "trainee-sheet": TraineeSheet,
+    "exercise": ExerciseFile,
 }
 
 

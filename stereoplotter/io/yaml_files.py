@@ -27,6 +27,7 @@ __all__ = [
     "describe_value",
     "did_you_mean",
     "load_yaml_mapping",
+    "read_text_file",
 ]
 
 _MISSING = object()
@@ -37,6 +38,17 @@ _MISSING = object()
 #: stand for billions of nodes ("billion laughs"), and deep nesting exhausts Python's stack.
 MAX_YAML_NODES = 1_000_000  # after expanding aliases
 MAX_YAML_DEPTH = 64
+
+
+def read_text_file(path: str | os.PathLike[str]) -> str:
+    """The UTF-8 text of ``path``; a missing or unreadable file is one ConfigError line."""
+    source = str(path)
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(source, "(file)", "an existing file", "no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(source, "(file)", "a readable UTF-8 text file", str(exc)) from None
 
 
 def load_yaml_mapping(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
@@ -55,12 +67,7 @@ def load_yaml_mapping(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str
         through an alias, or expands (through aliases) to more than :data:`MAX_YAML_NODES` nodes.
     """
     source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError(source, "(file)", "an existing file", "no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(source, "(file)", "a readable UTF-8 text file", str(exc)) from None
+    text = read_text_file(path)
     data = _parse_yaml(text, source)
     if data is None:
         raise ConfigError(source, "(top level)", "a mapping of fields", "an empty document")

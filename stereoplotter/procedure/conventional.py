@@ -524,7 +524,9 @@ def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
                 control,
                 before=before,
                 after=after,
-                unit="mm" if control in ("by", "bz") else "—",
+                unit="mm"
+                if control in ("by", "bz")
+                else ("tan" if control.startswith("k_") else "—"),
                 iteration=it,
                 equation="common tilt (q-neutral)",
             )
@@ -640,13 +642,15 @@ def _six_q(run, key: str, active, it: int, stage: str = "C2") -> list[NDArray[np
     imgs = run.scene.images(pts)
     seen = []
     for i in range(6):
-        q, _ = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
+        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
         seen.append(q)
         op.log.add(
             stage,
             f"standard point {i + 1}: fuse, judge the y-parallax",
             "",
             residual=q,
+            true=q_true,
+            judgment_error=q - q_true,
             tolerance=tol,
             passed=np.abs(q) <= tol,
             iteration=it,
@@ -690,7 +694,7 @@ def c2_relative_by_elements(
         for idx, control, element in _SEQUENCE:
             key = f"{key0}/a/{it}/{idx + 1}"
             img = (imgs[0][idx], imgs[1][idx])
-            q_seen, _ = op.fuse(pts[idx], img, key, active)
+            q_seen, q_true = op.fuse(pts[idx], img, key, active)
             target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
             before = op.physical(control)
             clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
@@ -706,9 +710,10 @@ def c2_relative_by_elements(
                 control,
                 before=before,
                 after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "—",
+                unit="rad" if control.startswith("kappa") else "tan",
                 judgment_error=target,
                 residual=q_seen,
+                true=q_true,
                 tolerance=tol,
                 passed=np.abs(q_seen) <= tol,
                 iteration=it,
@@ -777,7 +782,7 @@ def c2_relative_by_equations(
                 control,
                 before=before,
                 after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "—",
+                unit="rad" if control.startswith("kappa") else "tan",
                 iteration=it,
                 equation="(5.11)",
             )
@@ -906,8 +911,7 @@ def _level(
     tol = run.sheet.tolerances["control_height_m"]
     when = active if remedy else None  # the book's loop logs every iteration as before
     errs = [
-        _height_mean(run, pid, p, f"{key}/level/{pid}", active, pointings) - p[2]
-        for pid, p in rows
+        _height_mean(run, pid, p, f"{key}/level/{pid}", active, pointings) - p[2] for pid, p in rows
     ]
     resid = [e - errs[0] for e in errs]
     for (pid, _), r, e in zip(rows, resid, errs, strict=True):
@@ -940,12 +944,13 @@ def _level(
                 after = op.physical(control)
             op.log.add(
                 "C3",
-                f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: "
-                f"turn {control}",
+                f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: turn {control}",
                 control,
                 before=before,
                 after=after,
-                unit="mm" if control in ("by", "bz") else "—",
+                unit="mm"
+                if control in ("by", "bz")
+                else ("tan" if control.startswith("k_") else "—"),
                 iteration=it,
                 equation="levelling (assumption)",
                 remedy=remedy,

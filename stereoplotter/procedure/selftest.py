@@ -44,6 +44,7 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
+from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
@@ -396,7 +397,7 @@ def _q_stats(q_mm: NDArray) -> tuple[NDArray, NDArray]:
 
 
 def residual_table(
-    pair: SyntheticPair | None = None, tilts_deg=(0.5, 1.0, 3.0)
+    pair: SyntheticPair | None = None, tilts_deg=(0.5, 1.0, 3.0), mechanism=None
 ) -> list[dict[str, Any]]:
     r"""``kinematics.md`` §6: residual y-parallax of the per-axis approximation.
 
@@ -406,6 +407,9 @@ def residual_table(
         Default: the §5 data.
     tilts_deg : sequence of float
         Tilt magnitudes t. [°]
+    mechanism : CorrectionMechanism, optional
+        The instrument's own correction mechanism
+        (:mod:`stereoplotter.instrument.correction`); adds rows named by its ``key``.
 
     Returns
     -------
@@ -424,11 +428,16 @@ def residual_table(
     setting = pair.setting()
     signs = sign_combinations()
     rows = []
-    for strict in (False, True):
+    kinds = [("canonical", False, None), ("strict per-axis", True, None)]
+    if mechanism is not None:
+        kinds.append((mechanism.key, False, mechanism))
+    for name, strict, mech in kinds:
         for t_deg in tilts_deg:
             tilts = signs * (t_deg * _DEG)
             pl, pr = pair.photos(tilts)
             left, right = _true_units(pair, tilts, strict)
+            if mech is not None:
+                left, right = replace(left, mechanism=mech), replace(right, mechanism=mech)
             reading = y_parallax(pl, pr, setting, left, right)
             max_q, rms_q = _q_stats(reading.y_parallax_mm)
             q_after, reading_after, _ = touch_up(pl, pr, setting, left, right, "L")
@@ -437,7 +446,7 @@ def residual_table(
             deform_after = height_deformation_permille(reading_after.depth_mm, pair)
             rows.append(
                 {
-                    "unit": "strict per-axis" if strict else "canonical",
+                    "unit": name,
                     "tilt_deg": float(t_deg),
                     "max_q_um": float(max_q.max() * UM_PER_MM),
                     "rms_q_um": float(rms_q.max() * UM_PER_MM),
@@ -727,7 +736,8 @@ def run_kinematic_selftest(
         Decentration variants for the §5 table.
     instrument : InstrumentSpec, optional
         If given, D_max is taken from ``instrument.projection_distance_max_mm``; otherwise the §5
-        data (D_max = 185 mm, the SC-1 example) are used. Nothing else is read from it.
+        data (D_max = 185 mm, the SC-1 example) are used, and its correction mechanism
+        (:func:`~stereoplotter.instrument.correction.mechanism_for`) adds its own rows.
 
     Returns
     -------
@@ -744,7 +754,9 @@ def run_kinematic_selftest(
     ('canonical', 2.2)
     """
     pair = SyntheticPair()
+    mechanism = None
     if instrument is not None:
+        mechanism = mechanism_for(instrument)
         pair = replace(
             pair, projection_distance_max_mm=float(instrument.projection_distance_max_mm)
         )
@@ -772,7 +784,8 @@ def run_kinematic_selftest(
             "kappa_right_deg": pair.kappa_right * DEG_PER_RAD,
         },
         "sanity": sanity_checks(pair),
-        "residuals": residual_table(pair, tilts_deg),
+        "mechanism": None if mechanism is None else mechanism.key,
+        "residuals": residual_table(pair, tilts_deg, mechanism),
         "stage2": stage2_table(pair, tilts_deg, variants),
     }
 

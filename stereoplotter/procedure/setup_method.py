@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
@@ -71,6 +72,8 @@ __all__ = [
 ]
 
 _SIDE: dict[Side, str] = {"left": "л", "right": "п"}
+_SUB = {"1": "₁", "2": "₂", "3": "₃", "4": "₄"}
+_TILT = {"alpha": "α", "omega": "ω"}
 
 #: ``--practice``: "operator" applies the remedies after a failed check (the operator's
 #: practice; §26 intro: the set orientation "most often is not accurate enough and its
@@ -206,9 +209,7 @@ def _fid(run: Run, side: str, mark: str) -> NDArray[np.float64]:
 # --- stage 1 ---------------------------------------------------------------------------------
 
 
-def _measure_span(
-    run: Run, side: str, key: str, active, pointings: int = 1
-) -> NDArray[np.float64]:
+def _measure_span(run: Run, side: str, key: str, active, pointings: int = 1) -> NDArray[np.float64]:
     """L′: the mark on fiducial 3 then 4 of ``side``, Y read at each (the mean of
     ``pointings`` pointings and readings per mark, remedy R1)."""
     op = run.op
@@ -287,6 +288,24 @@ def _span_loop(
     return its, ok, np.maximum(np.abs(dl), np.abs(dr))
 
 
+def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy: str, active):
+    """Log the ΔZ (6.9) setting; the word follows the sign: the Z counter counts the projection
+    distance D, so ΔZ > 0 (a larger D) lowers the carriage and ΔZ < 0 raises it. [m, mm]"""
+    direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
+    op.log.add(
+        stage,
+        f"ΔZ = {dz_shown:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
+        "Z",
+        before=depth,
+        after=depth + dz_mm,
+        reading=depth + dz_mm,
+        iteration=it,
+        equation="(6.9), (6.11)",
+        remedy=remedy,
+        when=active if remedy else None,
+    )
+
+
 def _correct_span(
     run: Run, stage: str, k: str, it: int, active, diffs, spans, remedy: str = ""
 ) -> None:
@@ -338,25 +357,25 @@ def _correct_span(
     op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
     shown = op.log.shown if np.ndim(beyond) else 0
     if not np.ravel(beyond)[shown]:
-        op.log.add(
+        _log_delta_z(
+            op,
             stage,
-            f"ΔZ = {float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]):+.3f} m "
-            "(6.9): lower the carriage, O′_Z = O_Z + ΔZ",
-            "Z",
-            before=depth,
-            after=depth + dz_mm,
-            reading=depth + dz_mm,
-            iteration=it,
-            equation="(6.9), (6.11)",
-            remedy=remedy,
-            when=active if remedy else None,
+            float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]),
+            depth,
+            dz_mm,
+            it,
+            remedy,
+            active,
         )
     bz = op.read("bz", f"{k}/bz")
     # D_п as the operator knows it: D + b_z from the b_z scale's nominal place of zero; scaled
     # by f_пр/f′_пр where f_пр was changed, less the ΔZ just set (both move the right photo)
     depth_r = (depth + sense * (bz - NOMINAL_ZERO["bz"])) * f_ratio
-    dbz = depth_r + base_z_correction(depth_r, dr, meas_r) - (depth + dz_mm) - (
-        sense * (bz - NOMINAL_ZERO["bz"])
+    dbz = (
+        depth_r
+        + base_z_correction(depth_r, dr, meas_r)
+        - (depth + dz_mm)
+        - (sense * (bz - NOMINAL_ZERO["bz"]))
     )
     op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
     op.log.add(
@@ -551,15 +570,16 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
     t = op.knob_for(knob, unit, fid, rod, comp, fid[comp] + e)
     before = op.physical(knob)
     op.drive(knob, t, active)
+    coordinate = f"{counter.lower()}⁰{_SUB[mark]}"  # y⁰₃ for k_ω, x⁰₂ / x⁰₁ for k_α
     op.log.add(
         "2",
-        f"{side} photo: counter {counter} = {'MO' + sfx} + n·{axis[0]}⁰, turn {knob} "
-        f"until mark {mark} is under the measuring mark",
+        f"{side} photo: counter {counter} at {'MO_' + counter + sfx} + n·{coordinate} "
+        f"= {np.ravel(value)[0]:.2f} mm, turn {control_name(op.inst.spec.principle, knob)} "
+        f"(tan {_TILT[axis]}) until {mark_phrase(op.inst.spec.principle, mark)}",
         knob,
         before=before,
         after=op.physical(knob),
-        reading=value,
-        unit="—",
+        unit="tan",
         judgment_error=e,
         equation=eq,
     )
@@ -599,7 +619,7 @@ def stage2_transform(run: Run) -> None:
             seen.append(m4)
             op.log.add(
                 "2",
-                f"{side} photo: check mark 4 at MO_Y + n·y⁰₄",
+                f"{side} photo: check mark 4 at MO_Y{',п' if side == 'right' else ''} + n·y⁰₄",
                 "Y",
                 residual=m4,
                 tolerance=tol4,
@@ -622,12 +642,15 @@ def stage2_transform(run: Run) -> None:
             # MO_dx, MO_dy: the decentration scale's place of zero
             value = run.target(f"d_{d[1]},{_SIDE[side]}", NOMINAL_ZERO[control])
             op.set(control, value, f"2/{control}")
+            tilt = "α" if d == "dx" else "ω"
             op.log.add(
                 "2",
-                f"set the computed decentration {control}",
+                f"decentration {control_name(op.inst.spec.principle, control)} "
+                f"= MO_{d} + f′·tan {tilt}_{_SIDE[side]} "
+                f"(place of zero MO_{d} = {NOMINAL_ZERO[control]:g} mm)",
                 control,
                 reading=value,
-                equation="f′·tan α (§2.4)",
+                equation=f"f′·tan {tilt} (§2.4)",
             )
     bz = run.target("O_bz")
     op.set("bz", bz, "2/bz")
@@ -651,7 +674,7 @@ def clear_kappa(run: Run, stage: str) -> None:
         for idx, side in ((0, "right"), (1, "left")):
             key = f"{stage}/kappa/{it}/{idx + 1}"
             img = (imgs[0][idx], imgs[1][idx])
-            q_seen, _ = op.fuse(pts[idx], img, key, active)
+            q_seen, q_true = op.fuse(pts[idx], img, key, active)
             qs.append(q_seen)
             control = f"kappa_{side}"
             target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
@@ -669,6 +692,8 @@ def clear_kappa(run: Run, stage: str) -> None:
                 after=op.physical(control),
                 unit="rad",
                 residual=q_seen,
+                true=q_true,
+                judgment_error=q_seen - q_true,
                 tolerance=tol,
                 passed=ok_here,
                 iteration=it,
@@ -696,13 +721,15 @@ def _judge_standard_points(
     imgs = run.scene.images(pts)
     seen = []
     for i in range(6):
-        q, _ = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
+        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
         seen.append(q)
         op.log.add(
             stage,
             f"residual y-parallax at standard point {i + 1}",
             "",
             residual=q,
+            true=q_true,
+            judgment_error=q - q_true,
             tolerance=tol,
             passed=np.abs(q) <= tol,
             iteration=iteration,
@@ -780,7 +807,7 @@ def refine_relative_orientation(
                 control,
                 before=before,
                 after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "—",
+                unit="rad" if control.startswith("kappa") else "tan",
                 iteration=it,
                 equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
                 remedy=remedy,
@@ -987,7 +1014,7 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
                 control,
                 before=before,
                 after=after,
-                unit="mm" if control == "bz" else ("rad" if control.startswith("kappa") else "—"),
+                unit="mm" if control == "bz" else ("rad" if control.startswith("kappa") else "tan"),
                 iteration=it,
                 equation="levelling on control (assumption, q-neutral common tilt)",
                 remedy=remedy,
@@ -1060,7 +1087,7 @@ def log_control_height(op, stage: str, text: str, read, truth_m: float, tol, **e
     return the error read − truth. [m]"""
     op.log.add(
         stage,
-        text,
+        f"{text}, against the point's known height {truth_m:.2f} m",
         HEIGHT_SCALE,
         reading=read,
         unit="m",
@@ -1088,9 +1115,7 @@ def refine_scale_and_level(
     tol = run.sheet.tolerances["control_height_m"]
     remedy = "R3 refine scaling and levelling on control"
     inst = op.inst
-    design = level_design(
-        run.sheet, run.scene, inst.variant.linkage, inst.variant.strict_per_axis
-    )
+    design = level_design(run.sheet, run.scene, inst.variant.linkage, inst.variant.strict_per_axis)
     active = op.v(failed).astype(bool)
     rounds = np.zeros(np.shape(active), int)
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
@@ -1311,7 +1336,7 @@ def stage5_check(run: Run) -> None:
 
 
 def mechanism_level(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
 ) -> tuple[float, float]:
     """What the correction mechanism itself leaves at the sheet's own settings (the floor).
 
@@ -1320,10 +1345,17 @@ def mechanism_level(
     points [mm, photo scale], and the largest control-height error relative to the first height
     control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
     setup-data method sets exactly these values and has no relative orientation or levelling.
+    ``mechanism``: the instrument's own correction mechanism
+    (:func:`~stereoplotter.instrument.correction.mechanism_for`); None: canonical unit.
     """
     f = sheet.focal_length_corrected_mm
     units = [
-        UnitMap(unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis))
+        UnitMap(
+            replace(
+                unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis),
+                mechanism=mechanism,
+            )
+        )
         for p in sheet.photos
     ]
     bx, by, bz = sheet.base_mm
@@ -1343,7 +1375,9 @@ def mechanism_level(
     return q_max, float(np.max(np.abs(model_h - heights[:, 2])))
 
 
-def refuse_beyond_mechanism(sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False):
+def refuse_beyond_mechanism(
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
+):
     """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
     already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
     no operator can then build the model by the setup-data method on this instrument.
@@ -1352,7 +1386,7 @@ def refuse_beyond_mechanism(sheet: SetupSheet, scene: Scene, strict_per_axis: bo
     mechanism — the largest photo tilt, ``photos[i].exterior.alpha_deg`` or ``omega_deg`` — and
     the §26 tolerances the mechanism level exceeds.
     """
-    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis)
+    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis, mechanism)
     tol_q = sheet.tolerances["residual_y_parallax_mm"]
     tol_h = sheet.tolerances["control_height_m"]
     if q_max <= tol_q and h_max <= tol_h:

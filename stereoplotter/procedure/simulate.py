@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import decentration_variant
 from stereoplotter.instrument.spec import InstrumentSpec
@@ -174,7 +175,12 @@ def prepare_run(
         scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
     )
     if method == "setup":  # the floor: the mechanism at the sheet's own settings (D9)
-        refuse_beyond_mechanism(sheet, scene, decentration_variant(variant).strict_per_axis)
+        refuse_beyond_mechanism(
+            sheet,
+            scene,
+            decentration_variant(variant).strict_per_axis,
+            mechanism_for(spec),
+        )
     return PreparedRun(
         scenario,
         spec,

@@ -59,6 +59,14 @@ class Record:
         The book equation or design decision behind the act.
     remedy : str
         The remedy this act belongs to (``--practice operator``, after a failed check), or "".
+    true : float or None
+        The true value of what was seen (the y-parallax at the point, the height of the control
+        point, …) where the simulation knows it: shown beside the seen one. [residual's unit]
+    reading_unit : str
+        The unit of ``reading`` where it differs from ``unit`` (a counter reading in mm while a
+        knob turns in tan). "" = ``unit``.
+    residual_unit : str
+        The unit of ``residual``, ``tolerance``, ``judgment_error`` and ``true``: "mm" or "m".
     """
 
     number: int
@@ -76,6 +84,9 @@ class Record:
     iteration: int
     equation: str
     remedy: str = ""
+    true: float | None = None
+    reading_unit: str = ""
+    residual_unit: str = "mm"
 
 
 class Transcript:
@@ -104,6 +115,9 @@ class Transcript:
         equation: str = "",
         remedy: str = "",
         when: Any = None,
+        true: Any = None,
+        reading_unit: str = "",
+        residual_unit: str = "",
     ) -> None:
         """Append a record (array arguments are taken at trial ``shown``); ``when`` (a mask
         over the trials) skips the record where trial ``shown`` did not do the act."""
@@ -135,6 +149,9 @@ class Transcript:
                 int(iteration),
                 equation,
                 remedy,
+                _f(true, t),
+                reading_unit,
+                residual_unit or ("m" if unit == "m" else "mm"),
             )
         )
 
@@ -170,19 +187,44 @@ class Transcript:
             if r.control:
                 text += f" — {r.control}"
                 if r.reading is not None:
-                    text += f": {_num(r.reading, r.unit)}"
+                    text += f": {_num(r.reading, r.reading_unit or r.unit)}"
                 if r.before is not None and r.after is not None:
                     text += f" (from {_num(r.before, r.unit)} to {_num(r.after, r.unit)})"
-            if r.judgment_error is not None and r.judgment_error != 0.0:
-                text += f"; judgment error {r.judgment_error * 1e3:+.1f} µm"
-            if r.residual is not None:
-                text += f"; seen {r.residual:+.4f}"
-                if r.tolerance is not None:
-                    text += f" (tolerance {r.tolerance:.4f}: {'pass' if r.passed else 'FAIL'})"
+            elif r.reading is not None:
+                text += f" — read {_num(r.reading, r.reading_unit or r.unit)}"
+            text += _seen(r)
             if r.equation:
                 text += f"  ({r.equation})"
             lines.append(text)
         return "\n".join(lines) + "\n"
+
+
+def _small(value: float, unit: str, sign: str = "+") -> str:
+    """A residual, error or tolerance: µm for model mm (like the judgment errors), m to the
+    millimetre for ground heights."""
+    if unit == "m":
+        return f"{value:{sign}.3f} m"
+    return f"{value * 1e3:{sign}.1f} µm"
+
+
+def _seen(r: Record) -> str:
+    """``; judgment error …; seen … (true …; tolerance …: pass)`` where known."""
+    text = ""
+    u = r.residual_unit
+    if r.judgment_error is not None and r.judgment_error != 0.0:
+        text += f"; judgment error {_small(r.judgment_error, u)}"
+    if r.residual is not None:
+        text += f"; seen {_small(r.residual, u)}"
+        extra = []
+        if r.true is not None:
+            extra.append(f"true {_small(r.true, u)}")
+        if r.tolerance is not None:
+            extra.append(
+                f"tolerance {_small(r.tolerance, u, '')}: {'pass' if r.passed else 'FAIL'}"
+            )
+        if extra:
+            text += f" ({'; '.join(extra)})"
+    return text
 
 
 def _num(value: float, unit: str) -> str:
@@ -190,6 +232,8 @@ def _num(value: float, unit: str) -> str:
         return f"{math.degrees(value) * 60:+.2f}′"
     if unit == "m":
         return f"{value:.2f} m"
+    if unit == "tan":
+        return f"tan {value:+.6f}"
     if unit == "—":
         return f"{value:.6f}"
     return f"{value:.4f} {unit}"

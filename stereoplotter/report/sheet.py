@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.setup.sheet import SetupSheet, assumed_parameters
 from stereoplotter.setup.table24 import X_MARK_NAME, BlockResult, candidates_of
 
@@ -258,6 +259,19 @@ def _pm(value: float) -> str:
     return f"{round(value, 3) + 0.0:+.3f}"
 
 
+def _controls_rows(sheet: SetupSheet) -> list[str]:
+    """The instrument's own names of the correction controls (issue 11), one row per photo."""
+    principle = sheet.instrument_principle
+    rows = []
+    for p in sheet.photos:
+        names = ", ".join(
+            control_name(principle, f"{c}_{p.name}") for c in ("k_alpha", "k_omega", "dx", "dy")
+        )
+        how = mark_phrase(principle, "N")
+        rows.append(f"| controls, {p.name} | — | {names} | — | stage 2: {how} |")
+    return rows
+
+
 def sheet_markdown(sheet: SetupSheet) -> str:
     """Table 24 and the stage-by-stage list of readings, as Markdown."""
     d = sheet_to_dict(sheet)
@@ -312,6 +326,7 @@ def sheet_markdown(sheet: SetupSheet) -> str:
             f"| decentrations, {p.name} | d_x, d_y | {_fmt(p.decentration_mm[0])}, "
             f"{_fmt(p.decentration_mm[1])} | mm | f′·tan α, f′·tan ω |"
         )
+    lines += _controls_rows(sheet)
     for h in sheet.control_heights:
         lines.append(
             f"| model height over point {h['id']} | Z_{h['id']} | "

@@ -239,9 +239,89 @@ def _parallax_png(result: SimulationResult) -> bytes:
     return buf.getvalue()
 
 
+#: What a real operator does when a check still fails after the simulated operator's remedies
+#: (keyed by a word of the check's name); the book's practice of §26–§27 where it says one.
+OPERATOR_ADVICE = {
+    "|L − L′|": "measure both spans again; if they stay off, recompute f_пр, n and L on the "
+    "sheet ((6.3)–(6.5)) before turning ΔZ or Δb_z further",
+    "mark 4": "fit k_ω on mark 3 again and re-check mark 4; a misfit that stays means y⁰₃, y⁰₄ "
+    "or n on the sheet ((6.2), (6.12)) need checking",
+    "residual y-parallax": "clear the y-parallax once more by the relative orientation at the "
+    "six standard points (§27, conventional method), then go on and note the residual",
+    "control heights": "refine scaling (b_x) and levelling on control once more; a single "
+    "point that stays out is checked for its identification and height and left out if a "
+    "blunder",
+    "levelling": "level again on the levelling points, then re-read the control heights",
+    "corner": "place the sheet again over two corners and re-check the others (6.16)–(6.18)",
+    "plan control": "re-check the scaling (b_x) and the sheet's placement, then the points' "
+    "identification",
+}
+
+
+def _advice(check: str) -> str:
+    for word, text in OPERATOR_ADVICE.items():
+        if word in check:
+            return text
+    return "repeat the step and its check; look for a sheet or reading error before going on"
+
+
+def _at(value: Any, trial: int) -> float:
+    v = np.ravel(np.asarray(value, float))
+    return float(v[trial] if v.size > 1 else v[0])
+
+
+def _small(value: float, unit: str) -> str:
+    return f"{value:.3f} m" if unit == "m" else f"{value * 1e3:.1f} µm"
+
+
+def closing_summary(result: SimulationResult) -> str:
+    """The transcript's closing summary for trial ``transcript.shown``: every check passed or
+    failed with its worst residual and tolerance, the remedies applied, what went wrong and what
+    a real operator would do next (:data:`OPERATOR_ADVICE`)."""
+    t = result.transcript.shown
+    rows, failed = [], []
+    for name, c in result.checks.items():
+        if c.tolerance is None or c.passed is None:
+            rows.append(f"- (reported) {name}: {_small(abs(_at(c.residual, t)), c.unit)}")
+            continue
+        ok = bool(_at(c.passed, t))
+        rows.append(
+            f"- {'pass' if ok else 'FAIL'} {name}: worst {_small(abs(_at(c.residual, t)), c.unit)}"
+            f", tolerance {_small(_at(c.tolerance, t), c.unit)}"
+        )
+        if not ok:
+            failed.append(name)
+    judged = [c for c in result.checks.values() if c.tolerance is not None and c.passed is not None]
+    lines = [
+        "## Closing summary",
+        "",
+        f"Checks: {len(judged) - len(failed)} passed, {len(failed)} failed of {len(judged)}.",
+        *rows,
+    ]
+    applied = [(n, r) for n, r in result.remedies.items() if bool(_at(r.applied, t))]
+    lines += ["", "Remedies applied: " + (", ".join(
+        f"{n} ({int(_at(r.rounds, t))} rounds, check "
+        f"{'passed' if bool(_at(r.passed, t)) else 'still failed'} after)" for n, r in applied
+    ) if applied else "none") + "."]  # fmt: skip
+    if not failed:
+        lines += ["", "What went wrong: nothing outside tolerance at the end."]
+    else:
+        lines += ["", "What went wrong, and what a real operator would do:"]
+        for name in failed:
+            tried = [n for n, r in applied if r.check == name]
+            after = f" after {', '.join(tried)}" if tried else " (no remedy in this practice)"
+            lines.append(f"- {name}: still outside tolerance{after} → {_advice(name)}.")
+    return "\n".join(lines) + "\n"
+
+
+def transcript_text(result: SimulationResult) -> str:
+    """The learner's transcript: the numbered records, then :func:`closing_summary`."""
+    return result.transcript.to_text() + "\n" + closing_summary(result)
+
+
 def _trial0_files(result: SimulationResult) -> dict[str, bytes]:
     return {
-        "transcript.txt": result.transcript.to_text().encode("utf-8"),
+        "transcript.txt": transcript_text(result).encode("utf-8"),
         "transcript.jsonl": result.transcript.to_jsonl().encode("utf-8"),
         "parallax.png": _parallax_png(result),
     }
@@ -293,7 +373,10 @@ def load_operator_model(value: str | Path | OperatorModel | None) -> OperatorMod
     for key, v in data.items():
         if key not in _OPERATOR_FIELDS:
             raise ConfigError(
-                source, str(key), "a field of OperatorModel", key,
+                source,
+                str(key),
+                "a field of OperatorModel",
+                key,
                 did_you_mean(str(key), sorted(_OPERATOR_FIELDS)),
             )
         expected, kind = _OPERATOR_FIELDS[key]

@@ -104,3 +104,5 @@ class SetupSheet:
     exterior_sources: tuple[str, ...] = ()
     points_model_mm: tuple[dict[str, Any], ...] = ()
     table24: BlockResult | None = field(default=None, repr=False)
+    #: The instrument's ``principle`` (selects its correction mechanism and control names).
+    instrument_principle: str = ""

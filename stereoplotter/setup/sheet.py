@@ -30,9 +30,15 @@ from stereoplotter.geometry.similarity import (
     apply_similarity,
     fit_similarity_with_reflection,
 )
-from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
+from stereoplotter.instrument.limits import (
+    check_material_limits,
+    check_model_to_photo_scale,
+    check_photo_to_map_ratio,
+)
+from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import MapSheet, Point, Scenario
+from stereoplotter.scenario.summary import summarize_scenario
 from stereoplotter.scenario.synthetic import (
     synthesize_measurements,
     working_area_grid_m,
@@ -292,6 +298,44 @@ def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[
 # --- the computation ----------------------------------------------------------------------------
 
 
+def _check_material(scenario: Scenario, spec: InstrumentSpec) -> float:
+    """Documented limits on the pair (relief/H, f_k; :mod:`stereoplotter.instrument.limits`);
+    returns the mean flying height H. [m]"""
+    summary = summarize_scenario(scenario)
+    height = float(np.mean([p["flying_height_m"] for p in summary["photos"]]))
+    try:
+        check_material_limits(
+            spec,
+            relief_m=float(summary["relief"]["working_area_range_m"]),
+            flying_height_m=height,
+            camera_f_mm=float(scenario.camera.focal_length_mm),
+            what=scenario.source,
+        )
+    except RangeRefusal as exc:
+        raise SetupRefusal(str(exc)) from exc
+    return height
+
+
+def _check_model_scale(scenario: Scenario, spec: InstrumentSpec, sheet, height_m: float) -> None:
+    """SPR-3: model scale 0.5–2 × photo scale; SD-3: map scale 0.5–3 × photo scale
+    (m = 1000·H/f_k; :mod:`stereoplotter.instrument.limits`)."""
+    photo = MM_PER_M * height_m / float(scenario.camera.focal_length_mm)
+    try:
+        check_model_to_photo_scale(
+            spec,
+            photo_scale_denominator=photo,
+            model_scale_denominator=float(sheet.horizontal_scale_denominator),
+        )
+        if sheet.map_scale_denominator is not None:
+            check_photo_to_map_ratio(
+                spec,
+                photo_scale_denominator=photo,
+                map_scale_denominator=float(sheet.map_scale_denominator),
+            )
+    except RangeRefusal as exc:
+        raise SetupRefusal(f"{scenario.source}: {exc}") from exc
+
+
 def compute_setup_sheet(
     scenario: Scenario,
     spec: InstrumentSpec,
@@ -327,13 +371,14 @@ def compute_setup_sheet(
             f"{', '.join(p.name for p in scenario.photos)}: scenario {scenario.name!r} is not a "
             "stereopair"
         )
+    height_m = _check_material(scenario, spec)
     rng = np.random.default_rng(scenario.seed) if rng is None else rng
     measurements = synthesize_measurements(scenario, rng)
     known = known_exterior_orientation(scenario, measurements)
     marks = np.array(
         [measurements.photo(n).fiducials_mm for n in ("left", "right")]
     ) - np.asarray(scenario.camera.principal_point_mm, float)
-    return compute_sheet_from_measurements(
+    sheet = compute_sheet_from_measurements(
         name=scenario.name,
         source=scenario.source,
         spec=spec,
@@ -348,6 +393,8 @@ def compute_setup_sheet(
         map_sheet=scenario.map_sheet,
         exterior_sources=tuple(p.exterior.source for p in scenario.photos),
     )
+    _check_model_scale(scenario, spec, sheet, height_m)
+    return sheet
 
 
 @dataclass(frozen=True, slots=True)
@@ -475,6 +522,7 @@ def _finish(prep: _Prepared, table: BlockResult) -> SetupSheet:
         scenario=prep.name,
         instrument=spec.key,
         instrument_title=spec.title,
+        instrument_principle=spec.principle,
         frame_rotation=float(table.frame_rotation[0]),
         frame_origin_m=tuple(float(v) for v in table.frame_origin_m[0]),
         focal_length_corrected_mm=table.focal_length_of(0),

@@ -140,6 +140,10 @@ def corpus() -> dict[str, list[Seed]]:
         elif i % 3 == 1:
             errors[term.name] = term.scale * 0.5
     out["errors"] = [_seed("errors", "errors.yaml", _dump(errors))]
+    out["exercise"] = [
+        _seed("exercise", path.name, path.read_text(encoding="utf-8"))
+        for path in sorted(_shipped_dir("exercises").glob("*.yaml"))
+    ]
     out["geometry"] = [_seed("geometry", "geometry.yaml", _dump(dict(BOOK)))]
 
     # the block file again with its models in a CSV file
@@ -301,11 +305,12 @@ MUTATIONS = {
 #: Kinds, with their weights (the job's share taken from scenarios and instruments, so the
 #: default run keeps its 2 000 cases and about its time).
 KINDS = {
-    "scenario": 28,
+    "scenario": 26,
     "block": 10,
     "block_csv": 3,
     "csv": 5,
-    "instrument": 26,
+    "instrument": 24,
+    "exercise": 4,
     "errors": 12,
     "geometry": 8,
     "job": 5,
@@ -518,6 +523,12 @@ def _load(kind: str, path: Path) -> Any:
         draws = model.draw(np.random.default_rng(0), 3)
         assert all(np.all(np.isfinite(v)) for v in draws.values()), "non-finite draw"
         return model
+    if kind == "exercise":
+        from stereoplotter.io.exercise_file import load_exercise
+
+        exercise = load_exercise(path)
+        assert exercise.stages and exercise.preset_stages == exercise.preset_stages
+        return exercise
     if kind == "geometry":
         from stereoplotter.io.geometry_file import geometry_from_file
 
@@ -588,6 +599,8 @@ def _commands(rng: np.random.Generator, kind: str, path: str, shipped: dict[str,
                 "--json",
             ]
         ]
+    if kind == "exercise":
+        return [["exercise", "show", s, "--json"]]
     if kind == "geometry":
         return [["verify", "--trials", "2", "--procedure-trials", "0", "--json", "--geometry", s]]
     if kind in ("job", "job_csv"):

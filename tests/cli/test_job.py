@@ -332,7 +332,10 @@ def test_job_to_scenario_loads_simulates_and_keeps_the_pair(tmp_path, capsys):
     assert summary["evaluation"]["horizontal_scale_denominator"] == sheet["scale_horizontal"]
     assert summary["evaluation"]["vertical_scale_denominator"] == sheet["scale_vertical"]
     assert all(c["passed"] for c in summary["checks"].values())
-    assert summary["residual_y_parallax_um"]["grid_max"] < 5.0  # zero errors: the mechanism's own
+    # zero errors: the mechanism's own. Issue 11: SC-1's own mechanism (gimbal offset h = 20 mm,
+    # assumed) raises it from 1.10 µm (canonical unit, h = 0) to 6.04 µm on this pair; bound: the
+    # book's residual y-parallax tolerance, ¼ of the 0.05 mm mark
+    assert summary["residual_y_parallax_um"]["grid_max"] < 12.5
 
 
 def test_job_to_scenario_unknown_pair_is_one_line(tmp_path, capsys):

@@ -20,8 +20,9 @@ SHIPPED = {
     "scenario": sorted(data_dir("scenarios").glob("*.yaml")),
     "instrument": sorted(data_dir("instruments").glob("*.yaml")),
     "block": sorted((data_dir("scenarios") / "blocks").glob("*.yaml")),
+    "exercise": sorted(data_dir("exercises").glob("*.yaml")),
 }
-COUNTS = {"scenario": 4, "instrument": 3, "block": 1}
+COUNTS = {"scenario": 4, "instrument": 3, "block": 1, "exercise": 12}
 
 
 @pytest.mark.parametrize("kind", list(MODELS))

@@ -11,10 +11,13 @@ the stage-1 L-check (D5) turns into b_z. Bounds are derived below, not pinned fr
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
 
+from stereoplotter.instrument.correction import mechanism_for
+from stereoplotter.instrument.kinematics import unit_for_orientation
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure.operator import OperatorModel
@@ -26,6 +29,25 @@ from stereoplotter.setup.records import SetupRefusal
 INSTRUMENTS = ("sc1", "spr3", "sd3")
 PAIRS = ("pair60", "pair80")
 UM = 1e-3  # mm
+
+
+def _mechanism(instrument):
+    """The instrument's own correction mechanism (issue 11): the floor is its level."""
+    return mechanism_for(load_instrument(instrument))
+
+
+def _differential_scale(prep, instrument):
+    """|s_л − s_п|·y_max: y-parallax of the mechanisms' scales at the standard points. [mm]"""
+    mech, sheet = _mechanism(instrument), prep.sheet
+    f = sheet.focal_length_corrected_mm
+    s = []
+    for p in sheet.photos:
+        u = unit_for_orientation(p.alpha, p.omega, p.kappa, f)
+        ex, ey = u.decentration_x_mm, u.decentration_y_mm
+        s.append(float(mech.scale(f, u.tan_alpha, u.tan_omega, ex, ey)))
+    images = prep.scene.images(prep.scene.standard_points_m)
+    y_max = max(float(np.max(np.abs(i[..., 1]))) for i in images)
+    return abs(s[0] - s[1]) * y_max
 
 
 def _run(name, instrument, exact_marks=False):
@@ -70,9 +92,16 @@ def test_floor_passes_every_check_at_the_mechanism_level(name, instrument):
     prep, r = _run(name, instrument)
     failed = [n for n, c in r.checks.items() if c.passed is not None and not bool(c.passed)]
     assert failed == []
-    q_mech, h_mech = mechanism_level(prep.sheet, prep.scene)
+    q_mech, h_mech = mechanism_level(prep.sheet, prep.scene, mechanism=_mechanism(instrument))
+    q_canon, h_canon = mechanism_level(prep.sheet, prep.scene)
     q_span, h_span = _span_term(prep)
-    # 0.5 µm / 0.03 m: the tolerance of the loops' last steps with exact data (see below)
+    # 0.5 µm / 0.03 m: the tolerance of the loops' last steps with exact data (see below).
+    # Issue 11: the instrument's own mechanism scales each photo by s (second order in the
+    # tilts); the loops run with it while mechanism_level evaluates it at the sheet's settings, so
+    # the two levels are not additive: the larger one plus the differential scale |s_л − s_п|·y
+    # bounds the floor (measured on pair60 SC-1: 6.53 µm ≤ 6.94 µm).
+    q_mech = max(q_mech, q_canon) + _differential_scale(prep, instrument)
+    h_mech = max(h_mech, h_canon)
     assert np.max(np.abs(r.q_standard_mm)) <= q_mech + q_span + 0.5 * UM
     heights = r.checks["stage 3: control heights"].residual
     assert heights <= h_mech + h_span + 0.03
@@ -84,11 +113,18 @@ def test_with_exact_marks_the_floor_is_the_mechanism_level(name, instrument):
     # without the comparator errors of the sheet's inputs nothing is left but the mechanism:
     # the stage-1 loop lands b_z′ of the sheet (decision D9) and stages 2-3 set the sheet's values
     prep, r = _run(name, instrument, exact_marks=True)
-    q_mech, h_mech = mechanism_level(prep.sheet, prep.scene)
+    q_mech, h_mech = mechanism_level(prep.sheet, prep.scene, mechanism=_mechanism(instrument))
     bz = float(r.instrument.setting.base_z_mm)
     assert bz == pytest.approx(prep.sheet.base_mm[2], abs=0.1 * UM)
-    assert np.max(np.abs(r.q_standard_mm)) == pytest.approx(q_mech, abs=0.5 * UM)
-    assert r.checks["stage 3: control heights"].residual == pytest.approx(h_mech, abs=0.03)
+    # Issue 11 finding: the instrument's own mechanism scales the photo by s(T, e), 1 at the
+    # stage-1 zero settings, so the L-check's b_z′ no longer fits the tilted units exactly: the
+    # floor is no longer the mechanism level itself but is bounded as in the test above
+    # (pair60 SC-1: 2.48 µm against a level of 0.65 µm; ¼ mark = 12.5 µm).
+    q_canon, h_canon = mechanism_level(prep.sheet, prep.scene)
+    bound = max(q_mech, q_canon) + _differential_scale(prep, instrument) + 0.5 * UM
+    assert np.max(np.abs(r.q_standard_mm)) <= bound
+    heights = r.checks["stage 3: control heights"].residual
+    assert min(h_mech, h_canon) - 0.03 <= heights <= max(h_mech, h_canon) + 0.03
 
 
 def test_first_order_bz_correction_would_leave_bz_squared_over_d():
@@ -120,4 +156,10 @@ def test_mountain60_is_refused_with_the_mechanism_level(instrument):
     assert "\n" not in message
     assert message.startswith(f"{source}: photos[0].exterior.omega_deg: expected a tilt ")
     assert "found -2.9°" in message
-    assert "31.9 µm and 2.05 m" in message
+    # the canonical unit leaves 31.9 µm and 2.05 m (issue 9); each instrument's own mechanism
+    # adds its second-order term (issue 11, measured: SC-1 35.3, SPR-3 34.0, SD-3 32.8 µm)
+    found = re.search(r"leaves ([0-9.]+) µm and ([0-9.]+) m", message)
+    assert found is not None
+    q_um, h_m = float(found.group(1)), float(found.group(2))
+    assert 31.9 <= q_um <= 31.9 + 4.0
+    assert 2.05 <= h_m <= 2.05 + 0.1

@@ -41,23 +41,39 @@ def _set_up(inst: Instrument, sheet) -> dict[str, float]:
     return zero
 
 
+def _gimbal_scale(photo, f_mm: float, h_mm: float) -> float:
+    """The SC-1 carrier tilted by θ about gimbal axes h below the emulsion (docs/instruments.md):
+    the emulsion rises by h(1 − cos θ), so the projected photo is scaled by f/(f − h(1 − cos θ)).
+    θ from α, ω by the tilt of the carrier's normal (independent of the package's closed form,
+    which writes cos θ = 1/√(1 + tan²α + tan²ω))."""
+    normal = np.array([np.tan(photo.alpha), np.tan(photo.omega), 1.0])
+    cos_theta = normal[2] / np.linalg.norm(normal)
+    return f_mm / (f_mm - h_mm * (1.0 - cos_theta))
+
+
 def test_sheet_readings_put_the_marks_on_the_fiducials(sheet):
     # The sheet's (6.12)/(6.13) targets, computed with the book's single-axis (6.1)/(6.2), are
-    # exactly where the instrument's correction unit shows the fiducials (kinematics.md §3.3: the
-    # unit reproduces (6.1)/(6.2) on the axes). Independent paths: setup_data vs kinematics.
-    inst = Instrument.error_free(load_instrument("sc1"), sheet.focal_length_corrected_mm)
+    # where the instrument shows the fiducials: exactly for the canonical unit (kinematics.md
+    # §3.3: the unit reproduces (6.1)/(6.2) on the axes), and scaled by the SC-1 gimbal's
+    # second-order lift for the SC-1's own mechanism (gimbal offset 20 mm, assumed; issue 11).
+    # Independent paths: setup_data vs kinematics.
+    spec = load_instrument("sc1")
+    h_mm = spec.parameters["correction.gimbal_offset_mm"].value
+    inst = Instrument.error_free(spec, sheet.focal_length_corrected_mm)
     zero = _set_up(inst, sheet)
     for photo, n, (mo_x, mo_y) in (
         (sheet.photos[0], sheet.n_left, (0.0, 0.0)),
         (sheet.photos[1], sheet.n_right, (sheet.base_mm[0], sheet.base_mm[1])),
     ):
         unit = inst.state()["units"][photo.name]
+        s = _gimbal_scale(photo, sheet.focal_length_corrected_mm, h_mm)
+        assert 1e-5 < s - 1.0 < 5e-5  # pair60 tilts of 0.6°–0.9°: a few µm at 140 mm
         for mark in ("3", "4"):
             point = photo.marks_measured_mm[mark]
             xy = counters_from_photo(point, 185.0, unit, inst.setting, photo.name)
             assert xy[1] - mo_y == pytest.approx(
-                n * photo.transformed_book_mm[f"y{mark}"], abs=1e-9
-            )
+                n * photo.transformed_book_mm[f"y{mark}"] / s, abs=1e-4
+            )  # 0.1 µm: 1/30 of the 3 µm gimbal effect checked (27 nm found on pair60)
             inst.set("X", zero["X"] + xy[0])
             inst.set("Y", zero["Y"] + xy[1])
             offsets = inst.mark_offsets(**{f"{photo.name}_point_mm": point})
@@ -65,7 +81,9 @@ def test_sheet_readings_put_the_marks_on_the_fiducials(sheet):
         x_mark = "2" if photo.name == "left" else "1"
         point = photo.marks_measured_mm[x_mark]
         xy = counters_from_photo(point, 185.0, unit, inst.setting, photo.name)
-        assert xy[0] - mo_x == pytest.approx(n * photo.transformed_book_mm[f"x{x_mark}"], abs=1e-9)
+        assert xy[0] - mo_x == pytest.approx(
+            n * photo.transformed_book_mm[f"x{x_mark}"] / s, abs=1e-4
+        )
 
 
 def test_readings_are_zero_plus_scale_and_rounded_to_the_least_count():

@@ -228,7 +228,13 @@ def test_instrument_spec_supplies_d_max():
     spec = load_instrument("sc1")
     r = run_kinematic_selftest(tilts=[1.0 * deg], variants=("L",), instrument=spec)
     assert r["data"]["projection_distance_max_mm"] == spec.projection_distance_max_mm
-    assert [row["tilt_deg"] for row in r["residuals"]] == [1.0, 1.0]
+    # one row per unit: the canonical, the strict per-axis and the SC-1's own mechanism (issue 11)
+    rows = [(row["unit"], row["tilt_deg"]) for row in r["residuals"]]
+    assert rows == [
+        ("canonical", 1.0),
+        ("strict per-axis", 1.0),
+        ("sc1_mechanical_projection", 1.0),
+    ]
 
 
 # --- the touch-up solver ---------------------------------------------------------------------

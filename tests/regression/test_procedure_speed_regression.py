@@ -36,9 +36,17 @@ orientation where q fails after C3 and levels again): the default practice is "o
 the default run legitimately changes from C3's final checks on (trial 29's control heights
 0.393 → 0.622 m: CR2's refinement re-tilts it). ``practice="book"`` gives the previous values
 unchanged ("conventional/book", pinned to the old figures).
+
+Issue 11 gave each instrument its own correction mechanism; the SC-1's (a carrier tilted about
+gimbal axes h = 20 mm below the emulsion, assumed) scales each photo by a second-order factor.
+The runs below set h = 0, which makes the SC-1's mechanism the canonical unit of the recorded
+runs: the recorded values are then reproduced unchanged (checked at the merge of issue 11).
 """
 
 from __future__ import annotations
+
+import dataclasses
+from types import MappingProxyType
 
 import numpy as np
 import pytest
@@ -51,6 +59,10 @@ from stereoplotter.procedure import simulate
 @pytest.fixture(scope="module")
 def runs():
     sc, spec = load_scenario("scenarios/pair60.yaml"), load_instrument("sc1")
+    params = dict(spec.parameters)
+    key = "correction.gimbal_offset_mm"  # h = 0: the canonical unit of the recorded runs
+    params[key] = dataclasses.replace(params[key], value=0.0)
+    spec = dataclasses.replace(spec, parameters=MappingProxyType(params))
     out = {
         m: simulate(sc, spec, method=m, seed=3, trials=50, evaluate=False)
         for m in ("setup", "conventional")

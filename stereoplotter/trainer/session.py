@@ -1,0 +1,567 @@
+"""A trainee's session on the virtual instrument: actions, their log, undo/redo, hints, replay.
+
+:meth:`Session.start` builds what the simulated operator would get for the exercise — the setup
+sheet, the instrument with its injected errors (trial 0 of the exercise's seed, or of the
+trainee's seed), the scene — runs the simulated operator once on an identical instrument (the
+"par" of grading and the source of level-3 hints) and presets the stages before the
+exercise's first stage with the operator's own actions. :meth:`Session.act` carries out one
+action (:mod:`stereoplotter.trainer.actions`) and appends a log record with the digests of the
+session state before and after. :meth:`Session.replay` runs a log again; the new log is equal to
+the old one, record for record (so written again, byte for byte).
+
+Time: an action may carry ``t`` (seconds since the start, from the client); otherwise the
+session's monotonic clock gives it. The log keeps it, and a replay uses the logged ``t``.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from stereoplotter.errors import TrainerError
+from stereoplotter.instrument.virtual import (
+    CASSETTES,
+    DECENTRATIONS,
+    HEIGHT_SCALE,
+    KNOBS,
+    SCREWS,
+    Instrument,
+)
+from stereoplotter.procedure.operator import Noise, Operator
+from stereoplotter.procedure.simulate import PreparedRun, prepare_run
+from stereoplotter.procedure.transcript import Transcript
+from stereoplotter.trainer.actions import (
+    ACTION_FIELDS,
+    INSTRUMENT_KINDS,
+    apply,
+    check_action,
+    control_value,
+)
+from stereoplotter.trainer.exercise import STAGES, Exercise, resolve_exercise
+from stereoplotter.trainer.hints import hint_text
+from stereoplotter.trainer.operator_steps import OperatorRun, new_instrument, operator_run
+from stereoplotter.trainer.outcome import stage_measures
+
+__all__ = [
+    "LOG_FORMAT",
+    "SUBSTITUTE_STAGES",
+    "UNDO_DEPTH",
+    "Session",
+    "json_finite",
+    "state_digest",
+]
+
+LOG_FORMAT = "stereoplotter-session/1"
+#: The stages that use the six standard points: an incomplete model's substitutes are recorded
+#: before they are claimed.
+SUBSTITUTE_STAGES = ("2", "C2")
+#: Undo steps kept (each about 16 kB: a copy of the instrument, measured on e08); older ones
+#: are dropped (assumed: a trainee undoes a few moves, not a stage's hundreds).
+UNDO_DEPTH = 500
+
+
+def state_digest(state: dict[str, Any]) -> str:
+    """SHA-256 (first 16 hex digits) of the canonical JSON of a state."""
+    text = json.dumps(state, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _f(value: Any) -> float:
+    return float(np.asarray(value, float).reshape(-1)[0])
+
+
+@dataclass
+class _Undoable:
+    """What undo restores: the instrument and the session's own state."""
+
+    instrument: Instrument
+    commanded: dict[str, float]
+    locked: list[str]
+    records: dict[str, Any]
+    stage_index: int
+    claimed: list[str]
+    at_claim: dict[str, Instrument]
+
+
+class Session:
+    """One trainee at one exercise (build with :meth:`start` or :meth:`replay`)."""
+
+    def __init__(self, exercise: Exercise, trainee: str, seed: int, clock: bool = True):
+        self.exercise = exercise
+        self.trainee = trainee
+        self.seed = int(seed)
+        errors = "zero" if exercise.errors == "off" else None
+        self.prep: PreparedRun = prepare_run(
+            exercise.scenario, exercise.spec, exercise.method, errors, self.seed
+        )
+        self.par: OperatorRun = operator_run(self.prep, self.seed, exercise.stages[-1])
+        self.inst = new_instrument(self.prep, self.seed)
+        self.commanded: dict[str, float] = {}
+        self.locked: list[str] = []
+        self.records: dict[str, Any] = {}
+        self.claimed: list[str] = []
+        #: Stage → a copy of the instrument when the trainee claimed it (graded on it).
+        self.at_claim: dict[str, Instrument] = {}
+        self.stage_index = 0
+        self.log: list[dict[str, Any]] = []
+        self.hints_used: list[int] = []
+        self._undo: list[_Undoable] = []
+        self._redo: list[_Undoable] = []
+        self._t0 = time.monotonic() if clock else None
+        scene = self.prep.scene
+        self._std_images = scene.images(scene.standard_points_m)
+        for stage in exercise.preset_stages:
+            for action in self.par.stage_actions(stage):
+                apply(self.inst, action, self.commanded)
+
+    # --- construction ----------------------------------------------------------------------
+
+    @classmethod
+    def start(
+        cls, exercise: Exercise, *, trainee: str = "trainee", seed: int | None = None
+    ) -> Session:
+        """A new session: the exercise's seed, else ``seed``, else the trainee's own seed."""
+        if exercise.seed is not None:
+            use = exercise.seed
+        elif seed is not None:
+            use = int(seed)
+        else:
+            use = exercise.seed_for(trainee)
+        return cls(exercise, trainee, use)
+
+    def header(self) -> dict[str, Any]:
+        """The first line of the session log: format, exercise (file content), trainee, seed."""
+        return {
+            "format": LOG_FORMAT,
+            "exercise": self.exercise.source,
+            "exercise_name": self.exercise.name,
+            "trainee": self.trainee,
+            "seed": self.seed,
+            "preset_stages": list(self.exercise.preset_stages),
+        }
+
+    @classmethod
+    def replay(cls, records: list[dict[str, Any]], exercise: Exercise | None = None) -> Session:
+        """Run a session log (header + action records) again.
+
+        Raises
+        ------
+        TrainerError
+            The log is not a session log, or an action's outcome differs from the log (the
+            digest of the state after it, or a refusal).
+        """
+        if not records or records[0].get("format") != LOG_FORMAT:
+            raise TrainerError(f"session log: expected a first line with format {LOG_FORMAT}")
+        head = records[0]
+        if exercise is None:
+            exercise = resolve_exercise(head["exercise"])
+        session = cls(exercise, str(head["trainee"]), int(head["seed"]), clock=False)
+        for rec in records[1:]:
+            action = dict(rec["action"])
+            action["t"] = rec["t"]
+            try:
+                session.act(action)
+            except TrainerError:
+                if rec.get("refused") is None:
+                    raise
+            mine = session.log[-1]
+            if mine != rec:
+                raise TrainerError(
+                    f"session log: record {rec.get('n')} does not replay "
+                    f"(state {mine.get('state_after')} against {rec.get('state_after')})"
+                )
+        return session
+
+    # --- what the trainee sees -----------------------------------------------------------------
+
+    @property
+    def stages(self) -> tuple[str, ...]:
+        return self.exercise.stages
+
+    @property
+    def stage(self) -> str | None:
+        """The stage in hand (None when every stage is claimed)."""
+        if self.stage_index >= len(self.stages):
+            return None
+        return self.stages[self.stage_index]
+
+    def _counters(self) -> dict[str, Any]:
+        spec = self.inst.spec
+        out: dict[str, Any] = {}
+        for name in (*SCREWS, *DECENTRATIONS):
+            out[name] = {
+                "value": _f(self.inst.read(name)),
+                "unit": "mm",
+                "least_count": spec.z_least_count_mm if name == "Z" else spec.xy_least_count_mm,
+                "direction": self.inst.counter_sense(name),
+            }
+        if self.inst._height_gear is not None:
+            out[HEIGHT_SCALE] = {
+                "value": _f(self.inst.read(HEIGHT_SCALE)),
+                "unit": "m",
+                "least_count": spec.height_scale_least_count_m,
+                "direction": 1,
+            }
+        return out
+
+    def _controls(self) -> dict[str, Any]:
+        spec = self.inst.spec
+        out: dict[str, Any] = {}
+        for name in SCREWS:
+            lo, hi = (_f(self.inst.reading_of(name, v)) for v in self.inst.travel_mm(name))
+            out[name] = {
+                "value": control_value(self.inst, name, self.commanded),
+                "unit": "mm",
+                "min": min(lo, hi),
+                "max": max(lo, hi),
+                "step": spec.z_least_count_mm if name == "Z" else spec.xy_least_count_mm,
+            }
+        f_lo, f_hi = spec.f_instrument_range_mm
+        out["f_instrument"] = {
+            "value": self.commanded.get("f_instrument"),
+            "unit": "mm",
+            "min": float(f_lo),
+            "max": float(f_hi),
+            "step": spec.xy_least_count_mm,
+        }
+        k_lo, k_hi = spec.kappa_range
+        for name in CASSETTES:
+            out[name] = {
+                "value": self.commanded.get(name, 0.0),
+                "unit": "rad",
+                "min": float(k_lo),
+                "max": float(k_hi),
+                "step": 1e-4,
+            }
+        for name in DECENTRATIONS:
+            out[name] = {
+                "value": control_value(self.inst, name, self.commanded),
+                "unit": "mm",
+                "min": None,
+                "max": None,
+                "step": spec.xy_least_count_mm,
+            }
+        t_max = float(np.tan(spec.tilt_max))
+        for name in KNOBS:
+            out[name] = {
+                "value": self.commanded.get(name, 0.0),
+                "unit": "tan",
+                "min": -t_max,
+                "max": t_max,
+                "step": 1e-5,
+            }
+        return out
+
+    def _marks(self) -> dict[str, Any] | None:
+        """Where each mark stands on its photo; None before f_пр is set (no projection yet)."""
+        if "f_instrument" not in self.commanded:
+            return None
+        pl, pr = self.inst.marks()
+        left, right = (np.asarray(p, float).reshape(-1) for p in (pl, pr))
+        return {
+            "left": {
+                "x_mm": float(left[0]),
+                "y_mm": float(left[1]),
+                "kappa_rad": _f(self.inst.unit("left").kappa),
+            },
+            "right": {
+                "x_mm": float(right[0]),
+                "y_mm": float(right[1]),
+                "kappa_rad": _f(self.inst.unit("right").kappa),
+            },
+        }
+
+    def _parallax(self) -> dict[str, float] | None:
+        """y- and x-parallax at the standard point nearest the left mark. [µm]
+
+        y: the model's true y-parallax there (what the eye judges, no judgment error); x: the
+        right mark's x offset from that point's image less the left mark's.
+        """
+        if not self.exercise.allows("parallax_readout") or "f_instrument" not in self.commanded:
+            return None
+        il, ir = self._std_images
+        pl, pr = (np.asarray(p, float).reshape(-1) for p in self.inst.marks())
+        distance = np.hypot(*(il - pl).T)
+        for n in self.exercise.unusable_points:  # on water or outside the overlap: no reading
+            distance[n - 1] = np.inf
+        i = int(np.argmin(distance))
+        op = Operator(
+            self.inst, self.prep.operator, Noise(0, None, None, 0), Transcript(enabled=False)
+        )
+        q = op.y_parallax(
+            self.prep.scene.standard_points_m[i : i + 1], (il[i : i + 1], ir[i : i + 1])
+        )
+        x = (pr[0] - ir[i, 0]) - (pl[0] - il[i, 0])
+        return {
+            "y_um": round(_f(q) * 1000.0, 3),
+            "x_um": round(float(x) * 1000.0, 3),
+            "point": i + 1,
+        }
+
+    def _checks(self) -> list[dict[str, Any]]:
+        stage = self.stage
+        if stage is None:
+            return []
+        out = []
+        for name, check in self.par.run.results.items():
+            if _check_stage(name) == stage and check.tolerance is not None:
+                out.append({"name": name, "tolerance": _f(check.tolerance), "unit": check.unit})
+        return out
+
+    def _announced(self) -> dict[str, float] | None:
+        """The injected errors when the exercise announces them (internal units: mm, rad,
+        relative), else None."""
+        if self.exercise.errors != "announced":
+            return None
+        return {k: _f(v) for k, v in sorted(self.inst.injected.items()) if _f(v) != 0.0}
+
+    def allowed(self) -> list[str]:
+        """The action kinds allowed now."""
+        if self.stage is None:
+            return ["read"]
+        kinds = [k for k in ACTION_FIELDS if k not in ("undo", "redo", "hint")]
+        if self.exercise.allows("undo"):
+            if self._undo:
+                kinds.append("undo")
+            if self._redo:
+                kinds.append("redo")
+        if self.exercise.allows("hints"):
+            kinds.append("hint")
+        return kinds
+
+    def state(self) -> dict[str, Any]:
+        """What the trainee sees (JSON-serialisable; the contract's keys; a value that is not
+        finite, e.g. a range without a stop, is null)."""
+        return json_finite(
+            {
+                "instrument": self.exercise.spec.key,
+                "stage": self.stage,
+                "step": self.stage,
+                "counters": self._counters(),
+                "controls": self._controls(),
+                "marks": self._marks(),
+                "parallax": self._parallax(),
+                "checks": self._checks(),
+                "allowed": self.allowed(),
+                "mode": self.exercise.mode,
+                "done": self.stage is None,
+                "locked": list(self.locked),
+                "records": dict(self.records),
+                "injected_errors": self._announced(),
+            }
+        )
+
+    # --- acting ------------------------------------------------------------------------------
+
+    def _now(self, action: dict[str, Any]) -> float:
+        if "t" in action:
+            return float(action["t"])
+        if self._t0 is None:
+            return 0.0
+        return round(time.monotonic() - self._t0, 3)
+
+    def _snapshot(self) -> _Undoable:
+        return _Undoable(
+            _copy_instrument(self.inst),
+            dict(self.commanded),
+            list(self.locked),
+            copy.deepcopy(self.records),
+            self.stage_index,
+            list(self.claimed),
+            dict(self.at_claim),
+        )
+
+    def _restore(self, snap: _Undoable) -> None:
+        self.inst = snap.instrument
+        self.commanded = snap.commanded
+        self.locked = snap.locked
+        self.records = snap.records
+        self.stage_index = snap.stage_index
+        self.claimed = snap.claimed
+        self.at_claim = snap.at_claim
+
+    def act(self, action: dict[str, Any]) -> dict[str, Any]:
+        """Carry out one action; returns the new state (see :meth:`state`).
+
+        Raises
+        ------
+        TrainerError
+            The action is malformed, not allowed now, or refused by the instrument (the refusal
+            is logged too).
+        """
+        t = self._now(action) if isinstance(action, dict) else 0.0
+        before = self.state()
+        clean = {k: v for k, v in action.items() if k != "t"} if isinstance(action, dict) else {}
+        record: dict[str, Any] = {
+            "n": len(self.log) + 1,
+            "t": t,
+            "stage": self.stage,
+            "action": clean,
+            "state_before": state_digest(before),
+        }
+        try:
+            check_action(action)
+            record["result"] = json_finite(self._do(clean, before))
+        except TrainerError as exc:
+            record["refused"] = str(exc)
+            after = self.state()
+            record["state_after"] = state_digest(after)
+            self.log.append(record)
+            raise
+        after = self.state()
+        record["state_after"] = state_digest(after)
+        if clean["kind"] == "claim":
+            record["state"] = after
+        self.log.append(record)
+        return after
+
+    def _do(self, action: dict[str, Any], before: dict[str, Any]) -> Any:
+        kind = action["kind"]
+        if kind not in before["allowed"]:
+            raise TrainerError(
+                f"action {kind}: not allowed now (allowed: {', '.join(before['allowed'])})"
+            )
+        if kind == "undo":
+            self._redo.append(self._snapshot())
+            self._restore(self._undo.pop())
+            return None
+        if kind == "redo":
+            self._undo.append(self._snapshot())
+            self._restore(self._redo.pop())
+            return None
+        if kind == "hint":
+            return self._hint(int(action["level"]))
+        if kind in ("turn", "set") and action["control"] in self.locked:
+            raise TrainerError(f"action {kind}: {action['control']} is locked")
+        undoable = self.exercise.allows("undo") and kind != "read"
+        snap = self._snapshot() if undoable else None
+        if kind in INSTRUMENT_KINDS:
+            result = apply(self.inst, action, self.commanded)
+        elif kind == "lock":
+            if action["control"] not in self.locked:
+                self.locked.append(action["control"])
+            result = None
+        elif kind == "record":
+            self.records[str(action["name"])] = action["value"]
+            result = None
+        else:  # claim
+            result = self._claim(str(action["step"]))
+        if snap is not None:
+            self._undo.append(snap)
+            del self._undo[:-UNDO_DEPTH]
+            self._redo.clear()
+        return result
+
+    def _claim(self, step: str) -> dict[str, Any]:
+        if step != self.stage:
+            raise TrainerError(
+                f"action claim: step: the stage in hand is {self.stage}, found {step!r}"
+            )
+        if step in SUBSTITUTE_STAGES:
+            for n in self.exercise.unusable_points:
+                value = self.records.get(f"substitute {n}")
+                if not _is_point(value):
+                    raise TrainerError(
+                        f"action claim: standard point {n} is unusable: record 'substitute {n}' "
+                        "as [x_mm, y_mm] on the left photo first"
+                    )
+        self.claimed.append(step)
+        self.at_claim[step] = _copy_instrument(self.inst)
+        self.stage_index += 1
+        out: dict[str, Any] = {"claimed": step}
+        if self.exercise.mode == "practice":  # feedback: the stage's true outcome
+            out["measures"] = [
+                {
+                    "name": m.name,
+                    "value": _f(m.value),
+                    "tolerance": float(m.tolerance),
+                    "unit": m.unit,
+                    "passed": bool(_f(m.value) <= m.tolerance),
+                }
+                for m in stage_measures(self.inst, self.prep, step)
+            ]
+        return out
+
+    def _hint(self, level: int) -> dict[str, Any]:
+        stage = self.stage
+        assert stage is not None
+        self.hints_used.append(level)
+        actions = self.par.stage_actions(stage)
+        out: dict[str, Any] = {
+            "level": level,
+            "text": hint_text(self.exercise.method, stage, level),
+        }
+        # the operator's steps of the stage, each once, in the order first taken
+        out["steps"] = list(dict.fromkeys(self.par.stage_steps(stage)))
+        if level == 3:  # show me: the simulated operator does the stage on this instrument
+            for a in actions:
+                apply(self.inst, a, self.commanded)
+            out["applied"] = len(actions)
+        elif level == 2:
+            controls = []
+            for a in actions:
+                c = a.get("control") or a.get("counter") or a["kind"]
+                if c not in controls:
+                    controls.append(c)
+            out["controls"] = controls
+        return out
+
+    # --- the operator's actions as a script -----------------------------------------------------
+
+    def operator_script(self) -> list[dict[str, Any]]:
+        """The simulated operator's actions for the exercise's stages, each stage followed by
+        its claim: the acceptance test's scripted trainee."""
+        script: list[dict[str, Any]] = []
+        for stage in self.stages:
+            for a in self.par.stage_actions(stage):
+                script.append({k: v for k, v in a.items() if k != "stage"})
+            if stage in SUBSTITUTE_STAGES:  # the operator's substitute: the standard point itself
+                for n in self.exercise.unusable_points:
+                    xy = [float(v) for v in self._std_images[0][n - 1]]
+                    script.append({"kind": "record", "name": f"substitute {n}", "value": xy})
+            script.append({"kind": "claim", "step": stage})
+        return script
+
+
+def _is_point(value: Any) -> bool:
+    return (
+        isinstance(value, list)
+        and len(value) == 2
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        and all(math.isfinite(v) for v in value)
+    )
+
+
+def json_finite(value: Any) -> Any:
+    """``value`` with every non-finite float replaced by None (JSON has no inf, nan)."""
+    if isinstance(value, dict):
+        return {k: json_finite(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [json_finite(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def _copy_instrument(inst: Instrument) -> Instrument:
+    """A copy of the instrument's physical state (the spec and error model shared: frozen)."""
+    memo = {id(inst.spec): inst.spec, id(inst.errors): inst.errors}
+    return copy.deepcopy(inst, memo)
+
+
+def _check_stage(name: str) -> str | None:
+    """The stage a check of the procedure belongs to, by its name ("stage 5: …", "C2: …")."""
+    head = name.split(":", 1)[0].strip()
+    if head.startswith("stage "):
+        return head.split()[1].split("/")[0]
+    for stages in STAGES.values():
+        if head in stages:
+            return head
+    return None

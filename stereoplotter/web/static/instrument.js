@@ -1,0 +1,193 @@
+// The instrument page: WebSocket to the server (action → state), eyepieces, wheels, counters.
+import { drawField, anaglyph, scale } from "./eyepiece.js";
+import { Wheels, LABELS, decimals } from "./wheels.js";
+
+const sid = location.pathname.split("/").pop();
+const $ = (id) => document.getElementById(id);
+let state = null, hello = null, seq = 0;
+const waiting = new Map(); // seq → resolve(frame time)
+const trail = [];
+
+const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws/${sid}`);
+const wheels = new Wheels($("wheels"), send);
+
+function send(action) {
+  seq += 1;
+  ws.send(JSON.stringify({ action, seq }));
+  return seq;
+}
+
+function message(text, cls = "") {
+  const m = $("message"); m.textContent = text || ""; m.className = cls;
+}
+
+// --- eyepieces -----------------------------------------------------------------------------
+const off = { left: document.createElement("canvas"), right: document.createElement("canvas") };
+off.left.width = off.left.height = off.right.width = off.right.height = 320;
+let flickerSide = "left";
+
+// Photo patches (one per side): fetched when the mark nears a patch's edge or the magnification
+// changes; a move only redraws from the patch in hand.
+const patches = { left: null, right: null }, loading = { left: false, right: false };
+function needPatch(side, mark, mag) {
+  const p = patches[side];
+  if (loading[side] || !hello) return;
+  const fieldMm = 320 / (scale.pxPerMmAt1x * mag);
+  const halfMm = (hello.patch_px * hello.screen_pixel_mm) / mag / 2;
+  if (p && p.mag === mag && Math.abs(mark.x_mm - p.x_mm) < halfMm - fieldMm * 0.75
+      && Math.abs(mark.y_mm - p.y_mm) < halfMm - fieldMm * 0.75) return;
+  loading[side] = true;
+  const q = { side, x_mm: mark.x_mm, y_mm: mark.y_mm, mag, size: hello.patch_px, img: new Image() };
+  q.img.onload = () => { patches[side] = q; loading[side] = false; window.__patches = (window.__patches || 0) + 1; drawEyes(); };
+  q.img.onerror = () => { loading[side] = false; };
+  q.img.src = `/api/sessions/${sid}/patch.png?side=${side}&x=${mark.x_mm.toFixed(3)}&y=${mark.y_mm.toFixed(3)}&mag=${mag}&size=${hello.patch_px}`;
+  q.x_mm = Number(mark.x_mm.toFixed(3)); q.y_mm = Number(mark.y_mm.toFixed(3));
+}
+
+function drawEyes() {
+  const marks = state ? state.marks : null;
+  const mag = Number($("mag").value) || 6;
+  const mode = $("view").value;
+  if (marks) for (const side of ["left", "right"]) needPatch(side, marks[side], mag);
+  $("eyepieces").hidden = mode !== "split";
+  $("stereo").hidden = mode === "split";
+  if (mode === "split") {
+    for (const side of ["left", "right"]) {
+      drawField($(`eye-${side}`).getContext("2d"), marks && marks[side], mag, { patch: patches[side] });
+      $(`cap-${side}`).textContent = marks
+        ? `${side}: x ${marks[side].x_mm.toFixed(3)}  y ${marks[side].y_mm.toFixed(3)} mm` : `${side} photo`;
+    }
+  } else {
+    for (const side of ["left", "right"]) drawField(off[side].getContext("2d"), marks && marks[side], mag, { markColour: "#ffffff", patch: patches[side] });
+    const ctx = $("eye-stereo").getContext("2d");
+    if (mode === "anaglyph") anaglyph(ctx, off.left, off.right, $("colours").value.split(","));
+    else { ctx.drawImage(off[flickerSide], 0, 0); }
+  }
+  window.__frames = (window.__frames || 0) + 1;
+}
+setInterval(() => {
+  if ($("view").value === "flicker") { flickerSide = flickerSide === "left" ? "right" : "left"; drawEyes(); }
+}, 125);
+for (const id of ["view", "colours", "mag"]) $(id).addEventListener("change", drawEyes);
+
+// --- coordinatograph -----------------------------------------------------------------------
+function drawTable() {
+  const svg = $("table-svg");
+  const c = state.counters;
+  if (!c.X || !c.Y) return;
+  const x = c.X.value, y = c.Y.value;
+  if (x === null || y === null) return;
+  const last = trail[trail.length - 1];
+  if (!last || last[0] !== x || last[1] !== y) trail.push([x, y]);
+  if (trail.length > 400) trail.shift();
+  const pts = trail.map(([a, b]) => `${a},${400 - b}`).join(" ");
+  svg.innerHTML = `<rect x="-50" y="-150" width="700" height="700" fill="#f4efe2" stroke="#999"/>
+    <g stroke="#d9d0bb" stroke-width="1">${[...Array(15).keys()].map((i) => `<line x1="${-50 + i * 50}" y1="-150" x2="${-50 + i * 50}" y2="550"/><line x1="-50" y1="${-150 + i * 50}" x2="650" y2="${-150 + i * 50}"/>`).join("")}</g>
+    <polyline points="${pts}" fill="none" stroke="#3060a0" stroke-width="2"/>
+    <circle cx="${x}" cy="${400 - y}" r="7" fill="none" stroke="#c02020" stroke-width="3"/>
+    <text x="-40" y="540" font-size="22" fill="#333">X ${x.toFixed(2)}  Y ${y.toFixed(2)} mm</text>`;
+}
+
+// --- counters and stage --------------------------------------------------------------------
+function drawCounters() {
+  const body = $("counters").tBodies[0];
+  const names = Object.keys(state.counters).join(",");
+  if (body.dataset.names !== names) {
+    body.innerHTML = ""; body.dataset.names = names;
+    for (const name of Object.keys(state.counters)) {
+      const tr = body.insertRow();
+      tr.dataset.counter = name;
+      tr.innerHTML = `<td>${LABELS[name] || name}</td><td class="num"></td><td></td>
+        <td><button class="dir" title="reverse the counter's direction">±</button></td><td><button class="read">read</button></td>`;
+      tr.querySelector(".dir").onclick = () =>
+        send({ kind: "direction", counter: name, sign: -state.counters[name].direction });
+      tr.querySelector(".read").onclick = () => send({ kind: "read", counter: name });
+    }
+  }
+  for (const tr of body.rows) {
+    const c = state.counters[tr.dataset.counter];
+    tr.cells[1].textContent = c.value === null ? "—" : c.value.toFixed(decimals(c.least_count));
+    tr.cells[2].textContent = c.unit; tr.cells[2].title = `least count ${c.least_count} ${c.unit}`;
+    tr.querySelector(".dir").textContent = c.direction > 0 ? "+" : "−";
+  }
+}
+
+function drawStage() {
+  $("stage").textContent = state.done ? "all stages claimed" : `stage ${state.stage}`;
+  $("mode").textContent = hello.demonstration ? "demonstration" : state.mode;
+  $("mode").className = `badge ${hello.demonstration ? "demonstration" : state.mode}`;
+  const ul = $("checks"); ul.innerHTML = "";
+  for (const ch of state.checks) {
+    const li = document.createElement("li");
+    li.textContent = `${ch.name}: tolerance ${ch.tolerance === null ? "—" : ch.tolerance.toPrecision(3)} ${ch.unit}`;
+    ul.appendChild(li);
+  }
+  const allowed = new Set(state.allowed);
+  const demo = hello.demonstration;
+  $("undo").hidden = !allowed.has("undo") && !allowed.has("redo") && state.mode === "exam";
+  $("undo").disabled = demo || !allowed.has("undo");
+  $("redo").disabled = demo || !allowed.has("redo");
+  $("hints").hidden = !allowed.has("hint");
+  $("claim").disabled = demo || !allowed.has("claim");
+  $("demo").hidden = !demo;
+  $("done").hidden = !state.done;
+  $("grade-link").href = `/grade/${sid}`;
+  const p = state.parallax;
+  const um = (v) => (v === null || v === undefined ? "—" : v.toFixed(1));
+  $("parallax").textContent = p ? `parallax at standard point ${p.point}: q = ${um(p.y_um)} µm, p = ${um(p.x_um)} µm` : "";
+}
+
+function render() {
+  drawEyes(); drawCounters(); drawStage(); drawTable();
+  wheels.update(state.controls, state.locked || []);
+}
+
+ws.onmessage = (ev) => {
+  const msg = JSON.parse(ev.data);
+  if (msg.hello) {
+    hello = msg.hello;
+    scale.pxPerMmAt1x = 1 / hello.screen_pixel_mm;
+    $("who").textContent = `${hello.trainee} · ${hello.exercise}`;
+    $("title").textContent = "Stereoplotter trainer";
+    fetch("/api/exercises").then((r) => r.json()).then((all) => {
+      const ex = all.find((e) => e.name === hello.exercise);
+      if (ex) $("instructions").textContent = ex.description;
+    });
+  }
+  if (msg.state) state = msg.state;
+  window.__n = msg.n;
+  if (state) render();
+  if (msg.error) message(msg.error, "error");
+  else if (msg.result !== undefined && msg.result !== null) message(typeof msg.result === "string" ? msg.result
+    : typeof msg.result === "number" ? `reading: ${msg.result}` : JSON.stringify(msg.result), "hint");
+  else if (msg.demo) message(`operator: ${JSON.stringify(msg.demo.action)}`);
+  else if (!msg.hello) message("");
+  if (msg.demo) $("demo-count").textContent = `${msg.demo.done} / ${msg.demo.of}`;
+  if (msg.seq !== undefined && waiting.has(msg.seq)) { waiting.get(msg.seq)(performance.now()); waiting.delete(msg.seq); }
+  document.body.dataset.ready = "1";
+};
+
+$("claim").onclick = () => send({ kind: "claim", step: state.stage });
+$("undo").onclick = () => send({ kind: "undo" });
+$("redo").onclick = () => send({ kind: "redo" });
+$("gear-btn").onclick = () => send({ kind: "gear", value: Number($("gear").value) });
+for (const b of $("hints").querySelectorAll("button")) b.onclick = () => send({ kind: "hint", level: Number(b.dataset.level) });
+let playing = null;
+$("demo-step").onclick = () => ws.send(JSON.stringify({ demo: "step" }));
+$("demo-play").onclick = () => {
+  if (playing) { clearInterval(playing); playing = null; $("demo-play").textContent = "Play"; return; }
+  playing = setInterval(() => ws.send(JSON.stringify({ demo: "step" })), 60);
+  $("demo-play").textContent = "Pause";
+};
+
+// For tests and the latency benchmark: send an action, resolve with ms until its frame is drawn.
+window.trainer = {
+  state: () => state,
+  // both eyepieces drawn from a photo patch that covers the current marks
+  photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right),
+  actAndFrame(action) {
+    const t0 = performance.now();
+    const s = send(action);
+    return new Promise((res) => waiting.set(s, (t) => requestAnimationFrame(() => res(t - t0))));
+  },
+};

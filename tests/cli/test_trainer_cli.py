@@ -1,0 +1,98 @@
+"""The trainer on the command line: exercise list/show, session run, grade."""
+
+from __future__ import annotations
+
+import json
+import re
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+
+from stereoplotter.cli import main
+from stereoplotter.io.exercise_file import shipped_exercises
+
+
+def test_exercise_list_names_every_shipped_exercise(capsys):
+    assert main(["exercise", "list", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["name"] for r in rows] == sorted(p.stem for p in shipped_exercises())
+
+
+def test_exercise_show_a_missing_exercise_is_one_error_line(capsys):
+    assert main(["exercise", "show", "e99"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1
+
+
+def test_session_run_then_grade(tmp_path, capsys):
+    actions = tmp_path / "actions.jsonl"
+    actions.write_text(
+        '{"kind": "hint", "level": 3}\n{"kind": "turn", "control": "X", "delta": 0.5}\n'
+        '{"kind": "claim", "step": "1"}\n',
+        encoding="utf-8",
+    )
+    log = tmp_path / "s.jsonl"
+    assert (
+        main(["session", "run", "e01-setup-stage1", "--actions", str(actions), "-o", str(log)]) == 0
+    )
+    assert "3 actions (0 refused), stage all done" in capsys.readouterr().out
+    out = tmp_path / "grade"
+    assert main(["grade", str(log), "--json", "--population", "20", "-o", str(out)]) == 0
+    g = json.loads(capsys.readouterr().out)
+    assert g["process"]["hints"] == 1 and g["process"]["moves"] == 1
+    assert g["stages"]["1"]["claimed"]
+    assert json.loads((out / "grade.json").read_text(encoding="utf-8")) == g
+    assert (out / "grade.md").read_text(encoding="utf-8").startswith("# Grade: ")
+
+
+def test_a_refused_action_stops_the_run_but_the_log_is_written(tmp_path, capsys):
+    actions = tmp_path / "a.json"
+    actions.write_text('[{"kind": "turn", "control": "X", "delta": 1e6}]', encoding="utf-8")
+    log = tmp_path / "s.jsonl"
+    assert (
+        main(["session", "run", "e01-setup-stage1", "--actions", str(actions), "-o", str(log)]) == 1
+    )
+    assert "beyond the range stops" in capsys.readouterr().err
+    assert len(log.read_text(encoding="utf-8").splitlines()) == 2
+
+
+def test_trainer_serves_on_the_printed_free_port():
+    # `stereoplotter trainer` with the default port 0: the system picks a free port and the
+    # printed address is the one that answers (issue 14, deliverable 1)
+    with subprocess.Popen(
+        [sys.executable, "-m", "stereoplotter", "trainer", "--token", "t0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    ) as proc:
+        try:
+            first = proc.stdout.readline()
+            second = proc.stdout.readline()
+            url = re.search(r"http://localhost:(\d+)/$", first.strip())
+            assert url and int(url.group(1)) > 0, first
+            assert second.strip().endswith(f":{url.group(1)}/instructor?token=t0")
+            for _ in range(100):  # the server starts right after printing
+                try:
+                    with urllib.request.urlopen(url.group(0), timeout=2) as r:
+                        assert r.status == 200 and b"<html" in r.read().lower()
+                    break
+                except OSError:
+                    time.sleep(0.05)
+            else:
+                raise AssertionError("the printed address did not answer")
+        finally:
+            proc.terminate()
+            proc.wait(timeout=10)
+
+
+def test_trainer_on_a_busy_port_is_one_error_line(capsys):
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen(1)
+        port = busy.getsockname()[1]
+        assert main(["trainer", "--port", str(port)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: trainer: cannot listen on 127.0.0.1:{port}")
+    assert err.count("\n") == 1
