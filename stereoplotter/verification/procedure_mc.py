@@ -32,6 +32,16 @@ Configurations (chosen to match the formulas' assumptions as far as the model al
   off; :func:`levelling_formula` is the rigorous formula with the plane at any four points (the
   procedure levels on the scenario's control points, which moves the formula by +5 %).
 
+* ``method="setup_control"`` — §27 task 2, setup data refined on control: the setup run above,
+  then the built model levelled on Fig. 39's four control points by the least-squares plane
+  through its δp there ((6.47)–(6.50) exact control heights, per m_xy; (6.58)/(6.59) control
+  parallaxes observed with m_p = m_xy/√2, per m_p); domain of chapter 5. One setup run gives all
+  three readings (``fields`` of the result).
+
+Every run can carry the instrument's error terms at their σ (``instrument=True``, real
+mechanics), and is estimated with the linear control variate of
+:mod:`~stereoplotter.verification.control_variate` (unbiased; ``plain`` keeps the plain mean).
+
 :func:`relative_orientation_mc` runs the conventional relative orientation alone (σ_q only, fixed
 passes) against (5.54).
 """
@@ -340,6 +350,29 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
     return fields, d_zero
 
 
+def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
+    """The prepared run of the procedure MC: real mechanics only with instrument errors; the
+    standard points at a = c − p (``standard_points`` "book"); ``passes``: no check ever passes,
+    so every loop runs that many times."""
+    instrument = bool(options.get("instrument")) and errors != "zero"
+    prep = prepare_run(
+        sc, spec, base, errors, seed, operator=operator, ideal_mechanics=not instrument, **kw
+    )
+    if options.get("standard_points") == "book":
+        tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
+        prep = _standard_points_at_a(prep, g)
+        prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
+    passes = options.get("passes")
+    if passes:
+        never = {k: -math.inf for k in prep.sheet.tolerances}
+        prep = replace(
+            prep,
+            sheet=replace(prep.sheet, tolerances=never),
+            operator=replace(prep.operator, max_iterations=int(passes)),
+        )
+    return prep
+
+
 def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, options=None):
     """Per-trial mean squares of each field (:func:`_setup_fields`,
     :func:`_conventional_fields`), plain and with the linear control variate
@@ -349,7 +382,8 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
     budget (the random draws are keyed by trial, so the chunk size changes no result).
     ``options``: ``standard_points`` "book" (conventional: standard points at a = c − p),
     ``instrument`` (every injected instrument error at its configured σ, real mechanics),
-    ``sigma_control`` (setup: σ of the observed control parallaxes), ``control_variate``.
+    ``sigma_control`` (setup: σ of the observed control parallaxes), ``control_variate``,
+    ``passes`` (:func:`_prepared_run`).
     """
 
     options = options or {}
@@ -360,29 +394,7 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
     kw = {"practice": "book", **kw}
 
     def prepared(operator, errors="zero"):
-        prep = prepare_run(
-            sc,
-            spec,
-            base,
-            errors,
-            seed,
-            operator=operator,
-            ideal_mechanics=not (instrument and errors != "zero"),
-            **kw,
-        )
-        if options.get("standard_points") == "book":
-            tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
-            prep = _standard_points_at_a(prep, g)
-            prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
-        passes = options.get("passes")
-        if passes:  # fixed passes: no check ever passes, every loop runs ``passes`` times
-            never = {k: -math.inf for k in prep.sheet.tolerances}
-            prep = replace(
-                prep,
-                sheet=replace(prep.sheet, tolerances=never),
-                operator=replace(prep.operator, max_iterations=int(passes)),
-            )
-        return prep
+        return _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw)
 
     zero_prep = prepared(zero)
     zero_run = run_trials_chunk(zero_prep, 0, None, evaluate=False, transcript=False)
