@@ -18,6 +18,7 @@ import math
 import os
 import platform
 import sys
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
@@ -612,14 +613,15 @@ def _simulate(args: argparse.Namespace) -> int:
 def _verify(args: argparse.Namespace) -> int:
     from stereoplotter.io.geometry_file import geometry_from_file
     from stereoplotter.progress import step_progress
-    from stereoplotter.report.verification import run_procedure_mc, verify
+    from stereoplotter.report.verification import start_procedure_mc, verify
 
     geometry, scenarios = None, None
     if args.geometry:
         geometry, scenarios = geometry_from_file(args.geometry)
-    # the procedure MC once, shared by the table and the histograms
-    with step_progress("procedure MC") as progress:
-        proc = run_procedure_mc(args.procedure_trials, args.seed, scenarios, progress=progress)
+    # the procedure MC once, shared by the table and the histograms; its runs go on in worker
+    # processes while the linear rows are computed
+    t0 = time.perf_counter()
+    pending = start_procedure_mc(args.procedure_trials, args.seed, scenarios, args.instrument)
     with step_progress("verify") as progress:
         rows, seconds = verify(
             trials=args.trials,
@@ -629,6 +631,9 @@ def _verify(args: argparse.Namespace) -> int:
             progress=progress,
             procedure_trials=0,
         )
+    with step_progress("procedure MC") as progress:
+        proc = pending.result(progress)
+    seconds = time.perf_counter() - t0  # the table and the procedure MC (running alongside)
     if proc:
         from stereoplotter.verification.table import attach_procedure_mc
 
@@ -1013,8 +1018,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--procedure-trials",
         type=bounded_int(0, MAX_VERIFY_TRIALS),
-        default=1500,
-        help="trials of the procedure MC (simulated operator) per overlap and method; 0 disables",
+        default=None,
+        help="trials of each procedure MC run (simulated operator); default: per configuration, "
+        "enough for a 1 %% CI; 0 disables",
+    )
+    p.add_argument(
+        "--instrument",
+        default="sc1",
+        help="instrument of the procedure MC, ideal and with its error terms (default: "
+        "%(default)s, the book's SC-1)",
     )
     p.add_argument(
         "--geometry",

@@ -16,7 +16,6 @@ from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification import table
 from stereoplotter.verification.table import (
-    PROCEDURE_TRIALS,
     ROW_KEYS,
     closing_comparison,
     run_verification,
@@ -26,6 +25,7 @@ __all__ = [
     "book_instrument",
     "book_scenarios",
     "run_procedure_mc",
+    "start_procedure_mc",
     "verify",
     "write_verification",
 ]
@@ -44,21 +44,31 @@ def book_scenarios() -> dict:
     return {slot: load_scenario(folder / name) for slot, name in BOOK_SCENARIOS.items()}
 
 
-def book_instrument():
-    """The instrument of the procedure MC, the book's SC-1 (``sc1``, by name as ever)."""
-    return load_instrument(BOOK_INSTRUMENT)
+def book_instrument(name: str = BOOK_INSTRUMENT):
+    """The instrument of the procedure MC: the book's SC-1 (``sc1``, by name as ever), or the
+    instrument ``name`` (``verify --instrument``)."""
+    return load_instrument(name)
 
 
-def run_procedure_mc(trials=PROCEDURE_TRIALS, seed=20240601, scenarios=None, progress=None):
+def run_procedure_mc(
+    trials=None, seed=20240601, scenarios=None, progress=None, instrument=BOOK_INSTRUMENT
+):
     """:func:`stereoplotter.verification.table.run_procedure_mc` with the files loaded here:
     ``scenarios`` (loaded, "60"/"80" → Scenario or None) default to the book's
-    (:func:`book_scenarios`), the instrument is the book's SC-1 (:func:`book_instrument`)."""
-    if not trials:
-        return {}
+    (:func:`book_scenarios`), the instrument by name (default the book's SC-1). ``trials``:
+    None for the per-configuration defaults, 0 for none."""
+    return start_procedure_mc(trials, seed, scenarios, instrument).result(progress)
+
+
+def start_procedure_mc(trials=None, seed=20240601, scenarios=None, instrument=BOOK_INSTRUMENT):
+    """:func:`stereoplotter.verification.table.start_procedure_mc` with the files loaded here
+    (arguments as :func:`run_procedure_mc`): the runs start in worker processes."""
+    if trials == 0:
+        return table.PendingProcedureMC([], [], 1)
     if scenarios is None:
         scenarios = book_scenarios()
-    instrument = book_instrument() if any(scenarios.values()) else None
-    return table.run_procedure_mc(trials, seed, scenarios, progress, instrument=instrument)
+    spec = book_instrument(instrument) if any(scenarios.values()) else None
+    return table.start_procedure_mc(trials, seed, scenarios, instrument=spec)
 
 
 def _fmt(v, digits=4):
@@ -69,10 +79,20 @@ def _fmt(v, digits=4):
     return str(v)
 
 
-def _proc(r):
-    if r.get("mc_procedure") is None:
+def _proc(r, key="mc_procedure"):
+    if r.get(key) is None:
         return "—"
-    return f"{_fmt(r['mc_procedure'])} ± {r['mc_procedure_ci']:.2g}"
+    return f"{_fmt(r[key])} ± {r[key + '_ci']:.2g}"
+
+
+def _procedure_trials_text(trials) -> str:
+    if trials == 0:
+        return ""
+    if trials is None:
+        per = ", ".join(f"{k} {v}" for k, v in table.PROCEDURE_TRIALS.items())
+        inst = ", ".join(f"{k} {v}" for k, v in table.INSTRUMENT_TRIALS.items())
+        return f", procedure MC trials per run: {per}; with instrument errors: {inst}"
+    return f", procedure MC trials = {trials}"
 
 
 def _markdown(rows, closing, meta):
@@ -80,12 +100,7 @@ def _markdown(rows, closing, meta):
         "# Verification of Kushtin & Lyskov 1984, §27 and chapter 5",
         "",
         f"trials = {meta['trials']}, seed = {meta['seed']}, CI = ±{mc.CI_Z} s.e. (99.9 %),"
-        f" runtime {meta['seconds']:.1f} s"
-        + (
-            f", procedure MC trials = {meta['procedure_trials']}"
-            if meta.get("procedure_trials")
-            else ""
-        ),
+        f" runtime {meta['seconds']:.1f} s" + _procedure_trials_text(meta.get("procedure_trials")),
         "",
         "Verdicts are decided from the numbers (stereoplotter/verification/verdicts.py): a printed "
         "number agrees when the value rounded or truncated to its decimals equals it (both are "
@@ -94,23 +109,25 @@ def _markdown(rows, closing, meta):
         "redone from its own printed intermediates.",
         "",
         "| eq | quantity | printed | from printed inputs | book | rigorous | covariance | "
-        "linear MC ± CI | procedure MC | verdict | note |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "linear MC ± CI | procedure MC ± CI | formula at the simulated geometry | procedure MC "
+        "with instrument errors | verdict | note |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
             f"| {r['eq']} | {r['quantity']} | {_fmt(r['printed'])} | "
             f"{_fmt(r.get('from_printed_inputs'))} | {_fmt(r['book'])} | "
             f"{_fmt(r['rigorous'])} | {_fmt(r['covariance'])} | {_fmt(r['mc_linear'])} ± "
-            f"{r['mc_linear_ci']:.2g} | {_proc(r)} | {r['verdict']} | {r['note']} |"
+            f"{r['mc_linear_ci']:.2g} | {_proc(r)} | {_fmt(r.get('mc_procedure_formula'))} | "
+            f"{_proc(r, 'mc_procedure_instrument')} | {r['verdict']} | {r['note']} |"
         )
     lines += [
         "",
         "## Closing comparison (setup data vs conventional method)",
         "",
         "| overlap | book claim | printed setup/conv | book setup/conv (gain) | "
-        "rigorous setup/conv (gain) | MC setup/conv |",
-        "|---|---|---|---|---|---|",
+        "rigorous setup/conv (gain) | MC setup/conv | procedure MC setup/conv (gain) |",
+        "|---|---|---|---|---|---|---|",
     ]
     for c in closing:
         lines.append(
@@ -119,7 +136,10 @@ def _markdown(rows, closing, meta):
             f"{_fmt(c['conventional_book'])} ({c['gain_book']:+.0%}) | "
             f"{_fmt(c['setup_rigorous'])} / {_fmt(c['conventional_rigorous'])} "
             f"({c['gain_rigorous']:+.0%}) | {_fmt(c['setup_mc_linear'])} / "
-            f"{_fmt(c['conventional_mc_linear'])} |"
+            f"{_fmt(c['conventional_mc_linear'])} | {_fmt(c['setup_mc_procedure'])} / "
+            f"{_fmt(c['conventional_mc_procedure'])}"
+            + (f" ({c['gain_mc_procedure']:+.0%})" if c["gain_mc_procedure"] is not None else "")
+            + " |"
         )
     return "\n".join(lines) + "\n"
 
@@ -167,7 +187,7 @@ def verify(
     out_dir=None,
     geometry=None,
     progress=None,
-    procedure_trials: int = PROCEDURE_TRIALS,
+    procedure_trials: int | None = None,
     procedure_scenarios=None,
 ):
     """Run and optionally write the verification (the entry point for ``stereoplotter verify``).
@@ -186,9 +206,9 @@ def verify(
         geometry, scen = geometry_from_file(geometry)
         if procedure_scenarios is None:
             procedure_scenarios = scen
-    elif procedure_scenarios is None and not geometry and procedure_trials:
+    elif procedure_scenarios is None and not geometry and procedure_trials != 0:
         procedure_scenarios = book_scenarios()
-    instrument = book_instrument() if procedure_scenarios and procedure_trials else None
+    instrument = book_instrument() if procedure_scenarios and procedure_trials != 0 else None
     t0 = time.perf_counter()
     rows = run_verification(
         trials=trials,

@@ -32,6 +32,16 @@ Configurations (chosen to match the formulas' assumptions as far as the model al
   off; :func:`levelling_formula` is the rigorous formula with the plane at any four points (the
   procedure levels on the scenario's control points, which moves the formula by +5 %).
 
+* ``method="setup_control"`` — §27 task 2, setup data refined on control: the setup run above,
+  then the built model levelled on Fig. 39's four control points by the least-squares plane
+  through its δp there ((6.47)–(6.50) exact control heights, per m_xy; (6.58)/(6.59) control
+  parallaxes observed with m_p = m_xy/√2, per m_p); domain of chapter 5. One setup run gives all
+  three readings (``fields`` of the result).
+
+Every run can carry the instrument's error terms at their σ (``instrument=True``, real
+mechanics), and is estimated with the linear control variate of
+:mod:`~stereoplotter.verification.control_variate` (unbiased; ``plain`` keeps the plain mean).
+
 :func:`relative_orientation_mc` runs the conventional relative orientation alone (σ_q only, fixed
 passes) against (5.54).
 """
@@ -44,8 +54,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.accuracy.chapter5 import (
     control_points,
+    geodetic_orientation_parallax_rms,
     levelling_design,
     relative_orientation_design,
     relative_orientation_parallax_rms,
@@ -63,11 +75,11 @@ from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.procedure.trials import (
     DEFAULT_MEMORY_BUDGET_MB,
     chunk_trials_for,
-    iter_trial_chunks,
 )
 from stereoplotter.scenario.model import Terrain
 from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.sheet import compute_setup_sheet
+from stereoplotter.verification import control_variate as cvar
 from stereoplotter.verification.linear_mc import (
     CI_Z,
     LinearModel,
@@ -196,6 +208,10 @@ def _dp(scenario, sheet, inst, frame_pts):
 #: ``procedure_mc(sources=…)`` of the conventional method: which judgment errors are on.
 SOURCES = ("both", "y_parallax", "stereo")
 
+#: The procedure methods: §27 task 1 with unadjusted setup data ("setup"), task 2 with setup data
+#: refined on control ("setup_control"), and the conventional method.
+METHODS = ("setup", "setup_control", "conventional")
+
 
 def _configuration(method, sigma_mm, c, p, n, sources="both"):
     """Operator errors, domain x_л-range, unit and run options of ``method`` (module docstring).
@@ -205,7 +221,7 @@ def _configuration(method, sigma_mm, c, p, n, sources="both"):
     ("stereo", the levelling part (5.55))."""
 
     zero = OperatorModel().zero()
-    if method == "setup":
+    if method in ("setup", "setup_control"):
         op = replace(zero, monocular_sigma_mm=sigma_mm)
         return zero, op, (0.0, c), n * sigma_mm, {}  # domain of (6.27)
     if method == "conventional":
@@ -213,7 +229,7 @@ def _configuration(method, sigma_mm, c, p, n, sources="both"):
         sp = 0.0 if sources == "y_parallax" else sigma_mm
         op = replace(zero, stereo_sigma_mm=sp, y_parallax_sigma_mm=sq)
         return zero, op, (p - c, p), sigma_mm, {"relative": "equations"}  # x_п ∈ [−c, 0]
-    raise ValueError(f"method: expected 'setup' or 'conventional', found {method!r}")
+    raise ValueError(f"method: expected one of {METHODS}, found {method!r}")
 
 
 def _height_errors_parallax(sc, sheet, inst, frame_pts):
@@ -233,9 +249,10 @@ def _height_errors_parallax(sc, sheet, inst, frame_pts):
     units = inst.state()["units"]
     setting, left, right = inst.setting, units["left"], units["right"]
     gear = float(sheet.vertical_scale_denominator)
-    slip = np.asarray(inst.read(HEIGHT_SCALE, exact=True), float) + np.asarray(
-        inst.read("Z", exact=True), float
-    ) * gear / 1000.0
+    slip = (
+        np.asarray(inst.read(HEIGHT_SCALE, exact=True), float)
+        + np.asarray(inst.read("Z", exact=True), float) * gear / 1000.0
+    )
     if ev._trial_count(setting, (left, right)) is not None:
         setting = ev._with_point_axis(setting)
         left, right = ev._with_point_axis(left), ev._with_point_axis(right)
@@ -259,80 +276,167 @@ def _levelling_frame_points(prep):
     return ids, instrument_frame_m(local, origin, float(prep.sheet.frame_rotation))
 
 
-def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, options=None):
-    """Per-trial mean square of δp on the domain, and the error-free run's δp.
+def _setup_fields(sc, zero_run, g, xr, grid):
+    """Field makers of the setup-data method: δp on the (6.27) domain ("parallax", task 1), and
+    on the chapter-5 domain after levelling on Fig. 39's four control points (task 2,
+    :data:`METHODS` "setup_control"): "levelled" with exact control heights, "observed" with
+    each control height's parallax observed with σ_c (keyed draws ``mc/control/i``)."""
 
-    The error-free run once; the noisy trials in chunks under the memory budget (the random
-    draws are keyed by trial, so the chunk size changes no result). ``options`` (conventional
-    only, :func:`procedure_mc`): standard points at a = c − p, and the quantity "heights" with
-    both datums; then the return is a dict of per-trial mean squares by quantity.
+    f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
+    sheet = zero_run.sheet
+    pts = _domain_points(sc, sheet, xr, c, p, f, h, grid)
+    lev = _domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
+    book, _, _ = _control_frame_points(sc, sheet, g)
+    allp = np.vstack([pts, lev, book])
+    n, nl = len(pts), len(lev)
+    zero = _dp(sc, sheet, zero_run.instrument, allp)
+    refit = levelling_design(lev[:, 0], lev[:, 1]) @ np.linalg.pinv(
+        levelling_design(book[:, 0], book[:, 1])
+    )
+
+    def fields(result, noise, sigma_control=0.0):
+        d = _dp(sc, result.sheet, result.instrument, allp) - zero
+        dom, ctl = d[:, n : n + nl], d[:, n + nl :]
+        obs = ctl + np.stack(
+            [noise.normal(f"mc/control/{i}", sigma_control) for i in range(len(book))], -1
+        )
+        return {
+            "parallax": d[:, :n],
+            "levelled": dom - ctl @ refit.T,
+            "observed": dom - obs @ refit.T,
+        }
+
+    return fields, zero[:n]
+
+
+def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
+    """Field makers of the conventional method (``procedure_mc`` options): δp at the ideal model
+    position ("parallax") and the heights read on the slipped height scale in parallax units
+    (dp/dH = B·f/(Z_S − Z)², frame origin S_л) with three datums: the procedure's slip ("slip"),
+    the levelling plane's offset from the four levelling heights each observed with σ_p ("plane",
+    the formula's), and the built model re-levelled by the least-squares plane through its
+    height errors at x_п ∈ {−c, a}, y = ±c, each observed with σ_p ("book")."""
+
+    f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
+    sheet = zero_run.sheet
+    pts = _domain_points(sc, sheet, xr, c, p, f, h, grid)
+    d_zero = _dp(sc, sheet, zero_run.instrument, pts)
+    _, lev = _levelling_frame_points(zero_prep)
+    book, _, _ = _control_frame_points(sc, sheet, g)
+    allp = np.vstack([pts, lev, book])
+    k = (p * h / f) * f / allp[:, 2] ** 2  # photo mm of x-parallax per m of height
+    h_zero = _height_errors_parallax(sc, sheet, zero_run.instrument, allp)
+    n, nl = len(pts), len(lev)
+    refit = levelling_design(pts[:, 0], pts[:, 1]) @ np.linalg.pinv(
+        levelling_design(book[:, 0], book[:, 1])
+    )
+
+    def fields(result, noise):
+        d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
+        e = (_height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
+        obs = e[:, n : n + nl] + np.stack(
+            [noise.normal(f"mc/datum/{i}", sigma_p) for i in range(nl)], -1
+        )
+        ctl = e[:, n + nl :] + np.stack(
+            [noise.normal(f"mc/book/{i}", sigma_p) for i in range(len(book))], -1
+        )
+        return {
+            "parallax": d,
+            "slip": e[:, :n],
+            "plane": e[:, :n] - np.mean(obs, axis=-1, keepdims=True),
+            "book": e[:, :n] - ctl @ refit.T,
+        }
+
+    return fields, d_zero
+
+
+def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
+    """The prepared run of the procedure MC: real mechanics only with instrument errors; the
+    standard points at a = c − p (``standard_points`` "book"); ``passes``: no check ever passes,
+    so every loop runs that many times."""
+    instrument = bool(options.get("instrument")) and errors != "zero"
+    prep = prepare_run(
+        sc, spec, base, errors, seed, operator=operator, ideal_mechanics=not instrument, **kw
+    )
+    if options.get("standard_points") == "book":
+        tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
+        prep = _standard_points_at_a(prep, g)
+        prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
+    passes = options.get("passes")
+    if passes:
+        never = {k: -math.inf for k in prep.sheet.tolerances}
+        prep = replace(
+            prep,
+            sheet=replace(prep.sheet, tolerances=never),
+            operator=replace(prep.operator, max_iterations=int(passes)),
+        )
+    return prep
+
+
+def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, options=None):
+    """Per-trial mean squares of each field (:func:`_setup_fields`,
+    :func:`_conventional_fields`), plain and with the linear control variate
+    (:mod:`~stereoplotter.verification.control_variate`), and the error-free run's δp.
+
+    The error-free run once; the linearisation once; the noisy trials in chunks under the memory
+    budget (the random draws are keyed by trial, so the chunk size changes no result).
+    ``options``: ``standard_points`` "book" (conventional: standard points at a = c − p),
+    ``instrument`` (every injected instrument error at its configured σ, real mechanics),
+    ``sigma_control`` (setup: σ of the observed control parallaxes), ``control_variate``,
+    ``passes`` (:func:`_prepared_run`).
     """
 
-    f, p, c = g["f"], g["p"], g["c"]
     options = options or {}
-
+    instrument = bool(options.get("instrument"))
+    base = "conventional" if method == "conventional" else "setup"
     # The formulas of §27 describe the book's procedure, task 1: each element set once, no
     # remedies — for both methods (the operator's remedies would lower the setup-data value).
     kw = {"practice": "book", **kw}
 
-    def prepared(operator):
-        prep = prepare_run(
-            sc, spec, method, "zero", seed, operator=operator, ideal_mechanics=True, **kw
-        )
-        if options.get("standard_points") == "book":
-            tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
-            prep = _standard_points_at_a(prep, g)
-            prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
-        return prep
+    def prepared(operator, errors="zero"):
+        return _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw)
 
     zero_prep = prepared(zero)
     zero_run = run_trials_chunk(zero_prep, 0, None, evaluate=False, transcript=False)
-    pts = _domain_points(sc, zero_run.sheet, xr, c, p, f, g["flying_height_m"], grid)
-    d_zero = _dp(sc, zero_run.sheet, zero_run.instrument, pts)
-    prep = prepared(op)
-    chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, method)
-    ms = np.empty(int(trials))
-    if not options.get("heights"):
-        for result in iter_trial_chunks(prep, int(trials), chunk, evaluate=False):
-            d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
-            first = result.first_trial
-            ms[first : first + len(d)] = np.mean(d**2, axis=-1)  # per trial
-        return ms, d_zero
-    # heights as read, in parallax units (dp/dH = B·f/(Z_S − Z)², frame origin S_л)
-    _, lev = _levelling_frame_points(zero_prep)
-    book, _, _ = _control_frame_points(sc, zero_run.sheet, g)
-    allp = np.vstack([pts, lev, book])
-    base_m = p * g["flying_height_m"] / f
-    k = base_m * f / allp[:, 2] ** 2  # photo mm of x-parallax per m of height
-    h_zero = _height_errors_parallax(sc, zero_run.sheet, zero_run.instrument, allp)
-    out = {name: np.empty(int(trials)) for name in ("parallax", "slip", "plane", "book")}
-    n, nl = len(pts), len(lev)
-    # the book's levelling (mechanism off): the least-squares plane (1, X, Y) through the height
-    # errors at x_п ∈ {−c, a}, y = ±c, each observed with σ_p, removed from the built model
+    if base == "setup":
+        make, d_zero = _setup_fields(sc, zero_run, g, xr, grid)
+        sc_sigma = float(options.get("sigma_control", 0.0))
 
-    refit = levelling_design(pts[:, 0], pts[:, 1]) @ np.linalg.pinv(
-        levelling_design(book[:, 0], book[:, 1])
-    )
-    for result in iter_trial_chunks(prep, int(trials), chunk, evaluate=False):
-        first = result.first_trial
-        m = len(result.instrument.setting.base_x_mm)
-        d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
-        e = (_height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
-        # the book's datum: the levelling plane's offset from the four levelling heights, each
-        # observed with the stereo σ_p of the formula (keyed draws, one per point and trial)
-        noise = Noise(seed, m, None, first)
-        obs = e[:, n : n + nl] + np.stack(
-            [noise.normal(f"mc/datum/{i}", op.stereo_sigma_mm) for i in range(nl)], -1
+        def fields(result, noise):
+            return make(result, noise, sc_sigma)
+    else:
+        fields, d_zero = _conventional_fields(
+            sc, zero_prep, zero_run, g, xr, grid, op.stereo_sigma_mm
         )
-        out["parallax"][first : first + m] = np.mean(d**2, axis=-1)
-        out["slip"][first : first + m] = np.mean(e[:, :n] ** 2, axis=-1)
-        plane = e[:, :n] - np.mean(obs, axis=-1, keepdims=True)
-        out["plane"][first : first + m] = np.mean(plane**2, axis=-1)
-        ctl = e[:, n + nl :] + np.stack(
-            [noise.normal(f"mc/book/{i}", op.stereo_sigma_mm) for i in range(len(book))], -1
+    prep = prepared(op, None if instrument else "zero")
+    model = prep.model
+
+    def run(injected, noise, n):
+        result = run_trials_chunk(
+            prep, 0, n, evaluate=False, transcript=False, injected=injected, noise=noise
         )
-        out["book"][first : first + m] = np.mean((e[:, :n] - ctl @ refit.T) ** 2, axis=-1)
-    return out, d_zero
+        return fields(result, noise)
+
+    lin = cvar.linear_control(run, model) if options.get("control_variate", True) else None
+    chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, base)
+    plain: dict[str, np.ndarray] = {}
+    controlled: dict[str, np.ndarray] = {}
+    for first in range(0, int(trials), chunk):
+        m = min(chunk, int(trials) - first)
+        injected = model.draw_keyed(prep.seed, first, first + m)
+        noise = cvar.RecordingNoise(prep.seed, m, first)
+        result = run_trials_chunk(
+            prep, first, m, evaluate=False, transcript=False, injected=injected, noise=noise
+        )
+        fs = fields(result, noise)
+        cv = cvar.per_trial_controlled(fs, lin, noise, injected, model) if lin else {}
+        for name, v in fs.items():
+            plain.setdefault(name, np.empty(int(trials)))[first : first + m] = np.mean(
+                np.asarray(v) ** 2, axis=-1
+            )
+            if lin:
+                controlled.setdefault(name, np.empty(int(trials)))[first : first + m] = cv[name]
+    return plain, controlled, d_zero
 
 
 def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
@@ -389,13 +493,70 @@ def levelling_points_photo(scenario: Scenario, spec: InstrumentSpec, g: dict):
 def _rms_ci(ms, unit):
     """(RMS, CI half-width) per ``unit`` from per-trial mean squares (``CI_Z`` s.e.)."""
     mean_ms = float(np.mean(ms))
-    rms = math.sqrt(mean_ms)
-    half = CI_Z * rms * (float(np.std(ms, ddof=1)) / math.sqrt(len(ms))) / (2.0 * mean_ms)
+    rms = math.sqrt(max(mean_ms, 0.0))
+    half = CI_Z * (float(np.std(ms, ddof=1)) / math.sqrt(len(ms))) / (2.0 * rms)
     return rms / unit, half / unit
 
 
-# long: a 38-line docstring (the options and what each measures) and 63 lines of code (option
-# checks, the formula at both sets of levelling points, the run, the summary).
+def _check_options(method, **options):
+    if method not in METHODS:
+        raise ValueError(f"method: expected one of {METHODS}, found {method!r}")
+    allowed = {
+        "quantity": ("heights", "parallax"),
+        "standard_points": ("book", "nadirs"),
+        "datum": ("plane", "slip"),
+        "levelling": ("procedure", "book"),
+        "sources": SOURCES,
+        "control": ("exact", "observed"),
+    }
+    for name, value in options.items():
+        if value not in allowed[name]:
+            raise ValueError(f"{name}: expected one of {allowed[name]}, found {value!r}")
+
+
+def _field_name(method, quantity, levelling, datum, control):
+    """The field whose mean square is the procedure's statistic."""
+    if method == "setup":
+        return "parallax"
+    if method == "setup_control":
+        return "levelled" if control == "exact" else "observed"
+    if quantity == "parallax":
+        return "parallax"
+    return "book" if levelling == "book" else datum
+
+
+def _formulas(method, scenario, spec, g, sources, control):
+    """The rigorous formula at the simulated geometry for the statistic (per its unit)."""
+    f, p, c, a, n, ll = g["f"], g["p"], g["c"], g["a"], g["n"], g["l"]
+    if method == "setup":
+        return {
+            "rigorous": float(
+                sa.setup_parallax_rms_from_pointing(f, p, c, ll, n, 1.0, mode="rigorous")
+            )
+        }
+    if method == "setup_control":
+        if control == "exact":  # (6.47)–(6.50) per m_xy
+            return {
+                "rigorous": float(sa.setup_relative_residual_rms(a, c, f, ll, n, 1.0, "rigorous"))
+            }
+        # (6.58)/(6.59) per m_p with m_xy = √2 m_p and control parallaxes with m_p
+        residual = sa.setup_relative_residual_rms(a, c, f, ll, n, math.sqrt(2.0), "rigorous")
+        geodetic = geodetic_orientation_parallax_rms(a, c, p, f, 1.0, "rigorous")
+        return {"rigorous": float(math.hypot(residual, geodetic))}
+    part = {"both": None, "y_parallax": 0, "stereo": 1}[sources]
+    terms = (
+        relative_orientation_parallax_rms(a, c, p, 1.0, "rigorous"),
+        geodetic_orientation_parallax_rms(a, c, p, f, 1.0, "rigorous"),
+    )
+    rig = math.hypot(*terms) if part is None else terms[part]
+    return {
+        "rigorous": float(rig),
+        "procedure": levelling_formula(g, *levelling_points_photo(scenario, spec, g))[sources],
+        "book": levelling_formula(g, *control_points(a, c))[sources],
+    }
+
+
+# long: a 45-line docstring (the options and what each measures) and the run and summary.
 def procedure_mc(
     scenario: Scenario,
     method: str = "setup",
@@ -410,8 +571,20 @@ def procedure_mc(
     datum: str = "plane",
     levelling: str = "procedure",
     sources: str = "both",
+    control: str = "exact",
+    instrument: bool = False,
+    control_variate: bool = True,
+    passes: int | None = None,
 ) -> dict:
     """Run the procedure MC for one scenario and method (see the module docstring).
+
+    ``method`` (:data:`METHODS`): "setup" (§27 task 1: the setup-data method, stages 1–5, with
+    the operator's monocular pointing σ; δp on the (6.27) domain per m_xy = n_л·σ, (6.39)–(6.44));
+    "setup_control" (§27 task 2: the same run, then the model levelled on Fig. 39's four control
+    points x_п ∈ {−c, a}, y = ±c by the least-squares plane (1, X, Y) through the δp there —
+    the levelling that refines the setup data on control; δp on the chapter-5 domain; ``control``
+    "exact" per m_xy, (6.47)–(6.50), or "observed": each control parallax observed with
+    m_p = m_xy/√2, per m_p, (6.58)/(6.59)); "conventional".
 
     Conventional method only (``docs/accuracy.md``, "Why the total M_p was +54 % / +123 %"):
     ``quantity`` "heights" (the height read on the slipped height scale, in parallax units —
@@ -425,8 +598,13 @@ def procedure_mc(
     its height errors at Fig. 39's x_п ∈ {−c, a}, y = ±c, each observed with σ_p: the formula's
     control points). ``sources`` "both" (σ_q = σ_p = σ), "y_parallax" (σ_q only) or "stereo"
     (σ_p only). The result also carries ``by_datum`` (coefficient, ci) for "parallax", "slip",
-    "plane" and "book" of the same trials, and ``formula`` (:func:`levelling_formula` at the
-    procedure's levelling points, "procedure", and at Fig. 39's, "book"; the part of ``sources``).
+    "plane" and "book" of the same trials.
+
+    ``instrument``: every injected instrument error term of ``spec`` at its configured σ and the
+    real mechanics (backlash), besides the operator's σ; the unit stays the operator's.
+    ``control_variate``: the estimator with the linear control variate
+    (:mod:`~stereoplotter.verification.control_variate`; unbiased, its CI ≈ 10–40× narrower);
+    False: the plain mean.
 
     ``scenario`` and ``spec`` (the instrument, the book's SC-1) are loaded by the caller; this
     layer reads no files.
@@ -434,10 +612,13 @@ def procedure_mc(
     Returns
     -------
     dict
-        ``coefficient`` (RMS of δp per m_xy for "setup", per m_p = m_q for "conventional"),
-        ``ci`` (half-width, same units), ``rms_mm``, ``bias_mm`` (RMS δp of the error-free run on
-        the same domain), ``per_trial`` (per-trial RMS / unit, for histograms), the geometry
-        used (f, l, n, f_instrument, p, c, a, overlap) and ``seconds``.
+        ``coefficient`` (RMS per m_xy for "setup", per m_xy or m_p for "setup_control", per
+        m_p = m_q for "conventional"), ``ci`` (half-width, same units), ``plain`` (coefficient,
+        ci) of the plain mean, ``formula`` (``rigorous`` at the simulated geometry; for the
+        conventional method also :func:`levelling_formula` at the procedure's levelling points,
+        ``procedure``, and at Fig. 39's, ``book``), ``rms_mm``, ``bias_mm`` (RMS δp of the
+        error-free run on the same domain), ``per_trial`` (per-trial RMS / unit, for
+        histograms), the geometry used (f, l, n, f_instrument, p, c, a, overlap) and ``seconds``.
 
     Examples
     --------
@@ -452,50 +633,58 @@ def procedure_mc(
     import time
 
     t0 = time.perf_counter()
-    g = scenario_geometry(scenario, spec)
-    if method == "conventional":
-        for name, value, allowed in (
-            ("quantity", quantity, ("heights", "parallax")),
-            ("standard_points", standard_points, ("book", "nadirs")),
-            ("datum", datum, ("plane", "slip")),
-            ("levelling", levelling, ("procedure", "book")),
-            ("sources", sources, SOURCES),
-        ):
-            if value not in allowed:
-                raise ValueError(f"{name}: expected one of {allowed}, found {value!r}")
-    zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"], sources)
-    options, formula = {}, None
-    if method == "conventional":
-
-        options = {"standard_points": standard_points, "heights": True}
-        formula = {
-            "procedure": levelling_formula(g, *levelling_points_photo(scenario, spec, g))[sources],
-            "book": levelling_formula(g, *control_points(g["a"], g["c"]))[sources],
-        }
-    spec = replace(spec, standard_points_c_mm=g["c"])
-    ms, d_zero = _mean_squares(
-        scenario, spec, method, seed, trials, zero, op, xr, g, grid, kw, options
+    _check_options(
+        method,
+        quantity=quantity,
+        standard_points=standard_points,
+        datum=datum,
+        levelling=levelling,
+        sources=sources,
+        control=control,
     )
-    by = None
-    if isinstance(ms, dict):
-        by = {name: _rms_ci(v, unit) for name, v in ms.items()}
-        if quantity == "parallax":
-            ms = ms["parallax"]
-        else:
-            ms = ms["book" if levelling == "book" else datum]
-    mean_ms = float(np.mean(ms))
-    rms = math.sqrt(mean_ms)
-    se_ms = float(np.std(ms, ddof=1)) / math.sqrt(len(ms))
-    half = CI_Z * rms * se_ms / (2.0 * mean_ms)
-    extra = {} if by is None else {
-        "by_datum": by,
-        "quantity": quantity,
-        "standard_points": standard_points,
-        "datum": datum,
-        "levelling": levelling,
-        "sources": sources,
-        "formula": formula,
-    }
+    g = scenario_geometry(scenario, spec)
+    zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"], sources)
+    options = {"instrument": instrument, "control_variate": control_variate, "passes": passes}
+    if method == "conventional":
+        options["standard_points"] = standard_points
+    units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
+    if method != "conventional":  # m_p = m_xy/√2 of the observed control parallaxes
+        options["sigma_control"] = units["observed"]
+    spec_c = replace(spec, standard_points_c_mm=g["c"])
+    plain, controlled, d_zero = _mean_squares(
+        scenario, spec_c, method, seed, trials, zero, op, xr, g, grid, kw, options
+    )
+    name = _field_name(method, quantity, levelling, datum, control)
+    best = controlled or plain
+    fields = {}
+    if method != "conventional":  # one run, the three readings of §27 tasks 1 and 2
+        for key, m, c in (
+            ("parallax", "setup", "exact"),
+            ("levelled", "setup_control", "exact"),
+            ("observed", "setup_control", "observed"),
+        ):
+            cf, h = _rms_ci(best[key], units[key])
+            fields[key] = {
+                "coefficient": cf,
+                "ci": h,
+                "plain": _rms_ci(plain[key], units[key]),
+                "formula": _formulas(m, scenario, spec, g, sources, c)["rigorous"],
+            }
+        unit = units[name]
+    formula = _formulas(method, scenario, spec, g, sources, control)
+    coefficient, ci = _rms_ci(best[name], unit)
+    extra = {"fields": fields} if fields else {}
+    if method == "conventional":
+        extra = {
+            "by_datum": {k: _rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
+            "quantity": quantity,
+            "standard_points": standard_points,
+            "datum": datum,
+            "levelling": levelling,
+            "sources": sources,
+        }
+    if method == "setup_control":
+        extra["control"] = control
     return {
         **extra,
         "method": method,
@@ -503,11 +692,16 @@ def procedure_mc(
         "trials": int(trials),
         "seed": int(seed),
         "sigma_mm": sigma_mm,
-        "coefficient": rms / unit,
-        "ci": half / unit,
-        "rms_mm": rms,
+        "instrument": bool(instrument),
+        "instrument_key": spec.key,
+        "control_variate": bool(controlled),
+        "coefficient": coefficient,
+        "ci": ci,
+        "plain": _rms_ci(plain[name], unit),
+        "formula": formula,
+        "rms_mm": coefficient * unit,
         "bias_mm": float(np.sqrt(np.mean(d_zero**2))),
-        "per_trial": np.sqrt(ms) / unit,
+        "per_trial": np.sqrt(plain[name]) / unit,
         "seconds": time.perf_counter() - t0,
         **g,
     }
@@ -633,7 +827,6 @@ def relative_orientation_mc(
         ``unlevelled`` (RMS/σ_q without the plane removal), ``trials``, geometry, ``seconds``.
     """
     import time
-
 
     t0 = time.perf_counter()
     sc = idealised_geometry(scenario) if ideal_geometry else scenario

@@ -18,11 +18,12 @@ m_q = m_p = 1 (and m_xy = √2 m_p) for (6.45)-(6.61).
 from __future__ import annotations
 
 import math
+import multiprocessing
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
-from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
 from stereoplotter.verification.procedure_mc import procedure_mc
@@ -48,6 +49,7 @@ __all__ = [
     "closing_comparison",
     "run_procedure_mc",
     "run_verification",
+    "start_procedure_mc",
 ]
 
 ROW_KEYS = (
@@ -62,12 +64,38 @@ ROW_KEYS = (
     "mc_linear_ci",
     "mc_procedure",
     "mc_procedure_ci",
+    "mc_procedure_formula",
+    "mc_procedure_instrument",
+    "mc_procedure_instrument_ci",
     "verdict",
     "note",
 )
 PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this quantity)"
-#: Default trials of the procedure MC (CI half-width ≈ 6–9 % at 99.9 %, ≈ 1 s per run).
-PROCEDURE_TRIALS = 1500
+#: Procedure-MC configurations: name → :func:`procedure_mc` keyword arguments. "setup" is one
+#: run of the setup-data method with three readings (§27 task 1, and task 2: levelled on
+#: control exactly and with observed control parallaxes); the conventional method with both
+#: judgment errors, the y-parallax σ_q only and the stereo σ_p only. Conventional runs make a
+#: fixed number of passes of every loop (``passes``: no stop-when-satisfied selection, which
+#: (5.54)/(5.55) do not model; it makes the run smooth enough for the control variate). The
+#: setup run's statistic is the mean over a midpoint grid of 8 × 16 (not 16 × 32): half the
+#: time, values within 0.3 % of the finer grid on the same 4 000 trials (pair60 levelled
+#: 0.1298 / 0.1302, observed 0.6696 / 0.6707; parallax within 0.02 %).
+PROCEDURE_CONFIGS = {
+    "setup": {"method": "setup", "grid": (8, 16)},
+    "conventional": {"method": "conventional", "passes": 3},
+    "y_parallax": {"method": "conventional", "sources": "y_parallax", "passes": 3},
+    "stereo": {"method": "conventional", "sources": "stereo", "passes": 3},
+}
+#: Default trials per configuration: the fewest that keep every row's 99.9 % CI ≤ 1 % of its
+#: value at the book's scenarios (``benchmarks/bench_procedure_verify.py``; measured CIs in
+#: ``docs/accuracy.md``). The setup method's loops stop when a check passes, which makes its
+#: δp not linear in the draws and the control variate weak there: 45 000 trials.
+PROCEDURE_TRIALS = {"setup": 45000, "conventional": 1500, "y_parallax": 3000, "stereo": 300}
+#: Trials of the runs with every instrument error term at its σ (``mc_procedure_instrument``;
+#: a comparison with the ideal instrument, not held to 1 %).
+INSTRUMENT_TRIALS = {"setup": 4000, "conventional": 600, "y_parallax": 600, "stereo": 300}
+
+
 def _row_specs(g) -> list[Entry]:
     """Every row of the table as an :class:`~stereoplotter.verification.entry.Entry`, in order
     (the order fixes each row's random stream)."""
@@ -130,8 +158,7 @@ def check_geometry(fields, geometry: dict) -> None:
         if not all(math.isfinite(v) for v in values):
             raise fields.error(
                 "(geometry)",
-                "values of " + ", ".join(BOOK) + " for which every formula of the table is "
-                "finite",
+                "values of " + ", ".join(BOOK) + " for which every formula of the table is finite",
                 f"{entry.eq} {entry.quantity}: {values}",
             )
 
@@ -150,87 +177,224 @@ def _normalise_geometry(geometry) -> dict:
     return g
 
 
-#: Rows with a procedure MC: eq → (overlap slot, method).
+#: Rows with a procedure MC: eq → (overlap slot, configuration, field of the setup run or
+#: None, scaled by f/p). Every outcome row of §27, (6.39)–(6.61).
 PROCEDURE_ROWS = {
-    "(6.39)": ("60", "setup"),
-    "(6.40)": ("80", "setup"),
-    "(6.43)": ("60", "setup"),
-    "(6.44)": ("80", "setup"),
-    "(6.45)": ("60", "conventional"),
-    "(6.46)": ("80", "conventional"),
-    "(6.60)": ("60", "conventional"),
-    "(6.61)": ("80", "conventional"),
+    **{eq: ("60", "setup", "parallax", False) for eq in ("(6.39)", "(6.41)", "(6.43)")},
+    **{eq: ("80", "setup", "parallax", False) for eq in ("(6.40)", "(6.42)", "(6.44)")},
+    **{eq: ("60", "setup", "levelled", False) for eq in ("(6.47)", "(6.49)")},
+    **{eq: ("80", "setup", "levelled", False) for eq in ("(6.48)", "(6.50)")},
+    "(6.58)": ("60", "setup", "observed", False),
+    "(6.59)": ("80", "setup", "observed", False),
+    **{eq: ("60", "conventional", None, False) for eq in ("(6.45)", "(6.60)")},
+    **{eq: ("80", "conventional", None, False) for eq in ("(6.46)", "(6.53)", "(6.61)")},
+    **{eq: ("60", "y_parallax", None, False) for eq in ("(6.51)", "(6.56)")},
+    **{eq: ("80", "y_parallax", None, False) for eq in ("(6.52)", "(6.57)")},
+    "(6.54)": ("60", "stereo", None, False),
+    "(6.55)": ("80", "stereo", None, True),  # the row's unit: k = (M_p,го/m_p)·f/p
 }
 
 
-def run_procedure_mc(
-    trials=PROCEDURE_TRIALS, seed=20240601, scenarios=None, progress=None, *, instrument=None
-):
-    """The procedure MC of :mod:`stereoplotter.verification.procedure_mc` for the setup-data and the
-    conventional method at each overlap slot.
+#: The jobs of the current :func:`run_procedure_mc`, read by forked workers by index (the loaded
+#: scenarios and instrument hold mappings that do not pickle).
+_JOBS: list = []
 
-    ``scenarios`` maps "60"/"80" to a loaded :class:`~stereoplotter.scenario.model.Scenario` (None
-    for a slot skips it; None or empty: no procedure MC); the book's are the shipped ``pair60`` and
-    ``pair80`` (:func:`stereoplotter.report.verification.book_scenarios`). ``instrument`` is the
-    loaded :class:`~stereoplotter.instrument.spec.InstrumentSpec` (the book's SC-1), required
-    when a slot is run.
+
+def _job_at(i):
+    return _job(_JOBS[i])
+
+
+def _job(args):
+    scenario, spec, config, trials, seed, instrument = args
+    return procedure_mc(
+        scenario,
+        spec=spec,
+        trials=trials,
+        seed=seed,
+        instrument=instrument,
+        **PROCEDURE_CONFIGS[config],
+    )
+
+
+def _trials_of(trials, config, instrument):
+    if isinstance(trials, int):
+        return trials
+    return (INSTRUMENT_TRIALS if instrument else PROCEDURE_TRIALS)[config]
+
+
+def run_procedure_mc(
+    trials=None,
+    seed=20240601,
+    scenarios=None,
+    progress=None,
+    *,
+    instrument=None,
+    with_instrument=True,
+    workers=2,
+):
+    """:func:`start_procedure_mc` and wait for its result (arguments as there)."""
+    return start_procedure_mc(
+        trials,
+        seed,
+        scenarios,
+        instrument=instrument,
+        with_instrument=with_instrument,
+        workers=workers,
+    ).result(progress)
+
+
+def start_procedure_mc(
+    trials=None,
+    seed=20240601,
+    scenarios=None,
+    *,
+    instrument=None,
+    with_instrument=True,
+    workers=2,
+) -> PendingProcedureMC:
+    """The procedure MC of :mod:`stereoplotter.verification.procedure_mc` for every
+    configuration of :data:`PROCEDURE_CONFIGS` at each overlap slot, on the ideal instrument and
+    (``with_instrument``) with every instrument error term at its configured σ.
+
+    ``trials``: None (the defaults :data:`PROCEDURE_TRIALS`, :data:`INSTRUMENT_TRIALS`), an int
+    (every run), or 0 (none). ``scenarios`` maps "60"/"80" to a loaded
+    :class:`~stereoplotter.scenario.model.Scenario` (None for a slot skips it; None or empty: no
+    procedure MC); the book's are the shipped ``pair60`` and ``pair80``
+    (:func:`stereoplotter.report.verification.book_scenarios`). ``instrument`` is the loaded
+    :class:`~stereoplotter.instrument.spec.InstrumentSpec` (the book's SC-1), required when a
+    slot is run. ``workers``: processes (the runs are independent; 1 runs them here).
 
     Returns
     -------
-    dict
-        (slot, method) → :func:`~stereoplotter.verification.procedure_mc.procedure_mc` result.
+    PendingProcedureMC
+        Its :meth:`~PendingProcedureMC.result`: (slot, configuration) →
+        :func:`~stereoplotter.verification.procedure_mc.procedure_mc` result, and
+        (slot, configuration, "instrument") → the run with instrument errors.
     """
-
-    out = {}
-    if not trials or not scenarios:
-        return out
-    todo = [(s, m) for s in ("60", "80") if scenarios.get(s) for m in ("setup", "conventional")]
+    if trials == 0 or not scenarios:
+        return PendingProcedureMC([], [], 1)
+    todo = [
+        (s, c, inst)
+        for inst in ((False, True) if with_instrument else (False,))
+        for s in ("60", "80")
+        if scenarios.get(s)
+        for c in PROCEDURE_CONFIGS
+    ]
     if todo and instrument is None:
         raise ValueError("instrument: expected the InstrumentSpec of the procedure MC, found None")
-    for i, (slot, method) in enumerate(todo):
-        out[(slot, method)] = procedure_mc(
-            scenarios[slot], method, spec=instrument, trials=trials, seed=seed + 7 * i + 1
+    names = list(PROCEDURE_CONFIGS)
+    jobs = [
+        (
+            scenarios[s],
+            instrument,
+            c,
+            _trials_of(trials, c, inst),
+            seed + 7 * (2 * names.index(c) + (s == "80")) + 1,
+            inst,
         )
-        if progress is not None:
-            progress(i + 1, len(todo), f"proc {slot}% {method[:4]}")
-    return out
+        for s, c, inst in todo
+    ]
+    keys = [(s, c, "instrument") if inst else (s, c) for s, c, inst in todo]
+    return PendingProcedureMC(jobs, keys, workers)
 
 
-def _procedure_note(eq, res):
-    """The note of a procedure-MC row: formula at the simulated geometry, first-order error and
-    the mismatches of assumptions."""
+class PendingProcedureMC:
+    """Procedure-MC runs started in ``workers`` forked processes (longest first, so the workers
+    finish together); :meth:`result` waits for them. With one worker, or where processes cannot
+    be forked, the runs are made by :meth:`result` itself. Meanwhile the caller may compute
+    (the linear rows): ``verify`` overlaps the two."""
+
+    def __init__(self, jobs: list, keys: list, workers: int = 2):
+        self.jobs, self.keys = jobs, keys
+        self.order = sorted(range(len(jobs)), key=lambda i: -jobs[i][3])
+        self.pool = None
+        self.futures = {}
+        if workers > 1 and len(jobs) > 1 and "fork" in multiprocessing.get_all_start_methods():
+            _JOBS[:] = jobs  # inherited by the forked workers
+            context = multiprocessing.get_context("fork")
+            self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
+            self.futures = {self.pool.submit(_job_at, i): i for i in self.order}
+
+    def result(self, progress=None) -> dict:
+        """(slot, configuration[, "instrument"]) → result; ``progress(done, total, label)``."""
+        out = {}
+        n = len(self.jobs)
+        if self.pool is None:
+            for done, i in enumerate(self.order, 1):
+                out[self.keys[i]] = _job(self.jobs[i])
+                if progress is not None:
+                    progress(done, n, "proc " + " ".join(self.keys[i]))
+            return out
+        try:
+            for done, fut in enumerate(as_completed(self.futures), 1):
+                key = self.keys[self.futures[fut]]
+                out[key] = fut.result()
+                if progress is not None:
+                    progress(done, n, "proc " + " ".join(key))
+        finally:
+            self.pool.shutdown(cancel_futures=True)
+            _JOBS.clear()
+        return {k: out[k] for k in self.keys}
+
+
+def procedure_value(res: dict, field: str | None, scaled: bool) -> tuple[float, float, float]:
+    """(value, CI half-width, rigorous formula at the simulated geometry) of a row from its
+    procedure-MC run: the ``field`` of a setup run, or the run's coefficient (the formula then
+    with the levelling plane at the procedure's control points,
+    :func:`~stereoplotter.verification.procedure_mc.levelling_formula`);
+    × f/p if ``scaled``."""
+    if field is not None:
+        f = res["fields"][field]
+        v, h, ref = f["coefficient"], f["ci"], f["formula"]
+    else:  # the conventional formula with the plane at the procedure's own levelling points
+        v, h, ref = res["coefficient"], res["ci"], res["formula"]["procedure"]
+    k = res["f"] / res["p"] if scaled else 1.0
+    return v * k, h * k, ref * k
+
+
+_FIELD_TEXT = {
+    "parallax": "δp of the built model on the (6.27) domain per m_xy = n_л·σ (task 1)",
+    "levelled": "δp on the chapter-5 domain after levelling on Fig. 39's four control points "
+    "(least-squares plane, exact control heights) per m_xy = n_л·σ (task 2)",
+    "observed": "δp on the chapter-5 domain after levelling on Fig. 39's four control points, "
+    "each control parallax observed with m_p = m_xy/√2, per m_p (task 2)",
+}
+
+
+def _procedure_note(eq, res, field, scaled):
+    """The note of a procedure-MC row: the run, the formula at the simulated geometry, their
+    ratio and the mismatches of assumptions."""
     f, p, c, a, n, ll = res["f"], res["p"], res["c"], res["a"], res["n"], res["l"]
+    v, h, ref = procedure_value(res, field, scaled)
     head = (
         f"procedure MC ({res['scenario']}, T = {res['trials']}, σ = {res['sigma_mm'] * 1000:g} µm"
-        f" photo): {res['coefficient']:.3f} ± {res['ci']:.3f}"
+        f" photo, linear control variate): {v:.4f} ± {h:.4f} against the rigorous formula at the "
+        f"simulated geometry (f = {f:.2f}, p = {p:.2f}, c = {c:.2f}, a = {a:.2f}, l = {ll:g}, "
+        f"n_л = {n:.3f} of our SC-1 sheet) {ref:.4f}: ratio {v / ref - 1.0:+.1%}"
     )
-    if res["method"] == "setup":
-        ref = float(sa.setup_parallax_rms_from_pointing(f, p, c, ll, n, 1.0, mode="rigorous"))
-        err = res["coefficient"] / ref - 1.0
+    if res["method"] != "conventional":
         return (
-            f"{head} per m_xy = n_л·σ against the unit-consistent formula at the simulated "
-            f"geometry (p = {p:.2f}, c = {c:.2f}, l = {ll:g}, n_л = {n:.3f} of our SC-1 sheet, "
-            f"not the book's 1.42; (6.37) at photo scale, f·m_y/(n·l_y)) {ref:.3f}: first-order "
-            f"error {err:+.1%}; bias of the "
-            f"error-free run {res['bias_mm'] * 1000:.1f} µm removed. Mismatches: only the "
-            "monocular pointing σ of the operator; κ is cleared by y-parallax at standard points "
-            "1-2 (D8), not from the fiducial readings of (6.36); ω, α by one knob setting per "
-            "photo, not least squares of (6.31)/(6.33); tilted photos and relief of the scenario"
+            f"{head}. Measured: {_FIELD_TEXT[field]}; bias of the error-free run "
+            f"{res['bias_mm'] * 1000:.1f} µm removed. Mismatches: only the monocular pointing σ "
+            "of the operator; κ is cleared by y-parallax at standard points 1-2 (D8), not from "
+            "the fiducial readings of (6.36); ω, α by one knob setting per photo, not least "
+            "squares of (6.31)/(6.33); the loops stop when a check passes; tilted photos and "
+            "relief of the scenario"
         )
-    ref = float(sa.conventional_parallax_rms(a, c, p, f, 1.0, 1.0, "rigorous"))
-    err = res["coefficient"] / ref - 1.0
+    part = {
+        "both": "σ_q = σ_p = σ",
+        "y_parallax": "σ_q only (the (5.54) part)",
+        "stereo": "σ_p only (the (5.55) part" + (", × f/p: k" if scaled else "") + ")",
+    }
     return (
-        f"{head} per m_p = m_q against the rigorous formula at the simulated geometry "
-        f"(a = {a:.2f}, c = {c:.2f}, p = {p:.2f}) {ref:.3f}: ratio {err:+.1%}. Measured: the "
-        "heights as read on the slipped height scale, standard points at a = c − p, the height "
-        "datum the mean of the four levelling heights (the formula's plane; the procedure as "
-        "built slips at one point, which doubles the total — docs/accuracy.md); the stereo σ "
-        "part agrees with the formula at the procedure's own levelling points, the y-parallax σ "
-        "part stays above (5.54) by a remainder not yet explained. Mismatches: scaling by b_x on "
-        "plan control, levelling on the scenario's control points (not at x_п ∈ {−c, a}, "
-        f"y = ±c), relative orientation by (5.11); bias of the error-free run "
-        f"{res['bias_mm'] * 1000:.1f}"
-        " µm removed"
+        f"{head}. Measured: {part[res['sources']]}, per σ; the heights as read on the slipped "
+        "height scale, standard points at a = c − p, the height datum the mean of the four "
+        "levelling heights (the formula's plane), every loop 3 passes. The formula is taken with "
+        "the plane at the procedure's levelling points (the scenario's control points nearest "
+        "standard points 3–6); at Fig. 39's x_п ∈ {−c, a}, y = ±c it gives "
+        f"{res['formula']['rigorous']:.4f}. Mismatches: scaling "
+        "by b_x on plan control, relative orientation by (5.11); bias of the error-free run "
+        f"{res['bias_mm'] * 1000:.1f} µm removed"
     )
 
 
@@ -239,7 +403,7 @@ def run_verification(
     seed: int = 20240601,
     geometry=None,
     progress: Callable[[int, int, str], None] | None = None,
-    procedure_trials: int = PROCEDURE_TRIALS,
+    procedure_trials: int | None = None,
     procedure_scenarios=None,
     instrument=None,
 ) -> list[dict]:
@@ -256,8 +420,9 @@ def run_verification(
         Overrides of :data:`BOOK` (keys f, l, n, c, p60, a60, p80, a80).
     progress : callable, optional
         ``progress(done, total, eq)`` after each row.
-    procedure_trials : int
-        Trials of the procedure MC per (overlap, method); 0 disables it.
+    procedure_trials : int or None
+        Trials of the procedure MC per run (None: :data:`PROCEDURE_TRIALS` and
+        :data:`INSTRUMENT_TRIALS`); 0 disables it.
     procedure_scenarios : mapping, optional
         "60"/"80" → loaded scenario of the procedure MC (None for a slot skips it; None: no
         procedure MC). The book's are the shipped ``pair60``, ``pair80``, loaded by the caller
@@ -277,21 +442,39 @@ def run_verification(
     ('Table 19', True)
     """
     g = _normalise_geometry(geometry)
-    proc = run_procedure_mc(procedure_trials, seed, procedure_scenarios, instrument=instrument)
+    pending = start_procedure_mc(
+        procedure_trials, seed, procedure_scenarios, instrument=instrument
+    )  # in worker processes while the linear rows are computed here
     specs = _row_specs(g)
     rows = _rows(specs, trials, seed, progress, Setting.from_mapping(g).is_book)
-    attach_procedure_mc(rows, proc)
+    attach_procedure_mc(rows, pending.result())
     return rows
 
 
 def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
-    """Fill ``mc_procedure``, ``mc_procedure_ci`` and the note from :func:`run_procedure_mc`."""
+    """Fill ``mc_procedure``, ``mc_procedure_ci``, ``mc_procedure_formula`` (the rigorous
+    formula at the simulated geometry), ``mc_procedure_instrument`` (and its CI) and the note
+    from :func:`run_procedure_mc`."""
     for r in rows:
-        pr = proc.get(PROCEDURE_ROWS.get(r["eq"], ()))
-        if pr is None:
+        spec = PROCEDURE_ROWS.get(r["eq"])
+        if spec is None:
             continue
-        r["mc_procedure"], r["mc_procedure_ci"] = pr["coefficient"], pr["ci"]
-        r["note"] = r["note"].replace(PROCEDURE_NOTE, _procedure_note(r["eq"], pr))
+        slot, config, field, scaled = spec
+        pr = proc.get((slot, config))
+        if pr is not None:
+            v, h, ref = procedure_value(pr, field, scaled)
+            r["mc_procedure"], r["mc_procedure_ci"], r["mc_procedure_formula"] = v, h, ref
+            r["note"] = r["note"].replace(
+                PROCEDURE_NOTE, _procedure_note(r["eq"], pr, field, scaled)
+            )
+        pi = proc.get((slot, config, "instrument"))
+        if pi is not None:
+            v, h, _ = procedure_value(pi, field, scaled)
+            r["mc_procedure_instrument"], r["mc_procedure_instrument_ci"] = v, h
+            r["note"] += (
+                f"; with every instrument error term of {pi.get('instrument_key', 'the')} "
+                f"instrument at its σ (real mechanics, T = {pi['trials']}): {v:.4f} ± {h:.4f}"
+            )
     return rows
 
 
@@ -345,6 +528,9 @@ def _row(e: Entry, trials, rng, at_book: bool = True) -> dict:
         "mc_linear_ci": h * e.scale,
         "mc_procedure": None,
         "mc_procedure_ci": None,
+        "mc_procedure_formula": None,
+        "mc_procedure_instrument": None,
+        "mc_procedure_instrument_ci": None,
         "verdict": verdict,
         "note": note + "; " + PROCEDURE_NOTE,
     }

@@ -81,8 +81,16 @@ def test_plots_draw_against_the_rigorous_reference(rows):
     i43 = [r["eq"] for r in rows].index("(6.43)")
     assert by_label["book formula"][i43] == pytest.approx(1.2604 / 1.2143, abs=1e-3)
     # histograms: the red line is the rigorous value at the table's geometry (here a user one)
-    g = {"f": 100.0, "l": 90.0, "n": 1.6, "c": 80.0, "p60": 80.0, "a60": 0.0, "p80": 40.0,
-         "a80": 40.0}
+    g = {
+        "f": 100.0,
+        "l": 90.0,
+        "n": 1.6,
+        "c": 80.0,
+        "p60": 80.0,
+        "a60": 0.0,
+        "p80": 40.0,
+        "a80": 40.0,
+    }
     other = run_verification(trials=100, seed=1, geometry=g, procedure_trials=0)
     fig = ap.plot_mc_histograms(other, trials=300, geometry=g)
     ref = {r["eq"]: r["rigorous"] for r in other}
@@ -119,25 +127,25 @@ def test_procedure_mc_setup_matches_formula_at_simulated_geometry():
 
 
 def test_procedure_columns_filled_and_disabled():
+    """Issue 10 (3, 4): every outcome row of §27 at the slot that was simulated gets the
+    procedure value, its CI, the formula at the simulated geometry and the value with instrument
+    errors; the other slot's rows and every other row stay empty."""
     from stereoplotter.report.verification import book_instrument, book_scenarios
-    from stereoplotter.verification.table import PROCEDURE_ROWS, run_procedure_mc
-
-    proc = run_procedure_mc(150, 2, book_scenarios(), instrument=book_instrument())
-    rows = run_verification(
-        trials=200,
-        seed=2,
-        procedure_trials=150,
-        procedure_scenarios=book_scenarios(),
-        instrument=book_instrument(),
+    from stereoplotter.verification.table import (
+        PROCEDURE_ROWS,
+        attach_procedure_mc,
+        run_procedure_mc,
     )
+
+    proc = run_procedure_mc(100, 2, {"60": book_scenarios()["60"]}, instrument=book_instrument())
+    rows = attach_procedure_mc(run_verification(trials=200, seed=2, procedure_trials=0), proc)
+    outcome = {f"(6.{i})" for i in range(39, 62)}
+    assert set(PROCEDURE_ROWS) == outcome
+    keys = ("mc_procedure", "mc_procedure_ci", "mc_procedure_formula", "mc_procedure_instrument")
     for r in rows:
-        if r["eq"] in PROCEDURE_ROWS:
-            # the column holds the run of its (slot, method), same seed
-            run = proc[PROCEDURE_ROWS[r["eq"]]]
-            assert (r["mc_procedure"], r["mc_procedure_ci"]) == (run["coefficient"], run["ci"])
-            assert "procedure MC (pair" in r["note"]
-        else:
-            assert r["mc_procedure"] is None
+        filled = r["eq"] in outcome and PROCEDURE_ROWS[r["eq"]][0] == "60"
+        assert all((r[k] is not None) == filled for k in keys), r["eq"]
+        assert ("procedure MC (pair60" in r["note"]) == filled
     off = run_verification(trials=200, seed=2, procedure_trials=0)
     assert all(r["mc_procedure"] is None for r in off)
 
@@ -230,8 +238,9 @@ def test_procedure_mc_conventional_heights_datum_mechanisms(slot):
     from stereoplotter.report.verification import book_instrument, book_scenarios
     from stereoplotter.verification.procedure_mc import procedure_mc
 
-    r = procedure_mc(book_scenarios()[slot], "conventional", spec=book_instrument(),
-                     trials=4000, seed=11)
+    r = procedure_mc(
+        book_scenarios()[slot], "conventional", spec=book_instrument(), trials=4000, seed=11
+    )
     by, formula = r["by_datum"], r["formula"]
     ro = relative_orientation_parallax_rms(r["a"], r["c"], r["p"], 1.0, "rigorous")
     book = {"60": 0.6862, "80": 0.7235}[slot]
@@ -262,8 +271,14 @@ def test_procedure_mc_conventional_relative_part_is_the_levelling_points(slot):
     from stereoplotter.report.verification import book_instrument, book_scenarios
     from stereoplotter.verification.procedure_mc import procedure_mc
 
-    r = procedure_mc(book_scenarios()[slot], "conventional", spec=book_instrument(),
-                     trials=4000, seed=11, sources="y_parallax")
+    r = procedure_mc(
+        book_scenarios()[slot],
+        "conventional",
+        spec=book_instrument(),
+        trials=4000,
+        seed=11,
+        sources="y_parallax",
+    )
     formula = r["formula"]
     assert formula["book"] == pytest.approx({"60": 0.2327, "80": 0.3540}[slot], abs=5e-4)
     assert formula["procedure"] == pytest.approx({"60": 0.3877, "80": 0.4607}[slot], abs=5e-4)

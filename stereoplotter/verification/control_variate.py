@@ -1,0 +1,175 @@
+"""Linear control variate of a procedure Monte Carlo (``verification.procedure_mc``).
+
+The statistic of the procedure MC is the mean square of an error field v (T trials × P points)
+caused by random inputs u: the operator's judgments (one standard normal z per act key, σ·z) and
+the injected instrument errors (one draw per term and trial, scale·u). The procedure is run as
+built; nothing here changes a trial. For a small error the field is nearly linear in u:
+
+    v ≈ b + Σₖ Gₖ uₖ   (b: the field with every random input at 0, constants such as the
+                        backlash on; Gₖ = ∂v/∂uₖ by central differences of ±ε, ε = 0.1)
+
+so L = mean_p (b + Σₖ Gₖ uₖ)² is known per trial from the trial's own draws, and its expectation
+is exact: E[L] = mean_p b² + Σₖ var(uₖ) mean_p Gₖ² (var 1 for a normal draw, 1/3 for a uniform
+one on [−1, 1]). The estimator of E[mean_p v²] is the mean over trials of
+
+    mean_p v² − L + E[L]
+
+— unbiased whatever the procedure's non-linearity (E[L] is exact, the draws are the trial's), with
+a variance of only the non-linear remainder; its standard error comes from the per-trial scatter
+as usual. Acts that a noisy trial makes but the error-free run does not (a loop that iterates
+longer) are not in L; they stay in the remainder (still unbiased).
+
+Pure numpy; the runs themselves are made by the caller (``procedure.simulate.run_trials_chunk``
+with the noise objects of this module).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.instrument.error_model import ErrorModel
+from stereoplotter.procedure.operator import Noise
+
+__all__ = [
+    "STEP",
+    "DesignNoise",
+    "LinearControl",
+    "RecordingNoise",
+    "design_inputs",
+    "linear_control",
+    "per_trial_controlled",
+]
+
+#: Step of the central differences, in units of the draw (σ of a normal, half-width of a
+#: uniform). [—]
+STEP = 0.1
+
+#: Variance of the standardised draw of a distribution.
+_VARIANCE = {"normal": 1.0, "uniform": 1.0 / 3.0}
+
+
+class RecordingNoise(Noise):
+    """:class:`Noise` that keeps each act's standard normal draws, key → z (T,)."""
+
+    def __init__(self, seed: int, trials: int, first_trial: int = 0):
+        super().__init__(seed, trials, None, first_trial)
+        self.z: dict[str, NDArray[np.float64]] = {}
+
+    def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
+        v = super().normal(key, sigma)
+        if sigma != 0.0:
+            self.z[key] = np.asarray(v, float) / sigma
+        return v
+
+
+class DesignNoise(Noise):
+    """Designed judgments: ``steps[key]`` (T,) in units of the act's σ, every other act exact;
+    ``record`` collects the keys of the acts with σ > 0 in order of first use."""
+
+    def __init__(
+        self, trials: int, steps: dict[str, NDArray[np.float64]], record: list[str] | None = None
+    ):
+        super().__init__(0, trials)
+        self.steps = steps
+        self.record = record
+
+    def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
+        if self.record is not None and sigma != 0.0 and key not in self.record:
+            self.record.append(key)
+        step = self.steps.get(key)
+        return np.zeros(self.trials) if step is None else step * sigma
+
+
+@dataclass(frozen=True)
+class LinearControl:
+    """The linearised field per name: b (P,), G (K, P) over the inputs, and E[L]."""
+
+    inputs: tuple[str, ...]  # "noise:<key>" or "instrument:<term>"
+    center: dict[str, NDArray[np.float64]]
+    gradient: dict[str, NDArray[np.float64]]
+    expectation: dict[str, float]
+
+
+def _random_terms(model: ErrorModel | None) -> list:
+    if model is None:
+        return []
+    return [t for t in model.terms if t.distribution in _VARIANCE and t.scale]
+
+
+def design_inputs(model: ErrorModel | None, trials: int) -> dict[str, object]:
+    """Injected errors of a designed run of ``trials`` trials: constants at their value, every
+    random term 0 (arrays the caller steps). None: no instrument errors (an empty mapping)."""
+    if model is None:
+        return {}
+    out: dict[str, object] = {}
+    for t in model.terms:
+        if t.distribution == "constant":
+            out[t.name] = np.full(trials, t.scale)
+        else:
+            out[t.name] = np.zeros(trials)
+    return out
+
+
+def linear_control(
+    run: Callable[[dict, Noise, int], dict[str, NDArray[np.float64]]],
+    model: ErrorModel | None,
+) -> LinearControl:
+    """Linearise the fields of ``run(injected, noise, trials) -> {name: (T, P)}`` about the run
+    with every random input 0: a discovery run (1 trial) lists the acts, then one designed run
+    of 1 + 2K trials steps each input by ±:data:`STEP`. ``model``: the instrument's error model
+    (None: no instrument errors)."""
+    keys: list[str] = []
+    run(design_inputs(model, 1), DesignNoise(1, {}, keys), 1)
+    terms = _random_terms(model)
+    names = [f"noise:{k}" for k in keys] + [f"instrument:{t.name}" for t in terms]
+    trials = 1 + 2 * len(names)
+    injected = design_inputs(model, trials)
+    steps: dict[str, NDArray[np.float64]] = {}
+    for j, name in enumerate(names):
+        kind, _, key = name.partition(":")
+        s = np.zeros(trials)
+        s[1 + 2 * j], s[2 + 2 * j] = STEP, -STEP
+        if kind == "noise":
+            steps[key] = s
+        else:
+            injected[key] = s * model.term(key).scale
+    fields = run(injected, DesignNoise(trials, steps), trials)
+    variance = np.array([1.0] * len(keys) + [_VARIANCE[t.distribution] for t in terms], float)
+    center, gradient, expectation = {}, {}, {}
+    for name, v in fields.items():
+        v = np.asarray(v, float).reshape(trials, -1)
+        b = v[0]
+        g = (v[1::2] - v[2::2]) / (2.0 * STEP)
+        center[name], gradient[name] = b, g
+        expectation[name] = float(np.mean(b**2) + variance @ np.mean(g**2, axis=1))
+    return LinearControl(tuple(names), center, gradient, expectation)
+
+
+def per_trial_controlled(
+    fields: dict[str, NDArray[np.float64]],
+    lin: LinearControl,
+    noise: RecordingNoise,
+    injected: dict[str, object],
+    model: ErrorModel | None,
+) -> dict[str, NDArray[np.float64]]:
+    """Per trial and field: mean_p v² − L + E[L] (module docstring), shape (T,) each."""
+    trials = next(iter(fields.values())).shape[0]
+    u = np.zeros((len(lin.inputs), trials))
+    for j, name in enumerate(lin.inputs):
+        kind, _, key = name.partition(":")
+        if kind == "noise":
+            z = noise.z.get(key)
+            if z is not None:
+                u[j] = z
+        else:
+            u[j] = np.asarray(injected[key], float) / model.term(key).scale
+    out = {}
+    for name, v in fields.items():
+        v = np.asarray(v, float).reshape(trials, -1)
+        lin_v = lin.center[name][None, :] + u.T @ lin.gradient[name]
+        out[name] = np.mean(v**2, axis=1) - np.mean(lin_v**2, axis=1) + lin.expectation[name]
+    return out
