@@ -599,6 +599,7 @@ def _simulate(args: argparse.Namespace) -> int:
             errors=args.errors,
             operator=args.operator,
             practice=args.practice,
+            options=args.option,
             seed=args.seed,
             trials=args.trials,
             backend=args.backend,
@@ -982,6 +983,15 @@ def _parser() -> argparse.ArgumentParser:
         "levelling on control), bounded and logged; 'book': §27's task 1, each element set "
         "once, failed checks only recorded (both methods)",
     )
+    p.add_argument(
+        "--option",
+        action="append",
+        default=[],
+        choices=("correction_unit", "automatic_coordinatograph"),
+        help="fit an option of the SC complex to the SC-1 (repeatable; off by default): "
+        "'correction_unit' corrects the image errors within ±100 µm to 3 µm RMS, "
+        "'automatic_coordinatograph' drives the needle by a tracking servo (to 10 ×)",
+    )
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument(
         "--trials", type=positive_int, help="run T trials at once (closed-form back-end)"
@@ -1238,8 +1248,10 @@ def _trainer(args: argparse.Namespace) -> int:
     try:
         serve(args.host, args.port, args.token)
     except OSError as exc:
-        print(f"error: trainer: cannot listen on {args.host}:{args.port} ({exc.strerror or exc})",
-              file=sys.stderr)
+        print(
+            f"error: trainer: cannot listen on {args.host}:{args.port} ({exc.strerror or exc})",
+            file=sys.stderr,
+        )
         return 1
     return 0
 

@@ -16,18 +16,27 @@ Units: µm for image errors, mm and s for the servo. Randomness only through a G
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal
 
-__all__ = ["AutomaticCoordinatograph", "ErrorCorrectionUnit", "SC1Options"]
+__all__ = ["OPTION_NAMES", "AutomaticCoordinatograph", "ErrorCorrectionUnit", "SC1Options"]
 
 _RANGE_KEY = "facts.error_correction_unit_range_um"
 _RMS_KEY = "facts.error_correction_unit_rms_um"
 _ENLARGE_KEY = "gears.max_photo_to_map_enlargement_automatic"
+_AUTOMATIC_KEY = "coordinatograph.automatic_variant"
+
+#: The switch names of ``simulate --option NAME`` and their :class:`SC1Options` fields.
+OPTION_NAMES = {
+    "correction_unit": "error_correction_unit",
+    "automatic_coordinatograph": "automatic_coordinatograph",
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -36,6 +45,32 @@ class SC1Options:
 
     error_correction_unit: bool = False
     automatic_coordinatograph: bool = False
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The switch names of the fitted options (``OPTION_NAMES`` keys)."""
+        return tuple(k for k, field in OPTION_NAMES.items() if getattr(self, field))
+
+    @classmethod
+    def from_names(cls, spec: InstrumentSpec, names: Iterable[str]) -> SC1Options:
+        """The options ``names`` fitted to ``spec``; an unknown name or an option the instrument
+        file does not document (only the SC-1 of the SC complex has them) is refused in one line.
+        """
+        fields = {}
+        for name in names:
+            if name not in OPTION_NAMES:
+                raise StereoplotterError(
+                    f"--option: expected one of {', '.join(OPTION_NAMES)}, found {name!r}"
+                )
+            key = _RANGE_KEY if name == "correction_unit" else _AUTOMATIC_KEY
+            p = spec.parameters.get(key)
+            if p is None or p.value is False:
+                raise StereoplotterError(
+                    f"--option {name}: the {spec.title} has no such unit (its instrument file "
+                    f"has no {key}; the options belong to the SC complex built around the SC-1)"
+                )
+            fields[OPTION_NAMES[name]] = True
+        return cls(**fields)
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,11 +98,15 @@ class ErrorCorrectionUnit:
             )
         return cls(float(rng_p.value), float(rms_p.value), rng_p.file)
 
-    def residual_um(self, image_error_um: ArrayLike, rng: np.random.Generator) -> NDArray:
-        """Image error left after correction, shape (..., 2). [µm]
+    @property
+    def residual_sigma_um(self) -> float:
+        """σ of the residual per coordinate: RMS/√2 (the documented RMS read as the vector RMS,
+        ASSUMED). [µm]"""
+        return self.rms_um / float(np.sqrt(2.0))
 
-        Refuses (like a stop) an input error beyond ±range in either coordinate.
-        """
+    def check_input_um(self, image_error_um: ArrayLike) -> float:
+        """Refuse (like a stop) an image error beyond ±range in either coordinate; return the
+        largest |error|. [µm]"""
         e = np.asarray(image_error_um, float)
         worst = float(np.max(np.abs(e))) if e.size else 0.0
         if worst > self.range_um:
@@ -82,7 +121,16 @@ class ErrorCorrectionUnit:
                 file=self.file,
                 key=_RANGE_KEY,
             )
-        return rng.normal(0.0, self.rms_um / np.sqrt(2.0), e.shape)
+        return worst
+
+    def residual_um(self, image_error_um: ArrayLike, rng: np.random.Generator) -> NDArray:
+        """Image error left after correction, shape (..., 2). [µm]
+
+        Refuses (like a stop) an input error beyond ±range in either coordinate.
+        """
+        e = np.asarray(image_error_um, float)
+        self.check_input_um(e)
+        return rng.normal(0.0, self.residual_sigma_um, e.shape)
 
 
 @dataclass(frozen=True, slots=True)

@@ -38,6 +38,7 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.instrument.mechanics.play import PlayAxis
+from stereoplotter.instrument.sc1_complex import AutomaticCoordinatograph, SC1Options
 from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
 
 __all__ = [
@@ -177,6 +178,11 @@ class Instrument:
     injected : mapping, optional
         Already drawn injected errors (``ErrorModel.draw`` output, or one trial of it) instead of
         drawing them from ``rng``: lets a per-trial loop rebuild trial t of a vectorised run.
+    options : SC1Options, optional
+        Options of the SC complex (SC-1 only, off by default): with ``automatic_coordinatograph``
+        the needle is driven by the tracking servo (:mod:`stereoplotter.instrument.sc1_complex`)
+        instead of the geared screws. The error-correction unit acts on the image coordinates
+        before they reach the instrument (``procedure.simulate``).
 
     Notes
     -----
@@ -197,6 +203,7 @@ class Instrument:
         trials: int | None = None,
         ideal_mechanics: bool = False,
         injected: dict[str, Any] | None = None,
+        options: SC1Options | None = None,
     ):
         if backend not in BACKENDS:
             raise StereoplotterError(
@@ -207,6 +214,8 @@ class Instrument:
                 "the pymunk back-end runs single instruments; use backend='closed-form' for trials"
             )
         self.spec = spec
+        self.options = options if options is not None else SC1Options()
+        self._servo: AutomaticCoordinatograph | None = None
         self.variant = decentration_variant(variant)
         self.backend = backend
         self.trials = trials
@@ -611,7 +620,10 @@ class Instrument:
     # --- the coordinatograph ------------------------------------------------------------------
 
     def connect_coordinatograph(
-        self, ratio: float, origin_table_mm: tuple[float, float] | None = None
+        self,
+        ratio: float,
+        origin_table_mm: tuple[float, float] | None = None,
+        enlargement: float | None = None,
     ) -> None:
         """Couple the coordinatograph to the X, Y carriages through the gear ``ratio``.
 
@@ -623,11 +635,15 @@ class Instrument:
         origin_table_mm : (float, float), optional
             Table position of the needle when the carriages are on the plumb of S_л
             (X = Y = 0). Default: the table centre. [mm]
+        enlargement : float, optional
+            Photo → map enlargement M_photo/M_map of this setting; with the automatic
+            coordinatograph it is checked against the documented 10 ×. [—]
 
         Raises
         ------
         RangeRefusal
-            A ratio that is not one of the gears.
+            A ratio that is not one of the gears; with the automatic coordinatograph an
+            enlargement beyond its documented limit.
         """
         from stereoplotter.instrument.mechanics.coordinatograph import (
             Coordinatograph,
@@ -635,6 +651,10 @@ class Instrument:
         )
 
         check_in_range(self.spec, "coordinatograph_ratios", float(ratio), "coordinatograph ratio")
+        if self.options.automatic_coordinatograph:
+            self._servo = AutomaticCoordinatograph.from_spec(self.spec)
+            if enlargement is not None:
+                self._servo.check_enlargement(float(enlargement))
         params = CoordinatographParams.from_instrument(self.spec)
         if self.ideal_mechanics:
             ideal = {"backlash_mm": 0.0, "friction": 0.0, "stiffness_kg_s2": math.inf}
@@ -671,12 +691,22 @@ class Instrument:
             )
         return self._cg_origin + self._cg_ratio * np.asarray(model_xy_mm, float)
 
-    def needle(self, side: str | None = None) -> NDArray[np.float64]:
+    @property
+    def servo_sigma_mm(self) -> float:
+        """σ_s of the automatic coordinatograph's settled pen (0 without it; ASSUMED). [mm]"""
+        return 0.0 if self._servo is None else self._servo.sigma_mm
+
+    def needle(
+        self, side: str | None = None, servo_noise_mm: ArrayLike | None = None
+    ) -> NDArray[np.float64]:
         """Table position of the needle for the present carriages. [mm]
 
         The bridge and pen-carriage screws follow r·(X, Y) (gears), finishing from ``side``; the
         rails' non-orthogonality ε turns the pen carriage's axis (x += y·sin ε) and the needle has
-        its play in the holder (``errors.*``).
+        its play in the holder (``errors.*``). With the automatic coordinatograph the servo
+        holds the pen on r·(X, Y) at rest (the lag term v·τ vanishes when the carriages stop):
+        the screws' backlash and the pen play are replaced by the servo noise ``servo_noise_mm``
+        (a draw of N(0, σ_s²) per axis by the caller's generator, shape (..., 2); None: 0); ε stays.
         """
         if not hasattr(self, "_cg_axes"):
             raise StereoplotterError(
@@ -684,11 +714,17 @@ class Instrument:
             )
         target_x = self._cg_origin[0] + self._cg_ratio * np.asarray(self._pos("X"))
         target_y = self._cg_origin[1] + self._cg_ratio * np.asarray(self._pos("Y"))
-        x_axis, y_axis = self._cg_axes
-        x = np.asarray(x_axis.approach(self._arg(target_x), side), float)
-        y = np.asarray(y_axis.approach(self._arg(target_y), side), float)
         eps = self.injected["coordinatograph.nonorthogonality"]
-        play = self.injected["coordinatograph.pen_play"]
+        if self._servo is not None:
+            noise = np.zeros(2) if servo_noise_mm is None else np.asarray(servo_noise_mm, float)
+            x = target_x + noise[..., 0]
+            y = target_y + noise[..., 1]
+            play = 0.0
+        else:
+            x_axis, y_axis = self._cg_axes
+            x = np.asarray(x_axis.approach(self._arg(target_x), side), float)
+            y = np.asarray(y_axis.approach(self._arg(target_y), side), float)
+            play = self.injected["coordinatograph.pen_play"]
         x = x + (y - self._cg_origin[1]) * np.sin(eps) + play
         return (
             self._out(np.stack([x, y], axis=-1))

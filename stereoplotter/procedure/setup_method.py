@@ -20,6 +20,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.constants import MM_PER_M
+from stereoplotter.geometry.instrument_settings import sequence_for
 from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -41,6 +43,7 @@ from stereoplotter.procedure.records import (
     SheetReadings,
     StageRecord,
 )
+from stereoplotter.scenario.summary import summarize_scenario
 from stereoplotter.setup.equations import (
     base_z_correction,
     height_correction,
@@ -647,7 +650,8 @@ def stage2_transform(run: Run) -> None:
                 "2",
                 f"decentration {control_name(op.inst.spec.principle, control)} "
                 f"= MO_{d} + f′·tan {tilt}_{_SIDE[side]} "
-                f"(place of zero MO_{d} = {NOMINAL_ZERO[control]:g} mm)",
+                f"(place of zero MO_{d} = {NOMINAL_ZERO[control]:g} mm)"
+                + _table_settings(op.inst.spec.principle, d),
                 control,
                 reading=value,
                 equation=f"f′·tan {tilt} (§2.4)",
@@ -657,6 +661,23 @@ def stage2_transform(run: Run) -> None:
     op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
     clear_kappa(run, "2")
     check_standard_points(run, "2")
+
+
+def _table_settings(principle: str, control: str) -> str:
+    """On an instrument with several decentrations per tilt (the SPR-3's photo, correction
+    mechanism and follower), the ones this setting stands for (from the tables)."""
+    seq = sequence_for(principle)
+    if seq is None:
+        return ""
+    tilt = "alpha" if control == "dx" else "omega"
+    kinds = [s for s in seq.settings if s.kind == "derived" and s.tilt == tilt]
+    if len(kinds) < 2:
+        return ""
+    names = ", ".join(f"{s.name} {s.symbol}" for s in kinds)
+    return (
+        f"; from the tables: {names} all take this value (one pair per photo on the virtual "
+        "instrument, decision D2)"
+    )
 
 
 def clear_kappa(run: Run, stage: str) -> None:
@@ -1219,7 +1240,18 @@ def _needle_at(run: Run, corner: str, key: str) -> NDArray[np.float64]:
     op = run.op
     op.set("X", run.target(f"corner {corner}: O_X"), f"{key}/X")
     op.set("Y", run.target(f"corner {corner}: O_Y"), f"{key}/Y")
-    return np.asarray(op.inst.needle(op.model.finish_side), float)
+    return _needle(run, key)
+
+
+def _needle(run: Run, key: str) -> NDArray[np.float64]:
+    """The needle on the table; with the SC complex's automatic coordinatograph, its settled
+    servo noise drawn from the run's keyed streams (σ_s per axis)."""
+    op = run.op
+    sigma = op.inst.servo_sigma_mm
+    noise = None
+    if sigma:
+        noise = np.stack([op.noise.normal(f"servo/{key}/{a}", sigma) for a in "xy"], axis=-1)
+    return np.asarray(op.inst.needle(op.model.finish_side, noise), float)
 
 
 def stage4_orient_sheet(run: Run) -> None:
@@ -1234,7 +1266,13 @@ def stage4_orient_sheet(run: Run) -> None:
         run.sheet_pose = None
         return
     ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
-    op.inst.connect_coordinatograph(ratio)
+    enlargement = None
+    if op.inst.options.automatic_coordinatograph:  # photo → map, checked against its 10 ×
+        sc = run.scene.scenario
+        height = np.mean([p["flying_height_m"] for p in summarize_scenario(sc)["photos"]])
+        photo_scale = MM_PER_M * float(height) / float(sc.camera.focal_length_mm)
+        enlargement = photo_scale / sheet.map_scale_denominator
+    op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
     ideal = {k: _table(run, v) for k, v in corners.items()}
     inj = op.inst.injected
@@ -1314,7 +1352,7 @@ def stage5_check(run: Run) -> None:
         )
         img = run.scene.images(np.asarray(p.local_m, float)[None, :])
         op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
-        needle = np.asarray(op.inst.needle(op.model.finish_side), float)
+        needle = _needle(run, f"5/plan/{pid}")
         plotted = pose.table_of(_table(run, np.asarray(xy, float).reshape(2)))
         err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
         errs.append(err)

@@ -10,7 +10,7 @@ runs long runs in chunks.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -19,6 +19,7 @@ from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import decentration_variant
+from stereoplotter.instrument.sc1_complex import ErrorCorrectionUnit, SC1Options
 from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
@@ -147,6 +148,44 @@ class PreparedRun:
     variant: str = "L"
     relative: str = "elements"
     practice: str = "operator"
+    options: SC1Options = field(default_factory=SC1Options)
+
+
+def apply_correction_unit(
+    scenario: Scenario, spec: InstrumentSpec, operator: OperatorModel
+) -> tuple[Scenario, OperatorModel]:
+    """The SC complex's off-line error-correction unit on a scenario's photos (SC-1 option).
+
+    The unit takes out the systematic image errors — here the scenario's film deformation, the
+    only systematic image error a scenario carries — after checking them against its documented
+    ±100 µm at the format corner (|s|·10⁻⁶·format/2 per axis; a larger error is refused like a
+    stop), and leaves a residual of 3 µm vector RMS (documented) per image point. The residual is
+    taken as independent from point to point and from pointing to pointing (ASSUMED: no data on
+    its spatial correlation), i.e. added in quadrature to the operator's σ: σ_c per coordinate
+    on a monocular pointing, √2·σ_c on an x- or y-parallax (two images).
+
+    Returns
+    -------
+    (Scenario, OperatorModel)
+        The scenario with the film deformation corrected; the operator with the residual added.
+    """
+    unit = ErrorCorrectionUnit.from_spec(spec)
+    half_format_um = 0.5 * float(scenario.camera.format_mm) * 1000.0
+    for photo in scenario.photos:
+        unit.check_input_um(np.asarray(photo.film_deformation_ppm, float) * 1e-6 * half_format_um)
+    photos = tuple(replace(p, film_deformation_ppm=(0.0, 0.0)) for p in scenario.photos)
+    sc_mm = unit.residual_sigma_um / 1000.0
+
+    def plus(sigma_mm: float, k: float) -> float:
+        return float(np.hypot(sigma_mm, np.sqrt(k) * sc_mm))
+
+    model = replace(
+        operator,
+        monocular_sigma_mm=plus(operator.monocular_sigma_mm, 1.0),
+        stereo_sigma_mm=plus(operator.stereo_sigma_mm, 2.0),
+        y_parallax_sigma_mm=plus(operator.y_parallax_sigma_mm, 2.0),
+    )
+    return replace(scenario, photos=photos), model
 
 
 def prepare_run(
@@ -162,8 +201,13 @@ def prepare_run(
     variant: str = "L",
     relative: str = "elements",
     practice: str = "operator",
+    options: SC1Options | None = None,
 ) -> PreparedRun:
     """The fixed part of a run (arguments as :func:`simulate`)."""
+    options = SC1Options() if options is None else options
+    operator = OperatorModel() if operator is None else operator
+    if options.error_correction_unit:
+        scenario, operator = apply_correction_unit(scenario, spec, operator)
     if method not in METHODS:
         raise StereoplotterError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
     if practice not in PRACTICES:
@@ -187,7 +231,7 @@ def prepare_run(
         method,
         sheet,
         _errors(spec, errors),
-        OperatorModel() if operator is None else operator,
+        operator,
         scene,
         int(seed),
         backend,
@@ -195,7 +239,24 @@ def prepare_run(
         variant,
         relative,
         practice,
+        options,
     )
+
+
+def _log_options(op: Operator, prep: PreparedRun) -> None:
+    """Transcript lines for the SC complex's options fitted to the instrument."""
+    if prep.options.error_correction_unit:
+        op.log.add(
+            "1",
+            "SC complex: the error-correction unit has corrected the image coordinates (film "
+            "deformation within ±100 µm; residual 3 µm RMS added to every pointing)",
+        )
+    if prep.options.automatic_coordinatograph:
+        op.log.add(
+            "4",
+            "SC complex: the automatic coordinatograph's servo drives the needle (no gear "
+            "backlash or pen play; settled servo noise σ_s per axis)",
+        )
 
 
 def _run_one(
@@ -214,8 +275,10 @@ def _run_one(
         backend=prep.backend,
         trials=trials,
         ideal_mechanics=prep.ideal_mechanics,
+        options=prep.options,
     )
     op = Operator(inst, prep.operator, noise, Transcript(enabled=transcript))
+    _log_options(op, prep)
     run = Run(op, prep.sheet, prep.scene)
     run.practice = prep.practice
     if prep.method == "setup":
@@ -305,6 +368,7 @@ def simulate(
     relative: str = "elements",
     first_trial: int = 0,
     practice: str = "operator",
+    options: SC1Options | None = None,
 ) -> SimulationResult:
     """Run the setup-data or the conventional method on a virtual instrument.
 
@@ -340,6 +404,9 @@ def simulate(
         (repeat the stage-1 setting, refine the relative orientation, refine the scaling on the
         control heights), bounded and logged; "book": §27's task 1, no remedy. Both methods
         (the conventional method's remedies CR1, CR2: ``docs/procedure.md``).
+    options : SC1Options, optional
+        The SC complex's options on the SC-1 (off by default): the error-correction unit
+        (:func:`apply_correction_unit`) and the automatic coordinatograph (stages 4–5).
 
     Returns
     -------
@@ -357,6 +424,7 @@ def simulate(
         variant=variant,
         relative=relative,
         practice=practice,
+        options=options,
     )
     return run_trials_chunk(prep, first_trial, trials, evaluate=evaluate)
 

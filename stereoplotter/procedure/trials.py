@@ -290,5 +290,6 @@ def run_header(r: SimulationResult) -> dict[str, Any]:
         "practice": r.practice,
         "scenario": r.sheet.scenario,
         "instrument": r.sheet.instrument,
+        "instrument_options": list(r.instrument.options.names),
         "operator": r.operator_model.to_dict(),
     }

@@ -29,6 +29,7 @@ from fpdf import FPDF
 from fpdf.enums import XPos, YPos
 from fpdf.fonts import FontFace
 
+from stereoplotter.report.sheet import instrument_settings
 from stereoplotter.setup.records import SetupSheet
 
 __all__ = ["FormHeader", "form_pdf", "forms_pdf"]
@@ -285,8 +286,16 @@ def _page_details(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
             rig = p.transformed_rigorous_mm[key[1:]]
             axis = 0 if key[0] == "x" else 1
             measured = p.marks_measured_mm[key[1:]]
-            rows.append((p.name, key, f"{measured[0]:.3f}, {measured[1]:.3f}", f"{value:.4f}",
-                         f"{rig[0]:.4f}, {rig[1]:.4f}", f"{(value - rig[axis]) * 1000:+.2f}"))
+            rows.append(
+                (
+                    p.name,
+                    key,
+                    f"{measured[0]:.3f}, {measured[1]:.3f}",
+                    f"{value:.4f}",
+                    f"{rig[0]:.4f}, {rig[1]:.4f}",
+                    f"{(value - rig[axis]) * 1000:+.2f}",
+                )
+            )
     _table(pdf, ("photo", "mark", "measured x, y mm", "(6.1)/(6.2) mm", "(3.17) x⁰, y⁰ mm",
                  "difference µm"), rows, (18, 14, 38, 30, 44, 36))  # fmt: skip
     _heading(pdf, "Angles, decentrations and correction planes (instrument frame)")
@@ -298,6 +307,18 @@ def _page_details(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
     ]  # fmt: skip
     _table(pdf, ("photo", "α °", "ω °", "κ °", "d_x, d_y mm", "planes α, ω °"), rows,
            (18, 24, 24, 24, 45, 45))  # fmt: skip
+    settings = instrument_settings(sheet.table24, 0) if sheet.table24 is not None else None
+    if settings is not None:
+        _heading(pdf, f"Settings of the instrument: {settings['phi_omega_dependent']} depend on "
+                      f"φ, ω ({settings['count_status']})")  # fmt: skip
+        rows = [
+            (st["symbol"], st["name"], st["formula"],
+             *(f"{st[side]:.4f}" if st["unit"] == "deg" else _f(st[side])
+               for side in ("left", "right")), "°" if st["unit"] == "deg" else "mm")
+            for st in settings["settings"]
+        ]  # fmt: skip
+        _table(pdf, ("symbol", "setting", "formula", "left", "right", "unit"), rows,
+               (16, 62, 46, 22, 22, 12))  # fmt: skip
     _heading(pdf, "Height control: model heights Z_i (6.6)")
     rows = [
         (h_["id"], f"{h_['Z_m']:.2f}", f"{h_['flying_height_m']:.2f}",

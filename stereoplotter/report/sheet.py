@@ -13,11 +13,18 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from stereoplotter.geometry.instrument_settings import sequence_for, setting_values
 from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.setup.sheet import SetupSheet, assumed_parameters
 from stereoplotter.setup.table24 import X_MARK_NAME, BlockResult, candidates_of
 
-__all__ = ["NOT_IN_BLOCK_MODE", "setup_dict", "sheet_markdown", "sheet_to_dict"]
+__all__ = [
+    "NOT_IN_BLOCK_MODE",
+    "instrument_settings",
+    "setup_dict",
+    "sheet_markdown",
+    "sheet_to_dict",
+]
 
 #: Unit, equation and meaning of each top-level value of the sheet.
 ANNOTATIONS: dict[str, tuple[str, str, str]] = {
@@ -123,6 +130,7 @@ def setup_dict(table: BlockResult, i: int, sheet: SetupSheet | None = None) -> d
             p: dict(zip("xy", map(_num, table.decentration_mm[i, j]), strict=True))
             for j, p in enumerate(photos)
         },
+        "instrument_settings": instrument_settings(table, i),
         "correction_inclinations_deg": {
             p: dict(
                 zip(
@@ -166,6 +174,40 @@ def setup_dict(table: BlockResult, i: int, sheet: SetupSheet | None = None) -> d
         "not_in_block_mode": {} if sheet is not None else dict(NOT_IN_BLOCK_MODE),
     }
     return data
+
+
+def instrument_settings(table: BlockResult, i: int) -> dict[str, Any] | None:
+    """The instrument's own φ, ω-dependent settings of pair ``i`` with their formulas
+    (:mod:`stereoplotter.geometry.instrument_settings`); None for an instrument file whose
+    ``principle`` is none of the three."""
+    seq = sequence_for(table.spec.principle)
+    if seq is None:
+        return None
+    f, k = table.focal_length_of(i), float(table.transformation_coefficient[i])
+    values = {
+        p: setting_values(seq, f, k, float(table.angles[i, j, 0]), float(table.angles[i, j, 1]))
+        for j, p in enumerate(("left", "right"))
+    }
+    return {
+        "phi_omega_dependent": seq.phi_omega_dependent,
+        "counted": seq.counted,
+        "count_status": seq.count_status,
+        "count_basis": seq.count_basis,
+        "sequence": list(seq.sequence),
+        "settings": [
+            {
+                "key": s.key,
+                "name": s.name,
+                "symbol": s.symbol,
+                "unit": s.unit,
+                "formula": s.formula,
+                "kind": s.kind,
+                "left": _num(values["left"][m]),
+                "right": _num(values["right"][m]),
+            }
+            for m, s in enumerate(seq.settings)
+        ],
+    }
 
 
 def _single_pair_only(sheet: SetupSheet | None) -> dict[str, Any]:
@@ -272,6 +314,35 @@ def _controls_rows(sheet: SetupSheet) -> list[str]:
     return rows
 
 
+def _settings_lines(settings: dict[str, Any] | None, title: str) -> list[str]:
+    """The instrument's own settings (issue 11) as a Markdown section."""
+    if settings is None:
+        return []
+    status = "documented" if settings["count_status"] == "documented" else "ASSUMED"
+    lines = [
+        "",
+        f"## Settings of the {title}",
+        "",
+        f"{settings['phi_omega_dependent']} settings depend on φ, ω ({settings['counted']}; "
+        f"{status}: {settings['count_basis']}). Order:",
+        "",
+    ]
+    lines += [f"{n}. {step}" for n, step in enumerate(settings["sequence"], 1)]
+    lines += [
+        "",
+        "| setting | symbol | kind | formula | left | right | unit |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for s in settings["settings"]:
+        digits = 4 if s["unit"] == "deg" else 3
+        lines.append(
+            f"| {s['name']} | {s['symbol']} | {s['kind']} | {s['formula']} | "
+            f"{_fmt(s['left'], digits)} | {_fmt(s['right'], digits)} | "
+            f"{'°' if s['unit'] == 'deg' else 'mm'} |"
+        )
+    return lines
+
+
 def sheet_markdown(sheet: SetupSheet) -> str:
     """Table 24 and the stage-by-stage list of readings, as Markdown."""
     d = sheet_to_dict(sheet)
@@ -366,6 +437,7 @@ def sheet_markdown(sheet: SetupSheet) -> str:
                 f"| {p.name} | {key} | {value:.4f} | {rig[0]:.4f}, {rig[1]:.4f} | "
                 f"{(value - rig[axis]) * 1000:+.2f} |"
             )
+    lines += _settings_lines(d["instrument_settings"], sheet.instrument_title)
     lines += [
         "",
         "## Readings, stage by stage",

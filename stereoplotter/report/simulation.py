@@ -14,7 +14,7 @@ from __future__ import annotations
 import io
 import json
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.errors import ConfigError, did_you_mean
+from stereoplotter.instrument.sc1_complex import SC1Options
 from stereoplotter.io.errors_file import load_error_model
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
@@ -415,6 +416,7 @@ def run_simulation_command(
     progress: Callable[[int], None] | None = None,
     operator: str | Path | OperatorModel | None = None,
     practice: str = "operator",
+    options: Sequence[str] = (),
 ) -> SimulationOutcome:
     """What ``stereoplotter simulate`` does: run, summarise, write the files if ``output``.
 
@@ -424,9 +426,12 @@ def run_simulation_command(
     ``progress(n)`` is told the trials each finished chunk ran. ``operator`` is None (the
     assumed defaults), "zero" or a YAML of OperatorModel fields (:func:`load_operator_model`).
     ``practice`` is "operator" (remedies after a failed check) or "book" (§27 task 1, none).
+    ``options`` names the SC complex's options fitted to the SC-1 (``correction_unit``,
+    ``automatic_coordinatograph``; :class:`~stereoplotter.instrument.sc1_complex.SC1Options`).
     """
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
+    fitted = SC1Options.from_names(spec, options)
     seed = scenario.seed if seed is None else seed
     prep = prepare_run(
         scenario,
@@ -437,6 +442,7 @@ def run_simulation_command(
         backend,
         operator=load_operator_model(operator),
         practice=practice,
+        options=fitted,
     )
     out = None if output is None else Path(output)
     if trials is None:

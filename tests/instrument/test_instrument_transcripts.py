@@ -41,3 +41,11 @@ def test_sheet_names_the_instrument_controls():
     assert "lens-shift mechanism δ_α (k_alpha_left)" in texts["spr3"]
     assert "correction plane kα (follower) (k_alpha_left)" in texts["sd3"]
     assert "photo-carrier tilt α (gimbal) (k_alpha_left)" in texts["sc1"]
+
+
+def test_spr3_sets_its_three_decentrations_from_the_tables(tmp_path):
+    spr3 = _transcript(tmp_path, "spr3")
+    sd3 = _transcript(tmp_path, "sd3")
+    assert spr3.count("from the tables:") == 4  # dx, dy of each photo
+    assert "follower decentration x (correction plate) u_x" in spr3
+    assert "from the tables:" not in sd3
