@@ -76,6 +76,7 @@ class TraineeSheet(FileModel):
     focal_length_corrected_per_photo_mm: Any = None
     fiducials_rigorous_mm: Any = None
     correction_inclinations_deg: Any = None
+    instrument_settings: Any = None
     angles_deg: Any = None
     similarity: Any = None
     tolerances: Any = None

@@ -1437,6 +1437,19 @@ def refuse_beyond_mechanism(
     ]
     _, i, axis = max(tilts, key=lambda t: t[0])  # the first of equal tilts
     found = np.degrees(getattr(sc.photos[i].exterior, axis))
+    films = [
+        f"photos[{j}].film_deformation_ppm = [{p.film_deformation_ppm[0]:g}, "
+        f"{p.film_deformation_ppm[1]:g}]"
+        for j, p in enumerate(sc.photos)
+        if any(p.film_deformation_ppm)
+    ]
+    film_note = (
+        "; the films' deformation enters this level too ("
+        + ", ".join(films)
+        + "): the SC complex's correction unit takes it out (--option correction_unit)"
+        if films
+        else ""
+    )
     raise SetupRefusal(
         f"{sc.source}: photos[{i}].exterior.{axis}_deg: expected a tilt the setup-data method "
         f"on {sheet.instrument_title} can carry (§26: at the sheet's exact settings the "
@@ -1445,7 +1458,7 @@ def refuse_beyond_mechanism(
         f"{found:+.1f}° (the largest tilt of the pair): at f′ = "
         f"{sheet.focal_length_corrected_mm:.0f} mm the mechanism leaves {q_max * 1000:.1f} µm "
         f"and {h_max:.2f} m (instrument test, §6); the model needs relative orientation and "
-        "levelling (--method conventional)"
+        f"levelling (--method conventional){film_note}"
     )
 
 

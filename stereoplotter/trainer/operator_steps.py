@@ -99,15 +99,15 @@ class RecordingInstrument(Instrument):
         super().slip_height_scale(reading_m)
         self._note({"kind": "slip", "value": _num(reading_m)})
 
-    def connect_coordinatograph(self, ratio, origin_table_mm=None) -> None:  # type: ignore[override]
-        super().connect_coordinatograph(ratio, origin_table_mm)
+    def connect_coordinatograph(self, ratio, origin_table_mm=None, enlargement=None) -> None:  # type: ignore[override]
+        super().connect_coordinatograph(ratio, origin_table_mm, enlargement)
         action: dict[str, Any] = {"kind": "connect", "value": float(ratio)}
         if origin_table_mm is not None:
             action["origin_mm"] = [float(v) for v in origin_table_mm]
         self._note(action)
 
-    def needle(self, side=None):  # type: ignore[override]
-        out = super().needle(side)
+    def needle(self, side=None, servo_noise_mm=None):  # type: ignore[override]
+        out = super().needle(side, servo_noise_mm)
         action: dict[str, Any] = {"kind": "needle"}
         if side is not None:
             action["side"] = side
@@ -221,7 +221,5 @@ def operator_run(prep: PreparedRun, seed: int, upto: str | None = None) -> Opera
             break
     inst.recording = False
     records = op.log.records
-    steps = [
-        records[min(i, len(records) - 1)].step if records else "" for i in inst.record_index
-    ]
+    steps = [records[min(i, len(records) - 1)].step if records else "" for i in inst.record_index]
     return OperatorRun(inst.actions, run, inst, ends, steps)

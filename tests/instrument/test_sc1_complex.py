@@ -104,7 +104,9 @@ def test_correction_unit_takes_a_deformed_film_the_plain_sc1_refuses():
     sc, spec = load_scenario("scenarios/pair60.yaml"), load_instrument("sc1")
     film = _film(sc, (-900.0, 900.0))
     kw = dict(errors="zero", operator=OperatorModel().zero(), ideal_mechanics=True, seed=1)
-    with pytest.raises(SetupRefusal):
+    with pytest.raises(
+        SetupRefusal, match=r"film_deformation_ppm = \[-900, 900\].*correction_unit"
+    ):
         simulate(film, spec, **kw)
     r = simulate(film, spec, trials=20, options=SC1Options(error_correction_unit=True), **kw)
     q_rms = np.sqrt(np.mean(np.asarray(r.q_grid_mm) ** 2, axis=1))
