@@ -214,7 +214,8 @@ class Instrument:
                 "the pymunk back-end runs single instruments; use backend='closed-form' for trials"
             )
         self.spec = spec
-        self.options = options if options is not None else SC1Options()
+        # validated against the instrument file: only the SC-1 of the SC complex has them
+        self.options = SC1Options.from_names(spec, options.names) if options else SC1Options()
         self._servo: AutomaticCoordinatograph | None = None
         self.variant = decentration_variant(variant)
         self.backend = backend

@@ -19,7 +19,11 @@ from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import decentration_variant
-from stereoplotter.instrument.sc1_complex import ErrorCorrectionUnit, SC1Options
+from stereoplotter.instrument.sc1_complex import (
+    AutomaticCoordinatograph,
+    ErrorCorrectionUnit,
+    SC1Options,
+)
 from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
@@ -244,18 +248,21 @@ def prepare_run(
 
 
 def _log_options(op: Operator, prep: PreparedRun) -> None:
-    """Transcript lines for the SC complex's options fitted to the instrument."""
+    """Transcript lines (at the start) for the SC complex's options fitted to the instrument."""
     if prep.options.error_correction_unit:
+        unit = ErrorCorrectionUnit.from_spec(prep.spec)
         op.log.add(
             "1",
             "SC complex: the error-correction unit has corrected the image coordinates (film "
-            "deformation within ±100 µm; residual 3 µm RMS added to every pointing)",
+            f"deformation within ±{unit.range_um:g} µm; residual {unit.rms_um:g} µm RMS added to "
+            "every pointing)",
         )
     if prep.options.automatic_coordinatograph:
         op.log.add(
-            "4",
-            "SC complex: the automatic coordinatograph's servo drives the needle (no gear "
-            "backlash or pen play; settled servo noise σ_s per axis)",
+            "1",
+            "SC complex: the automatic coordinatograph's servo will drive the needle in stages "
+            f"4–5 (no gear backlash or pen play; settled noise σ_s = "
+            f"{op.inst.servo_sigma_mm or AutomaticCoordinatograph().sigma_mm:g} mm per axis)",
         )
 
 

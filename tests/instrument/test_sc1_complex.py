@@ -135,3 +135,11 @@ def test_automatic_coordinatograph_needle_is_the_gear_target_at_rest():
     assert inst.servo_sigma_mm == 0.02  # assumed (sc1_complex)
     with pytest.raises(RangeRefusal, match=r"10 ×"):
         inst.connect_coordinatograph(2.0, enlargement=10.5)
+
+
+def test_instrument_refuses_options_its_file_does_not_document():
+    with pytest.raises(StereoplotterError, match="has no such unit"):
+        Instrument(
+            load_instrument("sd3"), 100.0, rng=np.random.default_rng(0),
+            options=SC1Options(automatic_coordinatograph=True),
+        )  # fmt: skip
