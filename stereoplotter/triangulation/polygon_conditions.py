@@ -1,0 +1,144 @@
+"""Condition equations of the polygon method: sub-block polygons and control paths.
+
+A condition is a closed polygon of centres (misclosure Σ σ_s l_s, expected 0) or a path between
+two centres of known elements (expected: the known difference). Pure bookkeeping over centre ids;
+:mod:`~stereoplotter.triangulation.polygon` builds the equations from it.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections import deque
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from stereoplotter.errors import GeometryError
+
+__all__ = ["Condition", "build_conditions", "find_cells"]
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One condition: ``kind`` "polygon" or "control", its centres in traverse order, the side
+    indices and signs (+1 from → to), the expected sum per element ``known`` (6,) and the
+    elements it applies to ``applies`` (6,) bool."""
+
+    kind: str
+    centres: tuple[str, ...]
+    sides: tuple[int, ...]
+    signs: tuple[int, ...]
+    known: np.ndarray
+    applies: np.ndarray
+
+
+def _side_lookup(sides: Sequence[tuple[str, str]]) -> dict[tuple[str, str], tuple[int, int]]:
+    lookup: dict[tuple[str, str], tuple[int, int]] = {}
+    for s, (a, b) in enumerate(sides):
+        if (a, b) in lookup or (b, a) in lookup:
+            raise GeometryError(
+                f"sides[{s}]: expected one side per pair, found ({a!r}, {b!r}) again"
+            )
+        lookup[(a, b)] = (s, 1)
+        lookup[(b, a)] = (s, -1)
+    return lookup
+
+
+def find_cells(
+    centres: Sequence[str], sides: Sequence[tuple[str, str]]
+) -> tuple[tuple[str, ...], ...]:
+    """Every chordless 4-cycle of the side graph (the four-centre sub-blocks of a regular block).
+
+    Each cycle starts at its centre listed first in ``centres`` and goes on to the earlier-listed
+    of its two neighbours; cycles are ordered by their centres' positions.
+    """
+    index = {c: i for i, c in enumerate(centres)}
+    nbr: list[set[int]] = [set() for _ in centres]
+    for a, b in sides:
+        nbr[index[a]].add(index[b])
+        nbr[index[b]].add(index[a])
+    found = set()
+    for a in range(len(centres)):
+        for b in nbr[a]:
+            for d in nbr[a]:
+                if d <= b:
+                    continue
+                for c in nbr[b] & nbr[d]:
+                    if c == a or c in nbr[a] or d in nbr[b]:
+                        continue  # a chord: not a cell
+                    cyc = (a, b, c, d)
+                    k = cyc.index(min(cyc))
+                    cyc = cyc[k:] + cyc[:k]
+                    if cyc[3] < cyc[1]:
+                        cyc = (cyc[0], cyc[3], cyc[2], cyc[1])
+                    found.add(cyc)
+    return tuple(tuple(centres[i] for i in cyc) for cyc in sorted(found, key=sorted))
+
+
+def _shortest_path(start: int, goal: int, nbr: list[list[int]]) -> list[int]:
+    prev = {start: start}
+    queue = deque([start])
+    while queue:
+        i = queue.popleft()
+        if i == goal:
+            break
+        for j in nbr[i]:
+            if j not in prev:
+                prev[j] = i
+                queue.append(j)
+    if goal not in prev:
+        return []
+    path = [goal]
+    while path[-1] != start:
+        path.append(prev[path[-1]])
+    return path[::-1]
+
+
+def _oriented(path: Sequence[str], lookup, closed: bool) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    pairs = list(itertools.pairwise(path))
+    if closed:
+        pairs.append((path[-1], path[0]))
+    sides, signs = [], []
+    for a, b in pairs:
+        if (a, b) not in lookup:
+            raise GeometryError(f"polygons: expected a side between {a!r} and {b!r}, found none")
+        s, sign = lookup[(a, b)]
+        sides.append(s)
+        signs.append(sign)
+    return tuple(sides), tuple(signs)
+
+
+def build_conditions(
+    centres: Sequence[str],
+    sides: Sequence[tuple[str, str]],
+    cells: Sequence[Sequence[str]],
+    fixed: Mapping[str, np.ndarray],
+) -> list[Condition]:
+    """The polygons, then for each element the shortest paths from the first control centre
+    (in ``centres`` order) to every other control centre known in that element."""
+    lookup = _side_lookup(sides)
+    out = [
+        Condition("polygon", tuple(c), *_oriented(c, lookup, True), np.zeros(6), np.ones(6, bool))
+        for c in cells
+    ]
+    index = {c: i for i, c in enumerate(centres)}
+    nbr: list[list[int]] = [[] for _ in centres]
+    for a, b in sides:
+        nbr[index[a]].append(index[b])
+        nbr[index[b]].append(index[a])
+    control = sorted(fixed, key=index.__getitem__)
+    paths: dict[tuple[str, str], np.ndarray] = {}
+    for e in range(6):
+        known = [c for c in control if np.isfinite(fixed[c][e])]
+        for other in known[1:]:
+            paths.setdefault((known[0], other), np.zeros(6, bool))[e] = True
+    for (a, b), applies in paths.items():
+        path = _shortest_path(index[a], index[b], nbr)
+        if not path:
+            continue  # different parts of the net: each keeps its own control
+        ids = tuple(centres[i] for i in path)
+        s, g = _oriented(ids, lookup, False)
+        diff = np.where(applies, np.nan_to_num(fixed[b] - fixed[a]), 0.0)
+        out.append(Condition("control", ids, s, g, diff, applies))
+    return out
