@@ -76,6 +76,22 @@ def find_cells(
     return tuple(tuple(centres[i] for i in cyc) for cyc in sorted(found, key=sorted))
 
 
+def _components(n: int, nbr: list[list[int]]) -> list[int]:
+    label = [-1] * n
+    for seed in range(n):
+        if label[seed] >= 0:
+            continue
+        label[seed] = seed
+        queue = deque([seed])
+        while queue:
+            i = queue.popleft()
+            for j in nbr[i]:
+                if label[j] < 0:
+                    label[j] = seed
+                    queue.append(j)
+    return label
+
+
 def _shortest_path(start: int, goal: int, nbr: list[list[int]]) -> list[int]:
     prev = {start: start}
     queue = deque([start])
@@ -115,8 +131,9 @@ def build_conditions(
     cells: Sequence[Sequence[str]],
     fixed: Mapping[str, np.ndarray],
 ) -> list[Condition]:
-    """The polygons, then for each element the shortest paths from the first control centre
-    (in ``centres`` order) to every other control centre known in that element."""
+    """The polygons, then for each element and each connected part of the net the shortest
+    paths from its first control centre (in ``centres`` order) to every other control centre
+    known in that element."""
     lookup = _side_lookup(sides)
     out = [
         Condition("polygon", tuple(c), *_oriented(c, lookup, True), np.zeros(6), np.ones(6, bool))
@@ -127,16 +144,19 @@ def build_conditions(
     for a, b in sides:
         nbr[index[a]].append(index[b])
         nbr[index[b]].append(index[a])
+    component = _components(len(centres), nbr)
     control = sorted(fixed, key=index.__getitem__)
     paths: dict[tuple[str, str], np.ndarray] = {}
     for e in range(6):
-        known = [c for c in control if np.isfinite(fixed[c][e])]
-        for other in known[1:]:
-            paths.setdefault((known[0], other), np.zeros(6, bool))[e] = True
+        first: dict[int, str] = {}
+        for c in control:
+            if not np.isfinite(fixed[c][e]):
+                continue
+            head = first.setdefault(component[index[c]], c)
+            if head != c:
+                paths.setdefault((head, c), np.zeros(6, bool))[e] = True
     for (a, b), applies in paths.items():
         path = _shortest_path(index[a], index[b], nbr)
-        if not path:
-            continue  # different parts of the net: each keeps its own control
         ids = tuple(centres[i] for i in path)
         s, g = _oriented(ids, lookup, False)
         diff = np.where(applies, np.nan_to_num(fixed[b] - fixed[a]), 0.0)
