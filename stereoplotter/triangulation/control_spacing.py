@@ -81,8 +81,8 @@ def eta_covariance(n_bases: int) -> NDArray[np.float64]:
 
     var η(b) = Σ_{m=1}^{b} m² = b(b + 1)(2b + 1)/6.
 
-    >>> eta_covariance(3)[3, 3], eta_covariance(3)[2, 3]
-    (np.float64(14.0), np.float64(8.0))
+    >>> float(eta_covariance(3)[3, 3]), float(eta_covariance(3)[2, 3])
+    (14.0, 8.0)
     """
     t = accumulation_matrix(n_bases)
     return t @ t.T
