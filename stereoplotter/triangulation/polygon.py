@@ -50,7 +50,7 @@ from stereoplotter.errors import GeometryError
 from stereoplotter.triangulation.polygon_conditions import (
     Condition,
     build_conditions,
-    find_cells,
+    default_polygons,
 )
 
 __all__ = [
@@ -89,6 +89,8 @@ class PolygonNetwork:
         centres = tuple(str(c) for c in self.centres)
         if len(set(centres)) != len(centres):
             raise GeometryError("centres: expected distinct ids, found a repeated id")
+        object.__setattr__(self, "centres", centres)
+        object.__setattr__(self, "sides", tuple((str(a), str(b)) for a, b in self.sides))
         known = set(centres)
         for i, (a, b) in enumerate(self.sides):
             if a not in known or b not in known:
@@ -138,10 +140,10 @@ class PolygonNetwork:
         return np.asarray(self.weights, float)
 
     def cells(self) -> tuple[tuple[str, ...], ...]:
-        """The polygons (given, or the chordless 4-cycles of the side graph)."""
+        """The polygons (given, or :func:`default_polygons` of the side graph)."""
         if self.polygons is not None:
             return tuple(tuple(p) for p in self.polygons)
-        return find_cells(self.centres, self.sides)
+        return default_polygons(self.centres, self.sides)
 
 
 @dataclass(frozen=True)

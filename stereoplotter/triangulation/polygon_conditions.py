@@ -16,7 +16,7 @@ import numpy as np
 
 from stereoplotter.errors import GeometryError
 
-__all__ = ["Condition", "build_conditions", "find_cells"]
+__all__ = ["Condition", "build_conditions", "default_polygons", "find_cells"]
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,98 @@ def find_cells(
                         cyc = (cyc[0], cyc[3], cyc[2], cyc[1])
                     found.add(cyc)
     return tuple(tuple(centres[i] for i in cyc) for cyc in sorted(found, key=sorted))
+
+
+def _cycle_vector(cycle: Sequence[str], lookup, n_sides: int) -> np.ndarray:
+    sides, signs = _oriented(cycle, lookup, True)
+    vec = np.zeros(n_sides)
+    vec[list(sides)] = signs
+    return vec
+
+
+def _reduce(vec: np.ndarray, basis: list[tuple[int, np.ndarray]]) -> np.ndarray:
+    """vec minus its components along the pivoted basis (Gaussian elimination, ±1 entries)."""
+    vec = vec.copy()
+    for pivot, row in basis:
+        if vec[pivot] != 0:
+            vec -= vec[pivot] / row[pivot] * row
+    return vec
+
+
+def _tree_cycles(centres: Sequence[str], sides: Sequence[tuple[str, str]]):
+    """Fundamental cycles of a breadth-first spanning forest (one per non-tree side)."""
+    index = {c: i for i, c in enumerate(centres)}
+    nbr: list[list[int]] = [[] for _ in centres]
+    for a, b in sides:
+        nbr[index[a]].append(index[b])
+        nbr[index[b]].append(index[a])
+    parent = [-1] * len(centres)
+    depth = [0] * len(centres)
+    seen = [False] * len(centres)
+    tree = set()
+    for root in range(len(centres)):
+        if seen[root]:
+            continue
+        seen[root] = True
+        queue = deque([root])
+        while queue:
+            i = queue.popleft()
+            for j in nbr[i]:
+                if not seen[j]:
+                    seen[j], parent[j], depth[j] = True, i, depth[i] + 1
+                    tree.add(frozenset((i, j)))
+                    queue.append(j)
+    for a, b in sides:
+        i, j = index[a], index[b]
+        if frozenset((i, j)) in tree:
+            continue
+        left, right = [i], [j]
+        while left[-1] != right[-1]:
+            if depth[left[-1]] >= depth[right[-1]]:
+                left.append(parent[left[-1]])
+            else:
+                right.append(parent[right[-1]])
+        yield tuple(centres[k] for k in left + right[-2::-1])
+
+
+def default_polygons(
+    centres: Sequence[str], sides: Sequence[tuple[str, str]]
+) -> tuple[tuple[str, ...], ...]:
+    """A complete independent set of closed polygons: the sub-blocks first.
+
+    The chordless 4-cycles (:func:`find_cells`) and triangles of the side graph, kept while
+    independent; then, if the net has more independent cycles (sides − centres + parts), the
+    fundamental cycles of a spanning forest that are independent of those. For a regular block
+    this is exactly its sub-blocks; an irregular connection across strips adds its triangles or
+    longer loops, so no closure condition is lost.
+    """
+    lookup = _side_lookup(sides)
+    index = {c: i for i, c in enumerate(centres)}
+    nbr: list[set[int]] = [set() for _ in centres]
+    for a, b in sides:
+        nbr[index[a]].add(index[b])
+        nbr[index[b]].add(index[a])
+    triangles = [
+        (centres[a], centres[b], centres[c])
+        for a in range(len(centres))
+        for b in sorted(nbr[a])
+        if b > a
+        for c in sorted(nbr[a] & nbr[b])
+        if c > b
+    ]
+    basis: list[tuple[int, np.ndarray]] = []
+    out = []
+    parts = len(set(_components(len(centres), [sorted(n) for n in nbr])))
+    needed = len(sides) - len(centres) + parts
+    for cycle in (*find_cells(centres, sides), *triangles, *_tree_cycles(centres, sides)):
+        if len(basis) == needed:
+            break
+        rest = _reduce(_cycle_vector(cycle, lookup, len(sides)), basis)
+        nonzero = np.flatnonzero(np.abs(rest) > 1e-9)
+        if nonzero.size:
+            basis.append((int(nonzero[0]), rest))
+            out.append(tuple(cycle))
+    return tuple(out)
 
 
 def _components(n: int, nbr: list[list[int]]) -> list[int]:

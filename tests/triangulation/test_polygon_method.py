@@ -172,3 +172,27 @@ def test_inter_strip_improvement_monte_carlo():
     lo, hi = result.ratio_ci95
     assert lo <= result.exact_ratio <= hi
     assert 1.5 <= result.exact_ratio <= 2.0
+
+
+def test_irregular_connections_keep_every_closure():
+    """Across-strip sides to the nearest photo of a shifted strip make triangles: the default
+    polygons still form a complete independent set (sides − centres + 1 conditions), and the
+    least-squares adjustment closes every loop of the net."""
+    rng = np.random.default_rng(8)
+    centres = tuple([f"1-{j}" for j in range(1, 6)] + [f"2-{j}" for j in range(1, 5)])
+    sides = [(f"1-{j}", f"1-{j + 1}") for j in range(1, 5)]
+    sides += [(f"2-{j}", f"2-{j + 1}") for j in range(1, 4)]
+    sides += [("1-1", "2-1"), ("1-2", "2-1"), ("1-3", "2-2"), ("1-4", "2-3"), ("1-5", "2-4")]
+    sides += [("1-4", "2-4")]
+    net = PolygonNetwork(centres, tuple(sides), rng.normal(0, 1, (len(sides), 6)))
+    cells = net.cells()
+    assert len(cells) == len(sides) - len(centres) + 1
+    assert ("1-1", "1-2", "2-1") in cells  # the triangle
+    ls = adjust_polygons(net, method="least_squares")
+    # every closed walk closes: the centre elements reproduce every adjusted side
+    for s, (a, b) in enumerate(net.sides):
+        np.testing.assert_allclose(
+            ls.centre_elements[b] - ls.centre_elements[a], ls.side_values[s], atol=1e-9
+        )
+    it = adjust_polygons(net, method="iterative", max_iterations=1000)
+    np.testing.assert_allclose(it.corrections, ls.corrections, atol=1e-8)
