@@ -33,6 +33,18 @@ class Condition:
     applies: np.ndarray
 
 
+def _neighbours(
+    centres: Sequence[str], sides: Sequence[tuple[str, str]]
+) -> tuple[dict[str, int], list[set[int]]]:
+    """Centre positions and, for each centre, the positions of the centres joined to it."""
+    index = {c: i for i, c in enumerate(centres)}
+    nbr: list[set[int]] = [set() for _ in centres]
+    for a, b in sides:
+        nbr[index[a]].add(index[b])
+        nbr[index[b]].add(index[a])
+    return index, nbr
+
+
 def _side_lookup(sides: Sequence[tuple[str, str]]) -> dict[tuple[str, str], tuple[int, int]]:
     lookup: dict[tuple[str, str], tuple[int, int]] = {}
     for s, (a, b) in enumerate(sides):
@@ -53,11 +65,7 @@ def find_cells(
     Each cycle starts at its centre listed first in ``centres`` and goes on to the earlier-listed
     of its two neighbours; cycles are ordered by their centres' positions.
     """
-    index = {c: i for i, c in enumerate(centres)}
-    nbr: list[set[int]] = [set() for _ in centres]
-    for a, b in sides:
-        nbr[index[a]].add(index[b])
-        nbr[index[b]].add(index[a])
+    _, nbr = _neighbours(centres, sides)
     found = set()
     for a in range(len(centres)):
         for b in nbr[a]:
@@ -94,11 +102,7 @@ def _reduce(vec: np.ndarray, basis: list[tuple[int, np.ndarray]]) -> np.ndarray:
 
 def _tree_cycles(centres: Sequence[str], sides: Sequence[tuple[str, str]]):
     """Fundamental cycles of a breadth-first spanning forest (one per non-tree side)."""
-    index = {c: i for i, c in enumerate(centres)}
-    nbr: list[list[int]] = [[] for _ in centres]
-    for a, b in sides:
-        nbr[index[a]].append(index[b])
-        nbr[index[b]].append(index[a])
+    index, nbr = _neighbours(centres, sides)
     parent = [-1] * len(centres)
     depth = [0] * len(centres)
     seen = [False] * len(centres)
@@ -110,7 +114,7 @@ def _tree_cycles(centres: Sequence[str], sides: Sequence[tuple[str, str]]):
         queue = deque([root])
         while queue:
             i = queue.popleft()
-            for j in nbr[i]:
+            for j in sorted(nbr[i]):
                 if not seen[j]:
                     seen[j], parent[j], depth[j] = True, i, depth[i] + 1
                     tree.add(frozenset((i, j)))
@@ -140,11 +144,7 @@ def default_polygons(
     longer loops, so no closure condition is lost.
     """
     lookup = _side_lookup(sides)
-    index = {c: i for i, c in enumerate(centres)}
-    nbr: list[set[int]] = [set() for _ in centres]
-    for a, b in sides:
-        nbr[index[a]].add(index[b])
-        nbr[index[b]].add(index[a])
+    _, nbr = _neighbours(centres, sides)
     triangles = [
         (centres[a], centres[b], centres[c])
         for a in range(len(centres))
@@ -155,7 +155,7 @@ def default_polygons(
     ]
     basis: list[tuple[int, np.ndarray]] = []
     out = []
-    parts = len(set(_components(len(centres), [sorted(n) for n in nbr])))
+    parts = len(set(_components(len(centres), nbr)))
     needed = len(sides) - len(centres) + parts
     for cycle in (*find_cells(centres, sides), *triangles, *_tree_cycles(centres, sides)):
         if len(basis) == needed:
@@ -168,7 +168,7 @@ def default_polygons(
     return tuple(out)
 
 
-def _components(n: int, nbr: list[list[int]]) -> list[int]:
+def _components(n: int, nbr: Sequence[set[int]]) -> list[int]:
     label = [-1] * n
     for seed in range(n):
         if label[seed] >= 0:
@@ -184,14 +184,14 @@ def _components(n: int, nbr: list[list[int]]) -> list[int]:
     return label
 
 
-def _shortest_path(start: int, goal: int, nbr: list[list[int]]) -> list[int]:
+def _shortest_path(start: int, goal: int, nbr: Sequence[set[int]]) -> list[int]:
     prev = {start: start}
     queue = deque([start])
     while queue:
         i = queue.popleft()
         if i == goal:
             break
-        for j in nbr[i]:
+        for j in sorted(nbr[i]):
             if j not in prev:
                 prev[j] = i
                 queue.append(j)
@@ -231,11 +231,7 @@ def build_conditions(
         Condition("polygon", tuple(c), *_oriented(c, lookup, True), np.zeros(6), np.ones(6, bool))
         for c in cells
     ]
-    index = {c: i for i, c in enumerate(centres)}
-    nbr: list[list[int]] = [[] for _ in centres]
-    for a, b in sides:
-        nbr[index[a]].append(index[b])
-        nbr[index[b]].append(index[a])
+    index, nbr = _neighbours(centres, sides)
     component = _components(len(centres), nbr)
     control = sorted(fixed, key=index.__getitem__)
     paths: dict[tuple[str, str], np.ndarray] = {}

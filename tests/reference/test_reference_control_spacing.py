@@ -87,27 +87,27 @@ TABLE_2_ERRATA = {
 }
 
 
-def exact_eq1(control: tuple[int, ...], n_points: int) -> list[Fraction]:
-    """σ_η² − σ_p² (units σ_ε²) at points 1 … N, exact, the paper's numbering η_1 = ε_1."""
+def cov(i: int, k: int) -> Fraction:
+    """cov(η_i, η_k)/σ_ε² = Σ_{j ≤ min(i, k)} (i − j + 1)(k − j + 1), paper numbering."""
+    return Fraction(sum((i - j + 1) * (k - j + 1) for j in range(1, min(i, k) + 1)))
 
-    def cov(i: int, k: int) -> Fraction:
-        return Fraction(sum((i - j + 1) * (k - j + 1) for j in range(1, min(i, k) + 1)))
 
-    def lagrange(c: int, x: int) -> Fraction:
-        out = Fraction(1)
+def lagrange(control: tuple[int, ...], x: int) -> dict[int, Fraction]:
+    """Weights of η at the control points in the interpolating polynomial's value at x."""
+    w = {c: Fraction(1) for c in control}
+    for c in control:
         for d in control:
             if d != c:
-                out *= Fraction(x - d, c - d)
-        return out
+                w[c] *= Fraction(x - d, c - d)
+    return w
 
+
+def exact_eq1(control: tuple[int, ...], n_points: int) -> list[Fraction]:
+    """σ_η² − σ_p² (units σ_ε²) at points 1 … N, exact, the paper's numbering η_1 = ε_1."""
     values = []
     for x in range(1, n_points + 1):
-        weights = [lagrange(c, x) for c in control]
-        var_p = sum(
-            wi * wk * cov(ci, ck)
-            for wi, ci in zip(weights, control, strict=True)
-            for wk, ck in zip(weights, control, strict=True)
-        )
+        w = lagrange(control, x)
+        var_p = sum(w[c] * w[d] * cov(c, d) for c in control for d in control)
         values.append(cov(x, x) - var_p)
     return values
 
@@ -192,17 +192,9 @@ def test_degree_3_equal_spacing():
 
 def exact_actual(control: tuple[int, ...], n_points: int) -> list[Fraction]:
     """var(η − p) (units σ_ε²) at points 1 … N, exact, the paper's numbering."""
-
-    def cov(i: int, k: int) -> Fraction:
-        return Fraction(sum((i - j + 1) * (k - j + 1) for j in range(1, min(i, k) + 1)))
-
     out = []
     for x in range(1, n_points + 1):
-        w = {c: Fraction(1) for c in control}
-        for c in control:
-            for d in control:
-                if d != c:
-                    w[c] *= Fraction(x - d, c - d)
+        w = lagrange(control, x)
         value = cov(x, x) - 2 * sum(w[c] * cov(x, c) for c in control)
         value += sum(w[c] * w[d] * cov(c, d) for c in control for d in control)
         out.append(value)
