@@ -12,6 +12,7 @@ paper gets wrong are pinned corrected under ``# ERRATA`` (``docs/errata.md``).
 
 from __future__ import annotations
 
+import itertools
 from fractions import Fraction
 
 import numpy as np
@@ -118,6 +119,11 @@ def test_eq1_numpy_equals_exact_oracle(table, degree):
         exact = np.array([float(v) for v in exact_eq1(control, control[-1])])
         got = paper_residual_variance(control[-1] - 1, np.array(control) - 1, degree)
         np.testing.assert_allclose(got, exact, rtol=0, atol=1e-9 * np.abs(exact).max())
+        # Eq. (1) is negative inside the first link, then alternates link by link (the paper
+        # prints magnitudes only)
+        for link, (lo, hi) in enumerate(itertools.pairwise(control)):
+            inside = exact[lo : hi - 1]  # points lo + 1 … hi − 1
+            assert np.all(inside < 0) if link % 2 == 0 else np.all(inside > 0)
 
 
 @pytest.mark.parametrize(("table", "errata", "degree"), [
