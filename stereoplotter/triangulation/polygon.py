@@ -251,7 +251,8 @@ def _iterate(conds, rows, a, f, inv_w, tol, max_iterations, step, e, trace):
                 v[s] += dv
                 mlo, mhi = member.indptr[s], member.indptr[s + 1]
                 current[member.indices[mlo:mhi]] += member.data[mlo:mhi] * dv
-            trace.append((e, sweep, rows[p], float(big_f)))
+            if trace is not None:
+                trace.append((e, sweep, rows[p], float(big_f)))
         if np.max(np.abs(current)) <= tol:
             return v, sweep, True
         if np.array_equal(v, before):  # rounded portions all zero: a hand computation stops
@@ -291,12 +292,15 @@ def adjust_polygons(
     tolerance: float | np.ndarray | None = None,
     max_iterations: int = 100,
     step: float | None = None,
+    record: bool = False,
 ) -> PolygonAdjustment:
     """Adjust a block by the polygon method (see the module docstring).
 
     ``tolerance``: the paper's Δ per element (scalar or (6,)), in the element's unit; None =
     converged to rounding (1e-10 of the largest misclosure). ``step`` (iterative only, added):
     round every distributed portion to this step, as the paper's hand computation in 0.1′ does.
+    ``record`` (added): keep every step (element, sweep, condition, misclosure distributed) in
+    ``trace``.
     Centre elements: control values propagated along the adjusted sides; a part of the net
     without control starts at zeros at its first centre (arbitrary datum).
     """
@@ -315,7 +319,7 @@ def adjust_polygons(
     v = np.zeros((n_sides, 6))
     sweeps = np.zeros(6, np.int64)
     converged = True
-    trace: list[tuple[int, int, int, float]] = []
+    trace: list[tuple[int, int, int, float]] | None = [] if record else None
     for e in range(6):
         rows, a = _condition_matrix(conds, e, n_sides)
         f = f_all[rows, e]
@@ -342,5 +346,5 @@ def adjust_polygons(
         iterations=sweeps,
         converged=bool(converged),
         tolerance=tol,
-        trace=tuple(trace),
+        trace=tuple(trace or ()),
     )

@@ -33,7 +33,7 @@ BLOCKS = ((10, 2), (10, 3), (10, 5), (10, 10), (20, 5), (20, 10))
 def _example() -> None:
     net = example_network()
     ls = adjust_polygons(net, method="least_squares")
-    hand = adjust_polygons(net, tolerance=0.1, step=0.1, max_iterations=20)
+    hand = adjust_polygons(net, tolerance=0.1, step=0.1, max_iterations=20, record=True)
     exact = adjust_polygons(net, tolerance=0.1)
     print("Fig. 1 example, Δα in minutes; corrections in the table's senses")
     print(" side  true  δ̄α | printed LS | LS exact | printed polygon | hand 0.1′ | exact Δ=0.1′")

@@ -66,7 +66,12 @@ def test_hand_computation_steps():
     """Text: −10/4 = −2.5 per side; f_IV = +7 − 2.5 = +4.5; second approximation
     δα_2 + δα_13 = +1.1 + 1.1 = +2.2 for sub-block II."""
     result = adjust_polygons(
-        example_network(), method="iterative", tolerance=0.1, step=0.1, max_iterations=10
+        example_network(),
+        method="iterative",
+        tolerance=0.1,
+        step=0.1,
+        max_iterations=10,
+        record=True,
     )
     steps = [(sweep, cond, f) for e, sweep, cond, f in result.trace if e == 0]
     assert steps[0] == (1, 1, -10.0)  # sub-block II first (largest |f|)
@@ -77,7 +82,12 @@ def test_hand_computation_steps():
 
 def test_polygon_method_corrections():
     result = adjust_polygons(
-        example_network(), method="iterative", tolerance=0.1, step=0.1, max_iterations=10
+        example_network(),
+        method="iterative",
+        tolerance=0.1,
+        step=0.1,
+        max_iterations=10,
+        record=True,
     )
     v = printed_sense(result.corrections[:, 0])
     printed = np.array(PRINTED_POLYGON_CORRECTIONS)
