@@ -184,6 +184,20 @@ def _components(n: int, nbr: Sequence[set[int]]) -> list[int]:
     return label
 
 
+def _hops(start: int, nbr: Sequence[set[int]]) -> list[int]:
+    """Number of sides from ``start`` to every centre (−1 where unreachable)."""
+    dist = [-1] * len(nbr)
+    dist[start] = 0
+    queue = deque([start])
+    while queue:
+        i = queue.popleft()
+        for j in nbr[i]:
+            if dist[j] < 0:
+                dist[j] = dist[i] + 1
+                queue.append(j)
+    return dist
+
+
 def _shortest_path(start: int, goal: int, nbr: Sequence[set[int]]) -> list[int]:
     prev = {start: start}
     queue = deque([start])
@@ -223,9 +237,13 @@ def build_conditions(
     cells: Sequence[Sequence[str]],
     fixed: Mapping[str, np.ndarray],
 ) -> list[Condition]:
-    """The polygons, then for each element and each connected part of the net the shortest
-    paths from its first control centre (in ``centres`` order) to every other control centre
-    known in that element."""
+    """The polygons, then the control paths: for each element and each connected part of the
+    net, the shortest paths joining its control centres known in that element in a minimum
+    spanning tree of their path lengths (Prim, from the first in ``centres`` order): an
+    independent set of short paths. (The least-squares result does not depend on the choice;
+    the iteration's speed hardly does: 10 × 4 acceptance block of part B, four corner control
+    centres, 1e-10 tolerance: 204–229 sweeps with paths from the first control centre, 219–238
+    with this tree, against 55–57 without control.)"""
     lookup = _side_lookup(sides)
     out = [
         Condition("polygon", tuple(c), *_oriented(c, lookup, True), np.zeros(6), np.ones(6, bool))
@@ -234,15 +252,20 @@ def build_conditions(
     index, nbr = _neighbours(centres, sides)
     component = _components(len(centres), nbr)
     control = sorted(fixed, key=index.__getitem__)
+    hops = {c: _hops(index[c], nbr) for c in control}
     paths: dict[tuple[str, str], np.ndarray] = {}
     for e in range(6):
-        first: dict[int, str] = {}
-        for c in control:
-            if not np.isfinite(fixed[c][e]):
-                continue
-            head = first.setdefault(component[index[c]], c)
-            if head != c:
-                paths.setdefault((head, c), np.zeros(6, bool))[e] = True
+        known = [c for c in control if np.isfinite(fixed[c][e])]
+        for part in sorted({component[index[c]] for c in known}):
+            members = [c for c in known if component[index[c]] == part]
+            joined = members[:1]
+            while len(joined) < len(members):
+                a, b = min(
+                    ((a, b) for a in joined for b in members if b not in joined),
+                    key=lambda ab: hops[ab[0]][index[ab[1]]],
+                )
+                paths.setdefault((a, b), np.zeros(6, bool))[e] = True
+                joined.append(b)
     for (a, b), applies in paths.items():
         path = _shortest_path(index[a], index[b], nbr)
         ids = tuple(centres[i] for i in path)
