@@ -227,7 +227,7 @@ def _hand_round(x: float, step: float | None) -> float:
     return round(round(x / step, 9)) * step
 
 
-def _iterate(conds, rows, a, f, inv_w, tol, max_iterations, step, e, trace):
+def _iterate(rows, a, f, inv_w, tol, max_iterations, step, e, trace):
     """Popov's successive approximations for one element; returns v, sweeps, converged."""
     a = a.tocsr()
     n_rows = len(rows)
@@ -327,7 +327,7 @@ def adjust_polygons(
             v[:, e] = _least_squares(a, f, inv_w[:, e])
         else:
             v[:, e], sweeps[e], ok = _iterate(
-                conds, rows, a, f, inv_w[:, e], tol[e], max_iterations, step, e, trace
+                rows, a, f, inv_w[:, e], tol[e], max_iterations, step, e, trace
             )
             converged &= ok
     side_values = network.values + v
