@@ -279,6 +279,12 @@ def _page_table24(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
 
 
 def _page_details(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
+    _details_orientation(pdf, sheet)
+    _details_control(pdf, sheet, h)
+
+
+def _details_orientation(pdf: _Form, sheet: SetupSheet) -> None:
+    """Transformed marks, angles and decentrations, the instrument's settings."""
     _heading(pdf, "Transformed marks: the book's (6.1)/(6.2) beside the rigorous (3.17), κ = 0")
     rows = []
     for p in sheet.photos:
@@ -319,6 +325,10 @@ def _page_details(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
         ]  # fmt: skip
         _table(pdf, ("symbol", "setting", "formula", "left", "right", "unit"), rows,
                (16, 62, 46, 22, 22, 12))  # fmt: skip
+
+
+def _details_control(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
+    """Height control, sheet corners, the similarity, the distortion, the tolerances."""
     _heading(pdf, "Height control: model heights Z_i (6.6)")
     rows = [
         (h_["id"], f"{h_['Z_m']:.2f}", f"{h_['flying_height_m']:.2f}",

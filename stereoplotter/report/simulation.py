@@ -95,6 +95,36 @@ def _remedy_lines(s: dict[str, Any], single: bool) -> list[str]:
     return lines
 
 
+def _single_run_lines(s: dict[str, Any]) -> list[str]:
+    """The summary of one procedure: checks, remedies, residual y-parallax, iterations."""
+    lines = [
+        f"back-end {s['backend']}, seed {s['seed']}, one procedure; operator judgment "
+        "errors are assumed values.",
+        "",
+        "| check | residual | tolerance | passed | iterations |",
+        "|---|---|---|---|---|",
+    ]
+    for name, c in s["checks"].items():
+        label = name.replace("|", "\\|")
+        lines.append(
+            f"| {label} | {_g(c['residual'])} {c['unit']} | {_g(c.get('tolerance'))} | "
+            f"{c.get('passed', '—')} | {_g(c.get('iterations'))} |"
+        )
+    lines += _remedy_lines(s, single=True)
+    q = s["residual_y_parallax_um"]
+    lines += [
+        "",
+        f"Residual y-parallax of the built model (truth): max {_g(q['standard_points_max'])} "
+        f"µm at the six standard points; over the grid max {_g(q['grid_max'])} µm, "
+        f"RMS {_g(q['grid_rms'])} µm.",
+        "",
+        "Iterations per stage: "
+        + ", ".join(f"{k}: {_g(v)}" for k, v in s["iterations"].items()),
+        "",
+    ]
+    return lines
+
+
 def simulation_markdown(s: dict[str, Any]) -> str:
     """The Markdown summary of a run (one procedure, or statistics over trials)."""
     trials = s.get("trials")
@@ -103,32 +133,7 @@ def simulation_markdown(s: dict[str, Any]) -> str:
         "",
     ]
     if trials is None:
-        lines += [
-            f"back-end {s['backend']}, seed {s['seed']}, one procedure; operator judgment "
-            "errors are assumed values.",
-            "",
-            "| check | residual | tolerance | passed | iterations |",
-            "|---|---|---|---|---|",
-        ]
-        for name, c in s["checks"].items():
-            label = name.replace("|", "\\|")
-            lines.append(
-                f"| {label} | {_g(c['residual'])} {c['unit']} | {_g(c.get('tolerance'))} | "
-                f"{c.get('passed', '—')} | {_g(c.get('iterations'))} |"
-            )
-        lines += _remedy_lines(s, single=True)
-        q = s["residual_y_parallax_um"]
-        lines += [
-            "",
-            f"Residual y-parallax of the built model (truth): max {_g(q['standard_points_max'])} "
-            f"µm at the six standard points; over the grid max {_g(q['grid_max'])} µm, "
-            f"RMS {_g(q['grid_rms'])} µm.",
-            "",
-            "Iterations per stage: "
-            + ", ".join(f"{k}: {_g(v)}" for k, v in s["iterations"].items()),
-            "",
-        ]
-        return "\n".join(lines)
+        return "\n".join(lines + _single_run_lines(s))
     chunks = s.get("chunks", {})
     lines += [
         f"back-end {s['backend']}, seed {s['seed']}, {trials} trials"
