@@ -18,11 +18,12 @@ instrument coordinates.
 from __future__ import annotations
 
 import datetime as _dt
+import importlib.util
 import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
-from importlib import resources
+from pathlib import Path
 from typing import Any
 
 from fpdf import FPDF
@@ -60,8 +61,14 @@ class FormHeader:
 
 
 def _font_path(style: str = "") -> str:
+    """The DejaVu font file matplotlib ships, found without importing matplotlib (its package
+    folder from the import system's spec: only ``plotting`` imports matplotlib)."""
     name = {"": "DejaVuSans.ttf", "B": "DejaVuSans-Bold.ttf"}[style]
-    return str(resources.files("matplotlib") / "mpl-data" / "fonts" / "ttf" / name)
+    spec = importlib.util.find_spec("matplotlib")
+    if spec is None or not spec.submodule_search_locations:  # pragma: no cover - a dependency
+        raise RuntimeError("matplotlib (a dependency) is not installed: no DejaVu font")
+    folder = Path(next(iter(spec.submodule_search_locations)))
+    return str(folder / "mpl-data" / "fonts" / "ttf" / name)
 
 
 class _Form(FPDF):
