@@ -10,7 +10,7 @@ read or written, no PDF):
 * **sheets, one at a time** — ``setup.sheet.compute_sheet_from_measurements`` per pair (Table 24
   as a block of one, corners (6.7)/(6.8), readings);
 * **sheets, one call** — ``setup.sheet.compute_sheets_from_measurements``, what ``stereoplotter
-  setup JOB`` does (``report.job.compute_job``): Table 24 of all pairs in one
+  setup JOB`` does (``commands.setup_job.compute_job``): Table 24 of all pairs in one
   ``compute_table24`` call, then each pair's corners and readings;
 * **vectorised Table 24** — ((6.1)–(6.6) and the scale choice) of N = 8 × ``--copies`` pairs in
   one ``setup.table24.compute_table24`` call on the stacked measured inputs, each pair with its

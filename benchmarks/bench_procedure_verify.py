@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from stereoplotter.report.verification import book_instrument, book_scenarios
+from stereoplotter.io.book_setting import book_instrument, book_scenarios
 from stereoplotter.verification import table as v
 
 

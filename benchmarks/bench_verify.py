@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from stereoplotter.report.verification import book_instrument, book_scenarios
+from stereoplotter.io.book_setting import book_instrument, book_scenarios
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification import table as v
 

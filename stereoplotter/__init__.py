@@ -35,7 +35,7 @@ _API = {
     "compute_setup_sheet": "stereoplotter.setup.sheet",
     "compute_block": "stereoplotter.setup.block",
     "simulate": "stereoplotter.procedure.simulate",
-    "verify": "stereoplotter.report.verification",
+    "verify": "stereoplotter.commands.verification",
     "run_verification": "stereoplotter.verification.table",
     "evaluate_model": "stereoplotter.procedure.evaluation",
     "Instrument": "stereoplotter.instrument.virtual",

@@ -31,7 +31,7 @@ from stereoplotter.io.validation import (
     validate,
     vector,
 )
-from stereoplotter.io.yaml_files import load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.scenario.model import Camera
 
 __all__ = ["CSV_COLUMNS", "Block", "BlockFile", "load_block"]

@@ -29,7 +29,7 @@ from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import list_data_files, resolve_data_file
 from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.io.validation import FileModel, integer, one_of, sequence, text, validate
-from stereoplotter.io.yaml_files import load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.trainer.exercise import (
     ERROR_MODES,
     EXERCISE_FORMAT,

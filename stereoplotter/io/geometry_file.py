@@ -12,7 +12,7 @@ from stereoplotter.errors import ConfigError
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.validation import FileModel, number, validate
-from stereoplotter.io.yaml_files import load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.verification.procedure_mc import scenario_geometry
 from stereoplotter.verification.table import check_geometry
 

@@ -14,7 +14,7 @@ from stereoplotter.geometry.collinearity import object_to_photo
 from stereoplotter.imagery.cache import ViewCache
 from stereoplotter.imagery.eyepiece import anaglyph
 from stereoplotter.imagery.photo import render_photo
-from stereoplotter.io.yaml_files import atomic_write_bytes
+from stereoplotter.io.atomic_write import atomic_write_bytes
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import film_deformed
 

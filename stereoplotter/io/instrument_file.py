@@ -28,7 +28,7 @@ from stereoplotter.errors import ConfigError, StereoplotterError, describe_value
 from stereoplotter.instrument.spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
 from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
 from stereoplotter.io.validation import FileModel, _bounds, _fail, check_number, text, validate
-from stereoplotter.io.yaml_files import load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping
 
 __all__ = ["InstrumentFile", "instrument_from_mapping", "list_instruments", "load_instrument"]
 

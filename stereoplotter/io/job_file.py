@@ -66,7 +66,7 @@ from stereoplotter.io.validation import (
     validate,
     vector,
 )
-from stereoplotter.io.yaml_files import Fields, load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.scenario.model import Camera, Frame, MapSheet, Point
 
@@ -287,20 +287,19 @@ def load_job(path: str | os.PathLike[str]) -> Job:
     """
     data, source = load_yaml_mapping(path)
     doc = validate(JobFile, data, source)
-    fields = Fields(source)
     folder = Path(path).parent
     camera = camera_from_model(source, doc.camera)  # type: ignore[arg-type]
-    origin = _origin(fields, doc.frame)
+    origin = _origin(source, doc.frame)
     distances = (
         _fiducial_csv(folder, doc.fiducial_distances_csv) if doc.fiducial_distances_csv else {}
     )
-    photos = _photos(fields, doc, distances, fiducial_spans_mm(camera.fiducials_mm))
+    photos = _photos(source, doc, distances, fiducial_spans_mm(camera.fiducials_mm))
     rows = [(source, f"points[{i}]", p) for i, p in enumerate(doc.points)]
     for name in doc.points_csv:
         rows += _csv_rows(folder / name, PointModel)
     points = _points(doc.frame.kind, origin, rows)
-    sheets = _map_sheets(fields, doc.map_sheets)
-    pairs = _pairs(fields, doc, photos, sheets)
+    sheets = _map_sheets(source, doc.map_sheets)
+    pairs = _pairs(source, doc, photos, sheets)
     return Job(
         name=doc.name,
         date=doc.date,
@@ -322,15 +321,15 @@ def load_job(path: str | os.PathLike[str]) -> Job:
     )
 
 
-def _origin(fields: Fields, model: FrameModel) -> tuple[float, float, float] | None:
+def _origin(source: str, model: FrameModel) -> tuple[float, float, float] | None:
     if model.origin is None:
         return None
     o = model.origin
     try:
         frame_tie.local_frame(Frame("sk42", (o.north_m, o.east_m, o.height_m)))
     except StereoplotterError as exc:
-        raise fields.error(
-            "frame.origin", "an origin inside the SK-42 Gauss–Krüger domain",
+        raise ConfigError(
+            source, "frame.origin", "an origin inside the SK-42 Gauss–Krüger domain",
             [o.north_m, o.east_m, o.height_m], str(exc),
         ) from None  # fmt: skip
     return (o.north_m, o.east_m, o.height_m)
@@ -402,7 +401,7 @@ def _coordinates(
 
 
 def _photos(
-    fields: Fields,
+    source: str,
     doc: JobFile,
     csv_distances: dict[int, tuple[str, tuple[float, float]]],
     spans: NDArray[np.float64],
@@ -411,27 +410,27 @@ def _photos(
     for i, p in enumerate(doc.photos):
         path = f"photos[{i}]"
         if p.number in photos:
-            raise fields.error(f"{path}.number", "a photo number used once", p.number)
-        centre = _coordinates(fields.source, path, p, doc.frame.kind)
+            raise ConfigError(source, f"{path}.number", "a photo number used once", p.number)
+        centre = _coordinates(source, path, p, doc.frame.kind)
         if p.fiducial_distances_mm is not None and p.number in csv_distances:
-            raise fields.error(
-                f"{path}.fiducial_distances_mm", "the measured distances in one place",
+            raise ConfigError(
+                source, f"{path}.fiducial_distances_mm", "the measured distances in one place",
                 "them here and in " + csv_distances[p.number][0],
             )  # fmt: skip
         if p.fiducial_distances_mm is not None:
             d = (p.fiducial_distances_mm.d12, p.fiducial_distances_mm.d34)
-            where = [(fields.source, f"{path}.fiducial_distances_mm.{k}") for k in ("1-2", "3-4")]
+            where = [(source, f"{path}.fiducial_distances_mm.{k}") for k in ("1-2", "3-4")]
         elif p.number in csv_distances:
             d = csv_distances[p.number][1]
             where = [(csv_distances[p.number][0], k) for k in ("d12_mm", "d34_mm")]
         else:
-            raise fields.error(
-                f"{path}.fiducial_distances_mm",
+            raise ConfigError(
+                source, f"{path}.fiducial_distances_mm",
                 "the fiducial distances 1-2, 3-4 measured on this diapositive (here or in "
                 "fiducial_distances_csv)", "nothing",
             )  # fmt: skip
-        for (source, field), measured, span in zip(where, d, spans, strict=True):
-            _check_film(source, field, measured, float(span))
+        for (where_file, field), measured, span in zip(where, d, spans, strict=True):
+            _check_film(where_file, field, measured, float(span))
         angles = tuple(math.radians(a) for a in (p.alpha_deg, p.omega_deg, p.kappa_deg))
         photos[p.number] = JobPhoto(p.number, centre, angles, (float(d[0]), float(d[1])))  # type: ignore[arg-type]
     unknown = sorted(set(csv_distances) - set(photos))
@@ -471,15 +470,15 @@ def _points(
     return tuple(points)
 
 
-def _map_sheets(fields: Fields, models: list[NamedSheet]) -> dict[str, MapSheet]:
+def _map_sheets(source: str, models: list[NamedSheet]) -> dict[str, MapSheet]:
     sheets: dict[str, MapSheet] = {}
     for i, m in enumerate(models):
         path = f"map_sheets[{i}]"
         if m.corners is not None:
             if len(m.corners) != 4:
-                raise fields.error(f"{path}.corners", "4 corners (NW, NE, SE, SW)",
+                raise ConfigError(source, f"{path}.corners", "4 corners (NW, NE, SE, SW)",
                                    f"{len(m.corners)} corners")
-            corners = np.array([_corner(fields, c, f"{path}.corners[{j}]")
+            corners = np.array([_corner(source, c, f"{path}.corners[{j}]")
                                 for j, c in enumerate(m.corners)])  # fmt: skip
             name = m.name or f"sheet {i + 1}"
             sheet = MapSheet(m.scale, corners, m.name)
@@ -488,55 +487,56 @@ def _map_sheets(fields: Fields, models: list[NamedSheet]) -> dict[str, MapSheet]
             try:
                 corners, scale = frame_tie.sheet_corners_sk42(m.nomenclature)
             except StereoplotterError as exc:
-                raise fields.error(f"{path}.nomenclature", "a valid SK-42 nomenclature",
+                raise ConfigError(source, f"{path}.nomenclature", "a valid SK-42 nomenclature",
                                    m.nomenclature, str(exc)) from None
             if scale != m.scale:
-                raise fields.error(f"{path}.scale", f"{scale} (the scale of {m.nomenclature})",
-                                   m.scale)
+                raise ConfigError(source, f"{path}.scale",
+                                  f"{scale} (the scale of {m.nomenclature})", m.scale)
             name = m.nomenclature
             sheet = MapSheet(m.scale, corners, m.nomenclature)
         if name in sheets:
-            raise fields.error(path, "a map sheet listed once", name)
+            raise ConfigError(source, path, "a map sheet listed once", name)
         sheets[name] = sheet
     return sheets
 
 
-def _corner(fields: Fields, c: Corner, path: str) -> tuple[float, float]:
+def _corner(source: str, c: Corner, path: str) -> tuple[float, float]:
     try:
         frame_tie.check_conventional_ordinate(c.east_m)
     except StereoplotterError as exc:
-        raise fields.error(
-            f"{path}.east_m", "a conventional ordinate", c.east_m, str(exc)
+        raise ConfigError(
+            source, f"{path}.east_m", "a conventional ordinate", c.east_m, str(exc)
         ) from None
     return (c.north_m, c.east_m)
 
 
 def _pairs(
-    fields: Fields, doc: JobFile, photos: dict[int, JobPhoto], sheets: dict[str, MapSheet]
+    source: str, doc: JobFile, photos: dict[int, JobPhoto], sheets: dict[str, MapSheet]
 ) -> tuple[JobPair, ...]:
     pairs = []
     for i, p in enumerate(doc.pairs):
         path = f"pairs[{i}]"
         for side in ("left", "right"):
             if getattr(p, side) not in photos:
-                raise fields.error(f"{path}.{side}", "a photo number of photos",
+                raise ConfigError(source, f"{path}.{side}", "a photo number of photos",
                                    getattr(p, side), f"photos: {sorted(photos)}")
         if p.left == p.right:
-            raise fields.error(f"{path}.right", "another photo than the left one", p.right)
+            raise ConfigError(source, f"{path}.right", "another photo than the left one", p.right)
         if p.map_sheet is not None and p.map_sheet not in sheets:
-            raise fields.error(f"{path}.map_sheet", "a sheet of map_sheets", p.map_sheet,
+            raise ConfigError(source, f"{path}.map_sheet", "a sheet of map_sheets", p.map_sheet,
                                "listed: " + (", ".join(sheets) or "none"))
         sheet = sheets[p.map_sheet] if p.map_sheet else None
         if sheet is None and len(sheets) == 1:
             sheet = next(iter(sheets.values()))
         if sheet is None and sheets:
-            raise fields.error(f"{path}.map_sheet", "the sheet of this pair (several are listed)",
-                               "nothing")
+            raise ConfigError(source, f"{path}.map_sheet",
+                              "the sheet of this pair (several are listed)", "nothing")
         area = None
         if p.working_area is not None:
             area = (p.working_area.lowest_m, p.working_area.highest_m)
             if area[0] > area[1]:
-                raise fields.error(f"{path}.working_area", "lowest_m ≤ highest_m", list(area))
+                raise ConfigError(source, f"{path}.working_area", "lowest_m ≤ highest_m",
+                                  list(area))
         pairs.append(JobPair(p.left, p.right, sheet, area))
     return tuple(pairs)
 

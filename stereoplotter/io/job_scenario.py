@@ -34,8 +34,8 @@ import yaml
 from stereoplotter.errors import ConfigError
 from stereoplotter.geometry.film import fiducial_spans_mm
 from stereoplotter.geometry.rotation import angles_from_matrix
+from stereoplotter.io.atomic_write import atomic_write_bytes
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair, measured_pair
-from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.scenario.model import Point
 
 __all__ = ["TerrainFit", "fit_terrain", "job_pair_scenario", "write_job_scenario"]

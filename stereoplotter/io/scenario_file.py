@@ -30,7 +30,7 @@ from stereoplotter.io.validation import (
     validate,
     vector,
 )
-from stereoplotter.io.yaml_files import load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.scenario.model import (
     FIDUCIAL_NAMES,

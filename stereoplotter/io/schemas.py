@@ -16,6 +16,7 @@ from typing import Any
 
 from pydantic import BaseModel
 
+from stereoplotter.io.atomic_write import atomic_write_text
 from stereoplotter.io.block_file import BlockFile
 from stereoplotter.io.budget_output import BudgetOutput
 from stereoplotter.io.errors_file import ErrorsFile
@@ -25,7 +26,6 @@ from stereoplotter.io.instrument_file import InstrumentFile
 from stereoplotter.io.job_file import JobFile
 from stereoplotter.io.scenario_file import ScenarioFile
 from stereoplotter.io.trainee_sheet import TraineeSheet
-from stereoplotter.io.yaml_files import atomic_write_text
 
 __all__ = ["MODELS", "schema", "schema_text", "write_schemas"]
 

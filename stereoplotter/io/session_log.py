@@ -15,7 +15,8 @@ from typing import Any
 
 from stereoplotter.errors import ConfigError
 from stereoplotter.io import exercise_file  # noqa: F401  (registers the exercise resolver)
-from stereoplotter.io.yaml_files import atomic_write_bytes, read_text_file
+from stereoplotter.io.atomic_write import atomic_write_bytes
+from stereoplotter.io.yaml_input import read_text_file
 from stereoplotter.trainer.session import LOG_FORMAT, Session
 
 __all__ = ["log_bytes", "read_log", "replay_log", "write_log"]

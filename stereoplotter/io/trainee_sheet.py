@@ -15,7 +15,7 @@ from typing import Any
 from pydantic import Field
 
 from stereoplotter.io.validation import FileModel, number, text, validate
-from stereoplotter.io.yaml_files import load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping
 
 __all__ = ["TraineeSheet", "load_trainee_sheet"]
 

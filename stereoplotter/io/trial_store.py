@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.io.yaml_files import atomic_stream
+from stereoplotter.io.atomic_write import atomic_stream
 
 __all__ = ["TrialStore"]
 

@@ -106,44 +106,63 @@ def plot_setup_sheet(sheet: Any, figure: Any = None) -> Any:
     ax_right = fig.add_subplot(grid[1, 2])
     mark = " *" if any(sheet.assumed.values()) else ""
 
-    def r6(value: float) -> float:  # the 6-decimal rounding of sheet.yaml, then the format
-        return round(float(value), 6) + 0.0
+    rows = _sheet_table_rows(sheet, mark)
+    _draw_sheet_table(ax_table, sheet, rows, mark)
+    _draw_instrument_plan(ax_sheet, sheet)
+    for ax, photo in ((ax_left, sheet.photos[0]), (ax_right, sheet.photos[1])):
+        _draw_fiducials(ax, photo)
+    return fig
 
-    bx, by, bz = (r6(v) for v in sheet.base_mm)
+
+def _r6(value: float) -> float:
+    """The 6-decimal rounding of sheet.yaml, then the format."""
+    return round(float(value), 6) + 0.0
+
+
+def _sheet_table_rows(sheet: Any, mark: str) -> list[tuple[str, str]]:
+    """Table 24's rows (quantity, value); ``mark`` flags a value on assumed parameters."""
+    bx, by, bz = (_r6(v) for v in sheet.base_mm)
     rows = [
         ("M_г", f"1:{sheet.horizontal_scale_denominator}{mark}"),
         ("M_в", f"1:{sheet.vertical_scale_denominator}{mark}"),
-        ("f_пр, mm", f"{r6(sheet.f_instrument_mm):.3f}{mark}"),
-        ("k", f"{r6(sheet.transformation_coefficient):.5f}"),
+        ("f_пр, mm", f"{_r6(sheet.f_instrument_mm):.3f}{mark}"),
+        ("k", f"{_r6(sheet.transformation_coefficient):.5f}"),
         ("b_x, mm", f"{bx:.3f}{mark}"),
         ("b_y, mm", f"{by:.3f}{mark}"),
         ("b_z′, mm", f"{bz:.3f}{mark}"),
-        ("n_л", f"{r6(sheet.n_left):.5f}{mark}"),
-        ("n_п", f"{r6(sheet.n_right):.5f}{mark}"),
+        ("n_л", f"{_r6(sheet.n_left):.5f}{mark}"),
+        ("n_п", f"{_r6(sheet.n_right):.5f}{mark}"),
     ]
     for photo in sheet.photos:
         side = "л" if photo.name == "left" else "п"
         rows += [
-            (f"({k[0]}⁰{k[1:]})_{side}, mm", f"{r6(v):.3f}")
+            (f"({k[0]}⁰{k[1:]})_{side}, mm", f"{_r6(v):.3f}")
             for k, v in photo.transformed_book_mm.items()
         ]
     left, right = sheet.photos
     rows += [
-        ("L_л, mm", f"{r6(left.mark_span_mm):.3f}{mark}"),
-        ("L_п, mm", f"{r6(right.mark_span_mm):.3f}{mark}"),
+        ("L_л, mm", f"{_r6(left.mark_span_mm):.3f}{mark}"),
+        ("L_п, mm", f"{_r6(right.mark_span_mm):.3f}{mark}"),
     ]
     for photo in sheet.photos:
         side = "л" if photo.name == "left" else "п"
-        dx, dy = (r6(v) for v in photo.decentration_mm)
+        dx, dy = (_r6(v) for v in photo.decentration_mm)
         rows.append((f"d_x, d_y {side}, mm", f"{dx:.3f}, {dy:.3f}"))
     rows += [
-        (f"Z_{h['id']}, mm", f"{r6(h['model_height_mm']):.3f}{mark}")
+        (f"Z_{h['id']}, mm", f"{_r6(h['model_height_mm']):.3f}{mark}")
         for h in sheet.control_heights
     ]
     rows += [
-        (f"x′{c['corner']}, y′{c['corner']}, mm", f"{r6(c['x_mm']):.2f}, {r6(c['y_mm']):.2f}{mark}")
+        (
+            f"x′{c['corner']}, y′{c['corner']}, mm",
+            f"{_r6(c['x_mm']):.2f}, {_r6(c['y_mm']):.2f}{mark}",
+        )
         for c in sheet.corners
     ]
+    return rows
+
+
+def _draw_sheet_table(ax_table: Any, sheet: Any, rows: list[tuple[str, str]], mark: str) -> None:
     ax_table.axis("off")
     table = ax_table.table(
         cellText=[list(r) for r in rows],
@@ -160,6 +179,10 @@ def plot_setup_sheet(sheet: Any, figure: Any = None) -> Any:
         + ("\n* rests on assumed instrument parameters" if mark else ""),
         fontsize=9,
     )
+
+
+def _draw_instrument_plan(ax_sheet: Any, sheet: Any) -> None:
+    """The map-sheet frame and the control in instrument coordinates from the left plumb."""
     # map-sheet frame and control in instrument coordinates
     if sheet.corners:
         xy = np.array([[c["x_mm"], c["y_mm"]] for c in sheet.corners])
@@ -194,41 +217,42 @@ def plot_setup_sheet(sheet: Any, figure: Any = None) -> Any:
     ax_sheet.grid(True, lw=0.3)
     ax_sheet.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.02, 0.5))
     ax_sheet.set_title("Instrument coordinates from the left plumb (S_л)", fontsize=9)
-    # fiducial diagrams
-    for ax, photo in ((ax_left, sheet.photos[0]), (ax_right, sheet.photos[1])):
-        marks = np.array([photo.marks_measured_mm[k] for k in ("1", "2", "3", "4")])
-        ax.scatter(marks[:, 0], marks[:, 1], marker="+", s=80, color="k", label="marks (measured)")
-        for key, value in photo.transformed_book_mm.items():
-            m = key[1:]
-            x, y = photo.marks_measured_mm[m]
-            tx, ty = (value, y) if key[0] == "x" else (x, value)
-            ax.annotate(
-                "",
-                (x + 5 * (tx - x), y + 5 * (ty - y)),
-                (x, y),
-                arrowprops={"arrowstyle": "->", "color": "tab:blue"},
-            )
-            ax.annotate(
-                f"{m}: {key[0]}⁰ = {value:.3f}",
-                (x, y),
-                fontsize=7,
-                textcoords="offset points",
-                xytext=(5, -10),
-            )
-        ax.plot([], [], color="tab:blue", label="to the (6.1)/(6.2) target ×5")
-        ax.axhline(0, color="0.7", lw=0.5)
-        ax.axvline(0, color="0.7", lw=0.5)
-        ax.set_xlim(-140, 140)
-        ax.set_ylim(-140, 140)
-        ax.set_aspect("equal")
-        ax.set_title(
-            f"{photo.name} photo: α = {np.degrees(photo.alpha):.4f}°, "
-            f"ω = {np.degrees(photo.omega):.4f}°",
-            fontsize=9,
+
+
+def _draw_fiducials(ax: Any, photo: Any) -> None:
+    """A photo's measured marks and the arrows to their (6.1)/(6.2) targets (×5)."""
+    marks = np.array([photo.marks_measured_mm[k] for k in ("1", "2", "3", "4")])
+    ax.scatter(marks[:, 0], marks[:, 1], marker="+", s=80, color="k", label="marks (measured)")
+    for key, value in photo.transformed_book_mm.items():
+        m = key[1:]
+        x, y = photo.marks_measured_mm[m]
+        tx, ty = (value, y) if key[0] == "x" else (x, value)
+        ax.annotate(
+            "",
+            (x + 5 * (tx - x), y + 5 * (ty - y)),
+            (x, y),
+            arrowprops={"arrowstyle": "->", "color": "tab:blue"},
         )
-        ax.set_xlabel("x [mm]")
-        ax.legend(fontsize=6, loc="upper right")
-    return fig
+        ax.annotate(
+            f"{m}: {key[0]}⁰ = {value:.3f}",
+            (x, y),
+            fontsize=7,
+            textcoords="offset points",
+            xytext=(5, -10),
+        )
+    ax.plot([], [], color="tab:blue", label="to the (6.1)/(6.2) target ×5")
+    ax.axhline(0, color="0.7", lw=0.5)
+    ax.axvline(0, color="0.7", lw=0.5)
+    ax.set_xlim(-140, 140)
+    ax.set_ylim(-140, 140)
+    ax.set_aspect("equal")
+    ax.set_title(
+        f"{photo.name} photo: α = {np.degrees(photo.alpha):.4f}°, "
+        f"ω = {np.degrees(photo.omega):.4f}°",
+        fontsize=9,
+    )
+    ax.set_xlabel("x [mm]")
+    ax.legend(fontsize=6, loc="upper right")
 
 
 def plot_residual_y_parallax(result: Any, ax: Any = None) -> Any:

@@ -1,36 +1,17 @@
-"""What ``stereoplotter budget`` prints and writes: the error budget as Markdown, JSON and a chart.
+"""The error budget as text: Markdown (one table per measure) and JSON.
 
-:func:`run_budget_command` loads the scenario and the instrument, runs
-:func:`stereoplotter.verification.budget.run_budget` and times it; :func:`budget_markdown`
-renders one table per measure; :func:`write_budget` writes ``budget.md``, ``budget.json`` and
-``budget.png`` into a folder, each whole or not at all (figures rendered before any write).
+The command (load, run, the chart, write) is :mod:`stereoplotter.commands.error_budget`.
 """
 
 from __future__ import annotations
 
-import io
 import json
-import math
-import time
-from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 from stereoplotter.constants import ARCSEC_PER_RAD
-from stereoplotter.errors import StereoplotterError
-from stereoplotter.instrument.error_model import error_model_from_spec
-from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.scenario_file import load_scenario
-from stereoplotter.io.yaml_files import atomic_write_bytes
-from stereoplotter.plotting.budget import plot_budget
-from stereoplotter.verification.budget import (
-    DEFAULT_BUDGET_TRIALS,
-    MEASURES,
-    budget_work,
-    run_budget,
-)
+from stereoplotter.verification.budget import MEASURES
 
-__all__ = ["budget_json", "budget_markdown", "run_budget_command", "write_budget"]
+__all__ = ["budget_json", "budget_markdown"]
 
 #: Decimals of each measure in the Markdown tables.
 _DECIMALS = {
@@ -38,44 +19,6 @@ _DECIMALS = {
     "height_error_rms_permille": 4,
     "plan_error_rms_map_mm": 4,
 }
-_FILES = ("budget.md", "budget.json", "budget.png")
-
-
-def run_budget_command(
-    scenario: str,
-    instrument: str,
-    method: str = "setup",
-    trials: int = DEFAULT_BUDGET_TRIALS,
-    seed: int | None = None,
-    progress_bar: Callable[[int], Any] | None = None,
-) -> dict[str, Any]:
-    """Load, run and time the budget; ``progress_bar(total)`` is a context giving ``advance(n)``.
-
-    The seed defaults to the scenario's own.
-    """
-    spec = load_instrument(instrument)
-    sc = load_scenario(scenario)
-    total = budget_work(error_model_from_spec(spec), trials)
-    start = time.perf_counter()
-    run_seed = sc.seed if seed is None else seed
-    if progress_bar is None:
-        out = run_budget(sc, spec, method, trials=trials, seed=run_seed)
-    else:
-        with progress_bar(total) as advance:
-            out = run_budget(sc, spec, method, trials=trials, seed=run_seed, progress=advance)
-    out["seconds"] = round(time.perf_counter() - start, 1)
-    return _finite(out)
-
-
-def _finite(v: Any) -> Any:
-    """NaN (a measure the scenario cannot give) → None, so the JSON is standard."""
-    if isinstance(v, dict):
-        return {k: _finite(x) for k, x in v.items()}
-    if isinstance(v, list):
-        return [_finite(x) for x in v]
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    return v
 
 
 def budget_json(budget: dict[str, Any]) -> str:
@@ -144,21 +87,3 @@ def _fmt(v: float | None, d: int) -> str:
     if v is None:
         return "—"
     return f"{v + 0.0 if round(v, d) != 0 else 0.0:.{d}f}"
-
-
-def write_budget(budget: dict[str, Any], folder: str | Path) -> list[str]:
-    """``budget.md``, ``budget.json``, ``budget.png`` into ``folder`` (each atomically)."""
-    fig = plot_budget(budget)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100, metadata={"Software": None})
-    contents = {
-        "budget.md": budget_markdown(budget).encode("utf-8"),
-        "budget.json": budget_json(budget).encode("utf-8"),
-        "budget.png": buffer.getvalue(),
-    }
-    out = Path(folder)
-    if out.exists() and not out.is_dir():
-        raise StereoplotterError(f"{out}: -o: expected a folder, found a file")
-    for name, content in contents.items():
-        atomic_write_bytes(out / name, content)
-    return list(_FILES)

@@ -18,11 +18,12 @@ instrument coordinates.
 from __future__ import annotations
 
 import datetime as _dt
+import importlib.util
 import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
-from importlib import resources
+from pathlib import Path
 from typing import Any
 
 from fpdf import FPDF
@@ -60,8 +61,14 @@ class FormHeader:
 
 
 def _font_path(style: str = "") -> str:
+    """The DejaVu font file matplotlib ships, found without importing matplotlib (its package
+    folder from the import system's spec: only ``plotting`` imports matplotlib)."""
     name = {"": "DejaVuSans.ttf", "B": "DejaVuSans-Bold.ttf"}[style]
-    return str(resources.files("matplotlib") / "mpl-data" / "fonts" / "ttf" / name)
+    spec = importlib.util.find_spec("matplotlib")
+    if spec is None or not spec.submodule_search_locations:  # pragma: no cover - a dependency
+        raise RuntimeError("matplotlib (a dependency) is not installed: no DejaVu font")
+    folder = Path(next(iter(spec.submodule_search_locations)))
+    return str(folder / "mpl-data" / "fonts" / "ttf" / name)
 
 
 class _Form(FPDF):
@@ -279,6 +286,12 @@ def _page_table24(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
 
 
 def _page_details(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
+    _details_orientation(pdf, sheet)
+    _details_control(pdf, sheet, h)
+
+
+def _details_orientation(pdf: _Form, sheet: SetupSheet) -> None:
+    """Transformed marks, angles and decentrations, the instrument's settings."""
     _heading(pdf, "Transformed marks: the book's (6.1)/(6.2) beside the rigorous (3.17), κ = 0")
     rows = []
     for p in sheet.photos:
@@ -319,6 +332,10 @@ def _page_details(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
         ]  # fmt: skip
         _table(pdf, ("symbol", "setting", "formula", "left", "right", "unit"), rows,
                (16, 62, 46, 22, 22, 12))  # fmt: skip
+
+
+def _details_control(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
+    """Height control, sheet corners, the similarity, the distortion, the tolerances."""
     _heading(pdf, "Height control: model heights Z_i (6.6)")
     rows = [
         (h_["id"], f"{h_['Z_m']:.2f}", f"{h_['flying_height_m']:.2f}",

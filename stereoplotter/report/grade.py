@@ -1,19 +1,15 @@
 """The grade of a trainee's session as Markdown and JSON (``trainer.grading.grade``).
 
-:func:`grade_markdown` formats the grade dict; :func:`write_grade` writes ``grade.md`` and
-``grade.json`` into a folder (atomically, with the user's umask).
+:func:`grade_markdown` formats the grade dict, :func:`grade_json` its JSON; the ``grade``
+command writes both (:mod:`stereoplotter.commands.grade`).
 """
 
 from __future__ import annotations
 
 import json
-import os
-from pathlib import Path
 from typing import Any
 
-from stereoplotter.io.yaml_files import atomic_write_text
-
-__all__ = ["grade_json", "grade_markdown", "write_grade"]
+__all__ = ["grade_json", "grade_markdown"]
 
 
 def _num(value: Any, unit: str = "") -> str:
@@ -89,13 +85,3 @@ def grade_markdown(grade: dict[str, Any]) -> str:
         "",
     ]
     return "\n".join(lines)
-
-
-def write_grade(grade: dict[str, Any], folder: str | os.PathLike[str]) -> list[Path]:
-    """Write ``grade.md`` and ``grade.json`` into ``folder`` (created if missing)."""
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [out / "grade.md", out / "grade.json"]
-    atomic_write_text(paths[0], grade_markdown(grade))
-    atomic_write_text(paths[1], grade_json(grade))
-    return paths

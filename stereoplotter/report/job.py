@@ -1,12 +1,11 @@
-"""A production job at the edge: every pair's sheet, its printable form, the block summary.
+"""A production job's files: every pair's sheet, its printable form, the block summary.
 
-:func:`run_job` loads a job file (:mod:`stereoplotter.io.job_file`), computes each pair's sheet
-from its *measured* inputs with the one Table 24 computation (all pairs in one vectorised call:
-:func:`stereoplotter.setup.sheet.compute_sheets_from_measurements`), and :func:`write_job` writes
-per pair ``PAIR/sheet.yaml``, ``PAIR/sheet.md`` and ``PAIR/sheet.pdf`` (the form,
-:mod:`stereoplotter.report.forms`), and for the job ``forms.pdf`` (all forms), ``block.csv`` and
-``refused.md`` (the pairs the instrument cannot take, with the reason). No clock and no random
-number is read: the same job gives the same files, byte for byte.
+:func:`job_files` renders a computed job (:class:`JobResult`, made by
+:func:`stereoplotter.commands.setup_job.compute_job`) as per pair ``PAIR/sheet.yaml``,
+``PAIR/sheet.md`` and ``PAIR/sheet.pdf`` (the form, :mod:`stereoplotter.report.forms`), and for
+the job ``forms.pdf`` (all forms), ``block.csv`` and ``refused.md`` (the pairs the instrument
+cannot take, with the reason). No clock and no random number is read: the same job gives the
+same files, byte for byte.
 """
 
 from __future__ import annotations
@@ -14,35 +13,28 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from stereoplotter import __version__
-from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.instrument.spec import InstrumentSpec
-from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import Job, JobPair, MeasuredPair, load_job, measured_pair
-from stereoplotter.io.yaml_files import atomic_write_bytes
+from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
+from stereoplotter.io.yaml_output import yaml_text
 from stereoplotter.report.forms import FormHeader, form_pdf, forms_pdf
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
-from stereoplotter.setup.records import SetupOptions, SetupRefusal, SetupSheet
-from stereoplotter.setup.sheet import compute_sheets_from_measurements
+from stereoplotter.setup.records import SetupSheet
 
 __all__ = [
     "JobResult",
     "PairResult",
     "block_csv",
-    "compute_job",
     "form_header",
+    "job_files",
     "pair_dict",
     "refused_markdown",
-    "run_job",
-    "write_job",
 ]
 
 
@@ -65,69 +57,6 @@ class JobResult:
     job: Job
     spec: InstrumentSpec
     pairs: tuple[PairResult, ...]
-
-
-def _instrument(job: Job) -> InstrumentSpec:
-    """The job's instrument: a shipped name, or a YAML path relative to the job file (an unknown
-    name is refused as the job's field ``instrument``; a bad YAML file names itself)."""
-    beside = Path(job.source).parent / job.instrument
-    if beside.suffix in (".yaml", ".yml") and beside.exists():
-        return load_instrument(beside)
-    try:
-        return load_instrument(job.instrument)
-    except StereoplotterError as exc:
-        if str(exc).startswith(f"{job.instrument}: "):  # a YAML path that names itself
-            raise
-        raise ConfigError(job.source, "instrument", "a shipped instrument (sc1, spr3, sd3) or "
-                          "a YAML file beside the job", job.instrument, str(exc)) from None
-
-
-def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
-    """Every pair's sheet from its measured inputs; a refused pair keeps its reason.
-
-    The pairs' Table 24 is one vectorised call (per-pair f′ and marks,
-    :func:`~stereoplotter.setup.sheet.compute_sheets_from_measurements`); each sheet is the one
-    the pair alone would give, to the bit.
-    """
-    spec = spec or _instrument(job)
-    options = SetupOptions(
-        book_sign_n_right=job.book_sign,
-        horizontal_scale_denominator=job.horizontal_scale,
-        vertical_scale_denominator=job.vertical_scale,
-        bz_scale_sense=job.bz_scale_sense,
-    )
-    measured: list[MeasuredPair | SetupRefusal] = []
-    for pair in job.pairs:
-        try:
-            measured.append(measured_pair(job, pair))
-        except SetupRefusal as exc:
-            measured.append(exc)
-    ready = [m for m in measured if isinstance(m, MeasuredPair)]
-    sheets = iter(compute_sheets_from_measurements(
-        [m.sheet_arguments() for m in ready], spec=spec, options=options, source=job.source,
-        name=job.name,
-    ))  # fmt: skip
-    out = []
-    for pair, m in zip(job.pairs, measured, strict=True):
-        if isinstance(m, SetupRefusal):
-            out.append(PairResult(pair, None, None, str(m)))
-            continue
-        sheet = next(sheets)
-        if isinstance(sheet, SetupRefusal):
-            out.append(PairResult(pair, m, None, str(sheet)))
-        else:
-            out.append(PairResult(pair, m, sheet, ""))
-    return JobResult(job, spec, tuple(out))
-
-
-def run_job(
-    path: str | os.PathLike[str], output_dir: str | os.PathLike[str] | None = None
-) -> JobResult:
-    """Load a job file, compute every pair and optionally write the files (:func:`write_job`)."""
-    result = compute_job(load_job(path))
-    if output_dir is not None:
-        write_job(result, output_dir)
-    return result
 
 
 def _frame_text(m: MeasuredPair | None) -> str:
@@ -248,15 +177,14 @@ def refused_markdown(result: JobResult) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_job(result: JobResult, output_dir: str | os.PathLike[str]) -> list[str]:
-    """Write the files of a job (everything rendered before anything is written); the names."""
-    out = Path(output_dir)
+def job_files(result: JobResult) -> dict[str, bytes]:
+    """Every file of a job, rendered in memory: per pair ``PAIR/sheet.yaml`` (and, set up,
+    ``sheet.md`` and the form ``sheet.pdf``), ``forms.pdf``, ``block.csv`` and ``refused.md``."""
     files: dict[str, bytes] = {}
     forms = []
     for p in result.pairs:
         data = pair_dict(result.job, p)
-        text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True, width=100)
-        files[f"{p.pair.name}/sheet.yaml"] = text.encode("utf-8")
+        files[f"{p.pair.name}/sheet.yaml"] = yaml_text(data, width=100).encode("utf-8")
         if p.sheet is None:
             continue
         header = form_header(result.job, p)
@@ -268,7 +196,4 @@ def write_job(result: JobResult, output_dir: str | os.PathLike[str]) -> list[str
                                        result.job.date)  # fmt: skip
     files["block.csv"] = block_csv(result).encode("utf-8")
     files["refused.md"] = refused_markdown(result).encode("utf-8")
-    for name, content in files.items():
-        atomic_write_bytes(out / name, content)
-    return list(files)
-
+    return files

@@ -70,6 +70,54 @@ NOT_IN_BLOCK_MODE = {
 }
 
 
+def _marks_dict(table: BlockResult, i: int) -> dict[str, Any]:
+    """The marks' settings of pair ``i``: transformed and rigorous fiducials, L, decentrations."""
+    photos = ("left", "right")
+    fid, rig = table.fiducials_transformed_mm[i], table.fiducials_rigorous_mm[i]
+    return {
+        "fiducials_transformed_mm": {
+            p: {f"x{X_MARK_NAME[j]}": _num(fid[j, 0]), "y3": _num(fid[j, 1]), "y4": _num(fid[j, 2])}
+            for j, p in enumerate(photos)
+        },
+        "fiducials_rigorous_mm": {
+            p: {
+                key: [_num(rig[j, m, 0]), _num(rig[j, m, 1])]
+                for m, key in enumerate((X_MARK_NAME[j], "3", "4"))
+            }
+            for j, p in enumerate(photos)
+        },
+        "L_mm": dict(zip(photos, map(_num, table.mark_span_mm[i]), strict=True)),
+        "decentrations_mm": {
+            p: dict(zip("xy", map(_num, table.decentration_mm[i, j]), strict=True))
+            for j, p in enumerate(photos)
+        },
+    }
+
+
+def _angles_dict(table: BlockResult, i: int) -> dict[str, Any]:
+    """The correction mechanism's inclinations and the photos' angles of pair ``i`` [°]."""
+    photos = ("left", "right")
+    return {
+        "correction_inclinations_deg": {
+            p: dict(
+                zip(
+                    ("alpha", "omega"),
+                    (_num(math.degrees(v)) for v in table.correction_inclination[i, j]),
+                    strict=True,
+                )
+            )
+            for j, p in enumerate(photos)
+        },
+        "angles_deg": {
+            p: {
+                a: _num(math.degrees(table.angles[i, j, m]), 7)
+                for m, a in enumerate(("alpha", "omega", "kappa"))
+            }
+            for j, p in enumerate(photos)
+        },
+    }
+
+
 def setup_dict(table: BlockResult, i: int, sheet: SetupSheet | None = None) -> dict[str, Any]:
     """Pair ``i`` of a Table 24 computation as plain data: the one serialiser of setup sheets.
 
@@ -90,8 +138,6 @@ def setup_dict(table: BlockResult, i: int, sheet: SetupSheet | None = None) -> d
         The keys of ``sheet.yaml`` and of the ``--json`` output, the same for both. [mm, —, °]
     """
     ok = bool(table.accepted[i])
-    photos = ("left", "right")
-    fid, rig = table.fiducials_transformed_mm[i], table.fiducials_rigorous_mm[i]
     assumed = sheet.assumed if sheet is not None else assumed_parameters(table.spec)
     data: dict[str, Any] = {
         "scenario": sheet.scenario if sheet is not None else None,
@@ -114,40 +160,9 @@ def setup_dict(table: BlockResult, i: int, sheet: SetupSheet | None = None) -> d
         "n_left": _num(table.n_left[i]),
         "n_right": _num(table.n_right[i]),
         "base_mm": dict(zip(("bx", "by", "bz"), map(_num, table.base_mm[i]), strict=True)),
-        "fiducials_transformed_mm": {
-            p: {f"x{X_MARK_NAME[j]}": _num(fid[j, 0]), "y3": _num(fid[j, 1]), "y4": _num(fid[j, 2])}
-            for j, p in enumerate(photos)
-        },
-        "fiducials_rigorous_mm": {
-            p: {
-                key: [_num(rig[j, m, 0]), _num(rig[j, m, 1])]
-                for m, key in enumerate((X_MARK_NAME[j], "3", "4"))
-            }
-            for j, p in enumerate(photos)
-        },
-        "L_mm": dict(zip(photos, map(_num, table.mark_span_mm[i]), strict=True)),
-        "decentrations_mm": {
-            p: dict(zip("xy", map(_num, table.decentration_mm[i, j]), strict=True))
-            for j, p in enumerate(photos)
-        },
+        **_marks_dict(table, i),
         "instrument_settings": instrument_settings(table, i),
-        "correction_inclinations_deg": {
-            p: dict(
-                zip(
-                    ("alpha", "omega"),
-                    (_num(math.degrees(v)) for v in table.correction_inclination[i, j]),
-                    strict=True,
-                )
-            )
-            for j, p in enumerate(photos)
-        },
-        "angles_deg": {
-            p: {
-                a: _num(math.degrees(table.angles[i, j, m]), 7)
-                for m, a in enumerate(("alpha", "omega", "kappa"))
-            }
-            for j, p in enumerate(photos)
-        },
+        **_angles_dict(table, i),
         "control_heights_model_mm": {
             pid: _num(table.control_heights_model_mm[i, j])
             for j, pid in enumerate(table.height_point_ids[i])
@@ -346,8 +361,15 @@ def _settings_lines(settings: dict[str, Any] | None, title: str) -> list[str]:
 def sheet_markdown(sheet: SetupSheet) -> str:
     """Table 24 and the stage-by-stage list of readings, as Markdown."""
     d = sheet_to_dict(sheet)
-    flag = {k: " **(assumed)**" if params else "" for k, params in sheet.assumed.items()}
-    left, right = sheet.photos
+    lines = _intro_lines(sheet) + _table24_lines(sheet) + _similarity_lines(d)
+    lines += _mark_comparison_lines(sheet)
+    lines += _settings_lines(d["instrument_settings"], sheet.instrument_title)
+    lines += _readings_lines(sheet)
+    return "\n".join(lines) + "\n"
+
+
+def _intro_lines(sheet: SetupSheet) -> list[str]:
+    """The title, the source and the scale chain."""
     m_map = sheet.map_scale_denominator
     chain = (  # no map sheet: the horizontal scale was forced, there is no coordinatograph ratio
         f"no map sheet → horizontal model scale M_г = 1:{sheet.horizontal_scale_denominator} "
@@ -355,7 +377,7 @@ def sheet_markdown(sheet: SetupSheet) -> str:
         f"map 1:{m_map} → horizontal model scale M_г = 1:{sheet.horizontal_scale_denominator} "
         f"(coordinatograph ratio {sheet.horizontal_scale_denominator / m_map:g})"
     )  # fmt: skip
-    lines = [
+    return [
         f"# Setup sheet — {sheet.scenario} on {sheet.instrument_title}",
         "",
         "Computed by stereoplotter after Kushtin & Lyskov (1984), §26, Table 24. Values marked "
@@ -368,6 +390,15 @@ def sheet_markdown(sheet: SetupSheet) -> str:
         f"projection distances of the working area {sheet.depth_range_used_mm[0]:.1f} … "
         f"{sheet.depth_range_used_mm[1]:.1f} mm.",
         "",
+    ]
+
+
+def _table24_lines(sheet: SetupSheet) -> list[str]:
+    """Table 24: scales, f_пр, f′, base, n, marks, spans, decentrations, controls, heights,
+    sheet corners; an assumed value flagged."""
+    flag = {k: " **(assumed)**" if params else "" for k, params in sheet.assumed.items()}
+    left, right = sheet.photos
+    lines = [
         "## Table 24",
         "",
         "| quantity | symbol | value | unit | equation |",
@@ -409,6 +440,12 @@ def sheet_markdown(sheet: SetupSheet) -> str:
             f"{_fmt(c['x_mm'])}, {_fmt(c['y_mm'])}{flag['sheet_corners_mm']} | mm | "
             "(6.7) |"
         )
+    return lines
+
+
+def _similarity_lines(d: dict[str, Any]) -> list[str]:
+    """The similarity (6.8) on the control points, if the sheet has a map."""
+    lines: list[str] = []
     if d["similarity"]:
         s = d["similarity"]
         lines += [
@@ -420,7 +457,12 @@ def sheet_markdown(sheet: SetupSheet) -> str:
             + ", ".join(f"{k}: ({_pm(v[0])}, {_pm(v[1])})" for k, v in s["residuals_m"].items())
             + " m.",
         ]
-    lines += [
+    return lines
+
+
+def _mark_comparison_lines(sheet: SetupSheet) -> list[str]:
+    """The book's single-axis (6.1)/(6.2) marks against the rigorous (3.17)."""
+    lines = [
         "",
         "Transformed mark coordinates: the book's single-axis (6.1)/(6.2) against the "
         "rigorous (3.17) (κ = 0):",
@@ -437,8 +479,12 @@ def sheet_markdown(sheet: SetupSheet) -> str:
                 f"| {p.name} | {key} | {value:.4f} | {rig[0]:.4f}, {rig[1]:.4f} | "
                 f"{(value - rig[axis]) * 1000:+.2f} |"
             )
-    lines += _settings_lines(d["instrument_settings"], sheet.instrument_title)
-    lines += [
+    return lines
+
+
+def _readings_lines(sheet: SetupSheet) -> list[str]:
+    """Every reading stage by stage, and the assumed parameters used."""
+    lines = [
         "",
         "## Readings, stage by stage",
         "",
@@ -470,4 +516,4 @@ def sheet_markdown(sheet: SetupSheet) -> str:
             "These values come from no documented source; adjust them in the instrument "
             "YAML if yours differs: " + ", ".join(f"`{p}`" for p in params) + ".",
         ]
-    return "\n".join(lines) + "\n"
+    return lines

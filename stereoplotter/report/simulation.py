@@ -1,74 +1,24 @@
-"""What ``stereoplotter simulate`` prints and writes.
-
-One procedure (no ``--trials``): the transcript, the evaluation of the built model (values and
-per point), a Markdown summary and a parallax map. ``--trials T``: the trials run in chunks
-under a memory budget (``procedure.trials``); their per-trial measures are spooled to disk
-(``trial_store``) and summarised per measure with Monte Carlo standard errors; with an output
-folder the per-trial columns go to ``trials.npz``, the transcript and the map are of trial 0.
-
-Every file is written whole or not at all; the same seed gives byte-identical files.
+"""The texts of ``stereoplotter simulate``: the Markdown summary of a run (one procedure, or
+statistics over trials), the learner's transcript with its closing summary and the operator's
+advice. The command itself (load, run, write) is :mod:`stereoplotter.commands.simulate`.
 """
 
 from __future__ import annotations
 
-import io
-import json
-import logging
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from stereoplotter.errors import ConfigError, did_you_mean
-from stereoplotter.instrument.sc1_complex import SC1Options
-from stereoplotter.io.errors_file import load_error_model
-from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.scenario_file import load_scenario
-from stereoplotter.io.trial_store import TrialStore
-from stereoplotter.io.yaml_files import atomic_write_bytes, load_yaml_mapping
-from stereoplotter.plotting.figures import plot_residual_y_parallax
-from stereoplotter.procedure.operator import OperatorModel
-from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
-from stereoplotter.procedure.trials import (
-    DEFAULT_MEMORY_BUDGET_MB,
-    chunk_trials_for,
-    iter_trial_chunks,
-    run_info,
-    summarise_columns,
-    summarise_result,
-    trial_columns,
-)
+from stereoplotter.procedure.simulate import SimulationResult
 
 __all__ = [
-    "SimulationOutcome",
-    "load_operator_model",
-    "run_simulation_command",
+    "OPERATOR_ADVICE",
+    "closing_summary",
     "simulation_markdown",
-    "write_simulation",
+    "tolerance_note",
+    "transcript_text",
+    "trial0_texts",
 ]
-
-log = logging.getLogger(__name__)
-
-
-def _plain(v: Any) -> Any:
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    if isinstance(v, np.generic):
-        return v.item()
-    return str(v)
-
-
-def json_ready(data: Any) -> Any:
-    """Plain lists, floats and strings only."""
-    return json.loads(json.dumps(data, default=_plain))
-
-
-def _yaml(data: Any) -> str:
-    import yaml
-
-    return yaml.safe_dump(json_ready(data), sort_keys=False, allow_unicode=True)
 
 
 def _g(v: Any) -> str:
@@ -145,6 +95,36 @@ def _remedy_lines(s: dict[str, Any], single: bool) -> list[str]:
     return lines
 
 
+def _single_run_lines(s: dict[str, Any]) -> list[str]:
+    """The summary of one procedure: checks, remedies, residual y-parallax, iterations."""
+    lines = [
+        f"back-end {s['backend']}, seed {s['seed']}, one procedure; operator judgment "
+        "errors are assumed values.",
+        "",
+        "| check | residual | tolerance | passed | iterations |",
+        "|---|---|---|---|---|",
+    ]
+    for name, c in s["checks"].items():
+        label = name.replace("|", "\\|")
+        lines.append(
+            f"| {label} | {_g(c['residual'])} {c['unit']} | {_g(c.get('tolerance'))} | "
+            f"{c.get('passed', '—')} | {_g(c.get('iterations'))} |"
+        )
+    lines += _remedy_lines(s, single=True)
+    q = s["residual_y_parallax_um"]
+    lines += [
+        "",
+        f"Residual y-parallax of the built model (truth): max {_g(q['standard_points_max'])} "
+        f"µm at the six standard points; over the grid max {_g(q['grid_max'])} µm, "
+        f"RMS {_g(q['grid_rms'])} µm.",
+        "",
+        "Iterations per stage: "
+        + ", ".join(f"{k}: {_g(v)}" for k, v in s["iterations"].items()),
+        "",
+    ]
+    return lines
+
+
 def simulation_markdown(s: dict[str, Any]) -> str:
     """The Markdown summary of a run (one procedure, or statistics over trials)."""
     trials = s.get("trials")
@@ -153,32 +133,7 @@ def simulation_markdown(s: dict[str, Any]) -> str:
         "",
     ]
     if trials is None:
-        lines += [
-            f"back-end {s['backend']}, seed {s['seed']}, one procedure; operator judgment "
-            "errors are assumed values.",
-            "",
-            "| check | residual | tolerance | passed | iterations |",
-            "|---|---|---|---|---|",
-        ]
-        for name, c in s["checks"].items():
-            label = name.replace("|", "\\|")
-            lines.append(
-                f"| {label} | {_g(c['residual'])} {c['unit']} | {_g(c.get('tolerance'))} | "
-                f"{c.get('passed', '—')} | {_g(c.get('iterations'))} |"
-            )
-        lines += _remedy_lines(s, single=True)
-        q = s["residual_y_parallax_um"]
-        lines += [
-            "",
-            f"Residual y-parallax of the built model (truth): max {_g(q['standard_points_max'])} "
-            f"µm at the six standard points; over the grid max {_g(q['grid_max'])} µm, "
-            f"RMS {_g(q['grid_rms'])} µm.",
-            "",
-            "Iterations per stage: "
-            + ", ".join(f"{k}: {_g(v)}" for k, v in s["iterations"].items()),
-            "",
-        ]
-        return "\n".join(lines)
+        return "\n".join(lines + _single_run_lines(s))
     chunks = s.get("chunks", {})
     lines += [
         f"back-end {s['backend']}, seed {s['seed']}, {trials} trials"
@@ -226,18 +181,6 @@ def simulation_markdown(s: dict[str, Any]) -> str:
             "",
         ]
     return "\n".join(lines)
-
-
-def _parallax_png(result: SimulationResult) -> bytes:
-    """The true residual y-parallax over the working-area grid (trial 0) as a PNG."""
-
-    fig = plot_residual_y_parallax(result)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
-    return buf.getvalue()
 
 
 #: What a real operator does when a check still fails after the simulated operator's remedies
@@ -320,157 +263,9 @@ def transcript_text(result: SimulationResult) -> str:
     return result.transcript.to_text() + "\n" + closing_summary(result)
 
 
-def _trial0_files(result: SimulationResult) -> dict[str, bytes]:
+def trial0_texts(result: SimulationResult) -> dict[str, bytes]:
+    """``transcript.txt`` (:func:`transcript_text`) and ``transcript.jsonl`` of trial 0."""
     return {
         "transcript.txt": transcript_text(result).encode("utf-8"),
         "transcript.jsonl": result.transcript.to_jsonl().encode("utf-8"),
-        "parallax.png": _parallax_png(result),
     }
-
-
-def write_simulation(result: SimulationResult, out_dir: str | Path) -> dict[str, Path]:
-    """Write one run's transcript.txt, transcript.jsonl, evaluation.yaml, evaluation.md,
-    parallax.png (a vectorised result: the summary over its trials, trial 0's transcript)."""
-    s = summarise_result(result)
-    files = _trial0_files(result)
-    files["evaluation.yaml"] = _yaml(s).encode("utf-8")
-    files["evaluation.md"] = simulation_markdown(s).encode("utf-8")
-    return _write_all(Path(out_dir), files)
-
-
-def _write_all(out: Path, files: dict[str, bytes]) -> dict[str, Path]:
-    paths = {}
-    for name, data in files.items():
-        atomic_write_bytes(out / name, data)
-        paths[name] = out / name
-    log.info("wrote %s in %s", ", ".join(sorted(files)), out)
-    return paths
-
-
-_OPERATOR_FIELDS: dict[str, tuple[str, Any]] = {
-    "monocular_sigma_mm": ("a number ≥ 0 [mm]", float),
-    "stereo_sigma_mm": ("a number ≥ 0 [mm]", float),
-    "y_parallax_sigma_mm": ("a number ≥ 0 [mm]", float),
-    "reading_sigma_lc": ("a number ≥ 0 [least counts]", float),
-    "setting_sigma_lc": ("a number ≥ 0 [least counts]", float),
-    "quantise": ("true or false", bool),
-    "finish_side": ("below, above or null", str),
-    "max_iterations": ("an integer 1 … 100", int),
-}
-
-
-def load_operator_model(value: str | Path | OperatorModel | None) -> OperatorModel | None:
-    """The operator an ``--operator`` value names: None (the defaults), "zero" (no judgment,
-    reading or setting error, no quantisation: ``OperatorModel().zero()``) or a YAML file of
-    :class:`OperatorModel` fields (the others keep their defaults); a bad entry is one
-    :class:`ConfigError` naming the file and the field."""
-    if value is None or isinstance(value, OperatorModel):
-        return value
-    if str(value) == "zero":
-        return OperatorModel().zero()
-
-    data, source = load_yaml_mapping(value)
-    fields: dict[str, Any] = {}
-    for key, v in data.items():
-        if key not in _OPERATOR_FIELDS:
-            raise ConfigError(
-                source,
-                str(key),
-                "a field of OperatorModel",
-                key,
-                did_you_mean(str(key), sorted(_OPERATOR_FIELDS)),
-            )
-        expected, kind = _OPERATOR_FIELDS[key]
-        ok = {
-            float: isinstance(v, int | float) and not isinstance(v, bool) and 0 <= v < float("inf"),
-            bool: isinstance(v, bool),
-            int: isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 100,
-            str: v is None or v in ("below", "above"),
-        }[kind]
-        if not ok:
-            raise ConfigError(source, str(key), expected, v)
-        fields[key] = float(v) if kind is float else v
-    return OperatorModel(**fields)
-
-
-@dataclass
-class SimulationOutcome:
-    """What the command produced: the summary, its Markdown, the files written."""
-
-    summary: dict[str, Any]
-    text: str
-    files: dict[str, Path]
-
-
-def run_simulation_command(
-    scenario_path: str | Path,
-    instrument: str = "sc1",
-    method: str = "setup",
-    errors: str | None = None,
-    seed: int | None = None,
-    trials: int | None = None,
-    backend: str = "closed-form",
-    output: str | Path | None = None,
-    *,
-    memory_mb: float = DEFAULT_MEMORY_BUDGET_MB,
-    progress: Callable[[int], None] | None = None,
-    operator: str | Path | OperatorModel | None = None,
-    practice: str = "operator",
-    options: Sequence[str] = (),
-) -> SimulationOutcome:
-    """What ``stereoplotter simulate`` does: run, summarise, write the files if ``output``.
-
-    ``seed`` defaults to the scenario's seed; ``errors`` is None (instrument defaults), "zero" or
-    an errors YAML path. ``trials`` runs in chunks that fit ``memory_mb``; the summary holds
-    statistics, never per-trial arrays (those go to ``trials.npz`` in ``output``).
-    ``progress(n)`` is told the trials each finished chunk ran. ``operator`` is None (the
-    assumed defaults), "zero" or a YAML of OperatorModel fields (:func:`load_operator_model`).
-    ``practice`` is "operator" (remedies after a failed check) or "book" (§27 task 1, none).
-    ``options`` names the SC complex's options fitted to the SC-1 (``correction_unit``,
-    ``automatic_coordinatograph``; :class:`~stereoplotter.instrument.sc1_complex.SC1Options`).
-    """
-    scenario = load_scenario(scenario_path)
-    spec = load_instrument(instrument)
-    fitted = SC1Options.from_names(spec, options)
-    seed = scenario.seed if seed is None else seed
-    prep = prepare_run(
-        scenario,
-        spec,
-        method,
-        load_error_model(errors, spec),
-        seed,
-        backend,
-        operator=load_operator_model(operator),
-        practice=practice,
-        options=fitted,
-    )
-    out = None if output is None else Path(output)
-    if trials is None:
-        result = run_trials_chunk(prep, 0, None)
-        summary = json_ready(summarise_result(result))
-        files = {} if out is None else write_simulation(result, out)
-        if progress is not None:
-            progress(1)
-    else:
-        chunk = chunk_trials_for(memory_mb, method)
-        log.info("%d trials in chunks of %d (memory budget %g MB)", trials, chunk, memory_mb)
-        info = None
-        with TrialStore() as store:
-            for result in iter_trial_chunks(prep, trials, chunk, progress=progress):
-                if info is None:  # the first chunk: trial 0's transcript and map
-                    info = run_info(result, trials)
-                    trial0 = _trial0_files(result) if out is not None else {}
-                store.append(trial_columns(result))
-            extra = {"chunks": {"trials": chunk, "count": -(-trials // chunk)}}
-            summary = json_ready(summarise_columns(info, store.columns(), extra))
-            files = {}
-            if out is not None:
-                trial0["evaluation.yaml"] = _yaml(summary).encode("utf-8")
-                trial0["evaluation.md"] = simulation_markdown(summary).encode("utf-8")
-                files = _write_all(out, trial0)
-                store.write_npz(out / "trials.npz")
-                files["trials.npz"] = out / "trials.npz"
-    text = simulation_markdown(summary)
-    if files:
-        text += f"\nwritten: {', '.join(sorted(files))} in {out}\n"
-    return SimulationOutcome(summary, text, files)

@@ -1,74 +1,16 @@
-"""The verification table as files: Markdown, CSV and JSON, and the ``verify`` entry point."""
+"""The verification table as text: Markdown, CSV and JSON files, and the console summary."""
 
 from __future__ import annotations
 
 import csv
 import io
 import json
-import time
-from pathlib import Path
 
-from stereoplotter.io.geometry_file import geometry_from_file
-from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.paths import data_dir
-from stereoplotter.io.scenario_file import load_scenario
-from stereoplotter.io.yaml_files import atomic_write_bytes
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification import table
-from stereoplotter.verification.table import (
-    ROW_KEYS,
-    closing_comparison,
-    run_verification,
-)
+from stereoplotter.verification.table import ROW_KEYS, closing_comparison
 
-__all__ = [
-    "book_instrument",
-    "book_scenarios",
-    "run_procedure_mc",
-    "start_procedure_mc",
-    "verify",
-    "write_verification",
-]
-
-#: The book's §27 setting: the shipped scenarios of the procedure MC per overlap slot, and SC-1.
-BOOK_SCENARIOS = {"60": "pair60.yaml", "80": "pair80.yaml"}
-BOOK_INSTRUMENT = "sc1"
-
-
-def book_scenarios() -> dict:
-    """The shipped ``pair60``/``pair80`` scenarios, loaded, as "60"/"80" slots of the procedure MC.
-
-    Always the shipped files (never a user folder's file of the same name): they are the book's.
-    """
-    folder = data_dir("scenarios")
-    return {slot: load_scenario(folder / name) for slot, name in BOOK_SCENARIOS.items()}
-
-
-def book_instrument(name: str = BOOK_INSTRUMENT):
-    """The instrument of the procedure MC: the book's SC-1 (``sc1``, by name as ever), or the
-    instrument ``name`` (``verify --instrument``)."""
-    return load_instrument(name)
-
-
-def run_procedure_mc(
-    trials=None, seed=20240601, scenarios=None, progress=None, instrument=BOOK_INSTRUMENT
-):
-    """:func:`stereoplotter.verification.table.run_procedure_mc` with the files loaded here:
-    ``scenarios`` (loaded, "60"/"80" → Scenario or None) default to the book's
-    (:func:`book_scenarios`), the instrument by name (default the book's SC-1). ``trials``:
-    None for the per-configuration defaults, 0 for none."""
-    return start_procedure_mc(trials, seed, scenarios, instrument).result(progress)
-
-
-def start_procedure_mc(trials=None, seed=20240601, scenarios=None, instrument=BOOK_INSTRUMENT):
-    """:func:`stereoplotter.verification.table.start_procedure_mc` with the files loaded here
-    (arguments as :func:`run_procedure_mc`): the runs start in worker processes."""
-    if trials == 0:
-        return table.PendingProcedureMC([], [], 1)
-    if scenarios is None:
-        scenarios = book_scenarios()
-    spec = book_instrument(instrument) if any(scenarios.values()) else None
-    return table.start_procedure_mc(trials, seed, scenarios, instrument=spec)
+__all__ = ["verification_console", "verification_files", "verification_markdown"]
 
 
 def _fmt(v, digits=4):
@@ -95,7 +37,9 @@ def _procedure_trials_text(trials) -> str:
     return f", procedure MC trials = {trials}"
 
 
-def _markdown(rows, closing, meta):
+def verification_markdown(rows, closing, meta):
+    """``verification.md``: the rows and the closing comparison; ``meta`` holds trials, seed,
+    seconds and procedure_trials."""
     lines = [
         "# Verification of Kushtin & Lyskov 1984, §27 and chapter 5",
         "",
@@ -144,18 +88,11 @@ def _markdown(rows, closing, meta):
     return "\n".join(lines) + "\n"
 
 
-def write_verification(
-    rows: list[dict], out_dir, *, trials=None, seed=None, seconds=0.0, procedure_trials=None
-):
-    """Write ``verification.md``, ``verification.csv``, ``verification.json`` and
-    ``closing_comparison.json`` to ``out_dir``, each whole or not at all.
-
-    Returns
-    -------
-    list of pathlib.Path
-        The files written.
-    """
-    out = Path(out_dir)
+def verification_files(
+    rows: list[dict], *, trials=None, seed=None, seconds=0.0, procedure_trials=None
+) -> dict[str, bytes]:
+    """``verification.md``, ``verification.csv``, ``verification.json`` and
+    ``closing_comparison.json`` of the rows, rendered in memory."""
     closing = closing_comparison(rows)
     meta = {
         "trials": trials,
@@ -169,64 +106,35 @@ def write_verification(
     for r in rows:
         w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in ROW_KEYS})
     files = {
-        "verification.md": _markdown(rows, closing, meta),
+        "verification.md": verification_markdown(rows, closing, meta),
         "verification.csv": buf.getvalue(),
         "verification.json": json.dumps(rows, ensure_ascii=False, indent=1),
         "closing_comparison.json": json.dumps(closing, ensure_ascii=False, indent=1),
     }
-    paths = []
-    for name, text in files.items():
-        atomic_write_bytes(out / name, text.encode("utf-8"))
-        paths.append(out / name)
-    return paths
+    return {name: text.encode("utf-8") for name, text in files.items()}
 
 
-def verify(
-    trials: int = 60000,
-    seed: int = 20240601,
-    out_dir=None,
-    geometry=None,
-    progress=None,
-    procedure_trials: int | None = None,
-    procedure_scenarios=None,
-):
-    """Run and optionally write the verification (the entry point for ``stereoplotter verify``).
+def _cell(v) -> str:
+    return f"{v:10.4g}" if isinstance(v, int | float) else f"{'—':>10}"
 
-    ``geometry`` is a mapping of :data:`BOOK` keys or the path of a YAML file
-    (:func:`geometry_from_file`: a scenario also becomes the procedure MC's scenario). Without a
-    geometry the procedure MC runs on the book's scenarios (:func:`book_scenarios`); with a
-    mapping it is skipped unless ``procedure_scenarios`` (loaded scenarios) are given.
 
-    Returns
-    -------
-    rows : list of dict
-    seconds : float
-    """
-    if isinstance(geometry, str | Path):
-        geometry, scen = geometry_from_file(geometry)
-        if procedure_scenarios is None:
-            procedure_scenarios = scen
-    elif procedure_scenarios is None and not geometry and procedure_trials != 0:
-        procedure_scenarios = book_scenarios()
-    instrument = book_instrument() if procedure_scenarios and procedure_trials != 0 else None
-    t0 = time.perf_counter()
-    rows = run_verification(
-        trials=trials,
-        seed=seed,
-        geometry=geometry,
-        progress=progress,
-        procedure_trials=procedure_trials,
-        procedure_scenarios=procedure_scenarios,
-        instrument=instrument,
-    )
-    seconds = time.perf_counter() - t0
-    if out_dir is not None:
-        write_verification(
-            rows,
-            out_dir,
-            trials=trials,
-            seed=seed,
-            seconds=seconds,
-            procedure_trials=procedure_trials,
+def verification_console(rows: list[dict], *, trials, seed, seconds, output=None) -> str:
+    """What ``verify`` prints: one line per row (printed, rigorous, linear MC, procedure MC,
+    verdict), and the files written into ``output``."""
+    lines = [
+        f"verification of Eqs. (6.28)–(6.61): {len(rows)} rows, {trials} trials, "
+        f"seed {seed}, {seconds:.1f} s",
+        "",
+        f"{'eq':<14}{'printed':>10}{'rigorous':>10}{'MC':>10}{'proc. MC':>10}  verdict",
+    ]
+    for r in rows:
+        lines.append(
+            f"{r['eq']:<14}{_cell(r['printed'])}{_cell(r['rigorous'])}{_cell(r['mc_linear'])}"
+            f"{_cell(r['mc_procedure'])}  {r['verdict']}"
         )
-    return rows, seconds
+    if output:
+        lines.append(
+            f"\nwritten: verification.md, .csv, .json, closing_comparison.json, "
+            f"error_maps.png, verification_chart.png, mc_histograms.png in {output}"
+        )
+    return "\n".join(lines) + "\n"

@@ -7,8 +7,9 @@ covariance propagation on the same grid, a verdict and a note. The rows are data
 (``rows_chapter5``: Tables 19, 20 and chapter 5; ``rows_setup_elements``: (6.28)–(6.38);
 ``rows_outcomes``: (6.39)–(6.46); ``rows_levelled``: (6.47)–(6.61)); :func:`_row_specs` lists
 them in order. :func:`closing_comparison` is the book's closing claim (setup data vs the
-conventional method at 60 % and 80 %). The files are written by
-:mod:`stereoplotter.report.verification`.
+conventional method at 60 % and 80 %). Rendered by
+:mod:`stereoplotter.report.verification`, written by
+:mod:`stereoplotter.commands.verification`.
 
 Book geometry (§27): f = 70 mm, l = 85 mm, n = 1.42 (SC-1), c = 70 mm; 60 %: p = 70, a = 0;
 80 %: p = 35, a = 35. Values are coefficients: m_x = m_y = m_xy = 1 for (6.31)-(6.50),
@@ -260,7 +261,7 @@ def start_procedure_mc(
     (every run), or 0 (none). ``scenarios`` maps "60"/"80" to a loaded
     :class:`~stereoplotter.scenario.model.Scenario` (None for a slot skips it; None or empty: no
     procedure MC); the book's are the shipped ``pair60`` and ``pair80``
-    (:func:`stereoplotter.report.verification.book_scenarios`). ``instrument`` is the loaded
+    (:func:`stereoplotter.io.book_setting.book_scenarios`). ``instrument`` is the loaded
     :class:`~stereoplotter.instrument.spec.InstrumentSpec` (the book's SC-1), required when a
     slot is run. ``workers``: processes (the runs are independent; 1 runs them here).
 
@@ -426,7 +427,7 @@ def run_verification(
     procedure_scenarios : mapping, optional
         "60"/"80" → loaded scenario of the procedure MC (None for a slot skips it; None: no
         procedure MC). The book's are the shipped ``pair60``, ``pair80``, loaded by the caller
-        (:func:`stereoplotter.report.verification.book_scenarios`): this layer reads no files.
+        (:func:`stereoplotter.io.book_setting.book_scenarios`): this layer reads no files.
     instrument : InstrumentSpec, optional
         The instrument of the procedure MC (the book's SC-1); required with a scenario.
 

@@ -11,9 +11,9 @@ from stereoplotter.cli import main
 
 
 def test_public_names_resolve_to_their_modules():
+    from stereoplotter.commands.verification import verify
     from stereoplotter.io.scenario_file import load_scenario
     from stereoplotter.procedure.simulate import simulate
-    from stereoplotter.report.verification import verify
     from stereoplotter.setup.sheet import compute_setup_sheet
 
     assert stereoplotter.load_scenario is load_scenario

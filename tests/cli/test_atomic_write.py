@@ -9,7 +9,7 @@ from contextlib import contextmanager
 import pytest
 
 from stereoplotter.cli import main
-from stereoplotter.io import yaml_files as yamlio
+from stereoplotter.io import atomic_write as yamlio
 
 
 @contextmanager

@@ -139,7 +139,13 @@ def test_every_numeric_option_is_range_checked():
 
 
 def test_the_range_types_accept_their_ends():
-    from stereoplotter.cli import MAX_SEED, bounded_float, non_negative_int, positive_int, seed_int
+    from stereoplotter.commands.arguments import (
+        MAX_SEED,
+        bounded_float,
+        non_negative_int,
+        positive_int,
+        seed_int,
+    )
 
     assert positive_int("1") == 1 and non_negative_int("0") == 0
     assert seed_int(str(MAX_SEED)) == MAX_SEED
@@ -298,7 +304,7 @@ def test_setup_refusals_name_the_scenario_file(tmp_path, capsys):
     ],
 )
 def test_yaml_problems_are_config_errors(tmp_path, text, message):
-    from stereoplotter.io.yaml_files import load_yaml_mapping
+    from stereoplotter.io.yaml_input import load_yaml_mapping
 
     path = _write(tmp_path, text, "doc.yaml")
     t0 = time.perf_counter()

@@ -116,12 +116,13 @@ def test_python_dash_m_runs():
 
 def test_unexpected_error_is_one_line_exit_3(monkeypatch, capsys):
     import stereoplotter.cli as cli
+    import stereoplotter.commands.info as info_command
 
     def broken():
         raise ZeroDivisionError("boom")
 
     monkeypatch.delenv("STEREOPLOTTER_DEBUG", raising=False)
-    monkeypatch.setattr(cli, "_info", broken)
+    monkeypatch.setattr(info_command, "info", broken)
     assert cli.main(["info"]) == 3
     err = capsys.readouterr().err
     assert err.startswith("error: internal error (ZeroDivisionError: boom)")
@@ -129,7 +130,7 @@ def test_unexpected_error_is_one_line_exit_3(monkeypatch, capsys):
 
 
 def test_atomic_write_leaves_old_file_when_writing_fails(tmp_path, monkeypatch):
-    import stereoplotter.io.yaml_files as yamlio
+    import stereoplotter.io.atomic_write as yamlio
 
     target = tmp_path / "out.txt"
     yamlio.atomic_write_text(target, "old")

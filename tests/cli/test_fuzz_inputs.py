@@ -515,7 +515,7 @@ def _load(kind: str, path: Path) -> Any:
     if kind == "errors":
         from stereoplotter.instrument.error_model import error_model_from_spec
         from stereoplotter.io.instrument_file import load_instrument
-        from stereoplotter.io.yaml_files import load_yaml_mapping
+        from stereoplotter.io.yaml_input import load_yaml_mapping
 
         data, source = load_yaml_mapping(path)
         base = error_model_from_spec(load_instrument(_shipped_dir("instruments") / "sc1.yaml"))
@@ -534,8 +534,9 @@ def _load(kind: str, path: Path) -> Any:
 
         return geometry_from_file(path)
     if kind in ("job", "job_csv"):
+        from stereoplotter.commands.setup_job import compute_job
         from stereoplotter.io.job_file import load_job
-        from stereoplotter.report.job import compute_job, pair_dict
+        from stereoplotter.report.job import pair_dict
 
         job = load_job(path)
         result = compute_job(job)
@@ -784,7 +785,7 @@ def test_mutated_inputs_never_crash(tmp_path, monkeypatch):
 @pytest.mark.parametrize("raw", [_bomb_flow(), _bomb_flow(12, 6), _CLASSIC_BOMB])
 def test_alias_bombs_are_refused_quickly(tmp_path, raw):
     from stereoplotter.errors import ConfigError
-    from stereoplotter.io.yaml_files import MAX_YAML_NODES, load_yaml_mapping
+    from stereoplotter.io.yaml_input import MAX_YAML_NODES, load_yaml_mapping
 
     path = tmp_path / "bomb.yaml"
     path.write_text(raw if raw.startswith("a0:") else f"name: x\nvalue: {raw}\n", encoding="utf-8")

@@ -15,9 +15,10 @@ import yaml
 
 from stereoplotter import __version__
 from stereoplotter.cli import main
+from stereoplotter.commands.setup_job import compute_job
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import load_job, measured_pair
-from stereoplotter.report.job import compute_job, pair_dict
+from stereoplotter.report.job import pair_dict
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import (
     compute_sheet_from_measurements,

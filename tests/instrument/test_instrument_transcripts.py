@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
+from stereoplotter.commands.simulation import run_simulation_command
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.report.sheet import sheet_markdown
-from stereoplotter.report.simulation import run_simulation_command
 from stereoplotter.setup.sheet import compute_setup_sheet
 
 PAIR60 = Path(__file__).parents[2] / "stereoplotter" / "data" / "scenarios" / "pair60.yaml"

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from conftest import um
 
+from stereoplotter.commands.simulation import write_simulation
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
@@ -23,7 +24,6 @@ from stereoplotter.procedure.conventional import (
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
-from stereoplotter.report.simulation import write_simulation
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from stereoplotter.report.verification import write_verification
+from stereoplotter.commands.verification import write_verification
 from stereoplotter.verification import ROW_KEYS, run_verification
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.verdicts import is_verdict
@@ -110,7 +110,7 @@ def test_plots_draw_against_the_rigorous_reference(rows):
 
 def test_procedure_mc_setup_matches_formula_at_simulated_geometry():
     from stereoplotter.accuracy import setup_accuracy as sa
-    from stereoplotter.report.verification import book_instrument, book_scenarios
+    from stereoplotter.io.book_setting import book_instrument, book_scenarios
     from stereoplotter.verification.procedure_mc import procedure_mc
 
     sc = book_scenarios()["60"]
@@ -130,7 +130,7 @@ def test_procedure_columns_filled_and_disabled():
     """Issue 10 (3, 4): every outcome row of §27 at the slot that was simulated gets the
     procedure value, its CI, the formula at the simulated geometry and the value with instrument
     errors; the other slot's rows and every other row stay empty."""
-    from stereoplotter.report.verification import book_instrument, book_scenarios
+    from stereoplotter.io.book_setting import book_instrument, book_scenarios
     from stereoplotter.verification.table import (
         PROCEDURE_ROWS,
         attach_procedure_mc,
@@ -153,7 +153,7 @@ def test_procedure_columns_filled_and_disabled():
 def test_procedure_mc_needs_loaded_inputs():
     # the verification layer reads no files: no scenarios, no procedure MC; a scenario without
     # its instrument is refused
-    from stereoplotter.report.verification import book_scenarios
+    from stereoplotter.io.book_setting import book_scenarios
     from stereoplotter.verification.table import run_procedure_mc
 
     rows = run_verification(trials=50, seed=2, procedure_trials=50)
@@ -235,7 +235,7 @@ def test_procedure_mc_conventional_heights_datum_mechanisms(slot):
     at Fig. 39's x_п ∈ {-c, a}, y = ±c; the same rigorous model with the plane at those points
     gives 0.7210 / 0.7632. Pinned here at T = 4 000 (CI ≈ ±2.5 %)."""
     from stereoplotter.accuracy.chapter5 import relative_orientation_parallax_rms
-    from stereoplotter.report.verification import book_instrument, book_scenarios
+    from stereoplotter.io.book_setting import book_instrument, book_scenarios
     from stereoplotter.verification.procedure_mc import procedure_mc
 
     r = procedure_mc(
@@ -268,7 +268,7 @@ def test_procedure_mc_conventional_relative_part_is_the_levelling_points(slot):
     re-levelled at Fig. 39's points the
     same trials give (5.54) (the shipped tilts and relief lower it by 0-6 %, as in
     test_conventional_relative.py)."""
-    from stereoplotter.report.verification import book_instrument, book_scenarios
+    from stereoplotter.io.book_setting import book_instrument, book_scenarios
     from stereoplotter.verification.procedure_mc import procedure_mc
 
     r = procedure_mc(

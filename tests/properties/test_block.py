@@ -18,13 +18,13 @@ import pytest
 import yaml
 from oracles.setup_pair_oracle import per_pair_loop
 
+from stereoplotter.commands.setup_block import run_block, write_block
 from stereoplotter.errors import ConfigError
 from stereoplotter.geometry.rotation import rotation_matrix
 from stereoplotter.io.block_file import CSV_COLUMNS, load_block
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import scenario_from_mapping
-from stereoplotter.report.block import run_block, write_block
 from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.block import BlockResult, Refusal, compute_block
 from stereoplotter.setup.scale_choice import candidate_scales

@@ -19,13 +19,13 @@ import numpy as np
 import pytest
 import yaml
 
+from stereoplotter.commands.setup_job import compute_job
 from stereoplotter.geodesy import split_conventional_ordinate
 from stereoplotter.geodesy.photogrammetric import LocalFrame
 from stereoplotter.geometry.rotation import angles_from_matrix
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import grid_to_local_rotation, load_job
 from stereoplotter.io.scenario_file import load_scenario
-from stereoplotter.report.job import compute_job
 from stereoplotter.report.sheet import sheet_to_dict
 from stereoplotter.scenario.frame import local_frame, sk42_from_local
 

@@ -11,7 +11,7 @@ import pytest
 
 from stereoplotter.accuracy.chapter5 import geodetic_orientation_parallax_rms
 from stereoplotter.instrument.error_model import ErrorModel, ErrorTerm
-from stereoplotter.report.verification import book_instrument, book_scenarios
+from stereoplotter.io.book_setting import book_instrument, book_scenarios
 from stereoplotter.verification import control_variate as cvar
 from stereoplotter.verification.linear_mc import CI_Z
 from stereoplotter.verification.procedure_mc import procedure_mc

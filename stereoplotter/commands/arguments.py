@@ -1,0 +1,93 @@
+"""Argument types and defaults shared by the command modules.
+
+Every numeric option is range-checked by one of these ``type=`` functions: a bad value is one
+usage line naming what was expected and what was found (argparse adds the option's name).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+from importlib import import_module
+from typing import Any
+
+__all__ = [
+    "MAX_SCALE_DENOMINATOR",
+    "MAX_SEED",
+    "LibraryDefault",
+    "bounded_float",
+    "bounded_int",
+    "non_negative_int",
+    "positive_int",
+    "scale_denominator",
+    "seed_int",
+]
+
+#: The largest seed, as in scenario files (``seed``); numpy itself takes any integer ≥ 0.
+MAX_SEED = 2**63 - 1
+#: Scale denominators as the instrument gear sets allow (``gears.vertical_scale_denominators``).
+MAX_SCALE_DENOMINATOR = 10_000_000
+
+
+def bounded_int(low: int, high: int | None = None) -> Callable[[str], int]:
+    """An argparse ``type=``: an integer in [low, high] (``high=None``: no upper end).
+
+    The message names what was expected and what was found; argparse adds the option.
+    """
+    expected = f"an integer ≥ {low}" if high is None else f"an integer in [{low}, {high}]"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text, 10)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {expected}, found {text!r}") from None
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"expected {expected}, found {value}")
+        return value
+
+    parse.__name__ = f"integer in [{low}, {high}]"
+    return parse
+
+
+def bounded_float(low: float, high: float) -> Callable[[str], float]:
+    """An argparse ``type=``: a finite number in [low, high]."""
+    expected = f"a number in [{low:g}, {high:g}]"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {expected}, found {text!r}") from None
+        if not (math.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(f"expected {expected}, found {text}")
+        return value
+
+    parse.__name__ = f"number in [{low:g}, {high:g}]"
+    return parse
+
+
+positive_int = bounded_int(1)
+non_negative_int = bounded_int(0)
+seed_int = bounded_int(0, MAX_SEED)
+scale_denominator = bounded_int(1, MAX_SCALE_DENOMINATOR)
+
+
+class LibraryDefault:
+    """An option's default that is a constant of the library (``module.name``), imported only
+    when shown (``--help`` of that command, ``%(default)s``) or used (:meth:`of`): building the
+    parser loads no library module, so the CLI starts fast."""
+
+    def __init__(self, module: str, name: str):
+        self.module, self.name = module, name
+
+    def value(self) -> Any:
+        return getattr(import_module(self.module), self.name)
+
+    def __str__(self) -> str:
+        return str(self.value())
+
+    @staticmethod
+    def of(value: Any) -> Any:
+        """``value`` itself, or the constant a :class:`LibraryDefault` stands for."""
+        return value.value() if isinstance(value, LibraryDefault) else value

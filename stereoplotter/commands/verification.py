@@ -1,0 +1,177 @@
+"""The work of ``stereoplotter verify`` and the ``verify`` of the public API.
+
+Load (a geometry or scenario file, the book's scenarios and SC-1: :mod:`stereoplotter.io`) → run
+(:func:`stereoplotter.verification.table.run_verification`, the procedure MC in worker
+processes) → render (:mod:`stereoplotter.report.verification`, the figures by
+:mod:`stereoplotter.plotting`) → write (:mod:`stereoplotter.io.atomic_write`). Imported by
+:mod:`stereoplotter.commands.verify` only when the command runs (and by the public API), so the
+library is imported here at the top.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from stereoplotter.io.atomic_write import write_files
+from stereoplotter.io.book_setting import BOOK_INSTRUMENT, book_instrument, book_scenarios
+from stereoplotter.io.geometry_file import geometry_from_file
+from stereoplotter.progress import step_progress
+from stereoplotter.report.plain_data import json_text
+from stereoplotter.report.verification import verification_console, verification_files
+from stereoplotter.verification.table import (
+    attach_procedure_mc,
+    run_verification,
+    start_procedure_mc,
+)
+
+__all__ = ["run_verify_command", "start_book_procedure_mc", "verify", "write_verification"]
+
+
+def verify(
+    trials: int = 60000,
+    seed: int = 20240601,
+    out_dir=None,
+    geometry=None,
+    progress=None,
+    procedure_trials: int | None = None,
+    procedure_scenarios=None,
+):
+    """Run and optionally write the verification (the entry point for ``stereoplotter verify``).
+
+    ``geometry`` is a mapping of :data:`BOOK` keys or the path of a YAML file
+    (:func:`geometry_from_file`: a scenario also becomes the procedure MC's scenario). Without a
+    geometry the procedure MC runs on the book's scenarios (:func:`book_scenarios`); with a
+    mapping it is skipped unless ``procedure_scenarios`` (loaded scenarios) are given.
+
+    Returns
+    -------
+    rows : list of dict
+    seconds : float
+    """
+    if isinstance(geometry, str | Path):
+        geometry, scen = geometry_from_file(geometry)
+        if procedure_scenarios is None:
+            procedure_scenarios = scen
+    elif procedure_scenarios is None and not geometry and procedure_trials != 0:
+        procedure_scenarios = book_scenarios()
+    instrument = book_instrument() if procedure_scenarios and procedure_trials != 0 else None
+    t0 = time.perf_counter()
+    rows = run_verification(
+        trials=trials,
+        seed=seed,
+        geometry=geometry,
+        progress=progress,
+        procedure_trials=procedure_trials,
+        procedure_scenarios=procedure_scenarios,
+        instrument=instrument,
+    )
+    seconds = time.perf_counter() - t0
+    if out_dir is not None:
+        write_verification(
+            rows,
+            out_dir,
+            trials=trials,
+            seed=seed,
+            seconds=seconds,
+            procedure_trials=procedure_trials,
+        )
+    return rows, seconds
+
+
+def write_verification(
+    rows: list[dict], out_dir, *, trials=None, seed=None, seconds=0.0, procedure_trials=None
+):
+    """Write ``verification.md``, ``verification.csv``, ``verification.json`` and
+    ``closing_comparison.json`` (:func:`~stereoplotter.report.verification.verification_files`)
+    to ``out_dir``, each whole or not at all.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
+    files = verification_files(
+        rows, trials=trials, seed=seed, seconds=seconds, procedure_trials=procedure_trials
+    )
+    return list(write_files(out_dir, files).values())
+
+
+def start_book_procedure_mc(trials, seed, scenarios=None, instrument=BOOK_INSTRUMENT):
+    """:func:`stereoplotter.verification.table.start_procedure_mc` on loaded inputs:
+    ``scenarios`` ("60"/"80" → Scenario or None) default to the book's (:func:`book_scenarios`),
+    the instrument is loaded by name (default the book's SC-1) when a slot runs. ``trials``:
+    None for the per-configuration defaults, 0 for none."""
+    if trials == 0:
+        return start_procedure_mc(0, seed, {})
+    if scenarios is None:
+        scenarios = book_scenarios()
+    spec = book_instrument(instrument) if any(scenarios.values()) else None
+    return start_procedure_mc(trials, seed, scenarios, instrument=spec)
+
+
+def _figures(rows: list[dict], proc: dict, seed: int, geometry) -> dict[str, bytes]:
+    """error_maps.png, verification_chart.png and mc_histograms.png, encoded in memory."""
+    # imported here: matplotlib loads only when figures are drawn (the API's verify draws none)
+    from stereoplotter.plotting.accuracy import (
+        plot_error_maps,
+        plot_mc_histograms,
+        plot_verification_chart,
+    )
+    from stereoplotter.plotting.encode import figure_bytes
+
+    return {
+        "error_maps.png": figure_bytes(plot_error_maps()),
+        "verification_chart.png": figure_bytes(plot_verification_chart(rows).figure),
+        "mc_histograms.png": figure_bytes(
+            plot_mc_histograms(rows, proc, seed=seed, geometry=geometry)
+        ),
+    }
+
+
+def run_verify_command(args: argparse.Namespace) -> int:
+    """``verify``: the linear rows here while the procedure MC runs in worker processes; then
+    the table, the files (figures first, in memory: every file whole or not at all) and the
+    console summary or JSON."""
+    geometry, scenarios = None, None
+    if args.geometry:
+        geometry, scenarios = geometry_from_file(args.geometry)
+    # the procedure MC once, shared by the table and the histograms; its runs go on in worker
+    # processes while the linear rows are computed
+    t0 = time.perf_counter()
+    pending = start_book_procedure_mc(args.procedure_trials, args.seed, scenarios, args.instrument)
+    with step_progress("verify") as progress:
+        rows, seconds = verify(
+            trials=args.trials,
+            seed=args.seed,
+            out_dir=None,
+            geometry=geometry,
+            progress=progress,
+            procedure_trials=0,
+        )
+    with step_progress("procedure MC") as progress:
+        proc = pending.result(progress)
+    seconds = time.perf_counter() - t0  # the table and the procedure MC (running alongside)
+    if proc:
+        attach_procedure_mc(rows, proc)
+    if args.output:
+        figures = _figures(rows, proc, args.seed, geometry)
+        files = verification_files(
+            rows,
+            trials=args.trials,
+            seed=args.seed,
+            seconds=seconds,
+            procedure_trials=args.procedure_trials,
+        )
+        write_files(args.output, {**files, **figures})
+    if args.json:
+        sys.stdout.write(json_text(rows))
+        return 0
+    sys.stdout.write(
+        verification_console(
+            rows, trials=args.trials, seed=args.seed, seconds=seconds, output=args.output
+        )
+    )
+    return 0
