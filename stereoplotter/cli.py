@@ -380,8 +380,8 @@ def _demo_steps(args: argparse.Namespace, step) -> int:
 
 
 def _instrument(args: argparse.Namespace) -> int:
-    from stereoplotter.instrument.spec import format_instrument, instrument_to_dict
     from stereoplotter.io.instrument_file import load_instrument
+    from stereoplotter.spec.instrument_spec import format_instrument, instrument_to_dict
 
     spec = load_instrument(args.name)
     if args.instrument_command == "test":

@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.errors import ConfigError, describe_value, did_you_mean
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.random_streams import keyed_draws
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["DISTRIBUTIONS", "ErrorModel", "ErrorTerm", "error_model_from_spec"]
 

@@ -39,7 +39,8 @@ from stereoplotter.instrument.kinematics import (
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.instrument.mechanics.play import PlayAxis
 from stereoplotter.instrument.sc1_complex import AutomaticCoordinatograph, SC1Options
-from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.range_checks import check_in_range
 
 __all__ = [
     "BACKENDS",
@@ -187,7 +188,7 @@ class Instrument:
     Notes
     -----
     Ranges are stops: a setting outside the instrument's range raises
-    :class:`~stereoplotter.instrument.spec.RangeRefusal` or
+    :class:`~stereoplotter.spec.range_checks.RangeRefusal` or
     :class:`~stereoplotter.instrument.mechanics.base.TravelRefusal`; nothing is clipped.
     """
 

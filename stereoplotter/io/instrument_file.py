@@ -1,5 +1,5 @@
 """Reading instrument files (``instruments/*.yaml``) into a frozen
-:class:`~stereoplotter.instrument.spec.InstrumentSpec`: name resolution, ``inherits``, the leaf
+:class:`~stereoplotter.spec.instrument_spec.InstrumentSpec`: name resolution, ``inherits``, the leaf
 schema, validation and the mechanics feasibility check.
 
 Every value in an instrument file is a *leaf* ``{value, status, src | basis, note?}``
@@ -25,10 +25,10 @@ from pydantic import model_validator as _model_validator
 from pydantic_core import PydanticCustomError
 
 from stereoplotter.errors import ConfigError, StereoplotterError, describe_value, did_you_mean
-from stereoplotter.instrument.spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
 from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
 from stereoplotter.io.validation import FileModel, _bounds, _fail, check_number, text, validate
 from stereoplotter.io.yaml_files import load_yaml_mapping
+from stereoplotter.spec.instrument_spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
 
 __all__ = ["InstrumentFile", "instrument_from_mapping", "list_instruments", "load_instrument"]
 

@@ -24,7 +24,6 @@ from stereoplotter.instrument.sc1_complex import (
     ErrorCorrectionUnit,
     SC1Options,
 )
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
 from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
@@ -40,6 +39,7 @@ from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.sheet import SetupSheet, compute_setup_sheet
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "METHODS",

@@ -10,11 +10,11 @@ from typing import Any
 
 import yaml
 
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.io.block_file import load_block
 from stereoplotter.io.yaml_files import atomic_write_text
 from stereoplotter.report.sheet import setup_dict
 from stereoplotter.setup.block import BlockResult, compute_block
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["model_sheet", "run_block", "write_block"]
 

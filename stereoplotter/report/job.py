@@ -24,7 +24,6 @@ import yaml
 
 from stereoplotter import __version__
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair, load_job, measured_pair
 from stereoplotter.io.yaml_files import atomic_write_bytes
@@ -32,6 +31,7 @@ from stereoplotter.report.forms import FormHeader, form_pdf, forms_pdf
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupOptions, SetupRefusal, SetupSheet
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "JobResult",

@@ -30,12 +30,6 @@ from stereoplotter.geometry.similarity import (
     apply_similarity,
     fit_similarity_with_reflection,
 )
-from stereoplotter.instrument.limits import (
-    check_material_limits,
-    check_model_to_photo_scale,
-    check_photo_to_map_ratio,
-)
-from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import MapSheet, Point, Scenario
 from stereoplotter.scenario.summary import summarize_scenario
@@ -66,6 +60,13 @@ from stereoplotter.setup.table24 import (
     compute_table24,
     instrument_frames,
 )
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.limits import (
+    check_material_limits,
+    check_model_to_photo_scale,
+    check_photo_to_map_ratio,
+)
+from stereoplotter.spec.range_checks import RangeRefusal, check_in_range
 
 __all__ = [
     "CORNER_ORDER",
@@ -299,7 +300,7 @@ def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[
 
 
 def _check_material(scenario: Scenario, spec: InstrumentSpec) -> float:
-    """Documented limits on the pair (relief/H, f_k; :mod:`stereoplotter.instrument.limits`);
+    """Documented limits on the pair (relief/H, f_k; :mod:`stereoplotter.spec.limits`);
     returns the mean flying height H. [m]"""
     summary = summarize_scenario(scenario)
     height = float(np.mean([p["flying_height_m"] for p in summary["photos"]]))
@@ -318,7 +319,7 @@ def _check_material(scenario: Scenario, spec: InstrumentSpec) -> float:
 
 def _check_model_scale(scenario: Scenario, spec: InstrumentSpec, sheet, height_m: float) -> None:
     """SPR-3: model scale 0.5–2 × photo scale; SD-3: map scale 0.5–3 × photo scale
-    (m = 1000·H/f_k; :mod:`stereoplotter.instrument.limits`)."""
+    (m = 1000·H/f_k; :mod:`stereoplotter.spec.limits`)."""
     photo = MM_PER_M * height_m / float(scenario.camera.focal_length_mm)
     try:
         check_model_to_photo_scale(

@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from stereoplotter.errors import TrainerError
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.scenario.model import Scenario
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "ASSISTS",

@@ -89,8 +89,8 @@ from stereoplotter.verification.linear_mc import (
 )
 
 if TYPE_CHECKING:
-    from stereoplotter.instrument.spec import InstrumentSpec
     from stereoplotter.scenario.model import Scenario
+    from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "PROCEDURE_ROWS",

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import brentq
 
-from stereoplotter.instrument.spec import InstrumentSpec
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "CorrectionMechanism",
