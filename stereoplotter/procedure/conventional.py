@@ -1107,7 +1107,7 @@ def run_conventional_method(run, relative: str = "elements"):
 
     Parameters
     ----------
-    run : stereoplotter.procedure.setup_method.Run
+    run : stereoplotter.procedure.run.Run
         Instrument, sheet, operator and scene; receives results, iterations, zero readings.
     relative : {"elements", "equations"}
         Relative orientation element by element with over-correction, or by the six measured

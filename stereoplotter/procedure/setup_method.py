@@ -15,10 +15,10 @@ Reference
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.geometry.instrument_settings import sequence_for
@@ -36,13 +36,10 @@ from stereoplotter.instrument.kinematics import (
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
 from stereoplotter.procedure.operator import Operator, Scene, solve_1d
 from stereoplotter.procedure.records import (
-    Check,
     ControlHeight,
-    Remedy,
     SheetPose,
-    SheetReadings,
-    StageRecord,
 )
+from stereoplotter.procedure.run import Run
 from stereoplotter.scenario.summary import summarize_scenario
 from stereoplotter.setup.equations import (
     base_z_correction,
@@ -55,10 +52,8 @@ from stereoplotter.setup.sheet import SetupSheet
 __all__ = [
     "LEVEL_FREE",
     "LEVEL_TILTS",
-    "PRACTICES",
     "Q_ELEMENTS",
     "REPEAT_POINTINGS",
-    "Run",
     "check_standard_points",
     "clear_kappa",
     "level_design",
@@ -77,12 +72,6 @@ __all__ = [
 _SIDE: dict[Side, str] = {"left": "л", "right": "п"}
 _SUB = {"1": "₁", "2": "₂", "3": "₃", "4": "₄"}
 _TILT = {"alpha": "α", "omega": "ω"}
-
-#: ``--practice``: "operator" applies the remedies after a failed check (the operator's
-#: practice; §26 intro: the set orientation "most often is not accurate enough and its
-#: correction takes additional time"); "book" is §27's task 1 (the elements are set, each once
-#: by the stage text, and not refined: a failed check is recorded and the operator goes on).
-PRACTICES = ("operator", "book")
 
 #: Remedy R1 (stage 1, "otherwise the setting is repeated"): pointings per fiducial mark,
 #: averaged, when the L-check loop has ended failed (a choice: 4 halves the pointing σ).
@@ -118,91 +107,6 @@ LEVEL_TILTS = {
     "omega": ("k_omega_left", "k_omega_right"),
 }
 LEVEL_FREE = ("bz", "kappa_left", "kappa_right")
-
-
-@dataclass
-class Run:
-    """Everything a procedure works on, and what it found.
-
-    Attributes
-    ----------
-    op : Operator
-    sheet : SetupSheet
-    scene : Scene
-    zero : dict
-        Zero readings the operator has determined, by the sheet's names (MO_X, MO_Y, MO_X,п,
-        MO_Y,п, MO_by, MO_bz, MO_Z), arrays over the trials. [mm, m for MO_Z]
-    results : dict
-        Check name → :class:`~stereoplotter.procedure.records.Check`.
-    stages : dict
-        Stage → :class:`~stereoplotter.procedure.records.StageRecord` (iterations used).
-    sheet_pose : SheetPose or None
-        Stages 4–5: the sheet on the coordinatograph (None without a map sheet).
-    practice : {"book", "operator"}
-        :data:`PRACTICES`: remedies after a failed check only with "operator".
-    remedies : dict
-        Remedy name → :class:`~stereoplotter.procedure.records.Remedy` (operator practice).
-    readings : SheetReadings
-        The sheet's printed readings: every target reading the operator sets comes from here.
-    """
-
-    op: Operator
-    sheet: SetupSheet
-    scene: Scene
-    zero: dict[str, NDArray[np.float64]] = field(default_factory=dict)
-    results: dict[str, Check] = field(default_factory=dict)
-    stages: dict[str, StageRecord] = field(default_factory=dict)
-    sheet_pose: SheetPose | None = None
-    practice: str = "book"
-    remedies: dict[str, Remedy] = field(default_factory=dict)
-    readings: SheetReadings = field(init=False)
-
-    def __post_init__(self) -> None:
-        self.readings = SheetReadings.of(self.sheet)
-
-    def check(
-        self, name: str, residual, tolerance, unit: str = "mm", iterations=None
-    ) -> NDArray[np.bool_]:
-        """Record a tolerance check (|residual| ≤ tolerance) and return pass/fail per trial."""
-        residual = self.op.v(residual)
-        tol = self.op.v(tolerance) if tolerance is not None else None
-        passed = np.abs(residual) <= tol if tol is not None else None
-        its = None if iterations is None else self.op.v(iterations).astype(int)
-        self.results[name] = Check(name, residual, tol, passed, its, unit)
-        return passed
-
-    @property
-    def remedial(self) -> bool:
-        """The operator's practice: remedies after a failed check."""
-        return self.practice == "operator"
-
-    def record_remedy(self, name: str, check: str, applied, rounds) -> None:
-        """Record a remedy against the final state of ``check``."""
-        applied = self.op.v(applied).astype(bool)
-        passed = self.results[check].passed
-        self.remedies[name] = Remedy(
-            name, check, applied, self.op.v(rounds).astype(int), self.op.v(passed).astype(bool)
-        )
-
-    def record_stage(self, stage: str, iterations: ArrayLike) -> None:
-        """Record the iterations a stage (or loop) used, per trial."""
-        self.stages[stage] = StageRecord(stage, np.asarray(iterations).astype(int))
-
-    def stage_iterations(self, stage: str) -> NDArray[np.int64]:
-        """The iterations recorded for ``stage``."""
-        return self.stages[stage].iterations
-
-    def target(self, reading: str, zero: ArrayLike | None = None):
-        """The sheet's reading ``reading`` as set: its zero reading + the printed value.
-
-        ``zero`` defaults to the zero reading the operator has determined (``self.zero``, by
-        the sheet's name); the instrument's nominal zero places (MO_bx, MO_dx, MO_dy) are
-        passed by the caller.
-        """
-        r = self.readings[reading]
-        if r.zero_reading and zero is None:
-            zero = self.zero[r.zero_reading]
-        return r.target(zero)
 
 
 def _fid(run: Run, side: str, mark: str) -> NDArray[np.float64]:

@@ -27,11 +27,9 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.instrument.virtual import SCREWS, Instrument
-from stereoplotter.procedure.operator import Noise, Operator
-from stereoplotter.procedure.setup_method import Run
-from stereoplotter.procedure.simulate import PreparedRun
-from stereoplotter.procedure.transcript import Transcript
+from stereoplotter.instrument.virtual import SCREWS
+from stereoplotter.procedure.operator import Noise
+from stereoplotter.procedure.run import PreparedRun, build_run
 from stereoplotter.trainer.actions import apply
 from stereoplotter.trainer.operator_steps import new_instrument, stage_functions
 from stereoplotter.trainer.outcome import Measure, stage_measures
@@ -75,19 +73,17 @@ def population_measures(
     last = stages[-1]
     for first in range(0, trials, chunk):
         n = min(chunk, trials - first)
-        inst = Instrument(
-            prep.spec,
-            prep.sheet.focal_length_corrected_mm,
-            errors=prep.model,
+        # a population is vectorised over its trials: only the closed-form back-end runs that
+        run = build_run(
+            prep,
+            first,
+            n,
             injected=injected,
-            variant=prep.variant,
+            noise=Noise(seed, n, None, first),
+            transcript=False,
             backend="closed-form",
-            trials=n,
-            ideal_mechanics=prep.ideal_mechanics,
         )
-        op = Operator(inst, prep.operator, Noise(seed, n, None, first), Transcript(enabled=False))
-        run = Run(op, prep.sheet, prep.scene)
-        run.practice = prep.practice
+        inst = run.op.inst
         for name, fn in stage_functions(run, prep.method).items():
             fn()
             if name in out:

@@ -64,14 +64,13 @@ from stereoplotter.accuracy.chapter5 import (
     standard_points,
 )
 from stereoplotter.instrument.kinematics import counters_from_homologous_points
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, Instrument
+from stereoplotter.instrument.virtual import HEIGHT_SCALE
 from stereoplotter.procedure import conventional as cv
 from stereoplotter.procedure import evaluation as ev
 from stereoplotter.procedure.evaluation import instrument_frame_m
-from stereoplotter.procedure.operator import Noise, Operator, OperatorModel
-from stereoplotter.procedure.setup_method import Run
+from stereoplotter.procedure.operator import OperatorModel
+from stereoplotter.procedure.run import build_run
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
-from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.procedure.trials import (
     DEFAULT_MEMORY_BUDGET_MB,
     chunk_trials_for,
@@ -776,20 +775,11 @@ def _relative_only(prep, first, trials):
     """C1, the calibration and C2 by (5.11) on trials ``first … first + trials − 1`` (None: one
     error-free trial); returns the run."""
 
-    stop = None if trials is None else first + trials
-    inst = Instrument(
-        prep.spec,
-        prep.sheet.focal_length_corrected_mm,
-        errors=prep.model,
-        injected=prep.model.draw_keyed(prep.seed, first, stop),
-        variant=prep.variant,
-        backend=prep.backend,
-        trials=trials,
-        ideal_mechanics=True,
+    # rigid screws whatever ``prep`` says: the experiment isolates the relative orientation;
+    # "book": no remedy between C1 and C2 (the run is not the simulated procedure)
+    run = build_run(
+        prep, first, trials, transcript=False, ideal_mechanics=True, practice="book"
     )
-    noise = Noise(prep.seed, trials, None, first)
-    op = Operator(inst, prep.operator, noise, Transcript(enabled=False))
-    run = Run(op, prep.sheet, prep.scene)
     cv.c1_interior(run)
     cal = cv.calibrate(run, cv.levelling_points(run))
     cv.c2_relative_by_equations(run, cal, passes=prep.operator.max_iterations)
