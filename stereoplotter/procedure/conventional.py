@@ -39,7 +39,19 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 from stereoplotter.procedure.operator import solve_1d
-from stereoplotter.procedure.setup_method import interior_orientation
+from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.steps import (
+    REPEAT_POINTINGS,
+    control_point_m,
+    fixed_order_sum,
+    fuse_and_read,
+    height_mean,
+    interior_orientation,
+    judge_standard_points,
+    scale_by_two_points,
+    scale_pair,
+    slip_height_scale_on_mean,
+)
 
 __all__ = [
     "ELEMENTS",
@@ -409,12 +421,8 @@ _SIDE = {"left": "л", "right": "п"}
 _BOOK = {"alpha1": "α′₁", "alpha2": "α′₂", "omega2": "ω′₂", "kappa1": "κ′₁", "kappa2": "κ′₂"}
 
 
-def _psum(values) -> NDArray[np.float64]:
-    """A sum over points in a fixed order (a vectorised run and a per-trial loop agree)."""
-    total = None
-    for v in values:
-        total = v if total is None else total + v
-    return total
+#: How the conventional operator's judgment at a standard point reads in the transcript.
+_SIX_Q = "standard point {i}: fuse, judge the y-parallax"
 
 
 def _worst(values) -> NDArray[np.float64]:
@@ -634,31 +642,6 @@ def _turn(op, control: str, target, active) -> None:
     op.drive(control, np.clip(target, lo, hi), active)
 
 
-def _six_q(run, key: str, active, it: int, stage: str = "C2") -> list[NDArray[np.float64]]:
-    """Fuse on the six standard points and judge q at each (σ_q)."""
-    op = run.op
-    tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    pts = run.scene.standard_points_m
-    imgs = run.scene.images(pts)
-    seen = []
-    for i in range(6):
-        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
-        seen.append(q)
-        op.log.add(
-            stage,
-            f"standard point {i + 1}: fuse, judge the y-parallax",
-            "",
-            residual=q,
-            true=q_true,
-            judgment_error=q - q_true,
-            tolerance=tol,
-            passed=np.abs(q) <= tol,
-            iteration=it,
-            equation="≤ ¼ mark",
-        )
-    return seen
-
-
 #: The classic sequence (``instruments.md`` §6.1): point index, control, book element.
 _SEQUENCE = (
     (0, "kappa_right", "kappa2"),
@@ -719,7 +702,9 @@ def c2_relative_by_elements(
                 iteration=it,
                 equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
             )
-        seen = _six_q(run, f"{key0}/a/{it}/check", active, it, stage)
+        seen = judge_standard_points(
+            run, stage, f"{key0}/a/{it}/check", active, iteration=it, text=_SIX_Q
+        )
         worst = np.where(active, _worst(seen), worst)
         rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
         prev_rms = rms if prev_rms is None else np.where(active, rms, prev_rms)
@@ -755,7 +740,9 @@ def c2_relative_by_equations(
     prev_rms = None
     for it in range(1, bound + 1):
         its = np.where(active, it, its)
-        seen = _six_q(run, f"{key0}/b/{it}", active, it, stage)
+        seen = judge_standard_points(
+            run, stage, f"{key0}/b/{it}", active, iteration=it, text=_SIX_Q
+        )
         worst = np.where(active, _worst(seen), worst)
         if passes is None:
             rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
@@ -792,8 +779,7 @@ def c2_relative_by_equations(
 
 
 def _height_points(run, ids) -> list[tuple[str, NDArray[np.float64]]]:
-    sc = run.scene.scenario
-    return [(i, np.asarray(next(p for p in sc.points if p.id == i).local_m, float)) for i in ids]
+    return [(i, control_point_m(run, i)) for i in ids]
 
 
 def levelling_points(run) -> tuple[str, ...]:
@@ -807,41 +793,9 @@ def levelling_points(run) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _scale_pair(run) -> tuple[str, str]:
-    """The two plan control points farthest apart (the scale is taken between them)."""
-    ids = run.sheet.similarity_point_ids or tuple(h["id"] for h in run.sheet.control_heights)
-    rows = _height_points(run, ids)
-    best = max(
-        (float(np.hypot(*(a[1][:2] - b[1][:2]))), a[0], b[0])
-        for k, a in enumerate(rows)
-        for b in rows[k + 1 :]
-    )
-    return best[1], best[2]
-
-
-def _fuse_read(run, pid: str, p, key: str, active, read: tuple[str, ...]):
-    op = run.op
-    img = run.scene.images(p[None, :])
-    op.fuse(p, (img[0][0], img[1][0]), key, active)
-    return {c: op.read(c, f"{key}/{c}") for c in read}
-
-
-def _height_mean(run, pid: str, p, key: str, active, pointings: int) -> NDArray[np.float64]:
-    """The height scale read after ``pointings`` fusings on ``p``, averaged (the first fusing
-    has the single reading's noise key, so ``pointings=1`` is the book's single reading). [m]"""
-    total = None
-    for j in range(pointings):
-        k = key + (f"/p{j}" if j else "")
-        read = _fuse_read(run, pid, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
-        total = read if total is None else total + read
-    return total / pointings
-
-
 def _pointings(run) -> int:
     """Fusings per height reading in C3: the setup method's ``REPEAT_POINTINGS`` with the
     operator's practice (remedy CR1), one with the book's."""
-    from stereoplotter.procedure.setup_method import REPEAT_POINTINGS
-
     return REPEAT_POINTINGS if getattr(run, "remedial", False) else 1
 
 
@@ -861,13 +815,10 @@ def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int,
     tol = run.sheet.tolerances["control_height_m"]
     pid0, p0 = rows[0]
     if pointings == 1:
-        _fuse_read(run, pid0, p0, f"{key}/slip/{pid0}", active, ())
+        fuse_and_read(run, p0, f"{key}/slip/{pid0}", active, ())
         op.inst.slip_height_scale(p0[2])
     else:
-        seen0 = _height_mean(run, pid0, p0, f"{key}/slip/{pid0}", active, pointings)
-        exact = op.v(op.inst.read(HEIGHT_SCALE, exact=True))
-        act = op.all() if active is None else active
-        op.inst.slip_height_scale(np.where(act, exact + (p0[2] - seen0), exact))
+        slip_height_scale_on_mean(run, p0, f"{key}/slip/{pid0}", active, pointings)
     times = f" ({pointings} times, mean)" if pointings > 1 else ""
     op.log.add(
         "C3",
@@ -883,7 +834,7 @@ def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int,
     for pid, p in heights:
         if pid == pid0:
             continue
-        read = _height_mean(run, pid, p, f"{key}/h/{pid}", active, pointings)
+        read = height_mean(run, p, f"{key}/h/{pid}", active, pointings)
         errs.append(read - p[2])
         op.log.add(
             "C3",
@@ -910,9 +861,7 @@ def _level(
     op = run.op
     tol = run.sheet.tolerances["control_height_m"]
     when = active if remedy else None  # the book's loop logs every iteration as before
-    errs = [
-        _height_mean(run, pid, p, f"{key}/level/{pid}", active, pointings) - p[2] for pid, p in rows
-    ]
+    errs = [height_mean(run, p, f"{key}/level/{pid}", active, pointings) - p[2] for pid, p in rows]
     resid = [e - errs[0] for e in errs]
     for (pid, _), r, e in zip(rows, resid, errs, strict=True):
         op.log.add(
@@ -930,8 +879,8 @@ def _level(
             when=when,
         )
     w = cal.level_weights
-    phi_a = -_psum(w[1, i] * e for i, e in enumerate(errs))
-    phi_o = -_psum(w[2, i] * e for i, e in enumerate(errs))
+    phi_a = -fixed_order_sum(w[1, i] * e for i, e in enumerate(errs))
+    phi_o = -fixed_order_sum(w[2, i] * e for i, e in enumerate(errs))
     for name, phi, combo in (("α", phi_a, cal.common_alpha), ("ω", phi_o, cal.common_omega)):
         for control, rate in combo.items():
             if control in ("by", "bz"):
@@ -985,7 +934,7 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     tol = sheet.tolerances["control_height_m"]
     tol_q = sheet.tolerances["residual_y_parallax_mm"]
     mg = sheet.horizontal_scale_denominator
-    a_id, b_id = _scale_pair(run)
+    a_id, b_id = scale_pair(run, ties="last")
     (_, pa), (_, pb) = _height_points(run, (a_id, b_id))
     d_true = float(np.hypot(*(pa[:2] - pb[:2]))) * 1000.0 / mg
     rows = _height_points(run, level_ids)
@@ -995,14 +944,9 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     worst = op.v(np.nan)
     for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
-        ra = _fuse_read(run, a_id, pa, f"C3/{it}/scale/{a_id}", active, ("X", "Y"))
-        rb = _fuse_read(run, b_id, pb, f"C3/{it}/scale/{b_id}", active, ("X", "Y"))
-        d_model = np.hypot(ra["X"] - rb["X"], ra["Y"] - rb["Y"])
-        with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest read d = 0
-            ratio = np.where(active, d_true / d_model, 1.0)
-        bx = op.read("bx", f"C3/{it}/bx")
-        new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio
-        op.set("bx", new, f"C3/{it}/setbx", active)
+        bx, new, d_model = scale_by_two_points(
+            run, (a_id, pa), (b_id, pb), d_true, f"C3/{it}", active
+        )
         op.log.add(
             "C3",
             f"scale: fuse on {a_id} and {b_id}, model distance against {d_true:.3f} mm; "
@@ -1034,7 +978,7 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     if not run.remedial:  # the book: single readings, nothing after a failed check
         errs = _slip_and_read_heights(run, rows, heights, "C3", None, 1)
         run.check("C3: control heights", _worst(errs) if errs else op.v(0.0), tol, unit="m")
-        seen = _six_q(run, "C3/std", None, 1, stage="C3")
+        seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
         run.check("C3: residual y-parallax (6 points)", _worst(seen), tol_q)
         return
     _c3_operator_checks(run, cal, rows, heights, relative_fn, _pointings(run))
@@ -1057,14 +1001,14 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
     if errs and np.any(h_failed):
         again = _slip_and_read_heights(run, rows, heights, "C3/CR1", h_failed, pointings, CR1)
         h_worst = np.where(h_failed, _worst(again), h_worst)
-    seen = _six_q(run, "C3/std", None, 1, stage="C3")
+    seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
     q_worst = _worst(seen)
     q_failed = q_worst > tol_q
     rounds = np.zeros(np.shape(q_failed), int)
     if relative_fn is not None and np.any(q_failed):
         r_its, _ = _masked(run, q_failed, relative_fn, cal, "C3/CR2/ro")
         rounds = np.where(q_failed, r_its, 0)
-        seen = _six_q(run, "C3/CR2/std", q_failed, 1, stage="C3")
+        seen = judge_standard_points(run, "C3", "C3/CR2/std", q_failed, text=_SIX_Q)
         q_worst = np.where(q_failed, _worst(seen), q_worst)
         _level(run, cal, rows, "C3/CR2", q_failed, pointings, 1, CR2)
         errs = _slip_and_read_heights(run, rows, heights, "C3/CR2", q_failed, pointings, CR2)
@@ -1090,8 +1034,6 @@ def _masked(run, active, relative_fn, cal, key0):
 def c4_sheet(run) -> None:
     """C4: the sheet on the coordinatograph, corner 4 and the plotted plan control — stages 4–5
     of the setup-data method reused, with the corner coordinates of the setup sheet."""
-    from stereoplotter.procedure.setup_method import stage4_orient_sheet, stage5_check
-
     log = run.op.log
     start = len(log.records)
     stage4_orient_sheet(run)

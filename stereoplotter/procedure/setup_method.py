@@ -20,7 +20,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.constants import MM_PER_M
 from stereoplotter.geometry.instrument_settings import sequence_for
 from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.instrument.kinematics import (
@@ -37,10 +36,20 @@ from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
 from stereoplotter.procedure.operator import Operator, Scene, solve_1d
 from stereoplotter.procedure.records import (
     ControlHeight,
-    SheetPose,
 )
 from stereoplotter.procedure.run import Run
-from stereoplotter.scenario.summary import summarize_scenario
+from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.steps import (
+    REPEAT_POINTINGS,
+    control_point_m,
+    fixed_order_sum,
+    height_mean,
+    interior_orientation,
+    judge_standard_points,
+    scale_by_two_points,
+    scale_pair,
+    slip_height_scale_on_mean,
+)
 from stereoplotter.setup.equations import (
     base_z_correction,
     height_correction,
@@ -53,7 +62,6 @@ __all__ = [
     "LEVEL_FREE",
     "LEVEL_TILTS",
     "Q_ELEMENTS",
-    "REPEAT_POINTINGS",
     "check_standard_points",
     "clear_kappa",
     "level_design",
@@ -65,17 +73,11 @@ __all__ = [
     "stage1_scale_coefficient",
     "stage2_transform",
     "stage3_scale_model",
-    "stage4_orient_sheet",
-    "stage5_check",
 ]
 
 _SIDE: dict[Side, str] = {"left": "л", "right": "п"}
 _SUB = {"1": "₁", "2": "₂", "3": "₃", "4": "₄"}
 _TILT = {"alpha": "α", "omega": "ω"}
-
-#: Remedy R1 (stage 1, "otherwise the setting is repeated"): pointings per fiducial mark,
-#: averaged, when the L-check loop has ended failed (a choice: 4 halves the pointing σ).
-REPEAT_POINTINGS = 4
 
 #: Remedy R2 (after stage 2 and 3, q > ¼ mark): the elements that clear the y-parallax on a
 #: setup-data instrument — the five of a dependent-pair relative orientation as this
@@ -297,44 +299,6 @@ def _correct_span(
         equation="(6.10), (6.11)",
         remedy=remedy,
         when=active if remedy else None,
-    )
-
-
-def interior_orientation(run: Run, stage: str) -> None:
-    """Interior settings common to stage 1 and the conventional method's C1: the height-counter
-    gear M_в, f_пр, the cassettes parallel to the axes, the correction mechanisms and the
-    decentrations at their zero places (OCR L3755–3759)."""
-    op, sheet = run.op, run.sheet
-    log = op.log
-    op.inst.gear_height_counter(sheet.vertical_scale_denominator)
-    f_instrument = run.target("f_пр")
-    op.set("f_instrument", f_instrument, f"{stage}/f")
-    log.add(
-        stage,
-        "set the instrument principal distance f_пр",
-        "f_instrument",
-        reading=f_instrument,
-        equation="item 1",
-    )
-    for side in ("left", "right"):
-        op.drive(f"kappa_{side}", 0.0)
-        log.add(
-            stage,
-            f"turn the {side} cassette: fiducial lines parallel to the axes",
-            f"kappa_{side}",
-            reading=0.0,
-            unit="rad",
-            equation="stage 1",
-        )
-        for axis in ("alpha", "omega"):
-            op.drive(f"k_{axis}_{side}", 0.0)
-        for d in ("dx", "dy"):
-            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], f"{stage}/{d}_{side}")
-    log.add(
-        stage,
-        "correction mechanisms and decentrations to their zero places",
-        "",
-        equation="stage 1",
     )
 
 
@@ -636,40 +600,11 @@ def _solve_kappa(q_of, kappa0, target):
     return solve_1d(q_of, kappa0, target, iterations=4, h=1e-6)
 
 
-def _judge_standard_points(
-    run: Run, stage: str, key: str, active=None, remedy: str = "", iteration: int = 1
-) -> NDArray[np.float64]:
-    """Fuse on each of the six standard points and judge its y-parallax (σ_q): (..., 6)."""
-    op = run.op
-    tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    pts = run.scene.standard_points_m
-    imgs = run.scene.images(pts)
-    seen = []
-    for i in range(6):
-        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
-        seen.append(q)
-        op.log.add(
-            stage,
-            f"residual y-parallax at standard point {i + 1}",
-            "",
-            residual=q,
-            true=q_true,
-            judgment_error=q - q_true,
-            tolerance=tol,
-            passed=np.abs(q) <= tol,
-            iteration=iteration,
-            equation="≤ ¼ mark",
-            remedy=remedy,
-            when=active if remedy else None,
-        )
-    return np.stack(seen, axis=-1)
-
-
 def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     """The residual y-parallax at the six standard points, judged by the operator; with the
     operator's practice, remedy R2 where it exceeds ¼ mark."""
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    seen = _judge_standard_points(run, stage, f"{stage}/std")
+    seen = np.stack(judge_standard_points(run, stage, f"{stage}/std"), axis=-1)
     worst = np.max(np.abs(seen), axis=-1)
     name = f"stage {stage}: residual y-parallax (6 points)"
     if run.remedial:
@@ -738,7 +673,12 @@ def refine_relative_orientation(
                 remedy=remedy,
                 when=active,
             )
-        new = _judge_standard_points(run, stage, f"{stage}/R2/{it}", active, remedy, it)
+        new = np.stack(
+            judge_standard_points(
+                run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
+            ),
+            axis=-1,
+        )
         seen = np.where(active[..., None], new, seen)
         worst = np.where(active, np.max(np.abs(new), axis=-1), worst)
         active = active & (worst > tol)
@@ -847,17 +787,6 @@ def level_design(
     return LevelDesign(combos, misfit, np.column_stack(cols))
 
 
-def _scale_pair(run: Run) -> tuple[str, str]:
-    """The two plan control points of the sheet farthest apart (the scale is taken there)."""
-    sc = run.scene.scenario
-    ids = run.sheet.similarity_point_ids or tuple(h["id"] for h in run.sheet.control_heights)
-    pts = {i: np.asarray(next(p for p in sc.points if p.id == i).local_m, float) for i in ids}
-    return max(
-        ((a, b) for k, a in enumerate(ids) for b in ids[k + 1 :]),
-        key=lambda ab: float(np.hypot(*(pts[ab[0]][:2] - pts[ab[1]][:2]))),
-    )
-
-
 def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
     """The instrument coordinates (6.7) of a plan control point (the sheet's similarity)."""
     sheet = run.sheet
@@ -868,33 +797,22 @@ def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
     return np.asarray(xy, float).reshape(2)
 
 
-def _fuse_on(run: Run, p, key: str, active, read: tuple[str, ...]) -> dict[str, NDArray]:
-    op = run.op
-    img = run.scene.images(np.asarray(p, float)[None, :])
-    op.fuse(p, (img[0][0], img[1][0]), key, active)
-    return {c: op.read(c, f"{key}/{c}") for c in read}
-
-
 def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
     """R3 (1): fuse on the two plan control points farthest apart, compare the distance of the
     X, Y counters with that of their sheet coordinates (6.7), turn b_x in proportion."""
     op, sheet = run.op, run.sheet
     if sheet.similarity is None:
         return
-    a_id, b_id = _scale_pair(run)
-    sc = run.scene.scenario
-    pts = [np.asarray(next(p for p in sc.points if p.id == i).local_m, float) for i in (a_id, b_id)]
-    ra, rb = (
-        _fuse_on(run, p, f"3/R3/{it}/scale/{i}", active, ("X", "Y"))
-        for i, p in zip((a_id, b_id), pts, strict=True)
-    )
+    a_id, b_id = scale_pair(run)
     d_sheet = float(np.hypot(*(_sheet_xy(run, a_id) - _sheet_xy(run, b_id))))
-    d_model = np.hypot(ra["X"] - rb["X"], ra["Y"] - rb["Y"])
-    with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
-        ratio = np.where(active, d_sheet / d_model, 1.0)
-    bx = op.read("bx", f"3/R3/{it}/bx")
-    new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio  # MO_bx + b_x·ratio
-    op.set("bx", new, f"3/R3/{it}/setbx", active)
+    bx, new, d_model = scale_by_two_points(
+        run,
+        (a_id, control_point_m(run, a_id)),
+        (b_id, control_point_m(run, b_id)),
+        d_sheet,
+        f"3/R3/{it}",
+        active,
+    )
     op.log.add(
         "3",
         f"scale: fuse on {a_id} and {b_id}, counter distance against the sheet's "
@@ -918,11 +836,7 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
     sense = run.sheet.options.bz_scale_sense
     w = np.linalg.pinv(design.design)
     for row, name in ((1, "alpha"), (2, "omega")):
-        phi = None
-        for i, e in enumerate(errs):  # a sum in a fixed order (vectorised = per-trial)
-            term = w[row, i] * e
-            phi = term if phi is None else phi + term
-        phi = np.where(active, -phi, 0.0)
+        phi = np.where(active, -fixed_order_sum(w[row, i] * e for i, e in enumerate(errs)), 0.0)
         for control, rate in design.combos[name].items():
             if control == "bz":
                 before = op.read("bz", f"3/R3/{it}/{name}/bz")
@@ -953,16 +867,6 @@ def _shown(op: Operator, value) -> float:
     return float(flat[op.log.shown if flat.size > 1 else 0])
 
 
-def _height_seen(run: Run, p, key: str, active, pointings: int) -> NDArray[np.float64]:
-    """Fuse on ``p`` and read the height scale, ``pointings`` times, averaged. [m]"""
-    total = None
-    for j in range(pointings):
-        k = key + (f"/p{j}" if j else "")
-        read = _fuse_on(run, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
-        total = read if total is None else total + read
-    return total / pointings
-
-
 def _read_control_heights(
     run: Run,
     rows: list[ControlHeight],
@@ -977,9 +881,7 @@ def _read_control_heights(
     the errors (read − truth) of points 1 … n−1. [m]"""
     op, tol = run.op, run.sheet.tolerances["control_height_m"]
     p0 = rows[0].ground_m
-    seen0 = _height_seen(run, p0, f"{key}/slip", active, pointings)
-    exact = op.v(op.inst.read(HEIGHT_SCALE, exact=True))
-    op.inst.slip_height_scale(np.where(active, exact + (p0[2] - seen0), exact))
+    slip_height_scale_on_mean(run, p0, f"{key}/slip", active, pointings)
     op.log.add(
         "3",
         f"fuse on {rows[0].id} ({pointings} times), slip the height scale to H = {p0[2]:.2f} m",
@@ -996,7 +898,7 @@ def _read_control_heights(
             op,
             "3",
             f"control point {h.id}: fuse, read the height ({pointings} times, mean)",
-            _height_seen(run, h.ground_m, f"{key}/{h.id}", active, pointings),
+            height_mean(run, h.ground_m, f"{key}/{h.id}", active, pointings),
             h.ground_m[2],
             tol,
             iteration=it,
@@ -1129,152 +1031,6 @@ def stage3_scale_model(run: Run) -> None:
         remedy = "R3 stage 3: refine scaling and levelling on control"
         run.record_remedy(remedy, name, failed, rounds)
     check_standard_points(run, "3")
-
-
-# --- stages 4 and 5: the sheet on the coordinatograph ----------------------------------------
-
-
-def _table(run: Run, xy_mm) -> NDArray[np.float64]:
-    """Ideal table position of a model position (x′, y′) for the coordinatograph's origin."""
-    return run.op.inst.table_position_mm(xy_mm)
-
-
-def _needle_at(run: Run, corner: str, key: str) -> NDArray[np.float64]:
-    """Counters to the sheet's readings of ``corner`` (MO_X, MO_Y + x′, y′): the needle."""
-    op = run.op
-    op.set("X", run.target(f"corner {corner}: O_X"), f"{key}/X")
-    op.set("Y", run.target(f"corner {corner}: O_Y"), f"{key}/Y")
-    return _needle(run, key)
-
-
-def _needle(run: Run, key: str) -> NDArray[np.float64]:
-    """The needle on the table; with the SC complex's automatic coordinatograph, its settled
-    servo noise drawn from the run's keyed streams (σ_s per axis)."""
-    op = run.op
-    sigma = op.inst.servo_sigma_mm
-    noise = None
-    if sigma:
-        noise = np.stack([op.noise.normal(f"servo/{key}/{a}", sigma) for a in "xy"], axis=-1)
-    return np.asarray(op.inst.needle(op.model.finish_side, noise), float)
-
-
-def stage4_orient_sheet(run: Run) -> None:
-    """Stage 4: corner 1 under the needle (6.16), rotate about it to corner 3 (6.17), repeat.
-
-    Closed form (the sheet is rigid): the pin pierces mark 1 + placement error (injected
-    ``coordinatograph.sheet_placement_*`` plus σ_mono at map scale); the operator turns the
-    sheet until mark 3 lies on the needle's ray from the pin (σ_mono across it).
-    """
-    op, sheet = run.op, run.sheet
-    if not sheet.corners:
-        run.sheet_pose = None
-        return
-    ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
-    enlargement = None
-    if op.inst.options.automatic_coordinatograph:  # photo → map, checked against its 10 ×
-        sc = run.scene.scenario
-        height = np.mean([p["flying_height_m"] for p in summarize_scenario(sc)["photos"]])
-        photo_scale = MM_PER_M * float(height) / float(sc.camera.focal_length_mm)
-        enlargement = photo_scale / sheet.map_scale_denominator
-    op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
-    corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
-    ideal = {k: _table(run, v) for k, v in corners.items()}
-    inj = op.inst.injected
-    place = np.stack(
-        [
-            op.v(inj["coordinatograph.sheet_placement_x"]),
-            op.v(inj["coordinatograph.sheet_placement_y"]),
-        ],
-        axis=-1,
-    )
-    angle = op.v(0.0)
-    for it in (1, 2):
-        n1 = _needle_at(run, "1", f"4/{it}/c1")
-        e = np.stack(
-            [op.noise.normal(f"mono/4/{it}/pin/{a}", op.model.monocular_sigma_mm) for a in "xy"],
-            axis=-1,
-        )
-        pin_sheet = ideal["1"] + (place if it == 1 else 0.0) + e
-        op.log.add(
-            "4",
-            "counters to corner 1, pin the sheet's corner 1 under the needle",
-            "X",
-            reading=run.target("corner 1: O_X"),
-            iteration=it,
-            equation="(6.16)",
-        )
-        n3 = _needle_at(run, "3", f"4/{it}/c3")
-        e3 = op.noise.normal(f"mono/4/{it}/c3", op.model.monocular_sigma_mm)
-        a_needle = np.arctan2(n3[..., 1] - n1[..., 1], n3[..., 0] - n1[..., 0])
-        d = ideal["3"] - pin_sheet
-        a_mark = np.arctan2(d[..., 1], d[..., 0])
-        angle = a_needle - a_mark + e3 / np.hypot(d[..., 0], d[..., 1])
-        op.log.add(
-            "4",
-            "counters to corner 3, rotate the sheet about corner 1 until the needle meets corner 3",
-            "",
-            reading=None,
-            judgment_error=e3,
-            iteration=it,
-            equation="(6.17)",
-        )
-    run.sheet_pose = SheetPose(angle, pin_sheet, n1)
-    run.record_stage("4", op.v(2).astype(int))
-
-
-def stage5_check(run: Run) -> None:
-    """Stage 5: counters to corner 4 (6.18), misclosure ≤ 0.3 mm; plotted control points."""
-    op, sheet = run.op, run.sheet
-    pose = run.sheet_pose
-    if pose is None:
-        return
-    corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
-    n4 = _needle_at(run, "4", "5/c4")
-    mark4 = pose.table_of(_table(run, corners["4"]))
-    mis = np.hypot(*np.moveaxis(mark4 - n4, -1, 0))
-    tol = sheet.tolerances["corner_mm"]
-    op.log.add(
-        "5",
-        "counters to corner 4: misclosure of needle and corner 4",
-        "",
-        residual=mis,
-        tolerance=tol,
-        passed=mis <= tol,
-        equation="(6.18)",
-    )
-    run.check("stage 5: corner 4", mis, tol)
-    run.record_stage("5", op.v(1).astype(int))
-    # plotted plan control points: fuse on the point, compare the needle with the plotted point
-    sc = run.scene.scenario
-    if sheet.similarity is None:
-        return
-    errs = []
-    for pid in sheet.similarity_point_ids:
-        p = next(q for q in sc.points if q.id == pid)
-        xy = sheet_corner_instrument_coordinates(
-            sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
-        )
-        img = run.scene.images(np.asarray(p.local_m, float)[None, :])
-        op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
-        needle = _needle(run, f"5/plan/{pid}")
-        plotted = pose.table_of(_table(run, np.asarray(xy, float).reshape(2)))
-        err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
-        errs.append(err)
-        op.log.add(
-            "5",
-            f"plan control point {pid}: fuse, needle against the plotted point",
-            "",
-            residual=err,
-            equation="stage 5",
-        )
-    # Tolerance (assumed): the book gives no figure for this final check; it is the same
-    # comparison as corner 4 (needle against a point plotted on the sheet), so the corner-4
-    # figure 0.3 mm (documented, stage 5) is used — 3.75 σ of the assumed plotting σ 0.08 mm.
-    run.check(
-        "stage 5: plan control points (needle − plotted)",
-        np.max(np.stack(errs, axis=-1), axis=-1),
-        sheet.tolerances["corner_mm"],
-    )
 
 
 def mechanism_level(

@@ -34,9 +34,8 @@ from stereoplotter.procedure.setup_method import (
     stage1_scale_coefficient,
     stage2_transform,
     stage3_scale_model,
-    stage4_orient_sheet,
-    stage5_check,
 )
+from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.transcript import Transcript
 
 __all__ = [
