@@ -25,20 +25,20 @@ from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
-    UnitMap,
     counters_from_homologous_points,
     rod_from_counters,
-    rods_intersection,
     turn_correction_knob,
     unit_for_orientation,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
+from stereoplotter.procedure.floor import control_heights_of
 from stereoplotter.procedure.operator import Operator, Scene, solve_1d
 from stereoplotter.procedure.records import (
     ControlHeight,
 )
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.span_check import fiducial_mm, span_loop
 from stereoplotter.procedure.steps import (
     REPEAT_POINTINGS,
     control_point_m,
@@ -51,11 +51,8 @@ from stereoplotter.procedure.steps import (
     slip_height_scale_on_mean,
 )
 from stereoplotter.setup.equations import (
-    base_z_correction,
-    height_correction,
     sheet_corner_instrument_coordinates,
 )
-from stereoplotter.setup.records import SetupRefusal
 from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = [
@@ -65,10 +62,8 @@ __all__ = [
     "check_standard_points",
     "clear_kappa",
     "level_design",
-    "mechanism_level",
     "refine_relative_orientation",
     "refine_scale_and_level",
-    "refuse_beyond_mechanism",
     "run_setup_method",
     "stage1_scale_coefficient",
     "stage2_transform",
@@ -111,195 +106,7 @@ LEVEL_TILTS = {
 LEVEL_FREE = ("bz", "kappa_left", "kappa_right")
 
 
-def _fid(run: Run, side: str, mark: str) -> NDArray[np.float64]:
-    return run.scene.fiducials_mm[side][int(mark) - 1]
-
-
 # --- stage 1 ---------------------------------------------------------------------------------
-
-
-def _measure_span(run: Run, side: str, key: str, active, pointings: int = 1) -> NDArray[np.float64]:
-    """L′: the mark on fiducial 3 then 4 of ``side``, Y read at each (the mean of
-    ``pointings`` pointings and readings per mark, remedy R1)."""
-    op = run.op
-    ys = []
-    for mark in ("3", "4"):
-        y = 0.0
-        for j in range(pointings):
-            k = f"{key}/{side}/{mark}" + (f"/p{j}" if j else "")
-            op.mark_on(side, _fid(run, side, mark), k, active)
-            y = y + op.read("Y", k)
-        ys.append(y / pointings)
-    return ys[0] - ys[1]
-
-
-def _spans(run: Run, units_at_zero: bool) -> tuple[float, float]:
-    """The L to compare with: the sheet's L_л, L_п (6.5), or with the units at zero
-    n·(y₃ − y₄) of the measured marks (decision D5, ``kinematics.md`` §4.3: the literal (6.5)
-    would bias n by tan²ω(1 + l²/f′²) and can drive D beyond D_max).
-
-    The D5 span is a comparison value, not a reading set on a scale; the sheet does not print
-    it, so it is formed here from the sheet's measured marks and n.
-    """
-    if not units_at_zero:
-        return run.readings["L_л"].value, run.readings["L_п"].value
-    out = []
-    for photo in run.sheet.photos:
-        m = photo.marks_measured_mm
-        out.append(photo.n * (m["3"][1] - m["4"][1]))
-    return out[0], out[1]
-
-
-def _span_loop(
-    run: Run,
-    stage: str,
-    key: str,
-    units_at_zero: bool = False,
-    active=None,
-    pointings: int = 1,
-    remedy: str = "",
-) -> tuple[NDArray, NDArray, NDArray]:
-    """The L-check loop (6.9)–(6.11) until |L − L′| ≤ 0.03/n_л for both photos."""
-    op, sheet = run.op, run.sheet
-    tol = sheet.tolerances["mark_span_mm"]
-    span_l, span_r = _spans(run, units_at_zero)
-    active = op.all() if active is None else active.copy()
-    its = np.zeros(np.shape(active), int)
-    dl = dr = op.v(np.nan)
-    for it in range(1, op.model.max_iterations + 1):
-        its = np.where(active, it, its)
-        k = f"{key}/{it}"
-        meas_l = _measure_span(run, "left", k, active, pointings)
-        meas_r = _measure_span(run, "right", k, active, pointings)
-        dl = np.where(active, span_l - meas_l, dl)
-        dr = np.where(active, span_r - meas_r, dr)
-        ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
-        for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
-            op.log.add(
-                stage,
-                f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} "
-                f"= {span:.3f} mm",
-                "Y",
-                reading=meas,
-                residual=d,
-                tolerance=tol,
-                passed=np.abs(d) <= tol,
-                iteration=it,
-                equation="(6.5)" if not units_at_zero else "(6.5), decision D5",
-                remedy=remedy,
-                when=active if remedy else None,
-            )
-        active = active & ~ok
-        if not np.any(active):
-            break
-        _correct_span(run, stage, k, it, active, (dl, dr), (span_l, span_r), remedy)
-    ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
-    return its, ok, np.maximum(np.abs(dl), np.abs(dr))
-
-
-def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy: str, active):
-    """Log the ΔZ (6.9) setting; the word follows the sign: the Z counter counts the projection
-    distance D, so ΔZ > 0 (a larger D) lowers the carriage and ΔZ < 0 raises it. [m, mm]"""
-    direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
-    op.log.add(
-        stage,
-        f"ΔZ = {dz_shown:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
-        "Z",
-        before=depth,
-        after=depth + dz_mm,
-        reading=depth + dz_mm,
-        iteration=it,
-        equation="(6.9), (6.11)",
-        remedy=remedy,
-        when=active if remedy else None,
-    )
-
-
-def _correct_span(
-    run: Run, stage: str, k: str, it: int, active, diffs, spans, remedy: str = ""
-) -> None:
-    """One correction of the L-check: ΔZ (6.9) from the left photo (or f_пр at the bottom
-    stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11).
-
-    Decision D9 (``docs/procedure.md``, "The error-free floor"): (6.9) and (6.10) are applied
-    in their ratio form, which is exact for the span of a photo (L′ = n·(y₃ − y₄), n = D/f_пр):
-    ΔD = D·ΔL/L′ with the *measured* L′ in the denominator, and for the right photo its own
-    projection distance D_п = D + b_z, less the change ΔZ (or the f_пр change) that the left
-    correction makes to it. The printed first-order form D·ΔL_п/L_п under-corrects by the
-    factor L′_п/L_п ≈ D/(D + b_z′): with b_z at zero in stage 1 it leaves b_z′²/(D + b_z′) —
-    8.4 µm of b_z for pair60 (b_z′ = 1.25 mm), which the loop accepts (0.03/n_л mm of L is
-    11 µm of b_z) and which shows as 6 µm of y-parallax at the standard points.
-    """
-    op, sheet = run.op, run.sheet
-    dl, dr = diffs
-    span_l, span_r = spans
-    meas_l, meas_r = span_l - dl, span_r - dr  # L′ as measured
-    sense = sheet.options.bz_scale_sense
-    depth = op.read("Z", f"{k}/Z")
-    dz_m = height_correction(depth, dl, meas_l, sheet.vertical_scale_denominator)
-    dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
-    f_ratio = op.v(1.0)  # f′_пр/f_пр of this correction (bottom stop)
-    # Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a
-    # correction that asks for a deeper carriage cannot be set there. The operator reaches
-    # the same n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
-    stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
-    beyond = active & (depth + dz_mm > stop)
-    if np.any(beyond):
-        f_set = op.commanded["f_instrument"]
-        f_new = f_set * depth / (depth + dz_mm)
-        f_ratio = np.where(beyond, depth / (depth + dz_mm), 1.0)
-        op.set("f_instrument", f_new, f"{k}/setf", beyond)
-        op.log.add(
-            stage,
-            "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
-            "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
-            "f_instrument",
-            before=f_set,
-            after=f_new,
-            reading=f_new,
-            iteration=it,
-            equation="(6.3), (6.9)",
-            remedy=remedy,
-            when=beyond if remedy else None,
-        )
-        dz_mm = np.where(beyond, 0.0, dz_mm)
-    op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
-    shown = op.log.shown if np.ndim(beyond) else 0
-    if not np.ravel(beyond)[shown]:
-        _log_delta_z(
-            op,
-            stage,
-            float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]),
-            depth,
-            dz_mm,
-            it,
-            remedy,
-            active,
-        )
-    bz = op.read("bz", f"{k}/bz")
-    # D_п as the operator knows it: D + b_z from the b_z scale's nominal place of zero; scaled
-    # by f_пр/f′_пр where f_пр was changed, less the ΔZ just set (both move the right photo)
-    depth_r = (depth + sense * (bz - NOMINAL_ZERO["bz"])) * f_ratio
-    dbz = (
-        depth_r
-        + base_z_correction(depth_r, dr, meas_r)
-        - (depth + dz_mm)
-        - (sense * (bz - NOMINAL_ZERO["bz"]))
-    )
-    op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
-    op.log.add(
-        stage,
-        "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): "
-        "O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
-        "bz",
-        before=bz,
-        after=bz + sense * dbz,
-        reading=bz + sense * dbz,
-        iteration=it,
-        equation="(6.10), (6.11)",
-        remedy=remedy,
-        when=active if remedy else None,
-    )
 
 
 def stage1_scale_coefficient(run: Run) -> None:
@@ -350,11 +157,11 @@ def stage1_scale_coefficient(run: Run) -> None:
     o_by = run.target("O_by")
     op.set("by", o_by, "1/by")
     log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=o_by, equation="item 1")
-    its, ok, res = _span_loop(run, "1", "1/L", units_at_zero=True)
+    its, ok, res = span_loop(run, "1", "1/L", units_at_zero=True)
     name = "stage 1: |L − L′|"
     if run.remedial:  # R1: "otherwise the setting is repeated", with averaged pointings
         failed = ~ok
-        r_its, _, r_res = _span_loop(
+        r_its, _, r_res = span_loop(
             run, "1", "1/L/R1", True, failed, REPEAT_POINTINGS, "R1 repeat the setting"
         )
         res = np.where(failed, r_res, res)
@@ -421,7 +228,7 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
     the knob until the fiducial is under the mark ((6.12) or (6.13))."""
     op = run.op
     sfx = "" if side == "left" else ",п"
-    fid = _fid(run, side, mark)
+    fid = fiducial_mm(run, side, mark)
     if axis == "omega":
         counter, free, comp = "Y", "X", 1
         eq = "(6.12)"
@@ -459,7 +266,7 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
 def _mark4(run: Run, side: str, key: str, active) -> NDArray[np.float64]:
     """Check mark 4 at MO_Y + n·y⁰₄ (6.12): the offset of the mark from fiducial 4 seen."""
     op = run.op
-    fid = _fid(run, side, "4")
+    fid = fiducial_mm(run, side, "4")
     value = run.target(f"O_Y4,{_SIDE[side]}")
     op.set("Y", value, f"{key}/set", active)
     op.mark_on(side, fid, f"{key}/line", active, free="X")
@@ -479,7 +286,7 @@ def stage2_transform(run: Run) -> None:
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
         if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
-            l_its, _, _ = _span_loop(run, "2", f"2/L{it}", active=active)
+            l_its, _, _ = span_loop(run, "2", f"2/L{it}", active=active)
             run.record_stage("1", run.stage_iterations("1") + np.where(active, l_its, 0))
         else:  # with the correction units still at zero the cassette centre is on the plumb
             _zero_readings(run, "2/MO")
@@ -1031,107 +838,6 @@ def stage3_scale_model(run: Run) -> None:
         remedy = "R3 stage 3: refine scaling and levelling on control"
         run.record_remedy(remedy, name, failed, rounds)
     check_standard_points(run, "3")
-
-
-def mechanism_level(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
-) -> tuple[float, float]:
-    """What the correction mechanism itself leaves at the sheet's own settings (the floor).
-
-    The units at the sheet's α, ω, κ with its decentrations (``unit_for_orientation``), f_пр and
-    b = (b_x, b_y, b_z′) of the sheet, no error anywhere: the largest |q| at the six standard
-    points [mm, photo scale], and the largest control-height error relative to the first height
-    control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
-    setup-data method sets exactly these values and has no relative orientation or levelling.
-    ``mechanism``: the instrument's own correction mechanism
-    (:func:`~stereoplotter.instrument.correction.mechanism_for`); None: canonical unit.
-    """
-    f = sheet.focal_length_corrected_mm
-    units = [
-        UnitMap(
-            replace(
-                unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis),
-                mechanism=mechanism,
-            )
-        )
-        for p in sheet.photos
-    ]
-    bx, by, bz = sheet.base_mm
-    setting = InstrumentSetting(sheet.f_instrument_mm, bx, by, bz)
-
-    def reading(points_m):
-        pl, pr = scene.images(points_m)
-        return rods_intersection(units[0].rod_from_photo(pl), units[1].rod_from_photo(pr), setting)
-
-    q_max = float(np.max(np.abs(reading(scene.standard_points_m).y_parallax_mm)))
-    heights = np.array([h.ground_m for h in control_heights_of(sheet, scene)])
-    if len(heights) < 2:
-        return q_max, 0.0
-    depth = reading(heights).depth_mm
-    # deeper is lower: H_i = H_0 − (D_i − D_0)·M_в/1000 with the scale slipped at point 0
-    model_h = heights[0, 2] - (depth - depth[0]) * sheet.vertical_scale_denominator / 1000.0
-    return q_max, float(np.max(np.abs(model_h - heights[:, 2])))
-
-
-def refuse_beyond_mechanism(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
-):
-    """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
-    already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
-    no operator can then build the model by the setup-data method on this instrument.
-
-    The message names the scenario file and the field that carries the pair beyond the
-    mechanism — the largest photo tilt, ``photos[i].exterior.alpha_deg`` or ``omega_deg`` — and
-    the §26 tolerances the mechanism level exceeds.
-    """
-    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis, mechanism)
-    tol_q = sheet.tolerances["residual_y_parallax_mm"]
-    tol_h = sheet.tolerances["control_height_m"]
-    if q_max <= tol_q and h_max <= tol_h:
-        return
-    sc = scene.scenario
-    tilts = [
-        (abs(getattr(p.exterior, axis)), i, axis)
-        for i, p in enumerate(sc.photos)
-        for axis in ("alpha", "omega")
-    ]
-    _, i, axis = max(tilts, key=lambda t: t[0])  # the first of equal tilts
-    found = np.degrees(getattr(sc.photos[i].exterior, axis))
-    films = [
-        f"photos[{j}].film_deformation_ppm = [{p.film_deformation_ppm[0]:g}, "
-        f"{p.film_deformation_ppm[1]:g}]"
-        for j, p in enumerate(sc.photos)
-        if any(p.film_deformation_ppm)
-    ]
-    film_note = (
-        "; the films' deformation enters this level too ("
-        + ", ".join(films)
-        + "): the SC complex's correction unit takes it out (--option correction_unit)"
-        if films
-        else ""
-    )
-    raise SetupRefusal(
-        f"{sc.source}: photos[{i}].exterior.{axis}_deg: expected a tilt the setup-data method "
-        f"on {sheet.instrument_title} can carry (§26: at the sheet's exact settings the "
-        f"correction mechanism must leave ≤ ¼ mark {tol_q * 1000:.1f} µm of y-parallax at the "
-        f"standard points and ≤ H/3000 {tol_h:.2f} m at the control heights), found "
-        f"{found:+.1f}° (the largest tilt of the pair): at f′ = "
-        f"{sheet.focal_length_corrected_mm:.0f} mm the mechanism leaves {q_max * 1000:.1f} µm "
-        f"and {h_max:.2f} m (instrument test, §6); the model needs relative orientation and "
-        f"levelling (--method conventional){film_note}"
-    )
-
-
-def control_heights_of(sheet: SetupSheet, scene: Scene) -> list[ControlHeight]:
-    """The sheet's height control points with their ground points (the scene's truth)."""
-    sc = scene.scenario
-    rows = []
-    for h in sheet.control_heights:
-        p = next(p for p in sc.points if p.id == h["id"])
-        rows.append(
-            ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
-        )
-    return rows
 
 
 def run_setup_method(run: Run) -> Run:

@@ -26,10 +26,11 @@ from stereoplotter.instrument.sc1_complex import (
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
 from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
+from stereoplotter.procedure.floor import refuse_beyond_mechanism
 from stereoplotter.procedure.operator import Noise, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, StageRecord
 from stereoplotter.procedure.run import PRACTICES, PreparedRun, Run, build_run
-from stereoplotter.procedure.setup_method import refuse_beyond_mechanism, run_setup_method
+from stereoplotter.procedure.setup_method import run_setup_method
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import working_area_grid_m
