@@ -31,6 +31,7 @@ from stereoplotter.instrument.kinematics import (
     unit_for_orientation,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
+from stereoplotter.procedure import steps
 from stereoplotter.procedure.floor import control_heights_of
 from stereoplotter.procedure.operator import Operator, Scene, solve_1d
 from stereoplotter.procedure.records import (
@@ -39,17 +40,6 @@ from stereoplotter.procedure.records import (
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.span_check import fiducial_mm, span_loop
-from stereoplotter.procedure.steps import (
-    REPEAT_POINTINGS,
-    control_point_m,
-    fixed_order_sum,
-    height_mean,
-    interior_orientation,
-    judge_standard_points,
-    scale_by_two_points,
-    scale_pair,
-    slip_height_scale_on_mean,
-)
 from stereoplotter.setup.equations import (
     sheet_corner_instrument_coordinates,
 )
@@ -113,7 +103,7 @@ def stage1_scale_coefficient(run: Run) -> None:
     """Stage 1: interior settings, base, D = n_л f_пр, the L-check loop, MO_Z and MO_bz (D7)."""
     op, sheet = run.op, run.sheet
     log = op.log
-    interior_orientation(run, "1")
+    steps.interior_orientation(run, "1")
     o_bx = run.target("O_bx", NOMINAL_ZERO["bx"])  # MO_bx: the scale's place of zero
     op.set("bx", o_bx, "1/bx")
     log.add(
@@ -162,7 +152,7 @@ def stage1_scale_coefficient(run: Run) -> None:
     if run.remedial:  # R1: "otherwise the setting is repeated", with averaged pointings
         failed = ~ok
         r_its, _, r_res = span_loop(
-            run, "1", "1/L/R1", True, failed, REPEAT_POINTINGS, "R1 repeat the setting"
+            run, "1", "1/L/R1", True, failed, steps.REPEAT_POINTINGS, "R1 repeat the setting"
         )
         res = np.where(failed, r_res, res)
         its = its + np.where(failed, r_its, 0)
@@ -411,7 +401,7 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     """The residual y-parallax at the six standard points, judged by the operator; with the
     operator's practice, remedy R2 where it exceeds ¼ mark."""
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    seen = np.stack(judge_standard_points(run, stage, f"{stage}/std"), axis=-1)
+    seen = np.stack(steps.judge_standard_points(run, stage, f"{stage}/std"), axis=-1)
     worst = np.max(np.abs(seen), axis=-1)
     name = f"stage {stage}: residual y-parallax (6 points)"
     if run.remedial:
@@ -481,7 +471,7 @@ def refine_relative_orientation(
                 when=active,
             )
         new = np.stack(
-            judge_standard_points(
+            steps.judge_standard_points(
                 run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
             ),
             axis=-1,
@@ -610,12 +600,12 @@ def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
     op, sheet = run.op, run.sheet
     if sheet.similarity is None:
         return
-    a_id, b_id = scale_pair(run)
+    a_id, b_id = steps.scale_pair(run)
     d_sheet = float(np.hypot(*(_sheet_xy(run, a_id) - _sheet_xy(run, b_id))))
-    bx, new, d_model = scale_by_two_points(
+    bx, new, d_model = steps.scale_by_two_points(
         run,
-        (a_id, control_point_m(run, a_id)),
-        (b_id, control_point_m(run, b_id)),
+        (a_id, steps.control_point_m(run, a_id)),
+        (b_id, steps.control_point_m(run, b_id)),
         d_sheet,
         f"3/R3/{it}",
         active,
@@ -643,7 +633,9 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
     sense = run.sheet.options.bz_scale_sense
     w = np.linalg.pinv(design.design)
     for row, name in ((1, "alpha"), (2, "omega")):
-        phi = np.where(active, -fixed_order_sum(w[row, i] * e for i, e in enumerate(errs)), 0.0)
+        phi = np.where(
+            active, -steps.fixed_order_sum(w[row, i] * e for i, e in enumerate(errs)), 0.0
+        )
         for control, rate in design.combos[name].items():
             if control == "bz":
                 before = op.read("bz", f"3/R3/{it}/{name}/bz")
@@ -681,14 +673,14 @@ def _read_control_heights(
     active,
     remedy: str,
     it: int,
-    pointings: int = REPEAT_POINTINGS,
+    pointings: int = steps.REPEAT_POINTINGS,
 ) -> list[NDArray[np.float64]]:
     """Slip the height scale on control point 0 (the mean of ``pointings`` fusings and readings
     there), then fuse on the others and read their heights (each the mean of ``pointings``):
     the errors (read − truth) of points 1 … n−1. [m]"""
     op, tol = run.op, run.sheet.tolerances["control_height_m"]
     p0 = rows[0].ground_m
-    slip_height_scale_on_mean(run, p0, f"{key}/slip", active, pointings)
+    steps.slip_height_scale_on_mean(run, p0, f"{key}/slip", active, pointings)
     op.log.add(
         "3",
         f"fuse on {rows[0].id} ({pointings} times), slip the height scale to H = {p0[2]:.2f} m",
@@ -705,7 +697,7 @@ def _read_control_heights(
             op,
             "3",
             f"control point {h.id}: fuse, read the height ({pointings} times, mean)",
-            height_mean(run, h.ground_m, f"{key}/{h.id}", active, pointings),
+            steps.height_mean(run, h.ground_m, f"{key}/{h.id}", active, pointings),
             h.ground_m[2],
             tol,
             iteration=it,
