@@ -26,7 +26,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -38,6 +37,7 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.instrument.mechanics.play import PlayAxis
+from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import AutomaticCoordinatograph, SC1Options
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.spec.range_checks import check_in_range

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from functools import partial
 from pathlib import Path
 from types import MappingProxyType
@@ -25,6 +25,7 @@ from pydantic import model_validator as _model_validator
 from pydantic_core import PydanticCustomError
 
 from stereoplotter.errors import ConfigError, StereoplotterError, describe_value, did_you_mean
+from stereoplotter.instrument.principles import PRINCIPLES
 from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
 from stereoplotter.io.validation import FileModel, _bounds, _fail, check_number, text, validate
 from stereoplotter.io.yaml_files import load_yaml_mapping
@@ -68,9 +69,8 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("orientation.kappa_deg", "range", "deg", -180.0, 180.0, contains_zero=True),
     _Leaf("correction.tilt_max_deg", "number", "deg", high=45.0, **_POS),
     _Leaf("correction.decentration_mm", "range", "mm", -200.0, 200.0, contains_zero=True),
-    _Leaf("correction.follower_radius_mm", "number", "mm", 0.0, 100.0, required=False),
-    _Leaf("correction.lens_arm_length_mm", "number", "mm", high=5000.0, required=False, **_POS),
-    _Leaf("correction.gimbal_offset_mm", "number", "mm", 0.0, 500.0, required=False),
+    # each correction principle's own leaves, declared as plain data in its module
+    *(_Leaf(**asdict(f)) for p in PRINCIPLES.values() for f in p.schema_fields),
     _Leaf("counters.present", "bool"),
     _Leaf("counters.direction_switches", "bool"),
     _Leaf("counters.xy_least_count_mm", "number", "mm", high=1.0, **_POS),

@@ -34,7 +34,7 @@ def mechanism_level(
     control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
     setup-data method sets exactly these values and has no relative orientation or levelling.
     ``mechanism``: the instrument's own correction mechanism
-    (:func:`~stereoplotter.instrument.correction.mechanism_for`); None: canonical unit.
+    (:func:`~stereoplotter.instrument.principles.mechanism_for`); None: canonical unit.
     """
     f = sheet.focal_length_corrected_mm
     units = [

@@ -20,8 +20,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.geometry.instrument_settings import sequence_for
-from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
@@ -30,6 +28,7 @@ from stereoplotter.instrument.kinematics import (
     turn_correction_knob,
     unit_for_orientation,
 )
+from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
 from stereoplotter.procedure import steps
 from stereoplotter.procedure.floor import control_heights_of

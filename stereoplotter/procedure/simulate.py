@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import decentration_variant
+from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import (
     ErrorCorrectionUnit,
     SC1Options,

@@ -13,8 +13,12 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stereoplotter.geometry.instrument_settings import sequence_for, setting_values
-from stereoplotter.instrument.correction import control_name, mark_phrase
+from stereoplotter.instrument.principles import (
+    control_name,
+    mark_phrase,
+    sequence_for,
+    setting_values,
+)
 from stereoplotter.setup.sheet import SetupSheet, assumed_parameters
 from stereoplotter.setup.table24 import X_MARK_NAME, BlockResult, candidates_of
 

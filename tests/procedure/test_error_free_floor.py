@@ -16,8 +16,8 @@ import re
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.kinematics import unit_for_orientation
+from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure.floor import mechanism_level
