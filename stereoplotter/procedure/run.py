@@ -139,7 +139,8 @@ class Run:
 
 @dataclass(frozen=True)
 class PreparedRun:
-    """Everything a run fixes before its trials: sheet, error model, operator, scene, options.
+    """Everything a run fixes before its trials: sheet, error model, operator, scene (with the
+    true fiducials and the standard points), options and the evaluation grid.
 
     Built once by :func:`prepare_run`; :func:`run_trials_chunk` runs any range of trials on it,
     so a long run in chunks computes the sheet and the scene once.
@@ -159,6 +160,9 @@ class PreparedRun:
     relative: str = "elements"
     practice: str = "operator"
     options: SC1Options = field(default_factory=SC1Options)
+    #: The working-area grid where the true residual y-parallax is evaluated (local frame),
+    #: computed once per run (``simulate.residual_grid_m``). [m]
+    grid_m: NDArray[np.float64] | None = None
 
 
 def log_options(op: Operator, prep: PreparedRun) -> None:

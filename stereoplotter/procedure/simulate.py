@@ -216,6 +216,7 @@ def prepare_run(
         relative,
         practice,
         options,
+        residual_grid_m(scenario),
     )
 
 
@@ -235,7 +236,7 @@ def _run_one(
         run_conventional_method(run, prep.relative)
     scene = prep.scene
     q_std = op.y_parallax(scene.standard_points_m, scene.images(scene.standard_points_m))
-    grid = residual_grid_m(prep.scenario)
+    grid = prep.grid_m if prep.grid_m is not None else residual_grid_m(prep.scenario)
     q_grid = op.y_parallax(grid, scene.images(grid))
     return run, q_std, q_grid
 
