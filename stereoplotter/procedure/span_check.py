@@ -121,6 +121,39 @@ def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy:
     )
 
 
+def _past_bottom_stop(op, stage: str, k: str, it: int, active, depth, dz_mm, remedy: str):
+    """Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a correction
+    that asks for a deeper carriage cannot be set there. The operator reaches the same
+    n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
+
+    Returns the trials past the stop, f′_пр/f_пр of this correction (1 elsewhere) and ΔZ left
+    to set (0 past the stop). [—, mm]
+    """
+    f_ratio = op.v(1.0)
+    stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
+    beyond = active & (depth + dz_mm > stop)
+    if np.any(beyond):
+        f_set = op.commanded["f_instrument"]
+        f_new = f_set * depth / (depth + dz_mm)
+        f_ratio = np.where(beyond, depth / (depth + dz_mm), 1.0)
+        op.set("f_instrument", f_new, f"{k}/setf", beyond)
+        op.log.add(
+            stage,
+            "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
+            "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
+            "f_instrument",
+            before=f_set,
+            after=f_new,
+            reading=f_new,
+            iteration=it,
+            equation="(6.3), (6.9)",
+            remedy=remedy,
+            when=beyond if remedy else None,
+        )
+        dz_mm = np.where(beyond, 0.0, dz_mm)
+    return beyond, f_ratio, dz_mm
+
+
 def _correct_span(
     run: Run, stage: str, k: str, it: int, active, diffs, spans, remedy: str = ""
 ) -> None:
@@ -144,31 +177,7 @@ def _correct_span(
     depth = op.read("Z", f"{k}/Z")
     dz_m = height_correction(depth, dl, meas_l, sheet.vertical_scale_denominator)
     dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
-    f_ratio = op.v(1.0)  # f′_пр/f_пр of this correction (bottom stop)
-    # Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a
-    # correction that asks for a deeper carriage cannot be set there. The operator reaches
-    # the same n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
-    stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
-    beyond = active & (depth + dz_mm > stop)
-    if np.any(beyond):
-        f_set = op.commanded["f_instrument"]
-        f_new = f_set * depth / (depth + dz_mm)
-        f_ratio = np.where(beyond, depth / (depth + dz_mm), 1.0)
-        op.set("f_instrument", f_new, f"{k}/setf", beyond)
-        op.log.add(
-            stage,
-            "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
-            "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
-            "f_instrument",
-            before=f_set,
-            after=f_new,
-            reading=f_new,
-            iteration=it,
-            equation="(6.3), (6.9)",
-            remedy=remedy,
-            when=beyond if remedy else None,
-        )
-        dz_mm = np.where(beyond, 0.0, dz_mm)
+    beyond, f_ratio, dz_mm = _past_bottom_stop(op, stage, k, it, active, depth, dz_mm, remedy)
     op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
     shown = op.log.shown if np.ndim(beyond) else 0
     if not np.ravel(beyond)[shown]:

@@ -65,8 +65,6 @@ _MAXIMA = ("tilt_max",)
 _UPPER_END = {"projection_distance_range_mm": "projection.distance_max_mm"}
 
 
-# long: the docstring (parameters, the refusal, a doctest) is 32 lines; code ~55 (range, maximum,
-# documented upper end: one message each); the gear-set case is _check_in_gear_set
 def check_in_range(spec: InstrumentSpec, attribute_name: str, value: float, what: str) -> None:
     """Refuse a setting outside the instrument's range, as a mechanical stop would.
 
@@ -130,23 +128,7 @@ def check_in_range(spec: InstrumentSpec, attribute_name: str, value: float, what
         return
     end_key = _UPPER_END.get(attribute_name)
     if end_key in spec.parameters and shown > hi_y:
-        end = spec.parameters[end_key]
-        end_advice = (
-            f"the limit is documented ({', '.join(end.source)})"
-            if not end.is_assumed
-            else "raise it in the YAML if your instrument allows it"
-        )
-        raise RangeRefusal(
-            f"{what} = {shown:.3f}{unit} is above the {end.status} maximum {hi_y:g}{unit} of "
-            f"{end.file}: {end_key} (the stop refuses it; {end_advice})",
-            what=what,
-            value=shown,
-            low=lo_y,
-            high=hi_y,
-            status=end.status,
-            file=end.file,
-            key=end_key,
-        )
+        _refuse_above_end(spec.parameters[end_key], end_key, shown, (lo_y, hi_y), what, unit)
     raise RangeRefusal(
         f"{what} = {shown:.3f}{unit} is outside the {status} range [{lo_y:g}, {hi_y:g}]{unit} "
         f"of {file}: {key} (the stop refuses it; {advice})",
@@ -157,6 +139,30 @@ def check_in_range(spec: InstrumentSpec, attribute_name: str, value: float, what
         status=status,
         file=file,
         key=key,
+    )
+
+
+def _refuse_above_end(
+    end: Parameter, end_key: str, shown: float, limits: tuple[float, float], what: str, unit: str
+) -> None:
+    """The refusal of a value above a range whose upper end is its own documented leaf
+    (``projection.distance_max_mm``): the message names that leaf."""
+    lo_y, hi_y = limits
+    end_advice = (
+        f"the limit is documented ({', '.join(end.source)})"
+        if not end.is_assumed
+        else "raise it in the YAML if your instrument allows it"
+    )
+    raise RangeRefusal(
+        f"{what} = {shown:.3f}{unit} is above the {end.status} maximum {hi_y:g}{unit} of "
+        f"{end.file}: {end_key} (the stop refuses it; {end_advice})",
+        what=what,
+        value=shown,
+        low=lo_y,
+        high=hi_y,
+        status=end.status,
+        file=end.file,
+        key=end_key,
     )
 
 
