@@ -31,6 +31,7 @@ from stereoplotter.instrument.virtual import SCREWS
 from stereoplotter.procedure.operator import Noise
 from stereoplotter.procedure.run import PreparedRun, build_run
 from stereoplotter.trainer.actions import apply
+from stereoplotter.trainer.exercise import Exercise
 from stereoplotter.trainer.operator_steps import new_instrument, stage_functions
 from stereoplotter.trainer.outcome import Measure, stage_measures
 from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session, json_finite
@@ -253,13 +254,17 @@ def grade(
     *,
     population: int = 10_000,
     progress: Callable[[int], None] | None = None,
+    read_exercise: Callable[[dict[str, Any]], Exercise] | None = None,
 ) -> dict[str, Any]:
     """The grade of a session (or of a session log's records, replayed first) as a dict (JSON).
 
-    ``population`` 0 skips the percentile.
+    ``population`` 0 skips the percentile; ``read_exercise`` reads a log's exercise
+    (:meth:`Session.replay`).
     """
     session = (
-        session_or_log if isinstance(session_or_log, Session) else Session.replay(session_or_log)
+        session_or_log
+        if isinstance(session_or_log, Session)
+        else Session.replay(session_or_log, read_exercise=read_exercise)
     )
     ex = session.exercise
     par = _par_measures(session)
