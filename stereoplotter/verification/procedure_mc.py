@@ -49,6 +49,7 @@ passes) against (5.54).
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -629,8 +630,6 @@ def procedure_mc(
     >>> 0.3 < r["coefficient"] < 3.0
     True
     """
-    import time
-
     t0 = time.perf_counter()
     _check_options(
         method,
@@ -777,16 +776,21 @@ def _relative_only(prep, first, trials):
 
     # rigid screws whatever ``prep`` says: the experiment isolates the relative orientation;
     # "book": no remedy between C1 and C2 (the run is not the simulated procedure)
-    run = build_run(
-        prep, first, trials, transcript=False, ideal_mechanics=True, practice="book"
-    )
+    run = build_run(prep, first, trials, transcript=False, ideal_mechanics=True, practice="book")
     cv.c1_interior(run)
     cal = cv.calibrate(run, cv.levelling_points(run))
     cv.c2_relative_by_equations(run, cal, passes=prep.operator.max_iterations)
     return run
 
 
-# long: an 18-line docstring and one experiment in its steps (C1, C2 by (5.11), plane removal).
+def _midpoint_grid(c: float, grid: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The midpoints of an nx × ny grid over x_п ∈ [−c, 0], y ∈ [−c, c], flattened. [mm]"""
+    nx, ny = grid
+    xs = -c + (np.arange(nx) + 0.5) * c / nx
+    ys = -c + (np.arange(ny) + 0.5) * 2 * c / ny
+    return tuple(v.ravel() for v in np.meshgrid(xs, ys, indexing="ij"))
+
+
 def relative_orientation_mc(
     scenario: Scenario,
     *,
@@ -816,8 +820,6 @@ def relative_orientation_mc(
         ``coefficient``, ``ci``, ``formula`` ((5.54) rigorous at the simulated a, c, p),
         ``unlevelled`` (RMS/σ_q without the plane removal), ``trials``, geometry, ``seconds``.
     """
-    import time
-
     t0 = time.perf_counter()
     sc = idealised_geometry(scenario) if ideal_geometry else scenario
     g = scenario_geometry(sc, spec)
@@ -837,10 +839,7 @@ def relative_orientation_mc(
     )
     cpts, xc, yc = _control_frame_points(sc, sheet, g)
     d0, d0c = (_dp(sc, sheet, run0.op.inst, q) for q in (pts, cpts))
-    nx, ny = grid
-    xs = -g["c"] + (np.arange(nx) + 0.5) * g["c"] / nx
-    ys = -g["c"] + (np.arange(ny) + 0.5) * 2 * g["c"] / ny
-    xg, yg = (v.ravel() for v in np.meshgrid(xs, ys, indexing="ij"))
+    xg, yg = _midpoint_grid(g["c"], grid)
     plane = levelling_design(xg, yg) @ np.linalg.pinv(levelling_design(xc, yc))
     ms = np.empty(int(trials))
     raw = np.empty(int(trials))
