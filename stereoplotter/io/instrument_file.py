@@ -13,7 +13,6 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
 from functools import partial
 from pathlib import Path
 from types import MappingProxyType
@@ -30,6 +29,7 @@ from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
 from stereoplotter.io.validation import FileModel, _bounds, _fail, check_number, text, validate
 from stereoplotter.io.yaml_files import load_yaml_mapping
 from stereoplotter.spec.instrument_spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
+from stereoplotter.spec.schema_fields import SchemaField as _Leaf
 
 __all__ = ["InstrumentFile", "instrument_from_mapping", "list_instruments", "load_instrument"]
 
@@ -37,18 +37,6 @@ _LEAF_KEYS = ("value", "status", "src", "basis", "note")
 _MAX_INHERITANCE_DEPTH = 4
 
 # --- schema -----------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class _Leaf:
-    key: str
-    kind: str  # text, bool, int, number, range, pair, triple, int_list, number_list
-    unit: str = ""
-    low: float = -math.inf
-    high: float = math.inf
-    low_open: bool = False
-    required: bool = True
-    contains_zero: bool = False
 
 
 _POS = {"low": 0.0, "low_open": True}
@@ -70,7 +58,7 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("correction.tilt_max_deg", "number", "deg", high=45.0, **_POS),
     _Leaf("correction.decentration_mm", "range", "mm", -200.0, 200.0, contains_zero=True),
     # each correction principle's own leaves, declared as plain data in its module
-    *(_Leaf(**asdict(f)) for p in PRINCIPLES.values() for f in p.schema_fields),
+    *(f for p in PRINCIPLES.values() for f in p.schema_fields),
     _Leaf("counters.present", "bool"),
     _Leaf("counters.direction_switches", "bool"),
     _Leaf("counters.xy_least_count_mm", "number", "mm", high=1.0, **_POS),

@@ -55,6 +55,7 @@ from stereoplotter.procedure.steps import (
     scale_by_two_points,
     scale_pair,
     slip_height_scale_on_mean,
+    zero_base_y,
 )
 
 __all__ = [
@@ -439,7 +440,9 @@ def c1_interior(run) -> None:
         reading=NOMINAL_ZERO["Z"] + depth,
         equation="(6.3)",
     )
-    _c1_zero_by(run, by)
+    mo_by = zero_base_y(run, "C1")
+    op.set("by", mo_by + by, "C1/by")
+    log.add("C1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="stage 1")
     e = op.mark_on("left", np.zeros(2), "C1/MO")
     run.zero["MO_X"] = op.read("X", "C1/MO/X")
     run.zero["MO_Y"] = op.read("Y", "C1/MO/Y")
@@ -459,31 +462,6 @@ def c1_interior(run) -> None:
         judgment_error=e[..., 1],
         equation="decision D6",
     )
-
-
-def _c1_zero_by(run, by) -> None:
-    """C1: MO_by exactly as stage 1 — left mark on the left centre, b_y until the right mark is
-    on the right cassette centre's line — then O_by = MO_by + b_y of the sheet. [mm]"""
-    op, log = run.op, run.op.log
-    op.mark_on("left", np.zeros(2), "C1/MOby/left")
-    _, right_u = op.units()
-    car = {c: op.physical(c) for c in ("X", "Y", "Z")}
-    e = op.noise.normal("mono/C1/MOby/right", op.model.monocular_sigma_mm)
-    eta = op.unit_map("right", right_u).rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
-    n_r = (car["Z"] + op.physical("bz")) / op.inst.setting.f_instrument_mm
-    op.drive("by", car["Y"] - n_r * eta)
-    mo_by = op.read("by", "C1/MOby")
-    run.zero["MO_by"] = mo_by
-    log.add(
-        "C1",
-        "MO_by: right mark on the right cassette centre (by turning b_y)",
-        "by",
-        reading=mo_by,
-        judgment_error=e,
-        equation="stage 1",
-    )
-    op.set("by", mo_by + by, "C1/by")
-    log.add("C1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="stage 1")
 
 
 def _turn(op, control: str, target, active) -> None:

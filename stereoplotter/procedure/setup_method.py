@@ -122,27 +122,7 @@ def stage1_scale_coefficient(run: Run) -> None:
         reading=depth,
         equation="(6.3)",
     )
-    # MO_by: left mark on the left cassette centre, then b_y until the right mark is on the
-    # right cassette centre's line.
-    centre = np.zeros(2)
-    op.mark_on("left", centre, "1/MOby/left")
-    right_map = op.unit_map("right")  # kinematics.rod_from_photo with the unit's cos κ kept
-    setting = op.inst.setting
-    car = {c: op.physical(c) for c in ("X", "Y", "Z")}
-    e = op.noise.normal("mono/1/MOby/right", op.model.monocular_sigma_mm)
-    eta = right_map.rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
-    n_r = (car["Z"] + op.physical("bz")) / setting.f_instrument_mm
-    op.drive("by", car["Y"] - n_r * eta)
-    mo_by = op.read("by", "1/MOby")
-    run.zero["MO_by"] = mo_by
-    log.add(
-        "1",
-        "MO_by: right mark on the right cassette centre (by turning b_y)",
-        "by",
-        reading=mo_by,
-        judgment_error=e,
-        equation="stage 1",
-    )
+    steps.zero_base_y(run, "1")
     o_by = run.target("O_by")
     op.set("by", o_by, "1/by")
     log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=o_by, equation="item 1")

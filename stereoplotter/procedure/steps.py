@@ -33,6 +33,7 @@ __all__ = [
     "scale_by_two_points",
     "scale_pair",
     "slip_height_scale_on_mean",
+    "zero_base_y",
 ]
 
 #: Remedy R1 (stage 1, "otherwise the setting is repeated"): pointings per fiducial mark,
@@ -76,6 +77,32 @@ def interior_orientation(run: Run, stage: str) -> None:
         "",
         equation="stage 1",
     )
+
+
+def zero_base_y(run: Run, stage: str) -> NDArray[np.float64]:
+    """MO_by (stage 1 and C1): the left mark on the left cassette centre, then b_y turned until
+    the right mark is on the right cassette centre's line (σ_mono across it); recorded in
+    ``run.zero``. Returns MO_by. [mm]"""
+    op = run.op
+    key = f"{stage}/MOby"
+    op.mark_on("left", np.zeros(2), f"{key}/left")
+    right_map = op.unit_map("right")  # kinematics.rod_from_photo with the unit's cos κ kept
+    car = {c: op.physical(c) for c in ("X", "Y", "Z")}
+    e = op.noise.normal(f"mono/{key}/right", op.model.monocular_sigma_mm)
+    eta = right_map.rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
+    n_r = (car["Z"] + op.physical("bz")) / op.inst.setting.f_instrument_mm
+    op.drive("by", car["Y"] - n_r * eta)
+    mo_by = op.read("by", key)
+    run.zero["MO_by"] = mo_by
+    op.log.add(
+        stage,
+        "MO_by: right mark on the right cassette centre (by turning b_y)",
+        "by",
+        reading=mo_by,
+        judgment_error=e,
+        equation="stage 1",
+    )
+    return mo_by
 
 
 def control_point_m(run: Run, pid: str) -> NDArray[np.float64]:

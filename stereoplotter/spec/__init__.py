@@ -7,7 +7,8 @@ it; it imports neither). Reading and validating the YAML files is :mod:`stereopl
   leaf's status and provenance) and its presentation;
 * :mod:`.range_checks` — :func:`check_in_range` and :class:`RangeRefusal` (the mechanical stop);
 * :mod:`.limits` — the documented limits on the material (relief/H, model-to-photo scale,
-  photo-to-map ratio).
+  photo-to-map ratio);
+* :mod:`.schema_fields` — the leaves of an instrument file as plain data (io validates them).
 """
 
 from __future__ import annotations

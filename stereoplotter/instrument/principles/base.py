@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.geometry.tilt_correction import correction_inclination, decentration
+from stereoplotter.spec.schema_fields import SchemaField
 
 __all__ = [
     "CORRECTION_SETTING_TERMS",
@@ -62,24 +63,6 @@ class CorrectionMechanism:
     def scale_numeric(self, f_mm: float, ta: float, to: float, ex: float, ey: float) -> float:
         """s from a numeric solve of the linkage (scalar). [—]"""
         raise NotImplementedError
-
-
-@dataclass(frozen=True, slots=True)
-class SchemaField:
-    """One instrument-file leaf a principle adds, as plain data (the io layer validates it).
-
-    ``kind`` is one of the io schema's kinds (``number``, ``range``, …); ``low``/``high`` bound
-    the value (``low_open``: excluded); ``required`` False: an optional leaf.
-    """
-
-    key: str
-    kind: str
-    unit: str = ""
-    low: float = -math.inf
-    high: float = math.inf
-    low_open: bool = False
-    required: bool = True
-    contains_zero: bool = False
 
 
 @dataclass(frozen=True, slots=True)
