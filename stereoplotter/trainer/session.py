@@ -36,7 +36,8 @@ from stereoplotter.instrument.virtual import (
     Instrument,
 )
 from stereoplotter.procedure.operator import Noise, Operator
-from stereoplotter.procedure.simulate import PreparedRun, prepare_run
+from stereoplotter.procedure.run import PreparedRun
+from stereoplotter.procedure.simulate import prepare_run
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.trainer.actions import (
     ACTION_FIELDS,
