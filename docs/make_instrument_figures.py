@@ -2,7 +2,7 @@
 
 Run from the repository root: ``python docs/make_instrument_figures.py``; writes
 docs/img/mechanisms.png. Simple 2-D cross-sections in the X–Z plane, not to scale except where
-labelled; the dimensions are the ASSUMED ones of stereoplotter.instrument.correction.
+labelled; the dimensions are the ASSUMED ones of stereoplotter.instrument.principles.
 """
 
 from __future__ import annotations

@@ -28,6 +28,7 @@ def add_arguments(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     # imported here: the CLI loads no library module until a command runs (it starts fast)
     from stereoplotter.io.atomic_write import write_files
+    from stereoplotter.io.exercise_file import exercise_from_mapping
     from stereoplotter.io.session_log import read_log
     from stereoplotter.progress import progress_bar
     from stereoplotter.report.grade import grade_json, grade_markdown
@@ -35,7 +36,12 @@ def run(args: argparse.Namespace) -> int:
 
     records = read_log(args.log)
     with progress_bar(args.population, "simulated operators", unit="operator") as advance:
-        result = grade(records, population=args.population, progress=advance)
+        result = grade(
+            records,
+            population=args.population,
+            progress=advance,
+            read_exercise=exercise_from_mapping,
+        )
     if args.output:
         write_files(
             args.output,

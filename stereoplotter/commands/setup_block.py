@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.instrument.spec import InstrumentSpec
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.io.atomic_write import write_files
 from stereoplotter.io.block_file import load_block
 from stereoplotter.report.block import block_files, model_sheet

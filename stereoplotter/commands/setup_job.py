@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.instrument.spec import InstrumentSpec
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.io.atomic_write import write_files
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import Job, MeasuredPair, load_job, measured_pair

@@ -1,28 +1,6 @@
-"""Instruments: the specification of SC-1, SPR-3 and SD-3 (read from ``instruments/*.yaml`` by
-:mod:`stereoplotter.io.instrument_file`), their kinematics, mechanics and error model.
+"""Instruments: the stateful virtual SC-1, SPR-3 and SD-3 — their kinematics, correction
+principles, mechanics and error model.
 
-Every value carries its status (documented by a source, or assumed with a basis); see
-``docs/instruments.md``.
+The specification an instrument is built from (ranges, least counts, gear sets, each value
+documented or assumed) is the layer below, :mod:`stereoplotter.spec`; see ``docs/instruments.md``.
 """
-
-from __future__ import annotations
-
-from stereoplotter.instrument.spec import (
-    STATUSES,
-    InstrumentSpec,
-    Parameter,
-    RangeRefusal,
-    check_in_range,
-    format_instrument,
-    instrument_to_dict,
-)
-
-__all__ = [
-    "STATUSES",
-    "InstrumentSpec",
-    "Parameter",
-    "RangeRefusal",
-    "check_in_range",
-    "format_instrument",
-    "instrument_to_dict",
-]

@@ -21,8 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.errors import ConfigError, describe_value, did_you_mean
-from stereoplotter.instrument.spec import InstrumentSpec
+from stereoplotter.instrument.principles import error_terms_for
 from stereoplotter.random_streams import keyed_draws
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["DISTRIBUTIONS", "ErrorModel", "ErrorTerm", "error_model_from_spec"]
 
@@ -200,16 +201,8 @@ def _terms(spec: InstrumentSpec) -> list[ErrorTerm]:
                     f"error of setting the decentration {d} of the {side} photo",
                 )
             )
-        for c in ("alpha", "omega"):
-            terms.append(
-                term(
-                    f"setting.correction_{c}_{side}",
-                    "normal",
-                    "correction_setting_sigma",
-                    f"error of a k_{c} setting of the {side} correction mechanism",
-                    unit="rad",
-                )
-            )
+        for name, attribute, meaning, unit in error_terms_for(spec.principle, side):
+            terms.append(term(name, "normal", attribute, meaning, unit=unit))
     terms.append(
         term(
             "coordinatograph.nonorthogonality",

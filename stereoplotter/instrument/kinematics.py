@@ -172,7 +172,7 @@ class CorrectionUnit:
         Use the strict per-axis mechanism (α only in x, ω only in y, no common change of F;
         ``kinematics.md`` §3.3, last paragraph) instead of the correction plane.
     mechanism : CorrectionMechanism or None
-        The instrument's own construction (:mod:`stereoplotter.instrument.correction`): its
+        The instrument's own construction (:mod:`stereoplotter.instrument.principles`): its
         second-order scale factor s multiplies τ·(ξ, η) before the decentration. None: s = 1.
     """
 

@@ -23,7 +23,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.range_checks import RangeRefusal
 
 __all__ = ["OPTION_NAMES", "AutomaticCoordinatograph", "ErrorCorrectionUnit", "SC1Options"]
 

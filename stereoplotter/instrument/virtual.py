@@ -19,6 +19,7 @@ vectorised: every state is an array of shape (T,) when ``trials`` is given).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any, Final, Literal, get_args
 
@@ -26,7 +27,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -38,8 +38,10 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.instrument.mechanics.play import PlayAxis
+from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import AutomaticCoordinatograph, SC1Options
-from stereoplotter.instrument.spec import InstrumentSpec, check_in_range
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.range_checks import check_in_range
 
 __all__ = [
     "BACKENDS",
@@ -153,6 +155,23 @@ class Scale:
         return np.round(np.asarray(reading, float) / self.least_count) * self.least_count
 
 
+def _scales(
+    spec: InstrumentSpec, injected: dict[str, Any], full: Callable[[Any], NDArray[np.float64]]
+) -> dict[str, Scale]:
+    """The counters' scales with their injected zero-reading and ratio errors (least counts of
+    the spec: X, Y and the base scales at the xy least count, Z at its own)."""
+    least = {"X": spec.xy_least_count_mm, "Y": spec.xy_least_count_mm, "Z": spec.z_least_count_mm}
+    return {
+        name: Scale(
+            name,
+            full(nominal + injected[f"zero_reading.{name}"]),
+            full(injected.get(f"counter_scale.{name}", 0.0)),
+            least.get(name, spec.xy_least_count_mm),
+        )
+        for name, nominal in _NOMINAL_ZERO.items()
+    }
+
+
 class Instrument:
     """A virtual SC-1, SPR-3 or SD-3.
 
@@ -187,7 +206,7 @@ class Instrument:
     Notes
     -----
     Ranges are stops: a setting outside the instrument's range raises
-    :class:`~stereoplotter.instrument.spec.RangeRefusal` or
+    :class:`~stereoplotter.spec.range_checks.RangeRefusal` or
     :class:`~stereoplotter.instrument.mechanics.base.TravelRefusal`; nothing is clipped.
     """
 
@@ -238,20 +257,7 @@ class Instrument:
         def full(v: Any) -> NDArray[np.float64]:
             return np.broadcast_to(np.asarray(v, float), shape).copy()
 
-        least = {
-            "X": spec.xy_least_count_mm,
-            "Y": spec.xy_least_count_mm,
-            "Z": spec.z_least_count_mm,
-        }
-        self._scales: dict[str, Scale] = {}
-        for name, nominal in _NOMINAL_ZERO.items():
-            ratio = e.get(f"counter_scale.{name}", 0.0)
-            self._scales[name] = Scale(
-                name,
-                full(nominal + e[f"zero_reading.{name}"]),
-                full(ratio),
-                least.get(name, spec.xy_least_count_mm),
-            )
+        self._scales = _scales(spec, e, full)
         self._axes = {name: self._make_axis(name) for name in _SCREWS}
         self.focal_length_mm = float(focal_length_mm)
         self._f_instrument = full(math.nan)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from stereoplotter.instrument.spec import InstrumentSpec
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import load_scenario

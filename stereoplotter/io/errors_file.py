@@ -16,9 +16,9 @@ from typing import Annotated, Any
 from pydantic import ConfigDict, RootModel, WithJsonSchema
 
 from stereoplotter.instrument.error_model import DISTRIBUTIONS, ErrorModel, error_model_from_spec
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.io.validation import validate
 from stereoplotter.io.yaml_input import load_yaml_mapping
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["ErrorsFile", "load_error_model"]
 

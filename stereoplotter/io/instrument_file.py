@@ -1,5 +1,5 @@
 """Reading instrument files (``instruments/*.yaml``) into a frozen
-:class:`~stereoplotter.instrument.spec.InstrumentSpec`: name resolution, ``inherits``, the leaf
+:class:`~stereoplotter.spec.instrument_spec.InstrumentSpec`: name resolution, ``inherits``, the leaf
 schema, validation and the mechanics feasibility check.
 
 Every value in an instrument file is a *leaf* ``{value, status, src | basis, note?}``
@@ -13,7 +13,6 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 from types import MappingProxyType
@@ -25,10 +24,12 @@ from pydantic import model_validator as _model_validator
 from pydantic_core import PydanticCustomError
 
 from stereoplotter.errors import ConfigError, StereoplotterError, describe_value, did_you_mean
-from stereoplotter.instrument.spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
+from stereoplotter.instrument.principles import PRINCIPLES
 from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
 from stereoplotter.io.validation import FileModel, _bounds, _fail, check_number, text, validate
 from stereoplotter.io.yaml_input import load_yaml_mapping
+from stereoplotter.spec.instrument_spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
+from stereoplotter.spec.schema_fields import SchemaField as _Leaf
 
 __all__ = ["InstrumentFile", "instrument_from_mapping", "list_instruments", "load_instrument"]
 
@@ -36,18 +37,6 @@ _LEAF_KEYS = ("value", "status", "src", "basis", "note")
 _MAX_INHERITANCE_DEPTH = 4
 
 # --- schema -----------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class _Leaf:
-    key: str
-    kind: str  # text, bool, int, number, range, pair, triple, int_list, number_list
-    unit: str = ""
-    low: float = -math.inf
-    high: float = math.inf
-    low_open: bool = False
-    required: bool = True
-    contains_zero: bool = False
 
 
 _POS = {"low": 0.0, "low_open": True}
@@ -68,9 +57,8 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("orientation.kappa_deg", "range", "deg", -180.0, 180.0, contains_zero=True),
     _Leaf("correction.tilt_max_deg", "number", "deg", high=45.0, **_POS),
     _Leaf("correction.decentration_mm", "range", "mm", -200.0, 200.0, contains_zero=True),
-    _Leaf("correction.follower_radius_mm", "number", "mm", 0.0, 100.0, required=False),
-    _Leaf("correction.lens_arm_length_mm", "number", "mm", high=5000.0, required=False, **_POS),
-    _Leaf("correction.gimbal_offset_mm", "number", "mm", 0.0, 500.0, required=False),
+    # each correction principle's own leaves, declared as plain data in its module
+    *(f for p in PRINCIPLES.values() for f in p.schema_fields),
     _Leaf("counters.present", "bool"),
     _Leaf("counters.direction_switches", "bool"),
     _Leaf("counters.xy_least_count_mm", "number", "mm", high=1.0, **_POS),

@@ -14,8 +14,8 @@ import os
 from typing import Any
 
 from stereoplotter.errors import ConfigError
-from stereoplotter.io import exercise_file  # noqa: F401  (registers the exercise resolver)
 from stereoplotter.io.atomic_write import atomic_write_bytes
+from stereoplotter.io.exercise_file import exercise_from_mapping
 from stereoplotter.io.yaml_input import read_text_file
 from stereoplotter.trainer.session import LOG_FORMAT, Session
 
@@ -63,4 +63,4 @@ def read_log(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
 
 def replay_log(path: str | os.PathLike[str]) -> Session:
     """The session a log file records, replayed."""
-    return Session.replay(read_log(path))
+    return Session.replay(read_log(path), read_exercise=exercise_from_mapping)

@@ -1,10 +1,9 @@
 r"""The conventional method: relative orientation by the six standard points (ch. 5, §22).
 
-The pure equations the conventional procedure needs: the first-order y-parallax equation
-(5.10) in the basis system, its solution (5.11) for the six standard points of Fig. 39 and the
-over-correction factor of the element-by-element method; and the procedure itself on a virtual
-instrument (:func:`run_conventional_method`, stages C1–C4, ``docs/procedure.md``, "The
-conventional method"):
+The procedure on a virtual instrument (:func:`run_conventional_method`, stages C1–C4,
+``docs/procedure.md``, "The conventional method"); its pure equations — the first-order
+y-parallax equation (5.10), its solution (5.11) for the six standard points of Fig. 39 and the
+over-correction factor — are :mod:`~stereoplotter.procedure.relative_equations`:
 
 * C1 interior orientation as in stage 1 of the setup-data method, without computed data;
 * C2 relative orientation at the six standard points, element by element with over-correction
@@ -39,7 +38,25 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 from stereoplotter.procedure.operator import solve_1d
-from stereoplotter.procedure.setup_method import interior_orientation
+from stereoplotter.procedure.relative_equations import (
+    overcorrection_factor,
+    relative_orientation_from_standard_points,
+    y_parallax_first_order,
+)
+from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.steps import (
+    REPEAT_POINTINGS,
+    control_point_m,
+    fixed_order_sum,
+    fuse_and_read,
+    height_mean,
+    interior_orientation,
+    judge_standard_points,
+    scale_by_two_points,
+    scale_pair,
+    slip_height_scale_on_mean,
+    zero_base_y,
+)
 
 __all__ = [
     "ELEMENTS",
@@ -47,10 +64,7 @@ __all__ = [
     "Calibration",
     "calibrate",
     "control_sensitivity",
-    "overcorrection_factor",
-    "relative_orientation_from_standard_points",
     "run_conventional_method",
-    "y_parallax_first_order",
 ]
 
 #: The two ways of relative orientation offered (``procedure.md``, the conventional method).
@@ -64,148 +78,6 @@ ELEMENTS = {
     "kappa1": "kappa_left",
     "kappa2": "kappa_right",
 }
-
-
-def _a(v: ArrayLike) -> NDArray[np.float64]:
-    return np.asarray(v, dtype=float)
-
-
-def y_parallax_first_order(
-    x1: ArrayLike,
-    y1: ArrayLike,
-    x2: ArrayLike,
-    y2: ArrayLike,
-    focal_length_mm: ArrayLike,
-    alpha1: ArrayLike,
-    alpha2: ArrayLike,
-    omega2: ArrayLike,
-    kappa1: ArrayLike,
-    kappa2: ArrayLike,
-) -> NDArray[np.float64]:
-    r"""The y-parallax q = y₁ − y₂ that relative-orientation elements produce, first order.
-
-    Parameters
-    ----------
-    x1, y1, x2, y2 : float or ndarray
-        Coordinates of the point on the left and right photo. [mm]
-    focal_length_mm : float or ndarray
-        f (f₁ = f₂ = f). [mm]
-    alpha1, alpha2, omega2, kappa1, kappa2 : float or ndarray
-        α′₁, α′₂, ω′₂, κ′₁, κ′₂ of the basis system. [rad]
-
-    Returns
-    -------
-    ndarray
-        q solving the first equation of (5.10): the parallax the operator must clear. [mm]
-
-    Notes
-    -----
-    Eq. (5.10) of [1]_ (first line), solved for q:
-
-    .. math:: q = -\Bigl[\frac{x_1 y_2}{f}\alpha'_1 - \frac{x_2 y_1}{f}\alpha'_2
-              - \Bigl(f + \frac{y_1 y_2}{f}\Bigr)\omega'_2 + x_1\kappa'_1 - x_2\kappa'_2\Bigr]
-
-    Examples
-    --------
-    A point at the left principal point seen at x₂ = −90 mm: only κ′₂ acts.
-
-    >>> float(y_parallax_first_order(0.0, 0.0, -90.0, 0.0, 100.0, 0.0, 0.0, 0.0, 0.0, 1e-3))
-    -0.09
-    """
-    f = _a(focal_length_mm)
-    x1, y1, x2, y2 = _a(x1), _a(y1), _a(x2), _a(y2)
-    return -(
-        x1 * y2 / f * _a(alpha1)
-        - x2 * y1 / f * _a(alpha2)
-        - (f + y1 * y2 / f) * _a(omega2)
-        + x1 * _a(kappa1)
-        - x2 * _a(kappa2)
-    )
-
-
-def relative_orientation_from_standard_points(
-    q_mm: ArrayLike,
-    x11: ArrayLike,
-    x12: ArrayLike,
-    x21: ArrayLike,
-    x22: ArrayLike,
-    c_mm: ArrayLike,
-    focal_length_mm: ArrayLike,
-) -> dict[str, NDArray[np.float64]]:
-    r"""Relative-orientation elements from the y-parallaxes at the six standard points.
-
-    Parameters
-    ----------
-    q_mm : array_like, shape (..., 6)
-        q₁ … q₆ measured at points 1–6 of Fig. 39. [mm]
-    x11, x12 : float or ndarray
-        x of points 1 and 2 on the left photo (x₁₃ = x₁₅ = x₁₁, x₁₄ = x₁₆ = x₁₂). [mm]
-    x21, x22 : float or ndarray
-        x of points 1 and 2 on the right photo. [mm]
-    c_mm : float or ndarray
-        y of points 3, 4 (+c) and 5, 6 (−c). [mm]
-    focal_length_mm : float or ndarray
-        f. [mm]
-
-    Returns
-    -------
-    dict
-        "alpha1", "alpha2", "omega2", "kappa1", "kappa2" [rad].
-
-    Notes
-    -----
-    Eq. (5.11) of [1]_ in its general form before the substitution of Fig. 39 (the printed
-    specialised (5.11) is garbled in the OCR: its κ′₁ line has f where κ′₂ has f²):
-
-    .. math::
-        \alpha'_1 = -\frac{f[x_{22}(q_3 - q_5) - x_{21}(q_4 - q_6)]}{2c\,\Delta},\quad
-        \alpha'_2 = -\frac{f[x_{12}(q_3 - q_5) - x_{11}(q_4 - q_6)]}{2c\,\Delta},\quad
-        \Delta = x_{11}x_{22} - x_{12}x_{21},
-
-        \omega'_2 = \frac{f}{4c^2}[q_3 + q_4 + q_5 + q_6 - 2(q_1 + q_2)],
-
-        \kappa'_1 = \frac{f(x_{22} - x_{21})\omega'_2 - (q_1 x_{22} - q_2 x_{21})}
-                         {x_{11}x_{22} - x_{12}x_{21}},\quad
-        \kappa'_2 = \frac{f(x_{12} - x_{11})\omega'_2 - (q_1 x_{12} - q_2 x_{11})}
-                         {x_{11}x_{22} - x_{21}x_{12}}.
-
-    Examples
-    --------
-    With a = 0 (points on the photo y axes) and b = 90 mm, a pure κ′₂ = 1 mrad:
-
-    >>> q = [-0.09, 0.0, -0.09, 0.0, -0.09, 0.0]
-    >>> r = relative_orientation_from_standard_points(q, 0.0, 90.0, -90.0, 0.0, 80.0, 100.0)
-    >>> round(float(r["kappa2"]), 9), round(float(r["omega2"]), 12) + 0.0
-    (0.001, 0.0)
-    """
-    q = _a(q_mm)
-    q1, q2, q3, q4, q5, q6 = (q[..., i] for i in range(6))
-    f, c = _a(focal_length_mm), _a(c_mm)
-    x11, x12, x21, x22 = _a(x11), _a(x12), _a(x21), _a(x22)
-    det = x11 * x22 - x12 * x21
-    alpha1 = -f * (x22 * (q3 - q5) - x21 * (q4 - q6)) / (2.0 * c * det)
-    alpha2 = -f * (x12 * (q3 - q5) - x11 * (q4 - q6)) / (2.0 * c * det)
-    omega2 = f / (4.0 * c**2) * (q3 + q4 + q5 + q6 - 2.0 * (q1 + q2))
-    kappa1 = (f * (x22 - x21) * omega2 - (q1 * x22 - q2 * x21)) / det
-    kappa2 = (f * (x12 - x11) * omega2 - (q1 * x12 - q2 * x11)) / det
-    return {
-        "alpha1": alpha1,
-        "alpha2": alpha2,
-        "omega2": omega2,
-        "kappa1": kappa1,
-        "kappa2": kappa2,
-    }
-
-
-def overcorrection_factor(focal_length_mm: ArrayLike, c_mm: ArrayLike) -> NDArray[np.float64]:
-    r"""Over-correction of ω at points 5/6 in element-by-element orientation: ½(f²/c² − 1).
-
-    Examples
-    --------
-    >>> float(overcorrection_factor(100.0, 80.0))
-    0.28125
-    """
-    return 0.5 * (_a(focal_length_mm) ** 2 / _a(c_mm) ** 2 - 1.0)
 
 
 # --------------------------------------------------------------------------------------------
@@ -409,12 +281,8 @@ _SIDE = {"left": "л", "right": "п"}
 _BOOK = {"alpha1": "α′₁", "alpha2": "α′₂", "omega2": "ω′₂", "kappa1": "κ′₁", "kappa2": "κ′₂"}
 
 
-def _psum(values) -> NDArray[np.float64]:
-    """A sum over points in a fixed order (a vectorised run and a per-trial loop agree)."""
-    total = None
-    for v in values:
-        total = v if total is None else total + v
-    return total
+#: How the conventional operator's judgment at a standard point reads in the transcript.
+_SIX_Q = "standard point {i}: fuse, judge the y-parallax"
 
 
 def _worst(values) -> NDArray[np.float64]:
@@ -543,9 +411,6 @@ def c1_interior(run) -> None:
     on the right cassette centre as in stage 1, MO_X, MO_Y with the left mark on the left cassette
     centre (units at zero).
     """
-    # Over 80 lines with its docstring (71 of code): the book's C1 items in their order, each
-    # act followed by its transcript entry; splitting would scatter one sequence of settings.
-
     op, sheet = run.op, run.sheet
     log = op.log
     interior_orientation(run, "C1")
@@ -575,25 +440,7 @@ def c1_interior(run) -> None:
         reading=NOMINAL_ZERO["Z"] + depth,
         equation="(6.3)",
     )
-    # MO_by exactly as stage 1: left mark on the left centre, b_y until the right mark is on
-    # the right cassette centre's line
-    op.mark_on("left", np.zeros(2), "C1/MOby/left")
-    _, right_u = op.units()
-    car = {c: op.physical(c) for c in ("X", "Y", "Z")}
-    e = op.noise.normal("mono/C1/MOby/right", op.model.monocular_sigma_mm)
-    eta = op.unit_map("right", right_u).rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
-    n_r = (car["Z"] + op.physical("bz")) / op.inst.setting.f_instrument_mm
-    op.drive("by", car["Y"] - n_r * eta)
-    mo_by = op.read("by", "C1/MOby")
-    run.zero["MO_by"] = mo_by
-    log.add(
-        "C1",
-        "MO_by: right mark on the right cassette centre (by turning b_y)",
-        "by",
-        reading=mo_by,
-        judgment_error=e,
-        equation="stage 1",
-    )
+    mo_by = zero_base_y(run, "C1")
     op.set("by", mo_by + by, "C1/by")
     log.add("C1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="stage 1")
     e = op.mark_on("left", np.zeros(2), "C1/MO")
@@ -632,31 +479,6 @@ def _turn(op, control: str, target, active) -> None:
     if np.any(beyond & active):
         op.stopped[control] = op.stopped.get(control, np.zeros_like(beyond)) | (beyond & active)
     op.drive(control, np.clip(target, lo, hi), active)
-
-
-def _six_q(run, key: str, active, it: int, stage: str = "C2") -> list[NDArray[np.float64]]:
-    """Fuse on the six standard points and judge q at each (σ_q)."""
-    op = run.op
-    tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    pts = run.scene.standard_points_m
-    imgs = run.scene.images(pts)
-    seen = []
-    for i in range(6):
-        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
-        seen.append(q)
-        op.log.add(
-            stage,
-            f"standard point {i + 1}: fuse, judge the y-parallax",
-            "",
-            residual=q,
-            true=q_true,
-            judgment_error=q - q_true,
-            tolerance=tol,
-            passed=np.abs(q) <= tol,
-            iteration=it,
-            equation="≤ ¼ mark",
-        )
-    return seen
 
 
 #: The classic sequence (``instruments.md`` §6.1): point index, control, book element.
@@ -719,7 +541,9 @@ def c2_relative_by_elements(
                 iteration=it,
                 equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
             )
-        seen = _six_q(run, f"{key0}/a/{it}/check", active, it, stage)
+        seen = judge_standard_points(
+            run, stage, f"{key0}/a/{it}/check", active, iteration=it, text=_SIX_Q
+        )
         worst = np.where(active, _worst(seen), worst)
         rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
         prev_rms = rms if prev_rms is None else np.where(active, rms, prev_rms)
@@ -755,7 +579,9 @@ def c2_relative_by_equations(
     prev_rms = None
     for it in range(1, bound + 1):
         its = np.where(active, it, its)
-        seen = _six_q(run, f"{key0}/b/{it}", active, it, stage)
+        seen = judge_standard_points(
+            run, stage, f"{key0}/b/{it}", active, iteration=it, text=_SIX_Q
+        )
         worst = np.where(active, _worst(seen), worst)
         if passes is None:
             rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
@@ -792,8 +618,7 @@ def c2_relative_by_equations(
 
 
 def _height_points(run, ids) -> list[tuple[str, NDArray[np.float64]]]:
-    sc = run.scene.scenario
-    return [(i, np.asarray(next(p for p in sc.points if p.id == i).local_m, float)) for i in ids]
+    return [(i, control_point_m(run, i)) for i in ids]
 
 
 def levelling_points(run) -> tuple[str, ...]:
@@ -807,41 +632,9 @@ def levelling_points(run) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _scale_pair(run) -> tuple[str, str]:
-    """The two plan control points farthest apart (the scale is taken between them)."""
-    ids = run.sheet.similarity_point_ids or tuple(h["id"] for h in run.sheet.control_heights)
-    rows = _height_points(run, ids)
-    best = max(
-        (float(np.hypot(*(a[1][:2] - b[1][:2]))), a[0], b[0])
-        for k, a in enumerate(rows)
-        for b in rows[k + 1 :]
-    )
-    return best[1], best[2]
-
-
-def _fuse_read(run, pid: str, p, key: str, active, read: tuple[str, ...]):
-    op = run.op
-    img = run.scene.images(p[None, :])
-    op.fuse(p, (img[0][0], img[1][0]), key, active)
-    return {c: op.read(c, f"{key}/{c}") for c in read}
-
-
-def _height_mean(run, pid: str, p, key: str, active, pointings: int) -> NDArray[np.float64]:
-    """The height scale read after ``pointings`` fusings on ``p``, averaged (the first fusing
-    has the single reading's noise key, so ``pointings=1`` is the book's single reading). [m]"""
-    total = None
-    for j in range(pointings):
-        k = key + (f"/p{j}" if j else "")
-        read = _fuse_read(run, pid, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
-        total = read if total is None else total + read
-    return total / pointings
-
-
 def _pointings(run) -> int:
     """Fusings per height reading in C3: the setup method's ``REPEAT_POINTINGS`` with the
     operator's practice (remedy CR1), one with the book's."""
-    from stereoplotter.procedure.setup_method import REPEAT_POINTINGS
-
     return REPEAT_POINTINGS if getattr(run, "remedial", False) else 1
 
 
@@ -861,13 +654,10 @@ def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int,
     tol = run.sheet.tolerances["control_height_m"]
     pid0, p0 = rows[0]
     if pointings == 1:
-        _fuse_read(run, pid0, p0, f"{key}/slip/{pid0}", active, ())
+        fuse_and_read(run, p0, f"{key}/slip/{pid0}", active, ())
         op.inst.slip_height_scale(p0[2])
     else:
-        seen0 = _height_mean(run, pid0, p0, f"{key}/slip/{pid0}", active, pointings)
-        exact = op.v(op.inst.read(HEIGHT_SCALE, exact=True))
-        act = op.all() if active is None else active
-        op.inst.slip_height_scale(np.where(act, exact + (p0[2] - seen0), exact))
+        slip_height_scale_on_mean(run, p0, f"{key}/slip/{pid0}", active, pointings)
     times = f" ({pointings} times, mean)" if pointings > 1 else ""
     op.log.add(
         "C3",
@@ -883,7 +673,7 @@ def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int,
     for pid, p in heights:
         if pid == pid0:
             continue
-        read = _height_mean(run, pid, p, f"{key}/h/{pid}", active, pointings)
+        read = height_mean(run, p, f"{key}/h/{pid}", active, pointings)
         errs.append(read - p[2])
         op.log.add(
             "C3",
@@ -910,9 +700,7 @@ def _level(
     op = run.op
     tol = run.sheet.tolerances["control_height_m"]
     when = active if remedy else None  # the book's loop logs every iteration as before
-    errs = [
-        _height_mean(run, pid, p, f"{key}/level/{pid}", active, pointings) - p[2] for pid, p in rows
-    ]
+    errs = [height_mean(run, p, f"{key}/level/{pid}", active, pointings) - p[2] for pid, p in rows]
     resid = [e - errs[0] for e in errs]
     for (pid, _), r, e in zip(rows, resid, errs, strict=True):
         op.log.add(
@@ -930,8 +718,8 @@ def _level(
             when=when,
         )
     w = cal.level_weights
-    phi_a = -_psum(w[1, i] * e for i, e in enumerate(errs))
-    phi_o = -_psum(w[2, i] * e for i, e in enumerate(errs))
+    phi_a = -fixed_order_sum(w[1, i] * e for i, e in enumerate(errs))
+    phi_o = -fixed_order_sum(w[2, i] * e for i, e in enumerate(errs))
     for name, phi, combo in (("α", phi_a, cal.common_alpha), ("ω", phi_o, cal.common_omega)):
         for control, rate in combo.items():
             if control in ("by", "bz"):
@@ -985,7 +773,7 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     tol = sheet.tolerances["control_height_m"]
     tol_q = sheet.tolerances["residual_y_parallax_mm"]
     mg = sheet.horizontal_scale_denominator
-    a_id, b_id = _scale_pair(run)
+    a_id, b_id = scale_pair(run, ties="last")
     (_, pa), (_, pb) = _height_points(run, (a_id, b_id))
     d_true = float(np.hypot(*(pa[:2] - pb[:2]))) * 1000.0 / mg
     rows = _height_points(run, level_ids)
@@ -995,14 +783,9 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     worst = op.v(np.nan)
     for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
-        ra = _fuse_read(run, a_id, pa, f"C3/{it}/scale/{a_id}", active, ("X", "Y"))
-        rb = _fuse_read(run, b_id, pb, f"C3/{it}/scale/{b_id}", active, ("X", "Y"))
-        d_model = np.hypot(ra["X"] - rb["X"], ra["Y"] - rb["Y"])
-        with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest read d = 0
-            ratio = np.where(active, d_true / d_model, 1.0)
-        bx = op.read("bx", f"C3/{it}/bx")
-        new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio
-        op.set("bx", new, f"C3/{it}/setbx", active)
+        bx, new, d_model = scale_by_two_points(
+            run, (a_id, pa), (b_id, pb), d_true, f"C3/{it}", active
+        )
         op.log.add(
             "C3",
             f"scale: fuse on {a_id} and {b_id}, model distance against {d_true:.3f} mm; "
@@ -1034,7 +817,7 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     if not run.remedial:  # the book: single readings, nothing after a failed check
         errs = _slip_and_read_heights(run, rows, heights, "C3", None, 1)
         run.check("C3: control heights", _worst(errs) if errs else op.v(0.0), tol, unit="m")
-        seen = _six_q(run, "C3/std", None, 1, stage="C3")
+        seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
         run.check("C3: residual y-parallax (6 points)", _worst(seen), tol_q)
         return
     _c3_operator_checks(run, cal, rows, heights, relative_fn, _pointings(run))
@@ -1057,14 +840,14 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
     if errs and np.any(h_failed):
         again = _slip_and_read_heights(run, rows, heights, "C3/CR1", h_failed, pointings, CR1)
         h_worst = np.where(h_failed, _worst(again), h_worst)
-    seen = _six_q(run, "C3/std", None, 1, stage="C3")
+    seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
     q_worst = _worst(seen)
     q_failed = q_worst > tol_q
     rounds = np.zeros(np.shape(q_failed), int)
     if relative_fn is not None and np.any(q_failed):
         r_its, _ = _masked(run, q_failed, relative_fn, cal, "C3/CR2/ro")
         rounds = np.where(q_failed, r_its, 0)
-        seen = _six_q(run, "C3/CR2/std", q_failed, 1, stage="C3")
+        seen = judge_standard_points(run, "C3", "C3/CR2/std", q_failed, text=_SIX_Q)
         q_worst = np.where(q_failed, _worst(seen), q_worst)
         _level(run, cal, rows, "C3/CR2", q_failed, pointings, 1, CR2)
         errs = _slip_and_read_heights(run, rows, heights, "C3/CR2", q_failed, pointings, CR2)
@@ -1090,8 +873,6 @@ def _masked(run, active, relative_fn, cal, key0):
 def c4_sheet(run) -> None:
     """C4: the sheet on the coordinatograph, corner 4 and the plotted plan control — stages 4–5
     of the setup-data method reused, with the corner coordinates of the setup sheet."""
-    from stereoplotter.procedure.setup_method import stage4_orient_sheet, stage5_check
-
     log = run.op.log
     start = len(log.records)
     stage4_orient_sheet(run)
@@ -1107,7 +888,7 @@ def run_conventional_method(run, relative: str = "elements"):
 
     Parameters
     ----------
-    run : stereoplotter.procedure.setup_method.Run
+    run : stereoplotter.procedure.run.Run
         Instrument, sheet, operator and scene; receives results, iterations, zero readings.
     relative : {"elements", "equations"}
         Relative orientation element by element with over-correction, or by the six measured

@@ -47,7 +47,7 @@ from stereoplotter.instrument.virtual import (
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.random_streams import keyed_draws
 from stereoplotter.scenario.model import Scenario
-from stereoplotter.scenario.synthetic import synthesize_measurements
+from stereoplotter.scenario.synthetic import film_deformed
 
 __all__ = [
     "DrivenControl",
@@ -249,8 +249,8 @@ class Scene:
         """
         from stereoplotter.procedure.evaluation import instrument_frame_m, standard_points_m
 
-        m = synthesize_measurements(scenario, np.random.default_rng(0), noise=False)
-        fid = {p.photo: p.fiducials_true_mm for p in m.photos}
+        calibrated = scenario.camera.fiducial_array_mm()
+        fid = {p.name: film_deformed(p, calibrated) for p in scenario.photos}  # the true marks
         z0 = float(np.mean([p.local_m[2] for p in scenario.points]))
         h = float(scenario.photo("left").exterior.centre[2]) - z0
         frame = standard_points_m(scenario, frame_origin_m, frame_rotation, h, c_mm)

@@ -44,7 +44,6 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
-from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
@@ -57,6 +56,7 @@ from stereoplotter.instrument.kinematics import (
     turn_correction_knob,
     unit_for_orientation,
 )
+from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.setup.equations import (
     base_components,
     counter_scale_left,
@@ -409,7 +409,7 @@ def residual_table(
         Tilt magnitudes t. [°]
     mechanism : CorrectionMechanism, optional
         The instrument's own correction mechanism
-        (:mod:`stereoplotter.instrument.correction`); adds rows named by its ``key``.
+        (:mod:`stereoplotter.instrument.principles`); adds rows named by its ``key``.
 
     Returns
     -------
@@ -737,7 +737,7 @@ def run_kinematic_selftest(
     instrument : InstrumentSpec, optional
         If given, D_max is taken from ``instrument.projection_distance_max_mm``; otherwise the §5
         data (D_max = 185 mm, the SC-1 example) are used, and its correction mechanism
-        (:func:`~stereoplotter.instrument.correction.mechanism_for`) adds its own rows.
+        (:func:`~stereoplotter.instrument.principles.mechanism_for`) adds its own rows.
 
     Returns
     -------

@@ -15,78 +15,53 @@ Reference
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from stereoplotter.constants import MM_PER_M
-from stereoplotter.geometry.instrument_settings import sequence_for
-from stereoplotter.instrument.correction import control_name, mark_phrase
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
-    UnitMap,
     counters_from_homologous_points,
     rod_from_counters,
-    rods_intersection,
     turn_correction_knob,
     unit_for_orientation,
 )
+from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
+from stereoplotter.procedure import steps
+from stereoplotter.procedure.floor import control_heights_of
 from stereoplotter.procedure.operator import Operator, Scene, solve_1d
 from stereoplotter.procedure.records import (
-    Check,
     ControlHeight,
-    Remedy,
-    SheetPose,
-    SheetReadings,
-    StageRecord,
 )
-from stereoplotter.scenario.summary import summarize_scenario
+from stereoplotter.procedure.run import Run
+from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.span_check import fiducial_mm, span_loop
 from stereoplotter.setup.equations import (
-    base_z_correction,
-    height_correction,
     sheet_corner_instrument_coordinates,
 )
-from stereoplotter.setup.records import SetupRefusal
 from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = [
     "LEVEL_FREE",
     "LEVEL_TILTS",
-    "PRACTICES",
     "Q_ELEMENTS",
-    "REPEAT_POINTINGS",
-    "Run",
     "check_standard_points",
     "clear_kappa",
     "level_design",
-    "mechanism_level",
     "refine_relative_orientation",
     "refine_scale_and_level",
-    "refuse_beyond_mechanism",
     "run_setup_method",
     "stage1_scale_coefficient",
     "stage2_transform",
     "stage3_scale_model",
-    "stage4_orient_sheet",
-    "stage5_check",
 ]
 
 _SIDE: dict[Side, str] = {"left": "л", "right": "п"}
 _SUB = {"1": "₁", "2": "₂", "3": "₃", "4": "₄"}
 _TILT = {"alpha": "α", "omega": "ω"}
-
-#: ``--practice``: "operator" applies the remedies after a failed check (the operator's
-#: practice; §26 intro: the set orientation "most often is not accurate enough and its
-#: correction takes additional time"); "book" is §27's task 1 (the elements are set, each once
-#: by the stage text, and not refined: a failed check is recorded and the operator goes on).
-PRACTICES = ("operator", "book")
-
-#: Remedy R1 (stage 1, "otherwise the setting is repeated"): pointings per fiducial mark,
-#: averaged, when the L-check loop has ended failed (a choice: 4 halves the pointing σ).
-REPEAT_POINTINGS = 4
 
 #: Remedy R2 (after stage 2 and 3, q > ¼ mark): the elements that clear the y-parallax on a
 #: setup-data instrument — the five of a dependent-pair relative orientation as this
@@ -120,325 +95,14 @@ LEVEL_TILTS = {
 LEVEL_FREE = ("bz", "kappa_left", "kappa_right")
 
 
-@dataclass
-class Run:
-    """Everything a procedure works on, and what it found.
-
-    Attributes
-    ----------
-    op : Operator
-    sheet : SetupSheet
-    scene : Scene
-    zero : dict
-        Zero readings the operator has determined, by the sheet's names (MO_X, MO_Y, MO_X,п,
-        MO_Y,п, MO_by, MO_bz, MO_Z), arrays over the trials. [mm, m for MO_Z]
-    results : dict
-        Check name → :class:`~stereoplotter.procedure.records.Check`.
-    stages : dict
-        Stage → :class:`~stereoplotter.procedure.records.StageRecord` (iterations used).
-    sheet_pose : SheetPose or None
-        Stages 4–5: the sheet on the coordinatograph (None without a map sheet).
-    practice : {"book", "operator"}
-        :data:`PRACTICES`: remedies after a failed check only with "operator".
-    remedies : dict
-        Remedy name → :class:`~stereoplotter.procedure.records.Remedy` (operator practice).
-    readings : SheetReadings
-        The sheet's printed readings: every target reading the operator sets comes from here.
-    """
-
-    op: Operator
-    sheet: SetupSheet
-    scene: Scene
-    zero: dict[str, NDArray[np.float64]] = field(default_factory=dict)
-    results: dict[str, Check] = field(default_factory=dict)
-    stages: dict[str, StageRecord] = field(default_factory=dict)
-    sheet_pose: SheetPose | None = None
-    practice: str = "book"
-    remedies: dict[str, Remedy] = field(default_factory=dict)
-    readings: SheetReadings = field(init=False)
-
-    def __post_init__(self) -> None:
-        self.readings = SheetReadings.of(self.sheet)
-
-    def check(
-        self, name: str, residual, tolerance, unit: str = "mm", iterations=None
-    ) -> NDArray[np.bool_]:
-        """Record a tolerance check (|residual| ≤ tolerance) and return pass/fail per trial."""
-        residual = self.op.v(residual)
-        tol = self.op.v(tolerance) if tolerance is not None else None
-        passed = np.abs(residual) <= tol if tol is not None else None
-        its = None if iterations is None else self.op.v(iterations).astype(int)
-        self.results[name] = Check(name, residual, tol, passed, its, unit)
-        return passed
-
-    @property
-    def remedial(self) -> bool:
-        """The operator's practice: remedies after a failed check."""
-        return self.practice == "operator"
-
-    def record_remedy(self, name: str, check: str, applied, rounds) -> None:
-        """Record a remedy against the final state of ``check``."""
-        applied = self.op.v(applied).astype(bool)
-        passed = self.results[check].passed
-        self.remedies[name] = Remedy(
-            name, check, applied, self.op.v(rounds).astype(int), self.op.v(passed).astype(bool)
-        )
-
-    def record_stage(self, stage: str, iterations: ArrayLike) -> None:
-        """Record the iterations a stage (or loop) used, per trial."""
-        self.stages[stage] = StageRecord(stage, np.asarray(iterations).astype(int))
-
-    def stage_iterations(self, stage: str) -> NDArray[np.int64]:
-        """The iterations recorded for ``stage``."""
-        return self.stages[stage].iterations
-
-    def target(self, reading: str, zero: ArrayLike | None = None):
-        """The sheet's reading ``reading`` as set: its zero reading + the printed value.
-
-        ``zero`` defaults to the zero reading the operator has determined (``self.zero``, by
-        the sheet's name); the instrument's nominal zero places (MO_bx, MO_dx, MO_dy) are
-        passed by the caller.
-        """
-        r = self.readings[reading]
-        if r.zero_reading and zero is None:
-            zero = self.zero[r.zero_reading]
-        return r.target(zero)
-
-
-def _fid(run: Run, side: str, mark: str) -> NDArray[np.float64]:
-    return run.scene.fiducials_mm[side][int(mark) - 1]
-
-
 # --- stage 1 ---------------------------------------------------------------------------------
-
-
-def _measure_span(run: Run, side: str, key: str, active, pointings: int = 1) -> NDArray[np.float64]:
-    """L′: the mark on fiducial 3 then 4 of ``side``, Y read at each (the mean of
-    ``pointings`` pointings and readings per mark, remedy R1)."""
-    op = run.op
-    ys = []
-    for mark in ("3", "4"):
-        y = 0.0
-        for j in range(pointings):
-            k = f"{key}/{side}/{mark}" + (f"/p{j}" if j else "")
-            op.mark_on(side, _fid(run, side, mark), k, active)
-            y = y + op.read("Y", k)
-        ys.append(y / pointings)
-    return ys[0] - ys[1]
-
-
-def _spans(run: Run, units_at_zero: bool) -> tuple[float, float]:
-    """The L to compare with: the sheet's L_л, L_п (6.5), or with the units at zero
-    n·(y₃ − y₄) of the measured marks (decision D5, ``kinematics.md`` §4.3: the literal (6.5)
-    would bias n by tan²ω(1 + l²/f′²) and can drive D beyond D_max).
-
-    The D5 span is a comparison value, not a reading set on a scale; the sheet does not print
-    it, so it is formed here from the sheet's measured marks and n.
-    """
-    if not units_at_zero:
-        return run.readings["L_л"].value, run.readings["L_п"].value
-    out = []
-    for photo in run.sheet.photos:
-        m = photo.marks_measured_mm
-        out.append(photo.n * (m["3"][1] - m["4"][1]))
-    return out[0], out[1]
-
-
-def _span_loop(
-    run: Run,
-    stage: str,
-    key: str,
-    units_at_zero: bool = False,
-    active=None,
-    pointings: int = 1,
-    remedy: str = "",
-) -> tuple[NDArray, NDArray, NDArray]:
-    """The L-check loop (6.9)–(6.11) until |L − L′| ≤ 0.03/n_л for both photos."""
-    op, sheet = run.op, run.sheet
-    tol = sheet.tolerances["mark_span_mm"]
-    span_l, span_r = _spans(run, units_at_zero)
-    active = op.all() if active is None else active.copy()
-    its = np.zeros(np.shape(active), int)
-    dl = dr = op.v(np.nan)
-    for it in range(1, op.model.max_iterations + 1):
-        its = np.where(active, it, its)
-        k = f"{key}/{it}"
-        meas_l = _measure_span(run, "left", k, active, pointings)
-        meas_r = _measure_span(run, "right", k, active, pointings)
-        dl = np.where(active, span_l - meas_l, dl)
-        dr = np.where(active, span_r - meas_r, dr)
-        ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
-        for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
-            op.log.add(
-                stage,
-                f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} "
-                f"= {span:.3f} mm",
-                "Y",
-                reading=meas,
-                residual=d,
-                tolerance=tol,
-                passed=np.abs(d) <= tol,
-                iteration=it,
-                equation="(6.5)" if not units_at_zero else "(6.5), decision D5",
-                remedy=remedy,
-                when=active if remedy else None,
-            )
-        active = active & ~ok
-        if not np.any(active):
-            break
-        _correct_span(run, stage, k, it, active, (dl, dr), (span_l, span_r), remedy)
-    ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
-    return its, ok, np.maximum(np.abs(dl), np.abs(dr))
-
-
-def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy: str, active):
-    """Log the ΔZ (6.9) setting; the word follows the sign: the Z counter counts the projection
-    distance D, so ΔZ > 0 (a larger D) lowers the carriage and ΔZ < 0 raises it. [m, mm]"""
-    direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
-    op.log.add(
-        stage,
-        f"ΔZ = {dz_shown:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
-        "Z",
-        before=depth,
-        after=depth + dz_mm,
-        reading=depth + dz_mm,
-        iteration=it,
-        equation="(6.9), (6.11)",
-        remedy=remedy,
-        when=active if remedy else None,
-    )
-
-
-def _correct_span(
-    run: Run, stage: str, k: str, it: int, active, diffs, spans, remedy: str = ""
-) -> None:
-    """One correction of the L-check: ΔZ (6.9) from the left photo (or f_пр at the bottom
-    stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11).
-
-    Decision D9 (``docs/procedure.md``, "The error-free floor"): (6.9) and (6.10) are applied
-    in their ratio form, which is exact for the span of a photo (L′ = n·(y₃ − y₄), n = D/f_пр):
-    ΔD = D·ΔL/L′ with the *measured* L′ in the denominator, and for the right photo its own
-    projection distance D_п = D + b_z, less the change ΔZ (or the f_пр change) that the left
-    correction makes to it. The printed first-order form D·ΔL_п/L_п under-corrects by the
-    factor L′_п/L_п ≈ D/(D + b_z′): with b_z at zero in stage 1 it leaves b_z′²/(D + b_z′) —
-    8.4 µm of b_z for pair60 (b_z′ = 1.25 mm), which the loop accepts (0.03/n_л mm of L is
-    11 µm of b_z) and which shows as 6 µm of y-parallax at the standard points.
-    """
-    op, sheet = run.op, run.sheet
-    dl, dr = diffs
-    span_l, span_r = spans
-    meas_l, meas_r = span_l - dl, span_r - dr  # L′ as measured
-    sense = sheet.options.bz_scale_sense
-    depth = op.read("Z", f"{k}/Z")
-    dz_m = height_correction(depth, dl, meas_l, sheet.vertical_scale_denominator)
-    dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
-    f_ratio = op.v(1.0)  # f′_пр/f_пр of this correction (bottom stop)
-    # Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a
-    # correction that asks for a deeper carriage cannot be set there. The operator reaches
-    # the same n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
-    stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
-    beyond = active & (depth + dz_mm > stop)
-    if np.any(beyond):
-        f_set = op.commanded["f_instrument"]
-        f_new = f_set * depth / (depth + dz_mm)
-        f_ratio = np.where(beyond, depth / (depth + dz_mm), 1.0)
-        op.set("f_instrument", f_new, f"{k}/setf", beyond)
-        op.log.add(
-            stage,
-            "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
-            "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
-            "f_instrument",
-            before=f_set,
-            after=f_new,
-            reading=f_new,
-            iteration=it,
-            equation="(6.3), (6.9)",
-            remedy=remedy,
-            when=beyond if remedy else None,
-        )
-        dz_mm = np.where(beyond, 0.0, dz_mm)
-    op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
-    shown = op.log.shown if np.ndim(beyond) else 0
-    if not np.ravel(beyond)[shown]:
-        _log_delta_z(
-            op,
-            stage,
-            float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]),
-            depth,
-            dz_mm,
-            it,
-            remedy,
-            active,
-        )
-    bz = op.read("bz", f"{k}/bz")
-    # D_п as the operator knows it: D + b_z from the b_z scale's nominal place of zero; scaled
-    # by f_пр/f′_пр where f_пр was changed, less the ΔZ just set (both move the right photo)
-    depth_r = (depth + sense * (bz - NOMINAL_ZERO["bz"])) * f_ratio
-    dbz = (
-        depth_r
-        + base_z_correction(depth_r, dr, meas_r)
-        - (depth + dz_mm)
-        - (sense * (bz - NOMINAL_ZERO["bz"]))
-    )
-    op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
-    op.log.add(
-        stage,
-        "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): "
-        "O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
-        "bz",
-        before=bz,
-        after=bz + sense * dbz,
-        reading=bz + sense * dbz,
-        iteration=it,
-        equation="(6.10), (6.11)",
-        remedy=remedy,
-        when=active if remedy else None,
-    )
-
-
-def interior_orientation(run: Run, stage: str) -> None:
-    """Interior settings common to stage 1 and the conventional method's C1: the height-counter
-    gear M_в, f_пр, the cassettes parallel to the axes, the correction mechanisms and the
-    decentrations at their zero places (OCR L3755–3759)."""
-    op, sheet = run.op, run.sheet
-    log = op.log
-    op.inst.gear_height_counter(sheet.vertical_scale_denominator)
-    f_instrument = run.target("f_пр")
-    op.set("f_instrument", f_instrument, f"{stage}/f")
-    log.add(
-        stage,
-        "set the instrument principal distance f_пр",
-        "f_instrument",
-        reading=f_instrument,
-        equation="item 1",
-    )
-    for side in ("left", "right"):
-        op.drive(f"kappa_{side}", 0.0)
-        log.add(
-            stage,
-            f"turn the {side} cassette: fiducial lines parallel to the axes",
-            f"kappa_{side}",
-            reading=0.0,
-            unit="rad",
-            equation="stage 1",
-        )
-        for axis in ("alpha", "omega"):
-            op.drive(f"k_{axis}_{side}", 0.0)
-        for d in ("dx", "dy"):
-            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], f"{stage}/{d}_{side}")
-    log.add(
-        stage,
-        "correction mechanisms and decentrations to their zero places",
-        "",
-        equation="stage 1",
-    )
 
 
 def stage1_scale_coefficient(run: Run) -> None:
     """Stage 1: interior settings, base, D = n_л f_пр, the L-check loop, MO_Z and MO_bz (D7)."""
     op, sheet = run.op, run.sheet
     log = op.log
-    interior_orientation(run, "1")
+    steps.interior_orientation(run, "1")
     o_bx = run.target("O_bx", NOMINAL_ZERO["bx"])  # MO_bx: the scale's place of zero
     op.set("bx", o_bx, "1/bx")
     log.add(
@@ -458,36 +122,16 @@ def stage1_scale_coefficient(run: Run) -> None:
         reading=depth,
         equation="(6.3)",
     )
-    # MO_by: left mark on the left cassette centre, then b_y until the right mark is on the
-    # right cassette centre's line.
-    centre = np.zeros(2)
-    op.mark_on("left", centre, "1/MOby/left")
-    right_map = op.unit_map("right")  # kinematics.rod_from_photo with the unit's cos κ kept
-    setting = op.inst.setting
-    car = {c: op.physical(c) for c in ("X", "Y", "Z")}
-    e = op.noise.normal("mono/1/MOby/right", op.model.monocular_sigma_mm)
-    eta = right_map.rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
-    n_r = (car["Z"] + op.physical("bz")) / setting.f_instrument_mm
-    op.drive("by", car["Y"] - n_r * eta)
-    mo_by = op.read("by", "1/MOby")
-    run.zero["MO_by"] = mo_by
-    log.add(
-        "1",
-        "MO_by: right mark on the right cassette centre (by turning b_y)",
-        "by",
-        reading=mo_by,
-        judgment_error=e,
-        equation="stage 1",
-    )
+    steps.zero_base_y(run, "1")
     o_by = run.target("O_by")
     op.set("by", o_by, "1/by")
     log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=o_by, equation="item 1")
-    its, ok, res = _span_loop(run, "1", "1/L", units_at_zero=True)
+    its, ok, res = span_loop(run, "1", "1/L", units_at_zero=True)
     name = "stage 1: |L − L′|"
     if run.remedial:  # R1: "otherwise the setting is repeated", with averaged pointings
         failed = ~ok
-        r_its, _, r_res = _span_loop(
-            run, "1", "1/L/R1", True, failed, REPEAT_POINTINGS, "R1 repeat the setting"
+        r_its, _, r_res = span_loop(
+            run, "1", "1/L/R1", True, failed, steps.REPEAT_POINTINGS, "R1 repeat the setting"
         )
         res = np.where(failed, r_res, res)
         its = its + np.where(failed, r_its, 0)
@@ -553,7 +197,7 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
     the knob until the fiducial is under the mark ((6.12) or (6.13))."""
     op = run.op
     sfx = "" if side == "left" else ",п"
-    fid = _fid(run, side, mark)
+    fid = fiducial_mm(run, side, mark)
     if axis == "omega":
         counter, free, comp = "Y", "X", 1
         eq = "(6.12)"
@@ -591,7 +235,7 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
 def _mark4(run: Run, side: str, key: str, active) -> NDArray[np.float64]:
     """Check mark 4 at MO_Y + n·y⁰₄ (6.12): the offset of the mark from fiducial 4 seen."""
     op = run.op
-    fid = _fid(run, side, "4")
+    fid = fiducial_mm(run, side, "4")
     value = run.target(f"O_Y4,{_SIDE[side]}")
     op.set("Y", value, f"{key}/set", active)
     op.mark_on(side, fid, f"{key}/line", active, free="X")
@@ -611,7 +255,7 @@ def stage2_transform(run: Run) -> None:
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
         if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
-            l_its, _, _ = _span_loop(run, "2", f"2/L{it}", active=active)
+            l_its, _, _ = span_loop(run, "2", f"2/L{it}", active=active)
             run.record_stage("1", run.stage_iterations("1") + np.where(active, l_its, 0))
         else:  # with the correction units still at zero the cassette centre is on the plumb
             _zero_readings(run, "2/MO")
@@ -732,40 +376,11 @@ def _solve_kappa(q_of, kappa0, target):
     return solve_1d(q_of, kappa0, target, iterations=4, h=1e-6)
 
 
-def _judge_standard_points(
-    run: Run, stage: str, key: str, active=None, remedy: str = "", iteration: int = 1
-) -> NDArray[np.float64]:
-    """Fuse on each of the six standard points and judge its y-parallax (σ_q): (..., 6)."""
-    op = run.op
-    tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    pts = run.scene.standard_points_m
-    imgs = run.scene.images(pts)
-    seen = []
-    for i in range(6):
-        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
-        seen.append(q)
-        op.log.add(
-            stage,
-            f"residual y-parallax at standard point {i + 1}",
-            "",
-            residual=q,
-            true=q_true,
-            judgment_error=q - q_true,
-            tolerance=tol,
-            passed=np.abs(q) <= tol,
-            iteration=iteration,
-            equation="≤ ¼ mark",
-            remedy=remedy,
-            when=active if remedy else None,
-        )
-    return np.stack(seen, axis=-1)
-
-
 def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     """The residual y-parallax at the six standard points, judged by the operator; with the
     operator's practice, remedy R2 where it exceeds ¼ mark."""
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    seen = _judge_standard_points(run, stage, f"{stage}/std")
+    seen = np.stack(steps.judge_standard_points(run, stage, f"{stage}/std"), axis=-1)
     worst = np.max(np.abs(seen), axis=-1)
     name = f"stage {stage}: residual y-parallax (6 points)"
     if run.remedial:
@@ -834,7 +449,12 @@ def refine_relative_orientation(
                 remedy=remedy,
                 when=active,
             )
-        new = _judge_standard_points(run, stage, f"{stage}/R2/{it}", active, remedy, it)
+        new = np.stack(
+            steps.judge_standard_points(
+                run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
+            ),
+            axis=-1,
+        )
         seen = np.where(active[..., None], new, seen)
         worst = np.where(active, np.max(np.abs(new), axis=-1), worst)
         active = active & (worst > tol)
@@ -943,17 +563,6 @@ def level_design(
     return LevelDesign(combos, misfit, np.column_stack(cols))
 
 
-def _scale_pair(run: Run) -> tuple[str, str]:
-    """The two plan control points of the sheet farthest apart (the scale is taken there)."""
-    sc = run.scene.scenario
-    ids = run.sheet.similarity_point_ids or tuple(h["id"] for h in run.sheet.control_heights)
-    pts = {i: np.asarray(next(p for p in sc.points if p.id == i).local_m, float) for i in ids}
-    return max(
-        ((a, b) for k, a in enumerate(ids) for b in ids[k + 1 :]),
-        key=lambda ab: float(np.hypot(*(pts[ab[0]][:2] - pts[ab[1]][:2]))),
-    )
-
-
 def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
     """The instrument coordinates (6.7) of a plan control point (the sheet's similarity)."""
     sheet = run.sheet
@@ -964,33 +573,22 @@ def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
     return np.asarray(xy, float).reshape(2)
 
 
-def _fuse_on(run: Run, p, key: str, active, read: tuple[str, ...]) -> dict[str, NDArray]:
-    op = run.op
-    img = run.scene.images(np.asarray(p, float)[None, :])
-    op.fuse(p, (img[0][0], img[1][0]), key, active)
-    return {c: op.read(c, f"{key}/{c}") for c in read}
-
-
 def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
     """R3 (1): fuse on the two plan control points farthest apart, compare the distance of the
     X, Y counters with that of their sheet coordinates (6.7), turn b_x in proportion."""
     op, sheet = run.op, run.sheet
     if sheet.similarity is None:
         return
-    a_id, b_id = _scale_pair(run)
-    sc = run.scene.scenario
-    pts = [np.asarray(next(p for p in sc.points if p.id == i).local_m, float) for i in (a_id, b_id)]
-    ra, rb = (
-        _fuse_on(run, p, f"3/R3/{it}/scale/{i}", active, ("X", "Y"))
-        for i, p in zip((a_id, b_id), pts, strict=True)
-    )
+    a_id, b_id = steps.scale_pair(run)
     d_sheet = float(np.hypot(*(_sheet_xy(run, a_id) - _sheet_xy(run, b_id))))
-    d_model = np.hypot(ra["X"] - rb["X"], ra["Y"] - rb["Y"])
-    with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
-        ratio = np.where(active, d_sheet / d_model, 1.0)
-    bx = op.read("bx", f"3/R3/{it}/bx")
-    new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio  # MO_bx + b_x·ratio
-    op.set("bx", new, f"3/R3/{it}/setbx", active)
+    bx, new, d_model = steps.scale_by_two_points(
+        run,
+        (a_id, steps.control_point_m(run, a_id)),
+        (b_id, steps.control_point_m(run, b_id)),
+        d_sheet,
+        f"3/R3/{it}",
+        active,
+    )
     op.log.add(
         "3",
         f"scale: fuse on {a_id} and {b_id}, counter distance against the sheet's "
@@ -1014,11 +612,9 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
     sense = run.sheet.options.bz_scale_sense
     w = np.linalg.pinv(design.design)
     for row, name in ((1, "alpha"), (2, "omega")):
-        phi = None
-        for i, e in enumerate(errs):  # a sum in a fixed order (vectorised = per-trial)
-            term = w[row, i] * e
-            phi = term if phi is None else phi + term
-        phi = np.where(active, -phi, 0.0)
+        phi = np.where(
+            active, -steps.fixed_order_sum(w[row, i] * e for i, e in enumerate(errs)), 0.0
+        )
         for control, rate in design.combos[name].items():
             if control == "bz":
                 before = op.read("bz", f"3/R3/{it}/{name}/bz")
@@ -1049,16 +645,6 @@ def _shown(op: Operator, value) -> float:
     return float(flat[op.log.shown if flat.size > 1 else 0])
 
 
-def _height_seen(run: Run, p, key: str, active, pointings: int) -> NDArray[np.float64]:
-    """Fuse on ``p`` and read the height scale, ``pointings`` times, averaged. [m]"""
-    total = None
-    for j in range(pointings):
-        k = key + (f"/p{j}" if j else "")
-        read = _fuse_on(run, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
-        total = read if total is None else total + read
-    return total / pointings
-
-
 def _read_control_heights(
     run: Run,
     rows: list[ControlHeight],
@@ -1066,16 +652,14 @@ def _read_control_heights(
     active,
     remedy: str,
     it: int,
-    pointings: int = REPEAT_POINTINGS,
+    pointings: int = steps.REPEAT_POINTINGS,
 ) -> list[NDArray[np.float64]]:
     """Slip the height scale on control point 0 (the mean of ``pointings`` fusings and readings
     there), then fuse on the others and read their heights (each the mean of ``pointings``):
     the errors (read − truth) of points 1 … n−1. [m]"""
     op, tol = run.op, run.sheet.tolerances["control_height_m"]
     p0 = rows[0].ground_m
-    seen0 = _height_seen(run, p0, f"{key}/slip", active, pointings)
-    exact = op.v(op.inst.read(HEIGHT_SCALE, exact=True))
-    op.inst.slip_height_scale(np.where(active, exact + (p0[2] - seen0), exact))
+    steps.slip_height_scale_on_mean(run, p0, f"{key}/slip", active, pointings)
     op.log.add(
         "3",
         f"fuse on {rows[0].id} ({pointings} times), slip the height scale to H = {p0[2]:.2f} m",
@@ -1092,7 +676,7 @@ def _read_control_heights(
             op,
             "3",
             f"control point {h.id}: fuse, read the height ({pointings} times, mean)",
-            _height_seen(run, h.ground_m, f"{key}/{h.id}", active, pointings),
+            steps.height_mean(run, h.ground_m, f"{key}/{h.id}", active, pointings),
             h.ground_m[2],
             tol,
             iteration=it,
@@ -1225,253 +809,6 @@ def stage3_scale_model(run: Run) -> None:
         remedy = "R3 stage 3: refine scaling and levelling on control"
         run.record_remedy(remedy, name, failed, rounds)
     check_standard_points(run, "3")
-
-
-# --- stages 4 and 5: the sheet on the coordinatograph ----------------------------------------
-
-
-def _table(run: Run, xy_mm) -> NDArray[np.float64]:
-    """Ideal table position of a model position (x′, y′) for the coordinatograph's origin."""
-    return run.op.inst.table_position_mm(xy_mm)
-
-
-def _needle_at(run: Run, corner: str, key: str) -> NDArray[np.float64]:
-    """Counters to the sheet's readings of ``corner`` (MO_X, MO_Y + x′, y′): the needle."""
-    op = run.op
-    op.set("X", run.target(f"corner {corner}: O_X"), f"{key}/X")
-    op.set("Y", run.target(f"corner {corner}: O_Y"), f"{key}/Y")
-    return _needle(run, key)
-
-
-def _needle(run: Run, key: str) -> NDArray[np.float64]:
-    """The needle on the table; with the SC complex's automatic coordinatograph, its settled
-    servo noise drawn from the run's keyed streams (σ_s per axis)."""
-    op = run.op
-    sigma = op.inst.servo_sigma_mm
-    noise = None
-    if sigma:
-        noise = np.stack([op.noise.normal(f"servo/{key}/{a}", sigma) for a in "xy"], axis=-1)
-    return np.asarray(op.inst.needle(op.model.finish_side, noise), float)
-
-
-def stage4_orient_sheet(run: Run) -> None:
-    """Stage 4: corner 1 under the needle (6.16), rotate about it to corner 3 (6.17), repeat.
-
-    Closed form (the sheet is rigid): the pin pierces mark 1 + placement error (injected
-    ``coordinatograph.sheet_placement_*`` plus σ_mono at map scale); the operator turns the
-    sheet until mark 3 lies on the needle's ray from the pin (σ_mono across it).
-    """
-    op, sheet = run.op, run.sheet
-    if not sheet.corners:
-        run.sheet_pose = None
-        return
-    ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
-    enlargement = None
-    if op.inst.options.automatic_coordinatograph:  # photo → map, checked against its 10 ×
-        sc = run.scene.scenario
-        height = np.mean([p["flying_height_m"] for p in summarize_scenario(sc)["photos"]])
-        photo_scale = MM_PER_M * float(height) / float(sc.camera.focal_length_mm)
-        enlargement = photo_scale / sheet.map_scale_denominator
-    op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
-    corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
-    ideal = {k: _table(run, v) for k, v in corners.items()}
-    inj = op.inst.injected
-    place = np.stack(
-        [
-            op.v(inj["coordinatograph.sheet_placement_x"]),
-            op.v(inj["coordinatograph.sheet_placement_y"]),
-        ],
-        axis=-1,
-    )
-    angle = op.v(0.0)
-    for it in (1, 2):
-        n1 = _needle_at(run, "1", f"4/{it}/c1")
-        e = np.stack(
-            [op.noise.normal(f"mono/4/{it}/pin/{a}", op.model.monocular_sigma_mm) for a in "xy"],
-            axis=-1,
-        )
-        pin_sheet = ideal["1"] + (place if it == 1 else 0.0) + e
-        op.log.add(
-            "4",
-            "counters to corner 1, pin the sheet's corner 1 under the needle",
-            "X",
-            reading=run.target("corner 1: O_X"),
-            iteration=it,
-            equation="(6.16)",
-        )
-        n3 = _needle_at(run, "3", f"4/{it}/c3")
-        e3 = op.noise.normal(f"mono/4/{it}/c3", op.model.monocular_sigma_mm)
-        a_needle = np.arctan2(n3[..., 1] - n1[..., 1], n3[..., 0] - n1[..., 0])
-        d = ideal["3"] - pin_sheet
-        a_mark = np.arctan2(d[..., 1], d[..., 0])
-        angle = a_needle - a_mark + e3 / np.hypot(d[..., 0], d[..., 1])
-        op.log.add(
-            "4",
-            "counters to corner 3, rotate the sheet about corner 1 until the needle meets corner 3",
-            "",
-            reading=None,
-            judgment_error=e3,
-            iteration=it,
-            equation="(6.17)",
-        )
-    run.sheet_pose = SheetPose(angle, pin_sheet, n1)
-    run.record_stage("4", op.v(2).astype(int))
-
-
-def stage5_check(run: Run) -> None:
-    """Stage 5: counters to corner 4 (6.18), misclosure ≤ 0.3 mm; plotted control points."""
-    op, sheet = run.op, run.sheet
-    pose = run.sheet_pose
-    if pose is None:
-        return
-    corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
-    n4 = _needle_at(run, "4", "5/c4")
-    mark4 = pose.table_of(_table(run, corners["4"]))
-    mis = np.hypot(*np.moveaxis(mark4 - n4, -1, 0))
-    tol = sheet.tolerances["corner_mm"]
-    op.log.add(
-        "5",
-        "counters to corner 4: misclosure of needle and corner 4",
-        "",
-        residual=mis,
-        tolerance=tol,
-        passed=mis <= tol,
-        equation="(6.18)",
-    )
-    run.check("stage 5: corner 4", mis, tol)
-    run.record_stage("5", op.v(1).astype(int))
-    # plotted plan control points: fuse on the point, compare the needle with the plotted point
-    sc = run.scene.scenario
-    if sheet.similarity is None:
-        return
-    errs = []
-    for pid in sheet.similarity_point_ids:
-        p = next(q for q in sc.points if q.id == pid)
-        xy = sheet_corner_instrument_coordinates(
-            sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
-        )
-        img = run.scene.images(np.asarray(p.local_m, float)[None, :])
-        op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
-        needle = _needle(run, f"5/plan/{pid}")
-        plotted = pose.table_of(_table(run, np.asarray(xy, float).reshape(2)))
-        err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
-        errs.append(err)
-        op.log.add(
-            "5",
-            f"plan control point {pid}: fuse, needle against the plotted point",
-            "",
-            residual=err,
-            equation="stage 5",
-        )
-    # Tolerance (assumed): the book gives no figure for this final check; it is the same
-    # comparison as corner 4 (needle against a point plotted on the sheet), so the corner-4
-    # figure 0.3 mm (documented, stage 5) is used — 3.75 σ of the assumed plotting σ 0.08 mm.
-    run.check(
-        "stage 5: plan control points (needle − plotted)",
-        np.max(np.stack(errs, axis=-1), axis=-1),
-        sheet.tolerances["corner_mm"],
-    )
-
-
-def mechanism_level(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
-) -> tuple[float, float]:
-    """What the correction mechanism itself leaves at the sheet's own settings (the floor).
-
-    The units at the sheet's α, ω, κ with its decentrations (``unit_for_orientation``), f_пр and
-    b = (b_x, b_y, b_z′) of the sheet, no error anywhere: the largest |q| at the six standard
-    points [mm, photo scale], and the largest control-height error relative to the first height
-    control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
-    setup-data method sets exactly these values and has no relative orientation or levelling.
-    ``mechanism``: the instrument's own correction mechanism
-    (:func:`~stereoplotter.instrument.correction.mechanism_for`); None: canonical unit.
-    """
-    f = sheet.focal_length_corrected_mm
-    units = [
-        UnitMap(
-            replace(
-                unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis),
-                mechanism=mechanism,
-            )
-        )
-        for p in sheet.photos
-    ]
-    bx, by, bz = sheet.base_mm
-    setting = InstrumentSetting(sheet.f_instrument_mm, bx, by, bz)
-
-    def reading(points_m):
-        pl, pr = scene.images(points_m)
-        return rods_intersection(units[0].rod_from_photo(pl), units[1].rod_from_photo(pr), setting)
-
-    q_max = float(np.max(np.abs(reading(scene.standard_points_m).y_parallax_mm)))
-    heights = np.array([h.ground_m for h in control_heights_of(sheet, scene)])
-    if len(heights) < 2:
-        return q_max, 0.0
-    depth = reading(heights).depth_mm
-    # deeper is lower: H_i = H_0 − (D_i − D_0)·M_в/1000 with the scale slipped at point 0
-    model_h = heights[0, 2] - (depth - depth[0]) * sheet.vertical_scale_denominator / 1000.0
-    return q_max, float(np.max(np.abs(model_h - heights[:, 2])))
-
-
-def refuse_beyond_mechanism(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
-):
-    """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
-    already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
-    no operator can then build the model by the setup-data method on this instrument.
-
-    The message names the scenario file and the field that carries the pair beyond the
-    mechanism — the largest photo tilt, ``photos[i].exterior.alpha_deg`` or ``omega_deg`` — and
-    the §26 tolerances the mechanism level exceeds.
-    """
-    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis, mechanism)
-    tol_q = sheet.tolerances["residual_y_parallax_mm"]
-    tol_h = sheet.tolerances["control_height_m"]
-    if q_max <= tol_q and h_max <= tol_h:
-        return
-    sc = scene.scenario
-    tilts = [
-        (abs(getattr(p.exterior, axis)), i, axis)
-        for i, p in enumerate(sc.photos)
-        for axis in ("alpha", "omega")
-    ]
-    _, i, axis = max(tilts, key=lambda t: t[0])  # the first of equal tilts
-    found = np.degrees(getattr(sc.photos[i].exterior, axis))
-    films = [
-        f"photos[{j}].film_deformation_ppm = [{p.film_deformation_ppm[0]:g}, "
-        f"{p.film_deformation_ppm[1]:g}]"
-        for j, p in enumerate(sc.photos)
-        if any(p.film_deformation_ppm)
-    ]
-    film_note = (
-        "; the films' deformation enters this level too ("
-        + ", ".join(films)
-        + "): the SC complex's correction unit takes it out (--option correction_unit)"
-        if films
-        else ""
-    )
-    raise SetupRefusal(
-        f"{sc.source}: photos[{i}].exterior.{axis}_deg: expected a tilt the setup-data method "
-        f"on {sheet.instrument_title} can carry (§26: at the sheet's exact settings the "
-        f"correction mechanism must leave ≤ ¼ mark {tol_q * 1000:.1f} µm of y-parallax at the "
-        f"standard points and ≤ H/3000 {tol_h:.2f} m at the control heights), found "
-        f"{found:+.1f}° (the largest tilt of the pair): at f′ = "
-        f"{sheet.focal_length_corrected_mm:.0f} mm the mechanism leaves {q_max * 1000:.1f} µm "
-        f"and {h_max:.2f} m (instrument test, §6); the model needs relative orientation and "
-        f"levelling (--method conventional){film_note}"
-    )
-
-
-def control_heights_of(sheet: SetupSheet, scene: Scene) -> list[ControlHeight]:
-    """The sheet's height control points with their ground points (the scene's truth)."""
-    sc = scene.scenario
-    rows = []
-    for h in sheet.control_heights:
-        p = next(p for p in sc.points if p.id == h["id"])
-        rows.append(
-            ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
-        )
-    return rows
 
 
 def run_setup_method(run: Run) -> Run:

@@ -16,30 +16,26 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import decentration_variant
+from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import (
-    AutomaticCoordinatograph,
     ErrorCorrectionUnit,
     SC1Options,
 )
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
 from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
-from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
+from stereoplotter.procedure.floor import refuse_beyond_mechanism
+from stereoplotter.procedure.operator import Noise, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, StageRecord
-from stereoplotter.procedure.setup_method import (
-    PRACTICES,
-    Run,
-    refuse_beyond_mechanism,
-    run_setup_method,
-)
+from stereoplotter.procedure.run import PRACTICES, PreparedRun, Run, build_run
+from stereoplotter.procedure.setup_method import run_setup_method
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.sheet import SetupSheet, compute_setup_sheet
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "METHODS",
@@ -131,30 +127,6 @@ def _errors(spec: InstrumentSpec, errors: ErrorModel | str | None) -> ErrorModel
     )
 
 
-@dataclass(frozen=True)
-class PreparedRun:
-    """Everything a run fixes before its trials: sheet, error model, operator, scene, options.
-
-    Built once by :func:`prepare_run`; :func:`run_trials_chunk` runs any range of trials on it,
-    so a long run in chunks computes the sheet and the scene once.
-    """
-
-    scenario: Scenario
-    spec: InstrumentSpec
-    method: str
-    sheet: SetupSheet
-    model: ErrorModel
-    operator: OperatorModel
-    scene: Scene
-    seed: int
-    backend: str = "closed-form"
-    ideal_mechanics: bool = False
-    variant: str = "L"
-    relative: str = "elements"
-    practice: str = "operator"
-    options: SC1Options = field(default_factory=SC1Options)
-
-
 def apply_correction_unit(
     scenario: Scenario, spec: InstrumentSpec, operator: OperatorModel
 ) -> tuple[Scenario, OperatorModel]:
@@ -244,26 +216,8 @@ def prepare_run(
         relative,
         practice,
         options,
+        residual_grid_m(scenario),
     )
-
-
-def _log_options(op: Operator, prep: PreparedRun) -> None:
-    """Transcript lines (at the start) for the SC complex's options fitted to the instrument."""
-    if prep.options.error_correction_unit:
-        unit = ErrorCorrectionUnit.from_spec(prep.spec)
-        op.log.add(
-            "1",
-            "SC complex: the error-correction unit has corrected the image coordinates (film "
-            f"deformation within ±{unit.range_um:g} µm; residual {unit.rms_um:g} µm RMS added to "
-            "every pointing)",
-        )
-    if prep.options.automatic_coordinatograph:
-        op.log.add(
-            "1",
-            "SC complex: the automatic coordinatograph's servo will drive the needle in stages "
-            f"4–5 (no gear backlash or pen play; settled noise σ_s = "
-            f"{op.inst.servo_sigma_mm or AutomaticCoordinatograph().sigma_mm:g} mm per axis)",
-        )
 
 
 def _run_one(
@@ -272,29 +226,17 @@ def _run_one(
     trials: int | None,
     noise: Noise,
     transcript: bool = True,
+    first: int = 0,
 ):
-    inst = Instrument(
-        prep.spec,
-        prep.sheet.focal_length_corrected_mm,
-        errors=prep.model,
-        injected=injected,
-        variant=prep.variant,
-        backend=prep.backend,
-        trials=trials,
-        ideal_mechanics=prep.ideal_mechanics,
-        options=prep.options,
-    )
-    op = Operator(inst, prep.operator, noise, Transcript(enabled=transcript))
-    _log_options(op, prep)
-    run = Run(op, prep.sheet, prep.scene)
-    run.practice = prep.practice
+    run = build_run(prep, first, trials, injected=injected, noise=noise, transcript=transcript)
+    op = run.op
     if prep.method == "setup":
         run_setup_method(run)
     else:
         run_conventional_method(run, prep.relative)
     scene = prep.scene
     q_std = op.y_parallax(scene.standard_points_m, scene.images(scene.standard_points_m))
-    grid = residual_grid_m(prep.scenario)
+    grid = prep.grid_m if prep.grid_m is not None else residual_grid_m(prep.scenario)
     q_grid = op.y_parallax(grid, scene.images(grid))
     return run, q_std, q_grid
 

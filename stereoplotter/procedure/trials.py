@@ -24,7 +24,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M, UM_PER_MM
-from stereoplotter.procedure.simulate import PreparedRun, SimulationResult, run_trials_chunk
+from stereoplotter.procedure.run import PreparedRun
+from stereoplotter.procedure.simulate import SimulationResult, run_trials_chunk
 from stereoplotter.statistics import scale_summary, summarise_flags, summarise_values
 
 __all__ = [

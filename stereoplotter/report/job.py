@@ -20,12 +20,12 @@ from typing import Any
 import numpy as np
 
 from stereoplotter import __version__
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
 from stereoplotter.report.forms import FormHeader, form_pdf, forms_pdf
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupSheet
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "JobResult",

@@ -13,8 +13,12 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stereoplotter.geometry.instrument_settings import sequence_for, setting_values
-from stereoplotter.instrument.correction import control_name, mark_phrase
+from stereoplotter.instrument.principles import (
+    control_name,
+    mark_phrase,
+    sequence_for,
+    setting_values,
+)
 from stereoplotter.setup.sheet import SetupSheet, assumed_parameters
 from stereoplotter.setup.table24 import X_MARK_NAME, BlockResult, candidates_of
 
@@ -193,7 +197,7 @@ def setup_dict(table: BlockResult, i: int, sheet: SetupSheet | None = None) -> d
 
 def instrument_settings(table: BlockResult, i: int) -> dict[str, Any] | None:
     """The instrument's own φ, ω-dependent settings of pair ``i`` with their formulas
-    (:mod:`stereoplotter.geometry.instrument_settings`); None for an instrument file whose
+    (:mod:`stereoplotter.instrument.principles`); None for an instrument file whose
     ``principle`` is none of the three."""
     seq = sequence_for(table.spec.principle)
     if seq is None:

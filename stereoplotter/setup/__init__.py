@@ -1,9 +1,10 @@
 """The setup-data computer (Table 24, Eqs. (6.1)–(6.18) of Kushtin & Lyskov 1984, §26).
 
 Layer: pure. May import :mod:`stereoplotter.geometry`, :mod:`stereoplotter.geodesy`,
-:mod:`stereoplotter.scenario`, the instrument *specification* (:mod:`stereoplotter.instrument.spec`,
-data only) and the base modules (``constants``, ``errors``). Never imports the virtual
-instrument's kinematics or mechanics, the procedures, files (``io``), reports or plots.
+:mod:`stereoplotter.scenario`, the instrument *specification* (:mod:`stereoplotter.spec`, data
+and range checks only) and the base modules (``constants``, ``errors``). Never imports
+:mod:`stereoplotter.instrument` (the stateful virtual instrument: an import-linter contract),
+the procedures, files (``io``), reports or plots.
 
 * :mod:`.equations` — Eqs. (6.3)–(6.15), one function each, vectorised;
 * :mod:`.scale_choice` — the choice of M_г, M_в within the instrument's ranges;

@@ -31,7 +31,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.geometry.rotation import rotation_matrix
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.setup.scale_choice import candidate_scales
 from stereoplotter.setup.table24 import (
     X_MARK_NAME,
@@ -40,6 +39,7 @@ from stereoplotter.setup.table24 import (
     compute_table24,
     reason_text,
 )
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "X_MARK_NAME",

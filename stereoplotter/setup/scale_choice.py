@@ -28,12 +28,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.setup.equations import (
     base_components,
     instrument_principal_distance,
     projection_distance,
 )
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.range_checks import RangeRefusal, check_in_range
 
 __all__ = [
     "ScaleCandidate",
@@ -249,7 +250,7 @@ def describe_candidate(
     extent_m: ArrayLike | None = None,
 ) -> list[str]:
     """The failed conditions of one candidate of one pair, in the words of
-    :func:`~stereoplotter.instrument.spec.check_in_range` (value, range, status, file, key)."""
+    :func:`~stereoplotter.spec.range_checks.check_in_range` (value, range, status, file, key)."""
     mg, mv = (float(v) for v in candidate)
     b = base_components(np.zeros(3), np.asarray(base_m, float), mg, mv)
     d = projection_distance(np.asarray(depth_m, float), mv)

@@ -30,15 +30,9 @@ from stereoplotter.geometry.similarity import (
     apply_similarity,
     fit_similarity_with_reflection,
 )
-from stereoplotter.instrument.limits import (
-    check_material_limits,
-    check_model_to_photo_scale,
-    check_photo_to_map_ratio,
-)
-from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import MapSheet, Point, Scenario
-from stereoplotter.scenario.summary import summarize_scenario
+from stereoplotter.scenario.summary import flying_height_and_relief
 from stereoplotter.scenario.synthetic import (
     synthesize_measurements,
     working_area_grid_m,
@@ -66,6 +60,13 @@ from stereoplotter.setup.table24 import (
     compute_table24,
     instrument_frames,
 )
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.limits import (
+    check_material_limits,
+    check_model_to_photo_scale,
+    check_photo_to_map_ratio,
+)
+from stereoplotter.spec.range_checks import RangeRefusal, check_in_range
 
 __all__ = [
     "CORNER_ORDER",
@@ -298,15 +299,14 @@ def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[
 # --- the computation ----------------------------------------------------------------------------
 
 
-def _check_material(scenario: Scenario, spec: InstrumentSpec) -> float:
-    """Documented limits on the pair (relief/H, f_k; :mod:`stereoplotter.instrument.limits`);
-    returns the mean flying height H. [m]"""
-    summary = summarize_scenario(scenario)
-    height = float(np.mean([p["flying_height_m"] for p in summary["photos"]]))
+def _check_material(scenario: Scenario, spec: InstrumentSpec, grid_m: NDArray) -> float:
+    """Documented limits on the pair (relief/H, f_k; :mod:`stereoplotter.spec.limits`) with H
+    and the relief as the scenario summary prints them; returns the mean flying height H. [m]"""
+    height, relief = flying_height_and_relief(scenario, grid_m)
     try:
         check_material_limits(
             spec,
-            relief_m=float(summary["relief"]["working_area_range_m"]),
+            relief_m=relief,
             flying_height_m=height,
             camera_f_mm=float(scenario.camera.focal_length_mm),
             what=scenario.source,
@@ -318,7 +318,7 @@ def _check_material(scenario: Scenario, spec: InstrumentSpec) -> float:
 
 def _check_model_scale(scenario: Scenario, spec: InstrumentSpec, sheet, height_m: float) -> None:
     """SPR-3: model scale 0.5–2 × photo scale; SD-3: map scale 0.5–3 × photo scale
-    (m = 1000·H/f_k; :mod:`stereoplotter.instrument.limits`)."""
+    (m = 1000·H/f_k; :mod:`stereoplotter.spec.limits`)."""
     photo = MM_PER_M * height_m / float(scenario.camera.focal_length_mm)
     try:
         check_model_to_photo_scale(
@@ -371,7 +371,8 @@ def compute_setup_sheet(
             f"{', '.join(p.name for p in scenario.photos)}: scenario {scenario.name!r} is not a "
             "stereopair"
         )
-    height_m = _check_material(scenario, spec)
+    working_area_m = working_area_grid_m(scenario, (15, 15))  # once: relief and working area
+    height_m = _check_material(scenario, spec, working_area_m)
     rng = np.random.default_rng(scenario.seed) if rng is None else rng
     measurements = synthesize_measurements(scenario, rng)
     known = known_exterior_orientation(scenario, measurements)
@@ -389,7 +390,7 @@ def compute_setup_sheet(
         centres_m=np.array([k.centre_m for k in known]),
         rotations=np.array([k.rotation for k in known]),
         points=scenario.points,
-        working_area_m=working_area_grid_m(scenario, (15, 15)),
+        working_area_m=working_area_m,
         map_sheet=scenario.map_sheet,
         exterior_sources=tuple(p.exterior.source for p in scenario.photos),
     )

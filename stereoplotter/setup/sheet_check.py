@@ -17,8 +17,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from stereoplotter.constants import MM_PER_M
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.setup.records import SetupSheet
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["Expected", "ItemResult", "SheetCheck", "check_sheet", "expected_values"]
 

@@ -41,7 +41,6 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
-from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.setup.equations import (
     base_components,
     correction_inclination,
@@ -62,6 +61,8 @@ from stereoplotter.setup.scale_choice import (
     describe_candidate,
     scale_candidates,
 )
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.range_checks import RangeRefusal, check_in_range
 
 __all__ = [
     "SCALE_FLAGS",
@@ -281,7 +282,7 @@ def instrument_frames(
 
 
 def _inside_with_slack(v: NDArray, lo: float, hi: float) -> NDArray[np.bool_]:
-    """lo ≤ v ≤ hi with the 1e-9 relative slack of ``instrument.spec.check_in_range``."""
+    """lo ≤ v ≤ hi with the 1e-9 relative slack of ``spec.range_checks.check_in_range``."""
     eps = 1e-9 * max(1.0, abs(lo), abs(hi))
     with np.errstate(invalid="ignore"):
         return (v >= lo - eps) & (v <= hi + eps)

@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from stereoplotter.errors import TrainerError
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.scenario.model import Scenario
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "ASSISTS",
@@ -134,8 +134,16 @@ def register_resolver(resolver: Callable[[dict[str, Any]], Exercise]) -> None:
     _RESOLVER[:] = [resolver]
 
 
-def resolve_exercise(source: dict[str, Any]) -> Exercise:
-    """The :class:`Exercise` of a file content (a session log's header)."""
+def resolve_exercise(
+    source: dict[str, Any],
+    read_exercise: Callable[[dict[str, Any]], Exercise] | None = None,
+) -> Exercise:
+    """The :class:`Exercise` of a file content (a session log's header), read by
+    ``read_exercise`` (the io layer's ``exercise_from_mapping``, passed by the caller: the
+    trainer cannot import io). Without it, the reader registered by
+    :func:`register_resolver` — a transition for callers that do not pass it yet (issue 23)."""
+    if read_exercise is not None:
+        return read_exercise(source)
     if not _RESOLVER:
         raise TrainerError(
             "no exercise reader registered: import stereoplotter.io.exercise_file, "

@@ -27,12 +27,11 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.instrument.virtual import SCREWS, Instrument
-from stereoplotter.procedure.operator import Noise, Operator
-from stereoplotter.procedure.setup_method import Run
-from stereoplotter.procedure.simulate import PreparedRun
-from stereoplotter.procedure.transcript import Transcript
+from stereoplotter.instrument.virtual import SCREWS
+from stereoplotter.procedure.operator import Noise
+from stereoplotter.procedure.run import PreparedRun, build_run
 from stereoplotter.trainer.actions import apply
+from stereoplotter.trainer.exercise import Exercise
 from stereoplotter.trainer.operator_steps import new_instrument, stage_functions
 from stereoplotter.trainer.outcome import Measure, stage_measures
 from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session, json_finite
@@ -75,19 +74,17 @@ def population_measures(
     last = stages[-1]
     for first in range(0, trials, chunk):
         n = min(chunk, trials - first)
-        inst = Instrument(
-            prep.spec,
-            prep.sheet.focal_length_corrected_mm,
-            errors=prep.model,
+        # a population is vectorised over its trials: only the closed-form back-end runs that
+        run = build_run(
+            prep,
+            first,
+            n,
             injected=injected,
-            variant=prep.variant,
+            noise=Noise(seed, n, None, first),
+            transcript=False,
             backend="closed-form",
-            trials=n,
-            ideal_mechanics=prep.ideal_mechanics,
         )
-        op = Operator(inst, prep.operator, Noise(seed, n, None, first), Transcript(enabled=False))
-        run = Run(op, prep.sheet, prep.scene)
-        run.practice = prep.practice
+        inst = run.op.inst
         for name, fn in stage_functions(run, prep.method).items():
             fn()
             if name in out:
@@ -257,13 +254,17 @@ def grade(
     *,
     population: int = 10_000,
     progress: Callable[[int], None] | None = None,
+    read_exercise: Callable[[dict[str, Any]], Exercise] | None = None,
 ) -> dict[str, Any]:
     """The grade of a session (or of a session log's records, replayed first) as a dict (JSON).
 
-    ``population`` 0 skips the percentile.
+    ``population`` 0 skips the percentile; ``read_exercise`` reads a log's exercise
+    (:meth:`Session.replay`).
     """
     session = (
-        session_or_log if isinstance(session_or_log, Session) else Session.replay(session_or_log)
+        session_or_log
+        if isinstance(session_or_log, Session)
+        else Session.replay(session_or_log, read_exercise=read_exercise)
     )
     ex = session.exercise
     par = _par_measures(session)

@@ -28,16 +28,14 @@ from stereoplotter.procedure.conventional import (
     calibrate,
     levelling_points,
 )
-from stereoplotter.procedure.operator import Noise, Operator
+from stereoplotter.procedure.operator import Noise
+from stereoplotter.procedure.run import PreparedRun, Run, build_instrument, build_run
 from stereoplotter.procedure.setup_method import (
-    Run,
     stage1_scale_coefficient,
     stage2_transform,
     stage3_scale_model,
-    stage4_orient_sheet,
-    stage5_check,
 )
-from stereoplotter.procedure.simulate import PreparedRun
+from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.transcript import Transcript
 
 __all__ = [
@@ -122,14 +120,8 @@ class RecordingInstrument(Instrument):
 
 def new_instrument(prep: PreparedRun, seed: int, cls: type[Instrument] = Instrument) -> Instrument:
     """The instrument of trial 0 of a run seeded ``seed`` (errors drawn as ``simulate`` does)."""
-    return cls(
-        prep.spec,
-        prep.sheet.focal_length_corrected_mm,
-        errors=prep.model,
-        injected=prep.model.draw_keyed(seed, 0, None),
-        variant=prep.variant,
-        backend=prep.backend,
-        ideal_mechanics=prep.ideal_mechanics,
+    return build_instrument(
+        prep, injected=prep.model.draw_keyed(seed, 0, None), instrument_cls=cls
     )
 
 
@@ -206,12 +198,15 @@ def stage_functions(run: Run, method: str) -> dict[str, Callable[[], None]]:
 def operator_run(prep: PreparedRun, seed: int, upto: str | None = None) -> OperatorRun:
     """Run the simulated operator (trial 0 of seed ``seed``) stage by stage, noting its actions;
     it stops after stage ``upto`` (default: the method's last)."""
-    inst = new_instrument(prep, seed, RecordingInstrument)
+    run = build_run(
+        prep,
+        injected=prep.model.draw_keyed(seed, 0, None),
+        noise=Noise(seed, None, None, 0),
+        instrument_cls=RecordingInstrument,
+    )
+    op, inst = run.op, run.op.inst
     assert isinstance(inst, RecordingInstrument)
-    op = Operator(inst, prep.operator, Noise(seed, None, None, 0), Transcript())
     inst.transcript = op.log
-    run = Run(op, prep.sheet, prep.scene)
-    run.practice = prep.practice
     ends = {}
     for name, fn in stage_functions(run, prep.method).items():
         inst.stage = name

@@ -35,7 +35,7 @@ from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.evaluation import evaluate_model
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel
 from stereoplotter.procedure.records import SheetReadings
-from stereoplotter.procedure.simulate import PreparedRun
+from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.transcript import Transcript
 
 __all__ = ["Measure", "stage_measures"]

@@ -20,6 +20,7 @@ import hashlib
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,7 +36,8 @@ from stereoplotter.instrument.virtual import (
     Instrument,
 )
 from stereoplotter.procedure.operator import Noise, Operator
-from stereoplotter.procedure.simulate import PreparedRun, prepare_run
+from stereoplotter.procedure.run import PreparedRun
+from stereoplotter.procedure.simulate import prepare_run
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.trainer.actions import (
     ACTION_FIELDS,
@@ -148,8 +150,17 @@ class Session:
         }
 
     @classmethod
-    def replay(cls, records: list[dict[str, Any]], exercise: Exercise | None = None) -> Session:
+    def replay(
+        cls,
+        records: list[dict[str, Any]],
+        exercise: Exercise | None = None,
+        *,
+        read_exercise: Callable[[dict[str, Any]], Exercise] | None = None,
+    ) -> Session:
         """Run a session log (header + action records) again.
+
+        The exercise is ``exercise``, or the header's file content read by ``read_exercise``
+        (:func:`~stereoplotter.trainer.exercise.resolve_exercise`).
 
         Raises
         ------
@@ -161,7 +172,7 @@ class Session:
             raise TrainerError(f"session log: expected a first line with format {LOG_FORMAT}")
         head = records[0]
         if exercise is None:
-            exercise = resolve_exercise(head["exercise"])
+            exercise = resolve_exercise(head["exercise"], read_exercise)
         session = cls(exercise, str(head["trainee"]), int(head["seed"]), clock=False)
         for rec in records[1:]:
             action = dict(rec["action"])

@@ -50,12 +50,13 @@ from numpy.typing import NDArray
 from stereoplotter.constants import MM_PER_M, UM_PER_MM
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.procedure.operator import Noise, OperatorModel
-from stereoplotter.procedure.simulate import PreparedRun, prepare_run, run_trials_chunk
+from stereoplotter.procedure.run import PreparedRun
+from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB, chunk_trials_for
 from stereoplotter.random_streams import keyed_draws
 from stereoplotter.scenario.model import Scenario
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "DEFAULT_BUDGET_TRIALS",

@@ -49,6 +49,7 @@ passes) against (5.54).
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -64,14 +65,13 @@ from stereoplotter.accuracy.chapter5 import (
     standard_points,
 )
 from stereoplotter.instrument.kinematics import counters_from_homologous_points
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, Instrument
+from stereoplotter.instrument.virtual import HEIGHT_SCALE
 from stereoplotter.procedure import conventional as cv
 from stereoplotter.procedure import evaluation as ev
 from stereoplotter.procedure.evaluation import instrument_frame_m
-from stereoplotter.procedure.operator import Noise, Operator, OperatorModel
-from stereoplotter.procedure.setup_method import Run
+from stereoplotter.procedure.operator import OperatorModel
+from stereoplotter.procedure.run import build_run
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
-from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.procedure.trials import (
     DEFAULT_MEMORY_BUDGET_MB,
     chunk_trials_for,
@@ -89,8 +89,8 @@ from stereoplotter.verification.linear_mc import (
 )
 
 if TYPE_CHECKING:
-    from stereoplotter.instrument.spec import InstrumentSpec
     from stereoplotter.scenario.model import Scenario
+    from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "PROCEDURE_ROWS",
@@ -630,8 +630,6 @@ def procedure_mc(
     >>> 0.3 < r["coefficient"] < 3.0
     True
     """
-    import time
-
     t0 = time.perf_counter()
     _check_options(
         method,
@@ -776,27 +774,23 @@ def _relative_only(prep, first, trials):
     """C1, the calibration and C2 by (5.11) on trials ``first … first + trials − 1`` (None: one
     error-free trial); returns the run."""
 
-    stop = None if trials is None else first + trials
-    inst = Instrument(
-        prep.spec,
-        prep.sheet.focal_length_corrected_mm,
-        errors=prep.model,
-        injected=prep.model.draw_keyed(prep.seed, first, stop),
-        variant=prep.variant,
-        backend=prep.backend,
-        trials=trials,
-        ideal_mechanics=True,
-    )
-    noise = Noise(prep.seed, trials, None, first)
-    op = Operator(inst, prep.operator, noise, Transcript(enabled=False))
-    run = Run(op, prep.sheet, prep.scene)
+    # rigid screws whatever ``prep`` says: the experiment isolates the relative orientation;
+    # "book": no remedy between C1 and C2 (the run is not the simulated procedure)
+    run = build_run(prep, first, trials, transcript=False, ideal_mechanics=True, practice="book")
     cv.c1_interior(run)
     cal = cv.calibrate(run, cv.levelling_points(run))
     cv.c2_relative_by_equations(run, cal, passes=prep.operator.max_iterations)
     return run
 
 
-# long: an 18-line docstring and one experiment in its steps (C1, C2 by (5.11), plane removal).
+def _midpoint_grid(c: float, grid: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The midpoints of an nx × ny grid over x_п ∈ [−c, 0], y ∈ [−c, c], flattened. [mm]"""
+    nx, ny = grid
+    xs = -c + (np.arange(nx) + 0.5) * c / nx
+    ys = -c + (np.arange(ny) + 0.5) * 2 * c / ny
+    return tuple(v.ravel() for v in np.meshgrid(xs, ys, indexing="ij"))
+
+
 def relative_orientation_mc(
     scenario: Scenario,
     *,
@@ -826,8 +820,6 @@ def relative_orientation_mc(
         ``coefficient``, ``ci``, ``formula`` ((5.54) rigorous at the simulated a, c, p),
         ``unlevelled`` (RMS/σ_q without the plane removal), ``trials``, geometry, ``seconds``.
     """
-    import time
-
     t0 = time.perf_counter()
     sc = idealised_geometry(scenario) if ideal_geometry else scenario
     g = scenario_geometry(sc, spec)
@@ -847,10 +839,7 @@ def relative_orientation_mc(
     )
     cpts, xc, yc = _control_frame_points(sc, sheet, g)
     d0, d0c = (_dp(sc, sheet, run0.op.inst, q) for q in (pts, cpts))
-    nx, ny = grid
-    xs = -g["c"] + (np.arange(nx) + 0.5) * g["c"] / nx
-    ys = -g["c"] + (np.arange(ny) + 0.5) * 2 * g["c"] / ny
-    xg, yg = (v.ravel() for v in np.meshgrid(xs, ys, indexing="ij"))
+    xg, yg = _midpoint_grid(g["c"], grid)
     plane = levelling_design(xg, yg) @ np.linalg.pinv(levelling_design(xc, yc))
     ms = np.empty(int(trials))
     raw = np.empty(int(trials))

@@ -262,7 +262,7 @@ def start_procedure_mc(
     :class:`~stereoplotter.scenario.model.Scenario` (None for a slot skips it; None or empty: no
     procedure MC); the book's are the shipped ``pair60`` and ``pair80``
     (:func:`stereoplotter.io.book_setting.book_scenarios`). ``instrument`` is the loaded
-    :class:`~stereoplotter.instrument.spec.InstrumentSpec` (the book's SC-1), required when a
+    :class:`~stereoplotter.spec.instrument_spec.InstrumentSpec` (the book's SC-1), required when a
     slot is run. ``workers``: processes (the runs are independent; 1 runs them here).
 
     Returns

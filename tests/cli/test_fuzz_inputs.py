@@ -505,8 +505,8 @@ def _load(kind: str, path: Path) -> Any:
 
         return load_block(path)
     if kind == "instrument":
-        from stereoplotter.instrument.spec import format_instrument, instrument_to_dict
         from stereoplotter.io.instrument_file import load_instrument
+        from stereoplotter.spec.instrument_spec import format_instrument, instrument_to_dict
 
         spec = load_instrument(path)
         format_instrument(spec).encode("utf-8")

@@ -14,7 +14,7 @@ from typing import ClassVar
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.correction import (
+from stereoplotter.instrument.principles import (
     LensShift,
     MechanicalProjection,
     PlaneFollower,

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stereoplotter.geometry.instrument_settings import sequence_for, setting_values
+from stereoplotter.instrument.principles import sequence_for, setting_values
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.report.sheet import sheet_to_dict

@@ -7,15 +7,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.limits import (
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.setup.sheet import SetupRefusal, compute_setup_sheet
+from stereoplotter.spec.limits import (
     check_material_limits,
     check_model_to_photo_scale,
     check_photo_to_map_ratio,
 )
-from stereoplotter.instrument.spec import RangeRefusal, check_in_range
-from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.scenario_file import load_scenario
-from stereoplotter.setup.sheet import SetupRefusal, compute_setup_sheet
+from stereoplotter.spec.range_checks import RangeRefusal, check_in_range
 
 MOUNTAIN = Path(__file__).parents[2] / "stereoplotter" / "data" / "scenarios" / "mountain60.yaml"
 

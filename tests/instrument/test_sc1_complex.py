@@ -10,8 +10,8 @@ from stereoplotter.instrument.sc1_complex import (
     ErrorCorrectionUnit,
     SC1Options,
 )
-from stereoplotter.instrument.spec import RangeRefusal
 from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.spec.range_checks import RangeRefusal
 
 
 def test_options_off_by_default():

@@ -21,7 +21,6 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
-from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
 from stereoplotter.setup.block import (
     BlockResult,
     Refusal,
@@ -40,6 +39,8 @@ from stereoplotter.setup.equations import (
     projection_distance,
     transformation_coefficient,
 )
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.range_checks import RangeRefusal, check_in_range
 
 __all__ = ["per_pair_loop"]
 

@@ -20,8 +20,8 @@ import pytest
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure.conventional import CR1, CR2
-from stereoplotter.procedure.setup_method import REPEAT_POINTINGS
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
+from stereoplotter.procedure.steps import REPEAT_POINTINGS
 
 N = 400
 HEIGHTS = "C3: control heights"

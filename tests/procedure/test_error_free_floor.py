@@ -16,12 +16,12 @@ import re
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.correction import mechanism_for
 from stereoplotter.instrument.kinematics import unit_for_orientation
+from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.procedure.floor import mechanism_level
 from stereoplotter.procedure.operator import OperatorModel
-from stereoplotter.procedure.setup_method import mechanism_level
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
 from stereoplotter.scenario.model import ErrorSettings
 from stereoplotter.setup.records import SetupRefusal

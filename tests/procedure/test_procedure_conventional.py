@@ -10,7 +10,7 @@ from conftest import um
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import OperatorModel, simulate, simulate_per_trial
-from stereoplotter.procedure.conventional import overcorrection_factor
+from stereoplotter.procedure.relative_equations import overcorrection_factor
 
 SPEC = load_instrument("sc1")
 

@@ -20,7 +20,7 @@ from stereoplotter.procedure import (
     simulate,
     simulate_per_trial,
 )
-from stereoplotter.procedure.conventional import (
+from stereoplotter.procedure.relative_equations import (
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )

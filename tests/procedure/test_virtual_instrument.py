@@ -12,11 +12,11 @@ from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.error_model import error_model_from_spec
 from stereoplotter.instrument.kinematics import counters_from_photo
 from stereoplotter.instrument.mechanics.base import TravelRefusal
-from stereoplotter.instrument.spec import RangeRefusal
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.setup.sheet import compute_setup_sheet
+from stereoplotter.spec.range_checks import RangeRefusal
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -20,19 +20,19 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.instrument import (
-    InstrumentSpec,
-    RangeRefusal,
-    check_in_range,
-    format_instrument,
-    instrument_to_dict,
-)
 from stereoplotter.io.instrument_file import (
     instrument_from_mapping,
     list_instruments,
     load_instrument,
 )
 from stereoplotter.io.paths import data_dir
+from stereoplotter.spec import (
+    InstrumentSpec,
+    RangeRefusal,
+    check_in_range,
+    format_instrument,
+    instrument_to_dict,
+)
 
 NAMES = ("sc1", "spr3", "sd3")
 _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)

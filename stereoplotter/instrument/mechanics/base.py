@@ -33,7 +33,7 @@ from stereoplotter.instrument.mechanics.dead_band import G_MM_S2, half_play_mm, 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-    from stereoplotter.instrument.spec import InstrumentSpec
+    from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "G_MM_S2",

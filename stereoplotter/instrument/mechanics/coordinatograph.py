@@ -27,7 +27,7 @@ from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis, new_space
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-    from stereoplotter.instrument.spec import InstrumentSpec
+    from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["BRIDGE", "PEN_CARRIAGE", "Coordinatograph", "CoordinatographParams"]
 

@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from stereoplotter.instrument.mechanics.coordinatograph import Coordinatograph
-    from stereoplotter.instrument.spec import InstrumentSpec
+    from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "OperatorParams",

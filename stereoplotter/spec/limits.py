@@ -1,13 +1,14 @@
 """Documented limits of an instrument on the material it is given (issue 11, deliverable 3).
 
 A scenario outside a documented limit is refused like a mechanical stop, with one line naming the
-file, the key, the limit and its status (:class:`~stereoplotter.instrument.spec.RangeRefusal`).
+file, the key, the limit and its status (:class:`~stereoplotter.spec.range_checks.RangeRefusal`).
 Pure functions; units: m ground, mm photo.
 """
 
 from __future__ import annotations
 
-from stereoplotter.instrument.spec import InstrumentSpec, RangeRefusal, check_in_range
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+from stereoplotter.spec.range_checks import RangeRefusal, check_in_range
 
 __all__ = [
     "MAP_RATIO_KEY",

@@ -1,0 +1,124 @@
+"""The error-free floor of the setup-data method (decision D9, ``docs/procedure.md``): what the
+correction mechanism itself leaves at the sheet's own settings, and the refusal of a pair beyond
+it before any trial is run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from stereoplotter.instrument.kinematics import (
+    InstrumentSetting,
+    UnitMap,
+    rods_intersection,
+    unit_for_orientation,
+)
+from stereoplotter.procedure.operator import Scene
+from stereoplotter.procedure.records import ControlHeight
+from stereoplotter.setup.records import SetupRefusal
+from stereoplotter.setup.sheet import SetupSheet
+
+__all__ = ["control_heights_of", "mechanism_level", "refuse_beyond_mechanism"]
+
+
+def mechanism_level(
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
+) -> tuple[float, float]:
+    """What the correction mechanism itself leaves at the sheet's own settings (the floor).
+
+    The units at the sheet's α, ω, κ with its decentrations (``unit_for_orientation``), f_пр and
+    b = (b_x, b_y, b_z′) of the sheet, no error anywhere: the largest |q| at the six standard
+    points [mm, photo scale], and the largest control-height error relative to the first height
+    control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
+    setup-data method sets exactly these values and has no relative orientation or levelling.
+    ``mechanism``: the instrument's own correction mechanism
+    (:func:`~stereoplotter.instrument.principles.mechanism_for`); None: canonical unit.
+    """
+    f = sheet.focal_length_corrected_mm
+    units = [
+        UnitMap(
+            replace(
+                unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis),
+                mechanism=mechanism,
+            )
+        )
+        for p in sheet.photos
+    ]
+    bx, by, bz = sheet.base_mm
+    setting = InstrumentSetting(sheet.f_instrument_mm, bx, by, bz)
+
+    def reading(points_m):
+        pl, pr = scene.images(points_m)
+        return rods_intersection(units[0].rod_from_photo(pl), units[1].rod_from_photo(pr), setting)
+
+    q_max = float(np.max(np.abs(reading(scene.standard_points_m).y_parallax_mm)))
+    heights = np.array([h.ground_m for h in control_heights_of(sheet, scene)])
+    if len(heights) < 2:
+        return q_max, 0.0
+    depth = reading(heights).depth_mm
+    # deeper is lower: H_i = H_0 − (D_i − D_0)·M_в/1000 with the scale slipped at point 0
+    model_h = heights[0, 2] - (depth - depth[0]) * sheet.vertical_scale_denominator / 1000.0
+    return q_max, float(np.max(np.abs(model_h - heights[:, 2])))
+
+
+def refuse_beyond_mechanism(
+    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
+):
+    """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
+    already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
+    no operator can then build the model by the setup-data method on this instrument.
+
+    The message names the scenario file and the field that carries the pair beyond the
+    mechanism — the largest photo tilt, ``photos[i].exterior.alpha_deg`` or ``omega_deg`` — and
+    the §26 tolerances the mechanism level exceeds.
+    """
+    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis, mechanism)
+    tol_q = sheet.tolerances["residual_y_parallax_mm"]
+    tol_h = sheet.tolerances["control_height_m"]
+    if q_max <= tol_q and h_max <= tol_h:
+        return
+    sc = scene.scenario
+    tilts = [
+        (abs(getattr(p.exterior, axis)), i, axis)
+        for i, p in enumerate(sc.photos)
+        for axis in ("alpha", "omega")
+    ]
+    _, i, axis = max(tilts, key=lambda t: t[0])  # the first of equal tilts
+    found = np.degrees(getattr(sc.photos[i].exterior, axis))
+    films = [
+        f"photos[{j}].film_deformation_ppm = [{p.film_deformation_ppm[0]:g}, "
+        f"{p.film_deformation_ppm[1]:g}]"
+        for j, p in enumerate(sc.photos)
+        if any(p.film_deformation_ppm)
+    ]
+    film_note = (
+        "; the films' deformation enters this level too ("
+        + ", ".join(films)
+        + "): the SC complex's correction unit takes it out (--option correction_unit)"
+        if films
+        else ""
+    )
+    raise SetupRefusal(
+        f"{sc.source}: photos[{i}].exterior.{axis}_deg: expected a tilt the setup-data method "
+        f"on {sheet.instrument_title} can carry (§26: at the sheet's exact settings the "
+        f"correction mechanism must leave ≤ ¼ mark {tol_q * 1000:.1f} µm of y-parallax at the "
+        f"standard points and ≤ H/3000 {tol_h:.2f} m at the control heights), found "
+        f"{found:+.1f}° (the largest tilt of the pair): at f′ = "
+        f"{sheet.focal_length_corrected_mm:.0f} mm the mechanism leaves {q_max * 1000:.1f} µm "
+        f"and {h_max:.2f} m (instrument test, §6); the model needs relative orientation and "
+        f"levelling (--method conventional){film_note}"
+    )
+
+
+def control_heights_of(sheet: SetupSheet, scene: Scene) -> list[ControlHeight]:
+    """The sheet's height control points with their ground points (the scene's truth)."""
+    sc = scene.scenario
+    rows = []
+    for h in sheet.control_heights:
+        p = next(p for p in sc.points if p.id == h["id"])
+        rows.append(
+            ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
+        )
+    return rows

@@ -1,0 +1,217 @@
+"""The L-check of stages 1 and 2: the span L′ of fiducial marks 3, 4 measured on each photo
+against the sheet's L (6.5), corrected by ΔZ (6.9) and Δb_z (6.10), set as O′ = O + Δ (6.11),
+until |L − L′| ≤ 0.03/n_л for both photos.
+
+Units: mm on the instrument and photo, m on the height counter (ΔZ as shown).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.instrument.virtual import NOMINAL_ZERO, Side
+from stereoplotter.procedure.run import Run
+from stereoplotter.setup.equations import base_z_correction, height_correction
+
+__all__ = ["fiducial_mm", "span_loop"]
+
+_SIDE: dict[Side, str] = {"left": "л", "right": "п"}
+
+
+def fiducial_mm(run: Run, side: str, mark: str) -> NDArray[np.float64]:
+    """The true position of fiducial ``mark`` on the ``side`` photo. [mm]"""
+    return run.scene.fiducials_mm[side][int(mark) - 1]
+
+
+def _measure_span(run: Run, side: str, key: str, active, pointings: int = 1) -> NDArray[np.float64]:
+    """L′: the mark on fiducial 3 then 4 of ``side``, Y read at each (the mean of
+    ``pointings`` pointings and readings per mark, remedy R1)."""
+    op = run.op
+    ys = []
+    for mark in ("3", "4"):
+        y = 0.0
+        for j in range(pointings):
+            k = f"{key}/{side}/{mark}" + (f"/p{j}" if j else "")
+            op.mark_on(side, fiducial_mm(run, side, mark), k, active)
+            y = y + op.read("Y", k)
+        ys.append(y / pointings)
+    return ys[0] - ys[1]
+
+
+def _spans(run: Run, units_at_zero: bool) -> tuple[float, float]:
+    """The L to compare with: the sheet's L_л, L_п (6.5), or with the units at zero
+    n·(y₃ − y₄) of the measured marks (decision D5, ``kinematics.md`` §4.3: the literal (6.5)
+    would bias n by tan²ω(1 + l²/f′²) and can drive D beyond D_max).
+
+    The D5 span is a comparison value, not a reading set on a scale; the sheet does not print
+    it, so it is formed here from the sheet's measured marks and n.
+    """
+    if not units_at_zero:
+        return run.readings["L_л"].value, run.readings["L_п"].value
+    out = []
+    for photo in run.sheet.photos:
+        m = photo.marks_measured_mm
+        out.append(photo.n * (m["3"][1] - m["4"][1]))
+    return out[0], out[1]
+
+
+def span_loop(
+    run: Run,
+    stage: str,
+    key: str,
+    units_at_zero: bool = False,
+    active=None,
+    pointings: int = 1,
+    remedy: str = "",
+) -> tuple[NDArray, NDArray, NDArray]:
+    """The L-check loop (6.9)–(6.11) until |L − L′| ≤ 0.03/n_л for both photos."""
+    op, sheet = run.op, run.sheet
+    tol = sheet.tolerances["mark_span_mm"]
+    span_l, span_r = _spans(run, units_at_zero)
+    active = op.all() if active is None else active.copy()
+    its = np.zeros(np.shape(active), int)
+    dl = dr = op.v(np.nan)
+    for it in range(1, op.model.max_iterations + 1):
+        its = np.where(active, it, its)
+        k = f"{key}/{it}"
+        meas_l = _measure_span(run, "left", k, active, pointings)
+        meas_r = _measure_span(run, "right", k, active, pointings)
+        dl = np.where(active, span_l - meas_l, dl)
+        dr = np.where(active, span_r - meas_r, dr)
+        ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
+        for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
+            op.log.add(
+                stage,
+                f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} "
+                f"= {span:.3f} mm",
+                "Y",
+                reading=meas,
+                residual=d,
+                tolerance=tol,
+                passed=np.abs(d) <= tol,
+                iteration=it,
+                equation="(6.5)" if not units_at_zero else "(6.5), decision D5",
+                remedy=remedy,
+                when=active if remedy else None,
+            )
+        active = active & ~ok
+        if not np.any(active):
+            break
+        _correct_span(run, stage, k, it, active, (dl, dr), (span_l, span_r), remedy)
+    ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
+    return its, ok, np.maximum(np.abs(dl), np.abs(dr))
+
+
+def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy: str, active):
+    """Log the ΔZ (6.9) setting; the word follows the sign: the Z counter counts the projection
+    distance D, so ΔZ > 0 (a larger D) lowers the carriage and ΔZ < 0 raises it. [m, mm]"""
+    direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
+    op.log.add(
+        stage,
+        f"ΔZ = {dz_shown:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
+        "Z",
+        before=depth,
+        after=depth + dz_mm,
+        reading=depth + dz_mm,
+        iteration=it,
+        equation="(6.9), (6.11)",
+        remedy=remedy,
+        when=active if remedy else None,
+    )
+
+
+def _past_bottom_stop(op, stage: str, k: str, it: int, active, depth, dz_mm, remedy: str):
+    """Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a correction
+    that asks for a deeper carriage cannot be set there. The operator reaches the same
+    n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
+
+    Returns the trials past the stop, f′_пр/f_пр of this correction (1 elsewhere) and ΔZ left
+    to set (0 past the stop). [—, mm]
+    """
+    f_ratio = op.v(1.0)
+    stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
+    beyond = active & (depth + dz_mm > stop)
+    if np.any(beyond):
+        f_set = op.commanded["f_instrument"]
+        f_new = f_set * depth / (depth + dz_mm)
+        f_ratio = np.where(beyond, depth / (depth + dz_mm), 1.0)
+        op.set("f_instrument", f_new, f"{k}/setf", beyond)
+        op.log.add(
+            stage,
+            "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
+            "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
+            "f_instrument",
+            before=f_set,
+            after=f_new,
+            reading=f_new,
+            iteration=it,
+            equation="(6.3), (6.9)",
+            remedy=remedy,
+            when=beyond if remedy else None,
+        )
+        dz_mm = np.where(beyond, 0.0, dz_mm)
+    return beyond, f_ratio, dz_mm
+
+
+def _correct_span(
+    run: Run, stage: str, k: str, it: int, active, diffs, spans, remedy: str = ""
+) -> None:
+    """One correction of the L-check: ΔZ (6.9) from the left photo (or f_пр at the bottom
+    stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11).
+
+    Decision D9 (``docs/procedure.md``, "The error-free floor"): (6.9) and (6.10) are applied
+    in their ratio form, which is exact for the span of a photo (L′ = n·(y₃ − y₄), n = D/f_пр):
+    ΔD = D·ΔL/L′ with the *measured* L′ in the denominator, and for the right photo its own
+    projection distance D_п = D + b_z, less the change ΔZ (or the f_пр change) that the left
+    correction makes to it. The printed first-order form D·ΔL_п/L_п under-corrects by the
+    factor L′_п/L_п ≈ D/(D + b_z′): with b_z at zero in stage 1 it leaves b_z′²/(D + b_z′) —
+    8.4 µm of b_z for pair60 (b_z′ = 1.25 mm), which the loop accepts (0.03/n_л mm of L is
+    11 µm of b_z) and which shows as 6 µm of y-parallax at the standard points.
+    """
+    op, sheet = run.op, run.sheet
+    dl, dr = diffs
+    span_l, span_r = spans
+    meas_l, meas_r = span_l - dl, span_r - dr  # L′ as measured
+    sense = sheet.options.bz_scale_sense
+    depth = op.read("Z", f"{k}/Z")
+    dz_m = height_correction(depth, dl, meas_l, sheet.vertical_scale_denominator)
+    dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
+    beyond, f_ratio, dz_mm = _past_bottom_stop(op, stage, k, it, active, depth, dz_mm, remedy)
+    op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
+    shown = op.log.shown if np.ndim(beyond) else 0
+    if not np.ravel(beyond)[shown]:
+        _log_delta_z(
+            op,
+            stage,
+            float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]),
+            depth,
+            dz_mm,
+            it,
+            remedy,
+            active,
+        )
+    bz = op.read("bz", f"{k}/bz")
+    # D_п as the operator knows it: D + b_z from the b_z scale's nominal place of zero; scaled
+    # by f_пр/f′_пр where f_пр was changed, less the ΔZ just set (both move the right photo)
+    depth_r = (depth + sense * (bz - NOMINAL_ZERO["bz"])) * f_ratio
+    dbz = (
+        depth_r
+        + base_z_correction(depth_r, dr, meas_r)
+        - (depth + dz_mm)
+        - (sense * (bz - NOMINAL_ZERO["bz"]))
+    )
+    op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
+    op.log.add(
+        stage,
+        "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): "
+        "O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
+        "bz",
+        before=bz,
+        after=bz + sense * dbz,
+        reading=bz + sense * dbz,
+        iteration=it,
+        equation="(6.10), (6.11)",
+        remedy=remedy,
+        when=active if remedy else None,
+    )

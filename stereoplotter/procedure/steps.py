@@ -1,0 +1,222 @@
+"""Procedure steps both methods share: the interior settings, judging the six standard points,
+fusing on a control point and reading its counters, reading and slipping the height scale,
+scaling by two plan control points, and the fixed-order sums of the levelling fit.
+
+The setup-data method (:mod:`~stereoplotter.procedure.setup_method`) and the conventional method
+(:mod:`~stereoplotter.procedure.conventional`) compose these; neither imports the other. Every
+step takes the :class:`~stereoplotter.procedure.run.Run`, the noise key of its judgments (the
+keyed streams of :mod:`stereoplotter.random_streams`: the same key gives the same draw in either
+method) and the ``active`` trials (None: all). What a step writes in the transcript is the
+caller's wording where the methods word it differently.
+
+Units: mm on the instrument, m on the ground (the height scale reads m).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.procedure.run import Run
+
+__all__ = [
+    "REPEAT_POINTINGS",
+    "control_point_m",
+    "fixed_order_sum",
+    "fuse_and_read",
+    "height_mean",
+    "interior_orientation",
+    "judge_standard_points",
+    "scale_by_two_points",
+    "scale_pair",
+    "slip_height_scale_on_mean",
+    "zero_base_y",
+]
+
+#: Remedy R1 (stage 1, "otherwise the setting is repeated"): pointings per fiducial mark,
+#: averaged, when the L-check loop has ended failed (a choice: 4 halves the pointing σ).
+REPEAT_POINTINGS = 4
+
+
+def interior_orientation(run: Run, stage: str) -> None:
+    """Interior settings common to stage 1 and the conventional method's C1: the height-counter
+    gear M_в, f_пр, the cassettes parallel to the axes, the correction mechanisms and the
+    decentrations at their zero places (OCR L3755–3759)."""
+    op, sheet = run.op, run.sheet
+    log = op.log
+    op.inst.gear_height_counter(sheet.vertical_scale_denominator)
+    f_instrument = run.target("f_пр")
+    op.set("f_instrument", f_instrument, f"{stage}/f")
+    log.add(
+        stage,
+        "set the instrument principal distance f_пр",
+        "f_instrument",
+        reading=f_instrument,
+        equation="item 1",
+    )
+    for side in ("left", "right"):
+        op.drive(f"kappa_{side}", 0.0)
+        log.add(
+            stage,
+            f"turn the {side} cassette: fiducial lines parallel to the axes",
+            f"kappa_{side}",
+            reading=0.0,
+            unit="rad",
+            equation="stage 1",
+        )
+        for axis in ("alpha", "omega"):
+            op.drive(f"k_{axis}_{side}", 0.0)
+        for d in ("dx", "dy"):
+            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], f"{stage}/{d}_{side}")
+    log.add(
+        stage,
+        "correction mechanisms and decentrations to their zero places",
+        "",
+        equation="stage 1",
+    )
+
+
+def zero_base_y(run: Run, stage: str) -> NDArray[np.float64]:
+    """MO_by (stage 1 and C1): the left mark on the left cassette centre, then b_y turned until
+    the right mark is on the right cassette centre's line (σ_mono across it); recorded in
+    ``run.zero``. Returns MO_by. [mm]"""
+    op = run.op
+    key = f"{stage}/MOby"
+    op.mark_on("left", np.zeros(2), f"{key}/left")
+    right_map = op.unit_map("right")  # kinematics.rod_from_photo with the unit's cos κ kept
+    car = {c: op.physical(c) for c in ("X", "Y", "Z")}
+    e = op.noise.normal(f"mono/{key}/right", op.model.monocular_sigma_mm)
+    eta = right_map.rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
+    n_r = (car["Z"] + op.physical("bz")) / op.inst.setting.f_instrument_mm
+    op.drive("by", car["Y"] - n_r * eta)
+    mo_by = op.read("by", key)
+    run.zero["MO_by"] = mo_by
+    op.log.add(
+        stage,
+        "MO_by: right mark on the right cassette centre (by turning b_y)",
+        "by",
+        reading=mo_by,
+        judgment_error=e,
+        equation="stage 1",
+    )
+    return mo_by
+
+
+def control_point_m(run: Run, pid: str) -> NDArray[np.float64]:
+    """The scenario's control point ``pid`` in the local frame (X, Y, Z). [m]"""
+    sc = run.scene.scenario
+    return np.asarray(next(p for p in sc.points if p.id == pid).local_m, float)
+
+
+def scale_pair(run: Run, ties: str = "first") -> tuple[str, str]:
+    """The two plan control points of the sheet farthest apart (the scale is taken there);
+    the sheet's height control points where it has no plan control.
+
+    ``ties``: which of equally distant pairs (the two diagonals of a rectangle of control) —
+    "first" in the sheet's order of the points (the setup-data method), "last" the
+    lexicographically largest ids (the conventional method; kept so that its figures do not
+    change). The book names no rule.
+    """
+    ids = run.sheet.similarity_point_ids or tuple(h["id"] for h in run.sheet.control_heights)
+    pts = {i: control_point_m(run, i) for i in ids}
+    pairs = [(a, b) for k, a in enumerate(ids) for b in ids[k + 1 :]]
+    if ties == "last":
+        best = max((float(np.hypot(*(pts[a][:2] - pts[b][:2]))), a, b) for a, b in pairs)
+        return best[1], best[2]
+    return max(pairs, key=lambda ab: float(np.hypot(*(pts[ab[0]][:2] - pts[ab[1]][:2]))))
+
+
+def fuse_and_read(run: Run, p, key: str, active, read: tuple[str, ...]) -> dict[str, NDArray]:
+    """Fuse the floating mark on the ground point ``p`` [m] and read the counters ``read``."""
+    op = run.op
+    img = run.scene.images(np.asarray(p, float)[None, :])
+    op.fuse(p, (img[0][0], img[1][0]), key, active)
+    return {c: op.read(c, f"{key}/{c}") for c in read}
+
+
+def height_mean(run: Run, p, key: str, active, pointings: int) -> NDArray[np.float64]:
+    """The height scale read after ``pointings`` fusings on ``p``, averaged (the first fusing
+    has the single reading's noise key, so ``pointings=1`` is the book's single reading). [m]"""
+    total = None
+    for j in range(pointings):
+        k = key + (f"/p{j}" if j else "")
+        read = fuse_and_read(run, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
+        total = read if total is None else total + read
+    return total / pointings
+
+
+def slip_height_scale_on_mean(run: Run, p0, key: str, active, pointings: int) -> None:
+    """Fuse on the control point ``p0`` [m] ``pointings`` times and slip the height scale so
+    that the mean reading shows its known height; trials not ``active`` keep their scale."""
+    op = run.op
+    seen0 = height_mean(run, p0, key, active, pointings)
+    exact = op.v(op.inst.read(HEIGHT_SCALE, exact=True))
+    act = op.all() if active is None else active
+    op.inst.slip_height_scale(np.where(act, exact + (p0[2] - seen0), exact))
+
+
+def scale_by_two_points(
+    run: Run, a, b, distance_mm: float, key: str, active
+) -> tuple[NDArray, NDArray, NDArray]:
+    """Scaling: fuse on the ground points ``a``, ``b`` [m], compare the X, Y counters' distance
+    with ``distance_mm`` (the model distance the scale asks for) and turn b_x in proportion,
+    O′_bx = MO_bx + b_x·ratio. Returns (b_x read before, b_x set, the counters' distance). [mm]
+    """
+    op = run.op
+    ra = fuse_and_read(run, a[1], f"{key}/scale/{a[0]}", active, ("X", "Y"))
+    rb = fuse_and_read(run, b[1], f"{key}/scale/{b[0]}", active, ("X", "Y"))
+    d_model = np.hypot(ra["X"] - rb["X"], ra["Y"] - rb["Y"])
+    with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
+        ratio = np.where(active, distance_mm / d_model, 1.0)
+    bx = op.read("bx", f"{key}/bx")
+    new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio  # MO_bx + b_x·ratio
+    op.set("bx", new, f"{key}/setbx", active)
+    return bx, new, d_model
+
+
+def judge_standard_points(
+    run: Run,
+    stage: str,
+    key: str,
+    active=None,
+    *,
+    text: str = "residual y-parallax at standard point {i}",
+    remedy: str = "",
+    iteration: int = 1,
+) -> list[NDArray[np.float64]]:
+    """Fuse on each of the six standard points and judge its y-parallax (σ_q), logging each
+    against ¼ mark (``text`` with ``{i}`` the point's number). [mm], one array per point."""
+    op = run.op
+    tol = run.sheet.tolerances["residual_y_parallax_mm"]
+    pts = run.scene.standard_points_m
+    imgs = run.scene.images(pts)
+    seen = []
+    for i in range(6):
+        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
+        seen.append(q)
+        op.log.add(
+            stage,
+            text.format(i=i + 1),
+            "",
+            residual=q,
+            true=q_true,
+            judgment_error=q - q_true,
+            tolerance=tol,
+            passed=np.abs(q) <= tol,
+            iteration=iteration,
+            equation="≤ ¼ mark",
+            remedy=remedy,
+            when=active if remedy else None,
+        )
+    return seen
+
+
+def fixed_order_sum(values: Iterable) -> NDArray[np.float64]:
+    """A sum over points in a fixed order (a vectorised run and a per-trial loop agree)."""
+    total = None
+    for v in values:
+        total = v if total is None else total + v
+    return total

@@ -1,0 +1,88 @@
+"""One run assembler (issue 23): every caller builds its instrument, operator and Run through
+``stereoplotter.procedure.run``, so what one caller passes (the SC complex's options, the
+back-end, the mechanics) cannot drift from what another passes."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+import stereoplotter
+from stereoplotter.instrument.sc1_complex import SC1Options
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.procedure.run import build_instrument, build_run
+from stereoplotter.procedure.simulate import prepare_run
+
+PACKAGE = Path(stereoplotter.__file__).parent
+ASSEMBLER = PACKAGE / "procedure" / "run.py"
+
+#: The names whose call builds a run's parts: outside the assembler, only the instrument's own
+#: package may call them (a subclass calling its parent, a copy of an instrument).
+BUILDERS = {"Run", "Instrument", "RecordingInstrument", "instrument_cls"}
+
+#: The callers the issue names, and the assembler's function each must call.
+CALLERS = {
+    "procedure/simulate.py": "build_run",
+    "verification/procedure_mc.py": "build_run",
+    "trainer/grading.py": "build_run",
+    "trainer/operator_steps.py": "build_run",
+}
+
+
+def _called_names(path: Path) -> list[tuple[str, int]]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            f = node.func
+            name = (
+                f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
+            )
+            out.append((name, node.lineno))
+    return out
+
+
+def test_no_module_but_the_assembler_builds_a_run_or_an_instrument():
+    offenders = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE).as_posix()
+        if path == ASSEMBLER or rel.startswith("instrument/"):
+            continue
+        for name, line in _called_names(path):
+            if name in BUILDERS:
+                offenders.append(f"{rel}:{line}: {name}(…)")
+    assert offenders == []
+
+
+@pytest.mark.parametrize("rel, function", sorted(CALLERS.items()))
+def test_each_caller_goes_through_the_assembler(rel, function):
+    assert function in {name for name, _ in _called_names(PACKAGE / rel)}
+
+
+def test_budget_goes_through_simulate():
+    """The error budget runs its designed trials by ``run_trials_chunk`` (which calls
+    ``build_run``), never by an assembly of its own."""
+    names = {name for name, _ in _called_names(PACKAGE / "verification" / "budget.py")}
+    assert {"prepare_run", "run_trials_chunk"} <= names
+
+
+@pytest.fixture(scope="module")
+def prep_with_servo():
+    scenario = load_scenario("scenarios/pair60.yaml")
+    spec = load_instrument("sc1")
+    return prepare_run(scenario, spec, options=SC1Options(automatic_coordinatograph=True), seed=3)
+
+
+def test_the_options_reach_every_instrument(prep_with_servo):
+    """Before the assembler only ``simulate`` passed ``options=``; the trainer's and the
+    verification's instruments had the automatic coordinatograph off whatever the run said."""
+    prep = prep_with_servo
+    assert build_instrument(prep).options.automatic_coordinatograph
+    run = build_run(prep, 0, 4, transcript=True)
+    assert run.op.inst.options.automatic_coordinatograph
+    assert run.op.inst.trials == 4
+    assert "automatic coordinatograph" in run.op.log.records[0].step
+    assert run.practice == prep.practice
