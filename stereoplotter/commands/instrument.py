@@ -49,10 +49,10 @@ def add_arguments(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     # imported here: the CLI loads no library module until a command runs (it starts fast)
-    from stereoplotter.spec.instrument_spec import format_instrument, instrument_to_dict
     from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.procedure.selftest import format_selftest, run_kinematic_selftest
     from stereoplotter.report.plain_data import json_text
+    from stereoplotter.spec.instrument_spec import format_instrument, instrument_to_dict
 
     spec = load_instrument(args.name)
     if args.instrument_command == "test":

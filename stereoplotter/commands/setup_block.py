@@ -17,12 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.io.atomic_write import write_files
 from stereoplotter.io.block_file import load_block
 from stereoplotter.report.block import block_files, model_sheet
 from stereoplotter.report.plain_data import json_text
 from stereoplotter.setup.block import BlockResult, compute_block
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["run", "run_block", "write_block"]
 

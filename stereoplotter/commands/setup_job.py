@@ -16,7 +16,6 @@ import sys
 from pathlib import Path
 
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.io.atomic_write import write_files
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import Job, MeasuredPair, load_job, measured_pair
@@ -24,6 +23,7 @@ from stereoplotter.report.job import JobResult, PairResult, job_files, pair_dict
 from stereoplotter.report.plain_data import json_text
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["compute_job", "run", "run_job", "write_job"]
 

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.scenario.model import Scenario
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["BOOK_INSTRUMENT", "BOOK_SCENARIOS", "book_instrument", "book_scenarios"]
 
