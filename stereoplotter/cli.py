@@ -26,6 +26,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from stereoplotter import __version__
+from stereoplotter.commands import study as study_command
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.io.job_file import is_job_file
 from stereoplotter.io.paths import (
@@ -1115,6 +1116,7 @@ def _parser() -> argparse.ArgumentParser:
         help="port (default: 0, a free port chosen by the system; the address is printed)",
     )
     p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
+    study_command.add_arguments(sub)
     return parser
 
 
@@ -1342,6 +1344,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _grade(args)
         if args.command == "trainer":
             return _trainer(args)
+        if args.command == "study":
+            return args.func(args)
     except StereoplotterError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
