@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import argparse
 import copy
+import functools
 import sys
+from contextlib import nullcontext
 from typing import Any
 
 __all__ = ["add_arguments", "run_report", "run_study_command"]
@@ -94,32 +96,66 @@ def _value(text: str) -> Any:
         return text.strip()
 
 
-def run_study_command(args: argparse.Namespace) -> int:
-    """``study run``: the cells not yet in the store, serially or on Dask."""
-    # Imported here: dask, xarray and zarr (the extra `study`) load in seconds; `--help` must not.
-    from stereoplotter.io.study_file import load_study, study_fingerprint, study_from_mapping
+def run_into_store(
+    data: dict[str, Any],
+    source: str,
+    output: str,
+    client: Any = None,
+    bar: Any = None,
+    progress: Any = None,
+) -> tuple[int, int]:
+    """Run the study document ``data`` into the store ``output`` (created or resumed), serially
+    (``client`` None) or on a Dask client. ``bar(total)``: a context manager giving the
+    progress callback (``stereoplotter.progress.progress_bar``); ``progress(n)``: another
+    callback (tests). Returns (cells of the study, cells run now)."""
+    # Imported here: xarray and zarr (the extra `study`) load in seconds; `--help` must not.
+    from stereoplotter.io.study_file import study_fingerprint, study_from_mapping
     from stereoplotter.io.study_store import open_store
-    from stereoplotter.progress import progress_bar
     from stereoplotter.study.results import empty_dataset
-    from stereoplotter.study.runner import local_client, run_study, study_checks, study_terms
+    from stereoplotter.study.runner import run_study, study_checks, study_terms
 
-    _, data = load_study(args.study)
-    data = reduced(data, args)
-    design = study_from_mapping(data, args.study)
+    design = study_from_mapping(data, source)
     cells = design.cells()
     checks = study_checks(design, cells) if "checks" in design.measures else ()
     terms = study_terms(design) if "budget" in design.measures else ()
-    store = open_store(
-        args.output, empty_dataset(design, cells, checks, terms), study_fingerprint(data), data
-    )
+    empty = empty_dataset(design, cells, checks, terms)
+    store = open_store(output, empty, study_fingerprint(data), data)
     done = store.done()
-    todo = [i for i in range(len(cells)) if i not in done]
-    tasks = sum(len(design.tasks(i)) for i in todo)
+    tasks = sum(len(design.tasks(i)) for i in range(len(cells)) if i not in done)
     print(
-        f"study {design.name}: {len(cells)} cells ({len(done)} done), {tasks} tasks, "
+        f"study {design.name}: {len(cells)} cells ({len(done)} done), {tasks} tasks to run, "
         f"{design.trials} trials per cell",
         file=sys.stderr,
     )
+    with bar(tasks) if bar else nullcontext(lambda n: None) as advance:
+
+        def both(n: int) -> None:
+            advance(n)
+            if progress is not None:
+                progress(n)
+
+        ran = run_study(
+            design,
+            cells,
+            store.write_cell,
+            checks=checks,
+            terms=terms,
+            done=done,
+            client=client,
+            progress=both,
+        )
+    return len(cells), ran
+
+
+def run_study_command(args: argparse.Namespace) -> int:
+    """``study run``: the cells not yet in the store, serially or on Dask."""
+    # Imported here: dask.distributed (the extra `study`) loads in seconds; `--help` must not.
+    from stereoplotter.io.study_file import load_study
+    from stereoplotter.progress import progress_bar
+    from stereoplotter.study.runner import local_client
+
+    _, data = load_study(args.study)
+    data = reduced(data, args)
     client = None
     try:
         if args.scheduler:
@@ -130,24 +166,15 @@ def run_study_command(args: argparse.Namespace) -> int:
             client = local_client(args.workers)
         if client is not None and client.dashboard_link:
             print(f"Dask dashboard: {client.dashboard_link}", file=sys.stderr)
-        with progress_bar(tasks, f"study {design.name}", unit="task") as advance:
-            run_study(
-                design,
-                cells,
-                store.write_cell,
-                checks=checks,
-                terms=terms,
-                done=done,
-                client=client,
-                progress=advance,
-            )
+        bar = functools.partial(progress_bar, description="study", unit="task")
+        cells, ran = run_into_store(data, args.study, args.output, client, bar)
     finally:
         if client is not None:
-            cluster = client.cluster if not args.scheduler else None
+            cluster = None if args.scheduler else client.cluster
             client.close()
             if cluster is not None:
                 cluster.close()
-    print(f"study {design.name}: {len(cells)} cells in {args.output}", file=sys.stderr)
+    print(f"study: {ran} of {cells} cells run now; results in {args.output}", file=sys.stderr)
     return 0
 
 

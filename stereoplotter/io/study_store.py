@@ -74,7 +74,8 @@ def open_store(
         return StudyStore(target)
     ds = empty.copy()
     ds.attrs.update(
-        study_sha256=fingerprint, study_file=json.dumps(study, ensure_ascii=False, default=str)
+        study_sha256=fingerprint,
+        study_file=json.dumps(study, ensure_ascii=False, sort_keys=True, default=str),
     )
     encoding = {
         name: {"chunks": (min(CELLS_PER_CHUNK, ds.sizes["cell"]), *ds[name].shape[1:])}
