@@ -18,7 +18,7 @@ import os
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import Discriminator, Field, Tag, model_validator
+from pydantic import Discriminator, Field, Tag, create_model, model_validator
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.io.instrument_file import load_instrument
@@ -70,23 +70,25 @@ def _num(name: str) -> Any:
     return number(AXES[name].unit, low, high, low_open=low_open, description=AXES[name].meaning)
 
 
+def _ordered(self: Any) -> Any:
+    if not self.from_ < self.to:
+        raise _fail(f"a value above from = {self.from_:g}", self.to, at=("to",))
+    return self
+
+
 def _range_model(name: str) -> type[FileModel]:
+    """The model of a range of axis ``name`` (named ``Range_<axis>`` in the JSON Schema)."""
     value = _num(name)
-
-    class Range(FileModel):
-        __doc__ = f"A range of {name}: `steps` values from `from` to `to` (sampled with `sample`)."
-        from_: value = Field(alias="from")  # type: ignore[valid-type]
-        to: value  # type: ignore[valid-type]
-        steps: integer(2, 100_000, "values on a grid (ignored when sampled)") | None = None  # type: ignore[valid-type]
-
-        @model_validator(mode="after")
-        def _ordered(self) -> Range:
-            if not self.from_ < self.to:
-                raise _fail(f"a value above from = {self.from_:g}", self.to, at=("to",))
-            return self
-
-    Range.__name__ = Range.__qualname__ = f"Range_{name}"
-    return Range
+    steps = integer(2, 100_000, "values on a grid (ignored when sampled)")
+    return create_model(
+        f"Range_{name}",
+        __base__=FileModel,
+        __doc__=f"A range of {name}: `steps` values from `from` to `to` (sampled with `sample`).",
+        __validators__={"ordered": model_validator(mode="after")(_ordered)},
+        from_=(value, Field(alias="from")),
+        to=(value, ...),
+        steps=(steps | None, None),
+    )
 
 
 def _kind(v: Any) -> str:
@@ -236,7 +238,11 @@ def shipped_studies() -> list[Path]:
 
 def study_from_mapping(data: dict[str, Any], source: str = "<study>") -> StudyDesign:
     """Validate a parsed study document, load its scenario and instruments."""
-    doc = validate(StudyFile, data, source)
+    try:
+        doc = validate(StudyFile, data, source)
+    except ConfigError as exc:  # an axis is a tagged union: drop the tag from the field path
+        field = exc.field.replace(".list[", "[").replace(".range.", ".")
+        raise ConfigError(exc.source, field, exc.expected, exc.found, exc.hint) from None
     axes = _axes(doc, source)
     names = {a.name: a for a in axes}
     keys = list(names["instrument"].values) if "instrument" in names else [doc.instrument]
