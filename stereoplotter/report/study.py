@@ -53,6 +53,11 @@ def _axes(grid: xr.Dataset) -> tuple[list[str], list[str]]:
     return numeric, [d for d in dims if d not in numeric]
 
 
+def _varied(grid: xr.Dataset, numeric: list[str]) -> list[str]:
+    """The numeric axes with more than one value (the ones worth a line plot)."""
+    return [a for a in numeric if grid.sizes[a] > 1]
+
+
 def _label(axis: str) -> str:
     unit = AXES[axis].unit
     return f"{axis} [{unit}]" if unit and unit not in ("—", "") else axis
@@ -114,7 +119,7 @@ def _ratio_figures(grid: xr.Dataset, s: _Slicer, numeric: list[str]) -> dict[str
                 vmax=1.3,
                 bands=BANDS,
             )
-    for axis in numeric:
+    for axis in _varied(grid, numeric):
         others = {a: grid[a].values[0] for a in numeric if a != axis}
         panels = []
         for row in grid.row.values:
@@ -170,8 +175,15 @@ def _other_figures(grid: xr.Dataset, s: _Slicer) -> dict[str, Any]:
         sub.fixed = s.fixed
         panels = sub.panels(ratio, "height RMS, setup data / conventional")
         if panels:
+            top = max(2.0, float(np.nanmax([np.nanmax(p[3]) for p in panels])))
             figs["methods.png"] = plot_maps(
-                panels[:MAX_PANELS], xl, yl, label="setup data / conventional", vmin=0.5, vmax=1.5
+                panels[:MAX_PANELS],
+                xl,
+                yl,
+                label="setup data / conventional",
+                vmin=0.0,
+                vmax=top,
+                cmap="magma_r",
             )
     if "budget_delta_ms" in grid:
         terms = [str(t) for t in grid.term.values]
