@@ -4,7 +4,7 @@ Plain data, no files: ``io.study_file`` validates a study file and builds a :cla
 
 An axis is either a list of values or a range. Without a ``sample`` every ranged axis is
 ``steps`` evenly spaced values and the cells are the Cartesian product of all axes, in the order
-the axes are given (the last axis varies fastest). With a ``sample`` the ranged axes are sampled
+of :data:`AXES` (the last axis varies fastest; ``io.study_file`` sorts them so). With a ``sample`` the ranged axes are sampled
 jointly by a scrambled Sobol sequence or a Latin hypercube (``scipy.stats.qmc``, seeded) and the
 sample is crossed with the listed axes.
 
