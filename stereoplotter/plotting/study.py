@@ -62,7 +62,8 @@ def plot_maps(
         z = np.asarray(z, float)
         image = ax.imshow(z, origin="lower", cmap=cmap, vmin=vmin, vmax=vmax, aspect="auto")
         _ticks(ax, x, y)
-        ax.set(title=title, xlabel=xlabel, ylabel=ylabel)
+        ax.set(xlabel=xlabel, ylabel=ylabel)
+        ax.set_title(title, fontsize=8)
         for (j, i), v in np.ndenumerate(z):
             if not np.isfinite(v):
                 continue
@@ -100,7 +101,8 @@ def plot_lines(
             ax.errorbar(
                 x, v, yerr=2 * np.asarray(se, float), marker="o", ms=3, capsize=2, label=name
             )
-        ax.set(title=title, xlabel=xlabel, ylabel=ylabel)
+        ax.set(xlabel=xlabel, ylabel=ylabel)
+        ax.set_title(title, fontsize=8)
         if lines:
             ax.legend(fontsize=7)
     return fig
@@ -122,10 +124,12 @@ def plot_categories(
         z = np.asarray(z, float)
         ax.imshow(np.ma.masked_less(z, 0), origin="lower", cmap=cmap, norm=norm, aspect="auto")
         _ticks(ax, x, y)
-        ax.set(title=title, xlabel=xlabel, ylabel=ylabel)
+        ax.set(xlabel=xlabel, ylabel=ylabel)
+        ax.set_title(title, fontsize=8)
         for (j, i), v in np.ndenumerate(z):
             if v >= 0:
-                short = names[int(v)].split(".")[-1].replace("_", " ")
+                short = names[int(v)].removeprefix("operator.").replace("_", " ")
+                short = short.replace(".", ": ")
                 ax.text(i, j, short, ha="center", va="center", fontsize=6, wrap=True)
     return fig
 
@@ -145,7 +149,8 @@ def plot_scatter(
     art = None
     for ax, (title, x, y, c) in zip(axes, panels, strict=True):
         art = ax.scatter(x, y, c=c, cmap=cmap, vmin=vmin, vmax=vmax, s=18, edgecolor="k", lw=0.3)
-        ax.set(title=title, xlabel=xlabel, ylabel=ylabel)
+        ax.set(xlabel=xlabel, ylabel=ylabel)
+        ax.set_title(title, fontsize=8)
     if art is not None:
         fig.colorbar(art, ax=axes, label=label, shrink=0.8)
     return fig

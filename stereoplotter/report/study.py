@@ -190,7 +190,7 @@ def _other_figures(grid: xr.Dataset, s: _Slicer) -> dict[str, Any]:
         panels = []
         for m in grid.budget_measure.values:
             dominant = _dominant(grid.budget_delta_ms.sel(budget_measure=m))
-            panels += s.panels(dominant, f"dominant term: {m}")
+            panels += s.panels(dominant, f"dominant: {str(m).split('_rms')[0]}")
         if panels:
             figs["dominant_terms.png"] = plot_categories(panels[:MAX_PANELS], terms, xl, yl)
     return figs
