@@ -4,9 +4,9 @@ Plain data, no files: ``io.study_file`` validates a study file and builds a :cla
 
 An axis is either a list of values or a range. Without a ``sample`` every ranged axis is
 ``steps`` evenly spaced values and the cells are the Cartesian product of all axes, in the order
-of :data:`AXES` (the last axis varies fastest; ``io.study_file`` sorts them so). With a ``sample`` the ranged axes are sampled
-jointly by a scrambled Sobol sequence or a Latin hypercube (``scipy.stats.qmc``, seeded) and the
-sample is crossed with the listed axes.
+of :data:`AXES` (the last axis varies fastest; ``io.study_file`` sorts them so). With a
+``sample`` the ranged axes are sampled jointly by a scrambled Sobol sequence or a Latin
+hypercube (``scipy.stats.qmc``, seeded) and the sample is crossed with the listed axes.
 
 A cell's trials are cut into chunks of ``chunk_trials`` (a property of the study, so the same
 study partitions its work the same way on any cluster); the tasks are (cell, chunk) for the
