@@ -87,3 +87,23 @@ def test_published_schema_is_the_generated_one():
     assert published == study_schema_text()
     jsonschema = pytest.importorskip("jsonschema")
     jsonschema.validate(VALID, json.loads(published))
+
+
+def test_shipped_studies_validate_against_the_schema():
+    jsonschema = pytest.importorskip("jsonschema")
+    schema = json.loads((ROOT / "docs" / "schemas" / "study.schema.json").read_text("utf-8"))
+    for path in sorted((ROOT / "studies").glob("*.yaml")):
+        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+        assert list(jsonschema.Draft202012Validator(schema).iter_errors(doc)) == [], path.name
+
+
+def test_cli_answers_a_bad_study_with_one_error_line(tmp_path, capsys):
+    from stereoplotter.cli import main
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump({**VALID, "trials": 1}), encoding="utf-8")
+    code = main(["study", "run", str(bad), "-o", str(tmp_path / "r.zarr"), "--workers", "0"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1
+    assert err == [f"error: {bad}: trials: expected an integer in [2, 1000000000], found 1"]
+    assert not (tmp_path / "r.zarr").exists()
