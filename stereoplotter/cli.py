@@ -33,6 +33,7 @@ from stereoplotter.commands import (
     session,
     setup,
     simulate,
+    study,
     trainer,
     verify,
 )
@@ -56,6 +57,7 @@ COMMANDS = (
     verify,
     budget,
     demo,
+    study,
     exercise,
     session,
     grade,

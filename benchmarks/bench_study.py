@@ -1,0 +1,134 @@
+"""Scale of `stereoplotter study run`: procedures/s serial, on 1 and 2 local Dask workers, memory
+per worker, and a paper estimate of a 10⁸-procedure study on a cluster.
+
+python benchmarks/bench_study.py                      # 4 cells × 2000 trials, chunks of 1000
+python benchmarks/bench_study.py --trials 4000 --chunk 2000 --nodes 32 --cores-per-node 32
+
+The study: the shipped formula-validity file on f = 70, 140 mm × overlap 60, 80 %, SC-1, setup
+data, the chunked measures only (checks, y-parallax, heights, plan): 2·T/C chunk tasks of C
+trials each. Each configuration (serial; 1 worker; 2 workers) writes a fresh Zarr store; the
+cluster is started and warmed (the library imported on every worker) before the clock starts.
+The Datasets of the three runs are compared bit for bit.
+
+Peak memory per worker: the worker's maximum resident set size after the run (ru_maxrss), to be
+read against the chunk's budget (C × BYTES_PER_TRIAL of procedure.trials, plus the interpreter
+and the libraries).
+
+The paper estimate scales the measured per-core rate (serial, at this chunk size) by the
+cluster's cores and the measured parallel efficiency of 2 workers; the scheduler's load is the
+task rate against Dask's documented per-task overhead (about 1 ms of scheduler time per task,
+"Dask Best Practices"); the result size is the store's measured bytes per cell.
+"""
+
+import argparse
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+ROOT = Path(__file__).parents[1]
+sys.path.insert(0, str(ROOT))
+
+from stereoplotter.commands.study import run_into_store  # noqa: E402
+from stereoplotter.io.study_store import open_results  # noqa: E402
+from stereoplotter.procedure.trials import BYTES_PER_TRIAL  # noqa: E402
+
+#: Scheduler time per task (Dask documentation: "each task has an overhead of about 1 ms"). [s]
+SCHEDULER_SECONDS_PER_TASK = 1e-3
+
+
+def study(trials: int, chunk: int) -> dict:
+    data = yaml.safe_load((ROOT / "studies" / "formula-validity.yaml").read_text("utf-8"))
+    data["axes"] = {"f_mm": [70, 140], "overlap": [0.6, 0.8], "instrument": ["sc1"],
+                    "method": ["setup"]}  # fmt: skip
+    data.update(trials=trials, chunk_trials=chunk,
+                measures=["checks", "y_parallax", "heights", "plan"])  # fmt: skip
+    return data
+
+
+def _peak_rss_mb() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def _warm() -> None:
+    import stereoplotter.study.cells  # noqa: F401 - the library loaded before the clock starts
+
+
+def timed(data: dict, out: Path, workers: int | None):
+    client = cluster = None
+    if workers:
+        from distributed import Client, LocalCluster
+
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=None)  # fmt: skip
+        client = Client(cluster)
+        client.run(_warm)
+    try:
+        t0 = time.perf_counter()
+        run_into_store(data, "bench", str(out), client)
+        wall = time.perf_counter() - t0
+        rss = list(client.run(_peak_rss_mb).values()) if client else [_peak_rss_mb()]
+    finally:
+        if client:
+            client.close()
+            cluster.close()
+    return wall, rss
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--trials", type=int, default=2000, help="trials per cell")
+    ap.add_argument("--chunk", type=int, default=1000, help="trials per task")
+    ap.add_argument("--nodes", type=int, default=32)
+    ap.add_argument("--cores-per-node", type=int, default=32)
+    ap.add_argument("--procedures", type=float, default=1e8)
+    a = ap.parse_args()
+    print(f"cpu_count={os.cpu_count()} numpy={np.__version__} load={os.getloadavg()[0]:.1f}")
+    data = study(a.trials, a.chunk)
+    cells = 4
+    procedures = cells * a.trials
+    tasks = cells * -(-a.trials // a.chunk)
+    tmp = Path(tempfile.mkdtemp(prefix="bench_study_"))
+    results, rates = {}, {}
+    try:
+        for label, workers in (("serial", None), ("1 worker", 1), ("2 workers", 2)):
+            out = tmp / f"{label.replace(' ', '_')}.zarr"
+            wall, rss = timed(data, out, workers)
+            rates[label] = procedures / wall
+            results[label] = open_results(out)
+            print(f"{label:10s}: {wall:6.1f} s, {rates[label]:7.0f} procedures/s, "
+                  f"{tasks} tasks of {a.chunk} trials, peak RSS per process "
+                  + ", ".join(f"{r:.0f} MB" for r in rss))  # fmt: skip
+        same = all(results["serial"].identical(r) for r in results.values())
+        print(f"Datasets identical to the serial run: {same}")
+        speedup = rates["2 workers"] / rates["1 worker"]
+        print(f"speed-up 2 workers / 1 worker: {speedup:.2f}; chunk budget "
+              f"{a.chunk * BYTES_PER_TRIAL['setup'] / 1e6:.0f} MB per task")  # fmt: skip
+        per_cell = results["serial"].nbytes / cells  # uncompressed, coordinates included
+        per_task_s = 1.0 / rates["serial"] * a.chunk
+        cores = a.nodes * a.cores_per_node
+        efficiency = min(1.0, speedup / 2.0)
+        wall = a.procedures / (rates["serial"] * cores * efficiency)
+        n_tasks = a.procedures / a.chunk
+        sched = n_tasks * SCHEDULER_SECONDS_PER_TASK / wall
+        print("paper estimate:")
+        print(f"  {a.procedures:.0e} procedures on {a.nodes} nodes × {a.cores_per_node} cores, "
+              f"parallel efficiency {efficiency:.2f} (measured on 2 workers), "
+              f"{per_task_s:.2f} s per task of {a.chunk} trials")  # fmt: skip
+        print(f"  wall time ≈ {wall / 3600:.2f} h; {n_tasks:.0f} tasks, {n_tasks / wall:.1f} "
+              f"tasks/s: scheduler busy ≈ {sched:.1%} at 1 ms per task")  # fmt: skip
+        print(f"  result ≈ {per_cell / 1e3:.2f} kB per cell uncompressed (this study's variables);"
+              f" 10⁴ cells ≈ {per_cell * 1e4 / 1e6:.0f} MB")  # fmt: skip
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,186 @@
+"""``stereoplotter study run|report``: studies over the design space (``docs/studies.md``).
+
+``study run STUDY.yaml -o RESULTS.zarr [--scheduler ADDRESS] [--workers N]`` runs a study on
+dask.distributed — an embedded ``LocalCluster`` (processes, one per core) by default, the
+scheduler at ``ADDRESS`` when given, in this process with ``--workers 0`` — and writes each
+cell to the Zarr store as it finishes; run again, it skips the finished cells.
+``study report RESULTS.zarr -o DIR`` draws the figures and writes the Markdown summary.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import functools
+import sys
+from contextlib import nullcontext
+from typing import Any
+
+from stereoplotter.commands.arguments import bounded_int
+
+_non_negative = bounded_int(0)
+_positive = bounded_int(1)
+
+__all__ = ["add_arguments", "run", "run_report", "run_study_command"]
+
+
+def add_arguments(sub: Any) -> None:
+    """Add the ``study`` subparser (``run``, ``report``) to the CLI's subparsers."""
+    p = sub.add_parser(
+        "study",
+        help="studies over the design space on Dask (needs the extra stereoplotter[study])",
+    )
+    actions = p.add_subparsers(dest="study_command", required=True, metavar="ACTION")
+    r = actions.add_parser("run", help="run a study into a Zarr store (resumes a killed run)")
+    r.add_argument("study", help="a study file, or a shipped study's name (formula-validity)")
+    r.add_argument("-o", "--output", required=True, help="the results store (RESULTS.zarr)")
+    r.add_argument("--scheduler", help="a Dask scheduler's address (default: an embedded cluster)")
+    r.add_argument(
+        "--workers",
+        type=_non_negative,
+        help="worker processes of the embedded cluster (default: one per core; 0: serial, "
+        "in this process)",
+    )
+    r.add_argument("--trials", type=_positive, help="override the study's trials per cell")
+    r.add_argument(
+        "--procedure-trials", type=_non_negative, help="override the procedure MC's trials"
+    )
+    r.add_argument("--budget-trials", type=_non_negative, help="override the budget's trials")
+    r.add_argument(
+        "--steps", type=_positive, help="override the steps of every ranged axis (a reduced grid)"
+    )
+    r.add_argument(
+        "--axis",
+        action="append",
+        default=[],
+        metavar="NAME=V1,V2,…",
+        help="replace an axis by a list of values (repeatable; a reduced study)",
+    )
+    r.set_defaults(func=run_study_command)
+    rep = actions.add_parser("report", help="figures and a Markdown summary of a results store")
+    rep.add_argument("results", help="the results store (RESULTS.zarr)")
+    rep.add_argument("-o", "--output", required=True, help="folder for the report")
+    rep.set_defaults(func=run_report)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the chosen action (``study run`` or ``study report``)."""
+    return run_report(args) if args.study_command == "report" else run_study_command(args)
+
+
+def reduced(data: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
+    """The study document with the command line's overrides (a reduced run)."""
+    out = copy.deepcopy(data)
+    for key in ("trials", "procedure_trials", "budget_trials"):
+        value = getattr(args, key, None)
+        if value is not None:
+            out[key] = value
+    if getattr(args, "steps", None):
+        for axis in (out.get("axes") or {}).values():
+            if isinstance(axis, dict) and "steps" in axis:
+                axis["steps"] = args.steps
+    for item in getattr(args, "axis", None) or []:
+        name, _, values = item.partition("=")
+        out.setdefault("axes", {})[name.strip()] = [_value(v) for v in values.split(",") if v]
+    return out
+
+
+def _value(text: str) -> Any:
+    try:
+        return float(text)
+    except ValueError:
+        return text.strip()
+
+
+def run_into_store(
+    data: dict[str, Any],
+    source: str,
+    output: str,
+    client: Any = None,
+    bar: Any = None,
+    progress: Any = None,
+) -> tuple[int, int]:
+    """Run the study document ``data`` into the store ``output`` (created or resumed), serially
+    (``client`` None) or on a Dask client. ``bar(total)``: a context manager giving the
+    progress callback (``stereoplotter.progress.progress_bar``); ``progress(n)``: another
+    callback (tests). Returns (cells of the study, cells run now)."""
+    # Imported here: xarray and zarr (the extra `study`) load in seconds; `--help` must not.
+    from stereoplotter.io.study_file import study_fingerprint, study_from_mapping
+    from stereoplotter.io.study_store import open_store
+    from stereoplotter.study.results import empty_dataset
+    from stereoplotter.study.runner import run_study, study_checks, study_terms
+
+    design = study_from_mapping(data, source)
+    cells = design.cells()
+    checks = study_checks(design, cells) if "checks" in design.measures else ()
+    terms = study_terms(design) if "budget" in design.measures else ()
+    empty = empty_dataset(design, cells, checks, terms)
+    store = open_store(output, empty, study_fingerprint(data), data)
+    done = store.done()
+    tasks = sum(len(design.tasks(i)) for i in range(len(cells)) if i not in done)
+    print(
+        f"study {design.name}: {len(cells)} cells ({len(done)} done), {tasks} tasks to run, "
+        f"{design.trials} trials per cell",
+        file=sys.stderr,
+    )
+    with bar(tasks) if bar else nullcontext(lambda n: None) as advance:
+
+        def both(n: int) -> None:
+            advance(n)
+            if progress is not None:
+                progress(n)
+
+        ran = run_study(
+            design,
+            cells,
+            store.write_cell,
+            checks=checks,
+            terms=terms,
+            done=done,
+            client=client,
+            progress=both,
+        )
+    return len(cells), ran
+
+
+def run_study_command(args: argparse.Namespace) -> int:
+    """``study run``: the cells not yet in the store, serially or on Dask."""
+    # Imported here: dask.distributed (the extra `study`) loads in seconds; `--help` must not.
+    from stereoplotter.io.study_file import load_study
+    from stereoplotter.progress import progress_bar
+    from stereoplotter.study.runner import local_client
+
+    _, data = load_study(args.study)
+    data = reduced(data, args)
+    client = None
+    try:
+        if args.scheduler:
+            from distributed import Client  # the extra `study`, loaded only to run on Dask
+
+            client = Client(args.scheduler)
+        elif args.workers != 0:
+            client = local_client(args.workers)
+        if client is not None and client.dashboard_link:
+            print(f"Dask dashboard: {client.dashboard_link}", file=sys.stderr)
+        bar = functools.partial(progress_bar, description="study", unit="task")
+        cells, ran = run_into_store(data, args.study, args.output, client, bar)
+    finally:
+        if client is not None:
+            cluster = None if args.scheduler else client.cluster
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    print(f"study: {ran} of {cells} cells run now; results in {args.output}", file=sys.stderr)
+    return 0
+
+
+def run_report(args: argparse.Namespace) -> int:
+    """``study report``: figures and ``README.md`` in the output folder."""
+    # Imported here: xarray, zarr and matplotlib load in seconds; `--help` must not.
+    from stereoplotter.io.study_store import open_results
+    from stereoplotter.report.study import write_study_report
+
+    written = write_study_report(open_results(args.results), args.output, source=args.results)
+    for path in written:
+        print(path)
+    return 0
