@@ -177,10 +177,14 @@ def run_study_command(args: argparse.Namespace) -> int:
 def run_report(args: argparse.Namespace) -> int:
     """``study report``: figures and ``README.md`` in the output folder."""
     # Imported here: xarray, zarr and matplotlib load in seconds; `--help` must not.
+    from stereoplotter.io.atomic_write import write_files
     from stereoplotter.io.study_store import open_results
-    from stereoplotter.report.study import write_study_report
+    from stereoplotter.plotting.study_figures import study_figures
+    from stereoplotter.report.study import study_report_files
 
-    written = write_study_report(open_results(args.results), args.output, source=args.results)
-    for path in written:
+    ds = open_results(args.results)
+    figures, note = study_figures(ds)
+    written = write_files(args.output, study_report_files(ds, figures, note))
+    for path in written.values():
         print(path)
     return 0

@@ -34,7 +34,7 @@ from stereoplotter.io.validation import (
     text,
     validate,
 )
-from stereoplotter.io.yaml_files import load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB, chunk_trials_for
 from stereoplotter.study.design import AXES, GEOMETRY_AXES, MEASURES, Axis, Sample, StudyDesign
 

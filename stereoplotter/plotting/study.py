@@ -7,7 +7,6 @@ Figure. A map panel is (title, x values, y values, Z of shape (len(y), len(x)));
 
 from __future__ import annotations
 
-import io
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -20,7 +19,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
-__all__ = ["figure_png", "plot_categories", "plot_lines", "plot_maps", "plot_scatter"]
+__all__ = ["plot_categories", "plot_lines", "plot_maps", "plot_scatter"]
 
 MapPanel = tuple[str, Sequence[float], Sequence[float], np.ndarray]
 
@@ -154,11 +153,3 @@ def plot_scatter(
     if art is not None:
         fig.colorbar(art, ax=axes, label=label, shrink=0.8)
     return fig
-
-
-def figure_png(fig: Any, dpi: int = 110) -> bytes:
-    """The figure as PNG bytes; the figure is closed."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
-    plt.close(fig)
-    return buf.getvalue()

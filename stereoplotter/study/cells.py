@@ -34,11 +34,11 @@ from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import trial_columns
 from stereoplotter.scenario.model import Scenario
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.study.design import StudyDesign, Task
 from stereoplotter.study.geometry import cell_scenario
 from stereoplotter.verification.budget import MEASURES as BUDGET_MEASURES

@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 from scipy.stats import qmc
 
-from stereoplotter.instrument.spec import InstrumentSpec
 from stereoplotter.scenario.model import Scenario
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "AXES",

@@ -26,7 +26,13 @@ from stereoplotter.study.cells import OUTCOME_ROWS, VALUE_MEASURES, Moments, com
 from stereoplotter.study.design import AXES, StudyDesign, Task
 from stereoplotter.verification.budget import MEASURES as BUDGET_MEASURES
 
-__all__ = ["STATUS", "as_grid", "cell_values", "empty_dataset"]
+__all__ = [
+    "STATUS",
+    "as_grid",
+    "cell_values",
+    "dominant_term",
+    "empty_dataset",
+]
 
 #: Cell status codes.
 STATUS = {"pending": 0, "done": 1, "refused": 2}
@@ -170,3 +176,10 @@ def as_grid(ds: xr.Dataset) -> xr.Dataset:
     if not axes or int(np.prod(sizes)) != ds.sizes["cell"]:
         return ds
     return ds.set_index(cell=axes).unstack("cell")
+
+
+def dominant_term(delta: xr.DataArray) -> xr.DataArray:
+    """Index of the term with the largest one-at-a-time Δ MS per cell (NaN where none ran)."""
+    filled = delta.fillna(-np.inf)
+    idx = filled.argmax("term").astype(float)
+    return idx.where(np.isfinite(delta).any("term"))

@@ -8,7 +8,9 @@ import pytest
 pytest.importorskip("xarray")
 
 from stereoplotter import load_instrument, load_scenario
-from stereoplotter.report.study import study_summary, write_study_report
+from stereoplotter.io.atomic_write import write_files
+from stereoplotter.plotting.study_figures import study_figures
+from stereoplotter.report.study import study_report_files, study_summary
 from stereoplotter.study.design import Axis, StudyDesign
 from stereoplotter.study.results import STATUS, empty_dataset
 
@@ -61,7 +63,8 @@ def test_dominant_term_per_cell_from_the_one_at_a_time_runs(dataset):
 
 
 def test_report_writes_the_figures_and_the_markdown(dataset, tmp_path):
-    written = write_study_report(dataset, tmp_path)
+    figures, note = study_figures(dataset)
+    written = list(write_files(tmp_path, study_report_files(dataset, figures, note)).values())
     names = {p.name for p in written}
     assert {"ratio_maps.png", "pass_rates.png", "dominant_terms.png", "study.md"} <= names
     for p in written:
