@@ -257,19 +257,23 @@ def _step(p, orient, points, pairs, factor_only=False):
     return delta_c, delta_p, vv, (lu, scale)
 
 
-def _covariances(factor, n_photos: int, sigma0: float, chunk: int = 64) -> NDArray:
-    """σ₀²·(the 6 × 6 diagonal blocks of the inverse reduced matrix), in chunks of photos."""
+def _covariances(factor, n_photos: int, sigma0: float, chunk: int = 64) -> tuple[NDArray, NDArray]:
+    """σ₀²·(the 6 × 6 diagonal blocks of the inverse reduced matrix) and σ₀²·its blocks
+    (j + 1, j) (photo j + 1 against photo j), in chunks of photos; memory 6n × 6·chunk."""
     lu, scale = factor
     out = np.empty((n_photos, 6, 6))
+    after = np.zeros((n_photos, 6, 6))
     for start in range(0, n_photos, chunk):
         stop = min(n_photos, start + chunk)
+        k = np.arange(stop - start)
         cols = np.arange(6 * start, 6 * stop)
         e = np.zeros((6 * n_photos, cols.size))
         e[cols, np.arange(cols.size)] = scale[cols]
-        x = scale[:, None] * lu.solve(e)
-        blk = x[cols].reshape(stop - start, 6, stop - start, 6)
-        out[start:stop] = blk[np.arange(stop - start), :, np.arange(stop - start), :]
-    return sigma0**2 * out
+        x = (scale[:, None] * lu.solve(e)).reshape(n_photos, 6, stop - start, 6)
+        out[start:stop] = x[start + k, :, k, :]
+        nxt = k[start + k + 1 < n_photos]
+        after[start + nxt] = x[start + nxt + 1, :, nxt, :]
+    return sigma0**2 * out, sigma0**2 * after
 
 
 def bundle_adjust(
@@ -334,8 +338,9 @@ def bundle_adjust(
     redundancy = n_obs - 6 * p.n_photos - 3 * int(used.sum())
     sigma0 = float(np.sqrt(vv / redundancy)) if redundancy > 0 else float("nan")
     points[~used] = np.nan
-    cov = _covariances(factor, p.n_photos, sigma0) if covariance else None
-    return BlockSolution("bundle", orient, cov, points, it, sigma0, (f"redundancy {redundancy}",))
+    cov, after = _covariances(factor, p.n_photos, sigma0) if covariance else (None, None)
+    notes = (f"redundancy {redundancy}",)
+    return BlockSolution("bundle", orient, cov, points, it, sigma0, notes, after)
 
 
 def bundle_block(block: Block, **options) -> BlockSolution:

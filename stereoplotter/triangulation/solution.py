@@ -39,6 +39,9 @@ class BlockSolution:
         A posteriori standard deviation of unit weight (1 when the a priori σ were right). [—]
     notes : tuple of str
         What the method did that a reader of the report needs (e.g. the control it used).
+    next_covariances : ndarray, shape (n_photos, 6, 6), or None
+        Covariance of photo j + 1 against photo j (the next in ``Block.photos``; zero for the
+        last), for the pairs of the setup; None where the method gives none.
     """
 
     method: str
@@ -48,6 +51,17 @@ class BlockSolution:
     iterations: int
     sigma0: float
     notes: tuple[str, ...] = ()
+    next_covariances: NDArray[np.float64] | None = None
+
+    def pair_covariance(self, j: int) -> NDArray[np.float64] | None:
+        """12 × 12 covariance of photos j and j + 1 (rad, m), or None."""
+        if self.covariances is None or self.next_covariances is None:
+            return None
+        c = np.zeros((12, 12))
+        c[:6, :6], c[6:, 6:] = self.covariances[j], self.covariances[j + 1]
+        c[6:, :6] = self.next_covariances[j]
+        c[:6, 6:] = self.next_covariances[j].T
+        return c
 
     @property
     def standard_errors(self) -> NDArray[np.float64] | None:
