@@ -26,6 +26,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from stereoplotter import __version__
+from stereoplotter.commands import triangulate
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.io.job_file import is_job_file
 from stereoplotter.io.paths import (
@@ -1115,6 +1116,7 @@ def _parser() -> argparse.ArgumentParser:
         help="port (default: 0, a free port chosen by the system; the address is printed)",
     )
     p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
+    triangulate.add_arguments(sub)
     return parser
 
 
@@ -1305,6 +1307,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     configure_logging(getattr(args, "verbose", 0), getattr(args, "quiet", False))
     try:
         _resolve_data_arguments(args)
+        if hasattr(args, "func"):
+            return args.func(args)
         if args.command == "info":
             info = _info()
             sys.stdout.write(_json(info) if args.json else _format_info(info))

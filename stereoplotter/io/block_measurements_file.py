@@ -139,13 +139,15 @@ def _read_csv(path: Path, columns: tuple[str, ...]) -> list[tuple[str, dict[str,
         raise ConfigError(source, "(header)", ", ".join(columns), "an empty file")
     header = tuple(h.strip() for h in lines[0][1])
     if header != columns:
-        raise ConfigError(f"{source}:{lines[0][0]}", "(header)", ", ".join(columns),
-                          ", ".join(header))  # fmt: skip
+        raise ConfigError(
+            f"{source}:{lines[0][0]}", "(header)", ", ".join(columns), ", ".join(header)
+        )
     out = []
     for n, row in lines[1:]:
         if len(row) != len(columns):
-            raise ConfigError(f"{source}:{n}", "(row)", f"{len(columns)} values",
-                              f"{len(row)} values")  # fmt: skip
+            raise ConfigError(
+                f"{source}:{n}", "(row)", f"{len(columns)} values", f"{len(row)} values"
+            )
         out.append((f"{source}:{n}", dict(zip(columns, (v.strip() for v in row), strict=True))))
     return out
 
@@ -179,8 +181,9 @@ def _measurements(path: Path, photos: dict[str, int]) -> tuple[Any, ...]:
         y = _number(where, "y_mm", row["y_mm"], -1000.0, 1000.0, "mm")
         key = (photo, kind, row["point"])
         if key in seen or not row["point"]:
-            raise ConfigError(where, "point", f"a {kind} measured once per photo",
-                              repr(row["point"]))  # fmt: skip
+            raise ConfigError(
+                where, "point", f"a {kind} measured once per photo", repr(row["point"])
+            )
         seen.add(key)
         if kind == "fiducial":
             mark = _choice(where, "point", row["point"], ("1", "2", "3", "4"))
@@ -192,10 +195,19 @@ def _measurements(path: Path, photos: dict[str, int]) -> tuple[Any, ...]:
     missing = np.argwhere(np.isnan(fiducials[:, :, 0]))
     if missing.size:
         name = list(photos)[missing[0][0]]
-        raise ConfigError(str(path), "kind", f"the four fiducial marks of photo {name}",
-                          f"no mark {missing[0][1] + 1}")  # fmt: skip
-    return (fiducials, np.array(obs_photo, np.int64), np.array(obs_point, np.int64),
-            np.array(xy, float).reshape(-1, 2), tuple(ids))  # fmt: skip
+        raise ConfigError(
+            str(path),
+            "kind",
+            f"the four fiducial marks of photo {name}",
+            f"no mark {missing[0][1] + 1}",
+        )
+    return (
+        fiducials,
+        np.array(obs_photo, np.int64),
+        np.array(obs_point, np.int64),
+        np.array(xy, float).reshape(-1, 2),
+        tuple(ids),
+    )
 
 
 def _catalogue(path: Path, zone: int) -> tuple[CataloguePoint, ...]:
@@ -214,8 +226,7 @@ def _catalogue(path: Path, zone: int) -> tuple[CataloguePoint, ...]:
         except StereoplotterError as exc:
             raise ConfigError(where, "east_m", "a conventional ordinate", east, str(exc)) from None
         if z != zone:
-            raise ConfigError(where, "east_m", f"a point in the origin's zone {zone}",
-                              f"zone {z}")  # fmt: skip
+            raise ConfigError(where, "east_m", f"a point in the origin's zone {zone}", f"zone {z}")
         out[pid] = CataloguePoint(pid, role, kind, (north, east, height))
     return tuple(out.values())
 
@@ -295,16 +306,25 @@ def write_block_measurements(
     photos = block.photos
     rows: list[tuple[Any, ...]] = []
     for j, p in enumerate(photos):
-        rows += [(p, str(k + 1), "fiducial", f"{x:.4f}", f"{y:.4f}")
-                 for k, (x, y) in enumerate(block.fiducials_mm[j])]  # fmt: skip
+        rows += [
+            (p, str(k + 1), "fiducial", f"{x:.4f}", f"{y:.4f}")
+            for k, (x, y) in enumerate(block.fiducials_mm[j])
+        ]
     order = np.lexsort((block.obs_point, block.obs_photo))
     rows += [
-        (photos[block.obs_photo[i]], block.point_ids[block.obs_point[i]], "point",
-         f"{block.comparator_mm[i, 0]:.4f}", f"{block.comparator_mm[i, 1]:.4f}")
+        (
+            photos[block.obs_photo[i]],
+            block.point_ids[block.obs_point[i]],
+            "point",
+            f"{block.comparator_mm[i, 0]:.4f}",
+            f"{block.comparator_mm[i, 1]:.4f}",
+        )
         for i in order
-    ]  # fmt: skip
-    control = [(c.id, c.role, c.kind, f"{c.sk42_m[0]:.3f}", f"{c.sk42_m[1]:.3f}",
-                f"{c.sk42_m[2]:.3f}") for c in block.catalogue]  # fmt: skip
+    ]
+    control = [
+        (c.id, c.role, c.kind, f"{c.sk42_m[0]:.3f}", f"{c.sk42_m[1]:.3f}", f"{c.sk42_m[2]:.3f}")
+        for c in block.catalogue
+    ]
     cam = block.camera
     span = cam.fiducials_mm["2"][0] - cam.fiducials_mm["1"][0]
     span34 = cam.fiducials_mm["3"][1] - cam.fiducials_mm["4"][1]

@@ -1,0 +1,201 @@
+"""``stereoplotter triangulate`` and ``stereoplotter block synth``: phototriangulation of a block.
+
+``block synth -o DIR`` makes a synthetic block measurements file from an invented ground truth
+(:mod:`stereoplotter.triangulation.synth`) and writes the truth beside it (``truth.csv`` and the
+production job of the true orientations, ``truth/job.yaml``). ``triangulate BLOCK.yaml --method
+bundle|strip|polygon -o DIR`` writes each photo's orientation with its σ (``orientations.csv``),
+the residuals at control and check points (``residuals.csv``), a report (``report.md`` with
+``residuals.png``) and, when the block has a ``production`` section, the production job
+``job.yaml`` that ``stereoplotter setup`` turns into forms (``docs/triangulation.md``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+__all__ = ["add_arguments", "run", "run_synth"]
+
+METHODS = ("bundle", "strip", "polygon")
+
+
+def add_arguments(sub: Any) -> None:
+    """Add ``triangulate`` and ``block`` (action ``synth``) to the CLI's subparsers."""
+    p = sub.add_parser(
+        "triangulate",
+        help="analytic phototriangulation of a block: orientations, residuals, report, job file",
+    )
+    p.add_argument("block", help="block measurements file (stereoplotter-block-measurements/1)")
+    p.add_argument(
+        "--method",
+        choices=METHODS,
+        default="bundle",
+        help="bundle block adjustment (default), strip triangulation by independent "
+        "models with polynomials, or the polygon block adjustment",
+    )
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    p.set_defaults(func=run)
+    b = sub.add_parser("block", help="blocks of comparator measurements (docs/triangulation.md)")
+    acts = b.add_subparsers(dest="block_command", required=True, metavar="ACTION")
+    s = acts.add_parser("synth", help="a synthetic block from an invented ground truth")
+    s.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    s.add_argument("--strips", type=int, default=4, help="number of strips (default 4)")
+    s.add_argument("--photos", type=int, default=10, help="photos per strip (default 10)")
+    s.add_argument("--seed", type=int, default=1, help="seed of the truth and the errors")
+    s.add_argument(
+        "--control-every",
+        type=int,
+        default=4,
+        metavar="BASES",
+        help="control spacing along the block edges in bases (default 4)",
+    )
+    s.add_argument(
+        "--sigma-photo",
+        type=float,
+        default=0.005,
+        metavar="MM",
+        help="σ of a comparator coordinate [mm] (default 0.005)",
+    )
+    s.add_argument("--name", default="synthetic", help="name of the block")
+    s.add_argument("--instrument", default="sc1", help="instrument of the production job")
+    s.add_argument(
+        "--date",
+        default="2026-11-26",
+        help="date printed on the forms, YYYY-MM-DD (the clock is never read)",
+    )
+    s.set_defaults(func=run_synth)
+
+
+def _solve(block: Any, method: str) -> Any:
+    # imported here: the CLI starts without loading scipy's sparse solvers
+    if method == "bundle":
+        from stereoplotter.triangulation.bundle import bundle_block
+
+        return bundle_block(block)
+    from stereoplotter.triangulation import strip
+
+    return strip.strip_block(block) if method == "strip" else strip.polygon_block(block)
+
+
+def run(args: argparse.Namespace) -> int:
+    # imported here: the CLI starts fast (no pyproj, matplotlib or pydantic until a command runs)
+    from stereoplotter.io.block_measurements_file import load_block_measurements
+    from stereoplotter.io.triangulated_job import write_triangulated_job
+    from stereoplotter.io.yaml_files import atomic_write_bytes, atomic_write_text
+    from stereoplotter.plotting.triangulation import residual_figure_png
+    from stereoplotter.report.triangulation import orientation_csv, report_markdown, residual_csv
+    from stereoplotter.triangulation.solution import catalogue_residuals
+
+    block, production = load_block_measurements(args.block)
+    solution = _solve(block, args.method)
+    residuals = catalogue_residuals(block, solution)
+    out = Path(args.output)
+    atomic_write_bytes(out / "residuals.png", residual_figure_png(block, solution, residuals))
+    atomic_write_text(out / "orientations.csv", orientation_csv(block, solution))
+    atomic_write_text(out / "residuals.csv", residual_csv(block, residuals))
+    job = ""
+    if production is not None:
+        description = (
+            f"Exterior orientation of block {block.name} by stereoplotter triangulate "
+            f"--method {args.method} from {Path(args.block).name}."
+        )
+        write_triangulated_job(
+            out,
+            block,
+            production,
+            solution.orientations,
+            source=args.block,
+            description=description,
+        )
+        job = f"; job file {out / 'job.yaml'}"
+    atomic_write_text(out / "report.md", report_markdown(block, solution, residuals, args.block))
+    rms = residuals.rms(block, "check")
+    print(
+        f"block {block.name}: {len(block.photos)} photos by {args.method} in "
+        f"{solution.iterations} iterations, σ₀ = {solution.sigma0:.3f}; RMS at check points "
+        f"X {rms[0]:.3f}, Y {rms[1]:.3f}, Z {rms[2]:.3f} m; report {out / 'report.md'}{job}"
+    )
+    if production is None:
+        print("no production section in the block file: no job file written", file=sys.stderr)
+    return 0
+
+
+def _production_yaml(block: Any, orientations: Any, instrument: str, date: str) -> str:
+    """The ``production:`` section: instrument, date and the 1:10 000 sheets of the pairs."""
+    from stereoplotter.io.triangulated_job import sheets_of_pairs
+
+    sheets = sheets_of_pairs(block, orientations)
+    lines = ["production:", f"  instrument: {instrument}", f'  date: "{date}"', "  map_sheets:"]
+    lines += [f"    - {{nomenclature: {name}, scale: 10000}}" for name in sheets]
+    return "\n".join(lines) + "\n"
+
+
+def run_synth(args: argparse.Namespace) -> int:
+    # imported here: the CLI starts fast (numpy, pyproj, pydantic load only when a command runs)
+    import numpy as np
+
+    from stereoplotter.errors import ConfigError
+    from stereoplotter.io.block_measurements_file import (
+        load_block_measurements,
+        write_block_measurements,
+    )
+    from stereoplotter.io.triangulated_job import write_triangulated_job
+    from stereoplotter.io.yaml_files import atomic_write_text
+    from stereoplotter.random_streams import key_code
+    from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
+
+    for name, value, low in (
+        ("--strips", args.strips, 1),
+        ("--photos", args.photos, 2),
+        ("--control-every", args.control_every, 1),
+    ):
+        if value < low:
+            raise ConfigError("block synth", name, f"an integer ≥ {low}", value)
+    if not 0.0 < args.sigma_photo <= 0.1:
+        raise ConfigError("block synth", "--sigma-photo", "a σ in (0, 0.1] mm", args.sigma_photo)
+    spec = SynthSpec(
+        strips=args.strips,
+        photos_per_strip=args.photos,
+        name=args.name,
+        control_every_bases=args.control_every,
+        sigma_photo_mm=args.sigma_photo,
+    )
+    rng = np.random.default_rng([args.seed, key_code("block synth")])
+    block, truth = synthesize_block(spec, rng)
+    out = Path(args.output)
+    production = _production_yaml(block, truth.orientations, args.instrument, args.date)
+    description = (
+        f"Synthetic block of {spec.strips} × {spec.photos_per_strip} photos made by stereoplotter "
+        f"block synth --seed {args.seed} (the truth in truth.csv)."
+    )
+    write_block_measurements(out, block, description=description, production_yaml=production)
+    rows = ["photo,alpha_deg,omega_deg,kappa_deg,X_m,Y_m,Z_m"]
+    for p, o in zip(block.photos, truth.orientations, strict=True):
+        a, w, k = (math.degrees(float(v)) for v in o[:3])
+        rows.append(f"{p},{a:.8f},{w:.8f},{k:.8f},{o[3]:.4f},{o[4]:.4f},{o[5]:.4f}")
+    atomic_write_text(out / "truth.csv", "\n".join(rows) + "\n")
+    pts = ["point,X_m,Y_m,Z_m"] + [
+        f"{pid},{x:.4f},{y:.4f},{z:.4f}"
+        for pid, (x, y, z) in zip(block.point_ids, truth.points_m, strict=True)
+    ]
+    atomic_write_text(out / "truth_points.csv", "\n".join(pts) + "\n")
+    _, prod = load_block_measurements(out / "block.yaml")  # the file as triangulate reads it
+    assert prod is not None
+    write_triangulated_job(
+        out / "truth",
+        block,
+        prod,
+        truth.orientations,
+        source=str(out / "block.yaml"),
+        description="The TRUE exterior orientation of the synthetic block "
+        "(for comparison with the triangulated one).",
+    )
+    print(
+        f"block {block.name}: {len(block.photos)} photos, {block.obs_photo.size} point "
+        f"measurements, {len(block.catalogue)} catalogue points written to {out / 'block.yaml'}"
+        f"; truth in {out / 'truth.csv'} and {out / 'truth' / 'job.yaml'}"
+    )
+    return 0
