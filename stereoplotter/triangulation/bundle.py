@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from stereoplotter.errors import GeometryError
 from stereoplotter.geometry.resection import _model_and_jacobian
 from stereoplotter.triangulation.block import Block, catalogue_local, interior_orientation
-from stereoplotter.triangulation.solution import BlockSolution
+from stereoplotter.triangulation.solution import BlockSolution, sparse_least_squares
 
 __all__ = ["BundleProblem", "bundle_adjust", "bundle_block", "initial_approximation", "problem"]
 
@@ -89,14 +89,6 @@ def problem(block: Block) -> BundleProblem:
     )
 
 
-def _sparse_lstsq(a: sp.spmatrix, b: NDArray) -> NDArray:
-    """Least squares of a sparse full-rank system by its normal equations (SuperLU)."""
-    n = a.T @ a
-    scale = 1.0 / np.sqrt(n.diagonal())
-    d = sp.diags(scale)
-    return scale * spla.splu((d @ n @ d).tocsc()).solve(scale * (a.T @ b))
-
-
 def initial_approximation(p: BundleProblem) -> tuple[NDArray, NDArray]:
     r"""First approximation of orientations (n_photos, 6) and points (n_points, 3).
 
@@ -136,7 +128,7 @@ def initial_approximation(p: BundleProblem) -> tuple[NDArray, NDArray]:
     used[cols] = True
     sol = np.zeros(a.shape[1])
     try:
-        sol[used] = _sparse_lstsq(a[:, used], rhs)
+        sol[used] = sparse_least_squares(a[:, used], rhs)
     except RuntimeError as exc:  # SuperLU: exactly singular
         raise GeometryError(
             f"the plan similarity block is singular ({exc}): expected every photo tied to the "

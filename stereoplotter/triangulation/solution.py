@@ -8,6 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from stereoplotter.geometry.collinearity import object_to_photo
@@ -15,7 +17,13 @@ from stereoplotter.geometry.intersection import space_intersection
 from stereoplotter.geometry.rotation import rotation_matrix
 from stereoplotter.triangulation.block import Block, catalogue_local, interior_orientation
 
-__all__ = ["BlockSolution", "CatalogueResiduals", "catalogue_residuals", "photo_residuals"]
+__all__ = [
+    "BlockSolution",
+    "CatalogueResiduals",
+    "catalogue_residuals",
+    "photo_residuals",
+    "sparse_least_squares",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,3 +152,12 @@ def catalogue_residuals(block: Block, solution: BlockSolution) -> CatalogueResid
     local = catalogue_local(block)[index]
     rays = np.bincount(block.obs_point, minlength=len(block.point_ids))[points]
     return CatalogueResiduals(index, computed, local, computed - local, rays)
+
+
+def sparse_least_squares(a: sp.spmatrix, b: NDArray) -> NDArray[np.float64]:
+    """Least squares of a sparse full-rank system by its normal equations, scaled to unit
+    diagonal and factored by sparse LU (SuperLU). Raises RuntimeError when exactly singular."""
+    n = (a.T @ a).tocsc()
+    scale = 1.0 / np.sqrt(n.diagonal())
+    d = sp.diags(scale)
+    return scale * spla.splu((d @ n @ d).tocsc()).solve(scale * (a.T @ b))

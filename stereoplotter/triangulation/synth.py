@@ -136,7 +136,7 @@ def _grid(spec: SynthSpec, rng: np.random.Generator) -> tuple[NDArray, NDArray, 
     rows = np.arange(-1, 2 * (ns - 1) + 2)  # half-spacing rows, the outer edges included
     c, r = np.meshgrid(cols, rows)
     c, r = c.ravel(), r.ravel()
-    X = (c / 2.0 - (npp - 1) / 2.0) * spec.base_m + rng.uniform(-0.08, 0.08, c.size) * spec.base_m
+    X = (c / 2.0 - (npp - 1) / 2.0) * spec.base_m + rng.uniform(-0.03, 0.03, c.size) * spec.base_m
     Y = (r / 2.0 - (ns - 1) / 2.0) * spec.strip_spacing_m + rng.uniform(
         -0.05, 0.05, c.size
     ) * spec.strip_spacing_m
@@ -172,7 +172,7 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
 
     Photo numbers are ``100·strip + photo`` (``"101"`` … ``"110"``, ``"201"`` …); grid points
     ``"P<row>.<column>"`` (row and column of the grid, from 0). A point is measured on every photo
-    on which Eq. (2.53) puts it inside 46 % of the format from the centre (the usable field).
+    on which Eq. (2.53) puts it inside 47 % of the format from the centre (the usable field).
     """
     cam = _camera(spec)
     xy, c, r = _grid(spec, rng)
@@ -188,7 +188,7 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
     rot = rotation_matrix(stations[:, 0], stations[:, 1], stations[:, 2])
     photo = object_to_photo(points[None], stations[:, None, 3:], rot[:, None], cam.focal_length_mm)
     with np.errstate(invalid="ignore"):
-        seen = np.all(np.abs(photo) <= 0.46 * spec.format_mm, axis=-1)
+        seen = np.all(np.abs(photo) <= 0.47 * spec.format_mm, axis=-1)
     obs_photo, obs_point = np.nonzero(seen)
     n_photos, n_obs = stations.shape[0], obs_photo.size
     # the diapositive on the comparator: film deformation, a turn and a shift per photo
