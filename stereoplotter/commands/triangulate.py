@@ -77,7 +77,11 @@ def _solve(block: Any, method: str) -> Any:
         return bundle_block(block)
     from stereoplotter.triangulation import strip
 
-    return strip.strip_block(block) if method == "strip" else strip.polygon_block(block)
+    if method == "strip":
+        return strip.strip_block(block)
+    from stereoplotter.triangulation.polygon_block import polygon_block
+
+    return polygon_block(block)
 
 
 def run(args: argparse.Namespace) -> int:

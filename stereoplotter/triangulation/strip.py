@@ -34,6 +34,7 @@ it measured (:func:`~stereoplotter.geometry.resection.space_resection`).
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from itertools import pairwise
 
 import numpy as np
@@ -253,7 +254,64 @@ def _axes(centres: NDArray) -> StripAxes:
     return StripAxes((first + last) / 2.0, (last - first) / length, length / 2.0)
 
 
-# long: strips formed, oriented, adjusted by polynomials, photos resected: the method's steps
+@dataclass(frozen=True, slots=True)
+class OrientedStrip:
+    """A strip after its 7-parameter absolute orientation: photo indices, their rotations
+    (n, 3, 3) and centres (n, 3), the strip's point indices and ground coordinates [m]."""
+
+    photos: tuple[int, ...]
+    rotations: NDArray[np.float64]
+    centres: NDArray[np.float64]
+    point_ids: NDArray[np.int64]
+    points_m: NDArray[np.float64]
+
+
+def oriented_strips(block: Block, models: str = "independent") -> tuple[list[OrientedStrip], int]:
+    """Every strip formed (:func:`form_strip`) and absolutely oriented on its control by the
+    7-parameter similarity; and the most iterations a relative orientation took.
+
+    Raises
+    ------
+    GeometryError
+        A strip without 3 full control points (names the strip).
+    """
+    if models not in MODELS:
+        raise GeometryError(f"strip models: expected one of {', '.join(MODELS)}, found {models!r}")
+    xy = interior_orientation(block)
+    rows_of = _rows_of(block)
+    prob = problem(block)
+    index = {p: j for j, p in enumerate(block.photos)}
+    out, iterations = [], 0
+    for s, names in enumerate(block.strips):
+        photos = [index[p] for p in names]
+        sm = form_strip(xy, rows_of, photos, block.camera.focal_length_mm, models)
+        iterations = max(iterations, sm.iterations)
+        ids, pts = sm.points()
+        where = {i: k for k, i in enumerate(ids.tolist())}
+        c = [k for k, i in enumerate(prob.control_point.tolist()) if i in where]
+        try:
+            t = fit_similarity7(
+                pts[[where[i] for i in prob.control_point[c].tolist()]],
+                prob.control_m[c].reshape(-1, 3),
+                prob.control_weight[c].reshape(-1, 3),
+            )
+        except GeometryError as exc:
+            raise GeometryError(
+                f"strip {s + 1} ({names[0]} …): absolute orientation: {exc}"
+            ) from None
+        out.append(
+            OrientedStrip(
+                tuple(photos),
+                t.rotation @ np.array(sm.rotations),
+                apply_similarity7(t, np.array(sm.centres)),
+                ids,
+                apply_similarity7(t, pts),
+            )
+        )
+    return out, iterations
+
+
+# long: strips formed and oriented, adjusted by polynomials, photos resected: the method's steps
 def strip_block(block: Block, models: str = "independent", degree: int = 3) -> BlockSolution:
     """Exterior orientation of every photo by strip triangulation and polynomial adjustment.
 
@@ -271,41 +329,19 @@ def strip_block(block: Block, models: str = "independent", degree: int = 3) -> B
         A strip without 3 full control points, a pair without 5 common points, too little
         control for the polynomials.
     """
-    if models not in MODELS:
-        raise GeometryError(f"strip models: expected one of {', '.join(MODELS)}, found {models!r}")
+    strips, iterations = oriented_strips(block, models)
     xy = interior_orientation(block)
     f = block.camera.focal_length_mm
     rows_of = _rows_of(block)
     prob = problem(block)
-    index = {p: j for j, p in enumerate(block.photos)}
-    obs_strip, obs_point, strip_xyz, axes, initial = [], [], [], [], {}
-    iterations = 0
-    for s, names in enumerate(block.strips):
-        photos = [index[p] for p in names]
-        sm = form_strip(xy, rows_of, photos, f, models)
-        iterations = max(iterations, sm.iterations)
-        ids, pts = sm.points()
-        where = {i: k for k, i in enumerate(ids.tolist())}
-        c = [k for k, i in enumerate(prob.control_point.tolist()) if i in where]
-        if not c:
-            raise GeometryError(f"strip {s + 1} ({names[0]} …): no control point")
-        try:
-            t = fit_similarity7(
-                pts[[where[i] for i in prob.control_point[c].tolist()]],
-                prob.control_m[c],
-                prob.control_weight[c],
-            )
-        except GeometryError as exc:
-            raise GeometryError(
-                f"strip {s + 1} ({names[0]} …): absolute orientation: {exc}"
-            ) from None
-        centres = apply_similarity7(t, np.array(sm.centres))
-        for j, m, centre in zip(photos, sm.rotations, centres, strict=True):
-            initial[j] = (s, t.rotation @ m, centre)
-        obs_strip.append(np.full(ids.size, s))
-        obs_point.append(ids)
-        strip_xyz.append(apply_similarity7(t, pts))
-        axes.append(_axes(centres))
+    initial = {}
+    for s, st in enumerate(strips):
+        for j, m, centre in zip(st.photos, st.rotations, st.centres, strict=True):
+            initial[j] = (s, m, centre)
+    obs_strip = [np.full(st.point_ids.size, s) for s, st in enumerate(strips)]
+    obs_point = [st.point_ids for st in strips]
+    strip_xyz = [st.points_m for st in strips]
+    axes = [_axes(st.centres) for st in strips]
     height = np.mean([c[2][2] for c in initial.values()]) - np.mean(prob.control_m[:, 2])
     sigma_model = block.sigmas.photo_mm * height / f  # σ of a model coordinate at photo scale
     poly = adjust_strip_polynomials(
