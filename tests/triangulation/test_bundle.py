@@ -6,17 +6,18 @@ import dataclasses
 
 import numpy as np
 import pytest
+from conftest import arcsec, m
+from synthetic_blocks import block10x4, exact_block
 
 from stereoplotter.errors import GeometryError
 from stereoplotter.geometry.collinearity import object_to_photo
 from stereoplotter.geometry.rotation import rotation_matrix
 from stereoplotter.triangulation.bundle import bundle_adjust, problem
 from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
-from tests.conftest import arcsec, m
 
 
-def test_error_free_block_gives_the_true_orientations(exact_block):
-    block, truth = exact_block
+def test_error_free_block_gives_the_true_orientations():
+    block, truth = exact_block()
     s = bundle_adjust(problem(block))
     err = s.orientations - truth.orientations
     assert np.max(np.abs(err[:, :3])) < 1e-4 * arcsec
@@ -70,18 +71,18 @@ def test_covariance_equals_the_dense_inverse_of_the_full_normal_matrix():
     np.testing.assert_allclose(s.next_covariances[:-1], after, rtol=1e-4, atol=1e-14)
 
 
-def test_noisy_block_errors_match_the_propagated_sigma(block10x4):
+def test_noisy_block_errors_match_the_propagated_sigma():
     # the orientation errors against the truth, in units of their own σ: RMS 1 if the σ are right
     # (240 correlated values; a factor 1.5 either way would mean a wrong covariance)
-    block, truth = block10x4
+    block, truth = block10x4()
     s = bundle_adjust(problem(block))
     z = (s.orientations - truth.orientations) / s.standard_errors
     assert 1 / 1.5 < np.sqrt(np.mean(z**2)) < 1.5
     assert s.iterations <= 10
 
 
-def test_too_little_control_is_refused(block10x4):
-    block, _ = block10x4
+def test_too_little_control_is_refused():
+    block, _ = block10x4()
     no_control = dataclasses.replace(
         block, catalogue=tuple(dataclasses.replace(c, role="check") for c in block.catalogue)
     )
