@@ -35,20 +35,24 @@ import numpy as np
 from pydantic import ConfigDict, Field, field_validator
 
 from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.geometry.film import fiducial_spans_mm
 from stereoplotter.io.job_file import Certificate, NamedSheet, _check_date
 from stereoplotter.io.scenario_file import Origin, camera_from_model
 from stereoplotter.io.validation import FileModel, _fail, number, one_of, sequence, text, validate
 from stereoplotter.io.yaml_files import atomic_write_text, load_yaml_mapping
 from stereoplotter.scenario import frame as frame_tie
-from stereoplotter.scenario.model import Frame
+from stereoplotter.scenario.model import Camera, Frame
 from stereoplotter.triangulation.block import Block, CataloguePoint, Sigmas
 
 __all__ = [
     "FORMAT",
     "BlockMeasurementsFile",
     "Production",
+    "camera_yaml",
     "load_block_measurements",
     "write_block_measurements",
+    "yaml_flow",
+    "yaml_number",
 ]
 
 FORMAT = "stereoplotter-block-measurements/1"
@@ -278,6 +282,32 @@ def load_block_measurements(path: str | os.PathLike[str]) -> tuple[Block, Produc
     return block, production
 
 
+def yaml_number(value: float) -> str:
+    """A float as YAML 1.1 reads it back as a float (PyYAML takes ``1e-09`` for text)."""
+    text = repr(float(value))
+    mantissa, _, exponent = text.partition("e")
+    return f"{mantissa}.0e{exponent}" if exponent and "." not in mantissa else text
+
+
+def yaml_flow(**values: float) -> str:
+    """A YAML flow mapping of numbers: ``{key: value, …}``."""
+    return "{" + ", ".join(f"{k}: {yaml_number(v)}" for k, v in values.items()) + "}"
+
+
+def camera_yaml(cam: Camera) -> list[str]:
+    """The ``camera:`` section of a certificate with marks on the axes (lines of YAML)."""
+    spans = [float(v) for v in fiducial_spans_mm(cam.fiducials_mm)]
+    x0, y0 = (yaml_number(v) for v in cam.principal_point_mm)
+    return [
+        "camera:",
+        f"  focal_length_mm: {yaml_number(cam.focal_length_mm)}",
+        f"  principal_point_mm: [{x0}, {y0}]",
+        f"  format_mm: {yaml_number(cam.format_mm)}",
+        "  fiducials:",
+        f'    distances_mm: {{"1-2": {yaml_number(spans[0])}, "3-4": {yaml_number(spans[1])}}}',
+    ]
+
+
 def _csv_text(header: tuple[str, ...], rows: list[tuple[Any, ...]]) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
@@ -325,28 +355,25 @@ def write_block_measurements(
         (c.id, c.role, c.kind, f"{c.sk42_m[0]:.3f}", f"{c.sk42_m[1]:.3f}", f"{c.sk42_m[2]:.3f}")
         for c in block.catalogue
     ]
-    cam = block.camera
-    span = cam.fiducials_mm["2"][0] - cam.fiducials_mm["1"][0]
-    span34 = cam.fiducials_mm["3"][1] - cam.fiducials_mm["4"][1]
+    origin = block.origin_sk42_m
     s = block.sigmas
     text_lines = [
         f"format: {FORMAT}",
         f"name: {block.name}",
         *([f"description: >-\n  {description}"] if description else []),
-        "camera:",
-        f"  focal_length_mm: {cam.focal_length_mm!r}",
-        f"  principal_point_mm: [{cam.principal_point_mm[0]!r}, {cam.principal_point_mm[1]!r}]",
-        f"  format_mm: {cam.format_mm!r}",
-        "  fiducials:",
-        f'    distances_mm: {{"1-2": {span!r}, "3-4": {span34!r}}}',
+        *camera_yaml(block.camera),
         "frame:",
-        "  origin: {{north_m: {!r}, east_m: {!r}, height_m: {!r}}}".format(*block.origin_sk42_m),
+        "  origin: " + yaml_flow(north_m=origin[0], east_m=origin[1], height_m=origin[2]),
         "strips:",
         *[f"  - {_yaml_id_list(strip)}" for strip in block.strips],
         "measurements_csv: measurements.csv",
         "control_csv: control.csv",
-        f"sigma: {{photo_mm: {s.photo_mm!r}, control_plan_m: {s.control_plan_m!r}, "
-        f"control_height_m: {s.control_height_m!r}}}",
+        "sigma: "
+        + yaml_flow(
+            photo_mm=s.photo_mm,
+            control_plan_m=s.control_plan_m,
+            control_height_m=s.control_height_m,
+        ),
     ]
     files = {
         "measurements.csv": _csv_text(MEASUREMENT_COLUMNS, rows),

@@ -30,7 +30,7 @@ from stereoplotter.geodesy.gauss_kruger import geographic_from_gauss_kruger
 from stereoplotter.geodesy.map_sheet import sheet_bounds
 from stereoplotter.geodesy.photogrammetric import gauss_kruger_from_local
 from stereoplotter.geometry.film import fiducial_spans_mm
-from stereoplotter.io.block_measurements_file import Production
+from stereoplotter.io.block_measurements_file import Production, camera_yaml, yaml_flow
 from stereoplotter.io.job_file import FORMAT as JOB_FORMAT
 from stereoplotter.io.yaml_files import atomic_write_text
 from stereoplotter.scenario import frame as frame_tie
@@ -154,7 +154,6 @@ def job_files(
     1 mm, angles to 10⁻⁶°, as a listing prints them)."""
     numbers = [_photo_number(source, p) for p in block.photos]
     cam = block.camera
-    spans = [float(v) for v in fiducial_spans_mm(cam.fiducials_mm)]
     measured = fiducial_spans_mm({str(k + 1): block.fiducials_mm[:, k] for k in range(4)})
     origin = block.origin_sk42_m
     lines = [
@@ -166,15 +165,10 @@ def job_files(
         "description: >-",
         f"  {description}",
         f"instrument: {production.instrument}",
-        "camera:",
-        f"  focal_length_mm: {cam.focal_length_mm!r}",
-        f"  principal_point_mm: [{cam.principal_point_mm[0]!r}, {cam.principal_point_mm[1]!r}]",
-        f"  format_mm: {cam.format_mm!r}",
-        "  fiducials:",
-        f'    distances_mm: {{"1-2": {spans[0]!r}, "3-4": {spans[1]!r}}}',
+        *camera_yaml(cam),
         "frame:",
         "  kind: local",
-        f"  origin: {{north_m: {origin[0]!r}, east_m: {origin[1]!r}, height_m: {origin[2]!r}}}",
+        "  origin: " + yaml_flow(north_m=origin[0], east_m=origin[1], height_m=origin[2]),
         "photos:",
     ]
     for n, o in zip(numbers, orientations, strict=True):
