@@ -72,7 +72,7 @@ def test_photo_numbers_are_text(folder):
         ("control.csv", ",control,", ",kontrol,", r"control\.csv:\d+: role: expected one of"),
         (
             "block.yaml",
-            "photo_mm: 1e-09",
+            "photo_mm: 1.0e-09",
             "photo_mm: -1",
             r"block\.yaml: sigma\.photo_mm: expected",
         ),
