@@ -37,6 +37,19 @@ def add_arguments(sub: Any) -> None:
         "models with polynomials, or the polygon block adjustment",
     )
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    p.add_argument(
+        "--models",
+        choices=("independent", "dependent"),
+        default="independent",
+        help="strip method: how a strip is formed (default independent)",
+    )
+    p.add_argument(
+        "--degree",
+        type=int,
+        choices=(1, 2, 3),
+        default=3,
+        help="strip method: degree of the strip polynomials (default 3)",
+    )
     p.set_defaults(func=run)
     b = sub.add_parser("block", help="blocks of comparator measurements (docs/triangulation.md)")
     acts = b.add_subparsers(dest="block_command", required=True, metavar="ACTION")
@@ -51,6 +64,14 @@ def add_arguments(sub: Any) -> None:
         default=4,
         metavar="BASES",
         help="control spacing along the block edges in bases (default 4)",
+    )
+    s.add_argument(
+        "--control-degree",
+        type=int,
+        choices=(2, 3),
+        metavar="N",
+        help="instead: N + 1 control stations along the strips, spaced for polynomials of "
+        "degree N (the control spacing chosen from the residual variances)",
     )
     s.add_argument(
         "--sigma-photo",
@@ -69,16 +90,16 @@ def add_arguments(sub: Any) -> None:
     s.set_defaults(func=run_synth)
 
 
-def _solve(block: Any, method: str) -> Any:
+def _solve(block: Any, args: argparse.Namespace) -> Any:
     # imported here: the CLI starts without loading scipy's sparse solvers
-    if method == "bundle":
+    if args.method == "bundle":
         from stereoplotter.triangulation.bundle import bundle_block
 
         return bundle_block(block)
     from stereoplotter.triangulation import strip
 
-    if method == "strip":
-        return strip.strip_block(block)
+    if args.method == "strip":
+        return strip.strip_block(block, args.models, args.degree)
     from stereoplotter.triangulation.polygon_block import polygon_block
 
     return polygon_block(block)
@@ -94,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
     from stereoplotter.triangulation.solution import catalogue_residuals
 
     block, production = load_block_measurements(args.block)
-    solution = _solve(block, args.method)
+    solution = _solve(block, args)
     residuals = catalogue_residuals(block, solution)
     out = Path(args.output)
     atomic_write_bytes(out / "residuals.png", residual_figure_png(block, solution, residuals))
@@ -160,7 +181,13 @@ def run_synth(args: argparse.Namespace) -> int:
             raise ConfigError("block synth", name, f"an integer ≥ {low}", value)
     if not 0.0 < args.sigma_photo <= 0.1:
         raise ConfigError("block synth", "--sigma-photo", "a σ in (0, 0.1] mm", args.sigma_photo)
+    stations = None
+    if args.control_degree is not None:
+        from stereoplotter.triangulation.synth import control_stations_for_degree
+
+        stations = control_stations_for_degree(args.photos - 1, args.control_degree)
     spec = SynthSpec(
+        control_stations=stations,
         strips=args.strips,
         photos_per_strip=args.photos,
         name=args.name,

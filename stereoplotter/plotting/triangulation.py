@@ -20,10 +20,11 @@ __all__ = ["residual_figure", "residual_figure_png"]
 
 def residual_figure(block: Block, solution: BlockSolution, residuals: CatalogueResiduals) -> Figure:
     """The figure: photo centres by strip, plan residual arrows, height residual colours [m]."""
-    xyz = residuals.catalogue_m / 1000.0
-    v = np.nan_to_num(residuals.residuals_m)
-    kinds = np.array([block.catalogue[i].kind for i in residuals.index])
-    roles = np.array([block.catalogue[i].role for i in residuals.index])
+    seen = np.all(np.isfinite(residuals.residuals_m), axis=1)  # measured on ≥ 2 photos
+    xyz = residuals.catalogue_m[seen] / 1000.0
+    v = residuals.residuals_m[seen]
+    kinds = np.array([block.catalogue[i].kind for i in residuals.index[seen]])
+    roles = np.array([block.catalogue[i].role for i in residuals.index[seen]])
     v_plan = np.where((kinds == "height")[:, None], 0.0, v[:, :2])
     v_height = np.where(kinds == "plan", 0.0, v[:, 2])
     span = float(np.ptp(xyz[:, :2], axis=0).max()) or 1.0

@@ -156,8 +156,19 @@ def catalogue_residuals(block: Block, solution: BlockSolution) -> CatalogueResid
 
 def sparse_least_squares(a: sp.spmatrix, b: NDArray) -> NDArray[np.float64]:
     """Least squares of a sparse full-rank system by its normal equations, scaled to unit
-    diagonal and factored by sparse LU (SuperLU). Raises RuntimeError when exactly singular."""
+    diagonal and factored by sparse LU (SuperLU).
+
+    Raises RuntimeError when singular: exactly, or a pivot below 10⁻¹⁰ of the largest (at unit
+    diagonal a rank defect leaves pivots at rounding level, ~10⁻¹⁴; a weak but determined
+    geometry keeps them orders above 10⁻¹⁰).
+    """
     n = (a.T @ a).tocsc()
     scale = 1.0 / np.sqrt(n.diagonal())
     d = sp.diags(scale)
-    return scale * spla.splu((d @ n @ d).tocsc()).solve(scale * (a.T @ b))
+    lu = spla.splu((d @ n @ d).tocsc())
+    pivots = np.abs(lu.U.diagonal())
+    if pivots.min() < 1e-10 * pivots.max():
+        raise RuntimeError(
+            f"singular normal matrix (pivot ratio {pivots.min() / pivots.max():.1e})"
+        )
+    return scale * lu.solve(scale * (a.T @ b))

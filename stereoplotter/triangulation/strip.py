@@ -311,6 +311,26 @@ def oriented_strips(block: Block, models: str = "independent") -> tuple[list[Ori
     return out, iterations
 
 
+def _check_height_stations(block: Block, strips: list[OrientedStrip], degree: int) -> None:
+    """Refuse a degree the height control cannot fix: each strip needs height control at
+    degree + 1 stations along it (control points more than half a base apart count as two
+    stations; ties to other strips fix no heights)."""
+    prob = problem(block)
+    heights = prob.control_point[prob.control_weight[:, 2] > 0]
+    for s, st in enumerate(strips):
+        ax = _axes(st.centres)
+        inside = np.isin(st.point_ids, heights)
+        u = np.sort(ax.uv(st.points_m[inside, :2])[0] * ax.half)
+        base = 2.0 * ax.half / max(1, len(st.photos) - 1)
+        stations = int(u.size > 0) + int(np.count_nonzero(np.diff(u) > base / 2.0))
+        if stations < degree + 1:
+            raise GeometryError(
+                f"strip {s + 1} ({block.strips[s][0]} …) has height control at {stations} "
+                f"stations along it: polynomials of degree {degree} need {degree + 1} (give "
+                "more control or a lower degree)"
+            )
+
+
 # long: strips formed and oriented, adjusted by polynomials, photos resected: the method's steps
 def strip_block(block: Block, models: str = "independent", degree: int = 3) -> BlockSolution:
     """Exterior orientation of every photo by strip triangulation and polynomial adjustment.
@@ -330,6 +350,7 @@ def strip_block(block: Block, models: str = "independent", degree: int = 3) -> B
         control for the polynomials.
     """
     strips, iterations = oriented_strips(block, models)
+    _check_height_stations(block, strips, degree)
     xy = interior_orientation(block)
     f = block.camera.focal_length_mm
     rows_of = _rows_of(block)

@@ -33,7 +33,7 @@ from stereoplotter.triangulation.block import (
     sk42_from_block_local,
 )
 
-__all__ = ["SynthSpec", "Truth", "synthesize_block"]
+__all__ = ["SynthSpec", "Truth", "control_stations_for_degree", "synthesize_block"]
 
 #: The §10 origin of the shipped scenario pair60 (SK-42 zone 5, the book's §27 setting). [m]
 DEFAULT_ORIGIN_SK42_M = (6167100.0, 5352300.0, 0.0)
@@ -47,7 +47,8 @@ class SynthSpec:
     format, marks 85 mm from the centre, photo scale ≈ 1:20 000), forward overlap 60 % and side
     overlap 30 % (the usual aerial survey), tilts of σ 1° and swing of σ 1.5° (the tilts of the
     shipped block strip60 stay within 1°), σ 5 µm per comparator coordinate (a stereocomparator),
-    control to 5 cm.
+    control to 5 cm. ``control_stations`` (base numbers 0 … n_bases along every strip) replaces
+    the regular ``control_every_bases`` (e.g. :func:`control_stations_for_degree`).
     """
 
     strips: int = 4
@@ -63,6 +64,7 @@ class SynthSpec:
     position_sigma_m: float = 20.0
     terrain_relief_m: float = 100.0
     control_every_bases: int = 4
+    control_stations: tuple[int, ...] | None = None
     sigma_photo_mm: float = 0.005
     sigma_control_m: float = 0.05
     film_deformation_ppm: float = 50.0
@@ -91,6 +93,17 @@ class Truth:
     orientations: NDArray[np.float64]
     points_m: NDArray[np.float64]
     terrain: Terrain
+
+
+def control_stations_for_degree(n_bases: int, degree: int) -> tuple[int, ...]:
+    """Base numbers of degree + 1 control stations along a strip of ``n_bases`` bases, chosen
+    from the residual variances of the strip polynomial (Burshtynskaya's control spacing,
+    :func:`stereoplotter.triangulation.control_spacing.choose_control_spacing`)."""
+    try:
+        from stereoplotter.triangulation.control_spacing import choose_control_spacing
+    except ImportError:  # until control_spacing lands: evenly spaced, ends included
+        return tuple(sorted({round(k * n_bases / degree) for k in range(degree + 1)}))
+    return tuple(int(b) for b in choose_control_spacing(n_bases, degree))
 
 
 def _terrain(spec: SynthSpec, rng: np.random.Generator, extent: NDArray) -> Terrain:
@@ -146,9 +159,11 @@ def _grid(spec: SynthSpec, rng: np.random.Generator) -> tuple[NDArray, NDArray, 
 def _roles(spec: SynthSpec, c: NDArray, r: NDArray) -> tuple[NDArray, NDArray]:
     """Role and kind per grid point: full control on the outer rows and end columns every
     ``control_every_bases`` bases, height control on inner strip boundaries at those columns."""
-    step = 2 * spec.control_every_bases
     last = 2 * (spec.photos_per_strip - 1)
-    at_station = ((c - 0) % step == 0) | (c == last)
+    if spec.control_stations is not None:
+        at_station = np.isin(c, 2 * np.asarray(spec.control_stations))
+    else:
+        at_station = (c % (2 * spec.control_every_bases) == 0) | (c == last)
     at_station &= (c >= 0) & (c <= last)
     outer = (r == r.min()) | (r == r.max())
     boundary = (r % 2 == 1) & ~outer
