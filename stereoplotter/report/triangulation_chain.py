@@ -83,17 +83,36 @@ def _perturbed(args: dict, k: int, sign: float) -> dict:
     return {**args, "centres_m": centres, "rotations": rotations}
 
 
+def _drawn(args: dict, deltas: NDArray) -> list[dict]:
+    """The pair's sheet arguments with its 12 elements moved by each row of ``deltas``."""
+    out = []
+    centres = np.array(args["centres_m"], float)
+    angles = [np.array(angles_from_matrix(m), float) for m in np.array(args["rotations"], float)]
+    for d in deltas:
+        rot = np.array([rotation_matrix(*(angles[k] + d[6 * k : 6 * k + 3])) for k in range(2)])
+        out.append({**args, "centres_m": centres + d.reshape(2, 6)[:, 3:], "rotations": rot})
+    return out
+
+
 def chain_comparison(
     job_path: str | os.PathLike[str],
     truth_job_path: str | os.PathLike[str],
     block: Block,
     solution: BlockSolution,
+    draws: int = 0,
+    rng: np.random.Generator | None = None,
 ) -> list[ChainRow]:
     """Every accepted pair's sheet values, triangulated against true, with propagated σ.
 
     The jobs must be the block's (pairs of consecutive photos; local frame, as
     :mod:`stereoplotter.io.triangulated_job` writes them); ``solution`` must carry covariances.
+    ``draws`` = 0: linear propagation (central differences); > 0: Monte Carlo, the σ of the
+    sheet values over ``draws`` draws of the pair's 12 elements from their covariance (with
+    ``rng``) — needed for values that depend on the tilts to second order near zero tilt (the
+    mark spans L), where the linear σ vanishes.
     """
+    if draws:
+        return _chain_monte_carlo(job_path, truth_job_path, block, solution, draws, rng)
     job, truth = load_job(job_path), load_job(truth_job_path)
     tri, ref = compute_job(job), compute_job(truth)
     options = _options(job)
@@ -118,6 +137,35 @@ def chain_comparison(
         cov = solution.pair_covariance(index[str(p.pair.left)])
         assert cov is not None, "the solution has no covariances"
         sigma = np.sqrt(np.einsum("qi,ij,qj->q", jac, cov, jac))
+        a, b = _values(p.sheet), _values(q.sheet)
+        rows += [
+            ChainRow(p.pair.name, name, unit, float(a[i]), float(b[i]), float(sigma[i]))
+            for i, (name, unit, _) in enumerate(QUANTITIES)
+        ]
+    return rows
+
+
+def _chain_monte_carlo(job_path, truth_job_path, block, solution, draws, rng) -> list[ChainRow]:
+    rng = rng if rng is not None else np.random.default_rng(0)
+    job, truth = load_job(job_path), load_job(truth_job_path)
+    tri, ref = compute_job(job), compute_job(truth)
+    index = {p: j for j, p in enumerate(block.photos)}
+    ready = [(p, q) for p, q in zip(tri.pairs, ref.pairs, strict=True) if p.sheet and q.sheet]
+    batch = []
+    for p, _ in ready:
+        assert p.measured is not None
+        cov = solution.pair_covariance(index[str(p.pair.left)])
+        assert cov is not None, "the solution has no covariances"
+        deltas = rng.multivariate_normal(np.zeros(12), cov, size=draws)
+        batch += _drawn(p.measured.sheet_arguments(), deltas)
+    sheets = compute_sheets_from_measurements(
+        batch, spec=tri.spec, options=_options(job), source=job.source, name=job.name
+    )
+    rows: list[ChainRow] = []
+    for n, (p, q) in enumerate(ready):
+        assert p.sheet is not None and q.sheet is not None
+        drawn = [s for s in sheets[draws * n : draws * (n + 1)] if isinstance(s, SetupSheet)]
+        sigma = np.std(np.array([_values(s) for s in drawn]), axis=0, ddof=1)
         a, b = _values(p.sheet), _values(q.sheet)
         rows += [
             ChainRow(p.pair.name, name, unit, float(a[i]), float(b[i]), float(sigma[i]))

@@ -36,6 +36,7 @@ __all__ = [
     "block_frame",
     "catalogue_local",
     "interior_orientation",
+    "photo_coordinates",
     "sk42_from_block_local",
 ]
 
@@ -136,20 +137,27 @@ def interior_orientation(block: Block) -> NDArray[np.float64]:
     GeometryError
         Degenerate fiducial marks on a photo (names the photo).
     """
-    cam = block.camera
-    calibrated = fiducial_spans_mm(cam.fiducials_mm)
-    measured = fiducial_spans_mm({str(k + 1): block.fiducials_mm[:, k] for k in range(4)})
     out = np.empty_like(block.comparator_mm)
     order = np.argsort(block.obs_photo, kind="stable")
     bounds = np.searchsorted(block.obs_photo[order], np.arange(len(block.photos) + 1))
     for j, photo in enumerate(block.photos):
         rows = order[bounds[j] : bounds[j + 1]]
         try:
-            xy = to_fiducial_system(block.comparator_mm[rows], block.fiducials_mm[j])
+            out[rows] = photo_coordinates(
+                block.camera, block.comparator_mm[rows], block.fiducials_mm[j]
+            )
         except GeometryError as exc:
             raise GeometryError(f"photo {photo}: {exc}") from None
-        out[rows] = xy * (calibrated / measured[j])
-    return out - np.asarray(cam.principal_point_mm, float)
+    return out
+
+
+def photo_coordinates(cam: Camera, comparator_mm: NDArray, marks_mm: NDArray) -> NDArray:
+    """The interior orientation of :func:`interior_orientation` for one photo: comparator
+    points (n, 2) and its four measured marks (4, 2) → x, y relative to the principal point."""
+    calibrated = fiducial_spans_mm(cam.fiducials_mm)
+    measured = fiducial_spans_mm({str(k + 1): marks_mm[k] for k in range(4)})
+    xy = to_fiducial_system(comparator_mm, marks_mm) * (calibrated / measured)
+    return xy - np.asarray(cam.principal_point_mm, float)
 
 
 def block_frame(block: Block) -> LocalFrame:

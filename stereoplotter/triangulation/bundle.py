@@ -21,6 +21,7 @@ The first approximation is the plan similarity block of :func:`initial_approxima
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,10 +31,22 @@ from numpy.typing import NDArray
 
 from stereoplotter.errors import GeometryError
 from stereoplotter.geometry.resection import _model_and_jacobian
-from stereoplotter.triangulation.block import Block, catalogue_local, interior_orientation
+from stereoplotter.triangulation.block import (
+    Block,
+    catalogue_local,
+    interior_orientation,
+    photo_coordinates,
+)
 from stereoplotter.triangulation.solution import BlockSolution, sparse_least_squares
 
-__all__ = ["BundleProblem", "bundle_adjust", "bundle_block", "initial_approximation", "problem"]
+__all__ = [
+    "BundleProblem",
+    "bundle_adjust",
+    "bundle_block",
+    "initial_approximation",
+    "interior_orientation_covariance",
+    "problem",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -335,6 +348,52 @@ def bundle_adjust(
     return BlockSolution("bundle", orient, cov, points, it, sigma0, notes, after)
 
 
+def interior_orientation_covariance(
+    block: Block, p: BundleProblem, solution: BlockSolution
+) -> NDArray[np.float64]:
+    r"""Covariance (n_photos, 6, 6) the interior orientation adds to each photo's elements.
+
+    The four marks of a photo are measured with the σ of a point; the error of the fiducial
+    system they define moves every point of that photo together, which the adjustment (each
+    measurement independent) does not see. Its effect on the photo's elements, the points held:
+    C = σ²·G·D·Dᵀ·Gᵀ with D = ∂(x, y)/∂(the 8 mark coordinates) of the photo's points (central
+    differences of :func:`~stereoplotter.triangulation.block.photo_coordinates`, the interior
+    orientation the adjustment used) and G = (JᵀJ)⁻¹Jᵀ the least-squares map of photo
+    residuals to the elements (J of Eq. (2.53) at the solution).
+    """
+    keep = np.bincount(block.obs_point, minlength=len(block.point_ids))[block.obs_point] >= 2
+    rows_all = np.flatnonzero(keep)
+    _, jac = _linearise(p, solution.orientations, np.nan_to_num(solution.points_m))
+    out = np.zeros((p.n_photos, 6, 6))
+    h = 1e-3  # mm: the interior orientation is linear in the marks to far below this
+    for j in range(p.n_photos):
+        mine = np.flatnonzero(p.obs_photo == j)
+        if mine.size < 3:
+            continue
+        comparator = block.comparator_mm[rows_all[mine]]
+        d = np.empty((2 * mine.size, 8))
+        for k in range(8):
+            e = np.zeros((4, 2))
+            e.flat[k] = h
+            marks = block.fiducials_mm[j]
+            d[:, k] = (
+                photo_coordinates(block.camera, comparator, marks + e)
+                - photo_coordinates(block.camera, comparator, marks - e)
+            ).ravel() / (2 * h)
+        a = jac[mine].reshape(-1, 6)
+        g = np.linalg.solve(a.T @ a, a.T)
+        out[j] = block.sigmas.photo_mm**2 * g @ d @ d.T @ g.T
+    return out
+
+
 def bundle_block(block: Block, **options) -> BlockSolution:
-    """:func:`bundle_adjust` of :func:`problem` of a block."""
-    return bundle_adjust(problem(block), **options)
+    """:func:`bundle_adjust` of :func:`problem` of a block; with ``covariance`` (the default)
+    each photo's covariance includes its interior orientation's
+    (:func:`interior_orientation_covariance`)."""
+    p = problem(block)
+    s = bundle_adjust(p, **options)
+    if s.covariances is None:
+        return s
+    extra = interior_orientation_covariance(block, p, s)
+    notes = (*s.notes, "σ of the elements include the interior orientation's (4 marks per photo)")
+    return dataclasses.replace(s, covariances=s.covariances + extra, notes=notes)
