@@ -76,11 +76,29 @@ def test_strip_method_runs_from_the_command_line(chain, tmp_path):
         str(chain / "block" / "block.yaml"),
         "--method",
         "strip",
+        "--degree",
+        "2",
         "-o",
         str(tmp_path),
     ]
     assert main(argv) == 0
     assert "strip" in (tmp_path / "report.md").read_text(encoding="utf-8")
+
+
+def test_a_degree_the_control_cannot_fix_is_refused(chain, tmp_path, capsys):
+    # control at bases 0, 2, 4 of each strip: three stations fix a quadratic, not a cubic
+    argv = [
+        "triangulate",
+        str(chain / "block" / "block.yaml"),
+        "--method",
+        "strip",
+        "--degree",
+        "3",
+        "-o",
+        str(tmp_path),
+    ]
+    assert main(argv) == 1
+    assert "height control at 3 stations" in capsys.readouterr().err
 
 
 def test_bad_block_file_is_one_error_line(tmp_path, capsys):
