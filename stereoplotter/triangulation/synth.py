@@ -45,10 +45,12 @@ class SynthSpec:
 
     Defaults: the book's §27 setting of the worked job ``jobs/strip8`` (f = 70 mm, 180 mm
     format, marks 85 mm from the centre, photo scale ≈ 1:20 000), forward overlap 60 % and side
-    overlap 30 % (the usual aerial survey), tilts of σ 1° and swing of σ 1.5° (the tilts of the
-    shipped block strip60 stay within 1°), σ 5 µm per comparator coordinate (a stereocomparator),
-    control to 5 cm. ``control_stations`` (base numbers 0 … n_bases along every strip) replaces
-    the regular ``control_every_bases`` (e.g. :func:`control_stations_for_degree`).
+    overlap 30 % (the usual aerial survey), tilts of σ 1° and swing of σ 1.5°, both clipped at
+    2σ (the tilts of the shipped block strip60 stay within 1°; a tie point at the next photo's
+    nadir must stay in the usable field), σ 5 µm per comparator coordinate (a
+    stereocomparator), control to 5 cm. ``control_stations`` (base numbers 0 … n_bases along
+    every strip) replaces the regular ``control_every_bases`` (e.g.
+    :func:`control_stations_for_degree`).
     """
 
     strips: int = 4
@@ -107,9 +109,10 @@ def control_stations_for_degree(n_bases: int, degree: int) -> tuple[int, ...]:
 
 
 def _terrain(spec: SynthSpec, rng: np.random.Generator, extent: NDArray) -> Terrain:
-    """A base of 150 m, a gentle slope and one hill or hollow per ~25 km² of relief ± relief."""
+    """A base of 150 m, a gentle slope and one hill or hollow of up to ± relief per ~100 km²
+    (denser hills add up to twice the relief, which takes tie points out of the usable field)."""
     area = float(np.prod(extent[1] - extent[0]))
-    n = max(2, round(area / 25e6))
+    n = max(2, round(area / 100e6))
     hills = tuple(
         Hill(
             float(rng.uniform(extent[0, 0], extent[1, 0])),
@@ -122,19 +125,22 @@ def _terrain(spec: SynthSpec, rng: np.random.Generator, extent: NDArray) -> Terr
     return Terrain(150.0, (0.002, -0.001), hills)
 
 
-def _stations(spec: SynthSpec, rng: np.random.Generator, terrain_mean: float) -> NDArray:
+def _stations(spec: SynthSpec, rng: np.random.Generator, terrain: Terrain) -> NDArray:
+    """Stations on the strip lines; each strip flown at the photo scale's height above the mean
+    ground under it (a pilot keeps the scale over a slope)."""
     ns, npp = spec.strips, spec.photos_per_strip
     X = (np.arange(npp) - (npp - 1) / 2.0) * spec.base_m
     Y = (np.arange(ns) - (ns - 1) / 2.0) * spec.strip_spacing_m
     gx, gy = np.meshgrid(X, Y)
     n = ns * npp
-    flying = terrain_mean + spec.focal_length_mm * 1e-3 * spec.scale
-    tilt = np.radians(spec.tilt_sigma_deg)
+    ground = terrain.height_m(gx, gy).mean(axis=1, keepdims=True) + 0.0 * gx
+    flying = ground.ravel() + spec.focal_length_mm * 1e-3 * spec.scale
+    tilt, swing = np.radians(spec.tilt_sigma_deg), np.radians(spec.swing_sigma_deg)
     return np.column_stack(
         [
-            np.clip(rng.normal(0.0, tilt, n), -3 * tilt, 3 * tilt),
-            np.clip(rng.normal(0.0, tilt, n), -3 * tilt, 3 * tilt),
-            rng.normal(0.0, np.radians(spec.swing_sigma_deg), n),
+            np.clip(rng.normal(0.0, tilt, n), -2 * tilt, 2 * tilt),
+            np.clip(rng.normal(0.0, tilt, n), -2 * tilt, 2 * tilt),
+            np.clip(rng.normal(0.0, swing, n), -2 * swing, 2 * swing),
             gx.ravel() + rng.normal(0.0, spec.position_sigma_m, n),
             gy.ravel() + rng.normal(0.0, spec.position_sigma_m, n),
             flying + rng.normal(0.0, spec.height_sigma_m, n),
@@ -149,7 +155,7 @@ def _grid(spec: SynthSpec, rng: np.random.Generator) -> tuple[NDArray, NDArray, 
     rows = np.arange(-1, 2 * (ns - 1) + 2)  # half-spacing rows, the outer edges included
     c, r = np.meshgrid(cols, rows)
     c, r = c.ravel(), r.ravel()
-    X = (c / 2.0 - (npp - 1) / 2.0) * spec.base_m + rng.uniform(-0.03, 0.03, c.size) * spec.base_m
+    X = (c / 2.0 - (npp - 1) / 2.0) * spec.base_m + rng.uniform(-0.02, 0.02, c.size) * spec.base_m
     Y = (r / 2.0 - (ns - 1) / 2.0) * spec.strip_spacing_m + rng.uniform(
         -0.05, 0.05, c.size
     ) * spec.strip_spacing_m
@@ -194,7 +200,7 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
     extent = np.array([xy.min(axis=0), xy.max(axis=0)])
     terrain = _terrain(spec, rng, extent)
     points = np.column_stack([xy, terrain.height_m(xy[:, 0], xy[:, 1])])
-    stations = _stations(spec, rng, float(points[:, 2].mean()))
+    stations = _stations(spec, rng, terrain)
     strips = tuple(
         tuple(str(100 * (s + 1) + k + 1) for k in range(spec.photos_per_strip))
         for s in range(spec.strips)
