@@ -17,6 +17,7 @@ their own normal error. Randomness only from the ``Generator`` passed in.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -248,17 +249,5 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
         for i, s in zip(in_catalogue, sk42, strict=True)
     )
     sigmas = Sigmas(spec.sigma_photo_mm, spec.sigma_control_m, spec.sigma_control_m)
-    block = Block(
-        spec.name,
-        cam,
-        strips,
-        fiducials,
-        obs_photo,
-        obs_point,
-        measured,
-        ids,
-        catalogue,
-        spec.origin_sk42_m,
-        sigmas,
-    )
+    block = dataclasses.replace(block0, catalogue=catalogue, sigmas=sigmas)
     return block, Truth(stations, points, terrain)
