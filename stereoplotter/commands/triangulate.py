@@ -17,6 +17,42 @@ import sys
 from pathlib import Path
 from typing import Any
 
+try:
+    from stereoplotter.commands.arguments import bounded_float, bounded_int, seed_int
+except ImportError:  # until commands/arguments.py lands (the CLI restructuring): the same types
+
+    def bounded_int(low: int, high: int | None = None) -> Any:
+        """An argparse ``type=``: an integer in [low, high]."""
+        expected = f"an integer ≥ {low}" if high is None else f"an integer in [{low}, {high}]"
+
+        def parse(text: str) -> int:
+            try:
+                value = int(text, 10)
+            except ValueError:
+                raise argparse.ArgumentTypeError(f"expected {expected}, found {text!r}") from None
+            if value < low or (high is not None and value > high):
+                raise argparse.ArgumentTypeError(f"expected {expected}, found {value}")
+            return value
+
+        return parse
+
+    def bounded_float(low: float, high: float) -> Any:
+        """An argparse ``type=``: a finite number in [low, high]."""
+        expected = f"a number in [{low:g}, {high:g}]"
+
+        def parse(text: str) -> float:
+            try:
+                value = float(text)
+            except ValueError:
+                raise argparse.ArgumentTypeError(f"expected {expected}, found {text!r}") from None
+            if not (math.isfinite(value) and low <= value <= high):
+                raise argparse.ArgumentTypeError(f"expected {expected}, found {text}")
+            return value
+
+        return parse
+
+    seed_int = bounded_int(0, 2**63 - 1)
+
 __all__ = ["add_arguments", "run", "run_synth"]
 
 METHODS = ("bundle", "strip", "polygon")
@@ -55,12 +91,16 @@ def add_arguments(sub: Any) -> None:
     acts = b.add_subparsers(dest="block_command", required=True, metavar="ACTION")
     s = acts.add_parser("synth", help="a synthetic block from an invented ground truth")
     s.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
-    s.add_argument("--strips", type=int, default=4, help="number of strips (default 4)")
-    s.add_argument("--photos", type=int, default=10, help="photos per strip (default 10)")
-    s.add_argument("--seed", type=int, default=1, help="seed of the truth and the errors")
+    s.add_argument(
+        "--strips", type=bounded_int(1, 200), default=4, help="number of strips (default 4)"
+    )
+    s.add_argument(
+        "--photos", type=bounded_int(2, 500), default=10, help="photos per strip (default 10)"
+    )
+    s.add_argument("--seed", type=seed_int, default=1, help="seed of the truth and the errors")
     s.add_argument(
         "--control-every",
-        type=int,
+        type=bounded_int(1, 100),
         default=4,
         metavar="BASES",
         help="control spacing along the block edges in bases (default 4)",
@@ -75,10 +115,10 @@ def add_arguments(sub: Any) -> None:
     )
     s.add_argument(
         "--sigma-photo",
-        type=float,
+        type=bounded_float(1e-9, 0.1),
         default=0.005,
         metavar="MM",
-        help="σ of a comparator coordinate [mm] (default 0.005)",
+        help="σ of a comparator coordinate [mm] (default 0.005: a stereocomparator)",
     )
     s.add_argument("--name", default="synthetic", help="name of the block")
     s.add_argument("--instrument", default="sc1", help="instrument of the production job")
@@ -162,7 +202,6 @@ def run_synth(args: argparse.Namespace) -> int:
     # imported here: the CLI starts fast (numpy, pyproj, pydantic load only when a command runs)
     import numpy as np
 
-    from stereoplotter.errors import ConfigError
     from stereoplotter.io.block_measurements_file import (
         load_block_measurements,
         write_block_measurements,
@@ -172,15 +211,6 @@ def run_synth(args: argparse.Namespace) -> int:
     from stereoplotter.random_streams import key_code
     from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
 
-    for name, value, low in (
-        ("--strips", args.strips, 1),
-        ("--photos", args.photos, 2),
-        ("--control-every", args.control_every, 1),
-    ):
-        if value < low:
-            raise ConfigError("block synth", name, f"an integer ≥ {low}", value)
-    if not 0.0 < args.sigma_photo <= 0.1:
-        raise ConfigError("block synth", "--sigma-photo", "a σ in (0, 0.1] mm", args.sigma_photo)
     stations = None
     if args.control_degree is not None:
         from stereoplotter.triangulation.synth import control_stations_for_degree
