@@ -69,6 +69,7 @@ class BundleProblem:
     control_weight: NDArray[np.float64]
     f_mm: float
     sigma_photo_mm: float
+    point_ids: tuple[str, ...] = ()
 
 
 def problem(block: Block) -> BundleProblem:
@@ -99,6 +100,7 @@ def problem(block: Block) -> BundleProblem:
         control_weight=np.array(cw, float).reshape(-1, 3),
         f_mm=block.camera.focal_length_mm,
         sigma_photo_mm=s.photo_mm,
+        point_ids=block.point_ids,
     )
 
 
@@ -220,6 +222,15 @@ def _step(p, orient, points, pairs, factor_only=False):
     vv = float(np.sum(v**2) * w + np.sum(p.control_weight * dc**2))
     unused = np.bincount(p.obs_point, minlength=p.n_points) == 0
     npp[unused] = np.eye(3)
+    det = np.linalg.det(npp)
+    scale3 = np.einsum("nii->n", npp) ** 3
+    weak = np.flatnonzero(~(np.abs(det) > 1e-12 * scale3))
+    if weak.size:
+        name = p.point_ids[weak[0]] if p.point_ids else f"#{weak[0]}"
+        raise GeometryError(
+            f"point {name}: its rays do not fix it (measured on photos that see "
+            "it along one line?): check the point identification"
+        )
     pinv = np.linalg.inv(npp)
     ncp = w * np.einsum("nki,nkj->nij", jc, jp)  # per measurement, 6 × 3
     pt = p.obs_point[pairs.first]
