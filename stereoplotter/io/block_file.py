@@ -96,6 +96,7 @@ class Block:
         return len(self.model_names)
 
 
+
 # --- the models -------------------------------------------------------------------------------
 
 _TILT_BASIS = f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°"

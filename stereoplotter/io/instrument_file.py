@@ -257,11 +257,9 @@ def _value_schema(leaf: _Leaf) -> dict[str, Any]:
             zero = ", containing 0" if leaf.contains_zero else ""
             out["description"] = f"[lo, hi], lo ≤ hi{zero}"
     else:
-        item = (
-            number
-            if kind == "number_list"
-            else {"type": "integer", "minimum": int(leaf.low), "maximum": int(leaf.high)}
-        )
+        item = number if kind == "number_list" else {
+            "type": "integer", "minimum": int(leaf.low), "maximum": int(leaf.high)
+        }
         out = {"type": "array", "items": item, "minItems": 1, "description": "increasing"}
     if unit:
         out["description"] = f"{out.get('description', '')} {unit}".strip()
@@ -307,7 +305,9 @@ class LeafBase(FileModel):
         },
     )
 
-    status: Annotated[str, BeforeValidator(_check_status), WithJsonSchema({"enum": list(STATUSES)})]
+    status: Annotated[
+        str, BeforeValidator(_check_status), WithJsonSchema({"enum": list(STATUSES)})
+    ]
     src: Annotated[
         tuple[str, ...],
         BeforeValidator(_check_sources),
@@ -369,7 +369,9 @@ class _SectionBase(FileModel):
 
 
 def _section_model(section: str) -> type[FileModel]:
-    leaves = {name: (_LEAF_MODELS[f"{section}.{name}"] | None, None) for name in _SECTIONS[section]}
+    leaves = {
+        name: (_LEAF_MODELS[f"{section}.{name}"] | None, None) for name in _SECTIONS[section]
+    }
     return create_model(  # type: ignore[call-overload]
         section.capitalize() + "Section", __base__=_SectionBase, **leaves
     )
@@ -566,8 +568,8 @@ def _check_mechanics(spec: InstrumentSpec) -> None:
     try:
         CoordinatographParams.from_instrument(spec)
     except StereoplotterError as exc:
-        mass_key = (
-            "mechanics.pen_carriage_mass_kg" if " Y:" in str(exc) else ("mechanics.bridge_mass_kg")
+        mass_key = "mechanics.pen_carriage_mass_kg" if " Y:" in str(exc) else (
+            "mechanics.bridge_mass_kg"
         )
         raise refuse(mass_key, exc, "or lower mechanics.friction_coefficient") from None
 
@@ -678,7 +680,6 @@ def _cross_check(params: Mapping[str, Parameter], source: str) -> None:
                 d_max.value,
                 "D_max is the deepest position of the carriage; change both together",
             )
-
 
 def list_instruments() -> list[str]:
     """Short names of the instrument files in the ``instruments`` data folder.

@@ -111,12 +111,9 @@ class Certificate(FileModel):
     principal_point_mm: vector(2, "mm", -5.0, 5.0) = (0.0, 0.0)  # type: ignore[valid-type]
     format_mm: number("mm", 50.0, 300.0) = 180.0  # type: ignore[valid-type]
     fiducials: Fiducials
-    distortion: (
-        sequence(  # type: ignore[valid-type]
-            vector(2, "mm, µm", -1000.0, 1000.0, "r [mm], Δr [µm]")
-        )
-        | None
-    ) = None
+    distortion: sequence(  # type: ignore[valid-type]
+        vector(2, "mm, µm", -1000.0, 1000.0, "r [mm], Δr [µm]")
+    ) | None = None
 
 
 class FrameModel(FileModel):
@@ -399,9 +396,8 @@ def _coordinates(
         try:
             frame_tie.check_conventional_ordinate(values[1])
         except StereoplotterError as exc:
-            raise ConfigError(
-                where, f"{path}.east_m".lstrip("."), "a conventional ordinate", values[1], str(exc)
-            ) from None
+            raise ConfigError(where, f"{path}.east_m".lstrip("."), "a conventional ordinate",
+                              values[1], str(exc)) from None
     return (float(values[0]), float(values[1]), float(values[2]))
 
 
@@ -440,9 +436,8 @@ def _photos(
         photos[p.number] = JobPhoto(p.number, centre, angles, (float(d[0]), float(d[1])))  # type: ignore[arg-type]
     unknown = sorted(set(csv_distances) - set(photos))
     if unknown:
-        raise ConfigError(
-            csv_distances[unknown[0]][0], "photo", "a photo number of the job", unknown[0]
-        )
+        raise ConfigError(csv_distances[unknown[0]][0], "photo", "a photo number of the job",
+                          unknown[0])
     return photos
 
 
@@ -482,9 +477,8 @@ def _map_sheets(fields: Fields, models: list[NamedSheet]) -> dict[str, MapSheet]
         path = f"map_sheets[{i}]"
         if m.corners is not None:
             if len(m.corners) != 4:
-                raise fields.error(
-                    f"{path}.corners", "4 corners (NW, NE, SE, SW)", f"{len(m.corners)} corners"
-                )
+                raise fields.error(f"{path}.corners", "4 corners (NW, NE, SE, SW)",
+                                   f"{len(m.corners)} corners")
             corners = np.array([_corner(fields, c, f"{path}.corners[{j}]")
                                 for j, c in enumerate(m.corners)])  # fmt: skip
             name = m.name or f"sheet {i + 1}"
@@ -494,13 +488,11 @@ def _map_sheets(fields: Fields, models: list[NamedSheet]) -> dict[str, MapSheet]
             try:
                 corners, scale = frame_tie.sheet_corners_sk42(m.nomenclature)
             except StereoplotterError as exc:
-                raise fields.error(
-                    f"{path}.nomenclature", "a valid SK-42 nomenclature", m.nomenclature, str(exc)
-                ) from None
+                raise fields.error(f"{path}.nomenclature", "a valid SK-42 nomenclature",
+                                   m.nomenclature, str(exc)) from None
             if scale != m.scale:
-                raise fields.error(
-                    f"{path}.scale", f"{scale} (the scale of {m.nomenclature})", m.scale
-                )
+                raise fields.error(f"{path}.scale", f"{scale} (the scale of {m.nomenclature})",
+                                   m.scale)
             name = m.nomenclature
             sheet = MapSheet(m.scale, corners, m.nomenclature)
         if name in sheets:
@@ -527,28 +519,19 @@ def _pairs(
         path = f"pairs[{i}]"
         for side in ("left", "right"):
             if getattr(p, side) not in photos:
-                raise fields.error(
-                    f"{path}.{side}",
-                    "a photo number of photos",
-                    getattr(p, side),
-                    f"photos: {sorted(photos)}",
-                )
+                raise fields.error(f"{path}.{side}", "a photo number of photos",
+                                   getattr(p, side), f"photos: {sorted(photos)}")
         if p.left == p.right:
             raise fields.error(f"{path}.right", "another photo than the left one", p.right)
         if p.map_sheet is not None and p.map_sheet not in sheets:
-            raise fields.error(
-                f"{path}.map_sheet",
-                "a sheet of map_sheets",
-                p.map_sheet,
-                "listed: " + (", ".join(sheets) or "none"),
-            )
+            raise fields.error(f"{path}.map_sheet", "a sheet of map_sheets", p.map_sheet,
+                               "listed: " + (", ".join(sheets) or "none"))
         sheet = sheets[p.map_sheet] if p.map_sheet else None
         if sheet is None and len(sheets) == 1:
             sheet = next(iter(sheets.values()))
         if sheet is None and sheets:
-            raise fields.error(
-                f"{path}.map_sheet", "the sheet of this pair (several are listed)", "nothing"
-            )
+            raise fields.error(f"{path}.map_sheet", "the sheet of this pair (several are listed)",
+                               "nothing")
         area = None
         if p.working_area is not None:
             area = (p.working_area.lowest_m, p.working_area.highest_m)

@@ -92,14 +92,8 @@ def fit_terrain(xyz: np.ndarray) -> TerrainFit:
     plane_a = np.column_stack([np.ones(n), d])
     coef, _, rank, _ = np.linalg.lstsq(plane_a, z, rcond=None)
     if rank < 3:
-        return TerrainFit(
-            "flat",
-            flat.section,
-            n,
-            flat.rms_m,
-            flat.max_m,
-            "flat at the mean height (the points are collinear: no plane)",
-        )
+        return TerrainFit("flat", flat.section, n, flat.rms_m, flat.max_m,
+                          "flat at the mean height (the points are collinear: no plane)")
     res = z - plane_a @ coef
     base = float(coef[0] - coef[1:] @ centre)
     plane = TerrainFit(
@@ -116,24 +110,12 @@ def fit_terrain(xyz: np.ndarray) -> TerrainFit:
     base = float(coef[0] - coef[1:3] @ centre)
     if (rank < 4 or np.any(np.abs(coef[1:3]) > _SLOPE_MAX) or abs(coef[3]) > _HILL_MAX
             or not _BASE_RANGE[0] <= base <= _BASE_RANGE[1]):  # fmt: skip
-        return TerrainFit(
-            plane.kind,
-            plane.section,
-            n,
-            plane.rms_m,
-            plane.max_m,
-            plane.note.split(" (")[0] + " (the curved fit left the loader's ranges)",
-        )
+        return TerrainFit(plane.kind, plane.section, n, plane.rms_m, plane.max_m,
+                          plane.note.split(" (")[0] + " (the curved fit left the loader's ranges)")
     res = z - a @ coef
     section = _plane_section(base, (float(coef[1]), float(coef[2])))
-    section["hills"] = [
-        {
-            "X_m": round(float(centre[0]), 4),
-            "Y_m": round(float(centre[1]), 4),
-            "height_m": round(float(coef[3]), 4),
-            "radius_m": round(radius, 4),
-        }
-    ]
+    section["hills"] = [{"X_m": round(float(centre[0]), 4), "Y_m": round(float(centre[1]), 4),
+                         "height_m": round(float(coef[3]), 4), "radius_m": round(radius, 4)}]
     return TerrainFit(
         "plane+hill", section, n, float(np.sqrt(np.mean(res**2))), float(np.max(np.abs(res))),
         f"a plane plus one Gaussian hill by least squares ({n} heights ≥ {CURVED_MIN_POINTS}; "
@@ -208,10 +190,8 @@ def job_pair_scenario(job: Job, pair_name: str) -> tuple[dict[str, Any], Terrain
     fit = fit_terrain(heights)
     doc: dict[str, Any] = {
         "name": f"{job.name}-{pair.name}",
-        "description": (
-            f"Pair {pair.name} (photos {pair.left}, {pair.right}) of job {job.name} "
-            f"({Path(job.source).name}), made by stereoplotter job to-scenario."
-        ),
+        "description": (f"Pair {pair.name} (photos {pair.left}, {pair.right}) of job {job.name} "
+                        f"({Path(job.source).name}), made by stereoplotter job to-scenario."),
         "seed": 0,
         "camera": {
             "focal_length_mm": cam.focal_length_mm,
@@ -254,22 +234,15 @@ def scenario_yaml(doc: dict[str, Any], fit: TerrainFit) -> str:
     ]
     for key, value in doc.items():
         if key == "terrain":
-            text = (
-                f"TERRAIN (fitted, not measured): {fit.kind} — {fit.note}. Fitted to "
-                f"{fit.points} control heights: residual rms {fit.rms_m:.3f} m, max "
-                f"{fit.max_m:.3f} m. Change it freely: Z(X, Y) = base_height_m + "
-                "slope·(X, Y) + Σ Gaussian hills (docs/scenarios.md); the control and check "
-                "points keep their own Z_m below."
-            )
+            text = (f"TERRAIN (fitted, not measured): {fit.kind} — {fit.note}. Fitted to "
+                    f"{fit.points} control heights: residual rms {fit.rms_m:.3f} m, max "
+                    f"{fit.max_m:.3f} m. Change it freely: Z(X, Y) = base_height_m + "
+                    "slope·(X, Y) + Σ Gaussian hills (docs/scenarios.md); the control and check "
+                    "points keep their own Z_m below.")
             lines += [f"# {t}" for t in textwrap.wrap(text, 96)]
         lines += [f"# {t}" for t in _SECTION_NOTES.get(key, [])]
-        text = yaml.safe_dump(
-            {key: value},
-            sort_keys=False,
-            allow_unicode=True,
-            width=100,
-            default_flow_style=None if key in ("photos", "points") else False,
-        )
+        text = yaml.safe_dump({key: value}, sort_keys=False, allow_unicode=True, width=100,
+                              default_flow_style=None if key in ("photos", "points") else False)
         lines.append(text.rstrip("\n"))
     return "\n".join(lines) + "\n"
 

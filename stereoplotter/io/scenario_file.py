@@ -64,6 +64,7 @@ MIN_SIMILARITY_POINTS = 2
 _BLOCK_FIELDS = ("models", "models_csv")
 
 
+
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     """Read a scenario file.
 
@@ -332,7 +333,9 @@ class ErrorsModel(FileModel):
 class ScenarioFile(FileModel):
     """A scenario file (``docs/scenarios.md``)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, title="stereoplotter scenario file")
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, title="stereoplotter scenario file"
+    )
 
     name: text  # type: ignore[valid-type]
     description: str | None = None
@@ -390,14 +393,12 @@ def camera_from_model(source: str, model: CameraModel) -> Camera:
         dpath = f"{fid_path}.distances_mm"
         d = model.fiducials.distances_mm
         assert d is not None  # the model has exactly one of the two
-        d12 = number_at(source, f"{dpath}.1-2", d.d12, unit="mm", low=0.0, high=fmt, low_open=True)
-        d34 = number_at(source, f"{dpath}.3-4", d.d34, unit="mm", low=0.0, high=fmt, low_open=True)
-        marks = {
-            "1": (-d12 / 2, 0.0),
-            "2": (d12 / 2, 0.0),
-            "3": (0.0, d34 / 2),
-            "4": (0.0, -d34 / 2),
-        }
+        d12 = number_at(source, f"{dpath}.1-2", d.d12, unit="mm", low=0.0, high=fmt,
+                                  low_open=True)
+        d34 = number_at(source, f"{dpath}.3-4", d.d34, unit="mm", low=0.0, high=fmt,
+                                  low_open=True)
+        marks = {"1": (-d12 / 2, 0.0), "2": (d12 / 2, 0.0), "3": (0.0, d34 / 2),
+                 "4": (0.0, -d34 / 2)}
     pp = model.principal_point_mm
     return Camera(model.focal_length_mm, (pp[0], pp[1]), fmt, marks, given_as)
 
@@ -422,10 +423,7 @@ def _frame(source: str, model: FrameModel) -> Frame:
     except StereoplotterError as exc:  # e.g. a latitude beyond the geodesy's range
         raise ConfigError(
             source,
-            "frame.origin",
-            "an origin inside the SK-42 Gauss–Krüger domain",
-            list(origin),
-            str(exc),
+            "frame.origin", "an origin inside the SK-42 Gauss–Krüger domain", list(origin), str(exc)
         ) from None
     return frame
 
@@ -549,7 +547,8 @@ def _map_sheet(source: str, model: MapSheetModel, frame: Frame) -> MapSheet:
         corners, sheet_scale = frame_tie.sheet_corners_sk42(name)
     except StereoplotterError as exc:
         raise ConfigError(
-            source, f"{path}.nomenclature", "a valid SK-42 nomenclature", name, str(exc)
+            source,
+            f"{path}.nomenclature", "a valid SK-42 nomenclature", name, str(exc)
         ) from None
     if sheet_scale != scale:
         raise ConfigError(

@@ -319,10 +319,7 @@ def config_error(
     if kind == "stereoplotter":
         loc = (*loc, *ctx.get("at", ()))
         return ConfigError(
-            where,
-            field_path(loc) or "(top level)",
-            ctx["expected"],
-            ctx["found"],
+            where, field_path(loc) or "(top level)", ctx["expected"], ctx["found"],
             ctx.get("hint", ""),
         )
     if kind == "extra_forbidden":
