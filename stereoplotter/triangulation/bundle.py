@@ -25,6 +25,7 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
@@ -259,7 +260,8 @@ def _step(p, orient, points, pairs, factor_only=False):
     scale = 1.0 / np.sqrt(s.diagonal())
     d = sp.diags(scale)
     try:
-        lu = spla.splu((d @ s @ d).tocsc(), permc_spec="COLAMD")
+        scaled = (d @ s @ d).tocsc()
+        lu = spla.splu(scaled, permc_spec="COLAMD")
     except RuntimeError as exc:
         raise GeometryError(
             f"the reduced normal equations are singular ({exc}): expected "
@@ -270,13 +272,32 @@ def _step(p, orient, points, pairs, factor_only=False):
     np.add.at(back, p.obs_point, -np.einsum("nji,nj->ni", ncp, delta_c[p.obs_photo]))
     delta_p = np.einsum("nij,nj->ni", pinv, back)
     delta_p[unused] = 0.0
-    return delta_c, delta_p, vv, (lu, scale)
+    return delta_c, delta_p, vv, (lu, scale, scaled)
+
+
+#: Above this many photo unknowns the inverse is not formed densely (8 · n² bytes: 288 MB at
+#: 6000, i.e. 1000 photos) but column by column from the sparse factor (slow: minutes).
+DENSE_INVERSE_LIMIT = 6000
 
 
 def _covariances(factor, n_photos: int, sigma0: float, chunk: int = 64) -> tuple[NDArray, NDArray]:
     """σ₀²·(the 6 × 6 diagonal blocks of the inverse reduced matrix) and σ₀²·its blocks
-    (j + 1, j) (photo j + 1 against photo j), in chunks of photos; memory 6n × 6·chunk."""
-    lu, scale = factor
+    (j + 1, j) (photo j + 1 against photo j). Up to :data:`DENSE_INVERSE_LIMIT` unknowns by a
+    dense Cholesky inverse (LAPACK potrf/potri: 1000 photos in about 20 s); beyond, in chunks
+    of photos from the sparse factor (memory 6n × 6·chunk)."""
+    lu, scale, scaled = factor
+    if 6 * n_photos <= DENSE_INVERSE_LIMIT:
+        c, _ = sla.cho_factor(scaled.toarray(), lower=True, overwrite_a=True, check_finite=False)
+        inv, info = sla.lapack.dpotri(c, lower=1, overwrite_c=1)
+        if info != 0:
+            raise GeometryError(f"the reduced normal matrix is not positive definite ({info})")
+        inv = scale[:, None] * inv * scale[None, :]  # lower triangle holds the inverse
+        k = np.arange(n_photos)
+        blocks = inv.reshape(n_photos, 6, n_photos, 6)
+        diag = np.tril(blocks[k, :, k, :]) + np.swapaxes(np.tril(blocks[k, :, k, :], -1), 1, 2)
+        after = np.zeros((n_photos, 6, 6))
+        after[:-1] = blocks[k[1:], :, k[:-1], :]
+        return sigma0**2 * diag, sigma0**2 * after
     out = np.empty((n_photos, 6, 6))
     after = np.zeros((n_photos, 6, 6))
     for start in range(0, n_photos, chunk):

@@ -88,3 +88,18 @@ def test_too_little_control_is_refused():
     )
     with pytest.raises(GeometryError, match="plan control points"):
         bundle_adjust(problem(no_control))
+
+
+def test_sparse_and_dense_inverses_give_the_same_covariances(monkeypatch):
+    # above DENSE_INVERSE_LIMIT the blocks come column by column from the sparse factor
+    from stereoplotter.triangulation import bundle
+
+    block, _ = exact_block()
+    p = problem(block)
+    dense = bundle_adjust(p)
+    monkeypatch.setattr(bundle, "DENSE_INVERSE_LIMIT", 0)
+    sparse = bundle_adjust(p)
+    np.testing.assert_allclose(sparse.covariances, dense.covariances, rtol=1e-6, atol=1e-30)
+    np.testing.assert_allclose(
+        sparse.next_covariances, dense.next_covariances, rtol=1e-6, atol=1e-30
+    )
