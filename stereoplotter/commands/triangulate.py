@@ -148,7 +148,7 @@ def _solve(block: Any, args: argparse.Namespace) -> Any:
 def run(args: argparse.Namespace) -> int:
     # imported here: the CLI starts fast (no pyproj, matplotlib or pydantic until a command runs)
     from stereoplotter.io.block_measurements_file import load_block_measurements
-    from stereoplotter.io.triangulated_job import write_triangulated_job
+    from stereoplotter.io.triangulated_job import job_files
     from stereoplotter.io.yaml_files import atomic_write_bytes, atomic_write_text
     from stereoplotter.plotting.triangulation import residual_figure_png
     from stereoplotter.report.triangulation import orientation_csv, report_markdown, residual_csv
@@ -157,27 +157,29 @@ def run(args: argparse.Namespace) -> int:
     block, production = load_block_measurements(args.block)
     solution = _solve(block, args)
     residuals = catalogue_residuals(block, solution)
-    out = Path(args.output)
-    atomic_write_bytes(out / "residuals.png", residual_figure_png(block, solution, residuals))
-    atomic_write_text(out / "orientations.csv", orientation_csv(block, solution))
-    atomic_write_text(out / "residuals.csv", residual_csv(block, residuals))
-    job = ""
-    if production is not None:
+    files: dict[str, str | bytes] = {}
+    if production is not None:  # first: a photo number the job cannot take stops everything
         description = (
             f"Exterior orientation of block {block.name} by stereoplotter triangulate "
             f"--method {args.method} from {Path(args.block).name}."
         )
-        write_triangulated_job(
-            out,
-            block,
-            production,
-            solution.orientations,
-            source=args.block,
-            description=description,
+        files.update(
+            job_files(
+                block, production, solution.orientations, source=args.block, description=description
+            )
         )
-        job = f"; job file {out / 'job.yaml'}"
-    atomic_write_text(out / "report.md", report_markdown(block, solution, residuals, args.block))
+    files["orientations.csv"] = orientation_csv(block, solution)
+    files["residuals.csv"] = residual_csv(block, residuals)
+    files["residuals.png"] = residual_figure_png(block, solution, residuals)
+    files["report.md"] = report_markdown(block, solution, residuals, args.block)
+    out = Path(args.output)
+    for name, content in files.items():  # every file whole or not at all
+        if isinstance(content, bytes):
+            atomic_write_bytes(out / name, content)
+        else:
+            atomic_write_text(out / name, content)
     rms = residuals.rms(block, "check")
+    job = f"; job file {out / 'job.yaml'}" if production is not None else ""
     print(
         f"block {block.name}: {len(block.photos)} photos by {args.method} in "
         f"{solution.iterations} iterations, σ₀ = {solution.sigma0:.3f}; RMS at check points "
