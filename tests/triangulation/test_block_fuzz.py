@@ -34,7 +34,7 @@ def _mutate(text: str, rng: np.random.Generator) -> str:
     return "\n".join(lines) + "\n"
 
 
-@pytest.mark.parametrize("seed", range(48))  # 300 seeds ran clean once
+@pytest.mark.parametrize("seed", range(30))  # 300 seeds ran clean once
 def test_mutated_block_gives_a_result_or_one_error_line(seed, tmp_path, capsys):
     block, _ = synthesize_block(
         SynthSpec(strips=2, photos_per_strip=3, control_every_bases=1), np.random.default_rng(1)
