@@ -291,7 +291,8 @@ def _covariances(factor, n_photos: int, sigma0: float, chunk: int = 64) -> tuple
         inv, info = sla.lapack.dpotri(c, lower=1, overwrite_c=1)
         if info != 0:
             raise GeometryError(f"the reduced normal matrix is not positive definite ({info})")
-        inv = scale[:, None] * inv * scale[None, :]  # lower triangle holds the inverse
+        inv *= scale[:, None]  # in place: one n × n array; the lower triangle holds the inverse
+        inv *= scale[None, :]
         k = np.arange(n_photos)
         blocks = inv.reshape(n_photos, 6, n_photos, 6)
         diag = np.tril(blocks[k, :, k, :]) + np.swapaxes(np.tril(blocks[k, :, k, :], -1), 1, 2)
