@@ -35,6 +35,7 @@ from stereoplotter.commands import (
     simulate,
     study,
     trainer,
+    triangulate,
     verify,
 )
 from stereoplotter.errors import StereoplotterError
@@ -58,6 +59,7 @@ COMMANDS = (
     budget,
     demo,
     study,
+    triangulate,
     exercise,
     session,
     grade,

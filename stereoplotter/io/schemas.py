@@ -18,6 +18,7 @@ from pydantic import BaseModel
 
 from stereoplotter.io.atomic_write import atomic_write_text
 from stereoplotter.io.block_file import BlockFile
+from stereoplotter.io.block_measurements_file import BlockMeasurementsFile
 from stereoplotter.io.budget_output import BudgetOutput
 from stereoplotter.io.errors_file import ErrorsFile
 from stereoplotter.io.exercise_file import ExerciseFile
@@ -40,6 +41,7 @@ MODELS: dict[str, type[BaseModel]] = {
     "budget": BudgetOutput,  # an output: the JSON of `stereoplotter budget --json`
     "trainee-sheet": TraineeSheet,
     "exercise": ExerciseFile,
+    "block-measurements": BlockMeasurementsFile,
 }
 
 

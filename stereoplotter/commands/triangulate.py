@@ -1,0 +1,230 @@
+"""``stereoplotter triangulate`` and ``stereoplotter block synth``: phototriangulation of a block.
+
+``block synth -o DIR`` makes a synthetic block measurements file from an invented ground truth
+(:mod:`stereoplotter.triangulation.synth`) and writes the truth beside it (``truth.csv`` and the
+production job of the true orientations, ``truth/job.yaml``). ``triangulate BLOCK.yaml --method
+bundle|strip|polygon -o DIR`` writes each photo's orientation with its σ (``orientations.csv``),
+the residuals at control and check points (``residuals.csv``), a report (``report.md`` with
+``residuals.png``) and, when the block has a ``production`` section, the production job
+``job.yaml`` that ``stereoplotter setup`` turns into forms (``docs/triangulation.md``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+from stereoplotter.commands.arguments import bounded_float, bounded_int, seed_int
+
+__all__ = ["add_arguments", "run", "run_synth"]
+
+METHODS = ("bundle", "strip", "polygon")
+
+
+def add_arguments(sub: Any) -> None:
+    """Add ``triangulate`` and ``block`` (action ``synth``) to the CLI's subparsers."""
+    p = sub.add_parser(
+        "triangulate",
+        help="analytic phototriangulation of a block: orientations, residuals, report, job file",
+    )
+    p.add_argument("block", help="block measurements file (stereoplotter-block-measurements/1)")
+    p.add_argument(
+        "--method",
+        choices=METHODS,
+        default="bundle",
+        help="bundle block adjustment (default), strip triangulation by independent "
+        "models with polynomials, or the polygon block adjustment",
+    )
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    p.add_argument(
+        "--models",
+        choices=("independent", "dependent"),
+        default="independent",
+        help="strip method: how a strip is formed (default independent)",
+    )
+    p.add_argument(
+        "--degree",
+        type=int,
+        choices=(1, 2, 3),
+        default=3,
+        help="strip method: degree of the strip polynomials (default 3)",
+    )
+    p.set_defaults(func=run)
+    b = sub.add_parser("block", help="blocks of comparator measurements (docs/triangulation.md)")
+    acts = b.add_subparsers(dest="block_command", required=True, metavar="ACTION")
+    s = acts.add_parser("synth", help="a synthetic block from an invented ground truth")
+    s.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    s.add_argument(
+        "--strips", type=bounded_int(1, 200), default=4, help="number of strips (default 4)"
+    )
+    s.add_argument(
+        "--photos", type=bounded_int(2, 500), default=10, help="photos per strip (default 10)"
+    )
+    s.add_argument("--seed", type=seed_int, default=1, help="seed of the truth and the errors")
+    s.add_argument(
+        "--control-every",
+        type=bounded_int(1, 100),
+        default=4,
+        metavar="BASES",
+        help="control spacing along the block edges in bases (default 4)",
+    )
+    s.add_argument(
+        "--control-degree",
+        type=int,
+        choices=(2, 3),
+        metavar="N",
+        help="instead: N + 1 control stations along the strips, spaced for polynomials of "
+        "degree N (the control spacing chosen from the residual variances)",
+    )
+    s.add_argument(
+        "--sigma-photo",
+        type=bounded_float(1e-9, 0.1),
+        default=0.005,
+        metavar="MM",
+        help="σ of a comparator coordinate [mm] (default 0.005: a stereocomparator)",
+    )
+    s.add_argument("--name", default="synthetic", help="name of the block")
+    s.add_argument("--instrument", default="sc1", help="instrument of the production job")
+    s.add_argument(
+        "--date",
+        default="2026-11-26",
+        help="date printed on the forms, YYYY-MM-DD (the clock is never read)",
+    )
+    s.set_defaults(func=run_synth)
+
+
+def _solve(block: Any, args: argparse.Namespace) -> Any:
+    # imported here: the CLI starts without loading scipy's sparse solvers
+    if args.method == "bundle":
+        from stereoplotter.triangulation.bundle import bundle_block
+
+        return bundle_block(block)
+    from stereoplotter.triangulation import strip
+
+    if args.method == "strip":
+        return strip.strip_block(block, args.models, args.degree)
+    from stereoplotter.triangulation.polygon_block import polygon_block
+
+    return polygon_block(block)
+
+
+def run(args: argparse.Namespace) -> int:
+    # imported here: the CLI starts fast (no pyproj, matplotlib or pydantic until a command runs)
+    from stereoplotter.io.atomic_write import atomic_write_bytes, atomic_write_text
+    from stereoplotter.io.block_measurements_file import load_block_measurements
+    from stereoplotter.io.triangulated_job import job_files
+    from stereoplotter.plotting.triangulation import residual_figure_png
+    from stereoplotter.report.triangulation import orientation_csv, report_markdown, residual_csv
+    from stereoplotter.triangulation.solution import catalogue_residuals
+
+    block, production = load_block_measurements(args.block)
+    solution = _solve(block, args)
+    residuals = catalogue_residuals(block, solution)
+    files: dict[str, str | bytes] = {}
+    if production is not None:  # first: a photo number the job cannot take stops everything
+        description = (
+            f"Exterior orientation of block {block.name} by stereoplotter triangulate "
+            f"--method {args.method} from {Path(args.block).name}."
+        )
+        files.update(
+            job_files(
+                block, production, solution.orientations, source=args.block, description=description
+            )
+        )
+    files["orientations.csv"] = orientation_csv(block, solution)
+    files["residuals.csv"] = residual_csv(block, residuals)
+    files["residuals.png"] = residual_figure_png(block, solution, residuals)
+    files["report.md"] = report_markdown(block, solution, residuals, args.block)
+    out = Path(args.output)
+    for name, content in files.items():  # every file whole or not at all
+        if isinstance(content, bytes):
+            atomic_write_bytes(out / name, content)
+        else:
+            atomic_write_text(out / name, content)
+    rms = residuals.rms(block, "check")
+    job = f"; job file {out / 'job.yaml'}" if production is not None else ""
+    print(
+        f"block {block.name}: {len(block.photos)} photos by {args.method} in "
+        f"{solution.iterations} iterations, σ₀ = {solution.sigma0:.3f}; RMS at check points "
+        f"X {rms[0]:.3f}, Y {rms[1]:.3f}, Z {rms[2]:.3f} m; report {out / 'report.md'}{job}"
+    )
+    if production is None:
+        print("no production section in the block file: no job file written", file=sys.stderr)
+    return 0
+
+
+def _production_yaml(block: Any, orientations: Any, instrument: str, date: str) -> str:
+    """The ``production:`` section: instrument, date and the 1:10 000 sheets of the pairs."""
+    from stereoplotter.io.triangulated_job import sheets_of_pairs
+
+    sheets = sheets_of_pairs(block, orientations)
+    lines = ["production:", f"  instrument: {instrument}", f'  date: "{date}"', "  map_sheets:"]
+    lines += [f"    - {{nomenclature: {name}, scale: 10000}}" for name in sheets]
+    return "\n".join(lines) + "\n"
+
+
+def run_synth(args: argparse.Namespace) -> int:
+    # imported here: the CLI starts fast (numpy, pyproj, pydantic load only when a command runs)
+    import numpy as np
+
+    from stereoplotter.io.atomic_write import atomic_write_text
+    from stereoplotter.io.block_measurements_file import (
+        load_block_measurements,
+        write_block_measurements,
+    )
+    from stereoplotter.io.triangulated_job import write_triangulated_job
+    from stereoplotter.random_streams import key_code
+    from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
+
+    stations = None
+    if args.control_degree is not None:
+        from stereoplotter.triangulation.synth import control_stations_for_degree
+
+        stations = control_stations_for_degree(args.photos - 1, args.control_degree)
+    spec = SynthSpec(
+        control_stations=stations,
+        strips=args.strips,
+        photos_per_strip=args.photos,
+        name=args.name,
+        control_every_bases=args.control_every,
+        sigma_photo_mm=args.sigma_photo,
+    )
+    rng = np.random.default_rng([args.seed, key_code("block synth")])
+    block, truth = synthesize_block(spec, rng)
+    out = Path(args.output)
+    production = _production_yaml(block, truth.orientations, args.instrument, args.date)
+    description = (
+        f"Synthetic block of {spec.strips} × {spec.photos_per_strip} photos made by stereoplotter "
+        f"block synth --seed {args.seed} (the truth in truth.csv)."
+    )
+    write_block_measurements(out, block, description=description, production_yaml=production)
+    rows = ["photo,alpha_deg,omega_deg,kappa_deg,X_m,Y_m,Z_m"]
+    for p, o in zip(block.photos, truth.orientations, strict=True):
+        a, w, k = (math.degrees(float(v)) for v in o[:3])
+        rows.append(f"{p},{a:.8f},{w:.8f},{k:.8f},{o[3]:.4f},{o[4]:.4f},{o[5]:.4f}")
+    atomic_write_text(out / "truth.csv", "\n".join(rows) + "\n")
+    pts = ["point,X_m,Y_m,Z_m"] + [
+        f"{pid},{x:.4f},{y:.4f},{z:.4f}"
+        for pid, (x, y, z) in zip(block.point_ids, truth.points_m, strict=True)
+    ]
+    atomic_write_text(out / "truth_points.csv", "\n".join(pts) + "\n")
+    _, prod = load_block_measurements(out / "block.yaml")  # the file as triangulate reads it
+    assert prod is not None
+    write_triangulated_job(
+        out / "truth",
+        block,
+        prod,
+        truth.orientations,
+        source=str(out / "block.yaml"),
+        description="The TRUE exterior orientation of the synthetic block "
+        "(for comparison with the triangulated one).",
+    )
+    print(
+        f"block {block.name}: {len(block.photos)} photos, {block.obs_photo.size} point "
+        f"measurements, {len(block.catalogue)} catalogue points written to {out / 'block.yaml'}"
+        f"; truth in {out / 'truth.csv'} and {out / 'truth' / 'job.yaml'}"
+    )
+    return 0

@@ -1,0 +1,44 @@
+"""The polygon network built from the strips (runs once triangulation/polygon.py is present)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import arcsec, m
+from synthetic_blocks import exact_block
+
+from stereoplotter.errors import GeometryError
+from stereoplotter.triangulation.polygon_block import polygon_block, polygon_sides
+from stereoplotter.triangulation.strip import oriented_strips
+
+
+def test_sides_of_an_error_free_block_close_every_polygon():
+    # along-strip sides are the strips' increments, cross sides corrected by the common points:
+    # error-free, the increments around any cell of four photos sum to zero
+    block, truth = exact_block()
+    strips, _ = oriented_strips(block)
+    sides, values = polygon_sides(block, strips)
+    index = {p: j for j, p in enumerate(block.photos)}
+    for (a, b), v in zip(sides, values, strict=True):
+        d = truth.orientations[index[b]] - truth.orientations[index[a]]
+        assert np.max(np.abs(v[:3] - d[:3])) < 0.01 * arcsec
+        assert np.max(np.abs(v[3:] - d[3:])) < 1e-3 * m
+
+
+def test_polygon_method_returns_the_truth_on_an_error_free_block():
+    pytest.importorskip("stereoplotter.triangulation.polygon")
+    block, truth = exact_block()
+    s = polygon_block(block)
+    err = s.orientations - truth.orientations
+    assert np.max(np.abs(err[:, :3])) < 0.01 * arcsec
+    assert np.max(np.abs(err[:, 3:])) < 1e-3 * m
+
+
+def test_without_the_polygon_module_the_method_is_one_error_line():
+    try:
+        import stereoplotter.triangulation.polygon  # noqa: F401
+    except ImportError:
+        with pytest.raises(GeometryError, match="polygon method is not available"):
+            polygon_block(exact_block()[0])
+    else:
+        pytest.skip("the polygon module is present")

@@ -1,0 +1,109 @@
+"""`block synth` → `triangulate` → setup: the chain from comparator to forms, against the truth.
+
+The forms themselves (PDF) are `stereoplotter setup`'s, tested with jobs/strip8 in
+tests/cli/test_job.py; here the sheets of the triangulated job are computed in process.
+"""
+
+from __future__ import annotations
+
+import csv
+
+import pytest
+
+from stereoplotter.cli import main
+from stereoplotter.io.block_measurements_file import load_block_measurements
+from stereoplotter.report.triangulation_chain import chain_comparison
+from stereoplotter.triangulation.bundle import bundle_block
+
+
+@pytest.fixture(scope="module")
+def chain(tmp_path_factory):
+    root = tmp_path_factory.mktemp("chain")
+    argv = [
+        "block",
+        "synth",
+        "-o",
+        str(root / "block"),
+        "--strips",
+        "2",
+        "--photos",
+        "5",
+        "--control-every",
+        "2",
+        "--seed",
+        "5",
+    ]
+    assert main(argv) == 0
+    assert main(["triangulate", str(root / "block" / "block.yaml"), "-o", str(root / "tri")]) == 0
+    return root
+
+
+def test_triangulate_writes_orientations_residuals_report_and_job(chain):
+    names = {p.name for p in (chain / "tri").iterdir()}
+    assert {
+        "orientations.csv",
+        "residuals.csv",
+        "report.md",
+        "residuals.png",
+        "job.yaml",
+        "fiducials.csv",
+        "points.csv",
+    } <= names
+    with open(chain / "tri" / "orientations.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["photo"] for r in rows[:2]] == ["101", "102"] and len(rows) == 10
+    assert all(float(r["s_X_m"]) > 0 for r in rows)
+
+
+def test_forms_agree_with_forms_of_the_true_orientations_within_the_propagated_sigma(chain):
+    # 12 sheet values × 8 pairs: |Δ| ≤ 4σ for all (Bonferroni over ~100 comparisons at 1 %)
+    block, _ = load_block_measurements(chain / "block" / "block.yaml")
+    rows = chain_comparison(
+        chain / "tri" / "job.yaml",
+        chain / "block" / "truth" / "job.yaml",
+        block,
+        bundle_block(block),
+    )
+    compared = [r for r in rows if r.sigma > 1e-9]
+    assert len({r.pair for r in rows}) == 8 and len(compared) >= 8 * 10
+    worst = max(compared, key=lambda r: r.ratio)
+    assert worst.ratio <= 4.0, worst
+
+
+def test_strip_method_runs_from_the_command_line(chain, tmp_path):
+    argv = [
+        "triangulate",
+        str(chain / "block" / "block.yaml"),
+        "--method",
+        "strip",
+        "--degree",
+        "2",
+        "-o",
+        str(tmp_path),
+    ]
+    assert main(argv) == 0
+    assert "strip" in (tmp_path / "report.md").read_text(encoding="utf-8")
+
+
+def test_a_degree_the_control_cannot_fix_is_refused(chain, tmp_path, capsys):
+    # control at bases 0, 2, 4 of each strip: three stations fix a quadratic, not a cubic
+    argv = [
+        "triangulate",
+        str(chain / "block" / "block.yaml"),
+        "--method",
+        "strip",
+        "--degree",
+        "3",
+        "-o",
+        str(tmp_path),
+    ]
+    assert main(argv) == 1
+    assert "height control at 3 stations" in capsys.readouterr().err
+
+
+def test_bad_block_file_is_one_error_line(tmp_path, capsys):
+    bad = tmp_path / "block.yaml"
+    bad.write_text("format: stereoplotter-block-measurements/1\nname: x\n", encoding="utf-8")
+    assert main(["triangulate", str(bad), "-o", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: {bad}: ")
