@@ -15,10 +15,11 @@ from pathlib import Path
 import numpy as np
 
 from stereoplotter.cli import main
+from stereoplotter.commands.triangulation_chain import chain_comparison, chain_markdown
 from stereoplotter.errors import GeometryError
 from stereoplotter.io.block_measurements_file import load_block_measurements
-from stereoplotter.report.triangulation_chain import chain_comparison, chain_markdown
 from stereoplotter.triangulation.bundle import bundle_block
+from stereoplotter.triangulation.polygon_block import polygon_block
 from stereoplotter.triangulation.solution import catalogue_residuals
 from stereoplotter.triangulation.strip import strip_block
 
@@ -44,12 +45,7 @@ def methods_table(folder: Path) -> str:
                     lambda m=models, d=degree: strip_block(block, m, d),
                 )
             )
-    try:
-        from stereoplotter.triangulation.polygon_block import polygon_block
-
-        runs.append(("polygon (least squares)", lambda: polygon_block(block)))
-    except ImportError:
-        pass
+    runs.append(("polygon (least squares)", lambda: polygon_block(block)))
     lines = [
         "| method | RMS X | RMS Y | RMS Z | centres vs truth X, Y, Z | iterations | time |",
         "|---|---:|---:|---:|---|---:|---:|",

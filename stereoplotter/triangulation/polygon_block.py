@@ -22,9 +22,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.errors import GeometryError
 from stereoplotter.geometry.rotation import angles_from_matrix
 from stereoplotter.triangulation.block import Block
+from stereoplotter.triangulation.polygon import PolygonNetwork, adjust_polygons
 from stereoplotter.triangulation.solution import BlockSolution
 from stereoplotter.triangulation.strip import OrientedStrip, oriented_strips
 
@@ -76,15 +76,8 @@ def polygon_block(block: Block, method: str = "least_squares") -> BlockSolution:
     Raises
     ------
     GeometryError
-        The polygon module is missing, or the strips cannot be formed and oriented.
+        The strips cannot be formed and oriented.
     """
-    try:
-        from stereoplotter.triangulation.polygon import PolygonNetwork, adjust_polygons
-    except ImportError:  # until the polygon module lands on this branch
-        raise GeometryError(
-            "the polygon method is not available in this installation "
-            "(stereoplotter.triangulation.polygon is missing): use --method bundle or strip"
-        ) from None
     strips, iterations = oriented_strips(block, "independent")
     sides, values = polygon_sides(block, strips)
     fixed = {}

@@ -33,6 +33,7 @@ from stereoplotter.triangulation.block import (
     block_frame,
     sk42_from_block_local,
 )
+from stereoplotter.triangulation.control_spacing import choose_control_spacing
 
 __all__ = ["SynthSpec", "Truth", "control_stations_for_degree", "synthesize_block"]
 
@@ -102,10 +103,6 @@ def control_stations_for_degree(n_bases: int, degree: int) -> tuple[int, ...]:
     """Base numbers of degree + 1 control stations along a strip of ``n_bases`` bases, chosen
     from the residual variances of the strip polynomial (Burshtynskaya's control spacing,
     :func:`stereoplotter.triangulation.control_spacing.choose_control_spacing`)."""
-    try:
-        from stereoplotter.triangulation.control_spacing import choose_control_spacing
-    except ImportError:  # until control_spacing lands: evenly spaced, ends included
-        return tuple(sorted({round(k * n_bases / degree) for k in range(degree + 1)}))
     return tuple(int(b) for b in choose_control_spacing(n_bases, degree))
 
 

@@ -7,7 +7,6 @@ import pytest
 from conftest import arcsec, m
 from synthetic_blocks import exact_block
 
-from stereoplotter.errors import GeometryError
 from stereoplotter.triangulation.polygon_block import polygon_block, polygon_sides
 from stereoplotter.triangulation.strip import oriented_strips
 
@@ -32,13 +31,3 @@ def test_polygon_method_returns_the_truth_on_an_error_free_block():
     err = s.orientations - truth.orientations
     assert np.max(np.abs(err[:, :3])) < 0.01 * arcsec
     assert np.max(np.abs(err[:, 3:])) < 1e-3 * m
-
-
-def test_without_the_polygon_module_the_method_is_one_error_line():
-    try:
-        import stereoplotter.triangulation.polygon  # noqa: F401
-    except ImportError:
-        with pytest.raises(GeometryError, match="polygon method is not available"):
-            polygon_block(exact_block()[0])
-    else:
-        pytest.skip("the polygon module is present")

@@ -11,8 +11,8 @@ import csv
 import pytest
 
 from stereoplotter.cli import main
+from stereoplotter.commands.triangulation_chain import chain_comparison
 from stereoplotter.io.block_measurements_file import load_block_measurements
-from stereoplotter.report.triangulation_chain import chain_comparison
 from stereoplotter.triangulation.bundle import bundle_block
 
 

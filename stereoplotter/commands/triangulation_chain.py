@@ -18,9 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from stereoplotter.commands.setup_job import compute_job
 from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix
 from stereoplotter.io.job_file import Job, load_job
-from stereoplotter.report.job import compute_job
 from stereoplotter.setup.records import SetupOptions, SetupSheet
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
 from stereoplotter.triangulation.block import Block
