@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import socket
+from pathlib import Path
 
 import uvicorn
 
+from stereoplotter.io.session_store import default_data_dir
 from stereoplotter.web.app import create_app
 
 __all__ = ["listen", "serve"]
@@ -28,15 +30,26 @@ def listen(host: str = "127.0.0.1", port: int = 0) -> socket.socket:
     return sock
 
 
-def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None) -> None:
+#: Largest WebSocket frame read at all (a larger one closes the socket with 1009); frames over
+#: the protocol's own limit (guard.MAX_MESSAGE) are read and answered with an error. [bytes]
+WS_MAX_SIZE = 4 * 1024 * 1024
+
+
+def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
+          data_dir: str | None = None) -> None:
     """Serve until interrupted; prints the trainee and instructor addresses with the port
-    actually bound (the instructor's token is random unless given)."""
+    actually bound (the instructor's token is random unless given) and the data folder.
+    Sessions, logs and grades are kept in ``data_dir`` (default: the per-user folder)."""
+    folder = Path(data_dir) if data_dir else default_data_dir()
     sock = listen(host, port)
     bound = sock.getsockname()[1]
-    app = create_app(token)
+    names = (host,) if host not in ("0.0.0.0", "::", "") else ()
+    app = create_app(token, folder, processes=True, prepare_photos=True, hosts=names)
     reg = app.state.registry
     shown = "localhost" if host in ("127.0.0.1", "0.0.0.0") else host
     shown = f"[{shown}]" if ":" in shown else shown
     print(f"trainee page:    http://{shown}:{bound}/", flush=True)
     print(f"instructor page: http://{shown}:{bound}/instructor?token={reg.token}", flush=True)
-    uvicorn.Server(uvicorn.Config(app, log_level="warning")).run(sockets=[sock])
+    print(f"data folder:     {folder}", flush=True)
+    config = uvicorn.Config(app, log_level="warning", ws_max_size=WS_MAX_SIZE)
+    uvicorn.Server(config).run(sockets=[sock])
