@@ -46,7 +46,7 @@ def main() -> None:
         page.wait_for_selector("body[data-ready='1']")
         page.evaluate("window.trainer.actAndFrame({kind: 'set', control: 'f_instrument', "
                       "value: 109.34})")
-        page.wait_for_function("window.trainer.photosReady()", timeout=120_000)
+        page.wait_for_function("() => window.trainer.photosReady()", timeout=120_000)
         results = {}
         for view in ("split", "anaglyph"):
             page.select_option("#view", view)

@@ -169,18 +169,19 @@ def replay_frames(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 #: Both photos of an exercise's scenario as the imagery's tile pyramid, built once (in a worker,
-#: about 4 s for pair60) and shared by every session of every exercise with the same scenario,
-#: terrain and tilt: the ground texture is the scenario's own seed; a trainee's seed draws the
-#: instrument's errors, not the ground.
-def photo_key(exercise: Exercise) -> tuple[str, str, str]:
-    """What a session's photos depend on: the scenario, the terrain class and the tilt class."""
-    return (exercise.scenario_name, exercise.terrain, exercise.tilt)
+#: about 4 s for pair60) and shared by every session of the exercise: the ground texture's seed
+#: is the exercise's fixed seed, or the scenario's own for a per-trainee exercise (a trainee's
+#: seed draws the instrument's errors, not the ground), so the photos are ready before the
+#: first trainee starts.
+def photo_key(exercise: Exercise) -> tuple[str, str, str, int | None]:
+    """What a session's photos depend on: the scenario, terrain and tilt classes, the seed."""
+    return (exercise.scenario_name, exercise.terrain, exercise.tilt, exercise.seed)
 
 
 def build_view_cache(source: dict[str, Any]) -> ViewCache:
     """The view cache of an exercise's photos (run in a worker process: picklable in and out)."""
     ex = resolve_exercise(source)
-    return ViewCache(ex.scenario, None)
+    return ViewCache(ex.scenario, ex.seed)
 
 
 def format_mm(exercise: Exercise) -> float:

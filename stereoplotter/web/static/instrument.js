@@ -224,6 +224,8 @@ $("demo-play").onclick = () => {
 // For tests and the latency benchmark: send an action, resolve with ms until its frame is drawn.
 window.trainer = {
   state: () => state,
+  // drop the socket as a network would (the page must reconnect and resume)
+  drop: () => ws && ws.close(),
   // both eyepieces drawn from a photo patch that covers the current marks
   photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right),
   actAndFrame(action) {
