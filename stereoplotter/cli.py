@@ -1115,6 +1115,12 @@ def _parser() -> argparse.ArgumentParser:
         help="port (default: 0, a free port chosen by the system; the address is printed)",
     )
     p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
+    p.add_argument(
+        "--data-dir",
+        metavar="DIR",
+        help="folder of the trainer's SQLite file: sessions, logs, grades (default: "
+        "~/.local/share/stereoplotter/trainer, or $XDG_DATA_HOME/stereoplotter/trainer)",
+    )
     return parser
 
 
@@ -1246,7 +1252,7 @@ def _trainer(args: argparse.Namespace) -> int:
         )
         return 1
     try:
-        serve(args.host, args.port, args.token)
+        serve(args.host, args.port, args.token, args.data_dir)
     except OSError as exc:
         print(
             f"error: trainer: cannot listen on {args.host}:{args.port} ({exc.strerror or exc})",

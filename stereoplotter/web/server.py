@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import socket
+import sqlite3
+import sys
 from pathlib import Path
 
 import uvicorn
 
-from stereoplotter.io.session_store import default_data_dir
+from stereoplotter.io.session_store import SessionStore, default_data_dir
 from stereoplotter.web.app import create_app
 
 __all__ = ["listen", "serve"]
@@ -41,6 +43,12 @@ def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
     actually bound (the instructor's token is random unless given) and the data folder.
     Sessions, logs and grades are kept in ``data_dir`` (default: the per-user folder)."""
     folder = Path(data_dir) if data_dir else default_data_dir()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        SessionStore(folder).close()
+    except (OSError, sqlite3.Error) as exc:
+        print(f"error: trainer: data folder {folder}: {exc}", file=sys.stderr)
+        raise SystemExit(1) from None
     sock = listen(host, port)
     bound = sock.getsockname()[1]
     names = (host,) if host not in ("0.0.0.0", "::", "") else ()
