@@ -326,8 +326,12 @@ def create_app(
     @asynccontextmanager
     async def lifespan(app):
         yield
-        reg.grader.shutdown(wait=False, cancel_futures=True)
-        reg.imager.shutdown(wait=False, cancel_futures=True)
+        for pool in (reg.grader, reg.imager):
+            # a worker busy building photos would run on for seconds after the server
+            workers = list((getattr(pool, "_processes", None) or {}).values())
+            pool.shutdown(wait=False, cancel_futures=True)
+            for proc in workers:
+                proc.terminate()
         store.close()
 
     app = Starlette(
