@@ -76,9 +76,10 @@ CSV_FIELDS = (
     "passed",
     "percentile",
 )
-#: Photo patch requests: magnification and photo coordinates accepted (the format is 180 mm;
-#: ±150 mm reaches past any mark the instrument can place). [—], [mm]
-MAG_RANGE = (1.0, 40.0)
+#: Photo patch requests: magnification (from the coarse-first patch's, core.COARSE_MAG = 0.625)
+#: and photo coordinates accepted (the format is 180 mm; ±150 mm reaches past any mark the
+#: instrument can place). [—], [mm]
+MAG_RANGE = (0.6, 40.0)
 XY_LIMIT_MM = 150.0
 
 
@@ -332,6 +333,7 @@ def create_app(
             pool.shutdown(wait=False, cancel_futures=True)
             for proc in workers:
                 proc.terminate()
+        reg.actor.shutdown(wait=True)
         store.close()
 
     app = Starlette(

@@ -12,7 +12,7 @@ import re
 from typing import Any
 
 from stereoplotter.errors import StereoplotterError, TrainerError
-from stereoplotter.imagery.cache import ViewCache
+from stereoplotter.imagery.cache import EAGER_PIXEL_MM, ViewCache
 from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM
 from stereoplotter.io.exercise_file import (
     exercise_from_mapping,
@@ -28,6 +28,7 @@ from stereoplotter.trainer.grading import grade
 from stereoplotter.trainer.session import Session
 
 __all__ = [
+    "COARSE_MAG",
     "SCREEN_PIXEL_MM",
     "Catalogue",
     "CoreError",
@@ -54,6 +55,10 @@ CoreError = StereoplotterError
 #: Grading population (Monte Carlo runs of the simulated operator) used by the server; the
 #: core's default is 10 000; 256 gives the percentile to ±3 points at a fraction of a second.
 GRADE_POPULATION = 256
+#: Magnification of the page's coarse-first patch: its screen pixel is the pyramid's coarsest
+#: level rendered whole when the photos are built (``imagery.cache.EAGER_PIXEL_MM``), so the
+#: patch is answered without rendering a tile. [—]
+COARSE_MAG = SCREEN_PIXEL_MM / EAGER_PIXEL_MM
 #: An uploaded exercise's name.
 UPLOAD_NAME = re.compile(r"[a-z0-9][a-z0-9_-]{0,63}")
 

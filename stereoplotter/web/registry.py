@@ -19,7 +19,7 @@ from __future__ import annotations
 import secrets
 import threading
 import time
-from concurrent.futures import Executor, Future
+from concurrent.futures import Executor, Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -65,6 +65,8 @@ class Registry:
         self.catalogue = catalogue
         self.grader = grader
         self.imager = imager
+        #: The thread that carries out every session's actions, one at a time.
+        self.actor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="trainer-actor")
         self.rows: dict[str, dict[str, Any]] = {r["id"]: r for r in store.sessions()}
         self.grades: dict[str, dict[str, Any]] = store.grades()
         self.live: dict[str, Live] = {}

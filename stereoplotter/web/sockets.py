@@ -82,6 +82,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         "patch_px": PATCH_PX,
         "format_mm": core.format_mm(ex),
         "description": ex.description,
+        "coarse_mag": core.COARSE_MAG,
     }
     state = await run_in_threadpool(live.session.state)
     await websocket.send_text(
@@ -109,10 +110,10 @@ async def _answer(reg: Registry, live, message: dict[str, Any], limit: RateLimit
         msg = parse_message(message.get("text"))
         seq = msg.get("seq")
         if msg.get("demo") == "step" and live.demonstration:
-            reply = await run_in_threadpool(reg.demo_step, live)
+            reply = await _on_actor(reg, reg.demo_step, live)
         elif "action" in msg and not live.demonstration:
             action = clean_action(msg["action"], live.session.records)
-            reply = await run_in_threadpool(reg.act, live, action)
+            reply = await _on_actor(reg, reg.act, live, action)
         elif "action" in msg:
             raise Refused(400, "a demonstration takes demonstration steps, not actions")
         else:
@@ -125,6 +126,13 @@ async def _answer(reg: Registry, live, message: dict[str, Any], limit: RateLimit
     if seq is not None:
         reply["seq"] = seq
     return reply
+
+
+async def _on_actor(reg: Registry, fn, *args):
+    """Run an action on the registry's one actor thread: actions of all sessions one after the
+    other (first come, first served) instead of threads that share the interpreter's lock and
+    all finish late together."""
+    return await asyncio.get_running_loop().run_in_executor(reg.actor, fn, *args)
 
 
 async def instructor_socket(websocket: WebSocket, reg: Registry) -> None:

@@ -52,21 +52,34 @@ off.left.width = off.left.height = off.right.width = off.right.height = 320;
 let flickerSide = "left";
 
 // Photo patches (one per side): fetched when the mark nears a patch's edge or the magnification
-// changes; a move only redraws from the patch in hand.
+// changes; a move only redraws from the patch in hand. Coarse first: with the sharp patch a
+// small one at hello.coarse_mag (the pyramid's level rendered whole at start-up, answered at
+// once) is fetched too and drawn, scaled, until the sharp one arrives.
 const patches = { left: null, right: null }, loading = { left: false, right: false };
+function patchUrl(side, mark, mag, size) {
+  return `/api/sessions/${encodeURIComponent(sid)}/patch.png?side=${side}&x=${mark.x_mm.toFixed(3)}`
+    + `&y=${mark.y_mm.toFixed(3)}&mag=${mag}&size=${size}&key=${encodeURIComponent(key || "")}`;
+}
 function needPatch(side, mark, mag) {
   const p = patches[side];
   if (loading[side] || !hello) return;
   const fieldMm = 320 / (scale.pxPerMmAt1x * mag);
   const halfMm = (hello.patch_px * hello.screen_pixel_mm) / mag / 2;
-  if (p && p.mag === mag && Math.abs(mark.x_mm - p.x_mm) < halfMm - fieldMm * 0.75
+  if (p && !p.coarse && p.mag === mag && Math.abs(mark.x_mm - p.x_mm) < halfMm - fieldMm * 0.75
       && Math.abs(mark.y_mm - p.y_mm) < halfMm - fieldMm * 0.75) return;
   loading[side] = true;
-  const q = { side, x_mm: mark.x_mm, y_mm: mark.y_mm, mag, size: hello.patch_px, img: new Image() };
+  const at = { x_mm: Number(mark.x_mm.toFixed(3)), y_mm: Number(mark.y_mm.toFixed(3)) };
+  const q = { side, ...at, mag, size: hello.patch_px, img: new Image() };
   q.img.onload = () => { patches[side] = q; loading[side] = false; window.__patches = (window.__patches || 0) + 1; drawEyes(); };
   q.img.onerror = () => { loading[side] = false; };
-  q.img.src = `/api/sessions/${encodeURIComponent(sid)}/patch.png?side=${side}&x=${mark.x_mm.toFixed(3)}&y=${mark.y_mm.toFixed(3)}&mag=${mag}&size=${hello.patch_px}&key=${encodeURIComponent(key || "")}`;
-  q.x_mm = Number(mark.x_mm.toFixed(3)); q.y_mm = Number(mark.y_mm.toFixed(3));
+  q.img.src = patchUrl(side, mark, mag, hello.patch_px);
+  const cm = hello.coarse_mag, cs = Math.max(16, Math.round((hello.patch_px * cm) / mag));
+  const c = { side, ...at, mag: cm, size: cs, coarse: true, img: new Image() };
+  c.img.onload = () => {
+    const now = patches[side];
+    if (!now || now.coarse || now.mag !== Number($("mag").value)) { patches[side] = c; drawEyes(); }
+  };
+  c.img.src = patchUrl(side, mark, cm, cs);
 }
 
 function drawEyes() {
@@ -227,7 +240,8 @@ window.trainer = {
   // drop the socket as a network would (the page must reconnect and resume)
   drop: () => ws && ws.close(),
   // both eyepieces drawn from a photo patch that covers the current marks
-  photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right),
+  photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right
+    && !patches.left.coarse && !patches.right.coarse),
   actAndFrame(action) {
     const t0 = performance.now();
     const s = send(action);
