@@ -260,12 +260,9 @@ def create_app(
 
     async def replay_states(request: Request) -> Response:
         instructor_only(request)
-        sid, row = session_row(request)
-        frames = await asyncio.wrap_future(reg.replay_frames(sid))
-        return JSONResponse(
-            {"trainee": row["trainee"], "exercise": row["exercise"], "frames": frames},
-            headers={"Cache-Control": "no-store"},
-        )
+        sid, _ = session_row(request)
+        body = await asyncio.wrap_future(reg.replay_json(sid))
+        return Response(body, media_type="application/json", headers={"Cache-Control": "no-store"})
 
     async def grant(request: Request) -> Response:
         instructor_only(request)

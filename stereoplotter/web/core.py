@@ -46,6 +46,7 @@ __all__ = [
     "photo_patch",
     "replay",
     "replay_frames",
+    "replay_json",
     "start",
 ]
 
@@ -151,6 +152,13 @@ def grade_of(session_or_log: Session | list[dict[str, Any]]) -> dict[str, Any]:
 def grade_text(grade_dict: dict[str, Any]) -> str:
     """The grade as Markdown."""
     return grade_markdown(grade_dict)
+
+
+def replay_json(records: list[dict[str, Any]], trainee: str, exercise: str) -> bytes:
+    """The instructor's replay as JSON bytes (run in a worker process: the frames of a long log
+    are megabytes of JSON, encoded off the server's event loop)."""
+    body = {"trainee": trainee, "exercise": exercise, "frames": replay_frames(records)}
+    return json.dumps(body, allow_nan=False, separators=(",", ":")).encode()
 
 
 def replay_frames(records: list[dict[str, Any]]) -> list[dict[str, Any]]:

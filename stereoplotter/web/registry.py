@@ -250,8 +250,11 @@ class Registry:
             return self._grade_later(sid)
         return self.grader.submit(core.grade_records, self.store.records(sid))
 
-    def replay_frames(self, sid: str) -> Future:
-        return self.grader.submit(core.replay_frames, self.store.records(sid))
+    def replay_json(self, sid: str) -> Future:
+        """The instructor's replay of a session's log (JSON bytes, made in a worker)."""
+        row = self.rows[sid]
+        return self.grader.submit(core.replay_json, self.store.records(sid), row["trainee"],
+                                  row["exercise"])
 
     def photos(self, exercise) -> Future:
         """The view cache of an exercise's photos (built once, in a worker)."""
