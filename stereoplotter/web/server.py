@@ -49,6 +49,9 @@ def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
     except (OSError, sqlite3.Error) as exc:
         print(f"error: trainer: data folder {folder}: {exc}", file=sys.stderr)
         raise SystemExit(1) from None
+    if token is not None and len(token) < 16:
+        print("warning: trainer: --token is shorter than 16 characters: easy to guess",
+              file=sys.stderr)
     sock = listen(host, port)
     bound = sock.getsockname()[1]
     names = (host,) if host not in ("0.0.0.0", "::", "") else ()
