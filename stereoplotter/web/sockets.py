@@ -50,13 +50,16 @@ async def _auth(websocket: WebSocket) -> Any:
     try:
         text = await asyncio.wait_for(websocket.receive_text(), AUTH_TIMEOUT_S)
         return parse_message(text).get("auth")
-    except (TimeoutError, Refused, KeyError, RuntimeError):
+    except (TimeoutError, Refused, KeyError, RuntimeError, WebSocketDisconnect):
         return None
 
 
 async def _refuse(websocket: WebSocket, text: str, code: int = 4403) -> None:
-    await websocket.send_text(_dump({"error": text, "state": None}))
-    await websocket.close(code)
+    try:
+        await websocket.send_text(_dump({"error": text, "state": None}))
+        await websocket.close(code)
+    except (WebSocketDisconnect, RuntimeError):  # the page has gone already
+        pass
 
 
 async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
@@ -69,7 +72,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         )
     try:
         live = await run_in_threadpool(reg.resume, sid)
-    except core.CoreError as exc:
+    except Exception as exc:  # a log that no longer replays: refused in one line, logged
         log.warning("session %s does not resume: %s", sid, exc)
         return await _refuse(websocket, "this session cannot be resumed", 4500)
     ex = live.session.exercise
