@@ -9,7 +9,8 @@ the start-up preparation of the photos). Phase 2 runs the load: a demonstration 
 the simulated operator's e01 script (about 580 actions, a long log to replay); 20 trainees each
 turn a handwheel ``--rate`` times a second (send, wait for the state, sleep) for ``--seconds``;
 meanwhile the instructor's socket receives the pushed table, the instructor fetches the replay
-of the long log and the grade of unfinished practice sessions (computed on demand) in a loop,
+of the long log and the grade of unfinished practice sessions (computed on demand) in a loop
+(``--instructor-pause`` s between rounds),
 and every 5 s a trainee claims its stage (the finished session is graded in the worker). Prints
 the turn-to-state round trip
 (median, p95, max) and the first-view times.
@@ -158,7 +159,7 @@ async def trainee(
     return sid
 
 
-async def instructor(host, http, stop: float, replay_sid: str, stats: dict):
+async def instructor(host, http, stop: float, replay_sid: str, stats: dict, pause: float):
     auth = {"Authorization": f"Bearer {TOKEN}"}
     ws = await connect(f"ws://{host}/ws-instructor", max_size=2**24)
     await ws.send(json.dumps({"auth": TOKEN}))
@@ -181,6 +182,7 @@ async def instructor(host, http, stop: float, replay_sid: str, stats: dict):
                 g = await http.get(f"/api/sessions/{row['id']}/grade", headers=auth, timeout=120)
                 g.raise_for_status()
                 stats["grades"].append(time.perf_counter() - t0)
+        await asyncio.sleep(pause)
     reader.cancel()
     await ws.close()
 
@@ -231,7 +233,9 @@ async def main_async(args) -> None:
                     )
                     for n in range(args.trainees)
                 ]
-                await asyncio.gather(instructor(host, http, stop, demo_sid, stats), *tasks)
+                await asyncio.gather(
+                    instructor(host, http, stop, demo_sid, stats, args.instructor_pause), *tasks
+                )
         finally:
             proc.terminate()
             proc.wait(10)
@@ -263,6 +267,12 @@ def main() -> None:
     ap.add_argument("--trainees", type=int, default=20)
     ap.add_argument("--seconds", type=float, default=30.0)
     ap.add_argument("--rate", type=float, default=10.0, help="turns a second per trainee")
+    ap.add_argument(
+        "--instructor-pause",
+        type=float,
+        default=2.0,
+        help="seconds between the instructor's replay-and-grade rounds",
+    )
     asyncio.run(main_async(ap.parse_args()))
 
 
