@@ -87,7 +87,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         "description": ex.description,
         "coarse_mag": core.COARSE_MAG,
     }
-    state = await run_in_threadpool(live.session.state)
+    state = await _on_actor(reg, live.session.state)  # not while an action changes it
     await websocket.send_text(
         _dump({"hello": hello, "state": state, "error": None, "n": len(live.session.log)})
     )

@@ -84,6 +84,10 @@ def test_every_route_answers_bad_requests_with_one_line(client):
     for q in BAD_PATCH:
         _one_line_error(client.get(f"/api/sessions/{sid}/patch.png?{q}&key={secret}"))
     _one_line_error(client.get("/api/nothing-here"))
+    for mag, size in ((0.625, 80), (6, 768)):  # the page's coarse-first patch, then the sharp one
+        q = {"side": "left", "x": 1, "y": -2, "mag": mag, "size": size, "key": secret}
+        r = client.get(f"/api/sessions/{sid}/patch.png", params=q)
+        assert r.status_code == 200 and r.content[:8] == b"\x89PNG\r\n\x1a\n"
     assert (
         client.get(f"/api/sessions/{sid}/patch.png?side=left&x=0&y=0&mag=6&key=no").status_code
         == 403
