@@ -3,17 +3,16 @@ sessions are graded and replayed.
 
 The server is ``stereoplotter trainer`` in its own process (worker processes for grading,
 replays and photos, as a class would run it). Phase 1 times the first eyepiece view of each
-shipped practice exercise: POST a session, open its socket, set f_пр if the marks are not
-projected yet, and fetch both eyepieces' coarse-first patches, then both sharp ×6 patches (after
-the start-up preparation of the photos). Phase 2 runs the load: a demonstration session plays
-the simulated operator's e01 script (about 580 actions, a long log to replay); 20 trainees each
-turn a handwheel ``--rate`` times a second (send, wait for the state, sleep) for ``--seconds``;
-meanwhile the instructor's socket receives the pushed table, the instructor fetches the replay
-of the long log and the grade of unfinished practice sessions (computed on demand) in a loop
-(``--instructor-pause`` s between rounds),
-and every 5 s a trainee claims its stage (the finished session is graded in the worker). Prints
-the turn-to-state round trip
-(median, p95, max) and the first-view times.
+shipped exercise (a new trainee each, so an exam allows it): POST a session, open its socket,
+set f_пр if the marks are not projected yet, and fetch both eyepieces' coarse-first patches,
+then both sharp ×6 patches (after the start-up preparation of the photos). Phase 2 runs the
+load: a demonstration session plays the simulated operator's e01 script (about 580 actions, a
+long log to replay); 20 trainees each turn a handwheel ``--rate`` times a second (send, wait for
+the state, sleep) for ``--seconds``; meanwhile the instructor's socket receives the pushed
+table, the instructor fetches the replay of the long log and the grade of unfinished practice
+sessions (computed on demand) in a loop (``--instructor-pause`` s between rounds), and every
+5 s a trainee claims its stage (the finished session is graded in the worker). Prints the
+turn-to-state round trip (median, p95, max) and the first-view times.
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py [--trainees 20] [--seconds 30]
 """
@@ -192,11 +191,7 @@ async def main_async(args) -> None:
         proc, host = _start_server(data)
         try:
             async with httpx.AsyncClient(base_url=f"http://{host}", timeout=120) as http:
-                exercises = [
-                    e["name"]
-                    for e in (await http.get("/api/exercises")).json()
-                    if e["mode"] == "practice"
-                ]
+                exercises = [e["name"] for e in (await http.get("/api/exercises")).json()]
                 t0 = time.perf_counter()
                 cold = await first_view(http, host, exercises[-1], 0)  # the last photos queued
                 print(
