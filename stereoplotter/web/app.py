@@ -44,6 +44,7 @@ from stereoplotter.io.session_store import SessionStore, exercise_upload
 from stereoplotter.web import core
 from stereoplotter.web.guard import (
     Guard,
+    RateLimit,
     Refused,
     error,
     local_names,
@@ -81,6 +82,9 @@ CSV_FIELDS = (
 #: instrument can place). [—], [mm]
 MAG_RANGE = (0.6, 40.0)
 XY_LIMIT_MM = 150.0
+#: Sessions one client address may start: bursts of 60 (a class behind one address starting at
+#: once), then one every 2 s (assumed: ample for people, small for a script). [1/s], [sessions]
+START_LIMIT = (0.5, 60)
 
 
 def _page(name: str):
@@ -112,6 +116,7 @@ def create_app(
     processes: bool = False,
     prepare_photos: bool = False,
     hosts: tuple[str, ...] = (),
+    start_limit: tuple[float, int] = START_LIMIT,
 ) -> Starlette:
     """The application.
 
@@ -119,13 +124,23 @@ def create_app(
     file (None: in memory, nothing kept); ``processes`` grades, replays and builds photos in
     worker processes (else in one worker thread each: tests); ``prepare_photos`` starts
     building every exercise's photos at start-up; ``hosts`` are names besides localhost, this
-    machine's name and IP addresses that pages may use to reach the server.
+    machine's name and IP addresses that pages may use to reach the server; ``start_limit``
+    the sessions a client address may start (a rate [1/s] and a burst).
     """
     store = SessionStore(data_dir)
     catalogue = core.Catalogue(store.exercises())
     reg = Registry(token, store, catalogue, _executor(processes), _executor(processes))
     if prepare_photos:
         reg.prepare_photos()
+
+    starts: dict[str, RateLimit] = {}
+
+    def start_allowed(request: Request) -> None:
+        if len(starts) > 10_000:  # forget old addresses rather than grow without bound
+            starts.clear()
+        addr = request.client.host if request.client else "?"
+        if not starts.setdefault(addr, RateLimit(*start_limit)).allow():
+            raise Refused(429, "too many sessions started from this address: wait a moment")
 
     def is_instructor(request: Request) -> bool:
         given = request.query_params.get("token") or _bearer(request)
@@ -156,6 +171,7 @@ def create_app(
         return JSONResponse(catalogue.listing())
 
     async def new_session(request: Request) -> Response:
+        start_allowed(request)
         body = await read_json(request)
         exercise = body.get("exercise")
         if not isinstance(exercise, str):

@@ -22,6 +22,10 @@ PRACTICE = "e01-setup-stage1"
 EXAM = "e11-setup-exam"
 
 
+def make_test_client(app) -> TestClient:
+    return TestClient(app)
+
+
 def make_client(data_dir) -> TestClient:
     return TestClient(create_app(TOKEN, data_dir, hosts=("testserver",)))
 

@@ -11,8 +11,18 @@ from importlib import resources
 import pytest
 from starlette.websockets import WebSocketDisconnect
 
+from stereoplotter.web.app import create_app
 from stereoplotter.web.guard import CSP, MAX_MESSAGE
-from tests.web.conftest import EXAM, PRACTICE, TOKEN, ask, claim_all, open_socket, start
+from tests.web.conftest import (
+    EXAM,
+    PRACTICE,
+    TOKEN,
+    ask,
+    claim_all,
+    make_test_client,
+    open_socket,
+    start,
+)
 
 MARKUP = '<img src=x onerror="window.__pwned=1">'
 STATIC = resources.files("stereoplotter.web") / "static"
@@ -299,3 +309,15 @@ def test_a_flood_of_messages_is_slowed_not_served(client):
     finally:
         ws.__exit__(None, None, None)
     assert MAX_MESSAGE <= 4096
+
+
+def test_a_flood_of_session_starts_is_refused(tmp_path):
+    with make_test_client(
+        create_app(TOKEN, tmp_path, hosts=("testserver",), start_limit=(0.01, 3))
+    ) as c:
+        codes = [
+            c.post("/api/sessions", json={"exercise": PRACTICE, "trainee": f"f{i}"})
+            for i in range(5)
+        ]
+    assert [r.status_code for r in codes] == [200, 200, 200, 429, 429]
+    assert codes[-1].json()["error"].startswith("too many sessions")
