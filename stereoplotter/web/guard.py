@@ -205,7 +205,9 @@ async def read_json(request, limit: int = MAX_BODY) -> dict[str, Any]:
 
 async def read_body(request, limit: int = MAX_BODY) -> bytes:
     size = request.headers.get("content-length")
-    if size is not None and (not size.isdigit() or int(size) > limit):
+    if size is not None and not size.isdigit():
+        raise Refused(400, "Content-Length: expected a number of bytes")
+    if size is not None and int(size) > limit:
         raise Refused(413, f"body: at most {limit} bytes")
     chunks, n = [], 0
     async for chunk in request.stream():
