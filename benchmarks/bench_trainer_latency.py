@@ -43,6 +43,7 @@ def main() -> None:
         page = ctx.new_page()
         page.goto(base + "/")
         page.click("button[data-exercise='e01-setup-stage1']")
+        page.wait_for_url("**/s/*")  # the exercises page is ready too
         page.wait_for_selector("body[data-ready='1']")
         page.evaluate("window.trainer.actAndFrame({kind: 'set', control: 'f_instrument', "
                       "value: 109.34})")

@@ -100,7 +100,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
             reply = await _answer(reg, live, message, limit)
             reply["n"] = len(live.session.log)
             await websocket.send_text(_dump(reply))
-    except WebSocketDisconnect:
+    except (WebSocketDisconnect, OSError):  # the page went away (uvicorn: ClientDisconnected)
         return
 
 
@@ -155,5 +155,5 @@ async def instructor_socket(websocket: WebSocket, reg: Registry) -> None:
                     return
             except TimeoutError:
                 pass
-    except WebSocketDisconnect:
+    except (WebSocketDisconnect, OSError):  # the page went away
         return
