@@ -88,11 +88,11 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         "coarse_mag": core.COARSE_MAG,
     }
     state = await _on_actor(reg, live.session.state)  # not while an action changes it
-    await websocket.send_text(
-        _dump({"hello": hello, "state": state, "error": None, "n": len(live.session.log)})
-    )
     limit = RateLimit()
     try:
+        await websocket.send_text(
+            _dump({"hello": hello, "state": state, "error": None, "n": len(live.session.log)})
+        )
         while True:
             message = await websocket.receive()
             if message["type"] == "websocket.disconnect":
