@@ -321,3 +321,16 @@ def test_a_flood_of_session_starts_is_refused(tmp_path):
         ]
     assert [r.status_code for r in codes] == [200, 200, 200, 429, 429]
     assert codes[-1].json()["error"].startswith("too many sessions")
+
+
+def test_an_exam_refuses_hints_and_undo_on_the_socket(client):
+    sid, secret = start(client, EXAM, trainee="no-help")
+    ws, conn, hello = open_socket(client, sid, secret)
+    try:
+        assert "hint" not in hello["state"]["allowed"] and "undo" not in hello["state"]["allowed"]
+        for action in ({"kind": "hint", "level": 3}, {"kind": "undo"}):
+            reply = ask(conn, {"action": action})
+            assert "not allowed now" in reply["error"], reply
+            assert "result" not in reply
+    finally:
+        ws.__exit__(None, None, None)
