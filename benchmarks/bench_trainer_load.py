@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -228,9 +229,11 @@ async def main_async(args) -> None:
                     )
                     for n in range(args.trainees)
                 ]
-                await asyncio.gather(
-                    instructor(host, http, stop, demo_sid, stats, args.instructor_pause), *tasks
-                )
+                if not args.no_instructor:
+                    tasks.append(
+                        instructor(host, http, stop, demo_sid, stats, args.instructor_pause)
+                    )
+                await asyncio.gather(*tasks)
         finally:
             proc.terminate()
             proc.wait(10)
@@ -247,7 +250,7 @@ async def main_async(args) -> None:
     print(
         f"load: {args.trainees} trainees × {args.rate:g} turns/s + instructor, {args.seconds} s; "
         f"replays of a {n_log}-action log: {len(stats['replays'])} "
-        f"(median {statistics.median(stats['replays']):.2f} s), on-demand grades: "
+        f"(median {statistics.median(stats['replays'] or [math.nan]):.2f} s), on-demand grades: "
         f"{len(stats['grades'])}, table pushes: {stats['pushes']}"
     )
     print(
