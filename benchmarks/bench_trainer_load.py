@@ -200,7 +200,9 @@ async def main_async(args) -> None:
                     f"start-up (first view of {exercises[-1]} then: {cold[0]:.2f} s)"
                 )
                 views = {
-                    ex: await first_view(http, host, ex, i + 1) for i, ex in enumerate(exercises)
+                    ex: await first_view(http, host, ex, i + 1)
+                    for i, ex in enumerate(exercises)
+                    if not args.skip_first_view
                 }
                 # the long log to replay: the operator's e01 script as a demonstration
                 demo_sid, demo_secret = await _session(
@@ -238,8 +240,8 @@ async def main_async(args) -> None:
             proc.terminate()
             proc.wait(10)
     rtt.sort()
-    first = [v[0] for v in views.values()]
-    sharp = [v[1] for v in views.values()]
+    first = [v[0] for v in views.values()] or [math.nan]
+    sharp = [v[1] for v in views.values()] or [math.nan]
     print(
         f"first eyepiece view (POST session → both coarse patches), after preparation: "
         f"median {statistics.median(first):.2f} s, max {max(first):.2f} s; both sharp ×6: "
@@ -248,7 +250,8 @@ async def main_async(args) -> None:
     for ex, (a, b) in views.items():
         print(f"  {ex:32s} first {a:.2f} s, sharp {b:.2f} s")
     print(
-        f"load: {args.trainees} trainees × {args.rate:g} turns/s + instructor, {args.seconds} s; "
+        f"load: {args.trainees} trainees × {args.rate:g} turns/s"
+        f"{'' if args.no_instructor else ' + instructor'}, {args.seconds} s; "
         f"replays of a {n_log}-action log: {len(stats['replays'])} "
         f"(median {statistics.median(stats['replays'] or [math.nan]):.2f} s), on-demand grades: "
         f"{len(stats['grades'])}, table pushes: {stats['pushes']}"
