@@ -275,6 +275,16 @@ def main() -> None:
         default=2.0,
         help="seconds between the instructor's replay-and-grade rounds",
     )
+    ap.add_argument(
+        "--no-instructor",
+        action="store_true",
+        help="trainees only: no replays nor on-demand grades (a baseline)",
+    )
+    ap.add_argument(
+        "--skip-first-view",
+        action="store_true",
+        help="no first-view times (the photos are still prepared before the load)",
+    )
     asyncio.run(main_async(ap.parse_args()))
 
 
