@@ -259,7 +259,7 @@ async def main_async(args) -> None:
     print(
         f"turn-to-state round trip: n={len(rtt)} median {statistics.median(rtt):.1f} ms, "
         f"p95 {rtt[int(0.95 * (len(rtt) - 1))]:.1f} ms, max {rtt[-1]:.1f} ms "
-        f"(os.cpu_count() = {os.cpu_count()}, load average over the run "
+        f"(os.cpu_count() = {os.cpu_count()}, 1-minute load average at the end "
         f"{os.getloadavg()[0]:.1f})"
     )
 
