@@ -32,4 +32,3 @@ for (const ex of exercises) {
     el("p", { text: ex.description }),
     b));
 }
-document.body.dataset.ready = "1";
