@@ -43,10 +43,11 @@ def main() -> None:
         page = ctx.new_page()
         page.goto(base + "/")
         page.click("button[data-exercise='e01-setup-stage1']")
+        page.wait_for_url("**/s/*")  # the exercises page is ready too
         page.wait_for_selector("body[data-ready='1']")
         page.evaluate("window.trainer.actAndFrame({kind: 'set', control: 'f_instrument', "
                       "value: 109.34})")
-        page.wait_for_function("window.trainer.photosReady()", timeout=120_000)
+        page.wait_for_function("() => window.trainer.photosReady()", timeout=120_000)
         results = {}
         for view in ("split", "anaglyph"):
             page.select_option("#view", view)

@@ -26,6 +26,12 @@ def add_arguments(sub: Any) -> None:
         help="port (default: 0, a free port chosen by the system; the address is printed)",
     )
     p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
+    p.add_argument(
+        "--data-dir",
+        metavar="DIR",
+        help="folder of the trainer's SQLite file: sessions, logs, grades (default: "
+        "~/.local/share/stereoplotter/trainer, or $XDG_DATA_HOME/stereoplotter/trainer)",
+    )
     p.set_defaults(func=run)
 
 
@@ -41,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
         )
         return 1
     try:
-        serve(args.host, args.port, args.token)
+        serve(args.host, args.port, args.token, args.data_dir)
     except OSError as exc:
         print(
             f"error: trainer: cannot listen on {args.host}:{args.port} ({exc.strerror or exc})",

@@ -9,10 +9,9 @@ The exercise's ``terrain`` and ``tilt`` act on the scenario's file content befor
 :data:`RELIEF_CLASSES`); the tilt class scales the photos' α and ω so that the largest is the
 class's :data:`TILT_TARGET_DEG` (κ unchanged). A bad file gives one line naming the file and field.
 
-Importing this module registers :func:`exercise_from_mapping` with
-:func:`stereoplotter.trainer.exercise.register_resolver`, so that
-:meth:`Session.replay <stereoplotter.trainer.session.Session.replay>` rebuilds the exercise of a
-session log from its header.
+:func:`exercise_from_mapping` is the reader that callers pass to
+:meth:`Session.replay <stereoplotter.trainer.session.Session.replay>` (``read_exercise=``) to
+rebuild the exercise of a session log from its header; importing this module registers nothing.
 """
 
 from __future__ import annotations
@@ -38,7 +37,6 @@ from stereoplotter.trainer.exercise import (
     TERRAINS,
     TILTS,
     Exercise,
-    register_resolver,
 )
 
 __all__ = [
@@ -218,4 +216,3 @@ def shipped_exercises() -> list[Path]:
     return sorted(list_data_files("exercises"))
 
 
-register_resolver(exercise_from_mapping)

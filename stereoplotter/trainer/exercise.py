@@ -27,7 +27,6 @@ __all__ = [
     "TERRAINS",
     "TILTS",
     "Exercise",
-    "register_resolver",
     "resolve_exercise",
     "trainee_seed",
 ]
@@ -125,28 +124,16 @@ def trainee_seed(exercise: str, trainee: str) -> int:
     return int.from_bytes(digest[:8], "big") >> 1
 
 
-_RESOLVER: list[Callable[[dict[str, Any]], Exercise]] = []
-
-
-def register_resolver(resolver: Callable[[dict[str, Any]], Exercise]) -> None:
-    """Register how an exercise's file content becomes an :class:`Exercise` (the io layer
-    registers :func:`stereoplotter.io.exercise_file.exercise_from_mapping` when imported)."""
-    _RESOLVER[:] = [resolver]
-
-
 def resolve_exercise(
     source: dict[str, Any],
     read_exercise: Callable[[dict[str, Any]], Exercise] | None = None,
 ) -> Exercise:
     """The :class:`Exercise` of a file content (a session log's header), read by
     ``read_exercise`` (the io layer's ``exercise_from_mapping``, passed by the caller: the
-    trainer cannot import io). Without it, the reader registered by
-    :func:`register_resolver` — a transition for callers that do not pass it yet (issue 23)."""
-    if read_exercise is not None:
-        return read_exercise(source)
-    if not _RESOLVER:
+    trainer cannot import io, and nothing registers itself on import)."""
+    if read_exercise is None:
         raise TrainerError(
-            "no exercise reader registered: import stereoplotter.io.exercise_file, "
-            "or pass the exercise to Session.replay"
+            "no exercise reader given: pass read_exercise "
+            "(stereoplotter.io.exercise_file.exercise_from_mapping) or the exercise itself"
         )
-    return _RESOLVER[0](source)
+    return read_exercise(source)

@@ -7,33 +7,46 @@ Every call the server makes into :mod:`stereoplotter.trainer`, :mod:`stereoplott
 
 from __future__ import annotations
 
-import threading
+import json
+import re
 from typing import Any
 
 from stereoplotter.errors import StereoplotterError, TrainerError
-from stereoplotter.imagery.cache import ViewCache
+from stereoplotter.imagery.cache import EAGER_PIXEL_MM, ViewCache
 from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM
-from stereoplotter.io.exercise_file import load_exercise, shipped_exercises
+from stereoplotter.io.exercise_file import (
+    exercise_from_mapping,
+    load_exercise,
+    shipped_exercises,
+)
 from stereoplotter.io.images import png_bytes
+from stereoplotter.io.paths import available_names
 from stereoplotter.io.session_log import log_bytes
 from stereoplotter.report.grade import grade_markdown
-from stereoplotter.trainer.exercise import resolve_exercise
+from stereoplotter.trainer.exercise import Exercise, resolve_exercise
 from stereoplotter.trainer.grading import grade
 from stereoplotter.trainer.session import Session
 
 __all__ = [
+    "COARSE_MAG",
     "SCREEN_PIXEL_MM",
+    "Catalogue",
     "CoreError",
     "TrainerError",
-    "exercise_list",
+    "build_view_cache",
+    "format_mm",
     "grade_of",
+    "grade_records",
     "grade_text",
+    "log_bytes",
     "log_of",
     "log_text",
     "operator_script",
+    "photo_key",
     "photo_patch",
     "replay",
     "replay_frames",
+    "replay_json",
     "start",
 ]
 
@@ -43,14 +56,35 @@ CoreError = StereoplotterError
 #: Grading population (Monte Carlo runs of the simulated operator) used by the server; the
 #: core's default is 10 000; 256 gives the percentile to ±3 points at a fraction of a second.
 GRADE_POPULATION = 256
+#: Magnification of the page's coarse-first patch: its screen pixel is the pyramid's coarsest
+#: level rendered whole when the photos are built (``imagery.cache.EAGER_PIXEL_MM``), so the
+#: patch is answered without rendering a tile. [—]
+COARSE_MAG = SCREEN_PIXEL_MM / EAGER_PIXEL_MM
+#: An uploaded exercise's name.
+UPLOAD_NAME = re.compile(r"[a-z0-9][a-z0-9_-]{0,63}")
 
 
-def exercise_list() -> list[dict[str, Any]]:
-    """The shipped exercises, easiest first: name, title, level, mode, description."""
-    out = []
-    for path in shipped_exercises():
-        ex = load_exercise(path)
-        out.append(
+class Catalogue:
+    """The exercises the server knows: the shipped ones (by name, read once) and those the
+    instructor uploaded (validated, kept in the store). Nothing else is ever opened."""
+
+    def __init__(self, uploaded: dict[str, dict[str, Any]] | None = None):
+        self.by_name: dict[str, Exercise] = {}
+        self.shipped: set[str] = set()
+        for path in shipped_exercises():
+            ex = load_exercise(path)
+            self.by_name[ex.name] = ex
+            self.shipped.add(ex.name)
+        for name, source in (uploaded or {}).items():
+            if name not in self.by_name:
+                self.by_name[name] = exercise_from_mapping(source, f"uploaded exercise {name}")
+
+    def get(self, name: Any) -> Exercise | None:
+        return self.by_name.get(name) if isinstance(name, str) else None
+
+    def listing(self) -> list[dict[str, Any]]:
+        """The exercises, easiest first: name, title, level, mode, description."""
+        out = [
             {
                 "name": ex.name,
                 "title": ex.title,
@@ -59,14 +93,35 @@ def exercise_list() -> list[dict[str, Any]]:
                 "instrument": ex.spec.key,
                 "description": ex.description,
                 "assists": dict(ex.assists),
+                "uploaded": ex.name not in self.shipped,
             }
-        )
-    return sorted(out, key=lambda e: (e["level"], e["name"]))
+            for ex in self.by_name.values()
+        ]
+        return sorted(out, key=lambda e: (e["level"], e["name"]))
+
+    def add_upload(self, data: dict[str, Any]) -> Exercise:
+        """Validate an uploaded exercise's content: its name new and plain, its instrument and
+        scenario shipped names (never a path), the rest as an exercise file."""
+        name = data.get("name")
+        if not isinstance(name, str) or not UPLOAD_NAME.fullmatch(name):
+            raise CoreError("uploaded exercise: name: expected 1 to 64 of a-z, 0-9, '-', '_'")
+        if name in self.shipped:
+            raise CoreError(f"uploaded exercise: name: {name} is a shipped exercise")
+        for kind, field in (("instruments", "instrument"), ("scenarios", "scenario")):
+            value = data.get(field)
+            if value not in available_names(kind):
+                raise CoreError(
+                    f"uploaded exercise: {field}: expected one of "
+                    f"{', '.join(available_names(kind))}, found {str(value)[:40]!r}"
+                )
+        ex = exercise_from_mapping(data, "uploaded exercise")
+        self.by_name[name] = ex
+        return ex
 
 
-def start(exercise_name: str, trainee: str, seed: int | None = None) -> Session:
-    """A new session on a shipped exercise (by name)."""
-    return Session.start(load_exercise(exercise_name), trainee=trainee, seed=seed)
+def start(exercise: Exercise, trainee: str, seed: int | None = None) -> Session:
+    """A new session on a known exercise."""
+    return Session.start(exercise, trainee=trainee, seed=seed)
 
 
 def operator_script(session: Session) -> list[dict[str, Any]]:
@@ -86,12 +141,12 @@ def log_text(session: Session) -> bytes:
 
 def replay(records: list[dict[str, Any]]) -> Session:
     """A session run again from its log."""
-    return Session.replay(records)
+    return Session.replay(records, read_exercise=exercise_from_mapping)
 
 
 def grade_of(session_or_log: Session | list[dict[str, Any]]) -> dict[str, Any]:
     """The grade (``stereoplotter-grade/1`` dict) of a session or its log."""
-    return grade(session_or_log, population=GRADE_POPULATION)
+    return grade(session_or_log, population=GRADE_POPULATION, read_exercise=exercise_from_mapping)
 
 
 def grade_text(grade_dict: dict[str, Any]) -> str:
@@ -99,12 +154,19 @@ def grade_text(grade_dict: dict[str, Any]) -> str:
     return grade_markdown(grade_dict)
 
 
+def replay_json(records: list[dict[str, Any]], trainee: str, exercise: str) -> bytes:
+    """The instructor's replay as JSON bytes (run in a worker process: the frames of a long log
+    are megabytes of JSON, encoded off the server's event loop)."""
+    body = {"trainee": trainee, "exercise": exercise, "frames": replay_frames(records)}
+    return json.dumps(body, allow_nan=False, separators=(",", ":")).encode()
+
+
 def replay_frames(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """The log stepped through: for each action, the action and the state after it (the
     instructor's replay). The session is started afresh from the header and fed each recorded
     action at its recorded time; refused actions stay refused."""
     head = records[0]
-    session = Session(resolve_exercise(head["exercise"]), str(head["trainee"]), int(head["seed"]),
+    session = Session(resolve_exercise(head["exercise"], exercise_from_mapping), str(head["trainee"]), int(head["seed"]),
                       clock=False)
     frames = [{"action": None, "state": session.state(), "refused": None}]
     for rec in records[1:]:
@@ -119,26 +181,36 @@ def replay_frames(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return frames
 
 
-#: Both photos of a (scenario, seed) as the imagery's tile pyramid, built once and shared by the
-#: sessions that use them (building pair60 takes ~4 s).
-_CACHES: dict[tuple[str, int], ViewCache] = {}
-_CACHE_LOCK = threading.Lock()
+#: Both photos of an exercise's scenario as the imagery's tile pyramid, built once (in a worker,
+#: about 4 s for pair60) and shared by every session of the exercise: the ground texture's seed
+#: is the exercise's fixed seed, or the scenario's own for a per-trainee exercise (a trainee's
+#: seed draws the instrument's errors, not the ground), so the photos are ready before the
+#: first trainee starts.
+def photo_key(exercise: Exercise) -> tuple[str, str, str, int | None]:
+    """What a session's photos depend on: the scenario, terrain and tilt classes, the seed."""
+    return (exercise.scenario_name, exercise.terrain, exercise.tilt, exercise.seed)
 
 
-def view_cache(session: Session) -> ViewCache:
-    """The imagery view cache of the session's photos (built on first use)."""
-    key = (session.exercise.scenario_name, int(session.seed))
-    with _CACHE_LOCK:
-        if key not in _CACHES:
-            _CACHES[key] = ViewCache(session.exercise.scenario, session.seed)
-        return _CACHES[key]
+def build_view_cache(source: dict[str, Any]) -> ViewCache:
+    """The view cache of an exercise's photos (run in a worker process: picklable in and out)."""
+    ex = resolve_exercise(source)
+    return ViewCache(ex.scenario, ex.seed)
+
+
+def format_mm(exercise: Exercise) -> float:
+    """The photos' format side (the mark is off the photo beyond ±format/2). [mm]"""
+    return float(exercise.scenario.camera.format_mm)
+
+
+def grade_records(records: list[dict[str, Any]]) -> dict[str, Any]:
+    """The grade of a session log (run in a worker process)."""
+    return json.loads(json.dumps(grade(records, population=GRADE_POPULATION, read_exercise=exercise_from_mapping), allow_nan=False))
 
 
 def photo_patch(
-    session: Session, side: str, x_mm: float, y_mm: float, magnification: float, size_px: int
+    cache: ViewCache, side: str, x_mm: float, y_mm: float, magnification: float, size_px: int
 ) -> bytes:
     """PNG of the photo ``side`` around photo point x, y [mm], unrotated (κ = 0), one pixel
     = SCREEN_PIXEL_MM / magnification mm of photo, x to the right, y up: the page turns and
     places it under the mark itself, so a move needs no new image."""
-    cache = view_cache(session)
     return png_bytes(cache.view(side, x_mm, y_mm, 0.0, magnification, size_px))

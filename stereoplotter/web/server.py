@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import socket
+import sqlite3
+import sys
+from pathlib import Path
 
 import uvicorn
 
+from stereoplotter.io.session_store import SessionStore, default_data_dir
 from stereoplotter.web.app import create_app
 
 __all__ = ["listen", "serve"]
@@ -28,15 +32,35 @@ def listen(host: str = "127.0.0.1", port: int = 0) -> socket.socket:
     return sock
 
 
-def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None) -> None:
+#: Largest WebSocket frame read at all (a larger one closes the socket with 1009); frames over
+#: the protocol's own limit (guard.MAX_MESSAGE) are read and answered with an error. [bytes]
+WS_MAX_SIZE = 4 * 1024 * 1024
+
+
+def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
+          data_dir: str | None = None) -> None:
     """Serve until interrupted; prints the trainee and instructor addresses with the port
-    actually bound (the instructor's token is random unless given)."""
+    actually bound (the instructor's token is random unless given) and the data folder.
+    Sessions, logs and grades are kept in ``data_dir`` (default: the per-user folder)."""
+    folder = Path(data_dir) if data_dir else default_data_dir()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        SessionStore(folder).close()
+    except (OSError, sqlite3.Error) as exc:
+        print(f"error: trainer: data folder {folder}: {exc}", file=sys.stderr)
+        raise SystemExit(1) from None
+    if token is not None and len(token) < 16:
+        print("warning: trainer: --token is shorter than 16 characters: easy to guess",
+              file=sys.stderr)
     sock = listen(host, port)
     bound = sock.getsockname()[1]
-    app = create_app(token)
+    names = (host,) if host not in ("0.0.0.0", "::", "") else ()
+    app = create_app(token, folder, processes=True, prepare_photos=True, hosts=names)
     reg = app.state.registry
     shown = "localhost" if host in ("127.0.0.1", "0.0.0.0") else host
     shown = f"[{shown}]" if ":" in shown else shown
     print(f"trainee page:    http://{shown}:{bound}/", flush=True)
     print(f"instructor page: http://{shown}:{bound}/instructor?token={reg.token}", flush=True)
-    uvicorn.Server(uvicorn.Config(app, log_level="warning")).run(sockets=[sock])
+    print(f"data folder:     {folder}", flush=True)
+    config = uvicorn.Config(app, log_level="warning", ws_max_size=WS_MAX_SIZE)
+    uvicorn.Server(config).run(sockets=[sock])

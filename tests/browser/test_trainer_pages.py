@@ -37,7 +37,7 @@ def _start(page, server, exercise, trainee="browser"):
 
 def _settle(page, n):
     """Wait until the server has answered n actions."""
-    page.wait_for_function(f"window.__n >= {n}")
+    page.wait_for_function(f"() => window.__n >= {n}")  # a function: no eval under the CSP
 
 
 def _wheel(page, control, notches, shift=False):
@@ -69,7 +69,7 @@ def test_browser_trainee_completes_stage1_like_the_core_session(page, server, ar
     page.click("tr[data-counter='X'] button.read")
     n += 1
     _settle(page, n)
-    page.wait_for_function("window.trainer.photosReady()", timeout=60_000)  # both photos in
+    page.wait_for_function("() => window.trainer.photosReady()", timeout=60_000)  # both photos in
     page.wait_for_timeout(100)
     page.screenshot(path=str(artefacts / "instrument.png"), full_page=True)
     page.click("#claim")
@@ -83,8 +83,10 @@ def test_browser_trainee_completes_stage1_like_the_core_session(page, server, ar
         for row in page.locator("#counters tbody tr").all()
     }
 
-    log = [json.loads(line) for line in
-           page.request.get(f"{server}/api/sessions/{sid}/log.jsonl").text().splitlines()]
+    secret = page.evaluate(f"localStorage.getItem('stereoplotter-key-{sid}')")
+    key = {"Authorization": f"Bearer {secret}"}  # the session's own key (issue 22)
+    log = [json.loads(line) for line in page.request.get(
+        f"{server}/api/sessions/{sid}/log.jsonl", headers=key).text().splitlines()]
     assert len(log) == n + 1  # header + every click, key and wheel notch as one action
     kinds = [r["action"]["kind"] for r in log[1:]]
     assert kinds.count("turn") == 6 and kinds.count("set") == 4 and kinds[-1] == "claim"
@@ -108,7 +110,7 @@ def test_browser_trainee_completes_stage1_like_the_core_session(page, server, ar
         g["population"].pop("seconds")
     assert page_grade == core_grade
     page.screenshot(path=str(artefacts / "grade.png"), full_page=True)
-    md = page.request.get(f"{server}/api/sessions/{sid}/grade.md").text()
+    md = page.request.get(f"{server}/api/sessions/{sid}/grade.md", headers=key).text()
     assert md.startswith("#") and FIRST in md
 
 
@@ -147,7 +149,7 @@ def test_anaglyph_pixels_show_a_planted_y_parallax(page, server, artefacts):
     page.select_option("#colours", "red,cyan")
     page.fill("#mag", "10")
     page.dispatch_event("#mag", "change")
-    page.wait_for_function("(window.__patches || 0) >= 4 && window.trainer.photosReady()",
+    page.wait_for_function("() => (window.__patches || 0) >= 4 && window.trainer.photosReady()",
                            timeout=60_000)  # both sides at ×10
     page.wait_for_timeout(100)
     red0, cyan0 = page.evaluate(PROFILE_JS)

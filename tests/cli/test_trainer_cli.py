@@ -58,11 +58,12 @@ def test_a_refused_action_stops_the_run_but_the_log_is_written(tmp_path, capsys)
     assert len(log.read_text(encoding="utf-8").splitlines()) == 2
 
 
-def test_trainer_serves_on_the_printed_free_port():
+def test_trainer_serves_on_the_printed_free_port(tmp_path):
     # `stereoplotter trainer` with the default port 0: the system picks a free port and the
     # printed address is the one that answers (issue 14, deliverable 1)
     with subprocess.Popen(
-        [sys.executable, "-m", "stereoplotter", "trainer", "--token", "t0"],
+        [sys.executable, "-m", "stereoplotter", "trainer", "--token", "t0",
+         "--data-dir", str(tmp_path)],  # never the user's own data folder
         stdout=subprocess.PIPE,
         stderr=subprocess.DEVNULL,
         text=True,
@@ -87,12 +88,12 @@ def test_trainer_serves_on_the_printed_free_port():
             proc.wait(timeout=10)
 
 
-def test_trainer_on_a_busy_port_is_one_error_line(capsys):
+def test_trainer_on_a_busy_port_is_one_error_line(capsys, tmp_path):
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))
         busy.listen(1)
         port = busy.getsockname()[1]
-        assert main(["trainer", "--port", str(port)]) == 1
+        assert main(["trainer", "--port", str(port), "--data-dir", str(tmp_path)]) == 1
     err = capsys.readouterr().err
     assert err.startswith(f"error: trainer: cannot listen on 127.0.0.1:{port}")
     assert err.count("\n") == 1

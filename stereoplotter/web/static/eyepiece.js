@@ -5,12 +5,34 @@ const COLOURS = { red: [1, 0, 0], cyan: [0, 1, 1], green: [0, 1, 0], magenta: [1
 
 // Pixels of the eyepiece canvas per mm of photo at magnification 1 (1 / the imagery's
 // SCREEN_PIXEL_MM, sent by the server in its first message).
-export const scale = { pxPerMmAt1x: 10 };
+// formatMm: side of the photo format (the mark is off the photo beyond ±formatMm / 2).
+export const scale = { pxPerMmAt1x: 10, formatMm: null };
+
+// A mark outside the photo format: the field is the camera's black frame; say so.
+function offPhoto(mark) {
+  const h = scale.formatMm / 2;
+  return scale.formatMm !== null && (Math.abs(mark.x_mm) > h || Math.abs(mark.y_mm) > h);
+}
+
+function say(ctx, w, h, lines) {
+  ctx.save();
+  ctx.fillStyle = "rgba(16,19,20,0.75)"; ctx.fillRect(0, h / 2 - 30, w, 46);
+  ctx.fillStyle = "#ffd080"; ctx.font = "13px sans-serif"; ctx.textAlign = "center";
+  lines.forEach((t, i) => ctx.fillText(t, w / 2, h / 2 - 10 + 18 * i));
+  ctx.restore();
+}
 
 // The field of one eye centred on the mark (x_mm, y_mm), turned by the carrier's κ: the photo
 // patch the server sent (drawn where it lies on the photo), else a graticule of photo
 // coordinates (1 mm, bold every 5 mm) while it loads; then the mark itself at the centre.
-export function drawField(ctx, mark, magnification, { ink = "#e8e4d8", back = "#101314", markColour = "#ff4030", patch = null } = {}) {
+export function drawField(ctx, mark, magnification, opts = {}) {
+  drawPhoto(ctx, mark, magnification, opts);
+  const w = ctx.canvas.width, h = ctx.canvas.height;
+  if (mark && offPhoto(mark)) say(ctx, w, h, ["the mark is off the photo", `x ${mark.x_mm.toFixed(1)}  y ${mark.y_mm.toFixed(1)} mm`]);
+  else if (mark && !(opts.patch && opts.patch.img.complete)) say(ctx, w, h, ["loading the photo…", "(graticule meanwhile)"]);
+}
+
+function drawPhoto(ctx, mark, magnification, { ink = "#e8e4d8", back = "#101314", markColour = "#ff4030", patch = null } = {}) {
   const w = ctx.canvas.width, h = ctx.canvas.height;
   ctx.save();
   ctx.fillStyle = back; ctx.fillRect(0, 0, w, h);

@@ -1,29 +1,52 @@
-// The grade report page: the core's grade of this session, and downloads.
+// The grade report page: the core's grade of this session, and downloads. The session's own
+// key (kept by this browser when it started the session) or the instructor's token is needed.
+import { el, sessionKey, download } from "./dom.js";
+
 const sid = location.pathname.split("/").pop();
 const $ = (id) => document.getElementById(id);
-const r = await fetch(`/api/sessions/${sid}/grade`);
-const { grade } = await r.json();
+const token = new URLSearchParams(location.search).get("token");
+const auth = { Authorization: `Bearer ${token || sessionKey.get(sid) || ""}` };
+const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/grade`, { headers: auth });
+const body = await r.json();
+if (!r.ok) {
+  $("overall").append(el("p", { class: "fail", text: body.error }));
+  document.body.dataset.ready = "1";
+  throw new Error(body.error);
+}
+const grade = body.grade;
 window.__grade = grade;
 $("who").textContent = `${grade.trainee} · ${grade.exercise} · ${grade.mode}`;
 const o = grade.overall;
-$("overall").innerHTML = `<p style="font-size:18px"><span class="${o.passed ? "pass" : "fail"}">${o.passed ? "PASSED" : "NOT PASSED"}</span>
-  — score <b>${o.score.toFixed(3)}</b> (simulated operator ${o.par_score.toFixed(3)}),
-  percentile ${o.percentile.toFixed(1)} ± ${o.percentile_se.toFixed(1)} among simulated operators</p>
-  <p class="meta">${grade.title}</p>`;
-$("md").href = `/api/sessions/${sid}/grade.md`;
-$("log").href = `/api/sessions/${sid}/log.jsonl`;
+$("overall").append(
+  el("p", { class: "big" },
+    el("span", { class: o.passed ? "pass" : "fail", text: o.passed ? "PASSED" : "NOT PASSED" }),
+    " — score ", el("b", { text: o.score.toFixed(3) }),
+    ` (simulated operator ${o.par_score.toFixed(3)}), percentile ${o.percentile.toFixed(1)} ± `
+    + `${o.percentile_se.toFixed(1)} among simulated operators`),
+  el("p", { class: "meta", text: grade.title }));
+$("md").addEventListener("click", (e) => {
+  e.preventDefault(); download(`/api/sessions/${sid}/grade.md`, auth, `grade-${sid}.md`);
+});
+$("log").addEventListener("click", (e) => {
+  e.preventDefault(); download(`/api/sessions/${sid}/log.jsonl`, auth, `session-${sid}.jsonl`);
+});
 const fmt = (v) => (typeof v !== "number" ? String(v ?? "—")
   : Number.isInteger(v) ? String(v) : Math.abs(v) >= 1e-3 ? v.toFixed(4) : v.toExponential(2));
-for (const [stage, body] of Object.entries(grade.stages)) {
-  const div = document.createElement("div");
-  div.innerHTML = `<h3>Stage ${stage} ${body.claimed ? "" : "(not claimed)"}</h3>
-   <table><tr><th>measure</th><th>yours</th><th>tolerance</th><th>operator</th><th>percentile</th><th></th></tr>
-   ${body.measures.map((m) => `<tr><td>${m.name}</td><td class="num">${fmt(m.value)}</td><td class="num">${fmt(m.tolerance)} ${m.unit}</td>
-     <td class="num">${fmt(m.par)}</td><td class="num">${m.percentile == null ? "—" : m.percentile.toFixed(1)}</td>
-     <td class="${m.passed ? "pass" : "fail"}">${m.passed ? "✓" : "✗"}</td></tr>`).join("")}</table>`;
-  $("stages").appendChild(div);
+const num = (v) => el("td", { class: "num", text: v });
+for (const [stage, s] of Object.entries(grade.stages)) {
+  const table = el("table", {}, el("tr", {}, ...["measure", "yours", "tolerance", "operator",
+    "percentile", ""].map((h) => el("th", { text: h }))));
+  for (const m of s.measures) {
+    table.append(el("tr", {}, el("td", { text: m.name }), num(fmt(m.value)),
+      num(`${fmt(m.tolerance)} ${m.unit}`), num(fmt(m.par)),
+      num(m.percentile == null ? "—" : m.percentile.toFixed(1)),
+      el("td", { class: m.passed ? "pass" : "fail", text: m.passed ? "✓" : "✗" })));
+  }
+  $("stages").append(el("div", {}, el("h3", { text: `Stage ${stage} ${s.claimed ? "" : "(not claimed)"}` }), table));
 }
 const p = grade.process, q = grade.par_process || {};
-$("process").innerHTML = `<tr><th></th><th>yours</th><th>operator</th></tr>` +
-  Object.keys(p).filter((k) => typeof p[k] !== "object").map((k) => `<tr><td>${k.replaceAll("_", " ")}</td><td class="num">${fmt(p[k])}</td><td class="num">${fmt(q[k])}</td></tr>`).join("");
+$("process").append(el("tr", {}, el("th"), el("th", { text: "yours" }), el("th", { text: "operator" })));
+for (const k of Object.keys(p).filter((k) => typeof p[k] !== "object")) {
+  $("process").append(el("tr", {}, el("td", { text: k.replaceAll("_", " ") }), num(fmt(p[k])), num(fmt(q[k]))));
+}
 document.body.dataset.ready = "1";

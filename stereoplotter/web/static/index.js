@@ -1,5 +1,8 @@
-// Exercise picker: lists the shipped exercises and starts a session on the server.
+// Exercise picker: lists the exercises and starts a session on the server.
+import { el, sessionKey } from "./dom.js";
+
 const list = document.getElementById("exercises");
+const note = document.getElementById("note");
 
 async function start(name) {
   const body = {
@@ -7,23 +10,25 @@ async function start(name) {
     trainee: document.getElementById("trainee").value || "trainee",
     demonstration: document.getElementById("demo").checked,
   };
-  const r = await fetch("/api/sessions", { method: "POST", body: JSON.stringify(body) });
+  const r = await fetch("/api/sessions", {
+    method: "POST", body: JSON.stringify(body), headers: { "Content-Type": "application/json" },
+  });
   const j = await r.json();
-  if (!r.ok) { alert(j.error); return; }
-  location.href = `/s/${j.id}`;
+  if (!r.ok) { note.textContent = j.error; note.className = "fail"; return; }
+  sessionKey.set(j.id, j.secret);
+  location.href = `/s/${encodeURIComponent(j.id)}`;
 }
 
 const exercises = await (await fetch("/api/exercises")).json();
 for (const ex of exercises) {
-  const card = document.createElement("div");
-  card.className = "card";
-  card.innerHTML = `<h3></h3><div class="row"><span class="badge ${ex.mode}">${ex.mode}</span>
-    <span class="badge">level ${ex.level}</span><span class="badge">${ex.instrument}</span></div><p></p>`;
-  card.querySelector("h3").textContent = `${ex.name}: ${ex.title}`;
-  card.querySelector("p").textContent = ex.description;
-  const b = document.createElement("button");
-  b.className = "primary"; b.textContent = "Start"; b.dataset.exercise = ex.name;
-  b.onclick = () => start(ex.name);
-  card.appendChild(b);
-  list.appendChild(card);
+  const b = el("button", { class: "primary", "data-exercise": ex.name, text: "Start" });
+  b.addEventListener("click", () => start(ex.name));
+  list.append(el("div", { class: "card" },
+    el("h3", { text: `${ex.name}: ${ex.title}` }),
+    el("div", { class: "row" },
+      el("span", { class: `badge ${ex.mode === "exam" ? "exam" : "practice"}`, text: ex.mode }),
+      el("span", { class: "badge", text: `level ${ex.level}` }),
+      el("span", { class: "badge", text: ex.instrument })),
+    el("p", { text: ex.description }),
+    b));
 }

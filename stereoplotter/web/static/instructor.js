@@ -1,37 +1,69 @@
-// Instructor page: live sessions (polled), the results CSV and a step-by-step replay of a log.
-const token = new URLSearchParams(location.search).get("token") || "";
-const $ = (id) => document.getElementById(id);
-$("csv").href = `/api/instructor/results.csv?token=${encodeURIComponent(token)}`;
-let frames = [], timer = null;
+// Instructor page: live sessions (pushed by the server over a WebSocket), the results CSV, the
+// class archive, extra exam attempts, uploading an exercise, and a step-by-step replay of a log.
+import { el, download } from "./dom.js";
 
-async function refresh() {
-  const r = await fetch(`/api/instructor/sessions?token=${encodeURIComponent(token)}`);
-  if (!r.ok) { document.querySelector("main").innerHTML = `<section class="fail">${(await r.json()).error}</section>`; return; }
-  const rows = await r.json();
+const token = new URLSearchParams(location.search).get("token") || "";
+const auth = { Authorization: `Bearer ${token}` };
+const $ = (id) => document.getElementById(id);
+let frames = [], timer = null, retry = 500;
+
+$("csv").addEventListener("click", (e) => { e.preventDefault(); download("/api/instructor/results.csv", auth, "results.csv"); });
+$("zip").addEventListener("click", (e) => { e.preventDefault(); download("/api/instructor/archive.zip", auth, "class.zip"); });
+
+function refused(text) {
+  document.querySelector("main").replaceChildren(el("section", { class: "fail", text }));
+}
+
+function showRows(rows) {
   const body = $("sessions").tBodies[0];
-  body.innerHTML = "";
+  body.replaceChildren();
   for (const s of rows) {
-    const tr = body.insertRow();
-    tr.innerHTML = `<td>${s.trainee}</td><td>${s.exercise}</td><td><span class="badge ${s.mode}">${s.mode}</span></td>
-      <td>${s.done ? "done" : s.stage}</td><td class="num">${s.actions}</td><td>${s.started}</td>
-      <td class="num">${s.score ?? "—"}</td><td class="num">${s.percentile ?? "—"}</td>
-      <td class="${s.passed ? "pass" : s.passed === false ? "fail" : ""}">${s.passed === undefined ? "" : s.passed ? "passed" : "not passed"}</td>
-      <td><button>replay</button> <a href="/grade/${s.id}">grade</a></td>`;
-    tr.querySelector("button").onclick = () => replay(s.id);
+    const replayButton = el("button", { text: "replay" });
+    replayButton.addEventListener("click", () => replay(s.id));
+    const result = s.passed === undefined ? "" : s.passed ? "passed" : "not passed";
+    body.append(el("tr", { "data-id": s.id },
+      el("td", { text: s.trainee }), el("td", { text: s.exercise }),
+      el("td", {}, el("span", { class: `badge ${["exam", "practice", "demonstration"].includes(s.mode) ? s.mode : ""}`, text: s.mode })),
+      el("td", { text: s.done ? "done" : s.stage ?? "" }), el("td", { class: "num", text: s.actions }),
+      el("td", { text: s.started }), el("td", { class: "num", text: s.score ?? "—" }),
+      el("td", { class: "num", text: s.percentile ?? "—" }),
+      el("td", { class: s.passed ? "pass" : s.passed === false ? "fail" : "", text: result }),
+      el("td", {}, replayButton, " ",
+        el("a", { href: `/grade/${encodeURIComponent(s.id)}?token=${encodeURIComponent(token)}`, text: "grade" }))));
   }
   document.body.dataset.ready = "1";
 }
+
+function connect() {
+  const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws-instructor`);
+  ws.onopen = () => ws.send(JSON.stringify({ auth: token }));
+  ws.onmessage = (ev) => {
+    const msg = JSON.parse(ev.data);
+    if (msg.error) { refused(msg.error); ws.onclose = null; return; }
+    retry = 500;
+    $("status").textContent = "live";
+    if (msg.sessions) showRows(msg.sessions);
+  };
+  ws.onclose = () => {
+    $("status").textContent = "connection lost: reconnecting…";
+    setTimeout(connect, retry); retry = Math.min(10000, retry * 2);
+  };
+}
+connect();
 
 function show(i) {
   const f = frames[i];
   $("replay-n").textContent = `${i} / ${frames.length - 1}`;
   $("replay-action").textContent = f.action ? `${f.t} s: ${JSON.stringify(f.action)}${f.refused ? " — refused: " + f.refused : ""}` : "start";
-  $("replay-counters").innerHTML = Object.entries(f.state.counters).map(([k, c]) => `<tr><td>${k}</td><td class="num">${c.value === null ? "—" : c.value.toFixed(3)}</td><td>${c.unit}</td></tr>`).join("");
+  $("replay-counters").replaceChildren(...Object.entries(f.state.counters).map(([k, c]) =>
+    el("tr", {}, el("td", { text: k }), el("td", { class: "num", text: c.value === null ? "—" : c.value.toFixed(3) }), el("td", { text: c.unit }))));
 }
 
 async function replay(id) {
-  const r = await fetch(`/api/instructor/replay/${id}?token=${encodeURIComponent(token)}`);
+  $("replay-action").textContent = "replaying the log…";
+  const r = await fetch(`/api/instructor/replay/${encodeURIComponent(id)}`, { headers: auth });
   const j = await r.json();
+  if (!r.ok) { $("replay-action").textContent = j.error; return; }
   frames = j.frames;
   $("replay").hidden = false;
   $("replay-who").textContent = `${j.trainee} · ${j.exercise}`;
@@ -49,5 +81,22 @@ $("replay-play").onclick = () => {
     $("replay-pos").value = i; show(i);
   }, 200);
 };
-await refresh();
-setInterval(refresh, 3000);
+
+$("grant").addEventListener("submit", async (e) => {
+  e.preventDefault();
+  const r = await fetch("/api/instructor/grant", {
+    method: "POST", headers: { ...auth, "Content-Type": "application/json" },
+    body: JSON.stringify({ trainee: $("grant-trainee").value, exercise: $("grant-exercise").value }),
+  });
+  const j = await r.json();
+  $("grant-result").textContent = r.ok ? `${j.trainee}: ${j.extra_attempts} extra attempt(s) at ${j.exercise}` : j.error;
+});
+
+$("upload").addEventListener("submit", async (e) => {
+  e.preventDefault();
+  const file = $("upload-file").files[0];
+  if (!file) return;
+  const r = await fetch("/api/instructor/exercises", { method: "POST", headers: auth, body: await file.text() });
+  const j = await r.json();
+  $("upload-result").textContent = r.ok ? `added ${j.name}: ${j.title}` : j.error;
+});

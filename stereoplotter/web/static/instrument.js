@@ -1,20 +1,45 @@
 // The instrument page: WebSocket to the server (action → state), eyepieces, wheels, counters.
+// The session's key (kept by this browser when it started the session) opens the socket; a
+// dropped socket is reopened (with growing pauses) and the session resumes where its log ends.
 import { drawField, anaglyph, scale } from "./eyepiece.js";
 import { Wheels, LABELS, decimals } from "./wheels.js";
+import { el, sessionKey } from "./dom.js";
 
 const sid = location.pathname.split("/").pop();
+const key = sessionKey.get(sid);
 const $ = (id) => document.getElementById(id);
-let state = null, hello = null, seq = 0;
+let state = null, hello = null, seq = 0, ws = null, retry = 250;
 const waiting = new Map(); // seq → resolve(frame time)
 const trail = [];
-
-const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws/${sid}`);
 const wheels = new Wheels($("wheels"), send);
+
+function link(text, lost) {
+  $("link").textContent = text; $("link").className = lost ? "meta lost" : "meta";
+}
+
+function connect() {
+  ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws/${encodeURIComponent(sid)}`);
+  ws.onopen = () => ws.send(JSON.stringify({ auth: key || "" }));
+  ws.onmessage = onMessage;
+  ws.onclose = (ev) => {
+    if (ev.code === 4403) { link("", false); return; } // refused: the message says why
+    link("connection lost: reconnecting…", true);
+    setTimeout(connect, retry); retry = Math.min(8000, retry * 2);
+  };
+}
 
 function send(action) {
   seq += 1;
+  if (!ws || ws.readyState !== WebSocket.OPEN) {
+    message("not connected to the server: this action was not sent (reconnecting…)", "error");
+    return seq;
+  }
   ws.send(JSON.stringify({ action, seq }));
   return seq;
+}
+
+function sendDemo() {
+  if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify({ demo: "step" }));
 }
 
 function message(text, cls = "") {
@@ -27,21 +52,34 @@ off.left.width = off.left.height = off.right.width = off.right.height = 320;
 let flickerSide = "left";
 
 // Photo patches (one per side): fetched when the mark nears a patch's edge or the magnification
-// changes; a move only redraws from the patch in hand.
+// changes; a move only redraws from the patch in hand. Coarse first: with the sharp patch a
+// small one at hello.coarse_mag (the pyramid's level rendered whole at start-up, answered at
+// once) is fetched too and drawn, scaled, until the sharp one arrives.
 const patches = { left: null, right: null }, loading = { left: false, right: false };
+function patchUrl(side, mark, mag, size) {
+  return `/api/sessions/${encodeURIComponent(sid)}/patch.png?side=${side}&x=${mark.x_mm.toFixed(3)}`
+    + `&y=${mark.y_mm.toFixed(3)}&mag=${mag}&size=${size}&key=${encodeURIComponent(key || "")}`;
+}
 function needPatch(side, mark, mag) {
   const p = patches[side];
   if (loading[side] || !hello) return;
   const fieldMm = 320 / (scale.pxPerMmAt1x * mag);
   const halfMm = (hello.patch_px * hello.screen_pixel_mm) / mag / 2;
-  if (p && p.mag === mag && Math.abs(mark.x_mm - p.x_mm) < halfMm - fieldMm * 0.75
+  if (p && !p.coarse && p.mag === mag && Math.abs(mark.x_mm - p.x_mm) < halfMm - fieldMm * 0.75
       && Math.abs(mark.y_mm - p.y_mm) < halfMm - fieldMm * 0.75) return;
   loading[side] = true;
-  const q = { side, x_mm: mark.x_mm, y_mm: mark.y_mm, mag, size: hello.patch_px, img: new Image() };
+  const at = { x_mm: Number(mark.x_mm.toFixed(3)), y_mm: Number(mark.y_mm.toFixed(3)) };
+  const q = { side, ...at, mag, size: hello.patch_px, img: new Image() };
   q.img.onload = () => { patches[side] = q; loading[side] = false; window.__patches = (window.__patches || 0) + 1; drawEyes(); };
   q.img.onerror = () => { loading[side] = false; };
-  q.img.src = `/api/sessions/${sid}/patch.png?side=${side}&x=${mark.x_mm.toFixed(3)}&y=${mark.y_mm.toFixed(3)}&mag=${mag}&size=${hello.patch_px}`;
-  q.x_mm = Number(mark.x_mm.toFixed(3)); q.y_mm = Number(mark.y_mm.toFixed(3));
+  q.img.src = patchUrl(side, mark, mag, hello.patch_px);
+  const cm = hello.coarse_mag, cs = Math.max(16, Math.round((hello.patch_px * cm) / mag));
+  const c = { side, ...at, mag: cm, size: cs, coarse: true, img: new Image() };
+  c.img.onload = () => {
+    const now = patches[side];
+    if (!now || now.coarse || now.mag !== Number($("mag").value)) { patches[side] = c; drawEyes(); }
+  };
+  c.img.src = patchUrl(side, mark, cm, cs);
 }
 
 function drawEyes() {
@@ -71,8 +109,15 @@ setInterval(() => {
 for (const id of ["view", "colours", "mag"]) $(id).addEventListener("change", drawEyes);
 
 // --- coordinatograph -----------------------------------------------------------------------
+const NS = "http://www.w3.org/2000/svg";
+function svg(tag, attrs, text) {
+  const e = document.createElementNS(NS, tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, String(v));
+  if (text !== undefined) e.textContent = text;
+  return e;
+}
+
 function drawTable() {
-  const svg = $("table-svg");
   const c = state.counters;
   if (!c.X || !c.Y) return;
   const x = c.X.value, y = c.Y.value;
@@ -80,12 +125,16 @@ function drawTable() {
   const last = trail[trail.length - 1];
   if (!last || last[0] !== x || last[1] !== y) trail.push([x, y]);
   if (trail.length > 400) trail.shift();
-  const pts = trail.map(([a, b]) => `${a},${400 - b}`).join(" ");
-  svg.innerHTML = `<rect x="-50" y="-150" width="700" height="700" fill="#f4efe2" stroke="#999"/>
-    <g stroke="#d9d0bb" stroke-width="1">${[...Array(15).keys()].map((i) => `<line x1="${-50 + i * 50}" y1="-150" x2="${-50 + i * 50}" y2="550"/><line x1="-50" y1="${-150 + i * 50}" x2="650" y2="${-150 + i * 50}"/>`).join("")}</g>
-    <polyline points="${pts}" fill="none" stroke="#3060a0" stroke-width="2"/>
-    <circle cx="${x}" cy="${400 - y}" r="7" fill="none" stroke="#c02020" stroke-width="3"/>
-    <text x="-40" y="540" font-size="22" fill="#333">X ${x.toFixed(2)}  Y ${y.toFixed(2)} mm</text>`;
+  const grid = svg("g", { stroke: "#d9d0bb", "stroke-width": 1 });
+  for (let i = 0; i < 15; i++) {
+    grid.append(svg("line", { x1: -50 + i * 50, y1: -150, x2: -50 + i * 50, y2: 550 }),
+      svg("line", { x1: -50, y1: -150 + i * 50, x2: 650, y2: -150 + i * 50 }));
+  }
+  $("table-svg").replaceChildren(
+    svg("rect", { x: -50, y: -150, width: 700, height: 700, fill: "#f4efe2", stroke: "#999" }), grid,
+    svg("polyline", { points: trail.map(([a, b]) => `${a},${400 - b}`).join(" "), fill: "none", stroke: "#3060a0", "stroke-width": 2 }),
+    svg("circle", { cx: x, cy: 400 - y, r: 7, fill: "none", stroke: "#c02020", "stroke-width": 3 }),
+    svg("text", { x: -40, y: 540, "font-size": 22, fill: "#333" }, `X ${x.toFixed(2)}  Y ${y.toFixed(2)} mm`));
 }
 
 // --- counters and stage --------------------------------------------------------------------
@@ -93,12 +142,13 @@ function drawCounters() {
   const body = $("counters").tBodies[0];
   const names = Object.keys(state.counters).join(",");
   if (body.dataset.names !== names) {
-    body.innerHTML = ""; body.dataset.names = names;
+    body.replaceChildren(); body.dataset.names = names;
     for (const name of Object.keys(state.counters)) {
-      const tr = body.insertRow();
-      tr.dataset.counter = name;
-      tr.innerHTML = `<td>${LABELS[name] || name}</td><td class="num"></td><td></td>
-        <td><button class="dir" title="reverse the counter's direction">±</button></td><td><button class="read">read</button></td>`;
+      const tr = el("tr", { "data-counter": name }, el("td", { text: LABELS[name] || name }),
+        el("td", { class: "num" }), el("td"),
+        el("td", {}, el("button", { class: "dir", title: "reverse the counter's direction", text: "±" })),
+        el("td", {}, el("button", { class: "read", text: "read" })));
+      body.append(tr);
       tr.querySelector(".dir").onclick = () =>
         send({ kind: "direction", counter: name, sign: -state.counters[name].direction });
       tr.querySelector(".read").onclick = () => send({ kind: "read", counter: name });
@@ -116,7 +166,7 @@ function drawStage() {
   $("stage").textContent = state.done ? "all stages claimed" : `stage ${state.stage}`;
   $("mode").textContent = hello.demonstration ? "demonstration" : state.mode;
   $("mode").className = `badge ${hello.demonstration ? "demonstration" : state.mode}`;
-  const ul = $("checks"); ul.innerHTML = "";
+  const ul = $("checks"); ul.replaceChildren();
   for (const ch of state.checks) {
     const li = document.createElement("li");
     li.textContent = `${ch.name}: tolerance ${ch.tolerance === null ? "—" : ch.tolerance.toPrecision(3)} ${ch.unit}`;
@@ -131,7 +181,7 @@ function drawStage() {
   $("claim").disabled = demo || !allowed.has("claim");
   $("demo").hidden = !demo;
   $("done").hidden = !state.done;
-  $("grade-link").href = `/grade/${sid}`;
+  $("grade-link").href = `/grade/${encodeURIComponent(sid)}`;
   const p = state.parallax;
   const um = (v) => (v === null || v === undefined ? "—" : v.toFixed(1));
   $("parallax").textContent = p ? `parallax at standard point ${p.point}: q = ${um(p.y_um)} µm, p = ${um(p.x_um)} µm` : "";
@@ -142,17 +192,16 @@ function render() {
   wheels.update(state.controls, state.locked || []);
 }
 
-ws.onmessage = (ev) => {
+function onMessage(ev) {
   const msg = JSON.parse(ev.data);
   if (msg.hello) {
-    hello = msg.hello;
+    hello = msg.hello; retry = 250; link("", false);
     scale.pxPerMmAt1x = 1 / hello.screen_pixel_mm;
+    scale.formatMm = hello.format_mm;
     $("who").textContent = `${hello.trainee} · ${hello.exercise}`;
     $("title").textContent = "Stereoplotter trainer";
-    fetch("/api/exercises").then((r) => r.json()).then((all) => {
-      const ex = all.find((e) => e.name === hello.exercise);
-      if (ex) $("instructions").textContent = ex.description;
-    });
+    $("instructions").textContent = hello.description;
+    waiting.clear();
   }
   if (msg.state) state = msg.state;
   window.__n = msg.n;
@@ -165,7 +214,12 @@ ws.onmessage = (ev) => {
   if (msg.demo) $("demo-count").textContent = `${msg.demo.done} / ${msg.demo.of}`;
   if (msg.seq !== undefined && waiting.has(msg.seq)) { waiting.get(msg.seq)(performance.now()); waiting.delete(msg.seq); }
   document.body.dataset.ready = "1";
-};
+}
+if (key) connect();
+else {
+  message("this browser holds no key for this session: start a session from the exercises page", "error");
+  document.body.dataset.ready = "1";
+}
 
 $("claim").onclick = () => send({ kind: "claim", step: state.stage });
 $("undo").onclick = () => send({ kind: "undo" });
@@ -173,18 +227,21 @@ $("redo").onclick = () => send({ kind: "redo" });
 $("gear-btn").onclick = () => send({ kind: "gear", value: Number($("gear").value) });
 for (const b of $("hints").querySelectorAll("button")) b.onclick = () => send({ kind: "hint", level: Number(b.dataset.level) });
 let playing = null;
-$("demo-step").onclick = () => ws.send(JSON.stringify({ demo: "step" }));
+$("demo-step").onclick = sendDemo;
 $("demo-play").onclick = () => {
   if (playing) { clearInterval(playing); playing = null; $("demo-play").textContent = "Play"; return; }
-  playing = setInterval(() => ws.send(JSON.stringify({ demo: "step" })), 60);
+  playing = setInterval(sendDemo, 60);
   $("demo-play").textContent = "Pause";
 };
 
 // For tests and the latency benchmark: send an action, resolve with ms until its frame is drawn.
 window.trainer = {
   state: () => state,
+  // drop the socket as a network would (the page must reconnect and resume)
+  drop: () => ws && ws.close(),
   // both eyepieces drawn from a photo patch that covers the current marks
-  photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right),
+  photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right
+    && !patches.left.coarse && !patches.right.coarse),
   actAndFrame(action) {
     const t0 = performance.now();
     const s = send(action);

@@ -49,8 +49,9 @@ export class Wheels {
       const div = document.createElement("div");
       div.className = "wheel"; div.tabIndex = 0; div.dataset.control = name;
       const [svg, g] = svgWheel();
-      div.innerHTML = `<div class="label"></div>`;
-      div.querySelector(".label").textContent = LABELS[name] || name;
+      const label = document.createElement("div");
+      label.className = "label"; label.textContent = LABELS[name] || name;
+      div.appendChild(label);
       div.appendChild(svg);
       const val = document.createElement("div"); val.className = "value"; div.appendChild(val);
       const inp = document.createElement("input"); inp.type = "number"; inp.step = "any";

@@ -1,0 +1,292 @@
+"""A class on the trainer server (issue 22): 20 trainees on WebSockets and an instructor, while
+sessions are graded and replayed.
+
+The server is ``stereoplotter trainer`` in its own process (worker processes for grading,
+replays and photos, as a class would run it). Phase 1 times the first eyepiece view of each
+shipped exercise (a new trainee each, so an exam allows it): POST a session, open its socket,
+set f_пр if the marks are not projected yet, and fetch both eyepieces' coarse-first patches,
+then both sharp ×6 patches (after the start-up preparation of the photos). Phase 2 runs the
+load: a demonstration session plays the simulated operator's e01 script (about 580 actions, a
+long log to replay); 20 trainees each turn a handwheel ``--rate`` times a second (send, wait for
+the state, sleep) for ``--seconds``; meanwhile the instructor's socket receives the pushed
+table, the instructor fetches the replay of the long log and the grade of unfinished practice
+sessions (computed on demand) in a loop (``--instructor-pause`` s between rounds), and every
+5 s a trainee claims its stage (the finished session is graded in the worker). Prints the
+turn-to-state round trip (median, p95, max) and the first-view times.
+
+    PYTHONPATH=. python benchmarks/bench_trainer_load.py [--trainees 20] [--seconds 30]
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import httpx
+from websockets.asyncio.client import connect
+
+TOKEN = "bench-token"
+
+
+def _start_server(data_dir: str) -> tuple[subprocess.Popen, str]:
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "stereoplotter",
+            "trainer",
+            "--token",
+            TOKEN,
+            "--data-dir",
+            data_dir,
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+        env=dict(os.environ),
+    )
+    line = proc.stdout.readline()  # "trainee page:    http://localhost:PORT/"
+    port = line.rsplit(":", 1)[1].strip().rstrip("/")
+    return proc, f"127.0.0.1:{port}"
+
+
+async def _session(http: httpx.AsyncClient, exercise: str, trainee: str, **extra):
+    r = await http.post("/api/sessions", json={"exercise": exercise, "trainee": trainee, **extra})
+    r.raise_for_status()
+    return r.json()["id"], r.json()["secret"]
+
+
+async def _open(host: str, sid: str, secret: str):
+    ws = await connect(f"ws://{host}/ws/{sid}", max_size=2**24)
+    await ws.send(json.dumps({"auth": secret}))
+    hello = json.loads(await ws.recv())
+    return ws, hello
+
+
+async def _ask(ws, body: dict) -> dict:
+    await ws.send(json.dumps(body))
+    return json.loads(await ws.recv())
+
+
+async def first_view(http, host: str, exercise: str, n: int) -> tuple[float, float]:
+    """Seconds from POST of a session to both eyepieces' coarse-first patches received, and to
+    both sharp ×6 patches received (what the page fetches, in that order)."""
+    t0 = time.perf_counter()
+    sid, secret = await _session(http, exercise, f"first-view-{n}")
+    ws, hello = await _open(host, sid, secret)
+    state = hello["state"]
+    if state["marks"] is None:
+        f = state["controls"]["f_instrument"]
+        state = (
+            await _ask(
+                ws,
+                {
+                    "action": {
+                        "kind": "set",
+                        "control": "f_instrument",
+                        "value": round((f["min"] + f["max"]) / 2, 2),
+                    }
+                },
+            )
+        )["state"]
+    await ws.close()
+    if state["marks"] is None:  # nothing projected yet: the eyepieces say so, no photo
+        return (time.perf_counter() - t0,) * 2
+    times = []
+    for mag, size in ((hello["hello"]["coarse_mag"], 80), (6, 768)):
+        for side in ("left", "right"):
+            m = state["marks"][side]
+            r = await http.get(
+                f"/api/sessions/{sid}/patch.png",
+                params={
+                    "side": side,
+                    "x": f"{m['x_mm']:.3f}",
+                    "y": f"{m['y_mm']:.3f}",
+                    "mag": mag,
+                    "size": size,
+                    "key": secret,
+                },
+            )
+            r.raise_for_status()
+        times.append(time.perf_counter() - t0)
+    return times[0], times[1]
+
+
+async def trainee(
+    host, http, n: int, stop: float, out: list[float], claim_at: float | None, pause: float
+):
+    sid, secret = await _session(http, "e01-setup-stage1", f"trainee-{n:02d}")
+    ws, hello = await _open(host, sid, secret)
+    f = hello["state"]["controls"]["f_instrument"]
+    await _ask(
+        ws,
+        {
+            "action": {
+                "kind": "set",
+                "control": "f_instrument",
+                "value": round((f["min"] + f["max"]) / 2, 2),
+            }
+        },
+    )
+    i = 0
+    while time.monotonic() < stop:
+        t0 = time.perf_counter()
+        reply = await _ask(
+            ws,
+            {
+                "action": {"kind": "turn", "control": "X", "delta": 0.05 if i % 2 else -0.05},
+                "seq": i,
+            },
+        )
+        out.append((time.perf_counter() - t0) * 1e3)
+        assert reply.get("error") is None, reply
+        i += 1
+        if claim_at is not None and time.monotonic() > claim_at:
+            await _ask(ws, {"action": {"kind": "claim", "step": "1"}})  # graded in the worker
+            await ws.close()
+            sid, secret = await _session(http, "e01-setup-stage1", f"trainee-{n:02d}-b{i}")
+            ws, hello = await _open(host, sid, secret)
+            claim_at = None
+        await asyncio.sleep(pause)
+    await ws.close()
+    return sid
+
+
+async def instructor(host, http, stop: float, replay_sid: str, stats: dict, pause: float):
+    auth = {"Authorization": f"Bearer {TOKEN}"}
+    ws = await connect(f"ws://{host}/ws-instructor", max_size=2**24)
+    await ws.send(json.dumps({"auth": TOKEN}))
+
+    async def pushes():
+        while True:
+            json.loads(await ws.recv())
+            stats["pushes"] += 1
+
+    reader = asyncio.create_task(pushes())
+    while time.monotonic() < stop:
+        t0 = time.perf_counter()
+        r = await http.get(f"/api/instructor/replay/{replay_sid}", headers=auth, timeout=120)
+        r.raise_for_status()
+        stats["replays"].append(time.perf_counter() - t0)
+        rows = (await http.get("/api/instructor/sessions", headers=auth)).json()
+        for row in rows[:3]:
+            if row["mode"] == "practice" and not row["done"]:
+                t0 = time.perf_counter()
+                g = await http.get(f"/api/sessions/{row['id']}/grade", headers=auth, timeout=120)
+                g.raise_for_status()
+                stats["grades"].append(time.perf_counter() - t0)
+        await asyncio.sleep(pause)
+    reader.cancel()
+    await ws.close()
+
+
+async def main_async(args) -> None:
+    with tempfile.TemporaryDirectory() as data:
+        proc, host = _start_server(data)
+        try:
+            async with httpx.AsyncClient(base_url=f"http://{host}", timeout=120) as http:
+                exercises = [e["name"] for e in (await http.get("/api/exercises")).json()]
+                t0 = time.perf_counter()
+                cold = await first_view(http, host, exercises[-1], 0)  # the last photos queued
+                print(
+                    f"photos of every exercise prepared {time.perf_counter() - t0:.1f} s after "
+                    f"start-up (first view of {exercises[-1]} then: {cold[0]:.2f} s)"
+                )
+                views = {
+                    ex: await first_view(http, host, ex, i + 1)
+                    for i, ex in enumerate(exercises)
+                    if not args.skip_first_view
+                }
+                # the long log to replay: the operator's e01 script as a demonstration
+                demo_sid, demo_secret = await _session(
+                    http, "e01-setup-stage1", "operator", demonstration=True
+                )
+                ws, _ = await _open(host, demo_sid, demo_secret)
+                while True:
+                    reply = await _ask(ws, {"demo": "step"})
+                    if reply.get("error") == "demonstration finished":
+                        break
+                    await asyncio.sleep(0.02)  # under the rate limit
+                await ws.close()
+                n_log = reply["n"]
+                stop = time.monotonic() + args.seconds
+                rtt: list[float] = []
+                stats = {"pushes": 0, "replays": [], "grades": []}
+                tasks = [
+                    trainee(
+                        host,
+                        http,
+                        n,
+                        stop,
+                        rtt,
+                        time.monotonic() + 5 * (n + 1) if n < args.seconds // 5 else None,
+                        1 / args.rate,
+                    )
+                    for n in range(args.trainees)
+                ]
+                if not args.no_instructor:
+                    tasks.append(
+                        instructor(host, http, stop, demo_sid, stats, args.instructor_pause)
+                    )
+                await asyncio.gather(*tasks)
+        finally:
+            proc.terminate()
+            proc.wait(10)
+    rtt.sort()
+    first = [v[0] for v in views.values()] or [math.nan]
+    sharp = [v[1] for v in views.values()] or [math.nan]
+    print(
+        f"first eyepiece view (POST session → both coarse patches), after preparation: "
+        f"median {statistics.median(first):.2f} s, max {max(first):.2f} s; both sharp ×6: "
+        f"median {statistics.median(sharp):.2f} s, max {max(sharp):.2f} s"
+    )
+    for ex, (a, b) in views.items():
+        print(f"  {ex:32s} first {a:.2f} s, sharp {b:.2f} s")
+    print(
+        f"load: {args.trainees} trainees × {args.rate:g} turns/s"
+        f"{'' if args.no_instructor else ' + instructor'}, {args.seconds} s; "
+        f"replays of a {n_log}-action log: {len(stats['replays'])} "
+        f"(median {statistics.median(stats['replays'] or [math.nan]):.2f} s), on-demand grades: "
+        f"{len(stats['grades'])}, table pushes: {stats['pushes']}"
+    )
+    print(
+        f"turn-to-state round trip: n={len(rtt)} median {statistics.median(rtt):.1f} ms, "
+        f"p95 {rtt[int(0.95 * (len(rtt) - 1))]:.1f} ms, max {rtt[-1]:.1f} ms "
+        f"(os.cpu_count() = {os.cpu_count()}, 1-minute load average at the end "
+        f"{os.getloadavg()[0]:.1f})"
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--trainees", type=int, default=20)
+    ap.add_argument("--seconds", type=float, default=30.0)
+    ap.add_argument("--rate", type=float, default=10.0, help="turns a second per trainee")
+    ap.add_argument(
+        "--instructor-pause",
+        type=float,
+        default=2.0,
+        help="seconds between the instructor's replay-and-grade rounds",
+    )
+    ap.add_argument(
+        "--no-instructor",
+        action="store_true",
+        help="trainees only: no replays nor on-demand grades (a baseline)",
+    )
+    ap.add_argument(
+        "--skip-first-view",
+        action="store_true",
+        help="no first-view times (the photos are still prepared before the load)",
+    )
+    asyncio.run(main_async(ap.parse_args()))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,276 @@
+"""The browser trainer's results on disk: sessions, action logs, grades, exam attempts and
+instructor-uploaded exercises in one SQLite file (stdlib :mod:`sqlite3`, WAL journal).
+
+One :class:`SessionStore` is shared by the server's threads (one connection behind a lock;
+every write is its own transaction, committed before the call returns). A session is a row with
+its log header; each action record is a row appended as the action happens, so a restart of the
+server finds every action that was answered. A session's secret is kept only as its SHA-256.
+
+:func:`exercise_upload` reads an exercise file sent by the instructor (YAML or JSON text) with
+the same bounded YAML reader as the files on disk; the server validates it and stores its
+content here (no path from a client is ever opened).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import hmac
+import json
+import os
+import sqlite3
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from stereoplotter.errors import ConfigError
+from stereoplotter.io.yaml_files import _parse_yaml
+
+__all__ = [
+    "DB_NAME",
+    "SessionStore",
+    "default_data_dir",
+    "exercise_upload",
+    "secret_hash",
+]
+
+#: The database file inside the data folder.
+DB_NAME = "trainer.sqlite3"
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS sessions (
+    id TEXT PRIMARY KEY,
+    secret_hash TEXT NOT NULL,
+    trainee TEXT NOT NULL,
+    trainee_key TEXT NOT NULL,
+    exercise TEXT NOT NULL,
+    mode TEXT NOT NULL,
+    demonstration INTEGER NOT NULL,
+    started REAL NOT NULL,
+    header TEXT NOT NULL,
+    stage TEXT,
+    done INTEGER NOT NULL DEFAULT 0,
+    actions INTEGER NOT NULL DEFAULT 0
+);
+CREATE TABLE IF NOT EXISTS actions (
+    session_id TEXT NOT NULL,
+    n INTEGER NOT NULL,
+    record TEXT NOT NULL,
+    PRIMARY KEY (session_id, n)
+);
+CREATE TABLE IF NOT EXISTS grades (session_id TEXT PRIMARY KEY, grade TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS grants (
+    trainee_key TEXT NOT NULL,
+    exercise TEXT NOT NULL,
+    extra INTEGER NOT NULL,
+    PRIMARY KEY (trainee_key, exercise)
+);
+CREATE TABLE IF NOT EXISTS exercises (name TEXT PRIMARY KEY, source TEXT NOT NULL, added REAL);
+"""
+
+_ROW = (
+    "id",
+    "trainee",
+    "trainee_key",
+    "exercise",
+    "mode",
+    "demonstration",
+    "started",
+    "stage",
+    "done",
+    "actions",
+)
+
+
+def default_data_dir() -> Path:
+    """The per-user data folder: ``$XDG_DATA_HOME/stereoplotter/trainer``, else
+    ``~/.local/share/stereoplotter/trainer`` (``%LOCALAPPDATA%`` on Windows)."""
+    base = os.environ.get("XDG_DATA_HOME") or os.environ.get("LOCALAPPDATA")
+    root = Path(base) if base else Path.home() / ".local" / "share"
+    return root / "stereoplotter" / "trainer"
+
+
+def secret_hash(secret: str) -> str:
+    """SHA-256 (hex) of a session secret: what the store keeps."""
+    return hashlib.sha256(secret.encode("utf-8")).hexdigest()
+
+
+def exercise_upload(text: str) -> dict[str, Any]:
+    """The mapping of an uploaded exercise file (YAML or JSON text); one-line ConfigError
+    naming "uploaded exercise" (never a path) otherwise."""
+    data = _parse_yaml(text, "uploaded exercise")
+    if not isinstance(data, dict):
+        found = "an empty document" if data is None else type(data).__name__
+        raise ConfigError("uploaded exercise", "(top level)", "a mapping of fields", found)
+    return data
+
+
+def _dumps(value: Any) -> str:
+    return json.dumps(value, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
+
+
+class SessionStore:
+    """The trainer's SQLite file (``data_dir/trainer.sqlite3``; ``None``: in memory, nothing
+    kept after the process ends)."""
+
+    def __init__(self, data_dir: str | os.PathLike[str] | None = None):
+        if data_dir is None:
+            self.path = None
+            target = ":memory:"
+        else:
+            folder = Path(data_dir)
+            folder.mkdir(parents=True, exist_ok=True)
+            self.path = folder / DB_NAME
+            target = str(self.path)
+        self._lock = threading.Lock()
+        self._db = sqlite3.connect(target, check_same_thread=False, isolation_level=None)
+        self._db.execute("PRAGMA journal_mode=WAL")
+        self._db.execute("PRAGMA synchronous=NORMAL")
+        self._db.executescript(_SCHEMA)
+
+    def close(self) -> None:
+        with self._lock:
+            self._db.close()
+
+    def _run(self, sql: str, args: tuple = ()) -> list[tuple]:
+        with self._lock:
+            return self._db.execute(sql, args).fetchall()
+
+    # --- sessions -----------------------------------------------------------------------------
+
+    def add_session(
+        self,
+        row: dict[str, Any],
+        secret: str,
+        header: dict[str, Any],
+        max_attempts: int | None = None,
+    ) -> bool:
+        """Insert a session; with ``max_attempts``, only if the trainee has fewer sessions of
+        the exercise than that plus the instructor's grants (checked in the same transaction).
+        Returns whether it was inserted."""
+        with self._lock:
+            cur = self._db.cursor()
+            cur.execute("BEGIN IMMEDIATE")
+            try:
+                if max_attempts is not None:
+                    (used,) = cur.execute(
+                        "SELECT COUNT(*) FROM sessions WHERE trainee_key=? AND exercise=? "
+                        "AND demonstration=0",
+                        (row["trainee_key"], row["exercise"]),
+                    ).fetchone()
+                    got = cur.execute(
+                        "SELECT extra FROM grants WHERE trainee_key=? AND exercise=?",
+                        (row["trainee_key"], row["exercise"]),
+                    ).fetchone()
+                    if used >= max_attempts + (got[0] if got else 0):
+                        cur.execute("ROLLBACK")
+                        return False
+                cur.execute(
+                    "INSERT INTO sessions (id, secret_hash, trainee, trainee_key, exercise, mode, "
+                    "demonstration, started, header, stage, done, actions) "
+                    "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)",
+                    (
+                        row["id"],
+                        secret_hash(secret),
+                        row["trainee"],
+                        row["trainee_key"],
+                        row["exercise"],
+                        row["mode"],
+                        int(row["demonstration"]),
+                        row["started"],
+                        _dumps(header),
+                        row["stage"],
+                        int(row["done"]),
+                        0,
+                    ),
+                )
+                cur.execute("COMMIT")
+            except BaseException:
+                cur.execute("ROLLBACK")
+                raise
+        return True
+
+    def attempts(self, trainee_key: str, exercise: str) -> tuple[int, int]:
+        """(sessions started, extra attempts granted) of a trainee at an exercise."""
+        (used,) = self._run(
+            "SELECT COUNT(*) FROM sessions WHERE trainee_key=? AND exercise=? AND demonstration=0",
+            (trainee_key, exercise),
+        )[0]
+        got = self._run(
+            "SELECT extra FROM grants WHERE trainee_key=? AND exercise=?", (trainee_key, exercise)
+        )
+        return int(used), int(got[0][0]) if got else 0
+
+    def grant(self, trainee_key: str, exercise: str) -> int:
+        """One more attempt for a trainee at an exercise; returns the extra attempts now."""
+        with self._lock:
+            self._db.execute(
+                "INSERT INTO grants VALUES (?,?,1) ON CONFLICT(trainee_key, exercise) "
+                "DO UPDATE SET extra = extra + 1",
+                (trainee_key, exercise),
+            )
+            return int(
+                self._db.execute(
+                    "SELECT extra FROM grants WHERE trainee_key=? AND exercise=?",
+                    (trainee_key, exercise),
+                ).fetchone()[0]
+            )
+
+    def append_action(
+        self, sid: str, record: dict[str, Any], stage: str | None, done: bool
+    ) -> None:
+        """Append one action record and update the session's stage, done and action count."""
+        with self._lock:
+            self._db.execute("BEGIN")
+            try:
+                self._db.execute(
+                    "INSERT INTO actions VALUES (?,?,?)", (sid, int(record["n"]), _dumps(record))
+                )
+                self._db.execute(
+                    "UPDATE sessions SET stage=?, done=?, actions=? WHERE id=?",
+                    (stage, int(done), int(record["n"]), sid),
+                )
+                self._db.execute("COMMIT")
+            except BaseException:
+                self._db.execute("ROLLBACK")
+                raise
+
+    def sessions(self) -> list[dict[str, Any]]:
+        """Every session's row (no secret, no log), oldest first."""
+        rows = self._run(f"SELECT {', '.join(_ROW)} FROM sessions ORDER BY started, id")
+        return [dict(zip(_ROW, r, strict=True)) for r in rows]
+
+    def check_secret(self, sid: str, secret: str) -> bool:
+        """Whether ``secret`` is the session's (compared by hash, in constant time)."""
+        got = self._run("SELECT secret_hash FROM sessions WHERE id=?", (sid,))
+        if not got:
+            return False
+        return hmac.compare_digest(got[0][0], secret_hash(secret))
+
+    def records(self, sid: str) -> list[dict[str, Any]] | None:
+        """The session log (header, then the action records), or None."""
+        head = self._run("SELECT header FROM sessions WHERE id=?", (sid,))
+        if not head:
+            return None
+        rows = self._run("SELECT record FROM actions WHERE session_id=? ORDER BY n", (sid,))
+        return [json.loads(head[0][0]), *(json.loads(r[0]) for r in rows)]
+
+    # --- grades -------------------------------------------------------------------------------
+
+    def put_grade(self, sid: str, grade: dict[str, Any]) -> None:
+        self._run("INSERT OR REPLACE INTO grades VALUES (?,?)", (sid, _dumps(grade)))
+
+    def grades(self) -> dict[str, dict[str, Any]]:
+        """Every stored grade by session id."""
+        return {sid: json.loads(g) for sid, g in self._run("SELECT session_id, grade FROM grades")}
+
+    # --- uploaded exercises -------------------------------------------------------------------
+
+    def add_exercise(self, name: str, source: dict[str, Any]) -> None:
+        self._run(
+            "INSERT OR REPLACE INTO exercises VALUES (?,?,?)", (name, _dumps(source), time.time())
+        )
+
+    def exercises(self) -> dict[str, dict[str, Any]]:
+        """Uploaded exercises: name → file content."""
+        return {n: json.loads(s) for n, s in self._run("SELECT name, source FROM exercises")}

@@ -1,0 +1,140 @@
+"""Every route with bad bodies and parameters answers 4xx with one line of JSON, never 500;
+the instructor's table is pushed; the class is exported (CSV) and archived (zip of logs)."""
+
+from __future__ import annotations
+
+import io
+import json
+import zipfile
+
+from starlette.routing import Route, WebSocketRoute
+
+from tests.web.conftest import PRACTICE, TOKEN, claim_all, open_socket, start
+
+BAD_BODIES = [
+    b"",
+    b"{",
+    b"[]",
+    b"null",
+    b'"text"',
+    b"[" * 5000,
+    b'{"exercise": 5}',
+    b'{"exercise": "e01-setup-stage1", "trainee": 5}',
+    b'{"exercise": "e01-setup-stage1", "seed": "abc"}',
+    b'{"exercise": "e01-setup-stage1", "seed": 1e400}',
+    b'{"exercise": "e01-setup-stage1", "seed": -1}',
+    b'{"exercise": "e01-setup-stage1", "seed": true}',
+    b'{"exercise": "e01-setup-stage1", "demonstration": "yes"}',
+    b'{"trainee": "x", "exercise": "nope"}',
+    b"\xff\xfe",
+    b"x" * 70_000,
+]
+BAD_PATCH = [
+    "",
+    "side=top&x=0&y=0&mag=6",
+    "side=left&x=a&y=0&mag=6",
+    "side=left&x=0&y=0&mag=0",
+    "side=left&x=0&y=0&mag=-2",
+    "side=left&x=0&y=0&mag=nan",
+    "side=left&x=0&y=0&mag=inf",
+    "side=left&x=1e400&y=0&mag=6",
+    "side=left&x=0&y=0&mag=6&size=0",
+    "side=left&x=0&y=0&mag=6&size=99999",
+    "side=left&x=0&y=0&mag=6&size=1.5",
+    "side=left&x=999&y=0&mag=6",
+]
+
+
+def _one_line_error(r):
+    assert 400 <= r.status_code < 500, (r.request.url, r.status_code, r.text[:200])
+    body = r.json()
+    assert set(body) == {"error"} and "\n" not in body["error"] and body["error"]
+    assert "Traceback" not in body["error"]
+
+
+def test_every_route_answers_bad_requests_with_one_line(client):
+    sid, secret = start(client, trainee="walker")
+    paths = {"sid": sid}
+    routes = [r for r in client.app.routes if isinstance(r, Route)]
+    seen = set()
+    for route in routes:
+        path = route.path.format(**paths)
+        for method in sorted(route.methods - {"HEAD"}):
+            seen.add(route.path)
+            for auth in ({}, {"token": "wrong"}, {"key": "wrong"}, {"token": TOKEN}):
+                if method == "POST":
+                    for body in BAD_BODIES:
+                        r = client.post(path, params=auth, content=body)
+                        if route.path == "/api/instructor/exercises" and auth == {"token": TOKEN}:
+                            assert r.status_code != 200 or body == b"", body
+                        if r.status_code != 200:
+                            _one_line_error(r)
+                elif path.startswith("/api/"):
+                    r = client.get(path, params=auth)
+                    assert r.status_code < 500, path
+                    if r.status_code != 200:
+                        _one_line_error(r)
+            # unknown sessions, bad ids and wrong methods
+            if "{sid}" in route.path and route.path.startswith("/api/"):
+                for bad in ("nope", "0" * 16, "..%2f..%2fetc", "%00"):
+                    _one_line_error(client.get(route.path.format(sid=bad), params={"token": TOKEN}))
+            other = "GET" if method == "POST" else "POST"
+            if other not in route.methods and route.path.startswith("/api/"):
+                _one_line_error(client.request(other, path, params={"token": TOKEN}))
+    for q in BAD_PATCH:
+        _one_line_error(client.get(f"/api/sessions/{sid}/patch.png?{q}&key={secret}"))
+    _one_line_error(client.get("/api/nothing-here"))
+    for mag, size in ((0.625, 80), (6, 768)):  # the page's coarse-first patch, then the sharp one
+        q = {"side": "left", "x": 1, "y": -2, "mag": mag, "size": size, "key": secret}
+        r = client.get(f"/api/sessions/{sid}/patch.png", params=q)
+        assert r.status_code == 200 and r.content[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (
+        client.get(f"/api/sessions/{sid}/patch.png?side=left&x=0&y=0&mag=6&key=no").status_code
+        == 403
+    )
+    assert len(seen) == len(routes)
+    assert {r.path for r in client.app.routes if isinstance(r, WebSocketRoute)} == {
+        "/ws/{sid}",
+        "/ws-instructor",
+    }
+
+
+def test_instructor_table_is_pushed_without_regrading(client):
+    with client.websocket_connect("/ws-instructor") as ins:
+        ins.send_text(json.dumps({"auth": TOKEN}))
+        first = json.loads(ins.receive_text())["sessions"]
+        sid, secret = start(client, trainee="pushed")
+        rows = json.loads(ins.receive_text())["sessions"]
+        assert len(rows) == len(first) + 1 and rows[-1]["trainee"] == "pushed"
+        claim_all(client, sid, secret)
+        reg = client.app.state.registry
+        reg._grading[sid].result(timeout=60)  # graded once, in the worker, when finished
+        for _ in range(10):
+            rows = json.loads(ins.receive_text())["sessions"]
+            mine = next(r for r in rows if r["id"] == sid)
+            if "score" in mine:
+                break
+        assert mine["done"] and isinstance(mine["passed"], bool)
+        assert mine["score"] == round(reg.grades[sid]["overall"]["score"], 4)
+
+
+def test_csv_export_and_class_archive(client):
+    sid, secret = start(client, trainee="archived")
+    claim_all(client, sid, secret)
+    client.app.state.registry._grading[sid].result(timeout=60)
+    csv = client.get("/api/instructor/results.csv", headers={"Authorization": f"Bearer {TOKEN}"})
+    assert csv.status_code == 200 and csv.text.splitlines()[0].startswith("id,trainee,exercise")
+    assert any(line.startswith(f"{sid},archived,{PRACTICE}") for line in csv.text.splitlines())
+    z = client.get("/api/instructor/archive.zip", params={"token": TOKEN})
+    assert z.status_code == 200
+    with zipfile.ZipFile(io.BytesIO(z.content)) as arc:
+        names = arc.namelist()
+        assert "results.csv" in names and f"logs/session-{sid}.jsonl" in names
+        lines = arc.read(f"logs/session-{sid}.jsonl").decode().splitlines()
+        assert json.loads(lines[0])["trainee"] == "archived"
+        assert json.loads(lines[-1])["action"]["kind"] == "claim"
+        assert f"grades/grade-{sid}.json" in names
+    assert client.get("/api/instructor/archive.zip", params={"token": "x"}).status_code == 403
+    ws, _conn, hello = open_socket(client, sid, secret)
+    ws.__exit__(None, None, None)
+    assert hello["state"]["done"]
