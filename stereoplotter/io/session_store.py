@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from stereoplotter.errors import ConfigError
-from stereoplotter.io.yaml_files import _parse_yaml
+from stereoplotter.io.yaml_input import _parse_yaml
 
 __all__ = [
     "DB_NAME",

@@ -166,8 +166,8 @@ def replay_frames(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
     instructor's replay). The session is started afresh from the header and fed each recorded
     action at its recorded time; refused actions stay refused."""
     head = records[0]
-    session = Session(resolve_exercise(head["exercise"], exercise_from_mapping), str(head["trainee"]), int(head["seed"]),
-                      clock=False)
+    exercise = resolve_exercise(head["exercise"], exercise_from_mapping)
+    session = Session(exercise, str(head["trainee"]), int(head["seed"]), clock=False)
     frames = [{"action": None, "state": session.state(), "refused": None}]
     for rec in records[1:]:
         action = dict(rec["action"], t=rec["t"])
@@ -204,7 +204,8 @@ def format_mm(exercise: Exercise) -> float:
 
 def grade_records(records: list[dict[str, Any]]) -> dict[str, Any]:
     """The grade of a session log (run in a worker process)."""
-    return json.loads(json.dumps(grade(records, population=GRADE_POPULATION, read_exercise=exercise_from_mapping), allow_nan=False))
+    result = grade(records, population=GRADE_POPULATION, read_exercise=exercise_from_mapping)
+    return json.loads(json.dumps(result, allow_nan=False))
 
 
 def photo_patch(
