@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from stereoplotter.io.exercise_file import load_exercise
+from stereoplotter.io.exercise_file import exercise_from_mapping, load_exercise
 from stereoplotter.io.session_log import log_bytes
 from stereoplotter.trainer.grading import CHUNK, population_measures
 from stereoplotter.trainer.session import Session
@@ -44,7 +44,7 @@ def bench(name: str, population: int) -> None:
     state = (time.perf_counter() - t) / 50
     data = log_bytes([s.header(), *s.log])
     t = time.perf_counter()
-    r = Session.replay([s.header(), *s.log])
+    r = Session.replay([s.header(), *s.log], read_exercise=exercise_from_mapping)
     replay = time.perf_counter() - t
     assert log_bytes([r.header(), *r.log]) == data
     rss0 = _rss_mb()

@@ -193,7 +193,7 @@ def photo_key(exercise: Exercise) -> tuple[str, str, str, int | None]:
 
 def build_view_cache(source: dict[str, Any]) -> ViewCache:
     """The view cache of an exercise's photos (run in a worker process: picklable in and out)."""
-    ex = resolve_exercise(source)
+    ex = resolve_exercise(source, exercise_from_mapping)
     return ViewCache(ex.scenario, ex.seed)
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stereoplotter.io.exercise_file import load_exercise
+from stereoplotter.io.exercise_file import exercise_from_mapping, load_exercise
 from stereoplotter.io.session_log import read_log, write_log
 from stereoplotter.trainer.grading import grade, population_measures
 from stereoplotter.trainer.outcome import stage_measures
@@ -48,7 +48,7 @@ def test_the_scripted_trainee_reaches_the_operators_instrument_state(replayed):
 
 def test_the_scripted_trainee_gets_the_operators_grade(replayed):
     s, path = replayed
-    g = grade(read_log(path), population=64)
+    g = grade(read_log(path), population=64, read_exercise=exercise_from_mapping)
     for stage, body in g["stages"].items():
         assert body["claimed"]
         for row in body["measures"]:

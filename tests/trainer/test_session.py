@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from stereoplotter.errors import TrainerError
-from stereoplotter.io.exercise_file import load_exercise
+from stereoplotter.io.exercise_file import exercise_from_mapping, load_exercise
 from stereoplotter.io.session_log import read_log, replay_log, write_log
 from stereoplotter.trainer.session import Session
 
@@ -63,7 +63,7 @@ def test_replay_refuses_a_tampered_log(stage1, tmp_path):
     records = read_log(path)
     records[1]["action"]["delta"] = 3.0
     with pytest.raises(TrainerError, match="does not replay"):
-        Session.replay(records)
+        Session.replay(records, read_exercise=exercise_from_mapping)
 
 
 def test_exam_mode_refuses_undo_and_hints():
