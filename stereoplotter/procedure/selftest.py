@@ -257,6 +257,16 @@ def _apply_touch_up(p, setting, left, right, linkage):
     return setting, left, right
 
 
+def _central_jacobian(q_of, p: NDArray, shape: tuple[int, ...]) -> NDArray:
+    """∂q/∂p by central differences with the steps ``_TOUCH_UP_STEPS``, shape (*shape, 5)."""
+    jac = np.empty((*shape, 5))
+    for i, h in enumerate(_TOUCH_UP_STEPS):
+        dp = np.zeros(5)
+        dp[i] = h
+        jac[..., i] = (q_of(p + dp) - q_of(p - dp)) / (2 * h)
+    return jac
+
+
 def touch_up(
     photo_left: NDArray,
     photo_right: NDArray,
@@ -298,7 +308,6 @@ def touch_up(
     Near the true settings the problem is almost linear; in variant "B" the minimum lies far away
     (κ changes of ≈ 0.3 rad), which a plain Gauss–Newton step does not reach.
     """
-    # Over 80 lines only through its docstring: 40 lines of code.
     nb = photo_left.shape[0]
     p = np.zeros((nb, 5))
 
@@ -311,11 +320,7 @@ def touch_up(
     lam = np.full(nb, 1e-4)
     eye = np.eye(5)
     for _ in range(max_iterations):
-        jac = np.empty((*r.shape, 5))
-        for i, h in enumerate(_TOUCH_UP_STEPS):
-            dp = np.zeros(5)
-            dp[i] = h
-            jac[..., i] = (q_of(p + dp) - q_of(p - dp)) / (2 * h)
+        jac = _central_jacobian(q_of, p, r.shape)
         a = np.einsum("bni,bnj->bij", jac, jac)
         g = np.einsum("bni,bn->bi", jac, r)
         diag = np.einsum("bii->bi", a)[..., None, :] * eye
@@ -586,6 +591,20 @@ def stage2_setting(
 STAGE2_SIGNS = (1.0, -1.0, -1.0, 1.0)
 
 
+def _photo_unit(unit: CorrectionUnit, i: int, kappa) -> CorrectionUnit:
+    """Photo ``i`` (0 left, 1 right) of a stage-2 unit fitted for both photos, shape (T, 1)."""
+    return replace(
+        unit,
+        tan_alpha=unit.tan_alpha[i][:, None],
+        tan_omega=unit.tan_omega[i][:, None],
+        decentration_x_mm=unit.decentration_x_mm[i][:, None],
+        decentration_y_mm=unit.decentration_y_mm[i][:, None],
+        plane_decentration_x_mm=None,
+        plane_decentration_y_mm=None,
+        kappa=kappa,
+    )
+
+
 def stage2_table(
     pair: SyntheticPair | None = None,
     tilts_deg=(0.5, 1.0, 3.0),
@@ -612,7 +631,6 @@ def stage2_table(
         n·|Δη|) [mm]; ``mark4_tolerance_mm`` = 0.02·n_л [mm];
         ``max_q_um``, ``rms_q_um`` with b and κ exact [µm]; ``max_q_after_touch_up_um`` [µm].
     """
-    # Over 80 lines only through its docstring (the columns of the table): 56 lines of code.
     pair = pair or SyntheticPair()
     setting = pair.setting()
     n_l = pair.n_left
@@ -630,21 +648,8 @@ def stage2_table(
         unit, mismatch, rod_mismatch = stage2_setting(
             alpha, omega, np.array([[1.0], [-1.0]]), name, pair
         )
-
-        def pick(u, i, kappa):
-            return replace(
-                u,
-                tan_alpha=u.tan_alpha[i][:, None],
-                tan_omega=u.tan_omega[i][:, None],
-                decentration_x_mm=u.decentration_x_mm[i][:, None],
-                decentration_y_mm=u.decentration_y_mm[i][:, None],
-                plane_decentration_x_mm=None,
-                plane_decentration_y_mm=None,
-                kappa=kappa,
-            )
-
-        left = pick(unit, 0, pair.kappa_left)
-        right = pick(unit, 1, pair.kappa_right)
+        left = _photo_unit(unit, 0, pair.kappa_left)
+        right = _photo_unit(unit, 1, pair.kappa_right)
         reading = y_parallax(pl, pr, setting, left, right)
         max_q, rms_q = _q_stats(reading.y_parallax_mm)
         q_after, _, _ = touch_up(pl, pr, setting, left, right, v.linkage)

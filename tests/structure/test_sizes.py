@@ -29,8 +29,6 @@ LONG_FUNCTIONS = {
     "instrument/mechanics/sheet.py:orient_sheet": 101,
     "geometry/resection.py:space_resection": 97,
     "geometry/resection_book.py:line_coefficients": 93,
-    "procedure/selftest.py:stage2_table": 83,
-    "procedure/selftest.py:touch_up": 82,
 }
 
 
