@@ -124,7 +124,7 @@ def run_simulation_command(
     """
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
-    fitted = SC1Options.from_names(spec, options)
+    fitted = SC1Options.parse(options)  # checked against the instrument once, by prepare_run
     seed = scenario.seed if seed is None else seed
     prep = prepare_run(
         scenario,

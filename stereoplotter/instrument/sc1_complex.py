@@ -53,16 +53,22 @@ class SC1Options:
         return tuple(k for k, field in OPTION_NAMES.items() if getattr(self, field))
 
     @classmethod
-    def from_names(cls, spec: InstrumentSpec, names: Iterable[str]) -> SC1Options:
-        """The options ``names`` fitted to ``spec``; an unknown name or an option the instrument
-        file does not document (only the SC-1 of the SC complex has them) is refused in one line.
-        """
+    def parse(cls, names: Iterable[str]) -> SC1Options:
+        """The options of the switch names ``names``; an unknown name is refused in one line (the
+        instrument is checked by :meth:`fitted_to`)."""
         fields = {}
         for name in names:
             if name not in OPTION_NAMES:
                 raise StereoplotterError(
                     f"--option: expected one of {', '.join(OPTION_NAMES)}, found {name!r}"
                 )
+            fields[OPTION_NAMES[name]] = True
+        return cls(**fields)
+
+    def fitted_to(self, spec: InstrumentSpec) -> SC1Options:
+        """These options, checked against ``spec``: an option the instrument file does not
+        document (only the SC-1 of the SC complex has them) is refused in one line."""
+        for name in self.names:
             key = _RANGE_KEY if name == "correction_unit" else _AUTOMATIC_KEY
             p = spec.parameters.get(key)
             if p is None or p.value is False:
@@ -70,8 +76,12 @@ class SC1Options:
                     f"--option {name}: the {spec.title} has no such unit (its instrument file "
                     f"has no {key}; the options belong to the SC complex built around the SC-1)"
                 )
-            fields[OPTION_NAMES[name]] = True
-        return cls(**fields)
+        return self
+
+    @classmethod
+    def from_names(cls, spec: InstrumentSpec, names: Iterable[str]) -> SC1Options:
+        """The options ``names`` fitted to ``spec`` (:meth:`parse`, then :meth:`fitted_to`)."""
+        return cls.parse(names).fitted_to(spec)
 
 
 @dataclass(frozen=True, slots=True)

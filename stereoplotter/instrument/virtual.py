@@ -233,8 +233,8 @@ class Instrument:
                 "the pymunk back-end runs single instruments; use backend='closed-form' for trials"
             )
         self.spec = spec
-        # validated against the instrument file: only the SC-1 of the SC complex has them
-        self.options = SC1Options.from_names(spec, options.names) if options else SC1Options()
+        # checked against the instrument file: only the SC-1 of the SC complex has them
+        self.options = options.fitted_to(spec) if options else SC1Options()
         self._servo: AutomaticCoordinatograph | None = None
         self.variant = decentration_variant(variant)
         self.backend = backend

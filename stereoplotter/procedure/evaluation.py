@@ -604,6 +604,26 @@ def _imaged(scenario: Scenario, *xy: _F) -> NDArray[np.bool_]:
 
 # long: a 47-line docstring and one evaluation chain whose three closures (role_index, raw,
 # point_set) share the frame, the scales and the instrument state of the trial axis.
+def _plane_index(
+    scenario: Scenario, plane_point_ids: Sequence[str] | None, imaged: NDArray[np.bool_]
+) -> list[int]:
+    """Indices of the imaged points the levelling plane is fitted at (:func:`evaluate_model`)."""
+    if plane_point_ids is None:
+        plane_idx = [
+            i for i, p in enumerate(scenario.points) if p.role == "control" and p.kind == "full"
+        ]
+    else:
+        known = {p.id: i for i, p in enumerate(scenario.points)}
+        missing = [pid for pid in plane_point_ids if pid not in known]
+        if missing:
+            raise StereoplotterError(
+                f"plane_point_ids: {missing} are not points of scenario {scenario.name!r}; "
+                f"it has {sorted(known)}"
+            )
+        plane_idx = [known[pid] for pid in plane_point_ids]
+    return [i for i in plane_idx if imaged[i]]
+
+
 def evaluate_model(
     scenario: Scenario,
     sheet: Any,
@@ -616,6 +636,7 @@ def evaluate_model(
     standard_points_c_mm: float = STANDARD_POINTS_C_MM,
     plane_point_ids: Sequence[str] | None = None,
     corner4_misclosure_mm: ArrayLike | None = None,
+    grid_local_m: ArrayLike | None = None,
 ) -> ModelEvaluation:
     r"""Evaluate the model built on an instrument against the ground truth of the scenario.
 
@@ -647,6 +668,9 @@ def evaluate_model(
         "full" (plan and height). Fewer than 3 usable points: no plane removal.
     corner4_misclosure_mm : float or array_like (T,), optional
         Corner-4 misclosure from stage 5, passed through. [mm]
+    grid_local_m : array_like, shape (g, 3), optional
+        That grid if the caller computed it already (a prepared run's ``grid_m``, local frame);
+        ``grid_shape`` is then ignored. [m]
 
     Returns
     -------
@@ -679,7 +703,11 @@ def evaluate_model(
     mv = int(sheet.vertical_scale_denominator)
     map_scale = sheet.map_scale_denominator
 
-    grid_local = working_area_grid_m(scenario, grid_shape)
+    grid_local = (
+        working_area_grid_m(scenario, grid_shape)
+        if grid_local_m is None
+        else np.asarray(grid_local_m, float)
+    )
     grid_frame = instrument_frame_m(grid_local, origin, theta)
     flying_height = float(-np.mean(grid_frame[:, 2]))  # Z_Sл − mean Z
     h0 = origin[2] if height_zero is None else np.asarray(height_zero, float)
@@ -704,20 +732,7 @@ def evaluate_model(
     def role_index(role: str) -> list[int]:
         return [i for i, p in enumerate(scenario.points) if p.role == role and imaged[i]]
 
-    if plane_point_ids is None:
-        plane_idx = [
-            i for i, p in enumerate(scenario.points) if p.role == "control" and p.kind == "full"
-        ]
-    else:
-        known = {p.id: i for i, p in enumerate(scenario.points)}
-        missing = [pid for pid in plane_point_ids if pid not in known]
-        if missing:
-            raise StereoplotterError(
-                f"plane_point_ids: {missing} are not points of scenario {scenario.name!r}; "
-                f"it has {sorted(known)}"
-            )
-        plane_idx = [known[pid] for pid in plane_point_ids]
-    plane_idx = [i for i in plane_idx if imaged[i]]
+    plane_idx = _plane_index(scenario, plane_point_ids, imaged)
     plane_frame = instrument_frame_m(pts_local[plane_idx], origin, theta)
     use_plane = (
         len(plane_idx) >= 3

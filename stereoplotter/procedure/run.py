@@ -163,12 +163,15 @@ class PreparedRun:
     #: The working-area grid where the true residual y-parallax is evaluated (local frame),
     #: computed once per run (``simulate.residual_grid_m``). [m]
     grid_m: NDArray[np.float64] | None = None
+    #: The SC complex's error-correction unit as the instrument file documents it (read once per
+    #: run; None without the option).
+    correction_unit: ErrorCorrectionUnit | None = None
 
 
 def log_options(op: Operator, prep: PreparedRun) -> None:
     """Transcript lines (at the start) for the SC complex's options fitted to the instrument."""
     if prep.options.error_correction_unit:
-        unit = ErrorCorrectionUnit.from_spec(prep.spec)
+        unit = prep.correction_unit or ErrorCorrectionUnit.from_spec(prep.spec)
         op.log.add(
             "1",
             "SC complex: the error-correction unit has corrected the image coordinates (film "

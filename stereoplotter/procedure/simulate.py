@@ -41,6 +41,7 @@ __all__ = [
     "METHODS",
     "PreparedRun",
     "SimulationResult",
+    "prepare_pair",
     "prepare_run",
     "residual_grid_m",
     "run_trials_chunk",
@@ -128,7 +129,10 @@ def _errors(spec: InstrumentSpec, errors: ErrorModel | str | None) -> ErrorModel
 
 
 def apply_correction_unit(
-    scenario: Scenario, spec: InstrumentSpec, operator: OperatorModel
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    operator: OperatorModel,
+    unit: ErrorCorrectionUnit | None = None,
 ) -> tuple[Scenario, OperatorModel]:
     """The SC complex's off-line error-correction unit on a scenario's photos (SC-1 option).
 
@@ -140,12 +144,15 @@ def apply_correction_unit(
     its spatial correlation), i.e. added in quadrature to the operator's σ: σ_c per coordinate
     on a monocular pointing, √2·σ_c on an x- or y-parallax (two images).
 
+    ``unit``: the unit as read from ``spec`` (:meth:`ErrorCorrectionUnit.from_spec`), if the
+    caller has it already.
+
     Returns
     -------
     (Scenario, OperatorModel)
         The scenario with the film deformation corrected; the operator with the residual added.
     """
-    unit = ErrorCorrectionUnit.from_spec(spec)
+    unit = ErrorCorrectionUnit.from_spec(spec) if unit is None else unit
     half_format_um = 0.5 * float(scenario.camera.format_mm) * 1000.0
     for photo in scenario.photos:
         unit.check_input_um(np.asarray(photo.film_deformation_ppm, float) * 1e-6 * half_format_um)
@@ -179,28 +186,25 @@ def prepare_run(
     practice: str = "operator",
     options: SC1Options | None = None,
 ) -> PreparedRun:
-    """The fixed part of a run (arguments as :func:`simulate`)."""
-    options = SC1Options() if options is None else options
+    """The fixed part of a run (arguments as :func:`simulate`).
+
+    Everything a run's trials share is computed here, once: the SC complex's options checked
+    against the instrument file, the setup sheet with its range checks, the scene (true
+    fiducials, standard points), the floor of the mechanism and the residual grid
+    (:func:`prepare_pair`). The trials see the :class:`PreparedRun`, never recompute it.
+    """
+    options = SC1Options() if options is None else options.fitted_to(spec)
     operator = OperatorModel() if operator is None else operator
-    if options.error_correction_unit:
-        scenario, operator = apply_correction_unit(scenario, spec, operator)
+    unit = ErrorCorrectionUnit.from_spec(spec) if options.error_correction_unit else None
+    if unit is not None:
+        scenario, operator = apply_correction_unit(scenario, spec, operator, unit)
     if method not in METHODS:
         raise StereoplotterError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
     if practice not in PRACTICES:
         raise StereoplotterError(
             f"practice: expected one of {', '.join(PRACTICES)}, found {practice!r}"
         )
-    sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
-    scene = Scene.build(
-        scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
-    )
-    if method == "setup":  # the floor: the mechanism at the sheet's own settings (D9)
-        refuse_beyond_mechanism(
-            sheet,
-            scene,
-            decentration_variant(variant).strict_per_axis,
-            mechanism_for(spec),
-        )
+    sheet, scene, grid_m = prepare_pair(scenario, spec, method, variant)
     return PreparedRun(
         scenario,
         spec,
@@ -216,8 +220,30 @@ def prepare_run(
         relative,
         practice,
         options,
-        residual_grid_m(scenario),
+        grid_m,
+        unit,
     )
+
+
+def prepare_pair(
+    scenario: Scenario, spec: InstrumentSpec, method: str = "setup", variant: str = "L"
+) -> tuple[SetupSheet, Scene, np.ndarray]:
+    """The prepared pair of a run, built once: the setup sheet (frame, Table 24, every range
+    check of the sheet), the scene (true fiducials, the six standard points), for the setup
+    method the floor of the mechanism at the sheet's own settings (D9), and the residual grid
+    (:func:`residual_grid_m`, local frame). [—, —, m]"""
+    sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
+    scene = Scene.build(
+        scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
+    )
+    if method == "setup":  # the floor: the mechanism at the sheet's own settings (D9)
+        refuse_beyond_mechanism(
+            sheet,
+            scene,
+            decentration_variant(variant).strict_per_axis,
+            mechanism_for(spec),
+        )
+    return sheet, scene, residual_grid_m(scenario)
 
 
 def _run_one(
@@ -236,8 +262,7 @@ def _run_one(
         run_conventional_method(run, prep.relative)
     scene = prep.scene
     q_std = op.y_parallax(scene.standard_points_m, scene.images(scene.standard_points_m))
-    grid = prep.grid_m if prep.grid_m is not None else residual_grid_m(prep.scenario)
-    q_grid = op.y_parallax(grid, scene.images(grid))
+    q_grid = op.y_parallax(prep.grid_m, scene.images(prep.grid_m))
     return run, q_std, q_grid
 
 
@@ -277,7 +302,7 @@ def run_trials_chunk(
     if noise is None:
         noise = Noise(prep.seed, trials, None, first_trial)
     run, q_std, q_grid = _run_one(prep, injected, trials, noise, transcript)
-    evaluation = _evaluate(prep.scenario, prep.sheet, run) if evaluate else None
+    evaluation = _evaluate(prep, run) if evaluate else None
     return SimulationResult(
         prep.method,
         prep.backend,
@@ -440,7 +465,9 @@ def simulate_per_trial(
     return out
 
 
-def _evaluate(scenario, sheet, run: Run) -> ModelEvaluation:
+def _evaluate(prep: PreparedRun, run: Run) -> ModelEvaluation:
+    """The built model of ``run`` against the ground truth, on the prepared run's grid."""
+    sheet = prep.sheet
     inst = run.op.inst
     units = inst.state()["units"]
     # the metre height scale as the operator slipped it, at D = 0 [m]
@@ -450,7 +477,7 @@ def _evaluate(scenario, sheet, run: Run) -> ModelEvaluation:
     )
     corner = run.results.get("stage 5: corner 4")
     return evaluate_model(
-        scenario,
+        prep.scenario,
         sheet,
         inst.setting,
         units["left"],
@@ -458,4 +485,5 @@ def _evaluate(scenario, sheet, run: Run) -> ModelEvaluation:
         height_zero=zero,
         standard_points_c_mm=inst.spec.standard_points_c_mm,
         corner4_misclosure_mm=None if corner is None else corner.residual,
+        grid_local_m=prep.grid_m,
     )
