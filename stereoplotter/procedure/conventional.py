@@ -570,7 +570,7 @@ def c2_relative_by_equations(
     """
     op, sheet = run.op, run.sheet
     bound = _bound(op) if passes is None else int(passes)
-    imgs = run.scene.images(run.scene.standard_points_m)
+    imgs = run.scene.standard
     x11, x12 = imgs[0][0, 0], imgs[0][1, 0]
     x21, x22 = imgs[1][0, 0], imgs[1][1, 0]
     active = op.all()

@@ -49,15 +49,15 @@ def mechanism_level(
     bx, by, bz = sheet.base_mm
     setting = InstrumentSetting(sheet.f_instrument_mm, bx, by, bz)
 
-    def reading(points_m):
-        pl, pr = scene.images(points_m)
+    def reading(images):
+        pl, pr = images
         return rods_intersection(units[0].rod_from_photo(pl), units[1].rod_from_photo(pr), setting)
 
-    q_max = float(np.max(np.abs(reading(scene.standard_points_m).y_parallax_mm)))
+    q_max = float(np.max(np.abs(reading(scene.standard).y_parallax_mm)))
     heights = np.array([h.ground_m for h in control_heights_of(sheet, scene)])
     if len(heights) < 2:
         return q_max, 0.0
-    depth = reading(heights).depth_mm
+    depth = reading(scene.images(heights)).depth_mm
     # deeper is lower: H_i = H_0 − (D_i − D_0)·M_в/1000 with the scale slipped at point 0
     model_h = heights[0, 2] - (depth - depth[0]) * sheet.vertical_scale_denominator / 1000.0
     return q_max, float(np.max(np.abs(model_h - heights[:, 2])))

@@ -227,12 +227,16 @@ class Scene:
         3, 4 at +c and 5, 6 at −c on the photo y axis of photos 1, 2 (local frame). [m]
     c_mm : float
         c of the standard points on the photo. [mm]
+    standard_images_mm : (ndarray, ndarray)
+        True images of the standard points on the left and right photo, shape (6, 2) each,
+        computed once (:meth:`images`; read-only). [mm]
     """
 
     scenario: Scenario
     fiducials_mm: dict[str, NDArray[np.float64]]
     standard_points_m: NDArray[np.float64]
     c_mm: float
+    standard_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
 
     @classmethod
     def build(
@@ -255,16 +259,31 @@ class Scene:
         h = float(scenario.photo("left").exterior.centre[2]) - z0
         frame = standard_points_m(scenario, frame_origin_m, frame_rotation, h, c_mm)
         local = instrument_frame_m(frame, frame_origin_m, frame_rotation, inverse=True)
-        return cls(scenario, fid, local, c_mm)
+        scene = cls(scenario, fid, local, c_mm)
+        return replace(scene, standard_images_mm=scene.images(local, read_only=True))
 
-    def images(self, points_m: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """True images of ground points on the left and right photo (fiducial system). [mm]"""
+    def images(
+        self, points_m: ArrayLike, *, read_only: bool = False
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """True images of ground points on the left and right photo (fiducial system). [mm]
+
+        ``read_only``: the arrays refuse writes (images kept for the whole run)."""
         from stereoplotter.procedure.evaluation import film_points_mm
 
         pts = np.asarray(points_m, float)
-        return film_points_mm(self.scenario, "left", pts), film_points_mm(
+        out = film_points_mm(self.scenario, "left", pts), film_points_mm(
             self.scenario, "right", pts
         )
+        for a in out if read_only else ():
+            a.setflags(write=False)
+        return out
+
+    @property
+    def standard(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The true images of the six standard points, computed once per scene. [mm]"""
+        if self.standard_images_mm is None:
+            return self.images(self.standard_points_m)
+        return self.standard_images_mm
 
 
 class Operator:

@@ -38,6 +38,7 @@ from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "PRACTICES",
+    "PreparedPair",
     "PreparedRun",
     "Run",
     "build_instrument",
@@ -166,6 +167,21 @@ class PreparedRun:
     #: The SC complex's error-correction unit as the instrument file documents it (read once per
     #: run; None without the option).
     correction_unit: ErrorCorrectionUnit | None = None
+    #: The true images of ``grid_m`` on the left and right photo (read-only), once per run. [mm]
+    grid_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+
+@dataclass(frozen=True)
+class PreparedPair:
+    """The stereopair as a run needs it, built once (:func:`~stereoplotter.procedure.simulate.
+    prepare_pair`): the setup sheet (its frame S_л, θ; Table 24; every range check of the sheet
+    passed), the scene (true fiducials, the six standard points and their true images) and the
+    working-area grid of the residual y-parallax with its true images. [—, —, m, mm]"""
+
+    sheet: SetupSheet
+    scene: Scene
+    grid_m: NDArray[np.float64]
+    grid_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]]
 
 
 def log_options(op: Operator, prep: PreparedRun) -> None:

@@ -422,7 +422,7 @@ def refine_relative_orientation(
     """
     op = run.op
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    imgs = run.scene.images(run.scene.standard_points_m)
+    imgs = run.scene.standard
     remedy = "R2 refine the relative orientation"
     active = op.v(failed).astype(bool)
     rounds = np.zeros(np.shape(active), int)
@@ -540,7 +540,7 @@ def level_design(
     instrument model at the sheet's own settings (the operator's knowledge, the same for every
     trial)."""
     setting, units = _nominal_state(sheet, strict_per_axis)
-    std = scene.images(scene.standard_points_m)
+    std = scene.standard
     j = {
         c: _response(std, setting, units, {c: 1.0}, linkage)[0]
         for c in (*LEVEL_FREE, *LEVEL_TILTS["alpha"], *LEVEL_TILTS["omega"])

@@ -29,7 +29,7 @@ from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
 from stereoplotter.procedure.floor import refuse_beyond_mechanism
 from stereoplotter.procedure.operator import Noise, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, StageRecord
-from stereoplotter.procedure.run import PRACTICES, PreparedRun, Run, build_run
+from stereoplotter.procedure.run import PRACTICES, PreparedPair, PreparedRun, Run, build_run
 from stereoplotter.procedure.setup_method import run_setup_method
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
@@ -204,15 +204,15 @@ def prepare_run(
         raise StereoplotterError(
             f"practice: expected one of {', '.join(PRACTICES)}, found {practice!r}"
         )
-    sheet, scene, grid_m = prepare_pair(scenario, spec, method, variant)
+    pair = prepare_pair(scenario, spec, method, variant)
     return PreparedRun(
         scenario,
         spec,
         method,
-        sheet,
+        pair.sheet,
         _errors(spec, errors),
         operator,
-        scene,
+        pair.scene,
         int(seed),
         backend,
         ideal_mechanics,
@@ -220,18 +220,19 @@ def prepare_run(
         relative,
         practice,
         options,
-        grid_m,
+        pair.grid_m,
         unit,
+        pair.grid_images_mm,
     )
 
 
 def prepare_pair(
     scenario: Scenario, spec: InstrumentSpec, method: str = "setup", variant: str = "L"
-) -> tuple[SetupSheet, Scene, np.ndarray]:
+) -> PreparedPair:
     """The prepared pair of a run, built once: the setup sheet (frame, Table 24, every range
-    check of the sheet), the scene (true fiducials, the six standard points), for the setup
-    method the floor of the mechanism at the sheet's own settings (D9), and the residual grid
-    (:func:`residual_grid_m`, local frame). [—, —, m]"""
+    check of the sheet), the scene (true fiducials, the six standard points and their images),
+    for the setup method the floor of the mechanism at the sheet's own settings (D9), and the
+    residual grid (:func:`residual_grid_m`, local frame) with its true images."""
     sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
     scene = Scene.build(
         scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
@@ -243,7 +244,8 @@ def prepare_pair(
             decentration_variant(variant).strict_per_axis,
             mechanism_for(spec),
         )
-    return sheet, scene, residual_grid_m(scenario)
+    grid_m = residual_grid_m(scenario)
+    return PreparedPair(sheet, scene, grid_m, scene.images(grid_m, read_only=True))
 
 
 def _run_one(
@@ -261,8 +263,8 @@ def _run_one(
     else:
         run_conventional_method(run, prep.relative)
     scene = prep.scene
-    q_std = op.y_parallax(scene.standard_points_m, scene.images(scene.standard_points_m))
-    q_grid = op.y_parallax(prep.grid_m, scene.images(prep.grid_m))
+    q_std = op.y_parallax(scene.standard_points_m, scene.standard)
+    q_grid = op.y_parallax(prep.grid_m, prep.grid_images_mm)
     return run, q_std, q_grid
 
 
