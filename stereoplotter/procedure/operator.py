@@ -227,16 +227,20 @@ class Scene:
         3, 4 at +c and 5, 6 at −c on the photo y axis of photos 1, 2 (local frame). [m]
     c_mm : float
         c of the standard points on the photo. [mm]
-    standard_images_mm : (ndarray, ndarray)
+    standard : (ndarray, ndarray)
         True images of the standard points on the left and right photo, shape (6, 2) each,
-        computed once (:meth:`images`; read-only). [mm]
+        computed once with the scene (:meth:`images`; read-only). [mm]
     """
 
     scenario: Scenario
     fiducials_mm: dict[str, NDArray[np.float64]]
     standard_points_m: NDArray[np.float64]
     c_mm: float
-    standard_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+    standard: tuple[NDArray[np.float64], NDArray[np.float64]] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        # frozen: set once here, so that dataclasses.replace (new standard points) recomputes it
+        object.__setattr__(self, "standard", self.images(self.standard_points_m, read_only=True))
 
     @classmethod
     def build(
@@ -259,8 +263,7 @@ class Scene:
         h = float(scenario.photo("left").exterior.centre[2]) - z0
         frame = standard_points_m(scenario, frame_origin_m, frame_rotation, h, c_mm)
         local = instrument_frame_m(frame, frame_origin_m, frame_rotation, inverse=True)
-        scene = cls(scenario, fid, local, c_mm)
-        return replace(scene, standard_images_mm=scene.images(local, read_only=True))
+        return cls(scenario, fid, local, c_mm)
 
     def images(
         self, points_m: ArrayLike, *, read_only: bool = False
@@ -277,13 +280,6 @@ class Scene:
         for a in out if read_only else ():
             a.setflags(write=False)
         return out
-
-    @property
-    def standard(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """The true images of the six standard points, computed once per scene. [mm]"""
-        if self.standard_images_mm is None:
-            return self.images(self.standard_points_m)
-        return self.standard_images_mm
 
 
 class Operator:

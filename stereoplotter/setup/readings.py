@@ -66,23 +66,13 @@ def _r(
     return row
 
 
-# Over 80 lines: a table of reading rows in the order the operator sets them (one _r call a row);
-# splitting it by stage would scatter the order the sheet prints.
-def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
-    """All readings of stages 1–5 for a sheet, in the order the operator sets them.
-
-    Returns
-    -------
-    tuple of dict
-        ``stage``, ``step``, ``reading``, ``zero_reading`` (the MO it is added to, or "" for an
-        absolute value), ``value`` (signed), ``unit``, ``equation``, ``formula`` (text),
-        ``tolerance`` where the book gives one, ``note``.
-    """
+def _stage1_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """Stage 1: f_пр, the base, D_max, the mark spans and the zero readings."""
     tol = sheet.tolerances
     sense = sheet.options.bz_scale_sense
     bx, by, bz = sheet.base_mm
     left, right = sheet.photos
-    n_l, n_r = sheet.n_left, sheet.n_right
+    n_l = sheet.n_left
     rows = [
         _r(
             1,
@@ -150,6 +140,16 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
             "reading [m]",
         ),
     ]
+    return rows
+
+
+def _mark_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """Stage 2: k_ω on mark 3, the check on mark 4 and k_α on the x mark, left then right."""
+    tol = sheet.tolerances
+    bx, by, _ = sheet.base_mm
+    left, right = sheet.photos
+    n_l, n_r = sheet.n_left, sheet.n_right
+    rows: list[dict[str, Any]] = []
     for photo, n, zero_x, zero_y, x_mark in (
         (left, n_l, "MO_X", "MO_Y", "2"),
         (right, n_r, "MO_X,п", "MO_Y,п", "1"),
@@ -197,6 +197,16 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
                 **({"book_form": f"{zero_x} − {abs(n * t['x1']):.3f}"} if x_mark == "1" else {}),
             ),
         ]
+    return rows
+
+
+def _stage2_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """Stage 2 after the marks: the decentration scales, b_z and the residual y-parallax."""
+    tol = sheet.tolerances
+    sense = sheet.options.bz_scale_sense
+    bz = sheet.base_mm[2]
+    left, right = sheet.photos
+    rows: list[dict[str, Any]] = []
     for photo in (left, right):
         side = "л" if photo.name == "left" else "п"
         rows += [
@@ -243,6 +253,14 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
             relation="≤",
         ),
     ]
+    return rows
+
+
+def _height_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """Stage 3: the height-scale readings of the height control points (6.15)."""
+    tol = sheet.tolerances
+    n_l = sheet.n_left
+    rows: list[dict[str, Any]] = []
     for h in sheet.control_heights:
         value = float(
             height_scale_reading(
@@ -266,6 +284,13 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
                 note=f"Z_{h['id']} = {h['model_height_mm']:.3f} mm (6.6)",
             )
         )
+    return rows
+
+
+def _corner_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """Stages 4–5: the sheet corners (6.7), (6.16)–(6.18)."""
+    tol = sheet.tolerances
+    rows: list[dict[str, Any]] = []
     for corner in sheet.corners:
         stage = 5 if corner["corner"] == "4" else 4
         equation = {"1": "(6.16)", "3": "(6.17)", "4": "(6.18)"}.get(corner["corner"], "(6.7)")
@@ -293,4 +318,18 @@ def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
                 tolerance=tolerance,
             ),
         ]
-    return tuple(rows)
+    return rows
+
+
+def stage_readings(sheet: SetupSheet) -> tuple[dict[str, Any], ...]:
+    """All readings of stages 1–5 for a sheet, in the order the operator sets them.
+
+    Returns
+    -------
+    tuple of dict
+        ``stage``, ``step``, ``reading``, ``zero_reading`` (the MO it is added to, or "" for an
+        absolute value), ``value`` (signed), ``unit``, ``equation``, ``formula`` (text),
+        ``tolerance`` where the book gives one, ``note``.
+    """
+    rows = _stage1_rows(sheet) + _mark_rows(sheet) + _stage2_rows(sheet)
+    return tuple(rows + _height_rows(sheet) + _corner_rows(sheet))

@@ -519,6 +519,7 @@ def _finish(prep: _Prepared, table: BlockResult) -> SetupSheet:
     spec, options, points, points_m = prep.spec, prep.options, prep.points, prep.points_m
     mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
     n_left = float(table.n_left[0])
+    tolerances, assumed = _tolerances(spec, n_left, prep.depths_m), assumed_parameters(spec)
     sheet = SetupSheet(
         scenario=prep.name,
         instrument=spec.key,
@@ -550,9 +551,9 @@ def _finish(prep: _Prepared, table: BlockResult) -> SetupSheet:
         similarity_point_ids=tuple(points[i].id for i in prep.plan),
         corners=_corners(prep.similarity, prep.corners_gk, mg, n_left),
         readings=(),
-        tolerances=_tolerances(spec, n_left, prep.depths_m),
+        tolerances=tolerances,
         candidates=candidates_of(table, 0),
-        assumed=assumed_parameters(spec),
+        assumed=assumed,
         options=options,
         depth_range_used_mm=tuple(float(v) for v in table.depth_range_mm[0]),
         exterior_sources=prep.exterior_sources,
@@ -635,7 +636,8 @@ def compute_sheet_from_measurements(
         map_sheet=map_sheet,
         exterior_sources=exterior_sources,
     )
-    return _finish(prep, _table24([prep], name))
+    table = _table24([prep], name)
+    return _finish(prep, table)
 
 
 def compute_sheets_from_measurements(
