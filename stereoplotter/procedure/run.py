@@ -23,20 +23,25 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.instrument.error_model import ErrorModel
+from stereoplotter.instrument.kinematics import decentration_variant
+from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import (
     AutomaticCoordinatograph,
     ErrorCorrectionUnit,
     SC1Options,
 )
 from stereoplotter.instrument.virtual import Instrument
+from stereoplotter.procedure.floor import refuse_beyond_mechanism
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, SheetReadings, StageRecord
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
-from stereoplotter.setup.sheet import SetupSheet
+from stereoplotter.scenario.synthetic import working_area_grid_m
+from stereoplotter.setup.sheet import SetupSheet, compute_setup_sheet
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
+    "GRID_SHAPE",
     "PRACTICES",
     "PreparedPair",
     "PreparedRun",
@@ -44,6 +49,8 @@ __all__ = [
     "build_instrument",
     "build_run",
     "log_options",
+    "prepare_pair",
+    "residual_grid_m",
 ]
 
 #: ``--practice``: "operator" applies the remedies after a failed check (the operator's
@@ -162,7 +169,7 @@ class PreparedRun:
     practice: str = "operator"
     options: SC1Options = field(default_factory=SC1Options)
     #: The working-area grid where the true residual y-parallax is evaluated (local frame),
-    #: computed once per run (``simulate.residual_grid_m``). [m]
+    #: computed once per run (:func:`residual_grid_m`). [m]
     grid_m: NDArray[np.float64] | None = None
     #: The SC complex's error-correction unit as the instrument file documents it (read once per
     #: run; None without the option).
@@ -173,10 +180,10 @@ class PreparedRun:
 
 @dataclass(frozen=True)
 class PreparedPair:
-    """The stereopair as a run needs it, built once (:func:`~stereoplotter.procedure.simulate.
-    prepare_pair`): the setup sheet (its frame S_л, θ; Table 24; every range check of the sheet
-    passed), the scene (true fiducials, the six standard points and their true images) and the
-    working-area grid of the residual y-parallax with its true images. [—, —, m, mm]"""
+    """The stereopair as a run needs it, built once (:func:`prepare_pair`): the setup sheet (its
+    frame S_л, θ; Table 24; every range check of the sheet passed), the scene (true fiducials,
+    the six standard points and their true images) and the working-area grid of the residual
+    y-parallax with its true images. [—, —, m, mm]"""
 
     sheet: SetupSheet
     scene: Scene
@@ -308,3 +315,34 @@ def build_run(
     run = Run(op, prep.sheet, prep.scene)
     run.practice = prep.practice if practice is None else practice
     return run
+
+
+#: Rows and columns of the working-area grid where the true residual y-parallax is evaluated.
+GRID_SHAPE = (9, 9)
+
+
+def residual_grid_m(scenario: Scenario) -> np.ndarray:
+    """The working-area grid of ``q_grid_mm`` (:data:`GRID_SHAPE`, local frame). [m]"""
+    return working_area_grid_m(scenario, GRID_SHAPE)
+
+
+def prepare_pair(
+    scenario: Scenario, spec: InstrumentSpec, method: str = "setup", variant: str = "L"
+) -> PreparedPair:
+    """The prepared pair of a run, built once: the setup sheet (frame, Table 24, every range
+    check of the sheet), the scene (true fiducials, the six standard points and their images),
+    for the setup method the floor of the mechanism at the sheet's own settings (D9), and the
+    residual grid (:func:`residual_grid_m`, local frame) with its true images."""
+    sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
+    scene = Scene.build(
+        scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
+    )
+    if method == "setup":  # the floor: the mechanism at the sheet's own settings (D9)
+        refuse_beyond_mechanism(
+            sheet,
+            scene,
+            decentration_variant(variant).strict_per_axis,
+            mechanism_for(spec),
+        )
+    grid_m = residual_grid_m(scenario)
+    return PreparedPair(sheet, scene, grid_m, scene.images(grid_m, read_only=True))

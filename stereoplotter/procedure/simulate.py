@@ -17,8 +17,6 @@ import numpy as np
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
-from stereoplotter.instrument.kinematics import decentration_variant
-from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import (
     ErrorCorrectionUnit,
     SC1Options,
@@ -26,18 +24,25 @@ from stereoplotter.instrument.sc1_complex import (
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
 from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
-from stereoplotter.procedure.floor import refuse_beyond_mechanism
 from stereoplotter.procedure.operator import Noise, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, StageRecord
-from stereoplotter.procedure.run import PRACTICES, PreparedPair, PreparedRun, Run, build_run
+from stereoplotter.procedure.run import (
+    GRID_SHAPE,
+    PRACTICES,
+    PreparedRun,
+    Run,
+    build_run,
+    prepare_pair,
+    residual_grid_m,
+)
 from stereoplotter.procedure.setup_method import run_setup_method
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.scenario.model import Scenario
-from stereoplotter.scenario.synthetic import working_area_grid_m
-from stereoplotter.setup.sheet import SetupSheet, compute_setup_sheet
+from stereoplotter.setup.sheet import SetupSheet
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
+    "GRID_SHAPE",
     "METHODS",
     "PreparedRun",
     "SimulationResult",
@@ -226,28 +231,6 @@ def prepare_run(
     )
 
 
-def prepare_pair(
-    scenario: Scenario, spec: InstrumentSpec, method: str = "setup", variant: str = "L"
-) -> PreparedPair:
-    """The prepared pair of a run, built once: the setup sheet (frame, Table 24, every range
-    check of the sheet), the scene (true fiducials, the six standard points and their images),
-    for the setup method the floor of the mechanism at the sheet's own settings (D9), and the
-    residual grid (:func:`residual_grid_m`, local frame) with its true images."""
-    sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
-    scene = Scene.build(
-        scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
-    )
-    if method == "setup":  # the floor: the mechanism at the sheet's own settings (D9)
-        refuse_beyond_mechanism(
-            sheet,
-            scene,
-            decentration_variant(variant).strict_per_axis,
-            mechanism_for(spec),
-        )
-    grid_m = residual_grid_m(scenario)
-    return PreparedPair(sheet, scene, grid_m, scene.images(grid_m, read_only=True))
-
-
 def _run_one(
     prep: PreparedRun,
     injected: dict[str, Any],
@@ -266,15 +249,6 @@ def _run_one(
     q_std = op.y_parallax(scene.standard_points_m, scene.standard)
     q_grid = op.y_parallax(prep.grid_m, prep.grid_images_mm)
     return run, q_std, q_grid
-
-
-#: Rows and columns of the working-area grid where the true residual y-parallax is evaluated.
-GRID_SHAPE = (9, 9)
-
-
-def residual_grid_m(scenario: Scenario) -> np.ndarray:
-    """The working-area grid of ``q_grid_mm`` (:data:`GRID_SHAPE`, local frame). [m]"""
-    return working_area_grid_m(scenario, GRID_SHAPE)
 
 
 def run_trials_chunk(
