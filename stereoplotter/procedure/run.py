@@ -10,8 +10,9 @@ trainee's session drives it by hand). ``tests/procedure/test_run_assembler.py`` 
 other module builds a :class:`Run` or an :class:`~stereoplotter.instrument.virtual.Instrument`.
 
 :class:`PreparedRun` is what a run fixes before its trials (built once by
-:func:`stereoplotter.procedure.simulate.prepare_run`); :class:`Run` is what a procedure works on
-and what it found.
+:func:`stereoplotter.procedure.simulate.prepare_run`), its stereopair part the
+:class:`PreparedPair` of :func:`prepare_pair`; :class:`Run` is what a procedure works on and what
+it found.
 """
 
 from __future__ import annotations
