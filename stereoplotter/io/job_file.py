@@ -118,6 +118,34 @@ identifier = Annotated[
 ]
 
 
+#: A photo number names the pair's folder of the outputs (``101-102/sheet.pdf``): no path
+#: separator, no leading dot, no control character.
+_PHOTO_NUMBER = r"[^./\\\x00-\x1f\x7f][^/\\\x00-\x1f\x7f]*"
+
+
+def _check_photo_number(v: Any) -> str:
+    v = _check_identifier(v)
+    if not re.fullmatch(_PHOTO_NUMBER, v):
+        raise _fail(
+            "a photo number usable in a folder name (no / or \\, no leading dot, no control "
+            "character)", describe_value(v),
+        )  # fmt: skip
+    return v
+
+
+#: A photo number: an :data:`identifier` that can name the pair's output folder.
+photo_number = Annotated[
+    str,
+    BeforeValidator(_check_photo_number),
+    Field(
+        min_length=1,
+        pattern=_PHOTO_NUMBER,
+        description="text, compared as written (0415 and 415 are two); write it quoted: an "
+        "unquoted number with a leading zero is refused; it names the pair's output folder",
+    ),
+]
+
+
 def _check_date(v: Any) -> str:
     if isinstance(v, _dt.date) and not isinstance(v, _dt.datetime):  # an unquoted YAML date
         v = v.isoformat()
@@ -147,7 +175,7 @@ class FrameModel(FileModel):
 class PhotoModel(FileModel):
     """One photo: its number and exterior orientation (SK-42 or local by ``frame.kind``)."""
 
-    number: identifier
+    number: photo_number
     north_m: number("m", 0.0, 1.0e7) | None = None  # type: ignore[valid-type]
     east_m: number(_EAST, 1.0e6, 61.0e6) | None = None  # type: ignore[valid-type]
     height_m: number("m", -500.0, 50000.0) | None = None  # type: ignore[valid-type]
@@ -163,7 +191,7 @@ class PhotoModel(FileModel):
 class FiducialRow(FileModel):
     """A row of the fiducial-distance CSV: photo number, measured 1–2 and 3–4."""
 
-    photo: identifier
+    photo: photo_number
     d12_mm: number("mm", 0.0, 300.0, low_open=True)  # type: ignore[valid-type]
     d34_mm: number("mm", 0.0, 300.0, low_open=True)  # type: ignore[valid-type]
 
@@ -194,8 +222,8 @@ class WorkingArea(FileModel):
 
 
 class PairModel(FileModel):
-    left: identifier
-    right: identifier
+    left: photo_number
+    right: photo_number
     map_sheet: text | None = None  # type: ignore[valid-type]
     working_area: WorkingArea | None = None
 

@@ -258,3 +258,17 @@ def test_force_removes_pair_folders_of_a_run_without_manifest(tmp_path, capsys):
     assert report.removed == ("099-100/sheet.md", "099-100/sheet.yaml")
     assert report.kept_foreign == 2 and not (out / "099-100").exists()
     assert (out / "keep" / "x.txt").is_file() and (out / "101-102" / "sheet.pdf").is_file()
+
+
+@pytest.mark.parametrize("number", ["../101", "a/b", ".hidden", "1\\2"])
+def test_photo_number_must_be_usable_as_a_folder_name(tmp_path, capsys, number):
+    """A photo number is text, and names the pair's output folder: no path out of -o."""
+
+    def edit(doc):
+        doc["photos"][0]["number"] = number
+        doc["pairs"][0]["left"] = number
+
+    path = _job(tmp_path, edit)
+    assert main(["setup", str(path), "-o", str(tmp_path / "out")]) == 1
+    assert "photos[0].number: expected a photo number usable in a folder name" in _error(capsys)
+    assert not (tmp_path / "out").exists()
