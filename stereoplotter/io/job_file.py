@@ -762,13 +762,12 @@ def grid_to_local_rotation(
     zone, y = split_conventional_ordinate(east_m)
     if int(zone) != lf.zone:
         raise StereoplotterError(f"a station in zone {int(zone)}, the frame in zone {lf.zone}")
-    d = np.array([-step_m, step_m])
-    zero = np.zeros(2)
-    cols = []
-    for dn, de, dh in ((zero, d, zero), (d, zero, zero), (zero, zero, d)):
-        X, Y, Z = local_from_gauss_kruger(lf, north_m + dn, float(y) + de, height_m + dh)
-        cols.append(np.array([X[1] - X[0], Y[1] - Y[0], Z[1] - Z[0]]))
-    u, _, vt = np.linalg.svd(np.column_stack(cols))
+    d, zero = np.array([-step_m, step_m]), np.zeros(2)
+    # the six stepped points (east, north, up; − then +) in one geodesy call
+    dn, de, dh = (np.concatenate(v) for v in ((zero, d, zero), (d, zero, zero), (zero, zero, d)))
+    X, Y, Z = local_from_gauss_kruger(lf, north_m + dn, float(y) + de, height_m + dh)
+    cols = np.array([X[1::2] - X[0::2], Y[1::2] - Y[0::2], Z[1::2] - Z[0::2]])
+    u, _, vt = np.linalg.svd(cols)
     return u @ vt
 
 
