@@ -185,5 +185,5 @@ def _summary(result: JobResult, report: OutputReport, out: Path) -> str:
         lines.append(f"removed {len(report.removed)} stale files of the previous run: "
                      + ", ".join(report.removed[:6]) + (" …" if len(report.removed) > 6 else ""))
     if report.kept_foreign:
-        lines.append(f"left in place: {report.kept_foreign} files no job run wrote")
+        lines.append(f"left in place: {report.kept_foreign} file(s) no job run wrote")
     return "\n".join(lines) + "\n"

@@ -235,7 +235,7 @@ def test_output_folder_refused_unless_force_which_replaces_the_outputs(tmp_path,
     assert main(["setup", str(two), "-o", str(out), "--force"]) == 0
     said = capsys.readouterr().out
     assert "removed 3 stale files of the previous run: 101-102/sheet.md" in said
-    assert "left in place: 1 files no job run wrote" in said
+    assert "left in place: 1 file(s) no job run wrote" in said
     assert not (out / "101-102").exists()
     after = _tree(out)
     assert {"102-103/sheet.pdf", "102-103/sheet.yaml", "notes.txt"} <= after
