@@ -3,9 +3,12 @@
 Load the job file (:mod:`stereoplotter.io.job_file`) → compute each pair's sheet from its
 *measured* inputs with the one Table 24 computation (all pairs in one vectorised call,
 :func:`stereoplotter.setup.sheet.compute_sheets_from_measurements`) → render every pair's files
-(:func:`stereoplotter.report.job.job_files`) → write them, all rendered before any is written.
-Part of the ``setup`` command (:mod:`stereoplotter.commands.setup`), not a command of its own;
-imported by it only for a job file, so the library is imported here at the top.
+(:func:`stereoplotter.report.job.job_files`) → write them, all rendered before any is written,
+into a new or empty folder (``--force``: replacing the previous outputs as a whole, with a
+manifest; :mod:`stereoplotter.io.output_folder`). A pair that cannot be set up is refused alone
+(``refused.md``); the exit is 1 only when no pair is set up, or with ``--strict`` when any is
+refused. Part of the ``setup`` command (:mod:`stereoplotter.commands.setup`), not a command of
+its own; imported by it only for a job file, so the library is imported here at the top.
 """
 
 from __future__ import annotations
