@@ -53,7 +53,7 @@ for number, (X, Y, Z, a, o, k) in stations.items():
     m_grid = grid_to_local_rotation(frame, north, east, height).T @ m_local
     ag, og, kg = (math.degrees(float(v)) for v in angles_from_matrix(m_grid))
     photos.append(
-        f"  - {{number: {number}, north_m: {north:.3f}, east_m: {east:.3f}, "
+        f"  - {{number: \"{number}\", north_m: {north:.3f}, east_m: {east:.3f}, "
         f"height_m: {height:.3f}, alpha_deg: {ag:.5f}, omega_deg: {og:.5f}, kappa_deg: {kg:.5f}}}"
     )
 
@@ -92,7 +92,7 @@ for a, b in pairwise(numbers):
     X = (stations[a][0] + stations[b][0]) / 2.0
     east = sk42_from_local(frame, (X, 0.0, 0.0))[1]
     sheet = next(n for n, edge in sheets.items() if east < edge)
-    pairs.append(f"  - {{left: {a}, right: {b}, map_sheet: {sheet}}}")
+    pairs.append(f"  - {{left: \"{a}\", right: \"{b}\", map_sheet: {sheet}}}")
 
 job = f"""\
 # A worked production job: a strip of 8 stereopairs (photos 101-109) for the SC-1.

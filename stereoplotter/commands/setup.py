@@ -55,6 +55,17 @@ def add_arguments(sub: Any) -> None:
     p.add_argument("--vertical-scale", type=scale_denominator, metavar="M", help="force M_в = M")
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument("--json", action="store_true", help="print the sheet as JSON")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="job file: write into an output folder that holds files, replacing the previous "
+        "run's outputs as a whole (its stale pair folders removed)",
+    )
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="job file: exit 1 when any pair is refused (default: only when none is set up)",
+    )
     p.set_defaults(func=run)
 
 

@@ -3,9 +3,12 @@
 Load the job file (:mod:`stereoplotter.io.job_file`) → compute each pair's sheet from its
 *measured* inputs with the one Table 24 computation (all pairs in one vectorised call,
 :func:`stereoplotter.setup.sheet.compute_sheets_from_measurements`) → render every pair's files
-(:func:`stereoplotter.report.job.job_files`) → write them, all rendered before any is written.
-Part of the ``setup`` command (:mod:`stereoplotter.commands.setup`), not a command of its own;
-imported by it only for a job file, so the library is imported here at the top.
+(:func:`stereoplotter.report.job.job_files`) → write them, all rendered before any is written,
+into a new or empty folder (``--force``: replacing the previous outputs as a whole, with a
+manifest; :mod:`stereoplotter.io.output_folder`). A pair that cannot be set up is refused alone
+(``refused.md``); the exit is 1 only when no pair is set up, or with ``--strict`` when any is
+refused. Part of the ``setup`` command (:mod:`stereoplotter.commands.setup`), not a command of
+its own; imported by it only for a job file, so the library is imported here at the top.
 """
 
 from __future__ import annotations
@@ -16,10 +19,10 @@ import sys
 from pathlib import Path
 
 from stereoplotter.errors import ConfigError, StereoplotterError
-from stereoplotter.io.atomic_write import write_files
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import Job, MeasuredPair, load_job, measured_pair
-from stereoplotter.report.job import JobResult, PairResult, job_files, pair_dict
+from stereoplotter.io.output_folder import OutputReport, write_outputs
+from stereoplotter.report.job import JobResult, PairResult, job_files, manifest_about, pair_dict
 from stereoplotter.report.plain_data import json_text
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
@@ -87,20 +90,26 @@ def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
 
 
 def run_job(
-    path: str | os.PathLike[str], output_dir: str | os.PathLike[str] | None = None
+    path: str | os.PathLike[str],
+    output_dir: str | os.PathLike[str] | None = None,
+    *,
+    force: bool = False,
 ) -> JobResult:
     """Load a job file, compute every pair and optionally write the files (:func:`write_job`)."""
     result = compute_job(load_job(path))
     if output_dir is not None:
-        write_job(result, output_dir)
+        write_job(result, output_dir, force=force)
     return result
 
 
-def write_job(result: JobResult, output_dir: str | os.PathLike[str]) -> list[str]:
-    """Write the files of a job (everything rendered before anything is written); the names."""
+def write_job(
+    result: JobResult, output_dir: str | os.PathLike[str], *, force: bool = False
+) -> OutputReport:
+    """Write the files of a job and their manifest (everything rendered before anything is
+    written): into a new or empty folder, or with ``force`` replacing the previous outputs as a
+    whole (:func:`stereoplotter.io.output_folder.write_outputs`)."""
     files = job_files(result)
-    write_files(output_dir, files)
-    return list(files)
+    return write_outputs(output_dir, files, manifest_about(result), force=force)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -121,21 +130,41 @@ def run(args: argparse.Namespace) -> int:
         )
     job = load_job(args.scenario)
     result = compute_job(job, load_instrument(args.instrument) if args.instrument else None)
+    out = None if args.json and args.output is None else Path(args.output or "stereoplotter-setup")
+    force = getattr(args, "force", False)
+    report = write_job(result, out, force=force) if out is not None else None
     if args.json:
         pairs = [pair_dict(job, p) for p in result.pairs]
         sys.stdout.write(
             json_text({"job": job.name, "instrument": result.spec.key, "pairs": pairs})
         )
-        if args.output is None:
-            return 0
-    out = Path(args.output or "stereoplotter-setup")
-    names = write_job(result, out)
-    if not args.json:
-        sys.stdout.write(_summary(result, names, out))
+    elif report is not None and out is not None:
+        sys.stdout.write(_summary(result, report, out))
+    _refusals(result, out, strict=getattr(args, "strict", False))
     return 0
 
 
-def _summary(result: JobResult, names: list[str], out: Path) -> str:
+def _refusals(result: JobResult, out: Path | None, *, strict: bool) -> None:
+    """A job with refused pairs still gives the forms of the others (exit 0): exit 1 (this
+    error, after the files are written) only when no pair is set up, or with ``strict`` when
+    any is refused."""
+    refused = [p for p in result.pairs if not p.accepted]
+    if not refused or (len(refused) < len(result.pairs) and not strict):
+        return
+    where = f"reasons in {out / 'refused.md'}" if out is not None else "reasons in the JSON"
+    first = f"{refused[0].pair.name}: {refused[0].reason}"
+    if len(refused) == len(result.pairs):
+        raise StereoplotterError(
+            f"{result.job.source}: pairs: expected at least one pair set up, found all "
+            f"{len(refused)} refused ({where}; {first})"
+        )
+    raise StereoplotterError(
+        f"{result.job.source}: pairs: expected every pair set up (--strict), found "
+        f"{len(refused)} of {len(result.pairs)} refused ({where}; {first})"
+    )
+
+
+def _summary(result: JobResult, report: OutputReport, out: Path) -> str:
     accepted = sum(p.accepted for p in result.pairs)
     lines = [
         f"job {result.job.name} on {result.spec.title}: {accepted} of {len(result.pairs)} "
@@ -150,9 +179,14 @@ def _summary(result: JobResult, names: list[str], out: Path) -> str:
             if s is not None
             else f"  {p.pair.name}: REFUSED: {p.reason}"
         )
-    pdfs = sum(n.endswith("/sheet.pdf") for n in names)
+    pdfs = sum(n.endswith("/sheet.pdf") for n in report.written)
     lines.append(
         f"written: <pair>/sheet.yaml, sheet.md, sheet.pdf ({pdfs} forms), forms.pdf, "
-        f"block.csv, refused.md in {out}"
+        f"block.csv, refused.md, manifest.json in {out}"
     )
+    if report.removed:
+        lines.append(f"removed {len(report.removed)} stale files of the previous run: "
+                     + ", ".join(report.removed[:6]) + (" …" if len(report.removed) > 6 else ""))
+    if report.kept_foreign:
+        lines.append(f"left in place: {report.kept_foreign} file(s) no job run wrote")
     return "\n".join(lines) + "\n"

@@ -34,13 +34,14 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
+import yaml
 from numpy.typing import NDArray
-from pydantic import ConfigDict, Field, field_validator
+from pydantic import BeforeValidator, ConfigDict, Field, field_validator
 
-from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.errors import ConfigError, StereoplotterError, describe_value
 from stereoplotter.geodesy import split_conventional_ordinate
 from stereoplotter.geodesy.photogrammetric import local_from_gauss_kruger
 from stereoplotter.geometry.collinearity import object_to_photo, photo_to_object
@@ -66,9 +67,10 @@ from stereoplotter.io.validation import (
     validate,
     vector,
 )
-from stereoplotter.io.yaml_input import load_yaml_mapping
+from stereoplotter.io.yaml_input import load_yaml_mapping, read_text_file
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.scenario.model import Camera, Frame, MapSheet, Point
+from stereoplotter.setup.records import SetupRefusal
 
 __all__ = [
     "FORMAT",
@@ -93,6 +95,55 @@ WORKING_AREA_MARGIN = 0.05
 
 
 # --- the models -------------------------------------------------------------------------------
+
+
+def _check_identifier(v: Any) -> str:
+    """A photo number or point id is text: written as text, or an unquoted integer read back as
+    its digits (an unquoted number with a leading zero is refused before this, by
+    :func:`_unquoted_identifiers`: YAML has already read it as another number)."""
+    if isinstance(v, bool) or not isinstance(v, str | int) or str(v).strip() == "":
+        raise _fail("an identifier as text (quote it: \"0415\")", describe_value(v))
+    return str(v).strip()
+
+
+#: A photo number or point id: text, compared as written (``0415`` and ``415`` are two ids).
+identifier = Annotated[
+    str,
+    BeforeValidator(_check_identifier),
+    Field(
+        min_length=1,
+        description="text, compared as written (0415 and 415 are two); write it quoted: an "
+        "unquoted number with a leading zero is refused",
+    ),
+]
+
+
+#: A photo number names the pair's folder of the outputs (``101-102/sheet.pdf``): no path
+#: separator, no leading dot, no control character.
+_PHOTO_NUMBER = r"[^./\\\x00-\x1f\x7f][^/\\\x00-\x1f\x7f]*"
+
+
+def _check_photo_number(v: Any) -> str:
+    v = _check_identifier(v)
+    if not re.fullmatch(_PHOTO_NUMBER, v):
+        raise _fail(
+            "a photo number usable in a folder name (no / or \\, no leading dot, no control "
+            "character)", describe_value(v),
+        )  # fmt: skip
+    return v
+
+
+#: A photo number: an :data:`identifier` that can name the pair's output folder.
+photo_number = Annotated[
+    str,
+    BeforeValidator(_check_photo_number),
+    Field(
+        min_length=1,
+        pattern=_PHOTO_NUMBER,
+        description="text, compared as written (0415 and 415 are two); write it quoted: an "
+        "unquoted number with a leading zero is refused; it names the pair's output folder",
+    ),
+]
 
 
 def _check_date(v: Any) -> str:
@@ -124,7 +175,7 @@ class FrameModel(FileModel):
 class PhotoModel(FileModel):
     """One photo: its number and exterior orientation (SK-42 or local by ``frame.kind``)."""
 
-    number: integer(0, 10**9)  # type: ignore[valid-type]
+    number: photo_number
     north_m: number("m", 0.0, 1.0e7) | None = None  # type: ignore[valid-type]
     east_m: number(_EAST, 1.0e6, 61.0e6) | None = None  # type: ignore[valid-type]
     height_m: number("m", -500.0, 50000.0) | None = None  # type: ignore[valid-type]
@@ -140,7 +191,7 @@ class PhotoModel(FileModel):
 class FiducialRow(FileModel):
     """A row of the fiducial-distance CSV: photo number, measured 1–2 and 3–4."""
 
-    photo: integer(0, 10**9)  # type: ignore[valid-type]
+    photo: photo_number
     d12_mm: number("mm", 0.0, 300.0, low_open=True)  # type: ignore[valid-type]
     d34_mm: number("mm", 0.0, 300.0, low_open=True)  # type: ignore[valid-type]
 
@@ -148,7 +199,7 @@ class FiducialRow(FileModel):
 class PointModel(FileModel):
     """A control or check point (SK-42 or local coordinates, by ``frame.kind``)."""
 
-    id: text  # type: ignore[valid-type]
+    id: identifier
     role: one_of("control", "check") = "control"  # type: ignore[valid-type]
     kind: one_of("full", "plan", "height") = "full"  # type: ignore[valid-type]
     north_m: number("m", 0.0, 1.0e7) | None = None  # type: ignore[valid-type]
@@ -171,8 +222,8 @@ class WorkingArea(FileModel):
 
 
 class PairModel(FileModel):
-    left: integer(0, 10**9)  # type: ignore[valid-type]
-    right: integer(0, 10**9)  # type: ignore[valid-type]
+    left: photo_number
+    right: photo_number
     map_sheet: text | None = None  # type: ignore[valid-type]
     working_area: WorkingArea | None = None
 
@@ -226,7 +277,7 @@ class JobPhoto:
     ``fiducial_distances_mm`` the measured 1–2 and 3–4 [mm].
     """
 
-    number: int
+    number: str
     centre: tuple[float, float, float]
     angles: tuple[float, float, float]
     fiducial_distances_mm: tuple[float, float]
@@ -236,8 +287,8 @@ class JobPhoto:
 class JobPair:
     """A stereopair by photo numbers, its map sheet and optional working-area heights [m]."""
 
-    left: int
-    right: int
+    left: str
+    right: str
     map_sheet: MapSheet | None
     working_area_m: tuple[float, float] | None
 
@@ -260,13 +311,16 @@ class Job:
     distortion: tuple[tuple[float, float], ...]
     frame_kind: str
     origin_sk42_m: tuple[float, float, float] | None
-    photos: dict[int, JobPhoto]
+    photos: dict[str, JobPhoto]
     points: tuple[Point, ...]
     pairs: tuple[JobPair, ...]
     horizontal_scale: int | None
     vertical_scale: int | None
     book_sign: bool
     bz_scale_sense: int
+    #: Where each point's coordinates were written (as ``points``): (source, field) of its
+    #: ordinate, ``FILE:LINE:COLUMN`` for a CSV row.
+    point_places: tuple[tuple[str, str], ...] = ()
 
 
 def is_job_file(data: Any) -> bool:
@@ -280,23 +334,31 @@ def is_job_file(data: Any) -> bool:
 def load_job(path: str | os.PathLike[str]) -> Job:
     """Read and validate a job file (CSV files relative to it).
 
+    Photo numbers and point ids are text, compared as written; an unquoted YAML number with a
+    leading zero (read by YAML as another number: ``012417`` as octal 5391) is refused with the
+    advice to quote it. A CSV value's error names ``FILE:LINE:COLUMN`` (physical lines: comment
+    and blank lines counted); a CSV file that cannot be read names the job field that points
+    to it.
+
     Raises
     ------
     ConfigError
-        One line: file (or CSV file and line), field, expected, found.
+        One line: file (or CSV file, line and column), field, expected, found.
     """
     data, source = load_yaml_mapping(path)
+    _unquoted_identifiers(read_text_file(path), source)
     doc = validate(JobFile, data, source)
     folder = Path(path).parent
     camera = camera_from_model(source, doc.camera)  # type: ignore[arg-type]
     origin = _origin(source, doc.frame)
     distances = (
-        _fiducial_csv(folder, doc.fiducial_distances_csv) if doc.fiducial_distances_csv else {}
-    )
+        _fiducial_csv(folder, doc.fiducial_distances_csv, source)
+        if doc.fiducial_distances_csv else {}
+    )  # fmt: skip
     photos = _photos(source, doc, distances, fiducial_spans_mm(camera.fiducials_mm))
-    rows = [(source, f"points[{i}]", p) for i, p in enumerate(doc.points)]
-    for name in doc.points_csv:
-        rows += _csv_rows(folder / name, PointModel)
+    rows = [_Row(source, f"points[{i}]", p, {}) for i, p in enumerate(doc.points)]
+    for i, name in enumerate(doc.points_csv):
+        rows += _csv_rows(folder / name, PointModel, (source, f"points_csv[{i}]"))
     points = _points(doc.frame.kind, origin, rows)
     sheets = _map_sheets(source, doc.map_sheets)
     pairs = _pairs(source, doc, photos, sheets)
@@ -318,7 +380,46 @@ def load_job(path: str | os.PathLike[str]) -> Job:
         vertical_scale=doc.scales.vertical,
         book_sign=doc.options.book_sign,
         bz_scale_sense=doc.options.bz_scale_sense,
+        point_places=tuple(r.place(_ORDINATE[doc.frame.kind]) for r in rows),
     )
+
+
+#: The identifier fields of a job file: section → the keys of its entries that are identifiers.
+_IDENTIFIERS = {"photos": ("number",), "pairs": ("left", "right"), "points": ("id",)}
+_ORDINATE = {"sk42": "east_m", "local": "Y_m"}
+
+
+def _unquoted_identifiers(text: str, source: str) -> None:
+    """Refuse an identifier YAML has read as a number other than its digits.
+
+    An unquoted ``012417`` is octal 5391 to YAML 1.1, ``0415`` the text '0415' but ``0417``
+    the number 271; ``1_000`` is 1000. Only an unquoted integer written as its own decimal digits
+    (``101``) stands for its text. The document was checked (size, depth, aliases) by
+    :func:`load_yaml_mapping` before this second composition.
+    """
+    root = yaml.compose(text, Loader=yaml.SafeLoader)
+    if not isinstance(root, yaml.MappingNode):
+        return
+    for key, section in root.value:
+        fields = _IDENTIFIERS.get(key.value) if isinstance(key, yaml.ScalarNode) else None
+        if not fields or not isinstance(section, yaml.SequenceNode):
+            continue
+        for i, entry in enumerate(section.value):
+            if not isinstance(entry, yaml.MappingNode):
+                continue
+            for k, v in entry.value:
+                if not (isinstance(k, yaml.ScalarNode) and k.value in fields):
+                    continue
+                if not isinstance(v, yaml.ScalarNode) or v.style is not None:
+                    continue  # quoted, or not a scalar (the validation names it)
+                number = v.tag in ("tag:yaml.org,2002:int", "tag:yaml.org,2002:float")
+                if number and not re.fullmatch(r"[1-9][0-9]*|0", v.value):
+                    raise ConfigError(
+                        source, f"{key.value}[{i}].{k.value}",
+                        f'an identifier as text: quote it ("{v.value}"), or YAML reads it as '
+                        "another number", f"{v.value} unquoted (line {v.start_mark.line + 1}, "
+                        f"column {v.start_mark.column + 1})",
+                    )  # fmt: skip
 
 
 def _origin(source: str, model: FrameModel) -> tuple[float, float, float] | None:
@@ -335,31 +436,96 @@ def _origin(source: str, model: FrameModel) -> tuple[float, float, float] | None
     return (o.north_m, o.east_m, o.height_m)
 
 
-def _csv_rows(path: Path, model: type[FileModel]) -> list[tuple[str, str, Any]]:
-    """Validated rows of a CSV file with a header line; numbers written as numbers."""
+@dataclass(frozen=True, slots=True)
+class _Row:
+    """A validated entry of ``points`` or row of a CSV file: where it was written (the file, or
+    ``FILE:LINE`` of a CSV row), its field path in the file, the model and, for a CSV row, the
+    ``FILE:LINE:COLUMN`` of each value."""
+
+    where: str
+    path: str
+    model: Any
+    cells: dict[str, str]
+
+    def place(self, field: str) -> tuple[str, str]:
+        """(source, field) of a value for a message."""
+        if field in self.cells:
+            return self.cells[field], field
+        return self.where, f"{self.path}.{field}".lstrip(".")
+
+
+def _cell_columns(line: str) -> list[int]:
+    """The 1-based character column where each comma-separated field of one physical CSV line
+    starts (commas inside double quotes do not separate)."""
+    starts, quoted = [1], False
+    for i, ch in enumerate(line):
+        if ch == '"':
+            quoted = not quoted
+        elif ch == "," and not quoted:
+            starts.append(i + 2)
+    return starts
+
+
+def _csv_rows(path: Path, model: type[FileModel], named_by: tuple[str, str]) -> list[_Row]:
+    """Validated rows of a CSV file with a header line, every cell read as text (a text field
+    stays as written: the id ``0415`` is not the number 415; a number field is parsed by its
+    own check); lines starting with ``#`` and blank lines are skipped but counted.
+
+    ``named_by`` is the (job file, field) that names the CSV: a file that cannot be read is
+    reported there.
+    """
     source = str(path)
     try:
         with open(path, newline="", encoding="utf-8") as f:
-            lines = [row for row in csv.reader(f) if row and not row[0].startswith("#")]
-    except OSError as exc:
-        found = exc.strerror or str(exc)
-        raise ConfigError(source, "(file)", "a readable CSV file", found) from None
+            physical = f.read().splitlines()
+            f.seek(0)
+            reader = csv.reader(f)
+            lines = []
+            for row in reader:
+                if row and not row[0].lstrip().startswith("#") and any(c.strip() for c in row):
+                    lines.append((reader.line_num, row))
+    except (OSError, UnicodeDecodeError) as exc:
+        found = getattr(exc, "strerror", None) or str(exc)
+        raise ConfigError(named_by[0], named_by[1], "a readable UTF-8 CSV file (relative to the "
+                          "job file)", f"{source}: {found}") from None  # fmt: skip
+    except csv.Error as exc:
+        raise ConfigError(f"{source}:{reader.line_num}", "(row)", "valid CSV", str(exc)) from None
     if not lines:
         raise ConfigError(source, "(header)", "a header line and rows", "an empty file")
-    header = [h.strip() for h in lines[0]]
+    header = [h.strip() for h in lines[0][1]]
+    texts = {n for n, info in model.model_fields.items() if _is_text(info.annotation)}
     out = []
-    for n, row in enumerate(lines[1:], start=2):
+    for n, row in lines[1:]:
+        where = f"{source}:{n}"
         if len(row) != len(header):
             raise ConfigError(
-                f"{source}:{n}", "(row)", f"{len(header)} values ({', '.join(header)})",
+                where, "(row)", f"{len(header)} values ({', '.join(header)})",
                 f"{len(row)} values",
             )  # fmt: skip
-        item = {h: _csv_value(v) for h, v in zip(header, row, strict=True) if v.strip() != ""}
-        out.append((f"{source}:{n}", "", validate(model, item, f"{source}:{n}")))
+        columns = _cell_columns(physical[n - 1]) if n - 1 < len(physical) else []
+        cells = {h: f"{where}:{columns[j]}" if j < len(columns) else where
+                 for j, h in enumerate(header)}  # fmt: skip
+        item = {h: v.strip() if h in texts else _csv_number(v)
+                for h, v in zip(header, row, strict=True) if v.strip() != ""}  # fmt: skip
+        try:
+            value = validate(model, item, where)
+        except ConfigError as exc:
+            key = exc.field.split(".")[0].split("[")[0]
+            if key not in cells:
+                raise
+            raise ConfigError(cells[key], exc.field, exc.expected, exc.found, exc.hint) from None
+        out.append(_Row(where, "", value, cells))
     return out
 
 
-def _csv_value(v: str) -> Any:
+def _is_text(annotation: Any) -> bool:
+    """True for a field declared as text (an identifier, a word, a name): kept as written."""
+    return annotation is str or annotation in (str | None,) or "Literal" in str(annotation)
+
+
+def _csv_number(v: str) -> Any:
+    """A CSV cell of a number field: an int or float when it reads as one, else the text (which
+    the field's check then refuses, quoting it)."""
     v = v.strip()
     for kind in (int, float):
         try:
@@ -369,18 +535,19 @@ def _csv_value(v: str) -> Any:
     return v
 
 
-def _fiducial_csv(folder: Path, name: str) -> dict[int, tuple[str, tuple[float, float]]]:
-    out: dict[int, tuple[str, tuple[float, float]]] = {}
-    for where, _, row in _csv_rows(folder / name, FiducialRow):
-        if row.photo in out:
-            raise ConfigError(where, "photo", "each photo once", row.photo)
-        out[row.photo] = (where, (row.d12_mm, row.d34_mm))
+def _fiducial_csv(folder: Path, name: str, job_source: str) -> dict[str, _Row]:
+    """photo → its row of measured 1–2, 3–4 [mm]."""
+    out: dict[str, _Row] = {}
+    for row in _csv_rows(folder / name, FiducialRow, (job_source, "fiducial_distances_csv")):
+        photo = row.model.photo
+        if photo in out:
+            raise ConfigError(*row.place("photo"), "each photo once", photo)
+        out[photo] = row
     return out
 
 
-def _coordinates(
-    where: str, path: str, model: PhotoModel | PointModel, kind: str
-) -> tuple[float, float, float]:
+def _coordinates(row: _Row, kind: str) -> tuple[float, float, float]:
+    model = row.model
     names = ("north_m", "east_m", "height_m") if kind == "sk42" else ("X_m", "Y_m", "Z_m")
     other = ("X_m", "Y_m", "Z_m") if kind == "sk42" else ("north_m", "east_m", "height_m")
     values = [getattr(model, n) for n in names]
@@ -388,41 +555,43 @@ def _coordinates(
     if wrong or any(v is None for v in values):
         missing = [n for n, v in zip(names, values, strict=True) if v is None]
         raise ConfigError(
-            where, path or "(row)", f"the coordinates {', '.join(names)} (frame.kind: {kind})",
+            row.where, row.path or "(row)",
+            f"the coordinates {', '.join(names)} (frame.kind: {kind})",
             ("also " + ", ".join(wrong)) if wrong else "no " + ", ".join(missing),
         )  # fmt: skip
     if kind == "sk42":
         try:
             frame_tie.check_conventional_ordinate(values[1])
         except StereoplotterError as exc:
-            raise ConfigError(where, f"{path}.east_m".lstrip("."), "a conventional ordinate",
-                              values[1], str(exc)) from None
+            raise ConfigError(*row.place("east_m"), "a conventional ordinate", values[1],
+                              str(exc)) from None
     return (float(values[0]), float(values[1]), float(values[2]))
 
 
 def _photos(
     source: str,
     doc: JobFile,
-    csv_distances: dict[int, tuple[str, tuple[float, float]]],
+    csv_distances: dict[str, _Row],
     spans: NDArray[np.float64],
-) -> dict[int, JobPhoto]:
-    photos: dict[int, JobPhoto] = {}
+) -> dict[str, JobPhoto]:
+    photos: dict[str, JobPhoto] = {}
     for i, p in enumerate(doc.photos):
         path = f"photos[{i}]"
         if p.number in photos:
             raise ConfigError(source, f"{path}.number", "a photo number used once", p.number)
-        centre = _coordinates(source, path, p, doc.frame.kind)
+        centre = _coordinates(_Row(source, path, p, {}), doc.frame.kind)
         if p.fiducial_distances_mm is not None and p.number in csv_distances:
             raise ConfigError(
                 source, f"{path}.fiducial_distances_mm", "the measured distances in one place",
-                "them here and in " + csv_distances[p.number][0],
+                "them here and in " + csv_distances[p.number].where,
             )  # fmt: skip
         if p.fiducial_distances_mm is not None:
             d = (p.fiducial_distances_mm.d12, p.fiducial_distances_mm.d34)
             where = [(source, f"{path}.fiducial_distances_mm.{k}") for k in ("1-2", "3-4")]
         elif p.number in csv_distances:
-            d = csv_distances[p.number][1]
-            where = [(csv_distances[p.number][0], k) for k in ("d12_mm", "d34_mm")]
+            row = csv_distances[p.number]
+            d = (row.model.d12_mm, row.model.d34_mm)
+            where = [row.place(k) for k in ("d12_mm", "d34_mm")]
         else:
             raise ConfigError(
                 source, f"{path}.fiducial_distances_mm",
@@ -433,9 +602,9 @@ def _photos(
             _check_film(where_file, field, measured, float(span))
         angles = tuple(math.radians(a) for a in (p.alpha_deg, p.omega_deg, p.kappa_deg))
         photos[p.number] = JobPhoto(p.number, centre, angles, (float(d[0]), float(d[1])))  # type: ignore[arg-type]
-    unknown = sorted(set(csv_distances) - set(photos))
+    unknown = [n for n in csv_distances if n not in photos]
     if unknown:
-        raise ConfigError(csv_distances[unknown[0]][0], "photo", "a photo number of the job",
+        raise ConfigError(*csv_distances[unknown[0]].place("photo"), "a photo number of the job",
                           unknown[0])
     return photos
 
@@ -453,15 +622,18 @@ def _check_film(source: str, field: str, measured: float, span: float) -> None:
 
 
 def _points(
-    kind: str, origin: tuple[float, float, float] | None, rows: list[tuple[str, str, Any]]
+    kind: str, origin: tuple[float, float, float] | None, rows: list[_Row]
 ) -> tuple[Point, ...]:
     points: list[Point] = []
-    seen: set[str] = set()
-    for where, path, p in rows:
+    seen: dict[str, str] = {}
+    for row in rows:
+        p = row.model
         if p.id in seen:
-            raise ConfigError(where, f"{path}.id".lstrip("."), "a unique point id", p.id)
-        seen.add(p.id)
-        xyz = _coordinates(where, path, p, kind)
+            raise ConfigError(*row.place("id"), "a unique point id (ids are text, compared as "
+                              "written)", p.id, f"first at {seen[p.id]}")  # fmt: skip
+        src, fld = row.place("id")
+        seen[p.id] = src if row.cells else f"{src}: {fld}"
+        xyz = _coordinates(row, kind)
         if kind == "sk42":  # the local coordinates depend on the pair's frame: set per pair
             points.append(Point(p.id, p.role, p.kind, (math.nan,) * 3, xyz))
         else:
@@ -511,7 +683,7 @@ def _corner(source: str, c: Corner, path: str) -> tuple[float, float]:
 
 
 def _pairs(
-    source: str, doc: JobFile, photos: dict[int, JobPhoto], sheets: dict[str, MapSheet]
+    source: str, doc: JobFile, photos: dict[str, JobPhoto], sheets: dict[str, MapSheet]
 ) -> tuple[JobPair, ...]:
     pairs = []
     for i, p in enumerate(doc.pairs):
@@ -519,7 +691,7 @@ def _pairs(
         for side in ("left", "right"):
             if getattr(p, side) not in photos:
                 raise ConfigError(source, f"{path}.{side}", "a photo number of photos",
-                                   getattr(p, side), f"photos: {sorted(photos)}")
+                                   getattr(p, side), f"photos: {', '.join(photos)}")
         if p.left == p.right:
             raise ConfigError(source, f"{path}.right", "another photo than the left one", p.right)
         if p.map_sheet is not None and p.map_sheet not in sheets:
@@ -590,13 +762,12 @@ def grid_to_local_rotation(
     zone, y = split_conventional_ordinate(east_m)
     if int(zone) != lf.zone:
         raise StereoplotterError(f"a station in zone {int(zone)}, the frame in zone {lf.zone}")
-    d = np.array([-step_m, step_m])
-    zero = np.zeros(2)
-    cols = []
-    for dn, de, dh in ((zero, d, zero), (d, zero, zero), (zero, zero, d)):
-        X, Y, Z = local_from_gauss_kruger(lf, north_m + dn, float(y) + de, height_m + dh)
-        cols.append(np.array([X[1] - X[0], Y[1] - Y[0], Z[1] - Z[0]]))
-    u, _, vt = np.linalg.svd(np.column_stack(cols))
+    d, zero = np.array([-step_m, step_m]), np.zeros(2)
+    # the six stepped points (east, north, up; − then +) in one geodesy call
+    dn, de, dh = (np.concatenate(v) for v in ((zero, d, zero), (d, zero, zero), (zero, zero, d)))
+    X, Y, Z = local_from_gauss_kruger(lf, north_m + dn, float(y) + de, height_m + dh)
+    cols = np.array([X[1::2] - X[0::2], Y[1::2] - Y[0::2], Z[1::2] - Z[0::2]])
+    u, _, vt = np.linalg.svd(cols)
     return u @ vt
 
 
@@ -620,10 +791,12 @@ def _local_points(job: Job, frame: Frame | None) -> tuple[Point, ...]:
     zone, y = split_conventional_ordinate(sk42[:, 1])
     far = np.flatnonzero(np.asarray(zone) != lf.zone)
     if far.size:
-        raise StereoplotterError(
-            f"{job.source}: points: point {job.points[far[0]].id} is in zone "
-            f"{int(np.asarray(zone)[far[0]])}, the pair's frame in zone {lf.zone}: expected the "
-            "points of a job in one zone"
+        i = int(far[0])
+        src, fld = job.point_places[i] if job.point_places else (job.source, "points")
+        raise ConfigError(
+            src, fld, f"a point in zone {lf.zone} (the points of a job in one Gauss–Krüger zone, "
+            "the zone of the pair's frame)",
+            f"point {job.points[i].id} in zone {int(np.asarray(zone)[i])}",
         )
     X, Y, Z = local_from_gauss_kruger(lf, sk42[:, 0], np.asarray(y, float), sk42[:, 2])
     return tuple(
@@ -666,7 +839,7 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
         (c_l, m_l), (c_r, m_r) = _station(job, frame, left), _station(job, frame, right)
         points = _local_points(job, frame)
     except StereoplotterError as exc:
-        if str(exc).startswith(f"{job.source}: "):
+        if isinstance(exc, ConfigError) or str(exc).startswith(f"{job.source}: "):
             raise
         origin = "" if frame is None or frame.origin_sk42_m is None else (
             " at x = {:.0f} m, ȳ = {:.0f} m".format(*frame.origin_sk42_m[:2]))  # fmt: skip
@@ -687,10 +860,10 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
         lowest, highest = _local_heights(frame, c_l, c_r, pair.working_area_m)
     elif heights:
         lowest, highest = min(heights), max(heights)
-    else:
-        raise StereoplotterError(
-            f"{job.source}: pairs: pair {pair.name}: expected control points imaged on both "
-            "photos or a working_area (lowest_m, highest_m), found neither"
+    else:  # this pair alone cannot be set up: the job's other pairs still can
+        raise SetupRefusal(
+            "no control point imaged on both photos and no working_area (lowest_m, highest_m) "
+            "of the pair: nothing fixes the heights of its model"
         )
     z0 = (lowest + highest) / 2.0
     corners = np.array([[half, half], [-half, half], [-half, -half], [half, -half]])

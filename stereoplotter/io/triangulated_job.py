@@ -8,14 +8,15 @@ certificate, the instrument, date and map sheets of the block's ``production`` s
 pair per two consecutive photos of a strip, each on the map sheet that holds the pair's centre.
 ``stereoplotter setup job.yaml`` turns it into the forms (``docs/production.md``).
 
-The job format takes photo numbers as integers: a photo number that is not a plain decimal
-without leading zeros (``"0415"``) is refused rather than silently renumbered.
+Photo numbers are text in the job format: each is written quoted, exactly as the block file
+has it (``"0415"`` stays ``0415``).
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 import os
 from itertools import pairwise
@@ -25,7 +26,6 @@ import numpy as np
 import yaml
 from numpy.typing import NDArray
 
-from stereoplotter.errors import ConfigError
 from stereoplotter.geodesy.gauss_kruger import geographic_from_gauss_kruger
 from stereoplotter.geodesy.map_sheet import sheet_bounds
 from stereoplotter.geodesy.photogrammetric import gauss_kruger_from_local
@@ -44,15 +44,9 @@ from stereoplotter.triangulation.block import (
 __all__ = ["job_files", "nomenclature_10000", "sheets_of_pairs", "write_triangulated_job"]
 
 
-def _photo_number(source: str, photo: str) -> int:
-    if not photo.isdecimal() or str(int(photo)) != photo:
-        raise ConfigError(
-            source,
-            "strips",
-            "photo numbers the job file can take (plain decimals without leading zeros)",
-            repr(photo),
-        )
-    return int(photo)
+def _quoted(identifier: str) -> str:
+    """A photo number as a YAML text (JSON quoting is valid YAML): never read back as a number."""
+    return json.dumps(str(identifier), ensure_ascii=False)
 
 
 def _sheet_polygons(production: Production) -> list[tuple[str, NDArray[np.float64]]]:
@@ -152,7 +146,7 @@ def job_files(
     """The text of ``job.yaml``, ``fiducials.csv`` and ``points.csv`` of the triangulated block
     (orientations (n_photos, 6): α, ω, κ [rad], X_S, Y_S, Z_S [m] local; centres written to
     1 mm, angles to 10⁻⁶°, as a listing prints them)."""
-    numbers = [_photo_number(source, p) for p in block.photos]
+    numbers = [str(p) for p in block.photos]
     cam = block.camera
     measured = fiducial_spans_mm({str(k + 1): block.fiducials_mm[:, k] for k in range(4)})
     origin = block.origin_sk42_m
@@ -174,7 +168,7 @@ def job_files(
     for n, o in zip(numbers, orientations, strict=True):
         a, w, k = (math.degrees(float(v)) for v in o[:3])
         lines.append(
-            f"  - {{number: {n}, X_m: {o[3]:.3f}, Y_m: {o[4]:.3f}, Z_m: {o[5]:.3f}, "
+            f"  - {{number: {_quoted(n)}, X_m: {o[3]:.3f}, Y_m: {o[4]:.3f}, Z_m: {o[5]:.3f}, "
             f"alpha_deg: {a:.6f}, omega_deg: {w:.6f}, kappa_deg: {k:.6f}}}"
         )
     lines += ["fiducial_distances_csv: fiducials.csv", "points_csv: [points.csv]"]
@@ -185,7 +179,8 @@ def job_files(
         for left, right in pairwise(strip):
             centre = (orientations[index[left], 3:] + orientations[index[right], 3:]) / 2.0
             sheet = _pair_sheet(sk42_from_block_local(block, centre), sheets)
-            pairs.append(f"  - {{left: {left}, right: {right}, map_sheet: {sheet}}}")
+            pairs.append(f"  - {{left: {_quoted(left)}, right: {_quoted(right)}, "
+                         f"map_sheet: {sheet}}}")
     text = "\n".join(lines) + "\n" + _sheets_yaml(production) + "\n".join(pairs) + "\n"
     fid = io.StringIO()
     w = csv.writer(fid, lineterminator="\n")

@@ -4,8 +4,10 @@
 :func:`stereoplotter.commands.setup_job.compute_job`) as per pair ``PAIR/sheet.yaml``,
 ``PAIR/sheet.md`` and ``PAIR/sheet.pdf`` (the form, :mod:`stereoplotter.report.forms`), and for
 the job ``forms.pdf`` (all forms), ``block.csv`` and ``refused.md`` (the pairs the instrument
-cannot take, with the reason). No clock and no random number is read: the same job gives the
-same files, byte for byte.
+cannot take, with the reason: a pair refused alone, the others still produced), and
+:func:`manifest_about`, the header of the folder's manifest
+(:mod:`stereoplotter.io.output_folder`). No clock and no random number is read: the same job
+gives the same files, byte for byte.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ __all__ = [
     "block_csv",
     "form_header",
     "job_files",
+    "manifest_about",
     "pair_dict",
     "refused_markdown",
 ]
@@ -197,3 +200,13 @@ def job_files(result: JobResult) -> dict[str, bytes]:
     files["block.csv"] = block_csv(result).encode("utf-8")
     files["refused.md"] = refused_markdown(result).encode("utf-8")
     return files
+
+
+def manifest_about(result: JobResult) -> dict[str, Any]:
+    """Who wrote a job's output folder: the job, its file's name, the instrument and program."""
+    return {
+        "job": result.job.name,
+        "job_file": Path(result.job.source).name,
+        "instrument": result.spec.key,
+        "program": f"stereoplotter {__version__}",
+    }

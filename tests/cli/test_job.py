@@ -62,7 +62,7 @@ def test_same_job_gives_byte_identical_files(written, tmp_path):
     assert main(["setup", str(JOB), "-o", str(tmp_path)]) == 0
     first, second = _files(written), _files(tmp_path)
     assert sorted(first) == sorted(second)
-    assert len(first) == 8 * 3 + 3
+    assert len(first) == 8 * 3 + 4  # + manifest.json (issue 27)
     for name in first:
         assert first[name] == second[name], name
 
@@ -92,7 +92,8 @@ def test_f_prime_is_from_the_measured_fiducial_distances(written):
         expected = 70.0 * np.mean([*spans[left], *spans[right]]) / 170.0
         sheet = yaml.safe_load((written / pair / "sheet.yaml").read_text("utf-8"))
         assert sheet["focal_length_corrected_mm"] == pytest.approx(expected, abs=1e-6)
-        assert sheet["job"]["photos"] == {"left": left, "right": right}
+        # photo numbers are text (issue 27)
+        assert sheet["job"]["photos"] == {"left": str(left), "right": str(right)}
         per_photo = sheet["focal_length_corrected_per_photo_mm"]
         assert per_photo[0] == pytest.approx(70.0 * np.mean(spans[left]) / 170.0, abs=1e-6)
     # film shrinkage of 29–52 ppm: f′ is 2–4 µm short of f

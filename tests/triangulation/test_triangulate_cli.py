@@ -107,3 +107,24 @@ def test_bad_block_file_is_one_error_line(tmp_path, capsys):
     assert main(["triangulate", str(bad), "-o", str(tmp_path / "out")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"error: {bad}: ")
+
+
+def test_leading_zero_photo_numbers_pass_through_to_the_job(chain, tmp_path):
+    """Photo numbers are text in the job (issue 27): a block whose photo 101 is numbered 0101
+    gives a job whose photo and pair keep 0101 (the job format took integers and the writer
+    refused it)."""
+    import shutil
+
+    from stereoplotter.io.job_file import load_job
+
+    block = tmp_path / "block"
+    shutil.copytree(chain / "block", block)
+    text = (block / "block.yaml").read_text(encoding="utf-8")
+    assert '["101",' in text
+    (block / "block.yaml").write_text(text.replace('["101",', '["0101",', 1), encoding="utf-8")
+    rows = (block / "measurements.csv").read_text(encoding="utf-8")
+    (block / "measurements.csv").write_text(rows.replace("\n101,", "\n0101,"), encoding="utf-8")
+    assert main(["triangulate", str(block / "block.yaml"), "-o", str(tmp_path / "tri")]) == 0
+    job = load_job(tmp_path / "tri" / "job.yaml")
+    assert next(iter(job.photos)) == "0101" and "101" not in job.photos
+    assert job.pairs[0].name == "0101-102"

@@ -1,0 +1,107 @@
+"""Benchmark: whole sheets of a job's pairs, and their PDF forms (issue 27, deliverable 7).
+
+Run ``python benchmarks/bench_job_sheets.py`` (``--pairs 10000 --forms 100``).
+
+The 8 pairs of ``jobs/strip8`` are repeated up to ``--pairs`` pairs and timed end to end, as
+``stereoplotter setup JOB`` computes them (``commands.setup_job.compute_job``), split into:
+
+* **measured inputs** — ``io.job_file.measured_pair`` per pair (SK-42 → the pair's local frame,
+  f′, the pair's points, the working area);
+* **sheets** — ``setup.sheet.compute_sheets_from_measurements``: frame, (6.8), Table 24 of all
+  pairs in one call, corners, scale candidates and readings per pair;
+* of which **scale candidates** — ``setup.table24.candidates_of`` per pair (the candidate table
+  of the sheet), timed alone on the same Table 24;
+
+and the files of ``--forms`` pairs (``report.job.job_files``: every ``sheet.yaml``, ``sheet.md``,
+the PDF form of each pair and ``forms.pdf``), rendered in memory and then written through
+``commands.setup_job.write_job`` into a new folder.
+
+Goals (issue 27): ≥ 10⁴ pairs/s for the sheets without PDFs, ≥ 20 pairs/s with the PDF forms.
+Speed is measured here, never asserted in the tests.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from stereoplotter.commands.setup_job import compute_job, write_job
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.job_file import load_job, measured_pair
+from stereoplotter.report.job import job_files
+from stereoplotter.setup.records import SetupOptions
+from stereoplotter.setup.sheet import compute_sheets_from_measurements
+from stereoplotter.setup.table24 import candidates_of
+
+JOB = Path(__file__).resolve().parents[1] / "jobs" / "strip8" / "job.yaml"
+
+
+def _rate(n: int, seconds: float, what: str = "pairs") -> str:
+    return f"{n} {what} in {seconds:.2f} s = {n / seconds:,.0f} {what}/s"
+
+
+def _repeated(job, n: int):
+    """The job with its pairs repeated to ``n`` pairs, each copy on photos of its own numbers
+    (``101_k``): every pair has its own folder and form."""
+    photos, pairs = {}, []
+    for k in range(-(-n // len(job.pairs))):
+        for number, photo in job.photos.items():
+            photos[f"{number}_{k}"] = replace(photo, number=f"{number}_{k}")
+        pairs += [replace(p, left=f"{p.left}_{k}", right=f"{p.right}_{k}")
+                  for p in job.pairs]  # fmt: skip
+    return replace(job, photos=photos, pairs=tuple(pairs[:n]))
+
+
+def _timed(function, *args, **kwargs):
+    start = time.perf_counter()
+    value = function(*args, **kwargs)
+    return value, time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--pairs", type=int, default=10_000, help="pairs of the sheet runs")
+    parser.add_argument("--forms", type=int, default=100, help="pairs of the PDF run")
+    args = parser.parse_args()
+    job = load_job(JOB)
+    spec = load_instrument(job.instrument)
+    options = SetupOptions()
+    big = _repeated(job, args.pairs)
+    print(f"python {platform.python_version()}, numpy {np.__version__}, "
+          f"{platform.machine()}, os.cpu_count() = {os.cpu_count()}")  # fmt: skip
+
+    measured, t_measured = _timed(lambda: [measured_pair(big, p) for p in big.pairs])
+    arguments = [m.sheet_arguments() for m in measured]
+    sheets, t_sheets = _timed(
+        compute_sheets_from_measurements, arguments, spec=spec, options=options,
+        source=job.source,
+    )  # fmt: skip
+    tables = [s.table24 for s in sheets]
+    _, t_candidates = _timed(lambda: [candidates_of(t, 0) for t in tables])
+    result, t_job = _timed(compute_job, big, spec)
+    assert all(p.accepted for p in result.pairs)
+    print(f"measured inputs:  {_rate(len(measured), t_measured)}")
+    print(f"sheets:           {_rate(len(sheets), t_sheets)}")
+    print(f"  of which scale candidates: {t_candidates:.2f} s "
+          f"({t_candidates / t_sheets:.0%} of the sheets)")  # fmt: skip
+    print(f"whole job (compute_job, inputs + sheets): {_rate(len(result.pairs), t_job)}")
+
+    small = _repeated(job, args.forms)
+    result = compute_job(small, spec)
+    files, t_render = _timed(job_files, result)
+    pdfs = sum(name.endswith("/sheet.pdf") for name in files)
+    print(f"PDF forms (render all files in memory): {_rate(pdfs, t_render, 'forms')}")
+    with tempfile.TemporaryDirectory() as folder:
+        _, t_write = _timed(write_job, result, Path(folder) / "out")
+    print(f"PDF forms (render + write, manifest): {_rate(pdfs, t_write, 'forms')}")
+
+
+if __name__ == "__main__":
+    main()
