@@ -55,6 +55,18 @@ def add_arguments(sub: Any) -> None:
     p.add_argument("--vertical-scale", type=scale_denominator, metavar="M", help="force M_в = M")
     p.add_argument("--seed", type=seed_int, help="override the scenario's seed")
     p.add_argument("--json", action="store_true", help="print the sheet as JSON")
+    p.add_argument(
+        "--lang",
+        choices=("ru", "en"),
+        default="en",
+        help="language of the forms and sheet.md: ru (the book's terms) or en (default)",
+    )
+    p.add_argument(
+        "--rigorous",
+        action="store_true",
+        help="job forms: print the rigorous (3.17) mark targets and spans as the values to set "
+        "(default: the book's (6.1)/(6.2), (6.5), with a warning where they exceed a tolerance)",
+    )
     p.set_defaults(func=run)
 
 
@@ -100,16 +112,17 @@ def run(args: argparse.Namespace) -> int:
     if args.output is None and args.json:
         return 0
     out = Path(args.output or "stereoplotter-setup")
-    files = sheet_files(sheet, data)  # everything rendered before anything is written
+    files = sheet_files(sheet, data, getattr(args, "lang", "en"))  # everything rendered before anything is written
     write_files(out, files)
     if not args.json:
         sys.stdout.write(f"{sheet_summary(sheet)}\nwritten: {', '.join(files)} in {out}\n")
     return 0
 
 
-def sheet_files(sheet: Any, data: dict[str, Any]) -> dict[str, bytes]:
+def sheet_files(sheet: Any, data: dict[str, Any], lang: str = "en") -> dict[str, bytes]:
     """sheet.yaml, sheet.md, sheet.pdf and sheet.png of a setup sheet, rendered in memory
-    (``data``: :func:`~stereoplotter.report.sheet.sheet_to_dict` with the seed)."""
+    (``data``: :func:`~stereoplotter.report.sheet.sheet_to_dict` with the seed; ``lang`` of
+    sheet.md)."""
     # imported here: matplotlib and YAML load only for a command that writes a sheet
     import json
 
@@ -124,7 +137,7 @@ def sheet_files(sheet: Any, data: dict[str, Any]) -> dict[str, bytes]:
     pdf = figure_bytes(figure, "pdf", close=False)
     return {
         "sheet.yaml": text.encode("utf-8"),
-        "sheet.md": sheet_markdown(sheet).encode("utf-8"),
+        "sheet.md": sheet_markdown(sheet, lang).encode("utf-8"),
         "sheet.pdf": pdf,
         "sheet.png": figure_bytes(figure, "png", dpi=110),
     }

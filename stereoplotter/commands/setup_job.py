@@ -96,9 +96,11 @@ def run_job(
     return result
 
 
-def write_job(result: JobResult, output_dir: str | os.PathLike[str]) -> list[str]:
+def write_job(
+    result: JobResult, output_dir: str | os.PathLike[str], lang: str = "en", rigorous: bool = False
+) -> list[str]:
     """Write the files of a job (everything rendered before anything is written); the names."""
-    files = job_files(result)
+    files = job_files(result, lang, rigorous)
     write_files(output_dir, files)
     return list(files)
 
@@ -129,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
         if args.output is None:
             return 0
     out = Path(args.output or "stereoplotter-setup")
-    names = write_job(result, out)
+    names = write_job(result, out, getattr(args, "lang", "en"), getattr(args, "rigorous", False))
     if not args.json:
         sys.stdout.write(_summary(result, names, out))
     return 0

@@ -362,7 +362,7 @@ def _settings_lines(settings: dict[str, Any] | None, title: str) -> list[str]:
     return lines
 
 
-def sheet_markdown(sheet: SetupSheet) -> str:
+def sheet_markdown(sheet: SetupSheet, lang: str = "en") -> str:
     """Table 24 and the stage-by-stage list of readings, as Markdown."""
     d = sheet_to_dict(sheet)
     lines = _intro_lines(sheet) + _table24_lines(sheet) + _similarity_lines(d)
