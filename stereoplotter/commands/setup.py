@@ -112,7 +112,8 @@ def run(args: argparse.Namespace) -> int:
     if args.output is None and args.json:
         return 0
     out = Path(args.output or "stereoplotter-setup")
-    files = sheet_files(sheet, data, getattr(args, "lang", "en"))  # everything rendered before anything is written
+    # everything rendered before anything is written
+    files = sheet_files(sheet, data, getattr(args, "lang", "en"))
     write_files(out, files)
     if not args.json:
         sys.stdout.write(f"{sheet_summary(sheet)}\nwritten: {', '.join(files)} in {out}\n")

@@ -1,9 +1,9 @@
 """The printable setup form an operator sets the instrument from, as a PDF, in Russian or English.
 
 One form per stereopair, A4 portrait (document and drawing primitives:
-:mod:`stereoplotter.report.form_layout`; the text of the rows: :mod:`stereoplotter.report.form_fields`;
-every label from :mod:`stereoplotter.glossary`). The output is byte-identical for the same sheet,
-header and language.
+:mod:`stereoplotter.report.form_layout`; the text of the rows:
+:mod:`stereoplotter.report.form_fields`; every label from :mod:`stereoplotter.glossary`). The
+output is byte-identical for the same sheet, header and language.
 
 Pages: (1) the header, Table 24 with the coordinatograph gear r, and every reading to set at its
 least count, one row per stage (always on page 1: the fonts shrink until it fits), with the
@@ -105,7 +105,8 @@ def _table24_rows(sheet: SetupSheet, lang: str) -> list[tuple[str, ...]]:
         ("5", t("f_instrument"), "f_пр", _f(sheet.f_instrument_mm)
          + _flag(sheet, "f_instrument_mm"), "mm", item, t("note_fpr")),
         ("6", t("base_components"), "b_x, b_y, b_z′",
-         ", ".join(_f(v) for v in sheet.base_mm) + _flag(sheet, "base_mm"), "mm", item, t("note_b")),
+         ", ".join(_f(v) for v in sheet.base_mm) + _flag(sheet, "base_mm"), "mm", item,
+         t("note_b")),
         ("7", t("counter_coefficients"), "n_л, n_п", f"{sheet.n_left:.5f}, {sheet.n_right:.5f}"
          + _flag(sheet, "n_left"), "—", "(6.3), (6.4)", t("note_n")),
         ("8", t("marks_left"), "(x⁰₂)_л, (y⁰₃)_л, (y⁰₄)_л",

@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 
 from stereoplotter import __version__
+from stereoplotter.glossary import check_language, term
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
-from stereoplotter.glossary import check_language, term
 from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdf, forms_pdf
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupSheet

@@ -102,14 +102,16 @@ def test_gear_zero_readings_corrections_stage5_and_signatures(forms, job, lang):
     points = [q for q in s.points_model_mm if q["role"] == "check" or q["kind"] != "height"]
     assert {q["role"] for q in points} == {"control", "check"}
     for q in points:
-        assert (f"{q['id']} {TERMS['check_point' if q['role'] == 'check' else 'plan_control'][lang]}"
-                f" O_X = MO_X {_at(q['x_mm'], 2)} O_Y = MO_Y {_at(q['y_mm'], 2)}") in flat, q
+        role = TERMS["check_point" if q["role"] == "check" else "plan_control"][lang]
+        assert (
+            f"{q['id']} {role} O_X = MO_X {_at(q['x_mm'], 2)} O_Y = MO_Y {_at(q['y_mm'], 2)}"
+        ) in flat, q
     for key in ("signatures", "operator", "checker", "name", "signature", "date"):
         assert TERMS[key][lang] in flat, key
 
 
 def test_russian_form_uses_the_books_terms_and_embeds_cyrillic(forms):
-    data, reader, pages = forms["ru"]
+    _data, reader, pages = forms["ru"]
     for expected in ("Установочные данные (Таблица 24) — стереопара 101-102", "n_л, n_п", "f_пр",
                      "горизонтальный масштаб модели", "Места нуля МО", "исполнитель",
                      "Пределы метода"):  # fmt: skip
