@@ -172,6 +172,7 @@ _TABLE: dict[str, tuple[str, str]] = {
         "Этап 5: окончательный контроль по плановым и контрольным точкам",
     ),
     "point": ("point", "точка"),
+    "points_stage5": ("plan control and check points", "плановые и контрольные точки"),
     "role": ("role", "назначение"),
     "plan_control": ("plan control", "плановая опорная"),
     "check_point": ("check", "контрольная"),

@@ -222,7 +222,7 @@ def summary_rows(
                 name = name.replace("corner", term("corner", lang))
                 tolerances.setdefault(f"±{r['tolerance']:.3g} {r['unit']}", []).append(name)
         if stage == 5:
-            texts.append(f"{len(_stage5_points(sheet))} {term('point', lang)}: "
+            texts.append(f"{term('points_stage5', lang)}: "
                          + ", ".join(str(p["id"]) for p in _stage5_points(sheet)))  # fmt: skip
         tol = "; ".join(f"{', '.join(dict.fromkeys(n))} {t}" for t, n in tolerances.items())
         if texts:
@@ -262,12 +262,12 @@ def correction_rows(sheet: SetupSheet, lang: str, rigorous: bool = False) -> lis
     sign = "+" if sheet.options.bz_scale_sense > 0 else "−"
     blank = "__________"
     return [
-        ("L′_л", term("corr_L_left", lang), f"L_л = {ll:.3f} mm", "", f"{blank} mm"),
+        ("L′_л", term("corr_L_left", lang), f"L_л (6.5) = {ll:.3f} mm", "", f"{blank} mm"),
         ("ΔZ", term("corr_dz", lang), "ΔZ = D·(L_л − L′_л)·M_в/(1000·L_л)",
          f"{d * mv / (1000.0 * ll):.4f} m/mm", f"{blank} m"),
         ("O′_Z", term("corr_dz_counter", lang), "O′_Z = O_Z + D·(L_л − L′_л)/L_л",
          f"{d / ll:.5f}", f"{blank} mm"),
-        ("L′_п", term("corr_L_right", lang), f"L_п = {lr:.3f} mm", "", f"{blank} mm"),
+        ("L′_п", term("corr_L_right", lang), f"L_п (6.5) = {lr:.3f} mm", "", f"{blank} mm"),
         ("Δb_z", term("corr_dbz", lang), "Δb_z = D·(L_п − L′_п)/L_п", f"{d / lr:.5f}",
          f"{blank} mm"),
         ("O′_bz", term("corr_bz", lang), f"O′_bz = O_bz {sign} Δb_z", "", f"{blank} mm"),
@@ -298,4 +298,4 @@ def stage5_rows(sheet: SetupSheet, lc: LeastCounts, lang: str) -> list[tuple[str
 
 def signature_rows(lang: str) -> list[tuple[str, ...]]:
     """Operator and checker: name, signature and date fields."""
-    return [(term(who, lang), "", "", "") for who in ("operator", "checker")]
+    return [(term(who, lang), "_" * 30, "_" * 24, "_" * 16) for who in ("operator", "checker")]

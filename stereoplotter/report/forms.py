@@ -197,7 +197,7 @@ def _page_readings(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigor
     paragraph(pdf, t("readings_intro"), 6.5)
     table(pdf, (t("stage"), t("step"), t("reading"), t("least_count"), t("equation"),
                 t("tolerance"), t("set")), reading_rows(sheet, lc, lang, rigorous),
-          (8, 50, 52, 16, 17, 17, 15), size=6.5)  # fmt: skip
+          (9, 47, 50, 15, 22, 19, 13), size=6.5)  # fmt: skip
     heading(pdf, t("corrections"), 9)
     table(pdf, (t("symbol"), t("quantity"), t("formula"), t("factor"), t("result")),
           correction_rows(sheet, lang, rigorous), (12, 45, 58, 22, 38), size=6.5)  # fmt: skip
@@ -206,8 +206,9 @@ def _page_readings(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigor
                 f"{t('read')} Y"), stage5_rows(sheet, lc, lang),
           (14, 24, 35, 35, 17, 25, 25), size=6.5)  # fmt: skip
     heading(pdf, t("signatures"), 9)
+    pdf.ln(2)
     table(pdf, ("", t("name"), t("signature"), t("date")), signature_rows(lang),
-          (25, 60, 50, 40), size=9)  # fmt: skip
+          (25, 60, 50, 40), size=9, aligns=("LEFT",) * 4)  # fmt: skip
 
 
 def _page_details(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str) -> None:
