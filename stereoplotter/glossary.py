@@ -268,6 +268,37 @@ _TABLE: dict[str, tuple[str, str]] = {
         "| quantity | symbol | value | unit | equation |",
         "| величина | обозн. | значение | ед. | формула |",
     ),
+    # the transcript's closing summary (the English entries are the text it always had)
+    "cs_title": ("Closing summary", "Итоги"),
+    "cs_checks": (
+        "Checks: {p} passed, {f} failed of {n}.",
+        "Контроли: {p} в допуске, {f} вне допуска из {n}.",
+    ),
+    "cs_reported": ("reported", "для сведения"),
+    "cs_pass": ("pass", "в допуске"),
+    "cs_fail": ("FAIL", "ВНЕ ДОПУСКА"),
+    "cs_worst": ("worst", "наибольшее"),
+    "cs_remedies": ("Remedies applied", "Применённые исправления"),
+    "cs_rounds": ("rounds", "повт."),
+    "cs_passed_after": ("check passed after", "после них контроль в допуске"),
+    "cs_failed_after": ("check still failed after", "после них контроль вне допуска"),
+    "cs_nothing": (
+        "What went wrong: nothing outside tolerance at the end.",
+        "Что пошло не так: в конце всё в допуске.",
+    ),
+    "cs_wrong": (
+        "What went wrong, and what a real operator would do:",
+        "Что пошло не так и что сделал бы оператор:",
+    ),
+    "cs_still_outside": ("still outside tolerance", "по-прежнему вне допуска"),
+    "cs_after": ("after", "после"),
+    "cs_no_remedy": ("(no remedy in this practice)", "(в этой практике исправлений нет)"),
+    "cs_iteration": ("iteration", "итерация"),
+    "cs_default_advice": (
+        "repeat the step and its check; look for a sheet or reading error before going on",
+        "повторить действие и его контроль; прежде чем продолжать, искать ошибку "
+        "в установочных данных или в отсчёте",
+    ),
     # details and drawing
     "details_marks": (
         "Transformed marks: the book's (6.1)/(6.2) beside the rigorous (3.17), κ = 0",
