@@ -56,6 +56,19 @@ def _at(value: float, decimals: int) -> str:
     return f"{'−' if value < 0 and float(text) != 0 else '+'} {text}"
 
 
+def _readings_to_set(sheet, lang: str):
+    """(row, text) of every reading of stages 1–5 at the shipped least counts: 0.01 mm on the
+    counters and scales, 0.1 m on the height scale."""
+    decimals = {"mm": 2, "m": 1}
+    for r in sheet.readings:
+        if r["reading"] == "residual q":
+            continue
+        name = r["reading"].replace("corner", TERMS["corner"][lang])
+        value = _at(r["value"], decimals[r["unit"]])
+        yield r, (f"{name} = {r['zero_reading']} {value} {r['unit']}" if r["zero_reading"]
+                  else f"{name} = {value[2:]} {r['unit']}")  # fmt: skip
+
+
 @pytest.mark.parametrize("lang", ["ru", "en"])
 def test_every_reading_is_printed_at_its_least_count(forms, job, lang):
     """The counters and scales of the SC-1 read 0.01 mm, the metre height scale 0.1 m (all
@@ -64,15 +77,8 @@ def test_every_reading_is_printed_at_its_least_count(forms, job, lang):
     result, p = job
     spec = result.spec
     flat = _flat(forms, lang)
-    decimals = {"mm": 2, "m": 1}
     assert spec.xy_least_count_mm == 0.01 and spec.height_scale_least_count_m == 0.1
-    for r in p.sheet.readings:
-        if r["reading"] == "residual q":
-            continue
-        name = r["reading"].replace("corner", TERMS["corner"][lang])
-        value = _at(r["value"], decimals[r["unit"]])
-        expected = (f"{name} = {r['zero_reading']} {value} {r['unit']}" if r["zero_reading"]
-                    else f"{name} = {value[2:]} {r['unit']}")  # fmt: skip
+    for r, expected in _readings_to_set(p.sheet, lang):
         assert expected in flat, expected
         assert r["formula"] not in forms[lang][2][1], r  # no 0.001 mm to set
     assert "0.01 mm *" in flat and "0.1 m *" in flat
@@ -217,6 +223,13 @@ def test_setup_command_writes_the_same_bytes_in_ru(forms, tmp_path, job):
     byte, and sheet.md in Russian."""
     assert main(["setup", str(JOB), "--lang", "ru", "-o", str(tmp_path)]) == 0
     assert (tmp_path / "101-102" / "sheet.pdf").read_bytes() == forms["ru"][0]
+    for p in job[0].pairs:  # every pair's form: its readings at the least count, in Russian
+        reader = pypdf.PdfReader(tmp_path / p.pair.name / "sheet.pdf")
+        flat = re.sub(r"\s+", " ", " ".join(page.extract_text() for page in reader.pages))
+        assert f"Установочные данные (Таблица 24) — стереопара {p.pair.name}" in flat
+        for _, expected in _readings_to_set(p.sheet, "ru"):
+            assert expected in flat, (p.pair.name, expected)
+        assert len(reader.pages) in (5, 6)
     md = (tmp_path / "101-102" / "sheet.md").read_text("utf-8")
     assert "Установочные данные" in md and "левый снимок 101" in md
     assert least_counts(job[0].spec).scale_mm == 0.01
