@@ -171,7 +171,7 @@ def _page_summary(
         pdf,
         ("№" if lang == "ru" else "No.", term("quantity", lang), term("symbol", lang),
          term("value", lang), term("unit", lang), term("equation", lang), term("notes", lang)),
-        _table24_rows(sheet, lang), (6, 30, 22, 53, 6, 17, 41), size=size, gap=1.0,
+        _table24_rows(sheet, lang), (6, 30, 22, 52, 7, 17, 41), size=size, gap=1.0,
     )  # fmt: skip
     heading(pdf, term("readings_summary", lang), size + 2.5)
     paragraph(pdf, _least_count_line(h, lang), size)
