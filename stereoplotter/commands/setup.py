@@ -93,6 +93,11 @@ def run(args: argparse.Namespace) -> int:
             f"{args.scenario}: --instrument: expected sc1, spr3, sd3 or a YAML path, found "
             "nothing (only a job file names its own instrument)"
         )
+    if getattr(args, "rigorous", False):
+        raise StereoplotterError(
+            f"{args.scenario}: --rigorous: expected a job file (it sets the values of the job's "
+            "forms), found a scenario or block file"
+        )
     spec = load_instrument(args.instrument)
     if "models" in data or "models_csv" in data:
         return setup_block.run(args, spec)

@@ -233,3 +233,10 @@ def test_setup_command_writes_the_same_bytes_in_ru(forms, tmp_path, job):
     md = (tmp_path / "101-102" / "sheet.md").read_text("utf-8")
     assert "Установочные данные" in md and "левый снимок 101" in md
     assert least_counts(job[0].spec).scale_mm == 0.01
+
+
+def test_rigorous_is_refused_outside_a_job(capsys):
+    """--rigorous sets the values of a job's forms; a scenario has none: one line, exit 1."""
+    assert main(["setup", "pair60", "--instrument", "sc1", "--rigorous"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--rigorous: expected a job file" in err[0]
