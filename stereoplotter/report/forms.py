@@ -351,27 +351,31 @@ def _page_drawing(pdf: Form, sheet: SetupSheet, lang: str) -> None:
     paragraph(pdf, term("legend", lang) + f" θ = {math.degrees(sheet.frame_rotation):.4f}°.", 7.5)
 
 
-def _page1_size(sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool) -> float:
-    """The largest font size of :data:`_PAGE1_SIZES` at which page 1 holds its readings."""
+def _page1_size(
+    trial: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool
+) -> float:
+    """The largest font size of :data:`_PAGE1_SIZES` at which page 1 holds its readings, laid
+    out on fresh pages of ``trial`` (a throwaway document: one per call of :func:`form_pdf` or
+    :func:`forms_pdf`, so its fonts load once for all the pairs)."""
     for size in _PAGE1_SIZES:
-        trial = Form(header.date)
-        try:
-            trial.add_page()
-            _page_summary(trial, sheet, header, lang, rigorous, size)
-            if trial.page_no() == 1:
-                return size
-        finally:
-            trial.close_fonts()
+        trial.add_page()
+        first = trial.page_no()
+        _page_summary(trial, sheet, header, lang, rigorous, size)
+        if trial.page_no() == first:
+            return size
     return _PAGE1_SIZES[-1]
 
 
-def _add_form(pdf: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool) -> None:
+def _add_form(
+    pdf: Form, trial: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool
+) -> None:
     pdf.footer_text = (
         f"{header.job} · {term('pair', lang)} {header.pair} ({header.left_photo}, "
         f"{header.right_photo}) · {sheet.instrument} · {header.date} · {header.program}"
     )
+    size = _page1_size(trial, sheet, header, lang, rigorous)
     pdf.add_page()
-    _page_summary(pdf, sheet, header, lang, rigorous, _page1_size(sheet, header, lang, rigorous))
+    _page_summary(pdf, sheet, header, lang, rigorous, size)
     pdf.add_page()
     _page_readings(pdf, sheet, header, lang, rigorous)
     pdf.add_page()
@@ -388,11 +392,8 @@ def form_pdf(
     ``lang``: ``"ru"`` or ``"en"``; ``rigorous``: print the rigorous (3.17) mark targets and
     spans as the values to set (the book's beside them).
     """
-    check_language(lang)
-    pdf = Form(header.date, term("page", lang))
-    pdf.set_title(f"{term('setup_data', lang)} {header.job} {header.pair}")
-    _add_form(pdf, sheet, header, lang, rigorous)
-    return bytes(pdf.output())
+    return forms_pdf([(sheet, header)], f"{term('setup_data', lang)} {header.job} {header.pair}",
+                     header.date, lang, rigorous)  # fmt: skip
 
 
 def forms_pdf(
@@ -404,8 +405,11 @@ def forms_pdf(
 ) -> bytes:
     """The forms of many pairs in one PDF (the combined print of a block)."""
     check_language(lang)
-    pdf = Form(date, term("page", lang))
+    pdf, trial = Form(date, term("page", lang)), Form(date)
     pdf.set_title(title)
-    for sheet, header in forms:
-        _add_form(pdf, sheet, header, lang, rigorous)
+    try:
+        for sheet, header in forms:
+            _add_form(pdf, trial, sheet, header, lang, rigorous)
+    finally:
+        trial.close_fonts()
     return bytes(pdf.output())
