@@ -66,6 +66,18 @@ def add_arguments(sub: Any) -> None:
         action="store_true",
         help="job file: exit 1 when any pair is refused (default: only when none is set up)",
     )
+    p.add_argument(
+        "--lang",
+        choices=("ru", "en"),
+        default="en",
+        help="language of the forms and sheet.md: ru (the book's terms) or en (default)",
+    )
+    p.add_argument(
+        "--rigorous",
+        action="store_true",
+        help="job forms: print the rigorous (3.17) mark targets and spans as the values to set "
+        "(default: the book's (6.1)/(6.2), (6.5), with a warning where they exceed a tolerance)",
+    )
     p.set_defaults(func=run)
 
 
@@ -92,6 +104,11 @@ def run(args: argparse.Namespace) -> int:
             f"{args.scenario}: --instrument: expected sc1, spr3, sd3 or a YAML path, found "
             "nothing (only a job file names its own instrument)"
         )
+    if getattr(args, "rigorous", False):
+        raise StereoplotterError(
+            f"{args.scenario}: --rigorous: expected a job file (it sets the values of the job's "
+            "forms), found a scenario or block file"
+        )
     spec = load_instrument(args.instrument)
     if "models" in data or "models_csv" in data:
         return setup_block.run(args, spec)
@@ -111,16 +128,18 @@ def run(args: argparse.Namespace) -> int:
     if args.output is None and args.json:
         return 0
     out = Path(args.output or "stereoplotter-setup")
-    files = sheet_files(sheet, data)  # everything rendered before anything is written
+    # everything rendered before anything is written
+    files = sheet_files(sheet, data, getattr(args, "lang", "en"))
     write_files(out, files)
     if not args.json:
         sys.stdout.write(f"{sheet_summary(sheet)}\nwritten: {', '.join(files)} in {out}\n")
     return 0
 
 
-def sheet_files(sheet: Any, data: dict[str, Any]) -> dict[str, bytes]:
+def sheet_files(sheet: Any, data: dict[str, Any], lang: str = "en") -> dict[str, bytes]:
     """sheet.yaml, sheet.md, sheet.pdf and sheet.png of a setup sheet, rendered in memory
-    (``data``: :func:`~stereoplotter.report.sheet.sheet_to_dict` with the seed)."""
+    (``data``: :func:`~stereoplotter.report.sheet.sheet_to_dict` with the seed; ``lang`` of
+    sheet.md)."""
     # imported here: matplotlib and YAML load only for a command that writes a sheet
     import json
 
@@ -135,7 +154,7 @@ def sheet_files(sheet: Any, data: dict[str, Any]) -> dict[str, bytes]:
     pdf = figure_bytes(figure, "pdf", close=False)
     return {
         "sheet.yaml": text.encode("utf-8"),
-        "sheet.md": sheet_markdown(sheet).encode("utf-8"),
+        "sheet.md": sheet_markdown(sheet, lang).encode("utf-8"),
         "sheet.pdf": pdf,
         "sheet.png": figure_bytes(figure, "png", dpi=110),
     }

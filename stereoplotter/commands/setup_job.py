@@ -103,12 +103,18 @@ def run_job(
 
 
 def write_job(
-    result: JobResult, output_dir: str | os.PathLike[str], *, force: bool = False
+    result: JobResult,
+    output_dir: str | os.PathLike[str],
+    *,
+    force: bool = False,
+    lang: str = "en",
+    rigorous: bool = False,
 ) -> OutputReport:
     """Write the files of a job and their manifest (everything rendered before anything is
     written): into a new or empty folder, or with ``force`` replacing the previous outputs as a
-    whole (:func:`stereoplotter.io.output_folder.write_outputs`)."""
-    files = job_files(result)
+    whole (:func:`stereoplotter.io.output_folder.write_outputs`). ``lang`` and ``rigorous``: the
+    forms' language and which mark targets they give to set (:func:`report.job.job_files`)."""
+    files = job_files(result, lang, rigorous)
     return write_outputs(output_dir, files, manifest_about(result), force=force)
 
 
@@ -132,7 +138,17 @@ def run(args: argparse.Namespace) -> int:
     result = compute_job(job, load_instrument(args.instrument) if args.instrument else None)
     out = None if args.json and args.output is None else Path(args.output or "stereoplotter-setup")
     force = getattr(args, "force", False)
-    report = write_job(result, out, force=force) if out is not None else None
+    report = (
+        write_job(
+            result,
+            out,
+            force=force,
+            lang=getattr(args, "lang", "en"),
+            rigorous=getattr(args, "rigorous", False),
+        )
+        if out is not None
+        else None
+    )
     if args.json:
         pairs = [pair_dict(job, p) for p in result.pairs]
         sys.stdout.write(

@@ -89,6 +89,13 @@ def add_arguments(sub: Any) -> None:
         help="memory budget of one chunk of trials (default: %(default)s MB)",
     )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument(
+        "--lang",
+        choices=("ru", "en"),
+        default="en",
+        help="language of transcript.txt: ru (the book's terms; the records' own text stays "
+        "English) or en (default)",
+    )
     p.set_defaults(func=run)
 
 
@@ -113,6 +120,7 @@ def run(args: argparse.Namespace) -> int:
             output=args.output,
             memory_mb=LibraryDefault.of(args.memory_mb),
             progress=advance,
+            lang=args.lang,
         )
     sys.stdout.write(json_text(outcome.summary) if args.json else outcome.text)
     return 0

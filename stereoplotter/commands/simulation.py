@@ -61,9 +61,9 @@ def _parallax_png(result: SimulationResult) -> bytes:
     return figure_bytes(plot_residual_y_parallax(result), "png", dpi=100)
 
 
-def _trial0_files(result: SimulationResult) -> dict[str, bytes]:
-    """trial 0's transcript (text and JSON lines) and parallax map."""
-    return {**trial0_texts(result), "parallax.png": _parallax_png(result)}
+def _trial0_files(result: SimulationResult, lang: str = "en") -> dict[str, bytes]:
+    """trial 0's transcript (text in ``lang``, JSON lines) and parallax map."""
+    return {**trial0_texts(result, lang), "parallax.png": _parallax_png(result)}
 
 
 def _evaluation_files(summary: dict[str, Any]) -> dict[str, bytes]:
@@ -74,16 +74,18 @@ def _evaluation_files(summary: dict[str, Any]) -> dict[str, bytes]:
     }
 
 
-def simulation_files(result: SimulationResult) -> dict[str, bytes]:
+def simulation_files(result: SimulationResult, lang: str = "en") -> dict[str, bytes]:
     """One run's transcript.txt, transcript.jsonl, parallax.png, evaluation.yaml, evaluation.md
     rendered in memory (a vectorised result: the summary over its trials, trial 0's
-    transcript)."""
-    return {**_trial0_files(result), **_evaluation_files(summarise_result(result))}
+    transcript, in ``lang``)."""
+    return {**_trial0_files(result, lang), **_evaluation_files(summarise_result(result))}
 
 
-def write_simulation(result: SimulationResult, out_dir: str | Path) -> dict[str, Path]:
+def write_simulation(
+    result: SimulationResult, out_dir: str | Path, lang: str = "en"
+) -> dict[str, Path]:
     """Write :func:`simulation_files` into ``out_dir``; name → path."""
-    return write_files(out_dir, simulation_files(result))
+    return write_files(out_dir, simulation_files(result, lang))
 
 
 @dataclass
@@ -110,6 +112,7 @@ def run_simulation_command(
     operator: str | Path | OperatorModel | None = None,
     practice: str = "operator",
     options: Sequence[str] = (),
+    lang: str = "en",
 ) -> SimulationOutcome:
     """What ``stereoplotter simulate`` does: run, summarise, write the files if ``output``.
 
@@ -121,6 +124,7 @@ def run_simulation_command(
     ``practice`` is "operator" (remedies after a failed check) or "book" (§27 task 1, none).
     ``options`` names the SC complex's options fitted to the SC-1 (``correction_unit``,
     ``automatic_coordinatograph``; :class:`~stereoplotter.instrument.sc1_complex.SC1Options`).
+    ``lang`` (``"ru"``/``"en"``) is the language of the transcript.
     """
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
@@ -141,7 +145,7 @@ def run_simulation_command(
     if trials is None:
         result = run_trials_chunk(prep, 0, None)
         summary = json_ready(summarise_result(result))
-        files = {} if out is None else write_simulation(result, out)
+        files = {} if out is None else write_simulation(result, out, lang)
         if progress is not None:
             progress(1)
     else:
@@ -152,7 +156,7 @@ def run_simulation_command(
             for result in iter_trial_chunks(prep, trials, chunk, progress=progress):
                 if info is None:  # the first chunk: trial 0's transcript and map
                     info = run_info(result, trials)
-                    trial0 = _trial0_files(result) if out is not None else {}
+                    trial0 = _trial0_files(result, lang) if out is not None else {}
                 store.append(trial_columns(result))
             extra = {"chunks": {"trials": chunk, "count": -(-trials // chunk)}}
             summary = json_ready(summarise_columns(info, store.columns(), extra))

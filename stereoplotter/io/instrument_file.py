@@ -64,6 +64,7 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("counters.xy_least_count_mm", "number", "mm", high=1.0, **_POS),
     _Leaf("counters.z_abs_least_count_mm", "number", "mm", high=1.0, **_POS),
     _Leaf("counters.height_scale_least_count_m", "number", "m", high=100.0, **_POS),
+    _Leaf("counters.scale_least_count_mm", "number", "mm", high=1.0, required=False, **_POS),
     _Leaf("gears.vertical_scale_denominators", "int_list", "—", 1, 10_000_000),
     _Leaf("gears.coordinatograph_ratios", "number_list", "—", high=100.0, **_POS),
     _Leaf("gears.max_photo_to_map_enlargement", "number", "—", high=100.0, required=False, **_POS),

@@ -1,42 +1,47 @@
-"""The printable setup form: Table 24 with notes, every stage reading and a drawing, as a PDF.
+"""The printable setup form an operator sets the instrument from, as a PDF, in Russian or English.
 
-One form per stereopair, A4 portrait, written with fpdf2 (a document library: real text that can
-be searched and extracted, tables that break across pages, vector drawing, embedded TrueType
-fonts). The Cyrillic and Greek symbols of the book need a Unicode font: DejaVu Sans, the font that
-ships inside matplotlib (``mpl-data/fonts/ttf``), so no system font is read. The output is
-byte-identical for the same sheet and header: the creation date is the job's date, never the
-clock, and no producer version is written.
+One form per stereopair, A4 portrait (document and drawing primitives:
+:mod:`stereoplotter.report.form_layout`; the text of the rows:
+:mod:`stereoplotter.report.form_fields`; every label from :mod:`stereoplotter.glossary`). The
+output is byte-identical for the same sheet, header and language.
 
-Pages: (1) the header and Table 24 in the book's layout with a notes column (what each value is
-for and at which stage it is set) and, below it, every stage reading (6.9)–(6.18) in one row per
-stage; (2) the transformed marks, decentrations, Z_i of the height
-control, the sheet corners, the similarity (6.8) and the certificate's distortion; (3) the
-readings of stages 1–5, Eqs. (6.9)–(6.18); (4) the sheet frame and the control points in
-instrument coordinates.
+Pages: (1) the header, Table 24 with the coordinatograph gear r, and every reading to set at its
+least count, one row per stage (always on page 1: the fonts shrink until it fits), with the
+warning when the book's (6.1)/(6.2), (6.5) exceed a stage tolerance; (2) the working sheet: the
+zero readings MO to write in, every reading of stages 1–4 with its least count, tolerance and a
+column to write in, the (6.9)–(6.11) corrections from the measured L′ (factor, formula, field),
+stage 5 on corner 4, the plan control and the check points, the signatures; (3) the method's
+limits (book against rigorous (3.17) on the counters), angles, settings, height control, sheet
+corners, similarity (6.8), distortion, tolerances; (4) the sheet frame and the control points in
+instrument coordinates, labels placed so that none overlaps another.
 """
 
 from __future__ import annotations
 
-import datetime as _dt
-import importlib.util
 import math
-import re
 from collections.abc import Sequence
-from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
+from dataclasses import dataclass, field
 
-from fpdf import FPDF
-from fpdf.enums import XPos, YPos
-from fpdf.fonts import FontFace
-
+from stereoplotter.glossary import check_language, term
+from stereoplotter.report.form_fields import (
+    LeastCounts,
+    correction_rows,
+    limit_rows,
+    limits_exceeded,
+    reading_rows,
+    signature_rows,
+    stage5_rows,
+    summary_rows,
+    zero_reading_names,
+)
+from stereoplotter.report.form_layout import FONT, Form, LabelPlacer, heading, paragraph, table
 from stereoplotter.report.sheet import instrument_settings
 from stereoplotter.setup.records import SetupSheet
 
-__all__ = ["FormHeader", "form_pdf", "forms_pdf"]
+__all__ = ["FormHeader", "LeastCounts", "form_pdf", "forms_pdf"]
 
-_FONT = "DejaVu"
-_MARGIN_LEFT, _MARGIN_RIGHT, _MARGIN_TOP, _MARGIN_BOTTOM = 20.0, 15.0, 15.0, 18.0
+#: Font sizes of page 1 tried in turn until the readings summary ends on page 1.
+_PAGE1_SIZES = (6.5, 6.0, 5.5, 5.0, 4.5)
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,7 +49,8 @@ class FormHeader:
     """What the header of a form prints besides the sheet itself.
 
     ``date`` is YYYY-MM-DD from the job file (also the PDF's creation date); ``frame`` says in
-    which photogrammetric system the pair was computed; ``assumed`` is filled from the sheet.
+    which photogrammetric system the pair was computed; ``least_counts`` come from the
+    instrument spec.
     """
 
     job: str
@@ -58,65 +64,7 @@ class FormHeader:
     camera: str
     frame: str
     distortion: tuple[tuple[float, float], ...] = ()
-
-
-def _font_path(style: str = "") -> str:
-    """The DejaVu font file matplotlib ships, found without importing matplotlib (its package
-    folder from the import system's spec: only ``plotting`` imports matplotlib)."""
-    name = {"": "DejaVuSans.ttf", "B": "DejaVuSans-Bold.ttf"}[style]
-    spec = importlib.util.find_spec("matplotlib")
-    if spec is None or not spec.submodule_search_locations:  # pragma: no cover - a dependency
-        raise RuntimeError("matplotlib (a dependency) is not installed: no DejaVu font")
-    folder = Path(next(iter(spec.submodule_search_locations)))
-    return str(folder / "mpl-data" / "fonts" / "ttf" / name)
-
-
-class _Form(FPDF):
-    """A4 portrait with the margins, fonts and the running footer of the forms."""
-
-    def __init__(self, date: str) -> None:
-        super().__init__(orientation="P", unit="mm", format="A4")
-        self.add_font(_FONT, "", _font_path(""))
-        self.add_font(_FONT, "B", _font_path("B"))
-        self.set_margins(_MARGIN_LEFT, _MARGIN_TOP, _MARGIN_RIGHT)
-        self.set_auto_page_break(True, _MARGIN_BOTTOM)
-        day = _dt.datetime.strptime(date, "%Y-%m-%d").replace(tzinfo=_dt.UTC)
-        self.set_creation_date(day)
-        self.set_producer("stereoplotter")
-        self.set_creator("stereoplotter")
-        self.footer_text = ""
-
-    def footer(self) -> None:
-        self.set_y(-_MARGIN_BOTTOM + 5)
-        self.set_font(_FONT, "", 7)
-        self.set_text_color(90)
-        self.cell(0, 4, self.footer_text, align="L")
-        self.set_x(self.l_margin)
-        self.cell(0, 4, f"page {self.page_no()}", align="R")
-        self.set_text_color(0)
-
-
-# --- what the rows say -------------------------------------------------------------------------
-
-#: Notes of the Table 24 rows: what the value is for and at which stage it is set.
-NOTES = {
-    "M_г": "horizontal model scale r·M_map: set the coordinatograph gear r before stage 1",
-    "M_в": "vertical model scale: set the height-counter gears before stage 1; stage 3 reads at it",
-    "k": "f_пр/f′ = M_г/M_в, the height exaggeration; tilts the correction planes (stage 2)",
-    "f′": "f corrected for film deformation from the measured fiducial distances; "
-    "enters (6.1)/(6.2)",
-    "f_пр": "principal distance set on both projectors, stage 1",
-    "b": "base carriage: b_x, b_y set in stage 1; b_z′ recorded in stage 1 (MO_bz), set in "
-    "stage 2 (6.14)",
-    "n": "n_л = D_max/f_пр: carriage lowered to D_max in stage 1; n_п scales the right "
-    "photo's spans and targets",
-    "marks_left": "targets of k_ω (mark 3, check on 4) and k_α (mark 2), stage 2, (6.12)/(6.13)",
-    "marks_right": "targets of k_ω (mark 3, check on 4) and k_α (mark 1), stage 2, (6.12)/(6.13)",
-    "L": "span of marks 3–4 checked in stage 1; corrected with ΔZ (6.9) and Δb_z (6.10), (6.11)",
-    "d": "set on the decentration scales in stage 2",
-    "Z": "model height over the height control point: stage 3 readings O_Zi (6.15)",
-    "corner": "stage 4 (corners 1–3, (6.16)/(6.17)); corner 4 checks in stage 5 (6.18)",
-}
+    least_counts: LeastCounts = field(default_factory=LeastCounts)
 
 
 def _f(value: float | None, digits: int = 3) -> str:
@@ -131,280 +79,225 @@ def _flag(sheet: SetupSheet, key: str) -> str:
     return " *" if sheet.assumed.get(key) else ""
 
 
-def _table24_rows(sheet: SetupSheet) -> list[tuple[str, ...]]:
+def _gear_text(sheet: SetupSheet, lang: str) -> str:
+    """M_г = r·M_map with the gear r = M_г/M_map of the coordinatograph (the YAML's ratio)."""
+    m_map = sheet.map_scale_denominator
+    if m_map is None:
+        return term("no_gear", lang)
+    r = sheet.horizontal_scale_denominator / m_map
+    return f"{term('gear_ratio', lang)} r = {r:g} (M_г = r·M_map, 1:{m_map})"
+
+
+def _table24_rows(sheet: SetupSheet, lang: str) -> list[tuple[str, ...]]:
     left, right = sheet.photos
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
+    item = t("item1")
     rows: list[tuple[str, ...]] = [
-        ("1", "horizontal model scale", "M_г", f"1:{sheet.horizontal_scale_denominator}"
-         + _flag(sheet, "scale_horizontal"), "—", "item 1", NOTES["M_г"]),
-        ("2", "vertical model scale", "M_в", f"1:{sheet.vertical_scale_denominator}"
-         + _flag(sheet, "scale_vertical"), "—", "item 1", NOTES["M_в"]),
-        ("3", "transformation coefficient", "k", _f(sheet.transformation_coefficient, 5), "—",
-         "item 1", NOTES["k"]),
-        ("4", "corrected focal length", "f′", _f(sheet.focal_length_corrected_mm, 4), "mm",
-         "f·l′/l", NOTES["f′"]),
-        ("5", "instrument principal distance", "f_пр", _f(sheet.f_instrument_mm)
-         + _flag(sheet, "f_instrument_mm"), "mm", "item 1", NOTES["f_пр"]),
-        ("6", "base components", "b_x, b_y, b_z′",
-         ", ".join(_f(v) for v in sheet.base_mm) + _flag(sheet, "base_mm"), "mm", "item 1",
-         NOTES["b"]),
-        ("7", "counter coefficients", "n_л, n_п", f"{sheet.n_left:.5f}, {sheet.n_right:.5f}"
-         + _flag(sheet, "n_left"), "—", "(6.3), (6.4)", NOTES["n"]),
-        ("8", "marks, left photo", "(x⁰₂)_л, (y⁰₃)_л, (y⁰₄)_л",
+        ("1", t("scale_horizontal"), "M_г", f"1:{sheet.horizontal_scale_denominator}"
+         + _flag(sheet, "scale_horizontal") + "\n" + _gear_text(sheet, lang), "—", item,
+         t("note_mg")),
+        ("2", t("scale_vertical"), "M_в", f"1:{sheet.vertical_scale_denominator}"
+         + _flag(sheet, "scale_vertical"), "—", item, t("note_mv")),
+        ("3", t("transformation_coefficient"), "k", _f(sheet.transformation_coefficient, 5), "—",
+         item, t("note_k")),
+        ("4", t("focal_corrected"), "f′", _f(sheet.focal_length_corrected_mm, 4), "mm",
+         "f·l′/l", t("note_f1")),
+        ("5", t("f_instrument"), "f_пр", _f(sheet.f_instrument_mm)
+         + _flag(sheet, "f_instrument_mm"), "mm", item, t("note_fpr")),
+        ("6", t("base_components"), "b_x, b_y, b_z′",
+         ", ".join(_f(v) for v in sheet.base_mm) + _flag(sheet, "base_mm"), "mm", item,
+         t("note_b")),
+        ("7", t("counter_coefficients"), "n_л, n_п", f"{sheet.n_left:.5f}, {sheet.n_right:.5f}"
+         + _flag(sheet, "n_left"), "—", "(6.3), (6.4)", t("note_n")),
+        ("8", t("marks_left"), "(x⁰₂)_л, (y⁰₃)_л, (y⁰₄)_л",
          ", ".join(_f(left.transformed_book_mm[k]) for k in ("x2", "y3", "y4")), "mm",
-         "(6.1)/(6.2)", NOTES["marks_left"]),
-        ("9", "marks, right photo", "(x⁰₁)_п, (y⁰₃)_п, (y⁰₄)_п",
+         "(6.1)/(6.2)", t("note_marks")),
+        ("9", t("marks_right"), "(x⁰₁)_п, (y⁰₃)_п, (y⁰₄)_п",
          ", ".join(_f(right.transformed_book_mm[k]) for k in ("x1", "y3", "y4")), "mm",
-         "(6.1)/(6.2)", NOTES["marks_right"]),
-        ("10", "mark spans 3–4", "L_л, L_п",
+         "(6.1)/(6.2)", t("note_marks")),
+        ("10", t("mark_spans"), "L_л, L_п",
          f"{_f(left.mark_span_mm)}, {_f(right.mark_span_mm)}" + _flag(sheet, "L_mm"), "mm",
-         "(6.5)", NOTES["L"]),
+         "(6.5)", t("note_L")),
+        ("11", t("decentrations"), "d_x, d_y",
+         "; ".join(f"{_f(p.decentration_mm[0])}, {_f(p.decentration_mm[1])}" for p in sheet.photos),
+         "mm", "f′·tan α, f′·tan ω", t("note_d")),
     ]  # fmt: skip
-    rows.append(
-        ("11", "decentrations, left; right photo", "d_x, d_y (л; п)",
-         "\n".join(f"{_f(p.decentration_mm[0])}, {_f(p.decentration_mm[1])}" for p in sheet.photos),
-         "mm", "f′·tan α, f′·tan ω", NOTES["d"])
-    )  # fmt: skip
     if sheet.control_heights:
         values = [f"{h['id']}: {_f(h['model_height_mm'])}" for h in sheet.control_heights]
-        text = "\n".join("; ".join(values[i : i + 2]) for i in range(0, len(values), 2))
-        rows.append(
-            ("12", "model heights over the height control points", "Z_i",
-             text + _flag(sheet, "control_heights_model_mm"), "mm", "(6.6)", NOTES["Z"])
-        )  # fmt: skip
+        text = "\n".join("; ".join(values[i : i + 3]) for i in range(0, len(values), 3))
+        rows.append(("12", t("model_heights"), "Z_i", text
+                     + _flag(sheet, "control_heights_model_mm"), "mm", "(6.6)", t("note_Z")))
     if sheet.corners:
-        rows.append(
-            ("13", "sheet corners 1 SW, 2 SE, 3 NE, 4 NW", "x′_i, y′_i",
-             "\n".join(f"{c['corner']}: {_f(c['x_mm'])}, {_f(c['y_mm'])}" for c in sheet.corners)
-             + _flag(sheet, "sheet_corners_mm"), "mm", "(6.7)", NOTES["corner"])
-        )  # fmt: skip
+        values = [f"{c['corner']}: {_f(c['x_mm'])}, {_f(c['y_mm'])}" for c in sheet.corners]
+        text = "\n".join("; ".join(values[i : i + 2]) for i in range(0, len(values), 2))
+        rows.append(("13", t("sheet_corners"), "x′_i, y′_i", text
+                     + _flag(sheet, "sheet_corners_mm"), "mm", "(6.7)", t("note_corner")))
     return rows
 
 
-# --- drawing the pages ----------------------------------------------------------------------------
-
-
-def _heading(pdf: _Form, text: str, size: float = 11.0) -> None:
-    pdf.set_font(_FONT, "B", size)
-    pdf.cell(0, 7, text, new_x=XPos.LMARGIN, new_y=YPos.NEXT)
-    pdf.set_font(_FONT, "", 8)
-
-
-def _table(
-    pdf: _Form,
-    header: Sequence[str],
-    rows: Sequence[Sequence[str]],
-    widths: Sequence[float],
-    size: float = 7.5,
-    aligns: Sequence[str] | None = None,
-) -> None:
-    pdf.set_font(_FONT, "", size)
-    headings = any(header)
-    with pdf.table(
-        first_row_as_headings=headings,
-        col_widths=tuple(widths),
-        width=pdf.epw,
-        line_height=1.25 * size * 0.3528 + 0.6,
-        text_align=tuple(aligns) if aligns else "LEFT",
-        headings_style=_headings_style(),
-        borders_layout="SINGLE_TOP_LINE",
-        padding=0.6,
-    ) as table:
-        if headings:
-            row = table.row()
-            for h in header:
-                row.cell(h)
-        for r in rows:
-            row = table.row()
-            for c in r:
-                row.cell(str(c))
-    pdf.ln(2)
-
-
-def _headings_style() -> Any:
-    return FontFace(family=_FONT, emphasis="BOLD", fill_color=(225, 225, 225))
-
-
-def _header_block(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
-    _heading(pdf, f"Setup sheet (Table 24) — stereopair {h.pair}", 13)
-    pdf.set_font(_FONT, "", 8)
+def _header_rows(sheet: SetupSheet, h: FormHeader, lang: str) -> list[tuple[str, str]]:
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     assumed = sorted({p for ps in sheet.assumed.values() for p in ps})
-    items = [
-        ("job, pair", f"{h.job} ({h.job_file}) · pair {h.pair}: left photo {h.left_photo}, "
-         f"right photo {h.right_photo} · date {h.date} (from the job file) · {h.program}"),
-        ("map, instrument", f"map sheet {h.map_sheet} · {sheet.instrument_title} "
+    theta = math.degrees(sheet.frame_rotation)
+    return [
+        (f"{t('job')}, {t('pair')}", f"{h.job} ({h.job_file}) · {t('pair')} {h.pair}: "
+         f"{t('left_photo')} {h.left_photo}, {t('right_photo')} {h.right_photo} · {t('date')} "
+         f"{h.date} ({t('from_job_file')}) · {h.program}"),
+        (f"{t('map_sheet')}, {t('instrument')}", f"{h.map_sheet} · {sheet.instrument_title} "
          f"({sheet.instrument})"),
-        ("camera", h.camera),
-        ("frame", h.frame + f"; base azimuth θ = {math.degrees(sheet.frame_rotation):.4f}°"),
-        ("assumed", "values marked * rest on instrument parameters no source documents: "
-         + (", ".join(assumed) if assumed else "none")),
+        (t("camera"), h.camera),
+        (t("frame"), f"{h.frame}; {t('base_direction')} = {theta:.4f}°"),
+        (t("assumed"), t("assumed_note") + ": " + (", ".join(assumed) if assumed else t("none"))),
     ]  # fmt: skip
-    _table(pdf, ("", ""), items, (24, 151), size=7.5)
 
 
-#: The stages of the setup-data method, as the compact readings of page 1 name them.
-STAGES = {
-    1: "1 · scales, base, spans",
-    2: "2 · tilts, decentrations",
-    3: "3 · height control",
-    4: "4 · sheet corners 1–3",
-    5: "5 · corner 4, check",
-}
+def _least_count_line(h: FormHeader, lang: str) -> str:
+    lc = h.least_counts
+    star = lambda k: " *" if k in lc.assumed else ""  # noqa: E731 - a local shorthand
+    return (f"{term('least_count', lang)}: {term('counters', lang)} X, Y {lc.counter_mm:g} mm"
+            f"{star('counter_mm')}; {term('abs_height_counter', lang)} {lc.z_mm:g} mm"
+            f"{star('z_mm')}; {term('height_scale', lang)} {lc.height_m:g} m{star('height_m')}; "
+            f"{term('scales', lang)} f_пр, b, d {lc.scale_mm:g} mm{star('scale_mm')}")  # fmt: skip
 
 
-def _readings_rows(sheet: SetupSheet) -> list[tuple[str, str]]:
-    """Every stage reading (6.9)–(6.18) as 'reading = MO + value (± tolerance)', one row per
-    stage: the compact list of page 1 (page 3 has them one by one with a column to write in)."""
-    rows = []
-    for stage, title in STAGES.items():
-        texts, tolerances = [], {}
-        for r in sheet.readings:
-            if r["stage"] != stage:
-                continue
-            texts.append(r["formula"])
-            if "tolerance" in r and r["reading"] != "residual q":
-                name = re.sub(r"\d+", "i", r["reading"]) if stage == 3 else r["reading"]
-                tolerances.setdefault(f"±{r['tolerance']:.3g} {r['unit']}", []).append(name)
-        tol = "; ".join(f"{', '.join(dict.fromkeys(names))} {t}" for t, names in tolerances.items())
-        if texts:
-            rows.append((title, "; ".join(texts) + (f". Tolerance: {tol}" if tol else "")))
-    return rows
-
-
-def _page_table24(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
-    _header_block(pdf, sheet, h)
-    _heading(pdf, "Table 24 — setup data")
-    _table(
+def _page_summary(
+    pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigorous: bool, size: float
+) -> None:
+    """Page 1: header, Table 24 and the readings to set, one row per stage."""
+    heading(pdf, f"{term('setup_data', lang)} ({term('table24', lang)}) — "
+                 f"{term('stereopair', lang)} {h.pair}", size + 5)  # fmt: skip
+    table(pdf, ("", ""), _header_rows(sheet, h, lang), (26, 149), size=size, gap=1.0)
+    table(
         pdf,
-        ("No.", "quantity", "symbol", "value", "unit", "equation", "notes: what for, which stage"),
-        _table24_rows(sheet),
-        (6, 27, 23, 33, 7, 15, 64),
-        size=6.5,
-    )
-    _heading(pdf, "Readings to set, stage by stage (6.9)–(6.18): zero reading MO + value", 9)
-    _table(pdf, ("stage", "readings and tolerances; one by one with a column to write in: page 3"),
-           _readings_rows(sheet), (26, 149), size=6.5)  # fmt: skip
+        ("№" if lang == "ru" else "No.", term("quantity", lang), term("symbol", lang),
+         term("value", lang), term("unit", lang), term("equation", lang), term("notes", lang)),
+        _table24_rows(sheet, lang), (6, 30, 22, 52, 7, 17, 41), size=size, gap=1.0,
+    )  # fmt: skip
+    heading(pdf, term("readings_summary", lang), size + 2.5)
+    paragraph(pdf, _least_count_line(h, lang), size)
+    table(pdf, (term("stage", lang), ""), summary_rows(sheet, h.least_counts, lang, rigorous),
+          (26, 149), size=size, gap=1.0)  # fmt: skip
+    if limits_exceeded(sheet):
+        pdf.set_text_color(170, 0, 0)
+        paragraph(pdf, term("limit_warning", lang), size + 0.5)
+        pdf.set_text_color(0)
+    paragraph(pdf, term("limit_choice_rigorous" if rigorous else "limit_choice_book", lang), size)
 
 
-def _page_details(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
+def _page_readings(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigorous: bool) -> None:
+    """Page 2: zero readings, readings of stages 1–4, corrections, stage 5, signatures."""
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
+    lc = h.least_counts
+    heading(pdf, t("zero_readings"), 9)
+    names = zero_reading_names(sheet)
+    cells = [f"{n} = ________" for n in names]
+    table(pdf, ("",) * 4, [tuple(cells[i : i + 4] + [""] * (4 - len(cells[i : i + 4])))
+                           for i in range(0, len(cells), 4)], (1, 1, 1, 1), size=7.5)  # fmt: skip
+    heading(pdf, t("readings"), 9)
+    paragraph(pdf, t("readings_intro"), 6.5)
+    table(pdf, (t("stage"), t("step"), t("reading"), t("least_count"), t("equation"),
+                t("tolerance"), t("set")), reading_rows(sheet, lc, lang, rigorous),
+          (9, 47, 50, 15, 22, 19, 13), size=6.5)  # fmt: skip
+    heading(pdf, t("corrections"), 9)
+    table(pdf, (t("symbol"), t("quantity"), t("formula"), t("factor"), t("result")),
+          correction_rows(sheet, lang, rigorous), (12, 45, 58, 22, 38), size=6.5)  # fmt: skip
+    heading(pdf, t("stage5"), 9)
+    table(pdf, (t("point"), t("role"), "x′", "y′", t("tolerance"), f"{t('read')} X",
+                f"{t('read')} Y"), stage5_rows(sheet, lc, lang),
+          (14, 24, 35, 35, 17, 25, 25), size=6.5)  # fmt: skip
+    heading(pdf, t("signatures"), 9)
+    pdf.ln(2)
+    table(pdf, ("", t("name"), t("signature"), t("date")), signature_rows(lang),
+          (25, 60, 50, 40), size=9, aligns=("LEFT",) * 4)  # fmt: skip
+
+
+def _page_details(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str) -> None:
+    _details_limits(pdf, sheet, lang)
     _details_orientation(pdf, sheet)
     _details_control(pdf, sheet, h)
 
 
-def _details_orientation(pdf: _Form, sheet: SetupSheet) -> None:
-    """Transformed marks, angles and decentrations, the instrument's settings."""
-    _heading(pdf, "Transformed marks: the book's (6.1)/(6.2) beside the rigorous (3.17), κ = 0")
+def _details_limits(pdf: Form, sheet: SetupSheet, lang: str) -> None:
+    """Book against rigorous on the counters (× n), with the stage tolerance."""
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
+    heading(pdf, t("limits"), 9)
+    rows = [
+        (r["reading"], r["equation"], f"{r['book']:.3f}", f"{r['rigorous']:.3f}",
+         f"{r['difference'] * 1000:+.1f} µm", f"± {r['tolerance'] * 1000:.1f} µm",
+         t("limit_exceeds") if r["exceeds"] else t("limit_within"))
+        for r in limit_rows(sheet)
+    ]  # fmt: skip
+    table(pdf, (t("reading"), t("equation"), f"{t('limit_book')} mm", f"{t('limit_rigorous')} "
+                "(3.17) mm", t("limit_difference"), t("tolerance"), ""), rows,
+          (22, 22, 26, 30, 26, 24, 25), size=7)  # fmt: skip
+    heading(pdf, t("details_marks"), 9)
     rows = []
     for p in sheet.photos:
         for key, value in p.transformed_book_mm.items():
             rig = p.transformed_rigorous_mm[key[1:]]
             axis = 0 if key[0] == "x" else 1
             measured = p.marks_measured_mm[key[1:]]
-            rows.append(
-                (
-                    p.name,
-                    key,
-                    f"{measured[0]:.3f}, {measured[1]:.3f}",
-                    f"{value:.4f}",
-                    f"{rig[0]:.4f}, {rig[1]:.4f}",
-                    f"{(value - rig[axis]) * 1000:+.2f}",
-                )
-            )
-    _table(pdf, ("photo", "mark", "measured x, y mm", "(6.1)/(6.2) mm", "(3.17) x⁰, y⁰ mm",
-                 "difference µm"), rows, (18, 14, 38, 30, 44, 36))  # fmt: skip
-    _heading(pdf, "Angles, decentrations and correction planes (instrument frame)")
+            rows.append((t(p.name), key, f"{measured[0]:.3f}, {measured[1]:.3f}", f"{value:.4f}",
+                         f"{rig[0]:.4f}, {rig[1]:.4f}", f"{(value - rig[axis]) * 1000:+.2f}"))
+    table(pdf, (t("photo"), t("mark"), "x, y mm", "(6.1)/(6.2) mm", "(3.17) x⁰, y⁰ mm", "µm"),
+          rows, (18, 14, 38, 30, 44, 36), size=7)  # fmt: skip
+
+
+def _details_orientation(pdf: Form, sheet: SetupSheet) -> None:
+    """Angles, decentrations and correction planes; the instrument's settings."""
+    heading(pdf, "α, ω, κ; d_x, d_y; θ_α, θ_ω", 9)
     rows = [
         (p.name, f"{math.degrees(p.alpha):.5f}", f"{math.degrees(p.omega):.5f}",
          f"{math.degrees(p.kappa):.5f}", f"{_f(p.decentration_mm[0])}, {_f(p.decentration_mm[1])}",
          ", ".join(f"{math.degrees(v):.4f}" for v in p.correction_inclination))
         for p in sheet.photos
     ]  # fmt: skip
-    _table(pdf, ("photo", "α °", "ω °", "κ °", "d_x, d_y mm", "planes α, ω °"), rows,
-           (18, 24, 24, 24, 45, 45))  # fmt: skip
+    table(pdf, ("", "α °", "ω °", "κ °", "d_x, d_y mm", "θ_α, θ_ω °"), rows,
+          (18, 24, 24, 24, 45, 45), size=7)  # fmt: skip
     settings = instrument_settings(sheet.table24, 0) if sheet.table24 is not None else None
     if settings is not None:
-        _heading(pdf, f"Settings of the instrument: {settings['phi_omega_dependent']} depend on "
-                      f"φ, ω ({settings['count_status']})")  # fmt: skip
         rows = [
-            (st["symbol"], st["name"], st["formula"],
+            (st["symbol"], st["formula"],
              *(f"{st[side]:.4f}" if st["unit"] == "deg" else _f(st[side])
                for side in ("left", "right")), "°" if st["unit"] == "deg" else "mm")
             for st in settings["settings"]
         ]  # fmt: skip
-        _table(pdf, ("symbol", "setting", "formula", "left", "right", "unit"), rows,
-               (16, 62, 46, 22, 22, 12))  # fmt: skip
+        table(pdf, ("", "", "л", "п", ""), rows, (20, 60, 35, 35, 20), size=7)
 
 
-def _details_control(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
+def _details_control(pdf: Form, sheet: SetupSheet, h: FormHeader) -> None:
     """Height control, sheet corners, the similarity, the distortion, the tolerances."""
-    _heading(pdf, "Height control: model heights Z_i (6.6)")
-    rows = [
-        (h_["id"], f"{h_['Z_m']:.2f}", f"{h_['flying_height_m']:.2f}",
-         f"{h_['model_height_mm']:.3f}")
-        for h_ in sheet.control_heights
-    ]  # fmt: skip
-    _table(pdf, ("point", "Z m (pair frame)", "H_Ф = Z_Sл − Z m", "Z_i mm"), rows, (30, 50, 50, 50))
+    heading(pdf, "Z_i (6.6)", 9)
+    rows = [(h_["id"], f"{h_['Z_m']:.2f}", f"{h_['flying_height_m']:.2f}",
+             f"{h_['model_height_mm']:.3f}") for h_ in sheet.control_heights]  # fmt: skip
+    table(pdf, ("", "Z m", "H_Ф = Z_Sл − Z m", "Z_i mm"), rows, (30, 50, 50, 50), size=7)
     if sheet.corners:
-        _heading(pdf, f"Sheet corners (6.7) of {h.map_sheet}, from the left plumb")
-        rows = [
-            (c["corner"], c["position"], f"{c['gk_north_m']:.2f}", f"{c['gk_east_m']:.2f}",
-             _f(c["x_mm"]), _f(c["y_mm"]))
-            for c in sheet.corners
-        ]  # fmt: skip
-        _table(pdf, ("corner", "position", "x (north) m", "ȳ (east) m", "x′ mm", "y′ mm"), rows,
-               (18, 20, 38, 38, 33, 33))  # fmt: skip
+        heading(pdf, f"(6.7) {h.map_sheet}", 9)
+        rows = [(c["corner"], c["position"], f"{c['gk_north_m']:.2f}", f"{c['gk_east_m']:.2f}",
+                 _f(c["x_mm"]), _f(c["y_mm"])) for c in sheet.corners]  # fmt: skip
+        table(pdf, ("", "", "x m", "ȳ m", "x′ mm", "y′ mm"), rows, (18, 20, 38, 38, 33, 33),
+              size=7)  # fmt: skip
     if sheet.similarity is not None:
         fit = sheet.similarity
-        res = ", ".join(
-            f"{pid}: ({r[0]:+.3f}, {r[1]:+.3f})"
-            for pid, r in zip(sheet.similarity_point_ids, fit.residuals_m, strict=True)
-        )
-        pdf.set_font(_FONT, "", 7.5)
-        pdf.multi_cell(
-            0, 3.8,
-            f"Similarity (6.8) Gauss–Krüger → instrument frame over {len(fit.residuals_m)} plan "
-            f"control points: a = {fit.a:.6e}, b = {fit.b:.9f}, c_X = {fit.cx_m:.3f} m, "
-            f"c_Y = {fit.cy_m:.3f} m, RMS {fit.rms_m:.3f} m; residuals m: {res}.",
-            new_x=XPos.LMARGIN, new_y=YPos.NEXT,
-        )  # fmt: skip
+        res = ", ".join(f"{pid}: ({r[0]:+.3f}, {r[1]:+.3f})"
+                        for pid, r in zip(sheet.similarity_point_ids, fit.residuals_m, strict=True))
+        paragraph(pdf, f"(6.8) Gauss–Krüger → X, Y ({len(fit.residuals_m)}): a = {fit.a:.6e}, "
+                       f"b = {fit.b:.9f}, c_X = {fit.cx_m:.3f} m, c_Y = {fit.cy_m:.3f} m, RMS "
+                       f"{fit.rms_m:.3f} m; {res} m.", 7)  # fmt: skip
         pdf.ln(2)
     if h.distortion:
-        _heading(pdf, "Radial distortion of the certificate (not applied on the instrument)")
-        _table(pdf, ("r mm", *(f"{r:g}" for r, _ in h.distortion)),
-               [("Δr µm", *(f"{d:g}" for _, d in h.distortion))],
-               (20, *([160 / len(h.distortion)] * len(h.distortion))))  # fmt: skip
+        table(pdf, ("r mm", *(f"{r:g}" for r, _ in h.distortion)),
+              [("Δr µm", *(f"{d:g}" for _, d in h.distortion))],
+              (20, *([160 / len(h.distortion)] * len(h.distortion))), size=7)  # fmt: skip
     tol = sheet.tolerances
-    pdf.set_font(_FONT, "", 7.5)
-    pdf.multi_cell(
-        0, 3.8,
-        f"Tolerances: |L − L′| ≤ {tol['mark_span_mm']:.4f} mm; mark-4 misfit ≤ "
-        f"{tol['mark_fit_mm']:.4f} mm; residual y-parallax ≤ {tol['residual_y_parallax_mm']:.4f} "
-        f"mm; control heights ≤ {tol['control_height_m']:.3f} m; corner 4 ≤ "
-        f"{tol['corner_mm']:.2f} mm" + _flag(sheet, "tolerances") + ".",
-        new_x=XPos.LMARGIN, new_y=YPos.NEXT,
-    )  # fmt: skip
+    paragraph(pdf, f"|L − L′| ≤ {tol['mark_span_mm']:.4f} mm; O_Y4 ≤ {tol['mark_fit_mm']:.4f} mm; "
+                   f"q ≤ {tol['residual_y_parallax_mm']:.4f} mm; O_Zi ≤ "
+                   f"{tol['control_height_m']:.3f} m; corner 4 ≤ {tol['corner_mm']:.2f} mm"
+                   + _flag(sheet, "tolerances") + ".", 7)  # fmt: skip
 
 
-def _page_readings(pdf: _Form, sheet: SetupSheet) -> None:
-    _heading(pdf, "Readings, stage by stage (6.9)–(6.18): zero reading MO + signed value")
-    pdf.set_font(_FONT, "", 7.5)
-    pdf.multi_cell(
-        0, 3.8,
-        "MO is found on the instrument. The right photo's zero readings are MO_X,п = MO_X + b_x, "
-        "MO_Y,п = MO_Y + b_y. Write the reading actually set in the last column.",
-        new_x=XPos.LMARGIN, new_y=YPos.NEXT,
-    )  # fmt: skip
-    pdf.ln(1)
-    rows = []
-    for r in sheet.readings:
-        tol = f"± {r['tolerance']:.4g} {r['unit']}" if "tolerance" in r else ""
-        formula = r["formula"] + (f" (book: {r['book_form']})" if "book_form" in r else "")
-        rows.append((str(r["stage"]), r["step"], formula, r["equation"], tol, ""))
-    _table(pdf, ("stage", "step", "reading", "equation", "tolerance", "set"), rows,
-           (9, 44, 56, 30, 22, 14), size=7)  # fmt: skip
-
-
-def _page_drawing(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
-    _heading(pdf, "Sheet frame and control in instrument coordinates (from the left plumb)")
+def _page_drawing(pdf: Form, sheet: SetupSheet, lang: str) -> None:
+    heading(pdf, term("drawing", lang), 10)
     xs = [c["x_mm"] for c in sheet.corners] + [p["x_mm"] for p in sheet.points_model_mm]
     ys = [c["y_mm"] for c in sheet.corners] + [p["y_mm"] for p in sheet.points_model_mm]
     xs += [0.0, sheet.base_mm[0]]
@@ -412,9 +305,8 @@ def _page_drawing(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
     box_w, box_h = pdf.epw, 150.0
     x0, y0 = pdf.l_margin, pdf.get_y() + 4
     span = max(max(xs) - min(xs), max(ys) - min(ys), 1.0)
-    scale = min(
-        box_w / (max(xs) - min(xs) + 0.15 * span), box_h / (max(ys) - min(ys) + 0.15 * span)
-    )
+    scale = min(box_w / (max(xs) - min(xs) + 0.15 * span),
+                box_h / (max(ys) - min(ys) + 0.15 * span))  # fmt: skip
     cx, cy = (max(xs) + min(xs)) / 2, (max(ys) + min(ys)) / 2
 
     def at(x: float, y: float) -> tuple[float, float]:  # model mm → page mm, y up
@@ -424,73 +316,100 @@ def _page_drawing(pdf: _Form, sheet: SetupSheet, h: FormHeader) -> None:
     pdf.set_line_width(0.2)
     pdf.rect(x0, y0, box_w, box_h)
     pdf.set_draw_color(0)
-    pdf.set_font(_FONT, "", 7)
+    pdf.set_font(FONT, "", 7)
+    labels = LabelPlacer(pdf)
+    points = [(at(p["x_mm"], p["y_mm"]), p) for p in sheet.points_model_mm]
+    for (px, py), _ in points:  # every symbol is kept free of labels before any label is placed
+        labels.reserve((px - 1.5, py - 1.6, px + 1.5, py + 1.1))
+    bx, by = x0 + 4, y0 + box_h - 4
+    labels.text(bx, by - 1.5, f"{term('scale_bar', lang)} (1:{sheet.horizontal_scale_denominator})")
+    for label, (x, y) in (("S_л", (0.0, 0.0)), ("S_п", (sheet.base_mm[0], sheet.base_mm[1]))):
+        px, py = at(x, y)
+        pdf.line(px - 2, py, px + 2, py)
+        pdf.line(px, py - 2, px, py + 2)
+        labels.reserve((px - 2, py - 2, px + 2, py + 2))
+        labels.label(px, py, label)
     if sheet.corners:
         order = sorted(sheet.corners, key=lambda c: c["corner"])
         pts = [at(c["x_mm"], c["y_mm"]) for c in order]
         pdf.set_line_width(0.5)
         pdf.polygon(pts)
         for c, (px, py) in zip(order, pts, strict=True):
-            pdf.text(px + 1.2, py - 1.2, f"{c['corner']} ({c['position']})")
+            labels.label(px, py, f"{c['corner']} ({c['position']})")
     pdf.set_line_width(0.25)
-    for p in sheet.points_model_mm:
-        px, py = at(p["x_mm"], p["y_mm"])
+    for (px, py), p in points:
         if p["role"] == "check":
             pdf.circle(px, py, 1.1, style="D")
         elif p["kind"] == "height":
             pdf.circle(px, py, 1.1, style="F")
         else:
             pdf.polygon([(px, py - 1.5), (px - 1.3, py + 0.9), (px + 1.3, py + 0.9)], style="DF")
-        pdf.text(px + 1.6, py + 2.6, str(p["id"]))
-    for label, (x, y) in (("S_л", (0.0, 0.0)), ("S_п", (sheet.base_mm[0], sheet.base_mm[1]))):
-        px, py = at(x, y)
-        pdf.line(px - 2, py, px + 2, py)
-        pdf.line(px, py - 2, px, py + 2)
-        pdf.text(px + 1.5, py - 1.5, label)
-    # a 50 mm scale bar of the model
-    bx, by = x0 + 4, y0 + box_h - 4
+        labels.label(px, py, str(p["id"]))
     pdf.set_line_width(0.4)
     pdf.line(bx, by, bx + 50 * scale, by)
-    pdf.text(bx, by - 1.5, f"50 mm of the model (1:{sheet.horizontal_scale_denominator})")
     pdf.set_y(y0 + box_h + 3)
-    pdf.set_font(_FONT, "", 7.5)
-    pdf.multi_cell(
-        0, 3.8,
-        "Triangles: plan/full control; filled circles: height control; open circles: check "
-        "points; crosses: the plumbs of the left and right projection centres. X along the base "
-        f"(θ = {math.degrees(sheet.frame_rotation):.4f}° from the frame's X), Y to the left of it."
-        + ("" if sheet.corners else " No sheet corners: the job has no SK-42 tie or map sheet."),
-        new_x=XPos.LMARGIN, new_y=YPos.NEXT,
-    )  # fmt: skip
+    paragraph(pdf, term("legend", lang) + f" θ = {math.degrees(sheet.frame_rotation):.4f}°.", 7.5)
 
 
-def _add_form(pdf: _Form, sheet: SetupSheet, header: FormHeader) -> None:
+def _page1_size(
+    trial: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool
+) -> float:
+    """The largest font size of :data:`_PAGE1_SIZES` at which page 1 holds its readings, laid
+    out on fresh pages of ``trial`` (a throwaway document: one per call of :func:`form_pdf` or
+    :func:`forms_pdf`, so its fonts load once for all the pairs)."""
+    for size in _PAGE1_SIZES:
+        trial.add_page()
+        first = trial.page_no()
+        _page_summary(trial, sheet, header, lang, rigorous, size)
+        if trial.page_no() == first:
+            return size
+    return _PAGE1_SIZES[-1]
+
+
+def _add_form(
+    pdf: Form, trial: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool
+) -> None:
     pdf.footer_text = (
-        f"{header.job} · pair {header.pair} (photos {header.left_photo}, {header.right_photo}) · "
-        f"{sheet.instrument} · {header.date} · {header.program}"
+        f"{header.job} · {term('pair', lang)} {header.pair} ({header.left_photo}, "
+        f"{header.right_photo}) · {sheet.instrument} · {header.date} · {header.program}"
     )
+    size = _page1_size(trial, sheet, header, lang, rigorous)
     pdf.add_page()
-    _page_table24(pdf, sheet, header)
+    _page_summary(pdf, sheet, header, lang, rigorous, size)
     pdf.add_page()
-    _page_details(pdf, sheet, header)
+    _page_readings(pdf, sheet, header, lang, rigorous)
     pdf.add_page()
-    _page_readings(pdf, sheet)
+    _page_details(pdf, sheet, header, lang)
     pdf.add_page()
-    _page_drawing(pdf, sheet, header)
+    _page_drawing(pdf, sheet, lang)
 
 
-def form_pdf(sheet: SetupSheet, header: FormHeader) -> bytes:
-    """The form of one pair as PDF bytes (the same inputs give the same bytes)."""
-    pdf = _Form(header.date)
-    pdf.set_title(f"Setup sheet {header.job} {header.pair}")
-    _add_form(pdf, sheet, header)
-    return bytes(pdf.output())
+def form_pdf(
+    sheet: SetupSheet, header: FormHeader, lang: str = "en", rigorous: bool = False
+) -> bytes:
+    """The form of one pair as PDF bytes (the same inputs give the same bytes).
+
+    ``lang``: ``"ru"`` or ``"en"``; ``rigorous``: print the rigorous (3.17) mark targets and
+    spans as the values to set (the book's beside them).
+    """
+    return forms_pdf([(sheet, header)], f"{term('setup_data', lang)} {header.job} {header.pair}",
+                     header.date, lang, rigorous)  # fmt: skip
 
 
-def forms_pdf(forms: Sequence[tuple[SetupSheet, FormHeader]], title: str, date: str) -> bytes:
+def forms_pdf(
+    forms: Sequence[tuple[SetupSheet, FormHeader]],
+    title: str,
+    date: str,
+    lang: str = "en",
+    rigorous: bool = False,
+) -> bytes:
     """The forms of many pairs in one PDF (the combined print of a block)."""
-    pdf = _Form(date)
+    check_language(lang)
+    pdf, trial = Form(date, term("page", lang)), Form(date)
     pdf.set_title(title)
-    for sheet, header in forms:
-        _add_form(pdf, sheet, header)
+    try:
+        for sheet, header in forms:
+            _add_form(pdf, trial, sheet, header, lang, rigorous)
+    finally:
+        trial.close_fonts()
     return bytes(pdf.output())

@@ -22,9 +22,10 @@ from typing import Any
 import numpy as np
 
 from stereoplotter import __version__
+from stereoplotter.glossary import check_language, term
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
-from stereoplotter.report.forms import FormHeader, form_pdf, forms_pdf
+from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdf, forms_pdf
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupSheet
 from stereoplotter.spec.instrument_spec import InstrumentSpec
@@ -35,6 +36,7 @@ __all__ = [
     "block_csv",
     "form_header",
     "job_files",
+    "least_counts",
     "manifest_about",
     "pair_dict",
     "refused_markdown",
@@ -62,23 +64,51 @@ class JobResult:
     pairs: tuple[PairResult, ...]
 
 
-def _frame_text(m: MeasuredPair | None) -> str:
+def _frame_text(m: MeasuredPair | None, lang: str = "en") -> str:
     if m is None or m.origin_sk42_m is None:
-        return "the job's local photogrammetric system (no SK-42 tie)"
+        return term("frame_local", lang)
     n, e, h = m.origin_sk42_m
-    return f"§10 local system at SK-42 x = {n:.3f} m, ȳ = {e:.3f} m, H = {h:.3f} m"
+    return f"{term('frame_sk42', lang)} x = {n:.3f} m, ȳ = {e:.3f} m, H = {h:.3f} m"
 
 
-def form_header(job: Job, p: PairResult) -> FormHeader:
-    """The header of a pair's form, all from the job file (no clock)."""
+#: The least count of the f_пр, base and decentration scales: an optional leaf of the instrument
+#: file (the shipped ones give it, ``assumed``); a file without it falls back to the X, Y counters'.
+SCALE_LEAST_COUNT_KEY = "counters.scale_least_count_mm"
+
+
+def least_counts(spec: InstrumentSpec) -> LeastCounts:
+    """The least counts of the form from the instrument spec, with those the file assumes."""
+    keys = {
+        "counter_mm": "xy_least_count_mm",
+        "z_mm": "z_least_count_mm",
+        "height_m": "height_scale_least_count_m",
+    }
+    scale = spec.parameters.get(SCALE_LEAST_COUNT_KEY)
+    assumed = {k for k, attr in keys.items() if spec.is_assumed(attr)}
+    if scale is None or scale.is_assumed:
+        assumed.add("scale_mm")
+    return LeastCounts(
+        counter_mm=spec.xy_least_count_mm,
+        z_mm=spec.z_least_count_mm,
+        height_m=spec.height_scale_least_count_m,
+        scale_mm=float(scale.value) if scale is not None else spec.xy_least_count_mm,
+        assumed=frozenset(assumed),
+    )
+
+
+def form_header(
+    job: Job, p: PairResult, spec: InstrumentSpec | None = None, lang: str = "en"
+) -> FormHeader:
+    """The header of a pair's form, all from the job file (no clock) and the instrument's least
+    counts (``spec``; the defaults of :class:`LeastCounts` without one), in ``lang``."""
     cam = job.camera
     sheet = p.pair.map_sheet
-    sheet_text = "none (scales forced)" if sheet is None else (
+    sheet_text = term("no_map_sheet", lang) if sheet is None else (
         f"{sheet.nomenclature or 'given by corners'}, 1:{sheet.scale_denominator}"
     )  # fmt: skip
     camera = (f"{job.camera_name + ': ' if job.camera_name else ''}f = {cam.focal_length_mm:.3f} "
               f"mm, x₀, y₀ = {cam.principal_point_mm[0]:.3f}, {cam.principal_point_mm[1]:.3f} mm, "
-              f"fiducials given as {cam.fiducials_given_as}")  # fmt: skip
+              f"{term('fiducials_given_as', lang)} {cam.fiducials_given_as}")  # fmt: skip
     return FormHeader(
         job=job.name,
         job_file=Path(job.source).name,
@@ -89,8 +119,9 @@ def form_header(job: Job, p: PairResult) -> FormHeader:
         date=job.date,
         program=f"stereoplotter {__version__}",
         camera=camera,
-        frame=_frame_text(p.measured),
+        frame=_frame_text(p.measured, lang),
         distortion=job.distortion,
+        least_counts=least_counts(spec) if spec is not None else LeastCounts(),
     )
 
 
@@ -124,15 +155,17 @@ def _plain(value: Any) -> Any:
     raise TypeError(type(value).__name__)
 
 
-def _markdown(job: Job, p: PairResult) -> str:
-    h = form_header(job, p)
+def _markdown(job: Job, p: PairResult, lang: str = "en") -> str:
+    h = form_header(job, p, lang=lang)
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     head = (
-        f"Job **{h.job}** ({h.job_file}), pair **{h.pair}**: left photo {h.left_photo}, right "
-        f"photo {h.right_photo}; map sheet {h.map_sheet}; {h.camera}; frame: {h.frame}; "
-        f"date {h.date}; {h.program}.\n\n"
+        f"{t('job').capitalize()} **{h.job}** ({h.job_file}), {t('pair')} **{h.pair}**: "
+        f"{t('left_photo')} {h.left_photo}, {t('right_photo')} {h.right_photo}; "
+        f"{t('map_sheet')} {h.map_sheet}; {h.camera}; {t('frame')}: {h.frame}; "
+        f"{t('date')} {h.date}; {h.program}.\n\n"
     )
     assert p.sheet is not None
-    text = sheet_markdown(p.sheet)
+    text = sheet_markdown(p.sheet, lang)
     title, rest = text.split("\n", 1)
     return f"{title}\n\n{head}{rest.lstrip()}"
 
@@ -180,9 +213,14 @@ def refused_markdown(result: JobResult) -> str:
     return "\n".join(lines) + "\n"
 
 
-def job_files(result: JobResult) -> dict[str, bytes]:
+def job_files(result: JobResult, lang: str = "en", rigorous: bool = False) -> dict[str, bytes]:
     """Every file of a job, rendered in memory: per pair ``PAIR/sheet.yaml`` (and, set up,
-    ``sheet.md`` and the form ``sheet.pdf``), ``forms.pdf``, ``block.csv`` and ``refused.md``."""
+    ``sheet.md`` and the form ``sheet.pdf``), ``forms.pdf``, ``block.csv`` and ``refused.md``.
+
+    ``lang`` (``"ru"``/``"en"``) is the language of the forms and ``sheet.md``; ``rigorous``
+    prints the rigorous (3.17) mark targets and spans on the forms as the values to set.
+    """
+    check_language(lang)
     files: dict[str, bytes] = {}
     forms = []
     for p in result.pairs:
@@ -190,13 +228,13 @@ def job_files(result: JobResult) -> dict[str, bytes]:
         files[f"{p.pair.name}/sheet.yaml"] = yaml_text(data, width=100).encode("utf-8")
         if p.sheet is None:
             continue
-        header = form_header(result.job, p)
-        files[f"{p.pair.name}/sheet.md"] = _markdown(result.job, p).encode("utf-8")
-        files[f"{p.pair.name}/sheet.pdf"] = form_pdf(p.sheet, header)
+        header = form_header(result.job, p, result.spec, lang)
+        files[f"{p.pair.name}/sheet.md"] = _markdown(result.job, p, lang).encode("utf-8")
+        files[f"{p.pair.name}/sheet.pdf"] = form_pdf(p.sheet, header, lang, rigorous)
         forms.append((p.sheet, header))
     if forms:
-        files["forms.pdf"] = forms_pdf(forms, f"Setup sheets of job {result.job.name}",
-                                       result.job.date)  # fmt: skip
+        title = f"{term('setup_data', lang)}: {result.job.name}"
+        files["forms.pdf"] = forms_pdf(forms, title, result.job.date, lang, rigorous)
     files["block.csv"] = block_csv(result).encode("utf-8")
     files["refused.md"] = refused_markdown(result).encode("utf-8")
     return files

@@ -13,12 +13,14 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from stereoplotter.glossary import check_language, term
 from stereoplotter.instrument.principles import (
     control_name,
     mark_phrase,
     sequence_for,
     setting_values,
 )
+from stereoplotter.report.form_fields import step_text
 from stereoplotter.setup.sheet import SetupSheet, assumed_parameters
 from stereoplotter.setup.table24 import X_MARK_NAME, BlockResult, candidates_of
 
@@ -362,85 +364,93 @@ def _settings_lines(settings: dict[str, Any] | None, title: str) -> list[str]:
     return lines
 
 
-def sheet_markdown(sheet: SetupSheet) -> str:
-    """Table 24 and the stage-by-stage list of readings, as Markdown."""
+def sheet_markdown(sheet: SetupSheet, lang: str = "en") -> str:
+    """Table 24 and the stage-by-stage list of readings, as Markdown in ``lang`` (``"ru"`` uses
+    the book's terms, :mod:`stereoplotter.glossary`)."""
+    check_language(lang)
     d = sheet_to_dict(sheet)
-    lines = _intro_lines(sheet) + _table24_lines(sheet) + _similarity_lines(d)
+    lines = _intro_lines(sheet, lang) + _table24_lines(sheet, lang) + _similarity_lines(d)
     lines += _mark_comparison_lines(sheet)
     lines += _settings_lines(d["instrument_settings"], sheet.instrument_title)
-    lines += _readings_lines(sheet)
+    lines += _readings_lines(sheet, lang)
     return "\n".join(lines) + "\n"
 
 
-def _intro_lines(sheet: SetupSheet) -> list[str]:
+def _intro_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
     """The title, the source and the scale chain."""
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     m_map = sheet.map_scale_denominator
     chain = (  # no map sheet: the horizontal scale was forced, there is no coordinatograph ratio
-        f"no map sheet → horizontal model scale M_г = 1:{sheet.horizontal_scale_denominator} "
-        "(forced; no coordinatograph ratio)" if m_map is None else
-        f"map 1:{m_map} → horizontal model scale M_г = 1:{sheet.horizontal_scale_denominator} "
-        f"(coordinatograph ratio {sheet.horizontal_scale_denominator / m_map:g})"
+        f"{t('md_no_map')} → {t('scale_horizontal')} M_г = 1:{sheet.horizontal_scale_denominator} "
+        f"({t('md_forced')})" if m_map is None else
+        f"{t('md_map')} 1:{m_map} → {t('scale_horizontal')} M_г = "
+        f"1:{sheet.horizontal_scale_denominator} "
+        f"({t('md_ratio')} {sheet.horizontal_scale_denominator / m_map:g})"
     )  # fmt: skip
     return [
-        f"# Setup sheet — {sheet.scenario} on {sheet.instrument_title}",
+        f"# {t('md_title')} — {sheet.scenario} {t('md_on')} {sheet.instrument_title}",
         "",
-        "Computed by stereoplotter after Kushtin & Lyskov (1984), §26, Table 24. Values marked "
-        "**(assumed)** rest on instrument parameters that no source documents "
-        "(`docs/instruments.md`).",
+        t("md_computed"),
         "",
-        f"Scale chain: {chain}; vertical "
+        f"{t('md_chain')}: {chain}; {t('md_vertical')} "
         f"M_в = M_г/k = 1:{sheet.vertical_scale_denominator}; k = f_пр/f′ = "
         f"{sheet.transformation_coefficient:.5f}; n_л = D_max/f_пр = {sheet.n_left:.5f}; "
-        f"projection distances of the working area {sheet.depth_range_used_mm[0]:.1f} … "
+        f"{t('md_depths')} {sheet.depth_range_used_mm[0]:.1f} … "
         f"{sheet.depth_range_used_mm[1]:.1f} mm.",
         "",
     ]
 
 
-def _table24_lines(sheet: SetupSheet) -> list[str]:
+def _table24_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
     """Table 24: scales, f_пр, f′, base, n, marks, spans, decentrations, controls, heights,
     sheet corners; an assumed value flagged."""
-    flag = {k: " **(assumed)**" if params else "" for k, params in sheet.assumed.items()}
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
+    star = f" **({t('md_assumed_flag')})**"
+    flag = {k: star if params else "" for k, params in sheet.assumed.items()}
     left, right = sheet.photos
+    item = t("item1")
+    scale_h = "horizontal scale" if lang == "en" else t("scale_horizontal")
+    scale_v = "vertical scale" if lang == "en" else t("scale_vertical")
     lines = [
-        "## Table 24",
+        f"## {t('table24')}",
         "",
-        "| quantity | symbol | value | unit | equation |",
+        t("md_table24_header"),
         "|---|---|---|---|---|",
-        f"| horizontal scale | M_г | 1:{sheet.horizontal_scale_denominator}"
-        f"{flag['scale_horizontal']} | — | item 1 |",
-        f"| vertical scale | M_в | 1:{sheet.vertical_scale_denominator}"
-        f"{flag['scale_vertical']} | — | item 1 |",
-        f"| instrument principal distance | f_пр | {sheet.f_instrument_mm:.3f}"
-        f"{flag['f_instrument_mm']} | mm | item 1 |",
-        f"| corrected focal length | f′ | {sheet.focal_length_corrected_mm:.4f} | mm | f·l′/l |",
-        f"| base components | b_x, b_y, b_z′ | {_fmt(sheet.base_mm[0])}, {_fmt(sheet.base_mm[1])}, "
-        f"{_fmt(sheet.base_mm[2])}{flag['base_mm']} | mm | item 1 |",
-        f"| counter coefficients | n_л, n_п | {sheet.n_left:.5f}, {sheet.n_right:.5f}"
+        f"| {scale_h} | M_г | 1:{sheet.horizontal_scale_denominator}"
+        f"{flag['scale_horizontal']} | — | {item} |",
+        f"| {scale_v} | M_в | 1:{sheet.vertical_scale_denominator}"
+        f"{flag['scale_vertical']} | — | {item} |",
+        f"| {t('f_instrument')} | f_пр | {sheet.f_instrument_mm:.3f}"
+        f"{flag['f_instrument_mm']} | mm | {item} |",
+        f"| {t('focal_corrected')} | f′ | {sheet.focal_length_corrected_mm:.4f} | mm | f·l′/l |",
+        f"| {t('base_components')} | b_x, b_y, b_z′ | {_fmt(sheet.base_mm[0])}, "
+        f"{_fmt(sheet.base_mm[1])}, {_fmt(sheet.base_mm[2])}{flag['base_mm']} | mm | {item} |",
+        f"| {t('counter_coefficients')} | n_л, n_п | {sheet.n_left:.5f}, {sheet.n_right:.5f}"
         f"{flag['n_left']} | — | (6.3), (6.4) |",
-        f"| marks, left photo | (x⁰₂)_л, (y⁰₃)_л, (y⁰₄)_л | "
+        f"| {t('marks_left')} | (x⁰₂)_л, (y⁰₃)_л, (y⁰₄)_л | "
         f"{_fmt(left.transformed_book_mm['x2'])}, {_fmt(left.transformed_book_mm['y3'])}, "
         f"{_fmt(left.transformed_book_mm['y4'])} | mm | (6.1)/(6.2) |",
-        f"| marks, right photo | (x⁰₁)_п, (y⁰₃)_п, (y⁰₄)_п | "
+        f"| {t('marks_right')} | (x⁰₁)_п, (y⁰₃)_п, (y⁰₄)_п | "
         f"{_fmt(right.transformed_book_mm['x1'])}, {_fmt(right.transformed_book_mm['y3'])}, "
         f"{_fmt(right.transformed_book_mm['y4'])} | mm | (6.1)/(6.2) |",
-        f"| mark spans | L_л, L_п | {left.mark_span_mm:.3f}, {right.mark_span_mm:.3f}"
-        f"{flag['L_mm']} | mm | (6.5) |",
+        f"| {'mark spans' if lang == 'en' else t('mark_spans')} | L_л, L_п | "
+        f"{left.mark_span_mm:.3f}, {right.mark_span_mm:.3f}{flag['L_mm']} | mm | (6.5) |",
     ]
     for p in sheet.photos:
+        side = p.name if lang == "en" else t(p.name)
         lines.append(
-            f"| decentrations, {p.name} | d_x, d_y | {_fmt(p.decentration_mm[0])}, "
+            f"| {t('md_decentrations')}, {side} | d_x, d_y | {_fmt(p.decentration_mm[0])}, "
             f"{_fmt(p.decentration_mm[1])} | mm | f′·tan α, f′·tan ω |"
         )
     lines += _controls_rows(sheet)
     for h in sheet.control_heights:
         lines.append(
-            f"| model height over point {h['id']} | Z_{h['id']} | "
+            f"| {t('md_model_height')} {h['id']} | Z_{h['id']} | "
             f"{h['model_height_mm']:.3f}{flag['control_heights_model_mm']} | mm | (6.6) |"
         )
     for c in sheet.corners:
         lines.append(
-            f"| sheet corner {c['corner']} ({c['position']}) | x′, y′ | "
+            f"| {t('md_sheet_corner')} {c['corner']} ({c['position']}) | x′, y′ | "
             f"{_fmt(c['x_mm'])}, {_fmt(c['y_mm'])}{flag['sheet_corners_mm']} | mm | "
             "(6.7) |"
         )
@@ -486,38 +496,29 @@ def _mark_comparison_lines(sheet: SetupSheet) -> list[str]:
     return lines
 
 
-def _readings_lines(sheet: SetupSheet) -> list[str]:
+def _readings_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
     """Every reading stage by stage, and the assumed parameters used."""
-    lines = [
-        "",
-        "## Readings, stage by stage",
-        "",
-        "Every reading is a zero reading (MO, found on the instrument) plus the signed "
-        "value. The right photo's zero readings are MO_X,п = MO_X + b_x, "
-        "MO_Y,п = MO_Y + b_y.",
-        "",
-    ]
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
+    lines = ["", f"## {t('md_readings')}", "", t("md_readings_intro"), ""]
     stage = None
     for r in sheet.readings:
         if r["stage"] != stage:
             stage = r["stage"]
-            lines += [
-                "",
-                f"### Stage {stage}",
-                "",
-                "| step | reading | equation | tolerance |",
-                "|---|---|---|---|",
-            ]
+            lines += ["", f"### {t('md_stage')} {stage}", "", t("md_readings_header"),
+                      "|---|---|---|---|"]  # fmt: skip
         tol = f"± {r['tolerance']:.4g} {r['unit']}" if "tolerance" in r else ""
-        formula = r["formula"] + (f" (book: {r['book_form']})" if "book_form" in r else "")
-        lines.append(f"| {r['step']} | {formula} | {r['equation']} | {tol} |")
+        book = f" ({t('md_book')}: {r['book_form']})" if "book_form" in r else ""
+        formula = r["formula"] + book
+        if lang != "en":
+            formula = formula.replace("corner", t("corner"))
+        equation = r["equation"] if lang == "en" else r["equation"].replace("item 1", t("item1"))
+        lines.append(f"| {step_text(r, lang)} | {formula} | {equation} | {tol} |")
     if any(sheet.assumed.values()):
         params = sorted({p for ps in sheet.assumed.values() for p in ps})
         lines += [
             "",
-            "## Assumed instrument parameters used",
+            f"## {t('md_assumed_params')}",
             "",
-            "These values come from no documented source; adjust them in the instrument "
-            "YAML if yours differs: " + ", ".join(f"`{p}`" for p in params) + ".",
+            f"{t('md_assumed_params_text')}: " + ", ".join(f"`{p}`" for p in params) + ".",
         ]
     return lines

@@ -5,14 +5,17 @@ advice. The command itself (load, run, write) is :mod:`stereoplotter.commands.si
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
 
+from stereoplotter.glossary import check_language, term
 from stereoplotter.procedure.simulate import SimulationResult
 
 __all__ = [
     "OPERATOR_ADVICE",
+    "OPERATOR_ADVICE_RU",
     "closing_summary",
     "simulation_markdown",
     "tolerance_note",
@@ -202,11 +205,30 @@ OPERATOR_ADVICE = {
 }
 
 
-def _advice(check: str) -> str:
-    for word, text in OPERATOR_ADVICE.items():
+#: The same advice in Russian, by the same keys (the transcript's ``--lang ru``).
+OPERATOR_ADVICE_RU = {
+    "|L − L′|": "измерить оба расстояния ещё раз; если расхождение остаётся, пересчитать f_пр, n "
+    "и L в установочных данных ((6.3)–(6.5)), прежде чем снова вводить ΔZ или Δb_z",
+    "mark 4": "снова установить k_ω по метке 3 и проверить метку 4; если несовпадение остаётся, "
+    "проверить y⁰₃, y⁰₄ или n в установочных данных ((6.2), (6.12))",
+    "residual y-parallax": "ещё раз устранить поперечный параллакс взаимным ориентированием по "
+    "шести стандартным точкам (§27, обычный способ), затем продолжить и записать остаток",
+    "control heights": "ещё раз уточнить масштаб (b_x) и горизонтирование по опорным точкам; "
+    "точку, которая остаётся вне допуска, проверить по опознанию и высоте и исключить, если это "
+    "грубая ошибка",
+    "levelling": "снова горизонтировать по точкам горизонтирования, затем перечитать высоты "
+    "опорных точек",
+    "corner": "снова совместить лист по двум углам и проверить остальные (6.16)–(6.18)",
+    "plan control": "перепроверить масштаб (b_x) и положение листа, затем опознание точек",
+}
+
+
+def _advice(check: str, lang: str = "en") -> str:
+    advice = OPERATOR_ADVICE_RU if lang == "ru" else OPERATOR_ADVICE
+    for word, text in advice.items():
         if word in check:
             return text
-    return "repeat the step and its check; look for a sheet or reading error before going on"
+    return term("cs_default_advice", lang)
 
 
 def _at(value: Any, trial: int) -> float:
@@ -218,54 +240,83 @@ def _small(value: float, unit: str) -> str:
     return f"{value:.3f} m" if unit == "m" else f"{value * 1e3:.1f} µm"
 
 
-def closing_summary(result: SimulationResult) -> str:
+def closing_summary(result: SimulationResult, lang: str = "en") -> str:
     """The transcript's closing summary for trial ``transcript.shown``: every check passed or
     failed with its worst residual and tolerance, the remedies applied, what went wrong and what
-    a real operator would do next (:data:`OPERATOR_ADVICE`)."""
+    a real operator would do next (:data:`OPERATOR_ADVICE`), in ``lang``."""
     t = result.transcript.shown
+    tr = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     rows, failed = [], []
     for name, c in result.checks.items():
+        shown = _stage_words(name, lang)
         if c.tolerance is None or c.passed is None:
-            rows.append(f"- (reported) {name}: {_small(abs(_at(c.residual, t)), c.unit)}")
+            value = _small(abs(_at(c.residual, t)), c.unit)
+            rows.append(f"- ({tr('cs_reported')}) {shown}: {value}")
             continue
         ok = bool(_at(c.passed, t))
         rows.append(
-            f"- {'pass' if ok else 'FAIL'} {name}: worst {_small(abs(_at(c.residual, t)), c.unit)}"
-            f", tolerance {_small(_at(c.tolerance, t), c.unit)}"
+            f"- {tr('cs_pass') if ok else tr('cs_fail')} {shown}: {tr('cs_worst')} "
+            f"{_small(abs(_at(c.residual, t)), c.unit)}, {tr('tolerance')} "
+            f"{_small(_at(c.tolerance, t), c.unit)}"
         )
         if not ok:
             failed.append(name)
     judged = [c for c in result.checks.values() if c.tolerance is not None and c.passed is not None]
     lines = [
-        "## Closing summary",
+        f"## {tr('cs_title')}",
         "",
-        f"Checks: {len(judged) - len(failed)} passed, {len(failed)} failed of {len(judged)}.",
+        tr("cs_checks").format(p=len(judged) - len(failed), f=len(failed), n=len(judged)),
         *rows,
     ]
     applied = [(n, r) for n, r in result.remedies.items() if bool(_at(r.applied, t))]
-    lines += ["", "Remedies applied: " + (", ".join(
-        f"{n} ({int(_at(r.rounds, t))} rounds, check "
-        f"{'passed' if bool(_at(r.passed, t)) else 'still failed'} after)" for n, r in applied
-    ) if applied else "none") + "."]  # fmt: skip
+    lines += ["", f"{tr('cs_remedies')}: " + (", ".join(
+        f"{n} ({int(_at(r.rounds, t))} {tr('cs_rounds')}, "
+        f"{tr('cs_passed_after') if bool(_at(r.passed, t)) else tr('cs_failed_after')})"
+        for n, r in applied
+    ) if applied else tr("none")) + "."]  # fmt: skip
     if not failed:
-        lines += ["", "What went wrong: nothing outside tolerance at the end."]
+        lines += ["", tr("cs_nothing")]
     else:
-        lines += ["", "What went wrong, and what a real operator would do:"]
+        lines += ["", tr("cs_wrong")]
         for name in failed:
             tried = [n for n, r in applied if r.check == name]
-            after = f" after {', '.join(tried)}" if tried else " (no remedy in this practice)"
-            lines.append(f"- {name}: still outside tolerance{after} → {_advice(name)}.")
+            after = f" {tr('cs_after')} {', '.join(tried)}" if tried else f" {tr('cs_no_remedy')}"
+            lines.append(
+                f"- {_stage_words(name, lang)}: {tr('cs_still_outside')}"
+                f"{_stage_words(after, lang)} → {_advice(name, lang)}."
+            )
     return "\n".join(lines) + "\n"
 
 
-def transcript_text(result: SimulationResult) -> str:
+def _stage_words(text: str, lang: str) -> str:
+    """"stage N" of a check's or remedy's name in ``lang``."""
+    if lang == "en":
+        return text
+    return re.sub(r"\bstage (\w+)", lambda m: f"{term('stage', lang)} {m[1]}", text)
+
+
+def _records_text(result: SimulationResult, lang: str) -> str:
+    """The numbered records; in Russian the stage headings and tags are translated (the records'
+    own text is the procedure's, in English)."""
+    text = result.transcript.to_text()
+    if lang == "en":
+        return text
+    stage, iteration = term("md_stage", lang), term("cs_iteration", lang)
+    text = re.sub(r"^## Stage ", f"## {stage} ", text, flags=re.MULTILINE)
+    text = re.sub(r"\[stage (\w+)\]", lambda m: f"[{stage.lower()} {m[1]}]", text)
+    return re.sub(r"\(iteration (\d+)\)", lambda m: f"({iteration} {m[1]})", text)
+
+
+def transcript_text(result: SimulationResult, lang: str = "en") -> str:
     """The learner's transcript: the numbered records, then :func:`closing_summary`."""
-    return result.transcript.to_text() + "\n" + closing_summary(result)
+    check_language(lang)
+    return _records_text(result, lang) + "\n" + closing_summary(result, lang)
 
 
-def trial0_texts(result: SimulationResult) -> dict[str, bytes]:
-    """``transcript.txt`` (:func:`transcript_text`) and ``transcript.jsonl`` of trial 0."""
+def trial0_texts(result: SimulationResult, lang: str = "en") -> dict[str, bytes]:
+    """``transcript.txt`` (:func:`transcript_text`, in ``lang``) and ``transcript.jsonl`` of
+    trial 0."""
     return {
-        "transcript.txt": transcript_text(result).encode("utf-8"),
+        "transcript.txt": transcript_text(result, lang).encode("utf-8"),
         "transcript.jsonl": result.transcript.to_jsonl().encode("utf-8"),
     }

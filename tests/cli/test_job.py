@@ -106,7 +106,7 @@ def test_pdf_text_has_header_photo_numbers_and_readings(written):
     text = "\n".join(page.extract_text() for page in reader.pages)
     flat = re.sub(r"\s+", " ", text)
     for expected in (
-        "Setup sheet (Table 24) — stereopair 104-105",
+        "Setup data (Table 24) — stereopair 104-105",
         "strip8 (job.yaml)",
         "left photo 104, right photo 105",
         "N-35-14-А-б-3, 1:10000",
@@ -117,13 +117,13 @@ def test_pdf_text_has_header_photo_numbers_and_readings(written):
         f"1:{sheet['scale_horizontal']}",
         f"{sheet['f_instrument_mm']:.3f}",
         f"{sheet['base_mm']['bx']:.3f}",
-        "horizontal model scale r·M_map: set the coordinatograph gear",  # a note
+        "set the coordinatograph gear r before stage 1",  # a note
     ):
         assert expected in flat, expected
     readings = sheet["readings"]
     assert len(readings) >= 30
-    for r in readings:  # every stage reading (6.9)–(6.18) is printed as on sheet.yaml
-        assert re.sub(r"\s+", " ", r["formula"]) in flat, r["formula"]
+    for r in readings:  # every stage reading (6.9)–(6.18), at its least count (test_forms.py)
+        assert _at_least_count(r) in flat, r["formula"]
     for corner in sheet["sheet_corners_mm"].values():
         assert f"{corner['x']:.3f}, {corner['y']:.3f}" in flat
     for z in sheet["control_heights_model_mm"].values():
@@ -139,23 +139,31 @@ def test_first_page_has_header_table24_and_every_reading(written, pair):
     flat = re.sub(r"\s+", " ", reader.pages[0].extract_text())
     left, right = pair.split("-")
     for expected in (
-        f"Setup sheet (Table 24) — stereopair {pair}",
+        f"Setup data (Table 24) — stereopair {pair}",
         f"left photo {left}, right photo {right}",
         "2026-11-24 (from the job file)",
         f"stereoplotter {__version__}",
-        "Table 24 — setup data",
+        "Table 24",
         f"1:{sheet['scale_horizontal']}",
         f"{sheet['n_left']:.5f}, {sheet['n_right']:.5f}",
-        "Readings to set, stage by stage (6.9)–(6.18)",
+        "Readings to set (MO + value at the least count)",
     ):
         assert expected in flat, expected
     for r in sheet["readings"]:
-        assert re.sub(r"\s+", " ", r["formula"]) in flat, r["formula"]
+        assert _at_least_count(r) in flat, r["formula"]
     for corner in sheet["sheet_corners_mm"].values():  # sheet.yaml keeps 6 decimals: ±1e-6
         assert any(f"{_3(corner['x'], dx)}, {_3(corner['y'], dy)}" in flat
                    for dx in (-1, 1) for dy in (-1, 1)), corner  # fmt: skip
     for z in sheet["control_heights_model_mm"].values():
         assert _3(z, -1) in flat or _3(z, 1) in flat
+
+
+def _at_least_count(r: dict) -> str:
+    """A reading's value as the form sets it: 0.01 mm on the counters and scales, 0.1 m on the
+    height scale (sc1.yaml); the residual q is a bound, printed as sheet.yaml has it."""
+    if r["reading"] == "residual q":
+        return re.sub(r"\s+", " ", r["formula"])
+    return f"{abs(r['value']):.{2 if r['unit'] == 'mm' else 1}f} {r['unit']}"
 
 
 def _3(value: float, side: int) -> str:

@@ -1,0 +1,301 @@
+"""What the setup form says, in rows of text: the values to set at the least count, the zero
+readings and the (6.9)–(6.11) corrections to write in, the stage-5 readings, the signatures and
+the method's limits (the book's (6.1)/(6.2), (6.5) against the rigorous (3.17)).
+
+Text only, no layout: :mod:`stereoplotter.report.forms` draws these rows. Every label comes from
+:mod:`stereoplotter.glossary` in the form's language.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+from stereoplotter.glossary import term
+from stereoplotter.setup.records import SetupSheet
+
+__all__ = [
+    "LeastCounts",
+    "correction_rows",
+    "limit_rows",
+    "limits_exceeded",
+    "reading_rows",
+    "set_value",
+    "signature_rows",
+    "stage5_rows",
+    "summary_rows",
+    "zero_reading_names",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class LeastCounts:
+    """Least counts of the instrument's counters and scales (from the instrument spec).
+
+    ``counter_mm``: the X, Y counters (marks, spans, corners, points); ``z_mm``: the absolute
+    height counter; ``height_m``: the metre height scale (stage 3); ``scale_mm``: the f_пр, base
+    and decentration scales. ``assumed`` names those the instrument file marks ``assumed``.
+    """
+
+    counter_mm: float = 0.01
+    z_mm: float = 0.01
+    height_m: float = 0.1
+    scale_mm: float = 0.01
+    assumed: frozenset[str] = field(default_factory=frozenset)
+
+    def of(self, reading: str) -> tuple[str, float] | None:
+        """(kind, least count) of the counter or scale a reading is set on; None for none."""
+        if reading == "residual q":
+            return None
+        if reading == "f_пр" or reading.startswith(("O_b", "MO_b", "d_")):
+            return "scale_mm", self.scale_mm
+        if reading == "O_Z":
+            return "z_mm", self.z_mm
+        if reading.startswith("O_Z"):
+            return "height_m", self.height_m
+        return "counter_mm", self.counter_mm
+
+
+def _decimals(step: float) -> int:
+    return max(0, -math.floor(math.log10(step) + 1e-9))
+
+
+def set_value(value: float, step: float) -> str:
+    """``value`` rounded to the least count ``step``, printed to the step's decimals (no −0)."""
+    digits = _decimals(step)
+    rounded = round(value / step) * step
+    text = f"{abs(rounded):.{digits}f}"
+    return ("-" if rounded < 0 and float(text) != 0.0 else "") + text
+
+
+def _signed(value: float, step: float) -> str:
+    text = set_value(value, step)
+    return f"− {text[1:]}" if text.startswith("-") else f"+ {text}"
+
+
+# --- rigorous values --------------------------------------------------------------------------
+
+_MARK = re.compile(r"^O_(?P<axis>[XY])(?P<mark>[1-4]),(?P<side>[лп])$")
+
+
+def _rigorous_value(sheet: SetupSheet, reading: str) -> float | None:
+    """The rigorous (3.17) counterpart n·x⁰, n·y⁰ of a mark target, n·(y⁰₃ − y⁰₄) of a span."""
+    left, right = sheet.photos
+    if reading in ("L_л", "L_п"):
+        photo, n = (left, sheet.n_left) if reading == "L_л" else (right, sheet.n_right)
+        rig = photo.transformed_rigorous_mm
+        return n * (rig["3"][1] - rig["4"][1])
+    m = _MARK.match(reading)
+    if m is None:
+        return None
+    photo, n = (left, sheet.n_left) if m["side"] == "л" else (right, sheet.n_right)
+    return n * photo.transformed_rigorous_mm[m["mark"]][0 if m["axis"] == "X" else 1]
+
+
+def limit_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """Each mark target and span by the book and rigorously, on the counters (× n), with the
+    stage tolerance it is checked against (mark-4 fit for the targets, |L − L′| for spans)."""
+    tol = sheet.tolerances
+    out = []
+    for r in sheet.readings:
+        rig = _rigorous_value(sheet, r["reading"])
+        if rig is None:
+            continue
+        span = r["reading"].startswith("L_")
+        tolerance = tol["mark_span_mm"] if span else tol["mark_fit_mm"]
+        diff = r["value"] - rig
+        out.append({
+            "reading": r["reading"], "book": r["value"], "rigorous": rig, "difference": diff,
+            "tolerance": tolerance, "exceeds": abs(diff) > tolerance,
+            "equation": "(6.5)" if span else r["equation"],
+        })  # fmt: skip
+    return out
+
+
+def limits_exceeded(sheet: SetupSheet) -> bool:
+    """True when any book value deviates from the rigorous one by more than its tolerance."""
+    return any(row["exceeds"] for row in limit_rows(sheet))
+
+
+# --- readings -------------------------------------------------------------------------------------
+
+_STEPS_RU = (
+    (r"^f_пр$", "установить фокусное расстояние прибора f_пр"),
+    (r"^O_bx$", "базисная каретка b_x"),
+    (r"^O_by$", "базисная каретка b_y (MO_by по центрам кассет)"),
+    (r"^O_Z$", "опустить базисную каретку до D_max: абсолютный счётчик высот"),
+    (r"^L_л$", "контроль расстояния между метками 3–4, левый снимок"),
+    (r"^L_п$", "контроль расстояния между метками 3–4, правый снимок"),
+    (r"^MO_bz$", "записать место нуля b_z"),
+    (r"^O_Y3,л$", "левый снимок: k_ω по метке 3"),
+    (r"^O_Y4,л$", "левый снимок: контроль по метке 4"),
+    (r"^O_X2,л$", "левый снимок: k_α по метке 2"),
+    (r"^O_Y3,п$", "правый снимок: k_ω по метке 3"),
+    (r"^O_Y4,п$", "правый снимок: контроль по метке 4"),
+    (r"^O_X1,п$", "правый снимок: k_α по метке 1"),
+    (r"^d_x,л$", "левый снимок: шкала децентрации x"),
+    (r"^d_y,л$", "левый снимок: шкала децентрации y"),
+    (r"^d_x,п$", "правый снимок: шкала децентрации x"),
+    (r"^d_y,п$", "правый снимок: шкала децентрации y"),
+    (r"^O_bz$", "вертикальная составляющая базиса"),
+    (r"^residual q$", "κ_л, κ_п по начальным направлениям; остаточный поперечный параллакс"),
+    (r"^O_Z(?P<id>.+)$", "высотная опорная точка {id}: совместить марку с точкой"),
+    (r"^corner (?P<id>\d)", "угол трапеции {id}"),
+)
+
+
+def step_text(row: dict[str, Any], lang: str) -> str:
+    """What the operator does for a reading row, in ``lang``."""
+    if lang == "en":
+        return str(row["step"])
+    for pattern, text in _STEPS_RU:
+        m = re.match(pattern, row["reading"])
+        if m:
+            return text.format(**m.groupdict())
+    return str(row["step"])  # pragma: no cover - every reading of stages 1–5 is listed above
+
+
+def _reading_text(row: dict[str, Any], value: float, lc: LeastCounts, lang: str) -> str:
+    kind = lc.of(row["reading"])
+    name, zero, unit = row["reading"], row["zero_reading"], row["unit"]
+    name = name.replace("corner", term("corner", lang))
+    if kind is None:
+        return str(row["formula"])
+    step = kind[1]
+    if zero:
+        return f"{name} = {zero} {_signed(value, step)} {unit}"
+    return f"{name} = {set_value(value, step)} {unit}"
+
+
+def _least_count_text(row: dict[str, Any], lc: LeastCounts) -> str:
+    kind = lc.of(row["reading"])
+    if kind is None:
+        return "—"
+    name, step = kind
+    star = " *" if name in lc.assumed else ""
+    return f"{step:g} {'m' if name == 'height_m' else 'mm'}{star}"
+
+
+def _tolerance_text(row: dict[str, Any]) -> str:
+    return f"± {row['tolerance']:.4g} {row['unit']}" if "tolerance" in row else ""
+
+
+def reading_rows(
+    sheet: SetupSheet, lc: LeastCounts, lang: str, rigorous: bool = False
+) -> list[tuple[str, ...]]:
+    """Every reading of stages 1–4 (stage 5 is :func:`stage5_rows`): stage, step, the value to
+    set at its least count (the rigorous one for marks and spans when ``rigorous``, the book's
+    beside it), the least count, the equation, the tolerance and an empty column to write in."""
+    rows = []
+    for r in sheet.readings:
+        if r["stage"] == 5:
+            continue
+        value, equation, extra = r["value"], r["equation"], ""
+        rig = _rigorous_value(sheet, r["reading"]) if rigorous else None
+        if rig is not None:
+            kind = lc.of(r["reading"])
+            step = kind[1] if kind else 0.001
+            extra = f" ({term('limit_book', lang)}: {set_value(value, step)})"
+            value, equation = rig, "(3.17)"
+        equation = equation.replace("item 1", term("item1", lang))
+        rows.append((str(r["stage"]), step_text(r, lang), _reading_text(r, value, lc, lang) + extra,
+                     _least_count_text(r, lc), equation, _tolerance_text(r), ""))  # fmt: skip
+    return rows
+
+
+def summary_rows(
+    sheet: SetupSheet, lc: LeastCounts, lang: str, rigorous: bool = False
+) -> list[tuple[str, str]]:
+    """The compact readings of page 1: one row per stage, every value at its least count."""
+    out = []
+    for stage in range(1, 6):
+        texts, tolerances = [], {}
+        for r in sheet.readings:
+            if r["stage"] != stage:
+                continue
+            rig = _rigorous_value(sheet, r["reading"]) if rigorous else None
+            texts.append(_reading_text(r, r["value"] if rig is None else rig, lc, lang))
+            if "tolerance" in r and r["reading"] != "residual q":
+                name = re.sub(r"\d+$", "i", r["reading"]) if stage == 3 else r["reading"]
+                name = name.replace("corner", term("corner", lang))
+                tolerances.setdefault(f"±{r['tolerance']:.3g} {r['unit']}", []).append(name)
+        if stage == 5:
+            texts.append(f"{term('points_stage5', lang)}: "
+                         + ", ".join(str(p["id"]) for p in _stage5_points(sheet)))  # fmt: skip
+        tol = "; ".join(f"{', '.join(dict.fromkeys(n))} {t}" for t, n in tolerances.items())
+        if texts:
+            tail = f". {term('tolerance', lang)}: {tol}" if tol else ""
+            out.append((term(f"stage_{stage}", lang), "; ".join(texts) + tail))
+    return out
+
+
+# --- write-in fields ----------------------------------------------------------------------------
+
+
+def zero_reading_names(sheet: SetupSheet) -> list[str]:
+    """The zero readings every reading depends on, in the order the readings use them."""
+    names = dict.fromkeys(["MO_X", "MO_Y", "MO_Z"])
+    for r in sheet.readings:
+        zero = r["zero_reading"]
+        if zero.startswith("MO") and "," not in zero:
+            names.setdefault(zero)
+    names.setdefault("MO_bz")
+    return list(names)
+
+
+def correction_rows(sheet: SetupSheet, lang: str, rigorous: bool = False) -> list[tuple[str, ...]]:
+    """Rows of the (6.9)–(6.11) corrections: symbol, quantity, formula, factor, field.
+
+    D = n_л·f_пр is the absolute height reading of stage 1 (6.3); the factors are those of
+    :func:`stereoplotter.setup.equations.height_correction` and ``base_z_correction`` evaluated
+    for this sheet, so the operator multiplies the span error ΔL = L − L′ by them.
+    """
+    left, right = sheet.photos
+    d = sheet.n_left * sheet.f_instrument_mm
+    spans = {"L_л": left.mark_span_mm, "L_п": right.mark_span_mm}
+    if rigorous:
+        spans = {k: _rigorous_value(sheet, k) or v for k, v in spans.items()}
+    ll, lr = spans["L_л"], spans["L_п"]
+    mv = sheet.vertical_scale_denominator
+    sign = "+" if sheet.options.bz_scale_sense > 0 else "−"
+    blank = "__________"
+    return [
+        ("L′_л", term("corr_L_left", lang), f"L_л (6.5) = {ll:.3f} mm", "", f"{blank} mm"),
+        ("ΔZ", term("corr_dz", lang), "ΔZ = D·(L_л − L′_л)·M_в/(1000·L_л)",
+         f"{d * mv / (1000.0 * ll):.4f} m/mm", f"{blank} m"),
+        ("O′_Z", term("corr_dz_counter", lang), "O′_Z = O_Z + D·(L_л − L′_л)/L_л",
+         f"{d / ll:.5f}", f"{blank} mm"),
+        ("L′_п", term("corr_L_right", lang), f"L_п (6.5) = {lr:.3f} mm", "", f"{blank} mm"),
+        ("Δb_z", term("corr_dbz", lang), "Δb_z = D·(L_п − L′_п)/L_п", f"{d / lr:.5f}",
+         f"{blank} mm"),
+        ("O′_bz", term("corr_bz", lang), f"O′_bz = O_bz {sign} Δb_z", "", f"{blank} mm"),
+    ]  # fmt: skip
+
+
+def _stage5_points(sheet: SetupSheet) -> list[dict[str, Any]]:
+    return [p for p in sheet.points_model_mm if p["role"] == "check" or p["kind"] != "height"]
+
+
+def stage5_rows(sheet: SetupSheet, lc: LeastCounts, lang: str) -> list[tuple[str, ...]]:
+    """Stage 5: corner 4 and the x′, y′ readings of the plan control and check points, at the
+    counters' least count, with the coordinatograph tolerance of corner 4 and fields to write."""
+    step = lc.counter_mm
+    tol = f"± {sheet.tolerances['corner_mm']:.2g} mm"
+    rows = []
+    for c in sheet.corners:
+        if c["corner"] == "4":
+            rows.append((f"{term('corner', lang)} 4", c["position"],
+                         f"O_X = MO_X {_signed(c['x_mm'], step)}",
+                         f"O_Y = MO_Y {_signed(c['y_mm'], step)}", tol, "", ""))  # fmt: skip
+    for p in _stage5_points(sheet):
+        role = term("check_point" if p["role"] == "check" else "plan_control", lang)
+        rows.append((str(p["id"]), role, f"O_X = MO_X {_signed(p['x_mm'], step)}",
+                     f"O_Y = MO_Y {_signed(p['y_mm'], step)}", tol, "", ""))  # fmt: skip
+    return rows
+
+
+def signature_rows(lang: str) -> list[tuple[str, ...]]:
+    """Operator and checker: name, signature and date fields."""
+    return [(term(who, lang), "_" * 30, "_" * 24, "_" * 16) for who in ("operator", "checker")]

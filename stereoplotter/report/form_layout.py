@@ -1,0 +1,180 @@
+"""The setup form's document and drawing primitives: the A4 page with its fonts, tables, and text
+labels placed so that none overlaps another (the drawing's point and corner labels).
+
+fpdf2 (a document library: real text that can be searched and extracted, vector drawing,
+embedded TrueType subsets). The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
+font that ships inside matplotlib (``mpl-data/fonts/ttf``), found without importing matplotlib,
+so no system font is read.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import importlib.util
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from fpdf import FPDF
+from fpdf.enums import XPos, YPos
+from fpdf.fonts import FontFace
+
+__all__ = ["FONT", "Form", "LabelPlacer", "font_path", "heading", "paragraph", "table"]
+
+FONT = "DejaVu"
+MARGIN_LEFT, MARGIN_RIGHT, MARGIN_TOP, MARGIN_BOTTOM = 20.0, 15.0, 12.0, 16.0
+_PT = 0.3528  # mm per point
+
+
+def font_path(style: str = "") -> str:
+    """The DejaVu font file matplotlib ships, found without importing matplotlib (its package
+    folder from the import system's spec: only ``plotting`` imports matplotlib)."""
+    name = {"": "DejaVuSans.ttf", "B": "DejaVuSans-Bold.ttf"}[style]
+    spec = importlib.util.find_spec("matplotlib")
+    if spec is None or not spec.submodule_search_locations:  # pragma: no cover - a dependency
+        raise RuntimeError("matplotlib (a dependency) is not installed: no DejaVu font")
+    folder = Path(next(iter(spec.submodule_search_locations)))
+    return str(folder / "mpl-data" / "fonts" / "ttf" / name)
+
+
+class Form(FPDF):
+    """A4 portrait with the margins, fonts and the running footer of the forms.
+
+    The creation date is the job's date, never the clock, and no producer version is written:
+    the same inputs give the same bytes.
+    """
+
+    def __init__(self, date: str, page_word: str = "page") -> None:
+        super().__init__(orientation="P", unit="mm", format="A4")
+        self.add_font(FONT, "", font_path(""))
+        self.add_font(FONT, "B", font_path("B"))
+        self.set_margins(MARGIN_LEFT, MARGIN_TOP, MARGIN_RIGHT)
+        self.set_auto_page_break(True, MARGIN_BOTTOM)
+        day = _dt.datetime.strptime(date, "%Y-%m-%d").replace(tzinfo=_dt.UTC)
+        self.set_creation_date(day)
+        self.set_producer("stereoplotter")
+        self.set_creator("stereoplotter")
+        self.footer_text = ""
+        self.page_word = page_word
+
+    def close_fonts(self) -> None:
+        """Close the font files of a document that is never output (a trial layout)."""
+        for font in self.fonts.values():
+            close = getattr(font, "close", None)
+            if close is not None:
+                close()
+
+    def footer(self) -> None:
+        self.set_y(-MARGIN_BOTTOM + 5)
+        self.set_font(FONT, "", 7)
+        self.set_text_color(90)
+        self.cell(0, 4, self.footer_text, align="L")
+        self.set_x(self.l_margin)
+        self.cell(0, 4, f"{self.page_word} {self.page_no()}", align="R")
+        self.set_text_color(0)
+
+
+def heading(pdf: Form, text: str, size: float = 11.0) -> None:
+    pdf.set_font(FONT, "B", size)
+    pdf.cell(0, 1.5 * size * _PT + 1.0, text, new_x=XPos.LMARGIN, new_y=YPos.NEXT)
+    pdf.set_font(FONT, "", 8)
+
+
+def paragraph(pdf: Form, text: str, size: float = 7.5) -> None:
+    pdf.set_font(FONT, "", size)
+    pdf.multi_cell(0, 1.3 * size * _PT, text, new_x=XPos.LMARGIN, new_y=YPos.NEXT)
+
+
+def table(
+    pdf: Form,
+    header: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    widths: Sequence[float],
+    size: float = 7.5,
+    aligns: Sequence[str] | None = None,
+    gap: float = 2.0,
+) -> None:
+    """A table over the page width; rows that do not fit continue on the next page."""
+    pdf.set_font(FONT, "", size)
+    headings = any(header)
+    with pdf.table(
+        first_row_as_headings=headings,
+        col_widths=tuple(widths),
+        width=pdf.epw,
+        line_height=1.22 * size * _PT + 0.5,
+        text_align=tuple(aligns) if aligns else "LEFT",
+        headings_style=_headings_style(),
+        borders_layout="SINGLE_TOP_LINE",
+        padding=0.5,
+    ) as t:
+        if headings:
+            row = t.row()
+            for h in header:
+                row.cell(h)
+        for r in rows:
+            row = t.row()
+            for c in r:
+                row.cell(str(c))
+    pdf.ln(gap)
+
+
+def _headings_style() -> Any:
+    return FontFace(family=FONT, emphasis="BOLD", fill_color=(225, 225, 225))
+
+
+#: Where a label goes around its point, tried in this order: (dx, dy) of the text's baseline
+#: start in font heights, with the label's width subtracted for the left-hand places (w = 1).
+_PLACES = (
+    (0.6, 1.05, 0), (0.6, -0.35, 0), (-0.6, 1.05, 1), (-0.6, -0.35, 1),
+    (-0.5, 1.6, 0.5), (-0.5, -0.9, 0.5), (0.9, 0.35, 0), (-0.9, 0.35, 1),
+    (0.6, 2.1, 0), (-0.6, 2.1, 1), (0.6, -1.4, 0), (-0.6, -1.4, 1),
+)  # fmt: skip
+
+
+class LabelPlacer:
+    """Writes text labels next to points so that no two labels' boxes overlap.
+
+    A label's box is its advance width (the font's metrics) by the font's ascent and descent
+    (0.8 and 0.25 of the size); the first place of :data:`_PLACES` whose box overlaps no
+    earlier box is taken, else the one that overlaps least.
+    """
+
+    def __init__(self, pdf: Form) -> None:
+        self.pdf = pdf
+        self.boxes: list[tuple[float, float, float, float]] = []
+
+    def _box(self, x: float, y: float, width: float) -> tuple[float, float, float, float]:
+        size = self.pdf.font_size  # mm
+        return (x, y - 0.8 * size, x + width, y + 0.25 * size)
+
+    def _overlap(self, box: tuple[float, float, float, float]) -> float:
+        total = 0.0
+        for b in self.boxes:
+            w = min(box[2], b[2]) - max(box[0], b[0])
+            h = min(box[3], b[3]) - max(box[1], b[1])
+            if w > 0 and h > 0:
+                total += w * h
+        return total
+
+    def reserve(self, box: tuple[float, float, float, float]) -> None:
+        """Keep labels off an area (a symbol, the scale bar)."""
+        self.boxes.append(box)
+
+    def text(self, x: float, y: float, label: str) -> None:
+        """Write at (x, y) as baseline start, and reserve its box (no choice of place)."""
+        self.boxes.append(self._box(x, y, self.pdf.get_string_width(label)))
+        self.pdf.text(x, y, label)
+
+    def label(self, px: float, py: float, label: str) -> None:
+        """Write ``label`` beside the point (px, py) where it overlaps no earlier label."""
+        width, size = self.pdf.get_string_width(label), self.pdf.font_size
+        best: tuple[float, float, float] | None = None
+        for dx, dy, shift in _PLACES:
+            x, y = px + dx * size - shift * width, py + dy * size
+            cost = self._overlap(self._box(x, y, width))
+            if best is None or cost < best[0]:
+                best = (cost, x, y)
+            if cost == 0.0:
+                break
+        assert best is not None
+        self.text(best[1], best[2], label)
