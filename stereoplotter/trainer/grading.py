@@ -331,7 +331,7 @@ SUBSTITUTE_FRACTION = 0.2
 
 def _substitute_row(session: Session, n: int) -> dict[str, Any]:
     """The distance of the recorded substitute from standard point n on the left photo. [mm]"""
-    il = session.prep.scene.images(session.prep.scene.standard_points_m)[0]
+    il = session.prep.scene.standard[0]
     value = session.records.get(f"substitute {n}")
     tol = SUBSTITUTE_FRACTION * session.prep.scene.c_mm
     d = float(np.hypot(*(np.asarray(value, float) - il[n - 1]))) if value else float("inf")

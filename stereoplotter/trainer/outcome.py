@@ -94,7 +94,7 @@ def _span_error(inst: Instrument, prep: PreparedRun) -> NDArray[np.float64]:
 def _q_max(inst: Instrument, prep: PreparedRun) -> NDArray[np.float64]:
     op = Operator(inst, OperatorModel(), Noise(0, inst.trials, None, 0), Transcript(enabled=False))
     scene = prep.scene
-    q = op.y_parallax(scene.standard_points_m, scene.images(scene.standard_points_m))
+    q = op.y_parallax(scene.standard_points_m, scene.standard)
     return np.max(np.abs(np.nan_to_num(np.asarray(q, float), nan=np.inf)), axis=-1)
 
 

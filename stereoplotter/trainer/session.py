@@ -117,8 +117,6 @@ class Session:
         self._undo: list[_Undoable] = []
         self._redo: list[_Undoable] = []
         self._t0 = time.monotonic() if clock else None
-        scene = self.prep.scene
-        self._std_images = scene.images(scene.standard_points_m)
         for stage in exercise.preset_stages:
             for action in self.par.stage_actions(stage):
                 apply(self.inst, action, self.commanded)
@@ -297,7 +295,7 @@ class Session:
         """
         if not self.exercise.allows("parallax_readout") or "f_instrument" not in self.commanded:
             return None
-        il, ir = self._std_images
+        il, ir = self.prep.scene.standard
         pl, pr = (np.asarray(p, float).reshape(-1) for p in self.inst.marks())
         distance = np.hypot(*(il - pl).T)
         for n in self.exercise.unusable_points:  # on water or outside the overlap: no reading
@@ -535,7 +533,7 @@ class Session:
                 script.append({k: v for k, v in a.items() if k != "stage"})
             if stage in SUBSTITUTE_STAGES:  # the operator's substitute: the standard point itself
                 for n in self.exercise.unusable_points:
-                    xy = [float(v) for v in self._std_images[0][n - 1]]
+                    xy = [float(v) for v in self.prep.scene.standard[0][n - 1]]
                     script.append({"kind": "record", "name": f"substitute {n}", "value": xy})
             script.append({"kind": "claim", "step": stage})
         return script
