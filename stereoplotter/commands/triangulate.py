@@ -113,7 +113,7 @@ def _solve(block: Any, args: argparse.Namespace) -> Any:
 
 def run(args: argparse.Namespace) -> int:
     # imported here: the CLI starts fast (no pyproj, matplotlib or pydantic until a command runs)
-    from stereoplotter.io.atomic_write import atomic_write_bytes, atomic_write_text
+    from stereoplotter.io.atomic_write import write_files
     from stereoplotter.io.block_measurements_file import load_block_measurements
     from stereoplotter.io.triangulated_job import job_files
     from stereoplotter.plotting.triangulation import residual_figure_png
@@ -139,11 +139,8 @@ def run(args: argparse.Namespace) -> int:
     files["residuals.png"] = residual_figure_png(block, solution, residuals)
     files["report.md"] = report_markdown(block, solution, residuals, args.block)
     out = Path(args.output)
-    for name, content in files.items():  # every file whole or not at all
-        if isinstance(content, bytes):
-            atomic_write_bytes(out / name, content)
-        else:
-            atomic_write_text(out / name, content)
+    encoded = {n: c if isinstance(c, bytes) else c.encode("utf-8") for n, c in files.items()}
+    write_files(out, encoded)  # every file whole or not at all
     rms = residuals.rms(block, "check")
     job = f"; job file {out / 'job.yaml'}" if production is not None else ""
     print(

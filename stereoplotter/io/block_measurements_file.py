@@ -36,7 +36,7 @@ from pydantic import ConfigDict, Field, field_validator
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.geometry.film import fiducial_spans_mm
-from stereoplotter.io.atomic_write import atomic_write_text
+from stereoplotter.io.atomic_write import write_files
 from stereoplotter.io.job_file import Certificate, NamedSheet, _check_date
 from stereoplotter.io.scenario_file import Origin, camera_from_model
 from stereoplotter.io.validation import FileModel, _fail, number, one_of, sequence, text, validate
@@ -381,8 +381,6 @@ def write_block_measurements(
         "control.csv": _csv_text(CONTROL_COLUMNS, control),
         "block.yaml": "\n".join(text_lines) + "\n" + production_yaml,
     }
-    paths = []
-    for name, content in files.items():  # the YAML last: it refers to the CSV files
-        atomic_write_text(out / name, content)
-        paths.append(out / name)
-    return paths
+    # the YAML last: it refers to the CSV files
+    written = write_files(out, {name: text.encode("utf-8") for name, text in files.items()})
+    return list(written.values())

@@ -30,7 +30,7 @@ from stereoplotter.geodesy.gauss_kruger import geographic_from_gauss_kruger
 from stereoplotter.geodesy.map_sheet import sheet_bounds
 from stereoplotter.geodesy.photogrammetric import gauss_kruger_from_local
 from stereoplotter.geometry.film import fiducial_spans_mm
-from stereoplotter.io.atomic_write import atomic_write_text
+from stereoplotter.io.atomic_write import write_files
 from stereoplotter.io.block_measurements_file import Production, camera_yaml, yaml_flow
 from stereoplotter.io.job_file import FORMAT as JOB_FORMAT
 from stereoplotter.scenario import frame as frame_tie
@@ -209,8 +209,5 @@ def write_triangulated_job(
     """Write :func:`job_files` into ``folder`` (each file whole or not at all; ``job.yaml``
     last). Returns the paths."""
     files = job_files(block, production, orientations, source=source, description=description)
-    paths = []
-    for name, text in files.items():
-        atomic_write_text(Path(folder) / name, text)
-        paths.append(Path(folder) / name)
-    return paths
+    written = write_files(folder, {name: text.encode("utf-8") for name, text in files.items()})
+    return list(written.values())
