@@ -202,6 +202,9 @@ class Instrument:
         the needle is driven by the tracking servo (:mod:`stereoplotter.instrument.sc1_complex`)
         instead of the geared screws. The error-correction unit acts on the image coordinates
         before they reach the instrument (``procedure.simulate``).
+    options_checked : bool
+        ``options`` are fitted to ``spec`` already (:meth:`SC1Options.fitted_to`, done once per
+        run by ``procedure.simulate.prepare_run``): not checked again.
 
     Notes
     -----
@@ -223,6 +226,7 @@ class Instrument:
         ideal_mechanics: bool = False,
         injected: dict[str, Any] | None = None,
         options: SC1Options | None = None,
+        options_checked: bool = False,
     ):
         if backend not in BACKENDS:
             raise StereoplotterError(
@@ -233,8 +237,11 @@ class Instrument:
                 "the pymunk back-end runs single instruments; use backend='closed-form' for trials"
             )
         self.spec = spec
-        # checked against the instrument file: only the SC-1 of the SC complex has them
-        self.options = options.fitted_to(spec) if options else SC1Options()
+        # checked against the instrument file (only the SC-1 of the SC complex has them) unless
+        # the caller fitted them to this spec already (a prepared run checks them once)
+        if options is None:
+            options = SC1Options()
+        self.options = options if options_checked else options.fitted_to(spec)
         self._servo: AutomaticCoordinatograph | None = None
         self.variant = decentration_variant(variant)
         self.backend = backend

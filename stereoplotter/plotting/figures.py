@@ -14,7 +14,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from stereoplotter.procedure.simulate import residual_grid_m
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import footprint_m
 
@@ -267,7 +266,7 @@ def plot_residual_y_parallax(result: Any, ax: Any = None) -> Any:
         fig, ax = plt.subplots(figsize=(6, 5))
     else:
         fig = ax.figure
-    grid = residual_grid_m(result.scene.scenario)
+    grid = result.scene.grid_m
     q = np.asarray(result.q_grid_mm)
     q = q[0] if q.ndim > 1 else q
     sc = ax.scatter(grid[:, 0], grid[:, 1], c=q * 1e3, cmap="RdBu_r", s=80)

@@ -77,7 +77,8 @@ from stereoplotter.instrument.kinematics import (
     counters_from_homologous_points,
     marks_from_counters,
 )
-from stereoplotter.scenario.model import Scenario
+from stereoplotter.procedure.evaluation_results import ModelEvaluation, PointSetEvaluation
+from stereoplotter.scenario.model import Camera, Photo, Scenario
 from stereoplotter.scenario.synthetic import film_deformed, working_area_grid_m
 from stereoplotter.setup.equations import height_scale_reading, model_height
 from stereoplotter.setup.sheet import instrument_frame_m
@@ -85,14 +86,19 @@ from stereoplotter.setup.sheet import instrument_frame_m
 __all__ = [
     "STANDARD_POINTS_C_MM",
     "ModelEvaluation",
+    "ModelTruth",
     "PointSetEvaluation",
+    "PointSetTruth",
+    "evaluate_against",
     "evaluate_instrument",
     "evaluate_model",
     "film_points_mm",
     "ideal_model_mm",
     "instrument_frame_m",
+    "model_truth",
     "parallax_errors_at_ideal",
     "parallax_map_data",
+    "photo_points_mm",
     "plane_residuals",
     "standard_points_m",
 ]
@@ -169,11 +175,15 @@ def film_points_mm(scenario: Scenario, photo_name: str, points_m: ArrayLike) -> 
     principal point stays in the coordinates: the instrument carries it as a centring error
     (``setup-data.md``, Inputs).
     """
-    photo = scenario.photo(photo_name)
-    cam = scenario.camera
+    return photo_points_mm(scenario.camera, scenario.photo(photo_name), points_m)
+
+
+def photo_points_mm(camera: Camera, photo: Photo, points_m: ArrayLike) -> _F:
+    """:func:`film_points_mm` on one photo of the truth (its camera, exterior orientation and
+    film deformation). [m → mm]"""
     ext = photo.exterior
     xy = object_to_photo(
-        points_m, ext.centre, ext.rotation, cam.focal_length_mm, cam.principal_point_mm
+        points_m, ext.centre, ext.rotation, camera.focal_length_mm, camera.principal_point_mm
     )
     return film_deformed(photo, xy)
 
@@ -371,230 +381,12 @@ def _with_point_axis(obj: Any) -> Any:
 
 
 # --------------------------------------------------------------------------------------------
-# Results
-# --------------------------------------------------------------------------------------------
-
-
-def _rms(v: _F) -> _F:
-    return np.sqrt(np.mean(np.square(v), axis=-1))
-
-
-def _max_abs(v: _F) -> _F:
-    return np.max(np.abs(v), axis=-1)
-
-
-def _plain(v: Any) -> Any:
-    """JSON-ready: ndarrays to (nested) lists, numpy scalars to float."""
-    if isinstance(v, dict):
-        return {k: _plain(x) for k, x in v.items()}
-    if isinstance(v, list | tuple):
-        return [_plain(x) for x in v]
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    if isinstance(v, np.floating | np.integer):
-        return v.item()
-    return v
-
-
-def _out(v: _F, trials: int | None) -> Any:
-    """Summary value: a float for a single instrument, an array (T,) for T trials."""
-    v = np.asarray(v, float)
-    return float(v) if trials is None else v
-
-
-@dataclass(frozen=True, slots=True)
-class PointSetEvaluation:
-    r"""Errors of the built model at one set of ground points (grid, standard, control or check).
-
-    Attributes
-    ----------
-    ids : tuple of str
-        Point ids (grid points "g0", "g1", … in row-major order from low Y, low X).
-    ground_m : ndarray, shape (n, 3)
-        The points in the instrument frame (origin S_л, base along +X). [m]
-    model_mm : ndarray, shape (n, 3)
-        Ideal model (X − MO_X, Y − MO_Y, D). [mm]
-    x_parallax_error_mm, y_parallax_mm : ndarray, shape (n,) or (T, n)
-        δp and q at the ideal position (module docstring). [photo mm]
-    x_error_m, y_error_m : ndarray, shape (n,) or (T, n)
-        Plan error of the built point along the instrument-frame axes. [m]
-    height_error_m : ndarray, shape (n,) or (T, n)
-        ΔH of the built point, + = too high. [m]
-    y_parallax_seen_mm : ndarray, shape (n,) or (T, n)
-        The y-parallax the operator sees at the built point (``kinematics.md`` §3.4 sign). [mm]
-    height_error_after_plane_m, x_parallax_error_after_plane_mm : ndarray or None
-        The same after removing the plane fitted at the plane control points. [m], [mm]
-    """
-
-    ids: tuple[str, ...]
-    ground_m: _F
-    model_mm: _F
-    x_parallax_error_mm: _F
-    y_parallax_mm: _F
-    x_error_m: _F
-    y_error_m: _F
-    height_error_m: _F
-    y_parallax_seen_mm: _F
-    height_error_after_plane_m: _F | None = None
-    x_parallax_error_after_plane_mm: _F | None = None
-
-    @property
-    def plan_error_m(self) -> _F:
-        """|ΔX, ΔY| of the built point. [m]"""
-        return np.hypot(self.x_error_m, self.y_error_m)
-
-    def summary(
-        self, flying_height_m: float, map_scale_denominator: int | None, trials: int | None
-    ) -> dict[str, Any]:
-        """Max |·| and RMS over the points of every error (floats, or arrays (T,) for T trials).
-
-        Keys end in their unit: ``_mm`` photo mm (parallaxes), ``_m`` ground metres,
-        ``_map_mm`` mm on the map, ``_permille`` ‰ of the mean flying height H̄.
-        """
-        if not self.ids:
-            return {}
-        out: dict[str, Any] = {"n_points": len(self.ids)}
-        per_h = MM_PER_M / float(flying_height_m)
-
-        def put(name: str, v: _F | None, unit: str) -> None:
-            if v is None:
-                return
-            out[f"{name}_max_{unit}"] = _out(_max_abs(v), trials)
-            out[f"{name}_rms_{unit}"] = _out(_rms(v), trials)
-
-        put("x_parallax_error", self.x_parallax_error_mm, "mm")
-        put("y_parallax", self.y_parallax_mm, "mm")
-        put("x_parallax_error_after_plane", self.x_parallax_error_after_plane_mm, "mm")
-        put("plan_error", self.plan_error_m, "m")
-        if map_scale_denominator:
-            put("plan_error", self.plan_error_m * MM_PER_M / map_scale_denominator, "map_mm")
-        put("height_error", self.height_error_m, "m")
-        put("height_error", self.height_error_m * per_h, "permille")
-        if self.height_error_after_plane_m is not None:
-            put("height_error_after_plane", self.height_error_after_plane_m, "m")
-            put("height_error_after_plane", self.height_error_after_plane_m * per_h, "permille")
-        return out
-
-    def per_point(
-        self, flying_height_m: float, map_scale_denominator: int | None
-    ) -> dict[str, Any]:
-        """Per-point values (arrays (n,) or (T, n)) with derived units, keyed like ``summary``."""
-        per_h = MM_PER_M / float(flying_height_m)
-        out: dict[str, Any] = {
-            "ids": list(self.ids),
-            "ground_m": self.ground_m,
-            "model_mm": self.model_mm,
-            "x_parallax_error_mm": self.x_parallax_error_mm,
-            "y_parallax_mm": self.y_parallax_mm,
-            "y_parallax_seen_mm": self.y_parallax_seen_mm,
-            "x_error_m": self.x_error_m,
-            "y_error_m": self.y_error_m,
-            "plan_error_m": self.plan_error_m,
-            "height_error_m": self.height_error_m,
-            "height_error_permille": self.height_error_m * per_h,
-        }
-        if map_scale_denominator:
-            scale = MM_PER_M / map_scale_denominator
-            out["x_error_map_mm"] = self.x_error_m * scale
-            out["y_error_map_mm"] = self.y_error_m * scale
-            out["plan_error_map_mm"] = self.plan_error_m * scale
-        if self.height_error_after_plane_m is not None:
-            out["height_error_after_plane_m"] = self.height_error_after_plane_m
-            out["height_error_after_plane_permille"] = self.height_error_after_plane_m * per_h
-        if self.x_parallax_error_after_plane_mm is not None:
-            out["x_parallax_error_after_plane_mm"] = self.x_parallax_error_after_plane_mm
-        return out
-
-
-@dataclass(frozen=True, slots=True)
-class ModelEvaluation:
-    r"""The evaluation of a built model against the ground truth (see the module docstring).
-
-    Attributes
-    ----------
-    trials : int or None
-        T for a vectorised evaluation, None for a single instrument.
-    horizontal_scale_denominator, vertical_scale_denominator : int
-        M_г, M_в of the sheet (the ideal model). [—]
-    map_scale_denominator : int or None
-        M_map (plan errors on the map). [—]
-    flying_height_m : float
-        H̄ = Z_Sл − mean Z over the working-area grid (the H of ‰ H). [m]
-    height_zero_m : float or ndarray
-        The height-scale reading at D = 0 used to read the built heights. [m]
-    standard_points_c_mm : float
-        c of the standard points 3–6. [mm]
-    plane_point_ids : tuple of str
-        Control points the plane is fitted at (empty: no plane removal).
-    grid, standard_points, control, check : PointSetEvaluation
-        The uniform working-area grid, the six standard points (ids "1"–"6"), the control and the
-        independent check points imaged on both photos.
-    not_imaged : tuple of str
-        Control/check points outside the format of a photo (not evaluated).
-    corner4_misclosure_mm : float, ndarray or None
-        Passed through from the procedure (stage 5, Eq. (6.18) of [1]_). [mm on the sheet]
-    """
-
-    trials: int | None
-    horizontal_scale_denominator: int
-    vertical_scale_denominator: int
-    map_scale_denominator: int | None
-    flying_height_m: float
-    height_zero_m: Any
-    standard_points_c_mm: float
-    plane_point_ids: tuple[str, ...]
-    grid: PointSetEvaluation
-    standard_points: PointSetEvaluation
-    control: PointSetEvaluation
-    check: PointSetEvaluation
-    not_imaged: tuple[str, ...] = ()
-    corner4_misclosure_mm: Any = None
-
-    def sets(self) -> dict[str, PointSetEvaluation]:
-        """The four point sets by name."""
-        return {
-            "grid": self.grid,
-            "standard_points": self.standard_points,
-            "control": self.control,
-            "check": self.check,
-        }
-
-    def summary(self) -> dict[str, dict[str, Any]]:
-        """Max |·| and RMS per point set (see :meth:`PointSetEvaluation.summary`)."""
-        return {
-            name: s.summary(self.flying_height_m, self.map_scale_denominator, self.trials)
-            for name, s in self.sets().items()
-        }
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary (lists and floats): settings, summaries and per-point values."""
-        out: dict[str, Any] = {
-            "trials": self.trials,
-            "horizontal_scale_denominator": self.horizontal_scale_denominator,
-            "vertical_scale_denominator": self.vertical_scale_denominator,
-            "map_scale_denominator": self.map_scale_denominator,
-            "flying_height_m": self.flying_height_m,
-            "height_zero_m": self.height_zero_m,
-            "standard_points_c_mm": self.standard_points_c_mm,
-            "plane_point_ids": list(self.plane_point_ids),
-            "not_imaged": list(self.not_imaged),
-            "corner4_misclosure_mm": self.corner4_misclosure_mm,
-            "summary": self.summary(),
-            "points": {
-                name: s.per_point(self.flying_height_m, self.map_scale_denominator)
-                for name, s in self.sets().items()
-            },
-        }
-        return _plain(out)
-
-
-# --------------------------------------------------------------------------------------------
 # The evaluation
 # --------------------------------------------------------------------------------------------
 
 
-def _imaged(scenario: Scenario, *xy: _F) -> NDArray[np.bool_]:
-    half = scenario.camera.format_mm / 2.0
+def _imaged(format_mm: float, *xy: _F) -> NDArray[np.bool_]:
+    half = format_mm / 2.0
     ok = np.ones(xy[0].shape[:-1], bool)
     for v in xy:
         with np.errstate(invalid="ignore"):
@@ -602,8 +394,6 @@ def _imaged(scenario: Scenario, *xy: _F) -> NDArray[np.bool_]:
     return ok
 
 
-# long: a 47-line docstring and one evaluation chain whose three closures (role_index, raw,
-# point_set) share the frame, the scales and the instrument state of the trial axis.
 def _plane_index(
     scenario: Scenario, plane_point_ids: Sequence[str] | None, imaged: NDArray[np.bool_]
 ) -> list[int]:
@@ -622,6 +412,139 @@ def _plane_index(
             )
         plane_idx = [known[pid] for pid in plane_point_ids]
     return [i for i in plane_idx if imaged[i]]
+
+
+@dataclass(frozen=True, slots=True)
+class PointSetTruth:
+    """One point set of the evaluation as the ground truth fixes it, whatever the instrument.
+
+    Attributes
+    ----------
+    ids : tuple of str
+    frame_m : ndarray, shape (n, 3)
+        The points in the instrument frame (origin S_л, base along +X). [m]
+    height_m : ndarray, shape (n,)
+        Their true heights Z (photogrammetric frame). [m]
+    images_mm : (ndarray, ndarray)
+        Their true images (x⁰, y⁰) on the left and right film, shape (n, 2) each. [mm]
+    """
+
+    ids: tuple[str, ...]
+    frame_m: _F
+    height_m: _F
+    images_mm: tuple[_F, _F]
+
+
+def _point_set_truth(
+    scenario: Scenario, ids: Sequence[str], frame_m: ArrayLike, origin: _F, theta: float
+) -> PointSetTruth:
+    frame_m = np.asarray(frame_m, float).reshape(-1, 3)
+    local = instrument_frame_m(frame_m, origin, theta, inverse=True)
+    images = film_points_mm(scenario, "left", local), film_points_mm(scenario, "right", local)
+    return PointSetTruth(tuple(ids), frame_m, local[:, 2], images)
+
+
+@dataclass(frozen=True, slots=True)
+class ModelTruth:
+    """Everything :func:`evaluate_against` reads of the ground truth and the sheet, computed once
+    (:func:`model_truth`): a run evaluates every chunk of its trials on it.
+
+    Attributes
+    ----------
+    frame_origin_m, frame_rotation
+        S_л [m] and θ [rad] of the sheet's instrument frame.
+    horizontal_scale_denominator, vertical_scale_denominator, map_scale_denominator
+        M_г, M_в and M_map of the sheet. [—]
+    flying_height_m : float
+        H̄ = Z_Sл − mean Z over the working-area grid. [m]
+    standard_points_c_mm : float
+        c of the standard points 3–6. [mm]
+    grid, standard_points, control, check : PointSetTruth
+        The point sets evaluated (control and check points imaged on both photos).
+    plane : PointSetTruth or None
+        The points the levelling plane is fitted at (None: no plane removal).
+    not_imaged : tuple of str
+        Control/check points outside the format of a photo.
+    """
+
+    frame_origin_m: _F
+    frame_rotation: float
+    horizontal_scale_denominator: int
+    vertical_scale_denominator: int
+    map_scale_denominator: int | None
+    flying_height_m: float
+    standard_points_c_mm: float
+    grid: PointSetTruth
+    standard_points: PointSetTruth
+    control: PointSetTruth
+    check: PointSetTruth
+    plane: PointSetTruth | None
+    not_imaged: tuple[str, ...]
+
+
+def model_truth(
+    scenario: Scenario,
+    sheet: Any,
+    *,
+    grid_shape: tuple[int, int] = (9, 9),
+    standard_points_c_mm: float = STANDARD_POINTS_C_MM,
+    plane_point_ids: Sequence[str] | None = None,
+    grid_local_m: ArrayLike | None = None,
+) -> ModelTruth:
+    """The ground truth of an evaluation on ``sheet`` (arguments as :func:`evaluate_model`): the
+    point sets in the instrument frame with their true heights and images, the levelling plane's
+    points, the mean flying height H̄ over the grid and the standard points at c·H̄/f."""
+    origin = np.asarray(sheet.frame_origin_m, float)
+    theta = float(sheet.frame_rotation)
+    grid_local = (
+        working_area_grid_m(scenario, grid_shape)
+        if grid_local_m is None
+        else np.asarray(grid_local_m, float)
+    )
+    grid_frame = instrument_frame_m(grid_local, origin, theta)
+    flying_height = float(-np.mean(grid_frame[:, 2]))  # Z_Sл − mean Z
+    pts_local = np.array([p.local_m for p in scenario.points], float).reshape(-1, 3)
+    imaged = _imaged(
+        scenario.camera.format_mm,
+        film_points_mm(scenario, "left", pts_local),
+        film_points_mm(scenario, "right", pts_local),
+    )
+    plane_idx = _plane_index(scenario, plane_point_ids, imaged)
+    plane_frame = instrument_frame_m(pts_local[plane_idx], origin, theta)
+    use_plane = (
+        len(plane_idx) >= 3
+        and np.linalg.matrix_rank(np.column_stack([np.ones(len(plane_idx)), plane_frame[:, :2]]))
+        == 3
+    )
+
+    def point_set(idx: Sequence[int]) -> PointSetTruth:
+        ids = [scenario.points[i].id for i in idx]
+        frame_m = instrument_frame_m(pts_local[list(idx)], origin, theta)
+        return _point_set_truth(scenario, ids, frame_m, origin, theta)
+
+    def role(name: str) -> PointSetTruth:
+        return point_set([i for i, p in enumerate(scenario.points) if p.role == name and imaged[i]])
+
+    standard = standard_points_m(scenario, origin, theta, flying_height, standard_points_c_mm)
+    return ModelTruth(
+        frame_origin_m=origin,
+        frame_rotation=theta,
+        horizontal_scale_denominator=int(sheet.horizontal_scale_denominator),
+        vertical_scale_denominator=int(sheet.vertical_scale_denominator),
+        map_scale_denominator=sheet.map_scale_denominator,
+        flying_height_m=flying_height,
+        standard_points_c_mm=float(standard_points_c_mm),
+        grid=_point_set_truth(
+            scenario, [f"g{i}" for i in range(len(grid_frame))], grid_frame, origin, theta
+        ),
+        standard_points=_point_set_truth(
+            scenario, [str(i) for i in range(1, 7)], standard, origin, theta
+        ),
+        control=role("control"),
+        check=role("check"),
+        plane=point_set(plane_idx) if use_plane else None,
+        not_imaged=tuple(p.id for p, ok in zip(scenario.points, imaged, strict=True) if not ok),
+    )
 
 
 def evaluate_model(
@@ -647,16 +570,8 @@ def evaluate_model(
     sheet : SetupSheet
         Supplies the instrument frame (``frame_origin_m`` = S_л, ``frame_rotation`` = θ), the
         scales M_г, M_в of the ideal model and the map scale.
-    setting : InstrumentSetting
-        f_пр, b_x, b_y, b_z′, MO of the built instrument (e.g. ``Instrument.setting``); fields
-        scalar or of shape (T,).
-    left_unit, right_unit : CorrectionUnit
-        The correction units as built (``Instrument.state()["units"]``); scalar or (T,) fields.
-    height_zero : float or array_like (T,), optional
-        The reading of the metre height scale at D = 0 (the scale reads
-        height_zero − D·M_в/1000, cf. Eq. (6.15)); default the height Z_Sл of the sheet's S_л,
-        i.e. heights from the physical depth. Pass the slipped scale of stage 3 to judge the
-        heights as the operator reads them. [m]
+    setting, left_unit, right_unit, height_zero, corner4_misclosure_mm
+        The built instrument and its readings (:func:`evaluate_against`).
     grid_shape : (int, int)
         Rows and columns of the uniform grid over the working area
         (:func:`~stereoplotter.scenario.synthetic.working_area_grid_m`; points not imaged on both
@@ -666,8 +581,6 @@ def evaluate_model(
     plane_point_ids : sequence of str, optional
         Control points the levelling plane is fitted at; default the control points of kind
         "full" (plan and height). Fewer than 3 usable points: no plane removal.
-    corner4_misclosure_mm : float or array_like (T,), optional
-        Corner-4 misclosure from stage 5, passed through. [mm]
     grid_local_m : array_like, shape (g, 3), optional
         That grid if the caller computed it already (a prepared run's ``grid_m``, local frame);
         ``grid_shape`` is then ignored. [m]
@@ -681,6 +594,109 @@ def evaluate_model(
 
     Notes
     -----
+    :func:`model_truth` (the ground-truth part, which a prepared run computes once) and
+    :func:`evaluate_against` (the instrument part).
+    """
+    truth = model_truth(
+        scenario,
+        sheet,
+        grid_shape=grid_shape,
+        standard_points_c_mm=standard_points_c_mm,
+        plane_point_ids=plane_point_ids,
+        grid_local_m=grid_local_m,
+    )
+    return evaluate_against(
+        truth,
+        setting,
+        left_unit,
+        right_unit,
+        height_zero=height_zero,
+        corner4_misclosure_mm=corner4_misclosure_mm,
+    )
+
+
+def _raw(
+    t: PointSetTruth,
+    setting: InstrumentSetting,
+    units: tuple[CorrectionUnit, CorrectionUnit],
+    scales: tuple[int, int],
+    h0: Any,
+) -> dict[str, _F]:
+    """δp, q at the ideal position and the built point's errors at the points of ``t``."""
+    mg, mv = scales
+    gl, gr = t.images_mm
+    model = ideal_model_mm(t.frame_m, mg, mv)
+    dp, q = parallax_errors_at_ideal(model, gl, gr, setting, *units)
+    built = counters_from_homologous_points(gl, gr, setting, *units)
+    mo_x = np.asarray(setting.model_origin_x_mm, float)
+    mo_y = np.asarray(setting.model_origin_y_mm, float)
+    dx = (built.x_mm - mo_x - model[:, 0]) * mg / MM_PER_M
+    dy = (built.y_mm - mo_y - model[:, 1]) * mg / MM_PER_M
+    height = height_scale_reading(h0, built.depth_mm, 0.0, 0.0, mv)  # (6.15) scale
+    dh = height - t.height_m
+    shape = np.broadcast_shapes(np.shape(dp), np.shape(dx), (len(t.frame_m),))
+    out = {"ground_m": t.frame_m, "model_mm": model}
+    for name, v in (("dp", dp), ("q", q), ("dx", dx), ("dy", dy), ("dh", dh)):
+        out[name] = np.broadcast_to(v, shape).copy()
+    out["q_seen"] = np.broadcast_to(built.y_parallax_mm, shape).copy()
+    return out
+
+
+def _point_set(
+    r: dict[str, _F], plane: tuple[_F, dict[str, _F]] | None, ids: tuple[str, ...]
+) -> PointSetEvaluation:
+    """A point set's evaluation from its :func:`_raw` values (and the plane's, if any)."""
+    dh_plane = dp_plane = None
+    if plane is not None:
+        plane_xy, p = plane
+        xy = r["ground_m"][:, :2]
+        dh_plane = plane_residuals(r["dh"], plane_xy, p["dh"], xy)
+        dp_plane = plane_residuals(r["dp"], plane_xy, p["dp"], xy)
+    return PointSetEvaluation(
+        ids=ids,
+        ground_m=r["ground_m"],
+        model_mm=r["model_mm"],
+        x_parallax_error_mm=r["dp"],
+        y_parallax_mm=r["q"],
+        x_error_m=r["dx"],
+        y_error_m=r["dy"],
+        height_error_m=r["dh"],
+        y_parallax_seen_mm=r["q_seen"],
+        height_error_after_plane_m=dh_plane,
+        x_parallax_error_after_plane_mm=dp_plane,
+    )
+
+
+def evaluate_against(
+    truth: ModelTruth,
+    setting: InstrumentSetting,
+    left_unit: CorrectionUnit,
+    right_unit: CorrectionUnit,
+    *,
+    height_zero: ArrayLike | None = None,
+    corner4_misclosure_mm: ArrayLike | None = None,
+) -> ModelEvaluation:
+    r"""Evaluate the model built on an instrument against a prepared ground truth.
+
+    Parameters
+    ----------
+    truth : ModelTruth
+        The point sets, frame and scales (:func:`model_truth`).
+    setting : InstrumentSetting
+        f_пр, b_x, b_y, b_z′, MO of the built instrument (e.g. ``Instrument.setting``); fields
+        scalar or of shape (T,).
+    left_unit, right_unit : CorrectionUnit
+        The correction units as built (``Instrument.state()["units"]``); scalar or (T,) fields.
+    height_zero : float or array_like (T,), optional
+        The reading of the metre height scale at D = 0 (the scale reads
+        height_zero − D·M_в/1000, cf. Eq. (6.15)); default the height Z_Sл of the sheet's S_л,
+        i.e. heights from the physical depth. Pass the slipped scale of stage 3 to judge the
+        heights as the operator reads them. [m]
+    corner4_misclosure_mm : float or array_like (T,), optional
+        Corner-4 misclosure from stage 5, passed through. [mm]
+
+    Notes
+    -----
     Definitions in the module docstring. ``kinematics.md`` §3.3 (counters → marks) gives the
     parallax errors, §3.4 (homologous points → counters) the built model, §3.5 and §2.1 the ideal
     model (M_в = M_г/k, D below S_л, Eq. (6.6) of [1]_). The result depends on the instrument
@@ -688,29 +704,12 @@ def evaluate_model(
     built by the conventional method are judged alike. Vectorised: all trials in one pass;
     identical to a loop over single instruments.
     """
-    # Long (134 lines of code after a 45-line docstring): one vectorised pass that shares its
-    # broadcast state (point axis, trial count, frames) across the point sets; split only with
-    # care for the regression values. Left as is in this step.
     units = (left_unit, right_unit)
     trials = _trial_count(setting, units)
     if trials is not None:
         setting = _with_point_axis(setting)
-        left_unit, right_unit = (_with_point_axis(u) for u in units)
-
-    origin = np.asarray(sheet.frame_origin_m, float)
-    theta = float(sheet.frame_rotation)
-    mg = int(sheet.horizontal_scale_denominator)
-    mv = int(sheet.vertical_scale_denominator)
-    map_scale = sheet.map_scale_denominator
-
-    grid_local = (
-        working_area_grid_m(scenario, grid_shape)
-        if grid_local_m is None
-        else np.asarray(grid_local_m, float)
-    )
-    grid_frame = instrument_frame_m(grid_local, origin, theta)
-    flying_height = float(-np.mean(grid_frame[:, 2]))  # Z_Sл − mean Z
-    h0 = origin[2] if height_zero is None else np.asarray(height_zero, float)
+        units = tuple(_with_point_axis(u) for u in units)
+    h0 = truth.frame_origin_m[2] if height_zero is None else np.asarray(height_zero, float)
     for what, value in (("height_zero", h0), ("corner4_misclosure_mm", corner4_misclosure_mm)):
         shape = np.shape(value) if value is not None else ()
         if shape and shape != (trials,):
@@ -719,101 +718,37 @@ def evaluate_model(
                 f"instrument state, found shape {shape}"
             )
     h0_b = h0[:, None] if np.ndim(h0) == 1 else h0
+    scales = truth.horizontal_scale_denominator, truth.vertical_scale_denominator
 
-    # Control and check points imaged on both photos
-    pts_local = np.array([p.local_m for p in scenario.points], float).reshape(-1, 3)
-    imaged = _imaged(
-        scenario,
-        film_points_mm(scenario, "left", pts_local),
-        film_points_mm(scenario, "right", pts_local),
-    )
-    not_imaged = tuple(p.id for p, ok in zip(scenario.points, imaged, strict=True) if not ok)
+    def raw(t: PointSetTruth) -> dict[str, _F]:
+        return _raw(t, setting, units, scales, h0_b)
 
-    def role_index(role: str) -> list[int]:
-        return [i for i, p in enumerate(scenario.points) if p.role == role and imaged[i]]
-
-    plane_idx = _plane_index(scenario, plane_point_ids, imaged)
-    plane_frame = instrument_frame_m(pts_local[plane_idx], origin, theta)
-    use_plane = (
-        len(plane_idx) >= 3
-        and np.linalg.matrix_rank(np.column_stack([np.ones(len(plane_idx)), plane_frame[:, :2]]))
-        == 3
-    )
-
-    def raw(frame_m: _F) -> dict[str, _F]:
-        local = instrument_frame_m(frame_m, origin, theta, inverse=True)
-        gl = film_points_mm(scenario, "left", local)
-        gr = film_points_mm(scenario, "right", local)
-        model = ideal_model_mm(frame_m, mg, mv)
-        dp, q = parallax_errors_at_ideal(model, gl, gr, setting, left_unit, right_unit)
-        built = counters_from_homologous_points(gl, gr, setting, left_unit, right_unit)
-        mo_x = np.asarray(setting.model_origin_x_mm, float)
-        mo_y = np.asarray(setting.model_origin_y_mm, float)
-        dx = (built.x_mm - mo_x - model[:, 0]) * mg / MM_PER_M
-        dy = (built.y_mm - mo_y - model[:, 1]) * mg / MM_PER_M
-        height = height_scale_reading(h0_b, built.depth_mm, 0.0, 0.0, mv)  # (6.15) scale
-        dh = height - local[:, 2]
-        shape = np.broadcast_shapes(np.shape(dp), np.shape(dx), (len(frame_m),))
-        return {
-            "ground_m": frame_m,
-            "model_mm": model,
-            "dp": np.broadcast_to(dp, shape).copy(),
-            "q": np.broadcast_to(q, shape).copy(),
-            "dx": np.broadcast_to(dx, shape).copy(),
-            "dy": np.broadcast_to(dy, shape).copy(),
-            "dh": np.broadcast_to(dh, shape).copy(),
-            "q_seen": np.broadcast_to(built.y_parallax_mm, shape).copy(),
-        }
-
-    plane = raw(plane_frame) if use_plane else None
-
-    def point_set(ids: Sequence[str], frame_m: _F) -> PointSetEvaluation:
-        frame_m = np.asarray(frame_m, float).reshape(-1, 3)
-        r = raw(frame_m)
-        dh_plane = dp_plane = None
-        if plane is not None:
-            xy = frame_m[:, :2]
-            dh_plane = plane_residuals(r["dh"], plane_frame[:, :2], plane["dh"], xy)
-            dp_plane = plane_residuals(r["dp"], plane_frame[:, :2], plane["dp"], xy)
-        return PointSetEvaluation(
-            ids=tuple(ids),
-            ground_m=r["ground_m"],
-            model_mm=r["model_mm"],
-            x_parallax_error_mm=r["dp"],
-            y_parallax_mm=r["q"],
-            x_error_m=r["dx"],
-            y_error_m=r["dy"],
-            height_error_m=r["dh"],
-            y_parallax_seen_mm=r["q_seen"],
-            height_error_after_plane_m=dh_plane,
-            x_parallax_error_after_plane_mm=dp_plane,
+    plane = None
+    if truth.plane is not None:
+        plane = truth.plane.frame_m[:, :2], raw(truth.plane)
+    sets = {
+        name: _point_set(raw(t), plane, t.ids)
+        for name, t in (
+            ("grid", truth.grid),
+            ("standard_points", truth.standard_points),
+            ("control", truth.control),
+            ("check", truth.check),
         )
-
-    standard = standard_points_m(scenario, origin, theta, flying_height, standard_points_c_mm)
-    sets = {}
-    for role in ("control", "check"):
-        idx = role_index(role)
-        sets[role] = point_set(
-            [scenario.points[i].id for i in idx],
-            instrument_frame_m(pts_local[idx], origin, theta),
-        )
+    }
     c4 = corner4_misclosure_mm
     if c4 is not None:
         c4 = float(c4) if np.ndim(c4) == 0 else np.asarray(c4, float)
     return ModelEvaluation(
         trials=trials,
-        horizontal_scale_denominator=mg,
-        vertical_scale_denominator=mv,
-        map_scale_denominator=map_scale,
-        flying_height_m=flying_height,
+        horizontal_scale_denominator=scales[0],
+        vertical_scale_denominator=scales[1],
+        map_scale_denominator=truth.map_scale_denominator,
+        flying_height_m=truth.flying_height_m,
         height_zero_m=float(h0) if np.ndim(h0) == 0 else h0,
-        standard_points_c_mm=float(standard_points_c_mm),
-        plane_point_ids=tuple(scenario.points[i].id for i in plane_idx) if use_plane else (),
-        grid=point_set([f"g{i}" for i in range(len(grid_frame))], grid_frame),
-        standard_points=point_set([str(i) for i in range(1, 7)], standard),
-        control=sets["control"],
-        check=sets["check"],
-        not_imaged=not_imaged,
+        standard_points_c_mm=truth.standard_points_c_mm,
+        plane_point_ids=() if truth.plane is None else truth.plane.ids,
+        **sets,
+        not_imaged=truth.not_imaged,
         corner4_misclosure_mm=c4,
     )
 

@@ -79,18 +79,18 @@ def refuse_beyond_mechanism(
     tol_h = sheet.tolerances["control_height_m"]
     if q_max <= tol_q and h_max <= tol_h:
         return
-    sc = scene.scenario
+    photos = scene.photos
     tilts = [
         (abs(getattr(p.exterior, axis)), i, axis)
-        for i, p in enumerate(sc.photos)
+        for i, p in enumerate(photos)
         for axis in ("alpha", "omega")
     ]
     _, i, axis = max(tilts, key=lambda t: t[0])  # the first of equal tilts
-    found = np.degrees(getattr(sc.photos[i].exterior, axis))
+    found = np.degrees(getattr(photos[i].exterior, axis))
     films = [
         f"photos[{j}].film_deformation_ppm = [{p.film_deformation_ppm[0]:g}, "
         f"{p.film_deformation_ppm[1]:g}]"
-        for j, p in enumerate(sc.photos)
+        for j, p in enumerate(photos)
         if any(p.film_deformation_ppm)
     ]
     film_note = (
@@ -101,7 +101,7 @@ def refuse_beyond_mechanism(
         else ""
     )
     raise SetupRefusal(
-        f"{sc.source}: photos[{i}].exterior.{axis}_deg: expected a tilt the setup-data method "
+        f"{scene.source}: photos[{i}].exterior.{axis}_deg: expected a tilt the setup-data method "
         f"on {sheet.instrument_title} can carry (§26: at the sheet's exact settings the "
         f"correction mechanism must leave ≤ ¼ mark {tol_q * 1000:.1f} µm of y-parallax at the "
         f"standard points and ≤ H/3000 {tol_h:.2f} m at the control heights), found "
@@ -114,10 +114,9 @@ def refuse_beyond_mechanism(
 
 def control_heights_of(sheet: SetupSheet, scene: Scene) -> list[ControlHeight]:
     """The sheet's height control points with their ground points (the scene's truth)."""
-    sc = scene.scenario
     rows = []
     for h in sheet.control_heights:
-        p = next(p for p in sc.points if p.id == h["id"])
+        p = scene.point(h["id"])
         rows.append(
             ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
         )

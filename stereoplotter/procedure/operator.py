@@ -44,9 +44,15 @@ from stereoplotter.instrument.virtual import (
     SetControl,
     Side,
 )
+from stereoplotter.procedure.evaluation import (
+    instrument_frame_m,
+    photo_points_mm,
+    standard_points_m,
+)
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.random_streams import keyed_draws
-from stereoplotter.scenario.model import Scenario
+from stereoplotter.scenario.model import Camera, Photo, Point, Scenario
+from stereoplotter.scenario.summary import flying_height_and_relief
 from stereoplotter.scenario.synthetic import film_deformed
 
 __all__ = [
@@ -215,11 +221,18 @@ def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: floa
 
 @dataclass(frozen=True)
 class Scene:
-    """What lies in the cassettes and on the ground: the physical photos and the truth.
+    """What lies in the cassettes and on the ground: the physical photos and the truth a run
+    reads, taken from the scenario once (:meth:`build`); the procedure never reads the scenario.
 
     Attributes
     ----------
-    scenario : Scenario
+    camera : Camera
+        The taking camera (f, principal point, format).
+    photos : tuple of Photo
+        The photos "left" and "right" in the scenario's order: true exterior orientation and
+        film deformation.
+    points : tuple of Point
+        The scenario's control and check points (ids, roles, local and SK-42 coordinates).
     fiducials_mm : dict
         "left"/"right" → (4, 2) fiducial marks 1–4 on the (deformed) film. [mm]
     standard_points_m : ndarray, shape (6, 3)
@@ -227,20 +240,40 @@ class Scene:
         3, 4 at +c and 5, 6 at −c on the photo y axis of photos 1, 2 (local frame). [m]
     c_mm : float
         c of the standard points on the photo. [mm]
-    standard : (ndarray, ndarray)
-        True images of the standard points on the left and right photo, shape (6, 2) each,
-        computed once with the scene (:meth:`images`; read-only). [mm]
+    source : str
+        The scenario's file (named in a refusal).
+    flying_height_m : float
+        The scenario summary's mean flying height of the two photos above the mean point
+        height (each rounded to 0.1 m, :func:`~stereoplotter.scenario.summary.
+        flying_height_and_relief`). [m]
+    grid_m : ndarray, shape (g, 3), or None
+        The working-area grid where the true residual y-parallax is evaluated (local frame;
+        ``procedure.run.residual_grid_m``). [m]
+    standard, grid_images_mm : (ndarray, ndarray)
+        True images of the standard points (shape (6, 2) each) and of the grid (None without
+        one) on the left and right photo, computed once with the scene (:meth:`images`;
+        read-only). [mm]
     """
 
-    scenario: Scenario
+    camera: Camera
+    photos: tuple[Photo, ...]
+    points: tuple[Point, ...]
     fiducials_mm: dict[str, NDArray[np.float64]]
     standard_points_m: NDArray[np.float64]
     c_mm: float
+    source: str = ""
+    flying_height_m: float = float("nan")
+    grid_m: NDArray[np.float64] | None = None
     standard: tuple[NDArray[np.float64], NDArray[np.float64]] = field(init=False, repr=False)
+    grid_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]] | None = field(
+        init=False, repr=False
+    )
 
     def __post_init__(self) -> None:
-        # frozen: set once here, so that dataclasses.replace (new standard points) recomputes it
+        # frozen: set once here, so that dataclasses.replace (new standard points) recomputes them
         object.__setattr__(self, "standard", self.images(self.standard_points_m, read_only=True))
+        grid = None if self.grid_m is None else self.images(self.grid_m, read_only=True)
+        object.__setattr__(self, "grid_images_mm", grid)
 
     @classmethod
     def build(
@@ -249,21 +282,40 @@ class Scene:
         frame_origin_m: ArrayLike,
         frame_rotation: float,
         c_mm: float,
+        grid_m: ArrayLike | None = None,
     ) -> Scene:
-        """Photos of ``scenario`` and its six standard points (c from the instrument spec).
+        """Photos of ``scenario``, its points, its six standard points (c from the instrument
+        spec) and, if given, the residual grid ``grid_m`` (local frame) [m].
 
         The standard points are those of ``stereoplotter.procedure.evaluation.standard_points_m``
         (Fig. 39: nadirs ± c·H̄/f), H̄ the flying height of S_л over the mean control height.
         """
-        from stereoplotter.procedure.evaluation import instrument_frame_m, standard_points_m
-
         calibrated = scenario.camera.fiducial_array_mm()
         fid = {p.name: film_deformed(p, calibrated) for p in scenario.photos}  # the true marks
         z0 = float(np.mean([p.local_m[2] for p in scenario.points]))
         h = float(scenario.photo("left").exterior.centre[2]) - z0
         frame = standard_points_m(scenario, frame_origin_m, frame_rotation, h, c_mm)
         local = instrument_frame_m(frame, frame_origin_m, frame_rotation, inverse=True)
-        return cls(scenario, fid, local, c_mm)
+        height = flying_height_and_relief(scenario)[0]
+        return cls(
+            scenario.camera,
+            scenario.photos,
+            scenario.points,
+            fid,
+            local,
+            c_mm,
+            scenario.source,
+            height,
+            None if grid_m is None else np.asarray(grid_m, float),
+        )
+
+    def photo(self, name: str) -> Photo:
+        """The photo ``name`` ("left" or "right")."""
+        return next(p for p in self.photos if p.name == name)
+
+    def point(self, point_id: str) -> Point:
+        """The control or check point ``point_id``."""
+        return next(p for p in self.points if p.id == point_id)
 
     def images(
         self, points_m: ArrayLike, *, read_only: bool = False
@@ -271,12 +323,8 @@ class Scene:
         """True images of ground points on the left and right photo (fiducial system). [mm]
 
         ``read_only``: the arrays refuse writes (images kept for the whole run)."""
-        from stereoplotter.procedure.evaluation import film_points_mm
-
         pts = np.asarray(points_m, float)
-        out = film_points_mm(self.scenario, "left", pts), film_points_mm(
-            self.scenario, "right", pts
-        )
+        out = tuple(photo_points_mm(self.camera, self.photo(n), pts) for n in ("left", "right"))
         for a in out if read_only else ():
             a.setflags(write=False)
         return out

@@ -32,6 +32,7 @@ from stereoplotter.instrument.sc1_complex import (
     SC1Options,
 )
 from stereoplotter.instrument.virtual import Instrument
+from stereoplotter.procedure.evaluation import ModelTruth, model_truth
 from stereoplotter.procedure.floor import refuse_beyond_mechanism
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, SheetReadings, StageRecord
@@ -177,19 +178,24 @@ class PreparedRun:
     correction_unit: ErrorCorrectionUnit | None = None
     #: The true images of ``grid_m`` on the left and right photo (read-only), once per run. [mm]
     grid_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+    #: The ground truth the built model is evaluated against (points, frame, images), once per
+    #: run (:func:`~stereoplotter.procedure.evaluation.model_truth`; None: not prepared).
+    truth: ModelTruth | None = None
 
 
 @dataclass(frozen=True)
 class PreparedPair:
     """The stereopair as a run needs it, built once (:func:`prepare_pair`): the setup sheet (its
-    frame S_л, θ; Table 24; every range check of the sheet passed), the scene (true fiducials,
-    the six standard points and their true images) and the working-area grid of the residual
-    y-parallax with its true images. [—, —, m, mm]"""
+    frame S_л, θ; Table 24; every range check of the sheet passed), the scene (the photos, the
+    control points, true fiducials, the six standard points and their true images, the
+    working-area grid of the residual y-parallax with its true images) and the ground truth of
+    the evaluation. Every step of a run reads these, never the scenario. [—, —, m, mm, —]"""
 
     sheet: SetupSheet
     scene: Scene
     grid_m: NDArray[np.float64]
     grid_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]]
+    truth: ModelTruth
 
 
 def log_options(op: Operator, prep: PreparedRun) -> None:
@@ -254,6 +260,7 @@ def build_instrument(
         trials=trials,
         ideal_mechanics=prep.ideal_mechanics if ideal_mechanics is None else ideal_mechanics,
         options=prep.options,
+        options_checked=True,  # fitted to prep.spec once, by prepare_run
     )
 
 
@@ -331,13 +338,14 @@ def prepare_pair(
     scenario: Scenario, spec: InstrumentSpec, method: str = "setup", variant: str = "L"
 ) -> PreparedPair:
     """The prepared pair of a run, built once: the setup sheet (frame, Table 24, every range
-    check of the sheet), the scene (true fiducials, the six standard points and their images),
-    for the setup method the floor of the mechanism at the sheet's own settings (D9), and the
-    residual grid (:func:`residual_grid_m`, local frame) with its true images."""
+    check of the sheet), the scene (true fiducials, the six standard points and their images,
+    the residual grid (:func:`residual_grid_m`, local frame) with its true images), for the setup
+    method the floor of the mechanism at the sheet's own settings (D9), and the ground truth of
+    the evaluation on that grid. The scenario goes no further than here."""
     sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
-    scene = Scene.build(
-        scenario, sheet.frame_origin_m, sheet.frame_rotation, spec.standard_points_c_mm
-    )
+    grid_m = residual_grid_m(scenario)
+    c_mm = spec.standard_points_c_mm
+    scene = Scene.build(scenario, sheet.frame_origin_m, sheet.frame_rotation, c_mm, grid_m)
     if method == "setup":  # the floor: the mechanism at the sheet's own settings (D9)
         refuse_beyond_mechanism(
             sheet,
@@ -345,5 +353,5 @@ def prepare_pair(
             decentration_variant(variant).strict_per_axis,
             mechanism_for(spec),
         )
-    grid_m = residual_grid_m(scenario)
-    return PreparedPair(sheet, scene, grid_m, scene.images(grid_m, read_only=True))
+    truth = model_truth(scenario, sheet, standard_points_c_mm=c_mm, grid_local_m=scene.grid_m)
+    return PreparedPair(sheet, scene, scene.grid_m, scene.grid_images_mm, truth)

@@ -79,7 +79,7 @@ def _span_term(prep):
     dbz = d * abs(rel[1] - rel[0])
     y_max = max(float(np.max(np.abs(i[..., 1]))) for i in scene.images(scene.standard_points_m))
     x = [h["id"] for h in sheet.control_heights]
-    pts = np.array([p.local_m for p in scene.scenario.points if p.id in x])
+    pts = np.array([p.local_m for p in scene.points if p.id in x])
     tilt = dbz * sheet.vertical_scale_denominator / (
         sheet.base_mm[0] * sheet.horizontal_scale_denominator
     )
