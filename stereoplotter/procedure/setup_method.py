@@ -566,7 +566,7 @@ def level_design(
 def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
     """The instrument coordinates (6.7) of a plan control point (the sheet's similarity)."""
     sheet = run.sheet
-    p = next(q for q in run.scene.scenario.points if q.id == pid)
+    p = run.scene.point(pid)
     xy = sheet_corner_instrument_coordinates(
         sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
     )

@@ -14,7 +14,6 @@ from numpy.typing import NDArray
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.run import Run
-from stereoplotter.scenario.summary import summarize_scenario
 from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
 __all__ = ["stage4_orient_sheet", "stage5_check"]
@@ -58,9 +57,8 @@ def stage4_orient_sheet(run: Run) -> None:
     ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
     enlargement = None
     if op.inst.options.automatic_coordinatograph:  # photo → map, checked against its 10 ×
-        sc = run.scene.scenario
-        height = np.mean([p["flying_height_m"] for p in summarize_scenario(sc)["photos"]])
-        photo_scale = MM_PER_M * float(height) / float(sc.camera.focal_length_mm)
+        scene = run.scene
+        photo_scale = MM_PER_M * scene.flying_height_m / float(scene.camera.focal_length_mm)
         enlargement = photo_scale / sheet.map_scale_denominator
     op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
@@ -131,12 +129,11 @@ def stage5_check(run: Run) -> None:
     run.check("stage 5: corner 4", mis, tol)
     run.record_stage("5", op.v(1).astype(int))
     # plotted plan control points: fuse on the point, compare the needle with the plotted point
-    sc = run.scene.scenario
     if sheet.similarity is None:
         return
     errs = []
     for pid in sheet.similarity_point_ids:
-        p = next(q for q in sc.points if q.id == pid)
+        p = run.scene.point(pid)
         xy = sheet_corner_instrument_coordinates(
             sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
         )

@@ -23,7 +23,7 @@ from stereoplotter.instrument.sc1_complex import (
 )
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
-from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_model
+from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_against
 from stereoplotter.procedure.operator import Noise, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, StageRecord
 from stereoplotter.procedure.run import (
@@ -228,6 +228,7 @@ def prepare_run(
         pair.grid_m,
         unit,
         pair.grid_images_mm,
+        pair.truth,
     )
 
 
@@ -452,14 +453,11 @@ def _evaluate(prep: PreparedRun, run: Run) -> ModelEvaluation:
         + np.asarray(inst.state()["carriages_mm"]["Z"]) * sheet.vertical_scale_denominator / 1000.0
     )
     corner = run.results.get("stage 5: corner 4")
-    return evaluate_model(
-        prep.scenario,
-        sheet,
+    return evaluate_against(
+        prep.truth,
         inst.setting,
         units["left"],
         units["right"],
         height_zero=zero,
-        standard_points_c_mm=inst.spec.standard_points_c_mm,
         corner4_misclosure_mm=None if corner is None else corner.residual,
-        grid_local_m=prep.grid_m,
     )

@@ -107,8 +107,7 @@ def zero_base_y(run: Run, stage: str) -> NDArray[np.float64]:
 
 def control_point_m(run: Run, pid: str) -> NDArray[np.float64]:
     """The scenario's control point ``pid`` in the local frame (X, Y, Z). [m]"""
-    sc = run.scene.scenario
-    return np.asarray(next(p for p in sc.points if p.id == pid).local_m, float)
+    return np.asarray(run.scene.point(pid).local_m, float)
 
 
 def scale_pair(run: Run, ties: str = "first") -> tuple[str, str]:
