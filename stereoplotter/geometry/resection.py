@@ -301,16 +301,38 @@ def space_resection(
     >>> np.round(result.projection_centre_m, 3)
     array([2800.,  700.,  750.])
     """
+    data = _inputs(photo_mm, points_m, focal_length_mm, principal_point_mm)
+    params = _initial_params(*data, initial)
+    tolerances = angle_tolerance, position_tolerance_m
+    params, its, converged = _iterate(params, data, tolerances, max_iterations, raise_on_failure)
+    return _resection_result(params, *data, its, converged)
+
+
+def _inputs(photo_mm, points_m, focal_length_mm, principal_point_mm) -> tuple:
+    """(photo, points, f, principal point) of :func:`space_resection`, checked."""
     photo, points = _validate(photo_mm, points_m)
     f = float(focal_length_mm)
     if not f > 0.0:
         raise GeometryError(f"focal_length_mm must be positive, got {focal_length_mm!r}")
-    pp = np.asarray(principal_point_mm, dtype=float)
-    params = _initial_params(photo, points, f, pp, initial)
+    return photo, points, f, np.asarray(principal_point_mm, dtype=float)
+
+
+def _iterate(
+    params: NDArray[np.float64],
+    data: tuple,
+    tolerances: tuple[float, float],
+    max_iterations: int,
+    raise_on_failure: bool,
+) -> tuple[NDArray[np.float64], int, bool]:
+    """Gauss–Newton steps, Eq. (3.7), until the corrections satisfy Eq. (3.8) (``tolerances``:
+    ε₁ [rad] on the angles, ε₂ = ε₃ [m] on the centre) or ``max_iterations`` (arguments and
+    failure as :func:`space_resection`). Returns the elements, the iterations used and whether
+    they converged."""
+    angle_tolerance, position_tolerance_m = tolerances
     converged = False
     iterations = 0
     for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported after the loop)
-        delta = _gauss_newton_step(params, photo, points, f, pp)
+        delta = _gauss_newton_step(params, *data)
         params = params + delta  # Eq. (3.7)
         if np.all(np.abs(delta[:3]) <= angle_tolerance) and np.all(
             np.abs(delta[3:]) <= position_tolerance_m
@@ -324,7 +346,7 @@ def space_resection(
             f"{np.abs(delta[3:]).max():.3g} m); give a better `initial` or check the point "
             "identification"
         )
-    return _resection_result(params, photo, points, f, pp, iterations, converged)
+    return params, iterations, converged
 
 
 def _initial_params(photo, points, f, pp, initial) -> NDArray[np.float64]:

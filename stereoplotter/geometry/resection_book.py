@@ -212,25 +212,22 @@ def line_coefficients(
     dX, dY, h = dXYh[:, 0], dXYh[:, 1], dXYh[:, 2]
     K = (xy[j, 0] * xy[i, 1] - xy[i, 0] * xy[j, 1]) / f  # (3.24), K = 2S_oij / f
     Q = dx * dX + dy * dY  # (3.24)
-    if np.any(np.abs(Q) <= 1e-12 * (np.hypot(dx, dy) * np.hypot(dX, dY) + 1e-300)):
-        bad = pairs[np.abs(Q) <= 1e-12 * (np.hypot(dx, dy) * np.hypot(dX, dY) + 1e-300)]
-        raise GeometryError(
-            f"Q = 0 for lines {(bad + 1).tolist()} (1-based): coincident points, or photo and "
-            "ground directions at 90°; the working equation (3.23) cannot be divided by Q"
-        )
+    _refuse_zero_q(pairs, Q, np.hypot(dx, dy) * np.hypot(dX, dY))
     A = (K * dX + h * dy) / Q  # (3.24), corrected: h(y_j − y_i)
     B = (K * dY - h * dx) / Q  # (3.24)
     free_term = (dy * dX - dx * dY - K * h) / Q  # (3.24), corrected: (y_j − y_i)(X_j − X_i)
-    return LineCoefficients(
-        pairs=pairs,
-        photo_difference_mm=dxy,
-        ground_difference_m=dXYh,
-        K_mm=K,
-        Q=Q,
-        A=A,
-        B=B,
-        free_term=free_term,
-    )
+    return LineCoefficients(pairs, dxy, dXYh, K, Q, A, B, free_term)
+
+
+def _refuse_zero_q(pairs: NDArray[np.intp], Q: NDArray[np.float64], lengths) -> None:
+    """Raise :class:`GeometryError` for the lines whose Q of (3.24) vanishes (relative to the
+    product ``lengths`` of their photo and ground lengths)."""
+    zero = np.abs(Q) <= 1e-12 * (lengths + 1e-300)
+    if np.any(zero):
+        raise GeometryError(
+            f"Q = 0 for lines {(pairs[zero] + 1).tolist()} (1-based): coincident points, or photo "
+            "and ground directions at 90°; the working equation (3.23) cannot be divided by Q"
+        )
 
 
 def angular_normal_equations(

@@ -104,133 +104,158 @@ _FIXED_DISTRIBUTION = {
 
 # long: one entry per injected error term, in the fixed order of the draws; a table read top to
 # bottom, which splitting would scatter.
-def _terms(spec: InstrumentSpec) -> list[ErrorTerm]:
-    def term(name, dist, attribute, meaning, unit="mm", factor=1.0):
-        key = spec.key_of(attribute)
-        return ErrorTerm(
-            name,
-            dist,
-            float(getattr(spec, attribute)) * factor,
-            unit,
-            key,
-            spec.is_assumed(key),
-            meaning,
-        )
+#: A row of the error terms: (name, distribution, spec attribute of the scale, meaning, unit,
+#: factor applied to the attribute's value).
+_Row = tuple[str, str, str, str, str, float]
 
-    terms = []
-    for scale in ("X", "Y", "bx", "by", "bz", "dx_left", "dy_left", "dx_right", "dy_right"):
-        terms.append(
-            term(
-                f"zero_reading.{scale}",
-                "normal",
-                "zero_reading_scatter_mm",
-                f"error of the zero reading (место нуля) of the {scale} scale",
-            )
+#: The coordinatograph's terms (rails, needle, sheet placement).
+_COORDINATOGRAPH_ROWS: tuple[_Row, ...] = (
+    (
+        "coordinatograph.nonorthogonality",
+        "normal",
+        "coordinatograph_nonorthogonality_sigma",
+        "angle error between the coordinatograph X and Y rails",
+        "rad",
+        1.0,
+    ),
+    (
+        "coordinatograph.pen_play",
+        "uniform",
+        "pen_play_mm",
+        "play of the needle in its holder (half-width = play/2)",
+        "mm",
+        0.5,
+    ),
+    *(
+        (
+            f"coordinatograph.sheet_placement_{axis}",
+            "normal",
+            "sheet_placement_sigma_mm",
+            f"hand placement error of a sheet corner under the needle, {axis}",
+            "mm",
+            1.0,
         )
+        for axis in ("x", "y")
+    ),
+)
+
+
+def _counter_rows() -> list[_Row]:
+    """Zero readings, counter scale ratios and screw backlash."""
+    zero = "zero_reading_scatter_mm"
+    rows: list[_Row] = [
+        (
+            f"zero_reading.{s}",
+            "normal",
+            zero,
+            f"error of the zero reading (место нуля) of the {s} scale",
+            "mm",
+            1.0,
+        )
+        for s in ("X", "Y", "bx", "by", "bz", "dx_left", "dy_left", "dx_right", "dy_right")
+    ]
     # The absolute height counter reads D itself (stage 1 sets O_Z = n_л·f_пр on it): its zero
     # is a factory calibration, assumed good to one least count, not an unknown place of zero.
-    terms.insert(
+    rows.insert(
         2,
-        term(
+        (
             "zero_reading.Z",
             "normal",
             "z_least_count_mm",
             "calibration error of the absolute height counter (reads D), one least count",
+            "mm",
+            1.0,
         ),
     )
-    for counter in ("X", "Y", "Z"):
-        terms.append(
-            term(
-                f"counter_scale.{counter}",
-                "normal",
-                "counter_scale_error_ppm",
-                f"relative gear/scale ratio error of the {counter} counter",
-                unit="—",
-                factor=1e-6,
-            )
+    rows += [
+        (
+            f"counter_scale.{c}",
+            "normal",
+            "counter_scale_error_ppm",
+            f"relative gear/scale ratio error of the {c} counter",
+            "—",
+            1e-6,
         )
-    for axis, attribute in (
-        ("X", "backlash_xy_mm"),
-        ("Y", "backlash_xy_mm"),
-        ("Z", "backlash_z_mm"),
-        ("bx", "backlash_xy_mm"),
-        ("by", "backlash_xy_mm"),
-        ("bz", "backlash_z_mm"),
-    ):
-        terms.append(
-            term(
-                f"backlash.{axis}",
-                "constant",
-                attribute,
-                f"backlash (мёртвый ход) of the {axis} screw",
-            )
+        for c in ("X", "Y", "Z")
+    ]
+    screws = (("X", "xy"), ("Y", "xy"), ("Z", "z"), ("bx", "xy"), ("by", "xy"), ("bz", "z"))
+    rows += [
+        (
+            f"backlash.{a}",
+            "constant",
+            f"backlash_{kind}_mm",
+            f"backlash (мёртвый ход) of the {a} screw",
+            "mm",
+            1.0,
         )
-    terms.append(
-        term(
+        for a, kind in screws
+    ]
+    return rows
+
+
+def _setting_rows(spec: InstrumentSpec) -> list[_Row]:
+    """Errors of setting f_пр, the base, κ and the decentrations, and the correction
+    principle's own terms (:func:`~stereoplotter.instrument.principles.error_terms_for`)."""
+    rows: list[_Row] = [
+        (
             "setting.f_instrument",
             "normal",
             "f_instrument_setting_sigma_mm",
             "error of setting f_пр on its scale",
-        )
-    )
-    for b in ("bx", "by", "bz"):
-        terms.append(
-            term(
+            "mm",
+            1.0,
+        ),
+        *(
+            (
                 f"setting.{b}",
                 "normal",
                 "base_setting_sigma_mm",
                 f"error of setting {b} on its scale",
+                "mm",
+                1.0,
             )
-        )
+            for b in ("bx", "by", "bz")
+        ),
+    ]
     for side in ("left", "right"):
-        terms.append(
-            term(
+        rows.append(
+            (
                 f"setting.kappa_{side}",
                 "normal",
                 "kappa_setting_sigma",
                 f"error of setting κ of the {side} cassette",
-                unit="rad",
+                "rad",
+                1.0,
             )
         )
-        for d in ("dx", "dy"):
-            terms.append(
-                term(
-                    f"setting.{d}_{side}",
-                    "normal",
-                    "decentration_setting_sigma_mm",
-                    f"error of setting the decentration {d} of the {side} photo",
-                )
-            )
-        for name, attribute, meaning, unit in error_terms_for(spec.principle, side):
-            terms.append(term(name, "normal", attribute, meaning, unit=unit))
-    terms.append(
-        term(
-            "coordinatograph.nonorthogonality",
-            "normal",
-            "coordinatograph_nonorthogonality_sigma",
-            "angle error between the coordinatograph X and Y rails",
-            unit="rad",
-        )
-    )
-    terms.append(
-        term(
-            "coordinatograph.pen_play",
-            "uniform",
-            "pen_play_mm",
-            "play of the needle in its holder (half-width = play/2)",
-            factor=0.5,
-        )
-    )
-    for axis in ("x", "y"):
-        terms.append(
-            term(
-                f"coordinatograph.sheet_placement_{axis}",
+        rows += [
+            (
+                f"setting.{d}_{side}",
                 "normal",
-                "sheet_placement_sigma_mm",
-                f"hand placement error of a sheet corner under the needle, {axis}",
+                "decentration_setting_sigma_mm",
+                f"error of setting the decentration {d} of the {side} photo",
+                "mm",
+                1.0,
             )
-        )
-    return terms
+            for d in ("dx", "dy")
+        ]
+        rows += [
+            (name, "normal", attribute, meaning, unit, 1.0)
+            for name, attribute, meaning, unit in error_terms_for(spec.principle, side)
+        ]
+    return rows
+
+
+def _terms(spec: InstrumentSpec) -> list[ErrorTerm]:
+    """Every error term of ``spec``, its scale read from the spec attribute of its row."""
+
+    def term(name: str, dist: str, attribute: str, meaning: str, unit: str, factor: float):
+        key = spec.key_of(attribute)
+        value = float(getattr(spec, attribute)) * factor
+        return ErrorTerm(name, dist, value, unit, key, spec.is_assumed(key), meaning)
+
+    rows = [*_counter_rows(), *_setting_rows(spec), *_COORDINATOGRAPH_ROWS]
+    return [term(*row) for row in rows]
 
 
 @dataclass(frozen=True, slots=True)

@@ -667,6 +667,17 @@ def _point_set(
     )
 
 
+def _check_trial_shapes(trials: int | None, **values: Any) -> None:
+    """Refuse a value that is neither a scalar (or None) nor of the instrument state's (T,)."""
+    for what, value in values.items():
+        shape = np.shape(value) if value is not None else ()
+        if shape and shape != (trials,):
+            raise StereoplotterError(
+                f"{what}: expected a scalar or an array of shape (T,) = ({trials},) like the "
+                f"instrument state, found shape {shape}"
+            )
+
+
 def evaluate_against(
     truth: ModelTruth,
     setting: InstrumentSetting,
@@ -710,13 +721,7 @@ def evaluate_against(
         setting = _with_point_axis(setting)
         units = tuple(_with_point_axis(u) for u in units)
     h0 = truth.frame_origin_m[2] if height_zero is None else np.asarray(height_zero, float)
-    for what, value in (("height_zero", h0), ("corner4_misclosure_mm", corner4_misclosure_mm)):
-        shape = np.shape(value) if value is not None else ()
-        if shape and shape != (trials,):
-            raise StereoplotterError(
-                f"{what}: expected a scalar or an array of shape (T,) = ({trials},) like the "
-                f"instrument state, found shape {shape}"
-            )
+    _check_trial_shapes(trials, height_zero=h0, corner4_misclosure_mm=corner4_misclosure_mm)
     h0_b = h0[:, None] if np.ndim(h0) == 1 else h0
     scales = truth.horizontal_scale_denominator, truth.vertical_scale_denominator
 

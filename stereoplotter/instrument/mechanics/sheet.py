@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -397,14 +398,48 @@ def orient_sheet(
     board = SheetOnTable(
         corners_mm, sheet, angle_rad=initial_angle_rad, offset_mm=initial_offset_mm
     )
+    needle = partial(_needle, coordinatograph, side)
+    pins, looks, converged = _pin_and_rotate(board, needle, op, rng, passes, pin_error_mm)
+    check = needle(board.ideal[3])
+    marks = board.marks()
+    misclosure = marks[3] - check
+    norm = float(np.hypot(*misclosure))
+    return SheetOrientation(
+        marks_mm=marks,
+        residuals_mm=marks - board.ideal,
+        misclosure_mm=misclosure,
+        misclosure_norm_mm=norm,
+        tolerance_mm=float(tolerance_mm),
+        passed=norm <= tolerance_mm,
+        rotation_error_rad=board.angle_rad,
+        pin_errors_mm=pins,
+        looks=looks,
+        simulated_s=board.steps * board.params.dt_s,
+        converged=converged,
+    )
+
+
+def _needle(coordinatograph: Coordinatograph | None, side: Side, target: np.ndarray) -> np.ndarray:
+    """Where the needle goes when the counters are set on ``target``: exactly there with ideal
+    drives (no coordinatograph), else where :meth:`Coordinatograph.move_pen` puts it. [mm]"""
+    if coordinatograph is None:
+        return target.copy()
+    return coordinatograph.move_pen(target, side)
+
+
+def _pin_and_rotate(
+    board: SheetOnTable,
+    needle,
+    op: OperatorParams,
+    rng: np.random.Generator,
+    passes: int,
+    pin_error_mm: ArrayLike,
+) -> tuple[np.ndarray, int, bool]:
+    """The passes of :func:`orient_sheet`: pin corner 1 under the needle (hand placement error
+    ``pin_error_mm`` + σ_pin), turn the sheet until corner 3 lies under the needle. Returns the
+    pin errors (passes, 2) [mm], the looks used and whether every turn was satisfied."""
     p = board.params
     corners = board.ideal
-
-    def needle(target: np.ndarray) -> np.ndarray:
-        if coordinatograph is None:
-            return target.copy()
-        return coordinatograph.move_pen(target, side)
-
     look_steps = max(1, round(op.look_interval_s / p.dt_s))
     max_looks = max(1, math.ceil(op.max_time_s / (look_steps * p.dt_s)))
     threshold = max(op.acuity_mm, op.floor_mm)
@@ -422,20 +457,4 @@ def orient_sheet(
         looks += used
         converged &= satisfied
         board.stop()
-    check = needle(corners[3])
-    marks = board.marks()
-    misclosure = marks[3] - check
-    norm = float(np.hypot(*misclosure))
-    return SheetOrientation(
-        marks_mm=marks,
-        residuals_mm=marks - corners,
-        misclosure_mm=misclosure,
-        misclosure_norm_mm=norm,
-        tolerance_mm=float(tolerance_mm),
-        passed=norm <= tolerance_mm,
-        rotation_error_rad=board.angle_rad,
-        pin_errors_mm=pins,
-        looks=looks,
-        simulated_s=board.steps * p.dt_s,
-        converged=converged,
-    )
+    return pins, looks, converged
