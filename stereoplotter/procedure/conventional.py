@@ -239,8 +239,7 @@ def calibrate(run, level_ids: tuple[str, ...]) -> Calibration:
         sheet.focal_length_corrected_mm, strict_per_axis=inst.variant.strict_per_axis
     )
     linkage = inst.variant.linkage
-    pts = scene.standard_points_m
-    imgs = scene.images(pts)
+    imgs = scene.standard  # the standard points' true images, computed once
     f = sheet.focal_length_corrected_mm
     j = {
         c: control_sensitivity(imgs, setting, unit, unit, {c: 1.0}, linkage=linkage)[0]
@@ -506,7 +505,7 @@ def c2_relative_by_elements(
     tol = sheet.tolerances["residual_y_parallax_mm"]
     over = float(overcorrection_factor(sheet.focal_length_corrected_mm, run.scene.c_mm))
     pts = run.scene.standard_points_m
-    imgs = run.scene.images(pts)
+    imgs = run.scene.standard  # the standard points' true images, computed once
     active = op.all()
     its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)

@@ -330,7 +330,7 @@ def clear_kappa(run: Run, stage: str) -> None:
     op = run.op
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     pts = run.scene.standard_points_m
-    imgs = run.scene.images(pts)
+    imgs = run.scene.standard  # the standard points' true images, computed once
     active = op.all()
     its = np.zeros(np.shape(active), int)
     for it in range(1, op.model.max_iterations + 1):

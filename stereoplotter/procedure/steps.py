@@ -191,7 +191,7 @@ def judge_standard_points(
     op = run.op
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     pts = run.scene.standard_points_m
-    imgs = run.scene.images(pts)
+    imgs = run.scene.standard  # the standard points' true images, computed once
     seen = []
     for i in range(6):
         q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
