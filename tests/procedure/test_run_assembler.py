@@ -5,8 +5,10 @@ back-end, the mechanics) cannot drift from what another passes."""
 from __future__ import annotations
 
 import ast
+from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import stereoplotter
@@ -14,7 +16,7 @@ from stereoplotter.instrument.sc1_complex import SC1Options
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure.run import build_instrument, build_run
-from stereoplotter.procedure.simulate import prepare_run
+from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
 
 PACKAGE = Path(stereoplotter.__file__).parent
 ASSEMBLER = PACKAGE / "procedure" / "run.py"
@@ -86,3 +88,36 @@ def test_the_options_reach_every_instrument(prep_with_servo):
     assert run.op.inst.trials == 4
     assert "automatic coordinatograph" in run.op.log.records[0].step
     assert run.practice == prep.practice
+
+
+def test_the_options_are_checked_once_per_run(monkeypatch):
+    """Issue 23: the SC complex's options are checked against the instrument file by
+    ``prepare_run`` alone; the instruments of the run's chunks take them as checked."""
+    calls = []
+    checked = SC1Options.fitted_to
+
+    def counting(self, spec):
+        calls.append(spec.key)
+        return checked(self, spec)
+
+    monkeypatch.setattr(SC1Options, "fitted_to", counting)
+    scenario, spec = load_scenario("scenarios/pair60.yaml"), load_instrument("sc1")
+    prep = prepare_run(scenario, spec, options=SC1Options(automatic_coordinatograph=True))
+    for first in (0, 2, 4):
+        run_trials_chunk(prep, first, 2, evaluate=False, transcript=False)
+    assert calls == [spec.key]
+
+
+def test_the_trials_never_read_the_scenario():
+    """Issue 23, compute once: the prepared pair carries every fact the procedure and the
+    evaluation read (points, standard points and their images, fiducials, the residual grid
+    and the evaluation's truth), so trials run on a prepared run stripped of its scenario give
+    the same numbers."""
+    scenario, spec = load_scenario("scenarios/pair60.yaml"), load_instrument("sc1")
+    for method in ("setup", "conventional"):
+        prep = prepare_run(scenario, spec, method, seed=5)
+        a = run_trials_chunk(prep, 0, 3, transcript=False)
+        b = run_trials_chunk(replace(prep, scenario=None), 0, 3, transcript=False)
+        np.testing.assert_array_equal(a.q_grid_mm, b.q_grid_mm)
+        np.testing.assert_array_equal(a.q_standard_mm, b.q_standard_mm)
+        assert a.evaluation.to_dict() == b.evaluation.to_dict()
