@@ -485,23 +485,18 @@ class ModelTruth:
 def model_truth(
     scenario: Scenario,
     sheet: Any,
+    grid_local_m: ArrayLike,
     *,
-    grid_shape: tuple[int, int] = (9, 9),
     standard_points_c_mm: float = STANDARD_POINTS_C_MM,
     plane_point_ids: Sequence[str] | None = None,
-    grid_local_m: ArrayLike | None = None,
 ) -> ModelTruth:
-    """The ground truth of an evaluation on ``sheet`` (arguments as :func:`evaluate_model`): the
-    point sets in the instrument frame with their true heights and images, the levelling plane's
+    """The ground truth of an evaluation on ``sheet`` over the working-area grid
+    ``grid_local_m`` (local frame) [m] (other arguments as :func:`evaluate_model`): the point
+    sets in the instrument frame with their true heights and images, the levelling plane's
     points, the mean flying height H̄ over the grid and the standard points at c·H̄/f."""
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
-    grid_local = (
-        working_area_grid_m(scenario, grid_shape)
-        if grid_local_m is None
-        else np.asarray(grid_local_m, float)
-    )
-    grid_frame = instrument_frame_m(grid_local, origin, theta)
+    grid_frame = instrument_frame_m(np.asarray(grid_local_m, float), origin, theta)
     flying_height = float(-np.mean(grid_frame[:, 2]))  # Z_Sл − mean Z
     pts_local = np.array([p.local_m for p in scenario.points], float).reshape(-1, 3)
     imaged = _imaged(
@@ -597,13 +592,14 @@ def evaluate_model(
     :func:`model_truth` (the ground-truth part, which a prepared run computes once) and
     :func:`evaluate_against` (the instrument part).
     """
+    if grid_local_m is None:
+        grid_local_m = working_area_grid_m(scenario, grid_shape)
     truth = model_truth(
         scenario,
         sheet,
-        grid_shape=grid_shape,
+        grid_local_m,
         standard_points_c_mm=standard_points_c_mm,
         plane_point_ids=plane_point_ids,
-        grid_local_m=grid_local_m,
     )
     return evaluate_against(
         truth,

@@ -353,5 +353,5 @@ def prepare_pair(
             decentration_variant(variant).strict_per_axis,
             mechanism_for(spec),
         )
-    truth = model_truth(scenario, sheet, standard_points_c_mm=c_mm, grid_local_m=scene.grid_m)
+    truth = model_truth(scenario, sheet, scene.grid_m, standard_points_c_mm=c_mm)
     return PreparedPair(sheet, scene, scene.grid_m, scene.grid_images_mm, truth)
