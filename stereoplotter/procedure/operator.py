@@ -52,7 +52,7 @@ from stereoplotter.procedure.evaluation import (
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.random_streams import keyed_draws
 from stereoplotter.scenario.model import Camera, Photo, Point, Scenario
-from stereoplotter.scenario.summary import flying_height_and_relief
+from stereoplotter.scenario.summary import mean_flying_height_m
 from stereoplotter.scenario.synthetic import film_deformed
 
 __all__ = [
@@ -244,8 +244,8 @@ class Scene:
         The scenario's file (named in a refusal).
     flying_height_m : float
         The scenario summary's mean flying height of the two photos above the mean point
-        height (each rounded to 0.1 m, :func:`~stereoplotter.scenario.summary.
-        flying_height_and_relief`). [m]
+        height (each rounded to 0.1 m,
+        :func:`~stereoplotter.scenario.summary.mean_flying_height_m`). [m]
     grid_m : ndarray, shape (g, 3), or None
         The working-area grid where the true residual y-parallax is evaluated (local frame;
         ``procedure.run.residual_grid_m``). [m]
@@ -296,7 +296,7 @@ class Scene:
         h = float(scenario.photo("left").exterior.centre[2]) - z0
         frame = standard_points_m(scenario, frame_origin_m, frame_rotation, h, c_mm)
         local = instrument_frame_m(frame, frame_origin_m, frame_rotation, inverse=True)
-        height = flying_height_and_relief(scenario)[0]
+        height = mean_flying_height_m(scenario)
         return cls(
             scenario.camera,
             scenario.photos,

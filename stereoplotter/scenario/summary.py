@@ -12,11 +12,19 @@ from stereoplotter.constants import MM_PER_M
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import _imaged, footprint_m, working_area_grid_m
 
-__all__ = ["flying_height_and_relief", "summarize_scenario"]
+__all__ = ["flying_height_and_relief", "mean_flying_height_m", "summarize_scenario"]
 
 
 def _r(value: float, digits: int = 3) -> float:
     return round(float(value), digits)
+
+
+def mean_flying_height_m(scenario: Scenario) -> float:
+    """The summary's mean flying height H of the photos above the mean point height, each
+    photo's rounded to 0.1 m as printed. [m]"""
+    z_mean = float(np.array([p.local_m for p in scenario.points])[:, 2].mean())
+    heights = [_r(p.exterior.projection_centre_m[2] - z_mean, 1) for p in scenario.photos]
+    return float(np.mean(heights))
 
 
 def flying_height_and_relief(
@@ -30,11 +38,9 @@ def flying_height_and_relief(
     (:func:`~stereoplotter.scenario.synthetic.working_area_grid_m`).
     """
     pts = np.array([p.local_m for p in scenario.points])
-    z_mean = float(pts[:, 2].mean())
     grid = working_area_grid_m(scenario, (15, 15)) if grid_m is None else grid_m
     terrain_z = grid[:, 2] if len(grid) else pts[:, 2]
-    heights = [_r(p.exterior.projection_centre_m[2] - z_mean, 1) for p in scenario.photos]
-    return float(np.mean(heights)), _r(terrain_z.max() - terrain_z.min(), 2)
+    return mean_flying_height_m(scenario), _r(terrain_z.max() - terrain_z.min(), 2)
 
 
 def summarize_scenario(scenario: Scenario) -> dict[str, Any]:
