@@ -199,7 +199,8 @@ def prepare_run(
     (:func:`prepare_pair`). The trials see the :class:`PreparedRun`, never recompute it.
     """
     options = SC1Options() if options is None else options.fitted_to(spec)
-    operator = OperatorModel() if operator is None else operator
+    # the eye's σ_p, σ_q for this instrument's observation system (procedure.eye)
+    operator = (OperatorModel() if operator is None else operator).for_instrument(spec)
     unit = ErrorCorrectionUnit.from_spec(spec) if options.error_correction_unit else None
     if unit is not None:
         scenario, operator = apply_correction_unit(scenario, spec, operator, unit)

@@ -86,7 +86,7 @@ def cell_run(design: StudyDesign, cell: int, config: dict[str, Any]) -> CellRun:
     config = design.config(config)
     spec = design.instruments[str(config.get("instrument", next(iter(design.instruments))))]
     judgement = float(config.get("judgement_scale", 1.0))
-    base = OperatorModel()
+    base = OperatorModel().for_instrument(spec)  # the eye's σ_p, σ_q on this instrument
     operator = replace(
         base,
         monocular_sigma_mm=base.monocular_sigma_mm * judgement,
