@@ -1,4 +1,4 @@
-"""The operator's eye: how finely the simulated operator judges parallax, from physiology and optics.
+"""The operator's eye: how finely the simulated operator judges parallax (physiology, optics).
 
 The operator looks at the photos through the instrument's binocular observation system. Two
 figures of human stereo vision (the photogrammetry textbook's, ``docs/procedure.md`` §The
@@ -167,9 +167,7 @@ class Eye:
     def y_parallax_sigma_mm(self) -> float:
         """σ_q of a y-parallax judgement, second kind, photo scale. [mm]"""
         s = self.system
-        return angle_to_photo_mm(
-            self.acuity_second_arcsec, s.magnification, s.viewing_distance_mm
-        )
+        return angle_to_photo_mm(self.acuity_second_arcsec, s.magnification, s.viewing_distance_mm)
 
     def check_pass_probability(self, q_mm: Any, tolerance_mm: float, looks: int = LOOKS):
         """Probability that the six-point check passes at true y-parallaxes ``q_mm`` (one per

@@ -23,7 +23,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.procedure.eye import EYE_MODES, LEGACY_SIGMA_MM, Eye, ObservationSystem
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     UnitMap,
@@ -45,6 +44,7 @@ from stereoplotter.instrument.virtual import (
     SetControl,
     Side,
 )
+from stereoplotter.procedure.eye import EYE_MODES, LEGACY_SIGMA_MM, Eye, ObservationSystem
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.random_streams import keyed_draws
 from stereoplotter.scenario.model import Scenario
@@ -157,8 +157,8 @@ class OperatorModel:
             sp, sq, system = eye.stereo_sigma_mm, eye.y_parallax_sigma_mm, eye.system
         return replace(
             self,
-            stereo_sigma_mm=sp if self.stereo_sigma_mm is None else self.stereo_sigma_mm,
-            y_parallax_sigma_mm=sq if self.y_parallax_sigma_mm is None else self.y_parallax_sigma_mm,
+            stereo_sigma_mm=_given(self.stereo_sigma_mm, sp),
+            y_parallax_sigma_mm=_given(self.y_parallax_sigma_mm, sq),
             observation=system,
         )
 
@@ -654,6 +654,11 @@ class Operator:
 
         t0 = self.physical(knob)
         return solve_1d(seen, t0, target, iterations=6, h=1e-6)
+
+
+def _given(value: float | None, derived: float) -> float:
+    """A σ given as a number, else the derived one."""
+    return derived if value is None else value
 
 
 def _column(obj):
