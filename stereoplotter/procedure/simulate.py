@@ -158,6 +158,7 @@ def apply_correction_unit(
         The scenario with the film deformation corrected; the operator with the residual added.
     """
     unit = ErrorCorrectionUnit.from_spec(spec) if unit is None else unit
+    operator = operator.for_instrument(spec)  # the eye's σ_p, σ_q where not given
     half_format_um = 0.5 * float(scenario.camera.format_mm) * 1000.0
     for photo in scenario.photos:
         unit.check_input_um(np.asarray(photo.film_deformation_ppm, float) * 1e-6 * half_format_um)
