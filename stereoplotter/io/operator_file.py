@@ -28,14 +28,17 @@ _OPERATOR_FIELDS: dict[str, tuple[str, Any]] = {
 
 def load_operator_model(value: str | Path | OperatorModel | None) -> OperatorModel | None:
     """The operator an ``--operator`` value names: None (the defaults), "zero" (no judgment,
-    reading or setting error, no quantisation: ``OperatorModel().zero()``) or a YAML file of
-    :class:`OperatorModel` fields (the others keep their defaults: σ_p, σ_q from the operator's
-    eye, or ``eye: sigma`` for the free σ of 0.010 mm); a bad entry is one
+    reading or setting error, no quantisation: ``OperatorModel().zero()``), "sigma" (the free
+    σ_p = σ_q = 0.010 mm judged in a single look, the operator before the eye model) or a YAML
+    file of :class:`OperatorModel` fields (the others keep their defaults: σ_p, σ_q from the
+    operator's eye, or ``eye: sigma`` for the free σ of 0.010 mm); a bad entry is one
     :class:`ConfigError` naming the file and the field."""
     if value is None or isinstance(value, OperatorModel):
         return value
     if str(value) == "zero":
         return OperatorModel().zero()
+    if str(value) == "sigma":  # the operator before the eye model (issue 25)
+        return OperatorModel(eye="sigma", remeasure=False)
 
     data, source = load_yaml_mapping(value)
     fields: dict[str, Any] = {}
