@@ -128,14 +128,14 @@ def tolerance_note(s: dict[str, Any]) -> str:
             if q_true <= tol * 1000.0:
                 p = look_probability(q_true / 1000.0, tol, sq / 1000.0)
                 text += (
-                    f"; the built model's true residual is within it (max {q_true:.4g} µm at the "
+                    f"; the final model's true residual is within it (max {q_true:.4g} µm at the "
                     f"six points): the operator's judgement σ_q = {sq:.2f} µm sees "
                     f"{q_true:.4g} µm over {tol * 1000:.4g} µm in one look with probability "
                     f"{p:.2g}"
                 )
             else:
                 text += (
-                    f"; the built model's true residual exceeds it (max {q_true:.4g} µm at "
+                    f"; the final model's true residual exceeds it (max {q_true:.4g} µm at "
                     "the six points): the remedies did not clear it"
                 )
         parts.append(text)

@@ -523,7 +523,7 @@ def _linear_entry(
     z = (d_sim - delta) / se if se > 0.0 and math.isfinite(se) else None
     tiny = NEGLIGIBLE * abs(ms_on)
     if max(abs(delta), abs(check or 0.0), abs(d_sim)) <= tiny:
-        return {"rms": 0.0, "delta_ms": 0.0, "status": "negligible", "z": z, "reason": ""}
+        return {"rms": 0.0, "delta_ms": 0.0, "status": "negligible", "z": None, "reason": ""}
     scale = max(abs(delta), abs(check or 0.0))
     stable = check is not None and abs(delta - check) <= STEP_AGREEMENT * scale
     agrees = abs(z) <= Z_AGREE if z is not None else abs(d_sim - delta) <= tiny
