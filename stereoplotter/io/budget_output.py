@@ -34,6 +34,7 @@ class Linear(_Strict):
 
     rms: float | None
     delta_ms: float | None
+    predicted_ms: float | None
     status: Literal["validated", "negligible", "dropped", "none"]
     z: float | None
     reason: str

@@ -518,12 +518,26 @@ def _linear_entry(
     measured reason otherwise. ``changed``: the fraction of the trials with this term alone whose
     decisions differ from the error-free run's; ``ms_on``: the all-on mean square."""
     if delta is None:
-        return {"rms": None, "delta_ms": None, "status": "none", "z": None, "reason": ""}
+        return {
+            "rms": None,
+            "delta_ms": None,
+            "predicted_ms": None,
+            "status": "none",
+            "z": None,
+            "reason": "",
+        }
     d_sim, se = sim["delta_ms"], sim["delta_ms_se"]
     z = (d_sim - delta) / se if se > 0.0 and math.isfinite(se) else None
     tiny = NEGLIGIBLE * abs(ms_on)
     if max(abs(delta), abs(check or 0.0), abs(d_sim)) <= tiny:
-        return {"rms": 0.0, "delta_ms": 0.0, "status": "negligible", "z": None, "reason": ""}
+        return {
+            "rms": 0.0,
+            "delta_ms": 0.0,
+            "predicted_ms": delta,
+            "status": "negligible",
+            "z": None,
+            "reason": "",
+        }
     scale = max(abs(delta), abs(check or 0.0))
     stable = check is not None and abs(delta - check) <= STEP_AGREEMENT * scale
     agrees = abs(z) <= Z_AGREE if z is not None else abs(d_sim - delta) <= tiny
@@ -531,6 +545,7 @@ def _linear_entry(
         return {
             "rms": math.sqrt(max(delta, 0.0)),
             "delta_ms": delta,
+            "predicted_ms": delta,
             "status": "validated",
             "z": z,
             "reason": "",
@@ -547,7 +562,14 @@ def _linear_entry(
             f"({z:+.1f} SE); with this term alone the procedure decided otherwise than the "
             f"error-free run (loop passes, checks, remedies) in {changed:.1%} of the trials"
         )
-    return {"rms": None, "delta_ms": None, "status": "dropped", "z": z, "reason": why}
+    return {
+        "rms": None,
+        "delta_ms": None,
+        "predicted_ms": delta,
+        "status": "dropped",
+        "z": z,
+        "reason": why,
+    }
 
 
 def run_budget(
