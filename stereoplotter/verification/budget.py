@@ -515,7 +515,8 @@ def _linear_entry(
 ) -> dict[str, Any]:
     """The predicted Δ validated against the simulated one-at-a-time Δ (``sim``) within
     :data:`Z_AGREE` SE, and against the step check; dropped (rms and delta_ms null) with the
-    measured reason otherwise. ``changed``: the fraction of the trials with this term alone whose
+    measured reason otherwise (``predicted_ms``: the σ² expansion whatever its status).
+    ``changed``: the fraction of the trials with this term alone whose
     decisions differ from the error-free run's; ``ms_on``: the all-on mean square."""
     if delta is None:
         return {
