@@ -559,7 +559,7 @@ def _linear_entry(
         )
     else:
         why = (
-            f"linear Δ {delta:.4g} against the simulated {d_sim:.4g} ± {se:.2g} "
+            f"predicted Δ {delta:.4g} against the simulated {d_sim:.4g} ± {se:.2g} "
             f"({z:+.1f} SE); with this term alone the procedure decided otherwise than the "
             f"error-free run (loop passes, checks, remedies) in {changed:.1%} of the trials"
         )
