@@ -176,7 +176,9 @@ class OperatorModel:
         return eye.to_dict()
 
     def zero(self) -> OperatorModel:
-        """The same habits with no judgment error and exact readings.
+        """The same habits with no judgment error and exact readings; no remeasure (a second look
+        without judgment error sees the same; the verification builds its one-source operators
+        on this, and keeps the single look of its rows).
 
         Examples
         --------
@@ -191,6 +193,7 @@ class OperatorModel:
             reading_sigma_lc=0.0,
             setting_sigma_lc=0.0,
             quantise=False,
+            remeasure=False,
         )
 
     def to_dict(self) -> dict[str, Any]:
