@@ -49,8 +49,9 @@ def add_arguments(sub: Any) -> None:
     )
     p.add_argument(
         "--operator",
-        help="the operator: 'zero' (no judgment, reading or setting error, no rounding) or a "
-        "YAML of OperatorModel fields (default: the assumed operator)",
+        help="the operator: 'zero' (no judgment, reading or setting error, no rounding), "
+        "'sigma' (the free σ_p = σ_q = 0.010 mm judged in one look, before the eye model) or a "
+        "YAML of OperatorModel fields (default: σ_p, σ_q from the operator's eye)",
     )
     p.add_argument(
         "--practice",

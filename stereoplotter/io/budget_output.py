@@ -29,10 +29,15 @@ class Contribution(_Strict):
 
 
 class Linear(_Strict):
-    """The first-order prediction: Δ of the mean square and its √ (null: no linear model)."""
+    """The predicted Δ of the mean square (smooth σ² expansion) and its √, null where there is
+    no smooth model or the prediction was dropped; its validation against the simulated Δ."""
 
     rms: float | None
     delta_ms: float | None
+    predicted_ms: float | None
+    status: Literal["validated", "negligible", "dropped", "none"]
+    z: float | None
+    reason: str
 
 
 class Rms(_Strict):
@@ -44,12 +49,23 @@ class Rms(_Strict):
     ms_se: float | None
 
 
+class Interaction(_Strict):
+    """A term's Δ(all but one) − Δ(one at a time), paired, with its SE."""
+
+    term: str
+    delta_ms: float | None
+    delta_ms_se: float | None
+
+
 class Additivity(_Strict):
-    """Σ one-at-a-time Δᵢ, and its paired gap to Δ(all on − all off) with SE."""
+    """Σ one-at-a-time Δᵢ, its paired gap to Δ(all on − all off) with SE, whether it is within
+    2 SE, and the terms that interact beyond 2 SE."""
 
     sum_one_at_a_time_ms: float | None
     gap_ms: float | None
     gap_ms_se: float | None
+    adds_up: bool
+    interactions: list[Interaction]
 
 
 class Totals(_Strict):
@@ -105,6 +121,7 @@ class Term(_Strict):
     assumed: bool
     meaning: str
     linear_model: Literal["numerical linearisation", "no linear model", "zero (σ = 0)"]
+    decisions_changed: float
     one_at_a_time: ContributionByMeasure
     all_but_one: ContributionByMeasure
     linear: LinearByMeasure
@@ -124,6 +141,8 @@ class BudgetOutput(_Strict):
     seed: int
     configurations: int
     linearisation_step_sigma: float
+    check_step_sigma: float
+    agreement_z: float
     seconds: float | None = None
     measures: MeasureDescriptions
     operator: dict[str, object]

@@ -83,6 +83,9 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("coordinatograph.table_mm", "pair", "mm", high=5000.0, **_POS),
     _Leaf("coordinatograph.plotting_sigma_mm", "number", "mm", 0.0, 10.0),
     _Leaf("mark.diameter_mm", "number", "mm", high=5.0, **_POS),
+    # the operator's eye (procedure.eye): the binocular's magnification and viewing distance
+    _Leaf("observation.magnification", "number", "×", 0.5, 100.0, required=False),
+    _Leaf("observation.viewing_distance_mm", "number", "mm", 50.0, 1000.0, required=False),
     _Leaf("tolerances.L_check_times_n_mm", "number", "mm", high=10.0, **_POS),
     _Leaf("tolerances.mark_fit_per_n_mm", "number", "mm", high=10.0, **_POS),
     _Leaf("tolerances.residual_q_fraction_of_mark", "number", "—", high=10.0, **_POS),

@@ -7,6 +7,7 @@ from typing import Any
 
 from stereoplotter.errors import ConfigError, did_you_mean
 from stereoplotter.io.yaml_input import load_yaml_mapping
+from stereoplotter.procedure.eye import EYE_MODES
 from stereoplotter.procedure.operator import OperatorModel
 
 __all__ = ["load_operator_model"]
@@ -20,18 +21,24 @@ _OPERATOR_FIELDS: dict[str, tuple[str, Any]] = {
     "quantise": ("true or false", bool),
     "finish_side": ("below, above or null", str),
     "max_iterations": ("an integer 1 … 100", int),
+    "eye": ("physiological or sigma", "eye"),
+    "remeasure": ("true or false", bool),
 }
 
 
 def load_operator_model(value: str | Path | OperatorModel | None) -> OperatorModel | None:
     """The operator an ``--operator`` value names: None (the defaults), "zero" (no judgment,
-    reading or setting error, no quantisation: ``OperatorModel().zero()``) or a YAML file of
-    :class:`OperatorModel` fields (the others keep their defaults); a bad entry is one
+    reading or setting error, no quantisation: ``OperatorModel().zero()``), "sigma" (the free
+    σ_p = σ_q = 0.010 mm judged in a single look, the operator before the eye model) or a YAML
+    file of :class:`OperatorModel` fields (the others keep their defaults: σ_p, σ_q from the
+    operator's eye, or ``eye: sigma`` for the free σ of 0.010 mm); a bad entry is one
     :class:`ConfigError` naming the file and the field."""
     if value is None or isinstance(value, OperatorModel):
         return value
     if str(value) == "zero":
         return OperatorModel().zero()
+    if str(value) == "sigma":  # the operator before the eye model (issue 25)
+        return OperatorModel(eye="sigma", remeasure=False)
 
     data, source = load_yaml_mapping(value)
     fields: dict[str, Any] = {}
@@ -50,6 +57,7 @@ def load_operator_model(value: str | Path | OperatorModel | None) -> OperatorMod
             bool: isinstance(v, bool),
             int: isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 100,
             str: v is None or v in ("below", "above"),
+            "eye": v in EYE_MODES,
         }[kind]
         if not ok:
             raise ConfigError(source, str(key), expected, v)

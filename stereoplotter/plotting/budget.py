@@ -2,7 +2,8 @@
 
 One panel per measure, one horizontal bar per error term: its one-at-a-time contribution
 (signed RMS, a negative bar: the measure fell when the term was switched on) with ±1 SE, the
-all-but-one contribution as a hollow bar, and the linear prediction as a black tick. A linear
+all-but-one contribution as a hollow bar, and the validated prediction (smooth σ² expansion,
+none where dropped) as a black tick. A linear
 axis: the contributions range over two or three decades but carry signs, which a log axis
 cannot show. Terms that change no measure at all (exactly zero Δ in every configuration, e.g. a
 term at σ = 0 or one the evaluated model does not depend on) are left out and counted in the
@@ -43,7 +44,7 @@ def plot_budget(budget: dict[str, Any]) -> Any:
         lin = np.array([_num(r["linear"][key]["rms"]) for r in rows])
         ax.barh(y + 0.18, one, height=0.36, xerr=se, color="tab:blue", label="one at a time")
         ax.barh(y - 0.18, abo, height=0.36, fill=False, edgecolor="tab:orange", label="all but one")
-        ax.plot(lin, y, "k|", ms=12, mew=2, label="linear prediction")
+        ax.plot(lin, y, "k|", ms=12, mew=2, label="predicted (validated)")
         ax.axvline(0.0, color="0.4", lw=0.8)
         ax.set_xlabel(f"contribution, RMS [{desc['unit']}]")
         ax.set_title(desc["meaning"], fontsize=9)

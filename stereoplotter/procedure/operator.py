@@ -49,6 +49,7 @@ from stereoplotter.procedure.evaluation import (
     photo_points_mm,
     standard_points_m,
 )
+from stereoplotter.procedure.eye import EYE_MODES, LEGACY_SIGMA_MM, Eye, ObservationSystem
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.random_streams import keyed_draws
 from stereoplotter.scenario.model import Camera, Photo, Point, Scenario
@@ -88,13 +89,16 @@ class OperatorModel:
         σ_mono, mark on a point of one photo, per axis, photo scale. [mm] Assumed 0.010:
         below the book's m_q = 0.015 mm (a monocular setting on a sharp fiducial is easier
         than judging y-parallax) and of the order of the 0.01 mm least count of the counters.
-    stereo_sigma_mm : float
-        σ_p, x-parallax judged zero (mark "on the ground"), photo scale. [mm] Assumed 0.010,
-        as σ_mono (no figure in the book).
-    y_parallax_sigma_mm : float
-        σ_q, y-parallax judged zero. [mm] Assumed 0.010, below the book's m_q = 0.015 mm
-        (Table 18, documented) for a trained operator; with it the ¼-mark check (12.5 µm at
-        the assumed 0.05 mm mark) cannot pass reliably (``docs/procedure.md``, the sweep).
+    stereo_sigma_mm : float or None
+        σ_p, x-parallax judged zero (the fused mark "on the ground"), photo scale. [mm]
+        None (default): from the operator's eye (:mod:`stereoplotter.procedure.eye`), stereo
+        acuity of the first kind 30″ through the instrument's observation system,
+        σ_p = 30″·d/V (6.06 µm at the assumed V = 6×, d = 250 mm); a number: a free σ.
+    y_parallax_sigma_mm : float or None
+        σ_q, y-parallax judged (cleared, or seen against ¼ mark). [mm] None (default): from the
+        eye, second kind 10″, σ_q = 10″·d/V (2.02 µm at 6×, 250 mm); a number: a free σ. The
+        book's m_q = 0.015 mm (Table 18) is a whole measurement error (film, diapositive,
+        instrument and pointing, ch. 5), not the eye's alone.
     reading_sigma_lc : float
         σ_read in least counts of the scale read, before rounding to the least count. [—]
         Assumed 0.2: a vernier or drum read to the least count, no data.
@@ -107,22 +111,80 @@ class OperatorModel:
     max_iterations : int
         Bound of every tolerance loop and of every remedy's rounds (reported when reached,
         never silent). A convention (6), not a figure of the book.
+    eye : {"physiological", "sigma"}
+        How σ_p and σ_q left None are resolved for an instrument (:meth:`for_instrument`):
+        "physiological" (default) from the eye; "sigma" the free σ = 0.010 mm of the operator
+        before issue 25 (kept selectable, ``simulate --operator`` file ``eye: sigma``).
+    remeasure : bool
+        Habit: a point whose y-parallax is seen over ¼ mark is looked at again (a new pointing
+        and judgement) before it is declared failed (default True, a competent operator).
+    observation : ObservationSystem or None
+        The observation system the eye figures were derived for (set by :meth:`for_instrument`).
     assumed : bool
         Always True: none of these values is documented for the instruments.
     """
 
     monocular_sigma_mm: float = 0.010
-    stereo_sigma_mm: float = 0.010
-    y_parallax_sigma_mm: float = 0.010
+    stereo_sigma_mm: float | None = None
+    y_parallax_sigma_mm: float | None = None
     reading_sigma_lc: float = 0.2
     setting_sigma_lc: float = 0.2
     quantise: bool = True
     finish_side: str | None = "below"
     max_iterations: int = 6
+    eye: str = "physiological"
+    remeasure: bool = True
+    observation: ObservationSystem | None = None
     assumed: bool = field(default=True, init=False)
 
+    def for_instrument(self, spec: Any) -> OperatorModel:
+        """σ_p and σ_q left None resolved for the instrument ``spec`` (class doc, ``eye``).
+
+        Examples
+        --------
+        >>> from stereoplotter.io.instrument_file import load_instrument
+        >>> op = OperatorModel().for_instrument(load_instrument("sc1"))
+        >>> round(op.y_parallax_sigma_mm * 1000, 2), round(op.stereo_sigma_mm * 1000, 2)
+        (2.02, 6.06)
+        >>> OperatorModel(eye="sigma").for_instrument(None).y_parallax_sigma_mm
+        0.01
+        """
+        if self.eye not in EYE_MODES:
+            raise StereoplotterError(
+                f"operator eye: expected one of {', '.join(EYE_MODES)}, found {self.eye!r}"
+            )
+        if self.stereo_sigma_mm is not None and self.y_parallax_sigma_mm is not None:
+            return self
+        if self.eye == "sigma":
+            sp = sq = LEGACY_SIGMA_MM
+            system = None
+        else:
+            eye = Eye(ObservationSystem.from_spec(spec))
+            sp, sq, system = eye.stereo_sigma_mm, eye.y_parallax_sigma_mm, eye.system
+        return replace(
+            self,
+            stereo_sigma_mm=_given(self.stereo_sigma_mm, sp),
+            y_parallax_sigma_mm=_given(self.y_parallax_sigma_mm, sq),
+            observation=system,
+        )
+
+    def eye_figures(self) -> dict[str, Any] | None:
+        """The derived judgement figures (:meth:`Eye.to_dict`) where σ_p and σ_q both come from
+        the eye, else None."""
+        if self.observation is None or self.eye != "physiological":
+            return None
+        eye = Eye(self.observation)
+        if (self.stereo_sigma_mm, self.y_parallax_sigma_mm) != (
+            eye.stereo_sigma_mm,
+            eye.y_parallax_sigma_mm,
+        ):
+            return None
+        return eye.to_dict()
+
     def zero(self) -> OperatorModel:
-        """The same habits with no judgment error and exact readings.
+        """The same habits with no judgment error and exact readings; no remeasure (a second look
+        without judgment error sees the same; the verification builds its one-source operators
+        on this, and keeps the single look of its rows).
 
         Examples
         --------
@@ -137,11 +199,14 @@ class OperatorModel:
             reading_sigma_lc=0.0,
             setting_sigma_lc=0.0,
             quantise=False,
+            remeasure=False,
         )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready parameters with their status."""
-        out = {k: getattr(self, k) for k in self.__slots__ if k != "assumed"}
+        skip = ("assumed", "observation")
+        out = {k: getattr(self, k) for k in self.__slots__ if k not in skip}
+        out["eye_figures"] = self.eye_figures()
         out["status"] = "assumed"
         return out
 
@@ -345,7 +410,7 @@ class Operator:
         self, instrument: Instrument, model: OperatorModel, noise: Noise, transcript: Transcript
     ):
         self.inst = instrument
-        self.model = model
+        self.model = model.for_instrument(instrument.spec)
         self.noise = noise
         self.log = transcript
         self.trials = instrument.trials
@@ -640,6 +705,11 @@ class Operator:
 
         t0 = self.physical(knob)
         return solve_1d(seen, t0, target, iterations=6, h=1e-6)
+
+
+def _given(value: float | None, derived: float) -> float:
+    """A σ given as a number, else the derived one."""
+    return derived if value is None else value
 
 
 def _column(obj):

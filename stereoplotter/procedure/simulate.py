@@ -158,6 +158,7 @@ def apply_correction_unit(
         The scenario with the film deformation corrected; the operator with the residual added.
     """
     unit = ErrorCorrectionUnit.from_spec(spec) if unit is None else unit
+    operator = operator.for_instrument(spec)  # the eye's σ_p, σ_q where not given
     half_format_um = 0.5 * float(scenario.camera.format_mm) * 1000.0
     for photo in scenario.photos:
         unit.check_input_um(np.asarray(photo.film_deformation_ppm, float) * 1e-6 * half_format_um)
@@ -199,7 +200,8 @@ def prepare_run(
     (:func:`prepare_pair`). The trials see the :class:`PreparedRun`, never recompute it.
     """
     options = SC1Options() if options is None else options.fitted_to(spec)
-    operator = OperatorModel() if operator is None else operator
+    # the eye's σ_p, σ_q for this instrument's observation system (procedure.eye)
+    operator = (OperatorModel() if operator is None else operator).for_instrument(spec)
     unit = ErrorCorrectionUnit.from_spec(spec) if options.error_correction_unit else None
     if unit is not None:
         scenario, operator = apply_correction_unit(scenario, spec, operator, unit)

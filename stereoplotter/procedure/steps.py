@@ -187,14 +187,25 @@ def judge_standard_points(
     iteration: int = 1,
 ) -> list[NDArray[np.float64]]:
     """Fuse on each of the six standard points and judge its y-parallax (σ_q), logging each
-    against ¼ mark (``text`` with ``{i}`` the point's number). [mm], one array per point."""
+    against ¼ mark (``text`` with ``{i}`` the point's number). [mm], one array per point.
+
+    A detection (``procedure.eye``, (eye 2)): where the y-parallax is seen over ¼ mark and the
+    operator remeasures (``OperatorModel.remeasure``), the point is fused and judged again
+    (key ``…/again``, a new pointing and judgement) and the second look is what counts: a
+    point fails only when both looks see it over."""
     op = run.op
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     pts = run.scene.standard_points_m
     imgs = run.scene.standard  # the standard points' true images, computed once
+    act = op.all() if active is None else op.v(active).astype(bool)
     seen = []
     for i in range(6):
-        q, q_true = op.fuse(pts[i], (imgs[0][i], imgs[1][i]), f"{key}/{i + 1}", active)
+        img = (imgs[0][i], imgs[1][i])
+        q, q_true = op.fuse(pts[i], img, f"{key}/{i + 1}", active)
+        again = act & (np.abs(q) > tol) if op.model.remeasure else None
+        if again is not None and np.any(again):
+            q2, _ = op.fuse(pts[i], img, f"{key}/{i + 1}/again", again)
+            q = np.where(again, q2, q)
         seen.append(q)
         op.log.add(
             stage,

@@ -45,40 +45,72 @@ def _pm(entry: dict[str, Any], d: int) -> str:
 
 
 def budget_markdown(budget: dict[str, Any]) -> str:
-    """One Markdown table per measure: σ, one at a time ± SE, all but one ± SE, linear."""
+    """One Markdown table per measure: σ, one at a time ± SE, all but one ± SE, the predicted
+    (smooth σ² expansion) value with its agreement, and the additivity; then the dropped
+    predictions with their reasons."""
+    z = budget.get("agreement_z", 2.0)
     lines = [
         f"Error budget of `{budget['scenario']}` on `{budget['instrument']}`, "
         f"{budget['method']} method: {budget['trials']} trials per configuration "
         f"(common random numbers), seed {budget['seed']}, {budget['configurations']} "
         "configurations. A contribution is sign(Δ)·√|Δ| of the mean-square change Δ; "
-        "± one Monte Carlo standard error; linear: first-order prediction "
-        f"(central differences, step {budget['linearisation_step_sigma']} σ).",
+        "± one Monte Carlo standard error; predicted: the σ² order of Δ from a smooth expansion "
+        "of the error-free procedure with its decisions held fixed (differences at "
+        f"{budget['linearisation_step_sigma']:g} σ, checked at {budget['check_step_sigma']:g} σ), "
+        f"kept where it agrees with the one-at-a-time Δ within {z:g} SE (z = (Δ_sim − Δ_pred)/SE).",
         "",
     ]
+    dropped = []
     for key, (unit, meaning) in MEASURES.items():
         d = _DECIMALS[key]
         tot = budget["totals"][key]
         add = tot["additivity"]
+        gap_z = add["gap_ms"] / add["gap_ms_se"] if add["gap_ms_se"] else 0.0
+        verdict = (
+            f"the parts add up within {z:g} SE"
+            if add["adds_up"]
+            else f"the parts do not add up ({gap_z:+.1f} SE)"
+        )
         lines += [
             f"### {meaning} [{unit}]",
             "",
             f"All on {_pm(tot['all_on'], d)}, all off (error-free floor) "
-            f"{_pm(tot['all_off'], d)}, linear all on {_fmt(tot['linear_all_on_rms'], d)}; "
+            f"{_pm(tot['all_off'], d)}, predicted all on (floor + validated parts) "
+            f"{_fmt(tot['linear_all_on_rms'], d)}; "
             f"Σ one-at-a-time Δ = {_fmt(add['sum_one_at_a_time_ms'], d + 2)} against "
             f"Δ(all on − all off) = {_fmt(tot['total_delta']['delta_ms'], d + 2)} "
             f"(gap {_fmt(add['gap_ms'], d + 2)} ± {_fmt(add['gap_ms_se'], d + 2)}) "
-            f"[{unit}²].",
+            f"[{unit}²]: {verdict}.",
             "",
-            "| term | σ | one at a time | all but one | linear | linear model |",
-            "|---|---|---|---|---|---|",
+        ]
+        if add["interactions"]:
+            lines.append(
+                "Interactions, Δ(all but one) − Δ(one at a time) beyond "
+                f"{z:g} SE [{unit}²]: "
+                + "; ".join(
+                    f"`{i['term']}` {_fmt(i['delta_ms'], d + 2)} ± {_fmt(i['delta_ms_se'], d + 2)}"
+                    for i in add["interactions"]
+                )
+                + ".",
+            )
+            lines.append("")
+        lines += [
+            "| term | σ | one at a time | all but one | predicted | z | prediction |",
+            "|---|---|---|---|---|---|---|",
         ]
         for r in budget["terms"]:
-            lin = r["linear"][key]["rms"]
+            lin = r["linear"][key]
+            zt = "—" if lin.get("z") is None else f"{lin['z']:+.1f}"
             lines.append(
                 f"| `{r['name']}` | {_scale(r)} | {_pm(r['one_at_a_time'][key], d)} | "
-                f"{_pm(r['all_but_one'][key], d)} | {_fmt(lin, d)} | {r['linear_model']} |"
+                f"{_pm(r['all_but_one'][key], d)} | {_fmt(lin['rms'], d)} | {zt} | "
+                f"{lin.get('status', r['linear_model'])} |"
             )
+            if lin.get("status") == "dropped":
+                dropped.append(f"* `{r['name']}`, {meaning}: {lin['reason']}.")
         lines.append("")
+    if dropped:
+        lines += ["Predictions dropped, with the reason measured in this run:", "", *dropped, ""]
     return "\n".join(lines)
 
 

@@ -11,12 +11,15 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.glossary import check_language, term
+from stereoplotter.procedure.eye import look_probability
 from stereoplotter.procedure.simulate import SimulationResult
 
 __all__ = [
     "OPERATOR_ADVICE",
     "OPERATOR_ADVICE_RU",
     "closing_summary",
+    "eye_lines",
+    "judgement",
     "simulation_markdown",
     "tolerance_note",
     "transcript_text",
@@ -50,21 +53,93 @@ def _p95(s: dict[str, Any] | None) -> str:
     return _g(s["quantiles"]["p95"]["value"])
 
 
+def _eye(s: dict[str, Any]) -> dict[str, Any] | None:
+    return (s.get("operator") or {}).get("eye_figures")
+
+
+def judgement(check: str, operator: dict[str, Any] | None) -> str:
+    """How the operator judged a check (the σ of the act that decides it), photo scale. [µm]"""
+    if not operator:
+        return "—"
+    um = {
+        k: (operator.get(k) or 0.0) * 1000.0
+        for k in ("y_parallax_sigma_mm", "stereo_sigma_mm", "monocular_sigma_mm")
+    }
+    eye = operator.get("eye_figures")
+    if "y-parallax" in check:
+        looks = eye["looks_before_failure"] if eye and operator.get("remeasure") else 1
+        how = "10″·d/V, " if eye else ""
+        return f"σ_q {um['y_parallax_sigma_mm']:.2f} µm ({how}{looks} look{'s' * (looks > 1)})"
+    if "heights" in check:
+        how = " (30″·d/V)" if eye else ""
+        return f"σ_p {um['stereo_sigma_mm']:.2f} µm{how}"
+    if "plan control" in check:
+        return f"σ_p {um['stereo_sigma_mm']:.2f}, σ_mono {um['monocular_sigma_mm']:.2f} µm"
+    return f"σ_mono {um['monocular_sigma_mm']:.2f} µm (assumed)"
+
+
+def eye_lines(s: dict[str, Any]) -> list[str]:
+    """The operator's eye: the derived judgement figures with the status of their inputs."""
+    eye = _eye(s)
+    op = s.get("operator") or {}
+    if not eye:
+        if not op:
+            return []
+        return [
+            "",
+            f"Operator: free σ (eye: {op.get('eye')}), σ_p = "
+            f"{(op.get('stereo_sigma_mm') or 0) * 1000:.2f} µm, σ_q = "
+            f"{(op.get('y_parallax_sigma_mm') or 0) * 1000:.2f} µm (given, not derived).",
+        ]
+    return [
+        "",
+        "Operator's eye (derived, docs/procedure.md): stereo acuity "
+        f"{eye['acuity_first_kind_arcsec']:g}″ (first kind: the fused mark) and "
+        f"{eye['acuity_second_kind_arcsec']:g}″ (second kind: y-parallax) through the "
+        f"observation system V = {eye['magnification']:g}× ({eye['magnification_status']}), "
+        f"d = {eye['viewing_distance_mm']:g} mm ({eye['viewing_distance_status']}): "
+        f"σ_p = 30″·d/V = {eye['stereo_sigma_um']:.2f} µm, "
+        f"σ_q = 10″·d/V = {eye['y_parallax_sigma_um']:.2f} µm; a y-parallax check is a "
+        f"detection, a point failed only when {eye['looks_before_failure']} looks see it over "
+        "¼ mark.",
+    ]
+
+
 def tolerance_note(s: dict[str, Any]) -> str:
-    """One honest sentence for a single run's summary: inside the book's tolerances, or why not
-    (the figures of ``docs/procedure.md``, pass rates over 10 000 trials)."""
-    failed = [n for n, c in s.get("checks", {}).items() if c.get("passed") is False]
+    """One honest sentence for a single run's summary: inside the book's tolerances, or by how
+    much and why not, with the operator's derived judgement figures."""
+    checks = s.get("checks", {})
+    failed = [n for n, c in checks.items() if c.get("passed") is False]
     if not failed:
         return "The model is inside the book's tolerances (every check passed)."
-    return (
-        f"Outside the book's tolerances ({'; '.join(failed)}): with the assumed operator "
-        "(σ_q = 10 µm, judged at each of six points) the ¼-mark y-parallax check (12.5 µm with "
-        "the assumed 0.05 mm mark) passes in about 38 % of 10 000 pair60/SC-1 runs even with the "
-        "remedies (σ_q = 5 µm: 99 %, or a 0.08 mm mark: 95 %); H/3000 at the control heights "
-        "is met after the levelling remedy R3 in 99 % of pair60 runs but in 56 % of pair80 "
-        "runs, where one height reading's σ_p·H/b ≈ 0.39 m nearly fills the 0.47 m "
-        "(docs/procedure.md)."
-    )
+    q_true = (s.get("residual_y_parallax_um") or {}).get("standard_points_max")
+    op = s.get("operator") or {}
+    sq = (op.get("y_parallax_sigma_mm") or 0.0) * 1000.0
+    parts = []
+    for name in failed:
+        c = checks[name]
+        res, tol = c.get("residual"), c.get("tolerance")
+        unit = c.get("unit", "")
+        if res is None or tol is None:
+            parts.append(name)
+            continue
+        text = f"{name}: {_g(abs(res))} {unit} against {_g(tol)} (over by {_g(abs(res) - tol)})"
+        if "y-parallax" in name and q_true is not None and unit == "mm":
+            if q_true <= tol * 1000.0:
+                p = look_probability(q_true / 1000.0, tol, sq / 1000.0)
+                text += (
+                    f"; the final model's true residual is within it (max {q_true:.4g} µm at the "
+                    f"six points): the operator's judgement σ_q = {sq:.2f} µm sees "
+                    f"{q_true:.4g} µm over {tol * 1000:.4g} µm in one look with probability "
+                    f"{p:.2g}"
+                )
+            else:
+                text += (
+                    f"; the final model's true residual exceeds it (max {q_true:.4g} µm at "
+                    "the six points): the remedies did not clear it"
+                )
+        parts.append(text)
+    return "Outside the book's tolerances: " + "; ".join(parts) + "."
 
 
 def _remedy_lines(s: dict[str, Any], single: bool) -> list[str]:
@@ -104,15 +179,17 @@ def _single_run_lines(s: dict[str, Any]) -> list[str]:
         f"back-end {s['backend']}, seed {s['seed']}, one procedure; operator judgment "
         "errors are assumed values.",
         "",
-        "| check | residual | tolerance | passed | iterations |",
-        "|---|---|---|---|---|",
+        "| check | residual | tolerance | passed | iterations | judged with |",
+        "|---|---|---|---|---|---|",
     ]
+    op = s.get("operator")
     for name, c in s["checks"].items():
         label = name.replace("|", "\\|")
         lines.append(
             f"| {label} | {_g(c['residual'])} {c['unit']} | {_g(c.get('tolerance'))} | "
-            f"{c.get('passed', '—')} | {_g(c.get('iterations'))} |"
+            f"{c.get('passed', '—')} | {_g(c.get('iterations'))} | {judgement(name, op)} |"
         )
+    lines += eye_lines(s)
     lines += _remedy_lines(s, single=True)
     q = s["residual_y_parallax_um"]
     lines += [
@@ -121,8 +198,7 @@ def _single_run_lines(s: dict[str, Any]) -> list[str]:
         f"µm at the six standard points; over the grid max {_g(q['grid_max'])} µm, "
         f"RMS {_g(q['grid_rms'])} µm.",
         "",
-        "Iterations per stage: "
-        + ", ".join(f"{k}: {_g(v)}" for k, v in s["iterations"].items()),
+        "Iterations per stage: " + ", ".join(f"{k}: {_g(v)}" for k, v in s["iterations"].items()),
         "",
     ]
     return lines
@@ -144,9 +220,11 @@ def simulation_markdown(s: dict[str, Any]) -> str:
         + "; operator judgment errors are assumed values. Figures: mean ± Monte Carlo standard "
         "error; p95 the 95th percentile over the trials.",
         "",
-        "| check | passed (rate ± SE) | residual mean | residual p95 | tolerance | iterations |",
-        "|---|---|---|---|---|---|",
+        "| check | passed (rate ± SE) | residual mean | residual p95 | tolerance | iterations "
+        "| judged with |",
+        "|---|---|---|---|---|---|---|",
     ]
+    op = s.get("operator")
     for name, c in s["checks"].items():
         label = name.replace("|", "\\|")
         rate = c.get("pass_rate")
@@ -154,8 +232,9 @@ def simulation_markdown(s: dict[str, Any]) -> str:
         lines.append(
             f"| {label} | {passed} | {_stat(c.get('residual'))} {c['unit']} | "
             f"{_p95(c.get('residual'))} | {_stat(c.get('tolerance'))} | "
-            f"{_stat(c.get('iterations'))} |"
+            f"{_stat(c.get('iterations'))} | {judgement(name, op)} |"
         )
+    lines += eye_lines(s)
     lines += _remedy_lines(s, single=False)
     q = s["residual_y_parallax"]
     lines += [
@@ -289,7 +368,7 @@ def closing_summary(result: SimulationResult, lang: str = "en") -> str:
 
 
 def _stage_words(text: str, lang: str) -> str:
-    """"stage N" of a check's or remedy's name in ``lang``."""
+    """ "stage N" of a check's or remedy's name in ``lang``."""
     if lang == "en":
         return text
     return re.sub(r"\bstage (\w+)", lambda m: f"{term('stage', lang)} {m[1]}", text)

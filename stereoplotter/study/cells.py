@@ -86,7 +86,9 @@ def cell_run(design: StudyDesign, cell: int, config: dict[str, Any]) -> CellRun:
     config = design.config(config)
     spec = design.instruments[str(config.get("instrument", next(iter(design.instruments))))]
     judgement = float(config.get("judgement_scale", 1.0))
-    base = OperatorModel()
+    # judgement_scale multiplies the free σ of 10 µm (docs/studies.md), judged in one look: the
+    # operator of the studies' figures, not the eye-derived default (issue 25)
+    base = OperatorModel(eye="sigma", remeasure=False).for_instrument(spec)
     operator = replace(
         base,
         monocular_sigma_mm=base.monocular_sigma_mm * judgement,

@@ -65,7 +65,7 @@ def study_terms(design: StudyDesign) -> tuple[str, ...]:
     """The budget's error terms of every instrument of the study (instrument terms, operator)."""
     names: dict[str, None] = {}
     for spec in design.instruments.values():
-        for term in budget_terms(error_model_from_spec(spec), OperatorModel()):
+        for term in budget_terms(error_model_from_spec(spec), OperatorModel().for_instrument(spec)):
             names[term.name] = None
     return tuple(names)
 

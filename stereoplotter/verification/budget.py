@@ -25,14 +25,22 @@ are varied run by run.
 The contribution is reported as an RMS, sign(Δ)·√|Δ| (a negative Δ: switching the term on made
 the measure smaller), with SE = half the width of √ over Δ ± SE(Δ).
 
-Linear prediction (first-order propagation by a numerical linearisation of the error-free
-procedure, central differences with a step of ε = 0.1 σ): for an instrument term with gradient
-gₚ at grid point p, Δ_lin = var · mean_p gₚ² (var = σ² for a normal term, a²/3 for a uniform one
-of half-width a); for an operator error, the sum over every judgment act of the procedure (each
-act an independent draw). The backlash (a dead band, not differentiable at 0) and the rounding to
-the least count (a step function) have no linear model. No accuracy formula of ch. 6 gives the
-separate contribution of these terms on this grid, so every prediction here is the numerical
-one (``method`` says so per term).
+Predicted column ("linear", issue 25): the σ² order of Δ from a smooth expansion of the
+error-free procedure with its decisions held fixed. Differences at ±ε, ±2ε with ε = 0.001 σ
+(:data:`LINEARISATION_STEP`, far inside every loop's pass/fail jump of the error-free run) give
+the derivative g and the curvature h at each grid point p; for a zero-mean error of variance
+var, Δ_pred = var · mean_p (gₚ² + y₀ₚ·hₚ) — the linear term and the floor's curvature term
+(the error-free floor y₀ is not zero, so the curvature enters Δ at the same order σ²); var = σ²
+for a normal term, a²/3 for a uniform one of half-width a; for an operator error, the sum over
+every judgment act of the error-free procedure (each act an independent draw). The same at
+ε = 0.01 σ (:data:`CHECK_STEP`) must agree within 1 %, else the response is not smooth about
+zero error and the prediction is dropped. Each prediction is validated against the simulated
+one-at-a-time Δ: kept where |Δ_sim − Δ_pred| ≤ 2 SE (:data:`Z_AGREE`), else dropped with the
+measured reason (the z, and the fraction of trials whose decisions — loop passes, checks,
+remedies — differ from the error-free run's with that term alone). The backlash (a dead band)
+and the rounding to the least count (a step) have no smooth model. Additivity: Σ one-at-a-time
+Δ against Δ(all on − all off) within 2 SE, else the interacting terms are listed with their
+interaction Δ(all but one) − Δ(one at a time) and its SE.
 
 Pure: no file, no plot (``report.budget`` and ``plotting.budget`` render the result).
 """
@@ -74,8 +82,23 @@ __all__ = [
 #: 3 000 took 52 s (``benchmarks/bench_budget.py``). SE of the largest contributions ≈ 1 %.
 DEFAULT_BUDGET_TRIALS = 2000
 
-#: Step of the numerical linearisation, in σ of the term (central differences). [—]
-LINEARISATION_STEP = 0.1
+#: Step of the numerical linearisation, in σ of the term (central differences). Small enough
+#: that no decision of the error-free procedure (a loop's pass count, a check's pass/fail, a
+#: remedy) changes within it: the derivative is the procedure's with its decisions held fixed
+#: (issue 25; the 0.1 σ of issue 10 crossed the loops' pass/fail jumps). [—]
+LINEARISATION_STEP = 1e-3
+#: A second step: a term whose predicted Δ differs between the two steps by more than
+#: :data:`STEP_AGREEMENT` (relative) is not smooth about zero error — a branch or a kink within
+#: the steps (a smooth response changes by O(ε²) ≈ 1e-4 between them); its prediction is
+#: dropped. [—]
+CHECK_STEP = 1e-2
+STEP_AGREEMENT = 1e-2
+#: A contribution below this fraction of the all-on mean square, simulated and predicted, is
+#: negligible (numerical noise of the procedure's solves): no validation asked. [—]
+NEGLIGIBLE = 1e-6
+#: Agreement of the linear and the simulated one-at-a-time Δ: |Δ_sim − Δ_lin| ≤ Z·SE(Δ_sim);
+#: of Σ one-at-a-time Δ and Δ(all on − all off): |gap| ≤ Z·SE(gap) (the issue's 2 SE). [—]
+Z_AGREE = 2.0
 
 #: The three measures: key → (unit, what).
 MEASURES = {
@@ -286,6 +309,24 @@ def _measures(result: Any, first: int, stop: int, n_base: int) -> list[dict[str,
     ]
 
 
+#: Key of the per-trial decisions of a configuration (beside the measures' mean squares).
+DECISIONS = "decisions"
+
+
+def _decisions(result: Any, trials: int) -> NDArray[np.float64]:
+    """The procedure's decisions per trial, (T, k): every loop's passes, every check's pass or
+    fail and every remedy's application and rounds (what a linearisation holds fixed)."""
+    cols = [s.iterations for _, s in sorted(result.stages.items())]
+    for _, c in sorted(result.checks.items()):
+        if c.passed is not None:
+            cols.append(c.passed)
+    for _, r in sorted(result.remedies.items()):
+        cols += [r.applied, r.rounds]
+    if not cols:
+        return np.zeros((trials, 0))
+    return np.stack([np.broadcast_to(np.asarray(c, float), (trials,)) for c in cols], axis=-1)
+
+
 def _stacked_inputs(
     configs: Sequence[_Config],
     terms: Sequence[BudgetTerm],
@@ -333,7 +374,9 @@ def _run_group(
         result = run_trials_chunk(
             prep, 0, trials, evaluate=True, transcript=False, injected=injected, noise=noise
         )
-        for c, ms in zip(part, _measures(result, 0, trials, n_base), strict=True):
+        decisions = _decisions(result, trials)
+        for k, (c, ms) in enumerate(zip(part, _measures(result, 0, trials, n_base), strict=True)):
+            ms[DECISIONS] = decisions[k * n_base : (k + 1) * n_base]
             out[c.label] = ms
         if progress is not None:
             progress(trials)
@@ -342,8 +385,9 @@ def _run_group(
 
 def _linear_predictions(
     prep: PreparedRun, terms: Sequence[BudgetTerm]
-) -> dict[str, dict[str, float]]:
-    """Δ_lin per term and measure from central differences about the error-free procedure."""
+) -> tuple[dict[str, dict[str, float]], dict[str, dict[str, float]]]:
+    """Δ_lin per term and measure from central differences about the error-free procedure,
+    at :data:`LINEARISATION_STEP` and at :data:`CHECK_STEP` (the second for the step check)."""
     prep = replace(prep, operator=replace(prep.operator, quantise=False))
     zero = {t.name: 0.0 for t in terms if t.kind == "instrument"}
     acts: list[str] = []
@@ -359,20 +403,21 @@ def _linear_predictions(
     linear = [t for t in terms if t.variance_factor is not None and t.scale > 0]
     instrument = [t for t in linear if t.kind == "instrument"]
     pairs = len(instrument) + len(acts)
-    trials = 1 + 2 * pairs
+    steps_sigma = (LINEARISATION_STEP, CHECK_STEP)
+    trials = 1 + _POINTS * pairs * len(steps_sigma)
     injected: dict[str, Any] = {}
     for t in terms:
         if t.kind == "instrument":
             injected[t.name] = np.zeros(trials) if t.per_trial else 0.0
-    for j, t in enumerate(instrument):
-        injected[t.name][1 + 2 * j] = LINEARISATION_STEP * t.scale
-        injected[t.name][2 + 2 * j] = -LINEARISATION_STEP * t.scale
-    steps = {}
-    for k, key in enumerate(acts):
-        s = np.zeros(trials)
-        s[1 + 2 * (len(instrument) + k)] = LINEARISATION_STEP
-        s[2 + 2 * (len(instrument) + k)] = -LINEARISATION_STEP
-        steps[key] = s
+    steps: dict[str, NDArray] = {key: np.zeros(trials) for key in acts}
+    for b, eps in enumerate(steps_sigma):
+        first = 1 + _POINTS * pairs * b
+        for j, t in enumerate(instrument):
+            at = first + _POINTS * j
+            injected[t.name][at : at + _POINTS] = np.multiply(_OFFSETS, eps * t.scale)
+        for k, key in enumerate(acts):
+            at = first + _POINTS * (len(instrument) + k)
+            steps[key][at : at + _POINTS] = np.multiply(_OFFSETS, eps)
     result = run_trials_chunk(
         prep,
         0,
@@ -382,20 +427,25 @@ def _linear_predictions(
         injected=injected,
         noise=_LinearisationNoise(trials, steps),
     )
-    sq = _difference_squares(result, trials)  # measure → (pairs,)
-    out: dict[str, dict[str, float]] = {}
-    for j, t in enumerate(instrument):
-        out[t.name] = {m: float(t.variance_factor * v[j]) for m, v in sq.items()}
-    for name, (family, field, *_rest) in OPERATOR_TERMS.items():
-        if getattr(prep.operator, field) == 0.0:
-            continue
-        idx = [len(instrument) + k for k, key in enumerate(acts) if _family_of(key) == family]
-        out[name] = {m: float(np.sum(v[idx])) for m, v in sq.items()}
-    return out
+    fields = _difference_fields(result, trials)
+    out = []
+    for b, eps in enumerate(steps_sigma):
+        first = 1 + _POINTS * pairs * b
+        sq = _difference_squares(fields, first, pairs, eps)  # measure → (pairs,)
+        by_term: dict[str, dict[str, float]] = {}
+        for j, t in enumerate(instrument):
+            by_term[t.name] = {m: float(t.variance_factor * v[j]) for m, v in sq.items()}
+        for name, (family, field, *_rest) in OPERATOR_TERMS.items():
+            if getattr(prep.operator, field) == 0.0:
+                continue
+            idx = [len(instrument) + k for k, key in enumerate(acts) if _family_of(key) == family]
+            by_term[name] = {m: float(np.sum(v[idx])) for m, v in sq.items()}
+        out.append(by_term)
+    return out[0], out[1]
 
 
-def _difference_squares(result: Any, trials: int) -> dict[str, NDArray]:
-    """mean_p ((y₊ − y₋)/(2ε))² per ± pair of a linearisation run, in the measures' units²."""
+def _difference_fields(result: Any, trials: int) -> dict[str, list[NDArray]]:
+    """The measures' fields of a linearisation run, (trials, points) each, in their units."""
     ev = result.evaluation
     m = MM_PER_M / ev.map_scale_denominator if ev.map_scale_denominator else math.nan
     fields = {
@@ -408,13 +458,34 @@ def _difference_squares(result: Any, trials: int) -> dict[str, NDArray]:
             np.asarray(ev.grid.y_error_m, float) * m,
         ],
     }
+    return {k: [a.reshape(trials, -1) for a in v] for k, v in fields.items()}
+
+
+#: Points of the difference scheme per term, in steps ε: none at 0 (the error-free value itself
+#: can sit on a branch that any non-zero error leaves, e.g. a zero reading of exactly 0).
+_OFFSETS = (1.0, -1.0, 2.0, -2.0)
+_POINTS = len(_OFFSETS)
+
+
+def _difference_squares(
+    fields: dict[str, list[NDArray]], first: int, terms: int, eps: float
+) -> dict[str, NDArray]:
+    """mean_p (g² + y₀·h) per term from trial ``first`` on, in the measures' units² per σ²:
+    g = (y₁ − y₋₁)/(2ε) and h = (y₂ + y₋₂ − y₁ − y₋₁)/(3ε²) the first and second derivatives
+    (yₖ at k·ε, :data:`_OFFSETS`), y₀ the error-free result (trial 0). For a zero-mean error e of
+    variance σ², E[(y₀ + g·e + ½h·e²)²] − y₀² = σ²(g² + y₀·h) + O(σ⁴): the σ² order of Δ of the
+    mean square, which has the floor's curvature term y₀·h beside the linear g² (the floor y₀
+    is not zero)."""
     out = {}
     for key, arrays in fields.items():
         total = 0.0
         for a in arrays:
-            a = a.reshape(trials, -1)
-            g = (a[1::2] - a[2::2]) / (2.0 * LINEARISATION_STEP)
-            total = total + np.mean(g**2, axis=1)
+            y0 = a[0]
+            block = a[first : first + _POINTS * terms]
+            p1, m1, p2, m2 = (block[i::_POINTS] for i in range(_POINTS))
+            g = (p1 - m1) / (2.0 * eps)
+            h = (p2 + m2 - p1 - m1) / (3.0 * eps**2)
+            total = total + np.mean(g**2 + y0 * h, axis=1)
         out[key] = total
     return out
 
@@ -439,10 +510,67 @@ def _contribution(on: NDArray, off: NDArray) -> dict[str, float]:
     return {"rms": root, "se": (hi - lo) / 2.0, "delta_ms": delta, "delta_ms_se": se}
 
 
-def _linear_entry(delta: float | None) -> dict[str, Any]:
+def _linear_entry(
+    delta: float | None, check: float | None, sim: dict[str, float], changed: float, ms_on: float
+) -> dict[str, Any]:
+    """The predicted Δ validated against the simulated one-at-a-time Δ (``sim``) within
+    :data:`Z_AGREE` SE, and against the step check; dropped (rms and delta_ms null) with the
+    measured reason otherwise (``predicted_ms``: the σ² expansion whatever its status).
+    ``changed``: the fraction of the trials with this term alone whose
+    decisions differ from the error-free run's; ``ms_on``: the all-on mean square."""
     if delta is None:
-        return {"rms": None, "delta_ms": None}
-    return {"rms": math.sqrt(max(delta, 0.0)), "delta_ms": delta}
+        return {
+            "rms": None,
+            "delta_ms": None,
+            "predicted_ms": None,
+            "status": "none",
+            "z": None,
+            "reason": "",
+        }
+    d_sim, se = sim["delta_ms"], sim["delta_ms_se"]
+    z = (d_sim - delta) / se if se > 0.0 and math.isfinite(se) else None
+    tiny = NEGLIGIBLE * abs(ms_on)
+    if max(abs(delta), abs(check or 0.0), abs(d_sim)) <= tiny:
+        return {
+            "rms": 0.0,
+            "delta_ms": 0.0,
+            "predicted_ms": delta,
+            "status": "negligible",
+            "z": None,
+            "reason": "",
+        }
+    scale = max(abs(delta), abs(check or 0.0))
+    stable = check is not None and abs(delta - check) <= STEP_AGREEMENT * scale
+    agrees = abs(z) <= Z_AGREE if z is not None else abs(d_sim - delta) <= tiny
+    if agrees and stable:
+        return {
+            "rms": math.sqrt(max(delta, 0.0)),
+            "delta_ms": delta,
+            "predicted_ms": delta,
+            "status": "validated",
+            "z": z,
+            "reason": "",
+        }
+    if not stable:
+        why = (
+            f"not smooth about zero error: the σ² expansion at {LINEARISATION_STEP:g} σ "
+            f"({delta:.4g}) and at {CHECK_STEP:g} σ ({check:.4g}) differ (a branch or kink "
+            f"within the steps); simulated {d_sim:.4g} ± {se:.2g}"
+        )
+    else:
+        why = (
+            f"predicted Δ {delta:.4g} against the simulated {d_sim:.4g} ± {se:.2g} "
+            f"({z:+.1f} SE); with this term alone the procedure decided otherwise than the "
+            f"error-free run (loop passes, checks, remedies) in {changed:.1%} of the trials"
+        )
+    return {
+        "rms": None,
+        "delta_ms": None,
+        "predicted_ms": delta,
+        "status": "dropped",
+        "z": z,
+        "reason": why,
+    }
 
 
 def run_budget(
@@ -466,7 +594,8 @@ def run_budget(
     if method not in ("setup", "conventional"):
         raise StereoplotterError(f"method: expected setup or conventional, found {method!r}")
     model = error_model_from_spec(spec) if errors is None else errors
-    op = OperatorModel() if operator is None else operator
+    # σ_p, σ_q of the operator's eye on this instrument (procedure.eye), as the run uses them
+    op = (OperatorModel() if operator is None else operator).for_instrument(spec)
     terms = budget_terms(model, op)
     prep = prepare_run(scenario, spec, method, model, seed, operator=op)
     base = model.draw_keyed(prep.seed, 0, trials)
@@ -484,9 +613,15 @@ def run_budget(
     ms: dict[str, dict[str, NDArray]] = {}
     for group in groups.values():
         ms.update(_run_group(prep, group, terms, base, trials, chunk, cache, progress))
-    linear = _linear_predictions(prep, terms)
-    rows = [_term_row(t, ms, linear) for t in terms]
-    totals = {m: _totals(m, terms, ms, linear) for m in MEASURES}
+    linear, linear_check = _linear_predictions(prep, terms)
+    ref = ms["all off"][DECISIONS][:1]
+    changed = {
+        t.name: float(np.mean(np.any(ms[f"only {t.name}"][DECISIONS] != ref, axis=1)))
+        for t in terms
+    }
+    rows = [_term_row(t, ms, linear, linear_check, changed[t.name]) for t in terms]
+    valid = {r["name"]: {m: r["linear"][m]["delta_ms"] for m in MEASURES} for r in rows}
+    totals = {m: _totals(m, terms, ms, valid) for m in MEASURES}
     return {
         "scenario": scenario.name,
         "instrument": spec.key,
@@ -495,6 +630,8 @@ def run_budget(
         "seed": int(prep.seed),
         "configurations": len(configs),
         "linearisation_step_sigma": LINEARISATION_STEP,
+        "check_step_sigma": CHECK_STEP,
+        "agreement_z": Z_AGREE,
         "measures": {k: {"unit": u, "meaning": w} for k, (u, w) in MEASURES.items()},
         "operator": op.to_dict(),
         "terms": rows,
@@ -506,29 +643,43 @@ def _totals(
     m: str,
     terms: Sequence[BudgetTerm],
     ms: dict[str, dict[str, NDArray]],
-    linear: dict[str, dict[str, float]],
+    linear: dict[str, dict[str, float | None]],
 ) -> dict[str, Any]:
     """All on, all off (the error-free floor), and the additivity of the one-at-a-time Δᵢ.
 
     ``additivity``: Σᵢ Δᵢ(one at a time) against Δ(all on − all off), with the SE of their
-    per-trial paired gap (equal in expectation when the terms act linearly and independently).
+    per-trial paired gap (equal in expectation when the terms act linearly and independently);
+    ``adds_up``: |gap| ≤ :data:`Z_AGREE`·SE. ``interactions``: every term whose contribution in
+    the presence of the others differs from its contribution alone, Iᵢ = Δᵢ(all but one) −
+    Δᵢ(one at a time) (paired, same trials), by more than Z_AGREE·SE(Iᵢ).
     """
     off = ms["all off"][m]
-    gap_t = sum(ms[f"only {t.name}"][m] - off for t in terms) - (ms["all on"][m] - off)
+    on = ms["all on"][m]
+    gap_t = sum(ms[f"only {t.name}"][m] - off for t in terms) - (on - off)
     n = off.size
     floor = float(np.mean(off))
+    gap, gap_se = float(np.mean(gap_t)), float(np.std(gap_t, ddof=1) / math.sqrt(n))
+    interactions = []
+    for t in terms:
+        i_t = (on - ms[f"all but {t.name}"][m]) - (ms[f"only {t.name}"][m] - off)
+        d, se = float(np.mean(i_t)), float(np.std(i_t, ddof=1) / math.sqrt(n))
+        if abs(d) > Z_AGREE * se and d != 0.0:
+            interactions.append({"term": t.name, "delta_ms": d, "delta_ms_se": se})
+    lin = [v[m] for v in linear.values() if v.get(m) is not None]
     return {
-        "all_on": _rms(ms["all on"][m]),
+        "all_on": _rms(on),
         "all_off": _rms(off),
-        "total_delta": _contribution(ms["all on"][m], off),
+        "total_delta": _contribution(on, off),
         "additivity": {
             "sum_one_at_a_time_ms": float(
                 sum(np.mean(ms[f"only {t.name}"][m] - off) for t in terms)
             ),
-            "gap_ms": float(np.mean(gap_t)),
-            "gap_ms_se": float(np.std(gap_t, ddof=1) / math.sqrt(n)),
+            "gap_ms": gap,
+            "gap_ms_se": gap_se,
+            "adds_up": bool(abs(gap) <= Z_AGREE * gap_se),
+            "interactions": interactions,
         },
-        "linear_all_on_rms": math.sqrt(max(floor + sum(v[m] for v in linear.values()), 0.0)),
+        "linear_all_on_rms": math.sqrt(max(floor + sum(lin), 0.0)),
     }
 
 
@@ -539,7 +690,11 @@ def budget_work(model: ErrorModel, trials: int) -> int:
 
 
 def _term_row(
-    t: BudgetTerm, ms: dict[str, dict[str, NDArray]], linear: dict[str, dict[str, float]]
+    t: BudgetTerm,
+    ms: dict[str, dict[str, NDArray]],
+    linear: dict[str, dict[str, float]],
+    linear_check: dict[str, dict[str, float]],
+    changed: float,
 ) -> dict[str, Any]:
     if t.variance_factor is None:
         how = "no linear model"
@@ -547,8 +702,12 @@ def _term_row(
         how = "zero (σ = 0)"
     else:
         how = "numerical linearisation"
+    one = {m: _contribution(ms[f"only {t.name}"][m], ms["all off"][m]) for m in MEASURES}
     lin = linear.get(t.name)
-    zero_lin = {m: 0.0 for m in MEASURES} if how.startswith("zero") else None
+    if how.startswith("zero"):
+        lin = linear_check_t = {m: 0.0 for m in MEASURES}
+    else:
+        linear_check_t = linear_check.get(t.name)
     return {
         "name": t.name,
         "kind": t.kind,
@@ -559,14 +718,19 @@ def _term_row(
         "assumed": t.assumed,
         "meaning": t.meaning,
         "linear_model": how,
-        "one_at_a_time": {
-            m: _contribution(ms[f"only {t.name}"][m], ms["all off"][m]) for m in MEASURES
-        },
+        "decisions_changed": changed,
+        "one_at_a_time": one,
         "all_but_one": {
             m: _contribution(ms["all on"][m], ms[f"all but {t.name}"][m]) for m in MEASURES
         },
         "linear": {
-            m: _linear_entry((lin or zero_lin or {}).get(m) if (lin or zero_lin) else None)
+            m: _linear_entry(
+                None if lin is None else lin[m],
+                None if linear_check_t is None else linear_check_t[m],
+                one[m],
+                changed,
+                float(np.mean(ms["all on"][m])),
+            )
             for m in MEASURES
         },
     }

@@ -83,7 +83,8 @@ def test_option_on_another_instrument_is_one_line(capsys):
 
 def test_correction_unit_adds_its_residual_to_the_operator_in_quadrature():
     sc, spec = load_scenario("scenarios/pair60.yaml"), load_instrument("sc1")
-    corrected, op = apply_correction_unit(sc, spec, OperatorModel())
+    # the free-σ operator (10 µm, eye="sigma") keeps the figures below round
+    corrected, op = apply_correction_unit(sc, spec, OperatorModel(eye="sigma"))
     assert all(p.film_deformation_ppm == (0.0, 0.0) for p in corrected.photos)
     # σ_c = 3/√2 µm per coordinate (vector RMS 3 µm, SCX): √(10² + 4.5) and √(10² + 9) µm
     assert op.monocular_sigma_mm == pytest.approx(np.sqrt(100.0 + 4.5) / 1000.0, rel=1e-12)

@@ -1,11 +1,16 @@
-"""The per-part error budget (``verification.budget``): zero terms, linear terms, additivity.
+"""The per-part error budget (``verification.budget``): zero terms, the predicted column,
+additivity.
 
 One small run (64 trials per configuration, seed 5) of pair60 on the SC-1, setup method, with
-``zero_reading.dy_right`` switched off (σ = 0), serves every test. Tolerances are Monte Carlo
-intervals: 3 standard errors of the paired per-trial differences (≈ 99.7 % for a normal mean).
+``zero_reading.dy_right`` switched off (σ = 0), serves the structural tests; a run at 0.05 × every
+σ (100 trials) the predicted column and the additivity. Tolerances are Monte Carlo intervals:
+3 standard errors of the paired per-trial differences (≈ 99.7 % for a normal mean), 3.5 where
+some 33 predictions are compared at once.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -85,37 +90,82 @@ def test_a_term_at_zero_sigma_contributes_zero(budget):
         assert all(r["linear"][m]["delta_ms"] == 0.0 for m in MEASURES)
 
 
-@pytest.mark.parametrize(
-    ("term", "measure"),
-    [
-        # a decentration zero-reading error displaces a photo in its plane: the built points move
-        # in plan (left photo) and in height through the x-parallax (right photo) in proportion
-        ("zero_reading.dx_left", "plan_error_rms_map_mm"),
-        ("zero_reading.dx_right", "height_error_rms_permille"),
-    ],
+# --- the predicted column and the additivity, in the regime where they must hold --------------
+#
+# At 0.05 × every σ (instrument terms and operator judgments, no rounding) the errors are small
+# against every loop's pass/fail margin: the procedure decides as without errors, so the σ² order
+# is the whole of Δ and independent zero-mean parts add. Both are then properties the Monte Carlo
+# must reproduce within its CI: an independent check of the σ² expansion (derivatives, the floor's
+# curvature term, the sum over the operator's acts) and of the pairing of the configurations.
+
+SMALL = 0.05
+SMALL_TRIALS = 100
+#: ≈ 33 predictions compared at once: 3.5 SE keeps the family-wise false alarm near 1.5 %.
+Z_FAMILY = 3.5
+
+
+@pytest.fixture(scope="module")
+def small():
+    scenario, spec, _ = _pair60_sc1()
+    op = OperatorModel().for_instrument(spec)
+    op = replace(
+        op,
+        **{f: getattr(op, f) * SMALL for f in _SIGMAS},
+        quantise=False,
+    )
+    model = error_model_from_spec(spec).scaled(SMALL)
+    return run_budget(
+        scenario, spec, "setup", trials=SMALL_TRIALS, seed=5, errors=model, operator=op
+    )
+
+
+_SIGMAS = (
+    "monocular_sigma_mm",
+    "stereo_sigma_mm",
+    "y_parallax_sigma_mm",
+    "reading_sigma_lc",
+    "setting_sigma_lc",
 )
-def test_linear_term_agrees_with_its_linear_prediction(budget, term, measure):
-    # the prediction is independent of the Monte Carlo: a deterministic central difference of
-    # the error-free procedure at ±0.1 σ, times σ²; the Monte Carlo draws the term at full σ
-    _, rows = budget
-    c = rows[term]["one_at_a_time"][measure]
-    lin = rows[term]["linear"][measure]["delta_ms"]
-    assert rows[term]["linear_model"] == "numerical linearisation"
-    assert lin > 10 * c["delta_ms_se"] / 64**0.5  # a real effect, not noise
-    assert abs(c["delta_ms"] - lin) <= Z * c["delta_ms_se"]
 
 
-def test_one_at_a_time_contributions_add_up_to_the_total_in_plan(budget):
-    # For terms acting linearly and independently (zero-mean, independent draws), the mean square
-    # of their sum is the sum of their mean squares: E[gap] = 0, and the gap of the same trials
-    # has a paired standard error. Tolerance Z·SE of that gap. Asserted for the plan error only:
-    # in this run the height gap is 0.023 ± 0.008 ‰² (2.9 SE) and the y-parallax terms are far
-    # from linear (the linear and Monte Carlo contributions of operator.pointing differ in sign).
-    out, _ = budget
-    add = out["totals"]["plan_error_rms_map_mm"]["additivity"]
-    total = out["totals"]["plan_error_rms_map_mm"]["total_delta"]["delta_ms"]
-    assert abs(add["gap_ms"]) <= Z * add["gap_ms_se"]
-    assert abs(add["sum_one_at_a_time_ms"] - total) <= 0.05 * total
+def test_small_errors_keep_every_recorded_decision(small):
+    # the premise of the regime: no loop pass, check or remedy differs from the error-free run
+    assert all(r["decisions_changed"] == 0.0 for r in small["terms"])
+
+
+def test_small_errors_smooth_predictions_match_the_monte_carlo(small):
+    compared = 0
+    for r in small["terms"]:
+        for m in MEASURES:
+            lin = r["linear"][m]
+            if lin["status"] not in ("validated", "dropped") or lin["reason"].startswith("not"):
+                continue
+            compared += 1
+            assert abs(lin["z"]) <= Z_FAMILY, (r["name"], m, lin)
+    assert compared >= 20
+
+
+def test_small_errors_parts_add_up_in_all_three_measures(small):
+    # E[gap] = 0 for independent zero-mean parts acting linearly; paired SE of the gap
+    for m in MEASURES:
+        add = small["totals"][m]["additivity"]
+        assert abs(add["gap_ms"]) <= Z * add["gap_ms_se"], (m, add)
+
+
+def test_default_budget_reports_every_prediction_with_its_validation(budget):
+    # full σ: each prediction is validated within 2 SE, negligible, or dropped with a reason
+    # that quotes its measured figures; the totals say whether the parts add up
+    out, rows = budget
+    for r in rows.values():
+        for m in MEASURES:
+            lin = r["linear"][m]
+            if lin["status"] == "validated" and lin["z"] is not None:
+                assert abs(lin["z"]) <= out["agreement_z"]
+            if lin["status"] == "dropped":
+                assert lin["rms"] is None and ("SE" in lin["reason"] or "σ" in lin["reason"])
+    for m in MEASURES:
+        add = out["totals"][m]["additivity"]
+        assert add["adds_up"] or add["interactions"]
 
 
 def test_totals_all_off_is_the_error_free_floor(budget):

@@ -202,13 +202,25 @@ def test_tables_9_and_11_transformed_coordinates(table, angles):
             assert_allclose(rot[:, k], cosines, rtol=0, atol=1e-7)
 
 
-# [1] Table 9 and Table 11 headings (OCR L2149, L2248): sin and cos of alpha, 7 decimals.
-def test_tables_9_and_11_sine_and_cosine_of_alpha():
-    assert np.sin(ANGLES_I[0]) == pytest.approx(0.0522924, abs=1e-7)
-    assert np.cos(ANGLES_I[0]) == pytest.approx(0.9986318, abs=1e-7)
-    assert np.sin(ANGLES_III[0]) == pytest.approx(0.0523366, abs=1e-7)
-    # ERRATA: Table 11 prints cos(alpha^III) = 0.998295; it is 0.9986295 (a dropped digit).
-    assert np.cos(ANGLES_III[0]) == pytest.approx(0.9986295, abs=1e-7)
+# [1] Table 9 and Table 11 headings (OCR L2149, L2248) print sin α and cos α to 7 decimals for the
+# book's α^I and α^III; the project's rotation (2.50) with α alone must carry them: cos α on the
+# diagonal, sin α in the (3, 1) element (the sign of the book's α). Tolerance: one unit of the
+# 7th printed decimal.
+@pytest.mark.parametrize(
+    ("angles", "sin_printed", "cos_printed"),
+    [
+        (ANGLES_I, 0.0522924, 0.9986318),
+        # ERRATA: Table 11 prints cos α^III = 0.998295; it is 0.9986295 (a dropped digit).
+        (ANGLES_III, 0.0523366, 0.9986295),
+    ],
+    ids=["table9", "table11"],
+)
+def test_tables_9_and_11_sine_and_cosine_of_alpha_in_the_rotation(angles, sin_printed, cos_printed):
+    r = rotation_matrix(angles[0], 0.0, 0.0)
+    assert r[0, 0] == pytest.approx(cos_printed, abs=1e-7)
+    assert r[2, 2] == pytest.approx(cos_printed, abs=1e-7)
+    assert r[2, 0] == pytest.approx(sin_printed, abs=1e-7)
+    assert r[0, 2] == pytest.approx(-sin_printed, abs=1e-7)
 
 
 # --- Table 10: working equations, approximation II ----------------------------------------------

@@ -18,6 +18,8 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.setup.equations import (
     base_components,
     base_z_correction,
@@ -32,6 +34,7 @@ from stereoplotter.setup.equations import (
     sheet_corner_instrument_coordinates,
     sheet_corner_instrument_coordinates_book_form,
 )
+from stereoplotter.setup.sheet import compute_setup_sheet
 
 F = 70.0 * mm  # §27 setting: f = 70 mm, marks at l = 85 mm (OCR L3950–3956)
 L_MARK = 85.0 * mm
@@ -52,12 +55,29 @@ def test_6_1_6_2_equal_3_17_for_a_single_tilt(tilt_deg):
         assert transformed_y_single_tilt(y, t, F) == pytest.approx(rigorous, abs=1e-9 * um)
 
 
-def test_6_1_printed_form_includes_n_once():
-    # The printed (6.1) multiplies by n; the counter target is n·x⁰ with x⁰ n-free. ERRATA: (6.5)
-    # multiplies by n again; applying it twice would give L n times too large.
-    n, a, x = 1.4231, 1.0 * deg, 85.0
-    printed = F * (F * np.sin(a) + x * np.cos(a)) / (F * np.cos(a) - x * np.sin(a)) * n
-    assert n * transformed_x_single_tilt(x, a, F) == pytest.approx(printed, rel=1e-15)
+@pytest.fixture(scope="module")
+def pair60_sheet():
+    sc = load_scenario("pair60")
+    return compute_setup_sheet(sc, load_instrument("sc1"), rng=np.random.default_rng(sc.seed))
+
+
+def _rigorous_y(photo, mark, f):
+    # (3.17) rigorous with the single tilt ω, on the measured mark's y (the book's (6.2) frame)
+    y = photo.marks_measured_mm[mark][1]
+    return transformed_coordinates([0.0, y], rotation_matrix(0.0, photo.omega, 0.0), f)[1]
+
+
+def test_6_5_sheet_mark_span_applies_n_once(pair60_sheet):
+    # (6.5) L = n·(y⁰₃ − y⁰₄) on the pair60/SC-1 sheet against an independent computation: y⁰ of
+    # the measured marks 3, 4 through the rigorous (3.17) with the photo's ω, times n once.
+    # ERRATA: the printed (6.1)/(6.2) carry n and (6.5) multiplies again; n² would put L off by
+    # the factor n ≈ 1.69 (≈ 200 mm), far beyond the 0.018 mm tolerance of the L check.
+    f = pair60_sheet.focal_length_corrected_mm
+    for photo in pair60_sheet.photos:
+        span = photo.n * (_rigorous_y(photo, "3", f) - _rigorous_y(photo, "4", f))
+        assert photo.mark_span_mm == pytest.approx(span, abs=1e-9)
+        assert float(mark_span(photo.n, span / photo.n, 0.0)) == pytest.approx(span, abs=1e-9)
+        assert abs(photo.n * photo.mark_span_mm - span) > 100.0  # the n² reading is refused
 
 
 # --- (6.3), (6.4) ---------------------------------------------------------------------------
@@ -158,15 +178,24 @@ def test_6_15_height_scale_reading():
     assert float(height_scale_reading(500.0, 175.0, n_l, f_pr, mv)) == pytest.approx(580.0)
 
 
-def test_6_12_6_13_signed_form_equals_book_form():
-    # The book prints O_Y4 = MO_Y − (y⁰₄)_л and O_X1 = MO_X − (x⁰₁)_п with magnitudes; the code
-    # adds the signed value. Both give the same reading.
-    mo, n = 250.0, 1.6914
-    y4 = transformed_y_single_tilt(-L_MARK, 0.7 * deg, F)
-    x1 = transformed_x_single_tilt(-L_MARK, -0.5 * deg, F)
-    assert y4 < 0 and x1 < 0
-    assert mo + n * y4 == pytest.approx(mo - abs(n * y4), abs=1e-12)
-    assert mo + n * x1 == pytest.approx(mo - abs(n * x1), abs=1e-12)
+def test_6_12_6_13_sheet_readings_against_rigorous_transform(pair60_sheet):
+    # The pair60/SC-1 sheet's O_Y4,л (6.12) and O_X1,п (6.13) against an independent computation:
+    # n times the rigorous (3.17) coordinate of the measured mark with the single tilt (ω for y,
+    # α for x); the book form prints MO − |n·y⁰| to the 0.001 mm it shows.
+    rows = {r["reading"]: r for r in pair60_sheet.readings}
+    left, right = pair60_sheet.photos
+    f = pair60_sheet.focal_length_corrected_mm
+    y4 = left.n * _rigorous_y(left, "4", f)
+    x1 = right.n * transformed_coordinates(
+        [right.marks_measured_mm["1"][0], 0.0], rotation_matrix(right.alpha, 0.0, 0.0), f
+    )[0]
+    for name, zero, expected in (("O_Y4,л", "MO_Y", y4), ("O_X1,п", "MO_X,п", x1)):
+        row = rows[name]
+        assert row["zero_reading"] == zero
+        assert row["value"] == pytest.approx(expected, abs=1e-9)
+        assert expected < 0
+        printed = float(row["book_form"].split("−")[1])
+        assert printed == pytest.approx(abs(expected), abs=0.0005)
 
 
 # --- (6.7), (6.8) --------------------------------------------------------------------------

@@ -41,6 +41,11 @@ Issue 11 gave each instrument its own correction mechanism; the SC-1's (a carrie
 gimbal axes h = 20 mm below the emulsion, assumed) scales each photo by a second-order factor.
 The runs below set h = 0, which makes the SC-1's mechanism the canonical unit of the recorded
 runs: the recorded values are then reproduced unchanged (checked at the merge of issue 11).
+
+Issue 25 derived the default operator's σ_p, σ_q from the eye (6.06 and 2.02 µm) and made the
+six-point check a detection with a remeasure: the default run legitimately changes. The runs
+below name the operator of the recorded values, ``OperatorModel(eye="sigma", remeasure=False)``
+(σ_p = σ_q = 10 µm, one look; ``simulate --operator sigma``), and reproduce them unchanged.
 """
 
 from __future__ import annotations
@@ -54,6 +59,7 @@ import pytest
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import simulate
+from stereoplotter.procedure.operator import OperatorModel
 
 
 @pytest.fixture(scope="module")
@@ -63,12 +69,20 @@ def runs():
     key = "correction.gimbal_offset_mm"  # h = 0: the canonical unit of the recorded runs
     params[key] = dataclasses.replace(params[key], value=0.0)
     spec = dataclasses.replace(spec, parameters=MappingProxyType(params))
+    op = OperatorModel(eye="sigma", remeasure=False)  # the recorded runs' operator (issue 25)
     out = {
-        m: simulate(sc, spec, method=m, seed=3, trials=50, evaluate=False)
+        m: simulate(sc, spec, method=m, seed=3, trials=50, evaluate=False, operator=op)
         for m in ("setup", "conventional")
     }
     out["conventional/book"] = simulate(
-        sc, spec, method="conventional", seed=3, trials=50, evaluate=False, practice="book"
+        sc,
+        spec,
+        method="conventional",
+        seed=3,
+        trials=50,
+        evaluate=False,
+        practice="book",
+        operator=op,
     )
     return out
 
