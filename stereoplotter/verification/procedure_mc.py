@@ -80,6 +80,7 @@ from stereoplotter.scenario.model import Terrain
 from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.sheet import compute_setup_sheet
 from stereoplotter.verification import control_variate as cvar
+from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification.linear_mc import (
     CI_Z,
     LinearModel,
@@ -187,7 +188,13 @@ def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)
 
 
 def _dp(scenario, sheet, inst, frame_pts):
+    """δp [photo mm] of the built instrument ``inst`` at ``frame_pts`` (ideal model position)."""
+    units = inst.state()["units"]
+    return _dp_of(scenario, sheet, frame_pts)(inst.setting, units["left"], units["right"])
 
+
+def _dp_of(scenario, sheet, frame_pts):
+    """δp at ``frame_pts`` as a function of an instrument state (setting, left, right units)."""
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
     local = ev.instrument_frame_m(frame_pts, origin, theta, inverse=True)
@@ -196,14 +203,23 @@ def _dp(scenario, sheet, inst, frame_pts):
     model = ev.ideal_model_mm(
         frame_pts, sheet.horizontal_scale_denominator, sheet.vertical_scale_denominator
     )
-    units = inst.state()["units"]
-    setting, left, right = inst.setting, units["left"], units["right"]
+    return lambda setting, left, right: _dp_state(model, gl, gr, setting, left, right)
+
+
+def _dp_state(model, gl, gr, setting, left, right):
     if ev._trial_count(setting, (left, right)) is not None:
         setting = ev._with_point_axis(setting)
         left, right = ev._with_point_axis(left), ev._with_point_axis(right)
     dp, _ = ev.parallax_errors_at_ideal(model, gl, gr, setting, left, right)
     return np.asarray(dp, float)
 
+
+#: ``procedure_mc(linkage=…)`` → the instrument's decentration variant
+#: (:data:`~stereoplotter.instrument.kinematics.DECENTRATION_VARIANTS`): "drag", the knob drags
+#: the photo and plane decentrations (D1, "L"); "independent", the decentrations stay where
+#: they are set, and are set before the k_ω, k_α fits ("B2": set after them, as in the book's
+#: order, they would leave the fits made at zero decentration).
+LINKAGE_VARIANTS = {"drag": "L", "independent": "B2"}
 
 #: ``procedure_mc(sources=…)`` of the conventional method: which judgment errors are on.
 SOURCES = ("both", "y_parallax", "stereo")
@@ -294,18 +310,37 @@ def _setup_fields(sc, zero_run, g, xr, grid):
         levelling_design(book[:, 0], book[:, 1])
     )
 
+    def readings(d):
+        dom, ctl = d[:, n : n + nl], d[:, n + nl :]
+        return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
+
     def fields(result, noise, sigma_control=0.0):
         d = _dp(sc, result.sheet, result.instrument, allp) - zero
-        dom, ctl = d[:, n : n + nl], d[:, n + nl :]
-        obs = ctl + np.stack(
+        out = readings(d)
+        obs = np.stack(
             [noise.normal(f"mc/control/{i}", sigma_control) for i in range(len(book))], -1
         )
-        return {
-            "parallax": d[:, :n],
-            "levelled": dom - ctl @ refit.T,
-            "observed": dom - obs @ refit.T,
-        }
+        return {**out, "observed": out["levelled"] - obs @ refit.T}
 
+    units0 = zero_run.instrument.state()["units"]
+    state0 = (zero_run.instrument.setting, {s: units0[s] for s in ("left", "right")})
+    jac = dc.state_jacobian(*state0, _dp_of(sc, sheet, allp))
+
+    def decompose(result, main):
+        """The first-order fields of the decomposition (:mod:`.decomposition`) per reading."""
+        units = result.instrument.state()["units"]
+        trials = len(next(iter(main.values())))
+        deltas = dc.state_deltas(
+            result.instrument.setting, {s: units[s] for s in ("left", "right")}, *state0, trials
+        )
+        out = {}
+        for step, d in dc.linear_fields(jac, deltas).items():
+            r = readings(d)
+            r["observed"] = r["levelled"] + (main["observed"] - main["levelled"])
+            out.update({(key, step): v for key, v in r.items()})
+        return out
+
+    fields.decompose = decompose
     return fields, zero[:n]
 
 
@@ -404,6 +439,8 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
 
         def fields(result, noise):
             return make(result, noise, sc_sigma)
+
+        fields.decompose = make.decompose
     else:
         fields, d_zero = _conventional_fields(
             sc, zero_prep, zero_run, g, xr, grid, op.stereo_sigma_mm
@@ -430,11 +467,12 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         )
         fs = fields(result, noise)
         cv = cvar.per_trial_controlled(fs, lin, noise, injected, model) if lin else {}
-        for name, v in fs.items():
+        extra = fields.decompose(result, fs) if hasattr(fields, "decompose") else {}
+        for name, v in {**fs, **extra}.items():
             plain.setdefault(name, np.empty(int(trials)))[first : first + m] = np.mean(
                 np.asarray(v) ** 2, axis=-1
             )
-            if lin:
+            if lin and name in cv:
                 controlled.setdefault(name, np.empty(int(trials)))[first : first + m] = cv[name]
     return plain, controlled, d_zero
 
@@ -575,6 +613,7 @@ def procedure_mc(
     instrument: bool = False,
     control_variate: bool = True,
     passes: int | None = None,
+    linkage: str | None = None,
 ) -> dict:
     """Run the procedure MC for one scenario and method (see the module docstring).
 
@@ -642,6 +681,8 @@ def procedure_mc(
     )
     g = scenario_geometry(scenario, spec)
     zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"], sources)
+    linkage = linkage or spec.decentration_linkage
+    kw = {**kw, "variant": LINKAGE_VARIANTS[linkage]}
     options = {"instrument": instrument, "control_variate": control_variate, "passes": passes}
     if method == "conventional":
         options["standard_points"] = standard_points
@@ -662,11 +703,14 @@ def procedure_mc(
             ("observed", "setup_control", "observed"),
         ):
             cf, h = _rms_ci(best[key], units[key])
+            ref = _formulas(m, scenario, spec, g, sources, c)["rigorous"]
+            ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
             fields[key] = {
                 "coefficient": cf,
                 "ci": h,
                 "plain": _rms_ci(plain[key], units[key]),
-                "formula": _formulas(m, scenario, spec, g, sources, c)["rigorous"],
+                "formula": ref,
+                "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
             }
         unit = units[name]
     formula = _formulas(method, scenario, spec, g, sources, control)
@@ -692,6 +736,7 @@ def procedure_mc(
         "sigma_mm": sigma_mm,
         "instrument": bool(instrument),
         "instrument_key": spec.key,
+        "linkage": linkage,
         "control_variate": bool(controlled),
         "coefficient": coefficient,
         "ci": ci,
