@@ -13,7 +13,7 @@ import sympy as sp
 
 from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.accuracy import setup_accuracy as sa
-from stereoplotter.geometry import rotation  # noqa: F401  (the (3.22) convention lives there)
+from stereoplotter.geometry import rotation
 from stereoplotter.verification.verdicts import printed_agreement
 
 F, L, N, C = 70.0, 85.0, 1.42, 70.0  # §27 book geometry (OCR L3973-3990)
