@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -94,7 +94,9 @@ if TYPE_CHECKING:
     from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
+    "LINKAGE_VARIANTS",
     "PROCEDURE_ROWS",
+    "ProcedureOptions",
     "SOURCES",
     "idealised_geometry",
     "levelling_formula",
@@ -594,7 +596,62 @@ def _formulas(method, scenario, spec, g, sources, control):
     }
 
 
-# long: a 45-line docstring (the options and what each measures) and the run and summary.
+@dataclass(frozen=True)
+class ProcedureOptions:
+    """The options of :func:`procedure_mc` (keyword arguments there; defaults as here).
+
+    Attributes
+    ----------
+    sigma_mm : float
+        The operator's σ (photo scale): monocular pointing (setup) or σ_q = σ_p (conventional).
+    grid : tuple of int
+        Midpoint grid of the statistic (nx, ny).
+    quantity : {"heights", "parallax"}
+        Conventional only (``docs/accuracy.md``, "Why the total M_p was +54 % / +123 %"): the
+        height read on the slipped height scale in parallax units (what M_p measures) or δp at
+        the ideal model position (counts the b_x scale error and the model's datum).
+    standard_points : {"book", "nadirs"}
+        Conventional only: Fig. 39 at a = c − p (the formula's layout) or a = 0.
+    datum : {"plane", "slip"}
+        Conventional only: the formula's levelling offset (the four levelling heights, each
+        with σ_p) or the procedure's (the height scale slipped at one levelling point).
+    levelling : {"procedure", "book"}
+        Conventional only: the model as the procedure levelled it (the scenario's four control
+        points nearest standard points 3–6) or re-levelled by the least-squares plane through
+        its height errors at Fig. 39's x_п ∈ {−c, a}, y = ±c, each observed with σ_p.
+    sources : {"both", "y_parallax", "stereo"}
+        Conventional only: σ_q = σ_p = σ, σ_q only or σ_p only.
+    control : {"exact", "observed"}
+        "setup_control" only: exact control heights (per m_xy, (6.47)–(6.50)) or each control
+        parallax observed with m_p = m_xy/√2 (per m_p, (6.58)/(6.59)).
+    instrument : bool
+        Every injected instrument error term of ``spec`` at its configured σ and the real
+        mechanics (backlash), besides the operator's σ; the unit stays the operator's.
+    control_variate : bool
+        The estimator with the linear control variate
+        (:mod:`~stereoplotter.verification.control_variate`; unbiased, its CI ≈ 10–40×
+        narrower); False: the plain mean.
+    passes : int or None
+        Every loop makes this many passes (no check ever passes); None: as built.
+    linkage : {"drag", "independent"} or None
+        The knob–decentration linkage (:data:`LINKAGE_VARIANTS`); None: the instrument's
+        ``correction.decentration_linkage``.
+    """
+
+    sigma_mm: float = 0.01
+    grid: tuple = (16, 32)
+    quantity: str = "heights"
+    standard_points: str = "book"
+    datum: str = "plane"
+    levelling: str = "procedure"
+    sources: str = "both"
+    control: str = "exact"
+    instrument: bool = False
+    control_variate: bool = True
+    passes: int | None = None
+    linkage: str | None = None
+
+
 def procedure_mc(
     scenario: Scenario,
     method: str = "setup",
@@ -602,62 +659,27 @@ def procedure_mc(
     spec: InstrumentSpec,
     trials: int = 600,
     seed: int = 20240601,
-    sigma_mm: float = 0.01,
-    grid=(16, 32),
-    quantity: str = "heights",
-    standard_points: str = "book",
-    datum: str = "plane",
-    levelling: str = "procedure",
-    sources: str = "both",
-    control: str = "exact",
-    instrument: bool = False,
-    control_variate: bool = True,
-    passes: int | None = None,
-    linkage: str | None = None,
+    **options,
 ) -> dict:
     """Run the procedure MC for one scenario and method (see the module docstring).
 
-    ``method`` (:data:`METHODS`): "setup" (§27 task 1: the setup-data method, stages 1–5, with
-    the operator's monocular pointing σ; δp on the (6.27) domain per m_xy = n_л·σ, (6.39)–(6.44));
-    "setup_control" (§27 task 2: the same run, then the model levelled on Fig. 39's four control
-    points x_п ∈ {−c, a}, y = ±c by the least-squares plane (1, X, Y) through the δp there —
-    the levelling that refines the setup data on control; δp on the chapter-5 domain; ``control``
-    "exact" per m_xy, (6.47)–(6.50), or "observed": each control parallax observed with
-    m_p = m_xy/√2, per m_p, (6.58)/(6.59)); "conventional".
-
-    Conventional method only (``docs/accuracy.md``, "Why the total M_p was +54 % / +123 %"):
-    ``quantity`` "heights" (the height read on the slipped height scale, in parallax units —
-    what M_p measures) or "parallax" (δp at the ideal model position, the old quantity, which
-    counts the b_x scale error and the model's datum); ``standard_points`` "book" (Fig. 39 at
-    a = c − p, the formula's layout) or "nadirs" (a = 0, the instrument's); ``datum`` "plane"
-    (the formula's levelling offset: the four levelling heights, each with σ_p) or "slip" (the
-    procedure's: the height scale slipped at one levelling point). ``levelling`` "procedure"
-    (the model as the procedure levelled it, on the scenario's four control points nearest
-    standard points 3–6) or "book" (the built model re-levelled by the least-squares plane through
-    its height errors at Fig. 39's x_п ∈ {−c, a}, y = ±c, each observed with σ_p: the formula's
-    control points). ``sources`` "both" (σ_q = σ_p = σ), "y_parallax" (σ_q only) or "stereo"
-    (σ_p only). The result also carries ``by_datum`` (coefficient, ci) for "parallax", "slip",
-    "plane" and "book" of the same trials.
-
-    ``instrument``: every injected instrument error term of ``spec`` at its configured σ and the
-    real mechanics (backlash), besides the operator's σ; the unit stays the operator's.
-    ``control_variate``: the estimator with the linear control variate
-    (:mod:`~stereoplotter.verification.control_variate`; unbiased, its CI ≈ 10–40× narrower);
-    False: the plain mean.
-
-    ``scenario`` and ``spec`` (the instrument, the book's SC-1) are loaded by the caller; this
-    layer reads no files.
+    ``method`` (:data:`METHODS`): "setup" (§27 task 1: stages 1–5 with the operator's monocular
+    pointing σ; δp on the (6.27) domain per m_xy = n_л·σ, (6.39)–(6.44)); "setup_control" (§27
+    task 2: the same run levelled on Fig. 39's four control points by the least-squares plane
+    through the δp there; the chapter-5 domain); "conventional". ``options``: the fields of
+    :class:`ProcedureOptions`. ``scenario`` and ``spec`` (the book's SC-1) are loaded by the
+    caller; this layer reads no files.
 
     Returns
     -------
     dict
-        ``coefficient`` (RMS per m_xy for "setup", per m_xy or m_p for "setup_control", per
-        m_p = m_q for "conventional"), ``ci`` (half-width, same units), ``plain`` (coefficient,
-        ci) of the plain mean, ``formula`` (``rigorous`` at the simulated geometry; for the
-        conventional method also :func:`levelling_formula` at the procedure's levelling points,
-        ``procedure``, and at Fig. 39's, ``book``), ``rms_mm``, ``bias_mm`` (RMS δp of the
-        error-free run on the same domain), ``per_trial`` (per-trial RMS / unit, for
-        histograms), the geometry used (f, l, n, f_instrument, p, c, a, overlap) and ``seconds``.
+        ``coefficient`` (per m_xy, m_p or m_q as above), ``ci`` (half-width), ``plain``
+        (coefficient, ci of the plain mean), ``formula`` (``rigorous`` at the simulated
+        geometry; conventional also :func:`levelling_formula` at the procedure's levelling
+        points, ``procedure``, and at Fig. 39's, ``book``), ``rms_mm``, ``bias_mm`` (RMS δp of
+        the error-free run), ``per_trial``, the geometry (f, l, n, f_instrument, p, c, a,
+        overlap), ``seconds``; setup methods also ``fields`` (the three readings, each with its
+        ``decomposition``, :mod:`.decomposition`), conventional ``by_datum`` and the options.
 
     Examples
     --------
@@ -670,84 +692,91 @@ def procedure_mc(
     True
     """
     t0 = time.perf_counter()
+    o = ProcedureOptions(**options)
     _check_options(
         method,
-        quantity=quantity,
-        standard_points=standard_points,
-        datum=datum,
-        levelling=levelling,
-        sources=sources,
-        control=control,
+        **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
+        **{k: getattr(o, k) for k in ("sources", "control")},
     )
     g = scenario_geometry(scenario, spec)
-    zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"], sources)
-    linkage = linkage or spec.decentration_linkage
-    kw = {**kw, "variant": LINKAGE_VARIANTS[linkage]}
-    options = {"instrument": instrument, "control_variate": control_variate, "passes": passes}
-    if method == "conventional":
-        options["standard_points"] = standard_points
-    units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
-    if method != "conventional":  # m_p = m_xy/√2 of the observed control parallaxes
-        options["sigma_control"] = units["observed"]
-    spec_c = replace(spec, standard_points_c_mm=g["c"])
-    plain, controlled, d_zero = _mean_squares(
-        scenario, spec_c, method, seed, trials, zero, op, xr, g, grid, kw, options
-    )
-    name = _field_name(method, quantity, levelling, datum, control)
+    linkage = o.linkage or spec.decentration_linkage
+    plain, controlled, d_zero, units = _run(scenario, spec, method, trials, seed, o, g, linkage)
+    name = _field_name(method, o.quantity, o.levelling, o.datum, o.control)
     best = controlled or plain
-    fields = {}
-    if method != "conventional":  # one run, the three readings of §27 tasks 1 and 2
-        for key, m, c in (
-            ("parallax", "setup", "exact"),
-            ("levelled", "setup_control", "exact"),
-            ("observed", "setup_control", "observed"),
-        ):
-            cf, h = _rms_ci(best[key], units[key])
-            ref = _formulas(m, scenario, spec, g, sources, c)["rigorous"]
-            ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
-            fields[key] = {
-                "coefficient": cf,
-                "ci": h,
-                "plain": _rms_ci(plain[key], units[key]),
-                "formula": ref,
-                "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
-            }
-        unit = units[name]
-    formula = _formulas(method, scenario, spec, g, sources, control)
+    unit = units[name]
     coefficient, ci = _rms_ci(best[name], unit)
-    extra = {"fields": fields} if fields else {}
-    if method == "conventional":
-        extra = {
-            "by_datum": {k: _rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
-            "quantity": quantity,
-            "standard_points": standard_points,
-            "datum": datum,
-            "levelling": levelling,
-            "sources": sources,
-        }
-    if method == "setup_control":
-        extra["control"] = control
-    return {
-        **extra,
+    out = {
+        **_extras(scenario, spec, method, o, g, plain, best, units),
         "method": method,
         "scenario": scenario.name,
         "trials": int(trials),
         "seed": int(seed),
-        "sigma_mm": sigma_mm,
-        "instrument": bool(instrument),
+        "sigma_mm": o.sigma_mm,
+        "instrument": bool(o.instrument),
         "instrument_key": spec.key,
         "linkage": linkage,
         "control_variate": bool(controlled),
         "coefficient": coefficient,
         "ci": ci,
         "plain": _rms_ci(plain[name], unit),
-        "formula": formula,
+        "formula": _formulas(method, scenario, spec, g, o.sources, o.control),
         "rms_mm": coefficient * unit,
         "bias_mm": float(np.sqrt(np.mean(d_zero**2))),
         "per_trial": np.sqrt(plain[name]) / unit,
-        "seconds": time.perf_counter() - t0,
-        **g,
     }
+    return {**out, "seconds": time.perf_counter() - t0, **g}
+
+
+def _run(scenario, spec, method, trials, seed, o, g, linkage):
+    """The runs of :func:`procedure_mc`: per-trial mean squares (plain, controlled), the
+    error-free δp and the unit of each field [photo mm]."""
+    zero, op, xr, unit, kw = _configuration(method, o.sigma_mm, g["c"], g["p"], g["n"], o.sources)
+    kw = {**kw, "variant": LINKAGE_VARIANTS[linkage]}
+    options = {"instrument": o.instrument, "control_variate": o.control_variate}
+    options["passes"] = o.passes
+    if method == "conventional":
+        options["standard_points"] = o.standard_points
+        units = dict.fromkeys(("parallax", "slip", "plane", "book"), unit)
+    else:  # m_p = m_xy/√2 of the observed control parallaxes
+        units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
+        options["sigma_control"] = units["observed"]
+    spec_c = replace(spec, standard_points_c_mm=g["c"])
+    plain, controlled, d_zero = _mean_squares(
+        scenario, spec_c, method, seed, trials, zero, op, xr, g, o.grid, kw, options
+    )
+    return plain, controlled, d_zero, units
+
+
+def _extras(scenario, spec, method, o, g, plain, best, units):
+    """The method's own parts of the result: the three readings of a setup run with their
+    decompositions, or the conventional run's readings by datum and its options."""
+    if method == "conventional":
+        unit = units["plane"]
+        return {
+            "by_datum": {k: _rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
+            **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
+            "sources": o.sources,
+        }
+    fields = {}
+    for key, m, c in (
+        ("parallax", "setup", "exact"),
+        ("levelled", "setup_control", "exact"),
+        ("observed", "setup_control", "observed"),
+    ):
+        cf, h = _rms_ci(best[key], units[key])
+        ref = _formulas(m, scenario, spec, g, o.sources, c)["rigorous"]
+        ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
+        fields[key] = {
+            "coefficient": cf,
+            "ci": h,
+            "plain": _rms_ci(plain[key], units[key]),
+            "formula": ref,
+            "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
+        }
+    extra = {"fields": fields}
+    if method == "setup_control":
+        extra["control"] = o.control
+    return extra
 
 
 # --------------------------------------------------------------------------------------------

@@ -516,7 +516,7 @@ def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -
             "book_geometry": (book, 0.0),
             "simulated_geometry": (formula["rigorous"] * k, 0.0),
             "levelling_points": (formula["procedure"] * k, 0.0),
-            "procedure": (plain["value"], plain["ci"]),
+            "procedure": (value, ci),
         }
         names = list(levels)
         texts = (

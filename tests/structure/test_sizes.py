@@ -21,7 +21,6 @@ MAX_FUNCTION_LINES = 80
 LONG_FUNCTIONS = {
     "web/app.py:create_app": 253,
     "procedure/evaluation.py:evaluate_model": 192,
-    "verification/procedure_mc.py:procedure_mc": 146,
     "setup/block.py:compute_block": 128,
     "instrument/error_model.py:_terms": 127,
     "setup/table24.py:compute_table24": 126,
