@@ -96,8 +96,8 @@ if TYPE_CHECKING:
 __all__ = [
     "LINKAGE_VARIANTS",
     "PROCEDURE_ROWS",
-    "ProcedureOptions",
     "SOURCES",
+    "ProcedureOptions",
     "idealised_geometry",
     "levelling_formula",
     "levelling_points_photo",
