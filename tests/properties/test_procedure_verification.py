@@ -212,3 +212,26 @@ def test_levelled_setup_rows_are_the_formula_at_the_procedures_own_tilt_errors(s
     elements = lev["decomposition"]["values"]["elements"]
     assert abs(elements["value"] - at_measured) < elements["ci"] + ci_measured
     assert steps["element_errors"]["contribution"] < -steps["element_errors"]["ci"]
+
+
+def test_decentration_linkage_is_a_stated_parameter_and_bad_values_get_one_line(tmp_path):
+    """``correction.decentration_linkage`` of every shipped instrument: a leaf with its status
+    and basis (``drag``, assumed: no construction drawing); any other value is refused in one
+    line naming the file and the field, before any run."""
+    import yaml
+
+    from stereoplotter.errors import ConfigError
+    from stereoplotter.io.instrument_file import instrument_from_mapping, load_instrument
+    from stereoplotter.io.paths import data_dir
+
+    for name in ("sc1", "spr3", "sd3"):
+        spec = load_instrument(name)
+        leaf = spec.parameters["correction.decentration_linkage"]
+        assert spec.decentration_linkage == "drag" and leaf.is_assumed and "D1" in leaf.basis
+    data = yaml.safe_load((data_dir("instruments") / "sc1.yaml").read_text(encoding="utf-8"))
+    data["correction"]["decentration_linkage"]["value"] = "sticky"
+    with pytest.raises(ConfigError) as exc:
+        instrument_from_mapping(data, "bad.yaml")
+    text = str(exc.value)
+    assert "bad.yaml" in text and "correction.decentration_linkage" in text
+    assert "sticky" in text and len(text.strip().splitlines()) == 1
