@@ -492,6 +492,32 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
     return rows
 
 
+#: Mechanisms of decomposition steps, each shown by a switch run that removes it
+#: (``docs/accuracy.md``, "Decomposition of the procedure rows"), on the book's scenarios with
+#: the SC-1 and the dragging linkage only: step → text. Attached only to runs of that setting.
+MECHANISMS = {
+    "element_errors": "the knob–decentration linkage: switched to independent "
+    "(verify --linkage independent) the step changes sign (levelled rows −35 % → +8 %)",
+    "principal_distance": "the loops' stop when a check passes (f_пр is set by the stage-1 "
+    "L-check): with every loop at a fixed 2 or 4 passes the step is 0 within its CI",
+    "levelling_points": "the procedure's levelling points: re-levelled at Fig. 39's points "
+    "(procedure_mc levelling='book') the run is the formula there within its CI",
+    "procedure": "σ_q part: the scenario's tilted photos and relief (on vertical photos over "
+    "flat terrain the rest is 0 within its CI; 3, 6 or 10 passes do not change it)",
+}
+MECHANISM_SETTING = ({"pair60", "pair80"}, "sc1", "drag")
+
+
+def _mechanism(res: dict, step: str) -> str | None:
+    names, key, linkage = MECHANISM_SETTING
+    shown = res.get("scenario") in names and res.get("instrument_key") == key
+    if not shown or res.get("linkage") != linkage or res.get("instrument"):
+        return None
+    if step == "procedure" and res.get("sources") != "y_parallax":
+        return None
+    return MECHANISMS.get(step)
+
+
 def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -> dict:
     """The ``decomposition`` block of a procedure row (:mod:`.decomposition`): the formula at
     the book geometry (``book``, the row's rigorous column) → at the simulated geometry → the
@@ -538,6 +564,8 @@ def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -
             "steps": steps,
             "sum": book + sum(s["contribution"] for s in steps),
         }
+    for step in out["steps"]:
+        step["mechanism"] = _mechanism(res, step["step"])
     out["procedure"] = {"value": value, "ci": ci}
     out["closes"] = bool(abs(out["sum"] - value) <= ci + plain["ci"])
     out["linkage"] = res.get("linkage")
