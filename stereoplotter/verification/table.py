@@ -508,8 +508,10 @@ MECHANISMS = {
 MECHANISM_SETTING = ({"pair60", "pair80"}, "sc1", "drag")
 
 
-def _mechanism(res: dict, step: str) -> str | None:
+def _mechanism(res: dict, step: str, field: str | None) -> str | None:
     names, key, linkage = MECHANISM_SETTING
+    if step == "principal_distance" and field != "parallax":  # the switch run read δp only
+        return None
     shown = res.get("scenario") in names and res.get("instrument_key") == key
     if not shown or res.get("linkage") != linkage or res.get("instrument"):
         return None
@@ -565,7 +567,7 @@ def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -
             "sum": book + sum(s["contribution"] for s in steps),
         }
     for step in out["steps"]:
-        step["mechanism"] = _mechanism(res, step["step"])
+        step["mechanism"] = _mechanism(res, step["step"], field)
     out["procedure"] = {"value": value, "ci": ci}
     out["closes"] = bool(abs(out["sum"] - value) <= ci + plain["ci"])
     out["linkage"] = res.get("linkage")
