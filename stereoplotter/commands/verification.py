@@ -38,6 +38,7 @@ def verify(
     progress=None,
     procedure_trials: int | None = None,
     procedure_scenarios=None,
+    linkage: str | None = None,
 ):
     """Run and optionally write the verification (the entry point for ``stereoplotter verify``).
 
@@ -45,6 +46,7 @@ def verify(
     (:func:`geometry_from_file`: a scenario also becomes the procedure MC's scenario). Without a
     geometry the procedure MC runs on the book's scenarios (:func:`book_scenarios`); with a
     mapping it is skipped unless ``procedure_scenarios`` (loaded scenarios) are given.
+    ``linkage``: "drag" or "independent" for the procedure MC (None: the instrument file's).
 
     Returns
     -------
@@ -67,6 +69,7 @@ def verify(
         procedure_trials=procedure_trials,
         procedure_scenarios=procedure_scenarios,
         instrument=instrument,
+        linkage=linkage,
     )
     seconds = time.perf_counter() - t0
     if out_dir is not None:

@@ -419,6 +419,7 @@ def run_verification(
     procedure_trials: int | None = None,
     procedure_scenarios=None,
     instrument=None,
+    linkage=None,
 ) -> list[dict]:
     """Compute the verification table.
 
@@ -442,6 +443,8 @@ def run_verification(
         (:func:`stereoplotter.io.book_setting.book_scenarios`): this layer reads no files.
     instrument : InstrumentSpec, optional
         The instrument of the procedure MC (the book's SC-1); required with a scenario.
+    linkage : {"drag", "independent"}, optional
+        The knob–decentration linkage of the procedure MC (None: the instrument's).
 
     Returns
     -------
@@ -456,7 +459,7 @@ def run_verification(
     """
     g = _normalise_geometry(geometry)
     pending = start_procedure_mc(
-        procedure_trials, seed, procedure_scenarios, instrument=instrument
+        procedure_trials, seed, procedure_scenarios, instrument=instrument, linkage=linkage
     )  # in worker processes while the linear rows are computed here
     specs = _row_specs(g)
     rows = _rows(specs, trials, seed, progress, Setting.from_mapping(g).is_book)
