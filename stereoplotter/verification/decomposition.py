@@ -8,13 +8,15 @@ parts, each computed on the *same* trials as the procedure's value (no extra run
 2. → the first-order x-parallax field of each trial's own errors of the elements of (6.22)
    (b_x, b_y, b_z, α, ω, κ of both photos), propagated with the exact derivatives of the
    instrument model at the error-free setting (central differences, :func:`state_jacobian`):
-   ``element errors`` — the formula's σ's of (6.31)–(6.38) replaced by the scatter the
+   ``element_errors`` — the formula's σ's of (6.31)–(6.38) replaced by the scatter the
    procedure actually leaves, and (6.22)'s vertical-photo coefficients by the derivatives at
    the scenario's tilted photos and relief;
-3. → the first order of every other state variable the procedure sets (the photo and plane
-   decentrations e, c of both units, the model origin MO), which (6.22) does not carry:
+3. → + the first order of the trial's error of f_пр, the instrument principal distance the
+   procedure sets, which (6.22) does not carry: ``principal_distance``;
+4. → + the first order of every other state variable the procedure sets (the photo and plane
+   decentrations e, c of both units, the model origin MO), which (6.22) drops:
    ``decentrations``;
-4. → the procedure's δp (the instrument model itself, every order): ``non-linear`` (the rest).
+5. → the procedure's δp (the instrument model itself, every order): ``non_linear`` (the rest).
 
 Every step is a difference of RMS values of fields on the same trials and grid; its CI is the
 delta-method CI (``CI_Z`` standard errors) of the paired per-trial mean squares. The steps add up
