@@ -208,10 +208,8 @@ def test_levelled_setup_rows_are_the_formula_at_the_procedures_own_tilt_errors(s
     lev = setup80["fields"]["levelled"]
     ci_measured = CI_Z * at_measured / math.sqrt(2.0 * trials)
     assert abs(lev["coefficient"] - at_measured) < lev["ci"] + ci_measured
-    steps = {s["step"]: s for s in lev["decomposition"]["steps"]}
     elements = lev["decomposition"]["values"]["elements"]
     assert abs(elements["value"] - at_measured) < elements["ci"] + ci_measured
-    assert steps["element_errors"]["contribution"] < -steps["element_errors"]["ci"]
 
 
 def test_decentration_linkage_is_a_stated_parameter_and_bad_values_get_one_line(tmp_path):
