@@ -135,14 +135,15 @@ def state_deltas(setting, units, zero_setting, zero_units, trials: int) -> np.nd
     return out
 
 
-def linear_fields(jacobian: np.ndarray, deltas: np.ndarray) -> dict[str, np.ndarray]:
-    """The cumulative first-order fields (T, P) of :data:`LEVELS`: ``elements`` (the (6.22)
-    elements only), ``principal_distance`` (+ f_пр), ``first_order`` (every state variable)."""
-    out, field, done = {}, 0.0, 0
+def linear_fields(jacobian: np.ndarray, deltas: np.ndarray):
+    """The cumulative first-order fields (T, P) of :data:`LEVELS`, one at a time: (name, field)
+    for ``elements`` (the (6.22) elements only), ``principal_distance`` (+ f_пр) and
+    ``first_order`` (every state variable)."""
+    field, done = 0.0, 0
     for name, upto in LEVELS:
         field = field + deltas[done:upto].T @ jacobian[done:upto]
-        out[name], done = field, upto
-    return out
+        done = upto
+        yield name, field
 
 
 def _rms_ci(ms: np.ndarray) -> tuple[float, float]:

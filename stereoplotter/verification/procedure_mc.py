@@ -329,17 +329,19 @@ def _setup_fields(sc, zero_run, g, xr, grid):
     jac = dc.state_jacobian(*state0, _dp_of(sc, sheet, allp))
 
     def decompose(result, main):
-        """The first-order fields of the decomposition (:mod:`.decomposition`) per reading."""
+        """Per-trial mean squares of the first-order fields of the decomposition
+        (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²]."""
         units = result.instrument.state()["units"]
         trials = len(next(iter(main.values())))
         deltas = dc.state_deltas(
             result.instrument.setting, {s: units[s] for s in ("left", "right")}, *state0, trials
         )
+        noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
         out = {}
-        for step, d in dc.linear_fields(jac, deltas).items():
+        for step, d in dc.linear_fields(jac, deltas):
             r = readings(d)
-            r["observed"] = r["levelled"] + (main["observed"] - main["levelled"])
-            out.update({(key, step): v for key, v in r.items()})
+            r["observed"] = r["levelled"] + noise
+            out.update({(key, step): np.mean(v**2, axis=-1) for key, v in r.items()})
         return out
 
     fields.decompose = decompose
@@ -469,11 +471,11 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         )
         fs = fields(result, noise)
         cv = cvar.per_trial_controlled(fs, lin, noise, injected, model) if lin else {}
-        extra = fields.decompose(result, fs) if hasattr(fields, "decompose") else {}
-        for name, v in {**fs, **extra}.items():
-            plain.setdefault(name, np.empty(int(trials)))[first : first + m] = np.mean(
-                np.asarray(v) ** 2, axis=-1
-            )
+        ms = {name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()}
+        if hasattr(fields, "decompose"):  # already mean squares
+            ms.update(fields.decompose(result, fs))
+        for name, v in ms.items():
+            plain.setdefault(name, np.empty(int(trials)))[first : first + m] = v
             if lin and name in cv:
                 controlled.setdefault(name, np.empty(int(trials)))[first : first + m] = cv[name]
     return plain, controlled, d_zero
