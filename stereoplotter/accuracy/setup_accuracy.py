@@ -519,9 +519,11 @@ def setup_relative_residual_rms(
     mode : {"printed", "book", "rigorous"}
         ``printed``: :func:`setup_relative_residual_rms_printed`;
         ``book``: the integral of (6.47) over the chapter-5 domain with one m_α, m_ω
-        ((6.32), least-squares (6.35)) and the ω residual y(x + c/2);
-        ``rigorous``: both photos' independent errors (variance doubled: the residual depends on
-        α_л − α_п and ω_л − ω_п) and the exact plane residual y(x − (a − c)/2).
+        (the book's printed intermediates: (6.32) and (6.35) as printed, f√3/(2l²n)) and the
+        ω residual y(x + c/2);
+        ``rigorous``: the least-squares m_ω of (6.33), both photos' independent errors
+        (variance doubled: the residual depends on α_л − α_п and ω_л − ω_п) and the exact plane
+        residual y(x − (a − c)/2).
 
     Notes
     -----
@@ -535,7 +537,7 @@ def setup_relative_residual_rms(
     Examples
     --------
     >>> round(float(setup_relative_residual_rms(0.0, 70.0, 70.0, 85.0, 1.42, 1.0)), 4)
-    0.1572
+    0.1413
     """
     if mode == "printed":
         return setup_relative_residual_rms_printed(
@@ -544,7 +546,9 @@ def setup_relative_residual_rms(
     _check_mode(mode)
     a, c, f = a_mm, c_mm, focal_length_mm
     m_a = sigma_alpha_setup(f, mark_distance_mm, n, sigma_counter_mm)
-    m_w = sigma_omega_setup(f, mark_distance_mm, n, sigma_counter_mm, "book")
+    m_w = sigma_omega_setup(
+        f, mark_distance_mm, n, sigma_counter_mm, "printed" if mode == "book" else "rigorous"
+    )
     shift = c / 2.0 if mode == "book" else (c - a) / 2.0
     mean_w = c**2 / 3.0 * _mean_shifted_square(shift, c)
     mean_a = c**2 * (10 * a**2 + 5 * a * c + c**2) / 30.0

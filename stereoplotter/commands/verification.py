@@ -38,6 +38,7 @@ def verify(
     progress=None,
     procedure_trials: int | None = None,
     procedure_scenarios=None,
+    linkage: str | None = None,
 ):
     """Run and optionally write the verification (the entry point for ``stereoplotter verify``).
 
@@ -45,6 +46,7 @@ def verify(
     (:func:`geometry_from_file`: a scenario also becomes the procedure MC's scenario). Without a
     geometry the procedure MC runs on the book's scenarios (:func:`book_scenarios`); with a
     mapping it is skipped unless ``procedure_scenarios`` (loaded scenarios) are given.
+    ``linkage``: "drag" or "independent" for the procedure MC (None: the instrument file's).
 
     Returns
     -------
@@ -67,6 +69,7 @@ def verify(
         procedure_trials=procedure_trials,
         procedure_scenarios=procedure_scenarios,
         instrument=instrument,
+        linkage=linkage,
     )
     seconds = time.perf_counter() - t0
     if out_dir is not None:
@@ -99,17 +102,20 @@ def write_verification(
     return list(write_files(out_dir, files).values())
 
 
-def start_book_procedure_mc(trials, seed, scenarios=None, instrument=BOOK_INSTRUMENT):
+def start_book_procedure_mc(
+    trials, seed, scenarios=None, instrument=BOOK_INSTRUMENT, linkage=None
+):
     """:func:`stereoplotter.verification.table.start_procedure_mc` on loaded inputs:
     ``scenarios`` ("60"/"80" → Scenario or None) default to the book's (:func:`book_scenarios`),
     the instrument is loaded by name (default the book's SC-1) when a slot runs. ``trials``:
-    None for the per-configuration defaults, 0 for none."""
+    None for the per-configuration defaults, 0 for none. ``linkage``: "drag", "independent"
+    or None (the instrument file's)."""
     if trials == 0:
         return start_procedure_mc(0, seed, {})
     if scenarios is None:
         scenarios = book_scenarios()
     spec = book_instrument(instrument) if any(scenarios.values()) else None
-    return start_procedure_mc(trials, seed, scenarios, instrument=spec)
+    return start_procedure_mc(trials, seed, scenarios, instrument=spec, linkage=linkage)
 
 
 def _figures(rows: list[dict], proc: dict, seed: int, geometry) -> dict[str, bytes]:
@@ -141,7 +147,9 @@ def run_verify_command(args: argparse.Namespace) -> int:
     # the procedure MC once, shared by the table and the histograms; its runs go on in worker
     # processes while the linear rows are computed
     t0 = time.perf_counter()
-    pending = start_book_procedure_mc(args.procedure_trials, args.seed, scenarios, args.instrument)
+    pending = start_book_procedure_mc(
+        args.procedure_trials, args.seed, scenarios, args.instrument, args.linkage
+    )
     with step_progress("verify") as progress:
         rows, seconds = verify(
             trials=args.trials,

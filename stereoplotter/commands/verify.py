@@ -43,6 +43,14 @@ def add_arguments(sub: Any) -> None:
         "%(default)s, the book's SC-1)",
     )
     p.add_argument(
+        "--linkage",
+        choices=("drag", "independent"),
+        default=None,
+        help="knob–decentration linkage of the procedure MC's instrument: drag (turning k_α, "
+        "k_ω moves the decentrations, decision D1) or independent (decentrations set before "
+        "the k fits); default: the instrument file's correction.decentration_linkage",
+    )
+    p.add_argument(
         "--geometry",
         metavar="FILE",
         help="YAML: a scenario (f, l, n, photo base p, overlap; also runs the procedure MC on it) "

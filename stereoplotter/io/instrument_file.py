@@ -28,7 +28,13 @@ from stereoplotter.instrument.principles import PRINCIPLES
 from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
 from stereoplotter.io.validation import FileModel, _bounds, _fail, check_number, text, validate
 from stereoplotter.io.yaml_input import load_yaml_mapping
-from stereoplotter.spec.instrument_spec import _ATTRIBUTES, STATUSES, InstrumentSpec, Parameter
+from stereoplotter.spec.instrument_spec import (
+    _ATTRIBUTES,
+    DECENTRATION_LINKAGES,
+    STATUSES,
+    InstrumentSpec,
+    Parameter,
+)
 from stereoplotter.spec.schema_fields import SchemaField as _Leaf
 
 __all__ = ["InstrumentFile", "instrument_from_mapping", "list_instruments", "load_instrument"]
@@ -57,6 +63,7 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("orientation.kappa_deg", "range", "deg", -180.0, 180.0, contains_zero=True),
     _Leaf("correction.tilt_max_deg", "number", "deg", high=45.0, **_POS),
     _Leaf("correction.decentration_mm", "range", "mm", -200.0, 200.0, contains_zero=True),
+    _Leaf("correction.decentration_linkage", "text", required=False),
     # each correction principle's own leaves, declared as plain data in its module
     *(f for p in PRINCIPLES.values() for f in p.schema_fields),
     _Leaf("counters.present", "bool"),
@@ -484,6 +491,8 @@ def instrument_from_mapping(
     values: dict[str, Any] = {}
     for attribute, (dotted, convert) in _ATTRIBUTES.items():
         values[attribute] = convert(params[dotted].value) if dotted in params else None
+    if values["decentration_linkage"] is None:  # files without the leaf: decision D1
+        values["decentration_linkage"] = DECENTRATION_LINKAGES[0]
     if values["projection_distance_max_mm"] is None:
         values["projection_distance_max_mm"] = values["projection_distance_range_mm"][1]
     spec = InstrumentSpec(
@@ -661,6 +670,15 @@ def _merge_inherited(
 
 
 def _cross_check(params: Mapping[str, Parameter], source: str) -> None:
+    link = params.get("correction.decentration_linkage")
+    if link is not None and link.value not in DECENTRATION_LINKAGES:
+        raise ConfigError(
+            link.file or source,
+            "correction.decentration_linkage.value",
+            " or ".join(DECENTRATION_LINKAGES),
+            link.value,
+            "drag: turning k_α, k_ω moves the decentrations (D1); independent: it does not",
+        )
     d_max = params.get("projection.distance_max_mm")
     if d_max is not None:
         hi = params["projection.distance_mm"].value[1]

@@ -259,6 +259,8 @@ def stage2_transform(run: Run) -> None:
             run.record_stage("1", run.stage_iterations("1") + np.where(active, l_its, 0))
         else:  # with the correction units still at zero the cassette centre is on the plumb
             _zero_readings(run, "2/MO")
+            if op.inst.variant.decentrations_first:  # B2: the decentrations before the fits
+                _set_computed_decentrations(run)
         seen = []
         for side in ("left", "right"):
             _fit_knob(run, side, "omega", "3", f"2/{it}/{side}/omega", active)
@@ -283,6 +285,19 @@ def stage2_transform(run: Run) -> None:
     run.check("stage 2: mark 4", worst, tol4, iterations=its)
     for side, mark in (("left", "2"), ("right", "1")):
         _fit_knob(run, side, "alpha", mark, f"2/{side}/alpha", op.all())
+    if not op.inst.variant.decentrations_first:  # B2 set them before the k_ω fit
+        _set_computed_decentrations(run)
+    bz = run.target("O_bz")
+    op.set("bz", bz, "2/bz")
+    op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
+    clear_kappa(run, "2")
+    check_standard_points(run, "2")
+
+
+def _set_computed_decentrations(run: Run) -> None:
+    """The computed decentrations d = MO_d + f′·tan(tilt) on the scales (stage 2): after the
+    k_α, k_ω fits in the book's order, before them under variant B2 (``decentrations_first``)."""
+    op = run.op
     for side in ("left", "right"):
         for d in ("dx", "dy"):
             control = f"{d}_{side}"
@@ -300,11 +315,6 @@ def stage2_transform(run: Run) -> None:
                 reading=value,
                 equation=f"f′·tan {tilt} (§2.4)",
             )
-    bz = run.target("O_bz")
-    op.set("bz", bz, "2/bz")
-    op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
-    clear_kappa(run, "2")
-    check_standard_points(run, "2")
 
 
 def _table_settings(principle: str, control: str) -> str:

@@ -8,7 +8,7 @@ import json
 
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification import table
-from stereoplotter.verification.table import ROW_KEYS, closing_comparison
+from stereoplotter.verification.table import CSV_KEYS, closing_comparison
 
 __all__ = ["verification_console", "verification_files", "verification_markdown"]
 
@@ -85,7 +85,53 @@ def verification_markdown(rows, closing, meta):
             + (f" ({c['gain_mc_procedure']:+.0%})" if c["gain_mc_procedure"] is not None else "")
             + " |"
         )
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + decomposition_markdown(rows)) + "\n"
+
+
+_STEP_HEAD = {
+    "geometry": "geometry",
+    "element_errors": "(6.22) elements, own errors",
+    "principal_distance": "f_пр as set",
+    "decentrations": "decentrations, MO",
+    "non_linear": "non-linear rest",
+    "levelling_points": "procedure's levelling points",
+    "procedure": "rest of the procedure",
+}
+
+
+def decomposition_markdown(rows) -> list[str]:
+    """The decomposition of each procedure row (``decomposition`` of the rows, one line per
+    row): the formula at the book geometry, each step's contribution ± CI (99.9 %) and its
+    share of the formula at the simulated geometry, the sum and the row's procedure value."""
+    rows = [r for r in rows if r.get("decomposition")]
+    if not rows:
+        return []
+    out = [
+        "",
+        "## Decomposition of the procedure rows",
+        "",
+        "Formula at the book geometry → at the simulated geometry → first order of each "
+        "trial's own errors (the (6.22) elements, then f_пр, then the decentrations and model "
+        "origin) → the procedure; every step on the same trials, ± CI (99.9 %). Conventional "
+        "rows: → the formula with the plane at the procedure's levelling points → the rest. "
+        "*closes*: book + Σ steps (the plain mean) agrees with the row's value within the CIs.",
+        "",
+        "| eq | linkage | book geometry | steps | sum | procedure MC | closes |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        d = r["decomposition"]
+        steps = "; ".join(
+            f"{_STEP_HEAD.get(s['step'], s['step'])} {s['contribution']:+.4f} ± {s['ci']:.4f} "
+            f"({s['relative']:+.1%})"
+            for s in d["steps"]
+        )
+        out.append(
+            f"| {r['eq']} | {d.get('linkage') or '—'} | {d['values']['book_geometry']['value']:.4f}"
+            f" | {steps} | {d['sum']:.4f} | {d['procedure']['value']:.4f} ± "
+            f"{d['procedure']['ci']:.4f} | {'yes' if d['closes'] else 'NO'} |"
+        )
+    return out
 
 
 def verification_files(
@@ -101,10 +147,10 @@ def verification_files(
         "procedure_trials": procedure_trials,
     }
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=list(ROW_KEYS), extrasaction="ignore")
+    w = csv.DictWriter(buf, fieldnames=list(CSV_KEYS), extrasaction="ignore")
     w.writeheader()
     for r in rows:
-        w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in ROW_KEYS})
+        w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in CSV_KEYS})
     files = {
         "verification.md": verification_markdown(rows, closing, meta),
         "verification.csv": buf.getvalue(),

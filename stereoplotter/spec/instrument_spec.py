@@ -27,6 +27,7 @@ from types import MappingProxyType
 from typing import Any, ClassVar
 
 __all__ = [
+    "DECENTRATION_LINKAGES",
     "STATUSES",
     "InstrumentSpec",
     "Parameter",
@@ -36,6 +37,10 @@ __all__ = [
 
 #: The two status labels of a leaf (``docs/instruments.md``).
 STATUSES = ("documented", "assumed")
+#: ``correction.decentration_linkage``: turning a k_α, k_ω knob drags the photo and plane
+#: decentrations ("drag", decision D1, the default of a file without the leaf) or leaves them
+#: ("independent").
+DECENTRATION_LINKAGES = ("drag", "independent")
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,6 +113,7 @@ _ATTRIBUTES: dict[str, tuple[str, Callable[[Any], Any]]] = {
     "kappa_range": ("orientation.kappa_deg", _deg_range),
     "tilt_max": ("correction.tilt_max_deg", lambda v: v * _RAD),
     "decentration_range_mm": ("correction.decentration_mm", _same),
+    "decentration_linkage": ("correction.decentration_linkage", _same),
     "counters_present": ("counters.present", _same),
     "direction_switches": ("counters.direction_switches", _same),
     "xy_least_count_mm": ("counters.xy_least_count_mm", _same),
@@ -189,6 +195,9 @@ class InstrumentSpec:
         Largest |α|, |ω| the correction mechanisms handle. [rad]
     decentration_range_mm : tuple of float
         Decentration scales (photo and correction mechanism). [mm]
+    decentration_linkage : str
+        "drag" or "independent" (:data:`DECENTRATION_LINKAGES`): whether turning a k_α, k_ω
+        knob moves the decentrations; "drag" when the file does not say.
     xy_least_count_mm, z_least_count_mm : float
         Least counts of the X/Y counters and of the absolute height counter. [mm]
     height_scale_least_count_m : float
@@ -238,6 +247,7 @@ class InstrumentSpec:
     kappa_range: tuple[float, float]
     tilt_max: float
     decentration_range_mm: tuple[float, float]
+    decentration_linkage: str
     counters_present: bool
     direction_switches: bool
     xy_least_count_mm: float
@@ -430,7 +440,7 @@ def format_instrument(spec: InstrumentSpec, *, notes: bool = True) -> str:
     >>> from stereoplotter.io.instrument_file import load_instrument
     >>> text = format_instrument(load_instrument("sc1"))
     >>> print(text.splitlines()[2])  # doctest: +ELLIPSIS
-    values: 20 documented, 45 assumed (ASSUMED: no source states it for this instrument; edit ...
+    values: 20 documented, 46 assumed (ASSUMED: no source states it for this instrument; edit ...
     >>> [line.strip() for line in text.splitlines() if line.startswith("  distance_max_mm")]
     ['distance_max_mm = 185 mm  [documented: SEED6]']
     """

@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -80,6 +80,7 @@ from stereoplotter.scenario.model import Terrain
 from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.sheet import compute_setup_sheet
 from stereoplotter.verification import control_variate as cvar
+from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification.linear_mc import (
     CI_Z,
     LinearModel,
@@ -93,8 +94,10 @@ if TYPE_CHECKING:
     from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
+    "LINKAGE_VARIANTS",
     "PROCEDURE_ROWS",
     "SOURCES",
+    "ProcedureOptions",
     "idealised_geometry",
     "levelling_formula",
     "levelling_points_photo",
@@ -187,7 +190,13 @@ def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)
 
 
 def _dp(scenario, sheet, inst, frame_pts):
+    """δp [photo mm] of the built instrument ``inst`` at ``frame_pts`` (ideal model position)."""
+    units = inst.state()["units"]
+    return _dp_of(scenario, sheet, frame_pts)(inst.setting, units["left"], units["right"])
 
+
+def _dp_of(scenario, sheet, frame_pts):
+    """δp at ``frame_pts`` as a function of an instrument state (setting, left, right units)."""
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
     local = ev.instrument_frame_m(frame_pts, origin, theta, inverse=True)
@@ -196,14 +205,23 @@ def _dp(scenario, sheet, inst, frame_pts):
     model = ev.ideal_model_mm(
         frame_pts, sheet.horizontal_scale_denominator, sheet.vertical_scale_denominator
     )
-    units = inst.state()["units"]
-    setting, left, right = inst.setting, units["left"], units["right"]
+    return lambda setting, left, right: _dp_state(model, gl, gr, setting, left, right)
+
+
+def _dp_state(model, gl, gr, setting, left, right):
     if ev._trial_count(setting, (left, right)) is not None:
         setting = ev._with_point_axis(setting)
         left, right = ev._with_point_axis(left), ev._with_point_axis(right)
     dp, _ = ev.parallax_errors_at_ideal(model, gl, gr, setting, left, right)
     return np.asarray(dp, float)
 
+
+#: ``procedure_mc(linkage=…)`` → the instrument's decentration variant
+#: (:data:`~stereoplotter.instrument.kinematics.DECENTRATION_VARIANTS`): "drag", the knob drags
+#: the photo and plane decentrations (D1, "L"); "independent", the decentrations stay where
+#: they are set, and are set before the k_ω, k_α fits ("B2": set after them, as in the book's
+#: order, they would leave the fits made at zero decentration).
+LINKAGE_VARIANTS = {"drag": "L", "independent": "B2"}
 
 #: ``procedure_mc(sources=…)`` of the conventional method: which judgment errors are on.
 SOURCES = ("both", "y_parallax", "stereo")
@@ -294,18 +312,39 @@ def _setup_fields(sc, zero_run, g, xr, grid):
         levelling_design(book[:, 0], book[:, 1])
     )
 
+    def readings(d):
+        dom, ctl = d[:, n : n + nl], d[:, n + nl :]
+        return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
+
     def fields(result, noise, sigma_control=0.0):
         d = _dp(sc, result.sheet, result.instrument, allp) - zero
-        dom, ctl = d[:, n : n + nl], d[:, n + nl :]
-        obs = ctl + np.stack(
+        out = readings(d)
+        obs = np.stack(
             [noise.normal(f"mc/control/{i}", sigma_control) for i in range(len(book))], -1
         )
-        return {
-            "parallax": d[:, :n],
-            "levelled": dom - ctl @ refit.T,
-            "observed": dom - obs @ refit.T,
-        }
+        return {**out, "observed": out["levelled"] - obs @ refit.T}
 
+    units0 = zero_run.instrument.state()["units"]
+    state0 = (zero_run.instrument.setting, {s: units0[s] for s in ("left", "right")})
+    jac = dc.state_jacobian(*state0, _dp_of(sc, sheet, allp))
+
+    def decompose(result, main):
+        """Per-trial mean squares of the first-order fields of the decomposition
+        (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²]."""
+        units = result.instrument.state()["units"]
+        trials = len(next(iter(main.values())))
+        deltas = dc.state_deltas(
+            result.instrument.setting, {s: units[s] for s in ("left", "right")}, *state0, trials
+        )
+        noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
+        out = {}
+        for step, d in dc.linear_fields(jac, deltas):
+            r = readings(d)
+            r["observed"] = r["levelled"] + noise
+            out.update({(key, step): np.mean(v**2, axis=-1) for key, v in r.items()})
+        return out
+
+    fields.decompose = decompose
     return fields, zero[:n]
 
 
@@ -404,6 +443,8 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
 
         def fields(result, noise):
             return make(result, noise, sc_sigma)
+
+        fields.decompose = make.decompose
     else:
         fields, d_zero = _conventional_fields(
             sc, zero_prep, zero_run, g, xr, grid, op.stereo_sigma_mm
@@ -430,11 +471,12 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         )
         fs = fields(result, noise)
         cv = cvar.per_trial_controlled(fs, lin, noise, injected, model) if lin else {}
-        for name, v in fs.items():
-            plain.setdefault(name, np.empty(int(trials)))[first : first + m] = np.mean(
-                np.asarray(v) ** 2, axis=-1
-            )
-            if lin:
+        ms = {name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()}
+        if hasattr(fields, "decompose"):  # already mean squares
+            ms.update(fields.decompose(result, fs))
+        for name, v in ms.items():
+            plain.setdefault(name, np.empty(int(trials)))[first : first + m] = v
+            if lin and name in cv:
                 controlled.setdefault(name, np.empty(int(trials)))[first : first + m] = cv[name]
     return plain, controlled, d_zero
 
@@ -556,7 +598,62 @@ def _formulas(method, scenario, spec, g, sources, control):
     }
 
 
-# long: a 45-line docstring (the options and what each measures) and the run and summary.
+@dataclass(frozen=True)
+class ProcedureOptions:
+    """The options of :func:`procedure_mc` (keyword arguments there; defaults as here).
+
+    Attributes
+    ----------
+    sigma_mm : float
+        The operator's σ (photo scale): monocular pointing (setup) or σ_q = σ_p (conventional).
+    grid : tuple of int
+        Midpoint grid of the statistic (nx, ny).
+    quantity : {"heights", "parallax"}
+        Conventional only (``docs/accuracy.md``, "Why the total M_p was +54 % / +123 %"): the
+        height read on the slipped height scale in parallax units (what M_p measures) or δp at
+        the ideal model position (counts the b_x scale error and the model's datum).
+    standard_points : {"book", "nadirs"}
+        Conventional only: Fig. 39 at a = c − p (the formula's layout) or a = 0.
+    datum : {"plane", "slip"}
+        Conventional only: the formula's levelling offset (the four levelling heights, each
+        with σ_p) or the procedure's (the height scale slipped at one levelling point).
+    levelling : {"procedure", "book"}
+        Conventional only: the model as the procedure levelled it (the scenario's four control
+        points nearest standard points 3–6) or re-levelled by the least-squares plane through
+        its height errors at Fig. 39's x_п ∈ {−c, a}, y = ±c, each observed with σ_p.
+    sources : {"both", "y_parallax", "stereo"}
+        Conventional only: σ_q = σ_p = σ, σ_q only or σ_p only.
+    control : {"exact", "observed"}
+        "setup_control" only: exact control heights (per m_xy, (6.47)–(6.50)) or each control
+        parallax observed with m_p = m_xy/√2 (per m_p, (6.58)/(6.59)).
+    instrument : bool
+        Every injected instrument error term of ``spec`` at its configured σ and the real
+        mechanics (backlash), besides the operator's σ; the unit stays the operator's.
+    control_variate : bool
+        The estimator with the linear control variate
+        (:mod:`~stereoplotter.verification.control_variate`; unbiased, its CI ≈ 10–40×
+        narrower); False: the plain mean.
+    passes : int or None
+        Every loop makes this many passes (no check ever passes); None: as built.
+    linkage : {"drag", "independent"} or None
+        The knob–decentration linkage (:data:`LINKAGE_VARIANTS`); None: the instrument's
+        ``correction.decentration_linkage``.
+    """
+
+    sigma_mm: float = 0.01
+    grid: tuple = (16, 32)
+    quantity: str = "heights"
+    standard_points: str = "book"
+    datum: str = "plane"
+    levelling: str = "procedure"
+    sources: str = "both"
+    control: str = "exact"
+    instrument: bool = False
+    control_variate: bool = True
+    passes: int | None = None
+    linkage: str | None = None
+
+
 def procedure_mc(
     scenario: Scenario,
     method: str = "setup",
@@ -564,61 +661,27 @@ def procedure_mc(
     spec: InstrumentSpec,
     trials: int = 600,
     seed: int = 20240601,
-    sigma_mm: float = 0.01,
-    grid=(16, 32),
-    quantity: str = "heights",
-    standard_points: str = "book",
-    datum: str = "plane",
-    levelling: str = "procedure",
-    sources: str = "both",
-    control: str = "exact",
-    instrument: bool = False,
-    control_variate: bool = True,
-    passes: int | None = None,
+    **options,
 ) -> dict:
     """Run the procedure MC for one scenario and method (see the module docstring).
 
-    ``method`` (:data:`METHODS`): "setup" (§27 task 1: the setup-data method, stages 1–5, with
-    the operator's monocular pointing σ; δp on the (6.27) domain per m_xy = n_л·σ, (6.39)–(6.44));
-    "setup_control" (§27 task 2: the same run, then the model levelled on Fig. 39's four control
-    points x_п ∈ {−c, a}, y = ±c by the least-squares plane (1, X, Y) through the δp there —
-    the levelling that refines the setup data on control; δp on the chapter-5 domain; ``control``
-    "exact" per m_xy, (6.47)–(6.50), or "observed": each control parallax observed with
-    m_p = m_xy/√2, per m_p, (6.58)/(6.59)); "conventional".
-
-    Conventional method only (``docs/accuracy.md``, "Why the total M_p was +54 % / +123 %"):
-    ``quantity`` "heights" (the height read on the slipped height scale, in parallax units —
-    what M_p measures) or "parallax" (δp at the ideal model position, the old quantity, which
-    counts the b_x scale error and the model's datum); ``standard_points`` "book" (Fig. 39 at
-    a = c − p, the formula's layout) or "nadirs" (a = 0, the instrument's); ``datum`` "plane"
-    (the formula's levelling offset: the four levelling heights, each with σ_p) or "slip" (the
-    procedure's: the height scale slipped at one levelling point). ``levelling`` "procedure"
-    (the model as the procedure levelled it, on the scenario's four control points nearest
-    standard points 3–6) or "book" (the built model re-levelled by the least-squares plane through
-    its height errors at Fig. 39's x_п ∈ {−c, a}, y = ±c, each observed with σ_p: the formula's
-    control points). ``sources`` "both" (σ_q = σ_p = σ), "y_parallax" (σ_q only) or "stereo"
-    (σ_p only). The result also carries ``by_datum`` (coefficient, ci) for "parallax", "slip",
-    "plane" and "book" of the same trials.
-
-    ``instrument``: every injected instrument error term of ``spec`` at its configured σ and the
-    real mechanics (backlash), besides the operator's σ; the unit stays the operator's.
-    ``control_variate``: the estimator with the linear control variate
-    (:mod:`~stereoplotter.verification.control_variate`; unbiased, its CI ≈ 10–40× narrower);
-    False: the plain mean.
-
-    ``scenario`` and ``spec`` (the instrument, the book's SC-1) are loaded by the caller; this
-    layer reads no files.
+    ``method`` (:data:`METHODS`): "setup" (§27 task 1: stages 1–5 with the operator's monocular
+    pointing σ; δp on the (6.27) domain per m_xy = n_л·σ, (6.39)–(6.44)); "setup_control" (§27
+    task 2: the same run levelled on Fig. 39's four control points by the least-squares plane
+    through the δp there; the chapter-5 domain); "conventional". ``options``: the fields of
+    :class:`ProcedureOptions`. ``scenario`` and ``spec`` (the book's SC-1) are loaded by the
+    caller; this layer reads no files.
 
     Returns
     -------
     dict
-        ``coefficient`` (RMS per m_xy for "setup", per m_xy or m_p for "setup_control", per
-        m_p = m_q for "conventional"), ``ci`` (half-width, same units), ``plain`` (coefficient,
-        ci) of the plain mean, ``formula`` (``rigorous`` at the simulated geometry; for the
-        conventional method also :func:`levelling_formula` at the procedure's levelling points,
-        ``procedure``, and at Fig. 39's, ``book``), ``rms_mm``, ``bias_mm`` (RMS δp of the
-        error-free run on the same domain), ``per_trial`` (per-trial RMS / unit, for
-        histograms), the geometry used (f, l, n, f_instrument, p, c, a, overlap) and ``seconds``.
+        ``coefficient`` (per m_xy, m_p or m_q as above), ``ci`` (half-width), ``plain``
+        (coefficient, ci of the plain mean), ``formula`` (``rigorous`` at the simulated
+        geometry; conventional also :func:`levelling_formula` at the procedure's levelling
+        points, ``procedure``, and at Fig. 39's, ``book``), ``rms_mm``, ``bias_mm`` (RMS δp of
+        the error-free run), ``per_trial``, the geometry (f, l, n, f_instrument, p, c, a,
+        overlap), ``seconds``; setup methods also ``fields`` (the three readings, each with its
+        ``decomposition``, :mod:`.decomposition`), conventional ``by_datum`` and the options.
 
     Examples
     --------
@@ -631,78 +694,91 @@ def procedure_mc(
     True
     """
     t0 = time.perf_counter()
+    o = ProcedureOptions(**options)
     _check_options(
         method,
-        quantity=quantity,
-        standard_points=standard_points,
-        datum=datum,
-        levelling=levelling,
-        sources=sources,
-        control=control,
+        **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
+        **{k: getattr(o, k) for k in ("sources", "control")},
     )
     g = scenario_geometry(scenario, spec)
-    zero, op, xr, unit, kw = _configuration(method, sigma_mm, g["c"], g["p"], g["n"], sources)
-    options = {"instrument": instrument, "control_variate": control_variate, "passes": passes}
-    if method == "conventional":
-        options["standard_points"] = standard_points
-    units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
-    if method != "conventional":  # m_p = m_xy/√2 of the observed control parallaxes
-        options["sigma_control"] = units["observed"]
-    spec_c = replace(spec, standard_points_c_mm=g["c"])
-    plain, controlled, d_zero = _mean_squares(
-        scenario, spec_c, method, seed, trials, zero, op, xr, g, grid, kw, options
-    )
-    name = _field_name(method, quantity, levelling, datum, control)
+    linkage = o.linkage or spec.decentration_linkage
+    plain, controlled, d_zero, units = _run(scenario, spec, method, trials, seed, o, g, linkage)
+    name = _field_name(method, o.quantity, o.levelling, o.datum, o.control)
     best = controlled or plain
-    fields = {}
-    if method != "conventional":  # one run, the three readings of §27 tasks 1 and 2
-        for key, m, c in (
-            ("parallax", "setup", "exact"),
-            ("levelled", "setup_control", "exact"),
-            ("observed", "setup_control", "observed"),
-        ):
-            cf, h = _rms_ci(best[key], units[key])
-            fields[key] = {
-                "coefficient": cf,
-                "ci": h,
-                "plain": _rms_ci(plain[key], units[key]),
-                "formula": _formulas(m, scenario, spec, g, sources, c)["rigorous"],
-            }
-        unit = units[name]
-    formula = _formulas(method, scenario, spec, g, sources, control)
+    unit = units[name]
     coefficient, ci = _rms_ci(best[name], unit)
-    extra = {"fields": fields} if fields else {}
-    if method == "conventional":
-        extra = {
-            "by_datum": {k: _rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
-            "quantity": quantity,
-            "standard_points": standard_points,
-            "datum": datum,
-            "levelling": levelling,
-            "sources": sources,
-        }
-    if method == "setup_control":
-        extra["control"] = control
-    return {
-        **extra,
+    out = {
+        **_extras(scenario, spec, method, o, g, plain, best, units),
         "method": method,
         "scenario": scenario.name,
         "trials": int(trials),
         "seed": int(seed),
-        "sigma_mm": sigma_mm,
-        "instrument": bool(instrument),
+        "sigma_mm": o.sigma_mm,
+        "instrument": bool(o.instrument),
         "instrument_key": spec.key,
+        "linkage": linkage,
         "control_variate": bool(controlled),
         "coefficient": coefficient,
         "ci": ci,
         "plain": _rms_ci(plain[name], unit),
-        "formula": formula,
+        "formula": _formulas(method, scenario, spec, g, o.sources, o.control),
         "rms_mm": coefficient * unit,
         "bias_mm": float(np.sqrt(np.mean(d_zero**2))),
         "per_trial": np.sqrt(plain[name]) / unit,
-        "seconds": time.perf_counter() - t0,
-        **g,
     }
+    return {**out, "seconds": time.perf_counter() - t0, **g}
+
+
+def _run(scenario, spec, method, trials, seed, o, g, linkage):
+    """The runs of :func:`procedure_mc`: per-trial mean squares (plain, controlled), the
+    error-free δp and the unit of each field [photo mm]."""
+    zero, op, xr, unit, kw = _configuration(method, o.sigma_mm, g["c"], g["p"], g["n"], o.sources)
+    kw = {**kw, "variant": LINKAGE_VARIANTS[linkage]}
+    options = {"instrument": o.instrument, "control_variate": o.control_variate}
+    options["passes"] = o.passes
+    if method == "conventional":
+        options["standard_points"] = o.standard_points
+        units = dict.fromkeys(("parallax", "slip", "plane", "book"), unit)
+    else:  # m_p = m_xy/√2 of the observed control parallaxes
+        units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
+        options["sigma_control"] = units["observed"]
+    spec_c = replace(spec, standard_points_c_mm=g["c"])
+    plain, controlled, d_zero = _mean_squares(
+        scenario, spec_c, method, seed, trials, zero, op, xr, g, o.grid, kw, options
+    )
+    return plain, controlled, d_zero, units
+
+
+def _extras(scenario, spec, method, o, g, plain, best, units):
+    """The method's own parts of the result: the three readings of a setup run with their
+    decompositions, or the conventional run's readings by datum and its options."""
+    if method == "conventional":
+        unit = units["plane"]
+        return {
+            "by_datum": {k: _rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
+            **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
+            "sources": o.sources,
+        }
+    fields = {}
+    for key, m, c in (
+        ("parallax", "setup", "exact"),
+        ("levelled", "setup_control", "exact"),
+        ("observed", "setup_control", "observed"),
+    ):
+        cf, h = _rms_ci(best[key], units[key])
+        ref = _formulas(m, scenario, spec, g, o.sources, c)["rigorous"]
+        ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
+        fields[key] = {
+            "coefficient": cf,
+            "ci": h,
+            "plain": _rms_ci(plain[key], units[key]),
+            "formula": ref,
+            "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
+        }
+    extra = {"fields": fields}
+    if method == "setup_control":
+        extra["control"] = o.control
+    return extra
 
 
 # --------------------------------------------------------------------------------------------

@@ -59,8 +59,9 @@ def eq_6_48(s: Setting) -> Entry:
         "m_p,во/m_xy, formula at 80 %",
         _residual_printed(s, "80"),
         RULE,
-        "integral of (6.47) gives (…)/(15c²) not /21; with (6.35) corrected 1/24 not 1/48; "
-        "rigorous adds the second photo and the exact ω residual",
+        "the integral of (6.47) with the printed (6.32), (6.35) gives (…)/(15c²), not /21 "
+        "(sympy, tests/reference); rigorous: the least-squares (6.35) (1/24 for 1/48), the "
+        "second photo and the exact ω residual",
     )
 
 
@@ -86,8 +87,11 @@ def eq_6_50(s: Setting) -> Entry:
         "80",
         "m_p,во/m_xy, 80 %",
         0.12,
-        RULE,
-        "from printed inputs: the printed (6.48) at 80 %; 0.12 repeats the 60 % value",
+        "not reproducible",
+        "tried: the printed (6.48) at 80 % (its /21 is not derived from (6.47), whose "
+        "integral gives /(15c²)) "
+        f"{_residual_printed(s, '80'):.4f}; the integral of (6.47) with the printed (6.32), "
+        f"(6.35) {_residual(s, '80', 'book'):.4f}; 0.12 equals the 60 % value (6.49)",
         from_printed_inputs=_residual_printed(s, "80"),
         digits=2,
         upstream="(6.48)",

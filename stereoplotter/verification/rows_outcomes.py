@@ -133,12 +133,14 @@ def eq_6_45(s: Setting) -> Entry:
             rg,
             s.conventional(s.a60, s.p60),
             RULE,
-            "from printed inputs: √(0.24² + (0.95 p/f)²) with the book's (6.51) and (6.54); the "
-            f"unrounded printed (5.54), (5.55) give {pr:.4f}; the correct integral of (5.53) "
-            "gives the book value",
-            from_printed_inputs=math.hypot(0.24, 0.95 * s.p60 / s.f),
+            "from printed inputs: the intermediates printed before (6.45), the printed (5.54) "
+            f"and (5.55) of chapter 5, unrounded: {pr:.4f}; the 0.24 and 0.95 the book prints "
+            "after it ((6.51), (6.54)) give "
+            f"√(0.24² + (0.95 p/f)²) = {math.hypot(0.24, 0.95 * s.p60 / s.f):.4f}; the "
+            "integral of (5.53) gives the book value",
+            from_printed_inputs=pr,
             digits=2,
-            upstream="(6.54)",
+            upstream="(5.55)",
         )
     )
 
@@ -154,10 +156,12 @@ def eq_6_46(s: Setting) -> Entry:
             rg,
             s.conventional(s.a80, s.p80),
             "not reproducible",
-            "tried: from printed inputs √(0.33² + (0.63 p/f)²) with (6.52), (6.55); printed "
-            f"(5.54)/(5.55) give {pr:.4f}; √(0.63² + 0.23²) = 0.671 (p/f dropped and the 60 % "
-            "m_p,в used) is the only reading found that gives 0.67",
-            from_printed_inputs=math.hypot(0.33, 0.63 * s.p80 / s.f),
+            "tried: from the intermediates printed before (6.46), the printed (5.54)/(5.55) "
+            f"unrounded, {pr:.4f}; with the 0.33 and 0.63 printed after it ((6.52), (6.55)) "
+            f"√(0.33² + (0.63 p/f)²) = {math.hypot(0.33, 0.63 * s.p80 / s.f):.4f}; "
+            "√(0.63² + 0.23²) = 0.671 (p/f dropped and the 60 % m_p,в used) is the only reading "
+            "found that gives 0.67",
+            from_printed_inputs=pr,
             digits=2,
         )
     )

@@ -25,6 +25,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
+from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
 from stereoplotter.verification.procedure_mc import procedure_mc
@@ -70,7 +71,10 @@ ROW_KEYS = (
     "mc_procedure_instrument_ci",
     "verdict",
     "note",
+    "decomposition",
 )
+#: The columns of the CSV (the nested ``decomposition`` block is in the JSON only).
+CSV_KEYS = tuple(k for k in ROW_KEYS if k != "decomposition")
 PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this quantity)"
 #: Procedure-MC configurations: name → :func:`procedure_mc` keyword arguments. "setup" is one
 #: run of the setup-data method with three readings (§27 task 1, and task 2: levelled on
@@ -206,13 +210,14 @@ def _job_at(i):
 
 
 def _job(args):
-    scenario, spec, config, trials, seed, instrument = args
+    scenario, spec, config, trials, seed, instrument, linkage = args
     return procedure_mc(
         scenario,
         spec=spec,
         trials=trials,
         seed=seed,
         instrument=instrument,
+        linkage=linkage,
         **PROCEDURE_CONFIGS[config],
     )
 
@@ -232,6 +237,7 @@ def run_procedure_mc(
     instrument=None,
     with_instrument=True,
     workers=2,
+    linkage=None,
 ):
     """:func:`start_procedure_mc` and wait for its result (arguments as there)."""
     return start_procedure_mc(
@@ -241,6 +247,7 @@ def run_procedure_mc(
         instrument=instrument,
         with_instrument=with_instrument,
         workers=workers,
+        linkage=linkage,
     ).result(progress)
 
 
@@ -252,6 +259,7 @@ def start_procedure_mc(
     instrument=None,
     with_instrument=True,
     workers=2,
+    linkage=None,
 ) -> PendingProcedureMC:
     """The procedure MC of :mod:`stereoplotter.verification.procedure_mc` for every
     configuration of :data:`PROCEDURE_CONFIGS` at each overlap slot, on the ideal instrument and
@@ -264,6 +272,9 @@ def start_procedure_mc(
     (:func:`stereoplotter.io.book_setting.book_scenarios`). ``instrument`` is the loaded
     :class:`~stereoplotter.spec.instrument_spec.InstrumentSpec` (the book's SC-1), required when a
     slot is run. ``workers``: processes (the runs are independent; 1 runs them here).
+    ``linkage``: the knob–decentration linkage of the runs, "drag" or "independent" (None: the
+    instrument's ``correction.decentration_linkage``;
+    :data:`~stereoplotter.verification.procedure_mc.LINKAGE_VARIANTS`).
 
     Returns
     -------
@@ -292,6 +303,7 @@ def start_procedure_mc(
             _trials_of(trials, c, inst),
             seed + 7 * (2 * names.index(c) + (s == "80")) + 1,
             inst,
+            linkage,
         )
         for s, c, inst in todo
     ]
@@ -407,6 +419,7 @@ def run_verification(
     procedure_trials: int | None = None,
     procedure_scenarios=None,
     instrument=None,
+    linkage=None,
 ) -> list[dict]:
     """Compute the verification table.
 
@@ -430,6 +443,8 @@ def run_verification(
         (:func:`stereoplotter.io.book_setting.book_scenarios`): this layer reads no files.
     instrument : InstrumentSpec, optional
         The instrument of the procedure MC (the book's SC-1); required with a scenario.
+    linkage : {"drag", "independent"}, optional
+        The knob–decentration linkage of the procedure MC (None: the instrument's).
 
     Returns
     -------
@@ -444,7 +459,7 @@ def run_verification(
     """
     g = _normalise_geometry(geometry)
     pending = start_procedure_mc(
-        procedure_trials, seed, procedure_scenarios, instrument=instrument
+        procedure_trials, seed, procedure_scenarios, instrument=instrument, linkage=linkage
     )  # in worker processes while the linear rows are computed here
     specs = _row_specs(g)
     rows = _rows(specs, trials, seed, progress, Setting.from_mapping(g).is_book)
@@ -465,6 +480,7 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
         if pr is not None:
             v, h, ref = procedure_value(pr, field, scaled)
             r["mc_procedure"], r["mc_procedure_ci"], r["mc_procedure_formula"] = v, h, ref
+            r["decomposition"] = row_decomposition(r["rigorous"], pr, field, scaled)
             r["note"] = r["note"].replace(
                 PROCEDURE_NOTE, _procedure_note(r["eq"], pr, field, scaled)
             )
@@ -479,6 +495,117 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
     return rows
 
 
+#: Mechanisms of decomposition steps, each shown by a switch run that removes it
+#: (``docs/accuracy.md``, "Decomposition of the procedure rows"), on the book's scenarios with
+#: the SC-1 and the dragging linkage only: step → text. Attached only to runs of that setting.
+MECHANISMS = {
+    "element_errors": "the knob–decentration linkage: switched to independent "
+    "(verify --linkage independent) the step changes sign (levelled rows −35 % → +8 %)",
+    "principal_distance": "the loops' stop when a check passes (f_пр is set by the stage-1 "
+    "L-check): with every loop at a fixed 2 or 4 passes the step is 0 within its CI",
+    "levelling_points": "the procedure's levelling points: re-levelled at Fig. 39's points "
+    "(procedure_mc levelling='book') the run is the formula there within its CI",
+    "procedure": "σ_q part: the scenario's tilted photos and relief (on vertical photos over "
+    "flat terrain the rest is 0 within its CI; 3, 6 or 10 passes do not change it)",
+}
+MECHANISM_SETTING = ({"pair60", "pair80"}, "sc1", "drag")
+
+
+def _mechanism(res: dict, step: str, field: str | None) -> str | None:
+    names, key, linkage = MECHANISM_SETTING
+    if step == "principal_distance" and field != "parallax":  # the switch run read δp only
+        return None
+    shown = res.get("scenario") in names and res.get("instrument_key") == key
+    if not shown or res.get("linkage") != linkage or res.get("instrument"):
+        return None
+    if step == "procedure" and res.get("sources") != "y_parallax":
+        return None
+    return MECHANISMS.get(step)
+
+
+def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -> dict:
+    """The ``decomposition`` block of a procedure row (:mod:`.decomposition`): the formula at
+    the book geometry (``book``, the row's rigorous column) → at the simulated geometry → the
+    first order of each trial's own errors → the procedure, each step with its CI; ``sum``
+    (the plain procedure value of the same trials), ``procedure`` (the row's value, control
+    variate) and ``closes`` (they agree within their CIs).
+
+    Setup rows carry every step. Conventional rows: geometry (Fig. 39's points at the simulated
+    geometry) → the levelling plane at the procedure's own levelling points (the rigorous
+    formula there, :func:`~.procedure_mc.levelling_formula`) → the procedure (the rest, with
+    the run's CI): their element errors are not decomposed.
+    """
+    k = res["f"] / res["p"] if scaled else 1.0
+    value, ci, _ = procedure_value(res, field, scaled)
+    if field is not None:
+        out = dc.at_book(res["fields"][field]["decomposition"], book, k)
+        plain = out["values"]["procedure"]
+    else:
+        formula = res["formula"]
+        plain = {"value": value, "ci": 0.0}  # the rest is taken at the row's own value
+        levels = {
+            "book_geometry": (book, 0.0),
+            "simulated_geometry": (formula["rigorous"] * k, 0.0),
+            "levelling_points": (formula["procedure"] * k, 0.0),
+            "procedure": (value, ci),
+        }
+        names = list(levels)
+        texts = (
+            dc.STEPS[0][1],
+            "→ the plane at the procedure's levelling points (the formula there)",
+            "→ the procedure (the rest: element errors not decomposed)",
+        )
+        steps = []
+        for a, b, text in zip(names[:-1], names[1:], texts, strict=True):
+            c = levels[b][0] - levels[a][0]
+            ref = book if a == "book_geometry" else levels["simulated_geometry"][0]
+            name = "geometry" if a == "book_geometry" else b
+            steps.append(
+                {"step": name, "text": text, "contribution": c, "ci": levels[b][1],
+                 "relative": c / ref}
+            )
+        out = {
+            "values": {n: {"value": v, "ci": h} for n, (v, h) in levels.items()},
+            "steps": steps,
+            "sum": book + sum(s["contribution"] for s in steps),
+        }
+    for step in out["steps"]:
+        step["mechanism"] = _mechanism(res, step["step"], field)
+    out["procedure"] = {"value": value, "ci": ci}
+    out["closes"] = bool(abs(out["sum"] - value) <= ci + plain["ci"])
+    out["linkage"] = res.get("linkage")
+    return out
+
+
+#: Rows that print a quantity already printed by an earlier row (M_p/m_p of the conventional
+#: method with m_q = m_p at 60 % and 80 %: (6.45) = (6.53) = (6.60), (6.46) = (6.61)): one
+#: verdict and one value from printed inputs per quantity, decided at its first print.
+SAME_QUANTITY = {"(6.60)": "(6.45)", "(6.61)": "(6.46)"}
+
+
+def _one_verdict_per_quantity(rows: list[dict]) -> list[dict]:
+    """The later print of a quantity (:data:`SAME_QUANTITY`) takes the first print's verdict
+    and value from printed inputs; its note keeps what its own print gave."""
+    by = {r["eq"]: r for r in rows}
+    for later, first in SAME_QUANTITY.items():
+        a, b = by.get(first), by.get(later)
+        if a is None or b is None:
+            continue
+        own = f"{b['verdict']}: {b['note']}"
+        if b["from_printed_inputs"] is not None:
+            own = f"from its own printed inputs {b['from_printed_inputs']:.4f}, {own}"
+        b["note"] = (
+            f"same quantity as {first} (one verdict, decided there); this row's own print "
+            f"{_fmt_printed(b['printed'])}, {own}"
+        )
+        b["verdict"], b["from_printed_inputs"] = a["verdict"], a["from_printed_inputs"]
+    return rows
+
+
+def _fmt_printed(v) -> str:
+    return "—" if v is None else f"{v:g}"
+
+
 def _rows(specs: list[Entry], trials, seed, progress, at_book: bool = True):
     rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(specs))]
     rows = []
@@ -486,7 +613,7 @@ def _rows(specs: list[Entry], trials, seed, progress, at_book: bool = True):
         rows.append(_row(e, trials, rngs[i], at_book))
         if progress is not None:
             progress(i + 1, len(specs), e.eq)
-    return rows
+    return _one_verdict_per_quantity(rows)
 
 
 def _verdict(e: Entry, at_book: bool) -> tuple[float | None, float | None, str, str]:
@@ -534,6 +661,7 @@ def _row(e: Entry, trials, rng, at_book: bool = True) -> dict:
         "mc_procedure_instrument_ci": None,
         "verdict": verdict,
         "note": note + "; " + PROCEDURE_NOTE,
+        "decomposition": None,
     }
 
 

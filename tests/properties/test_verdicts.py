@@ -20,13 +20,22 @@ def book():
 
 
 def test_from_printed_inputs_is_the_books_arithmetic(book):
-    # (6.45): √(0.24² + 0.95²) = √0.9601; (6.58): √((0.12·√2)² + 0.95²) = √(0.0288 + 0.9025)
-    assert book["(6.45)"]["from_printed_inputs"] == pytest.approx(0.979847, abs=1e-6)
+    # (6.45) from what the book prints BEFORE it: the printed (5.54) and (5.55) at a = 0, p = c
+    # = f: √(1/48 + 1/30) and √(11/12), in quadrature √(1/48 + 1/30 + 11/12) = 0.985309 (the
+    # 0.24, 0.95 of (6.51), (6.54) come after it); (6.60) is the same quantity: the same value
+    assert book["(6.45)"]["from_printed_inputs"] == pytest.approx(0.985309, abs=1e-6)
+    assert book["(6.60)"]["from_printed_inputs"] == pytest.approx(0.985309, abs=1e-6)
+    # (6.46) = (6.61) at a = p = 35, c = 70: (5.54) 1/48 + 29400/330750, (5.55)
+    # (p/f)²·52675/132300: √0.2092593 = 0.457449
+    assert book["(6.46)"]["from_printed_inputs"] == pytest.approx(0.457449, abs=1e-6)
+    assert book["(6.61)"]["from_printed_inputs"] == pytest.approx(0.457449, abs=1e-6)
+    # (6.58): √((0.12·√2)² + 0.95²) = √(0.0288 + 0.9025); (6.59): √(0.0288 + 0.315²)
     assert book["(6.58)"]["from_printed_inputs"] == pytest.approx(0.965039, abs=1e-6)
-    # (6.59): √(0.0288 + 0.315²); (6.60): √(0.23² + 0.95²); (6.61): √(0.33² + 0.315²)
     assert book["(6.59)"]["from_printed_inputs"] == pytest.approx(0.357805, abs=1e-6)
-    assert book["(6.60)"]["from_printed_inputs"] == pytest.approx(0.977446, abs=1e-6)
-    assert book["(6.61)"]["from_printed_inputs"] == pytest.approx(0.456207, abs=1e-6)
+    # the later prints keep their own arithmetic in the note: (6.60) √(0.23² + 0.95²),
+    # (6.61) √(0.33² + 0.315²)
+    assert "from its own printed inputs 0.9774" in book["(6.60)"]["note"]
+    assert "from its own printed inputs 0.4562" in book["(6.61)"]["note"]
     # (6.43)/(6.44): the printed (6.41)/(6.42) at n = 1.42:
     # √(124 + 10n²)/(6.7n), √(113 + 2.5n²)/(6.7n)
     n = 1.42
@@ -41,7 +50,7 @@ def test_from_printed_inputs_is_the_books_arithmetic(book):
 def test_truncation_claims_checked_both_ways(book):
     # 0.9650 rounds to 0.97 and truncates to 0.96: the printed 0.96 is a truncation
     assert "rounds to 0.97, truncates to 0.96: truncated" in book["(6.58)"]["note"]
-    assert "rounds to 0.98, truncates to 0.97: rounded" in book["(6.45)"]["note"]
+    assert "rounds to 0.99, truncates to 0.98: truncated" in book["(6.45)"]["note"]
     for r in book.values():
         if "truncat" in r["note"] or "rounded" in r["note"]:
             assert "rounds to" in r["note"] and "truncates to" in r["note"], r["eq"]
@@ -52,14 +61,16 @@ VERDICTS_AT_BOOK = {
     "(6.39)": "inherits error of (6.37)",
     "(6.43)": "inherits error of (6.37)",
     "(6.44)": "misprint",  # (6.42) gives 1.142
-    "(6.45)": "inherits error of (6.54)",  # 0.98 from 0.24, 0.95; (5.55) wrong at 60 %
+    "(6.45)": "inherits error of (5.55)",  # 0.98 from the printed (5.54), (5.55)
     "(6.46)": "not reproducible",
     "(6.51)": "misprint",  # (5.54) 0.2327, the book's own (6.56) 0.23
     "(6.54)": "inherits error of (5.55)",
     "(6.55)": "convention",  # (p/f)·m_p versus k·m_p
+    "(6.50)": "not reproducible",  # the /21 of (6.48) is not derived: no corrected value
     "(6.58)": "inherits error of (6.49), (6.54)",
-    "(6.60)": "not reproducible",
-    "(6.61)": "convention",
+    # one verdict per quantity: (6.60) = (6.45), (6.61) = (6.46)
+    "(6.60)": "inherits error of (5.55)",
+    "(6.61)": "not reproducible",
 }
 
 

@@ -13,7 +13,7 @@ import sympy as sp
 
 from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.accuracy import setup_accuracy as sa
-from stereoplotter.geometry import rotation  # noqa: F401  (the (3.22) convention lives there)
+from stereoplotter.geometry import rotation
 from stereoplotter.verification.verdicts import printed_agreement
 
 F, L, N, C = 70.0, 85.0, 1.42, 70.0  # §27 book geometry (OCR L3973-3990)
@@ -53,9 +53,15 @@ def test_628_printed_polynomial_is_the_integral_627():
 
 
 def test_654_alpha_term_of_554_is_the_integral_552():
+    # the α term of (5.54) is the integral (5.52) of (x² + xp − ac)²/(c²(a + c)²) over
+    # x_п ∈ [−c, 0] (sympy); the project's (5.54) is that term plus the ω term 1/48
     integral = sp.integrate((x**2 + x * p - a * c) ** 2, (x, -c, 0)) / c / c**2 / (a + c) ** 2
     printed = (6 * c**2 + 10 * a * c - 5 * p * (2 * a + c)) / (30 * (a + c) ** 2)
     assert sp.simplify((integral - printed).subs(p, c - a)) == 0
+    for aa, cc in ((0.0, 70.0), (35.0, 70.0), (20.0, 70.0)):
+        alpha_term = float(integral.subs({a: aa, c: cc, p: cc - aa}))
+        got = c5.relative_orientation_parallax_rms(aa, cc, cc - aa, 1.0, "book")
+        assert got**2 == pytest.approx(1 / 48 + alpha_term, rel=1e-12)
 
 
 def test_555_printed_is_not_the_integral_553():
@@ -72,6 +78,26 @@ def test_555_printed_is_not_the_integral_553():
     assert sp.expand(k - (7 * a**2 + 11 * c**2 - 4 * a * c)).subs(c, 2 * a) == 0
 
 
+def test_648_is_the_integral_of_647():
+    # ERRATA: (6.47) with the printed m_α = f√2/(n l²) (6.32) and m_ω = f√3/(2 l² n) (6.35),
+    # integrated over x_п ∈ [−c, 0], y ∈ [−c, c] (sympy): c²/(n l²)·√(1/48 + (6c² + 10ac −
+    # 5p(2a + c))/(15c²)) with p = c − a; the book prints /21 for /(15c²). The project's book
+    # mode is that integral.
+    ll, nn = sp.symbols("l n", positive=True)
+    m_a, m_w = f * sp.sqrt(2) / (nn * ll**2), f * sp.sqrt(3) / (2 * ll**2 * nn)
+    var = (y**2 * (x + c / 2) ** 2 * m_w**2 + (x - a) ** 2 * (x + c) ** 2 * m_a**2) / f**2
+    integral = _mean(var, -c, 0)
+    closed = (c**2 / (nn * ll**2)) ** 2 * (
+        sp.Rational(1, 48) + (6 * c**2 + 10 * a * c - 5 * p * (2 * a + c)) / (15 * c**2)
+    )
+    assert sp.simplify(sp.expand(integral - closed.subs(p, c - a))) == 0
+    for aa in (A60, A80, 20.0):
+        v = float(sp.sqrt(integral.subs({a: aa, c: C, f: F, ll: L, nn: N})))
+        assert sa.setup_relative_residual_rms(aa, C, F, L, N, 1.0, "book") == pytest.approx(
+            v, rel=1e-12
+        )
+
+
 def test_634_least_squares_of_633():
     # ERRATA: (6.34) prints Q_ωω = 3f²/(4l⁴n²); (6.33) solved by least squares gives 3f²/(2l⁴n²)
     Lq, n = sp.symbols("L n", positive=True)  # L = l²/f
@@ -79,6 +105,10 @@ def test_634_least_squares_of_633():
     Q = (A.T * A).inv() / n**2
     assert sp.simplify(Q[0, 0] - 1 / n**2) == 0
     assert sp.simplify(Q[1, 1] - sp.Rational(3, 2) / (Lq**2 * n**2)) == 0
+    # the project's m_ω: rigorous = √Q_ωω; the printed (6.35) is √(Q_ωω/2)
+    q11 = float(Q[1, 1].subs({Lq: L**2 / F, n: N}))
+    assert sa.sigma_omega_setup(F, L, N, 1.0, "rigorous") ** 2 == pytest.approx(q11, rel=1e-12)
+    assert sa.sigma_omega_setup(F, L, N, 1.0, "printed") ** 2 == pytest.approx(q11 / 2, rel=1e-12)
 
 
 def test_table19_by_least_squares():
@@ -100,12 +130,15 @@ def test_table20_by_least_squares():
 
 def test_620_omega_sign_against_322():
     # conventions.md §6 caveat 2: (6.20) prints −x_л y ω_л/f; (3.22) gives +x y ω/f for x⁰.
-    dp = sa.parallax_error_field_setup(50.0, 30.0, 70.0, 70.0, {"omega_left": 1e-4})
-    assert dp == pytest.approx(50.0 * 30.0 / 70.0 * 1e-4)
-    dp620 = sa.parallax_error_field_setup(
-        50.0, 30.0, 70.0, 70.0, {"omega_left": 1e-4}, omega_sign="6.20"
-    )
-    assert dp620 == pytest.approx(-dp)
+    # Independent: collinearity with the direction cosines of (2.50) (geometry.rotation). The
+    # point imaged at (x⁰, y⁰) on the vertical photo falls at x on the photo tilted by ω; the
+    # error field carries x⁰ − x (first order; ω = 1e-4 leaves a relative 1e-4 second order).
+    x0, y0, f, w = 50.0, 30.0, 70.0, 1e-4
+    m = rotation.rotation_matrix(0.0, w, 0.0)
+    d = np.array([x0, y0, -f]) @ m  # the ray in the tilted photo's axes
+    x_tilted = -f * d[0] / d[2]
+    dp = sa.parallax_error_field_setup(x0, y0, f, 70.0, {"omega_left": w})
+    assert dp == pytest.approx(x0 - x_tilted, rel=2e-3)
 
 
 # --- printed values --------------------------------------------------------------------------
@@ -258,8 +291,12 @@ def test_645_from_printed_chain_and_corrected():
 
 
 def test_646_not_reproducible():
+    # the printed (5.54) and (5.55) at a = p = 35, c = 70 by hand: 1/48 + 29400/330750 and
+    # (p/f)²·52675/132300, √0.2092593 = 0.457449; neither rounding nor truncation gives 0.67
     pr = sa.conventional_parallax_rms(A80, C, P80, F, 1.0, 1.0, "printed")
-    assert abs(pr - 0.67) > 0.2  # 0.457
+    assert pr == pytest.approx(math.sqrt(1 / 48 + 29400 / 330750 + 0.25 * 52675 / 132300))
+    assert pr == pytest.approx(0.457449, abs=5e-7)
+    assert _how(0.67, pr) is None
 
 
 def test_649_650_651_552():
@@ -267,12 +304,16 @@ def test_649_650_651_552():
     assert sa.setup_relative_residual_rms_printed(A60, C, L, N, 1.0) == pytest.approx(
         0.12496, abs=5e-6
     )
-    # ERRATA: (6.48) integrated correctly (…/(15c²), 1/24): (6.49) is 0.157, not 0.12
+    # ERRATA: (6.48) integrated: c²/(n l²)·√(1/48 + 1/15) = 0.141278 at 60 % and
+    # c²/(n l²)·√(1/48 + 0.4) = 0.309828 at 80 % (test_648_is_the_integral_of_647); the printed
+    # 0.12 of (6.50) is neither this nor the printed (6.48) (0.2644): not reproducible
     assert sa.setup_relative_residual_rms(A60, C, F, L, N, 1.0, "book") == pytest.approx(
-        0.1572, abs=5e-5
+        0.141278, abs=5e-6
     )
-    # (6.50) 0.12 is not what the printed (6.48) gives at 80 % (0.264)
-    assert abs(sa.setup_relative_residual_rms_printed(A80, C, L, N, 1.0) - 0.12) > 0.1
+    assert sa.setup_relative_residual_rms(A80, C, F, L, N, 1.0, "book") == pytest.approx(
+        0.309828, abs=5e-6
+    )
+    assert _how(0.12, sa.setup_relative_residual_rms_printed(A80, C, L, N, 1.0)) is None
     # ERRATA: (6.51) prints 0.24; (5.54) gives 0.2327 and (6.56) prints 0.23
     ro60 = c5.relative_orientation_parallax_rms(A60, C, P60, 1.0)
     assert abs(ro60 - 0.23) < 0.005
@@ -303,8 +344,6 @@ def test_557_558():
 
 
 def test_table18_row_5556_f70():
-    # Table 18 (OCR L3111), P_x = 55.6 %, a = 0, f = 70, m_q = 0.015, b = 80, c = 80: 23.9", 29.3"
+    # Table 18 (OCR L3111), P_x = 55.6 %, f = 70, m_q = 0.015, c = 80: m_ω 29.3″ (half a unit)
     rho = 648000 / math.pi
-    m_a = 70 * 0.015 / (80 * 80 * R2) * rho
-    assert abs(m_a - 23.9) < 0.05
     assert abs(math.sqrt(c5.cofactor_omega_relative(70.0, 80.0)) * 0.015 * rho - 29.3) < 0.05
