@@ -56,7 +56,6 @@ from stereoplotter.setup.table24 import (
     X_MARK_NAME,
     BlockResult,
     Refusal,
-    candidates_of,
     compute_table24,
     instrument_frames,
 )
@@ -552,7 +551,6 @@ def _finish(prep: _Prepared, table: BlockResult) -> SetupSheet:
         corners=_corners(prep.similarity, prep.corners_gk, mg, n_left),
         readings=(),
         tolerances=tolerances,
-        candidates=candidates_of(table, 0),
         assumed=assumed,
         options=options,
         depth_range_used_mm=tuple(float(v) for v in table.depth_range_mm[0]),
