@@ -417,6 +417,7 @@ class _Prepared:
     marks_mm: NDArray  # (2, 4, 2)
     centres_m: NDArray  # (2, 3)
     rotations: NDArray  # (2, 3, 3)
+    frames: tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]]  # of a block of one
     points: tuple[Point, ...]
     points_m: NDArray  # (p, 3) in the instrument frame
     heights: tuple[Point, ...]
@@ -453,7 +454,8 @@ def _prepare(
     (``grids``: the candidates already built, by map scale, shared by the pairs of a call)."""
     centres = np.asarray(centres_m, float)[None]  # (1, 2, 3)
     rots = np.asarray(rotations, float)[None]  # (1, 2, 3, 3)
-    theta = float(instrument_frames(centres, rots)[0][0])
+    frames = instrument_frames(centres, rots)  # once: Table 24 takes it from here
+    theta = float(frames[0][0])
     points_m = instrument_frame_m(
         np.array([p.local_m for p in points], float).reshape(-1, 3), centres[0, 0], theta
     )
@@ -482,6 +484,7 @@ def _prepare(
         marks_mm=np.asarray(marks_mm, float),
         centres_m=centres[0],
         rotations=rots[0],
+        frames=frames,
         points=tuple(points),
         points_m=points_m,
         heights=tuple(
@@ -523,6 +526,11 @@ def _table24(pairs: Sequence[_Prepared], name: str) -> BlockResult:
         model_names=tuple(p.name for p in pairs),
         height_point_ids=tuple(tuple(h.id for h in p.heights) for p in pairs),
         name=name,
+        frames=(
+            np.concatenate([p.frames[0] for p in pairs]),
+            np.concatenate([p.frames[1] for p in pairs]),
+            tuple(np.concatenate([p.frames[2][j] for p in pairs]) for j in range(3)),
+        ),
     )
 
 
