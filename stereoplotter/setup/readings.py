@@ -24,7 +24,7 @@ def _signed(value: float, digits: int = 3) -> str:
     """``+ 1.234`` or ``− 1.234`` [as given]; a value that rounds to zero is ``+ 0.000`` (never
     ``+ -0.000`` or ``− 0.000``)."""
     text = f"{abs(value):.{digits}f}"
-    negative = value < 0 and float(text) != 0.0
+    negative = value < 0 and text.strip("0.") != ""  # not a value that rounds to zero
     return f"{'−' if negative else '+'} {text}"
 
 
