@@ -38,8 +38,10 @@ def font_path(style: str = "") -> str:
 
 
 #: Advance widths of texts, by (font file, text, size): a pure function of the font file, kept
-#: for the process (fpdf2 sums the glyph widths of every fragment again at each line break).
+#: for the process (fpdf2 sums the glyph widths of every fragment again at each line break);
+#: emptied when it holds :data:`_WIDTHS_MAX` entries (a memory bound for a job of many forms).
 _WIDTHS: dict[tuple[str, str, float], tuple[int, float]] = {}
+_WIDTHS_MAX = 200_000
 
 
 class _RememberedWidths(TTFFont):
@@ -56,6 +58,8 @@ class _RememberedWidths(TTFFont):
         key = (str(self.ttffile), text, font_size_pt)
         width = _WIDTHS.get(key)
         if width is None:
+            if len(_WIDTHS) >= _WIDTHS_MAX:
+                _WIDTHS.clear()
             width = _WIDTHS[key] = super().get_text_width(text, font_size_pt, None)
         elif font_size_pt > self.biggest_size_pt:
             self.biggest_size_pt = font_size_pt
