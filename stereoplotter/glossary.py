@@ -380,7 +380,7 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
      "пропорционально"),
     (f"fuse on {_ID.format('p')} \\({_N.format('n')} times, mean\\), slip the height scale to "
      f"H = {_N.format('h')} m",
-     "навести марку на {p} ({n} раз, среднее), сдвинуть шкалу высот на H = {h} m"),
+     "навести марку на {p} ({n}-кратно, среднее), сдвинуть шкалу высот на H = {h} m"),
     (f"fuse on {_ID.format('p')}, slip the height scale to H = {_N.format('h')} m",
      "навести марку на {p}, сдвинуть шкалу высот на H = {h} m"),
     (f"common tilt (?P<a>Δ[αω]) = {_N.format('v')} mrad: turn {_ID.format('c')}",
@@ -389,7 +389,7 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
      "горизонтирование: опорная точка {p}, ошибка высоты относительно точки {q}"),
     (f"control point {_ID.format('p')}: fuse, read the height \\({_N.format('n')} times, "
      "mean\\)",
-     "опорная точка {p}: навести марку, отсчитать высоту ({n} раз, среднее)"),
+     "опорная точка {p}: навести марку, отсчитать высоту ({n}-кратно, среднее)"),
     (f"control point {_ID.format('p')}: fuse, read the height",
      "опорная точка {p}: навести марку, отсчитать высоту"),
     # the sheet: corners and plan control
@@ -448,7 +448,7 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
      "опорная точка {p}: навести марку, отсчитать высоту, сравнить с известной высотой {h} m"),
     (f"control point {_ID.format('p')}: fuse, read the height \\({_N.format('n')} times, mean\\), "
      f"against the point's known height {_N.format('h')} m",
-     "опорная точка {p}: навести марку, отсчитать высоту ({n} раз, среднее), сравнить с "
+     "опорная точка {p}: навести марку, отсчитать высоту ({n}-кратно, среднее), сравнить с "
      "известной высотой {h} m"),
     (f"scale: fuse on {_ID.format('a')} and {_ID.format('b')}, counter distance against the "
      f"sheet's {_N.format('d')} mm \\(6.7\\); turn b_x in proportion",
@@ -456,7 +456,7 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
      "изменить b_x пропорционально"),
     (f"fuse on {_ID.format('p')} \\({_N.format('n')} times\\), slip the height scale to "
      f"H = {_N.format('h')} m",
-     "навести марку на {p} ({n} раз), сдвинуть шкалу высот на H = {h} m"),
+     "навести марку на {p} ({n}-кратно), сдвинуть шкалу высот на H = {h} m"),
     (f"level: common tilt (?P<a>Δφ_[ao]) = {_N.format('v')} mrad, turn {_ID.format('c')}",
      "горизонтирование: общий наклон {a} = {v} мрад, вращать {c}"),
     # the correction mechanisms' names (gimbal, lens shift, plates), inside the steps above
