@@ -9,9 +9,10 @@ languages are given for every key), never a silent fallback.
 
 from __future__ import annotations
 
+import re
 from types import MappingProxyType
 
-__all__ = ["LANGUAGES", "TERMS", "check_language", "term"]
+__all__ = ["LANGUAGES", "PHRASES", "TERMS", "check_language", "term", "translate"]
 
 #: The languages of the outputs (``--lang``).
 LANGUAGES = ("ru", "en")
@@ -294,6 +295,7 @@ _TABLE: dict[str, tuple[str, str]] = {
     "cs_after": ("after", "после"),
     "cs_no_remedy": ("(no remedy in this practice)", "(в этой практике исправлений нет)"),
     "cs_iteration": ("iteration", "итерация"),
+    "tr_remedy": ("REMEDY", "ИСПРАВЛЕНИЕ"),
     "cs_default_advice": (
         "repeat the step and its check; look for a sheet or reading error before going on",
         "повторить действие и его контроль; прежде чем продолжать, искать ошибку "
@@ -325,6 +327,215 @@ _TABLE: dict[str, tuple[str, str]] = {
 TERMS = MappingProxyType(
     {key: MappingProxyType({"en": en, "ru": ru}) for key, (en, ru) in _TABLE.items()}
 )
+
+
+# The procedure's record texts (a transcript's steps, equations, remedies and checks), by their
+# templates: (English pattern, Russian with the pattern's {groups}), tried in order, the whole
+# text matched. A declarative table; the procedure writes English, the transcript is rendered in
+# Russian through it (``report/simulation.py``). A text no pattern matches stays English: the
+# tests look for such text in the transcripts they render.
+_N = r"(?P<{}>[-+]?[\d.]+)"
+_ID = r"(?P<{}>[^\s,:;()]+)"
+_PHRASE_TABLE: tuple[tuple[str, str], ...] = (
+    # stage 1 / C1: the instrument's setting
+    ("set the instrument principal distance f_пр", "установить главное расстояние прибора f_пр"),
+    ("turn the left cassette: fiducial lines parallel to the axes",
+     "повернуть левую кассету: координатные метки параллельно осям"),
+    ("turn the right cassette: fiducial lines parallel to the axes",
+     "повернуть правую кассету: координатные метки параллельно осям"),
+    ("correction mechanisms and decentrations to their zero places",
+     "коррекционные механизмы и децентрации — в нулевые положения"),
+    ("base carriage: b_x of the sheet", "базисная каретка: b_x по установочным данным"),
+    ("base carriage: O_by = MO_by \\+ b_y", "базисная каретка: O_by = MO_by + b_y"),
+    (f"b_z′ = {_N.format('v')} \\(found by the levelling, {_ID.format('s')}\\)",
+     "b_z′ = {v} (находится горизонтированием, {s})"),
+    ("lower the carriage to D = n_л·f_пр", "опустить каретку до D = n_л·f_пр"),
+    ("MO_by: right mark on the right cassette centre \\(by turning b_y\\)",
+     "MO_by: правая марка на центр правой кассеты (вращением b_y)"),
+    ("left mark on the left cassette centre → MO_X", "левая марка на центр левой кассеты → MO_X"),
+    ("… and MO_Y", "… и MO_Y"),
+    # relative orientation: the six standard points
+    (f"standard point {_ID.format('p')}: clear the y-parallax with {_ID.format('c')} "
+     f"\\((?P<s>[^)]*)\\) and over-correct by {_N.format('v')} of the turn",
+     "стандартная точка {p}: устранить поперечный параллакс элементом {c} ({s}) с "
+     "перекоррекцией на {v} поворота"),
+    (f"standard point {_ID.format('p')}: clear the y-parallax with {_ID.format('c')} "
+     "\\((?P<s>[^)]*)\\)",
+     "стандартная точка {p}: устранить поперечный параллакс элементом {c} ({s})"),
+    (f"standard point {_ID.format('p')}: fuse, judge the y-parallax",
+     "стандартная точка {p}: навести марку, оценить поперечный параллакс"),
+    (f"pass {_N.format('k')}: RMS of the six looks {_N.format('v')} µm — first pass: orient again",
+     "проход {k}: СКО по шести точкам {v} µm — первый проход: ориентировать ещё раз"),
+    (f"pass {_N.format('k')}: RMS of the six looks {_N.format('v')} µm — ratio {_N.format('r')} "
+     f"> {_N.format('l')}: no longer decreasing, stop",
+     "проход {k}: СКО по шести точкам {v} µm — отношение {r} > {l}: больше не уменьшается, "
+     "конец"),
+    (f"pass {_N.format('k')}: RMS of the six looks {_N.format('v')} µm — ratio {_N.format('r')} "
+     f"≤ {_N.format('l')}: still decreasing",
+     "проход {k}: СКО по шести точкам {v} µm — отношение {r} ≤ {l}: ещё уменьшается"),
+    # scaling and levelling
+    (f"scale: fuse on {_ID.format('a')} and {_ID.format('b')}, model distance against "
+     f"{_N.format('d')} mm; turn b_x in proportion",
+     "масштаб: навести марку на {a} и {b}, расстояние в модели против {d} mm; изменить b_x "
+     "пропорционально"),
+    (f"fuse on {_ID.format('p')} \\({_N.format('n')} times, mean\\), slip the height scale to "
+     f"H = {_N.format('h')} m",
+     "навести марку на {p} ({n}-кратно, среднее), сдвинуть шкалу высот на H = {h} m"),
+    (f"fuse on {_ID.format('p')}, slip the height scale to H = {_N.format('h')} m",
+     "навести марку на {p}, сдвинуть шкалу высот на H = {h} m"),
+    (f"common tilt (?P<a>Δ[αω]) = {_N.format('v')} mrad: turn {_ID.format('c')}",
+     "общий наклон {a} = {v} мрад: вращать {c}"),
+    (f"level: control point {_ID.format('p')}, height error against point {_ID.format('q')}",
+     "горизонтирование: опорная точка {p}, ошибка высоты относительно точки {q}"),
+    (f"control point {_ID.format('p')}: fuse, read the height \\({_N.format('n')} times, "
+     "mean\\)",
+     "опорная точка {p}: навести марку, отсчитать высоту ({n}-кратно, среднее)"),
+    (f"control point {_ID.format('p')}: fuse, read the height",
+     "опорная точка {p}: навести марку, отсчитать высоту"),
+    # the sheet: corners and plan control
+    (f"counters to corner {_ID.format('a')}, pin the sheet's corner {_ID.format('b')} under the "
+     "needle",
+     "счётчики на угол {a}, закрепить угол {b} листа под иглой"),
+    (f"counters to corner {_ID.format('a')}, rotate the sheet about corner {_ID.format('b')} "
+     f"until the needle meets corner {_ID.format('c')}",
+     "счётчики на угол {a}, повернуть лист вокруг угла {b} до совпадения иглы с углом {c}"),
+    (f"counters to corner {_ID.format('a')}: misclosure of needle and corner {_ID.format('b')}",
+     "счётчики на угол {a}: несовпадение иглы и угла {b}"),
+    (f"plan control point {_ID.format('p')}: fuse, needle against the plotted point",
+     "плановая опорная точка {p}: навести марку, игла против нанесённой точки"),
+    # the setup-data method (§26): stages 1–3 from the sheet
+    ("base carriage: O_bx = MO_bx \\+ b_x", "базисная каретка: O_bx = MO_bx + b_x"),
+    ("lower the carriage to O_Z = n_л·f_пр \\(absolute height counter\\)",
+     "опустить каретку до O_Z = n_л·f_пр (счётчик абсолютных высот)"),
+    (f"measure L′_(?P<s>[лп]) \\(marks 3, 4\\), compare with L_(?P<t>[лп]) = {_N.format('v')} mm",
+     "измерить L′_{s} (метки 3, 4), сравнить с L_{t} = {v} mm"),
+    ("ΔZ would take the carriage past its bottom stop \\(D_max\\): n = D/f_пр reached by f_пр "
+     "instead, f′_пр = f_пр·D/\\(D \\+ ΔD\\)",
+     "ΔZ вывел бы каретку за нижний упор (D_max): n = D/f_пр достигается изменением f_пр, "
+     "f′_пр = f_пр·D/(D + ΔD)"),
+    ("Δb_z \\(6.10\\), ratio form with D_п = D \\+ b_z and L′_п \\(decision D9\\): "
+     "O′_bz = O_bz \\+ Δb_z",
+     "Δb_z (6.10) в форме отношения с D_п = D + b_z и L′_п (решение D9): O′_bz = O_bz + Δb_z"),
+    (f"ΔZ = {_N.format('v')} m \\(6.9\\): lower the carriage, O′_Z = O_Z \\+ ΔZ",
+     "ΔZ = {v} m (6.9): опустить каретку, O′_Z = O_Z + ΔZ"),
+    ("record MO_Z on the height scale", "записать MO_Z по шкале высот"),
+    ("record MO_bz = \\(b_z reading\\) − b_z′", "записать MO_bz = (отсчёт b_z) − b_z′"),
+    ("right mark on the right cassette centre → MO_X,п",
+     "правая марка на центр правой кассеты → MO_X,п"),
+    ("… and MO_Y,п", "… и MO_Y,п"),
+    (f"(?P<p>left|right) photo: counter (?P<a>[XY]) at (?P<f>[^=]+) = {_N.format('v')} mm, turn "
+     f"(?P<d>.+) \\({_ID.format('c')}\\) \\((?P<u>tan [αω])\\) until mark (?P<m>\\d) is "
+     "under the measuring mark",
+     "{p} снимок: счётчик {a} на {f} = {v} mm, вращать {d} ({c}) ({u}) до совмещения метки {m} "
+     "с измерительной маркой"),
+    ("(?P<p>left|right) photo: check mark 4 at (?P<f>.+)", "{p} снимок: проверить метку 4 при {f}"),
+    (f"decentration (?P<d>.+) \\({_ID.format('c')}\\) = (?P<f>[^(]+) \\(place of zero "
+     f"(?P<z>MO_d[xy]) = {_N.format('v')} mm\\)",
+     "децентрация {d} ({c}) = {f} (место нуля {z} = {v} mm)"),
+    (f"standard point {_ID.format('p')}: clear the y-parallax with (?P<c>κ_[лп])",
+     "стандартная точка {p}: устранить поперечный параллакс вращением {c}"),
+    (f"residual y-parallax at standard point {_ID.format('p')}",
+     "остаточный поперечный параллакс в стандартной точке {p}"),
+    (f"turn {_ID.format('c')} by the least-squares clearing of the six q seen",
+     "вращать {c} по уравниванию шести наблюдённых q (метод наименьших квадратов)"),
+    (f"height scale to O_Z{_ID.format('n')} for control point {_ID.format('p')}",
+     "шкалу высот на O_Z{n} для опорной точки {p}"),
+    (f"fuse the mark on point {_ID.format('p')} by turning b_x",
+     "совместить марку с точкой {p} вращением b_x"),
+    (f"slip the height scale to H = {_N.format('h')} m", "сдвинуть шкалу высот на H = {h} m"),
+    (f"control point {_ID.format('p')}: fuse, read the height, against the point's known height "
+     f"{_N.format('h')} m",
+     "опорная точка {p}: навести марку, отсчитать высоту, сравнить с известной высотой {h} m"),
+    (f"control point {_ID.format('p')}: fuse, read the height \\({_N.format('n')} times, mean\\), "
+     f"against the point's known height {_N.format('h')} m",
+     "опорная точка {p}: навести марку, отсчитать высоту ({n}-кратно, среднее), сравнить с "
+     "известной высотой {h} m"),
+    (f"scale: fuse on {_ID.format('a')} and {_ID.format('b')}, counter distance against the "
+     f"sheet's {_N.format('d')} mm \\(6.7\\); turn b_x in proportion",
+     "масштаб: навести марку на {a} и {b}, расстояние по счётчикам против {d} mm по листу (6.7); "
+     "изменить b_x пропорционально"),
+    (f"fuse on {_ID.format('p')} \\({_N.format('n')} times\\), slip the height scale to "
+     f"H = {_N.format('h')} m",
+     "навести марку на {p} ({n}-кратно), сдвинуть шкалу высот на H = {h} m"),
+    (f"level: common tilt (?P<a>Δφ_[ao]) = {_N.format('v')} mrad, turn {_ID.format('c')}",
+     "горизонтирование: общий наклон {a} = {v} мрад, вращать {c}"),
+    # the correction mechanisms' names (gimbal, lens shift, plates), inside the steps above
+    ("photo-carrier tilt (?P<a>[αω]) \\(gimbal\\)",
+     "наклон снимкодержателя {a} (карданный подвес)"),
+    ("photo-carrier decentration (?P<a>[xy])", "децентрация снимкодержателя {a}"),
+    ("lens-shift mechanism (?P<a>δ_[αω])", "механизм смещения объектива {a}"),
+    ("photo-carriage decentration (?P<a>[xy])", "децентрация снимкодержателя {a}"),
+    ("correction plane (?P<a>k[αω]) \\(follower\\)", "коррекционная плоскость {a} (копир)"),
+    ("photo decentration (?P<a>[xy]) \\(from the plane settings\\)",
+     "децентрация снимка {a} (по установке плоскостей)"),
+    ("left", "левый"),
+    ("right", "правый"),
+    # the equation or decision behind a record
+    ("item 1", "п. 1"),
+    (f"stage {_ID.format('s')}", "этап {s}"),
+    (f"decision {_ID.format('d')}", "решение {d}"),
+    ("scale by b_x", "масштаб по b_x"),
+    ("assumption", "допущение"),
+    ("levelling \\(assumption\\)", "горизонтирование (допущение)"),
+    ("stopping rule", "правило остановки"),
+    ("≤ ¼ mark", "≤ ¼ марки"),
+    ("\\(6.5\\), decision D5", "(6.5), решение D5"),
+    ("f′·tan (?P<a>[αω]) \\(§2.4\\)", "f′·tan {a} (§2.4)"),
+    ("§26 stages 2, 3: κ along the initial direction; refine k_ω",
+     "§26, этапы 2, 3: κ по начальному направлению; уточнить k_ω"),
+    ("§26 stage 3: scaling refined \\(b_x\\)", "§26, этап 3: уточнение масштаба (b_x)"),
+    ("levelling on control \\(assumption, q-neutral common tilt\\)",
+     "горизонтирование по опорным точкам (допущение: общий наклон, не меняющий q)"),
+    # remedies and checks (the closing summary)
+    ("(?P<r>C?R\\d+) (?P<b>.+)", "{r} {b}"),
+    ("read the control heights as the mean of several fusings",
+     "отсчитывать высоты опорных точек как среднее нескольких наведений"),
+    ("refine the relative orientation only where q fails, then check the heights again",
+     "уточнить взаимное ориентирование только там, где q вне допуска, затем снова проверить "
+     "высоты"),
+    ("refine the relative orientation", "уточнить взаимное ориентирование"),
+    ("refine scaling and levelling on control",
+     "уточнить масштаб и горизонтирование по опорным точкам"),
+    ("\\|L − L′\\|", "|L − L′|"),
+    (f"mark {_ID.format('m')}", "метка {m}"),
+    (f"residual y-parallax \\({_N.format('n')} points\\)",
+     "остаточный поперечный параллакс ({n} точек)"),
+    ("levelling points \\(against the first\\)", "точки горизонтирования (относительно первой)"),
+    ("control heights", "высоты опорных точек"),
+    (f"corner {_ID.format('c')}", "угол {c}"),
+    ("plan control points \\(needle − plotted\\)", "плановые опорные точки (игла − нанесённая)"),
+)  # fmt: skip
+
+#: The record texts' templates, compiled: (pattern, Russian).
+PHRASES: tuple[tuple[re.Pattern[str], str], ...] = tuple(
+    (re.compile(pattern), russian) for pattern, russian in _PHRASE_TABLE
+)
+
+
+def translate(text: str, lang: str) -> str:
+    """A record text of the procedure (a step, an equation, a remedy, a check) in ``lang``: the
+    first template of :data:`PHRASES` matching the whole text, filled with its values (each
+    value translated in turn: a mechanism's name, "left"); a
+    ``"stage N: …"`` prefix is translated in front of the rest. English, or a text no template
+    matches, is returned as it is.
+
+    >>> translate("standard point 3: fuse, judge the y-parallax", "ru")
+    'стандартная точка 3: навести марку, оценить поперечный параллакс'
+    >>> translate("stage 5: corner 4", "ru")
+    'этап 5: угол 4'
+    """
+    if check_language(lang) == "en" or not text:
+        return text
+    for pattern, russian in PHRASES:
+        m = pattern.fullmatch(text)
+        if m:
+            return russian.format(**{k: translate(v, lang) for k, v in m.groupdict().items()})
+    head, sep, rest = text.partition(": ")
+    if sep and rest:
+        first, second = translate(head, lang), translate(rest, lang)
+        if (first, second) != (head, rest):
+            return f"{first}: {second}"
+    return text
 
 
 def check_language(lang: str) -> str:

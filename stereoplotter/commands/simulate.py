@@ -94,8 +94,8 @@ def add_arguments(sub: Any) -> None:
         "--lang",
         choices=("ru", "en"),
         default="en",
-        help="language of transcript.txt: ru (the book's terms; the records' own text stays "
-        "English) or en (default)",
+        help="language of transcript.txt: ru (the book's terms, every record rendered through "
+        "the glossary) or en (default)",
     )
     p.set_defaults(func=run)
 

@@ -153,14 +153,13 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _production_yaml(block: Any, orientations: Any, instrument: str, date: str) -> str:
+def _production(block: Any, orientations: Any, instrument: str, date: str) -> dict[str, Any]:
     """The ``production:`` section: instrument, date and the 1:10 000 sheets of the pairs."""
+    # imported here: the CLI starts fast (pyproj and pydantic load only when a command runs)
+    from stereoplotter.io.block_measurements_file import production_data
     from stereoplotter.io.triangulated_job import sheets_of_pairs
 
-    sheets = sheets_of_pairs(block, orientations)
-    lines = ["production:", f"  instrument: {instrument}", f'  date: "{date}"', "  map_sheets:"]
-    lines += [f"    - {{nomenclature: {name}, scale: 10000}}" for name in sheets]
-    return "\n".join(lines) + "\n"
+    return production_data(instrument, date, sheets_of_pairs(block, orientations))
 
 
 def run_synth(args: argparse.Namespace) -> int:
@@ -192,12 +191,12 @@ def run_synth(args: argparse.Namespace) -> int:
     rng = np.random.default_rng([args.seed, key_code("block synth")])
     block, truth = synthesize_block(spec, rng)
     out = Path(args.output)
-    production = _production_yaml(block, truth.orientations, args.instrument, args.date)
+    production = _production(block, truth.orientations, args.instrument, args.date)
     description = (
         f"Synthetic block of {spec.strips} × {spec.photos_per_strip} photos made by stereoplotter "
         f"block synth --seed {args.seed} (the truth in truth.csv)."
     )
-    write_block_measurements(out, block, description=description, production_yaml=production)
+    write_block_measurements(out, block, description=description, production=production)
     rows = ["photo,alpha_deg,omega_deg,kappa_deg,X_m,Y_m,Z_m"]
     for p, o in zip(block.photos, truth.orientations, strict=True):
         a, w, k = (math.degrees(float(v)) for v in o[:3])

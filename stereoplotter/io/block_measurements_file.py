@@ -41,6 +41,7 @@ from stereoplotter.io.job_file import Certificate, NamedSheet, _check_date
 from stereoplotter.io.scenario_file import Origin, camera_from_model
 from stereoplotter.io.validation import FileModel, _fail, number, one_of, sequence, text, validate
 from stereoplotter.io.yaml_input import load_yaml_mapping
+from stereoplotter.io.yaml_output import Flow, Folded, Quoted, yaml_document
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.scenario.model import Camera, Frame
 from stereoplotter.triangulation.block import Block, CataloguePoint, Sigmas
@@ -49,10 +50,11 @@ __all__ = [
     "FORMAT",
     "BlockMeasurementsFile",
     "Production",
-    "camera_yaml",
+    "camera_data",
     "load_block_measurements",
+    "origin_data",
+    "production_data",
     "write_block_measurements",
-    "yaml_flow",
     "yaml_number",
 ]
 
@@ -290,23 +292,32 @@ def yaml_number(value: float) -> str:
     return f"{mantissa}.0e{exponent}" if exponent and "." not in mantissa else text
 
 
-def yaml_flow(**values: float) -> str:
-    """A YAML flow mapping of numbers: ``{key: value, …}``."""
-    return "{" + ", ".join(f"{k}: {yaml_number(v)}" for k, v in values.items()) + "}"
-
-
-def camera_yaml(cam: Camera) -> list[str]:
-    """The ``camera:`` section of a certificate with marks on the axes (lines of YAML)."""
+def camera_data(cam: Camera) -> dict[str, Any]:
+    """The ``camera:`` section of a certificate with marks on the axes (data for
+    :func:`~stereoplotter.io.yaml_output.yaml_document`)."""
     spans = [float(v) for v in fiducial_spans_mm(cam.fiducials_mm)]
-    x0, y0 = (yaml_number(v) for v in cam.principal_point_mm)
-    return [
-        "camera:",
-        f"  focal_length_mm: {yaml_number(cam.focal_length_mm)}",
-        f"  principal_point_mm: [{x0}, {y0}]",
-        f"  format_mm: {yaml_number(cam.format_mm)}",
-        "  fiducials:",
-        f'    distances_mm: {{"1-2": {yaml_number(spans[0])}, "3-4": {yaml_number(spans[1])}}}',
-    ]
+    return {
+        "focal_length_mm": float(cam.focal_length_mm),
+        "principal_point_mm": Flow([float(v) for v in cam.principal_point_mm]),
+        "format_mm": float(cam.format_mm),
+        "fiducials": {"distances_mm": Flow({Quoted("1-2"): spans[0], Quoted("3-4"): spans[1]})},
+    }
+
+
+def origin_data(origin_sk42_m: tuple[float, float, float]) -> Flow:
+    """The SK-42 origin of the local system of §10 as a one-line mapping."""
+    north, east, height = (float(v) for v in origin_sk42_m)
+    return Flow({"north_m": north, "east_m": east, "height_m": height})
+
+
+def production_data(instrument: str, date: str, map_sheets: list[str]) -> dict[str, Any]:
+    """The ``production:`` section of a block file: the instrument, the date (YYYY-MM-DD) and
+    the 1:10 000 sheets by nomenclature."""
+    return {
+        "instrument": instrument,
+        "date": Quoted(date),
+        "map_sheets": [Flow({"nomenclature": name, "scale": 10000}) for name in map_sheets],
+    }
 
 
 def _csv_text(header: tuple[str, ...], rows: list[tuple[Any, ...]]) -> str:
@@ -317,22 +328,18 @@ def _csv_text(header: tuple[str, ...], rows: list[tuple[Any, ...]]) -> str:
     return buf.getvalue()
 
 
-def _yaml_id_list(ids: tuple[str, ...]) -> str:
-    return (
-        "[" + ", ".join('"' + p.replace("\\", "\\\\").replace('"', '\\"') + '"' for p in ids) + "]"
-    )
-
-
 def write_block_measurements(
     folder: str | os.PathLike[str],
     block: Block,
     *,
     description: str = "",
-    production_yaml: str = "",
+    production: dict[str, Any] | None = None,
 ) -> list[Path]:
     """Write ``block.yaml``, ``measurements.csv`` and ``control.csv`` into ``folder`` (comparator
-    readings to 0.1 µm, catalogue to 1 mm); ``production_yaml`` is the text of the optional
-    ``production:`` section, written as given. Returns the paths written."""
+    readings to 0.1 µm, catalogue to 1 mm); ``production`` is the optional ``production:``
+    section (:func:`production_data`). ``block.yaml`` goes through the safe YAML emitter
+    (:func:`~stereoplotter.io.yaml_output.yaml_document`): a name or photo number is written so
+    that it reads back as the same text. Returns the paths written."""
     out = Path(folder)
     photos = block.photos
     rows: list[tuple[Any, ...]] = []
@@ -356,30 +363,30 @@ def write_block_measurements(
         (c.id, c.role, c.kind, f"{c.sk42_m[0]:.3f}", f"{c.sk42_m[1]:.3f}", f"{c.sk42_m[2]:.3f}")
         for c in block.catalogue
     ]
-    origin = block.origin_sk42_m
     s = block.sigmas
-    text_lines = [
-        f"format: {FORMAT}",
-        f"name: {block.name}",
-        *([f"description: >-\n  {description}"] if description else []),
-        *camera_yaml(block.camera),
-        "frame:",
-        "  origin: " + yaml_flow(north_m=origin[0], east_m=origin[1], height_m=origin[2]),
-        "strips:",
-        *[f"  - {_yaml_id_list(strip)}" for strip in block.strips],
-        "measurements_csv: measurements.csv",
-        "control_csv: control.csv",
-        "sigma: "
-        + yaml_flow(
-            photo_mm=s.photo_mm,
-            control_plan_m=s.control_plan_m,
-            control_height_m=s.control_height_m,
+    doc: dict[str, Any] = {"format": FORMAT, "name": block.name}
+    if description:
+        doc["description"] = Folded(description)
+    doc |= {
+        "camera": camera_data(block.camera),
+        "frame": {"origin": origin_data(block.origin_sk42_m)},
+        "strips": [Flow([Quoted(p) for p in strip]) for strip in block.strips],
+        "measurements_csv": "measurements.csv",
+        "control_csv": "control.csv",
+        "sigma": Flow(
+            {
+                "photo_mm": float(s.photo_mm),
+                "control_plan_m": float(s.control_plan_m),
+                "control_height_m": float(s.control_height_m),
+            }
         ),
-    ]
+    }
+    if production is not None:
+        doc["production"] = production
     files = {
         "measurements.csv": _csv_text(MEASUREMENT_COLUMNS, rows),
         "control.csv": _csv_text(CONTROL_COLUMNS, control),
-        "block.yaml": "\n".join(text_lines) + "\n" + production_yaml,
+        "block.yaml": yaml_document(doc),
     }
     # the YAML last: it refers to the CSV files
     written = write_files(out, {name: text.encode("utf-8") for name, text in files.items()})

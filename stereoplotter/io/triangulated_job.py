@@ -16,14 +16,13 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import math
 import os
 from itertools import pairwise
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-import yaml
 from numpy.typing import NDArray
 
 from stereoplotter.geodesy.gauss_kruger import geographic_from_gauss_kruger
@@ -31,8 +30,9 @@ from stereoplotter.geodesy.map_sheet import sheet_bounds
 from stereoplotter.geodesy.photogrammetric import gauss_kruger_from_local
 from stereoplotter.geometry.film import fiducial_spans_mm
 from stereoplotter.io.atomic_write import write_files
-from stereoplotter.io.block_measurements_file import Production, camera_yaml, yaml_flow
+from stereoplotter.io.block_measurements_file import Production, camera_data, origin_data
 from stereoplotter.io.job_file import FORMAT as JOB_FORMAT
+from stereoplotter.io.yaml_output import Flow, Folded, Quoted, yaml_document
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.triangulation.block import (
     Block,
@@ -42,11 +42,6 @@ from stereoplotter.triangulation.block import (
 )
 
 __all__ = ["job_files", "nomenclature_10000", "sheets_of_pairs", "write_triangulated_job"]
-
-
-def _quoted(identifier: str) -> str:
-    """A photo number as a YAML text (JSON quoting is valid YAML): never read back as a number."""
-    return json.dumps(str(identifier), ensure_ascii=False)
 
 
 def _sheet_polygons(production: Production) -> list[tuple[str, NDArray[np.float64]]]:
@@ -129,12 +124,18 @@ def sheets_of_pairs(block: Block, orientations: NDArray[np.float64]) -> list[str
     return out
 
 
-def _sheets_yaml(production: Production) -> str:
-    data = [m.model_dump(exclude_none=True, by_alias=True) for m in production.map_sheets]
-    return yaml.safe_dump({"map_sheets": data}, allow_unicode=True, sort_keys=False)
+def _sheets_data(production: Production) -> list[dict[str, Any]]:
+    return [m.model_dump(exclude_none=True, by_alias=True) for m in production.map_sheets]
 
 
-# long: one YAML document and two CSV tables written out field by field
+def _photo_row(number: str, o: NDArray[np.float64]) -> Flow:
+    """A photo of the job: its number (text) and orientation, centres to 1 mm, angles to 10⁻⁶°."""
+    a, w, k = (round(math.degrees(float(v)), 6) for v in o[:3])
+    x, y, z = (round(float(v), 3) for v in o[3:6])
+    return Flow({"number": Quoted(number), "X_m": x, "Y_m": y, "Z_m": z, "alpha_deg": a,
+                 "omega_deg": w, "kappa_deg": k})  # fmt: skip
+
+
 def job_files(
     block: Block,
     production: Production,
@@ -145,43 +146,38 @@ def job_files(
 ) -> dict[str, str]:
     """The text of ``job.yaml``, ``fiducials.csv`` and ``points.csv`` of the triangulated block
     (orientations (n_photos, 6): α, ω, κ [rad], X_S, Y_S, Z_S [m] local; centres written to
-    1 mm, angles to 10⁻⁶°, as a listing prints them)."""
+    1 mm, angles to 10⁻⁶°, as a listing prints them). ``job.yaml`` goes through the safe YAML
+    emitter (:func:`~stereoplotter.io.yaml_output.yaml_document`): names and photo numbers read
+    back as the same text."""
     numbers = [str(p) for p in block.photos]
-    cam = block.camera
     measured = fiducial_spans_mm({str(k + 1): block.fiducials_mm[:, k] for k in range(4)})
-    origin = block.origin_sk42_m
-    lines = [
-        f"# Written by stereoplotter triangulate from {Path(source).name}: the exterior",
-        "# orientation of every photo from the triangulation, in the block's local system.",
-        f"format: {JOB_FORMAT}",
-        f"name: {block.name}",
-        f'date: "{production.date}"',
-        "description: >-",
-        f"  {description}",
-        f"instrument: {production.instrument}",
-        *camera_yaml(cam),
-        "frame:",
-        "  kind: local",
-        "  origin: " + yaml_flow(north_m=origin[0], east_m=origin[1], height_m=origin[2]),
-        "photos:",
-    ]
-    for n, o in zip(numbers, orientations, strict=True):
-        a, w, k = (math.degrees(float(v)) for v in o[:3])
-        lines.append(
-            f"  - {{number: {_quoted(n)}, X_m: {o[3]:.3f}, Y_m: {o[4]:.3f}, Z_m: {o[5]:.3f}, "
-            f"alpha_deg: {a:.6f}, omega_deg: {w:.6f}, kappa_deg: {k:.6f}}}"
-        )
-    lines += ["fiducial_distances_csv: fiducials.csv", "points_csv: [points.csv]"]
     sheets = _sheet_polygons(production)
-    pairs = ["pairs:"]
     index = {p: j for j, p in enumerate(block.photos)}
+    pairs = []
     for strip in block.strips:
         for left, right in pairwise(strip):
             centre = (orientations[index[left], 3:] + orientations[index[right], 3:]) / 2.0
             sheet = _pair_sheet(sk42_from_block_local(block, centre), sheets)
-            pairs.append(f"  - {{left: {_quoted(left)}, right: {_quoted(right)}, "
-                         f"map_sheet: {sheet}}}")
-    text = "\n".join(lines) + "\n" + _sheets_yaml(production) + "\n".join(pairs) + "\n"
+            pairs.append(Flow({"left": Quoted(left), "right": Quoted(right), "map_sheet": sheet}))
+    doc = {
+        "format": JOB_FORMAT,
+        "name": block.name,
+        "date": Quoted(production.date),
+        "description": Folded(description),
+        "instrument": production.instrument,
+        "camera": camera_data(block.camera),
+        "frame": {"kind": "local", "origin": origin_data(block.origin_sk42_m)},
+        "photos": [_photo_row(n, o) for n, o in zip(numbers, orientations, strict=True)],
+        "fiducial_distances_csv": "fiducials.csv",
+        "points_csv": Flow(["points.csv"]),
+        "map_sheets": _sheets_data(production),
+        "pairs": pairs,
+    }
+    comment = (
+        f"Written by stereoplotter triangulate from {Path(source).name}: the exterior\n"
+        "orientation of every photo from the triangulation, in the block's local system."
+    )
+    text = yaml_document(doc, comment=comment)
     fid = io.StringIO()
     w = csv.writer(fid, lineterminator="\n")
     w.writerow(("photo", "d12_mm", "d34_mm"))

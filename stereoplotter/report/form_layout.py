@@ -17,7 +17,7 @@ from typing import Any
 
 from fpdf import FPDF
 from fpdf.enums import XPos, YPos
-from fpdf.fonts import FontFace
+from fpdf.fonts import FontFace, TTFFont
 
 __all__ = ["FONT", "Form", "LabelPlacer", "font_path", "heading", "paragraph", "table"]
 
@@ -37,6 +37,35 @@ def font_path(style: str = "") -> str:
     return str(folder / "mpl-data" / "fonts" / "ttf" / name)
 
 
+#: Advance widths of texts, by (font file, text, size): a pure function of the font file, kept
+#: for the process (fpdf2 sums the glyph widths of every fragment again at each line break);
+#: emptied when it holds :data:`_WIDTHS_MAX` entries (a memory bound for a job of many forms).
+_WIDTHS: dict[tuple[str, str, float], tuple[int, float]] = {}
+_WIDTHS_MAX = 200_000
+
+
+class _RememberedWidths(TTFFont):
+    """A TrueType font whose text widths are computed once per process (the same numbers as
+    :meth:`TTFFont.get_text_width`, so the same bytes)."""
+
+    __slots__ = ()
+
+    def get_text_width(
+        self, text: str, font_size_pt: float, text_shaping_params: dict[str, Any] | None
+    ) -> tuple[int, float]:
+        if text_shaping_params:  # pragma: no cover - the forms do not shape text
+            return super().get_text_width(text, font_size_pt, text_shaping_params)
+        key = (str(self.ttffile), text, font_size_pt)
+        width = _WIDTHS.get(key)
+        if width is None:
+            if len(_WIDTHS) >= _WIDTHS_MAX:
+                _WIDTHS.clear()
+            width = _WIDTHS[key] = super().get_text_width(text, font_size_pt, None)
+        elif font_size_pt > self.biggest_size_pt:
+            self.biggest_size_pt = font_size_pt
+        return width
+
+
 class Form(FPDF):
     """A4 portrait with the margins, fonts and the running footer of the forms.
 
@@ -48,6 +77,8 @@ class Form(FPDF):
         super().__init__(orientation="P", unit="mm", format="A4")
         self.add_font(FONT, "", font_path(""))
         self.add_font(FONT, "B", font_path("B"))
+        for font in self.fonts.values():  # same layout (slots): only the width lookup changes
+            font.__class__ = _RememberedWidths
         self.set_margins(MARGIN_LEFT, MARGIN_TOP, MARGIN_RIGHT)
         self.set_auto_page_break(True, MARGIN_BOTTOM)
         day = _dt.datetime.strptime(date, "%Y-%m-%d").replace(tzinfo=_dt.UTC)

@@ -38,7 +38,7 @@ from stereoplotter.report.form_layout import FONT, Form, LabelPlacer, heading, p
 from stereoplotter.report.sheet import instrument_settings
 from stereoplotter.setup.records import SetupSheet
 
-__all__ = ["FormHeader", "LeastCounts", "form_pdf", "forms_pdf"]
+__all__ = ["FormHeader", "LeastCounts", "form_pdf", "forms_pdf", "page1_sizes"]
 
 #: Font sizes of page 1 tried in turn until the readings summary ends on page 1.
 _PAGE1_SIZES = (6.5, 6.0, 5.5, 5.0, 4.5)
@@ -355,8 +355,8 @@ def _page1_size(
     trial: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool
 ) -> float:
     """The largest font size of :data:`_PAGE1_SIZES` at which page 1 holds its readings, laid
-    out on fresh pages of ``trial`` (a throwaway document: one per call of :func:`form_pdf` or
-    :func:`forms_pdf`, so its fonts load once for all the pairs)."""
+    out on fresh pages of ``trial`` (a throwaway document shared by all the forms of a call of
+    :func:`page1_sizes`, so its fonts load once)."""
     for size in _PAGE1_SIZES:
         trial.add_page()
         first = trial.page_no()
@@ -366,14 +366,28 @@ def _page1_size(
     return _PAGE1_SIZES[-1]
 
 
+def page1_sizes(
+    forms: Sequence[tuple[SetupSheet, FormHeader]], lang: str = "en", rigorous: bool = False
+) -> list[float]:
+    """The page-1 font size of each form (:func:`_page1_size`), found once: a job passes them to
+    both :func:`form_pdf` and :func:`forms_pdf`, which then lay out each form once."""
+    check_language(lang)
+    if not forms:
+        return []
+    trial = Form(forms[0][1].date)
+    try:
+        return [_page1_size(trial, sheet, header, lang, rigorous) for sheet, header in forms]
+    finally:
+        trial.close_fonts()
+
+
 def _add_form(
-    pdf: Form, trial: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool
+    pdf: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool, size: float
 ) -> None:
     pdf.footer_text = (
         f"{header.job} · {term('pair', lang)} {header.pair} ({header.left_photo}, "
         f"{header.right_photo}) · {sheet.instrument} · {header.date} · {header.program}"
     )
-    size = _page1_size(trial, sheet, header, lang, rigorous)
     pdf.add_page()
     _page_summary(pdf, sheet, header, lang, rigorous, size)
     pdf.add_page()
@@ -385,15 +399,20 @@ def _add_form(
 
 
 def form_pdf(
-    sheet: SetupSheet, header: FormHeader, lang: str = "en", rigorous: bool = False
+    sheet: SetupSheet,
+    header: FormHeader,
+    lang: str = "en",
+    rigorous: bool = False,
+    size: float | None = None,
 ) -> bytes:
     """The form of one pair as PDF bytes (the same inputs give the same bytes).
 
     ``lang``: ``"ru"`` or ``"en"``; ``rigorous``: print the rigorous (3.17) mark targets and
-    spans as the values to set (the book's beside them).
+    spans as the values to set (the book's beside them); ``size``: page 1's font size from
+    :func:`page1_sizes` (found here when not given).
     """
     return forms_pdf([(sheet, header)], f"{term('setup_data', lang)} {header.job} {header.pair}",
-                     header.date, lang, rigorous)  # fmt: skip
+                     header.date, lang, rigorous, None if size is None else [size])  # fmt: skip
 
 
 def forms_pdf(
@@ -402,14 +421,14 @@ def forms_pdf(
     date: str,
     lang: str = "en",
     rigorous: bool = False,
+    sizes: Sequence[float] | None = None,
 ) -> bytes:
-    """The forms of many pairs in one PDF (the combined print of a block)."""
+    """The forms of many pairs in one PDF (the combined print of a block); ``sizes``: their
+    page-1 font sizes from :func:`page1_sizes` (found here when not given)."""
     check_language(lang)
-    pdf, trial = Form(date, term("page", lang)), Form(date)
+    sizes = page1_sizes(forms, lang, rigorous) if sizes is None else sizes
+    pdf = Form(date, term("page", lang))
     pdf.set_title(title)
-    try:
-        for sheet, header in forms:
-            _add_form(pdf, trial, sheet, header, lang, rigorous)
-    finally:
-        trial.close_fonts()
+    for (sheet, header), size in zip(forms, sizes, strict=True):
+        _add_form(pdf, sheet, header, lang, rigorous, size)
     return bytes(pdf.output())

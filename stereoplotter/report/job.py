@@ -25,7 +25,7 @@ from stereoplotter import __version__
 from stereoplotter.glossary import check_language, term
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
-from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdf, forms_pdf
+from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdf, forms_pdf, page1_sizes
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupSheet
 from stereoplotter.spec.instrument_spec import InstrumentSpec
@@ -222,7 +222,7 @@ def job_files(result: JobResult, lang: str = "en", rigorous: bool = False) -> di
     """
     check_language(lang)
     files: dict[str, bytes] = {}
-    forms = []
+    forms, names = [], []
     for p in result.pairs:
         data = pair_dict(result.job, p)
         files[f"{p.pair.name}/sheet.yaml"] = yaml_text(data, width=100).encode("utf-8")
@@ -230,11 +230,15 @@ def job_files(result: JobResult, lang: str = "en", rigorous: bool = False) -> di
             continue
         header = form_header(result.job, p, result.spec, lang)
         files[f"{p.pair.name}/sheet.md"] = _markdown(result.job, p, lang).encode("utf-8")
-        files[f"{p.pair.name}/sheet.pdf"] = form_pdf(p.sheet, header, lang, rigorous)
+        files[f"{p.pair.name}/sheet.pdf"] = b""  # in the order of the files before
         forms.append((p.sheet, header))
+        names.append(p.pair.name)
+    sizes = page1_sizes(forms, lang, rigorous)  # once: each form is then laid out once per PDF
+    for name, (sheet, header), size in zip(names, forms, sizes, strict=True):
+        files[f"{name}/sheet.pdf"] = form_pdf(sheet, header, lang, rigorous, size)
     if forms:
         title = f"{term('setup_data', lang)}: {result.job.name}"
-        files["forms.pdf"] = forms_pdf(forms, title, result.job.date, lang, rigorous)
+        files["forms.pdf"] = forms_pdf(forms, title, result.job.date, lang, rigorous, sizes)
     files["block.csv"] = block_csv(result).encode("utf-8")
     files["refused.md"] = refused_markdown(result).encode("utf-8")
     return files

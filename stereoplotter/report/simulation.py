@@ -10,9 +10,10 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.glossary import check_language, term
+from stereoplotter.glossary import check_language, term, translate
 from stereoplotter.procedure.eye import look_probability
 from stereoplotter.procedure.simulate import SimulationResult
+from stereoplotter.procedure.transcript import Record
 
 __all__ = [
     "OPERATOR_ADVICE",
@@ -349,7 +350,7 @@ def closing_summary(result: SimulationResult, lang: str = "en") -> str:
     ]
     applied = [(n, r) for n, r in result.remedies.items() if bool(_at(r.applied, t))]
     lines += ["", f"{tr('cs_remedies')}: " + (", ".join(
-        f"{n} ({int(_at(r.rounds, t))} {tr('cs_rounds')}, "
+        f"{_stage_words(n, lang)} ({int(_at(r.rounds, t))} {tr('cs_rounds')}, "
         f"{tr('cs_passed_after') if bool(_at(r.passed, t)) else tr('cs_failed_after')})"
         for n, r in applied
     ) if applied else tr("none")) + "."]  # fmt: skip
@@ -359,31 +360,70 @@ def closing_summary(result: SimulationResult, lang: str = "en") -> str:
         lines += ["", tr("cs_wrong")]
         for name in failed:
             tried = [n for n, r in applied if r.check == name]
-            after = f" {tr('cs_after')} {', '.join(tried)}" if tried else f" {tr('cs_no_remedy')}"
+            after = (f" {tr('cs_after')} {', '.join(_stage_words(n, lang) for n in tried)}"
+                     if tried else f" {tr('cs_no_remedy')}")  # fmt: skip
             lines.append(
                 f"- {_stage_words(name, lang)}: {tr('cs_still_outside')}"
-                f"{_stage_words(after, lang)} → {_advice(name, lang)}."
+                f"{after} → {_advice(name, lang)}."
             )
     return "\n".join(lines) + "\n"
 
 
 def _stage_words(text: str, lang: str) -> str:
-    """ "stage N" of a check's or remedy's name in ``lang``."""
+    """A check's or remedy's name in ``lang`` (its template in the glossary, "stage N" too)."""
     if lang == "en":
         return text
+    text = translate(text, lang)
     return re.sub(r"\bstage (\w+)", lambda m: f"{term('stage', lang)} {m[1]}", text)
 
 
+#: The fixed words of a record line after its step (``Transcript.to_text``), in Russian.
+_TAIL_RU = (
+    (" (from ", " (от "), (" to ", " до "), (" — read ", " — отсчёт "),
+    ("; judgment error ", "; ошибка наблюдения "), ("; seen ", "; видно "),
+    (" (true ", " (истинное "), ("; tolerance ", "; допуск "), (" (tolerance ", " (допуск "),
+    (": pass)", ": в допуске)"), (": FAIL)", ": ВНЕ ДОПУСКА)"),
+)  # fmt: skip
+
+
+def _record_line(line: str, r: Record, lang: str) -> str:
+    """One line of ``Transcript.to_text`` in ``lang``: its frame (stage, remedy, iteration,
+    the words around the values) from the glossary, the step, the remedy and the equation by
+    their templates (:func:`~stereoplotter.glossary.translate`); the values as printed."""
+    head = f"{r.number}. [stage {r.stage}]"
+    prefix = f"{r.number}. [{term('stage', lang)} {r.stage}]"
+    if r.remedy:
+        head += f" REMEDY ({r.remedy}):"
+        prefix += f" {term('tr_remedy', lang)} ({translate(r.remedy, lang)}):"
+    if r.iteration > 1:
+        head += f" (iteration {r.iteration})"
+        prefix += f" ({term('cs_iteration', lang)} {r.iteration})"
+    head += f" {r.step}"
+    prefix += f" {translate(r.step, lang)}"
+    tail = line[len(head):]
+    equation = f"  ({r.equation})" if r.equation else ""
+    if equation and tail.endswith(equation):
+        tail = tail[: -len(equation)]
+        equation = f"  ({translate(r.equation, lang)})"
+    for english, russian in _TAIL_RU:
+        tail = tail.replace(english, russian)
+    return prefix + tail + equation
+
+
 def _records_text(result: SimulationResult, lang: str) -> str:
-    """The numbered records; in Russian the stage headings and tags are translated (the records'
-    own text is the procedure's, in English)."""
+    """The numbered records (``Transcript.to_text``); in Russian every line is rendered again
+    with its words from the glossary (:func:`_record_line`), the numbers as printed."""
     text = result.transcript.to_text()
     if lang == "en":
         return text
-    stage, iteration = term("md_stage", lang), term("cs_iteration", lang)
-    text = re.sub(r"^## Stage ", f"## {stage} ", text, flags=re.MULTILINE)
-    text = re.sub(r"\[stage (\w+)\]", lambda m: f"[{stage.lower()} {m[1]}]", text)
-    return re.sub(r"\(iteration (\d+)\)", lambda m: f"({iteration} {m[1]})", text)
+    records = iter(result.transcript.records)
+    lines = []
+    for line in text.splitlines():
+        if line.startswith("## Stage "):
+            lines.append(f"## {term('md_stage', lang)} {line.removeprefix('## Stage ')}")
+        else:
+            lines.append(_record_line(line, next(records), lang))
+    return "\n".join(lines) + "\n"
 
 
 def transcript_text(result: SimulationResult, lang: str = "en") -> str:

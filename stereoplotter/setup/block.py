@@ -19,6 +19,27 @@ plan control of each model; compute those per model with
 (``model_x_offset_range_mm``) is not checked here, since a block file gives no plan extent of the
 working area; the single-pair sheet checks it.
 
+The chain, per pair and all at once: the frame rotation θ = atan2(ΔY_S, ΔX_S), M′ = R_Z(−θ)·M
+and α, ω, κ from M′ (``docs/setup-data.md``, Frame); the scale choice of item 1 of [1]_ on the
+(pair × candidate) grid — feasible when f_пр = f′·M_г/M_в is in range, the projection distances
+(Z_Sл − Z)·1000/M_в of the lowest and highest ground, and the same plus b_z′ for the right rod,
+are inside [D_min, D_max], and b_x, b_y, b_z′ are in range; the largest model scale (smallest
+M_г) wins, then the smallest M_в, as in :func:`stereoplotter.setup.sheet.compute_setup_sheet`;
+then Eqs. (6.3), (6.4), (6.1)/(6.2) (n-free) and (3.17) with κ = 0 for the marks, (6.5), the
+decentrations and (6.6).
+
+Example — the model of the book's §27 setting (f = 70 mm, 60 % overlap, photo scale 1:20 000):
+
+>>> from stereoplotter.io.instrument_file import load_instrument
+>>> marks = [[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]]
+>>> r = compute_block(70.0, marks, [[-720.0, 0.0, 1550.0]], [[0.0, 0.0, 0.0]],
+...                   [[720.0, 0.0, 1560.0]], [[0.0, 0.0, 0.0]], [[120.0, 210.0]],
+...                   load_instrument("sc1"), 10000)
+>>> float(r.horizontal_scale_denominator[0]), float(r.vertical_scale_denominator[0])
+(12500.0, 8000.0)
+>>> round(float(r.n_left[0]), 5), round(float(r.base_mm[0, 0]), 3)
+(1.69143, 115.2)
+
 Decisions (``docs/setup-data.md``): f′ is the camera's calibrated f unless the caller passes a
 corrected one (a block file has no measured fiducial spans); the marks of (6.1)/(6.2) are the
 calibrated ones, taken relative to the principal point.
@@ -99,8 +120,33 @@ def prepare_block_arrays(
     return f, marks, centres, angles, terrain, heights
 
 
-# Over 80 lines by its numpydoc docstring and doctest alone; the body checks the arguments and
-# makes one call to compute_table24.
+def _labels_and_invalid(
+    n: int,
+    centres: NDArray,
+    angles: NDArray,
+    terrain: NDArray,
+    heights: NDArray,
+    model_names: tuple[str, ...] | None,
+    height_point_ids: tuple[tuple[str, ...], ...] | None,
+) -> tuple[tuple[str, ...], tuple[tuple[str, ...], ...], NDArray[np.bool_]]:
+    """The model names (1, 2, … by default), the height point ids (1, 2, … per model by
+    default), and the unusable pairs: a non-finite input or terrain lowest > highest."""
+    invalid = ~(
+        np.isfinite(centres).all(axis=(1, 2))
+        & np.isfinite(angles).all(axis=(1, 2))
+        & np.isfinite(terrain).all(axis=1)
+    )
+    with np.errstate(invalid="ignore"):
+        invalid |= terrain[:, 0] > terrain[:, 1]
+    names = tuple(model_names) if model_names is not None else tuple(f"{i + 1}" for i in range(n))
+    ids = (
+        height_point_ids
+        if height_point_ids is not None
+        else tuple(tuple(str(j + 1) for j in range(heights.shape[1])) for _ in range(n))
+    )
+    return names, ids, invalid
+
+
 def compute_block(
     focal_length_corrected_mm: float,
     fiducials_mm: ArrayLike,
@@ -158,74 +204,24 @@ def compute_block(
 
     Notes
     -----
-    Chains, per pair and all at once: the frame rotation θ = atan2(ΔY_S, ΔX_S),
-    M′ = R_Z(−θ)·M and α, ω, κ from M′ (``docs/setup-data.md``, Frame); the scale choice of item 1
-    of [1]_ on the (pair × candidate) grid — feasible when f_пр = f′·M_г/M_в is in range, the
-    projection distances (Z_Sл − Z)·1000/M_в of the lowest and highest ground, and the same plus
-    b_z′ for the right rod, are inside [D_min, D_max], and b_x, b_y, b_z′ are in range; the largest
-    model scale (smallest M_г) wins, then the smallest M_в, as in
-    :func:`stereoplotter.setup.sheet.compute_setup_sheet`; then Eqs. (6.3), (6.4), (6.1)/(6.2)
-    (n-free) and (3.17) with κ = 0 for the marks, (6.5), the decentrations and (6.6).
-
-    (6.7)/(6.8) — the sheet corners — are **not** computed in block mode (they need a map sheet
-    and plan control per model), nor is the X, Y travel of the model checked.
-
-    Examples
-    --------
-    The model of the book's §27 setting (f = 70 mm, 60 % overlap, photo scale 1:20 000):
-
-    >>> import numpy as np
-    >>> from stereoplotter.io.instrument_file import load_instrument
-    >>> marks = [[-85.0, 0.0], [85.0, 0.0], [0.0, 85.0], [0.0, -85.0]]
-    >>> r = compute_block(70.0, marks, [[-720.0, 0.0, 1550.0]], [[0.0, 0.0, 0.0]],
-    ...                   [[720.0, 0.0, 1560.0]], [[0.0, 0.0, 0.0]], [[120.0, 210.0]],
-    ...                   load_instrument("sc1"), 10000)
-    >>> float(r.horizontal_scale_denominator[0]), float(r.vertical_scale_denominator[0])
-    (12500.0, 8000.0)
-    >>> round(float(r.n_left[0]), 5), round(float(r.base_mm[0, 0]), 3)
-    (1.69143, 115.2)
+    The chain is the module's (with its example); (6.7)/(6.8) — the sheet corners — are **not**
+    computed in block mode (they need a map sheet and plan control per model), nor is the X, Y
+    travel checked.
     """
     f, marks, centres, angles, terrain, heights = prepare_block_arrays(
-        focal_length_corrected_mm,
-        fiducials_mm,
-        principal_point_mm,
-        centre_left_m,
-        angles_left,
-        centre_right_m,
-        angles_right,
-        terrain_m,
-        height_points_m,
+        focal_length_corrected_mm, fiducials_mm, principal_point_mm, centre_left_m, angles_left,
+        centre_right_m, angles_right, terrain_m, height_points_m,
+    )  # fmt: skip
+    names, ids, invalid = _labels_and_invalid(
+        centres.shape[0], centres, angles, terrain, heights, model_names, height_point_ids
     )
-    n = centres.shape[0]
-    invalid = ~(
-        np.isfinite(centres).all(axis=(1, 2))
-        & np.isfinite(angles).all(axis=(1, 2))
-        & np.isfinite(terrain).all(axis=1)
-    )
-    with np.errstate(invalid="ignore"):
-        invalid |= terrain[:, 0] > terrain[:, 1]
     grid = candidate_grid(
         spec, map_scale_denominator, horizontal_scale_denominator, vertical_scale_denominator
     )
-    names = tuple(model_names) if model_names is not None else tuple(f"{i + 1}" for i in range(n))
-    ids = (
-        height_point_ids
-        if height_point_ids is not None
-        else tuple(tuple(str(j + 1) for j in range(heights.shape[1])) for _ in range(n))
-    )
     return compute_table24(
-        f,
-        marks,
-        centres,
-        rotation_matrix(angles[..., 0], angles[..., 1], angles[..., 2]),
+        f, marks, centres, rotation_matrix(angles[..., 0], angles[..., 1], angles[..., 2]),
         centres[:, 0, 2:3] - terrain[:, ::-1],  # Z_Sл − highest, Z_Sл − lowest ground
-        grid,
-        spec,
-        heights_m=heights,
-        invalid=invalid,
-        map_scale_denominator=map_scale_denominator,
-        book_sign=book_sign,
-        model_names=names,
-        height_point_ids=ids,
-        name=name,
-    )
+        grid, spec, heights_m=heights, invalid=invalid,
+        map_scale_denominator=map_scale_denominator, book_sign=book_sign, model_names=names,
+        height_point_ids=ids, name=name,
+    )  # fmt: skip

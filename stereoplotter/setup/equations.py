@@ -35,6 +35,8 @@ from stereoplotter.geometry.tilt_correction import correction_inclination, decen
 __all__ = [
     "base_components",
     "base_z_correction",
+    "corner_offsets_book_form_mm",
+    "corner_offsets_mm",
     "correction_inclination",
     "counter_scale_left",
     "counter_scale_right",
@@ -418,7 +420,23 @@ def sheet_corner_instrument_coordinates(
     The printed form multiplies by n as well; it equals this one when its M_г is the photo-scale
     denominator M_photo = n_л·M_г (:func:`sheet_corner_instrument_coordinates_book_form`).
     """
-    xy = apply_similarity(fit, gk_north_m, gk_east_m) - _a(origin_m)
+    return corner_offsets_mm(
+        apply_similarity(fit, gk_north_m, gk_east_m), horizontal_scale_denominator, origin_m
+    )
+
+
+def corner_offsets_mm(
+    corners_ground_m: ArrayLike,
+    horizontal_scale_denominator: float,
+    origin_m: ArrayLike = (0.0, 0.0),
+) -> NDArray[np.float64]:
+    r"""The scaling half of Eq. (6.7): x′, y′ of corners already on the ground by (6.8).
+
+    ``corners_ground_m`` shape (..., 2): X_Ф, Y_Ф of the corners [m] (the sheet computes them
+    once for the carriage extent and the readings); returns x′, y′ [mm] as
+    :func:`sheet_corner_instrument_coordinates`.
+    """
+    xy = _a(corners_ground_m) - _a(origin_m)
     return xy * MM_PER_M / float(horizontal_scale_denominator)
 
 
@@ -436,5 +454,18 @@ def sheet_corner_instrument_coordinates_book_form(
     as :func:`sheet_corner_instrument_coordinates`; with the model M_г it would be n times too
     large. Kept for reproducing the book.
     """
-    xy = apply_similarity(fit, gk_north_m, gk_east_m) - _a(origin_m)
+    return corner_offsets_book_form_mm(
+        apply_similarity(fit, gk_north_m, gk_east_m), n, photo_scale_denominator, origin_m
+    )
+
+
+def corner_offsets_book_form_mm(
+    corners_ground_m: ArrayLike,
+    n: float,
+    photo_scale_denominator: float,
+    origin_m: ArrayLike = (0.0, 0.0),
+) -> NDArray[np.float64]:
+    """The printed (6.7) of corners already on the ground by (6.8), as
+    :func:`sheet_corner_instrument_coordinates_book_form`. [mm]"""
+    xy = _a(corners_ground_m) - _a(origin_m)
     return float(n) * xy * MM_PER_M / float(photo_scale_denominator)

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from stereoplotter.setup.equations import height_scale_reading
 from stereoplotter.setup.records import SetupSheet
 
@@ -22,7 +24,7 @@ def _signed(value: float, digits: int = 3) -> str:
     """``+ 1.234`` or ``− 1.234`` [as given]; a value that rounds to zero is ``+ 0.000`` (never
     ``+ -0.000`` or ``− 0.000``)."""
     text = f"{abs(value):.{digits}f}"
-    negative = value < 0 and float(text) != 0.0
+    negative = value < 0 and text.strip("0.") != ""  # not a value that rounds to zero
     return f"{'−' if negative else '+'} {text}"
 
 
@@ -260,17 +262,16 @@ def _height_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
     """Stage 3: the height-scale readings of the height control points (6.15)."""
     tol = sheet.tolerances
     n_l = sheet.n_left
+    heights = sheet.control_heights
+    values = height_scale_reading(
+        0.0,
+        np.array([h["model_height_mm"] for h in heights], float),
+        n_l,
+        sheet.f_instrument_mm,
+        sheet.vertical_scale_denominator,
+    ).tolist()  # (6.15) of every height point in one array expression
     rows: list[dict[str, Any]] = []
-    for h in sheet.control_heights:
-        value = float(
-            height_scale_reading(
-                0.0,
-                h["model_height_mm"],
-                n_l,
-                sheet.f_instrument_mm,
-                sheet.vertical_scale_denominator,
-            )
-        )
+    for h, value in zip(heights, values, strict=True):
         rows.append(
             _r(
                 3,

@@ -97,7 +97,6 @@ class SetupSheet:
     corners: tuple[dict[str, Any], ...]
     readings: tuple[dict[str, Any], ...]
     tolerances: dict[str, float]
-    candidates: tuple[ScaleCandidate, ...]
     assumed: dict[str, tuple[str, ...]]
     options: SetupOptions = field(default_factory=SetupOptions)
     depth_range_used_mm: tuple[float, float] = (math.nan, math.nan)

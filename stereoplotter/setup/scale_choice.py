@@ -21,6 +21,7 @@ the largest model scale.
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from dataclasses import dataclass
 
@@ -43,6 +44,7 @@ __all__ = [
     "candidate_scales",
     "choose_candidates",
     "describe_candidate",
+    "reason_names",
     "scale_candidates",
 ]
 
@@ -82,7 +84,8 @@ def scale_candidates(
     flags: ArrayLike,
     map_scale_denominator: int | None,
 ) -> tuple[ScaleCandidate, ...]:
-    """The candidates of one pair as :class:`ScaleCandidate` records.
+    """The candidates of one pair as :class:`ScaleCandidate` records (f_пр of every candidate
+    in one array expression, the reason names of each flag code computed once).
 
     Parameters
     ----------
@@ -95,16 +98,29 @@ def scale_candidates(
     map_scale_denominator : int or None
         M_map, for the coordinatograph ratio M_г/M_map (NaN without a map).
     """
-    return tuple(
-        ScaleCandidate(
-            int(mg),
-            int(mv),
-            mg / map_scale_denominator if map_scale_denominator else math.nan,
-            float(instrument_principal_distance(focal_length_corrected_mm, mg, mv)),
-            tuple((flag.name or "").lower() for flag in ScaleCheck if flag and code & int(flag)),
-        )
-        for (mg, mv), code in zip(np.asarray(candidates, float), np.asarray(flags), strict=True)
+    grid = np.asarray(candidates, float)
+    f_instrument = instrument_principal_distance(focal_length_corrected_mm, grid[:, 0], grid[:, 1])
+    ratios = (
+        (grid[:, 0] / map_scale_denominator).tolist()
+        if map_scale_denominator
+        else [math.nan] * len(grid)
     )
+    return tuple(
+        ScaleCandidate(int(mg), int(mv), ratio, f_pr, reason_names(code))
+        for (mg, mv), ratio, f_pr, code in zip(
+            grid.tolist(), ratios, f_instrument.tolist(), np.asarray(flags).tolist(), strict=True
+        )
+    )
+
+
+@functools.lru_cache(maxsize=256)
+def reason_names(code: int) -> tuple[str, ...]:
+    """The :class:`ScaleCheck` names (lower case) of the bits set in ``code``, in flag order.
+
+    >>> reason_names(2 | 512)
+    ('f_instrument', 'model_x')
+    """
+    return tuple((flag.name or "").lower() for flag in ScaleCheck if flag and code & int(flag))
 
 
 def candidate_scales(

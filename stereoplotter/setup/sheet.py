@@ -38,9 +38,9 @@ from stereoplotter.scenario.synthetic import (
     working_area_grid_m,
 )
 from stereoplotter.setup.equations import (
+    corner_offsets_book_form_mm,
+    corner_offsets_mm,
     decentration,
-    sheet_corner_instrument_coordinates,
-    sheet_corner_instrument_coordinates_book_form,
 )
 from stereoplotter.setup.readings import stage_readings
 from stereoplotter.setup.records import (
@@ -56,7 +56,6 @@ from stereoplotter.setup.table24 import (
     X_MARK_NAME,
     BlockResult,
     Refusal,
-    candidates_of,
     compute_table24,
     instrument_frames,
 )
@@ -262,15 +261,14 @@ def _plan_control(
 
 
 def _corners(
-    fit: SimilarityFit | None, corners_gk: NDArray | None, mg: int, n_left: float
+    corners_gk: NDArray | None, corners_m: NDArray, mg: int, n_left: float
 ) -> tuple[dict[str, object], ...]:
-    """(6.7): the sheet corners in instrument coordinates from the left plumb."""
-    if fit is None or corners_gk is None:
+    """(6.7): the sheet corners in instrument coordinates from the left plumb, from their ground
+    X, Y by (6.8) (computed once, in :func:`_plan_control`)."""
+    if corners_gk is None or len(corners_m) == 0:
         return ()
-    xy = sheet_corner_instrument_coordinates(fit, corners_gk[:, 0], corners_gk[:, 1], mg)
-    xy_book = sheet_corner_instrument_coordinates_book_form(
-        fit, corners_gk[:, 0], corners_gk[:, 1], n_left, n_left * mg
-    )
+    xy = corner_offsets_mm(corners_m, mg)
+    xy_book = corner_offsets_book_form_mm(corners_m, n_left, n_left * mg)
     return tuple(
         {
             "corner": key,
@@ -283,6 +281,15 @@ def _corners(
             "y_book_form_mm": float(xy_book[j, 1]),
         }
         for j, key in enumerate(("1", "2", "3", "4"))
+    )
+
+
+def _points_model(points: tuple[Point, ...], points_m: NDArray, mg: int) -> tuple[dict, ...]:
+    """The pair's points in model mm from the left plumb (X, Y ·1000/M_г), for the drawing."""
+    xy = (points_m[:, :2] * MM_PER_M / mg).tolist()
+    return tuple(
+        {"id": p.id, "role": p.role, "kind": p.kind, "x_mm": x, "y_mm": y}
+        for p, (x, y) in zip(points, xy, strict=True)
     )
 
 
@@ -410,6 +417,7 @@ class _Prepared:
     marks_mm: NDArray  # (2, 4, 2)
     centres_m: NDArray  # (2, 3)
     rotations: NDArray  # (2, 3, 3)
+    frames: tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]]  # of a block of one
     points: tuple[Point, ...]
     points_m: NDArray  # (p, 3) in the instrument frame
     heights: tuple[Point, ...]
@@ -419,6 +427,7 @@ class _Prepared:
     similarity: SimilarityFit | None
     plan: list[int]
     corners_gk: NDArray | None
+    corners_m: NDArray  # (4, 2) the sheet corners on the ground by (6.8), or (0, 2)
     map_scale: int | None
     grid: NDArray  # (C, 2)
     exterior_sources: tuple[str, ...]
@@ -439,11 +448,14 @@ def _prepare(
     working_area_m: NDArray,
     map_sheet: MapSheet | None,
     exterior_sources: tuple[str, ...],
+    grids: dict[int | None, NDArray] | None = None,
 ) -> _Prepared:
-    """The frame, the ground in it, the plan control (6.8) and the scale candidates of one pair."""
+    """The frame, the ground in it, the plan control (6.8) and the scale candidates of one pair
+    (``grids``: the candidates already built, by map scale, shared by the pairs of a call)."""
     centres = np.asarray(centres_m, float)[None]  # (1, 2, 3)
     rots = np.asarray(rotations, float)[None]  # (1, 2, 3, 3)
-    theta = float(instrument_frames(centres, rots)[0][0])
+    frames = instrument_frames(centres, rots)  # once: Table 24 takes it from here
+    theta = float(frames[0][0])
     points_m = instrument_frame_m(
         np.array([p.local_m for p in points], float).reshape(-1, 3), centres[0, 0], theta
     )
@@ -459,6 +471,10 @@ def _prepare(
             "horizontal model scale M_г from the coordinatograph gears, found nothing (or force "
             "M_г with --horizontal-scale)"
         )
+    grids = {} if grids is None else grids
+    if map_scale not in grids:
+        grids[map_scale] = _candidate_grid(spec, options, map_scale)
+    grid = grids[map_scale]
     return _Prepared(
         name=name,
         spec=spec,
@@ -468,6 +484,7 @@ def _prepare(
         marks_mm=np.asarray(marks_mm, float),
         centres_m=centres[0],
         rotations=rots[0],
+        frames=frames,
         points=tuple(points),
         points_m=points_m,
         heights=tuple(
@@ -479,8 +496,9 @@ def _prepare(
         similarity=fit,
         plan=plan,
         corners_gk=corners_gk,
+        corners_m=corners_m,
         map_scale=map_scale,
-        grid=_candidate_grid(spec, options, map_scale),
+        grid=grid,
         exterior_sources=tuple(exterior_sources),
     )
 
@@ -508,18 +526,31 @@ def _table24(pairs: Sequence[_Prepared], name: str) -> BlockResult:
         model_names=tuple(p.name for p in pairs),
         height_point_ids=tuple(tuple(h.id for h in p.heights) for p in pairs),
         name=name,
+        frames=(
+            np.concatenate([p.frames[0] for p in pairs]),
+            np.concatenate([p.frames[1] for p in pairs]),
+            tuple(np.concatenate([p.frames[2][j] for p in pairs]) for j in range(3)),
+        ),
     )
 
 
-def _finish(prep: _Prepared, table: BlockResult) -> SetupSheet:
-    """The sheet of a prepared pair from its Table 24 (a block of one), or its refusal."""
-    if int(table.reason_code[0]) & SCALE_FLAGS:
+def _finish(
+    prep: _Prepared, table: BlockResult, assumed: dict[str, tuple[str, ...]] | None = None
+) -> SetupSheet:
+    """The sheet of a prepared pair from its Table 24 (a block of one), or its refusal.
+
+    The range checks are Table 24's reason code, computed once for all pairs: only a refused
+    pair goes through the checks again, for the words of its refusal."""
+    code = int(table.reason_code[0])
+    if code & SCALE_FLAGS:
         _refuse_scales(table, prep.extent_m[None])
-    _check_settings(table)
+    if code or float(np.abs(table.angles[0, :, :2]).max()) > prep.spec.tilt_max:
+        _check_settings(table)  # the words of the refusal (_check_tilt has no slack)
     spec, options, points, points_m = prep.spec, prep.options, prep.points, prep.points_m
     mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
     n_left = float(table.n_left[0])
-    tolerances, assumed = _tolerances(spec, n_left, prep.depths_m), assumed_parameters(spec)
+    tolerances = _tolerances(spec, n_left, prep.depths_m)
+    assumed = assumed_parameters(spec) if assumed is None else assumed
     sheet = SetupSheet(
         scenario=prep.name,
         instrument=spec.key,
@@ -549,24 +580,14 @@ def _finish(prep: _Prepared, table: BlockResult) -> SetupSheet:
         ),  # (6.6)
         similarity=prep.similarity,
         similarity_point_ids=tuple(points[i].id for i in prep.plan),
-        corners=_corners(prep.similarity, prep.corners_gk, mg, n_left),
+        corners=_corners(prep.corners_gk, prep.corners_m, mg, n_left),
         readings=(),
         tolerances=tolerances,
-        candidates=candidates_of(table, 0),
         assumed=assumed,
         options=options,
         depth_range_used_mm=tuple(float(v) for v in table.depth_range_mm[0]),
         exterior_sources=prep.exterior_sources,
-        points_model_mm=tuple(
-            {
-                "id": p.id,
-                "role": p.role,
-                "kind": p.kind,
-                "x_mm": float(points_m[i, 0] * MM_PER_M / mg),
-                "y_mm": float(points_m[i, 1] * MM_PER_M / mg),
-            }
-            for i, p in enumerate(points)
-        ),
+        points_model_mm=_points_model(points, points_m, mg),
         table24=table,
     )
     return replace(sheet, readings=stage_readings(sheet))
@@ -671,9 +692,11 @@ def compute_sheets_from_measurements(
     """
     out: list[SetupSheet | SetupRefusal | None] = [None] * len(pairs)
     groups: dict[bytes, list[tuple[int, _Prepared]]] = {}
+    grids: dict[int | None, NDArray] = {}  # the scale candidates of each map scale, once
+    assumed = assumed_parameters(spec)
     for i, arguments in enumerate(pairs):
         try:
-            prep = _prepare(spec=spec, options=options, source=source, **arguments)
+            prep = _prepare(spec=spec, options=options, source=source, grids=grids, **arguments)
         except SetupRefusal as exc:
             out[i] = exc
             continue
@@ -682,7 +705,7 @@ def compute_sheets_from_measurements(
         table = _table24([p for _, p in members], name)
         for j, (i, prep) in enumerate(members):
             try:
-                out[i] = _finish(prep, table.take(j))
+                out[i] = _finish(prep, table.take(j), assumed)
             except SetupRefusal as exc:
                 out[i] = exc
     return [r for r in out if r is not None]

@@ -316,9 +316,94 @@ def _marks(
     return np.stack([x0, y3, y4], axis=-1) * mask[..., None], rigorous * mask[..., None, None]
 
 
-# Over 80 lines with its docstring: the body (~75 lines) is the chain of Table 24 in reading order,
-# each step one equation call on (N,) arrays, ending in the one BlockResult constructor; the parts
-# that stand alone (frames, stops, marks) are helpers above.
+def _pair_inputs(
+    focal_length_corrected_mm: ArrayLike,
+    marks_mm: ArrayLike,
+    centres_m: NDArray,
+    rotations: NDArray,
+    depth_m: NDArray,
+    invalid: NDArray | None,
+) -> tuple[NDArray, NDArray, NDArray]:
+    """f′ per pair (N,), the marks per pair and photo (N, 2, 4, 2), and the unusable pairs (a
+    non-finite input or a depth range upside down, unless given)."""
+    n = centres_m.shape[0]
+    f_pairs = np.array(np.broadcast_to(np.asarray(focal_length_corrected_mm, float), (n,)))
+    marks = np.asarray(marks_mm, float)
+    if marks.ndim == 2:
+        marks = np.broadcast_to(marks, (2, *marks.shape))
+    marks = np.broadcast_to(marks, (n, 2, 4, 2))  # f′ per pair: the marks of (3.17) per pair too
+    if invalid is None:
+        invalid = ~(
+            np.isfinite(centres_m).all(axis=(1, 2))
+            & np.isfinite(rotations).all(axis=(1, 2, 3))
+            & np.isfinite(depth_m).all(axis=1)
+        )
+        with np.errstate(invalid="ignore"):
+            invalid |= depth_m[:, 0] > depth_m[:, 1]
+    return f_pairs, marks, invalid
+
+
+def _choice_and_stops(
+    spec: InstrumentSpec,
+    f: NDArray,
+    grid: NDArray,
+    depth_m: NDArray,
+    frames: tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]],
+    extent_m: NDArray | None,
+    invalid: NDArray,
+) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Item 1 on the (pair × candidate) grid, then the stops that do not depend on the scale:
+    the candidate flags (N, C), the chosen candidate (N,), the reason code (N,) and the
+    decentrations (N, 2, 2). ``f`` has shape (N, 1): it broadcasts against the (C,) candidates
+    in f_пр = f′·M_г/M_в."""
+    _, base_m, (alpha, omega, kappa) = frames
+    flags_c = candidate_flags(spec, f, grid, depth_m, base_m, extent_m)  # (N, C)
+    chosen, any_ok = choose_candidates(flags_c, grid)
+    reason = np.where(any_ok, 0, flags_c[np.arange(len(f)), chosen])
+    dec = np.stack([decentration(f, alpha), decentration(f, omega)], axis=-1)  # (N, 2, 2)
+    reason |= _stop_codes(spec, alpha, omega, kappa, dec)
+    reason = np.where(invalid, int(Refusal.INVALID_INPUT), reason)
+    return flags_c, chosen, reason.astype(np.int64), dec
+
+
+def _settings(
+    spec: InstrumentSpec,
+    f_pairs: NDArray,
+    marks: NDArray,
+    mg: NDArray,
+    mv: NDArray,
+    ok: NDArray,
+    frames: tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]],
+    book_sign: bool,
+) -> dict[str, NDArray]:
+    """f_пр, k, (6.3) n_л, (6.4) n_п, the base, (6.1)/(6.2) and (3.17) of the marks, (6.5) and the
+    correction-plane inclinations of the pairs at their chosen scales (NaN where refused)."""
+    _, base_m, (alpha, omega, _) = frames
+    f_pr = instrument_principal_distance(f_pairs, mg, mv)
+    k = transformation_coefficient(f_pr, f_pairs)
+    n_left = counter_scale_left(spec.projection_distance_max_mm, f_pr)  # (6.3)
+    n_right = counter_scale_right(n_left, 0.0, base_m[:, 2], f_pr, mv, book_sign=book_sign)  # (6.4)
+    mask2 = np.where(ok, 1.0, np.nan)[:, None]
+    fiducials, rigorous = _marks(f_pairs[:, None], marks, alpha, omega, mask2)
+    inclination = np.stack(
+        [correction_inclination(k[:, None], alpha), correction_inclination(k[:, None], omega)],
+        axis=-1,
+    )
+    return {
+        "f_instrument_mm": f_pr,
+        "transformation_coefficient": k,
+        "n_left": n_left,
+        "n_right": n_right,
+        "base_mm": base_components(np.zeros(3), base_m, mg, mv),
+        "fiducials_transformed_mm": fiducials,
+        "fiducials_rigorous_mm": rigorous,
+        "mark_span_mm": mark_span(
+            np.stack([n_left, n_right], axis=1), fiducials[..., 1], fiducials[..., 2]
+        ),  # (6.5)
+        "correction_inclination": inclination,
+    }
+
+
 def compute_table24(
     focal_length_corrected_mm: ArrayLike,
     marks_mm: ArrayLike,
@@ -336,6 +421,7 @@ def compute_table24(
     model_names: tuple[str, ...],
     height_point_ids: tuple[tuple[str, ...], ...],
     name: str = "block",
+    frames: tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]] | None = None,
 ) -> BlockResult:
     """Table 24 (Eqs. (6.1)–(6.6) of [1]_ and item 1) of N pairs, vectorised.
 
@@ -345,10 +431,8 @@ def compute_table24(
         f′, shared or per pair (each pair's film). [mm]
     marks_mm : array_like, shape (4, 2) or (N, 2, 4, 2)
         Marks 1–4 relative to the principal point, shared or per pair and photo. [mm]
-    centres_m : ndarray, shape (N, 2, 3)
-        S_л, S_п. [m]
-    rotations : ndarray, shape (N, 2, 3, 3)
-        M of the left and right photo. [—]
+    centres_m, rotations : ndarray, shape (N, 2, 3) and (N, 2, 3, 3)
+        S_л, S_п [m] and M of the left and right photo [—].
     depth_m : ndarray, shape (N, 2)
         Z_Sл − highest, Z_Sл − lowest ground of the working area. [m]
     grid : ndarray, shape (C, 2)
@@ -360,91 +444,42 @@ def compute_table24(
         Plan extent of model and sheet corners from S_л in the instrument frame (checked against
         the carriage travel when given). [m]
     invalid : ndarray of bool, shape (N,), optional
-        Pairs whose input is unusable; by default those with a non-finite input or a depth range
-        upside down.
+        Unusable pairs; by default those with a non-finite input or a depth range upside down.
     map_scale_denominator, book_sign, model_names, height_point_ids, name
         Carried into the result; ``book_sign`` chooses the printed sign of (6.4).
+    frames : tuple, optional
+        :func:`instrument_frames` of these pairs when the caller has it already (computed once).
 
     Returns
     -------
     BlockResult
     """
-    n = centres_m.shape[0]
-    f_pairs = np.array(np.broadcast_to(np.asarray(focal_length_corrected_mm, float), (n,)))
-    f = f_pairs[:, None]  # (N, 1): broadcasts over the photos and the scale candidates
-    marks = np.asarray(marks_mm, float)
-    if marks.ndim == 2:
-        marks = np.broadcast_to(marks, (2, *marks.shape))
-    marks = np.broadcast_to(marks, (n, 2, 4, 2))  # f′ per pair: the marks of (3.17) per pair too
-    if invalid is None:
-        invalid = ~(
-            np.isfinite(centres_m).all(axis=(1, 2))
-            & np.isfinite(rotations).all(axis=(1, 2, 3))
-            & np.isfinite(depth_m).all(axis=1)
-        )
-        with np.errstate(invalid="ignore"):
-            invalid |= depth_m[:, 0] > depth_m[:, 1]
-    theta, base_m, (alpha, omega, kappa) = instrument_frames(centres_m, rotations)
-
-    # Item 1: scale choice on the (pair × candidate) grid.
-    # f of shape (N, 1) broadcasts against the (C,) candidates in f_пр = f′·M_г/M_в.
-    flags_c = candidate_flags(spec, f, grid, depth_m, base_m, extent_m)  # (N, C)
-    chosen, any_ok = choose_candidates(flags_c, grid)
-    reason = np.where(any_ok, 0, flags_c[np.arange(n), chosen])
-    dec = np.stack([decentration(f, alpha), decentration(f, omega)], axis=-1)  # (N, 2, 2)
-    reason |= _stop_codes(spec, alpha, omega, kappa, dec)
-    reason = np.where(invalid, int(Refusal.INVALID_INPUT), reason)
+    f_pairs, marks, invalid = _pair_inputs(
+        focal_length_corrected_mm, marks_mm, centres_m, rotations, depth_m, invalid
+    )
+    frames = instrument_frames(centres_m, rotations) if frames is None else frames
+    theta, base_m, angles = frames
+    flags_c, chosen, reason, dec = _choice_and_stops(
+        spec, f_pairs[:, None], grid, depth_m, frames, extent_m, invalid
+    )
     ok = reason == 0
-
     mg = np.where(ok, grid[chosen, 0], np.nan)
     mv = np.where(ok, grid[chosen, 1], np.nan)
-    f_pr = instrument_principal_distance(f_pairs, mg, mv)
-    k = transformation_coefficient(f_pr, f_pairs)
-    n_left = counter_scale_left(spec.projection_distance_max_mm, f_pr)  # (6.3)
-    n_right = counter_scale_right(n_left, 0.0, base_m[:, 2], f_pr, mv, book_sign=book_sign)  # (6.4)
-    mask2 = np.where(ok, 1.0, np.nan)[:, None]
-    fiducials, rigorous = _marks(f, marks, alpha, omega, mask2)
-    inclination = np.stack(
-        [correction_inclination(k[:, None], alpha), correction_inclination(k[:, None], omega)],
-        axis=-1,
-    )
     flying = centres_m[:, 0, 2:3] - heights_m  # H_Фi = Z_Sл − Z_Фi
     return BlockResult(
-        name=name,
-        instrument=spec.key,
-        model_names=model_names,
-        spec=spec,
-        map_scale_denominator=map_scale_denominator,
-        focal_length_corrected_mm=f_pairs,
-        book_sign=book_sign,
-        candidate_scales=grid,
-        candidate_flags=flags_c,
-        feasible_candidates=flags_c == 0,
-        candidate_index=chosen,
-        reason_code=reason.astype(np.int64),
-        frame_rotation=theta,
-        frame_origin_m=centres_m[:, 0].copy(),
-        base_ground_m=base_m,
-        depth_ground_m=depth_m,
-        angles=np.stack([alpha, omega, kappa], axis=-1),
-        horizontal_scale_denominator=mg,
-        vertical_scale_denominator=mv,
-        f_instrument_mm=f_pr,
-        transformation_coefficient=k,
-        n_left=n_left,
-        n_right=n_right,
-        base_mm=base_components(np.zeros(3), base_m, mg, mv),
-        fiducials_transformed_mm=fiducials,
-        fiducials_rigorous_mm=rigorous,
-        mark_span_mm=mark_span(
-            np.stack([n_left, n_right], axis=1), fiducials[..., 1], fiducials[..., 2]
-        ),  # (6.5)
-        decentration_mm=dec * mask2[..., None],
-        correction_inclination=inclination,
+        name=name, instrument=spec.key, model_names=model_names, spec=spec,
+        map_scale_denominator=map_scale_denominator, focal_length_corrected_mm=f_pairs,
+        book_sign=book_sign, candidate_scales=grid, candidate_flags=flags_c,
+        feasible_candidates=flags_c == 0, candidate_index=chosen, reason_code=reason,
+        frame_rotation=theta, frame_origin_m=centres_m[:, 0].copy(), base_ground_m=base_m,
+        depth_ground_m=depth_m, angles=np.stack(angles, axis=-1),
+        horizontal_scale_denominator=mg, vertical_scale_denominator=mv,
+        decentration_mm=dec * np.where(ok, 1.0, np.nan)[:, None, None],
         depth_range_mm=projection_distance(depth_m, mv[:, None]),
         height_point_ids=height_point_ids,
         control_heights_model_mm=model_height(flying, mv[:, None]),  # (6.6)
-    )
+        **_settings(spec, f_pairs, marks, mg, mv, ok, frames, book_sign),
+    )  # fmt: skip
 
 
 def candidates_of(result: BlockResult, i: int) -> tuple[ScaleCandidate, ...]:
