@@ -64,6 +64,7 @@ __all__ = [
     "SUBSTITUTE_STAGES",
     "UNDO_DEPTH",
     "Session",
+    "check_stage",
     "json_finite",
     "state_digest",
 ]
@@ -334,7 +335,7 @@ class Session:
             return []
         out = []
         for name, check in self.par.run.results.items():
-            if _check_stage(name) == stage and check.tolerance is not None:
+            if check_stage(name) == stage and check.tolerance is not None:
                 out.append({"name": name, "tolerance": _f(check.tolerance), "unit": check.unit})
         return out
 
@@ -616,7 +617,7 @@ def _copy_instrument(inst: Instrument) -> Instrument:
     return copy.deepcopy(inst, memo)
 
 
-def _check_stage(name: str) -> str | None:
+def check_stage(name: str) -> str | None:
     """The stage a check of the procedure belongs to, by its name ("stage 5: …", "C2: …")."""
     head = name.split(":", 1)[0].strip()
     if head.startswith("stage "):
