@@ -7,7 +7,8 @@ exercise's own seed (a per-trainee exercise: the trainee "robot"):
   the exact simulated operator, compacted and finished) replayed through a session;
 * **operator** — the simulated operator with its judgment errors (the grade's par: its score,
   and its points by the same rule, no hints);
-* **hint 3 then claim** — in every stage, a hint of level 3 (show me) and the claim.
+* **hint 3 then claim** — in every stage, a hint of level 3 (show me) and the claim (an
+  incomplete model refuses the claim without the substitutes: the trainee stops there).
 
 Each is graded with ``grade(population=0)``: score (largest value/tolerance), points after the
 hint cost, passed.
@@ -34,6 +35,7 @@ def add_parser(exs: Any) -> None:
 
 def _row(exercise: Any) -> dict[str, Any]:
     # imported here: the CLI loads no library module until a command runs (it starts fast)
+    from stereoplotter.errors import TrainerError
     from stereoplotter.trainer.grade_tables import PASS_POINTS, outcome_points
     from stereoplotter.trainer.grading import grade
     from stereoplotter.trainer.robot import robot_script
@@ -48,9 +50,12 @@ def _row(exercise: Any) -> dict[str, Any]:
     for stage in exercise.stages:
         if exercise.allows("hints"):
             lazy.act({"kind": "hint", "level": 3})
-        lazy.act({"kind": "claim", "step": stage})
+        try:
+            lazy.act({"kind": "claim", "step": stage})
+        except TrainerError:  # an incomplete model's claim wants the substitutes: it stops here
+            break
     h = grade(lazy, population=0)["overall"]
-    par_points = outcome_points(g["par_score"])
+    par_points = outcome_points(g["par_score"] if g["par_score"] is not None else float("inf"))
     return {
         "name": exercise.name,
         "level": exercise.level,
@@ -63,7 +68,7 @@ def _row(exercise: Any) -> dict[str, Any]:
         "operator": {
             "score": g["par_score"],
             "points": par_points,
-            "passed": bool(g["par_score"] <= 1.0 and par_points >= PASS_POINTS),
+            "passed": bool(par_points >= PASS_POINTS and (g["par_score"] or 2.0) <= 1.0),
         },
         "hint3_claim": {
             "score": h["score"],
@@ -81,7 +86,8 @@ def grades_rows(exercises: list[Any]) -> list[dict[str, Any]]:
 
 def _cell(g: dict[str, Any]) -> str:
     verdict = "passed" if g["passed"] else "failed"
-    return f"{g['score']:.2f} / {g['points']:.0f} / {verdict}"
+    score = "∞" if g["score"] is None else f"{g['score']:.2f}"  # JSON's null: not finite
+    return f"{score} / {g['points']:.0f} / {verdict}"
 
 
 def grades_markdown(rows: list[dict[str, Any]]) -> str:
