@@ -127,10 +127,11 @@ def process_measures(
     """Process measures of a sequence of log records (or bare actions with a ``stage``).
 
     The final approach of a lead screw is the side its last move finished from: the ``side`` of
-    the action when given, else the direction of the move. ``stage_controls``: stage → the controls the simulated operator turns in it (for "out of
-    order"); ``stage_checks``: stage → the names of its checks (the skipped ones are named).
-    Moves are ``turn`` and ``set`` actions; a ``set`` moves by the difference from the
-    control's previous value where the log knows it (its own earlier turns and sets).
+    the action when given, else the direction of the move. ``stage_controls``: stage → the
+    controls the simulated operator turns in it (for "out of order"); ``stage_checks``: stage →
+    the names of its checks (the skipped ones are named). Moves are ``turn`` and ``set``
+    actions; a ``set`` moves by the difference from the control's previous value where the log
+    knows it (its own earlier turns and sets).
     """
     moves = reversals = iterations = out_of_order = hints = undos = refused = 0
     last_dir: dict[str, int] = {}
