@@ -19,7 +19,7 @@ How it is built, per stage of the exercise:
    each control in the run (a lead screw finished from the side its original last move came
    from, so the carriage takes up the backlash the same way) and the run's last reading: the
    instrument ends in the state the run left it in, in a few page actions instead of hundreds
-   (:func:`robot_stats`; e12: 467 actions, the operator's 6 940).
+   (:func:`robot_stats`; e12: 467 actions instead of the exact operator's 6 967).
 3. **Finished.** Where the stage's residual y-parallax at the six standard points (stages 2, 3,
    C2, C3) still exceeds half its tolerance, the robot clears it by least squares on the five
    elements of relative orientation (κ_л, κ_п, k_α,л, k_α,п, k_ω,п), Gauss–Newton on the true
