@@ -60,6 +60,7 @@ __all__ = [
     "compact",
     "robot_script",
     "robot_stats",
+    "without_sides",
 ]
 
 #: Stages graded on the residual y-parallax at the six standard points.
@@ -291,6 +292,37 @@ def _robot_run(session: Any) -> OperatorRun:
         _finish(stage, inst, session.prep, _commanded(inst), ex.unusable_points)
 
     return operator_run(prep, session.seed, ex.stages[-1], after_stage=finish)
+
+
+#: The pre-position of :func:`without_sides`: this far beyond the target before the last stroke
+#: (assumed: well beyond the backlash of the instruments' screws, 0.005–0.02 mm). [mm]
+PRE_POSITION_MM = 0.2
+
+
+def without_sides(script: list[dict[str, Any]], session: Any) -> list[dict[str, Any]]:
+    """The script with each ``side`` of a lead screw's setting replaced by a plain setting
+    :data:`PRE_POSITION_MM` beyond the target on that side, then the target (what the side
+    does inside the instrument, ``PlayAxis.approach``): for a page without a "finish from"
+    choice. A setting whose pre-position would pass a stop, a setting of the height scale H and
+    the needle are left plain (their move's own direction finishes them; the grade does not
+    read the needle; every shipped exercise still passes, ``tests/trainer``)."""
+    out: list[dict[str, Any]] = []
+    for a in script:
+        side = a.get("side")
+        if side is None:
+            out.append(a)
+            continue
+        if a["kind"] != "set" or a["control"] not in SCREWS:  # the needle, the height scale
+            out.append({k: v for k, v in a.items() if k != "side"})
+            continue
+        lo, hi = sorted(
+            float(np.asarray(session.inst.reading_of(a["control"], v)).reshape(-1)[0])
+            for v in session.inst.travel_mm(a["control"])
+        )
+        pre = a["value"] - PRE_POSITION_MM if side == "below" else a["value"] + PRE_POSITION_MM
+        plain = {k: v for k, v in a.items() if k != "side"}
+        out += [{**plain, "value": round(pre, 6)}, plain] if lo <= pre <= hi else [plain]
+    return out
 
 
 def robot_stats(session: Any, script: list[dict[str, Any]]) -> dict[str, int]:
