@@ -409,6 +409,8 @@ def stage_check_names(session: Session) -> dict[str, list[str]]:
     out: dict[str, list[str]] = {}
     for name, check in session.par.run.results.items():
         stage = check_stage(name)
+        if stage == "5" and session.exercise.method == "conventional":
+            stage = "C4"  # the conventional method's sheet checks are named "stage 5"
         if stage is not None and check.tolerance is not None:
             out.setdefault(stage, []).append(name)
     return out

@@ -111,3 +111,12 @@ def test_a_refusal_names_the_instrument_never_a_server_path():
         message = str(exc.value)
         assert "instrument sd3" in message, message
         assert ".yaml" not in message and "/" not in message and "YAML" not in message
+
+
+@pytest.mark.parametrize(
+    ("name", "stage"), [("e02-conventional-c1", "C1"), ("e04-setup-stage4", "4")]
+)
+def test_every_stage_lists_its_checks_with_tolerances(name, stage):
+    state = Session.start(load_exercise(name), trainee="ann").state()
+    assert state["stage"] == stage
+    assert state["checks"] and all(c["tolerance"] > 0 for c in state["checks"])
