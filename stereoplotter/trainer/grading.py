@@ -16,7 +16,12 @@
   seed; trial 0 is the par), run vectorised over the trials in chunks; the percentile of a
   measure is the share of them whose value is no better (≥) than the trainee's, in %.
 
-The overall score is the largest value/tolerance over the exercise's measures (≤ 1 passes).
+The overall score is the largest value/tolerance over the exercise's measures. Points: the
+outcome's points less the hints' cost (:mod:`~stereoplotter.trainer.grade_tables`); passed when
+every stage is claimed, the score is ≤ 1 and the points reach ``PASS_POINTS``. The grade also
+carries the per-point tables and the y-parallax map (``tables``), the process per stage with
+time from the stage's first action (``process_by_stage``) and the checks skipped by name
+(``process.skipped_checks``).
 """
 
 from __future__ import annotations
@@ -32,9 +37,16 @@ from stereoplotter.procedure.operator import Noise
 from stereoplotter.procedure.run import PreparedRun, build_run
 from stereoplotter.trainer.actions import apply
 from stereoplotter.trainer.exercise import Exercise
+from stereoplotter.trainer.grade_tables import (
+    PASS_POINTS,
+    hint_cost,
+    outcome_points,
+    point_tables,
+    stage_process,
+)
 from stereoplotter.trainer.operator_steps import new_instrument, stage_functions
 from stereoplotter.trainer.outcome import Measure, stage_measures
-from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session, json_finite
+from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session, check_stage, json_finite
 
 __all__ = [
     "GRADE_FORMAT",
@@ -64,6 +76,7 @@ def population_measures(
     injected: dict[str, Any],
     chunk: int = CHUNK,
     progress: Callable[[int], None] | None = None,
+    unusable: tuple[int, ...] = (),
 ) -> dict[str, dict[str, np.ndarray]]:
     """The measures of ``stages`` for ``trials`` simulated operators on one instrument.
 
@@ -88,9 +101,8 @@ def population_measures(
         for name, fn in stage_functions(run, prep.method).items():
             fn()
             if name in out:
-                out[name].append(
-                    {m.name: np.asarray(m.value, float) for m in stage_measures(inst, prep, name)}
-                )
+                measures = stage_measures(inst, prep, name, unusable)
+                out[name].append({m.name: np.asarray(m.value, float) for m in measures})
             if name == last:
                 break
         if progress is not None:
@@ -105,17 +117,21 @@ def _sign(x: float) -> int:
     return 1 if x > 0 else -1 if x < 0 else 0
 
 
+_Controls = dict[str, set[str]] | None
+_Checks = dict[str, list[str]] | None
+
+
 def process_measures(
-    actions: list[dict[str, Any]], stage_controls: dict[str, set[str]] | None = None
+    actions: list[dict[str, Any]], stage_controls: _Controls = None, stage_checks: _Checks = None
 ) -> dict[str, Any]:
     """Process measures of a sequence of log records (or bare actions with a ``stage``).
 
     The final approach of a lead screw is the side its last move finished from: the ``side`` of
-    the action when given, else the direction of the move.
-
-    ``stage_controls``: stage → the controls the simulated operator turns in it (for "out of
-    order"). Moves are ``turn`` and ``set`` actions; a ``set`` moves by the difference from the
-    control's previous value where the log knows it (its own earlier turns and sets).
+    the action when given, else the direction of the move. ``stage_controls``: stage → the
+    controls the simulated operator turns in it (for "out of order"); ``stage_checks``: stage →
+    the names of its checks (the skipped ones are named). Moves are ``turn`` and ``set``
+    actions; a ``set`` moves by the difference from the control's previous value where the log
+    knows it (its own earlier turns and sets).
     """
     moves = reversals = iterations = out_of_order = hints = undos = refused = 0
     last_dir: dict[str, int] = {}
@@ -180,10 +196,23 @@ def process_measures(
         "iterations": iterations,
         "steps_out_of_order": out_of_order,
         "checks_skipped": sum(1 for s in claimed if reads_in.get(s, 0) == 0),
+        "skipped_checks": _skipped(claimed, reads_in, stage_checks or {}),
         "hints": hints,
         "undos": undos,
         "refused": refused,
     }
+
+
+def _skipped(
+    claimed: list[str], reads_in: dict[str, int], stage_checks: dict[str, list[str]]
+) -> list[str]:
+    """The names of the checks of each stage claimed without a counter read in it."""
+    return [
+        name
+        for s in claimed
+        if reads_in.get(s, 0) == 0
+        for name in (stage_checks.get(s) or [f"stage {s}: no counter read"])
+    ]
 
 
 def _measure_row(m: Measure, par: Measure | None, pop: np.ndarray | None) -> dict[str, Any]:
@@ -214,7 +243,7 @@ def _par_measures(session: Session) -> dict[str, list[Measure]]:
         for a in session.par.stage_actions(stage):
             apply(inst, a, commanded)
         if stage in session.stages:
-            out[stage] = stage_measures(inst, session.prep, stage)
+            out[stage] = stage_measures(inst, session.prep, stage, session.exercise.unusable_points)
     return out
 
 
@@ -237,7 +266,7 @@ def _outcome(
                 pop_ratio = r if pop_ratio is None else np.maximum(pop_ratio, r)
         inst = session.at_claim.get(stage, session.inst)
         rows = []
-        for m in stage_measures(inst, session.prep, stage):
+        for m in stage_measures(inst, session.prep, stage, ex.unusable_points):
             rows.append(_measure_row(m, par_by_name.get(m.name), pop_by_name.get(m.name)))
             ratios.append(rows[-1]["value"] / m.tolerance)
         if stage in SUBSTITUTE_STAGES:
@@ -277,6 +306,7 @@ def grade(
             population,
             session.inst.injected,
             progress=progress,
+            unusable=ex.unusable_points,
         )
         if population
         else {}
@@ -288,11 +318,9 @@ def grade(
         s: {a["control"] for a in session.par.stage_actions(s) if "control" in a} for s in ex.stages
     }
     script = _par_script(session)
-    overall: dict[str, Any] = {
-        "score": score,
-        "passed": bool(score <= 1.0 and all(s["claimed"] for s in stages_out.values())),
-        "par_score": max(par_ratios) if par_ratios else None,
-    }
+    checks = stage_check_names(session)
+    hints = hint_cost(ex.stages, session.log)
+    overall = _overall(score, stages_out, par_ratios, hints["total"])
     if pop_ratio is not None:
         pct = percentile(score, pop_ratio)
         overall["percentile"] = pct
@@ -313,8 +341,16 @@ def grade(
             "errors": ex.errors,
             "stages": stages_out,
             "overall": overall,
-            "process": process_measures(session.log, controls),
-            "par_process": process_measures(script, controls),
+            "process": process_measures(session.log, controls, checks),
+            "par_process": process_measures(script, controls, checks),
+            "process_by_stage": stage_process(
+                session.log,
+                ex.stages,
+                lambda records, c: process_measures(records, c, checks),
+                controls,
+            ),
+            "hints": hints,
+            "tables": point_tables(session),
             "population": {
                 "operators": population,
                 "seconds": round(pop_seconds, 3),
@@ -344,6 +380,40 @@ def _substitute_row(session: Session, n: int) -> dict[str, Any]:
         "par": 0.0,
         "par_passed": True,
     }
+
+
+def _overall(
+    score: float, stages_out: dict[str, Any], par_ratios: list[float], hint_total: float
+) -> dict[str, Any]:
+    """Score, points after the hints' cost and the verdict (``grade_tables``' rule)."""
+    earned = outcome_points(score)
+    points = max(0.0, earned - hint_total)
+    return {
+        "score": score,
+        "passed": bool(
+            score <= 1.0
+            and all(s["claimed"] for s in stages_out.values())
+            and points >= PASS_POINTS
+        ),
+        "par_score": max(par_ratios) if par_ratios else None,
+        "outcome_points": earned,
+        "hint_cost": hint_total,
+        "points": round(points, 3),
+        "pass_points": PASS_POINTS,
+        "within_tolerance": bool(score <= 1.0),
+    }
+
+
+def stage_check_names(session: Session) -> dict[str, list[str]]:
+    """Stage → the names of the procedure's checks in it (the simulated operator's run)."""
+    out: dict[str, list[str]] = {}
+    for name, check in session.par.run.results.items():
+        stage = check_stage(name)
+        if stage == "5" and session.exercise.method == "conventional":
+            stage = "C4"  # the conventional method's sheet checks are named "stage 5"
+        if stage is not None and check.tolerance is not None:
+            out.setdefault(stage, []).append(name)
+    return out
 
 
 def _par_script(session: Session) -> list[dict[str, Any]]:
