@@ -31,6 +31,7 @@ from stereoplotter.instrument.kinematics import (
 from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
 from stereoplotter.procedure import steps
+from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.floor import control_heights_of
 from stereoplotter.procedure.operator import Operator, Scene, solve_1d
 from stereoplotter.procedure.records import (
@@ -129,11 +130,14 @@ def stage1_scale_coefficient(run: Run) -> None:
     its, ok, res = span_loop(run, "1", "1/L", units_at_zero=True)
     name = "stage 1: |L − L′|"
     if run.remedial:  # R1: "otherwise the setting is repeated", with averaged pointings
+        remedy = "R1 repeat the setting"
         failed = ~ok
-        r_its, _, r_res = span_loop(
-            run, "1", "1/L/R1", True, failed, steps.REPEAT_POINTINGS, "R1 repeat the setting"
-        )
-        res = np.where(failed, r_res, res)
+        with compacted(run, failed) as cut:  # on the trials that failed only
+            r_its, _, r_res = span_loop(
+                cut.run, "1", "1/L/R1", True, cut.active, steps.REPEAT_POINTINGS, remedy
+            )
+        r_its = cut.put(np.zeros_like(its), r_its)
+        res = cut.put(res, r_res)
         its = its + np.where(failed, r_its, 0)
     run.record_stage("1", its)
     run.check(name, res, sheet.tolerances["mark_span_mm"], iterations=its)
@@ -422,7 +426,6 @@ def refine_relative_orientation(
     """
     op = run.op
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    imgs = run.scene.standard
     remedy = "R2 refine the relative orientation"
     active = op.v(failed).astype(bool)
     rounds = np.zeros(np.shape(active), int)
@@ -431,34 +434,42 @@ def refine_relative_orientation(
         if not np.any(active):
             break
         rounds = np.where(active, it, rounds)
-        jac = _q_jacobian(run, imgs)
-        jt = np.swapaxes(jac, -1, -2)
-        delta = -np.linalg.solve(jt @ jac, (jt @ seen[..., None]))[..., 0]
-        for j, control in enumerate(Q_ELEMENTS):
-            before = op.physical(control)
-            op.drive(control, before + delta[..., j], active)
-            op.log.add(
-                stage,
-                f"turn {control} by the least-squares clearing of the six q seen",
-                control,
-                before=before,
-                after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "tan",
-                iteration=it,
-                equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
-                remedy=remedy,
-                when=active,
-            )
-        new = np.stack(
-            steps.judge_standard_points(
-                run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
-            ),
-            axis=-1,
-        )
-        seen = np.where(active[..., None], new, seen)
-        worst = np.where(active, np.max(np.abs(new), axis=-1), worst)
+        with compacted(run, active) as cut:  # the round on the trials still failing only
+            new = _r2_round(cut.run, stage, it, cut.take(seen), cut.active, remedy)
+        seen = cut.put(seen, new)
+        worst = cut.put(worst, np.max(np.abs(new), axis=-1))
         active = active & (worst > tol)
     return rounds, worst
+
+
+def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArray[np.float64]:
+    """One round of R2 on ``active``: the least-squares turns from the six q seen, then the six
+    points judged again; the q seen, (..., 6). [mm]"""
+    op = run.op
+    jac = _q_jacobian(run, run.scene.standard)
+    jt = np.swapaxes(jac, -1, -2)
+    delta = -np.linalg.solve(jt @ jac, (jt @ seen[..., None]))[..., 0]
+    for j, control in enumerate(Q_ELEMENTS):
+        before = op.physical(control)
+        op.drive(control, before + delta[..., j], active)
+        op.log.add(
+            stage,
+            f"turn {control} by the least-squares clearing of the six q seen",
+            control,
+            before=before,
+            after=op.physical(control),
+            unit="rad" if control.startswith("kappa") else "tan",
+            iteration=it,
+            equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
+            remedy=remedy,
+            when=active,
+        )
+    return np.stack(
+        steps.judge_standard_points(
+            run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
+        ),
+        axis=-1,
+    )
 
 
 # --- stage 3 ---------------------------------------------------------------------------------
@@ -728,12 +739,14 @@ def refine_scale_and_level(
         if not np.any(active):
             break
         rounds = np.where(active, it, rounds)
-        _refine_scale(run, it, active, remedy)
-        level = _read_control_heights(run, rows, f"3/R3/{it}/level", active, remedy, it)
-        _level(run, design, [op.v(0.0) * 0.0, *level], it, active, remedy)
-        errs = _read_control_heights(run, rows, f"3/R3/{it}/check", active, remedy, it)
-        new = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
-        worst = np.where(active, new, worst)
+        with compacted(run, active) as cut:  # the round on the trials still failing only
+            sub, on = cut.run, cut.active
+            _refine_scale(sub, it, on, remedy)
+            level = _read_control_heights(sub, rows, f"3/R3/{it}/level", on, remedy, it)
+            _level(sub, design, [sub.op.v(0.0) * 0.0, *level], it, on, remedy)
+            errs = _read_control_heights(sub, rows, f"3/R3/{it}/check", on, remedy, it)
+            new = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
+        worst = cut.put(worst, new)
         active = active & (worst > tol)
     return rounds, worst
 

@@ -1,0 +1,232 @@
+"""Compaction: a remedy round run on the failing trials of a chunk only.
+
+A remedy (R1, R2, R3 of the setup-data method; CR1, CR2 of the conventional method) works on
+the trials whose check failed. With masks alone every act of a round still costs the whole
+chunk: the arrays are (T,) and the inactive trials are carried along. :func:`compacted` cuts
+the run down to the active trials — the instrument's state (every per-trial array of its
+scales, axes, units and injected errors), the operator's (commanded knobs, stops) and the zero
+readings — runs the round on that sub-run, and scatters the new state back.
+
+The operator's judgment noise stays keyed by the trial index (:class:`SubsetNoise` takes the
+chunk's keyed draws at the sub-run's trials), so a trial draws the same numbers compacted or not.
+One difference from the masked round is by design: a masked round also re-sets the screws of
+the trials at rest to their present reading (``Operator.set`` and ``drive`` turn every trial,
+the inactive ones to where they are), which can move a nut by the last bit of the reading's
+round trip through its scale; a compacted round leaves the trials at rest untouched, as the
+docstring of :mod:`~stereoplotter.procedure.setup_method` says ("a trial whose loop has passed
+is left alone"). ``tests/procedure/test_compaction.py`` compares both on the same trials.
+
+Runs of fewer than :data:`COMPACT_MIN_TRIALS` trials are not compacted (a single procedure, the
+per-trial oracle and the small pinned runs keep the masked arithmetic).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.procedure.operator import Noise
+from stereoplotter.procedure.run import Run
+from stereoplotter.procedure.transcript import Transcript
+
+__all__ = ["COMPACT_MIN_TRIALS", "Cut", "SubsetNoise", "compacted", "scatter"]
+
+#: Smallest chunk that is compacted (a convention: below it the copies cost about what the
+#: inactive trials would). [trials]
+COMPACT_MIN_TRIALS = 64
+
+#: Instrument attributes without per-trial state (not walked).
+_FIXED = frozenset({"spec", "errors", "options", "variant", "backend", "ideal_mechanics"})
+
+
+class SubsetNoise(Noise):
+    """The keyed noise of trials ``index`` of a parent :class:`Noise` (shape (n,))."""
+
+    def __init__(self, parent: Noise, index: NDArray[np.intp]):
+        super().__init__(parent.seed, len(index), None, parent.first_trial)
+        self.parent = parent
+        self.index = index
+
+    def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
+        return self.parent.normal(key, sigma)[self.index]
+
+
+def _walkable(value: Any) -> bool:
+    return type(value).__module__.startswith("stereoplotter.") and not isinstance(value, type)
+
+
+def _attributes(value: Any) -> list[str]:
+    if dataclasses.is_dataclass(value):
+        return [f.name for f in dataclasses.fields(value)]
+    names = list(getattr(value, "__dict__", {}))
+    for cls in type(value).__mro__:
+        names += [s for s in getattr(cls, "__slots__", ()) if s not in ("__dict__", "__weakref__")]
+    return names
+
+
+def _rebuilt(value: Any, changes: dict[str, Any]) -> Any:
+    if not changes:
+        return value
+    out = copy.copy(value)
+    for name, v in changes.items():
+        object.__setattr__(out, name, v)
+    return out
+
+
+def _take(value: Any, index: NDArray[np.intp], trials: int) -> Any:
+    """``value`` with every per-trial array (leading axis ``trials``) cut to ``index``."""
+    if isinstance(value, np.ndarray):
+        return value[index] if value.ndim and value.shape[0] == trials else value
+    if isinstance(value, dict):
+        return {k: _take(v, index, trials) for k, v in value.items()}
+    if isinstance(value, list | tuple) and not hasattr(value, "_fields"):
+        return type(value)(_take(v, index, trials) for v in value)
+    if _walkable(value):
+        changes = {}
+        for name in _attributes(value):
+            if not hasattr(value, name):
+                continue
+            old = getattr(value, name)
+            new = _take(old, index, trials)
+            if new is not old:
+                changes[name] = new
+        return _rebuilt(value, changes)
+    return value
+
+
+def scatter(whole: Any, part: Any, index: NDArray[np.intp], trials: int) -> Any:
+    """``whole`` with the trials ``index`` replaced by ``part`` (:func:`_take`'s inverse)."""
+    if part is whole:
+        return whole
+    if isinstance(part, np.ndarray) and part.ndim and part.shape[0] == len(index):
+        if isinstance(whole, np.ndarray) and whole.ndim and whole.shape[0] == trials:
+            out = whole.astype(np.result_type(whole, part), copy=True)
+        else:  # a value common to the trials that the sub-run made per trial
+            shape = (trials, *part.shape[1:])
+            out = np.broadcast_to(np.asarray(whole, np.result_type(whole, part)), shape).copy()
+        out[index] = part
+        return out
+    if isinstance(part, dict) and isinstance(whole, dict):
+        return {**whole, **{k: scatter(whole.get(k), v, index, trials) for k, v in part.items()}}
+    if isinstance(part, list | tuple) and type(part) is type(whole) and len(part) == len(whole):
+        if hasattr(part, "_fields"):
+            return part
+        return type(whole)(scatter(w, p, index, trials) for w, p in zip(whole, part, strict=True))
+    if _walkable(part) and type(part) is type(whole):
+        changes = {}
+        for name in _attributes(part):
+            if not hasattr(part, name):
+                continue
+            old = getattr(whole, name)
+            new = scatter(old, getattr(part, name), index, trials)
+            if new is not old:
+                changes[name] = new
+        return _rebuilt(whole, changes)
+    return part  # a state common to all trials (a scalar) set by the sub-run
+
+
+def _sub_run(run: Run, index: NDArray[np.intp]) -> Run:
+    op, trials = run.op, run.op.trials
+    inst = copy.copy(op.inst)
+    for name, value in vars(op.inst).items():
+        if name not in _FIXED:
+            setattr(inst, name, _take(value, index, trials))
+    inst.trials = len(index)
+    inst._unit_maps = {}  # a cache of the parent's units
+    log = Transcript(enabled=False)
+    where = np.flatnonzero(index == op.log.shown)
+    if op.log.enabled and where.size:
+        log = Transcript(shown=int(where[0]))
+        log.records = op.log.records  # one transcript: the records go on in order
+    sub_op = copy.copy(op)
+    sub_op.inst, sub_op.log, sub_op.trials = inst, log, len(index)
+    sub_op.noise = SubsetNoise(op.noise, index)
+    sub_op.commanded = _take(op.commanded, index, trials)
+    sub_op.stopped = _take(op.stopped, index, trials)
+    sub_op._stops = _take(op._stops, index, trials)
+    sub = copy.copy(run)
+    sub.op = sub_op
+    sub.zero = _take(run.zero, index, trials)
+    sub.results, sub.stages = _take(run.results, index, trials), _take(run.stages, index, trials)
+    sub.remedies = _take(run.remedies, index, trials)
+    return sub
+
+
+def _merge(run: Run, sub: Run, index: NDArray[np.intp]) -> None:
+    op, trials = run.op, run.op.trials
+    for name, value in vars(sub.op.inst).items():
+        if name in _FIXED or name in ("trials", "_unit_maps"):
+            continue
+        setattr(op.inst, name, scatter(getattr(op.inst, name, None), value, index, trials))
+    op.inst._unit_maps = {}
+    for control, value in sub.op.commanded.items():
+        old = op.commanded.get(control)
+        if old is None:  # first turned in the sub-run (a knob, a cassette): the others are
+            old = op.physical(control)  # where they physically are, as ``drive`` takes them
+        op.commanded[control] = scatter(old, value, index, trials)
+    for control, value in sub.op.stopped.items():
+        old = op.stopped.get(control, np.zeros(trials, bool))
+        op.stopped[control] = scatter(old, value, index, trials)
+    # the stops' readings: a cache of the scales, the parent's own where it has them
+    op._stops = {
+        k: scatter(v, sub.op._stops[k], index, trials) if k in sub.op._stops else v
+        for k, v in op._stops.items()
+    }
+    run.zero = scatter(run.zero, sub.zero, index, trials)
+    run.results = scatter(run.results, sub.results, index, trials)
+    run.stages = scatter(run.stages, sub.stages, index, trials)
+    run.remedies = scatter(run.remedies, sub.remedies, index, trials)
+
+
+class Cut:
+    """A compacted round: ``run`` (the sub-run), ``active`` (its mask), ``take`` and ``put``."""
+
+    def __init__(
+        self, run: Run, active: NDArray[np.bool_], index: NDArray[np.intp] | None, trials: int
+    ):
+        self.run = run
+        self.active = active
+        self.index = index
+        self._trials = trials
+
+    def take(self, value: Any) -> Any:
+        """A per-trial array of the whole run cut to the sub-run's trials."""
+        if self.index is None:
+            return value
+        return _take(value, self.index, self._trials)
+
+    def put(self, whole: Any, part: Any) -> NDArray[Any]:
+        """``whole`` (over the run's trials) with the sub-run's trials replaced by ``part``."""
+        if self.index is None:
+            mask = np.asarray(self.active, bool)
+            part, whole = np.asarray(part), np.asarray(whole)
+            ndim = max(part.ndim, whole.ndim)
+            return np.where(mask.reshape(mask.shape + (1,) * (ndim - mask.ndim)), part, whole)
+        return scatter(np.asarray(whole), np.asarray(part), self.index, self._trials)
+
+
+@contextmanager
+def compacted(run: Run, active: NDArray[np.bool_]) -> Iterator[Cut]:
+    """``with compacted(run, active) as cut:`` a round on the active trials (``cut.run``).
+
+    ``cut.run`` is the run cut to the trials of ``active`` — or ``run`` itself, masked by
+    ``cut.active``, when all are active, the run is a single procedure or it has fewer than
+    :data:`COMPACT_MIN_TRIALS` trials; ``cut.take(x)`` cuts a per-trial array of the caller to
+    the sub-run, ``cut.put(whole, part)`` puts a sub-run's result back. On leaving, the
+    sub-run's state is written back into ``run``.
+    """
+    trials = run.op.trials
+    mask = np.asarray(active, bool)
+    if not trials or trials < COMPACT_MIN_TRIALS or mask.all():
+        yield Cut(run, mask, None, trials)
+        return
+    index = np.flatnonzero(mask)
+    sub = _sub_run(run, index)
+    yield Cut(sub, sub.op.all(), index, trials)
+    _merge(run, sub, index)
