@@ -37,11 +37,12 @@ from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_
 from stereoplotter.procedure.trials import (
     DEFAULT_MEMORY_BUDGET_MB,
     chunk_trials_for,
-    iter_trial_chunks,
+    default_workers,
+    iter_chunk_columns,
     run_info,
+    split_chunk,
     summarise_columns,
     summarise_result,
-    trial_columns,
 )
 from stereoplotter.report.plain_data import json_ready
 from stereoplotter.report.simulation import simulation_markdown, trial0_texts
@@ -113,6 +114,7 @@ def run_simulation_command(
     practice: str = "operator",
     options: Sequence[str] = (),
     lang: str = "en",
+    workers: int | None = None,
 ) -> SimulationOutcome:
     """What ``stereoplotter simulate`` does: run, summarise, write the files if ``output``.
 
@@ -124,7 +126,9 @@ def run_simulation_command(
     ``practice`` is "operator" (remedies after a failed check) or "book" (§27 task 1, none).
     ``options`` names the SC complex's options fitted to the SC-1 (``correction_unit``,
     ``automatic_coordinatograph``; :class:`~stereoplotter.instrument.sc1_complex.SC1Options`).
-    ``lang`` (``"ru"``/``"en"``) is the language of the transcript.
+    ``lang`` (``"ru"``/``"en"``) is the language of the transcript. ``workers``: processes for
+    the chunks (default :func:`~stereoplotter.procedure.trials.default_workers`; the results do
+    not depend on it).
     """
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
@@ -149,15 +153,17 @@ def run_simulation_command(
         if progress is not None:
             progress(1)
     else:
-        chunk = chunk_trials_for(memory_mb, method)
+        workers = default_workers() if workers is None else workers
+        chunk = split_chunk(trials, chunk_trials_for(memory_mb, method), workers)
         log.info("%d trials in chunks of %d (memory budget %g MB)", trials, chunk, memory_mb)
         info = None
         with TrialStore() as store:
-            for result in iter_trial_chunks(prep, trials, chunk, progress=progress):
-                if info is None:  # the first chunk: trial 0's transcript and map
+            chunks = iter_chunk_columns(prep, trials, chunk, workers=workers, progress=progress)
+            for result, columns in chunks:
+                if result is not None:  # the first chunk: trial 0's transcript and map
                     info = run_info(result, trials)
                     trial0 = _trial0_files(result, lang) if out is not None else {}
-                store.append(trial_columns(result))
+                store.append(columns)
             extra = {"chunks": {"trials": chunk, "count": -(-trials // chunk)}}
             summary = json_ready(summarise_columns(info, store.columns(), extra))
             files = {}
