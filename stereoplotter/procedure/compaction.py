@@ -202,31 +202,40 @@ class Cut:
         return _take(value, self.index, self._trials)
 
     def put(self, whole: Any, part: Any) -> NDArray[Any]:
-        """``whole`` (over the run's trials) with the sub-run's trials replaced by ``part``."""
+        """``whole`` (over the run's trials) with the sub-run's *active* trials replaced by
+        ``part`` (``np.where(active, part, whole)`` of the masked round)."""
+        mask = np.asarray(self.active, bool)
+        part, whole = np.asarray(part), np.asarray(whole)
         if self.index is None:
-            mask = np.asarray(self.active, bool)
-            part, whole = np.asarray(part), np.asarray(whole)
             ndim = max(part.ndim, whole.ndim)
             return np.where(mask.reshape(mask.shape + (1,) * (ndim - mask.ndim)), part, whole)
-        return scatter(np.asarray(whole), np.asarray(part), self.index, self._trials)
+        return scatter(whole, part[mask], self.index[mask], self._trials)
 
 
 @contextmanager
 def compacted(run: Run, active: NDArray[np.bool_]) -> Iterator[Cut]:
     """``with compacted(run, active) as cut:`` a round on the active trials (``cut.run``).
 
-    ``cut.run`` is the run cut to the trials of ``active`` — or ``run`` itself, masked by
-    ``cut.active``, when all are active, the run is a single procedure or it has fewer than
-    :data:`COMPACT_MIN_TRIALS` trials; ``cut.take(x)`` cuts a per-trial array of the caller to
-    the sub-run, ``cut.put(whole, part)`` puts a sub-run's result back. On leaving, the
-    sub-run's state is written back into ``run``.
+    ``cut.run`` is the run cut to the trials of ``active`` and the transcript's trial (kept
+    whether active or not, so that its records are those of the masked round) — or ``run``
+    itself when that is all of them, the run is a single procedure or it has fewer than
+    :data:`COMPACT_MIN_TRIALS` trials; ``cut.active`` is the mask within ``cut.run``;
+    ``cut.take(x)`` cuts a per-trial array of the caller to the sub-run, ``cut.put(whole,
+    part)`` puts a sub-run's result back at its active trials. On leaving, the sub-run's state
+    is written back into ``run``.
     """
     trials = run.op.trials
     mask = np.asarray(active, bool)
-    if not trials or trials < COMPACT_MIN_TRIALS or mask.all():
+    if not trials or trials < COMPACT_MIN_TRIALS:
         yield Cut(run, mask, None, trials)
         return
-    index = np.flatnonzero(mask)
+    keep = mask.copy()
+    if run.op.log.enabled:  # the transcript's trial goes along, masked as before
+        keep[run.op.log.shown] = True
+    if keep.all():
+        yield Cut(run, mask, None, trials)
+        return
+    index = np.flatnonzero(keep)
     sub = _sub_run(run, index)
-    yield Cut(sub, sub.op.all(), index, trials)
+    yield Cut(sub, mask[index], index, trials)
     _merge(run, sub, index)

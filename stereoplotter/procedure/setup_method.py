@@ -258,28 +258,12 @@ def stage2_transform(run: Run) -> None:
     worst = op.v(np.nan)
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
-        if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
-            l_its, _, _ = span_loop(run, "2", f"2/L{it}", active=active)
+        with compacted(run, active) as cut:  # the trials whose mark 4 is still off only
+            l_its, new = _stage2_round(cut.run, it, cut.active, tol4)
+        if it > 1:  # D5: the L-check repeated with the units set
+            l_its = cut.put(np.zeros(np.shape(active), int), l_its)
             run.record_stage("1", run.stage_iterations("1") + np.where(active, l_its, 0))
-        else:  # with the correction units still at zero the cassette centre is on the plumb
-            _zero_readings(run, "2/MO")
-        seen = []
-        for side in ("left", "right"):
-            _fit_knob(run, side, "omega", "3", f"2/{it}/{side}/omega", active)
-            m4 = _mark4(run, side, f"2/{it}/{side}/m4", active)
-            seen.append(m4)
-            op.log.add(
-                "2",
-                f"{side} photo: check mark 4 at MO_Y{',п' if side == 'right' else ''} + n·y⁰₄",
-                "Y",
-                residual=m4,
-                tolerance=tol4,
-                passed=np.abs(m4) <= tol4,
-                iteration=it,
-                equation="(6.12)",
-            )
-        new = np.maximum(np.abs(seen[0]), np.abs(seen[1]))
-        worst = np.where(active, new, worst)
+        worst = cut.put(worst, new)
         active = active & ~(worst <= tol4)
         if not np.any(active):
             break
@@ -311,6 +295,35 @@ def stage2_transform(run: Run) -> None:
     check_standard_points(run, "2")
 
 
+def _stage2_round(run: Run, it: int, active, tol4: float):
+    """One pass of stage 2's k_ω loop on ``active``: (from the second on) the L-check again
+    with the units set (D5), or the zero readings; k_ω fitted and mark 4 checked on both
+    photos. Returns the L-check's iterations (None on the first pass) and the worst mark-4
+    offset seen. [—, mm]"""
+    op = run.op
+    l_its = None
+    if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
+        l_its, _, _ = span_loop(run, "2", f"2/L{it}", active=active)
+    else:  # with the correction units still at zero the cassette centre is on the plumb
+        _zero_readings(run, "2/MO")
+    seen = []
+    for side in ("left", "right"):
+        _fit_knob(run, side, "omega", "3", f"2/{it}/{side}/omega", active)
+        m4 = _mark4(run, side, f"2/{it}/{side}/m4", active)
+        seen.append(m4)
+        op.log.add(
+            "2",
+            f"{side} photo: check mark 4 at MO_Y{',п' if side == 'right' else ''} + n·y⁰₄",
+            "Y",
+            residual=m4,
+            tolerance=tol4,
+            passed=np.abs(m4) <= tol4,
+            iteration=it,
+            equation="(6.12)",
+        )
+    return l_its, np.maximum(np.abs(seen[0]), np.abs(seen[1]))
+
+
 def _table_settings(principle: str, control: str) -> str:
     """On an instrument with several decentrations per tilt (the SPR-3's photo, correction
     mechanism and follower), the ones this setting stands for (from the tables)."""
@@ -339,40 +352,48 @@ def clear_kappa(run: Run, stage: str) -> None:
     its = np.zeros(np.shape(active), int)
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
-        qs = []
-        for idx, side in ((0, "right"), (1, "left")):
-            key = f"{stage}/kappa/{it}/{idx + 1}"
-            img = (imgs[0][idx], imgs[1][idx])
-            q_seen, q_true = op.fuse(pts[idx], img, key, active)
-            qs.append(q_seen)
-            control = f"kappa_{side}"
-            target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
-            q_of = op.q_turning(control, img)  # q with κ turned, the rest as it is now
-            ok_here = np.abs(q_seen) <= tol
-            move = active & ~ok_here if it > 1 else active
-            kappa = op.physical(control)
-            new = _solve_kappa(q_of, kappa, target)
-            op.drive(control, new, move)
-            op.log.add(
-                stage,
-                f"standard point {idx + 1}: clear the y-parallax with κ_{_SIDE[side]}",
-                control,
-                before=kappa,
-                after=op.physical(control),
-                unit="rad",
-                residual=q_seen,
-                true=q_true,
-                judgment_error=q_seen - q_true,
-                tolerance=tol,
-                passed=ok_here,
-                iteration=it,
-                equation="decision D8",
-            )
-        ok = (np.abs(qs[0]) <= tol) & (np.abs(qs[1]) <= tol)
-        active = active & ~ok
+        with compacted(run, active) as cut:  # the trials whose q is still beyond ¼ mark only
+            ok = _kappa_round(cut.run, stage, it, cut.active, pts, imgs, tol)
+        active = active & ~cut.put(np.zeros(np.shape(active), bool), ok)
         if it > 1 and not np.any(active):
             break
     run.record_stage(f"{stage}/kappa", its)
+
+
+def _kappa_round(run: Run, stage: str, it: int, active, pts, imgs, tol: float):
+    """One pass of D8 on ``active``: q at standard point 1 cleared with κ_п, at point 2 with
+    κ_л; whether both were within ¼ mark as seen before the turns."""
+    op = run.op
+    qs = []
+    for idx, side in ((0, "right"), (1, "left")):
+        key = f"{stage}/kappa/{it}/{idx + 1}"
+        img = (imgs[0][idx], imgs[1][idx])
+        q_seen, q_true = op.fuse(pts[idx], img, key, active)
+        qs.append(q_seen)
+        control = f"kappa_{side}"
+        target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+        q_of = op.q_turning(control, img)  # q with κ turned, the rest as it is now
+        ok_here = np.abs(q_seen) <= tol
+        move = active & ~ok_here if it > 1 else active
+        kappa = op.physical(control)
+        new = _solve_kappa(q_of, kappa, target)
+        op.drive(control, new, move)
+        op.log.add(
+            stage,
+            f"standard point {idx + 1}: clear the y-parallax with κ_{_SIDE[side]}",
+            control,
+            before=kappa,
+            after=op.physical(control),
+            unit="rad",
+            residual=q_seen,
+            true=q_true,
+            judgment_error=q_seen - q_true,
+            tolerance=tol,
+            passed=ok_here,
+            iteration=it,
+            equation="decision D8",
+        )
+    return (np.abs(qs[0]) <= tol) & (np.abs(qs[1]) <= tol)
 
 
 def _solve_kappa(q_of, kappa0, target):
