@@ -37,6 +37,7 @@ from stereoplotter.instrument.kinematics import (
     turn_correction_knob,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.operator import solve_1d
 from stereoplotter.procedure.relative_equations import (
     overcorrection_factor,
@@ -838,21 +839,26 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
     h_worst = _worst(errs) if errs else op.v(0.0)
     h_failed = h_worst > tol
     if errs and np.any(h_failed):
-        again = _slip_and_read_heights(run, rows, heights, "C3/CR1", h_failed, pointings, CR1)
-        h_worst = np.where(h_failed, _worst(again), h_worst)
+        with compacted(run, h_failed) as cut:  # CR1 on the trials that failed only
+            again = _slip_and_read_heights(
+                cut.run, rows, heights, "C3/CR1", cut.active, pointings, CR1
+            )
+        h_worst = cut.put(h_worst, _worst(again))
     seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
     q_worst = _worst(seen)
     q_failed = q_worst > tol_q
     rounds = np.zeros(np.shape(q_failed), int)
     if relative_fn is not None and np.any(q_failed):
-        r_its, _ = _masked(run, q_failed, relative_fn, cal, "C3/CR2/ro")
-        rounds = np.where(q_failed, r_its, 0)
-        seen = judge_standard_points(run, "C3", "C3/CR2/std", q_failed, text=_SIX_Q)
-        q_worst = np.where(q_failed, _worst(seen), q_worst)
-        _level(run, cal, rows, "C3/CR2", q_failed, pointings, 1, CR2)
-        errs = _slip_and_read_heights(run, rows, heights, "C3/CR2", q_failed, pointings, CR2)
+        with compacted(run, q_failed) as cut:  # CR2 on the trials that failed only
+            sub, on = cut.run, cut.active
+            r_its, _ = _masked(sub, on, relative_fn, cal, "C3/CR2/ro")
+            seen = judge_standard_points(sub, "C3", "C3/CR2/std", on, text=_SIX_Q)
+            _level(sub, cal, rows, "C3/CR2", on, pointings, 1, CR2)
+            errs = _slip_and_read_heights(sub, rows, heights, "C3/CR2", on, pointings, CR2)
+        rounds = cut.put(rounds, r_its)
+        q_worst = cut.put(q_worst, _worst(seen))
         if errs:
-            h_worst = np.where(q_failed, _worst(errs), h_worst)
+            h_worst = cut.put(h_worst, _worst(errs))
     run.check(name_h, h_worst, tol, unit="m")
     run.check(name_q, q_worst, tol_q)
     run.record_remedy(CR1, name_h, h_failed, np.where(h_failed, pointings, 0))
@@ -860,14 +866,19 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
 
 
 def _masked(run, active, relative_fn, cal, key0):
-    """The relative orientation for the trials still ``active`` only (the others stay)."""
-    op = run.op
-    saved = op.all
-    op.all = lambda: active.copy()
-    try:
-        return relative_fn(run, cal, stage="C3", key0=key0)
-    finally:
-        op.all = saved
+    """The relative orientation for the trials still ``active`` only (the others stay): run on
+    those trials alone (:func:`~stereoplotter.procedure.compaction.compacted`), masked within.
+    Returns its iterations and worst |q| (0 and NaN where not ``active``)."""
+    with compacted(run, active) as cut:
+        op = cut.run.op
+        saved = op.all
+        on = cut.active
+        op.all = lambda: on.copy()
+        try:
+            its, worst = relative_fn(cut.run, cal, stage="C3", key0=key0)
+        finally:
+            op.all = saved
+    return cut.put(np.zeros(np.shape(active), int), its), cut.put(run.op.v(np.nan), worst)
 
 
 def c4_sheet(run) -> None:
