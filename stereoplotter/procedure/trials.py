@@ -34,6 +34,7 @@ from stereoplotter.statistics import scale_summary, summarise_flags, summarise_v
 __all__ = [
     "BYTES_PER_TRIAL",
     "DEFAULT_MEMORY_BUDGET_MB",
+    "PARALLEL_MIN_CHUNK",
     "RunInfo",
     "chunk_trials_for",
     "default_workers",
@@ -106,18 +107,26 @@ def default_workers() -> int:
         return max(1, os.cpu_count() or 1)
 
 
+#: Smallest chunk cut for the worker processes (a convention: below it a chunk's fixed cost,
+#: ≈ 0.1 s of Python per pass of the procedure, is as large as its trials'). [trials]
+PARALLEL_MIN_CHUNK = 1000
+
+
 def split_chunk(trials: int, chunk_trials: int, workers: int) -> int:
     """Trials per chunk with ``workers`` processes: the memory budget's chunk, cut so that each
-    process gets at least two chunks (the last chunks then end together).
+    process gets about two chunks (the last ones then end together), not below
+    :data:`PARALLEL_MIN_CHUNK`; a run of at most that many trials is not cut.
 
     Examples
     --------
     >>> split_chunk(100_000, 8000, 2), split_chunk(10_000, 8000, 2), split_chunk(10_000, 8000, 1)
     (8000, 2500, 8000)
+    >>> split_chunk(30, 8000, 2), split_chunk(3000, 8000, 2)
+    (8000, 1000)
     """
-    if workers <= 1:
+    if workers <= 1 or trials <= PARALLEL_MIN_CHUNK:
         return chunk_trials
-    return max(1, min(chunk_trials, -(-trials // (2 * workers))))
+    return min(chunk_trials, max(-(-trials // (2 * workers)), PARALLEL_MIN_CHUNK))
 
 
 #: The prepared run of the forked chunk workers (set before the pool forks).
