@@ -11,7 +11,7 @@ Load (scenario, instrument, errors, operator: :mod:`stereoplotter.io`) → run
 map by :mod:`stereoplotter.plotting`) → write (:mod:`stereoplotter.io.atomic_write`). Every file
 is written whole or not at all; the same seed gives byte-identical files. Imported by
 :mod:`stereoplotter.commands.simulate` (and ``demo``) only when the command runs, so the library
-is imported here at the top.
+is imported here at the top — but for the plotting, which only a written map needs.
 """
 
 from __future__ import annotations
@@ -30,8 +30,6 @@ from stereoplotter.io.operator_file import load_operator_model
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.trial_store import TrialStore
 from stereoplotter.io.yaml_output import yaml_text
-from stereoplotter.plotting.encode import figure_bytes
-from stereoplotter.plotting.figures import plot_residual_y_parallax
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import (
@@ -59,6 +57,10 @@ log = logging.getLogger(__name__)
 
 def _parallax_png(result: SimulationResult) -> bytes:
     """The true residual y-parallax over the working-area grid (trial 0) as a PNG."""
+    # imported here: matplotlib (≈ 1.5 s of start-up) only where a map is written (-o)
+    from stereoplotter.plotting.encode import figure_bytes
+    from stereoplotter.plotting.figures import plot_residual_y_parallax
+
     return figure_bytes(plot_residual_y_parallax(result), "png", dpi=100)
 
 

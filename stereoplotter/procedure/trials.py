@@ -114,19 +114,19 @@ PARALLEL_MIN_CHUNK = 1000
 
 def split_chunk(trials: int, chunk_trials: int, workers: int) -> int:
     """Trials per chunk with ``workers`` processes: the memory budget's chunk, cut so that each
-    process gets about two chunks (the last ones then end together), not below
-    :data:`PARALLEL_MIN_CHUNK`; a run of at most that many trials is not cut.
+    process gets a chunk (a chunk has a fixed cost of its own: as few as the processes need),
+    not below :data:`PARALLEL_MIN_CHUNK`; a run of at most that many trials is not cut.
 
     Examples
     --------
     >>> split_chunk(100_000, 8000, 2), split_chunk(10_000, 8000, 2), split_chunk(10_000, 8000, 1)
-    (8000, 2500, 8000)
-    >>> split_chunk(30, 8000, 2), split_chunk(3000, 8000, 2)
+    (8000, 5000, 8000)
+    >>> split_chunk(30, 8000, 2), split_chunk(1500, 8000, 2)
     (8000, 1000)
     """
     if workers <= 1 or trials <= PARALLEL_MIN_CHUNK:
         return chunk_trials
-    return min(chunk_trials, max(-(-trials // (2 * workers)), PARALLEL_MIN_CHUNK))
+    return min(chunk_trials, max(-(-trials // workers), PARALLEL_MIN_CHUNK))
 
 
 #: The prepared run of the forked chunk workers (set before the pool forks).
@@ -172,6 +172,7 @@ def iter_chunk_columns(
     try:
         result = run_trials_chunk(prep, 0, sizes[0], evaluate=evaluate, transcript=True)
         yield result, trial_columns(result)
+        del result  # the caller keeps what it needs of the first chunk
         if progress is not None:
             progress(sizes[0])
         for k, (first, n) in enumerate(zip(starts[1:], sizes[1:], strict=True)):

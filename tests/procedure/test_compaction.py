@@ -78,7 +78,7 @@ def test_chunks_in_worker_processes_give_the_columns_of_this_process(pair):
             np.testing.assert_array_equal(a[name], b[name], err_msg=name)
 
 
-def test_chunk_cut_gives_each_process_two_chunks():
-    assert split_chunk(10_000, 8000, 2) == 2500
+def test_chunk_cut_gives_each_process_a_chunk():
+    assert split_chunk(10_000, 8000, 2) == 5000
     assert split_chunk(100_000, 8000, 2) == 8000
     assert split_chunk(10_000, 8000, 1) == 8000
