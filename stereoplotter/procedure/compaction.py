@@ -57,17 +57,39 @@ class SubsetNoise(Noise):
         return self.parent.normal(key, sigma)[self.index]
 
 
-def _walkable(value: Any) -> bool:
-    return type(value).__module__.startswith("stereoplotter.") and not isinstance(value, type)
+#: Per type: (walked, fixed attribute names, a dataclass). A stereoplotter class is walked: a
+#: dataclass by its fields, another object by its ``__dict__`` and slots.
+_TYPES: dict[type, tuple[bool, list[str], bool]] = {}
+
+#: What a cut took that cannot change in place (arrays, frozen dataclasses): id(part) → (part,
+#: whole), so that :func:`scatter` leaves alone what the sub-run did not replace.
+Memo = dict[int, tuple[Any, Any]]
 
 
-def _attributes(value: Any) -> list[str]:
-    if dataclasses.is_dataclass(value):
-        return [f.name for f in dataclasses.fields(value)]
-    names = list(getattr(value, "__dict__", {}))
-    for cls in type(value).__mro__:
-        names += [s for s in getattr(cls, "__slots__", ()) if s not in ("__dict__", "__weakref__")]
-    return names
+def _attributes(value: Any) -> list[str] | None:
+    """The attribute names of a walked object, None for any other value."""
+    kind = type(value)
+    entry = _TYPES.get(kind)
+    if entry is None:
+        walked = kind.__module__.startswith("stereoplotter.") and not isinstance(value, type)
+        is_dc = dataclasses.is_dataclass(value)
+        fixed = []
+        if walked:
+            fixed = [f.name for f in dataclasses.fields(value)] if is_dc else _slot_names(kind)
+        entry = _TYPES[kind] = (walked, fixed, is_dc)
+    walked, fixed, is_dc = entry
+    if not walked:
+        return None
+    if is_dc or not hasattr(value, "__dict__"):
+        return fixed
+    return [*vars(value), *fixed]
+
+
+def _slot_names(kind: type) -> list[str]:
+    out: list[str] = []
+    for cls in kind.__mro__:
+        out += [n for n in getattr(cls, "__slots__", ()) if n not in ("__dict__", "__weakref__")]
+    return out
 
 
 def _rebuilt(value: Any, changes: dict[str, Any]) -> Any:
@@ -79,31 +101,56 @@ def _rebuilt(value: Any, changes: dict[str, Any]) -> Any:
     return out
 
 
-def _take(value: Any, index: NDArray[np.intp], trials: int) -> Any:
+def _take(value: Any, index: NDArray[np.intp], trials: int, memo: Memo | None = None) -> Any:
     """``value`` with every per-trial array (leading axis ``trials``) cut to ``index``."""
     if isinstance(value, np.ndarray):
-        return value[index] if value.ndim and value.shape[0] == trials else value
-    if isinstance(value, dict):
-        return {k: _take(v, index, trials) for k, v in value.items()}
-    if isinstance(value, list | tuple) and not hasattr(value, "_fields"):
-        return type(value)(_take(v, index, trials) for v in value)
-    if _walkable(value):
+        if not (value.ndim and value.shape[0] == trials):
+            return value
+        out = value[index]
+    elif isinstance(value, dict):
+        out = {k: _take(v, index, trials, memo) for k, v in value.items()}
+    elif isinstance(value, list | tuple) and not hasattr(value, "_fields"):
+        out = type(value)(_take(v, index, trials, memo) for v in value)
+    else:
+        names = _attributes(value)
+        if names is None:
+            return value
         changes = {}
-        for name in _attributes(value):
+        for name in names:
             if not hasattr(value, name):
                 continue
             old = getattr(value, name)
-            new = _take(old, index, trials)
+            new = _take(old, index, trials, memo)
             if new is not old:
                 changes[name] = new
-        return _rebuilt(value, changes)
-    return value
+        out = _rebuilt(value, changes)
+        if out is value:
+            return value
+    if memo is not None and _immutable(out):
+        memo[id(out)] = (out, value)
+    return out
 
 
-def scatter(whole: Any, part: Any, index: NDArray[np.intp], trials: int) -> Any:
+def _immutable(value: Any) -> bool:
+    """An array (the state is replaced, never written into) or a frozen dataclass: a part
+    still in place after the sub-run is unchanged. Dicts and other objects are changed in
+    place (``inst._units[side] = …``, ``axis._car = …``) and always walked back."""
+    if isinstance(value, np.ndarray):
+        return True
+    params = getattr(type(value), "__dataclass_params__", None)
+    return bool(params is not None and params.frozen)
+
+
+def scatter(
+    whole: Any, part: Any, index: NDArray[np.intp], trials: int, memo: Memo | None = None
+) -> Any:
     """``whole`` with the trials ``index`` replaced by ``part`` (:func:`_take`'s inverse)."""
     if part is whole:
         return whole
+    if memo is not None:
+        hit = memo.get(id(part))
+        if hit is not None and hit[0] is part and hit[1] is whole:
+            return whole  # taken and left in place: unchanged
     if isinstance(part, np.ndarray) and part.ndim and part.shape[0] == len(index):
         if isinstance(whole, np.ndarray) and whole.ndim and whole.shape[0] == trials:
             out = whole.astype(np.result_type(whole, part), copy=True)
@@ -113,30 +160,35 @@ def scatter(whole: Any, part: Any, index: NDArray[np.intp], trials: int) -> Any:
         out[index] = part
         return out
     if isinstance(part, dict) and isinstance(whole, dict):
-        return {**whole, **{k: scatter(whole.get(k), v, index, trials) for k, v in part.items()}}
+        return {
+            **whole,
+            **{k: scatter(whole.get(k), v, index, trials, memo) for k, v in part.items()},
+        }
     if isinstance(part, list | tuple) and type(part) is type(whole) and len(part) == len(whole):
         if hasattr(part, "_fields"):
             return part
-        return type(whole)(scatter(w, p, index, trials) for w, p in zip(whole, part, strict=True))
-    if _walkable(part) and type(part) is type(whole):
+        pairs = zip(whole, part, strict=True)
+        return type(whole)(scatter(w, p, index, trials, memo) for w, p in pairs)
+    names = _attributes(part)
+    if names is not None and type(part) is type(whole):
         changes = {}
-        for name in _attributes(part):
+        for name in names:
             if not hasattr(part, name):
                 continue
             old = getattr(whole, name)
-            new = scatter(old, getattr(part, name), index, trials)
+            new = scatter(old, getattr(part, name), index, trials, memo)
             if new is not old:
                 changes[name] = new
         return _rebuilt(whole, changes)
     return part  # a state common to all trials (a scalar) set by the sub-run
 
 
-def _sub_run(run: Run, index: NDArray[np.intp]) -> Run:
+def _sub_run(run: Run, index: NDArray[np.intp], memo: Memo) -> Run:
     op, trials = run.op, run.op.trials
     inst = copy.copy(op.inst)
     for name, value in vars(op.inst).items():
-        if name not in _FIXED:
-            setattr(inst, name, _take(value, index, trials))
+        if name not in _FIXED and name != "_unit_maps":
+            setattr(inst, name, _take(value, index, trials, memo))
     inst.trials = len(index)
     inst._unit_maps = {}  # a cache of the parent's units
     log = Transcript(enabled=False)
@@ -147,41 +199,44 @@ def _sub_run(run: Run, index: NDArray[np.intp]) -> Run:
     sub_op = copy.copy(op)
     sub_op.inst, sub_op.log, sub_op.trials = inst, log, len(index)
     sub_op.noise = SubsetNoise(op.noise, index)
-    sub_op.commanded = _take(op.commanded, index, trials)
-    sub_op.stopped = _take(op.stopped, index, trials)
-    sub_op._stops = _take(op._stops, index, trials)
+    sub_op.commanded = _take(op.commanded, index, trials, memo)
+    sub_op.stopped = _take(op.stopped, index, trials, memo)
+    sub_op._stops = _take(op._stops, index, trials, memo)
     sub = copy.copy(run)
     sub.op = sub_op
-    sub.zero = _take(run.zero, index, trials)
-    sub.results, sub.stages = _take(run.results, index, trials), _take(run.stages, index, trials)
-    sub.remedies = _take(run.remedies, index, trials)
+    sub.zero = _take(run.zero, index, trials, memo)
+    sub.results, sub.stages = (
+        _take(run.results, index, trials, memo),
+        _take(run.stages, index, trials, memo),
+    )
+    sub.remedies = _take(run.remedies, index, trials, memo)
     return sub
 
 
-def _merge(run: Run, sub: Run, index: NDArray[np.intp]) -> None:
+def _merge(run: Run, sub: Run, index: NDArray[np.intp], memo: Memo) -> None:
     op, trials = run.op, run.op.trials
     for name, value in vars(sub.op.inst).items():
         if name in _FIXED or name in ("trials", "_unit_maps"):
             continue
-        setattr(op.inst, name, scatter(getattr(op.inst, name, None), value, index, trials))
-    op.inst._unit_maps = {}
+        setattr(op.inst, name, scatter(getattr(op.inst, name, None), value, index, trials, memo))
+    # the parent's unit maps stay: each is checked against its unit (by identity) when used
     for control, value in sub.op.commanded.items():
         old = op.commanded.get(control)
         if old is None:  # first turned in the sub-run (a knob, a cassette): the others are
             old = op.physical(control)  # where they physically are, as ``drive`` takes them
-        op.commanded[control] = scatter(old, value, index, trials)
+        op.commanded[control] = scatter(old, value, index, trials, memo)
     for control, value in sub.op.stopped.items():
         old = op.stopped.get(control, np.zeros(trials, bool))
-        op.stopped[control] = scatter(old, value, index, trials)
+        op.stopped[control] = scatter(old, value, index, trials, memo)
     # the stops' readings: a cache of the scales, the parent's own where it has them
     op._stops = {
-        k: scatter(v, sub.op._stops[k], index, trials) if k in sub.op._stops else v
+        k: scatter(v, sub.op._stops[k], index, trials, memo) if k in sub.op._stops else v
         for k, v in op._stops.items()
     }
-    run.zero = scatter(run.zero, sub.zero, index, trials)
-    run.results = scatter(run.results, sub.results, index, trials)
-    run.stages = scatter(run.stages, sub.stages, index, trials)
-    run.remedies = scatter(run.remedies, sub.remedies, index, trials)
+    run.zero = scatter(run.zero, sub.zero, index, trials, memo)
+    run.results = scatter(run.results, sub.results, index, trials, memo)
+    run.stages = scatter(run.stages, sub.stages, index, trials, memo)
+    run.remedies = scatter(run.remedies, sub.remedies, index, trials, memo)
 
 
 class Cut:
@@ -211,6 +266,13 @@ class Cut:
             return np.where(mask.reshape(mask.shape + (1,) * (ndim - mask.ndim)), part, whole)
         return scatter(whole, part[mask], self.index[mask], self._trials)
 
+    def put_all(self, whole: Any, part: Any) -> NDArray[Any]:
+        """``whole`` with every trial of the sub-run replaced by ``part`` (active or not: a
+        value the masked round computed for all its trials), ``part`` itself uncut."""
+        if self.index is None:
+            return np.asarray(part)
+        return scatter(np.asarray(whole), np.asarray(part), self.index, self._trials)
+
 
 @contextmanager
 def compacted(run: Run, active: NDArray[np.bool_]) -> Iterator[Cut]:
@@ -236,6 +298,7 @@ def compacted(run: Run, active: NDArray[np.bool_]) -> Iterator[Cut]:
         yield Cut(run, mask, None, trials)
         return
     index = np.flatnonzero(keep)
-    sub = _sub_run(run, index)
+    memo: Memo = {}
+    sub = _sub_run(run, index, memo)
     yield Cut(sub, mask[index], index, trials)
-    _merge(run, sub, index)
+    _merge(run, sub, index, memo)

@@ -504,57 +504,71 @@ def c2_relative_by_elements(
     """
 
     op, sheet = run.op, run.sheet
-    tol = sheet.tolerances["residual_y_parallax_mm"]
     over = float(overcorrection_factor(sheet.focal_length_corrected_mm, run.scene.c_mm))
-    pts = run.scene.standard_points_m
-    imgs = run.scene.images(pts)
     active = op.all()
     its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
     prev_rms = None
     for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
-        for idx, control, element in _SEQUENCE:
-            key = f"{key0}/a/{it}/{idx + 1}"
-            img = (imgs[0][idx], imgs[1][idx])
-            q_seen, q_true = op.fuse(pts[idx], img, key, active)
-            target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
-            before = op.physical(control)
-            clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
-            extra = ""
-            if element == "omega2":
-                clear = before + (1.0 + over) * (clear - before)
-                extra = f" and over-correct by {over:+.4f} of the turn"
-            _turn(op, control, clear, active)
-            op.log.add(
-                stage,
-                f"standard point {idx + 1}: clear the y-parallax with {control} "
-                f"({_BOOK[element]}){extra}",
-                control,
-                before=before,
-                after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "tan",
-                judgment_error=target,
-                residual=q_seen,
-                true=q_true,
-                tolerance=tol,
-                passed=np.abs(q_seen) <= tol,
-                iteration=it,
-                equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
-            )
-        seen = judge_standard_points(
-            run, stage, f"{key0}/a/{it}/check", active, iteration=it, text=_SIX_Q
-        )
-        worst = np.where(active, _worst(seen), worst)
-        rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
-        prev_rms = rms if prev_rms is None else np.where(active, rms, prev_rms)
-        active = active & ~done
+        with compacted(run, active) as cut:  # the trials still orienting only
+            on = cut.active
+            ahead = None if prev_rms is None else cut.take(prev_rms)
+            seen, rms, done = _c2_pass(cut.run, stage, key0, it, on, ahead, over)
+            going = on & ~done
+            moved = np.zeros(np.shape(on), bool)
+            if cal is not None and np.any(going):
+                moved = _transfer_common_tilt(cut.run, cal, going, stage, it)
+        worst = cut.put(worst, _worst(seen))
+        prev_rms = cut.put_all(op.v(np.nan), rms) if prev_rms is None else cut.put(prev_rms, rms)
+        active = active & ~cut.put(np.zeros(np.shape(active), bool), done)
+        prev_rms = np.where(cut.put(np.zeros(np.shape(active), bool), moved), np.nan, prev_rms)
         if not np.any(active):
             break
-        if cal is not None:
-            moved = _transfer_common_tilt(run, cal, active, stage, it)
-            prev_rms = np.where(moved, np.nan, prev_rms)
     return its, worst
+
+
+def _c2_pass(run, stage: str, key0: str, it: int, active, prev_rms, over: float):
+    """Pass ``it`` of C2 (a) on ``active``: the five points cleared element by element, then the
+    six looks and the stopping rule. Returns the six q seen, their RMS and the trials that stop
+    (:func:`_c2_stop`)."""
+    op = run.op
+    tol = run.sheet.tolerances["residual_y_parallax_mm"]
+    pts = run.scene.standard_points_m
+    imgs = run.scene.images(pts)
+    for idx, control, element in _SEQUENCE:
+        key = f"{key0}/a/{it}/{idx + 1}"
+        img = (imgs[0][idx], imgs[1][idx])
+        q_seen, q_true = op.fuse(pts[idx], img, key, active)
+        target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+        before = op.physical(control)
+        clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
+        extra = ""
+        if element == "omega2":
+            clear = before + (1.0 + over) * (clear - before)
+            extra = f" and over-correct by {over:+.4f} of the turn"
+        _turn(op, control, clear, active)
+        op.log.add(
+            stage,
+            f"standard point {idx + 1}: clear the y-parallax with {control} "
+            f"({_BOOK[element]}){extra}",
+            control,
+            before=before,
+            after=op.physical(control),
+            unit="rad" if control.startswith("kappa") else "tan",
+            judgment_error=target,
+            residual=q_seen,
+            true=q_true,
+            tolerance=tol,
+            passed=np.abs(q_seen) <= tol,
+            iteration=it,
+            equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
+        )
+    seen = judge_standard_points(
+        run, stage, f"{key0}/a/{it}/check", active, iteration=it, text=_SIX_Q
+    )
+    rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
+    return seen, rms, done
 
 
 def c2_relative_by_equations(
