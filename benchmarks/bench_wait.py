@@ -164,6 +164,7 @@ def profile(args: argparse.Namespace) -> None:
     stats.sort_stats("cumulative").print_stats(args.top)
     stats.sort_stats("tottime").print_stats(args.top)
     text = out.getvalue().replace(str(Path(stereoplotter.__file__).parent.parent) + "/", "")
+    text = text.replace(str(HERE.parent) + "/", "").replace(sys.prefix + "/", "<python>/")
     print(text)
     target = HERE / "profiles" / f"{args.name}-{args.label}.txt"
     target.parent.mkdir(exist_ok=True)
