@@ -35,11 +35,15 @@ from stereoplotter.procedure.operator import Noise
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.transcript import Transcript
 
-__all__ = ["COMPACT_MIN_TRIALS", "Cut", "SubsetNoise", "compacted", "scatter"]
+__all__ = ["COMPACT_MAX_SHARE", "COMPACT_MIN_TRIALS", "Cut", "SubsetNoise", "compacted", "scatter"]
 
 #: Smallest chunk that is compacted (a convention: below it the copies cost about what the
 #: inactive trials would). [trials]
 COMPACT_MIN_TRIALS = 64
+
+#: Largest share of a chunk's trials that is cut out for a round (a convention: a cut gathers
+#: and scatters ≈ 200 per-trial arrays, ≈ 3–7 ms; a round on nearly all trials gains less). [—]
+COMPACT_MAX_SHARE = 0.8
 
 #: Instrument attributes without per-trial state (not walked).
 _FIXED = frozenset({"spec", "errors", "options", "variant", "backend", "ideal_mechanics"})
@@ -280,8 +284,9 @@ def compacted(run: Run, active: NDArray[np.bool_]) -> Iterator[Cut]:
 
     ``cut.run`` is the run cut to the trials of ``active`` and the transcript's trial (kept
     whether active or not, so that its records are those of the masked round) — or ``run``
-    itself when that is all of them, the run is a single procedure or it has fewer than
-    :data:`COMPACT_MIN_TRIALS` trials; ``cut.active`` is the mask within ``cut.run``;
+    itself when they are more than :data:`COMPACT_MAX_SHARE` of them, the run is a single
+    procedure or it has fewer than :data:`COMPACT_MIN_TRIALS` trials; ``cut.active`` is the
+    mask within ``cut.run``;
     ``cut.take(x)`` cuts a per-trial array of the caller to the sub-run, ``cut.put(whole,
     part)`` puts a sub-run's result back at its active trials. On leaving, the sub-run's state
     is written back into ``run``.
@@ -294,7 +299,7 @@ def compacted(run: Run, active: NDArray[np.bool_]) -> Iterator[Cut]:
     keep = mask.copy()
     if run.op.log.enabled:  # the transcript's trial goes along, masked as before
         keep[run.op.log.shown] = True
-    if keep.all():
+    if keep.sum() > COMPACT_MAX_SHARE * trials:
         yield Cut(run, mask, None, trials)
         return
     index = np.flatnonzero(keep)

@@ -420,17 +420,21 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
 
 def _q_jacobian(run: Run, imgs) -> NDArray[np.float64]:
     """∂q/∂element at the six standard points for :data:`Q_ELEMENTS`, the rest of the
-    instrument as it is (the operator's knowledge of how each element moves q): (..., 6, 5)."""
+    instrument as it is (the operator's knowledge of how each element moves q): (..., 6, 5).
+
+    The six points in one evaluation per turn (points on a leading axis, trials on the last):
+    the point-dependent arithmetic is + − × ÷ only, so each value is the one of a point alone.
+    """
     op = run.op
+    left, right = (np.asarray(im, float) for im in imgs)
+    if op.trials:  # (6, 1, 2): the points broadcast against the trials' (T,) state
+        left, right = left[:, None, :], right[:, None, :]
+    h = 1e-6
     cols = []
     for control in Q_ELEMENTS:
         x0 = op.physical(control)
-        h = 1e-6
-        col = []
-        for i in range(6):
-            q_of = op.q_turning(control, (imgs[0][i], imgs[1][i]))
-            col.append((q_of(x0 + h) - q_of(x0 - h)) / (2.0 * h))
-        cols.append(np.stack(col, axis=-1))
+        q_of = op.q_turning(control, (left, right))
+        cols.append(np.moveaxis((q_of(x0 + h) - q_of(x0 - h)) / (2.0 * h), 0, -1))
     return np.stack(cols, axis=-1)
 
 
