@@ -1,7 +1,9 @@
-"""Compaction: a remedy round run on the failing trials of a chunk only.
+"""Compaction: a round of a bounded loop run on the trials of a chunk still in it only.
 
 A remedy (R1, R2, R3 of the setup-data method; CR1, CR2 of the conventional method) works on
-the trials whose check failed. With masks alone every act of a round still costs the whole
+the trials whose check failed, and each pass of a stage's loop (the L-check, stage 2's k_ω,
+D8's κ, C2's passes) on the trials still outside the tolerance. With masks alone every act of a
+round still costs the whole
 chunk: the arrays are (T,) and the inactive trials are carried along. :func:`compacted` cuts
 the run down to the active trials — the instrument's state (every per-trial array of its
 scales, axes, units and injected errors), the operator's (commanded knobs, stops) and the zero
@@ -9,15 +11,15 @@ readings — runs the round on that sub-run, and scatters the new state back.
 
 The operator's judgment noise stays keyed by the trial index (:class:`SubsetNoise` takes the
 chunk's keyed draws at the sub-run's trials), so a trial draws the same numbers compacted or not.
-One difference from the masked round is by design: a masked round also re-sets the screws of
-the trials at rest to their present reading (``Operator.set`` and ``drive`` turn every trial,
-the inactive ones to where they are), which can move a nut by the last bit of the reading's
-round trip through its scale; a compacted round leaves the trials at rest untouched, as the
-docstring of :mod:`~stereoplotter.procedure.setup_method` says ("a trial whose loop has passed
-is left alone"). ``tests/procedure/test_compaction.py`` compares both on the same trials.
+The trial of the transcript always goes along (masked as before), so its records are unchanged.
+Unlike a masked round, a compacted one does not re-set the screws of the other trials at rest
+to their present reading (``Operator.set`` and ``drive`` turn every trial); on the runs
+compared (``tests/procedure/test_compaction.py``; ``simulate --json`` of pair60 on the SC-1,
+SPR-3 and SD-3, both methods, against the masked code) the results were equal to the last bit.
 
 Runs of fewer than :data:`COMPACT_MIN_TRIALS` trials are not compacted (a single procedure, the
-per-trial oracle and the small pinned runs keep the masked arithmetic).
+per-trial oracle and the small pinned runs keep the masked arithmetic), nor rounds that keep
+more than :data:`COMPACT_MAX_SHARE` of the trials.
 """
 
 from __future__ import annotations
