@@ -89,6 +89,12 @@ def add_arguments(sub: Any) -> None:
         metavar="MB",
         help="memory budget of one chunk of trials (default: %(default)s MB)",
     )
+    p.add_argument(
+        "--workers",
+        type=positive_int,
+        help="processes that run the chunks of --trials (default: one per processor this "
+        "process may use; the results do not depend on it)",
+    )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument(
         "--lang",
@@ -122,6 +128,7 @@ def run(args: argparse.Namespace) -> int:
             memory_mb=LibraryDefault.of(args.memory_mb),
             progress=advance,
             lang=args.lang,
+            workers=args.workers,
         )
     sys.stdout.write(json_text(outcome.summary) if args.json else outcome.text)
     return 0

@@ -11,7 +11,7 @@ Load (scenario, instrument, errors, operator: :mod:`stereoplotter.io`) → run
 map by :mod:`stereoplotter.plotting`) → write (:mod:`stereoplotter.io.atomic_write`). Every file
 is written whole or not at all; the same seed gives byte-identical files. Imported by
 :mod:`stereoplotter.commands.simulate` (and ``demo``) only when the command runs, so the library
-is imported here at the top.
+is imported here at the top — but for the plotting, which only a written map needs.
 """
 
 from __future__ import annotations
@@ -30,18 +30,17 @@ from stereoplotter.io.operator_file import load_operator_model
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.trial_store import TrialStore
 from stereoplotter.io.yaml_output import yaml_text
-from stereoplotter.plotting.encode import figure_bytes
-from stereoplotter.plotting.figures import plot_residual_y_parallax
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import (
     DEFAULT_MEMORY_BUDGET_MB,
     chunk_trials_for,
-    iter_trial_chunks,
+    default_workers,
+    iter_chunk_columns,
     run_info,
+    split_chunk,
     summarise_columns,
     summarise_result,
-    trial_columns,
 )
 from stereoplotter.report.plain_data import json_ready
 from stereoplotter.report.simulation import simulation_markdown, trial0_texts
@@ -58,6 +57,10 @@ log = logging.getLogger(__name__)
 
 def _parallax_png(result: SimulationResult) -> bytes:
     """The true residual y-parallax over the working-area grid (trial 0) as a PNG."""
+    # imported here: matplotlib (≈ 1.5 s of start-up) only where a map is written (-o)
+    from stereoplotter.plotting.encode import figure_bytes
+    from stereoplotter.plotting.figures import plot_residual_y_parallax
+
     return figure_bytes(plot_residual_y_parallax(result), "png", dpi=100)
 
 
@@ -113,6 +116,7 @@ def run_simulation_command(
     practice: str = "operator",
     options: Sequence[str] = (),
     lang: str = "en",
+    workers: int | None = None,
 ) -> SimulationOutcome:
     """What ``stereoplotter simulate`` does: run, summarise, write the files if ``output``.
 
@@ -124,7 +128,9 @@ def run_simulation_command(
     ``practice`` is "operator" (remedies after a failed check) or "book" (§27 task 1, none).
     ``options`` names the SC complex's options fitted to the SC-1 (``correction_unit``,
     ``automatic_coordinatograph``; :class:`~stereoplotter.instrument.sc1_complex.SC1Options`).
-    ``lang`` (``"ru"``/``"en"``) is the language of the transcript.
+    ``lang`` (``"ru"``/``"en"``) is the language of the transcript. ``workers``: processes for
+    the chunks (default :func:`~stereoplotter.procedure.trials.default_workers`; the results do
+    not depend on it).
     """
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
@@ -149,15 +155,17 @@ def run_simulation_command(
         if progress is not None:
             progress(1)
     else:
-        chunk = chunk_trials_for(memory_mb, method)
+        workers = default_workers() if workers is None else workers
+        chunk = split_chunk(trials, chunk_trials_for(memory_mb, method), workers)
         log.info("%d trials in chunks of %d (memory budget %g MB)", trials, chunk, memory_mb)
         info = None
         with TrialStore() as store:
-            for result in iter_trial_chunks(prep, trials, chunk, progress=progress):
-                if info is None:  # the first chunk: trial 0's transcript and map
+            chunks = iter_chunk_columns(prep, trials, chunk, workers=workers, progress=progress)
+            for result, columns in chunks:
+                if result is not None:  # the first chunk: trial 0's transcript and map
                     info = run_info(result, trials)
                     trial0 = _trial0_files(result, lang) if out is not None else {}
-                store.append(trial_columns(result))
+                store.append(columns)
             extra = {"chunks": {"trials": chunk, "count": -(-trials // chunk)}}
             summary = json_ready(summarise_columns(info, store.columns(), extra))
             files = {}

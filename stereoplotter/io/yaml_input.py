@@ -88,7 +88,58 @@ class _BoundedLoader(yaml.SafeLoader):
 
 def _parse_yaml(text: str, source: str) -> Any:
     """``yaml.safe_load`` with the document checked (:func:`_check_document`) before it is
-    constructed, and every failure as a :class:`ConfigError`."""
+    constructed, and every failure as a :class:`ConfigError`.
+
+    Read with libyaml where PyYAML has it (:func:`_parse_fast`, ≈ 10× faster: the shipped
+    files are ≈ 60 % of ``stereoplotter info``); a document libyaml refuses, or that fails a
+    check, is read again by the pure-Python loader, whose messages (line, column, the
+    offending character) are the ones reported.
+    """
+    found = _parse_fast(text, source)
+    if found is not _FAILED:
+        return found
+    return _parse_python(text, source)
+
+
+#: :func:`_parse_fast` could not read the document (the pure-Python loader says why).
+_FAILED = object()
+
+
+def _parse_fast(text: str, source: str) -> Any:
+    """The document read by libyaml's parser (the same nodes, resolver and constructor as
+    :class:`_BoundedLoader`), or :data:`_FAILED`. Its depth is counted on the event stream
+    first, without recursion, so that no deep document reaches libyaml's recursive composer."""
+    if not getattr(yaml, "__with_libyaml__", False):
+        return _FAILED
+    try:
+        events = yaml.CSafeLoader(text)
+        try:
+            depth = 0
+            while events.check_event():
+                event = events.get_event()
+                if isinstance(event, yaml.CollectionStartEvent):
+                    depth += 1
+                    if depth > MAX_YAML_DEPTH + 1:
+                        return _FAILED
+                elif isinstance(event, yaml.CollectionEndEvent):
+                    depth -= 1
+        finally:
+            events.dispose()
+        loader = yaml.CSafeLoader(text)
+        try:
+            node = loader.get_single_node()
+            if node is None:
+                return None
+            _check_document(node, source)
+            return loader.construct_document(node)
+        finally:
+            loader.dispose()
+    except Exception:  # every failure is reported by the pure-Python loader
+        return _FAILED
+
+
+def _parse_python(text: str, source: str) -> Any:
+    """:func:`_parse_yaml` by PyYAML's pure-Python loader, bounded (:class:`_BoundedLoader`)."""
     try:
         loader = _BoundedLoader(text)  # the reader refuses control characters here
     except yaml.YAMLError as exc:

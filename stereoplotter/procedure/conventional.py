@@ -37,6 +37,7 @@ from stereoplotter.instrument.kinematics import (
     turn_correction_knob,
 )
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.operator import solve_1d
 from stereoplotter.procedure.relative_equations import (
     overcorrection_factor,
@@ -502,57 +503,71 @@ def c2_relative_by_elements(
     """
 
     op, sheet = run.op, run.sheet
-    tol = sheet.tolerances["residual_y_parallax_mm"]
     over = float(overcorrection_factor(sheet.focal_length_corrected_mm, run.scene.c_mm))
-    pts = run.scene.standard_points_m
-    imgs = run.scene.standard  # the standard points' true images, computed once
     active = op.all()
     its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
     prev_rms = None
     for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
-        for idx, control, element in _SEQUENCE:
-            key = f"{key0}/a/{it}/{idx + 1}"
-            img = (imgs[0][idx], imgs[1][idx])
-            q_seen, q_true = op.fuse(pts[idx], img, key, active)
-            target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
-            before = op.physical(control)
-            clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
-            extra = ""
-            if element == "omega2":
-                clear = before + (1.0 + over) * (clear - before)
-                extra = f" and over-correct by {over:+.4f} of the turn"
-            _turn(op, control, clear, active)
-            op.log.add(
-                stage,
-                f"standard point {idx + 1}: clear the y-parallax with {control} "
-                f"({_BOOK[element]}){extra}",
-                control,
-                before=before,
-                after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "tan",
-                judgment_error=target,
-                residual=q_seen,
-                true=q_true,
-                tolerance=tol,
-                passed=np.abs(q_seen) <= tol,
-                iteration=it,
-                equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
-            )
-        seen = judge_standard_points(
-            run, stage, f"{key0}/a/{it}/check", active, iteration=it, text=_SIX_Q
-        )
-        worst = np.where(active, _worst(seen), worst)
-        rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
-        prev_rms = rms if prev_rms is None else np.where(active, rms, prev_rms)
-        active = active & ~done
+        with compacted(run, active) as cut:  # the trials still orienting only
+            on = cut.active
+            ahead = None if prev_rms is None else cut.take(prev_rms)
+            seen, rms, done = _c2_pass(cut.run, stage, key0, it, on, ahead, over)
+            going = on & ~done
+            moved = np.zeros(np.shape(on), bool)
+            if cal is not None and np.any(going):
+                moved = _transfer_common_tilt(cut.run, cal, going, stage, it)
+        worst = cut.put(worst, _worst(seen))
+        prev_rms = cut.put_all(op.v(np.nan), rms) if prev_rms is None else cut.put(prev_rms, rms)
+        active = active & ~cut.put(np.zeros(np.shape(active), bool), done)
+        prev_rms = np.where(cut.put(np.zeros(np.shape(active), bool), moved), np.nan, prev_rms)
         if not np.any(active):
             break
-        if cal is not None:
-            moved = _transfer_common_tilt(run, cal, active, stage, it)
-            prev_rms = np.where(moved, np.nan, prev_rms)
     return its, worst
+
+
+def _c2_pass(run, stage: str, key0: str, it: int, active, prev_rms, over: float):
+    """Pass ``it`` of C2 (a) on ``active``: the five points cleared element by element, then the
+    six looks and the stopping rule. Returns the six q seen, their RMS and the trials that stop
+    (:func:`_c2_stop`)."""
+    op = run.op
+    tol = run.sheet.tolerances["residual_y_parallax_mm"]
+    pts = run.scene.standard_points_m
+    imgs = run.scene.standard  # the standard points' true images, computed once
+    for idx, control, element in _SEQUENCE:
+        key = f"{key0}/a/{it}/{idx + 1}"
+        img = (imgs[0][idx], imgs[1][idx])
+        q_seen, q_true = op.fuse(pts[idx], img, key, active)
+        target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+        before = op.physical(control)
+        clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
+        extra = ""
+        if element == "omega2":
+            clear = before + (1.0 + over) * (clear - before)
+            extra = f" and over-correct by {over:+.4f} of the turn"
+        _turn(op, control, clear, active)
+        op.log.add(
+            stage,
+            f"standard point {idx + 1}: clear the y-parallax with {control} "
+            f"({_BOOK[element]}){extra}",
+            control,
+            before=before,
+            after=op.physical(control),
+            unit="rad" if control.startswith("kappa") else "tan",
+            judgment_error=target,
+            residual=q_seen,
+            true=q_true,
+            tolerance=tol,
+            passed=np.abs(q_seen) <= tol,
+            iteration=it,
+            equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
+        )
+    seen = judge_standard_points(
+        run, stage, f"{key0}/a/{it}/check", active, iteration=it, text=_SIX_Q
+    )
+    rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
+    return seen, rms, done
 
 
 def c2_relative_by_equations(
@@ -837,21 +852,26 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
     h_worst = _worst(errs) if errs else op.v(0.0)
     h_failed = h_worst > tol
     if errs and np.any(h_failed):
-        again = _slip_and_read_heights(run, rows, heights, "C3/CR1", h_failed, pointings, CR1)
-        h_worst = np.where(h_failed, _worst(again), h_worst)
+        with compacted(run, h_failed) as cut:  # CR1 on the trials that failed only
+            again = _slip_and_read_heights(
+                cut.run, rows, heights, "C3/CR1", cut.active, pointings, CR1
+            )
+        h_worst = cut.put(h_worst, _worst(again))
     seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
     q_worst = _worst(seen)
     q_failed = q_worst > tol_q
     rounds = np.zeros(np.shape(q_failed), int)
     if relative_fn is not None and np.any(q_failed):
-        r_its, _ = _masked(run, q_failed, relative_fn, cal, "C3/CR2/ro")
-        rounds = np.where(q_failed, r_its, 0)
-        seen = judge_standard_points(run, "C3", "C3/CR2/std", q_failed, text=_SIX_Q)
-        q_worst = np.where(q_failed, _worst(seen), q_worst)
-        _level(run, cal, rows, "C3/CR2", q_failed, pointings, 1, CR2)
-        errs = _slip_and_read_heights(run, rows, heights, "C3/CR2", q_failed, pointings, CR2)
+        with compacted(run, q_failed) as cut:  # CR2 on the trials that failed only
+            sub, on = cut.run, cut.active
+            r_its, _ = _masked(sub, on, relative_fn, cal, "C3/CR2/ro")
+            seen = judge_standard_points(sub, "C3", "C3/CR2/std", on, text=_SIX_Q)
+            _level(sub, cal, rows, "C3/CR2", on, pointings, 1, CR2)
+            errs = _slip_and_read_heights(sub, rows, heights, "C3/CR2", on, pointings, CR2)
+        rounds = cut.put(rounds, r_its)
+        q_worst = cut.put(q_worst, _worst(seen))
         if errs:
-            h_worst = np.where(q_failed, _worst(errs), h_worst)
+            h_worst = cut.put(h_worst, _worst(errs))
     run.check(name_h, h_worst, tol, unit="m")
     run.check(name_q, q_worst, tol_q)
     run.record_remedy(CR1, name_h, h_failed, np.where(h_failed, pointings, 0))
@@ -859,14 +879,19 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
 
 
 def _masked(run, active, relative_fn, cal, key0):
-    """The relative orientation for the trials still ``active`` only (the others stay)."""
-    op = run.op
-    saved = op.all
-    op.all = lambda: active.copy()
-    try:
-        return relative_fn(run, cal, stage="C3", key0=key0)
-    finally:
-        op.all = saved
+    """The relative orientation for the trials still ``active`` only (the others stay): run on
+    those trials alone (:func:`~stereoplotter.procedure.compaction.compacted`), masked within.
+    Returns its iterations and worst |q| (0 and NaN where not ``active``)."""
+    with compacted(run, active) as cut:
+        op = cut.run.op
+        saved = op.all
+        on = cut.active
+        op.all = lambda: on.copy()
+        try:
+            its, worst = relative_fn(cut.run, cal, stage="C3", key0=key0)
+        finally:
+            op.all = saved
+    return cut.put(np.zeros(np.shape(active), int), its), cut.put(run.op.v(np.nan), worst)
 
 
 def c4_sheet(run) -> None:

@@ -31,6 +31,7 @@ from stereoplotter.instrument.kinematics import (
 from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
 from stereoplotter.procedure import steps
+from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.floor import control_heights_of
 from stereoplotter.procedure.operator import Operator, Scene, solve_1d
 from stereoplotter.procedure.records import (
@@ -129,11 +130,14 @@ def stage1_scale_coefficient(run: Run) -> None:
     its, ok, res = span_loop(run, "1", "1/L", units_at_zero=True)
     name = "stage 1: |L − L′|"
     if run.remedial:  # R1: "otherwise the setting is repeated", with averaged pointings
+        remedy = "R1 repeat the setting"
         failed = ~ok
-        r_its, _, r_res = span_loop(
-            run, "1", "1/L/R1", True, failed, steps.REPEAT_POINTINGS, "R1 repeat the setting"
-        )
-        res = np.where(failed, r_res, res)
+        with compacted(run, failed) as cut:  # on the trials that failed only
+            r_its, _, r_res = span_loop(
+                cut.run, "1", "1/L/R1", True, cut.active, steps.REPEAT_POINTINGS, remedy
+            )
+        r_its = cut.put(np.zeros_like(its), r_its)
+        res = cut.put(res, r_res)
         its = its + np.where(failed, r_its, 0)
     run.record_stage("1", its)
     run.check(name, res, sheet.tolerances["mark_span_mm"], iterations=its)
@@ -254,30 +258,12 @@ def stage2_transform(run: Run) -> None:
     worst = op.v(np.nan)
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
-        if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
-            l_its, _, _ = span_loop(run, "2", f"2/L{it}", active=active)
+        with compacted(run, active) as cut:  # the trials whose mark 4 is still off only
+            l_its, new = _stage2_round(cut.run, it, cut.active, tol4)
+        if it > 1:  # D5: the L-check repeated with the units set
+            l_its = cut.put(np.zeros(np.shape(active), int), l_its)
             run.record_stage("1", run.stage_iterations("1") + np.where(active, l_its, 0))
-        else:  # with the correction units still at zero the cassette centre is on the plumb
-            _zero_readings(run, "2/MO")
-            if op.inst.variant.decentrations_first:  # B2: the decentrations before the fits
-                _set_computed_decentrations(run)
-        seen = []
-        for side in ("left", "right"):
-            _fit_knob(run, side, "omega", "3", f"2/{it}/{side}/omega", active)
-            m4 = _mark4(run, side, f"2/{it}/{side}/m4", active)
-            seen.append(m4)
-            op.log.add(
-                "2",
-                f"{side} photo: check mark 4 at MO_Y{',п' if side == 'right' else ''} + n·y⁰₄",
-                "Y",
-                residual=m4,
-                tolerance=tol4,
-                passed=np.abs(m4) <= tol4,
-                iteration=it,
-                equation="(6.12)",
-            )
-        new = np.maximum(np.abs(seen[0]), np.abs(seen[1]))
-        worst = np.where(active, new, worst)
+        worst = cut.put(worst, new)
         active = active & ~(worst <= tol4)
         if not np.any(active):
             break
@@ -317,6 +303,37 @@ def _set_computed_decentrations(run: Run) -> None:
             )
 
 
+def _stage2_round(run: Run, it: int, active, tol4: float):
+    """One pass of stage 2's k_ω loop on ``active``: (from the second on) the L-check again
+    with the units set (D5), or the zero readings; k_ω fitted and mark 4 checked on both
+    photos. Returns the L-check's iterations (None on the first pass) and the worst mark-4
+    offset seen. [—, mm]"""
+    op = run.op
+    l_its = None
+    if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
+        l_its, _, _ = span_loop(run, "2", f"2/L{it}", active=active)
+    else:  # with the correction units still at zero the cassette centre is on the plumb
+        _zero_readings(run, "2/MO")
+        if op.inst.variant.decentrations_first:  # B2: the decentrations before the fits
+            _set_computed_decentrations(run)
+    seen = []
+    for side in ("left", "right"):
+        _fit_knob(run, side, "omega", "3", f"2/{it}/{side}/omega", active)
+        m4 = _mark4(run, side, f"2/{it}/{side}/m4", active)
+        seen.append(m4)
+        op.log.add(
+            "2",
+            f"{side} photo: check mark 4 at MO_Y{',п' if side == 'right' else ''} + n·y⁰₄",
+            "Y",
+            residual=m4,
+            tolerance=tol4,
+            passed=np.abs(m4) <= tol4,
+            iteration=it,
+            equation="(6.12)",
+        )
+    return l_its, np.maximum(np.abs(seen[0]), np.abs(seen[1]))
+
+
 def _table_settings(principle: str, control: str) -> str:
     """On an instrument with several decentrations per tilt (the SPR-3's photo, correction
     mechanism and follower), the ones this setting stands for (from the tables)."""
@@ -345,40 +362,48 @@ def clear_kappa(run: Run, stage: str) -> None:
     its = np.zeros(np.shape(active), int)
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
-        qs = []
-        for idx, side in ((0, "right"), (1, "left")):
-            key = f"{stage}/kappa/{it}/{idx + 1}"
-            img = (imgs[0][idx], imgs[1][idx])
-            q_seen, q_true = op.fuse(pts[idx], img, key, active)
-            qs.append(q_seen)
-            control = f"kappa_{side}"
-            target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
-            q_of = op.q_turning(control, img)  # q with κ turned, the rest as it is now
-            ok_here = np.abs(q_seen) <= tol
-            move = active & ~ok_here if it > 1 else active
-            kappa = op.physical(control)
-            new = _solve_kappa(q_of, kappa, target)
-            op.drive(control, new, move)
-            op.log.add(
-                stage,
-                f"standard point {idx + 1}: clear the y-parallax with κ_{_SIDE[side]}",
-                control,
-                before=kappa,
-                after=op.physical(control),
-                unit="rad",
-                residual=q_seen,
-                true=q_true,
-                judgment_error=q_seen - q_true,
-                tolerance=tol,
-                passed=ok_here,
-                iteration=it,
-                equation="decision D8",
-            )
-        ok = (np.abs(qs[0]) <= tol) & (np.abs(qs[1]) <= tol)
-        active = active & ~ok
+        with compacted(run, active) as cut:  # the trials whose q is still beyond ¼ mark only
+            ok = _kappa_round(cut.run, stage, it, cut.active, pts, imgs, tol)
+        active = active & ~cut.put(np.zeros(np.shape(active), bool), ok)
         if it > 1 and not np.any(active):
             break
     run.record_stage(f"{stage}/kappa", its)
+
+
+def _kappa_round(run: Run, stage: str, it: int, active, pts, imgs, tol: float):
+    """One pass of D8 on ``active``: q at standard point 1 cleared with κ_п, at point 2 with
+    κ_л; whether both were within ¼ mark as seen before the turns."""
+    op = run.op
+    qs = []
+    for idx, side in ((0, "right"), (1, "left")):
+        key = f"{stage}/kappa/{it}/{idx + 1}"
+        img = (imgs[0][idx], imgs[1][idx])
+        q_seen, q_true = op.fuse(pts[idx], img, key, active)
+        qs.append(q_seen)
+        control = f"kappa_{side}"
+        target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+        q_of = op.q_turning(control, img)  # q with κ turned, the rest as it is now
+        ok_here = np.abs(q_seen) <= tol
+        move = active & ~ok_here if it > 1 else active
+        kappa = op.physical(control)
+        new = _solve_kappa(q_of, kappa, target)
+        op.drive(control, new, move)
+        op.log.add(
+            stage,
+            f"standard point {idx + 1}: clear the y-parallax with κ_{_SIDE[side]}",
+            control,
+            before=kappa,
+            after=op.physical(control),
+            unit="rad",
+            residual=q_seen,
+            true=q_true,
+            judgment_error=q_seen - q_true,
+            tolerance=tol,
+            passed=ok_here,
+            iteration=it,
+            equation="decision D8",
+        )
+    return (np.abs(qs[0]) <= tol) & (np.abs(qs[1]) <= tol)
 
 
 def _solve_kappa(q_of, kappa0, target):
@@ -405,17 +430,21 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
 
 def _q_jacobian(run: Run, imgs) -> NDArray[np.float64]:
     """∂q/∂element at the six standard points for :data:`Q_ELEMENTS`, the rest of the
-    instrument as it is (the operator's knowledge of how each element moves q): (..., 6, 5)."""
+    instrument as it is (the operator's knowledge of how each element moves q): (..., 6, 5).
+
+    The six points in one evaluation per turn (points on a leading axis, trials on the last):
+    the point-dependent arithmetic is + − × ÷ only, so each value is the one of a point alone.
+    """
     op = run.op
+    left, right = (np.asarray(im, float) for im in imgs)
+    if op.trials:  # (6, 1, 2): the points broadcast against the trials' (T,) state
+        left, right = left[:, None, :], right[:, None, :]
+    h = 1e-6
     cols = []
     for control in Q_ELEMENTS:
         x0 = op.physical(control)
-        h = 1e-6
-        col = []
-        for i in range(6):
-            q_of = op.q_turning(control, (imgs[0][i], imgs[1][i]))
-            col.append((q_of(x0 + h) - q_of(x0 - h)) / (2.0 * h))
-        cols.append(np.stack(col, axis=-1))
+        q_of = op.q_turning(control, (left, right))
+        cols.append(np.moveaxis((q_of(x0 + h) - q_of(x0 - h)) / (2.0 * h), 0, -1))
     return np.stack(cols, axis=-1)
 
 
@@ -432,7 +461,6 @@ def refine_relative_orientation(
     """
     op = run.op
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    imgs = run.scene.standard
     remedy = "R2 refine the relative orientation"
     active = op.v(failed).astype(bool)
     rounds = np.zeros(np.shape(active), int)
@@ -441,34 +469,42 @@ def refine_relative_orientation(
         if not np.any(active):
             break
         rounds = np.where(active, it, rounds)
-        jac = _q_jacobian(run, imgs)
-        jt = np.swapaxes(jac, -1, -2)
-        delta = -np.linalg.solve(jt @ jac, (jt @ seen[..., None]))[..., 0]
-        for j, control in enumerate(Q_ELEMENTS):
-            before = op.physical(control)
-            op.drive(control, before + delta[..., j], active)
-            op.log.add(
-                stage,
-                f"turn {control} by the least-squares clearing of the six q seen",
-                control,
-                before=before,
-                after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "tan",
-                iteration=it,
-                equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
-                remedy=remedy,
-                when=active,
-            )
-        new = np.stack(
-            steps.judge_standard_points(
-                run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
-            ),
-            axis=-1,
-        )
-        seen = np.where(active[..., None], new, seen)
-        worst = np.where(active, np.max(np.abs(new), axis=-1), worst)
+        with compacted(run, active) as cut:  # the round on the trials still failing only
+            new = _r2_round(cut.run, stage, it, cut.take(seen), cut.active, remedy)
+        seen = cut.put(seen, new)
+        worst = cut.put(worst, np.max(np.abs(new), axis=-1))
         active = active & (worst > tol)
     return rounds, worst
+
+
+def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArray[np.float64]:
+    """One round of R2 on ``active``: the least-squares turns from the six q seen, then the six
+    points judged again; the q seen, (..., 6). [mm]"""
+    op = run.op
+    jac = _q_jacobian(run, run.scene.standard)
+    jt = np.swapaxes(jac, -1, -2)
+    delta = -np.linalg.solve(jt @ jac, (jt @ seen[..., None]))[..., 0]
+    for j, control in enumerate(Q_ELEMENTS):
+        before = op.physical(control)
+        op.drive(control, before + delta[..., j], active)
+        op.log.add(
+            stage,
+            f"turn {control} by the least-squares clearing of the six q seen",
+            control,
+            before=before,
+            after=op.physical(control),
+            unit="rad" if control.startswith("kappa") else "tan",
+            iteration=it,
+            equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
+            remedy=remedy,
+            when=active,
+        )
+    return np.stack(
+        steps.judge_standard_points(
+            run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
+        ),
+        axis=-1,
+    )
 
 
 # --- stage 3 ---------------------------------------------------------------------------------
@@ -738,12 +774,14 @@ def refine_scale_and_level(
         if not np.any(active):
             break
         rounds = np.where(active, it, rounds)
-        _refine_scale(run, it, active, remedy)
-        level = _read_control_heights(run, rows, f"3/R3/{it}/level", active, remedy, it)
-        _level(run, design, [op.v(0.0) * 0.0, *level], it, active, remedy)
-        errs = _read_control_heights(run, rows, f"3/R3/{it}/check", active, remedy, it)
-        new = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
-        worst = np.where(active, new, worst)
+        with compacted(run, active) as cut:  # the round on the trials still failing only
+            sub, on = cut.run, cut.active
+            _refine_scale(sub, it, on, remedy)
+            level = _read_control_heights(sub, rows, f"3/R3/{it}/level", on, remedy, it)
+            _level(sub, design, [sub.op.v(0.0) * 0.0, *level], it, on, remedy)
+            errs = _read_control_heights(sub, rows, f"3/R3/{it}/check", on, remedy, it)
+            new = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
+        worst = cut.put(worst, new)
         active = active & (worst > tol)
     return rounds, worst
 

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.instrument.virtual import NOMINAL_ZERO, Side
+from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.run import Run
 from stereoplotter.setup.equations import base_z_correction, height_correction
 
@@ -74,33 +75,53 @@ def span_loop(
     dl = dr = op.v(np.nan)
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
-        k = f"{key}/{it}"
-        meas_l = _measure_span(run, "left", k, active, pointings)
-        meas_r = _measure_span(run, "right", k, active, pointings)
-        dl = np.where(active, span_l - meas_l, dl)
-        dr = np.where(active, span_r - meas_r, dr)
+        with compacted(run, active) as cut:  # the trials still outside the tolerance only
+            dl_s, dr_s = _span_round(
+                cut.run, stage, f"{key}/{it}", it, cut.active, (span_l, span_r),
+                (cut.take(dl), cut.take(dr)), units_at_zero, pointings, remedy,
+            )  # fmt: skip
+        dl, dr = cut.put(dl, dl_s), cut.put(dr, dr_s)
         ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
-        for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
-            op.log.add(
-                stage,
-                f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} "
-                f"= {span:.3f} mm",
-                "Y",
-                reading=meas,
-                residual=d,
-                tolerance=tol,
-                passed=np.abs(d) <= tol,
-                iteration=it,
-                equation="(6.5)" if not units_at_zero else "(6.5), decision D5",
-                remedy=remedy,
-                when=active if remedy else None,
-            )
         active = active & ~ok
         if not np.any(active):
             break
-        _correct_span(run, stage, k, it, active, (dl, dr), (span_l, span_r), remedy)
     ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
     return its, ok, np.maximum(np.abs(dl), np.abs(dr))
+
+
+def _span_round(
+    run: Run, stage: str, k: str, it: int, active, spans, diffs, units_at_zero: bool,
+    pointings: int, remedy: str,
+) -> tuple[NDArray, NDArray]:  # fmt: skip
+    """One pass of the L-check on ``active``: measure L′ of both photos, log, and correct the
+    trials outside the tolerance; the differences L − L′ (kept where not ``active``). [mm]"""
+    op = run.op
+    tol = run.sheet.tolerances["mark_span_mm"]
+    span_l, span_r = spans
+    meas_l = _measure_span(run, "left", k, active, pointings)
+    meas_r = _measure_span(run, "right", k, active, pointings)
+    dl = np.where(active, span_l - meas_l, diffs[0])
+    dr = np.where(active, span_r - meas_r, diffs[1])
+    ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
+    for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
+        op.log.add(
+            stage,
+            f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} "
+            f"= {span:.3f} mm",
+            "Y",
+            reading=meas,
+            residual=d,
+            tolerance=tol,
+            passed=np.abs(d) <= tol,
+            iteration=it,
+            equation="(6.5)" if not units_at_zero else "(6.5), decision D5",
+            remedy=remedy,
+            when=active if remedy else None,
+        )
+    going = active & ~ok
+    if np.any(going):
+        _correct_span(run, stage, k, it, going, (dl, dr), spans, remedy)
+    return dl, dr
 
 
 def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy: str, active):

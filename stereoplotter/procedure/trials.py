@@ -16,7 +16,10 @@ Carlo standard errors (:mod:`stereoplotter.statistics`), never per-trial arrays.
 from __future__ import annotations
 
 import math
+import multiprocessing
+import os
 from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -31,11 +34,15 @@ from stereoplotter.statistics import scale_summary, summarise_flags, summarise_v
 __all__ = [
     "BYTES_PER_TRIAL",
     "DEFAULT_MEMORY_BUDGET_MB",
+    "PARALLEL_MIN_CHUNK",
     "RunInfo",
     "chunk_trials_for",
+    "default_workers",
+    "iter_chunk_columns",
     "iter_trial_chunks",
     "run_header",
     "run_info",
+    "split_chunk",
     "summarise_columns",
     "summarise_result",
     "trial_columns",
@@ -90,6 +97,100 @@ def iter_trial_chunks(
         yield result
         if progress is not None:
             progress(n)
+
+
+def default_workers() -> int:
+    """Processes for the chunks of a long run: the processors this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+#: Smallest chunk cut for the worker processes (a convention: below it a chunk's fixed cost,
+#: ≈ 0.1 s of Python per pass of the procedure, is as large as its trials'). [trials]
+PARALLEL_MIN_CHUNK = 1000
+
+
+def split_chunk(trials: int, chunk_trials: int, workers: int) -> int:
+    """Trials per chunk with ``workers`` processes: the memory budget's chunk, cut so that each
+    process gets a chunk (a chunk has a fixed cost of its own: as few as the processes need),
+    not below :data:`PARALLEL_MIN_CHUNK`; a run of at most that many trials is not cut.
+
+    Examples
+    --------
+    >>> split_chunk(100_000, 8000, 2), split_chunk(10_000, 8000, 2), split_chunk(10_000, 8000, 1)
+    (8000, 5000, 8000)
+    >>> split_chunk(30, 8000, 2), split_chunk(1500, 8000, 2)
+    (8000, 1000)
+    """
+    if workers <= 1 or trials <= PARALLEL_MIN_CHUNK:
+        return chunk_trials
+    return min(chunk_trials, max(-(-trials // workers), PARALLEL_MIN_CHUNK))
+
+
+#: The prepared run of the forked chunk workers (set before the pool forks).
+_PREPARED: list[tuple[PreparedRun, bool]] = []
+
+
+def _chunk_columns(first: int, n: int) -> dict[str, NDArray[Any]]:
+    prep, evaluate = _PREPARED[0]
+    return _columns_here(prep, first, n, evaluate)
+
+
+def iter_chunk_columns(
+    prep: PreparedRun,
+    trials: int,
+    chunk_trials: int,
+    *,
+    workers: int = 1,
+    evaluate: bool = True,
+    progress: Callable[[int], None] | None = None,
+) -> Iterator[tuple[SimulationResult | None, dict[str, NDArray[Any]]]]:
+    """Trials 0 … T−1 in chunks, as ``(result, columns)`` in trial order: the first chunk's
+    :class:`SimulationResult` (with trial 0's transcript) and then None, and each chunk's
+    :func:`trial_columns`.
+
+    With ``workers`` > 1 the chunks after the first run in that many forked processes while
+    this one runs the first. Every draw is keyed by the trial, so the columns are the same
+    whatever the workers and the chunks.
+    """
+    if trials < 1:
+        raise ValueError(f"trials: expected ≥ 1, found {trials}")
+    if chunk_trials < 1:
+        raise ValueError(f"chunk_trials: expected ≥ 1, found {chunk_trials}")
+    starts = list(range(0, trials, chunk_trials))
+    sizes = [min(chunk_trials, trials - f) for f in starts]
+    pool = None
+    futures: list[Future] = []
+    if workers > 1 and len(starts) > 1 and "fork" in multiprocessing.get_all_start_methods():
+        _PREPARED[:] = [(prep, evaluate)]  # inherited by the forked workers
+        context = multiprocessing.get_context("fork")
+        pool = ProcessPoolExecutor(max_workers=min(workers, len(starts) - 1), mp_context=context)
+        rest = zip(starts[1:], sizes[1:], strict=True)
+        futures = [pool.submit(_chunk_columns, f, n) for f, n in rest]
+    try:
+        result = run_trials_chunk(prep, 0, sizes[0], evaluate=evaluate, transcript=True)
+        yield result, trial_columns(result)
+        del result  # the caller keeps what it needs of the first chunk
+        if progress is not None:
+            progress(sizes[0])
+        for k, (first, n) in enumerate(zip(starts[1:], sizes[1:], strict=True)):
+            if pool is None:
+                columns = _columns_here(prep, first, n, evaluate)
+            else:
+                columns = futures[k].result()
+            yield None, columns
+            if progress is not None:
+                progress(n)
+    finally:
+        if pool is not None:
+            pool.shutdown(cancel_futures=True)
+            _PREPARED.clear()
+
+
+def _columns_here(prep: PreparedRun, first: int, n: int, evaluate: bool) -> dict[str, NDArray]:
+    return trial_columns(run_trials_chunk(prep, first, n, evaluate=evaluate, transcript=False))
 
 
 def _full(value: Any, trials: int, dtype: type = float) -> NDArray[Any]:

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-from scipy.optimize import brentq
 
 from stereoplotter.instrument.principles.base import (
     CorrectionMechanism,
@@ -51,6 +50,9 @@ class MechanicalProjection(CorrectionMechanism):
 
     def scale_numeric(self, f_mm, ta, to, ex, ey):
         t = float(np.hypot(ta, to))
+        # imported here: only this numeric cross-check needs scipy (≈ 1 s of start-up)
+        from scipy.optimize import brentq
+
         theta = brentq(lambda a: np.tan(a) - t, -0.1, 1.5, xtol=1e-15) if t else 0.0
         return float(f_mm / (f_mm - self.gimbal_offset_mm * (1.0 - np.cos(theta))))
 

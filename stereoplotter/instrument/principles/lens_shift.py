@@ -11,7 +11,6 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-from scipy.optimize import brentq
 
 from stereoplotter.instrument.principles.base import (
     CorrectionMechanism,
@@ -55,6 +54,9 @@ class LensShift(CorrectionMechanism):
     def scale_numeric(self, f_mm, ta, to, ex, ey):
         d = float(np.hypot(ex, ey))
         big = self.arm_length_mm
+        # imported here: only this numeric cross-check needs scipy (≈ 1 s of start-up)
+        from scipy.optimize import brentq
+
         psi = brentq(lambda a: big * np.sin(a) - d, -0.1, 1.5, xtol=1e-15) if d else 0.0
         return float(f_mm / (f_mm - big * (1.0 - np.cos(psi))))
 

@@ -11,7 +11,6 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-from scipy.optimize import brentq
 
 from stereoplotter.instrument.principles.base import (
     CorrectionMechanism,
@@ -55,6 +54,9 @@ class PlaneFollower(CorrectionMechanism):
 
         def dist(t):
             return (t * f_mm - const) / np.linalg.norm(n) - self.follower_radius_mm
+
+        # imported here: only this numeric cross-check needs scipy (≈ 1 s of start-up)
+        from scipy.optimize import brentq
 
         t = brentq(dist, 0.5, 2.0, xtol=1e-15, rtol=1e-15)
         t0 = (f_mm + self.follower_radius_mm) / f_mm
