@@ -12,11 +12,13 @@ from __future__ import annotations
 import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from stereoplotter.errors import TrainerError
-from stereoplotter.scenario.model import Scenario
-from stereoplotter.spec.instrument_spec import InstrumentSpec
+
+if TYPE_CHECKING:  # annotations only: `exercise new` reads this module's constants at start-up
+    from stereoplotter.scenario.model import Scenario
+    from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "ASSISTS",

@@ -7,8 +7,17 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
+
+#: The trainer's modules but its exercise vocabulary (``trainer.exercise``: the choices of
+#: ``exercise new``, imports no numpy) and the package itself.
+_TRAINER = tuple(
+    f"stereoplotter.trainer.{p.stem}"
+    for p in sorted((Path(__file__).parents[2] / "stereoplotter" / "trainer").glob("*.py"))
+    if p.stem not in ("__init__", "exercise")
+)
 
 #: Loaded by no command's parser, nor by ``--version``/``--help``: the heavy libraries, the
 #: pydantic models of the input files (each command's own) and the web server.
@@ -28,7 +37,7 @@ NOT_AT_START = (
     "stereoplotter.io.study_file",
     "stereoplotter.procedure",
     "stereoplotter.verification",
-    "stereoplotter.trainer",
+    *_TRAINER,
 )
 
 #: What ``info`` (versions, data files) has no use for.
