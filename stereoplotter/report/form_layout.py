@@ -125,28 +125,107 @@ def table(
     aligns: Sequence[str] | None = None,
     gap: float = 2.0,
 ) -> None:
-    """A table over the page width; rows that do not fit continue on the next page."""
+    """A table over the page width; rows that do not fit continue on the next page, under the
+    header again.
+
+    Laid out here in one pass (each cell's lines broken at spaces by the font's advance widths,
+    remembered per string), drawn with the document's low-level text and line calls: the look
+    of fpdf2's ``table`` with ``SINGLE_TOP_LINE`` borders (a grey bold header row with a line
+    under it), padding 0.5 mm, each cell's lines centred in its row.
+    """
+    scale = pdf.epw / sum(widths)
+    cols = [w * scale for w in widths]
+    lefts = [pdf.l_margin + sum(cols[:j]) for j in range(len(cols))]
+    aligns = tuple(aligns) if aligns else ("LEFT",) * len(cols)
+    line = 1.22 * size * _PT + 0.5
+    head = [_wrap(pdf, str(h), w - 2 * _PAD, "B", size) for h, w in zip(header, cols, strict=True)]
+    if any(header):
+        _draw_row(pdf, head, lefts, cols, aligns, line, size, "B")
+    for r in rows:
+        cells = [_wrap(pdf, str(c), w - 2 * _PAD, "", size) for c, w in zip(r, cols, strict=True)]
+        if pdf.get_y() + _row_height(cells, line) > pdf.page_break_trigger:
+            pdf.add_page()
+            if any(header):
+                _draw_row(pdf, head, lefts, cols, aligns, line, size, "B")
+        _draw_row(pdf, cells, lefts, cols, aligns, line, size, "")
     pdf.set_font(FONT, "", size)
-    headings = any(header)
-    with pdf.table(
-        first_row_as_headings=headings,
-        col_widths=tuple(widths),
-        width=pdf.epw,
-        line_height=1.22 * size * _PT + 0.5,
-        text_align=tuple(aligns) if aligns else "LEFT",
-        headings_style=_headings_style(),
-        borders_layout="SINGLE_TOP_LINE",
-        padding=0.5,
-    ) as t:
-        if headings:
-            row = t.row()
-            for h in header:
-                row.cell(h)
-        for r in rows:
-            row = t.row()
-            for c in r:
-                row.cell(str(c))
-    pdf.ln(gap)
+    pdf.set_xy(pdf.l_margin, pdf.get_y() + gap)
+
+
+_PAD = 0.5  # mm, the cell padding of the tables
+#: The lines of a cell's text by (style, size, width, text): a pure function of the font file.
+_LINES: dict[tuple[str, float, float, str], tuple[str, ...]] = {}
+
+
+def _width(pdf: Form, text: str, style: str, size: float) -> float:
+    """The advance width of ``text`` in mm at ``size`` pt (remembered, :data:`_WIDTHS`)."""
+    _, points = pdf.fonts[f"{FONT.lower()}{style}"].get_text_width(text, size, None)
+    return points / pdf.k
+
+
+def _wrap(pdf: Form, text: str, width: float, style: str, size: float) -> tuple[str, ...]:
+    """The lines of ``text`` in a cell ``width`` mm wide: at its newlines, then greedily at
+    spaces (a word wider than the cell is broken between characters)."""
+    key = (style, size, round(width, 6), text)
+    lines = _LINES.get(key)
+    if lines is not None:
+        return lines
+    out: list[str] = []
+    for paragraph_ in text.split("\n"):
+        current = ""
+        for word in paragraph_.split(" "):
+            trial = f"{current} {word}" if current else word
+            if _width(pdf, trial, style, size) <= width or not current:
+                current = trial
+            else:
+                out.append(current)
+                current = word
+            while _width(pdf, current, style, size) > width and len(current) > 1:
+                cut = len(current) - 1
+                while cut > 1 and _width(pdf, current[:cut], style, size) > width:
+                    cut -= 1
+                out.append(current[:cut])
+                current = current[cut:]
+        out.append(current)
+    if len(_LINES) >= _WIDTHS_MAX:
+        _LINES.clear()
+    lines = _LINES[key] = tuple(out)
+    return lines
+
+
+def _row_height(cells: Sequence[Sequence[str]], line: float) -> float:
+    return max(len(c) for c in cells) * line + 2 * _PAD
+
+
+def _draw_row(
+    pdf: Form,
+    cells: Sequence[Sequence[str]],
+    lefts: Sequence[float],
+    cols: Sequence[float],
+    aligns: Sequence[str],
+    line: float,
+    size: float,
+    style: str,
+) -> None:
+    """One row at the current y: a header row (``style`` "B") filled grey and underlined."""
+    top, height = pdf.get_y(), _row_height(cells, line)
+    if style == "B":
+        pdf.set_fill_color(225)
+        pdf.rect(pdf.l_margin, top, sum(cols), height, style="F")
+    pdf.set_font(FONT, style, size)
+    for lines, x, w, align in zip(cells, lefts, cols, aligns, strict=True):
+        y = top + _PAD + (height - 2 * _PAD - len(lines) * line) / 2
+        for text in lines:
+            if text:
+                dx = _PAD
+                if align[0] in "RC":
+                    free = w - 2 * _PAD - _width(pdf, text, style, size)
+                    dx += free if align[0] == "R" else free / 2
+                pdf.text(x + dx, y + 0.5 * line + 0.3 * size / pdf.k, text)
+            y += line
+    if style == "B":
+        pdf.line(pdf.l_margin, top + height, pdf.l_margin + sum(cols), top + height)
+    pdf.set_y(top + height)
 
 
 def _headings_style() -> Any:
