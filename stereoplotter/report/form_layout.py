@@ -9,15 +9,17 @@ so no system font is read.
 
 from __future__ import annotations
 
+import copy
 import datetime as _dt
 import importlib.util
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from fontTools import ttLib
 from fpdf import FPDF
 from fpdf.enums import XPos, YPos
-from fpdf.fonts import FontFace, TTFFont
+from fpdf.fonts import FontFace, SubsetMap, TTFFont
 
 __all__ = ["FONT", "Form", "LabelPlacer", "font_path", "heading", "paragraph", "table"]
 
@@ -66,6 +68,39 @@ class _RememberedWidths(TTFFont):
         return width
 
 
+#: The two fonts as parsed once per process (metrics, character map, glyph ids), by style;
+#: each document gets a copy of its own (see :func:`_document_font`).
+_PARSED: dict[str, _RememberedWidths] = {}
+
+
+def _document_font(style: str, index: int) -> _RememberedWidths:
+    """A font for one document: the font parsed once per process (``FPDF.add_font`` reads the
+    character map and every glyph's width, ≈ 0.25 s a font), with what a document changes made
+    its own: its index, the glyphs it uses (the subset) and a fresh font file object (fpdf2
+    subsets that object in place when the document is output)."""
+    parsed = _PARSED.get(style)
+    if parsed is None:
+        loader = FPDF()
+        loader.add_font(FONT, style, font_path(style))
+        parsed = loader.fonts[f"{FONT.lower()}{style}"]
+        parsed.__class__ = _RememberedWidths  # same layout (slots): only the width lookup changes
+        _PARSED[style] = parsed
+    font = copy.copy(parsed)
+    font.i = index
+    font.ttfont = ttLib.TTFont(parsed.ttffile, recalcTimestamp=False, lazy=True)
+    font.missing_glyphs = []
+    font.biggest_size_pt = 0
+    font._hbfont = None
+    font.subset = SubsetMap(font)
+    return font
+
+
+#: The font file objects as subset by an output, by (font file, glyph names): the next document
+#: with the same glyphs starts from one (:meth:`Form.output`); at most :data:`_SUBSETS_MAX`.
+_SUBSETS: dict[tuple[str, frozenset[str]], ttLib.TTFont] = {}
+_SUBSETS_MAX = 32
+
+
 class Form(FPDF):
     """A4 portrait with the margins, fonts and the running footer of the forms.
 
@@ -75,10 +110,8 @@ class Form(FPDF):
 
     def __init__(self, date: str, page_word: str = "page") -> None:
         super().__init__(orientation="P", unit="mm", format="A4")
-        self.add_font(FONT, "", font_path(""))
-        self.add_font(FONT, "B", font_path("B"))
-        for font in self.fonts.values():  # same layout (slots): only the width lookup changes
-            font.__class__ = _RememberedWidths
+        for style in ("", "B"):
+            self.fonts[f"{FONT.lower()}{style}"] = _document_font(style, len(self.fonts) + 1)
         self.set_margins(MARGIN_LEFT, MARGIN_TOP, MARGIN_RIGHT)
         self.set_auto_page_break(True, MARGIN_BOTTOM)
         day = _dt.datetime.strptime(date, "%Y-%m-%d").replace(tzinfo=_dt.UTC)
@@ -87,6 +120,30 @@ class Form(FPDF):
         self.set_creator("stereoplotter")
         self.footer_text = ""
         self.page_word = page_word
+
+    def output(self, *args: Any, **kwargs: Any) -> Any:
+        """The document's bytes, with each font's subset taken from :data:`_SUBSETS` when an
+        earlier document of this process used the same glyphs (fpdf2 subsets the font file
+        object in place; subsetting that result again to the same glyphs is the same font,
+        byte for byte, in a fraction of the time), and remembered for the next document."""
+        used = []
+        for font in self.fonts.values():
+            if not isinstance(font, TTFFont):  # pragma: no cover - the forms embed TrueType only
+                continue
+            key = (str(font.ttffile), frozenset(font.subset.get_all_glyph_names()))
+            remembered = _SUBSETS.pop(key, None)  # taken out while in use (another thread misses)
+            if remembered is not None:
+                font.ttfont.close()
+                font.ttfont = remembered
+            used.append((key, font))
+        data = super().output(*args, **kwargs)
+        for key, font in used:
+            if len(_SUBSETS) >= _SUBSETS_MAX:
+                for ttfont in _SUBSETS.values():
+                    ttfont.close()
+                _SUBSETS.clear()
+            _SUBSETS[key] = font.ttfont
+        return data
 
     def close_fonts(self) -> None:
         """Close the font files of a document that is never output (a trial layout)."""
