@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import datetime as _dt
 import importlib.util
+import io
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -87,7 +88,7 @@ def _document_font(style: str, index: int) -> _RememberedWidths:
         _PARSED[style] = parsed
     font = copy.copy(parsed)
     font.i = index
-    font.ttfont = ttLib.TTFont(parsed.ttffile, recalcTimestamp=False, lazy=True)
+    font.ttfont = _SavedFont(parsed.ttffile, recalcTimestamp=False, lazy=True)
     font.missing_glyphs = []
     font.biggest_size_pt = 0
     font._hbfont = None
@@ -95,9 +96,23 @@ def _document_font(style: str, index: int) -> _RememberedWidths:
     return font
 
 
+class _SavedFont(ttLib.TTFont):
+    """A font file object that compiles itself once: its subset is only ever made again to
+    the same glyphs (:meth:`Form.output`), so its bytes do not change after the first save."""
+
+    saved: bytes | None = None
+
+    def save(self, file: Any, reorderTables: bool | None = True) -> None:
+        if self.saved is None:
+            buffer = io.BytesIO()
+            super().save(buffer, reorderTables)
+            self.saved = buffer.getvalue()
+        file.write(self.saved)
+
+
 #: The font file objects as subset by an output, by (font file, glyph names): the next document
 #: with the same glyphs starts from one (:meth:`Form.output`); at most :data:`_SUBSETS_MAX`.
-_SUBSETS: dict[tuple[str, frozenset[str]], ttLib.TTFont] = {}
+_SUBSETS: dict[tuple[str, frozenset[str]], _SavedFont] = {}
 _SUBSETS_MAX = 32
 
 
@@ -169,8 +184,18 @@ def heading(pdf: Form, text: str, size: float = 11.0) -> None:
 
 
 def paragraph(pdf: Form, text: str, size: float = 7.5) -> None:
+    """Text over the page width, broken into lines at spaces (:func:`_wrap`), left-aligned,
+    continued on the next page when the page is full."""
     pdf.set_font(FONT, "", size)
-    pdf.multi_cell(0, 1.3 * size * _PT, text, new_x=XPos.LMARGIN, new_y=YPos.NEXT)
+    line = 1.3 * size * _PT
+    for text_line in _wrap(pdf, text, pdf.epw - 2 * pdf.c_margin, "", size):
+        if pdf.get_y() + line > pdf.page_break_trigger:
+            pdf.add_page()
+            pdf.set_font(FONT, "", size)
+        if text_line:
+            pdf.text(pdf.l_margin + pdf.c_margin, pdf.get_y() + 0.5 * line + 0.3 * pdf.font_size,
+                     text_line)  # fmt: skip
+        pdf.set_xy(pdf.l_margin, pdf.get_y() + line)
 
 
 def table(
