@@ -221,10 +221,14 @@ def table(
     aligns = tuple(aligns) if aligns else ("LEFT",) * len(cols)
     line = 1.22 * size * _PT + 0.5
     head = [_wrap(pdf, str(h), w - 2 * _PAD, "B", size) for h, w in zip(header, cols, strict=True)]
-    if any(header):
+    body = [[_wrap(pdf, str(c), w - 2 * _PAD, "", size) for c, w in zip(r, cols, strict=True)]
+            for r in rows]  # fmt: skip
+    if any(header):  # the header stays with the first row
+        first = _row_height(body[0], line) if body else 0.0
+        if pdf.get_y() + _row_height(head, line) + first > pdf.page_break_trigger:
+            pdf.add_page()
         _draw_row(pdf, head, lefts, cols, aligns, line, size, "B")
-    for r in rows:
-        cells = [_wrap(pdf, str(c), w - 2 * _PAD, "", size) for c, w in zip(r, cols, strict=True)]
+    for cells in body:
         if pdf.get_y() + _row_height(cells, line) > pdf.page_break_trigger:
             pdf.add_page()
             if any(header):
