@@ -2,7 +2,12 @@
 labels placed so that none overlaps another (the drawing's point and corner labels).
 
 fpdf2 (a document library: real text that can be searched and extracted, vector drawing,
-embedded TrueType subsets). The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
+embedded TrueType subsets), through its low-level calls for the tables and paragraphs: their
+lines are broken here by the font's advance widths, remembered per string, and drawn with
+``text`` and ``line`` — fpdf2's own ``table`` and ``multi_cell`` measured every fragment again at
+each character (≈ 80 % of a form's time in the profile of issue 27). The fonts are parsed once
+per process and each font subset compiled once per set of glyphs (:meth:`Form.output`).
+The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
 font that ships inside matplotlib (``mpl-data/fonts/ttf``), found without importing matplotlib,
 so no system font is read.
 """
