@@ -162,6 +162,9 @@ class Form(FPDF):
                 for ttfont in _SUBSETS.values():
                     ttfont.close()
                 _SUBSETS.clear()
+            earlier = _SUBSETS.get(key)  # another thread's document of the same glyphs
+            if earlier is not None and earlier is not font.ttfont:
+                earlier.close()
             _SUBSETS[key] = font.ttfont
         return data
 

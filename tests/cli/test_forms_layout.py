@@ -35,6 +35,8 @@ def _form(result, i: int) -> bytes:
 def test_a_forms_bytes_do_not_depend_on_the_forms_before_it(result):
     """Pair 2's form from a process that remembers nothing equals the one rendered after pairs
     0 and 1 (the parsed fonts, their subsets and the text widths are remembered in between)."""
+    for font in [*form_layout._PARSED.values(), *form_layout._SUBSETS.values()]:
+        font.close()  # forgotten as a fresh process would not have them
     for memory in (form_layout._PARSED, form_layout._SUBSETS, form_layout._WIDTHS,
                    form_layout._LINES):  # fmt: skip
         memory.clear()
