@@ -2,22 +2,30 @@
 labels placed so that none overlaps another (the drawing's point and corner labels).
 
 fpdf2 (a document library: real text that can be searched and extracted, vector drawing,
-embedded TrueType subsets). The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
+embedded TrueType subsets), through its low-level calls for the tables and paragraphs: their
+lines are broken here by the font's advance widths, remembered per string, and drawn with
+``text`` and ``line`` — fpdf2's own ``table`` and ``multi_cell`` measured every fragment again at
+each character (≈ 80 % of a form's time in the profile of issue 27). The fonts are parsed once
+per process and each font subset compiled once per set of glyphs (:meth:`Form.output`).
+The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
 font that ships inside matplotlib (``mpl-data/fonts/ttf``), found without importing matplotlib,
 so no system font is read.
 """
 
 from __future__ import annotations
 
+import copy
 import datetime as _dt
 import importlib.util
+import io
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from fontTools import ttLib
 from fpdf import FPDF
 from fpdf.enums import XPos, YPos
-from fpdf.fonts import FontFace, TTFFont
+from fpdf.fonts import FontFace, SubsetMap, TTFFont
 
 __all__ = ["FONT", "Form", "LabelPlacer", "font_path", "heading", "paragraph", "table"]
 
@@ -66,6 +74,53 @@ class _RememberedWidths(TTFFont):
         return width
 
 
+#: The two fonts as parsed once per process (metrics, character map, glyph ids), by style;
+#: each document gets a copy of its own (see :func:`_document_font`).
+_PARSED: dict[str, _RememberedWidths] = {}
+
+
+def _document_font(style: str, index: int) -> _RememberedWidths:
+    """A font for one document: the font parsed once per process (``FPDF.add_font`` reads the
+    character map and every glyph's width, ≈ 0.25 s a font), with what a document changes made
+    its own: its index, the glyphs it uses (the subset) and a fresh font file object (fpdf2
+    subsets that object in place when the document is output)."""
+    parsed = _PARSED.get(style)
+    if parsed is None:
+        loader = FPDF()
+        loader.add_font(FONT, style, font_path(style))
+        parsed = loader.fonts[f"{FONT.lower()}{style}"]
+        parsed.__class__ = _RememberedWidths  # same layout (slots): only the width lookup changes
+        _PARSED[style] = parsed
+    font = copy.copy(parsed)
+    font.i = index
+    font.ttfont = _SavedFont(parsed.ttffile, recalcTimestamp=False, lazy=True)
+    font.missing_glyphs = []
+    font.biggest_size_pt = 0
+    font._hbfont = None
+    font.subset = SubsetMap(font)
+    return font
+
+
+class _SavedFont(ttLib.TTFont):
+    """A font file object that compiles itself once: its subset is only ever made again to
+    the same glyphs (:meth:`Form.output`), so its bytes do not change after the first save."""
+
+    saved: bytes | None = None
+
+    def save(self, file: Any, reorderTables: bool | None = True) -> None:
+        if self.saved is None:
+            buffer = io.BytesIO()
+            super().save(buffer, reorderTables)
+            self.saved = buffer.getvalue()
+        file.write(self.saved)
+
+
+#: The font file objects as subset by an output, by (font file, glyph names): the next document
+#: with the same glyphs starts from one (:meth:`Form.output`); at most :data:`_SUBSETS_MAX`.
+_SUBSETS: dict[tuple[str, frozenset[str]], _SavedFont] = {}
+_SUBSETS_MAX = 32
+
+
 class Form(FPDF):
     """A4 portrait with the margins, fonts and the running footer of the forms.
 
@@ -75,10 +130,8 @@ class Form(FPDF):
 
     def __init__(self, date: str, page_word: str = "page") -> None:
         super().__init__(orientation="P", unit="mm", format="A4")
-        self.add_font(FONT, "", font_path(""))
-        self.add_font(FONT, "B", font_path("B"))
-        for font in self.fonts.values():  # same layout (slots): only the width lookup changes
-            font.__class__ = _RememberedWidths
+        for style in ("", "B"):
+            self.fonts[f"{FONT.lower()}{style}"] = _document_font(style, len(self.fonts) + 1)
         self.set_margins(MARGIN_LEFT, MARGIN_TOP, MARGIN_RIGHT)
         self.set_auto_page_break(True, MARGIN_BOTTOM)
         day = _dt.datetime.strptime(date, "%Y-%m-%d").replace(tzinfo=_dt.UTC)
@@ -87,6 +140,33 @@ class Form(FPDF):
         self.set_creator("stereoplotter")
         self.footer_text = ""
         self.page_word = page_word
+
+    def output(self, *args: Any, **kwargs: Any) -> Any:
+        """The document's bytes, with each font's subset taken from :data:`_SUBSETS` when an
+        earlier document of this process used the same glyphs (fpdf2 subsets the font file
+        object in place; subsetting that result again to the same glyphs is the same font,
+        byte for byte, in a fraction of the time), and remembered for the next document."""
+        used = []
+        for font in self.fonts.values():
+            if not isinstance(font, TTFFont):  # pragma: no cover - the forms embed TrueType only
+                continue
+            key = (str(font.ttffile), frozenset(font.subset.get_all_glyph_names()))
+            remembered = _SUBSETS.pop(key, None)  # taken out while in use (another thread misses)
+            if remembered is not None:
+                font.ttfont.close()
+                font.ttfont = remembered
+            used.append((key, font))
+        data = super().output(*args, **kwargs)
+        for key, font in used:
+            if len(_SUBSETS) >= _SUBSETS_MAX:
+                for ttfont in _SUBSETS.values():
+                    ttfont.close()
+                _SUBSETS.clear()
+            earlier = _SUBSETS.get(key)  # another thread's document of the same glyphs
+            if earlier is not None and earlier is not font.ttfont:
+                earlier.close()
+            _SUBSETS[key] = font.ttfont
+        return data
 
     def close_fonts(self) -> None:
         """Close the font files of a document that is never output (a trial layout)."""
@@ -112,8 +192,18 @@ def heading(pdf: Form, text: str, size: float = 11.0) -> None:
 
 
 def paragraph(pdf: Form, text: str, size: float = 7.5) -> None:
+    """Text over the page width, broken into lines at spaces (:func:`_wrap`), left-aligned,
+    continued on the next page when the page is full."""
     pdf.set_font(FONT, "", size)
-    pdf.multi_cell(0, 1.3 * size * _PT, text, new_x=XPos.LMARGIN, new_y=YPos.NEXT)
+    line = 1.3 * size * _PT
+    for text_line in _wrap(pdf, text, pdf.epw - 2 * pdf.c_margin, "", size):
+        if pdf.get_y() + line > pdf.page_break_trigger:
+            pdf.add_page()
+            pdf.set_font(FONT, "", size)
+        if text_line:
+            pdf.text(pdf.l_margin + pdf.c_margin, pdf.get_y() + 0.5 * line + 0.3 * pdf.font_size,
+                     text_line)  # fmt: skip
+        pdf.set_xy(pdf.l_margin, pdf.get_y() + line)
 
 
 def table(
@@ -125,28 +215,111 @@ def table(
     aligns: Sequence[str] | None = None,
     gap: float = 2.0,
 ) -> None:
-    """A table over the page width; rows that do not fit continue on the next page."""
+    """A table over the page width; rows that do not fit continue on the next page, under the
+    header again.
+
+    Laid out here in one pass (each cell's lines broken at spaces by the font's advance widths,
+    remembered per string), drawn with the document's low-level text and line calls: the look
+    of fpdf2's ``table`` with ``SINGLE_TOP_LINE`` borders (a grey bold header row with a line
+    under it), padding 0.5 mm, each cell's lines centred in its row.
+    """
+    scale = pdf.epw / sum(widths)
+    cols = [w * scale for w in widths]
+    lefts = [pdf.l_margin + sum(cols[:j]) for j in range(len(cols))]
+    aligns = tuple(aligns) if aligns else ("LEFT",) * len(cols)
+    line = 1.22 * size * _PT + 0.5
+    head = [_wrap(pdf, str(h), w - 2 * _PAD, "B", size) for h, w in zip(header, cols, strict=True)]
+    body = [[_wrap(pdf, str(c), w - 2 * _PAD, "", size) for c, w in zip(r, cols, strict=True)]
+            for r in rows]  # fmt: skip
+    if any(header):  # the header stays with the first row
+        first = _row_height(body[0], line) if body else 0.0
+        if pdf.get_y() + _row_height(head, line) + first > pdf.page_break_trigger:
+            pdf.add_page()
+        _draw_row(pdf, head, lefts, cols, aligns, line, size, "B")
+    for cells in body:
+        if pdf.get_y() + _row_height(cells, line) > pdf.page_break_trigger:
+            pdf.add_page()
+            if any(header):
+                _draw_row(pdf, head, lefts, cols, aligns, line, size, "B")
+        _draw_row(pdf, cells, lefts, cols, aligns, line, size, "")
     pdf.set_font(FONT, "", size)
-    headings = any(header)
-    with pdf.table(
-        first_row_as_headings=headings,
-        col_widths=tuple(widths),
-        width=pdf.epw,
-        line_height=1.22 * size * _PT + 0.5,
-        text_align=tuple(aligns) if aligns else "LEFT",
-        headings_style=_headings_style(),
-        borders_layout="SINGLE_TOP_LINE",
-        padding=0.5,
-    ) as t:
-        if headings:
-            row = t.row()
-            for h in header:
-                row.cell(h)
-        for r in rows:
-            row = t.row()
-            for c in r:
-                row.cell(str(c))
-    pdf.ln(gap)
+    pdf.set_xy(pdf.l_margin, pdf.get_y() + gap)
+
+
+_PAD = 0.5  # mm, the cell padding of the tables
+#: The lines of a cell's text by (style, size, width, text): a pure function of the font file.
+_LINES: dict[tuple[str, float, float, str], tuple[str, ...]] = {}
+
+
+def _width(pdf: Form, text: str, style: str, size: float) -> float:
+    """The advance width of ``text`` in mm at ``size`` pt (remembered, :data:`_WIDTHS`)."""
+    _, points = pdf.fonts[f"{FONT.lower()}{style}"].get_text_width(text, size, None)
+    return points / pdf.k
+
+
+def _wrap(pdf: Form, text: str, width: float, style: str, size: float) -> tuple[str, ...]:
+    """The lines of ``text`` in a cell ``width`` mm wide: at its newlines, then greedily at
+    spaces (a word wider than the cell is broken between characters)."""
+    key = (style, size, round(width, 6), text)
+    lines = _LINES.get(key)
+    if lines is not None:
+        return lines
+    out: list[str] = []
+    for paragraph_ in text.split("\n"):
+        current = ""
+        for word in paragraph_.split(" "):
+            trial = f"{current} {word}" if current else word
+            if _width(pdf, trial, style, size) <= width or not current:
+                current = trial
+            else:
+                out.append(current)
+                current = word
+            while _width(pdf, current, style, size) > width and len(current) > 1:
+                cut = len(current) - 1
+                while cut > 1 and _width(pdf, current[:cut], style, size) > width:
+                    cut -= 1
+                out.append(current[:cut])
+                current = current[cut:]
+        out.append(current)
+    if len(_LINES) >= _WIDTHS_MAX:
+        _LINES.clear()
+    lines = _LINES[key] = tuple(out)
+    return lines
+
+
+def _row_height(cells: Sequence[Sequence[str]], line: float) -> float:
+    return max(len(c) for c in cells) * line + 2 * _PAD
+
+
+def _draw_row(
+    pdf: Form,
+    cells: Sequence[Sequence[str]],
+    lefts: Sequence[float],
+    cols: Sequence[float],
+    aligns: Sequence[str],
+    line: float,
+    size: float,
+    style: str,
+) -> None:
+    """One row at the current y: a header row (``style`` "B") filled grey and underlined."""
+    top, height = pdf.get_y(), _row_height(cells, line)
+    if style == "B":
+        pdf.set_fill_color(225)
+        pdf.rect(pdf.l_margin, top, sum(cols), height, style="F")
+    pdf.set_font(FONT, style, size)
+    for lines, x, w, align in zip(cells, lefts, cols, aligns, strict=True):
+        y = top + _PAD + (height - 2 * _PAD - len(lines) * line) / 2
+        for text in lines:
+            if text:
+                dx = _PAD
+                if align[0] in "RC":
+                    free = w - 2 * _PAD - _width(pdf, text, style, size)
+                    dx += free if align[0] == "R" else free / 2
+                pdf.text(x + dx, y + 0.5 * line + 0.3 * size / pdf.k, text)
+            y += line
+    if style == "B":
+        pdf.line(pdf.l_margin, top + height, pdf.l_margin + sum(cols), top + height)
+    pdf.set_y(top + height)
 
 
 def _headings_style() -> Any:

@@ -225,7 +225,8 @@ def job_files(result: JobResult, lang: str = "en", rigorous: bool = False) -> di
     forms, names = [], []
     for p in result.pairs:
         data = pair_dict(result.job, p)
-        files[f"{p.pair.name}/sheet.yaml"] = yaml_text(data, width=100).encode("utf-8")
+        text = yaml_text(data, width=100, c_emitter=True)  # libyaml: same text (strip8, block3x6)
+        files[f"{p.pair.name}/sheet.yaml"] = text.encode("utf-8")
         if p.sheet is None:
             continue
         header = form_header(result.job, p, result.spec, lang)
