@@ -23,6 +23,8 @@ from stereoplotter.io.images import png_bytes
 from stereoplotter.io.paths import available_names
 from stereoplotter.io.session_log import log_bytes
 from stereoplotter.report.grade import grade_markdown
+from stereoplotter.report.sheet import sheet_to_dict
+from stereoplotter.trainer.actions import ACTION_FIELDS
 from stereoplotter.trainer.exercise import Exercise, resolve_exercise
 from stereoplotter.trainer.grading import grade
 from stereoplotter.trainer.session import Session
@@ -33,6 +35,7 @@ __all__ = [
     "Catalogue",
     "CoreError",
     "TrainerError",
+    "action_catalogue",
     "build_view_cache",
     "format_mm",
     "grade_of",
@@ -42,11 +45,13 @@ __all__ = [
     "log_of",
     "log_text",
     "operator_script",
+    "overview_of",
     "photo_key",
     "photo_patch",
     "replay",
     "replay_frames",
     "replay_json",
+    "sheet_of",
     "start",
 ]
 
@@ -215,3 +220,43 @@ def photo_patch(
     = SCREEN_PIXEL_MM / magnification mm of photo, x to the right, y up: the page turns and
     places it under the mark itself, so a move needs no new image."""
     return png_bytes(cache.view(side, x_mm, y_mm, 0.0, magnification, size_px))
+
+
+def sheet_of(exercise: Exercise) -> dict[str, Any]:
+    """The exercise's setup sheet as the page shows it (JSON-ready; run in a worker thread)."""
+    session = Session(exercise, "sheet", exercise.seed or 0, clock=False)
+    return _jsonable(sheet_to_dict(session.prep.sheet))
+
+
+def overview_of(session: Session) -> dict[str, Any]:
+    """Both photos at a glance (run on the actor thread): fiducials, standard points, the marks;
+    photo coordinates in mm, x right, y up."""
+    scene = session.prep.scene
+    left, right = scene.standard
+    return _jsonable(
+        {
+            "format_mm": format_mm(session.exercise),
+            "fiducials": {k: v.tolist() for k, v in scene.fiducials_mm.items()},
+            "standard": {"left": left.tolist(), "right": right.tolist()},
+            "unusable": list(session.exercise.unusable_points),
+            "marks": session.state()["marks"],
+        }
+    )
+
+
+def action_catalogue() -> list[dict[str, Any]]:
+    """Every action the core accepts with its parameters (kind, fields), for the page's
+    controls."""
+    return [{"kind": k, "fields": list(v)} for k, v in ACTION_FIELDS.items()]
+
+
+def _jsonable(value: Any) -> Any:
+    """``value`` through JSON (numpy scalars and arrays as numbers, non-finite as null)."""
+    return json.loads(json.dumps(value, default=_plain, allow_nan=True).replace("NaN", "null")
+                      .replace("-Infinity", "null").replace("Infinity", "null"))
+
+
+def _plain(value: Any) -> Any:
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return str(value)

@@ -38,6 +38,7 @@ __all__ = [
     "one_line",
     "origin_ok",
     "parse_message",
+    "scrub_paths",
     "seed_value",
     "trainee_key",
     "trainee_name",
@@ -85,6 +86,17 @@ def one_line(text: object) -> str:
     s = " ".join(str(text).split())
     s = _PATH.sub("<path>", s)
     return s if len(s) <= 300 else s[:299] + "…"
+
+
+def scrub_paths(value: Any) -> Any:
+    """``value`` (JSON-like) with every server path in its text replaced by ``<path>``."""
+    if isinstance(value, str):
+        return _PATH.sub("<path>", value)
+    if isinstance(value, dict):
+        return {k: scrub_paths(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [scrub_paths(v) for v in value]
+    return value
 
 
 def error(status: int, text: object) -> JSONResponse:

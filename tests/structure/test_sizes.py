@@ -19,7 +19,6 @@ MAX_FUNCTION_LINES = 80
 #: Functions still over the limit (not yet split; issue 23) → their length in lines when listed,
 #: which they may not exceed.
 LONG_FUNCTIONS = {
-    "web/app.py:create_app": 253,
     "procedure/evaluation.py:evaluate_model": 192,
     "verification/procedure_mc.py:procedure_mc": 146,
     "setup/block.py:compute_block": 128,
