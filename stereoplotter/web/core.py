@@ -247,7 +247,11 @@ def overview_of(session: Session) -> dict[str, Any]:
 def action_catalogue() -> list[dict[str, Any]]:
     """Every action the core accepts with its parameters (kind, fields), for the page's
     controls."""
-    return [{"kind": k, "fields": list(v)} for k, v in ACTION_FIELDS.items()]
+    optional = {"turn": ["side"], "set": ["side"], "needle": ["side"], "connect": ["origin_mm"]}
+    return [
+        {"kind": k, "fields": list(v), "optional": optional.get(k, [])}
+        for k, v in ACTION_FIELDS.items()
+    ]
 
 
 def _jsonable(value: Any) -> Any:

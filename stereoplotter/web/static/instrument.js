@@ -4,6 +4,8 @@
 import { drawField, anaglyph, scale } from "./eyepiece.js";
 import { Wheels, LABELS, decimals } from "./wheels.js";
 import { el, sessionKey } from "./dom.js";
+import { buildActions, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
+import { Overview } from "./overview.js";
 
 const sid = location.pathname.split("/").pop();
 const key = sessionKey.get(sid);
@@ -11,7 +13,11 @@ const $ = (id) => document.getElementById(id);
 let state = null, hello = null, seq = 0, ws = null, retry = 250;
 const waiting = new Map(); // seq → resolve(frame time)
 const trail = [];
-const wheels = new Wheels($("wheels"), send);
+const wheels = new Wheels($("wheels"), send, {
+  multiplier: () => $("step-mult").value, side: () => $("approach").value,
+});
+const sent = new Map(); // seq → [action, state before] (for its result and coupled motions)
+let overview = null;
 
 function link(text, lost) {
   $("link").textContent = text; $("link").className = lost ? "meta lost" : "meta";
@@ -28,18 +34,39 @@ function connect() {
   };
 }
 
+// Messages leave at most at the server's rate (told in hello: a rate and a burst), a little
+// under it: a fast hand (or the robot trainee) is queued here, never refused there.
+const queue = [];
+let tokens = 0, lastFill = performance.now(), pumping = null;
+function pump() {
+  pumping = null;
+  const [rate, burst] = hello && hello.rate ? hello.rate : [60, 120];
+  const now = performance.now();
+  tokens = Math.min(burst * 0.9, tokens + ((now - lastFill) / 1000) * rate * 0.9);
+  lastFill = now;
+  while (queue.length && tokens >= 1 && ws && ws.readyState === WebSocket.OPEN) {
+    ws.send(queue.shift()); tokens -= 1;
+  }
+  window.__queued = queue.length;
+  if (queue.length) pumping = setTimeout(pump, Math.max(4, 1000 / rate));
+}
+
 function send(action) {
   seq += 1;
   if (!ws || ws.readyState !== WebSocket.OPEN) {
     message("not connected to the server: this action was not sent (reconnecting…)", "error");
     return seq;
   }
-  ws.send(JSON.stringify({ action, seq }));
+  sent.set(seq, [action, state]);
+  queue.push(JSON.stringify({ action, seq }));
+  if (!pumping) pump();
   return seq;
 }
 
 function sendDemo() {
-  if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify({ demo: "step" }));
+  if (!ws || ws.readyState !== WebSocket.OPEN) return;
+  queue.push(JSON.stringify({ demo: "step" }));
+  if (!pumping) pump();
 }
 
 function message(text, cls = "") {
@@ -101,6 +128,7 @@ function drawEyes() {
     if (mode === "anaglyph") anaglyph(ctx, off.left, off.right, $("colours").value.split(","));
     else { ctx.drawImage(off[flickerSide], 0, 0); }
   }
+  if (overview) overview.draw(marks, mag);
   window.__frames = (window.__frames || 0) + 1;
 }
 setInterval(() => {
@@ -184,7 +212,10 @@ function drawStage() {
   $("grade-link").href = `/grade/${encodeURIComponent(sid)}`;
   const p = state.parallax;
   const um = (v) => (v === null || v === undefined ? "—" : v.toFixed(1));
-  $("parallax").textContent = p ? `parallax at standard point ${p.point}: q = ${um(p.y_um)} µm, p = ${um(p.x_um)} µm` : "";
+  $("parallax").textContent = p ? `parallax at standard point ${p.point}: q = ${um(p.y_um)} µm, p = ${um(p.x_um)} µm`
+    : state.marks ? "no q/p read-out in this exercise: judge the parallax in the eyepieces (or the anaglyph)" : "";
+  showChecklist($("checklist"), state.checklist || []);
+  showAnnounced($("announced"), $("announced-list"), state.announced || state.injected_errors);
 }
 
 function render() {
@@ -202,15 +233,21 @@ function onMessage(ev) {
     $("title").textContent = "Stereoplotter trainer";
     $("instructions").textContent = hello.description;
     waiting.clear();
+    buildActions($("actions"), hello.actions || [], Object.keys(msg.state.controls), send, message);
+    loadOverview();
   }
   if (msg.state) state = msg.state;
   window.__n = msg.n;
   if (state) render();
+  const [action, before] = msg.seq !== undefined && sent.has(msg.seq) ? sent.get(msg.seq) : [msg.demo && msg.demo.action, null];
+  if (msg.seq !== undefined) sent.delete(msg.seq);
   if (msg.error) message(msg.error, "error");
-  else if (msg.result !== undefined && msg.result !== null) message(typeof msg.result === "string" ? msg.result
-    : typeof msg.result === "number" ? `reading: ${msg.result}` : JSON.stringify(msg.result), "hint");
-  else if (msg.demo) message(`operator: ${JSON.stringify(msg.demo.action)}`);
+  else if (msg.demo) message(`operator: ${describe(msg.demo.action)}`);
   else if (!msg.hello) message("");
+  if (!msg.hello && !msg.error) {
+    showResult($("result"), action, msg.result);
+    showCoupled($("coupled"), action, before, msg.state, msg.coupled || (msg.state && msg.state.coupled));
+  }
   if (msg.demo) $("demo-count").textContent = `${msg.demo.done} / ${msg.demo.of}`;
   if (msg.seq !== undefined && waiting.has(msg.seq)) { waiting.get(msg.seq)(performance.now()); waiting.delete(msg.seq); }
   document.body.dataset.ready = "1";
@@ -224,19 +261,75 @@ else {
 $("claim").onclick = () => send({ kind: "claim", step: state.stage });
 $("undo").onclick = () => send({ kind: "undo" });
 $("redo").onclick = () => send({ kind: "redo" });
-$("gear-btn").onclick = () => send({ kind: "gear", value: Number($("gear").value) });
 for (const b of $("hints").querySelectorAll("button")) b.onclick = () => send({ kind: "hint", level: Number(b.dataset.level) });
 let playing = null;
 $("demo-step").onclick = sendDemo;
+function play() {
+  if (playing) clearInterval(playing);
+  playing = setInterval(sendDemo, 1000 / Number($("demo-speed").value));
+  $("demo-play").textContent = "Pause";
+}
 $("demo-play").onclick = () => {
   if (playing) { clearInterval(playing); playing = null; $("demo-play").textContent = "Play"; return; }
-  playing = setInterval(sendDemo, 60);
-  $("demo-play").textContent = "Pause";
+  play();
 };
+$("demo-speed").onchange = () => { if (playing) play(); };
+
+// An action in words (the demonstration's operator, the replay).
+export function describe(a) {
+  if (!a) return "";
+  const what = LABELS[a.control || a.counter] || a.control || a.counter || "";
+  const side = a.side ? ` from ${a.side}` : "";
+  if (a.kind === "set") return `set ${what} to ${a.value}${side}`;
+  if (a.kind === "turn") return `turn ${what} by ${a.delta}`;
+  if (a.kind === "read") return `read ${what}`;
+  if (a.kind === "record") return `record ${a.name} = ${Array.isArray(a.value) ? a.value.join(", ") : a.value}`;
+  if (a.kind === "claim") return `claim stage ${a.step}`;
+  return [a.kind, a.value, what, a.side].filter((v) => v !== undefined && v !== "").join(" ");
+}
+
+// --- photo overview and the setup sheet ----------------------------------------------------
+const auth = () => ({ Authorization: `Bearer ${key || ""}` });
+async function loadOverview() {
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/overview`, { headers: auth() });
+  const data = await r.json();
+  if (!r.ok) { $("overview-note").textContent = data.error; return; }
+  overview = new Overview($("overview-svg"), (xy) => {
+    const n = $("substitute-for").value;
+    if (!n) { $("overview-note").textContent = "no standard point of this exercise needs a substitute"; return; }
+    send({ kind: "record", name: `substitute ${n}`, value: xy });
+  });
+  overview.set(data);
+  $("substitute-for").replaceChildren(...(data.unusable || []).map((n) => el("option", { value: String(n), text: String(n) })));
+  $("overview-note").textContent = (data.unusable || []).length
+    ? `unusable: ${data.unusable.join(", ")} (on water or outside the overlap)` : "";
+  document.body.dataset.overview = "1";
+  drawEyes();
+}
+
+let sheetLoaded = false;
+async function openSheet() {
+  $("sheet").hidden = false;
+  if (sheetLoaded) return;
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/sheet`, { headers: auth() });
+  const data = await r.json();
+  if (!r.ok) { $("sheet-body").textContent = data.error; return; }
+  sheetLoaded = true;
+  $("sheet-title").textContent = data.title || "";
+  showSheet($("sheet-body"), data);
+  $("sheet-body").className = "";
+  document.body.dataset.sheet = "1";
+}
+$("sheet-btn").onclick = () => ($("sheet").hidden ? openSheet() : ($("sheet").hidden = true));
+$("sheet-close").onclick = () => { $("sheet").hidden = true; };
+$("sheet-print").onclick = () => { document.body.classList.add("print-sheet"); window.print(); };
+window.addEventListener("afterprint", () => document.body.classList.remove("print-sheet"));
 
 // For tests and the latency benchmark: send an action, resolve with ms until its frame is drawn.
 window.trainer = {
   state: () => state,
+  // every action sent has left the page's queue and been answered
+  idle: () => queue.length === 0 && sent.size === 0,
   // drop the socket as a network would (the page must reconnect and resume)
   drop: () => ws && ws.close(),
   // both eyepieces drawn from a photo patch that covers the current marks

@@ -1,0 +1,196 @@
+// The instrument page's panels built from the core's data: the action controls (one per action
+// kind of the core's catalogue), readable results, the stage checklist, announced errors,
+// coupled motions and the setup sheet. DOM from elements and text nodes only (issue 22).
+import { el } from "./dom.js";
+import { LABELS } from "./wheels.js";
+
+// Kinds with their own widgets elsewhere on the page: wheels (turn, set), the counters table
+// (direction, read), the stage panel (claim, undo, redo, hint).
+export const ELSEWHERE = new Set(["turn", "set", "direction", "read", "claim", "undo", "redo", "hint"]);
+
+const SIDES = [["", "either side"], ["below", "below"], ["above", "above"]];
+
+// A catalogue field as {name, type, unit, optional, choices, text} (the core may send a name only).
+export function fieldOf(f) {
+  return typeof f === "string" ? { name: f } : f;
+}
+
+// A typed record value: a number, a list of numbers ("12.5, -3"), else the text itself.
+export function parseValue(text) {
+  const t = text.trim();
+  if (t !== "" && t.split(/[,;\s]+/).every((p) => p !== "" && Number.isFinite(Number(p)))) {
+    const parts = t.split(/[,;\s]+/).map(Number);
+    return parts.length === 1 ? parts[0] : parts;
+  }
+  return t;
+}
+
+function input(kind, f, controls) {
+  const id = `act-${kind}-${f.name}`;
+  if (f.name === "control") {
+    return el("select", { id, name: f.name }, ...controls.map((c) => el("option", { value: c, text: LABELS[c] || c })));
+  }
+  if (f.name === "side") return el("select", { id, name: f.name }, ...SIDES.map(([v, t]) => el("option", { value: v, text: t })));
+  if (f.choices) return el("select", { id, name: f.name }, ...f.choices.map((c) => el("option", { value: String(c), text: String(c) })));
+  if (f.name === "origin_mm") return el("input", { id, name: f.name, placeholder: "x, y (optional)", class: "w80" });
+  if (f.name === "name") return el("input", { id, name: f.name, placeholder: "e.g. zero X", maxlength: 64, class: "w120" });
+  if (f.name === "value" && kind === "record") return el("input", { id, name: f.name, placeholder: "number or x, y", class: "w120" });
+  return el("input", { id, name: f.name, type: "number", step: "any", class: "w80", placeholder: f.unit || "" });
+}
+
+// The action's fields read from its form; null (with a message) when one is missing.
+function collect(kind, form, fields) {
+  const action = { kind };
+  for (const f of fields) {
+    const box = form.elements.namedItem(f.name);
+    const raw = box.value.trim();
+    if (raw === "") {
+      if (f.optional || f.name === "side" || f.name === "origin_mm") continue;
+      return null;
+    }
+    if (f.name === "value" && kind === "record") action.value = parseValue(raw);
+    else if (f.name === "origin_mm") action.origin_mm = parseValue(raw);
+    else if (box.tagName === "SELECT" || f.name === "name" || f.name === "control") action[f.name] = raw;
+    else action[f.name] = Number(raw);
+  }
+  return action;
+}
+
+// One form per action kind of the catalogue not handled elsewhere: its fields, a button.
+export function buildActions(root, catalogue, controls, send, say) {
+  root.replaceChildren();
+  for (const entry of catalogue) {
+    if (ELSEWHERE.has(entry.kind)) continue;
+    const fields = (entry.fields || []).map(fieldOf);
+    const optional = (entry.optional || []).map(fieldOf).map((f) => ({ ...f, optional: true }));
+    const all = [...fields, ...optional];
+    const button = el("button", { type: "submit", id: `act-${entry.kind}`, text: entry.label || entry.kind });
+    const form = el("form", { class: "row action", "data-kind": entry.kind, title: entry.text || "" },
+      button, ...all.map((f) => el("label", {}, `${f.label || f.name}${f.unit ? ` [${f.unit}]` : ""} `, input(entry.kind, f, controls))));
+    if (entry.text) form.append(el("span", { class: "meta small", text: entry.text }));
+    form.addEventListener("submit", (e) => {
+      e.preventDefault();
+      const action = collect(entry.kind, form, all);
+      if (action === null) { say(`${entry.kind}: fill in ${fields.map((f) => f.name).join(", ")}`, "error"); return; }
+      send(action);
+    });
+    root.append(form);
+  }
+}
+
+const fmt = (v) => (typeof v !== "number" ? String(v)
+  : Number.isInteger(v) ? String(v) : Math.abs(v) >= 1e-3 ? v.toFixed(4) : v.toExponential(2));
+
+// What an action answered, as readable text and tables (never a JSON dump).
+export function showResult(root, action, result) {
+  root.replaceChildren();
+  if (result === null || result === undefined) return;
+  if (typeof result === "number") {
+    const what = action && action.counter ? `${LABELS[action.counter] || action.counter} reads` : "reading:";
+    root.append(el("p", { text: `${what} ${fmt(result)}` }));
+    return;
+  }
+  if (typeof result === "string") { root.append(el("p", { text: result })); return; }
+  if (Array.isArray(result)) {
+    const what = action && action.kind === "needle" ? "the needle pricked at" : "result:";
+    root.append(el("p", { text: `${what} ${result.map(fmt).join(", ")}` }));
+    return;
+  }
+  if (result.claimed) root.append(el("p", { class: "big", text: `Stage ${result.claimed} claimed.` }));
+  if (result.level) root.append(el("h3", { text: `Hint ${result.level}` }));
+  if (result.text) for (const para of String(result.text).split(/\n\s*\n/)) root.append(el("p", { text: para }));
+  if (result.cost !== undefined && result.cost !== null) root.append(el("p", { class: "meta", text: `this hint costs ${fmt(result.cost)} of the score` }));
+  if (result.steps && result.steps.length) {
+    root.append(el("p", { class: "meta", text: "the simulated operator's steps in this stage:" }),
+      el("ol", {}, ...result.steps.map((s) => el("li", { text: typeof s === "string" ? s : s.text || s.name || "" }))));
+  }
+  if (result.controls && result.controls.length) {
+    root.append(el("p", { text: `controls the operator uses here: ${result.controls.map((c) => LABELS[c] || c).join(", ")}` }));
+  }
+  if (result.applied) root.append(el("p", { text: `the operator's ${result.applied} actions of the stage were carried out on your instrument` }));
+  if (result.measures && result.measures.length) {
+    root.append(el("table", {}, el("tr", {}, ...["measure", "value", "tolerance", ""].map((h) => el("th", { text: h }))),
+      ...result.measures.map((m) => el("tr", {}, el("td", { text: m.name }), el("td", { class: "num", text: `${fmt(m.value)} ${m.unit}` }),
+        el("td", { class: "num", text: `${fmt(m.tolerance)} ${m.unit}` }),
+        el("td", { class: m.passed ? "pass" : "fail", text: m.passed ? "within" : "outside" })))));
+  }
+}
+
+// The stage's steps as a checklist (the core's, ticked as the trainee goes).
+export function showChecklist(root, items) {
+  root.replaceChildren(...(items || []).map((it) => {
+    const done = !!(it.done || it.ticked);
+    return el("li", { class: done ? "done" : "", "data-done": done ? "1" : "0" },
+      el("span", { class: "tick", text: done ? "☑ " : "☐ " }), it.text || it.step || it.name || "");
+  }));
+}
+
+// Announced injected errors: name and size (the core's text when it sends one).
+export function showAnnounced(box, list, errors) {
+  const rows = Array.isArray(errors) ? errors
+    : Object.entries(errors || {}).map(([name, value]) => ({ name, value }));
+  box.hidden = rows.length === 0;
+  list.replaceChildren(...rows.map((r) => el("li", {
+    text: r.text || `${r.name}: ${fmt(r.value)}${r.unit ? ` ${r.unit}` : ""}`,
+  })));
+}
+
+// Counters that moved though the action did not name them: said, with the core's reason.
+export function showCoupled(root, action, before, after, explanations) {
+  root.replaceChildren();
+  if (!action || !before || !after || !["turn", "set"].includes(action.kind)) return;
+  const moved = [];
+  for (const [name, c] of Object.entries(after.counters)) {
+    const b = before.counters[name];
+    if (!b || name === action.control || b.value === null || c.value === null) continue;
+    if (Math.abs(c.value - b.value) >= c.least_count) moved.push([name, b.value, c.value, c.unit]);
+  }
+  const texts = (explanations || []).map((x) => (typeof x === "string" ? x : x.text)).filter(Boolean);
+  if (!moved.length && !texts.length) return;
+  root.append(el("p", { class: "meta", text: `${LABELS[action.control] || action.control} moved other counters too:` }),
+    el("ul", {}, ...moved.map(([n, b, a, u]) => el("li", { text: `${LABELS[n] || n}: ${fmt(b)} → ${fmt(a)} ${u}` }))));
+  for (const t of texts) root.append(el("p", { class: "coupled-why", text: t }));
+}
+
+// A list of numbers or of short lists as text: "1.5, 2" or "(1.5, 2); (3, 4)".
+function listText(value) {
+  return value.map((v) => (Array.isArray(v) ? `(${listText(v)})`
+    : v && typeof v === "object" ? Object.entries(v).map(([k, x]) => `${k} ${fmt(x)}`).join(" ")
+      : fmt(v))).join(value.some(Array.isArray) ? "; " : ", ");
+}
+
+// Any JSON value as nested tables: a mapping as name/value rows, a list of mappings as a table.
+export function renderData(value, depth = 0) {
+  if (value === null || value === undefined) return el("span", { class: "dim", text: "—" });
+  if (typeof value !== "object") return el("span", { text: fmt(value) });
+  if (Array.isArray(value)) {
+    if (value.length && value.every((v) => v && typeof v === "object" && !Array.isArray(v))) {
+      const cols = [...new Set(value.flatMap((v) => Object.keys(v)))];
+      return el("table", { class: "data" }, el("tr", {}, ...cols.map((c) => el("th", { text: c.replaceAll("_", " ") }))),
+        ...value.map((v) => el("tr", {}, ...cols.map((c) => el("td", {}, renderData(v[c], depth + 1))))));
+    }
+    return el("span", { text: listText(value) });
+  }
+  const table = el("table", { class: depth ? "data nested" : "data" });
+  for (const [k, v] of Object.entries(value)) {
+    table.append(el("tr", {}, el("th", { text: k.replaceAll("_", " ") }), el("td", {}, renderData(v, depth + 1))));
+  }
+  return table;
+}
+
+// The setup sheet: its sections (the core's order), each as a heading and its data.
+export function showSheet(root, sheet) {
+  const sections = sheet.sections || sheet;
+  root.replaceChildren();
+  if (Array.isArray(sections)) {
+    for (const s of sections) {
+      root.append(el("h3", { text: s.title || s.name || "" }));
+      if (s.text) root.append(el("p", { text: s.text }));
+      root.append(renderData(s.rows || s.data || s.values || null));
+    }
+    return;
+  }
+  for (const [k, v] of Object.entries(sections)) {
+    root.append(el("h3", { text: k.replaceAll("_", " ") }), renderData(v));
+  }
+}
