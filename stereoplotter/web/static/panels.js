@@ -190,7 +190,9 @@ export function showSheet(root, sheet) {
     }
     return;
   }
+  const plain = Object.fromEntries(Object.entries(sections).filter(([, v]) => v === null || typeof v !== "object"));
+  if (Object.keys(plain).length) root.append(renderData(plain));
   for (const [k, v] of Object.entries(sections)) {
-    root.append(el("h3", { text: k.replaceAll("_", " ") }), renderData(v));
+    if (v !== null && typeof v === "object") root.append(el("h3", { text: k.replaceAll("_", " ") }), renderData(v));
   }
 }
