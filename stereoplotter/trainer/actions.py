@@ -29,6 +29,7 @@ from stereoplotter.instrument.virtual import (
 )
 
 __all__ = [
+    "ACTION_CATALOGUE",
     "ACTION_FIELDS",
     "COUNTERS",
     "INSTRUMENT_KINDS",
@@ -61,6 +62,125 @@ INSTRUMENT_KINDS = ("turn", "set", "direction", "read", "gear", "slip", "connect
 COUNTERS = (*SCREWS, *DECENTRATIONS, HEIGHT_SCALE)
 #: Every control a trainee turns or sets.
 TURNABLE = (*SCREWS, HEIGHT_SCALE, "f_instrument", *CASSETTES, *DECENTRATIONS, *KNOBS)
+
+
+def _field(name: str, type_: str, unit: str | None = None, **more: Any) -> dict[str, Any]:
+    return {"name": name, "type": type_, "unit": unit, "optional": False, **more}
+
+
+_SIDE = _field("side", "choice", None, choices=["below", "above"], optional=True)
+#: Every action the core accepts, with its fields, for a page to make one control per kind
+#: (JSON). Field ``type``: ``choice`` (one of ``choices``), ``number``, ``integer``, ``text``,
+#: ``point`` ([x_mm, y_mm] on the left photo) or ``number-or-point``; ``unit`` in the control's
+#: own unit where the field is a number (``"control"``: mm of a counter, m of the height scale,
+#: rad of κ, tangent of a correction knob, mm of f_пр). ``acts_on``: ``instrument`` or
+#: ``session``; ``assist``: the exercise assist that must allow it (exam: never undo nor hints).
+ACTION_CATALOGUE: list[dict[str, Any]] = [
+    {
+        "kind": "turn",
+        "label": "turn a handwheel, knob or scale by a step",
+        "fields": [
+            _field("control", "choice", None, choices=list(TURNABLE)),
+            _field("delta", "number", "control"),
+            _SIDE,
+        ],
+        "acts_on": "instrument",
+        "assist": None,
+    },
+    {
+        "kind": "set",
+        "label": "turn a control until its scale shows a value",
+        "fields": [
+            _field("control", "choice", None, choices=list(TURNABLE)),
+            _field("value", "number", "control"),
+            _SIDE,
+        ],
+        "acts_on": "instrument",
+        "assist": None,
+    },
+    {
+        "kind": "direction",
+        "label": "switch a counter's direction",
+        "fields": [
+            _field("counter", "choice", None, choices=[*SCREWS, *DECENTRATIONS]),
+            _field("sign", "choice", None, choices=[1, -1]),
+        ],
+        "acts_on": "instrument",
+        "assist": None,
+    },
+    {
+        "kind": "read",
+        "label": "read a counter to its least count",
+        "fields": [_field("counter", "choice", None, choices=list(COUNTERS))],
+        "acts_on": "instrument",
+        "assist": None,
+    },
+    {
+        "kind": "lock",
+        "label": "lock a control (a later turn is refused)",
+        "fields": [_field("control", "choice", None, choices=list(TURNABLE))],
+        "acts_on": "session",
+        "assist": None,
+    },
+    {
+        "kind": "record",
+        "label": "write a value on the sheet: a zero reading, or 'substitute N' as a point "
+        "clicked on the left photo",
+        "fields": [
+            _field("name", "text", None, examples=["MO_X", "substitute 5"]),
+            _field("value", "number-or-point", "mm"),
+        ],
+        "acts_on": "session",
+        "assist": None,
+    },
+    {
+        "kind": "gear",
+        "label": "gear the height counter for the vertical scale M_в",
+        "fields": [_field("value", "integer", "—")],
+        "acts_on": "instrument",
+        "assist": None,
+    },
+    {
+        "kind": "slip",
+        "label": "slip the metre height scale to show a height now",
+        "fields": [_field("value", "number", "m")],
+        "acts_on": "instrument",
+        "assist": None,
+    },
+    {
+        "kind": "connect",
+        "label": "connect the coordinatograph at a ratio M_г/M_map",
+        "fields": [
+            _field("value", "number", "—"),
+            _field("origin_mm", "point", "mm", optional=True),
+        ],
+        "acts_on": "instrument",
+        "assist": None,
+    },
+    {
+        "kind": "needle",
+        "label": "lower the coordinatograph's needle (mark the sheet)",
+        "fields": [_SIDE],
+        "acts_on": "instrument",
+        "assist": None,
+    },
+    {
+        "kind": "claim",
+        "label": "claim the stage in hand done",
+        "fields": [_field("step", "choice", None, choices=[*"12345", "C1", "C2", "C3", "C4"])],
+        "acts_on": "session",
+        "assist": None,
+    },
+    {"kind": "undo", "label": "undo", "fields": [], "acts_on": "session", "assist": "undo"},
+    {"kind": "redo", "label": "redo", "fields": [], "acts_on": "session", "assist": "undo"},
+    {
+        "kind": "hint",
+        "label": "a hint: 1 what to do, 2 which control, 3 show me",
+        "fields": [_field("level", "choice", None, choices=[1, 2, 3])],
+        "acts_on": "session",
+        "assist": "hints",
+    },
+]
 
 
 def _number(action: dict[str, Any], key: str) -> float:
@@ -104,6 +224,17 @@ def check_action(action: Any) -> dict[str, Any]:
         _number(action, "delta")
     if kind in ("set", "slip", "connect", "gear"):
         _number(action, "value")
+    if kind == "connect" and action.get("origin_mm") is not None:
+        o = action["origin_mm"]
+        if (
+            not isinstance(o, list)
+            or len(o) != 2
+            or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                for v in o
+            )
+        ):
+            raise TrainerError(f"action connect: origin_mm: expected [x_mm, y_mm], found {o!r}")
     if "side" in action and action["side"] not in ("below", "above", None):
         raise TrainerError(
             f"action {kind}: side: expected below, above or null, found {action['side']!r}"

@@ -64,6 +64,7 @@ def population_measures(
     injected: dict[str, Any],
     chunk: int = CHUNK,
     progress: Callable[[int], None] | None = None,
+    unusable: tuple[int, ...] = (),
 ) -> dict[str, dict[str, np.ndarray]]:
     """The measures of ``stages`` for ``trials`` simulated operators on one instrument.
 
@@ -88,9 +89,8 @@ def population_measures(
         for name, fn in stage_functions(run, prep.method).items():
             fn()
             if name in out:
-                out[name].append(
-                    {m.name: np.asarray(m.value, float) for m in stage_measures(inst, prep, name)}
-                )
+                measures = stage_measures(inst, prep, name, unusable)
+                out[name].append({m.name: np.asarray(m.value, float) for m in measures})
             if name == last:
                 break
         if progress is not None:
@@ -214,7 +214,7 @@ def _par_measures(session: Session) -> dict[str, list[Measure]]:
         for a in session.par.stage_actions(stage):
             apply(inst, a, commanded)
         if stage in session.stages:
-            out[stage] = stage_measures(inst, session.prep, stage)
+            out[stage] = stage_measures(inst, session.prep, stage, session.exercise.unusable_points)
     return out
 
 
@@ -237,7 +237,7 @@ def _outcome(
                 pop_ratio = r if pop_ratio is None else np.maximum(pop_ratio, r)
         inst = session.at_claim.get(stage, session.inst)
         rows = []
-        for m in stage_measures(inst, session.prep, stage):
+        for m in stage_measures(inst, session.prep, stage, ex.unusable_points):
             rows.append(_measure_row(m, par_by_name.get(m.name), pop_by_name.get(m.name)))
             ratios.append(rows[-1]["value"] / m.tolerance)
         if stage in SUBSTITUTE_STAGES:
@@ -277,6 +277,7 @@ def grade(
             population,
             session.inst.injected,
             progress=progress,
+            unusable=ex.unusable_points,
         )
         if population
         else {}

@@ -195,9 +195,16 @@ def stage_functions(run: Run, method: str) -> dict[str, Callable[[], None]]:
     return _conventional_stages(run)
 
 
-def operator_run(prep: PreparedRun, seed: int, upto: str | None = None) -> OperatorRun:
+def operator_run(
+    prep: PreparedRun,
+    seed: int,
+    upto: str | None = None,
+    after_stage: Callable[[str, RecordingInstrument], None] | None = None,
+) -> OperatorRun:
     """Run the simulated operator (trial 0 of seed ``seed``) stage by stage, noting its actions;
-    it stops after stage ``upto`` (default: the method's last)."""
+    it stops after stage ``upto`` (default: the method's last). ``after_stage(stage, inst)``
+    runs at the end of each stage, its calls on the instrument noted as the stage's actions
+    (the robot trainee's finishing, :mod:`stereoplotter.trainer.robot`)."""
     run = build_run(
         prep,
         injected=prep.model.draw_keyed(seed, 0, None),
@@ -211,6 +218,8 @@ def operator_run(prep: PreparedRun, seed: int, upto: str | None = None) -> Opera
     for name, fn in stage_functions(run, prep.method).items():
         inst.stage = name
         fn()
+        if after_stage is not None:
+            after_stage(name, inst)
         ends[name] = len(inst.actions)
         if name == upto:
             break

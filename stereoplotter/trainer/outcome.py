@@ -38,7 +38,7 @@ from stereoplotter.procedure.records import SheetReadings
 from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.transcript import Transcript
 
-__all__ = ["Measure", "stage_measures"]
+__all__ = ["Measure", "model_evaluation", "stage_measures", "standard_q"]
 
 
 @dataclass(frozen=True)
@@ -61,6 +61,18 @@ def _f_error(inst: Instrument, prep: PreparedRun) -> NDArray[np.float64]:
     f_set = np.asarray(inst.state()["f_instrument_mm"], float)
     target = SheetReadings.of(prep.sheet)["f_пр"].value
     return np.abs(np.nan_to_num(f_set, nan=np.inf) - target)
+
+
+def _f_scale_error(inst: Instrument, prep: PreparedRun) -> NDArray[np.float64]:
+    """|f_пр on its scale − the sheet's f_пр|: what the trainee set, without the scale's hidden
+    setting error (the instrument's, not the trainee's: an exact operator on e09 sets the scale
+    to the sheet's value and leaves 0.0155 mm of true error). [mm]"""
+    return np.abs(_f_error_signed(inst, prep) - inst.injected["setting.f_instrument"])
+
+
+def _f_error_signed(inst: Instrument, prep: PreparedRun) -> NDArray[np.float64]:
+    f_set = np.asarray(inst.state()["f_instrument_mm"], float)
+    return np.nan_to_num(f_set, nan=np.inf) - SheetReadings.of(prep.sheet)["f_пр"].value
 
 
 def _exact_operator(inst: Instrument) -> Operator:
@@ -91,14 +103,26 @@ def _span_error(inst: Instrument, prep: PreparedRun) -> NDArray[np.float64]:
     return worst
 
 
-def _q_max(inst: Instrument, prep: PreparedRun) -> NDArray[np.float64]:
+def standard_q(inst: Instrument, prep: PreparedRun) -> NDArray[np.float64]:
+    """The true y-parallax at the six standard points, shape (6,) or (T, 6). [mm]"""
     op = Operator(inst, OperatorModel(), Noise(0, inst.trials, None, 0), Transcript(enabled=False))
     scene = prep.scene
-    q = op.y_parallax(scene.standard_points_m, scene.standard)
-    return np.max(np.abs(np.nan_to_num(np.asarray(q, float), nan=np.inf)), axis=-1)
+    return np.asarray(op.y_parallax(scene.standard_points_m, scene.standard), float)
 
 
-def _evaluation(inst: Instrument, prep: PreparedRun):
+def _q_max(
+    inst: Instrument, prep: PreparedRun, unusable: tuple[int, ...] = ()
+) -> NDArray[np.float64]:
+    """The largest |q| over the usable standard points (an unusable one, on water or outside
+    the overlap, cannot be seen: its substitute is graded instead). [mm]"""
+    q = np.abs(np.nan_to_num(standard_q(inst, prep), nan=np.inf))
+    keep = [n - 1 for n in range(1, 7) if n not in unusable]
+    return np.max(q[..., keep], axis=-1)
+
+
+def model_evaluation(inst: Instrument, prep: PreparedRun):
+    """The built model against the ground truth (``evaluate_model``), heights read on the
+    slipped metre scale once the height counter is geared."""
     units = inst.state()["units"]
     zero = None
     if inst._height_gear is not None:
@@ -142,8 +166,12 @@ def _worst(values: Any) -> NDArray[np.float64]:
     return np.max(np.abs(np.nan_to_num(np.asarray(values, float), nan=np.inf)), axis=-1)
 
 
-def stage_measures(inst: Instrument, prep: PreparedRun, stage: str) -> list[Measure]:
-    """The measures of ``stage`` on the instrument as it stands (see the module docstring)."""
+def stage_measures(
+    inst: Instrument, prep: PreparedRun, stage: str, unusable: tuple[int, ...] = ()
+) -> list[Measure]:
+    """The measures of ``stage`` on the instrument as it stands (see the module docstring);
+    ``unusable``: the standard points (1–6) of an incomplete model, left out of the
+    y-parallax."""
     tol = prep.sheet.tolerances
     lc = prep.spec.xy_least_count_mm
     out: list[Measure] = []
@@ -154,7 +182,7 @@ def stage_measures(inst: Instrument, prep: PreparedRun, stage: str) -> list[Meas
         span = _span_error(inst, prep)
         out.append(Measure("scale coefficient |L − L′| (true)", span, tol["mark_span_mm"], "mm"))
     if stage == "C1" and not f_unset:
-        out.append(Measure("f_пр as set − sheet f_пр", _f_error(inst, prep), lc, "mm"))
+        out.append(Measure("f_пр as set − sheet f_пр", _f_scale_error(inst, prep), lc, "mm"))
     if stage == "1":
         geared = inst._height_gear == float(prep.sheet.vertical_scale_denominator)
         value = np.zeros(inst.trials) if inst.trials else 0.0
@@ -169,13 +197,13 @@ def stage_measures(inst: Instrument, prep: PreparedRun, stage: str) -> list[Meas
         out.append(
             Measure(
                 "residual y-parallax at the 6 standard points (true)",
-                _q_max(inst, prep),
+                _q_max(inst, prep, unusable),
                 float(tol["residual_y_parallax_mm"]),
                 "mm",
             )
         )
     if stage in ("3", "C3"):
-        ev = _evaluation(inst, prep)
+        ev = model_evaluation(inst, prep)
         out.append(
             Measure(
                 "height error at the control points",
@@ -185,7 +213,7 @@ def stage_measures(inst: Instrument, prep: PreparedRun, stage: str) -> list[Meas
             )
         )
     if stage in ("4", "5", "C4"):
-        ev = _evaluation(inst, prep)
+        ev = model_evaluation(inst, prep)
         m_map = ev.map_scale_denominator or prep.sheet.horizontal_scale_denominator
         plan = _rigid_residual_m(ev.control) * 1000.0 / m_map
         out.append(

@@ -494,7 +494,7 @@ class Session:
                     "unit": m.unit,
                     "passed": bool(_f(m.value) <= m.tolerance),
                 }
-                for m in stage_measures(self.inst, self.prep, step)
+                for m in stage_measures(self.inst, self.prep, step, self.exercise.unusable_points)
             ]
         return out
 
