@@ -24,7 +24,7 @@ from stereoplotter.io.paths import available_names
 from stereoplotter.io.session_log import log_bytes
 from stereoplotter.report.grade import grade_markdown
 from stereoplotter.report.sheet import sheet_to_dict
-from stereoplotter.trainer.actions import ACTION_FIELDS
+from stereoplotter.trainer.actions import ACTION_CATALOGUE
 from stereoplotter.trainer.exercise import Exercise, resolve_exercise
 from stereoplotter.trainer.grading import grade
 from stereoplotter.trainer.session import Session
@@ -162,7 +162,11 @@ def grade_text(grade_dict: dict[str, Any]) -> str:
 def replay_json(records: list[dict[str, Any]], trainee: str, exercise: str) -> bytes:
     """The instructor's replay as JSON bytes (run in a worker process: the frames of a long log
     are megabytes of JSON, encoded off the server's event loop)."""
-    body = {"trainee": trainee, "exercise": exercise, "frames": replay_frames(records)}
+    head = records[0]
+    ex = resolve_exercise(head["exercise"], exercise_from_mapping)
+    view = {"screen_pixel_mm": SCREEN_PIXEL_MM, "format_mm": format_mm(ex), "patch_px": 768}
+    frames = replay_frames(records)
+    body = {"trainee": trainee, "exercise": exercise, "view": view, "frames": frames}
     return json.dumps(body, allow_nan=False, separators=(",", ":")).encode()
 
 
@@ -245,13 +249,9 @@ def overview_of(session: Session) -> dict[str, Any]:
 
 
 def action_catalogue() -> list[dict[str, Any]]:
-    """Every action the core accepts with its parameters (kind, fields), for the page's
-    controls."""
-    optional = {"turn": ["side"], "set": ["side"], "needle": ["side"], "connect": ["origin_mm"]}
-    return [
-        {"kind": k, "fields": list(v), "optional": optional.get(k, [])}
-        for k, v in ACTION_FIELDS.items()
-    ]
+    """Every action the core accepts with its fields (``trainer.actions.ACTION_CATALOGUE``),
+    for the page to make one control per kind."""
+    return ACTION_CATALOGUE
 
 
 def _jsonable(value: Any) -> Any:

@@ -36,7 +36,9 @@ def _free_port() -> int:
 @pytest.fixture(scope="session")
 def server():
     """The base URL of a trainer server running in this process (stopped at the end)."""
-    app = create_app(TOKEN)
+    # the robot trainee's page sends as fast as the server takes: a high message rate (the
+    # page paces itself by the rate the server tells it; the classroom default is 60/s)
+    app = create_app(TOKEN, message_limit=(2000.0, 4000))
     port = _free_port()
     srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
     thread = threading.Thread(target=srv.run, daemon=True)

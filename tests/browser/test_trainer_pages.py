@@ -184,7 +184,7 @@ def test_exam_hides_hints_and_undo(page, server, artefacts):
     page.click("#hints button[data-level='1']")
     _settle(page, 1)
     shown = page.locator("#result").inner_text()
-    assert shown.lower().startswith("hint 1") and '{"' not in shown  # readable text, not a JSON dump
+    assert shown.lower().startswith("hint 1") and '{"' not in shown  # text, not a JSON dump
 
 
 def test_demonstration_plays_the_operators_actions(page, server):

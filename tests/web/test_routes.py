@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import zipfile
 
 from starlette.routing import Route, WebSocketRoute
 
-from tests.web.conftest import PRACTICE, TOKEN, claim_all, open_socket, start
+from tests.web.conftest import PRACTICE, TOKEN, ask, claim_all, open_socket, start
 
 BAD_BODIES = [
     b"",
@@ -138,3 +139,40 @@ def test_csv_export_and_class_archive(client):
     ws, _conn, hello = open_socket(client, sid, secret)
     ws.__exit__(None, None, None)
     assert hello["state"]["done"]
+
+
+#: A server path in any text the page is sent (the issue saw one in a stop's refusal).
+SERVER_PATH = re.compile(r"(?:[A-Za-z]:)?[\w.\-~]*(?:[\\/][\w.\-~ ]+){2,}")
+
+
+def test_sheet_and_overview_need_the_sessions_key_and_name_no_path(client):
+    sid, secret = start(client, exercise="e07-setup-stage2-incomplete", trainee="sheets")
+    for route in ("sheet", "overview"):
+        path = f"/api/sessions/{sid}/{route}"
+        assert client.get(path).status_code == 403
+        assert client.get(path, params={"key": "x" * 43}).status_code == 403
+        other = f"/api/sessions/{'0' * 16}/{route}"
+        assert client.get(other, params={"key": secret}).status_code == 404
+        r = client.get(path, headers={"Authorization": f"Bearer {secret}"})
+        assert r.status_code == 200, r.text
+        assert not SERVER_PATH.search(r.text), SERVER_PATH.search(r.text)
+        assert client.get(path, params={"token": TOKEN}).status_code == 200
+    ov = client.get(f"/api/sessions/{sid}/overview", params={"key": secret}).json()
+    photos = ov["photos"] if "photos" in ov else None
+    if photos is not None:  # the core's overview: six standard points a photo, 5 and 6 unusable
+        left = photos["left"]["standard_points"]
+        assert [p["id"] for p in left] == ["1", "2", "3", "4", "5", "6"]
+        assert [p["id"] for p in left if p["usable"] is False] == ["5", "6"]
+
+
+def test_a_stops_refusal_names_the_file_not_its_path(client):
+    sid, secret = start(client, trainee="stopped")
+    ws, conn, hello = open_socket(client, sid, secret)
+    try:
+        assert not SERVER_PATH.search(json.dumps(hello, ensure_ascii=False))
+        reply = ask(conn, {"action": {"kind": "set", "control": "Z", "value": 1e4}, "seq": 1})
+        assert "sc1.yaml" in reply["error"] and not SERVER_PATH.search(reply["error"]), reply
+        kinds = {a["kind"] for a in hello["hello"]["actions"]}
+        assert {"record", "connect", "slip", "needle", "lock", "gear"} <= kinds
+    finally:
+        ws.__exit__(None, None, None)

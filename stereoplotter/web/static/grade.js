@@ -1,6 +1,7 @@
 // The grade report page: the core's grade of this session, and downloads. The session's own
 // key (kept by this browser when it started the session) or the instructor's token is needed.
 import { el, sessionKey, download } from "./dom.js";
+import { fmt, pointTables, findMaps, drawMap, processParts } from "./gradeparts.js";
 
 const sid = location.pathname.split("/").pop();
 const $ = (id) => document.getElementById(id);
@@ -30,9 +31,14 @@ $("md").addEventListener("click", (e) => {
 $("log").addEventListener("click", (e) => {
   e.preventDefault(); download(`/api/sessions/${sid}/log.jsonl`, auth, `session-${sid}.jsonl`);
 });
-const fmt = (v) => (typeof v !== "number" ? String(v ?? "—")
-  : Number.isInteger(v) ? String(v) : Math.abs(v) >= 1e-3 ? v.toFixed(4) : v.toExponential(2));
 const num = (v) => el("td", { class: "num", text: v });
+if (o.hint_cost || grade.hints) {
+  const h = grade.hints || {};
+  $("overall").append(el("p", { class: "meta", text: `hints: ${(h.used || []).length ? h.used.join(", ") : "none"}`
+    + (o.hint_cost !== undefined ? ` — cost ${fmt(o.hint_cost)} added to the score` : "")
+    + (o.score_before_hints !== undefined ? ` (score without them ${fmt(o.score_before_hints)})` : "")
+    + (h.rule ? `; rule: ${h.rule}` : "") }));
+}
 for (const [stage, s] of Object.entries(grade.stages)) {
   const table = el("table", {}, el("tr", {}, ...["measure", "yours", "tolerance", "operator",
     "percentile", ""].map((h) => el("th", { text: h }))));
@@ -42,11 +48,17 @@ for (const [stage, s] of Object.entries(grade.stages)) {
       num(m.percentile == null ? "—" : m.percentile.toFixed(1)),
       el("td", { class: m.passed ? "pass" : "fail", text: m.passed ? "✓" : "✗" })));
   }
-  $("stages").append(el("div", {}, el("h3", { text: `Stage ${stage} ${s.claimed ? "" : "(not claimed)"}` }), table));
+  $("stages").append(el("div", { class: "stage", "data-stage": stage },
+    el("h3", { text: `Stage ${stage} ${s.claimed ? "" : "(not claimed)"}` }), table, ...pointTables(s)));
 }
-const p = grade.process, q = grade.par_process || {};
-$("process").append(el("tr", {}, el("th"), el("th", { text: "yours" }), el("th", { text: "operator" })));
-for (const k of Object.keys(p).filter((k) => typeof p[k] !== "object")) {
-  $("process").append(el("tr", {}, el("td", { text: k.replaceAll("_", " ") }), num(fmt(p[k])), num(fmt(q[k]))));
+const maps = findMaps(grade);
+$("maps").hidden = maps.length === 0;
+for (const m of maps) {
+  const canvas = el("canvas", { width: 420, height: 326, class: "pmap" });
+  const title = m.map.title || m.path.concat(m.key).join(" · ").replaceAll("_", " ");
+  $("maps").append(el("figure", {}, canvas, el("figcaption", { text: title })));
+  const drawn = drawMap(canvas, m);
+  canvas.dataset.cells = `${drawn.rows}x${drawn.cols}`;
 }
+$("process").append(...processParts(grade.process, grade.par_process));
 document.body.dataset.ready = "1";

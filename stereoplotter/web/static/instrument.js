@@ -4,7 +4,7 @@
 import { drawField, anaglyph, scale } from "./eyepiece.js";
 import { Wheels, LABELS, decimals } from "./wheels.js";
 import { el, sessionKey } from "./dom.js";
-import { buildActions, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
+import { buildActions, describe, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
 import { Overview } from "./overview.js";
 
 const sid = location.pathname.split("/").pop();
@@ -214,13 +214,19 @@ function drawStage() {
   const um = (v) => (v === null || v === undefined ? "—" : v.toFixed(1));
   $("parallax").textContent = p ? `parallax at standard point ${p.point}: q = ${um(p.y_um)} µm, p = ${um(p.x_um)} µm`
     : state.marks ? "no q/p read-out in this exercise: judge the parallax in the eyepieces (or the anaglyph)" : "";
-  showChecklist($("checklist"), state.checklist || []);
-  showAnnounced($("announced"), $("announced-list"), state.announced || state.injected_errors);
+  showChecklist($("checklist"), state.checklist);
+  showAnnounced($("announced"), $("announced-list"), state.injected_errors_list || state.injected_errors);
 }
 
-function render() {
-  drawEyes(); drawCounters(); drawStage(); drawTable();
-  wheels.update(state.controls, state.locked || []);
+let framePending = false;
+function render() { // at most once an animation frame, however many states arrive
+  if (framePending) return;
+  framePending = true;
+  requestAnimationFrame(() => {
+    framePending = false;
+    drawEyes(); drawCounters(); drawStage(); drawTable();
+    wheels.update(state.controls, state.locked || []);
+  });
 }
 
 function onMessage(ev) {
@@ -246,7 +252,7 @@ function onMessage(ev) {
   else if (!msg.hello) message("");
   if (!msg.hello && !msg.error) {
     showResult($("result"), action, msg.result);
-    showCoupled($("coupled"), action, before, msg.state, msg.coupled || (msg.state && msg.state.coupled));
+    showCoupled($("coupled"), action, before, msg.state, msg.state && msg.state.events);
   }
   if (msg.demo) $("demo-count").textContent = `${msg.demo.done} / ${msg.demo.of}`;
   if (msg.seq !== undefined && waiting.has(msg.seq)) { waiting.get(msg.seq)(performance.now()); waiting.delete(msg.seq); }
@@ -275,19 +281,6 @@ $("demo-play").onclick = () => {
 };
 $("demo-speed").onchange = () => { if (playing) play(); };
 
-// An action in words (the demonstration's operator, the replay).
-export function describe(a) {
-  if (!a) return "";
-  const what = LABELS[a.control || a.counter] || a.control || a.counter || "";
-  const side = a.side ? ` from ${a.side}` : "";
-  if (a.kind === "set") return `set ${what} to ${a.value}${side}`;
-  if (a.kind === "turn") return `turn ${what} by ${a.delta}`;
-  if (a.kind === "read") return `read ${what}`;
-  if (a.kind === "record") return `record ${a.name} = ${Array.isArray(a.value) ? a.value.join(", ") : a.value}`;
-  if (a.kind === "claim") return `claim stage ${a.step}`;
-  return [a.kind, a.value, what, a.side].filter((v) => v !== undefined && v !== "").join(" ");
-}
-
 // --- photo overview and the setup sheet ----------------------------------------------------
 const auth = () => ({ Authorization: `Bearer ${key || ""}` });
 async function loadOverview() {
@@ -300,9 +293,10 @@ async function loadOverview() {
     send({ kind: "record", name: `substitute ${n}`, value: xy });
   });
   overview.set(data);
-  $("substitute-for").replaceChildren(...(data.unusable || []).map((n) => el("option", { value: String(n), text: String(n) })));
-  $("overview-note").textContent = (data.unusable || []).length
-    ? `unusable: ${data.unusable.join(", ")} (on water or outside the overlap)` : "";
+  const unusable = data.photos
+    ? data.photos.left.standard_points.filter((p) => p.usable === false).map((p) => p.id) : data.unusable || [];
+  $("substitute-for").replaceChildren(...unusable.map((n) => el("option", { value: String(n), text: String(n) })));
+  $("overview-note").textContent = unusable.length ? `unusable: ${unusable.join(", ")} (on water or outside the overlap)` : "";
   document.body.dataset.overview = "1";
   drawEyes();
 }

@@ -21,7 +21,13 @@ function place(data, i, [x, y]) {
 
 // The points of one kind on one side: [{id, xy}] from the overview's lists (the core sends a
 // list of {id, left: [x, y], right: [x, y]} per kind, or {left: [[x, y]...], right: ...}).
-function pointsOf(list, side) {
+function pointsOf(data, key, side) {
+  if (data.photos) { // the core's overview: photos.left|right.<key> = [{id, x_mm, y_mm, usable}]
+    const photo = data.photos[side] || {};
+    const name = { standard: "standard_points", control: "control_points", check: "check_points", fiducials: "fiducials" }[key];
+    return (photo[name] || []).map((p) => ({ id: String(p.id), xy: [p.x_mm, p.y_mm], usable: p.usable !== false }));
+  }
+  const list = data[key];
   if (!list) return [];
   if (Array.isArray(list)) {
     return list.filter((p) => p && p[side]).map((p, i) => ({ id: String(p.id ?? i + 1), xy: p[side], usable: p.usable !== false }));
@@ -62,12 +68,11 @@ export class Overview {
         svg("text", { x: x0, y: TOP - 8, class: "ov-caption" }, name));
     });
     ["left", "right"].forEach((side, i) => {
-      const fid = d.fiducials ? d.fiducials[side] || [] : [];
-      for (const xy of Array.isArray(fid) ? fid : Object.values(fid)) {
-        const [x, y] = place(d, i, xy);
+      for (const f of pointsOf(d, "fiducials", side)) {
+        const [x, y] = place(d, i, f.xy);
         out.push(svg("path", { d: `M${x - 5},${y}h10M${x},${y - 5}v10`, class: "ov-fiducial" }));
       }
-      for (const p of pointsOf(d.standard, side)) {
+      for (const p of pointsOf(d, "standard", side)) {
         const [x, y] = place(d, i, p.xy);
         const bad = (d.unusable || []).includes(Number(p.id)) || !p.usable;
         const g = svg("g", { class: bad ? "ov-standard unusable" : "ov-standard", "data-point": p.id });
@@ -75,11 +80,11 @@ export class Overview {
         g.append(svg("circle", { cx: x, cy: y, r: 6 }), svg("text", { x: x + 8, y: y - 6 }, p.id));
         out.push(g);
       }
-      for (const p of pointsOf(d.control, side)) {
+      for (const p of pointsOf(d, "control", side)) {
         const [x, y] = place(d, i, p.xy);
         out.push(svg("path", { d: `M${x},${y - 5}l5,9h-10z`, class: "ov-control" }), svg("text", { x: x + 6, y: y + 10, class: "ov-id" }, p.id));
       }
-      for (const p of pointsOf(d.check, side)) {
+      for (const p of pointsOf(d, "check", side)) {
         const [x, y] = place(d, i, p.xy);
         out.push(svg("rect", { x: x - 4, y: y - 4, width: 8, height: 8, class: "ov-check" }), svg("text", { x: x + 6, y: y + 10, class: "ov-id" }, p.id));
       }

@@ -27,15 +27,17 @@ export function parseValue(text) {
 
 function input(kind, f, controls) {
   const id = `act-${kind}-${f.name}`;
-  if (f.name === "control") {
-    return el("select", { id, name: f.name }, ...controls.map((c) => el("option", { value: c, text: LABELS[c] || c })));
+  if (f.type === "choice" || f.name === "control" || f.name === "side" || f.choices) {
+    const choices = f.name === "control" ? controls : f.choices || [];
+    const opts = choices.map((c) => el("option", { value: String(c), text: LABELS[c] || String(c) }));
+    if (f.optional) opts.unshift(el("option", { value: "", text: f.name === "side" ? "either side" : "—" }));
+    return el("select", { id, name: f.name }, ...opts);
   }
-  if (f.name === "side") return el("select", { id, name: f.name }, ...SIDES.map(([v, t]) => el("option", { value: v, text: t })));
-  if (f.choices) return el("select", { id, name: f.name }, ...f.choices.map((c) => el("option", { value: String(c), text: String(c) })));
-  if (f.name === "origin_mm") return el("input", { id, name: f.name, placeholder: "x, y (optional)", class: "w80" });
-  if (f.name === "name") return el("input", { id, name: f.name, placeholder: "e.g. zero X", maxlength: 64, class: "w120" });
-  if (f.name === "value" && kind === "record") return el("input", { id, name: f.name, placeholder: "number or x, y", class: "w120" });
-  return el("input", { id, name: f.name, type: "number", step: "any", class: "w80", placeholder: f.unit || "" });
+  if (f.type === "point" || f.type === "number-or-point" || f.type === "text") {
+    const hint = f.type === "text" ? (f.examples || []).join(", ") : f.type === "point" ? "x, y" : "number or x, y";
+    return el("input", { id, name: f.name, placeholder: hint + (f.optional ? " (optional)" : ""), maxlength: 64, class: "w120" });
+  }
+  return el("input", { id, name: f.name, type: "number", step: f.type === "integer" ? "1" : "any", class: "w80" });
 }
 
 // The action's fields read from its form; null (with a message) when one is missing.
@@ -45,12 +47,12 @@ function collect(kind, form, fields) {
     const box = form.elements.namedItem(f.name);
     const raw = box.value.trim();
     if (raw === "") {
-      if (f.optional || f.name === "side" || f.name === "origin_mm") continue;
+      if (f.optional) continue;
       return null;
     }
-    if (f.name === "value" && kind === "record") action.value = parseValue(raw);
-    else if (f.name === "origin_mm") action.origin_mm = parseValue(raw);
-    else if (box.tagName === "SELECT" || f.name === "name" || f.name === "control") action[f.name] = raw;
+    if (f.type === "point" || f.type === "number-or-point") action[f.name] = parseValue(raw);
+    else if (f.type === "choice" && (f.choices || []).every((c) => typeof c === "number")) action[f.name] = Number(raw);
+    else if (f.type === "choice" || f.type === "text" || box.tagName === "SELECT") action[f.name] = raw;
     else action[f.name] = Number(raw);
   }
   return action;
@@ -61,13 +63,13 @@ export function buildActions(root, catalogue, controls, send, say) {
   root.replaceChildren();
   for (const entry of catalogue) {
     if (ELSEWHERE.has(entry.kind)) continue;
-    const fields = (entry.fields || []).map(fieldOf);
-    const optional = (entry.optional || []).map(fieldOf).map((f) => ({ ...f, optional: true }));
-    const all = [...fields, ...optional];
-    const button = el("button", { type: "submit", id: `act-${entry.kind}`, text: entry.label || entry.kind });
-    const form = el("form", { class: "row action", "data-kind": entry.kind, title: entry.text || "" },
-      button, ...all.map((f) => el("label", {}, `${f.label || f.name}${f.unit ? ` [${f.unit}]` : ""} `, input(entry.kind, f, controls))));
-    if (entry.text) form.append(el("span", { class: "meta small", text: entry.text }));
+    const all = (entry.fields || []).map(fieldOf);
+    const fields = all.filter((f) => !f.optional);
+    const button = el("button", { type: "submit", id: `act-${entry.kind}`, text: entry.kind });
+    const unit = (f) => (f.unit && f.unit !== "control" && f.unit !== "—" ? ` [${f.unit}]` : "");
+    const form = el("form", { class: "row action", "data-kind": entry.kind, title: entry.label || "" },
+      button, ...all.map((f) => el("label", {}, `${f.name.replaceAll("_", " ")}${unit(f)} `, input(entry.kind, f, controls))));
+    if (entry.label) form.append(el("span", { class: "meta small", text: entry.label }));
     form.addEventListener("submit", (e) => {
       e.preventDefault();
       const action = collect(entry.kind, form, all);
@@ -96,11 +98,12 @@ export function showResult(root, action, result) {
     root.append(el("p", { text: `${what} ${result.map(fmt).join(", ")}` }));
     return;
   }
-  if (result.claimed) root.append(el("p", { class: "big", text: `Stage ${result.claimed} claimed.` }));
+  if (result.claimed && !result.text) root.append(el("p", { class: "big", text: `Stage ${result.claimed} claimed.` }));
   if (result.level) root.append(el("h3", { text: `Hint ${result.level}` }));
-  if (result.text) for (const para of String(result.text).split(/\n\s*\n/)) root.append(el("p", { text: para }));
+  if (result.lines && result.lines.length) for (const line of result.lines) root.append(el("p", { text: typeof line === "string" ? line : line.text || "" }));
+  else if (result.text) for (const para of String(result.text).split(/\n\s*\n/)) root.append(el("p", { text: para }));
   if (result.cost !== undefined && result.cost !== null) root.append(el("p", { class: "meta", text: `this hint costs ${fmt(result.cost)} of the score` }));
-  if (result.steps && result.steps.length) {
+  if (result.steps && result.steps.length && !(result.lines && result.lines.length)) {
     root.append(el("p", { class: "meta", text: "the simulated operator's steps in this stage:" }),
       el("ol", {}, ...result.steps.map((s) => el("li", { text: typeof s === "string" ? s : s.text || s.name || "" }))));
   }
@@ -117,7 +120,9 @@ export function showResult(root, action, result) {
 }
 
 // The stage's steps as a checklist (the core's, ticked as the trainee goes).
-export function showChecklist(root, items) {
+export function showChecklist(root, list) {
+  const items = Array.isArray(list) ? list : list ? list.steps : [];
+  root.dataset.done = list && list.done !== undefined ? `${list.done}/${list.total}` : "";
   root.replaceChildren(...(items || []).map((it) => {
     const done = !!(it.done || it.ticked);
     return el("li", { class: done ? "done" : "", "data-done": done ? "1" : "0" },
@@ -145,7 +150,12 @@ export function showCoupled(root, action, before, after, explanations) {
     if (!b || name === action.control || b.value === null || c.value === null) continue;
     if (Math.abs(c.value - b.value) >= c.least_count) moved.push([name, b.value, c.value, c.unit]);
   }
-  const texts = (explanations || []).map((x) => (typeof x === "string" ? x : x.text)).filter(Boolean);
+  const events = (explanations || []).filter((x) => x && (typeof x === "string" || x.kind === "coupled" || x.text));
+  if (events.some((x) => x.moved)) { // the core's own account: what moved and why
+    moved.length = 0;
+    for (const x of events) for (const [n, [b, a]] of Object.entries(x.moved || {})) moved.push([n, b, a, after.counters[n] ? after.counters[n].unit : ""]);
+  }
+  const texts = events.map((x) => (typeof x === "string" ? x : x.text)).filter(Boolean);
   if (!moved.length && !texts.length) return;
   root.append(el("p", { class: "meta", text: `${LABELS[action.control] || action.control} moved other counters too:` }),
     el("ul", {}, ...moved.map(([n, b, a, u]) => el("li", { text: `${LABELS[n] || n}: ${fmt(b)} → ${fmt(a)} ${u}` }))));
@@ -195,4 +205,17 @@ export function showSheet(root, sheet) {
   for (const [k, v] of Object.entries(sections)) {
     if (v !== null && typeof v === "object") root.append(el("h3", { text: k.replaceAll("_", " ") }), renderData(v));
   }
+}
+
+// An action in words (the demonstration's operator, the replay).
+export function describe(a) {
+  if (!a) return "";
+  const what = LABELS[a.control || a.counter] || a.control || a.counter || "";
+  const side = a.side ? ` from ${a.side}` : "";
+  if (a.kind === "set") return `set ${what} to ${a.value}${side}`;
+  if (a.kind === "turn") return `turn ${what} by ${a.delta}`;
+  if (a.kind === "read") return `read ${what}`;
+  if (a.kind === "record") return `record ${a.name} = ${Array.isArray(a.value) ? a.value.join(", ") : a.value}`;
+  if (a.kind === "claim") return `claim stage ${a.step}`;
+  return [a.kind, a.value, what, a.side].filter((v) => v !== undefined && v !== "").join(" ");
 }

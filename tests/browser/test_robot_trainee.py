@@ -1,0 +1,76 @@
+"""Issue 24, item 2: a robot trainee completes every shipped exercise through the instrument
+page's controls alone, and the page's grade is the core's grade of the same log.
+
+The robot's actions are the core's :func:`~stereoplotter.trainer.robot.robot_script` for the
+exercise (the simulated operator's settings that pass it), each made as a gesture
+(:mod:`tests.browser.robot`): a typed value and Enter, a click. The test never opens a
+WebSocket; it reads the log over HTTP with the session's own key (issue 22) and grades it with
+the core, independently of the server. Parametrized over the shipped exercise files: a new file
+is covered with no new code.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+
+import pytest
+
+from stereoplotter.io.exercise_file import exercise_from_mapping, load_exercise, shipped_exercises
+from stereoplotter.trainer.grading import grade
+from stereoplotter.trainer.robot import robot_script
+from stereoplotter.trainer.session import Session
+from stereoplotter.web.core import GRADE_POPULATION
+from tests.browser.robot import Hands
+
+SHIPPED = shipped_exercises()
+TRAINEE = "robot"
+
+
+@pytest.fixture(scope="module")
+def robot_page(browser):
+    """One tab for the whole walk (a new session per exercise loads the page afresh)."""
+    p = browser.new_page()
+    yield p
+    p.close()
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
+def test_robot_trainee_completes_the_exercise_through_the_page(
+    robot_page, server, path, record_property
+):
+    page, t0 = robot_page, time.perf_counter()
+    ex = load_exercise(path)
+    script = robot_script(Session.start(ex, trainee=TRAINEE))
+    page.goto(server + "/")
+    page.fill("#trainee", TRAINEE)
+    page.click(f"button[data-exercise='{ex.name}']")
+    page.wait_for_url("**/s/*")
+    page.wait_for_selector("body[data-ready='1']")
+    page.wait_for_selector("body[data-overview='1']")
+    sid = page.url.rsplit("/", 1)[1]
+    hands = Hands(page)
+    for action in script:
+        hands.do(action)
+    hands.settle()
+    page.wait_for_selector("#done:not([hidden])")
+    assert page.evaluate("window.trainer.state().done")
+
+    secret = page.evaluate(f"localStorage.getItem('stereoplotter-key-{sid}')")
+    r = page.request.get(f"{server}/api/sessions/{sid}/log.jsonl",
+                         headers={"Authorization": f"Bearer {secret}"})
+    log = [json.loads(line) for line in r.text().splitlines()]
+    assert [rec["action"]["kind"] for rec in log[1:]] == [a["kind"] for a in script]
+    assert not [rec for rec in log[1:] if rec.get("refused")]
+
+    page.click("#grade-link")
+    page.wait_for_selector("body[data-ready='1']")
+    shown = page.evaluate("window.__grade")
+    core = json.loads(json.dumps(
+        grade(log, population=GRADE_POPULATION, read_exercise=exercise_from_mapping)))
+    for g in (shown, core):  # the wall-clock time of the grading run itself
+        g["population"].pop("seconds")
+    assert shown == core
+    assert shown["overall"]["passed"], shown["overall"]
+    record_property("robot_seconds", round(time.perf_counter() - t0, 2))
+    record_property("robot_actions", len(script))
