@@ -52,6 +52,7 @@ __all__ = [
     "replay_frames",
     "replay_json",
     "sheet_of",
+    "show_me",
     "start",
 ]
 
@@ -246,6 +247,15 @@ def overview_of(session: Session) -> dict[str, Any]:
             "marks": session.state()["marks"],
         }
     )
+
+
+def show_me(session: Session) -> list[dict[str, Any]]:
+    """The simulated operator's actions of the stage in hand (what hint 3 applies at once), for
+    the page to play one by one at its chosen speed ("show me", animated)."""
+    stage = session.stage
+    if stage is None:
+        return []
+    return [{k: v for k, v in a.items() if k != "stage"} for a in session.par.stage_actions(stage)]
 
 
 def action_catalogue() -> list[dict[str, Any]]:

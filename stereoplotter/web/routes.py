@@ -200,6 +200,19 @@ async def overview(request: Request) -> Response:
     return JSONResponse(body, headers=_NO_STORE)
 
 
+async def show_me(request: Request) -> Response:
+    """The operator's actions of the stage in hand, for an animated "show me" (hint 3): given
+    only where the exercise allows hints, never in a demonstration."""
+    sid, row = _own_or_instructor(request)
+    reg = _web(request).reg
+    live = await run_in_threadpool(reg.resume, sid)
+    if live.demonstration or not live.session.exercise.allows("hints") or row["mode"] == "exam":
+        raise Refused(403, "show me: this exercise gives no hints")
+    loop = asyncio.get_running_loop()
+    actions = await loop.run_in_executor(reg.actor, core.show_me, live.session)
+    return JSONResponse({"stage": live.session.stage, "actions": actions}, headers=_NO_STORE)
+
+
 async def _grade(request: Request) -> tuple[dict[str, Any], dict[str, Any]]:
     sid, row = _session_row(request)
     _may_read(request, sid, row)

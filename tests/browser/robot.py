@@ -1,9 +1,13 @@
 """The robot trainee's hands: each action of the core's ``robot_script`` as the gesture a person
-makes on the instrument page — a value typed into a handwheel's box and Enter (Shift+Enter:
-finish the approach from below, Alt+Enter: from above), a click on a counter's *read*, a value
-typed into an action's form and its button, a click on a standard point of the photo overview
-(a substitute), *Claim stage done*. No WebSocket message is sent by the test: the page sends
-what the gestures ask for, paced at the server's rate.
+makes on the instrument page. Settings and readings, the bulk of a script, are typed into the
+page's keyboard box (``X 215.3 below`` Enter, ``read X`` Enter: the box keeps the focus, so a
+run of them is keys only — a Playwright click or fill costs 12–37 ms on the shared 2-core
+machine, a key press 3.5 ms); ``SLOW_HANDS`` types them into each handwheel's own box instead
+(Enter, Shift+Enter: finish from below, Alt+Enter: from above) and clicks *read*. Gear, slip,
+connect, needle, record: a value typed into the action's form and its button; a substitute
+standard point: a click on it in the photo overview; the stage: *Claim stage done*. No WebSocket
+message is sent by the test: the page sends what the gestures ask for, paced at the server's
+rate.
 """
 
 from __future__ import annotations
@@ -23,9 +27,18 @@ def _number(value: float) -> str:
 class Hands:
     """Gestures on an open instrument page; :attr:`sent` counts the actions they cause."""
 
-    def __init__(self, page):
+    def __init__(self, page, slow: bool = False):
         self.page = page
         self.sent = 0
+        self.slow = slow
+        self.typing = False  # the keyboard box holds the focus
+
+    def _type(self, text: str) -> None:
+        if not self.typing:
+            self.page.focus("#command")
+            self.typing = True
+        self.page.keyboard.insert_text(text)
+        self.page.keyboard.press("Enter")
 
     def settle(self, timeout: float = 60_000) -> None:
         """Wait until the server has answered every action sent (the log holds them)."""
@@ -33,6 +46,8 @@ class Hands:
 
     def do(self, action: dict[str, Any]) -> None:
         kind = action["kind"]
+        if kind not in ("set", "read", "turn"):
+            self.typing = False  # a click elsewhere takes the focus
         getattr(self, f"_{kind}")(action)
         self.sent += 1
         if kind == "claim":  # the next stage's controls follow the claim's answer
@@ -41,17 +56,24 @@ class Hands:
     # --- one gesture per kind -----------------------------------------------------------------
 
     def _set(self, a: dict[str, Any]) -> None:
+        if not self.slow:
+            side = f" {a['side']}" if a.get("side") else ""
+            self._type(f"{a['control']} {_number(a['value'])}{side}")
+            return
+        self.typing = False
         box = f".wheel[data-control='{a['control']}'] input"
-        self.page.focus(box)
-        self.page.keyboard.press("Control+A")
-        self.page.keyboard.insert_text(_number(a["value"]))
+        self.page.fill(box, _number(a["value"]))  # focuses the box, replaces its text
         self.page.keyboard.press(ENTER[a.get("side")])
 
-    def _turn(self, a: dict[str, Any]) -> None:  # a typed 'turn by': set to the scale + delta
-        state = self.page.evaluate("window.trainer.state().controls")
-        self._set({**a, "value": state[a["control"]]["value"] + a["delta"]})
+    def _turn(self, a: dict[str, Any]) -> None:
+        side = f" {a['side']}" if a.get("side") else ""
+        self._type(f"turn {a['control']} {_number(a['delta'])}{side}")
 
     def _read(self, a: dict[str, Any]) -> None:
+        if not self.slow:
+            self._type(f"read {a['counter']}")
+            return
+        self.typing = False
         self.page.click(f"tr[data-counter='{a['counter']}'] button.read")
 
     def _direction(self, a: dict[str, Any]) -> None:

@@ -4,7 +4,7 @@
 import { drawField, anaglyph, scale } from "./eyepiece.js";
 import { Wheels, LABELS, decimals } from "./wheels.js";
 import { el, sessionKey } from "./dom.js";
-import { buildActions, describe, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
+import { buildActions, describe, parseCommand, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
 import { Overview } from "./overview.js";
 
 const sid = location.pathname.split("/").pop();
@@ -109,11 +109,24 @@ function needPatch(side, mark, mag) {
   c.img.src = patchUrl(side, mark, cm, cs);
 }
 
+// A new photo patch is asked for once the mark has rested (PATCH_REST_MS without a new
+// state): a fast run of moves shows the patch in hand (or the graticule) and the server renders
+// one patch where the mark stops, not one per move.
+const PATCH_REST_MS = 120;
+let patchTimer = null;
+function askPatches(marks, mag) {
+  clearTimeout(patchTimer);
+  patchTimer = setTimeout(() => {
+    const m = state && state.marks;
+    if (m) for (const side of ["left", "right"]) needPatch(side, m[side], Number($("mag").value) || mag);
+  }, PATCH_REST_MS);
+}
+
 function drawEyes() {
   const marks = state ? state.marks : null;
   const mag = Number($("mag").value) || 6;
   const mode = $("view").value;
-  if (marks) for (const side of ["left", "right"]) needPatch(side, marks[side], mag);
+  if (marks) askPatches(marks, mag);
   $("eyepieces").hidden = mode !== "split";
   $("stereo").hidden = mode === "split";
   if (mode === "split") {
@@ -218,19 +231,33 @@ function drawStage() {
   showAnnounced($("announced"), $("announced-list"), state.injected_errors_list || state.injected_errors);
 }
 
+// The controls with the metre height scale H once the height counter is geared (the core
+// lists H among the counters; it is set and turned like a handwheel).
+function withHeightScale(st) {
+  const h = st.counters.H;
+  if (!h || st.controls.H) return st.controls;
+  return { ...st.controls, H: { value: h.value, unit: h.unit, step: h.least_count, min: null, max: null } };
+}
+
 let framePending = false;
 function render() { // at most once an animation frame, however many states arrive
   if (framePending) return;
   framePending = true;
   requestAnimationFrame(() => {
+    const t0 = performance.now();
     framePending = false;
     drawEyes(); drawCounters(); drawStage(); drawTable();
-    wheels.update(state.controls, state.locked || []);
+    wheels.update(withHeightScale(state), state.locked || []);
+    window.__renderMs = (window.__renderMs || 0) + performance.now() - t0; // for the benchmarks
   });
 }
 
 function onMessage(ev) {
-  const msg = JSON.parse(ev.data);
+  const t0 = performance.now();
+  try { handle(JSON.parse(ev.data)); } finally { window.__messageMs = (window.__messageMs || 0) + performance.now() - t0; }
+}
+
+function handle(msg) {
   if (msg.hello) {
     hello = msg.hello; retry = 250; link("", false);
     scale.pxPerMmAt1x = 1 / hello.screen_pixel_mm;
@@ -268,7 +295,38 @@ $("claim").onclick = () => send({ kind: "claim", step: state.stage });
 $("undo").onclick = () => send({ kind: "undo" });
 $("redo").onclick = () => send({ kind: "redo" });
 for (const b of $("hints").querySelectorAll("button")) b.onclick = () => send({ kind: "hint", level: Number(b.dataset.level) });
-let playing = null;
+$("command").addEventListener("keydown", (e) => {
+  if (e.key !== "Enter" || !state) return;
+  const names = [...Object.keys(withHeightScale(state)), ...Object.keys(state.counters)];
+  const parsed = parseCommand($("command").value, [...new Set(names)]);
+  if (parsed.error) { message(parsed.error, "error"); return; }
+  send(parsed.action);
+  $("command").value = "";
+});
+
+let playing = null, showing = null;
+// "Show me", animated: the operator's actions of the stage sent one by one at the chosen speed
+// (the eyepieces, wheels and counters move as they go), then hint 3 logged (its cost; it
+// applies the same settings again, which the instrument already shows).
+$("show-me").onclick = async () => {
+  if (showing) { clearInterval(showing); showing = null; $("show-me").textContent = "Show me"; return; }
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/showme`, { headers: auth() });
+  const body = await r.json();
+  if (!r.ok) { message(body.error, "error"); return; }
+  const actions = body.actions;
+  let i = 0;
+  $("show-me").textContent = "Stop";
+  showing = setInterval(() => {
+    if (i >= actions.length) {
+      clearInterval(showing); showing = null; $("show-me").textContent = "Show me";
+      send({ kind: "hint", level: 3 });
+      return;
+    }
+    const a = actions[i++];
+    $("show-me-count").textContent = `show me ${i} / ${actions.length}: ${describe(a)}`;
+    send(a);
+  }, 1000 / Number($("demo-speed").value));
+};
 $("demo-step").onclick = sendDemo;
 function play() {
   if (playing) clearInterval(playing);

@@ -219,3 +219,25 @@ export function describe(a) {
   if (a.kind === "claim") return `claim stage ${a.step}`;
   return [a.kind, a.value, what, a.side].filter((v) => v !== undefined && v !== "").join(" ");
 }
+
+// A typed action of the keyboard box: "X 215.3 [below|above]" or "set X 215.3 …" (set),
+// "turn X 0.5 …", "read X", "lock X". The control or counter as the core names it or as the
+// page labels it; null (and why) when the text is not an action.
+export function parseCommand(text, names) {
+  const words = text.trim().split(/\s+/).filter(Boolean);
+  const byLabel = Object.fromEntries(Object.entries(LABELS).map(([k, v]) => [v.toLowerCase(), k]));
+  const name = (w) => (names.includes(w) ? w : byLabel[String(w).toLowerCase()] || null);
+  let verb = "set";
+  if (["set", "turn", "read", "lock"].includes((words[0] || "").toLowerCase())) verb = words.shift().toLowerCase();
+  const control = name(words[0]);
+  if (!control) return { error: `keyboard: expected a control (${names.join(", ")}), found ${words[0] || "nothing"}` };
+  if (verb === "read") return { action: { kind: "read", counter: control } };
+  if (verb === "lock") return { action: { kind: "lock", control } };
+  const value = Number(words[1]);
+  if (words[1] === undefined || !Number.isFinite(value)) return { error: `keyboard: ${verb} ${control}: expected a number` };
+  const side = (words[2] || "").toLowerCase();
+  if (side && side !== "below" && side !== "above") return { error: "keyboard: the side is below or above" };
+  const action = verb === "turn" ? { kind: "turn", control, delta: value } : { kind: "set", control, value };
+  if (side) action.side = side;
+  return { action };
+}
