@@ -14,8 +14,18 @@ from __future__ import annotations
 
 from typing import Any
 
+from stereoplotter.io.exercise_file import load_exercise
+from stereoplotter.trainer.robot import robot_script
+from stereoplotter.trainer.session import Session
+
 #: Keys that finish a typed value on a handwheel, by the approach side.
 ENTER = {None: "Enter", "below": "Shift+Enter", "above": "Alt+Enter"}
+
+
+def script_for(path: str, trainee: str) -> list[dict[str, Any]]:
+    """The core's robot script for an exercise file and trainee (run in a worker process: the
+    scripts of the exercises to come are made while the browser works on this one)."""
+    return robot_script(Session.start(load_exercise(path), trainee=trainee))
 
 
 def _number(value: float) -> str:

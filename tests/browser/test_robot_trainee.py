@@ -13,30 +13,45 @@ from __future__ import annotations
 
 import json
 import time
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
 
 import pytest
 
 from stereoplotter.io.exercise_file import exercise_from_mapping, load_exercise, shipped_exercises
 from stereoplotter.trainer.grading import grade
-from stereoplotter.trainer.robot import robot_script
-from stereoplotter.trainer.session import Session
 from stereoplotter.web.core import GRADE_POPULATION
-from tests.browser.robot import Hands
+from tests.browser.robot import Hands, script_for
 
 SHIPPED = shipped_exercises()
 TRAINEE = "robot"
 
 
 def _as_javascript_numbers(value):
-    """``value`` as the page holds it: JavaScript numbers are doubles, so an integer beyond 2⁵³
-    (a per-trainee seed) reads back rounded to one."""
+    """``value`` with every integer beyond 2⁵³ (a per-trainee seed) as the double the page holds
+    (JavaScript numbers are doubles; Playwright hands it back as the double's shortest
+    decimal digits)."""
     if isinstance(value, dict):
         return {k: _as_javascript_numbers(v) for k, v in value.items()}
     if isinstance(value, list):
         return [_as_javascript_numbers(v) for v in value]
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2**53:
-        return int(float(value))
+        return float(value)
     return value
+
+
+@pytest.fixture(scope="module")
+def scripts(request):
+    """The robot script of each exercise selected, made ahead in a worker process (in the
+    tests' order) while the browser works."""
+    chosen = [
+        item.callspec.params["path"]
+        for item in request.session.items
+        if item.module is request.module and hasattr(item, "callspec")
+    ]
+    pool = ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"))
+    yield {p: pool.submit(script_for, str(p), TRAINEE) for p in chosen}
+    pool.shutdown(wait=True, cancel_futures=True)
 
 
 @pytest.fixture(scope="module")
@@ -49,11 +64,11 @@ def robot_page(browser):
 
 @pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
 def test_robot_trainee_completes_the_exercise_through_the_page(
-    robot_page, process_server, path, record_property
+    robot_page, process_server, scripts, path, record_property
 ):
     page, t0, server = robot_page, time.perf_counter(), process_server
     ex = load_exercise(path)
-    script = robot_script(Session.start(ex, trainee=TRAINEE))
+    script = scripts[path].result(timeout=600)
     page.goto(server + "/")
     page.fill("#trainee", TRAINEE)
     page.click(f"button[data-exercise='{ex.name}']")
@@ -82,7 +97,7 @@ def test_robot_trainee_completes_the_exercise_through_the_page(
         grade(log, population=GRADE_POPULATION, read_exercise=exercise_from_mapping)))
     for g in (shown, core):  # the wall-clock time of the grading run itself
         g["population"].pop("seconds")
-    assert shown == _as_javascript_numbers(core)
+    assert _as_javascript_numbers(shown) == _as_javascript_numbers(core)
     assert shown["overall"]["passed"], shown["overall"]
     record_property("robot_seconds", round(time.perf_counter() - t0, 2))
     record_property("robot_actions", len(script))

@@ -231,3 +231,22 @@ def test_exercise_picker_lists_the_shipped_exercises(page, server, artefacts):
     page.screenshot(path=str(artefacts / "exercises.png"), full_page=True)
     # docs/img/trainer-*.png are copies of these artefacts, made by hand: a test run never
     # writes into the checkout's docs
+
+
+def test_an_exam_shows_no_parallax_numbers(page, server):
+    """Issue 24, item 4: with the q/p read-out off the page shows no parallax number; the
+    eyepieces are what the trainee judges from. Practice with the read-out shows one."""
+    for exercise, readout in ((EXAM, False), ("e03-setup-stage2", True)):
+        _start(page, server, exercise, trainee=f"readout-{readout}")
+        page.fill("#command", "f_instrument 109.34")
+        page.press("#command", "Enter")
+        _settle(page, 1)
+        page.wait_for_function("() => window.trainer.state().marks !== null")
+        page.wait_for_timeout(50)  # the frame after the state
+        text = page.locator("#parallax").inner_text()
+        state = page.evaluate("window.trainer.state()")
+        if readout:
+            assert state["parallax"] is not None and "µm" in text
+        else:
+            assert state["parallax"] is None
+            assert not any(c.isdigit() for c in text) and "eyepieces" in text

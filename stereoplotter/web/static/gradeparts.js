@@ -17,7 +17,8 @@ export function rowsTable(rows, cls = "") {
     ...rows.map((r) => el("tr", {}, ...cols.map((c) => {
       const v = r[c];
       if (typeof v === "boolean") return el("td", { class: v ? "pass" : "fail", text: v ? "✓" : "✗" });
-      if (Array.isArray(v)) return el("td", { class: "num", text: v.map(fmt).join(", ") });
+      if (Array.isArray(v)) return el("td", { text: v.length ? v.map(fmt).join(", ") : "none" });
+      if (v && typeof v === "object") return el("td", { text: Object.entries(v).map(([a, b]) => `${words(a)} ${fmt(b)}`).join(", ") });
       return el("td", { class: typeof v === "number" ? "num" : "", text: fmt(v) });
     }))));
 }
@@ -120,4 +121,55 @@ export function processParts(p, par) {
 // A mapping with its lists joined (a table cell each).
 function flat(x) {
   return Object.fromEntries(Object.entries(x).map(([k, v]) => [k, Array.isArray(v) ? (v.length ? v.join(", ") : "none") : v && typeof v === "object" ? Object.entries(v).map(([a, b]) => `${words(a)} ${fmt(b)}`).join(", ") : v]));
+}
+
+const TABLE_TITLES = {
+  y_parallax: "Y-parallax at the six standard points",
+  heights: "Height errors at the control points (built − true)",
+  plan: "Plan errors at the control points (built − true)",
+};
+
+// The grade's per-point tables (grade.tables): each titled with its unit and tolerance.
+export function tableParts(tables) {
+  const out = [];
+  for (const [key, title] of Object.entries(TABLE_TITLES)) {
+    const t = tables[key];
+    if (!t || !isRows(t.rows)) continue;
+    const tol = t.tolerance !== undefined ? `, tolerance ${fmt(t.tolerance)} ${t.unit}` : "";
+    const map = t.map_tolerance !== undefined ? ` (${fmt(t.map_tolerance)} ${t.map_unit} on the map)` : "";
+    const stage = t.stage ? ` — as built at stage ${t.stage}` : "";
+    out.push(el("h3", { text: `${title} [${t.unit}]${tol}${map}${stage}` }), rowsTable(t.rows, key));
+  }
+  return out;
+}
+
+// The y-parallax map of the built model (grade.tables.y_parallax_map: points on a grid of the
+// working area with their value): one cell per point, coloured against ±tolerance (blue −,
+// red +), its value written in it; north up.
+export function drawPointMap(canvas, map, tolerance) {
+  const pts = map.points.filter((p) => typeof p.value === "number");
+  const xs = [...new Set(map.points.map((p) => p.x_m))].sort((a, b) => a - b);
+  const ys = [...new Set(map.points.map((p) => p.y_m))].sort((a, b) => a - b);
+  const near = (list, v) => list.reduce((best, x, i) => (Math.abs(x - v) < Math.abs(list[best] - v) ? i : best), 0);
+  const [cols, rows] = map.shape ? [map.shape[1], map.shape[0]] : [xs.length, ys.length];
+  const gx = cols === xs.length ? xs : null, gy = rows === ys.length ? ys : null;
+  const ctx = canvas.getContext("2d");
+  const w = canvas.width, h = canvas.height - 30;
+  const tol = tolerance || Math.max(...pts.map((p) => Math.abs(p.value)));
+  ctx.fillStyle = "#15181a"; ctx.fillRect(0, 0, canvas.width, canvas.height);
+  const cw = w / cols, ch = h / rows;
+  ctx.font = "10px sans-serif"; ctx.textAlign = "center";
+  map.points.forEach((p, k) => {
+    const i = gx ? near(gx, p.x_m) : k % cols, j = gy ? near(gy, p.y_m) : Math.floor(k / cols);
+    ctx.fillStyle = typeof p.value === "number" ? colour(p.value / tol) : "#444";
+    ctx.fillRect(i * cw, h - (j + 1) * ch, Math.ceil(cw), Math.ceil(ch));
+    ctx.fillStyle = "#111";
+    if (typeof p.value === "number") ctx.fillText(p.value.toFixed(1), i * cw + cw / 2, h - j * ch - ch / 2 + 3);
+  });
+  ctx.textAlign = "left";
+  for (let k = 0; k <= 100; k++) { ctx.fillStyle = colour(k / 50 - 1); ctx.fillRect((k / 101) * w, h + 6, w / 100 + 1, 8); }
+  ctx.fillStyle = "#e8e4d8";
+  ctx.fillText(`−${fmt(tol)} ${map.unit || ""}`, 2, h + 27); ctx.fillText("0", w / 2 - 3, h + 27);
+  ctx.fillText(`+${fmt(tol)} ${map.unit || ""}`, w - 80, h + 27);
+  return { rows, cols, tol };
 }

@@ -367,7 +367,7 @@ async function openSheet() {
   const data = await r.json();
   if (!r.ok) { $("sheet-body").textContent = data.error; return; }
   sheetLoaded = true;
-  $("sheet-title").textContent = data.title || "";
+  $("sheet-title").textContent = [data.exercise, data.method && `${data.method} method`, data.instrument].filter(Boolean).join(" · ");
   showSheet($("sheet-body"), data);
   $("sheet-body").className = "";
   document.body.dataset.sheet = "1";

@@ -188,21 +188,32 @@ export function renderData(value, depth = 0) {
   return table;
 }
 
-// The setup sheet: its sections (the core's order), each as a heading and its data.
+const SHEET_PARTS = {
+  certificate: "Camera certificate",
+  interior: "Interior orientation and scales",
+  table24: "Table 24: the setup data",
+  readings: "Readings of the five stages",
+};
+
+// The setup sheet (the core's exercise_sheet): the parts the exercise gives, each as a heading
+// and its data, and the parts withheld with the reason; any other sheet as nested tables.
 export function showSheet(root, sheet) {
-  const sections = sheet.sections || sheet;
   root.replaceChildren();
-  if (Array.isArray(sections)) {
-    for (const s of sections) {
-      root.append(el("h3", { text: s.title || s.name || "" }));
-      if (s.text) root.append(el("p", { text: s.text }));
-      root.append(renderData(s.rows || s.data || s.values || null));
+  if (sheet.given) {
+    for (const part of sheet.given) {
+      if (sheet[part] === undefined) continue;
+      root.append(el("h3", { text: SHEET_PARTS[part] || part.replaceAll("_", " ") }), renderData(sheet[part]));
+    }
+    const withheld = Object.entries(sheet.withheld || {});
+    if (withheld.length) {
+      root.append(el("h3", { text: "Not given in this exercise" }),
+        el("ul", {}, ...withheld.map(([part, why]) => el("li", { text: `${SHEET_PARTS[part] || part}: ${why}` }))));
     }
     return;
   }
-  const plain = Object.fromEntries(Object.entries(sections).filter(([, v]) => v === null || typeof v !== "object"));
+  const plain = Object.fromEntries(Object.entries(sheet).filter(([, v]) => v === null || typeof v !== "object"));
   if (Object.keys(plain).length) root.append(renderData(plain));
-  for (const [k, v] of Object.entries(sections)) {
+  for (const [k, v] of Object.entries(sheet)) {
     if (v !== null && typeof v === "object") root.append(el("h3", { text: k.replaceAll("_", " ") }), renderData(v));
   }
 }
