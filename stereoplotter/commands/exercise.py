@@ -1,10 +1,12 @@
-"""``stereoplotter exercise list|show``: the trainer's exercises (docs/trainer.md)."""
+"""``stereoplotter exercise list|show|new|sheet|grades``: the trainer's exercises."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 from typing import Any
+
+from stereoplotter.commands import exercise_grades, exercise_new, exercise_sheet
 
 __all__ = ["add_arguments", "exercise_row", "run"]
 
@@ -15,6 +17,9 @@ def add_arguments(sub: Any) -> None:
     e = exs.add_parser("list", help="the exercises found, easiest first")
     e.add_argument("--json", action="store_true", help="print JSON instead of text")
     e.set_defaults(func=run)
+    exercise_new.add_parser(exs)
+    exercise_sheet.add_parser(exs)
+    exercise_grades.add_parser(exs)
     e = exs.add_parser("show", help="an exercise's settings")
     e.add_argument("name", help="an exercise name (e01-setup-stage1) or YAML file")
     e.add_argument("--json", action="store_true", help="print JSON instead of text")

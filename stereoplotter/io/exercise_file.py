@@ -24,11 +24,13 @@ from typing import Any
 from pydantic import Field, field_validator
 
 from stereoplotter.errors import ConfigError
+from stereoplotter.io.atomic_write import atomic_write_text
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import list_data_files, resolve_data_file
 from stereoplotter.io.scenario_file import scenario_from_mapping
 from stereoplotter.io.validation import FileModel, integer, one_of, sequence, text, validate
 from stereoplotter.io.yaml_input import load_yaml_mapping
+from stereoplotter.io.yaml_output import yaml_text
 from stereoplotter.trainer.exercise import (
     ERROR_MODES,
     EXERCISE_FORMAT,
@@ -47,6 +49,7 @@ __all__ = [
     "exercise_from_mapping",
     "load_exercise",
     "shipped_exercises",
+    "write_exercise",
 ]
 
 #: The largest |α|, |ω| of the photos in each tilt class (assumed: the book's "small tilts"
@@ -216,3 +219,23 @@ def shipped_exercises() -> list[Path]:
     return sorted(list_data_files("exercises"))
 
 
+
+
+def write_exercise(
+    path: str | os.PathLike[str], data: dict[str, Any], *, overwrite: bool = False
+) -> Exercise:
+    """Validate an exercise file's content (as :func:`load_exercise` would read it back) and
+    write it as YAML, whole or not at all (temporary file and rename, the user's umask).
+
+    Raises
+    ------
+    ConfigError
+        The content is not a valid exercise (one line naming the field), or the file exists
+        and ``overwrite`` is false.
+    """
+    target = Path(path)
+    exercise = exercise_from_mapping(data, str(target))
+    if target.exists() and not overwrite:
+        raise ConfigError(str(target), "path", "a new file (or --force)", "an existing file")
+    atomic_write_text(target, yaml_text(data, width=100))
+    return exercise

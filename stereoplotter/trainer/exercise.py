@@ -70,7 +70,7 @@ class Exercise:
     assists : dict
         ``parallax_readout``, ``undo``, ``hints`` → bool.
     mode : {"practice", "exam"}
-        Exam: no undo, no hints whatever ``assists`` says.
+        Exam: no undo, no hints and no parallax read-out whatever ``assists`` says.
     seed : int or None
         Fixed seed, or None: per trainee (:func:`trainee_seed`).
     description : str
@@ -101,8 +101,9 @@ class Exercise:
     source: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     def allows(self, assist: str) -> bool:
-        """Whether the trainee may use an assist (exam mode: no undo and no hints)."""
-        if self.mode == "exam" and assist in ("undo", "hints"):
+        """Whether the trainee may use an assist (exam mode: no undo, no hints and no numeric
+        parallax read-out: the eyepieces are the read-out)."""
+        if self.mode == "exam" and assist in ASSISTS:
             return False
         return bool(self.assists.get(assist, False))
 

@@ -16,7 +16,12 @@
   seed; trial 0 is the par), run vectorised over the trials in chunks; the percentile of a
   measure is the share of them whose value is no better (≥) than the trainee's, in %.
 
-The overall score is the largest value/tolerance over the exercise's measures (≤ 1 passes).
+The overall score is the largest value/tolerance over the exercise's measures. Points: the
+outcome's points less the hints' cost (:mod:`~stereoplotter.trainer.grade_tables`); passed when
+every stage is claimed, the score is ≤ 1 and the points reach ``PASS_POINTS``. The grade also
+carries the per-point tables and the y-parallax map (``tables``), the process per stage with
+time from the stage's first action (``process_by_stage``) and the checks skipped by name
+(``process.skipped_checks``).
 """
 
 from __future__ import annotations
@@ -32,9 +37,16 @@ from stereoplotter.procedure.operator import Noise
 from stereoplotter.procedure.run import PreparedRun, build_run
 from stereoplotter.trainer.actions import apply
 from stereoplotter.trainer.exercise import Exercise
+from stereoplotter.trainer.grade_tables import (
+    PASS_POINTS,
+    hint_cost,
+    outcome_points,
+    point_tables,
+    stage_process,
+)
 from stereoplotter.trainer.operator_steps import new_instrument, stage_functions
 from stereoplotter.trainer.outcome import Measure, stage_measures
-from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session, json_finite
+from stereoplotter.trainer.session import SUBSTITUTE_STAGES, Session, check_stage, json_finite
 
 __all__ = [
     "GRADE_FORMAT",
@@ -106,7 +118,9 @@ def _sign(x: float) -> int:
 
 
 def process_measures(
-    actions: list[dict[str, Any]], stage_controls: dict[str, set[str]] | None = None
+    actions: list[dict[str, Any]],
+    stage_controls: dict[str, set[str]] | None = None,
+    stage_checks: dict[str, list[str]] | None = None,
 ) -> dict[str, Any]:
     """Process measures of a sequence of log records (or bare actions with a ``stage``).
 
@@ -114,7 +128,8 @@ def process_measures(
     the action when given, else the direction of the move.
 
     ``stage_controls``: stage → the controls the simulated operator turns in it (for "out of
-    order"). Moves are ``turn`` and ``set`` actions; a ``set`` moves by the difference from the
+    order"); ``stage_checks``: stage → the names of its checks (the skipped ones are named).
+    Moves are ``turn`` and ``set`` actions; a ``set`` moves by the difference from the
     control's previous value where the log knows it (its own earlier turns and sets).
     """
     moves = reversals = iterations = out_of_order = hints = undos = refused = 0
@@ -180,6 +195,12 @@ def process_measures(
         "iterations": iterations,
         "steps_out_of_order": out_of_order,
         "checks_skipped": sum(1 for s in claimed if reads_in.get(s, 0) == 0),
+        "skipped_checks": [
+            name
+            for s in claimed
+            if reads_in.get(s, 0) == 0
+            for name in ((stage_checks or {}).get(s) or [f"stage {s}: no counter read"])
+        ],
         "hints": hints,
         "undos": undos,
         "refused": refused,
@@ -289,10 +310,23 @@ def grade(
         s: {a["control"] for a in session.par.stage_actions(s) if "control" in a} for s in ex.stages
     }
     script = _par_script(session)
+    checks = stage_check_names(session)
+    hints = hint_cost(ex.stages, session.log)
+    earned = outcome_points(score)
+    points = max(0.0, earned - hints["total"])
     overall: dict[str, Any] = {
         "score": score,
-        "passed": bool(score <= 1.0 and all(s["claimed"] for s in stages_out.values())),
+        "passed": bool(
+            score <= 1.0
+            and all(s["claimed"] for s in stages_out.values())
+            and points >= PASS_POINTS
+        ),
         "par_score": max(par_ratios) if par_ratios else None,
+        "outcome_points": earned,
+        "hint_cost": hints["total"],
+        "points": round(points, 3),
+        "pass_points": PASS_POINTS,
+        "within_tolerance": bool(score <= 1.0),
     }
     if pop_ratio is not None:
         pct = percentile(score, pop_ratio)
@@ -314,8 +348,16 @@ def grade(
             "errors": ex.errors,
             "stages": stages_out,
             "overall": overall,
-            "process": process_measures(session.log, controls),
-            "par_process": process_measures(script, controls),
+            "process": process_measures(session.log, controls, checks),
+            "par_process": process_measures(script, controls, checks),
+            "process_by_stage": stage_process(
+                session.log,
+                ex.stages,
+                lambda records, c: process_measures(records, c, checks),
+                controls,
+            ),
+            "hints": hints,
+            "tables": point_tables(session),
             "population": {
                 "operators": population,
                 "seconds": round(pop_seconds, 3),
@@ -345,6 +387,16 @@ def _substitute_row(session: Session, n: int) -> dict[str, Any]:
         "par": 0.0,
         "par_passed": True,
     }
+
+
+def stage_check_names(session: Session) -> dict[str, list[str]]:
+    """Stage → the names of the procedure's checks in it (the simulated operator's run)."""
+    out: dict[str, list[str]] = {}
+    for name, check in session.par.run.results.items():
+        stage = check_stage(name)
+        if stage is not None and check.tolerance is not None:
+            out.setdefault(stage, []).append(name)
+    return out
 
 
 def _par_script(session: Session) -> list[dict[str, Any]]:

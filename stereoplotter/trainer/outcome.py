@@ -38,7 +38,7 @@ from stereoplotter.procedure.records import SheetReadings
 from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.transcript import Transcript
 
-__all__ = ["Measure", "model_evaluation", "stage_measures", "standard_q"]
+__all__ = ["Measure", "model_evaluation", "rigid_residuals_m", "stage_measures", "standard_q"]
 
 
 @dataclass(frozen=True)
@@ -143,10 +143,10 @@ def model_evaluation(inst: Instrument, prep: PreparedRun):
     )
 
 
-def _rigid_residual_m(points) -> NDArray[np.float64]:
-    """The largest plan residual at the points after the best rotation and shift of the built
-    plan onto the true one (what orienting the sheet on the control points removes; the
-    coordinatograph's gear fixes the scale). Closed-form 2-D Procrustes, per trial. [m]"""
+def rigid_residuals_m(points) -> NDArray[np.float64]:
+    """The plan residual at each point after the best rotation and shift of the built plan onto
+    the true one (what orienting the sheet on the control points removes; the coordinatograph's
+    gear fixes the scale). Closed-form 2-D Procrustes, per trial; shape (n,) or (T, n). [m]"""
     true = np.asarray(points.ground_m, float)[:, :2]
     built = true + np.stack(
         [np.asarray(points.x_error_m, float), np.asarray(points.y_error_m, float)], axis=-1
@@ -159,7 +159,12 @@ def _rigid_residual_m(points) -> NDArray[np.float64]:
     c, s = np.cos(theta), np.sin(theta)
     rx = c * b0[..., 0] - s * b0[..., 1] - t0[:, 0]
     ry = s * b0[..., 0] + c * b0[..., 1] - t0[:, 1]
-    return np.max(np.hypot(rx, ry), axis=-1)
+    return np.hypot(rx, ry)
+
+
+def _rigid_residual_m(points) -> NDArray[np.float64]:
+    """The largest of :func:`rigid_residuals_m`. [m]"""
+    return np.max(rigid_residuals_m(points), axis=-1)
 
 
 def _worst(values: Any) -> NDArray[np.float64]:

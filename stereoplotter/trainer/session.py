@@ -46,16 +46,25 @@ from stereoplotter.trainer.actions import (
     check_action,
     control_value,
 )
-from stereoplotter.trainer.exercise import STAGES, Exercise, resolve_exercise
+from stereoplotter.trainer.exercise import ASSISTS, STAGES, Exercise, resolve_exercise
 from stereoplotter.trainer.hints import hint_text
 from stereoplotter.trainer.operator_steps import OperatorRun, new_instrument, operator_run
 from stereoplotter.trainer.outcome import stage_measures
+from stereoplotter.trainer.panel import (
+    checklist_ticks,
+    coupled_motion,
+    note_progress,
+    step_rules,
+    step_targets,
+)
+from stereoplotter.trainer.texts import announced_row, claim_text, hint_lines
 
 __all__ = [
     "LOG_FORMAT",
     "SUBSTITUTE_STAGES",
     "UNDO_DEPTH",
     "Session",
+    "check_stage",
     "json_finite",
     "state_digest",
 ]
@@ -117,6 +126,12 @@ class Session:
         self._undo: list[_Undoable] = []
         self._redo: list[_Undoable] = []
         self._t0 = time.monotonic() if clock else None
+        #: Stage → (controls used, counters read, points read at): the checklist's
+        #: ticks (:func:`~stereoplotter.trainer.panel.checklist`; an undo does not untick).
+        self.progress: dict[str, Any] = {}
+        #: What the last action moved that it did not name (coupled motions), with a reason.
+        self.events: list[dict[str, Any]] = []
+        self._rules: dict[str, list[dict[str, Any]]] = {}
         for stage in exercise.preset_stages:
             for action in self.par.stage_actions(stage):
                 apply(self.inst, action, self.commanded)
@@ -320,7 +335,7 @@ class Session:
             return []
         out = []
         for name, check in self.par.run.results.items():
-            if _check_stage(name) == stage and check.tolerance is not None:
+            if check_stage(name) == stage and check.tolerance is not None:
                 out.append({"name": name, "tolerance": _f(check.tolerance), "unit": check.unit})
         return out
 
@@ -330,6 +345,22 @@ class Session:
         if self.exercise.errors != "announced":
             return None
         return {k: _f(v) for k, v in sorted(self.inst.injected.items()) if _f(v) != 0.0}
+
+    def step_rules(self, stage: str) -> list[dict[str, Any]]:
+        """The operator's steps of a stage with their tick rules (cached)."""
+        if stage not in self._rules:
+            self._rules[stage] = step_rules(self.par, stage)
+        return self._rules[stage]
+
+    def _targets(self, stage: str) -> dict[Any, Any]:
+        key = f"targets {stage}"
+        if key not in self._rules:
+            self._rules[key] = step_targets(self, stage)  # type: ignore[assignment]
+        return self._rules[key]  # type: ignore[return-value]
+
+    def progress_of(self, stage: str) -> tuple[set[str], set[str], set[Any]]:
+        """(controls used, counters read, points (role, id) read at) in a stage."""
+        return self.progress.get(stage, (set(), set(), set()))
 
     def allowed(self) -> list[str]:
         """The action kinds allowed now."""
@@ -364,8 +395,19 @@ class Session:
                 "locked": list(self.locked),
                 "records": dict(self.records),
                 "injected_errors": self._announced(),
+                "injected_errors_list": self._announced_list(),
+                "events": list(self.events),
+                "assists": {k: self.exercise.allows(k) for k in ASSISTS},
             }
-        )
+        ) | {"checklist_ticks": checklist_ticks(self)}
+
+    def _announced_list(self) -> list[dict[str, Any]] | None:
+        """The announced injected errors as readable rows (``name``, ``value``, ``unit``,
+        ``text``), or None when the exercise does not announce them."""
+        errors = self._announced()
+        if errors is None:
+            return None
+        return [announced_row(name, value) for name, value in errors.items()]
 
     # --- acting ------------------------------------------------------------------------------
 
@@ -415,9 +457,16 @@ class Session:
             "action": clean,
             "state_before": state_digest(before),
         }
+        self.events = []
         try:
             check_action(action)
             record["result"] = json_finite(self._do(clean, before))
+            if record["stage"] is not None:
+                marks = self._marks() if clean["kind"] == "read" else None
+                xy = None if marks is None else [marks["left"]["x_mm"], marks["left"]["y_mm"]]
+                targets = self._targets(record["stage"])
+                note_progress(self.progress, record["stage"], clean, xy, targets)
+            self.events = coupled_motion(clean, before["counters"], self._counters())
         except TrainerError as exc:
             record["refused"] = str(exc)
             after = self.state()
@@ -484,7 +533,7 @@ class Session:
         self.claimed.append(step)
         self.at_claim[step] = _copy_instrument(self.inst)
         self.stage_index += 1
-        out: dict[str, Any] = {"claimed": step}
+        out: dict[str, Any] = {"claimed": step, "text": f"stage {step} claimed"}
         if self.exercise.mode == "practice":  # feedback: the stage's true outcome
             out["measures"] = [
                 {
@@ -496,6 +545,7 @@ class Session:
                 }
                 for m in stage_measures(self.inst, self.prep, step, self.exercise.unusable_points)
             ]
+            out["text"] = claim_text(step, out["measures"])
         return out
 
     def _hint(self, level: int) -> dict[str, Any]:
@@ -520,6 +570,8 @@ class Session:
                 if c not in controls:
                     controls.append(c)
             out["controls"] = controls
+        out["lines"] = hint_lines(out)
+        out["text"] = "\n".join(out["lines"])
         return out
 
     # --- the operator's actions as a script -----------------------------------------------------
@@ -565,7 +617,7 @@ def _copy_instrument(inst: Instrument) -> Instrument:
     return copy.deepcopy(inst, memo)
 
 
-def _check_stage(name: str) -> str | None:
+def check_stage(name: str) -> str | None:
     """The stage a check of the procedure belongs to, by its name ("stage 5: …", "C2: …")."""
     head = name.split(":", 1)[0].strip()
     if head.startswith("stage "):

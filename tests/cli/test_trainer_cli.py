@@ -17,7 +17,8 @@ from stereoplotter.io.exercise_file import shipped_exercises
 def test_exercise_list_names_every_shipped_exercise(capsys):
     assert main(["exercise", "list", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)
-    assert [r["name"] for r in rows] == sorted(p.stem for p in shipped_exercises())
+    assert sorted(r["name"] for r in rows) == sorted(p.stem for p in shipped_exercises())
+    assert [r["level"] for r in rows] == sorted(r["level"] for r in rows)  # easiest first
 
 
 def test_exercise_show_a_missing_exercise_is_one_error_line(capsys):
@@ -97,3 +98,36 @@ def test_trainer_on_a_busy_port_is_one_error_line(capsys, tmp_path):
     err = capsys.readouterr().err
     assert err.startswith(f"error: trainer: cannot listen on 127.0.0.1:{port}")
     assert err.count("\n") == 1
+
+
+def test_exercise_new_writes_a_file_that_loads_back(tmp_path, capsys):
+    from stereoplotter.io.exercise_file import load_exercise
+
+    path = tmp_path / "mine.yaml"
+    argv = ["exercise", "new", "mine", "--stages", "2", "--unusable-points", "5", "--seed", "4"]
+    assert main([*argv, "--errors", "announced", "-o", str(path)]) == 0
+    ex = load_exercise(path)
+    assert (ex.name, ex.stages, ex.model, ex.unusable_points, ex.seed) == (
+        "mine", ("2",), "incomplete", (5,), 4
+    )
+    assert main([*argv, "-o", str(path)]) == 1  # exists: no overwrite without --force
+    assert "a new file (or --force)" in capsys.readouterr().err
+
+
+def test_exercise_new_refuses_a_bad_option_in_one_line_and_writes_nothing(tmp_path, capsys):
+    path = tmp_path / "bad.yaml"
+    assert main(["exercise", "new", "bad", "--stages", "C9", "-o", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {path}: stages: expected") and err.count("\n") == 1
+    assert not path.exists()
+
+
+def test_exercise_sheet_gives_a_conventional_exercise_no_orientation_values(capsys):
+    assert main(["exercise", "sheet", "e05-conventional-c2", "--json"]) == 0
+    sheet = json.loads(capsys.readouterr().out)
+    assert sheet["given"] == ["certificate", "interior"]
+    assert "readings" not in sheet and "table24" not in sheet
+    # f_пр = k·f′ of pair60 on SC-1: 1.5625 × 70 mm (Table 24), to the sheet's 6 digits
+    assert abs(sheet["interior"]["f_instrument_mm"] - 1.5625 * 70.0) < 1e-3
+    assert main(["exercise", "sheet", "e03-setup-stage2"]) == 0
+    assert "## Table 24" in capsys.readouterr().out

@@ -15,12 +15,15 @@ from stereoplotter.trainer.session import Session
 SHIPPED = shipped_exercises()
 
 
-def test_at_least_ten_exercises_graded_from_easy_to_hard():
+def test_at_least_24_exercises_cover_every_stage_on_every_instrument():
     exercises = [load_exercise(p) for p in SHIPPED]
-    assert len(exercises) >= 10
-    levels = [e.level for e in exercises]  # file names e01…e12 are in the order of difficulty
-    assert levels == sorted(levels)
-    assert levels[0] == 1 and levels[-1] > levels[0]
+    assert len(exercises) >= 24
+    levels = [e.level for e in exercises]
+    assert min(levels) == 1 and max(levels) >= 10
+    # every stage of both methods on each of the three instruments (alone or in an "all")
+    covered = {(e.spec.key, s) for e in exercises for s in e.stages}
+    wanted = {(i, s) for i in ("sc1", "spr3", "sd3") for m in STAGES.values() for s in m}
+    assert wanted <= covered, sorted(wanted - covered)
     kinds = {(e.method, e.mode, e.errors, e.terrain, e.model) for e in exercises}
     assert {k[0] for k in kinds} == {"setup", "conventional"}
     assert {k[1] for k in kinds} == {"practice", "exam"}
