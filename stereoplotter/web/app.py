@@ -78,6 +78,7 @@ ROUTES = [
     Route("/api/sessions", routes.new_session, methods=["POST"]),
     Route("/api/sessions/{sid}/sheet", routes.sheet),
     Route("/api/sessions/{sid}/overview", routes.overview),
+    Route("/api/sessions/{sid}/checklist", routes.checklist),
     Route("/api/sessions/{sid}/showme", routes.show_me),
     Route("/api/sessions/{sid}/grade", routes.grade_json),
     Route("/api/sessions/{sid}/grade.md", routes.grade_md),

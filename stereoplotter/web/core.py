@@ -11,6 +11,7 @@ import json
 import re
 from typing import Any
 
+from stereoplotter.commands.exercise_sheet import exercise_sheet
 from stereoplotter.errors import StereoplotterError, TrainerError
 from stereoplotter.imagery.cache import EAGER_PIXEL_MM, ViewCache
 from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM
@@ -23,10 +24,10 @@ from stereoplotter.io.images import png_bytes
 from stereoplotter.io.paths import available_names
 from stereoplotter.io.session_log import log_bytes
 from stereoplotter.report.grade import grade_markdown
-from stereoplotter.report.sheet import sheet_to_dict
 from stereoplotter.trainer.actions import ACTION_CATALOGUE
 from stereoplotter.trainer.exercise import Exercise, resolve_exercise
 from stereoplotter.trainer.grading import grade
+from stereoplotter.trainer.panel import checklist, overview, show_me_actions
 from stereoplotter.trainer.session import Session
 
 __all__ = [
@@ -37,6 +38,7 @@ __all__ = [
     "TrainerError",
     "action_catalogue",
     "build_view_cache",
+    "checklist_of",
     "format_mm",
     "grade_of",
     "grade_records",
@@ -228,34 +230,26 @@ def photo_patch(
 
 
 def sheet_of(exercise: Exercise) -> dict[str, Any]:
-    """The exercise's setup sheet as the page shows it (JSON-ready; run in a worker thread)."""
-    session = Session(exercise, "sheet", exercise.seed or 0, clock=False)
-    return _jsonable(sheet_to_dict(session.prep.sheet))
+    """The exercise's own setup sheet as the page shows it (``exercise_sheet``: the parts the
+    method gives, computed for the exercise's modified scenario; run in a worker thread)."""
+    return _jsonable(exercise_sheet(exercise))
 
 
 def overview_of(session: Session) -> dict[str, Any]:
-    """Both photos at a glance (run on the actor thread): fiducials, standard points, the marks;
-    photo coordinates in mm, x right, y up."""
-    scene = session.prep.scene
-    left, right = scene.standard
-    return _jsonable(
-        {
-            "format_mm": format_mm(session.exercise),
-            "fiducials": {k: v.tolist() for k, v in scene.fiducials_mm.items()},
-            "standard": {"left": left.tolist(), "right": right.tolist()},
-            "unusable": list(session.exercise.unusable_points),
-            "marks": session.state()["marks"],
-        }
-    )
+    """Both photos at a glance (``trainer.panel.overview``; run on the actor thread)."""
+    return _jsonable(overview(session))
+
+
+def checklist_of(session: Session) -> dict[str, Any] | None:
+    """The stage in hand's steps with their done flags (``trainer.panel.checklist``; the state
+    carries only the flags on every action; run on the actor thread)."""
+    return _jsonable(checklist(session))
 
 
 def show_me(session: Session) -> list[dict[str, Any]]:
     """The simulated operator's actions of the stage in hand (what hint 3 applies at once), for
     the page to play one by one at its chosen speed ("show me", animated)."""
-    stage = session.stage
-    if stage is None:
-        return []
-    return [{k: v for k, v in a.items() if k != "stage"} for a in session.par.stage_actions(stage)]
+    return show_me_actions(session)
 
 
 def action_catalogue() -> list[dict[str, Any]]:

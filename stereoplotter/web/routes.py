@@ -200,6 +200,16 @@ async def overview(request: Request) -> Response:
     return JSONResponse(body, headers=_NO_STORE)
 
 
+async def checklist(request: Request) -> Response:
+    """The steps of the stage in hand (their texts; the state ticks them on every action)."""
+    sid, _ = _own_or_instructor(request)
+    reg = _web(request).reg
+    live = await run_in_threadpool(reg.resume, sid)
+    loop = asyncio.get_running_loop()
+    body = await loop.run_in_executor(reg.actor, core.checklist_of, live.session)
+    return JSONResponse(body, headers=_NO_STORE)
+
+
 async def show_me(request: Request) -> Response:
     """The operator's actions of the stage in hand, for an animated "show me" (hint 3): given
     only where the exercise allows hints, never in a demonstration."""

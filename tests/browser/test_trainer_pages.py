@@ -151,8 +151,8 @@ def test_anaglyph_pixels_show_a_planted_y_parallax(page, server, artefacts):
     page.select_option("#colours", "red,cyan")
     page.fill("#mag", "10")
     page.dispatch_event("#mag", "change")
-    page.wait_for_function("() => (window.__patches || 0) >= 4 && window.trainer.photosReady()",
-                           timeout=60_000)  # both sides at ×10
+    page.wait_for_function("() => window.trainer.photosReady() && window.trainer.patchMags()"
+                           ".every((m) => m === 10)", timeout=60_000)  # both sides at ×10
     page.wait_for_timeout(100)
     red0, cyan0 = page.evaluate(PROFILE_JS)
     m0 = page.evaluate("window.trainer.state().marks")

@@ -227,7 +227,7 @@ function drawStage() {
   const um = (v) => (v === null || v === undefined ? "—" : v.toFixed(1));
   $("parallax").textContent = p ? `parallax at standard point ${p.point}: q = ${um(p.y_um)} µm, p = ${um(p.x_um)} µm`
     : state.marks ? "no q/p read-out in this exercise: judge the parallax in the eyepieces (or the anaglyph)" : "";
-  showChecklist($("checklist"), state.checklist);
+  tickChecklist(state.checklist_ticks);
   showAnnounced($("announced"), $("announced-list"), state.injected_errors_list || state.injected_errors);
 }
 
@@ -339,6 +339,22 @@ $("demo-play").onclick = () => {
 };
 $("demo-speed").onchange = () => { if (playing) play(); };
 
+// --- the stage's checklist: its steps fetched once a stage, ticked from every state ------------
+let checklist = null, checklistFor = null;
+async function tickChecklist(ticks) {
+  if (!ticks) { showChecklist($("checklist"), []); return; }
+  if (checklistFor !== ticks.stage) {
+    checklistFor = ticks.stage;
+    const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/checklist`, { headers: auth() });
+    checklist = r.ok ? await r.json() : null;
+  }
+  if (!checklist || checklist.stage !== ticks.stage) return;
+  checklist.steps.forEach((s, i) => { s.done = !!ticks.done[i]; });
+  checklist.done = ticks.done.filter(Boolean).length;
+  showChecklist($("checklist"), checklist);
+  $("checklist-count").textContent = `${checklist.done} / ${checklist.total}`;
+}
+
 // --- photo overview and the setup sheet ----------------------------------------------------
 const auth = () => ({ Authorization: `Bearer ${key || ""}` });
 async function loadOverview() {
@@ -380,6 +396,8 @@ window.addEventListener("afterprint", () => document.body.classList.remove("prin
 // For tests and the latency benchmark: send an action, resolve with ms until its frame is drawn.
 window.trainer = {
   state: () => state,
+  // the magnifications of the sharp patches in hand (left, right)
+  patchMags: () => [patches.left, patches.right].map((p) => (p && !p.coarse ? p.mag : null)),
   // every action sent has left the page's queue and been answered
   idle: () => queue.length === 0 && sent.size === 0,
   // drop the socket as a network would (the page must reconnect and resume)

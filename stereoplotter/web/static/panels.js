@@ -100,7 +100,8 @@ export function showResult(root, action, result) {
   }
   if (result.claimed && !result.text) root.append(el("p", { class: "big", text: `Stage ${result.claimed} claimed.` }));
   if (result.level) root.append(el("h3", { text: `Hint ${result.level}` }));
-  if (result.lines && result.lines.length) for (const line of result.lines) root.append(el("p", { text: typeof line === "string" ? line : line.text || "" }));
+  if (Array.isArray(result.text)) for (const line of result.text) root.append(el("p", { text: String(line) }));
+  else if (result.lines && result.lines.length) for (const line of result.lines) root.append(el("p", { text: typeof line === "string" ? line : line.text || "" }));
   else if (result.text) for (const para of String(result.text).split(/\n\s*\n/)) root.append(el("p", { text: para }));
   if (result.cost !== undefined && result.cost !== null) root.append(el("p", { class: "meta", text: `this hint costs ${fmt(result.cost)} of the score` }));
   if (result.steps && result.steps.length && !(result.lines && result.lines.length)) {
