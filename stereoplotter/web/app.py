@@ -4,8 +4,10 @@ Who may see what:
 
 - anyone who reaches the server: the pages, the exercise list, and starting a session (which
   answers the session's id and its secret, given once);
-- a session's secret (``Authorization: Bearer SECRET`` or ``?key=SECRET``): its socket and photo
-  patches at any time; its grade and log once every stage is claimed;
+- a session's secret (``Authorization: Bearer SECRET`` or ``?key=SECRET``): its socket, photo
+  patches, setup sheet, photo overview and stage checklist at any time, the operator's actions
+  of the stage for an animated "show me" where the exercise gives hints; its grade and log once
+  every stage is claimed;
 - the instructor's token (``?token=`` or ``Authorization: Bearer``): every session's table,
   grade, log and replay, the results CSV, an archive of the logs, extra exam attempts, and
   uploading an exercise. The grade of an exam that is not finished is given to nobody (it

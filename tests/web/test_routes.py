@@ -10,7 +10,7 @@ import zipfile
 
 from starlette.routing import Route, WebSocketRoute
 
-from tests.web.conftest import PRACTICE, TOKEN, ask, claim_all, open_socket, start
+from tests.web.conftest import EXAM, PRACTICE, TOKEN, ask, claim_all, open_socket, start
 
 BAD_BODIES = [
     b"",
@@ -55,6 +55,7 @@ def _one_line_error(r):
 
 def test_every_route_answers_bad_requests_with_one_line(client):
     sid, secret = start(client, trainee="walker")
+    _, other_secret = start(client, trainee="another walker")
     paths = {"sid": sid}
     routes = [r for r in client.app.routes if isinstance(r, Route)]
     seen = set()
@@ -75,6 +76,11 @@ def test_every_route_answers_bad_requests_with_one_line(client):
                     assert r.status_code < 500, path
                     if r.status_code != 200:
                         _one_line_error(r)
+            # another session's key opens nothing of this one
+            if route.path.startswith("/api/sessions/{sid}"):
+                r = client.get(path, params={"key": other_secret})
+                assert r.status_code == 403, (path, r.status_code)
+                _one_line_error(r)
             # unknown sessions, bad ids and wrong methods
             if "{sid}" in route.path and route.path.startswith("/api/"):
                 for bad in ("nope", "0" * 16, "..%2f..%2fetc", "%00"):
@@ -171,6 +177,9 @@ def test_sheet_and_overview_need_the_sessions_key_and_name_no_path(client):
         paths = [m.group(0) for t in _texts(r.json()) for m in SERVER_PATH.finditer(t)]
         assert paths == []
         assert client.get(path, params={"token": TOKEN}).status_code == 200
+    exam_sid, exam_secret = start(client, exercise=EXAM, trainee="sheets")
+    r = client.get(f"/api/sessions/{exam_sid}/showme", params={"key": exam_secret})
+    assert r.status_code == 403 and "no hints" in r.json()["error"]  # an exam shows nothing
     ov = client.get(f"/api/sessions/{sid}/overview", params={"key": secret}).json()
     photos = ov["photos"] if "photos" in ov else None
     if photos is not None:  # the core's overview: six standard points a photo, 5 and 6 unusable
