@@ -83,7 +83,9 @@ def main(argv: list[str] | None = None) -> int:
         _robot(page, SHEET, upto=12)  # f_пр set: the marks stand on the photos
         page.click("#sheet-btn")
         page.wait_for_selector("body[data-sheet='1']")
+        page.evaluate("document.getElementById('sheet').classList.add('full')")  # all of it
         page.locator("#sheet").screenshot(path=str(out / "trainer-sheet.png"))
+        page.evaluate("document.getElementById('sheet').classList.remove('full')")
         page.click("#sheet-close")
         page.locator("#overview").screenshot(path=str(out / "trainer-overview.png"))
 
@@ -94,6 +96,7 @@ def main(argv: list[str] | None = None) -> int:
                                "document.getElementById('show-me-count').textContent)",
                                timeout=60_000)
         page.wait_for_function("() => window.trainer.photosReady()", timeout=60_000)
+        page.evaluate("window.scrollTo(0, 0)")
         page.screenshot(path=str(out / "trainer-showme.png"))
         page.click("#show-me")  # stop
 

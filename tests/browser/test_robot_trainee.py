@@ -62,6 +62,7 @@ def robot_page(browser):
     p.close()
 
 
+@pytest.mark.slow  # a few minutes on the shared machine: still in the README's test command
 @pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
 def test_robot_trainee_completes_the_exercise_through_the_page(
     robot_page, process_server, scripts, path, record_property

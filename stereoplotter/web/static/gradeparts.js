@@ -163,7 +163,7 @@ export function drawPointMap(canvas, map, tolerance) {
     const i = gx ? near(gx, p.x_m) : k % cols, j = gy ? near(gy, p.y_m) : Math.floor(k / cols);
     ctx.fillStyle = typeof p.value === "number" ? colour(p.value / tol) : "#444";
     ctx.fillRect(i * cw, h - (j + 1) * ch, Math.ceil(cw), Math.ceil(ch));
-    ctx.fillStyle = "#111";
+    ctx.fillStyle = typeof p.value === "number" && Math.abs(p.value / tol) > 0.6 ? "#fff" : "#111";
     if (typeof p.value === "number") ctx.fillText(p.value.toFixed(1), i * cw + cw / 2, h - j * ch - ch / 2 + 3);
   });
   ctx.textAlign = "left";

@@ -1,7 +1,7 @@
 // The instrument page: WebSocket to the server (action → state), eyepieces, wheels, counters.
 // The session's key (kept by this browser when it started the session) opens the socket; a
 // dropped socket is reopened (with growing pauses) and the session resumes where its log ends.
-import { drawField, anaglyph, scale } from "./eyepiece.js";
+import { drawField, anaglyph, covers, scale } from "./eyepiece.js";
 import { Wheels, LABELS, decimals } from "./wheels.js";
 import { el, sessionKey } from "./dom.js";
 import { buildActions, describe, parseCommand, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
@@ -404,7 +404,8 @@ window.trainer = {
   drop: () => ws && ws.close(),
   // both eyepieces drawn from a photo patch that covers the current marks
   photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right
-    && !patches.left.coarse && !patches.right.coarse),
+    && !patches.left.coarse && !patches.right.coarse
+    && covers(patches.left, state.marks.left) && covers(patches.right, state.marks.right)),
   actAndFrame(action) {
     const t0 = performance.now();
     const s = send(action);
