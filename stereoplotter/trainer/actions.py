@@ -14,6 +14,7 @@ they represent (—), f_пр in mm.
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import numpy as np
@@ -37,6 +38,7 @@ __all__ = [
     "apply",
     "check_action",
     "control_value",
+    "refusal_text",
 ]
 
 #: Each action kind → its required fields (optional ones: ``side`` of set/turn/needle, ``t``).
@@ -242,6 +244,18 @@ def check_action(action: Any) -> dict[str, Any]:
     return action
 
 
+#: A file path in an instrument's refusal (``…/data/instruments/sd3.yaml``): a trainee is told
+#: the instrument, never where the server keeps its files.
+_PATH = re.compile(r"(?:[^\s:]*[/\\])?([\w.-]+)\.ya?ml\b")
+
+
+def refusal_text(message: str) -> str:
+    """An instrument's refusal without file paths (the file named by its stem, "sd3") and
+    without the advice to edit the file (the trainee cannot)."""
+    text = _PATH.sub(lambda m: f"instrument {m.group(1)}", message)
+    return text.replace("; widen the range in the YAML if your instrument allows it", "")
+
+
 def control_value(inst: Instrument, control: str, commanded: dict[str, float]) -> float:
     """What a control's own scale shows now (exact), in the control's unit.
 
@@ -296,5 +310,5 @@ def apply(inst: Instrument, action: dict[str, Any], commanded: dict[str, float])
     except TrainerError:
         raise
     except StereoplotterError as exc:
-        raise TrainerError(f"action {kind}: refused: {exc}") from None
+        raise TrainerError(f"action {kind}: refused: {refusal_text(str(exc))}") from None
     raise TrainerError(f"action {kind}: not an instrument action")

@@ -96,19 +96,11 @@ def _last_stage_instrument(session: Any) -> tuple[Any, str]:
     return session.at_claim.get(last, session.inst), last
 
 
-def point_tables(session: Any) -> dict[str, Any]:
-    """The per-point tables and the y-parallax map (see the module docstring)."""
-    inst, last = _last_stage_instrument(session)
-    prep = session.prep
-    tol = prep.sheet.tolerances
-    out: dict[str, Any] = {"y_parallax": None, "heights": None, "plan": None}
-    out["y_parallax_map"] = None
-    if "f_instrument" not in session.commanded or last not in (*_PARALLAX, *_HEIGHTS):
-        return out
-    q = np.asarray(standard_q(inst, prep), float).reshape(-1) * 1000.0
-    tq = float(tol["residual_y_parallax_mm"]) * 1000.0
+def _parallax_table(session: Any, inst: Any, last: str) -> dict[str, Any]:
+    q = np.asarray(standard_q(inst, session.prep), float).reshape(-1) * 1000.0
+    tq = float(session.prep.sheet.tolerances["residual_y_parallax_mm"]) * 1000.0
     unusable = session.exercise.unusable_points
-    out["y_parallax"] = {
+    return {
         "unit": "µm",
         "tolerance": tq,
         "stage": last,
@@ -122,64 +114,79 @@ def point_tables(session: Any) -> dict[str, Any]:
             for n in range(1, 7)
         ],
     }
-    ev = model_evaluation(inst, prep)
-    grid = ev.grid
-    out["y_parallax_map"] = {
+
+
+def _map(grid: Any) -> dict[str, Any]:
+    return {
         "unit": "µm",
         "shape": [9, 9],
         "points": [
-            {
-                "id": pid,
-                "x_m": float(g[0]),
-                "y_m": float(g[1]),
-                "value": float(v) * 1000.0,
-            }
+            {"id": pid, "x_m": float(g[0]), "y_m": float(g[1]), "value": float(v) * 1000.0}
             for pid, g, v in zip(
                 grid.ids, np.asarray(grid.ground_m), np.asarray(grid.y_parallax_mm), strict=True
             )
         ],
     }
-    control = ev.control
+
+
+def _heights_table(control: Any, th: float) -> dict[str, Any]:
+    return {
+        "unit": "m",
+        "tolerance": th,
+        "rows": [
+            {"id": pid, "error": float(e), "passed": bool(abs(float(e)) <= th)}
+            for pid, e in zip(control.ids, np.asarray(control.height_error_m), strict=True)
+        ],
+    }
+
+
+def _plan_table(control: Any, m_map: float, tmap: float) -> dict[str, Any]:
+    rows = []
+    fitted = np.asarray(rigid_residuals_m(control), float).reshape(-1)
+    for pid, dx, dy, e in zip(
+        control.ids,
+        np.asarray(control.x_error_m),
+        np.asarray(control.y_error_m),
+        fitted,
+        strict=True,
+    ):
+        rows.append(
+            {
+                "id": pid,
+                "dx": float(dx),
+                "dy": float(dy),
+                "error": float(np.hypot(dx, dy)),
+                "fitted_error": float(e),
+                "map_error": float(e) * 1000.0 / m_map,
+                "passed": bool(float(e) * 1000.0 / m_map <= tmap),
+            }
+        )
+    return {
+        "unit": "m",
+        "tolerance": tmap * m_map / 1000.0,
+        "map_unit": "mm",
+        "map_tolerance": tmap,
+        "rows": rows,
+    }
+
+
+def point_tables(session: Any) -> dict[str, Any]:
+    """The per-point tables and the y-parallax map (see the module docstring)."""
+    inst, last = _last_stage_instrument(session)
+    prep = session.prep
+    tol = prep.sheet.tolerances
+    out: dict[str, Any] = {"y_parallax": None, "heights": None, "plan": None}
+    out["y_parallax_map"] = None
+    if "f_instrument" not in session.commanded or last not in (*_PARALLAX, *_HEIGHTS):
+        return out
+    out["y_parallax"] = _parallax_table(session, inst, last)
+    ev = model_evaluation(inst, prep)
+    out["y_parallax_map"] = _map(ev.grid)
     if last in _HEIGHTS:
-        th = float(tol["control_height_m"])
-        out["heights"] = {
-            "unit": "m",
-            "tolerance": th,
-            "rows": [
-                {"id": pid, "error": float(e), "passed": bool(abs(float(e)) <= th)}
-                for pid, e in zip(control.ids, np.asarray(control.height_error_m), strict=True)
-            ],
-        }
+        out["heights"] = _heights_table(ev.control, float(tol["control_height_m"]))
     if last in _PLAN:
         m_map = ev.map_scale_denominator or prep.sheet.horizontal_scale_denominator
-        tmap = float(tol["corner_mm"])
-        rows = []
-        fitted = np.asarray(rigid_residuals_m(control), float).reshape(-1)
-        for pid, dx, dy, e in zip(
-            control.ids,
-            np.asarray(control.x_error_m),
-            np.asarray(control.y_error_m),
-            fitted,
-            strict=True,
-        ):
-            rows.append(
-                {
-                    "id": pid,
-                    "dx": float(dx),
-                    "dy": float(dy),
-                    "error": float(np.hypot(dx, dy)),
-                    "fitted_error": float(e),
-                    "map_error": float(e) * 1000.0 / m_map,
-                    "passed": bool(float(e) * 1000.0 / m_map <= tmap),
-                }
-            )
-        out["plan"] = {
-            "unit": "m",
-            "tolerance": tmap * m_map / 1000.0,
-            "map_unit": "mm",
-            "map_tolerance": tmap,
-            "rows": rows,
-        }
+        out["plan"] = _plan_table(ev.control, float(m_map), float(tol["corner_mm"]))
     return out
 
 

@@ -117,20 +117,21 @@ def _sign(x: float) -> int:
     return 1 if x > 0 else -1 if x < 0 else 0
 
 
+_Controls = dict[str, set[str]] | None
+_Checks = dict[str, list[str]] | None
+
+
 def process_measures(
-    actions: list[dict[str, Any]],
-    stage_controls: dict[str, set[str]] | None = None,
-    stage_checks: dict[str, list[str]] | None = None,
+    actions: list[dict[str, Any]], stage_controls: _Controls = None, stage_checks: _Checks = None
 ) -> dict[str, Any]:
     """Process measures of a sequence of log records (or bare actions with a ``stage``).
 
     The final approach of a lead screw is the side its last move finished from: the ``side`` of
-    the action when given, else the direction of the move.
-
-    ``stage_controls``: stage → the controls the simulated operator turns in it (for "out of
-    order"); ``stage_checks``: stage → the names of its checks (the skipped ones are named).
-    Moves are ``turn`` and ``set`` actions; a ``set`` moves by the difference from the
-    control's previous value where the log knows it (its own earlier turns and sets).
+    the action when given, else the direction of the move. ``stage_controls``: stage → the
+    controls the simulated operator turns in it (for "out of order"); ``stage_checks``: stage →
+    the names of its checks (the skipped ones are named). Moves are ``turn`` and ``set``
+    actions; a ``set`` moves by the difference from the control's previous value where the log
+    knows it (its own earlier turns and sets).
     """
     moves = reversals = iterations = out_of_order = hints = undos = refused = 0
     last_dir: dict[str, int] = {}
@@ -195,16 +196,23 @@ def process_measures(
         "iterations": iterations,
         "steps_out_of_order": out_of_order,
         "checks_skipped": sum(1 for s in claimed if reads_in.get(s, 0) == 0),
-        "skipped_checks": [
-            name
-            for s in claimed
-            if reads_in.get(s, 0) == 0
-            for name in ((stage_checks or {}).get(s) or [f"stage {s}: no counter read"])
-        ],
+        "skipped_checks": _skipped(claimed, reads_in, stage_checks or {}),
         "hints": hints,
         "undos": undos,
         "refused": refused,
     }
+
+
+def _skipped(
+    claimed: list[str], reads_in: dict[str, int], stage_checks: dict[str, list[str]]
+) -> list[str]:
+    """The names of the checks of each stage claimed without a counter read in it."""
+    return [
+        name
+        for s in claimed
+        if reads_in.get(s, 0) == 0
+        for name in (stage_checks.get(s) or [f"stage {s}: no counter read"])
+    ]
 
 
 def _measure_row(m: Measure, par: Measure | None, pop: np.ndarray | None) -> dict[str, Any]:
@@ -312,22 +320,7 @@ def grade(
     script = _par_script(session)
     checks = stage_check_names(session)
     hints = hint_cost(ex.stages, session.log)
-    earned = outcome_points(score)
-    points = max(0.0, earned - hints["total"])
-    overall: dict[str, Any] = {
-        "score": score,
-        "passed": bool(
-            score <= 1.0
-            and all(s["claimed"] for s in stages_out.values())
-            and points >= PASS_POINTS
-        ),
-        "par_score": max(par_ratios) if par_ratios else None,
-        "outcome_points": earned,
-        "hint_cost": hints["total"],
-        "points": round(points, 3),
-        "pass_points": PASS_POINTS,
-        "within_tolerance": bool(score <= 1.0),
-    }
+    overall = _overall(score, stages_out, par_ratios, hints["total"])
     if pop_ratio is not None:
         pct = percentile(score, pop_ratio)
         overall["percentile"] = pct
@@ -389,11 +382,35 @@ def _substitute_row(session: Session, n: int) -> dict[str, Any]:
     }
 
 
+def _overall(
+    score: float, stages_out: dict[str, Any], par_ratios: list[float], hint_total: float
+) -> dict[str, Any]:
+    """Score, points after the hints' cost and the verdict (``grade_tables``' rule)."""
+    earned = outcome_points(score)
+    points = max(0.0, earned - hint_total)
+    return {
+        "score": score,
+        "passed": bool(
+            score <= 1.0
+            and all(s["claimed"] for s in stages_out.values())
+            and points >= PASS_POINTS
+        ),
+        "par_score": max(par_ratios) if par_ratios else None,
+        "outcome_points": earned,
+        "hint_cost": hint_total,
+        "points": round(points, 3),
+        "pass_points": PASS_POINTS,
+        "within_tolerance": bool(score <= 1.0),
+    }
+
+
 def stage_check_names(session: Session) -> dict[str, list[str]]:
     """Stage → the names of the procedure's checks in it (the simulated operator's run)."""
     out: dict[str, list[str]] = {}
     for name, check in session.par.run.results.items():
         stage = check_stage(name)
+        if stage == "5" and session.exercise.method == "conventional":
+            stage = "C4"  # the conventional method's sheet checks are named "stage 5"
         if stage is not None and check.tolerance is not None:
             out.setdefault(stage, []).append(name)
     return out

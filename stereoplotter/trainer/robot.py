@@ -14,11 +14,12 @@ How it is built, per stage of the exercise:
    (:func:`~stereoplotter.trainer.operator_steps.operator_run`). The operator *with* its judgment
    errors (the grade's par) does not always pass on the true values (e08: control heights 0.51 m
    against 0.46 m, ``docs/trainer.md``), so it is not the robot.
-2. **Compacted.** A run of pointing moves (``set`` of X, Y, Z) and readings between two other
-   actions is replaced by the last setting of each lead screw in the run, finished from the side
-   the original last move came from (so the carriage takes up the backlash the same way), and
-   the run's last reading: the instrument ends in the state the run left it in, in a few page
-   actions instead of hundreds (e09: 3 096 → see ``robot_stats``).
+2. **Compacted.** A run of pointing moves (``set`` of X, Y, Z), settings of κ and the
+   correction knobs and readings between two other actions is replaced by the last setting of
+   each control in the run (a lead screw finished from the side its original last move came
+   from, so the carriage takes up the backlash the same way) and the run's last reading: the
+   instrument ends in the state the run left it in, in a few page actions instead of hundreds
+   (:func:`robot_stats`; e12: 467 actions instead of the exact operator's 6 967).
 3. **Finished.** Where the stage's residual y-parallax at the six standard points (stages 2, 3,
    C2, C3) still exceeds half its tolerance, the robot clears it by least squares on the five
    elements of relative orientation (κ_л, κ_п, k_α,л, k_α,п, k_ω,п), Gauss–Newton on the true
@@ -44,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.instrument.virtual import DECENTRATIONS, SCREWS, Instrument
+from stereoplotter.instrument.virtual import CASSETTES, DECENTRATIONS, KNOBS, SCREWS, Instrument
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel
 from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.transcript import Transcript
@@ -59,6 +60,7 @@ __all__ = [
     "compact",
     "robot_script",
     "robot_stats",
+    "without_sides",
 ]
 
 #: Stages graded on the residual y-parallax at the six standard points.
@@ -79,6 +81,7 @@ GAUSS_NEWTON_STEPS = 4
 #: Steps of the numerical Jacobian: κ in rad, knobs in tan. [—]
 _H = 1e-5
 _POINTING = ("X", "Y", "Z")
+_ELEMENTS = (*CASSETTES, *KNOBS)
 
 
 def _exact_q(inst: Instrument, prep: PreparedRun) -> np.ndarray:
@@ -199,12 +202,18 @@ def _finish(
     return out
 
 
-def compact(actions: list[dict[str, Any]], readings: dict[str, float]) -> list[dict[str, Any]]:
+def compact(
+    actions: list[dict[str, Any]], readings: dict[str, float], elements: bool = True
+) -> list[dict[str, Any]]:
     """The actions with each run of pointing moves and readings replaced by the last setting of
     each lead screw in the run (from the side its original last move finished) and the run's last
     reading (see the module docstring, 2).
 
     ``readings``: each screw's reading before the first action (updated as the actions go). [mm]
+    ``elements``: the settings of κ and the correction knobs belong to a run too (their last
+    setting in the run is kept): κ moves nothing else, and a knob drags only its own
+    decentration by f′·ΔT, the same in one step as in many; a decentration, f_пр, a base screw,
+    the height scale or the coordinatograph ends the run.
     """
     out: list[dict[str, Any]] = []
     run: list[dict[str, Any]] = []
@@ -218,6 +227,10 @@ def compact(actions: list[dict[str, Any]], readings: dict[str, float]) -> list[d
                 continue
             control = a["control"]
             side = a.get("side")
+            if control in _ELEMENTS:
+                last.pop(control, None)
+                last[control] = dict(a)
+                continue
             if side is None:
                 before = readings.get(control)
                 if before is not None and a["value"] != before:
@@ -231,7 +244,8 @@ def compact(actions: list[dict[str, Any]], readings: dict[str, float]) -> list[d
         run.clear()
 
     for a in actions:
-        pointing = a["kind"] == "read" or (a["kind"] == "set" and a["control"] in _POINTING)
+        movable = _POINTING + _ELEMENTS if elements else _POINTING
+        pointing = a["kind"] == "read" or (a["kind"] == "set" and a["control"] in movable)
         if pointing:
             run.append(a)
             continue
@@ -278,6 +292,37 @@ def _robot_run(session: Any) -> OperatorRun:
         _finish(stage, inst, session.prep, _commanded(inst), ex.unusable_points)
 
     return operator_run(prep, session.seed, ex.stages[-1], after_stage=finish)
+
+
+#: The pre-position of :func:`without_sides`: this far beyond the target before the last stroke
+#: (assumed: well beyond the backlash of the instruments' screws, 0.005–0.02 mm). [mm]
+PRE_POSITION_MM = 0.2
+
+
+def without_sides(script: list[dict[str, Any]], session: Any) -> list[dict[str, Any]]:
+    """The script with each ``side`` of a lead screw's setting replaced by a plain setting
+    :data:`PRE_POSITION_MM` beyond the target on that side, then the target (what the side
+    does inside the instrument, ``PlayAxis.approach``): for a page without a "finish from"
+    choice. A setting whose pre-position would pass a stop, a setting of the height scale H and
+    the needle are left plain (their move's own direction finishes them; the grade does not
+    read the needle; every shipped exercise still passes, ``tests/trainer``)."""
+    out: list[dict[str, Any]] = []
+    for a in script:
+        side = a.get("side")
+        if side is None:
+            out.append(a)
+            continue
+        if a["kind"] != "set" or a["control"] not in SCREWS:  # the needle, the height scale
+            out.append({k: v for k, v in a.items() if k != "side"})
+            continue
+        lo, hi = sorted(
+            float(np.asarray(session.inst.reading_of(a["control"], v)).reshape(-1)[0])
+            for v in session.inst.travel_mm(a["control"])
+        )
+        pre = a["value"] - PRE_POSITION_MM if side == "below" else a["value"] + PRE_POSITION_MM
+        plain = {k: v for k, v in a.items() if k != "side"}
+        out += [{**plain, "value": round(pre, 6)}, plain] if lo <= pre <= hi else [plain]
+    return out
 
 
 def robot_stats(session: Any, script: list[dict[str, Any]]) -> dict[str, int]:

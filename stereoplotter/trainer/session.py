@@ -330,13 +330,37 @@ class Session:
         }
 
     def _checks(self) -> list[dict[str, Any]]:
+        """The stage's checks with their tolerances: the procedure's own (the conventional
+        method's C4 names its checks "stage 5"), else what the grade measures (``graded``)."""
         stage = self.stage
         if stage is None:
             return []
+        own = ("C4", "5") if stage == "C4" else (stage,)
         out = []
         for name, check in self.par.run.results.items():
-            if check_stage(name) == stage and check.tolerance is not None:
+            if check_stage(name) in own and check.tolerance is not None:
                 out.append({"name": name, "tolerance": _f(check.tolerance), "unit": check.unit})
+        if not out:
+            tol = self.prep.sheet.tolerances
+            if stage == "C1":
+                out.append(
+                    {
+                        "name": "C1: f_пр on its scale against the sheet",
+                        "tolerance": float(self.exercise.spec.xy_least_count_mm),
+                        "unit": "mm",
+                        "graded": True,
+                    }
+                )
+            elif stage in ("4", "C4"):
+                out.append(
+                    {
+                        "name": f"{'stage 4' if stage == '4' else 'C4'}: plan error at the "
+                        "control points on the map (sheet fitted), coordinatograph connected",
+                        "tolerance": float(tol["corner_mm"]),
+                        "unit": "mm",
+                        "graded": True,
+                    }
+                )
         return out
 
     def _announced(self) -> dict[str, float] | None:

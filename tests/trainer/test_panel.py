@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from stereoplotter.errors import TrainerError
 from stereoplotter.io.exercise_file import exercise_from_mapping, load_exercise
 from stereoplotter.trainer.actions import ACTION_CATALOGUE, ACTION_FIELDS
 from stereoplotter.trainer.panel import checklist, overview, sheet_parts, show_me_actions
@@ -97,3 +98,25 @@ def test_an_exam_carries_no_parallax_numbers_whatever_the_file_says():
 def test_the_conventional_method_withholds_the_orientation_values():
     assert sheet_parts(load_exercise("e05-conventional-c2"))["given"] == ["certificate", "interior"]
     assert "readings" in sheet_parts(load_exercise("e03-setup-stage2"))["given"]
+
+
+def test_a_refusal_names_the_instrument_never_a_server_path():
+    s = Session.start(load_exercise("e10-setup-mountain"), trainee="ann")
+    for action in (
+        {"kind": "turn", "control": "Z", "delta": 1e5},
+        {"kind": "set", "control": "kappa_left", "value": 2.0},
+    ):
+        with pytest.raises(TrainerError) as exc:
+            s.act(action)
+        message = str(exc.value)
+        assert "instrument sd3" in message, message
+        assert ".yaml" not in message and "/" not in message and "YAML" not in message
+
+
+@pytest.mark.parametrize(
+    ("name", "stage"), [("e02-conventional-c1", "C1"), ("e04-setup-stage4", "4")]
+)
+def test_every_stage_lists_its_checks_with_tolerances(name, stage):
+    state = Session.start(load_exercise(name), trainee="ann").state()
+    assert state["stage"] == stage
+    assert state["checks"] and all(c["tolerance"] > 0 for c in state["checks"])
