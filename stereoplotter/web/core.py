@@ -28,7 +28,7 @@ from stereoplotter.trainer.actions import ACTION_CATALOGUE
 from stereoplotter.trainer.exercise import Exercise, resolve_exercise
 from stereoplotter.trainer.grading import grade
 from stereoplotter.trainer.panel import checklist, overview, show_me_actions
-from stereoplotter.trainer.session import Session
+from stereoplotter.trainer.session import Session, json_finite
 
 __all__ = [
     "COARSE_MAG",
@@ -260,8 +260,7 @@ def action_catalogue() -> list[dict[str, Any]]:
 
 def _jsonable(value: Any) -> Any:
     """``value`` through JSON (numpy scalars and arrays as numbers, non-finite as null)."""
-    return json.loads(json.dumps(value, default=_plain, allow_nan=True).replace("NaN", "null")
-                      .replace("-Infinity", "null").replace("Infinity", "null"))
+    return json_finite(json.loads(json.dumps(value, default=_plain)))
 
 
 def _plain(value: Any) -> Any:
