@@ -17,6 +17,7 @@ from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 
 import pytest
+from playwright.sync_api import Error as PlaywrightError
 
 from stereoplotter.io.exercise_file import exercise_from_mapping, load_exercise, shipped_exercises
 from stereoplotter.trainer.grading import grade
@@ -25,6 +26,20 @@ from tests.browser.robot import Hands, script_for
 
 SHIPPED = shipped_exercises()
 TRAINEE = "robot"
+
+
+def _get(page, url: str, secret: str) -> str:
+    """GET with the session's key; once more if the server closed an idle kept-alive
+    connection just as it was reused (uvicorn closes them after 5 s: ECONNRESET)."""
+    for attempt in range(2):
+        try:
+            r = page.request.get(url, headers={"Authorization": f"Bearer {secret}"})
+            assert r.ok, r.text()
+            return r.text()
+        except PlaywrightError:
+            if attempt:
+                raise
+    raise AssertionError("unreachable")
 
 
 def _as_javascript_numbers(value):
@@ -85,9 +100,8 @@ def test_robot_trainee_completes_the_exercise_through_the_page(
     assert page.evaluate("window.trainer.state().done")
 
     secret = page.evaluate(f"localStorage.getItem('stereoplotter-key-{sid}')")
-    r = page.request.get(f"{server}/api/sessions/{sid}/log.jsonl",
-                         headers={"Authorization": f"Bearer {secret}"})
-    log = [json.loads(line) for line in r.text().splitlines()]
+    log = [json.loads(line) for line in _get(page, f"{server}/api/sessions/{sid}/log.jsonl",
+                                             secret).splitlines()]
     assert [rec["action"]["kind"] for rec in log[1:]] == [a["kind"] for a in script]
     assert not [rec for rec in log[1:] if rec.get("refused")]
 
