@@ -23,9 +23,12 @@ from stereoplotter.io.images import png_bytes
 from stereoplotter.io.paths import available_names
 from stereoplotter.io.session_log import log_bytes
 from stereoplotter.report.grade import grade_markdown
+from stereoplotter.report.sheet import sheet_to_dict
+from stereoplotter.trainer.actions import ACTION_CATALOGUE
 from stereoplotter.trainer.exercise import Exercise, resolve_exercise
 from stereoplotter.trainer.grading import grade
-from stereoplotter.trainer.session import Session
+from stereoplotter.trainer.panel import checklist, overview, sheet_parts, show_me_actions
+from stereoplotter.trainer.session import Session, json_finite
 
 __all__ = [
     "COARSE_MAG",
@@ -33,7 +36,9 @@ __all__ = [
     "Catalogue",
     "CoreError",
     "TrainerError",
+    "action_catalogue",
     "build_view_cache",
+    "checklist_of",
     "format_mm",
     "grade_of",
     "grade_records",
@@ -42,11 +47,14 @@ __all__ = [
     "log_of",
     "log_text",
     "operator_script",
+    "overview_of",
     "photo_key",
     "photo_patch",
     "replay",
     "replay_frames",
     "replay_json",
+    "sheet_of",
+    "show_me",
     "start",
 ]
 
@@ -157,7 +165,11 @@ def grade_text(grade_dict: dict[str, Any]) -> str:
 def replay_json(records: list[dict[str, Any]], trainee: str, exercise: str) -> bytes:
     """The instructor's replay as JSON bytes (run in a worker process: the frames of a long log
     are megabytes of JSON, encoded off the server's event loop)."""
-    body = {"trainee": trainee, "exercise": exercise, "frames": replay_frames(records)}
+    head = records[0]
+    ex = resolve_exercise(head["exercise"], exercise_from_mapping)
+    view = {"screen_pixel_mm": SCREEN_PIXEL_MM, "format_mm": format_mm(ex), "patch_px": 768}
+    frames = replay_frames(records)
+    body = {"trainee": trainee, "exercise": exercise, "view": view, "frames": frames}
     return json.dumps(body, allow_nan=False, separators=(",", ":")).encode()
 
 
@@ -215,3 +227,71 @@ def photo_patch(
     = SCREEN_PIXEL_MM / magnification mm of photo, x to the right, y up: the page turns and
     places it under the mark itself, so a move needs no new image."""
     return png_bytes(cache.view(side, x_mm, y_mm, 0.0, magnification, size_px))
+
+
+def sheet_of(exercise: Exercise) -> dict[str, Any]:
+    """The exercise's own setup sheet as the page shows it (run in a worker thread): the parts
+    the method gives (``trainer.panel.sheet_parts``) of the sheet computed for the exercise's
+    modified scenario, serialised by ``report.sheet``; the keys of ``stereoplotter exercise
+    sheet --json`` (``commands.exercise_sheet``, which the web layer may not import: commands
+    import the web server, and the layers admit no cycle)."""
+    session = Session(exercise, "sheet", exercise.seed or 0, clock=False)
+    table = sheet_to_dict(session.prep.sheet)
+    parts = sheet_parts(exercise)
+    cam = exercise.scenario.camera
+    out: dict[str, Any] = {
+        "exercise": exercise.name,
+        "method": exercise.method,
+        "instrument": exercise.spec.key,
+        **parts,
+        "certificate": {
+            "focal_length_mm": cam.focal_length_mm,
+            "principal_point_mm": list(cam.principal_point_mm),
+            "format_mm": cam.format_mm,
+            "fiducials_mm": {k: list(xy) for k, xy in cam.fiducials_mm.items()},
+        },
+        "interior": {
+            k: table[k]
+            for k in ("f_instrument_mm", "scale_horizontal", "scale_vertical", "scale_map",
+                      "n_left", "n_right", "base_mm", "tolerances")
+        },
+    }
+    if "table24" in parts["given"]:
+        out["table24"] = {k: v for k, v in table.items() if k != "readings"}
+    if "readings" in parts["given"]:
+        out["readings"] = table["readings"]
+    return _jsonable(out)
+
+
+def overview_of(session: Session) -> dict[str, Any]:
+    """Both photos at a glance (``trainer.panel.overview``; run on the actor thread)."""
+    return _jsonable(overview(session))
+
+
+def checklist_of(session: Session) -> dict[str, Any] | None:
+    """The stage in hand's steps with their done flags (``trainer.panel.checklist``; the state
+    carries only the flags on every action; run on the actor thread)."""
+    return _jsonable(checklist(session))
+
+
+def show_me(session: Session) -> list[dict[str, Any]]:
+    """The simulated operator's actions of the stage in hand (what hint 3 applies at once), for
+    the page to play one by one at its chosen speed ("show me", animated)."""
+    return show_me_actions(session)
+
+
+def action_catalogue() -> list[dict[str, Any]]:
+    """Every action the core accepts with its fields (``trainer.actions.ACTION_CATALOGUE``),
+    for the page to make one control per kind."""
+    return ACTION_CATALOGUE
+
+
+def _jsonable(value: Any) -> Any:
+    """``value`` through JSON (numpy scalars and arrays as numbers, non-finite as null)."""
+    return json_finite(json.loads(json.dumps(value, default=_plain)))
+
+
+def _plain(value: Any) -> Any:
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return str(value)

@@ -38,6 +38,7 @@ __all__ = [
     "one_line",
     "origin_ok",
     "parse_message",
+    "scrub_paths",
     "seed_value",
     "trainee_key",
     "trainee_name",
@@ -69,7 +70,13 @@ MAX_RECORDS = 64
 #: 30 notches a second; assumed ample for a person, small for a flood). [1/s], [messages]
 RATE, BURST = 60.0, 120
 
-_PATH = re.compile(r"(?:[A-Za-z]:)?(?:[\\/][\w.\-~ ]+){2,}[\\/]?")
+_PATH = re.compile(r"(?:[A-Za-z]:)?[\w.\-~]*(?:[\\/][\w.\-~ ]+){2,}[\\/]?")
+
+
+def _file_name(match: re.Match) -> str:
+    """A server path as the name of its file only (``…/instruments/sc1.yaml`` → ``file
+    sc1.yaml``): what it names stays readable, where it lies is not shown."""
+    return "file " + re.split(r"[\\/]", match.group(0).rstrip("\\/").strip())[-1]
 
 
 class Refused(Exception):
@@ -81,10 +88,22 @@ class Refused(Exception):
 
 
 def one_line(text: object) -> str:
-    """``text`` as one line, server paths replaced by ``<path>``, at most 300 characters."""
+    """``text`` as one line, each server path replaced by its file's name, at most 300
+    characters."""
     s = " ".join(str(text).split())
-    s = _PATH.sub("<path>", s)
+    s = _PATH.sub(_file_name, s)
     return s if len(s) <= 300 else s[:299] + "…"
+
+
+def scrub_paths(value: Any) -> Any:
+    """``value`` (JSON-like) with every server path in its text replaced by its file's name."""
+    if isinstance(value, str):
+        return _PATH.sub(_file_name, value)
+    if isinstance(value, dict):
+        return {k: scrub_paths(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [scrub_paths(v) for v in value]
+    return value
 
 
 def error(status: int, text: object) -> JSONResponse:

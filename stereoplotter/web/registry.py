@@ -25,7 +25,7 @@ from typing import Any
 
 from stereoplotter.io.session_store import SessionStore
 from stereoplotter.web import core
-from stereoplotter.web.guard import Refused, trainee_key
+from stereoplotter.web.guard import BURST, RATE, Refused, trainee_key
 
 __all__ = ["MAX_ACTIONS", "Live", "Registry"]
 
@@ -59,12 +59,15 @@ class Registry:
         catalogue: core.Catalogue,
         grader: Executor,
         imager: Executor,
+        message_limit: tuple[float, int] = (RATE, BURST),
     ):
         self.token = token or secrets.token_urlsafe(16)
         self.store = store
         self.catalogue = catalogue
         self.grader = grader
         self.imager = imager
+        #: Socket messages one page may send: a rate [1/s] and a burst (``guard.RATE``, ``BURST``).
+        self.message_limit = message_limit
         #: The thread that carries out every session's actions, one at a time.
         self.actor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="trainer-actor")
         self.rows: dict[str, dict[str, Any]] = {r["id"]: r for r in store.sessions()}

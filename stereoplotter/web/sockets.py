@@ -26,7 +26,14 @@ from starlette.concurrency import run_in_threadpool
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from stereoplotter.web import core
-from stereoplotter.web.guard import RateLimit, Refused, clean_action, one_line, parse_message
+from stereoplotter.web.guard import (
+    RateLimit,
+    Refused,
+    clean_action,
+    one_line,
+    parse_message,
+    scrub_paths,
+)
 from stereoplotter.web.registry import Registry
 
 __all__ = ["AUTH_TIMEOUT_S", "PUSH_S", "instructor_socket", "trainee_socket"]
@@ -86,9 +93,13 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         "format_mm": core.format_mm(ex),
         "description": ex.description,
         "coarse_mag": core.COARSE_MAG,
+        "actions": core.action_catalogue(),
+        "rate": list(reg.message_limit),
+        "mode": ex.mode,
     }
     state = await _on_actor(reg, live.session.state)  # not while an action changes it
-    limit = RateLimit()
+    hello = scrub_paths(hello)
+    limit = RateLimit(*reg.message_limit)
     try:
         await websocket.send_text(
             _dump({"hello": hello, "state": state, "error": None, "n": len(live.session.log)})
@@ -98,6 +109,8 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
             if message["type"] == "websocket.disconnect":
                 return
             reply = await _answer(reg, live, message, limit)
+            if reply.get("error"):  # an instrument's refusal may name a file: never shown
+                reply["error"] = one_line(reply["error"])
             reply["n"] = len(live.session.log)
             await websocket.send_text(_dump(reply))
     except (WebSocketDisconnect, OSError):  # the page went away (uvicorn: ClientDisconnected)

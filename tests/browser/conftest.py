@@ -7,6 +7,7 @@ to ``tmp/artefacts/`` of the checkout (kept as test artefacts).
 
 from __future__ import annotations
 
+import multiprocessing
 import socket
 import threading
 import time
@@ -36,7 +37,9 @@ def _free_port() -> int:
 @pytest.fixture(scope="session")
 def server():
     """The base URL of a trainer server running in this process (stopped at the end)."""
-    app = create_app(TOKEN)
+    # the robot trainee's page sends as fast as the server takes: a high message rate (the
+    # page paces itself by the rate the server tells it; the classroom default is 60/s)
+    app = create_app(TOKEN, message_limit=(2000.0, 4000))
     port = _free_port()
     srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
     thread = threading.Thread(target=srv.run, daemon=True)
@@ -49,6 +52,34 @@ def server():
     yield f"http://127.0.0.1:{port}"
     srv.should_exit = True
     thread.join(5)
+
+
+def _serve(port: int) -> None:
+    """The trainer server alone in a process (the robot trainee's: its actions and grading run
+    beside the test's browser driving and core grading, not under one interpreter lock)."""
+    app = create_app(TOKEN, message_limit=(2000.0, 4000))
+    uvicorn.run(app, host="127.0.0.1", port=port, log_level="warning")
+
+
+@pytest.fixture(scope="session")
+def process_server():
+    """The base URL of a trainer server in its own process (terminated at the end)."""
+    port = _free_port()
+    proc = multiprocessing.get_context("spawn").Process(target=_serve, args=(port,), daemon=True)
+    proc.start()
+    deadline = time.monotonic() + 60
+    while True:
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=0.2):
+                break
+        except OSError:
+            if time.monotonic() > deadline or not proc.is_alive():
+                proc.terminate()
+                pytest.fail("trainer server process did not start within 60 s")
+            time.sleep(0.1)
+    yield f"http://127.0.0.1:{port}"
+    proc.terminate()
+    proc.join(10)
 
 
 @pytest.fixture(scope="session")

@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import zipfile
 
 from starlette.routing import Route, WebSocketRoute
 
-from tests.web.conftest import PRACTICE, TOKEN, claim_all, open_socket, start
+from tests.web.conftest import EXAM, PRACTICE, TOKEN, ask, claim_all, open_socket, start
 
 BAD_BODIES = [
     b"",
@@ -54,6 +55,7 @@ def _one_line_error(r):
 
 def test_every_route_answers_bad_requests_with_one_line(client):
     sid, secret = start(client, trainee="walker")
+    _, other_secret = start(client, trainee="another walker")
     paths = {"sid": sid}
     routes = [r for r in client.app.routes if isinstance(r, Route)]
     seen = set()
@@ -74,6 +76,11 @@ def test_every_route_answers_bad_requests_with_one_line(client):
                     assert r.status_code < 500, path
                     if r.status_code != 200:
                         _one_line_error(r)
+            # another session's key opens nothing of this one
+            if route.path.startswith("/api/sessions/{sid}"):
+                r = client.get(path, params={"key": other_secret})
+                assert r.status_code == 403, (path, r.status_code)
+                _one_line_error(r)
             # unknown sessions, bad ids and wrong methods
             if "{sid}" in route.path and route.path.startswith("/api/"):
                 for bad in ("nope", "0" * 16, "..%2f..%2fetc", "%00"):
@@ -138,3 +145,57 @@ def test_csv_export_and_class_archive(client):
     ws, _conn, hello = open_socket(client, sid, secret)
     ws.__exit__(None, None, None)
     assert hello["state"]["done"]
+
+
+#: A server path in any text the page is sent (the issue saw one in a stop's refusal).
+SERVER_PATH = re.compile(r"(?:[A-Za-z]:)?[\w.\-~]*(?:[\\/][\w.\-~ ]+){2,}")
+
+
+def _texts(value):
+    """Every string in a JSON value (keys and values)."""
+    if isinstance(value, str):
+        yield value
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            yield k
+            yield from _texts(v)
+    elif isinstance(value, list):
+        for v in value:
+            yield from _texts(v)
+
+
+def test_sheet_and_overview_need_the_sessions_key_and_name_no_path(client):
+    sid, secret = start(client, exercise="e07-setup-stage2-incomplete", trainee="sheets")
+    for route in ("sheet", "overview", "checklist", "showme"):
+        path = f"/api/sessions/{sid}/{route}"
+        assert client.get(path).status_code == 403
+        assert client.get(path, params={"key": "x" * 43}).status_code == 403
+        other = f"/api/sessions/{'0' * 16}/{route}"
+        assert client.get(other, params={"key": secret}).status_code == 404
+        r = client.get(path, headers={"Authorization": f"Bearer {secret}"})
+        assert r.status_code == 200, r.text
+        paths = [m.group(0) for t in _texts(r.json()) for m in SERVER_PATH.finditer(t)]
+        assert paths == []
+        assert client.get(path, params={"token": TOKEN}).status_code == 200
+    exam_sid, exam_secret = start(client, exercise=EXAM, trainee="sheets")
+    r = client.get(f"/api/sessions/{exam_sid}/showme", params={"key": exam_secret})
+    assert r.status_code == 403 and "no hints" in r.json()["error"]  # an exam shows nothing
+    ov = client.get(f"/api/sessions/{sid}/overview", params={"key": secret}).json()
+    photos = ov["photos"] if "photos" in ov else None
+    if photos is not None:  # the core's overview: six standard points a photo, 5 and 6 unusable
+        left = photos["left"]["standard_points"]
+        assert [p["id"] for p in left] == ["1", "2", "3", "4", "5", "6"]
+        assert [p["id"] for p in left if p["usable"] is False] == ["5", "6"]
+
+
+def test_a_stops_refusal_names_the_file_not_its_path(client):
+    sid, secret = start(client, trainee="stopped")
+    ws, conn, hello = open_socket(client, sid, secret)
+    try:
+        assert [t for t in _texts(hello) if SERVER_PATH.search(t)] == []
+        reply = ask(conn, {"action": {"kind": "set", "control": "Z", "value": 1e4}, "seq": 1})
+        assert "refused" in reply["error"] and not SERVER_PATH.search(reply["error"]), reply
+        kinds = {a["kind"] for a in hello["hello"]["actions"]}
+        assert {"record", "connect", "slip", "needle", "lock", "gear"} <= kinds
+    finally:
+        ws.__exit__(None, None, None)

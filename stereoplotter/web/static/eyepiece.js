@@ -8,6 +8,14 @@ const COLOURS = { red: [1, 0, 0], cyan: [0, 1, 1], green: [0, 1, 0], magenta: [1
 // formatMm: side of the photo format (the mark is off the photo beyond ±formatMm / 2).
 export const scale = { pxPerMmAt1x: 10, formatMm: null };
 
+// Whether a photo patch holds the photo around the mark (a patch left behind by a fast move
+// does not: the field shows the graticule until the new one arrives).
+export function covers(patch, mark) {
+  if (!patch || !mark || !patch.img.complete) return false;
+  const half = patch.size / (scale.pxPerMmAt1x * patch.mag) / 2;
+  return Math.abs(patch.x_mm - mark.x_mm) < half && Math.abs(patch.y_mm - mark.y_mm) < half;
+}
+
 // A mark outside the photo format: the field is the camera's black frame; say so.
 function offPhoto(mark) {
   const h = scale.formatMm / 2;
@@ -29,7 +37,7 @@ export function drawField(ctx, mark, magnification, opts = {}) {
   drawPhoto(ctx, mark, magnification, opts);
   const w = ctx.canvas.width, h = ctx.canvas.height;
   if (mark && offPhoto(mark)) say(ctx, w, h, ["the mark is off the photo", `x ${mark.x_mm.toFixed(1)}  y ${mark.y_mm.toFixed(1)} mm`]);
-  else if (mark && !(opts.patch && opts.patch.img.complete)) say(ctx, w, h, ["loading the photo…", "(graticule meanwhile)"]);
+  else if (mark && !covers(opts.patch, mark)) say(ctx, w, h, ["loading the photo…", "(graticule meanwhile)"]);
 }
 
 function drawPhoto(ctx, mark, magnification, { ink = "#e8e4d8", back = "#101314", markColour = "#ff4030", patch = null } = {}) {
@@ -44,7 +52,7 @@ function drawPhoto(ctx, mark, magnification, { ink = "#e8e4d8", back = "#101314"
   const s = scale.pxPerMmAt1x * magnification;
   ctx.translate(w / 2, h / 2);
   ctx.rotate(mark.kappa_rad); // a view column shows photo R(κ)·(du, dv) (imagery.eyepiece)
-  if (patch && patch.img.complete) {
+  if (covers(patch, mark)) {
     const k = magnification / patch.mag; // canvas px per patch px
     const n = patch.size * k;
     const cx = (patch.x_mm - mark.x_mm) * s, cy = -(patch.y_mm - mark.y_mm) * s;

@@ -1,11 +1,15 @@
 // Instructor page: live sessions (pushed by the server over a WebSocket), the results CSV, the
 // class archive, extra exam attempts, uploading an exercise, and a step-by-step replay of a log.
 import { el, download } from "./dom.js";
+import { drawField, scale } from "./eyepiece.js";
+import { describe } from "./panels.js";
 
 const token = new URLSearchParams(location.search).get("token") || "";
 const auth = { Authorization: `Bearer ${token}` };
 const $ = (id) => document.getElementById(id);
-let frames = [], timer = null, retry = 500;
+let frames = [], timer = null, retry = 500, replayId = null, view = null;
+const patches = { left: null, right: null };
+const MAG = 6; // the replay's eyepiece magnification
 
 $("csv").addEventListener("click", (e) => { e.preventDefault(); download("/api/instructor/results.csv", auth, "results.csv"); });
 $("zip").addEventListener("click", (e) => { e.preventDefault(); download("/api/instructor/archive.zip", auth, "class.zip"); });
@@ -51,10 +55,28 @@ function connect() {
 }
 connect();
 
+// The replay's eyepieces: the photo patch around each mark (fetched with the token when the mark
+// leaves the patch in hand), drawn as the trainee's page draws them.
+function eyes(marks) {
+  for (const side of ["left", "right"]) {
+    const m = marks && marks[side], ctx = $(`replay-${side}`).getContext("2d");
+    const p = patches[side], half = (view.patch_px * view.screen_pixel_mm) / MAG / 2;
+    if (m && (!p || Math.abs(m.x_mm - p.x_mm) > half * 0.6 || Math.abs(m.y_mm - p.y_mm) > half * 0.6)) {
+      const q = { x_mm: Number(m.x_mm.toFixed(3)), y_mm: Number(m.y_mm.toFixed(3)), mag: MAG, size: view.patch_px, img: new Image() };
+      q.img.onload = () => { patches[side] = q; show(Number($("replay-pos").value)); };
+      q.img.src = `/api/sessions/${encodeURIComponent(replayId)}/patch.png?side=${side}&x=${q.x_mm}&y=${q.y_mm}`
+        + `&mag=${MAG}&size=${q.size}&token=${encodeURIComponent(token)}`;
+      patches[side] = patches[side] || null;
+    }
+    drawField(ctx, m, MAG, { patch: patches[side] });
+  }
+}
+
 function show(i) {
   const f = frames[i];
+  if (view) eyes(f.state.marks);
   $("replay-n").textContent = `${i} / ${frames.length - 1}`;
-  $("replay-action").textContent = f.action ? `${f.t} s: ${JSON.stringify(f.action)}${f.refused ? " — refused: " + f.refused : ""}` : "start";
+  $("replay-action").textContent = f.action ? `${f.t} s: ${describe(f.action)}${f.refused ? " — refused: " + f.refused : ""}` : "start";
   $("replay-counters").replaceChildren(...Object.entries(f.state.counters).map(([k, c]) =>
     el("tr", {}, el("td", { text: k }), el("td", { class: "num", text: c.value === null ? "—" : c.value.toFixed(3) }), el("td", { text: c.unit }))));
 }
@@ -64,7 +86,8 @@ async function replay(id) {
   const r = await fetch(`/api/instructor/replay/${encodeURIComponent(id)}`, { headers: auth });
   const j = await r.json();
   if (!r.ok) { $("replay-action").textContent = j.error; return; }
-  frames = j.frames;
+  frames = j.frames; replayId = id; view = j.view; patches.left = patches.right = null;
+  scale.pxPerMmAt1x = 1 / view.screen_pixel_mm; scale.formatMm = view.format_mm;
   $("replay").hidden = false;
   $("replay-who").textContent = `${j.trainee} · ${j.exercise}`;
   $("replay-pos").max = frames.length - 1;
@@ -79,7 +102,7 @@ $("replay-play").onclick = () => {
     const i = Number($("replay-pos").value) + 1;
     if (i >= frames.length) { clearInterval(timer); timer = null; return; }
     $("replay-pos").value = i; show(i);
-  }, 200);
+  }, 1000 / Number($("replay-speed").value));
 };
 
 $("grant").addEventListener("submit", async (e) => {

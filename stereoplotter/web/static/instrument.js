@@ -1,9 +1,11 @@
 // The instrument page: WebSocket to the server (action → state), eyepieces, wheels, counters.
 // The session's key (kept by this browser when it started the session) opens the socket; a
 // dropped socket is reopened (with growing pauses) and the session resumes where its log ends.
-import { drawField, anaglyph, scale } from "./eyepiece.js";
+import { drawField, anaglyph, covers, scale } from "./eyepiece.js";
 import { Wheels, LABELS, decimals } from "./wheels.js";
 import { el, sessionKey } from "./dom.js";
+import { buildActions, describe, parseCommand, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
+import { Overview } from "./overview.js";
 
 const sid = location.pathname.split("/").pop();
 const key = sessionKey.get(sid);
@@ -11,7 +13,11 @@ const $ = (id) => document.getElementById(id);
 let state = null, hello = null, seq = 0, ws = null, retry = 250;
 const waiting = new Map(); // seq → resolve(frame time)
 const trail = [];
-const wheels = new Wheels($("wheels"), send);
+const wheels = new Wheels($("wheels"), send, {
+  multiplier: () => $("step-mult").value, side: () => $("approach").value,
+});
+const sent = new Map(); // seq → [action, state before] (for its result and coupled motions)
+let overview = null;
 
 function link(text, lost) {
   $("link").textContent = text; $("link").className = lost ? "meta lost" : "meta";
@@ -28,18 +34,39 @@ function connect() {
   };
 }
 
+// Messages leave at most at the server's rate (told in hello: a rate and a burst), a little
+// under it: a fast hand (or the robot trainee) is queued here, never refused there.
+const queue = [];
+let tokens = 0, lastFill = performance.now(), pumping = null;
+function pump() {
+  pumping = null;
+  const [rate, burst] = hello && hello.rate ? hello.rate : [60, 120];
+  const now = performance.now();
+  tokens = Math.min(burst * 0.9, tokens + ((now - lastFill) / 1000) * rate * 0.9);
+  lastFill = now;
+  while (queue.length && tokens >= 1 && ws && ws.readyState === WebSocket.OPEN) {
+    ws.send(queue.shift()); tokens -= 1;
+  }
+  window.__queued = queue.length;
+  if (queue.length) pumping = setTimeout(pump, Math.max(4, 1000 / rate));
+}
+
 function send(action) {
   seq += 1;
   if (!ws || ws.readyState !== WebSocket.OPEN) {
     message("not connected to the server: this action was not sent (reconnecting…)", "error");
     return seq;
   }
-  ws.send(JSON.stringify({ action, seq }));
+  sent.set(seq, [action, state]);
+  queue.push(JSON.stringify({ action, seq }));
+  if (!pumping) pump();
   return seq;
 }
 
 function sendDemo() {
-  if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify({ demo: "step" }));
+  if (!ws || ws.readyState !== WebSocket.OPEN) return;
+  queue.push(JSON.stringify({ demo: "step" }));
+  if (!pumping) pump();
 }
 
 function message(text, cls = "") {
@@ -82,11 +109,24 @@ function needPatch(side, mark, mag) {
   c.img.src = patchUrl(side, mark, cm, cs);
 }
 
+// A new photo patch is asked for once the mark has rested (PATCH_REST_MS without a new
+// state): a fast run of moves shows the patch in hand (or the graticule) and the server renders
+// one patch where the mark stops, not one per move.
+const PATCH_REST_MS = 120;
+let patchTimer = null;
+function askPatches(marks, mag) {
+  clearTimeout(patchTimer);
+  patchTimer = setTimeout(() => {
+    const m = state && state.marks;
+    if (m) for (const side of ["left", "right"]) needPatch(side, m[side], Number($("mag").value) || mag);
+  }, PATCH_REST_MS);
+}
+
 function drawEyes() {
   const marks = state ? state.marks : null;
   const mag = Number($("mag").value) || 6;
   const mode = $("view").value;
-  if (marks) for (const side of ["left", "right"]) needPatch(side, marks[side], mag);
+  if (marks) askPatches(marks, mag);
   $("eyepieces").hidden = mode !== "split";
   $("stereo").hidden = mode === "split";
   if (mode === "split") {
@@ -101,6 +141,7 @@ function drawEyes() {
     if (mode === "anaglyph") anaglyph(ctx, off.left, off.right, $("colours").value.split(","));
     else { ctx.drawImage(off[flickerSide], 0, 0); }
   }
+  if (overview) overview.draw(marks, mag);
   window.__frames = (window.__frames || 0) + 1;
 }
 setInterval(() => {
@@ -184,16 +225,39 @@ function drawStage() {
   $("grade-link").href = `/grade/${encodeURIComponent(sid)}`;
   const p = state.parallax;
   const um = (v) => (v === null || v === undefined ? "—" : v.toFixed(1));
-  $("parallax").textContent = p ? `parallax at standard point ${p.point}: q = ${um(p.y_um)} µm, p = ${um(p.x_um)} µm` : "";
+  $("parallax").textContent = p ? `parallax at standard point ${p.point}: q = ${um(p.y_um)} µm, p = ${um(p.x_um)} µm`
+    : state.marks ? "no q/p read-out in this exercise: judge the parallax in the eyepieces (or the anaglyph)" : "";
+  tickChecklist(state.checklist_ticks);
+  showAnnounced($("announced"), $("announced-list"), state.injected_errors_list || state.injected_errors);
 }
 
-function render() {
-  drawEyes(); drawCounters(); drawStage(); drawTable();
-  wheels.update(state.controls, state.locked || []);
+// The controls with the metre height scale H once the height counter is geared (the core
+// lists H among the counters; it is set and turned like a handwheel).
+function withHeightScale(st) {
+  const h = st.counters.H;
+  if (!h || st.controls.H) return st.controls;
+  return { ...st.controls, H: { value: h.value, unit: h.unit, step: h.least_count, min: null, max: null } };
+}
+
+let framePending = false;
+function render() { // at most once an animation frame, however many states arrive
+  if (framePending) return;
+  framePending = true;
+  requestAnimationFrame(() => {
+    const t0 = performance.now();
+    framePending = false;
+    drawEyes(); drawCounters(); drawStage(); drawTable();
+    wheels.update(withHeightScale(state), state.locked || []);
+    window.__renderMs = (window.__renderMs || 0) + performance.now() - t0; // for the benchmarks
+  });
 }
 
 function onMessage(ev) {
-  const msg = JSON.parse(ev.data);
+  const t0 = performance.now();
+  try { handle(JSON.parse(ev.data)); } finally { window.__messageMs = (window.__messageMs || 0) + performance.now() - t0; }
+}
+
+function handle(msg) {
   if (msg.hello) {
     hello = msg.hello; retry = 250; link("", false);
     scale.pxPerMmAt1x = 1 / hello.screen_pixel_mm;
@@ -202,15 +266,21 @@ function onMessage(ev) {
     $("title").textContent = "Stereoplotter trainer";
     $("instructions").textContent = hello.description;
     waiting.clear();
+    buildActions($("actions"), hello.actions || [], Object.keys(msg.state.controls), send, message);
+    loadOverview();
   }
   if (msg.state) state = msg.state;
   window.__n = msg.n;
   if (state) render();
+  const [action, before] = msg.seq !== undefined && sent.has(msg.seq) ? sent.get(msg.seq) : [msg.demo && msg.demo.action, null];
+  if (msg.seq !== undefined) sent.delete(msg.seq);
   if (msg.error) message(msg.error, "error");
-  else if (msg.result !== undefined && msg.result !== null) message(typeof msg.result === "string" ? msg.result
-    : typeof msg.result === "number" ? `reading: ${msg.result}` : JSON.stringify(msg.result), "hint");
-  else if (msg.demo) message(`operator: ${JSON.stringify(msg.demo.action)}`);
+  else if (msg.demo) message(`operator: ${describe(msg.demo.action)}`);
   else if (!msg.hello) message("");
+  if (!msg.hello && !msg.error) {
+    showResult($("result"), action, msg.result);
+    showCoupled($("coupled"), action, before, msg.state, msg.state && msg.state.events);
+  }
   if (msg.demo) $("demo-count").textContent = `${msg.demo.done} / ${msg.demo.of}`;
   if (msg.seq !== undefined && waiting.has(msg.seq)) { waiting.get(msg.seq)(performance.now()); waiting.delete(msg.seq); }
   document.body.dataset.ready = "1";
@@ -224,24 +294,118 @@ else {
 $("claim").onclick = () => send({ kind: "claim", step: state.stage });
 $("undo").onclick = () => send({ kind: "undo" });
 $("redo").onclick = () => send({ kind: "redo" });
-$("gear-btn").onclick = () => send({ kind: "gear", value: Number($("gear").value) });
 for (const b of $("hints").querySelectorAll("button")) b.onclick = () => send({ kind: "hint", level: Number(b.dataset.level) });
-let playing = null;
+$("command").addEventListener("keydown", (e) => {
+  if (e.key !== "Enter" || !state) return;
+  const names = [...Object.keys(withHeightScale(state)), ...Object.keys(state.counters)];
+  const parsed = parseCommand($("command").value, [...new Set(names)]);
+  if (parsed.error) { message(parsed.error, "error"); return; }
+  send(parsed.action);
+  $("command").value = "";
+});
+
+let playing = null, showing = null;
+// "Show me", animated: the operator's actions of the stage sent one by one at the chosen speed
+// (the eyepieces, wheels and counters move as they go), then hint 3 logged (its cost; it
+// applies the same settings again, which the instrument already shows).
+$("show-me").onclick = async () => {
+  if (showing) { clearInterval(showing); showing = null; $("show-me").textContent = "Show me"; return; }
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/showme`, { headers: auth() });
+  const body = await r.json();
+  if (!r.ok) { message(body.error, "error"); return; }
+  const actions = body.actions;
+  let i = 0;
+  $("show-me").textContent = "Stop";
+  showing = setInterval(() => {
+    if (i >= actions.length) {
+      clearInterval(showing); showing = null; $("show-me").textContent = "Show me";
+      send({ kind: "hint", level: 3 });
+      return;
+    }
+    const a = actions[i++];
+    $("show-me-count").textContent = `show me ${i} / ${actions.length}: ${describe(a)}`;
+    send(a);
+  }, 1000 / Number($("demo-speed").value));
+};
 $("demo-step").onclick = sendDemo;
+function play() {
+  if (playing) clearInterval(playing);
+  playing = setInterval(sendDemo, 1000 / Number($("demo-speed").value));
+  $("demo-play").textContent = "Pause";
+}
 $("demo-play").onclick = () => {
   if (playing) { clearInterval(playing); playing = null; $("demo-play").textContent = "Play"; return; }
-  playing = setInterval(sendDemo, 60);
-  $("demo-play").textContent = "Pause";
+  play();
 };
+$("demo-speed").onchange = () => { if (playing) play(); };
+
+// --- the stage's checklist: its steps fetched once a stage, ticked from every state ------------
+let checklist = null, checklistFor = null;
+async function tickChecklist(ticks) {
+  if (!ticks) { showChecklist($("checklist"), []); return; }
+  if (checklistFor !== ticks.stage) {
+    checklistFor = ticks.stage;
+    const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/checklist`, { headers: auth() });
+    checklist = r.ok ? await r.json() : null;
+  }
+  if (!checklist || checklist.stage !== ticks.stage) return;
+  checklist.steps.forEach((s, i) => { s.done = !!ticks.done[i]; });
+  checklist.done = ticks.done.filter(Boolean).length;
+  showChecklist($("checklist"), checklist);
+  $("checklist-count").textContent = `${checklist.done} / ${checklist.total}`;
+}
+
+// --- photo overview and the setup sheet ----------------------------------------------------
+const auth = () => ({ Authorization: `Bearer ${key || ""}` });
+async function loadOverview() {
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/overview`, { headers: auth() });
+  const data = await r.json();
+  if (!r.ok) { $("overview-note").textContent = data.error; return; }
+  overview = new Overview($("overview-svg"), (xy) => {
+    const n = $("substitute-for").value;
+    if (!n) { $("overview-note").textContent = "no standard point of this exercise needs a substitute"; return; }
+    send({ kind: "record", name: `substitute ${n}`, value: xy });
+  });
+  overview.set(data);
+  const unusable = data.photos
+    ? data.photos.left.standard_points.filter((p) => p.usable === false).map((p) => p.id) : data.unusable || [];
+  $("substitute-for").replaceChildren(...unusable.map((n) => el("option", { value: String(n), text: String(n) })));
+  $("overview-note").textContent = unusable.length ? `unusable: ${unusable.join(", ")} (on water or outside the overlap)` : "";
+  document.body.dataset.overview = "1";
+  drawEyes();
+}
+
+let sheetLoaded = false;
+async function openSheet() {
+  $("sheet").hidden = false;
+  if (sheetLoaded) return;
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/sheet`, { headers: auth() });
+  const data = await r.json();
+  if (!r.ok) { $("sheet-body").textContent = data.error; return; }
+  sheetLoaded = true;
+  $("sheet-title").textContent = [data.exercise, data.method && `${data.method} method`, data.instrument].filter(Boolean).join(" · ");
+  showSheet($("sheet-body"), data);
+  $("sheet-body").className = "";
+  document.body.dataset.sheet = "1";
+}
+$("sheet-btn").onclick = () => ($("sheet").hidden ? openSheet() : ($("sheet").hidden = true));
+$("sheet-close").onclick = () => { $("sheet").hidden = true; };
+$("sheet-print").onclick = () => { document.body.classList.add("print-sheet"); window.print(); };
+window.addEventListener("afterprint", () => document.body.classList.remove("print-sheet"));
 
 // For tests and the latency benchmark: send an action, resolve with ms until its frame is drawn.
 window.trainer = {
   state: () => state,
+  // the magnifications of the sharp patches in hand (left, right)
+  patchMags: () => [patches.left, patches.right].map((p) => (p && !p.coarse ? p.mag : null)),
+  // every action sent has left the page's queue and been answered
+  idle: () => queue.length === 0 && sent.size === 0,
   // drop the socket as a network would (the page must reconnect and resume)
   drop: () => ws && ws.close(),
   // both eyepieces drawn from a photo patch that covers the current marks
   photosReady: () => !!(state && state.marks && patches.left && patches.right && !loading.left && !loading.right
-    && !patches.left.coarse && !patches.right.coarse),
+    && !patches.left.coarse && !patches.right.coarse
+    && covers(patches.left, state.marks.left) && covers(patches.right, state.marks.right)),
   actAndFrame(action) {
     const t0 = performance.now();
     const s = send(action);

@@ -39,8 +39,11 @@ function svgWheel() {
 }
 
 export class Wheels {
-  constructor(root, send) {
+  // opts.multiplier(): the step multiplier chosen on the page; opts.side(): the approach side
+  // a typed value finishes from ("" either); opts.onLock(name): lock the control.
+  constructor(root, send, opts = {}) {
     this.root = root; this.send = send; this.items = {};
+    this.opts = { multiplier: () => 1, side: () => "", onLock: null, ...opts };
   }
 
   build(controls) {
@@ -57,15 +60,24 @@ export class Wheels {
       const inp = document.createElement("input"); inp.type = "number"; inp.step = "any";
       inp.title = `set ${name} (${c.unit})`;
       div.appendChild(inp);
+      const lock = document.createElement("button");
+      lock.className = "lock"; lock.textContent = "lock"; lock.title = `lock ${LABELS[name] || name}: later turns are refused`;
+      lock.addEventListener("click", () => this.send({ kind: "lock", control: name }));
+      div.appendChild(lock);
       this.root.appendChild(div);
       const item = { div, g, val, inp, step: c.step || 0.01, unit: c.unit };
       this.items[name] = item;
       const turn = (n) => this.send({ kind: "turn", control: name, delta: +(n * item.step).toPrecision(12) });
-      const factor = (e) => (e.altKey ? 100 : e.shiftKey ? 10 : 1);
+      const factor = (e) => (e.altKey ? 100 : e.shiftKey ? 10 : 1) * Number(this.opts.multiplier() || 1);
       svg.addEventListener("wheel", (e) => { e.preventDefault(); turn((e.deltaY < 0 ? 1 : -1) * factor(e)); }, { passive: false });
       div.addEventListener("keydown", (e) => {
         if (e.target === inp) {
-          if (e.key === "Enter" && inp.value !== "") this.send({ kind: "set", control: name, value: Number(inp.value) });
+          if (e.key === "Enter" && inp.value !== "") {
+            const side = e.shiftKey ? "below" : e.altKey ? "above" : this.opts.side();
+            const action = { kind: "set", control: name, value: Number(inp.value) };
+            if (side) action.side = side;
+            this.send(action);
+          }
           return;
         }
         const k = { ArrowUp: 1, ArrowRight: 1, ArrowDown: -1, ArrowLeft: -1, PageUp: 100, PageDown: -100 }[e.key];
@@ -93,6 +105,7 @@ export class Wheels {
       const turns = v === null ? 0 : (v / it.step) * (Math.PI / 18);
       it.g.setAttribute("transform", `rotate(${((turns * 180) / Math.PI) % 360})`);
       it.div.classList.toggle("locked", locked.includes(name));
+      it.div.querySelector(".lock").disabled = locked.includes(name);
     }
   }
 }
