@@ -22,12 +22,12 @@ from stereoplotter.io.exercise_file import (
 from stereoplotter.io.images import png_bytes
 from stereoplotter.io.paths import available_names
 from stereoplotter.io.session_log import log_bytes
+from stereoplotter.report.exercise_sheet import exercise_sheet
 from stereoplotter.report.grade import grade_markdown
-from stereoplotter.report.sheet import sheet_to_dict
 from stereoplotter.trainer.actions import ACTION_CATALOGUE
 from stereoplotter.trainer.exercise import Exercise, resolve_exercise
 from stereoplotter.trainer.grading import grade
-from stereoplotter.trainer.panel import checklist, overview, sheet_parts, show_me_actions
+from stereoplotter.trainer.panel import checklist, overview, show_me_actions
 from stereoplotter.trainer.session import Session, json_finite
 
 __all__ = [
@@ -230,37 +230,11 @@ def photo_patch(
 
 
 def sheet_of(exercise: Exercise) -> dict[str, Any]:
-    """The exercise's own setup sheet as the page shows it (run in a worker thread): the parts
-    the method gives (``trainer.panel.sheet_parts``) of the sheet computed for the exercise's
-    modified scenario, serialised by ``report.sheet``; the keys of ``stereoplotter exercise
-    sheet --json`` (``commands.exercise_sheet``, which the web layer may not import: commands
-    import the web server, and the layers admit no cycle)."""
+    """The exercise's own setup sheet as the page shows it (run in a worker thread): the data of
+    :func:`stereoplotter.report.exercise_sheet.exercise_sheet` (as ``stereoplotter exercise
+    sheet --json``) for a session at the exercise's seed (0 where it is per trainee)."""
     session = Session(exercise, "sheet", exercise.seed or 0, clock=False)
-    table = sheet_to_dict(session.prep.sheet)
-    parts = sheet_parts(exercise)
-    cam = exercise.scenario.camera
-    out: dict[str, Any] = {
-        "exercise": exercise.name,
-        "method": exercise.method,
-        "instrument": exercise.spec.key,
-        **parts,
-        "certificate": {
-            "focal_length_mm": cam.focal_length_mm,
-            "principal_point_mm": list(cam.principal_point_mm),
-            "format_mm": cam.format_mm,
-            "fiducials_mm": {k: list(xy) for k, xy in cam.fiducials_mm.items()},
-        },
-        "interior": {
-            k: table[k]
-            for k in ("f_instrument_mm", "scale_horizontal", "scale_vertical", "scale_map",
-                      "n_left", "n_right", "base_mm", "tolerances")
-        },
-    }
-    if "table24" in parts["given"]:
-        out["table24"] = {k: v for k, v in table.items() if k != "readings"}
-    if "readings" in parts["given"]:
-        out["readings"] = table["readings"]
-    return _jsonable(out)
+    return _jsonable(exercise_sheet(session))
 
 
 def overview_of(session: Session) -> dict[str, Any]:
