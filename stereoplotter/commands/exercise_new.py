@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from stereoplotter.commands.arguments import bounded_int
 from stereoplotter.trainer.exercise import (
     ERROR_MODES,
     EXERCISE_FORMAT,
@@ -29,7 +30,9 @@ def add_parser(exs: Any) -> None:
     e = exs.add_parser("new", help="write a validated exercise file from options")
     e.add_argument("name", help="the exercise's name (also the file name without .yaml)")
     e.add_argument("--title", help="one line shown to the trainee (default: from the options)")
-    e.add_argument("--level", type=int, default=1, help="difficulty 1-20 (default 1)")
+    e.add_argument(
+        "--level", type=bounded_int(1, 20), default=1, help="difficulty 1-20 (default 1)"
+    )
     e.add_argument("--description", default="", help="the instructions shown to the trainee")
     e.add_argument("--instrument", default="sc1", help="sc1, spr3, sd3 or a file (default sc1)")
     e.add_argument(
