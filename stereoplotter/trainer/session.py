@@ -131,6 +131,9 @@ class Session:
         self.progress: dict[str, Any] = {}
         #: What the last action moved that it did not name (coupled motions), with a reason.
         self.events: list[dict[str, Any]] = []
+        #: The state after the last action, keyed by the log's length: the next action's "before"
+        #: (the state changes only by acting; building it twice per action was half the time).
+        self._last_state: tuple[int, dict[str, Any]] | None = None
         self._rules: dict[str, list[dict[str, Any]]] = {}
         for stage in exercise.preset_stages:
             for action in self.par.stage_actions(stage):
@@ -472,7 +475,8 @@ class Session:
             is logged too).
         """
         t = self._now(action) if isinstance(action, dict) else 0.0
-        before = self.state()
+        last = self._last_state
+        before = last[1] if last is not None and last[0] == len(self.log) else self.state()
         clean = {k: v for k, v in action.items() if k != "t"} if isinstance(action, dict) else {}
         record: dict[str, Any] = {
             "n": len(self.log) + 1,
@@ -496,12 +500,14 @@ class Session:
             after = self.state()
             record["state_after"] = state_digest(after)
             self.log.append(record)
+            self._last_state = (len(self.log), dict(after))
             raise
         after = self.state()
         record["state_after"] = state_digest(after)
         if clean["kind"] == "claim":
             record["state"] = after
         self.log.append(record)
+        self._last_state = (len(self.log), dict(after))
         return after
 
     def _do(self, action: dict[str, Any], before: dict[str, Any]) -> Any:
