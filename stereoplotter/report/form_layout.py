@@ -77,6 +77,8 @@ class _RememberedWidths(TTFFont):
 #: The two fonts as parsed once per process (metrics, character map, glyph ids), by style;
 #: each document gets a copy of its own (see :func:`_document_font`).
 _PARSED: dict[str, _RememberedWidths] = {}
+#: The font files' bytes, by path (each document's font file object reads from them).
+_FONT_BYTES: dict[str, bytes] = {}
 
 
 def _document_font(style: str, index: int) -> _RememberedWidths:
@@ -89,11 +91,15 @@ def _document_font(style: str, index: int) -> _RememberedWidths:
         loader = FPDF()
         loader.add_font(FONT, style, font_path(style))
         parsed = loader.fonts[f"{FONT.lower()}{style}"]
+        parsed.ttfont.close()  # its file stays open otherwise; each document has its own copy
         parsed.__class__ = _RememberedWidths  # same layout (slots): only the width lookup changes
         _PARSED[style] = parsed
     font = copy.copy(parsed)
     font.i = index
-    font.ttfont = _SavedFont(parsed.ttffile, recalcTimestamp=False, lazy=True)
+    data = _FONT_BYTES.get(parsed.ttffile)
+    if data is None:  # read whole once: a lazily read file object would stay open until collected
+        data = _FONT_BYTES[parsed.ttffile] = Path(parsed.ttffile).read_bytes()
+    font.ttfont = _SavedFont(io.BytesIO(data), recalcTimestamp=False, lazy=True)
     font.missing_glyphs = []
     font.biggest_size_pt = 0
     font._hbfont = None

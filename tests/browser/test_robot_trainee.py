@@ -62,7 +62,7 @@ def scripts(request):
     chosen = [
         item.callspec.params["path"]
         for item in request.session.items
-        if item.module is request.module and hasattr(item, "callspec")
+        if getattr(item, "module", None) is request.module and hasattr(item, "callspec")
     ]
     pool = ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"))
     yield {p: pool.submit(script_for, str(p), TRAINEE) for p in chosen}

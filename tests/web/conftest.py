@@ -27,7 +27,10 @@ def make_test_client(app) -> TestClient:
 
 
 def make_client(data_dir) -> TestClient:
-    return TestClient(create_app(TOKEN, data_dir, hosts=("testserver",)))
+    """A client of a server whose session starts are not rate-limited: a test module starts
+    more sessions in a second than a classroom address may (the limit itself is tried by
+    ``test_attacks.py`` on a server of its own)."""
+    return TestClient(create_app(TOKEN, data_dir, hosts=("testserver",), start_limit=(1e3, 10**4)))
 
 
 @pytest.fixture(scope="module")
