@@ -202,11 +202,18 @@ def per_trial_controlled(
     out = {}
     for name, v in fields.items():
         v = np.asarray(v, float).reshape(trials, -1)
-        lin_v = lin.center[name][None, :] + u.T @ lin.gradient[name]
+        # mean_p (b + uG)² = mean_p b² + 2 u·(G b)/P + u (G Gᵀ/P) uᵀ: K² work a trial, not K·P
+        b, g = lin.center[name], lin.gradient[name]
+        npts = b.size
+        lin_ms = (
+            float(b @ b) / npts
+            + (2.0 / npts) * (g @ b) @ u
+            + np.einsum("kt,kt->t", (g @ g.T / npts) @ u, u)
+        )
         if on is None:
             expect = lin.expectation[name]
         else:
             b2 = float(np.mean(lin.center[name] ** 2))
             expect = b2 + (lin.variance * lin.gradient_ms[name]) @ on
-        out[name] = np.mean(v**2, axis=1) - np.mean(lin_v**2, axis=1) + expect
+        out[name] = np.einsum("tp,tp->t", v, v) / v.shape[1] - lin_ms + expect
     return out
