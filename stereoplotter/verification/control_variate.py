@@ -202,14 +202,9 @@ def per_trial_controlled(
     out = {}
     for name, v in fields.items():
         v = np.asarray(v, float).reshape(trials, -1)
-        # mean_p (b + uG)² = mean_p b² + 2 u·(G b)/P + u (G Gᵀ/P) uᵀ: K² work a trial, not K·P
-        b, g = lin.center[name], lin.gradient[name]
-        npts = b.size
-        lin_ms = (
-            float(b @ b) / npts
-            + (2.0 / npts) * (g @ b) @ u
-            + np.einsum("kt,kt->t", (g @ g.T / npts) @ u, u)
-        )
+        lin_v = u.T @ lin.gradient[name]
+        lin_v += lin.center[name][None, :]
+        lin_ms = np.einsum("tp,tp->t", lin_v, lin_v) / lin_v.shape[1]
         if on is None:
             expect = lin.expectation[name]
         else:
