@@ -306,15 +306,18 @@ def _setup_fields(sc, zero_run, g, xr, grid):
     pts = _domain_points(sc, sheet, xr, c, p, f, h, grid)
     lev = _domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
     book, _, _ = _control_frame_points(sc, sheet, g)
-    allp = np.vstack([pts, lev, book])
     n, nl = len(pts), len(lev)
+    # below 70 % overlap c = p: the two domains are one (60 %: x_л ∈ [0, p]), δp computed once
+    same = pts.shape == lev.shape and np.array_equal(pts, lev)
+    allp = np.vstack([pts, book] if same else [pts, lev, book])
+    first_lev, first_ctl = (0, n) if same else (n, n + nl)
     zero = _dp(sc, sheet, zero_run.instrument, allp)
     refit = levelling_design(lev[:, 0], lev[:, 1]) @ np.linalg.pinv(
         levelling_design(book[:, 0], book[:, 1])
     )
 
     def readings(d):
-        dom, ctl = d[:, n : n + nl], d[:, n + nl :]
+        dom, ctl = d[:, first_lev : first_lev + nl], d[:, first_ctl:]
         return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
 
     def fields(result, noise, sigma_control=0.0):
