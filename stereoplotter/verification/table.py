@@ -24,6 +24,7 @@ from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification import linear_mc as mc
@@ -215,7 +216,10 @@ TRIAL_COST = {"setup": 1.0, "conventional": 4.0}
 
 
 def _job_at(i):
-    return _job(_JOBS[i])
+    # one BLAS thread a worker: the workers are the parallelism (two processes × two OpenBLAS
+    # threads on two cores made `verify` 1.2 × the CPU and 1.5 × the wall, benchmarks/README.md)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _job(_JOBS[i])
 
 
 def _job(args):
@@ -297,7 +301,11 @@ def start_procedure_mc(
     procedure MC); the book's are the shipped ``pair60`` and ``pair80``
     (:func:`stereoplotter.io.book_setting.book_scenarios`). ``instrument`` is the loaded
     :class:`~stereoplotter.spec.instrument_spec.InstrumentSpec` (the book's SC-1), required when a
-    slot is run. ``workers``: processes (the runs are independent; 1 runs them here).
+    slot is run. ``workers``: processes (the runs are independent; 1 runs them here). The
+    configurations of :data:`SHARED_RUNS` at a slot are one run (one job) with a block of trials
+    each: the conventional one on trials 0 … T − 1 of its seed as before, σ_q only and σ_p only
+    on the trials after it (issue 26: one error-free run, one linearisation and the procedure's
+    per-act work for the three).
     ``linkage``: the knob–decentration linkage of the runs, "drag" or "independent" (None: the
     instrument's ``correction.decentration_linkage``;
     :data:`~stereoplotter.verification.procedure_mc.LINKAGE_VARIANTS`).
@@ -368,6 +376,8 @@ class PendingProcedureMC:
             context = multiprocessing.get_context("fork")
             self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
             self.futures = {self.pool.submit(_job_at, i): i for i in self.order}
+            # and one here while they run (the caller's linear rows): no process oversubscribes
+            self.limits = threadpool_limits(limits=1, user_api="blas")
 
     def result(self, progress=None) -> dict:
         """(slot, configuration[, "instrument"]) → result; ``progress(done, total, label)``."""
@@ -387,6 +397,7 @@ class PendingProcedureMC:
                     progress(done, n, "proc " + " ".join(self.keys[i][0]))
         finally:
             self.pool.shutdown(cancel_futures=True)
+            self.limits.restore_original_limits()
             _JOBS.clear()
         return {k: out[k] for ks in self.keys for k in ks}
 
