@@ -39,6 +39,7 @@ __all__ = [
     "DesignNoise",
     "LinearControl",
     "RecordingNoise",
+    "SourceNoise",
     "design_inputs",
     "linear_control",
     "per_trial_controlled",
@@ -61,6 +62,29 @@ class RecordingNoise(Noise):
 
     def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
         v = super().normal(key, sigma)
+        if sigma != 0.0:
+            self.z[key] = np.asarray(v, float) / sigma
+        return v
+
+
+class SourceNoise(RecordingNoise):
+    """:class:`RecordingNoise` whose acts of some sources are exact on some trials: ``off`` maps
+    a key prefix (``"q/"``, ``"stereo/"``) to a (T,) mask of the trials where the acts whose key
+    starts with it draw 0. A trial so masked is the trial of a run with that source's σ = 0 (the
+    other draws keyed as ever), so one run holds the blocks of several source configurations
+    (``procedure_mc.conventional_sources_mc``); the recorded z are the masked ones."""
+
+    def __init__(
+        self, seed: int, trials: int, first_trial: int, off: dict[str, NDArray[np.bool_]]
+    ):
+        super().__init__(seed, trials, first_trial)
+        self.off = off
+
+    def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
+        v = Noise.normal(self, key, sigma)
+        mask = next((m for prefix, m in self.off.items() if key.startswith(prefix)), None)
+        if mask is not None and sigma != 0.0:
+            v = np.where(mask, 0.0, v)
         if sigma != 0.0:
             self.z[key] = np.asarray(v, float) / sigma
         return v
@@ -92,6 +116,10 @@ class LinearControl:
     center: dict[str, NDArray[np.float64]]
     gradient: dict[str, NDArray[np.float64]]
     expectation: dict[str, float]
+    #: var(uₖ) (1 normal, 1/3 uniform) and mean_p Gₖ² per name: E[L] of a trial whose inputs
+    #: are partly off (:class:`SourceNoise`) is mean_p b² + Σₖ var(uₖ)·onₖ·mean_p Gₖ².
+    variance: NDArray[np.float64] | None = None
+    gradient_ms: dict[str, NDArray[np.float64]] | None = None
 
 
 def _random_terms(model: ErrorModel | None) -> list:
@@ -139,14 +167,14 @@ def linear_control(
             injected[key] = s * model.term(key).scale
     fields = run(injected, DesignNoise(trials, steps), trials)
     variance = np.array([1.0] * len(keys) + [_VARIANCE[t.distribution] for t in terms], float)
-    center, gradient, expectation = {}, {}, {}
+    center, gradient, expectation, gms = {}, {}, {}, {}
     for name, v in fields.items():
         v = np.asarray(v, float).reshape(trials, -1)
         b = v[0]
         g = (v[1::2] - v[2::2]) / (2.0 * STEP)
-        center[name], gradient[name] = b, g
-        expectation[name] = float(np.mean(b**2) + variance @ np.mean(g**2, axis=1))
-    return LinearControl(tuple(names), center, gradient, expectation)
+        center[name], gradient[name], gms[name] = b, g, np.mean(g**2, axis=1)
+        expectation[name] = float(np.mean(b**2) + variance @ gms[name])
+    return LinearControl(tuple(names), center, gradient, expectation, variance, gms)
 
 
 def per_trial_controlled(
@@ -155,8 +183,12 @@ def per_trial_controlled(
     noise: RecordingNoise,
     injected: dict[str, object],
     model: ErrorModel | None,
+    on: NDArray[np.float64] | None = None,
 ) -> dict[str, NDArray[np.float64]]:
-    """Per trial and field: mean_p v² − L + E[L] (module docstring), shape (T,) each."""
+    """Per trial and field: mean_p v² − L + E[L] (module docstring), shape (T,) each.
+
+    ``on`` (K, T): 1 where input k is drawn on trial t, 0 where it is held exact
+    (:class:`SourceNoise`); E[L] is then per trial. None: every input on."""
     trials = next(iter(fields.values())).shape[0]
     u = np.zeros((len(lin.inputs), trials))
     for j, name in enumerate(lin.inputs):
@@ -170,6 +202,13 @@ def per_trial_controlled(
     out = {}
     for name, v in fields.items():
         v = np.asarray(v, float).reshape(trials, -1)
-        lin_v = lin.center[name][None, :] + u.T @ lin.gradient[name]
-        out[name] = np.mean(v**2, axis=1) - np.mean(lin_v**2, axis=1) + lin.expectation[name]
+        lin_v = u.T @ lin.gradient[name]
+        lin_v += lin.center[name][None, :]
+        lin_ms = np.einsum("tp,tp->t", lin_v, lin_v) / lin_v.shape[1]
+        if on is None:
+            expect = lin.expectation[name]
+        else:
+            b2 = float(np.mean(lin.center[name] ** 2))
+            expect = b2 + (lin.variance * lin.gradient_ms[name]) @ on
+        out[name] = np.einsum("tp,tp->t", v, v) / v.shape[1] - lin_ms + expect
     return out

@@ -303,22 +303,31 @@ def mc_rms(model: LinearModel, trials: int, rng: np.random.Generator, chunk: int
     """
     if trials < 2:
         raise ValueError(f"trials = {trials} must be at least 2")
+    # The field of a trial is linear in its draws x = (z, control noise): field = x @ B, B of
+    # (J + n_c) × P composed once; its mean square over the grid is then the quadratic form
+    # x Q xᵀ with Q = B Bᵀ/P, (J + n_c)² work a trial instead of J·P (the same draws, in the
+    # same order, as drawing the field; equal to rounding). White noise is drawn on the field.
     J = model.M.shape[1]
     P = model.G.shape[1]
+    B = model.M.T @ model.G  # (J, P)
+    nc = 0
+    if model.Gc is not None:
+        B = B - (model.M.T @ model.Gc) @ model.P_fit.T
+        if model.sigma_control:
+            nc = model.Gc.shape[1]
+            B = np.vstack([B, -model.sigma_control * model.P_fit.T])
+    Q = B @ B.T / P
     out = np.empty(trials)
     for start in range(0, trials, chunk):
         t = min(chunk, trials - start)
-        z = rng.standard_normal((t, J))
-        e = z @ model.M.T  # (t, K)
-        field = e @ model.G  # (t, P)
-        if model.Gc is not None:
-            fc = e @ model.Gc
-            if model.sigma_control:
-                fc = fc + model.sigma_control * rng.standard_normal((t, fc.shape[1]))
-            field -= fc @ model.P_fit.T
+        x = rng.standard_normal((t, J))
+        if nc:
+            x = np.hstack([x, rng.standard_normal((t, nc))])
         if model.sigma_white:
-            field += model.sigma_white * rng.standard_normal((t, P))
-        out[start : start + t] = np.mean(field**2, axis=1)
+            field = x @ B + model.sigma_white * rng.standard_normal((t, P))
+            out[start : start + t] = np.einsum("tp,tp->t", field, field) / P
+        else:
+            out[start : start + t] = np.einsum("ti,ti->t", x @ Q, x)
     ms = out.mean()
     se = out.std(ddof=1) / np.sqrt(trials)
     rms = float(np.sqrt(ms))

@@ -98,6 +98,7 @@ __all__ = [
     "PROCEDURE_ROWS",
     "SOURCES",
     "ProcedureOptions",
+    "conventional_sources_mc",
     "idealised_geometry",
     "levelling_formula",
     "levelling_points_photo",
@@ -305,15 +306,18 @@ def _setup_fields(sc, zero_run, g, xr, grid):
     pts = _domain_points(sc, sheet, xr, c, p, f, h, grid)
     lev = _domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
     book, _, _ = _control_frame_points(sc, sheet, g)
-    allp = np.vstack([pts, lev, book])
     n, nl = len(pts), len(lev)
+    # below 70 % overlap c = p: the two domains are one (60 %: x_л ∈ [0, p]), δp computed once
+    same = pts.shape == lev.shape and np.array_equal(pts, lev)
+    allp = np.vstack([pts, book] if same else [pts, lev, book])
+    first_lev, first_ctl = (0, n) if same else (n, n + nl)
     zero = _dp(sc, sheet, zero_run.instrument, allp)
     refit = levelling_design(lev[:, 0], lev[:, 1]) @ np.linalg.pinv(
         levelling_design(book[:, 0], book[:, 1])
     )
 
     def readings(d):
-        dom, ctl = d[:, n : n + nl], d[:, n + nl :]
+        dom, ctl = d[:, first_lev : first_lev + nl], d[:, first_ctl:]
         return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
 
     def fields(result, noise, sigma_control=0.0):
@@ -462,15 +466,21 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
     chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, base)
     plain: dict[str, np.ndarray] = {}
     controlled: dict[str, np.ndarray] = {}
+    off = options.get("off")
     for first in range(0, int(trials), chunk):
         m = min(chunk, int(trials) - first)
         injected = model.draw_keyed(prep.seed, first, first + m)
-        noise = cvar.RecordingNoise(prep.seed, m, first)
+        if off:
+            part = {k: v[first : first + m] for k, v in off.items()}
+            noise = cvar.SourceNoise(prep.seed, m, first, part)
+        else:
+            noise = cvar.RecordingNoise(prep.seed, m, first)
         result = run_trials_chunk(
             prep, first, m, evaluate=False, transcript=False, injected=injected, noise=noise
         )
         fs = fields(result, noise)
-        cv = cvar.per_trial_controlled(fs, lin, noise, injected, model) if lin else {}
+        on = _inputs_on(lin, part, m) if lin and off else None
+        cv = cvar.per_trial_controlled(fs, lin, noise, injected, model, on) if lin else {}
         ms = {name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()}
         if hasattr(fields, "decompose"):  # already mean squares
             ms.update(fields.decompose(result, fs))
@@ -479,6 +489,17 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
             if lin and name in cv:
                 controlled.setdefault(name, np.empty(int(trials)))[first : first + m] = cv[name]
     return plain, controlled, d_zero
+
+
+def _inputs_on(lin, off, trials):
+    """(K, T): 1 where input k of ``lin`` is drawn on a trial, 0 where its source is off."""
+    on = np.ones((len(lin.inputs), trials))
+    for j, name in enumerate(lin.inputs):
+        kind, _, key = name.partition(":")
+        mask = next((m for p, m in off.items() if key.startswith(p)), None)
+        if kind == "noise" and mask is not None:
+            on[j] = ~mask
+    return on
 
 
 def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
@@ -567,8 +588,10 @@ def _field_name(method, quantity, levelling, datum, control):
     return "book" if levelling == "book" else datum
 
 
-def _formulas(method, scenario, spec, g, sources, control):
-    """The rigorous formula at the simulated geometry for the statistic (per its unit)."""
+def _formulas(method, scenario, spec, g, sources, control, levelled=None):
+    """The rigorous formula at the simulated geometry for the statistic (per its unit).
+    ``levelled``: the two :func:`levelling_formula` results (procedure's points, Fig. 39's) if
+    already computed."""
     f, p, c, a, n, ll = g["f"], g["p"], g["c"], g["a"], g["n"], g["l"]
     if method == "setup":
         return {
@@ -591,10 +614,15 @@ def _formulas(method, scenario, spec, g, sources, control):
         geodetic_orientation_parallax_rms(a, c, p, f, 1.0, "rigorous"),
     )
     rig = math.hypot(*terms) if part is None else terms[part]
+    if levelled is None:
+        levelled = (
+            levelling_formula(g, *levelling_points_photo(scenario, spec, g)),
+            levelling_formula(g, *control_points(a, c)),
+        )
     return {
         "rigorous": float(rig),
-        "procedure": levelling_formula(g, *levelling_points_photo(scenario, spec, g))[sources],
-        "book": levelling_formula(g, *control_points(a, c))[sources],
+        "procedure": levelled[0][sources],
+        "book": levelled[1][sources],
     }
 
 
@@ -703,16 +731,23 @@ def procedure_mc(
     g = scenario_geometry(scenario, spec)
     linkage = o.linkage or spec.decentration_linkage
     plain, controlled, d_zero, units = _run(scenario, spec, method, trials, seed, o, g, linkage)
+    out = _result(scenario, spec, method, o, g, linkage, (plain, controlled, d_zero, units))
+    return {**out, "trials": int(trials), "seed": int(seed), "seconds": time.perf_counter() - t0}
+
+
+def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
+    """The result of :func:`procedure_mc` from the per-trial mean squares of its run(s)."""
+    plain, controlled, d_zero, units = runs
     name = _field_name(method, o.quantity, o.levelling, o.datum, o.control)
     best = controlled or plain
     unit = units[name]
     coefficient, ci = _rms_ci(best[name], unit)
+    if formulas is None:
+        formulas = _formulas(method, scenario, spec, g, o.sources, o.control)
     out = {
         **_extras(scenario, spec, method, o, g, plain, best, units),
         "method": method,
         "scenario": scenario.name,
-        "trials": int(trials),
-        "seed": int(seed),
         "sigma_mm": o.sigma_mm,
         "instrument": bool(o.instrument),
         "instrument_key": spec.key,
@@ -721,18 +756,80 @@ def procedure_mc(
         "coefficient": coefficient,
         "ci": ci,
         "plain": _rms_ci(plain[name], unit),
-        "formula": _formulas(method, scenario, spec, g, o.sources, o.control),
+        "formula": formulas,
         "rms_mm": coefficient * unit,
         "bias_mm": float(np.sqrt(np.mean(d_zero**2))),
         "per_trial": np.sqrt(plain[name]) / unit,
     }
-    return {**out, "seconds": time.perf_counter() - t0, **g}
+    return {**out, **g}
 
 
-def _run(scenario, spec, method, trials, seed, o, g, linkage):
+#: Key prefixes of the acts of each judgment source of the conventional method (σ_q: the
+#: y-parallax judgments ``q/…``; σ_p: the stereo judgments ``stereo/…`` and the observed
+#: levelling heights ``mc/datum/…``, ``mc/book/…`` of :func:`_conventional_fields`).
+SOURCE_PREFIXES = {"y_parallax": ("q/",), "stereo": ("stereo/", "mc/datum/", "mc/book/")}
+
+
+def conventional_sources_mc(
+    scenario: Scenario,
+    *,
+    spec: InstrumentSpec,
+    trials: dict[str, int],
+    seed: int = 20240601,
+    **options,
+) -> dict[str, dict]:
+    """:func:`procedure_mc` of the conventional method for several ``sources`` at once, as one
+    run: ``trials`` maps a source (:data:`SOURCES`) to its trials, laid out in blocks of one run
+    with σ_q = σ_p = σ whose acts of the sources a block leaves out draw 0 on its trials
+    (:class:`~stereoplotter.verification.control_variate.SourceNoise`). A block's trials are those
+    of a run with only its sources on (the draws keyed by trial: block b holds trials
+    first_b … first_b + T_b − 1 of ``seed``), so each result is that of ``procedure_mc`` on those
+    trials; the error-free run, the linearisation and the procedure's per-act overhead are shared.
+    Returns source → result (as :func:`procedure_mc`; ``first_trial`` its block's start).
+    """
+    t0 = time.perf_counter()
+    if "sources" in options:
+        raise ValueError("sources: given by the keys of trials")
+    unknown = set(trials) - set(SOURCES)
+    if unknown:
+        raise ValueError(f"trials: expected sources among {SOURCES}, found {sorted(unknown)}")
+    o = ProcedureOptions(**options)
+    _check_options("conventional", **{k: getattr(o, k) for k in ("quantity", "standard_points")})
+    g = scenario_geometry(scenario, spec)
+    linkage = o.linkage or spec.decentration_linkage
+    names = list(trials)
+    bounds = np.cumsum([0] + [int(trials[k]) for k in names])
+    off_of = {
+        prefix: np.concatenate(
+            [np.full(int(trials[k]), k not in ("both", src)) for k in names]
+        )
+        for src, prefixes in SOURCE_PREFIXES.items()
+        for prefix in prefixes
+    }
+    plain, controlled, d_zero, units = _run(
+        scenario, spec, "conventional", int(bounds[-1]), seed, o, g, linkage, off_of
+    )
+    lev = levelling_formula(g, *levelling_points_photo(scenario, spec, g))
+    book = levelling_formula(g, *control_points(g["a"], g["c"]))
+    out = {}
+    for k, first, last in zip(names, bounds[:-1], bounds[1:], strict=True):
+        ok = replace(o, sources=k)
+        cut = [{n: v[first:last] for n, v in d.items()} for d in (plain, controlled)]
+        formulas = _formulas("conventional", scenario, spec, g, k, o.control, (lev, book))
+        runs = (*cut, d_zero, units)
+        res = _result(scenario, spec, "conventional", ok, g, linkage, runs, formulas)
+        out[k] = {**res, "trials": int(last - first), "seed": int(seed), "first_trial": int(first)}
+    seconds = time.perf_counter() - t0
+    return {k: {**v, "seconds": seconds} for k, v in out.items()}
+
+
+def _run(scenario, spec, method, trials, seed, o, g, linkage, off=None):
     """The runs of :func:`procedure_mc`: per-trial mean squares (plain, controlled), the
-    error-free δp and the unit of each field [photo mm]."""
-    zero, op, xr, unit, kw = _configuration(method, o.sigma_mm, g["c"], g["p"], g["n"], o.sources)
+    error-free δp and the unit of each field [photo mm]. ``off``: key prefix → (trials,) mask of
+    the trials whose acts of that prefix draw 0 (:func:`conventional_sources_mc`; the run then
+    has every source on)."""
+    sources = "both" if off else o.sources
+    zero, op, xr, unit, kw = _configuration(method, o.sigma_mm, g["c"], g["p"], g["n"], sources)
     kw = {**kw, "variant": LINKAGE_VARIANTS[linkage]}
     options = {"instrument": o.instrument, "control_variate": o.control_variate}
     options["passes"] = o.passes
@@ -743,6 +840,7 @@ def _run(scenario, spec, method, trials, seed, o, g, linkage):
         units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
         options["sigma_control"] = units["observed"]
     spec_c = replace(spec, standard_points_c_mm=g["c"])
+    options["off"] = off
     plain, controlled, d_zero = _mean_squares(
         scenario, spec_c, method, seed, trials, zero, op, xr, g, o.grid, kw, options
     )

@@ -24,11 +24,12 @@ from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
-from stereoplotter.verification.procedure_mc import procedure_mc
+from stereoplotter.verification.procedure_mc import conventional_sources_mc, procedure_mc
 from stereoplotter.verification.rows_chapter5 import chapter5_entries
 from stereoplotter.verification.rows_levelled import (
     closing_entries,
@@ -204,22 +205,51 @@ PROCEDURE_ROWS = {
 #: scenarios and instrument hold mappings that do not pickle).
 _JOBS: list = []
 
+#: The configurations that run the same procedure (the conventional method, its judgment
+#: sources on or off): one job, one run with a block of trials per configuration
+#: (:func:`~stereoplotter.verification.procedure_mc.conventional_sources_mc`), which shares the
+#: error-free run, the linearisation and the procedure's per-act work.
+SHARED_RUNS = {"conventional": ("conventional", "y_parallax", "stereo")}
+#: Cost of a trial relative to a setup trial, for the order of the jobs (longest first: both
+#: workers finish together); measured by ``benchmarks/bench_procedure_verify.py``.
+TRIAL_COST = {"setup": 1.0, "conventional": 4.0}
+
 
 def _job_at(i):
-    return _job(_JOBS[i])
+    # one BLAS thread a worker: the workers are the parallelism (two processes × two OpenBLAS
+    # threads on two cores made `verify` 1.2 × the CPU and 1.5 × the wall, benchmarks/README.md)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _job(_JOBS[i])
 
 
 def _job(args):
-    scenario, spec, config, trials, seed, instrument, linkage = args
-    return procedure_mc(
+    """A job's results, configuration → :func:`procedure_mc` result."""
+    scenario, spec, configs, trials, seed, instrument, linkage = args
+    if len(configs) == 1:
+        (config,) = configs
+        res = procedure_mc(
+            scenario,
+            spec=spec,
+            trials=trials[config],
+            seed=seed,
+            instrument=instrument,
+            linkage=linkage,
+            **PROCEDURE_CONFIGS[config],
+        )
+        return {config: res}
+    passes = {PROCEDURE_CONFIGS[c]["passes"] for c in configs}
+    (passes,) = passes  # the shared run makes one number of passes
+    by_source = {PROCEDURE_CONFIGS[c].get("sources", "both"): c for c in configs}
+    out = conventional_sources_mc(
         scenario,
         spec=spec,
-        trials=trials,
+        trials={k: trials[c] for k, c in by_source.items()},
         seed=seed,
         instrument=instrument,
         linkage=linkage,
-        **PROCEDURE_CONFIGS[config],
+        passes=passes,
     )
+    return {by_source[k]: r for k, r in out.items()}
 
 
 def _trials_of(trials, config, instrument):
@@ -271,7 +301,11 @@ def start_procedure_mc(
     procedure MC); the book's are the shipped ``pair60`` and ``pair80``
     (:func:`stereoplotter.io.book_setting.book_scenarios`). ``instrument`` is the loaded
     :class:`~stereoplotter.spec.instrument_spec.InstrumentSpec` (the book's SC-1), required when a
-    slot is run. ``workers``: processes (the runs are independent; 1 runs them here).
+    slot is run. ``workers``: processes (the runs are independent; 1 runs them here). The
+    configurations of :data:`SHARED_RUNS` at a slot are one run (one job) with a block of trials
+    each: the conventional one on trials 0 … T − 1 of its seed as before, σ_q only and σ_p only
+    on the trials after it (issue 26: one error-free run, one linearisation and the procedure's
+    per-act work for the three).
     ``linkage``: the knob–decentration linkage of the runs, "drag" or "independent" (None: the
     instrument's ``correction.decentration_linkage``;
     :data:`~stereoplotter.verification.procedure_mc.LINKAGE_VARIANTS`).
@@ -295,31 +329,46 @@ def start_procedure_mc(
     if todo and instrument is None:
         raise ValueError("instrument: expected the InstrumentSpec of the procedure MC, found None")
     names = list(PROCEDURE_CONFIGS)
+    shared = {c: lead for lead, cs in SHARED_RUNS.items() for c in cs}
+    groups: dict = {}
+    for s, c, inst in todo:  # the configurations of one procedure go into one job
+        groups.setdefault((s, shared.get(c, c), inst), []).append(c)
     jobs = [
         (
             scenarios[s],
             instrument,
-            c,
-            _trials_of(trials, c, inst),
-            seed + 7 * (2 * names.index(c) + (s == "80")) + 1,
+            tuple(cs),
+            {c: _trials_of(trials, c, inst) for c in cs},
+            seed + 7 * (2 * names.index(lead) + (s == "80")) + 1,
             inst,
             linkage,
         )
-        for s, c, inst in todo
+        for (s, lead, inst), cs in groups.items()
     ]
-    keys = [(s, c, "instrument") if inst else (s, c) for s, c, inst in todo]
+    keys = [
+        [(s, c, "instrument") if inst else (s, c) for c in cs]
+        for (s, _, inst), cs in groups.items()
+    ]
     return PendingProcedureMC(jobs, keys, workers)
 
 
+def _cost(job) -> float:
+    """Estimated cost of a job in setup trials (:data:`TRIAL_COST`)."""
+    configs, trials = job[2], job[3]
+    method = PROCEDURE_CONFIGS[configs[0]]["method"]
+    return TRIAL_COST.get(method, 1.0) * sum(trials.values())
+
+
 class PendingProcedureMC:
-    """Procedure-MC runs started in ``workers`` forked processes (longest first, so the workers
+    """Procedure-MC jobs started in ``workers`` forked processes (longest first, so the workers
     finish together); :meth:`result` waits for them. With one worker, or where processes cannot
-    be forked, the runs are made by :meth:`result` itself. Meanwhile the caller may compute
-    (the linear rows): ``verify`` overlaps the two."""
+    be forked, the jobs are run by :meth:`result` itself. Meanwhile the caller may compute
+    (the linear rows): ``verify`` overlaps the two. ``keys[i]``: the result keys of job i, one
+    per configuration it runs."""
 
     def __init__(self, jobs: list, keys: list, workers: int = 2):
         self.jobs, self.keys = jobs, keys
-        self.order = sorted(range(len(jobs)), key=lambda i: -jobs[i][3])
+        self.order = sorted(range(len(jobs)), key=lambda i: -_cost(jobs[i]))
         self.pool = None
         self.futures = {}
         if workers > 1 and len(jobs) > 1 and "fork" in multiprocessing.get_all_start_methods():
@@ -327,6 +376,8 @@ class PendingProcedureMC:
             context = multiprocessing.get_context("fork")
             self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
             self.futures = {self.pool.submit(_job_at, i): i for i in self.order}
+            # and one here while they run (the caller's linear rows): no process oversubscribes
+            self.limits = threadpool_limits(limits=1, user_api="blas")
 
     def result(self, progress=None) -> dict:
         """(slot, configuration[, "instrument"]) → result; ``progress(done, total, label)``."""
@@ -334,20 +385,25 @@ class PendingProcedureMC:
         n = len(self.jobs)
         if self.pool is None:
             for done, i in enumerate(self.order, 1):
-                out[self.keys[i]] = _job(self.jobs[i])
+                out.update(self._keyed(i, _job(self.jobs[i])))
                 if progress is not None:
-                    progress(done, n, "proc " + " ".join(self.keys[i]))
-            return out
+                    progress(done, n, "proc " + " ".join(self.keys[i][0]))
+            return {k: out[k] for ks in self.keys for k in ks}
         try:
             for done, fut in enumerate(as_completed(self.futures), 1):
-                key = self.keys[self.futures[fut]]
-                out[key] = fut.result()
+                i = self.futures[fut]
+                out.update(self._keyed(i, fut.result()))
                 if progress is not None:
-                    progress(done, n, "proc " + " ".join(key))
+                    progress(done, n, "proc " + " ".join(self.keys[i][0]))
         finally:
             self.pool.shutdown(cancel_futures=True)
+            self.limits.restore_original_limits()
             _JOBS.clear()
-        return {k: out[k] for k in self.keys}
+        return {k: out[k] for ks in self.keys for k in ks}
+
+    def _keyed(self, i, results):
+        """Job i's results (configuration → result) under their keys."""
+        return {key: results[key[1]] for key in self.keys[i]}
 
 
 def procedure_value(res: dict, field: str | None, scaled: bool) -> tuple[float, float, float]:
