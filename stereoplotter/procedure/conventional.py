@@ -578,7 +578,7 @@ def c2_relative_by_equations(
     knob at its stop hands its tilt to a common tilt (:func:`_transfer_common_tilt`).
 
     ``passes``: exactly this many measurements, no stopping rule (the fixed passes of the
-    (5.54) Monte Carlo, ``verification.procedure_mc.relative_orientation_mc``).
+    (5.54) Monte Carlo, ``verification.relative_orientation_mc``).
 
     Returns the iterations and the worst |q| seen at the last measurement, arrays over the trials.
     """

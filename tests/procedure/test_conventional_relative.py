@@ -11,7 +11,7 @@ import pytest
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import load_scenario
-from stereoplotter.verification.procedure_mc import relative_orientation_mc
+from stereoplotter.verification.relative_orientation_mc import relative_orientation_mc
 
 
 def _run(name, ideal):
