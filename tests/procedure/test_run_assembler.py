@@ -28,7 +28,9 @@ BUILDERS = {"Run", "Instrument", "RecordingInstrument", "instrument_cls"}
 #: The callers the issue names, and the assembler's function each must call.
 CALLERS = {
     "procedure/simulate.py": "build_run",
-    "verification/procedure_mc.py": "build_run",
+    # the relative orientation alone builds its runs itself; procedure_mc.py runs its trials
+    # through procedure/simulate.py (run_trials_chunk, whose runs build_run assembles)
+    "verification/relative_orientation_mc.py": "build_run",
     "trainer/grading.py": "build_run",
     "trainer/operator_steps.py": "build_run",
 }
