@@ -14,7 +14,7 @@ Measures by stage (setup-data method 1–5; conventional C1–C4):
 * ``2``, ``C2`` and again ``3``, ``C3`` — the largest true residual y-parallax at the six standard
   points (Fig. 39) against ``residual_y_parallax_mm`` (Eq. (5.11)'s 0.0125 mm at photo scale).
 * ``3``, ``C3`` — the largest height error of the built model at the control points against
-  ``control_height_m`` (:func:`~stereoplotter.procedure.evaluation.evaluate_model`, heights read
+  ``control_height_m`` (:func:`~stereoplotter.procedure.evaluation.evaluate_against`, heights read
   on the slipped metre scale).
 * ``4``, ``5``, ``C4`` — the largest plan error of the built model at the control points on the
   map against ``corner_mm`` (0.3 mm on the sheet, §27 stage 5), and the coordinatograph connected.
@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.instrument.virtual import Instrument
-from stereoplotter.procedure.evaluation import evaluate_model
+from stereoplotter.procedure.evaluation import evaluate_against
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel
 from stereoplotter.procedure.records import SheetReadings
 from stereoplotter.procedure.run import PreparedRun
@@ -121,8 +121,9 @@ def _q_max(
 
 
 def model_evaluation(inst: Instrument, prep: PreparedRun):
-    """The built model against the ground truth (``evaluate_model``), heights read on the
-    slipped metre scale once the height counter is geared."""
+    """The built model against the prepared run's ground truth (``evaluate_against`` on
+    ``prep.truth``, computed once per session), heights read on the slipped metre scale once the
+    height counter is geared."""
     units = inst.state()["units"]
     zero = None
     if inst._height_gear is not None:
@@ -132,14 +133,8 @@ def model_evaluation(inst: Instrument, prep: PreparedRun):
             * prep.sheet.vertical_scale_denominator
             / 1000.0
         )
-    return evaluate_model(
-        prep.scenario,
-        prep.sheet,
-        inst.setting,
-        units["left"],
-        units["right"],
-        height_zero=zero,
-        standard_points_c_mm=inst.spec.standard_points_c_mm,
+    return evaluate_against(
+        prep.truth, inst.setting, units["left"], units["right"], height_zero=zero
     )
 
 
