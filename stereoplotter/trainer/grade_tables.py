@@ -37,7 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.trainer.outcome import model_evaluation, rigid_residuals_m, standard_q
+from stereoplotter.trainer.outcome import (
+    PARALLAX_STAGES,
+    model_evaluation,
+    rigid_residuals_m,
+    standard_q,
+)
 
 __all__ = [
     "FULL_POINTS",
@@ -55,7 +60,6 @@ FULL_POINTS = 100.0
 HINT_COST = {1: 0.10, 2: 0.25, 3: 0.75}
 #: Points needed to pass (and every measure within its tolerance). [points]
 PASS_POINTS = 60.0
-_PARALLAX = ("2", "3", "C2", "C3")
 _HEIGHTS = ("3", "C3", "4", "5", "C4")
 _PLAN = ("4", "5", "C4")
 
@@ -177,7 +181,7 @@ def point_tables(session: Any) -> dict[str, Any]:
     tol = prep.sheet.tolerances
     out: dict[str, Any] = {"y_parallax": None, "heights": None, "plan": None}
     out["y_parallax_map"] = None
-    if "f_instrument" not in session.commanded or last not in (*_PARALLAX, *_HEIGHTS):
+    if "f_instrument" not in session.commanded or last not in (*PARALLAX_STAGES, *_HEIGHTS):
         return out
     out["y_parallax"] = _parallax_table(session, inst, last)
     ev = model_evaluation(inst, prep)

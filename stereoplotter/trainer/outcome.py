@@ -38,7 +38,17 @@ from stereoplotter.procedure.records import SheetReadings
 from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.transcript import Transcript
 
-__all__ = ["Measure", "model_evaluation", "rigid_residuals_m", "stage_measures", "standard_q"]
+__all__ = [
+    "PARALLAX_STAGES",
+    "Measure",
+    "model_evaluation",
+    "rigid_residuals_m",
+    "stage_measures",
+    "standard_q",
+]
+
+#: Stages graded on the residual y-parallax at the six standard points.
+PARALLAX_STAGES = ("2", "3", "C2", "C3")
 
 
 @dataclass(frozen=True)
@@ -193,7 +203,7 @@ def stage_measures(
         return out
     if stage not in ("2", "C2", "3", "C3", "4", "5", "C4"):
         raise ValueError(f"no stage {stage!r}")
-    if stage in ("2", "C2", "3", "C3"):
+    if stage in PARALLAX_STAGES:
         out.append(
             Measure(
                 "residual y-parallax at the 6 standard points (true)",

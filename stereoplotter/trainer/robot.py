@@ -46,16 +46,13 @@ from typing import Any
 import numpy as np
 
 from stereoplotter.instrument.virtual import CASSETTES, DECENTRATIONS, KNOBS, SCREWS, Instrument
-from stereoplotter.procedure.operator import Noise, Operator, OperatorModel
 from stereoplotter.procedure.run import PreparedRun
-from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.trainer.actions import apply, control_value
 from stereoplotter.trainer.exercise import Exercise
 from stereoplotter.trainer.operator_steps import OperatorRun, RecordingInstrument, operator_run
-from stereoplotter.trainer.outcome import model_evaluation
+from stereoplotter.trainer.outcome import PARALLAX_STAGES, model_evaluation, standard_q
 
 __all__ = [
-    "PARALLAX_STAGES",
     "RELATIVE_ELEMENTS",
     "compact",
     "robot_script",
@@ -63,8 +60,6 @@ __all__ = [
     "without_sides",
 ]
 
-#: Stages graded on the residual y-parallax at the six standard points.
-PARALLAX_STAGES = ("2", "3", "C2", "C3")
 #: The five elements of relative orientation the robot clears the y-parallax with (the
 #: operator's own least-squares step of stage 2 turns the same five).
 RELATIVE_ELEMENTS = ("kappa_left", "kappa_right", "k_alpha_left", "k_alpha_right", "k_omega_right")
@@ -85,10 +80,8 @@ _ELEMENTS = (*CASSETTES, *KNOBS)
 
 
 def _exact_q(inst: Instrument, prep: PreparedRun) -> np.ndarray:
-    """The true y-parallax at the six standard points (no judgment). [mm]"""
-    op = Operator(inst, OperatorModel().zero(), Noise(0, None, None, 0), Transcript(enabled=False))
-    scene = prep.scene
-    return np.asarray(op.y_parallax(scene.standard_points_m, scene.standard), float).reshape(-1)
+    """The true y-parallax at the six standard points, flat (6,). [mm]"""
+    return np.asarray(standard_q(inst, prep), float).reshape(-1)
 
 
 def _copy(inst: Instrument) -> Instrument:

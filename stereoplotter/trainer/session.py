@@ -134,7 +134,8 @@ class Session:
         #: The state after the last action, keyed by the log's length: the next action's "before"
         #: (the state changes only by acting; building it twice per action was half the time).
         self._last_state: tuple[int, dict[str, Any]] | None = None
-        self._rules: dict[str, list[dict[str, Any]]] = {}
+        self._rules: dict[str, list[dict[str, Any]]] = {}  # stage → its steps' tick rules
+        self._target_points: dict[str, dict[Any, Any]] = {}  # stage → the points its steps read
         for stage in exercise.preset_stages:
             for action in self.par.stage_actions(stage):
                 apply(self.inst, action, self.commanded)
@@ -380,10 +381,10 @@ class Session:
         return self._rules[stage]
 
     def _targets(self, stage: str) -> dict[Any, Any]:
-        key = f"targets {stage}"
-        if key not in self._rules:
-            self._rules[key] = step_targets(self, stage)  # type: ignore[assignment]
-        return self._rules[key]  # type: ignore[return-value]
+        """The points a stage's steps read at (cached; :func:`~.panel.step_targets`)."""
+        if stage not in self._target_points:
+            self._target_points[stage] = step_targets(self, stage)
+        return self._target_points[stage]
 
     def progress_of(self, stage: str) -> tuple[set[str], set[str], set[Any]]:
         """(controls used, counters read, points (role, id) read at) in a stage."""
