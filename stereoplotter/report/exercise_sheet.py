@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from stereoplotter.procedure.run import prepare_pair
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.trainer.panel import sheet_parts
 from stereoplotter.trainer.session import Session
@@ -94,11 +95,11 @@ def _markdown(out: dict[str, Any], full: str | None) -> str:
 
 def exercise_sheet(exercise_or_session: Any) -> dict[str, Any]:
     """The sheet panel's data for an exercise or a session (see the module docstring)."""
-    session = exercise_or_session
-    if not isinstance(session, Session):
-        session = Session.start(exercise_or_session, trainee="sheet")
-    exercise = session.exercise
-    sheet = session.prep.sheet
+    if isinstance(exercise_or_session, Session):
+        exercise, sheet = exercise_or_session.exercise, exercise_or_session.prep.sheet
+    else:  # the sheet alone: a session's (prepare_run's) without the operator's run
+        exercise = exercise_or_session
+        sheet = prepare_pair(exercise.scenario, exercise.spec, exercise.method).sheet
     table = sheet_to_dict(sheet)
     parts = sheet_parts(exercise)
     out: dict[str, Any] = {

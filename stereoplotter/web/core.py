@@ -231,10 +231,9 @@ def photo_patch(
 
 def sheet_of(exercise: Exercise) -> dict[str, Any]:
     """The exercise's own setup sheet as the page shows it (run in a worker thread): the data of
-    :func:`stereoplotter.report.exercise_sheet.exercise_sheet` (as ``stereoplotter exercise
-    sheet --json``) for a session at the exercise's seed (0 where it is per trainee)."""
-    session = Session(exercise, "sheet", exercise.seed or 0, clock=False)
-    return _jsonable(exercise_sheet(session))
+    :func:`stereoplotter.report.exercise_sheet.exercise_sheet`, as ``stereoplotter exercise
+    sheet --json`` (the sheet depends on the exercise, not on a trainee's seed)."""
+    return _jsonable(exercise_sheet(exercise))
 
 
 def overview_of(session: Session) -> dict[str, Any]:
