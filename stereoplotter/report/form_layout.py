@@ -25,7 +25,7 @@ from typing import Any
 from fontTools import ttLib
 from fpdf import FPDF
 from fpdf.enums import XPos, YPos
-from fpdf.fonts import FontFace, SubsetMap, TTFFont
+from fpdf.fonts import SubsetMap, TTFFont
 
 __all__ = ["FONT", "Form", "LabelPlacer", "font_path", "heading", "paragraph", "table"]
 
@@ -326,10 +326,6 @@ def _draw_row(
     if style == "B":
         pdf.line(pdf.l_margin, top + height, pdf.l_margin + sum(cols), top + height)
     pdf.set_y(top + height)
-
-
-def _headings_style() -> Any:
-    return FontFace(family=FONT, emphasis="BOLD", fill_color=(225, 225, 225))
 
 
 #: Where a label goes around its point, tried in this order: (dx, dy) of the text's baseline
