@@ -140,15 +140,24 @@ _COORDINATOGRAPH_ROWS: tuple[_Row, ...] = (
 )
 
 
+#: Scales whose place of zero §26 uses as a known constant instead of finding it.
+_KNOWN_ZEROS = frozenset({"bx", "dx_left", "dy_left", "dx_right", "dy_right"})
+
+
 def _counter_rows() -> list[_Row]:
     """Zero readings, counter scale ratios and screw backlash."""
-    zero = "zero_reading_scatter_mm"
+    # §26 finds the places of zero of X, Y, b_y and b_z (unknown, ``zero_reading_scatter_mm``);
+    # it takes those of b_x and of the decentration scales as known instrument constants
+    # (O_bx = MO_bx + b_x; the computed decentrations "taking their places of zero into
+    # account"), so only their calibration error enters (``known_zero_error_mm``).
     rows: list[_Row] = [
         (
             f"zero_reading.{s}",
             "normal",
-            zero,
-            f"error of the zero reading (место нуля) of the {s} scale",
+            "known_zero_error_mm" if s in _KNOWN_ZEROS else "zero_reading_scatter_mm",
+            f"calibration error of the known zero reading (место нуля) of the {s} scale"
+            if s in _KNOWN_ZEROS
+            else f"error of the zero reading (место нуля) of the {s} scale",
             "mm",
             1.0,
         )

@@ -104,6 +104,7 @@ _SCHEMA: tuple[_Leaf, ...] = (
     _Leaf("errors.backlash_xy_mm", "number", "mm", 0.0, 0.2),
     _Leaf("errors.backlash_z_mm", "number", "mm", 0.0, 0.2),
     _Leaf("errors.zero_reading_scatter_mm", "number", "mm", 0.0, 100.0),
+    _Leaf("errors.known_zero_error_mm", "number", "mm", 0.0, 100.0),
     _Leaf("errors.counter_scale_error_ppm", "number", "ppm", 0.0, 1.0e4),
     _Leaf("errors.f_instrument_setting_mm", "number", "mm", 0.0, 10.0),
     _Leaf("errors.base_setting_mm", "number", "mm", 0.0, 10.0),

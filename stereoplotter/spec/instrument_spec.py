@@ -136,6 +136,7 @@ _ATTRIBUTES: dict[str, tuple[str, Callable[[Any], Any]]] = {
     "backlash_xy_mm": ("errors.backlash_xy_mm", _same),
     "backlash_z_mm": ("errors.backlash_z_mm", _same),
     "zero_reading_scatter_mm": ("errors.zero_reading_scatter_mm", _same),
+    "known_zero_error_mm": ("errors.known_zero_error_mm", _same),
     "counter_scale_error_ppm": ("errors.counter_scale_error_ppm", _same),
     "f_instrument_setting_sigma_mm": ("errors.f_instrument_setting_mm", _same),
     "base_setting_sigma_mm": ("errors.base_setting_mm", _same),
@@ -270,6 +271,7 @@ class InstrumentSpec:
     backlash_xy_mm: float
     backlash_z_mm: float
     zero_reading_scatter_mm: float
+    known_zero_error_mm: float
     counter_scale_error_ppm: float
     f_instrument_setting_sigma_mm: float
     base_setting_sigma_mm: float

@@ -182,6 +182,7 @@ def test_undocumented_instrument_data_are_assumed(name):
         "mark_diameter_mm",
         "backlash_xy_mm",
         "zero_reading_scatter_mm",
+        "known_zero_error_mm",
     ):
         assert spec.is_assumed(attribute), attribute
     assert spec.counters_present and spec.direction_switches  # SEED6 L3693, stage 2
