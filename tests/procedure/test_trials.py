@@ -47,8 +47,11 @@ def test_keyed_streams_do_not_depend_on_the_cut():
 
 @pytest.mark.parametrize("method", ["setup", "conventional"])
 def test_chunked_run_equals_one_vectorised_run(pair, method):
-    """Trials 0…11 in chunks of 5 give the values of one run of 12 (rtol 1e-12: the
-    elementary functions may round the last bit differently for arrays of other lengths)."""
+    """Trials 0…11 in chunks of 5 give the values of one run of 12 (rtol 1e-10: the
+    elementary functions may round the last bit differently for arrays of other lengths, and
+    the procedure's iterations and least-squares fits carry that on: 4.3e-12 measured in
+    ``height_error_after_plane_max_m``, seed 4, once b_x and the decentrations drew 0.01 mm
+    zero errors; far below any printed figure)."""
     sc, spec = pair
     one = trial_columns(simulate(sc, spec, method, seed=4, trials=12))
     prep = prepare_run(sc, spec, method, seed=4)
@@ -56,7 +59,7 @@ def test_chunked_run_equals_one_vectorised_run(pair, method):
     assert [len(next(iter(c.values()))) for c in chunks] == [5, 5, 2]
     for name, want in one.items():
         got = np.concatenate([c[name] for c in chunks])
-        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15, err_msg=name)
+        np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-15, err_msg=name)
 
 
 def test_single_run_is_trial_zero_of_a_vectorised_run(pair):

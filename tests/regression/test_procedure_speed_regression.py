@@ -46,6 +46,11 @@ Issue 25 derived the default operator's ﾏダp, ﾏダq from the eye (6.06 and 2.02 ﾂ
 six-point check a detection with a remeasure: the default run legitimately changes. The runs
 below name the operator of the recorded values, ``OperatorModel(eye="sigma", remeasure=False)``
 (ﾏダp = ﾏダq = 10 ﾂｵm, one look; ``simulate --operator sigma``), and reproduce them unchanged.
+
+The places of zero of b_x and of the decentration scales became known constants of the
+instrument (ﾂｧ26 uses them without finding them): their default error is now the calibration
+error ``known_zero_error_mm`` (0.01 mm) instead of the 0.2 mm scatter. The runs below override
+those five terms back to 0.2 mm (:data:`RECORDED_ZERO_SCATTER`) and reproduce the values unchanged.
 """
 
 from __future__ import annotations
@@ -56,10 +61,16 @@ from types import MappingProxyType
 import numpy as np
 import pytest
 
+from stereoplotter.instrument.error_model import error_model_from_spec
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import simulate
 from stereoplotter.procedure.operator import OperatorModel
+
+#: The recorded runs' zero-reading scatter of b_x and the decentrations (module docstring). [mm]
+RECORDED_ZERO_SCATTER = {
+    f"zero_reading.{s}": 0.2 for s in ("bx", "dx_left", "dy_left", "dx_right", "dy_right")
+}
 
 
 @pytest.fixture(scope="module")
@@ -70,8 +81,11 @@ def runs():
     params[key] = dataclasses.replace(params[key], value=0.0)
     spec = dataclasses.replace(spec, parameters=MappingProxyType(params))
     op = OperatorModel(eye="sigma", remeasure=False)  # the recorded runs' operator (issue 25)
+    errors = error_model_from_spec(spec).with_overrides(RECORDED_ZERO_SCATTER)
     out = {
-        m: simulate(sc, spec, method=m, seed=3, trials=50, evaluate=False, operator=op)
+        m: simulate(
+            sc, spec, method=m, seed=3, trials=50, evaluate=False, operator=op, errors=errors
+        )
         for m in ("setup", "conventional")
     }
     out["conventional/book"] = simulate(
@@ -83,6 +97,7 @@ def runs():
         evaluate=False,
         practice="book",
         operator=op,
+        errors=errors,
     )
     return out
 
