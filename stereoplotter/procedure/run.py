@@ -200,8 +200,8 @@ class PreparedPair:
 
 def log_options(op: Operator, prep: PreparedRun) -> None:
     """Transcript lines (at the start) for the SC complex's options fitted to the instrument."""
-    if prep.options.error_correction_unit:
-        unit = prep.correction_unit or ErrorCorrectionUnit.from_spec(prep.spec)
+    unit = prep.correction_unit  # read from the spec once, by prepare_run
+    if unit is not None:
         op.log.add(
             "1",
             "SC complex: the error-correction unit has corrected the image coordinates (film "
@@ -353,5 +353,11 @@ def prepare_pair(
             decentration_variant(variant).strict_per_axis,
             mechanism_for(spec),
         )
-    truth = model_truth(scenario, sheet, scene.grid_m, standard_points_c_mm=c_mm)
+    truth = model_truth(
+        scenario,
+        sheet,
+        scene.grid_m,
+        standard_points_c_mm=c_mm,
+        grid_images_mm=scene.grid_images_mm,
+    )
     return PreparedPair(sheet, scene, scene.grid_m, scene.grid_images_mm, truth)

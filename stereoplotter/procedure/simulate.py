@@ -236,12 +236,15 @@ def prepare_run(
 
 def _run_one(
     prep: PreparedRun,
-    injected: dict[str, Any],
+    injected: dict[str, Any] | None,
     trials: int | None,
-    noise: Noise,
+    noise: Noise | None,
     transcript: bool = True,
     first: int = 0,
 ):
+    """Trials ``first … first + trials − 1`` of ``prep`` (the keyed draws where ``injected``,
+    ``noise`` are None: :func:`~stereoplotter.procedure.run.build_run`), with the true residual
+    y-parallax at the standard points and over the grid."""
     run = build_run(prep, first, trials, injected=injected, noise=noise, transcript=transcript)
     op = run.op
     if prep.method == "setup":
@@ -275,12 +278,7 @@ def run_trials_chunk(
         raise StereoplotterError(
             "the pymunk back-end runs single procedures; use --backend closed-form for --trials"
         )
-    stop = None if trials is None else first_trial + trials
-    if injected is None:
-        injected = prep.model.draw_keyed(prep.seed, first_trial, stop)
-    if noise is None:
-        noise = Noise(prep.seed, trials, None, first_trial)
-    run, q_std, q_grid = _run_one(prep, injected, trials, noise, transcript)
+    run, q_std, q_grid = _run_one(prep, injected, trials, noise, transcript, first_trial)
     evaluation = _evaluate(prep, run) if evaluate else None
     return SimulationResult(
         prep.method,
