@@ -231,6 +231,8 @@ def prepare_run(
         unit,
         pair.grid_images_mm,
         pair.truth,
+        pair.heights,
+        pair.level,
     )
 
 
