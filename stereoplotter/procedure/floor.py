@@ -54,7 +54,7 @@ def sheet_settings(
 @dataclass(frozen=True)
 class ControlHeights:
     """The sheet's height control points as a run reads them, built once per run
-    (:meth:`of`, ``procedure.run.prepare_pair``).
+    (:func:`control_heights_of`, ``procedure.run.prepare_pair``).
 
     Attributes
     ----------
@@ -69,16 +69,6 @@ class ControlHeights:
     rows: tuple[ControlHeight, ...]
     ground_m: NDArray[np.float64]
     images_mm: tuple[NDArray[np.float64], NDArray[np.float64]]
-
-    @classmethod
-    def of(cls, sheet: SetupSheet, scene: Scene) -> ControlHeights:
-        """The sheet's height control points with their ground points and true images (the
-        scene's truth)."""
-        rows = tuple(control_heights_of(sheet, scene))
-        ground = np.array([h.ground_m for h in rows]).reshape(-1, 3)
-        if not rows:
-            return cls(rows, ground, (np.zeros((0, 2)), np.zeros((0, 2))))
-        return cls(rows, ground, scene.images(ground))
 
 
 def mechanism_level(
@@ -97,7 +87,7 @@ def mechanism_level(
     setup-data method sets exactly these values and has no relative orientation or levelling.
     ``mechanism``: the instrument's own correction mechanism
     (:func:`~stereoplotter.instrument.principles.mechanism_for`); None: canonical unit.
-    ``heights``: the sheet's height control points (:meth:`ControlHeights.of`).
+    ``heights``: the sheet's height control points (:func:`control_heights_of`).
     """
     setting, exact = sheet_settings(sheet, strict_per_axis, mechanism)
     units = [UnitMap(exact[side]) for side in ("left", "right")]
@@ -169,12 +159,16 @@ def refuse_beyond_mechanism(
     )
 
 
-def control_heights_of(sheet: SetupSheet, scene: Scene) -> list[ControlHeight]:
-    """The sheet's height control points with their ground points (the scene's truth)."""
-    rows = []
+def control_heights_of(sheet: SetupSheet, scene: Scene) -> ControlHeights:
+    """The sheet's height control points with their ground points and their true images (the
+    scene's truth), once per run (``procedure.run.prepare_pair``)."""
+    rows: list[ControlHeight] = []
     for h in sheet.control_heights:
         p = scene.point(h["id"])
         rows.append(
             ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
         )
-    return rows
+    ground = np.array([h.ground_m for h in rows]).reshape(-1, 3)
+    if not rows:
+        return ControlHeights((), ground, (np.zeros((0, 2)), np.zeros((0, 2))))
+    return ControlHeights(tuple(rows), ground, scene.images(ground))

@@ -108,7 +108,7 @@ def level_design(
     instrument model at the sheet's own settings
     (:func:`~stereoplotter.procedure.floor.sheet_settings`): the operator's knowledge, the same
     for every trial, which a prepared run holds (``procedure.run.prepare_pair``). ``heights``:
-    the sheet's height control points (:class:`~stereoplotter.procedure.floor.ControlHeights`).
+    the sheet's height control points (:func:`~stereoplotter.procedure.floor.control_heights_of`).
     """
     setting, units = sheet_settings(sheet, strict_per_axis)
     std = scene.standard

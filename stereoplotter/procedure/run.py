@@ -33,7 +33,11 @@ from stereoplotter.instrument.sc1_complex import (
 )
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.evaluation import ModelTruth, model_truth
-from stereoplotter.procedure.floor import ControlHeights, refuse_beyond_mechanism
+from stereoplotter.procedure.floor import (
+    ControlHeights,
+    control_heights_of,
+    refuse_beyond_mechanism,
+)
 from stereoplotter.procedure.levelling import LevelDesign, level_design
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, SheetReadings, StageRecord
@@ -366,7 +370,7 @@ def prepare_pair(
     grid_m = residual_grid_m(scenario)
     c_mm = spec.standard_points_c_mm
     scene = Scene.build(scenario, sheet.frame_origin_m, sheet.frame_rotation, c_mm, grid_m)
-    heights = ControlHeights.of(sheet, scene)
+    heights = control_heights_of(sheet, scene)
     level = None
     if method == "setup":  # the mechanism at the sheet's own settings (D9, R3)
         linkage = decentration_variant(variant)
