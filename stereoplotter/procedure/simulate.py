@@ -448,11 +448,12 @@ def _evaluate(prep: PreparedRun, run: Run) -> ModelEvaluation:
     """The built model of ``run`` against the ground truth, on the prepared run's grid."""
     sheet = prep.sheet
     inst = run.op.inst
-    units = inst.state()["units"]
+    state = inst.state()
+    units = state["units"]
     # the metre height scale as the operator slipped it, at D = 0 [m]
     zero = (
         np.asarray(inst.read("H", exact=True))
-        + np.asarray(inst.state()["carriages_mm"]["Z"]) * sheet.vertical_scale_denominator / 1000.0
+        + np.asarray(state["carriages_mm"]["Z"]) * sheet.vertical_scale_denominator / 1000.0
     )
     corner = run.results.get("stage 5: corner 4")
     return evaluate_against(
