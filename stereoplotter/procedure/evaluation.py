@@ -511,6 +511,7 @@ def model_truth(
     """
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
+    c_mm = standard_points_c_mm
     grid_local = np.asarray(grid_local_m, float).reshape(-1, 3)
     pts_local = np.array([p.local_m for p in scenario.points], float).reshape(-1, 3)
     # every ground point of the pair in the instrument frame, in one turn
@@ -524,13 +525,8 @@ def model_truth(
         grid_images_mm = _pair_images(scenario, grid_local)
     imaged = _imaged(scenario.camera.format_mm, *images)
     plane_idx = _plane_index(scenario, plane_point_ids, imaged)
-    use_plane = (
-        len(plane_idx) >= 3
-        and np.linalg.matrix_rank(
-            np.column_stack([np.ones(len(plane_idx)), pts_frame[plane_idx, :2]])
-        )
-        == 3
-    )
+    plane_xy = np.column_stack([np.ones(len(plane_idx)), pts_frame[plane_idx, :2]])
+    use_plane = len(plane_idx) >= 3 and np.linalg.matrix_rank(plane_xy) == 3
 
     def point_set(idx: Sequence[int]) -> PointSetTruth:
         rows = list(idx)
@@ -544,9 +540,7 @@ def model_truth(
     def role(name: str) -> PointSetTruth:
         return point_set([i for i, p in enumerate(scenario.points) if p.role == name and imaged[i]])
 
-    std_local, std_frame = _standard_points(
-        scenario, origin, theta, flying_height, standard_points_c_mm
-    )
+    std_local, std_frame = _standard_points(scenario, origin, theta, flying_height, c_mm)
     return ModelTruth(
         frame_origin_m=origin,
         frame_rotation=theta,
@@ -554,7 +548,7 @@ def model_truth(
         vertical_scale_denominator=int(sheet.vertical_scale_denominator),
         map_scale_denominator=sheet.map_scale_denominator,
         flying_height_m=flying_height,
-        standard_points_c_mm=float(standard_points_c_mm),
+        standard_points_c_mm=float(c_mm),
         grid=PointSetTruth(
             tuple(f"g{i}" for i in range(len(grid_frame))),
             grid_frame,
