@@ -219,6 +219,18 @@ def standard_points_m(
     6 (x₂, −c). Here x₁, x₂ are the ground nadirs of the left and right photos (the plumbs of the
     true S_л, S_п) and c is taken to the ground at the mean photo scale, c·H̄/f.
     """
+    return _standard_points(scenario, frame_origin_m, frame_rotation, flying_height_m, c_mm)[1]
+
+
+def _standard_points(
+    scenario: Scenario,
+    frame_origin_m: ArrayLike,
+    frame_rotation: float,
+    flying_height_m: float,
+    c_mm: float,
+) -> tuple[_F, _F]:
+    """:func:`standard_points_m` in the local frame (heights from the terrain) and in the
+    instrument frame, shape (6, 3) each. [m]"""
     origin = np.asarray(frame_origin_m, float)
     nadirs = instrument_frame_m(
         np.array([p.exterior.centre for p in (scenario.photo("left"), scenario.photo("right"))]),
@@ -240,7 +252,7 @@ def standard_points_m(
         np.column_stack([plan, np.zeros(6)]), origin, frame_rotation, inverse=True
     )
     local[:, 2] = scenario.terrain.height_m(local[:, 0], local[:, 1])
-    return instrument_frame_m(local, origin, frame_rotation)
+    return local, instrument_frame_m(local, origin, frame_rotation)
 
 
 def parallax_errors_at_ideal(
@@ -435,13 +447,9 @@ class PointSetTruth:
     images_mm: tuple[_F, _F]
 
 
-def _point_set_truth(
-    scenario: Scenario, ids: Sequence[str], frame_m: ArrayLike, origin: _F, theta: float
-) -> PointSetTruth:
-    frame_m = np.asarray(frame_m, float).reshape(-1, 3)
-    local = instrument_frame_m(frame_m, origin, theta, inverse=True)
-    images = film_points_mm(scenario, "left", local), film_points_mm(scenario, "right", local)
-    return PointSetTruth(tuple(ids), frame_m, local[:, 2], images)
+def _pair_images(scenario: Scenario, points_m: _F) -> tuple[_F, _F]:
+    """True images of ground points (local frame) on the left and right film. [m → mm]"""
+    return film_points_mm(scenario, "left", points_m), film_points_mm(scenario, "right", points_m)
 
 
 @dataclass(frozen=True, slots=True)
@@ -489,38 +497,50 @@ def model_truth(
     *,
     standard_points_c_mm: float = STANDARD_POINTS_C_MM,
     plane_point_ids: Sequence[str] | None = None,
+    grid_images_mm: tuple[ArrayLike, ArrayLike] | None = None,
 ) -> ModelTruth:
     """The ground truth of an evaluation on ``sheet`` over the working-area grid
     ``grid_local_m`` (local frame) [m] (other arguments as :func:`evaluate_model`): the point
     sets in the instrument frame with their true heights and images, the levelling plane's
-    points, the mean flying height H̄ over the grid and the standard points at c·H̄/f."""
+    points, the mean flying height H̄ over the grid and the standard points at c·H̄/f.
+
+    Each fact is computed once: the grid and the scenario's points are turned into the frame in
+    one pass and imaged once, and every point set takes its rows; heights and images come from
+    the local coordinates, never from a frame round trip. ``grid_images_mm``: the grid's true
+    images on the left and right film if the caller has them already (the prepared scene's). [mm]
+    """
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
-    grid_frame = instrument_frame_m(np.asarray(grid_local_m, float), origin, theta)
-    flying_height = float(-np.mean(grid_frame[:, 2]))  # Z_Sл − mean Z
+    c_mm = standard_points_c_mm
+    grid_local = np.asarray(grid_local_m, float).reshape(-1, 3)
     pts_local = np.array([p.local_m for p in scenario.points], float).reshape(-1, 3)
-    imaged = _imaged(
-        scenario.camera.format_mm,
-        film_points_mm(scenario, "left", pts_local),
-        film_points_mm(scenario, "right", pts_local),
+    # every ground point of the pair in the instrument frame, in one turn
+    grid_frame, pts_frame = np.split(
+        instrument_frame_m(np.concatenate([grid_local, pts_local]), origin, theta),
+        [len(grid_local)],
     )
+    flying_height = float(-np.mean(grid_frame[:, 2]))  # Z_Sл − mean Z
+    images = _pair_images(scenario, pts_local)
+    if grid_images_mm is None:
+        grid_images_mm = _pair_images(scenario, grid_local)
+    imaged = _imaged(scenario.camera.format_mm, *images)
     plane_idx = _plane_index(scenario, plane_point_ids, imaged)
-    plane_frame = instrument_frame_m(pts_local[plane_idx], origin, theta)
-    use_plane = (
-        len(plane_idx) >= 3
-        and np.linalg.matrix_rank(np.column_stack([np.ones(len(plane_idx)), plane_frame[:, :2]]))
-        == 3
-    )
+    plane_xy = np.column_stack([np.ones(len(plane_idx)), pts_frame[plane_idx, :2]])
+    use_plane = len(plane_idx) >= 3 and np.linalg.matrix_rank(plane_xy) == 3
 
     def point_set(idx: Sequence[int]) -> PointSetTruth:
-        ids = [scenario.points[i].id for i in idx]
-        frame_m = instrument_frame_m(pts_local[list(idx)], origin, theta)
-        return _point_set_truth(scenario, ids, frame_m, origin, theta)
+        rows = list(idx)
+        return PointSetTruth(
+            tuple(scenario.points[i].id for i in rows),
+            pts_frame[rows],
+            pts_local[rows, 2],
+            (images[0][rows], images[1][rows]),
+        )
 
     def role(name: str) -> PointSetTruth:
         return point_set([i for i, p in enumerate(scenario.points) if p.role == name and imaged[i]])
 
-    standard = standard_points_m(scenario, origin, theta, flying_height, standard_points_c_mm)
+    std_local, std_frame = _standard_points(scenario, origin, theta, flying_height, c_mm)
     return ModelTruth(
         frame_origin_m=origin,
         frame_rotation=theta,
@@ -528,12 +548,18 @@ def model_truth(
         vertical_scale_denominator=int(sheet.vertical_scale_denominator),
         map_scale_denominator=sheet.map_scale_denominator,
         flying_height_m=flying_height,
-        standard_points_c_mm=float(standard_points_c_mm),
-        grid=_point_set_truth(
-            scenario, [f"g{i}" for i in range(len(grid_frame))], grid_frame, origin, theta
+        standard_points_c_mm=float(c_mm),
+        grid=PointSetTruth(
+            tuple(f"g{i}" for i in range(len(grid_frame))),
+            grid_frame,
+            grid_local[:, 2],
+            tuple(np.asarray(g, float) for g in grid_images_mm),
         ),
-        standard_points=_point_set_truth(
-            scenario, [str(i) for i in range(1, 7)], standard, origin, theta
+        standard_points=PointSetTruth(
+            tuple(str(i) for i in range(1, 7)),
+            std_frame,
+            std_local[:, 2],
+            _pair_images(scenario, std_local),
         ),
         control=role("control"),
         check=role("check"),

@@ -5,11 +5,13 @@ it before any trial is run.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.typing import NDArray
 
 from stereoplotter.instrument.kinematics import (
+    CorrectionUnit,
     InstrumentSetting,
     UnitMap,
     rods_intersection,
@@ -20,51 +22,96 @@ from stereoplotter.procedure.records import ControlHeight
 from stereoplotter.setup.records import SetupRefusal
 from stereoplotter.setup.sheet import SetupSheet
 
-__all__ = ["control_heights_of", "mechanism_level", "refuse_beyond_mechanism"]
+__all__ = [
+    "ControlHeights",
+    "control_heights_of",
+    "mechanism_level",
+    "refuse_beyond_mechanism",
+    "sheet_settings",
+]
+
+
+def sheet_settings(
+    sheet: SetupSheet, strict_per_axis: bool = False, mechanism=None
+) -> tuple[InstrumentSetting, dict[str, CorrectionUnit]]:
+    """The instrument at the sheet's own settings, without any error: f_пр and
+    b = (b_x, b_y, b_z′) of the sheet, and the correction units "left", "right" at the sheet's
+    α, ω, κ with their decentrations (``unit_for_orientation`` at f′). ``mechanism``: the
+    instrument's own correction mechanism
+    (:func:`~stereoplotter.instrument.principles.mechanism_for`); None: canonical unit."""
+    f = sheet.focal_length_corrected_mm
+    units = {
+        side: replace(
+            unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis),
+            mechanism=mechanism,
+        )
+        for side, p in zip(("left", "right"), sheet.photos, strict=True)
+    }
+    bx, by, bz = sheet.base_mm
+    return InstrumentSetting(sheet.f_instrument_mm, bx, by, bz), units
+
+
+@dataclass(frozen=True)
+class ControlHeights:
+    """The sheet's height control points as a run reads them, built once per run
+    (:func:`control_heights_of`, ``procedure.run.prepare_pair``).
+
+    Attributes
+    ----------
+    rows : tuple of ControlHeight
+        Id, the sheet's Z_i of (6.6) and the ground point of each, in the sheet's order.
+    ground_m : ndarray, shape (n, 3)
+        The ground points (local frame). [m]
+    images_mm : (ndarray, ndarray)
+        Their true images on the left and right photo, shape (n, 2) each. [mm]
+    """
+
+    rows: tuple[ControlHeight, ...]
+    ground_m: NDArray[np.float64]
+    images_mm: tuple[NDArray[np.float64], NDArray[np.float64]]
 
 
 def mechanism_level(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
+    sheet: SetupSheet,
+    scene: Scene,
+    heights: ControlHeights,
+    strict_per_axis: bool = False,
+    mechanism=None,
 ) -> tuple[float, float]:
     """What the correction mechanism itself leaves at the sheet's own settings (the floor).
 
-    The units at the sheet's α, ω, κ with its decentrations (``unit_for_orientation``), f_пр and
-    b = (b_x, b_y, b_z′) of the sheet, no error anywhere: the largest |q| at the six standard
+    The instrument at the sheet's own settings (:func:`sheet_settings`), no error anywhere: the
+    largest |q| at the six standard
     points [mm, photo scale], and the largest control-height error relative to the first height
     control point (where stage 3 slips the height scale) [m]. The stages cannot do better: the
     setup-data method sets exactly these values and has no relative orientation or levelling.
     ``mechanism``: the instrument's own correction mechanism
     (:func:`~stereoplotter.instrument.principles.mechanism_for`); None: canonical unit.
+    ``heights``: the sheet's height control points (:func:`control_heights_of`).
     """
-    f = sheet.focal_length_corrected_mm
-    units = [
-        UnitMap(
-            replace(
-                unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis),
-                mechanism=mechanism,
-            )
-        )
-        for p in sheet.photos
-    ]
-    bx, by, bz = sheet.base_mm
-    setting = InstrumentSetting(sheet.f_instrument_mm, bx, by, bz)
+    setting, exact = sheet_settings(sheet, strict_per_axis, mechanism)
+    units = [UnitMap(exact[side]) for side in ("left", "right")]
 
     def reading(images):
         pl, pr = images
         return rods_intersection(units[0].rod_from_photo(pl), units[1].rod_from_photo(pr), setting)
 
     q_max = float(np.max(np.abs(reading(scene.standard).y_parallax_mm)))
-    heights = np.array([h.ground_m for h in control_heights_of(sheet, scene)])
-    if len(heights) < 2:
+    ground = heights.ground_m
+    if len(ground) < 2:
         return q_max, 0.0
-    depth = reading(scene.images(heights)).depth_mm
+    depth = reading(heights.images_mm).depth_mm
     # deeper is lower: H_i = H_0 − (D_i − D_0)·M_в/1000 with the scale slipped at point 0
-    model_h = heights[0, 2] - (depth - depth[0]) * sheet.vertical_scale_denominator / 1000.0
-    return q_max, float(np.max(np.abs(model_h - heights[:, 2])))
+    model_h = ground[0, 2] - (depth - depth[0]) * sheet.vertical_scale_denominator / 1000.0
+    return q_max, float(np.max(np.abs(model_h - ground[:, 2])))
 
 
 def refuse_beyond_mechanism(
-    sheet: SetupSheet, scene: Scene, strict_per_axis: bool = False, mechanism=None
+    sheet: SetupSheet,
+    scene: Scene,
+    heights: ControlHeights,
+    strict_per_axis: bool = False,
+    mechanism=None,
 ):
     """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
     already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
@@ -72,9 +119,9 @@ def refuse_beyond_mechanism(
 
     The message names the scenario file and the field that carries the pair beyond the
     mechanism — the largest photo tilt, ``photos[i].exterior.alpha_deg`` or ``omega_deg`` — and
-    the §26 tolerances the mechanism level exceeds.
+    the §26 tolerances the mechanism level exceeds. ``heights`` as :func:`mechanism_level`.
     """
-    q_max, h_max = mechanism_level(sheet, scene, strict_per_axis, mechanism)
+    q_max, h_max = mechanism_level(sheet, scene, heights, strict_per_axis, mechanism)
     tol_q = sheet.tolerances["residual_y_parallax_mm"]
     tol_h = sheet.tolerances["control_height_m"]
     if q_max <= tol_q and h_max <= tol_h:
@@ -112,12 +159,16 @@ def refuse_beyond_mechanism(
     )
 
 
-def control_heights_of(sheet: SetupSheet, scene: Scene) -> list[ControlHeight]:
-    """The sheet's height control points with their ground points (the scene's truth)."""
-    rows = []
+def control_heights_of(sheet: SetupSheet, scene: Scene) -> ControlHeights:
+    """The sheet's height control points with their ground points and their true images (the
+    scene's truth), once per run (``procedure.run.prepare_pair``)."""
+    rows: list[ControlHeight] = []
     for h in sheet.control_heights:
         p = scene.point(h["id"])
         rows.append(
             ControlHeight(str(h["id"]), float(h["model_height_mm"]), np.asarray(p.local_m, float))
         )
-    return rows
+    ground = np.array([h.ground_m for h in rows]).reshape(-1, 3)
+    if not rows:
+        return ControlHeights((), ground, (np.zeros((0, 2)), np.zeros((0, 2))))
+    return ControlHeights(tuple(rows), ground, scene.images(ground))

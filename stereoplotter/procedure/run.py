@@ -33,7 +33,12 @@ from stereoplotter.instrument.sc1_complex import (
 )
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.evaluation import ModelTruth, model_truth
-from stereoplotter.procedure.floor import refuse_beyond_mechanism
+from stereoplotter.procedure.floor import (
+    ControlHeights,
+    control_heights_of,
+    refuse_beyond_mechanism,
+)
+from stereoplotter.procedure.levelling import LevelDesign, level_design
 from stereoplotter.procedure.operator import Noise, Operator, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, SheetReadings, StageRecord
 from stereoplotter.procedure.transcript import Transcript
@@ -86,6 +91,12 @@ class Run:
         Remedy name → :class:`~stereoplotter.procedure.records.Remedy` (operator practice).
     readings : SheetReadings
         The sheet's printed readings: every target reading the operator sets comes from here.
+    heights : ControlHeights or None
+        The sheet's height control points with their ground points and true images (prepared
+        once per run, :func:`prepare_pair`).
+    level : LevelDesign or None
+        Remedy R3's levelling design at the sheet's own settings (setup-data method; prepared
+        once per run).
     """
 
     op: Operator
@@ -97,6 +108,8 @@ class Run:
     sheet_pose: SheetPose | None = None
     practice: str = "book"
     remedies: dict[str, Remedy] = field(default_factory=dict)
+    heights: ControlHeights | None = None
+    level: LevelDesign | None = None
     readings: SheetReadings = field(init=False)
 
     def __post_init__(self) -> None:
@@ -181,6 +194,12 @@ class PreparedRun:
     #: The ground truth the built model is evaluated against (points, frame, images), once per
     #: run (:func:`~stereoplotter.procedure.evaluation.model_truth`; None: not prepared).
     truth: ModelTruth | None = None
+    #: The sheet's height control points with their ground points and true images, once per
+    #: run (None: not prepared).
+    heights: ControlHeights | None = None
+    #: Remedy R3's levelling design at the sheet's own settings, once per run (setup-data
+    #: method; None for the conventional method).
+    level: LevelDesign | None = None
 
 
 @dataclass(frozen=True)
@@ -188,20 +207,24 @@ class PreparedPair:
     """The stereopair as a run needs it, built once (:func:`prepare_pair`): the setup sheet (its
     frame S_л, θ; Table 24; every range check of the sheet passed), the scene (the photos, the
     control points, true fiducials, the six standard points and their true images, the
-    working-area grid of the residual y-parallax with its true images) and the ground truth of
-    the evaluation. Every step of a run reads these, never the scenario. [—, —, m, mm, —]"""
+    working-area grid of the residual y-parallax with its true images), the ground truth of
+    the evaluation, the sheet's height control points with their true images and, for the
+    setup-data method, remedy R3's levelling design at the sheet's own settings. Every step of a
+    run reads these, never the scenario. [—, —, m, mm, —, —, —]"""
 
     sheet: SetupSheet
     scene: Scene
     grid_m: NDArray[np.float64]
     grid_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]]
     truth: ModelTruth
+    heights: ControlHeights
+    level: LevelDesign | None = None
 
 
 def log_options(op: Operator, prep: PreparedRun) -> None:
     """Transcript lines (at the start) for the SC complex's options fitted to the instrument."""
-    if prep.options.error_correction_unit:
-        unit = prep.correction_unit or ErrorCorrectionUnit.from_spec(prep.spec)
+    unit = prep.correction_unit  # read from the spec once, by prepare_run
+    if unit is not None:
         op.log.add(
             "1",
             "SC complex: the error-correction unit has corrected the image coordinates (film "
@@ -320,7 +343,7 @@ def build_run(
         noise = Noise(prep.seed, trials, None, first)
     op = Operator(inst, prep.operator, noise, Transcript(enabled=transcript))
     log_options(op, prep)
-    run = Run(op, prep.sheet, prep.scene)
+    run = Run(op, prep.sheet, prep.scene, heights=prep.heights, level=prep.level)
     run.practice = prep.practice if practice is None else practice
     return run
 
@@ -340,18 +363,25 @@ def prepare_pair(
     """The prepared pair of a run, built once: the setup sheet (frame, Table 24, every range
     check of the sheet), the scene (true fiducials, the six standard points and their images,
     the residual grid (:func:`residual_grid_m`, local frame) with its true images), for the setup
-    method the floor of the mechanism at the sheet's own settings (D9), and the ground truth of
-    the evaluation on that grid. The scenario goes no further than here."""
+    method the floor of the mechanism at the sheet's own settings (D9) and remedy R3's levelling
+    design there, and the ground truth of the evaluation on that grid. The scenario goes no
+    further than here."""
     sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
     grid_m = residual_grid_m(scenario)
     c_mm = spec.standard_points_c_mm
     scene = Scene.build(scenario, sheet.frame_origin_m, sheet.frame_rotation, c_mm, grid_m)
-    if method == "setup":  # the floor: the mechanism at the sheet's own settings (D9)
-        refuse_beyond_mechanism(
-            sheet,
-            scene,
-            decentration_variant(variant).strict_per_axis,
-            mechanism_for(spec),
-        )
-    truth = model_truth(scenario, sheet, scene.grid_m, standard_points_c_mm=c_mm)
-    return PreparedPair(sheet, scene, scene.grid_m, scene.grid_images_mm, truth)
+    heights = control_heights_of(sheet, scene)
+    level = None
+    if method == "setup":  # the mechanism at the sheet's own settings (D9, R3)
+        linkage = decentration_variant(variant)
+        strict = linkage.strict_per_axis
+        refuse_beyond_mechanism(sheet, scene, heights, strict, mechanism_for(spec))
+        level = level_design(sheet, scene, heights, linkage.linkage, strict)
+    truth = model_truth(
+        scenario,
+        sheet,
+        scene.grid_m,
+        standard_points_c_mm=c_mm,
+        grid_images_mm=scene.grid_images_mm,
+    )
+    return PreparedPair(sheet, scene, scene.grid_m, scene.grid_images_mm, truth, heights, level)

@@ -15,25 +15,18 @@ Reference
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.instrument.kinematics import (
-    CorrectionUnit,
-    InstrumentSetting,
-    counters_from_homologous_points,
-    rod_from_counters,
-    turn_correction_knob,
-    unit_for_orientation,
-)
+from stereoplotter.instrument.kinematics import rod_from_counters
 from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
 from stereoplotter.procedure import steps
 from stereoplotter.procedure.compaction import compacted
-from stereoplotter.procedure.floor import control_heights_of
-from stereoplotter.procedure.operator import Operator, Scene, solve_1d
+from stereoplotter.procedure.levelling import LevelDesign
+from stereoplotter.procedure.operator import Operator, solve_1d
 from stereoplotter.procedure.records import (
     ControlHeight,
 )
@@ -43,15 +36,11 @@ from stereoplotter.procedure.span_check import fiducial_mm, span_loop
 from stereoplotter.setup.equations import (
     sheet_corner_instrument_coordinates,
 )
-from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = [
-    "LEVEL_FREE",
-    "LEVEL_TILTS",
     "Q_ELEMENTS",
     "check_standard_points",
     "clear_kappa",
-    "level_design",
     "refine_relative_orientation",
     "refine_scale_and_level",
     "run_setup_method",
@@ -76,24 +65,6 @@ _TILT = {"alpha": "α", "omega": "ω"}
 #: tilt). With three elements (κ_л, κ_п, k_ω,п) and an operator without σ_q the true q at the
 #: standard points still exceeded ¼ mark in 41 % of pair60/SC-1 runs; with the five, in 0.1 %.
 Q_ELEMENTS = ("kappa_left", "kappa_right", "k_omega_right", "k_alpha_left", "k_alpha_right")
-
-#: Remedy R3 (stage 3, control heights beyond H/3000): the common tilts that level the model on
-#: a setup-data instrument. §26 refines only the *scaling* "by the heights of control points"
-#: (stage 3, b_x) and has no levelling step; the levelling here is an assumption (the §26 intro:
-#: the set orientation "most often is not accurate enough and its correction takes additional
-#: time"). A common tilt of the model turns both correction units by the same angle — k_α,л and
-#: k_α,п about the Y axis (along the base), k_ω,л and k_ω,п about the X axis — and moves the
-#: right pivot with the turned base: by the rigid rotation of b = (b_x, b_y, b_z′), Δb_z′ =
-#: −b_x·φ_α (the tilt along the base needs b_z′), and Δb_z′ = b_y·φ_ω, Δb_y = −b_z′·φ_ω, both
-#: second order here (b_y ≈ 0, b_z′ ≈ 1 mm). :data:`LEVEL_FREE` (b_z′, κ_л, κ_п) are solved by
-#: least squares on the instrument model so that q at the six standard points is unchanged to
-#: first order (:func:`level_design`; the solved Δb_z′/φ_α = −b_x within 1 % and the κ's small
-#: are tested in ``tests/procedure/test_heights_remedy.py``).
-LEVEL_TILTS = {
-    "alpha": ("k_alpha_left", "k_alpha_right"),
-    "omega": ("k_omega_left", "k_omega_right"),
-}
-LEVEL_FREE = ("bz", "kappa_left", "kappa_right")
 
 
 # --- stage 1 ---------------------------------------------------------------------------------
@@ -510,105 +481,6 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
 # --- stage 3 ---------------------------------------------------------------------------------
 
 
-def control_heights(run: Run) -> list[ControlHeight]:
-    """The sheet's height control points with their ground points (the scene's truth)."""
-    return control_heights_of(run.sheet, run.scene)
-
-
-@dataclass(frozen=True)
-class LevelDesign:
-    """What the operator knows of levelling a model on this instrument (one table per sheet).
-
-    Attributes
-    ----------
-    combos : dict
-        "alpha"/"omega" → control → turn per radian of the common tilt (knobs in T, κ in rad,
-        ``bz`` in mm of b_z′): :data:`LEVEL_TILTS` by 1 each, :data:`LEVEL_FREE` solved so that
-        q at the six standard points is unchanged to first order.
-    q_misfit : dict
-        "alpha"/"omega" → the largest |∂q/∂φ| left at the six standard points by the combo,
-        against the largest |∂q/∂φ| of the knobs alone. [—]
-    design : ndarray, shape (n, 3)
-        Columns 1, ∂H/∂φ_α, ∂H/∂φ_ω at the sheet's control heights. [m, m/rad]
-    """
-
-    combos: dict[str, dict[str, float]]
-    q_misfit: dict[str, float]
-    design: NDArray[np.float64]
-
-
-def _nominal_state(sheet: SetupSheet, strict_per_axis: bool):
-    """The sheet's own settings (as :func:`mechanism_level`): setting and units."""
-    f = sheet.focal_length_corrected_mm
-    units = {
-        side: unit_for_orientation(p.alpha, p.omega, p.kappa, f, strict_per_axis=strict_per_axis)
-        for side, p in zip(("left", "right"), sheet.photos, strict=True)
-    }
-    bx, by, bz = sheet.base_mm
-    return InstrumentSetting(sheet.f_instrument_mm, bx, by, bz), units
-
-
-def _turned(
-    setting: InstrumentSetting, units: dict[str, CorrectionUnit], changes, linkage: str
-) -> tuple[InstrumentSetting, dict[str, CorrectionUnit]]:
-    units = dict(units)
-    for control, d in changes.items():
-        if control == "bz":
-            setting = replace(setting, base_z_mm=np.asarray(setting.base_z_mm) + d)
-        elif control.startswith("kappa_"):
-            side = control.split("_")[1]
-            units[side] = replace(units[side], kappa=np.asarray(units[side].kappa) + d)
-        else:
-            _, axis, side = control.split("_")
-            now = units[side].tan_alpha if axis == "alpha" else units[side].tan_omega
-            units[side] = turn_correction_knob(
-                units[side], axis, np.asarray(now) + d, linkage=linkage
-            )
-    return setting, units
-
-
-def _response(images, setting, units, changes, linkage: str, step: float = 1e-5):
-    """∂q [mm, photo] and ∂D [mm, model] per unit of a combined turn (central differences)."""
-    out = []
-    for sign in (1.0, -1.0):
-        ch = {k: sign * step * v for k, v in changes.items()}
-        s, u = _turned(setting, units, ch, linkage)
-        out.append(counters_from_homologous_points(images[0], images[1], s, u["left"], u["right"]))
-    dq = (out[0].y_parallax_mm - out[1].y_parallax_mm) / (2.0 * step)
-    dd = (out[0].depth_mm - out[1].depth_mm) / (2.0 * step)
-    return dq, dd
-
-
-def level_design(
-    sheet: SetupSheet, scene: Scene, linkage: str = "L", strict_per_axis: bool = False
-) -> LevelDesign:
-    """The q-neutral common tilts of remedy R3 and their height sensitivities, on the
-    instrument model at the sheet's own settings (the operator's knowledge, the same for every
-    trial)."""
-    setting, units = _nominal_state(sheet, strict_per_axis)
-    std = scene.standard
-    j = {
-        c: _response(std, setting, units, {c: 1.0}, linkage)[0]
-        for c in (*LEVEL_FREE, *LEVEL_TILTS["alpha"], *LEVEL_TILTS["omega"])
-    }
-    combos, misfit = {}, {}
-    for name, knobs in LEVEL_TILTS.items():
-        fixed = {k: 1.0 for k in knobs}
-        rhs = -sum(j[k] for k in knobs)
-        a = np.column_stack([j[k] for k in LEVEL_FREE])
-        sol = np.linalg.lstsq(a, rhs, rcond=None)[0]
-        combos[name] = {**fixed, **{k: float(v) for k, v in zip(LEVEL_FREE, sol, strict=True)}}
-        left = _response(std, setting, units, combos[name], linkage)[0]
-        misfit[name] = float(np.max(np.abs(left)) / np.max(np.abs(rhs)))
-    heights = np.array([h.ground_m for h in control_heights_of(sheet, scene)])
-    imgs = scene.images(heights)
-    cols = [np.ones(len(heights))]
-    for name in LEVEL_TILTS:
-        _, dd = _response(imgs, setting, units, combos[name], linkage)
-        cols.append(-dd * sheet.vertical_scale_denominator / 1000.0)  # deeper is lower
-    return LevelDesign(combos, misfit, np.column_stack(cols))
-
-
 def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
     """The instrument coordinates (6.7) of a plan control point (the sheet's similarity)."""
     sheet = run.sheet
@@ -693,7 +565,7 @@ def _shown(op: Operator, value) -> float:
 
 def _read_control_heights(
     run: Run,
-    rows: list[ControlHeight],
+    rows: Sequence[ControlHeight],
     key: str,
     active,
     remedy: str,
@@ -752,21 +624,20 @@ def log_control_height(op, stage: str, text: str, read, truth_m: float, tol, **e
 
 
 def refine_scale_and_level(
-    run: Run, rows: list[ControlHeight], errs, failed: NDArray[np.bool_]
+    run: Run, rows: Sequence[ControlHeight], errs, failed: NDArray[np.bool_]
 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Remedy R3: a control height misses H/3000 after stage 3. Each round: (1) the scale by
     b_x on the two plan control points farthest apart; (2) the levelling: read the control
-    heights, fit offset + φ_α, φ_ω (:func:`level_design`) and turn the q-neutral common tilts
-    by −φ; (3) slip the height scale again on the first control point and check all control
-    heights. Bounded by ``OperatorModel.max_iterations`` rounds.
+    heights, fit offset + φ_α, φ_ω (the run's :class:`LevelDesign`, prepared once per run) and
+    turn the q-neutral common tilts by −φ; (3) slip the height scale again on the first control
+    point and check all control heights. Bounded by ``OperatorModel.max_iterations`` rounds.
 
     Returns the rounds used and the worst |height error| last (per trial). [m]
     """
     op = run.op
     tol = run.sheet.tolerances["control_height_m"]
     remedy = "R3 refine scaling and levelling on control"
-    inst = op.inst
-    design = level_design(run.sheet, run.scene, inst.variant.linkage, inst.variant.strict_per_axis)
+    design = run.level
     active = op.v(failed).astype(bool)
     rounds = np.zeros(np.shape(active), int)
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
@@ -790,7 +661,7 @@ def stage3_scale_model(run: Run) -> None:
     """Stage 3: (6.15) at a height control point, b_x until the mark fuses, slip the height
     scale, check the other control heights (H/3000), re-check κ and the residual y-parallax."""
     op, sheet = run.op, run.sheet
-    rows = control_heights(run)
+    rows = run.heights.rows  # the sheet's height control points, prepared once per run
     tol = sheet.tolerances["control_height_m"]
     h0 = rows[0]
     p0 = h0.ground_m

@@ -231,17 +231,22 @@ def prepare_run(
         unit,
         pair.grid_images_mm,
         pair.truth,
+        pair.heights,
+        pair.level,
     )
 
 
 def _run_one(
     prep: PreparedRun,
-    injected: dict[str, Any],
+    injected: dict[str, Any] | None,
     trials: int | None,
-    noise: Noise,
+    noise: Noise | None,
     transcript: bool = True,
     first: int = 0,
 ):
+    """Trials ``first … first + trials − 1`` of ``prep`` (the keyed draws where ``injected``,
+    ``noise`` are None: :func:`~stereoplotter.procedure.run.build_run`), with the true residual
+    y-parallax at the standard points and over the grid."""
     run = build_run(prep, first, trials, injected=injected, noise=noise, transcript=transcript)
     op = run.op
     if prep.method == "setup":
@@ -275,12 +280,7 @@ def run_trials_chunk(
         raise StereoplotterError(
             "the pymunk back-end runs single procedures; use --backend closed-form for --trials"
         )
-    stop = None if trials is None else first_trial + trials
-    if injected is None:
-        injected = prep.model.draw_keyed(prep.seed, first_trial, stop)
-    if noise is None:
-        noise = Noise(prep.seed, trials, None, first_trial)
-    run, q_std, q_grid = _run_one(prep, injected, trials, noise, transcript)
+    run, q_std, q_grid = _run_one(prep, injected, trials, noise, transcript, first_trial)
     evaluation = _evaluate(prep, run) if evaluate else None
     return SimulationResult(
         prep.method,
@@ -448,11 +448,12 @@ def _evaluate(prep: PreparedRun, run: Run) -> ModelEvaluation:
     """The built model of ``run`` against the ground truth, on the prepared run's grid."""
     sheet = prep.sheet
     inst = run.op.inst
-    units = inst.state()["units"]
+    state = inst.state()
+    units = state["units"]
     # the metre height scale as the operator slipped it, at D = 0 [m]
     zero = (
         np.asarray(inst.read("H", exact=True))
-        + np.asarray(inst.state()["carriages_mm"]["Z"]) * sheet.vertical_scale_denominator / 1000.0
+        + np.asarray(state["carriages_mm"]["Z"]) * sheet.vertical_scale_denominator / 1000.0
     )
     corner = run.results.get("stage 5: corner 4")
     return evaluate_against(

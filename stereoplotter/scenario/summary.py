@@ -27,19 +27,17 @@ def mean_flying_height_m(scenario: Scenario) -> float:
     return float(np.mean(heights))
 
 
-def flying_height_and_relief(
-    scenario: Scenario, grid_m: np.ndarray | None = None
-) -> tuple[float, float]:
+def flying_height_and_relief(scenario: Scenario, grid_m: np.ndarray) -> tuple[float, float]:
     """The summary's mean flying height H above the mean point height (each photo's rounded to
     0.1 m, as printed) and the terrain's height range over the working area (rounded to
     0.01 m; the points' range without a working area). [m]
 
-    ``grid_m``: the 15 × 15 working-area grid when the caller has it already
-    (:func:`~stereoplotter.scenario.synthetic.working_area_grid_m`).
+    ``grid_m``: the working-area grid the summary reads the relief on, 15 × 15
+    (:func:`~stereoplotter.scenario.synthetic.working_area_grid_m`), computed once by the
+    caller.
     """
     pts = np.array([p.local_m for p in scenario.points])
-    grid = working_area_grid_m(scenario, (15, 15)) if grid_m is None else grid_m
-    terrain_z = grid[:, 2] if len(grid) else pts[:, 2]
+    terrain_z = grid_m[:, 2] if len(grid_m) else pts[:, 2]
     return mean_flying_height_m(scenario), _r(terrain_z.max() - terrain_z.min(), 2)
 
 

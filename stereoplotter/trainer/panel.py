@@ -102,7 +102,7 @@ def overview(session: Any) -> dict[str, Any]:
     the module docstring)."""
     ex: Exercise = session.exercise
     scene = session.prep.scene
-    points = ex.scenario.points
+    points = scene.points
     images = scene.images(np.array([p.local_m for p in points], float)) if points else None
     marks = None
     if "f_instrument" in session.commanded:
@@ -129,7 +129,7 @@ def overview(session: Any) -> dict[str, Any]:
             del photo["mark"]["id"]
         photos[side] = photo
     return {
-        "format_mm": float(ex.scenario.camera.format_mm),
+        "format_mm": float(scene.camera.format_mm),
         "mark_diameter_mm": diameter,
         "photos": photos,
     }
@@ -171,9 +171,10 @@ def _point_xy(session: Any, point: tuple[str, str]) -> np.ndarray | None:
     if role == "standard":
         n = int(pid) if pid.isdigit() else 0
         return scene_left(session)[n - 1] if 1 <= n <= 6 else None
-    for p in session.exercise.scenario.points:
+    scene = session.prep.scene
+    for p in scene.points:
         if p.id == pid:
-            return np.asarray(session.prep.scene.images(np.array([p.local_m]))[0][0], float)
+            return np.asarray(scene.images(np.array([p.local_m]))[0][0], float)
     return None
 
 

@@ -92,8 +92,10 @@ def test_floor_passes_every_check_at_the_mechanism_level(name, instrument):
     prep, r = _run(name, instrument)
     failed = [n for n, c in r.checks.items() if c.passed is not None and not bool(c.passed)]
     assert failed == []
-    q_mech, h_mech = mechanism_level(prep.sheet, prep.scene, mechanism=_mechanism(instrument))
-    q_canon, h_canon = mechanism_level(prep.sheet, prep.scene)
+    q_mech, h_mech = mechanism_level(
+        prep.sheet, prep.scene, prep.heights, mechanism=_mechanism(instrument)
+    )
+    q_canon, h_canon = mechanism_level(prep.sheet, prep.scene, prep.heights)
     q_span, h_span = _span_term(prep)
     # 0.5 µm / 0.03 m: the tolerance of the loops' last steps with exact data (see below).
     # Issue 11: the instrument's own mechanism scales each photo by s (second order in the
@@ -113,14 +115,16 @@ def test_with_exact_marks_the_floor_is_the_mechanism_level(name, instrument):
     # without the comparator errors of the sheet's inputs nothing is left but the mechanism:
     # the stage-1 loop lands b_z′ of the sheet (decision D9) and stages 2-3 set the sheet's values
     prep, r = _run(name, instrument, exact_marks=True)
-    q_mech, h_mech = mechanism_level(prep.sheet, prep.scene, mechanism=_mechanism(instrument))
+    q_mech, h_mech = mechanism_level(
+        prep.sheet, prep.scene, prep.heights, mechanism=_mechanism(instrument)
+    )
     bz = float(r.instrument.setting.base_z_mm)
     assert bz == pytest.approx(prep.sheet.base_mm[2], abs=0.1 * UM)
     # Issue 11 finding: the instrument's own mechanism scales the photo by s(T, e), 1 at the
     # stage-1 zero settings, so the L-check's b_z′ no longer fits the tilted units exactly: the
     # floor is no longer the mechanism level itself but is bounded as in the test above
     # (pair60 SC-1: 2.48 µm against a level of 0.65 µm; ¼ mark = 12.5 µm).
-    q_canon, h_canon = mechanism_level(prep.sheet, prep.scene)
+    q_canon, h_canon = mechanism_level(prep.sheet, prep.scene, prep.heights)
     bound = max(q_mech, q_canon) + _differential_scale(prep, instrument) + 0.5 * UM
     assert np.max(np.abs(r.q_standard_mm)) <= bound
     heights = r.checks["stage 3: control heights"].residual

@@ -9,8 +9,9 @@ import pytest
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import simulate
+from stereoplotter.procedure.floor import control_heights_of
+from stereoplotter.procedure.levelling import level_design
 from stereoplotter.procedure.operator import OperatorModel
-from stereoplotter.procedure.setup_method import level_design
 
 H = "stage 3: control heights"
 R3 = "R3 stage 3: refine scaling and levelling on control"
@@ -30,7 +31,7 @@ def test_common_tilt_along_the_base_is_the_rigid_turn_of_the_base(name):
     sc, spec = load_scenario(name), load_instrument("sc1")
     r = simulate(sc, spec, seed=3, trials=2, evaluate=False)
     sheet = r.sheet
-    d = level_design(sheet, r.scene)
+    d = level_design(sheet, r.scene, control_heights_of(sheet, r.scene))
     bx = sheet.base_mm[0]
     k = sheet.horizontal_scale_denominator / sheet.vertical_scale_denominator
     alpha, omega = d.combos["alpha"], d.combos["omega"]
