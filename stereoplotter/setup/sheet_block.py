@@ -1,0 +1,424 @@
+"""The sheets of many pairs as columns: frame, ground, (6.8), sheet corners and Table 24.
+
+One pass over the pairs of a job, in stages that each take the whole block (numpy over the pairs;
+the pairs' points, of unequal counts, concatenated with each point's pair index):
+
+1. **inputs** — each pair's measured inputs gathered into arrays (:func:`_gather`);
+2. **frame** — θ and the turned angles of every pair (:func:`~stereoplotter.setup.table24.
+   instrument_frames`), the points and the working-area ground in each pair's instrument frame
+   (:func:`instrument_frame_m`), their depth range and plan extent;
+3. **plan control** — (6.8) from Gauss–Krüger to each pair's frame over its plan control
+   (:func:`~stereoplotter.geometry.similarity.fit_similarities_with_reflection`), the sheet
+   corners on the ground by (6.8);
+4. **Table 24** — :func:`~stereoplotter.setup.table24.compute_table24` of all pairs that share
+   the scale candidates (one call per map scale).
+
+The per-pair records an operator reads (:class:`~stereoplotter.setup.records.SetupSheet` with its
+stage readings) are built from these columns only when asked for
+(:func:`stereoplotter.setup.sheet.sheet_of_block`). The decisions behind every value are in
+``docs/setup-data.md``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.geometry.grouped import group_sums
+from stereoplotter.geometry.rotation import rotation_z
+from stereoplotter.geometry.similarity import (
+    SimilarityFits,
+    fit_similarities_with_reflection,
+)
+from stereoplotter.scenario.model import Point
+from stereoplotter.setup.records import SetupOptions, SetupRefusal
+from stereoplotter.setup.scale_choice import candidate_scales
+from stereoplotter.setup.table24 import BlockResult, compute_table24, instrument_frames
+from stereoplotter.spec.instrument_spec import InstrumentSpec
+
+__all__ = ["CORNER_ORDER", "SheetBlock", "compute_sheet_block", "instrument_frame_m"]
+
+#: Sheet-corner numbering (decision, docs/setup-data.md): 1 = lower left, then counter-clockwise
+#: in map view, north up. The scenario stores corners NW, NE, SE, SW; this maps 1..4 to them.
+CORNER_ORDER = {"1": 3, "2": 2, "3": 1, "4": 0}
+_CORNERS = [CORNER_ORDER[k] for k in ("1", "2", "3", "4")]
+
+
+def instrument_frame_m(
+    points_m: ArrayLike,
+    frame_origin_m: ArrayLike,
+    frame_rotation: ArrayLike,
+    *,
+    inverse: bool = False,
+) -> NDArray[np.float64]:
+    r"""Ground points in the instrument frame of the setup sheet (or back).
+
+    Parameters
+    ----------
+    points_m : array_like, shape (..., 3)
+        X, Y, Z in the photogrammetric frame of the scenario (``inverse=False``) or in the
+        instrument frame (``inverse=True``). [m]
+    frame_origin_m : array_like, shape (3,) or (..., 3)
+        S_л, the origin of the instrument frame in the photogrammetric frame: one, or one per
+        point (the points of many pairs at once). [m]
+    frame_rotation : float or array_like, shape (...)
+        θ, the azimuth of the horizontal base in the photogrammetric frame: one, or one per
+        point. [rad]
+    inverse : bool
+        Map instrument-frame points back to the photogrammetric frame.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        The points in the other frame. [m]
+
+    Notes
+    -----
+    ``docs/setup-data.md``, "The frame turn": the photogrammetric frame moved to S_л and turned
+    by −θ about Z, p = R_Z(−θ)(P − S_л), so that the base runs along +X.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p = instrument_frame_m([10.0, 10.0, 0.0], [0.0, 0.0, 100.0], np.pi / 4)
+    >>> (np.round(p, 6) + 0.0).tolist()
+    [14.142136, 0.0, -100.0]
+    >>> back = instrument_frame_m(p, [0.0, 0.0, 100.0], np.pi / 4, inverse=True)
+    >>> (np.round(back, 9) + 0.0).tolist()
+    [10.0, 10.0, 0.0]
+    """
+    origin = np.asarray(frame_origin_m, float)
+    theta = np.asarray(frame_rotation, float)
+    points = np.asarray(points_m, float)
+    if theta.ndim == 0:
+        if inverse:
+            return points @ rotation_z(float(theta)).T + origin
+        return (points - origin) @ rotation_z(-float(theta)).T
+    turn = rotation_z(theta if inverse else -theta)  # (..., 3, 3), one per point
+    if inverse:
+        return (turn @ points[..., :, None])[..., 0] + origin
+    return (turn @ (points - origin)[..., :, None])[..., 0]
+
+
+@dataclass(frozen=True, slots=True)
+class SheetBlock:
+    """The columns of the sheets of P pairs (:func:`compute_sheet_block`).
+
+    Per pair (axis 0 of length P): ``frame_rotation`` θ [rad], ``depth_m`` (shallowest, deepest)
+    Z_Sл − Z and ``depth_mean_m`` of the ground samples and points [m], ``extent_m`` (X, Y) ×
+    (min, max) of them and the sheet corners [m], ``corners_gk`` and ``corners_m`` the sheet
+    corners 1–4 in Gauss–Krüger and on the ground by (6.8) (NaN without a map sheet or two plan
+    points) [m], ``fit_row`` the pair's row of ``fits`` (−1: no fit). The points of all pairs are
+    concatenated: ``points_m`` (n, 3) in each pair's instrument frame [m], pair ``i``'s from
+    ``point_start[i]`` to ``point_start[i + 1]``. ``refusals`` holds the refusal of a pair refused
+    before Table 24 (else None); ``tables`` the Table 24 of each group of pairs sharing the scale
+    candidates, ``table_of[i]`` = (group, row) of pair ``i`` (−1, −1 when refused before).
+    """
+
+    spec: InstrumentSpec
+    options: SetupOptions
+    source: str
+    inputs: tuple[Mapping[str, Any], ...]
+    refusals: tuple[SetupRefusal | None, ...]
+    frame_rotation: NDArray[np.float64]
+    points_m: NDArray[np.float64]
+    point_start: NDArray[np.intp]
+    plan: tuple[tuple[int, ...], ...]
+    heights: tuple[tuple[Point, ...], ...]
+    depth_m: NDArray[np.float64]
+    depth_mean_m: NDArray[np.float64]
+    extent_m: NDArray[np.float64]
+    corners_gk: NDArray[np.float64]
+    corners_m: NDArray[np.float64]
+    fits: SimilarityFits | None
+    fit_row: NDArray[np.intp]
+    map_scales: tuple[int | None, ...]
+    tables: tuple[BlockResult, ...]
+    table_of: NDArray[np.intp]
+
+    def __len__(self) -> int:
+        return len(self.inputs)
+
+    def points_of(self, i: int) -> NDArray[np.float64]:
+        """Pair ``i``'s points in its instrument frame, shape (p, 3). [m]"""
+        return self.points_m[self.point_start[i] : self.point_start[i + 1]]
+
+
+def _candidate_grid(
+    spec: InstrumentSpec, options: SetupOptions, map_scale: int | None
+) -> NDArray[np.float64]:
+    """Item 1 of §26: the (M_г, M_в) candidates (:mod:`stereoplotter.setup.scale_choice`)."""
+    try:
+        return candidate_scales(
+            spec,
+            map_scale,
+            options.horizontal_scale_denominator,
+            options.vertical_scale_denominator,
+        )
+    except StereoplotterError as exc:
+        raise SetupRefusal(f"{exc} (--horizontal-scale)") from None
+
+
+@dataclass(frozen=True, slots=True)
+class _Gathered:
+    """Stage 1: the measured inputs of the pairs as arrays (points and ground concatenated)."""
+
+    centres_m: NDArray  # (P, 2, 3)
+    rotations: NDArray  # (P, 2, 3, 3)
+    points_local_m: NDArray  # (n, 3)
+    point_start: NDArray  # (P + 1,)
+    grid_local_m: NDArray  # (g, 3): the working areas' ground samples
+    grid_start: NDArray  # (P + 1,)
+    plan: tuple[tuple[int, ...], ...]
+    plan_gk: NDArray  # (m, 2) north, east of the plan control of the pairs with a sheet
+    corners_gk: NDArray  # (P, 4, 2), NaN without a map sheet
+    heights: tuple[tuple[Point, ...], ...]
+    map_scales: tuple[int | None, ...]
+
+
+def _gather(pairs: Sequence[Mapping[str, Any]]) -> _Gathered:
+    """Stage 1: each pair's inputs into the block's arrays (the only loop over the pairs)."""
+    count = len(pairs)
+    local, ground, plans, plan_gk, heights, scales = [], [], [], [], [], []
+    corners = np.full((count, 4, 2), np.nan)
+    for i, pair in enumerate(pairs):
+        points: tuple[Point, ...] = tuple(pair["points"])
+        xyz = np.array([p.local_m for p in points], float).reshape(-1, 3)
+        local.append(xyz)
+        ground.append(np.asarray(pair["working_area_m"], float).reshape(-1, 3))
+        sheet = pair["map_sheet"]
+        plan = tuple(
+            j
+            for j, p in enumerate(points)
+            if p.role == "control" and p.kind in ("full", "plan") and p.sk42_m is not None
+        )
+        plans.append(plan)
+        if sheet is not None:
+            corners[i] = np.asarray(sheet.corners_sk42_m, float)[_CORNERS, :2]
+            if len(plan) >= 2:
+                plan_gk += [points[j].sk42_m[:2] for j in plan]
+        heights.append(
+            tuple(p for p in points if p.role == "control" and p.kind in ("full", "height"))
+        )
+        scales.append(sheet.scale_denominator if sheet is not None else None)
+    sizes = np.array([len(v) for v in local], np.intp)
+    ground_sizes = np.array([len(v) for v in ground], np.intp)
+    return _Gathered(
+        centres_m=np.array([p["centres_m"] for p in pairs], float).reshape(count, 2, 3),
+        rotations=np.array([p["rotations"] for p in pairs], float).reshape(count, 2, 3, 3),
+        points_local_m=np.concatenate(local) if local else np.zeros((0, 3)),
+        point_start=np.concatenate([[0], np.cumsum(sizes)]).astype(np.intp),
+        grid_local_m=np.concatenate(ground) if ground else np.zeros((0, 3)),
+        grid_start=np.concatenate([[0], np.cumsum(ground_sizes)]).astype(np.intp),
+        plan=tuple(plans),
+        plan_gk=np.array(plan_gk, float).reshape(-1, 2),
+        corners_gk=corners,
+        heights=tuple(heights),
+        map_scales=tuple(scales),
+    )
+
+
+def _in_frames(
+    xyz: NDArray, start: NDArray, centres_m: NDArray, theta: NDArray
+) -> NDArray[np.float64]:
+    """Stage 2: points of every pair (pair ``i``'s from ``start[i]`` to ``start[i + 1]``) in
+    their pair's instrument frame, :func:`instrument_frame_m`'s product p = (P − S_л)·R_Z(−θ)ᵀ
+    taken pair by pair (the product of one pair's rows: a product over all pairs at once, or
+    over another number of rows, rounds differently in the last bit, and an exact (6.8) fit's
+    residuals then print −0.000 for +0.000, ``jobs/block3x6``)."""
+    out = np.empty_like(xyz)
+    turned = rotation_z(-theta).transpose(0, 2, 1)  # R_Z(−θ)ᵀ of each pair
+    origins = centres_m[:, 0]
+    for i, (a, b) in enumerate(zip(start[:-1].tolist(), start[1:].tolist(), strict=True)):
+        if b > a:
+            out[a:b] = (xyz[a:b] - origins[i]) @ turned[i]
+    return out
+
+
+def _ranges(
+    grid_m: NDArray, grid_start: NDArray, points_m: NDArray, point_start: NDArray,
+    corners_m: NDArray,
+) -> tuple[NDArray, NDArray, NDArray]:  # fmt: skip
+    """Stage 2: per pair the depth range Z_Sл − Z (shallowest, deepest) and its mean over the
+    ground samples and points, and the plan extent (X, Y) × (min, max) of them and the sheet
+    corners on the ground. [m]"""
+    grid_n, point_n = np.diff(grid_start), np.diff(point_start)
+    start = np.concatenate([[0], np.cumsum(grid_n + point_n)])
+    ground = np.empty((len(grid_m) + len(points_m), 3))  # each pair's grid, then its points
+    ground[np.repeat(start[:-1] - grid_start[:-1], grid_n) + np.arange(len(grid_m))] = grid_m
+    ground[np.repeat(start[:-1] + grid_n - point_start[:-1], point_n)
+           + np.arange(len(points_m))] = points_m  # fmt: skip
+    cuts = start[:-1]
+    depths = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
+    depth = np.stack([np.minimum.reduceat(depths, cuts), np.maximum.reduceat(depths, cuts)], -1)
+    mean = group_sums(depths, start) / np.diff(start)  # numpy.mean of each pair alone
+    low = np.minimum.reduceat(ground[:, :2], cuts)
+    high = np.maximum.reduceat(ground[:, :2], cuts)
+    low = np.fmin(low, np.min(np.where(np.isnan(corners_m), np.inf, corners_m), axis=1))
+    high = np.fmax(high, np.max(np.where(np.isnan(corners_m), -np.inf, corners_m), axis=1))
+    return depth, mean, np.stack([low, high], axis=-1)
+
+
+def _plan_control(
+    gathered: _Gathered, points_m: NDArray
+) -> tuple[SimilarityFits | None, NDArray, NDArray]:
+    """Stage 3: (6.8) over the plan control of each pair with a map sheet and two plan points,
+    and its sheet corners on the ground by (6.8) (NaN for the other pairs). [m]"""
+    count = len(gathered.plan)
+    fitted = [
+        i
+        for i, plan in enumerate(gathered.plan)
+        if len(plan) >= 2 and not np.isnan(gathered.corners_gk[i, 0, 0])
+    ]
+    row = np.full(count, -1, np.intp)
+    corners_m = np.full((count, 4, 2), np.nan)
+    if not fitted:
+        return None, row, corners_m
+    row[fitted] = np.arange(len(fitted))
+    sizes = [len(gathered.plan[i]) for i in fitted]
+    index = np.concatenate(
+        [gathered.point_start[i] + np.array(gathered.plan[i], np.intp) for i in fitted]
+    )
+    group = np.repeat(np.arange(len(fitted)), sizes)
+    north, east = gathered.plan_gk[:, 0], gathered.plan_gk[:, 1]
+    fits = fit_similarities_with_reflection(
+        group, north, east, points_m[index, 0], points_m[index, 1], groups=len(fitted)
+    )
+    gk = gathered.corners_gk[fitted]  # (f, 4, 2)
+    a, b = fits.a[:, None], fits.b[:, None]
+    corners_m[fitted] = np.stack(  # Eq. (6.8), apply_similarity's expressions per pair
+        [a * gk[..., 0] + b * gk[..., 1] + fits.cx_m[:, None],
+         -a * gk[..., 1] + b * gk[..., 0] + fits.cy_m[:, None]], axis=-1,
+    )  # fmt: skip
+    return fits, row, corners_m
+
+
+def compute_sheet_block(
+    pairs: Sequence[Mapping[str, Any]],
+    *,
+    spec: InstrumentSpec,
+    options: SetupOptions,
+    source: str,
+    name: str = "job",
+) -> SheetBlock:
+    """The columns of the sheets of many pairs from their measurements (stages 1–4 above).
+
+    Parameters
+    ----------
+    pairs : sequence of mapping
+        Per pair the keyword arguments of
+        :func:`stereoplotter.setup.sheet.compute_sheet_from_measurements` other than ``spec``,
+        ``options`` and ``source``.
+    spec, options, source
+        Shared by the pairs (``source``: the file named in refusals).
+    name : str
+        The name of the block.
+
+    Returns
+    -------
+    SheetBlock
+    """
+    gathered = _gather(pairs)
+    count = len(pairs)
+    theta, base_m, angles = instrument_frames(gathered.centres_m, gathered.rotations)
+    points_m = _in_frames(gathered.points_local_m, gathered.point_start, gathered.centres_m, theta)
+    grid_m = _in_frames(gathered.grid_local_m, gathered.grid_start, gathered.centres_m, theta)
+    fits, fit_row, corners_m = _plan_control(gathered, points_m)
+    depth, depth_mean, extent = _ranges(
+        grid_m, gathered.grid_start, points_m, gathered.point_start, corners_m
+    )
+    refusals: list[SetupRefusal | None] = [None] * count
+    grids: dict[int | None, NDArray | SetupRefusal] = {}
+    groups: dict[int | None, list[int]] = {}
+    for i, scale in enumerate(gathered.map_scales):
+        if scale is None and options.horizontal_scale_denominator is None:
+            refusals[i] = SetupRefusal(
+                f"{source}: map_sheet: expected a map sheet, whose scale chooses the "
+                "horizontal model scale M_г from the coordinatograph gears, found nothing (or "
+                "force M_г with --horizontal-scale)"
+            )
+            continue
+        if scale not in grids:
+            try:
+                grids[scale] = _candidate_grid(spec, options, scale)
+            except SetupRefusal as exc:
+                grids[scale] = exc
+        grid = grids[scale]
+        if isinstance(grid, SetupRefusal):
+            refusals[i] = grid
+            continue
+        groups.setdefault(scale, []).append(i)
+    table_of = np.full((count, 2), -1, np.intp)
+    tables = []
+    for k, (scale, members) in enumerate(groups.items()):
+        rows = np.array(members, np.intp)
+        table_of[rows, 0], table_of[rows, 1] = k, np.arange(len(rows))
+        tables.append(_table24(pairs, gathered, rows, grids[scale], scale, depth, extent,
+                               (theta, base_m, angles), spec, options, name))  # fmt: skip
+    return SheetBlock(
+        spec=spec,
+        options=options,
+        source=source,
+        inputs=tuple(pairs),
+        refusals=tuple(refusals),
+        frame_rotation=theta,
+        points_m=points_m,
+        point_start=gathered.point_start,
+        plan=gathered.plan,
+        heights=gathered.heights,
+        depth_m=depth,
+        depth_mean_m=depth_mean,
+        extent_m=extent,
+        corners_gk=gathered.corners_gk,
+        corners_m=corners_m,
+        fits=fits,
+        fit_row=fit_row,
+        map_scales=gathered.map_scales,
+        tables=tuple(tables),
+        table_of=table_of,
+    )
+
+
+def _table24(
+    pairs: Sequence[Mapping[str, Any]],
+    gathered: _Gathered,
+    rows: NDArray,
+    grid: NDArray,
+    map_scale: int | None,
+    depth: NDArray,
+    extent: NDArray,
+    frames: tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]],
+    spec: InstrumentSpec,
+    options: SetupOptions,
+    name: str,
+) -> BlockResult:
+    """Stage 4: Table 24 of the pairs ``rows`` (sharing the scale candidates ``grid``) in one
+    :func:`compute_table24` call, with each pair's f′, marks and frame."""
+    chosen = [gathered.heights[i] for i in rows]
+    width = max((len(h) for h in chosen), default=0)
+    heights = np.full((len(rows), width), np.nan)
+    for j, h in enumerate(chosen):
+        heights[j, : len(h)] = [p.local_m[2] for p in h]
+    theta, base_m, angles = frames
+    return compute_table24(
+        np.array([float(pairs[i]["focal_length_corrected_mm"]) for i in rows]),
+        np.array([np.asarray(pairs[i]["marks_mm"], float) for i in rows]),
+        gathered.centres_m[rows],
+        gathered.rotations[rows],
+        depth[rows],
+        grid,
+        spec,
+        heights_m=heights,
+        extent_m=extent[rows],
+        map_scale_denominator=map_scale,
+        book_sign=options.book_sign_n_right,
+        model_names=tuple(pairs[i]["name"] for i in rows),
+        height_point_ids=tuple(tuple(p.id for p in h) for h in chosen),
+        name=name,
+        frames=(theta[rows], base_m[rows], tuple(a[rows] for a in angles)),
+    )
