@@ -44,17 +44,13 @@ from stereoplotter.setup.records import (
     SetupSheet,
 )
 from stereoplotter.setup.scale_choice import describe_candidate
-from stereoplotter.setup.sheet_block import (
-    CORNER_ORDER,
-    SheetBlock,
-    compute_sheet_block,
-    instrument_frame_m,
-)
+from stereoplotter.setup.sheet_block import CORNER_ORDER, SheetBlock, compute_sheet_block
 from stereoplotter.setup.table24 import (
     SCALE_FLAGS,
     X_MARK_NAME,
     BlockResult,
     Refusal,
+    instrument_frame_m,
 )
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.spec.limits import (

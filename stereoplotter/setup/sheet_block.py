@@ -4,12 +4,12 @@ One pass over the pairs of a job, in stages that each take the whole block (nump
 the pairs' points, of unequal counts, concatenated with each point's pair index):
 
 1. **inputs** — each pair's measured inputs gathered into arrays (:func:`_gather`);
-2. **frame** — θ and the turned angles of every pair (:func:`~stereoplotter.setup.table24.
-   instrument_frames`), the points and the working-area ground in each pair's instrument frame
-   (:func:`instrument_frame_m`), their depth range and plan extent;
+2. **frames** — θ and the turned angles of every pair, the working-area ground and the points in
+   each pair's instrument frame and their depth range
+   (:func:`~stereoplotter.setup.table24.pair_frames`);
 3. **plan control** — (6.8) from Gauss–Krüger to each pair's frame over its plan control
    (:func:`~stereoplotter.geometry.similarity.fit_similarities_with_reflection`), the sheet
-   corners on the ground by (6.8);
+   corners on the ground by (6.8), the plan extent of ground, points and corners;
 4. **Table 24** — :func:`~stereoplotter.setup.table24.compute_table24` of all pairs that share
    the scale candidates (one call per map scale).
 
@@ -26,11 +26,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.geometry.grouped import group_sums
-from stereoplotter.geometry.rotation import rotation_z
 from stereoplotter.geometry.similarity import (
     SimilarityFits,
     fit_similarities_with_reflection,
@@ -38,71 +36,15 @@ from stereoplotter.geometry.similarity import (
 from stereoplotter.scenario.model import Point
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.scale_choice import candidate_scales
-from stereoplotter.setup.table24 import BlockResult, compute_table24, instrument_frames
+from stereoplotter.setup.table24 import BlockResult, PairFrames, compute_table24, pair_frames
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
-__all__ = ["CORNER_ORDER", "SheetBlock", "compute_sheet_block", "instrument_frame_m"]
+__all__ = ["CORNER_ORDER", "SheetBlock", "compute_sheet_block"]
 
 #: Sheet-corner numbering (decision, docs/setup-data.md): 1 = lower left, then counter-clockwise
 #: in map view, north up. The scenario stores corners NW, NE, SE, SW; this maps 1..4 to them.
 CORNER_ORDER = {"1": 3, "2": 2, "3": 1, "4": 0}
 _CORNERS = [CORNER_ORDER[k] for k in ("1", "2", "3", "4")]
-
-
-def instrument_frame_m(
-    points_m: ArrayLike,
-    frame_origin_m: ArrayLike,
-    frame_rotation: ArrayLike,
-    *,
-    inverse: bool = False,
-) -> NDArray[np.float64]:
-    r"""Ground points in the instrument frame of the setup sheet (or back).
-
-    Parameters
-    ----------
-    points_m : array_like, shape (..., 3)
-        X, Y, Z in the photogrammetric frame of the scenario (``inverse=False``) or in the
-        instrument frame (``inverse=True``). [m]
-    frame_origin_m : array_like, shape (3,) or (..., 3)
-        S_л, the origin of the instrument frame in the photogrammetric frame: one, or one per
-        point (the points of many pairs at once). [m]
-    frame_rotation : float or array_like, shape (...)
-        θ, the azimuth of the horizontal base in the photogrammetric frame: one, or one per
-        point. [rad]
-    inverse : bool
-        Map instrument-frame points back to the photogrammetric frame.
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        The points in the other frame. [m]
-
-    Notes
-    -----
-    ``docs/setup-data.md``, "The frame turn": the photogrammetric frame moved to S_л and turned
-    by −θ about Z, p = R_Z(−θ)(P − S_л), so that the base runs along +X.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> p = instrument_frame_m([10.0, 10.0, 0.0], [0.0, 0.0, 100.0], np.pi / 4)
-    >>> (np.round(p, 6) + 0.0).tolist()
-    [14.142136, 0.0, -100.0]
-    >>> back = instrument_frame_m(p, [0.0, 0.0, 100.0], np.pi / 4, inverse=True)
-    >>> (np.round(back, 9) + 0.0).tolist()
-    [10.0, 10.0, 0.0]
-    """
-    origin = np.asarray(frame_origin_m, float)
-    theta = np.asarray(frame_rotation, float)
-    points = np.asarray(points_m, float)
-    if theta.ndim == 0:
-        if inverse:
-            return points @ rotation_z(float(theta)).T + origin
-        return (points - origin) @ rotation_z(-float(theta)).T
-    turn = rotation_z(theta if inverse else -theta)  # (..., 3, 3), one per point
-    if inverse:
-        return (turn @ points[..., :, None])[..., 0] + origin
-    return (turn @ (points - origin)[..., :, None])[..., 0]
 
 
 @dataclass(frozen=True, slots=True)
@@ -172,8 +114,8 @@ class _Gathered:
     rotations: NDArray  # (P, 2, 3, 3)
     points_local_m: NDArray  # (n, 3)
     point_start: NDArray  # (P + 1,)
-    grid_local_m: NDArray  # (g, 3): the working areas' ground samples
-    grid_start: NDArray  # (P + 1,)
+    ground_local_m: NDArray  # (g, 3): each pair's working area, then its points
+    ground_start: NDArray  # (2P + 1,): pair i's working area from 2i, its points from 2i + 1
     plan: tuple[tuple[int, ...], ...]
     plan_gk: NDArray  # (m, 2) north, east of the plan control of the pairs with a sheet
     corners_gk: NDArray  # (P, 4, 2), NaN without a map sheet
@@ -190,7 +132,7 @@ def _gather(pairs: Sequence[Mapping[str, Any]]) -> _Gathered:
         points: tuple[Point, ...] = tuple(pair["points"])
         xyz = np.array([p.local_m for p in points], float).reshape(-1, 3)
         local.append(xyz)
-        ground.append(np.asarray(pair["working_area_m"], float).reshape(-1, 3))
+        ground += [np.asarray(pair["working_area_m"], float).reshape(-1, 3), xyz]
         sheet = pair["map_sheet"]
         plan = tuple(
             j
@@ -213,8 +155,8 @@ def _gather(pairs: Sequence[Mapping[str, Any]]) -> _Gathered:
         rotations=np.array([p["rotations"] for p in pairs], float).reshape(count, 2, 3, 3),
         points_local_m=np.concatenate(local) if local else np.zeros((0, 3)),
         point_start=np.concatenate([[0], np.cumsum(sizes)]).astype(np.intp),
-        grid_local_m=np.concatenate(ground) if ground else np.zeros((0, 3)),
-        grid_start=np.concatenate([[0], np.cumsum(ground_sizes)]).astype(np.intp),
+        ground_local_m=np.concatenate(ground) if ground else np.zeros((0, 3)),
+        ground_start=np.concatenate([[0], np.cumsum(ground_sizes)]).astype(np.intp),
         plan=tuple(plans),
         plan_gk=np.array(plan_gk, float).reshape(-1, 2),
         corners_gk=corners,
@@ -223,45 +165,24 @@ def _gather(pairs: Sequence[Mapping[str, Any]]) -> _Gathered:
     )
 
 
-def _in_frames(
-    xyz: NDArray, start: NDArray, centres_m: NDArray, theta: NDArray
-) -> NDArray[np.float64]:
-    """Stage 2: points of every pair (pair ``i``'s from ``start[i]`` to ``start[i + 1]``) in
-    their pair's instrument frame, :func:`instrument_frame_m`'s product p = (P − S_л)·R_Z(−θ)ᵀ
-    taken pair by pair (the product of one pair's rows: a product over all pairs at once, or
-    over another number of rows, rounds differently in the last bit, and an exact (6.8) fit's
-    residuals then print −0.000 for +0.000, ``jobs/block3x6``)."""
-    out = np.empty_like(xyz)
-    turned = rotation_z(-theta).transpose(0, 2, 1)  # R_Z(−θ)ᵀ of each pair
-    origins = centres_m[:, 0]
-    for i, (a, b) in enumerate(zip(start[:-1].tolist(), start[1:].tolist(), strict=True)):
-        if b > a:
-            out[a:b] = (xyz[a:b] - origins[i]) @ turned[i]
-    return out
-
-
-def _ranges(
-    grid_m: NDArray, grid_start: NDArray, points_m: NDArray, point_start: NDArray,
-    corners_m: NDArray,
-) -> tuple[NDArray, NDArray, NDArray]:  # fmt: skip
-    """Stage 2: per pair the depth range Z_Sл − Z (shallowest, deepest) and its mean over the
-    ground samples and points, and the plan extent (X, Y) × (min, max) of them and the sheet
-    corners on the ground. [m]"""
-    grid_n, point_n = np.diff(grid_start), np.diff(point_start)
-    start = np.concatenate([[0], np.cumsum(grid_n + point_n)])
-    ground = np.empty((len(grid_m) + len(points_m), 3))  # each pair's grid, then its points
-    ground[np.repeat(start[:-1] - grid_start[:-1], grid_n) + np.arange(len(grid_m))] = grid_m
-    ground[np.repeat(start[:-1] + grid_n - point_start[:-1], point_n)
-           + np.arange(len(points_m))] = points_m  # fmt: skip
+def _extent(ground_m: NDArray, start: NDArray, corners_m: NDArray) -> NDArray[np.float64]:
+    """Stage 3: per pair the plan extent (X, Y) × (min, max) of its ground samples, points and
+    sheet corners on the ground (NaN: none). [m]"""
     cuts = start[:-1]
-    depths = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
-    depth = np.stack([np.minimum.reduceat(depths, cuts), np.maximum.reduceat(depths, cuts)], -1)
-    mean = group_sums(depths, start) / np.diff(start)  # numpy.mean of each pair alone
-    low = np.minimum.reduceat(ground[:, :2], cuts)
-    high = np.maximum.reduceat(ground[:, :2], cuts)
+    low = np.minimum.reduceat(ground_m[:, :2], cuts)
+    high = np.maximum.reduceat(ground_m[:, :2], cuts)
     low = np.fmin(low, np.min(np.where(np.isnan(corners_m), np.inf, corners_m), axis=1))
     high = np.fmax(high, np.max(np.where(np.isnan(corners_m), -np.inf, corners_m), axis=1))
-    return depth, mean, np.stack([low, high], axis=-1)
+    return np.stack([low, high], axis=-1)
+
+
+def _rows_of_points(ground_start: NDArray) -> NDArray[np.intp]:
+    """The rows of the pairs' points in the interleaved ground (working area, points, …)."""
+    first, last = ground_start[1:-1:2], ground_start[2::2]
+    sizes = last - first
+    return np.repeat(first - np.concatenate([[0], np.cumsum(sizes)[:-1]]), sizes) + np.arange(
+        int(sizes.sum())
+    )
 
 
 def _plan_control(
@@ -325,13 +246,15 @@ def compute_sheet_block(
     """
     gathered = _gather(pairs)
     count = len(pairs)
-    theta, base_m, angles = instrument_frames(gathered.centres_m, gathered.rotations)
-    points_m = _in_frames(gathered.points_local_m, gathered.point_start, gathered.centres_m, theta)
-    grid_m = _in_frames(gathered.grid_local_m, gathered.grid_start, gathered.centres_m, theta)
-    fits, fit_row, corners_m = _plan_control(gathered, points_m)
-    depth, depth_mean, extent = _ranges(
-        grid_m, gathered.grid_start, points_m, gathered.point_start, corners_m
+    # stage 2, the frames: θ and the angles, the ground and points turned, the depth ranges
+    frames = pair_frames(
+        gathered.centres_m, gathered.rotations, gathered.ground_local_m, gathered.ground_start
     )
+    pair_start = gathered.ground_start[::2]
+    points_m = frames.ground_m[_rows_of_points(gathered.ground_start)]
+    # stage 3, the plan control: (6.8), the sheet corners, the plan extent
+    fits, fit_row, corners_m = _plan_control(gathered, points_m)
+    extent = _extent(frames.ground_m, pair_start, corners_m)
     refusals: list[SetupRefusal | None] = [None] * count
     grids: dict[int | None, NDArray | SetupRefusal] = {}
     groups: dict[int | None, list[int]] = {}
@@ -358,21 +281,21 @@ def compute_sheet_block(
     for k, (scale, members) in enumerate(groups.items()):
         rows = np.array(members, np.intp)
         table_of[rows, 0], table_of[rows, 1] = k, np.arange(len(rows))
-        tables.append(_table24(pairs, gathered, rows, grids[scale], scale, depth, extent,
-                               (theta, base_m, angles), spec, options, name))  # fmt: skip
+        tables.append(_table24(pairs, gathered, rows, grids[scale], scale, frames, extent,
+                               spec, options, name))  # fmt: skip
     return SheetBlock(
         spec=spec,
         options=options,
         source=source,
         inputs=tuple(pairs),
         refusals=tuple(refusals),
-        frame_rotation=theta,
+        frame_rotation=frames.theta,
         points_m=points_m,
         point_start=gathered.point_start,
         plan=gathered.plan,
         heights=gathered.heights,
-        depth_m=depth,
-        depth_mean_m=depth_mean,
+        depth_m=frames.depth_m,
+        depth_mean_m=frames.depth_mean_m,
         extent_m=extent,
         corners_gk=gathered.corners_gk,
         corners_m=corners_m,
@@ -390,9 +313,8 @@ def _table24(
     rows: NDArray,
     grid: NDArray,
     map_scale: int | None,
-    depth: NDArray,
+    frames: PairFrames,
     extent: NDArray,
-    frames: tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]],
     spec: InstrumentSpec,
     options: SetupOptions,
     name: str,
@@ -404,13 +326,13 @@ def _table24(
     heights = np.full((len(rows), width), np.nan)
     for j, h in enumerate(chosen):
         heights[j, : len(h)] = [p.local_m[2] for p in h]
-    theta, base_m, angles = frames
+    theta, base_m, angles = frames.frames
     return compute_table24(
         np.array([float(pairs[i]["focal_length_corrected_mm"]) for i in rows]),
         np.array([np.asarray(pairs[i]["marks_mm"], float) for i in rows]),
         gathered.centres_m[rows],
         gathered.rotations[rows],
-        depth[rows],
+        frames.depth_m[rows],
         grid,
         spec,
         heights_m=heights,
