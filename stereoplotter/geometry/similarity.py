@@ -156,7 +156,9 @@ class SimilarityFits:
 
     Made by :func:`fit_similarities_with_reflection`.
     ``a``, ``b``, ``cx_m``, ``cy_m``, ``rms_m``, ``redundancy`` have shape (G,);
-    ``residuals_m`` (n, 2) in the order of the points given, ``group`` (n,) their group.
+    ``residuals_m`` (n, 2) in the order of the points given, ``group`` (n,) their group;
+    ``order`` the points sorted by group (stably), group ``g``'s from ``start[g]`` to
+    ``start[g + 1]`` of it.
     """
 
     a: NDArray[np.float64]
@@ -167,12 +169,15 @@ class SimilarityFits:
     rms_m: NDArray[np.float64]
     redundancy: NDArray[np.int64]
     group: NDArray[np.intp]
+    order: NDArray[np.intp]
+    start: NDArray[np.intp]
 
     def fit(self, g: int) -> SimilarityFit:
         """Group ``g`` as a :class:`SimilarityFit` (its residuals in the order given)."""
         return SimilarityFit(
             float(self.a[g]), float(self.b[g]), float(self.cx_m[g]), float(self.cy_m[g]),
-            self.residuals_m[self.group == g], float(self.rms_m[g]), int(self.redundancy[g]),
+            self.residuals_m[self.order[self.start[g] : self.start[g + 1]]],
+            float(self.rms_m[g]), int(self.redundancy[g]),
         )  # fmt: skip
 
 
@@ -252,4 +257,4 @@ def fit_similarities_with_reflection(
     fitted_y = -a[idx] * yg + b[idx] * xg + cy[idx]
     residuals = np.stack([fitted_x - X, fitted_y - Y], axis=-1)
     rms = np.sqrt(total(residuals[:, 0] ** 2 + residuals[:, 1] ** 2) / count)
-    return SimilarityFits(a, b, cx, cy, residuals, rms, 2 * count - 4, idx)
+    return SimilarityFits(a, b, cx, cy, residuals, rms, 2 * count - 4, idx, order, start)

@@ -146,22 +146,22 @@ def _check_settings(table: BlockResult) -> None:
 def _photo_setups(table: BlockResult, marks_mm: NDArray) -> tuple[PhotoSetup, ...]:
     """The per-photo settings of pair 0 of ``table``; ``marks_mm`` shape (2, 4, 2)."""
     photos = []
+    marks = marks_mm.tolist()
+    angles, fid = table.angles[0].tolist(), table.fiducials_transformed_mm[0].tolist()
+    rigorous, spans = table.fiducials_rigorous_mm[0].tolist(), table.mark_span_mm[0].tolist()
+    dec, incl = table.decentration_mm[0].tolist(), table.correction_inclination[0].tolist()
     for j, (name, n) in enumerate((("left", table.n_left[0]), ("right", table.n_right[0]))):
         x_mark = X_MARK_NAME[j]
-        fid = table.fiducials_transformed_mm[0, j]
         photos.append(
             PhotoSetup(
                 name,
-                *(float(v) for v in table.angles[0, j]),
-                {str(i + 1): (float(m[0]), float(m[1])) for i, m in enumerate(marks_mm[j])},
-                {f"x{x_mark}": float(fid[0]), "y3": float(fid[1]), "y4": float(fid[2])},
-                {
-                    key: tuple(float(v) for v in table.fiducials_rigorous_mm[0, j, m])
-                    for m, key in enumerate((x_mark, "3", "4"))
-                },
-                float(table.mark_span_mm[0, j]),
-                tuple(float(v) for v in table.decentration_mm[0, j]),
-                tuple(float(v) for v in table.correction_inclination[0, j]),
+                *angles[j],
+                {str(i + 1): (m[0], m[1]) for i, m in enumerate(marks[j])},
+                {f"x{x_mark}": fid[j][0], "y3": fid[j][1], "y4": fid[j][2]},
+                {key: tuple(rigorous[j][m]) for m, key in enumerate((x_mark, "3", "4"))},
+                spans[j],
+                tuple(dec[j]),
+                tuple(incl[j]),
                 float(n),
             )
         )
@@ -339,6 +339,7 @@ def sheet_of_block(
     fit = None if block.fits is None or block.fit_row[i] < 0 else block.fits.fit(block.fit_row[i])
     corners_gk = None if inputs["map_sheet"] is None else block.corners_gk[i]
     centre_z = float(np.asarray(inputs["centres_m"], float)[0, 2])
+    heights_mm = table.control_heights_model_mm[0].tolist()
     sheet = SetupSheet(
         scenario=inputs["name"],
         instrument=spec.key,
@@ -364,7 +365,7 @@ def sheet_of_block(
                 "flying_height_m": float(centre_z - p.local_m[2]),
                 "model_height_mm": float(z),
             }
-            for p, z in zip(block.heights[i], table.control_heights_model_mm[0], strict=True)
+            for p, z in zip(block.heights[i], heights_mm, strict=True)
         ),  # (6.6)
         similarity=fit,
         similarity_point_ids=tuple(points[j].id for j in block.plan[i]),
