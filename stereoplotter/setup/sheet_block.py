@@ -169,6 +169,8 @@ def _extent(ground_m: NDArray, start: NDArray, corners_m: NDArray) -> NDArray[np
     """Stage 3: per pair the plan extent (X, Y) × (min, max) of its ground samples, points and
     sheet corners on the ground (NaN: none). [m]"""
     cuts = start[:-1]
+    if len(cuts) == 0:
+        return np.zeros((0, 2, 2))
     low = np.minimum.reduceat(ground_m[:, :2], cuts)
     high = np.maximum.reduceat(ground_m[:, :2], cuts)
     low = np.fmin(low, np.min(np.where(np.isnan(corners_m), np.inf, corners_m), axis=1))

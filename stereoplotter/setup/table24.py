@@ -400,7 +400,7 @@ def pair_frames(
     """
     theta, turn, base_m, angles = _turns(centres_m, rotations)
     count = len(theta)
-    runs = (len(run_start) - 1) // max(count, 1)
+    runs = max((len(run_start) - 1) // max(count, 1), 1)
     out = np.empty_like(ground_local_m)
     transposed = turn.transpose(0, 2, 1)  # R_Z(−θ)ᵀ of each pair
     origins = centres_m[:, 0]
@@ -410,6 +410,8 @@ def pair_frames(
     start = run_start[::runs]
     depths = -out[:, 2]  # Z_Sл − Z (S_л is the origin)
     cuts = start[:-1]
+    if count == 0:  # no pair: reduceat takes no empty list of cuts
+        return PairFrames(theta, base_m, angles, out, np.zeros((0, 2)), np.zeros(0))
     depth = np.stack([np.minimum.reduceat(depths, cuts), np.maximum.reduceat(depths, cuts)], -1)
     mean = group_sums(depths, start) / np.diff(start)
     return PairFrames(theta, base_m, angles, out, depth, mean)
