@@ -30,11 +30,7 @@ from stereoplotter.scenario.synthetic import (
     synthesize_measurements,
     working_area_grid_m,
 )
-from stereoplotter.setup.equations import (
-    corner_offsets_book_form_mm,
-    corner_offsets_mm,
-    decentration,
-)
+from stereoplotter.setup.equations import decentration
 from stereoplotter.setup.readings import stage_readings
 from stereoplotter.setup.records import (
     PhotoSetup,
@@ -168,25 +164,23 @@ def _photo_setups(table: BlockResult, marks_mm: NDArray) -> tuple[PhotoSetup, ..
     return tuple(photos)
 
 
-def _corners(
-    corners_gk: NDArray | None, corners_m: NDArray | None, mg: int, n_left: float
-) -> tuple[dict[str, object], ...]:
-    """(6.7): the sheet corners in instrument coordinates from the left plumb, from their ground
-    X, Y by (6.8) (computed once for the block, :func:`compute_sheet_block`)."""
-    if corners_gk is None or corners_m is None:
+def _corners(block: SheetBlock, i: int) -> tuple[dict[str, object], ...]:
+    """(6.7): pair ``i``'s sheet corners in instrument coordinates from the left plumb, from their
+    ground X, Y by (6.8), both computed for the block (:func:`compute_sheet_block`)."""
+    if block.inputs[i]["map_sheet"] is None or block.fit_row[i] < 0:
         return ()
-    xy = corner_offsets_mm(corners_m, mg)
-    xy_book = corner_offsets_book_form_mm(corners_m, n_left, n_left * mg)
+    gk = block.corners_gk[i].tolist()
+    xy, xy_book = block.corners_mm[i].tolist(), block.corners_book_form_mm[i].tolist()
     return tuple(
         {
             "corner": key,
             "position": CORNER_NAMES[key],
-            "gk_north_m": float(corners_gk[j, 0]),
-            "gk_east_m": float(corners_gk[j, 1]),
-            "x_mm": float(xy[j, 0]),
-            "y_mm": float(xy[j, 1]),
-            "x_book_form_mm": float(xy_book[j, 0]),
-            "y_book_form_mm": float(xy_book[j, 1]),
+            "gk_north_m": gk[j][0],
+            "gk_east_m": gk[j][1],
+            "x_mm": xy[j][0],
+            "y_mm": xy[j][1],
+            "x_book_form_mm": xy_book[j][0],
+            "y_book_form_mm": xy_book[j][1],
         }
         for j, key in enumerate(("1", "2", "3", "4"))
     )
@@ -337,7 +331,6 @@ def sheet_of_block(
     mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
     n_left = float(table.n_left[0])
     fit = None if block.fits is None or block.fit_row[i] < 0 else block.fits.fit(block.fit_row[i])
-    corners_gk = None if inputs["map_sheet"] is None else block.corners_gk[i]
     centre_z = float(np.asarray(inputs["centres_m"], float)[0, 2])
     heights_mm = table.control_heights_model_mm[0].tolist()
     sheet = SetupSheet(
@@ -369,7 +362,7 @@ def sheet_of_block(
         ),  # (6.6)
         similarity=fit,
         similarity_point_ids=tuple(points[j].id for j in block.plan[i]),
-        corners=_corners(corners_gk, None if fit is None else block.corners_m[i], mg, n_left),
+        corners=_corners(block, i),
         readings=(),
         tolerances=_tolerances(spec, n_left, float(block.depth_mean_m[i])),
         assumed=assumed_parameters(spec) if assumed is None else assumed,

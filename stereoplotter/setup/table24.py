@@ -366,10 +366,10 @@ class PairFrames:
     depth_m: NDArray[np.float64]
     depth_mean_m: NDArray[np.float64]
 
-    @property
-    def frames(self) -> tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]]:
-        """(θ, base, angles): the ``frames`` argument of :func:`compute_table24`."""
-        return self.theta, self.base_m, self.angles
+    def take(self, rows: NDArray) -> tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]]:
+        """(θ, base, angles) of the pairs ``rows``: the ``frames`` argument of
+        :func:`compute_table24`."""
+        return self.theta[rows], self.base_m[rows], tuple(a[rows] for a in self.angles)
 
 
 def pair_frames(
