@@ -36,6 +36,8 @@ def group_sums(values: ArrayLike, start: ArrayLike) -> NDArray[np.float64]:
     """
     v = np.asarray(values, float)
     first = np.asarray(start, np.intp)
+    if len(first) == 2:  # one group
+        return np.array([v[first[0] : first[1]].sum()])
     size = np.diff(first)
     out = np.zeros(len(size))
     for n in np.unique(size).tolist():

@@ -229,15 +229,15 @@ def fit_similarities_with_reflection(
 
     order = np.argsort(idx, kind="stable")
     start = np.concatenate([[0], np.cumsum(count)])
+    in_order = bool(np.all(idx[:-1] <= idx[1:]))  # the groups given one after the other
 
     def total(v: NDArray) -> NDArray:  # as numpy.sum of each group alone gives it
-        return group_sums(v[order], start)
+        return group_sums(v if in_order else v[order], start)
 
     mxg, myg, mX, mY = (total(v) / count for v in (xg, yg, X, Y))
     dx, dy, dX, dY = xg - mxg[idx], yg - myg[idx], X - mX[idx], Y - mY[idx]
     spread = total(dx**2 + dy**2)
-    largest = np.zeros(groups)
-    np.maximum.at(largest, idx, np.maximum(np.abs(xg), np.abs(yg)))
+    largest = np.maximum.reduceat(np.maximum(np.abs(xg), np.abs(yg))[order], start[:-1])
     extent = np.maximum(1.0, largest)
     flat = spread <= (1e-9 * extent) ** 2
     if flat.any():
