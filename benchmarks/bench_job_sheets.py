@@ -7,8 +7,12 @@ The 8 pairs of ``jobs/strip8`` are repeated up to ``--pairs`` pairs and timed en
 
 * **measured inputs** — ``io.job_file.measured_pair`` per pair (SK-42 → the pair's local frame,
   f′, the pair's points, the working area);
-* **sheets** — ``setup.sheet.compute_sheets_from_measurements``: frame, (6.8), Table 24 of all
-  pairs in one call, corners, scale candidates and readings per pair;
+* **sheet block** — ``setup.sheet_block.compute_sheet_block``: the columns of all pairs' sheets
+  (frame, ground in it, (6.8) over pairs of unequal point counts, sheet corners, Table 24 with
+  the scale choice), no per-pair record;
+* **sheets** — ``setup.sheet.compute_sheets_from_measurements``: the block, then each pair's
+  record (``SetupSheet`` with its stage readings, ``setup.sheet.sheet_of_block``) as a job
+  builds them before printing;
 * **scale-candidate tables** — ``setup.table24.candidates_of`` per pair (the candidate table
   that ``sheet.yaml`` prints), timed alone on the same Table 24;
 
@@ -40,6 +44,7 @@ from stereoplotter.io.job_file import load_job, measured_pair
 from stereoplotter.report.job import job_files
 from stereoplotter.setup.records import SetupOptions
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
+from stereoplotter.setup.sheet_block import compute_sheet_block
 from stereoplotter.setup.table24 import candidates_of
 
 JOB = Path(__file__).resolve().parents[1] / "jobs" / "strip8" / "job.yaml"
@@ -85,6 +90,9 @@ def main() -> None:
 
     measured, t_measured = _timed(lambda: [measured_pair(big, p) for p in big.pairs])
     arguments = [m.sheet_arguments() for m in measured]
+    block, t_block = _timed(
+        compute_sheet_block, arguments, spec=spec, options=options, source=job.source
+    )
     sheets, t_sheets = _timed(
         compute_sheets_from_measurements, arguments, spec=spec, options=options,
         source=job.source,
@@ -94,7 +102,8 @@ def main() -> None:
     result, t_job = _timed(compute_job, big, spec)
     assert all(p.accepted for p in result.pairs)
     print(f"measured inputs:  {_rate(len(measured), t_measured)}")
-    print(f"sheets:           {_rate(len(sheets), t_sheets)}")
+    print(f"sheet block:      {_rate(len(block), t_block)}")
+    print(f"sheets (block + records): {_rate(len(sheets), t_sheets)}")
     print(f"scale-candidate tables (candidates_of): {_rate(len(tables), t_candidates)}")
     print(f"whole job (compute_job, inputs + sheets): {_rate(len(result.pairs), t_job)}")
 

@@ -21,8 +21,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import GeometryError
+from stereoplotter.geometry.grouped import group_sums
 
-__all__ = ["SimilarityFit", "apply_similarity", "fit_similarity_with_reflection"]
+__all__ = [
+    "SimilarityFit",
+    "SimilarityFits",
+    "apply_similarity",
+    "fit_similarities_with_reflection",
+    "fit_similarity_with_reflection",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -139,30 +146,115 @@ def fit_similarity_with_reflection(
             "similarity (6.8): expected four 1-D arrays of equal length, found shapes "
             f"{[v.shape for v in arrays]}"
         )
-    if n < 2:
+    fits = fit_similarities_with_reflection(np.zeros(n, np.intp), *arrays, groups=1)
+    return fits.fit(0)
+
+
+@dataclass(frozen=True, slots=True)
+class SimilarityFits:
+    """The fits of Eq. (6.8) of many groups of points at once.
+
+    Made by :func:`fit_similarities_with_reflection`.
+    ``a``, ``b``, ``cx_m``, ``cy_m``, ``rms_m``, ``redundancy`` have shape (G,);
+    ``residuals_m`` (n, 2) in the order of the points given, ``group`` (n,) their group;
+    ``order`` the points sorted by group (stably), group ``g``'s from ``start[g]`` to
+    ``start[g + 1]`` of it.
+    """
+
+    a: NDArray[np.float64]
+    b: NDArray[np.float64]
+    cx_m: NDArray[np.float64]
+    cy_m: NDArray[np.float64]
+    residuals_m: NDArray[np.float64]
+    rms_m: NDArray[np.float64]
+    redundancy: NDArray[np.int64]
+    group: NDArray[np.intp]
+    order: NDArray[np.intp]
+    start: NDArray[np.intp]
+
+    def fit(self, g: int) -> SimilarityFit:
+        """Group ``g`` as a :class:`SimilarityFit` (its residuals in the order given)."""
+        return SimilarityFit(
+            float(self.a[g]), float(self.b[g]), float(self.cx_m[g]), float(self.cy_m[g]),
+            self.residuals_m[self.order[self.start[g] : self.start[g + 1]]],
+            float(self.rms_m[g]), int(self.redundancy[g]),
+        )  # fmt: skip
+
+
+def fit_similarities_with_reflection(
+    group: ArrayLike,
+    gk_north_m: ArrayLike,
+    gk_east_m: ArrayLike,
+    X_m: ArrayLike,
+    Y_m: ArrayLike,
+    *,
+    groups: int,
+) -> SimilarityFits:
+    r"""Least-squares fits of Eq. (6.8), one per group of points, of unequal point counts.
+
+    Parameters
+    ----------
+    group : array_like of int, shape (n,)
+        The group (0 … ``groups`` − 1) of each point.
+    gk_north_m, gk_east_m, X_m, Y_m : array_like, shape (n,)
+        As for :func:`fit_similarity_with_reflection`. [m]
+    groups : int
+        The number of groups; each must hold at least 2 points.
+
+    Returns
+    -------
+    SimilarityFits
+
+    Raises
+    ------
+    GeometryError
+        A group with fewer than 2 points, a non-finite value, or a group whose points coincide.
+
+    Notes
+    -----
+    The solution of :func:`fit_similarity_with_reflection` (which calls this with one group):
+    each group's sums are those of ``numpy.sum`` over the group alone, to the bit.
+    """
+    idx = np.asarray(group, np.intp)
+    xg, yg, X, Y = (np.asarray(v, float) for v in (gk_north_m, gk_east_m, X_m, Y_m))
+    count = np.bincount(idx, minlength=groups)
+    if groups < 1 or count.min() < 2:
+        n = 0 if groups < 1 else int(count.min())
         raise GeometryError(
             f"similarity (6.8): expected at least 2 control points with X_г, Y_г and X_Ф, Y_Ф, "
             f"found {n}"
         )
-    if not all(np.all(np.isfinite(v)) for v in arrays):
+    if not all(np.all(np.isfinite(v)) for v in (xg, yg, X, Y)):
         raise GeometryError("similarity (6.8): control point coordinates must be finite")
-    xg, yg, X, Y = arrays
-    mxg, myg, mX, mY = (float(v.mean()) for v in arrays)
-    dx, dy, dX, dY = xg - mxg, yg - myg, X - mX, Y - mY
-    spread = float(np.sum(dx**2 + dy**2))
-    extent = max(1.0, float(np.max(np.abs(np.concatenate([xg, yg])))))
-    if spread <= (1e-9 * extent) ** 2:
+
+    order = np.argsort(idx, kind="stable")
+    start = np.concatenate([[0], np.cumsum(count)])
+    in_order = bool(np.all(idx[:-1] <= idx[1:]))  # the groups given one after the other
+
+    def total(v: NDArray) -> NDArray:  # as numpy.sum of each group alone gives it
+        return group_sums(v if in_order else v[order], start)
+
+    mxg, myg, mX, mY = (total(v) / count for v in (xg, yg, X, Y))
+    dx, dy, dX, dY = xg - mxg[idx], yg - myg[idx], X - mX[idx], Y - mY[idx]
+    spread = total(dx**2 + dy**2)
+    largest = np.maximum.reduceat(np.maximum(np.abs(xg), np.abs(yg))[order], start[:-1])
+    extent = np.maximum(1.0, largest)
+    flat = spread <= (1e-9 * extent) ** 2
+    if flat.any():
+        g = int(np.flatnonzero(flat)[0])
         raise GeometryError(
-            f"similarity (6.8): the {n} control points coincide in X_г, Y_г (spread "
-            f"{np.sqrt(spread):.3g} m); a and b are undetermined: give points at least "
+            f"similarity (6.8): the {count[g]} control points coincide in X_г, Y_г (spread "
+            f"{np.sqrt(spread[g]):.3g} m); a and b are undetermined: give points at least "
             "a few hundred metres apart"
         )
     # Normal equations of the centred problem: they are diagonal, N = spread·I.
-    a = float(np.sum(dx * dX - dy * dY)) / spread
-    b = float(np.sum(dy * dX + dx * dY)) / spread
+    a = total(dx * dX - dy * dY) / spread
+    b = total(dy * dX + dx * dY) / spread
     cx = mX - a * mxg - b * myg
     cy = mY + a * myg - b * mxg
-    fit = SimilarityFit(a, b, cx, cy, np.zeros((n, 2)), 0.0, 2 * n - 4)
-    residuals = apply_similarity(fit, xg, yg) - np.stack([X, Y], axis=-1)
-    rms = float(np.sqrt(np.mean(np.sum(residuals**2, axis=-1))))
-    return SimilarityFit(a, b, cx, cy, residuals, rms, 2 * n - 4)
+    # Eq. (6.8) at the points (apply_similarity's expressions, per group) minus X_Ф, Y_Ф
+    fitted_x = a[idx] * xg + b[idx] * yg + cx[idx]
+    fitted_y = -a[idx] * yg + b[idx] * xg + cy[idx]
+    residuals = np.stack([fitted_x - X, fitted_y - Y], axis=-1)
+    rms = np.sqrt(total(residuals[:, 0] ** 2 + residuals[:, 1] ** 2) / count)
+    return SimilarityFits(a, b, cx, cy, residuals, rms, 2 * count - 4, idx, order, start)

@@ -6,8 +6,10 @@ embedded TrueType subsets), through its low-level calls for the tables and parag
 lines are broken here by the font's advance widths, remembered per string, and drawn with
 ``text`` and ``line`` — fpdf2's own ``table`` and ``multi_cell`` measured every fragment again at
 each character (≈ 80 % of a form's time in the profile of issue 27). The fonts are parsed once
-per process and each font subset compiled once per set of glyphs (:meth:`Form.output`).
-The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
+per process and each font subset compiled once per set of glyphs (:meth:`Form.output`). A
+document of many forms takes each form's pages as drawn for the form alone, their text
+re-encoded to its own font subsets and their footers numbered in it (:meth:`Form.append_pages`):
+no form is laid out twice. The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
 font that ships inside matplotlib (``mpl-data/fonts/ttf``), found without importing matplotlib,
 so no system font is read.
 """
@@ -18,14 +20,16 @@ import copy
 import datetime as _dt
 import importlib.util
 import io
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from fontTools import ttLib
 from fpdf import FPDF
-from fpdf.enums import XPos, YPos
+from fpdf.enums import TextMode, XPos, YPos
 from fpdf.fonts import SubsetMap, TTFFont
+from fpdf.util import escape_parens
 
 __all__ = ["FONT", "Form", "LabelPlacer", "font_path", "heading", "paragraph", "table"]
 
@@ -146,6 +150,114 @@ class Form(FPDF):
         self.set_creator("stereoplotter")
         self.footer_text = ""
         self.page_word = page_word
+        #: Per page, its body (the content before its footer) and the drawing state after it
+        #: (:meth:`append_pages` copies the body and draws the footer again).
+        self.page_ends: dict[int, tuple[bytes, dict[str, Any]]] = {}
+        #: Per font index, each character's code in this document's subset (:meth:`text`).
+        self._codes: dict[int, dict[str, str]] = {}
+        #: Per font index, each text as its "(…) Tj" operand in this document.
+        self._encoded: dict[int, dict[str, str]] = {}
+
+    def text(self, x: float, y: float, text: str = "") -> None:
+        """fpdf2's ``text`` for what the forms draw (filled text, no underline, a TrueType
+        font): the same bytes, each text encoded once per document (fpdf2 maps every character
+        through its subset again at every call; its ``text`` was 36 % of ``job_files``' time,
+        its ``encode_text`` 17 %, by cProfile of strip8 × 5, issue 27)."""
+        font = self.current_font
+        if (not self.page or not self.font_family or self.buffer or self.underline
+                or self.strikethrough or self.text_mode != TextMode.FILL
+                or self._record_text_quad_points or not isinstance(font, TTFFont)
+                or font.is_symbol or font.color_font):  # fmt: skip
+            super().text(x, y, text)  # pragma: no cover - the forms draw none of these
+            return
+        if not self.current_font_is_set_on_page:
+            self._out(self._set_font_for_page(font, self.font_size_pt))
+        encoded = self._encoded.setdefault(font.i, {}).get(text)
+        if encoded is None:
+            codes = self._codes.setdefault(font.i, {})
+            mapped = []
+            for char in text:
+                code = codes.get(char)
+                if code is None:
+                    picked = font.subset.pick(ord(char))
+                    code = codes[char] = "" if picked is None else chr(picked)
+                mapped.append(code)
+            encoded = self._encoded[font.i][text] = _operand("".join(mapped))
+        line = f"BT {x * self.k:.2f} {(self.h - y) * self.k:.2f} Td {encoded} ET"
+        if self.fill_color != self.text_color:
+            line = f"q {self.text_color.serialize().lower()} {line} Q"
+        self._out(line)
+
+    def append_pages(self, source: Form) -> None:
+        """Append the pages of ``source`` (a :class:`Form` already output) as drawn there: each
+        page's body copied, its text re-encoded to this document's font subsets, its footer
+        drawn again here (with this document's page number). No page is laid out again; the
+        pages look as in ``source`` (the PDF page starts from the default graphics state, so a
+        page's content does not depend on the page before it)."""
+        codes: dict[int, dict[int, int]] = {}
+        operands: dict[tuple[int, bytes], bytes] = {}
+        for number in range(1, source.page + 1):
+            body, state = source.page_ends[number]
+            if self.page > 0:
+                self._render_footer()
+            label = None if self.page == 0 else self.pages[self.page].get_page_label()
+            self._beginpage("", "", False, self.page_duration, self.page_transition)
+            self.pages[self.page].set_page_label(label, None)
+            self.pages[self.page].contents.extend(self._reencoded(body, source, codes, operands))
+            for (page, kind), names in list(source._resource_catalog.resources_per_page.items()):
+                if page == number:
+                    self._resource_catalog.resources_per_page[(self.page, kind)].update(names)
+            self._set_state(state)
+
+    def _reencoded(
+        self,
+        body: bytes,
+        source: Form,
+        codes: dict[int, dict[int, int]],
+        operands: dict[tuple[int, bytes], bytes],
+    ) -> bytes:
+        """``body`` of a page of ``source`` with every "(…) Tj" operand mapped from the
+        source's subset codes to this document's (the font of each from the "Tf" before it);
+        ``codes`` and ``operands`` remember the mapping for the pages of one source."""
+        own = {f.i: f for f in self.fonts.values()}
+        theirs = {f.i: f for f in source.fonts.values()}
+        current = [0]
+
+        def swap(match: re.Match[bytes]) -> bytes:
+            if match.group(1) is not None:
+                current[0] = int(match.group(1))
+                return match.group(0)
+            index = current[0]
+            done = operands.get((index, match.group(2)))
+            if done is not None:
+                return done
+            table = codes.get(index)
+            if table is None:
+                target = own[index].subset
+                table = codes[index] = {
+                    code: target.pick_glyph(glyph)
+                    for glyph, code in theirs[index].subset.items()
+                    if glyph is not None
+                }
+            text = _UNESCAPE.sub(_unescape, match.group(2)).decode("utf-16-be")
+            done = _operand("".join(chr(table[ord(c)]) for c in text)).encode("latin-1")
+            operands[(index, match.group(2))] = done
+            return done
+
+        if b"(" in _TOKENS.sub(b"", body):  # pragma: no cover - text not written by the forms
+            raise RuntimeError("a page holds text other than (…) Tj operands: not copied")
+        return _TOKENS.sub(swap, body)
+
+    def _state(self) -> dict[str, Any]:
+        state = {name: getattr(self, name) for name in _STATE}
+        state["current_font"] = None if self.current_font is None else self.current_font.fontkey
+        return state
+
+    def _set_state(self, state: dict[str, Any]) -> None:
+        for name, value in state.items():
+            setattr(self, name, value)
+        if state["current_font"] is not None:
+            self.current_font = self.fonts[state["current_font"]]
 
     def output(self, *args: Any, **kwargs: Any) -> Any:
         """The document's bytes, with each font's subset taken from :data:`_SUBSETS` when an
@@ -182,6 +294,7 @@ class Form(FPDF):
                 close()
 
     def footer(self) -> None:
+        self.page_ends[self.page] = (bytes(self.pages[self.page].contents), self._state())
         self.set_y(-MARGIN_BOTTOM + 5)
         self.set_font(FONT, "", 7)
         self.set_text_color(90)
@@ -189,6 +302,26 @@ class Form(FPDF):
         self.set_x(self.l_margin)
         self.cell(0, 4, f"{self.page_word} {self.page_no()}", align="R")
         self.set_text_color(0)
+
+
+#: The drawing state a page's footer starts from (:meth:`Form.append_pages`).
+_STATE = (
+    "font_family", "font_style", "font_size_pt", "current_font", "current_font_is_set_on_page",
+    "line_width", "draw_color", "fill_color", "text_color", "underline", "strikethrough",
+    "font_stretching", "char_spacing", "dash_pattern", "footer_text",
+)  # fmt: skip
+#: A content stream's font selections and text operands (the forms write only "(…) Tj").
+_TOKENS = re.compile(rb"/F(\d+) [-+]?[0-9.]+ Tf|\(((?:\\.|[^\\)])*)\) Tj", re.S)
+_UNESCAPE = re.compile(rb"\\(.)", re.S)
+
+
+def _unescape(match: re.Match[bytes]) -> bytes:
+    return b"\r" if match.group(1) == b"r" else match.group(1)
+
+
+def _operand(codes: str) -> str:
+    """A "(…) Tj" operand of subset codes, as fpdf2's ``TTFFont.encode_text`` writes it."""
+    return f"({escape_parens(codes.encode('utf-16-be').decode('latin-1'))}) Tj"
 
 
 def heading(pdf: Form, text: str, size: float = 11.0) -> None:

@@ -38,7 +38,7 @@ from stereoplotter.report.form_layout import FONT, Form, LabelPlacer, heading, p
 from stereoplotter.report.sheet import instrument_settings
 from stereoplotter.setup.records import SetupSheet
 
-__all__ = ["FormHeader", "LeastCounts", "form_pdf", "forms_pdf", "page1_sizes"]
+__all__ = ["FormHeader", "LeastCounts", "form_pdf", "form_pdfs", "forms_pdf"]
 
 #: Font sizes of page 1 tried in turn until the readings summary ends on page 1.
 _PAGE1_SIZES = (6.5, 6.0, 5.5, 5.0, 4.5)
@@ -351,51 +351,31 @@ def _page_drawing(pdf: Form, sheet: SetupSheet, lang: str) -> None:
     paragraph(pdf, term("legend", lang) + f" θ = {math.degrees(sheet.frame_rotation):.4f}°.", 7.5)
 
 
-def _page1_size(
-    trial: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool
-) -> float:
-    """The largest font size of :data:`_PAGE1_SIZES` at which page 1 holds its readings, laid
-    out on fresh pages of ``trial`` (a throwaway document shared by all the forms of a call of
-    :func:`page1_sizes`, so its fonts load once)."""
-    for size in _PAGE1_SIZES:
-        trial.add_page()
-        first = trial.page_no()
-        _page_summary(trial, sheet, header, lang, rigorous, size)
-        if trial.page_no() == first:
-            return size
-    return _PAGE1_SIZES[-1]
-
-
-def page1_sizes(
-    forms: Sequence[tuple[SetupSheet, FormHeader]], lang: str = "en", rigorous: bool = False
-) -> list[float]:
-    """The page-1 font size of each form (:func:`_page1_size`), found once: a job passes them to
-    both :func:`form_pdf` and :func:`forms_pdf`, which then lay out each form once."""
-    check_language(lang)
-    if not forms:
-        return []
-    trial = Form(forms[0][1].date)
-    try:
-        return [_page1_size(trial, sheet, header, lang, rigorous) for sheet, header in forms]
-    finally:
-        trial.close_fonts()
-
-
-def _add_form(
-    pdf: Form, sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool, size: float
-) -> None:
-    pdf.footer_text = (
-        f"{header.job} · {term('pair', lang)} {header.pair} ({header.left_photo}, "
-        f"{header.right_photo}) · {sheet.instrument} · {header.date} · {header.program}"
-    )
-    pdf.add_page()
-    _page_summary(pdf, sheet, header, lang, rigorous, size)
+def _form_document(
+    sheet: SetupSheet, header: FormHeader, lang: str, rigorous: bool, size: float | None = None
+) -> Form:
+    """The form of one pair laid out (not yet output): page 1 at the largest font size of
+    :data:`_PAGE1_SIZES` at which it holds its readings (``size``: that size, known), each
+    size tried on a fresh document, the rest of the form laid out once after it."""
+    for trial in (_PAGE1_SIZES if size is None else (size,)):
+        pdf = Form(header.date, term("page", lang))
+        pdf.set_title(f"{term('setup_data', lang)} {header.job} {header.pair}")
+        pdf.footer_text = (
+            f"{header.job} · {term('pair', lang)} {header.pair} ({header.left_photo}, "
+            f"{header.right_photo}) · {sheet.instrument} · {header.date} · {header.program}"
+        )
+        pdf.add_page()
+        _page_summary(pdf, sheet, header, lang, rigorous, trial)
+        if pdf.page_no() == 1 or trial == _PAGE1_SIZES[-1] or size is not None:
+            break
+        pdf.close_fonts()
     pdf.add_page()
     _page_readings(pdf, sheet, header, lang, rigorous)
     pdf.add_page()
     _page_details(pdf, sheet, header, lang)
     pdf.add_page()
     _page_drawing(pdf, sheet, lang)
+    return pdf
 
 
 def form_pdf(
@@ -408,11 +388,33 @@ def form_pdf(
     """The form of one pair as PDF bytes (the same inputs give the same bytes).
 
     ``lang``: ``"ru"`` or ``"en"``; ``rigorous``: print the rigorous (3.17) mark targets and
-    spans as the values to set (the book's beside them); ``size``: page 1's font size from
-    :func:`page1_sizes` (found here when not given).
+    spans as the values to set (the book's beside them); ``size``: page 1's font size (found
+    here when not given).
     """
-    return forms_pdf([(sheet, header)], f"{term('setup_data', lang)} {header.job} {header.pair}",
-                     header.date, lang, rigorous, None if size is None else [size])  # fmt: skip
+    check_language(lang)
+    return bytes(_form_document(sheet, header, lang, rigorous, size).output())
+
+
+def form_pdfs(
+    forms: Sequence[tuple[SetupSheet, FormHeader]],
+    title: str,
+    date: str,
+    lang: str = "en",
+    rigorous: bool = False,
+) -> tuple[list[bytes], bytes]:
+    """The form of each pair (:func:`form_pdf`) and all of them in one PDF (the combined
+    print of a block), each form laid out once: the combined document takes each form's pages
+    as drawn (:meth:`Form.append_pages`: the text re-encoded to its font subsets, the footers
+    numbered in it)."""
+    check_language(lang)
+    combined = Form(date, term("page", lang))
+    combined.set_title(title)
+    singles = []
+    for sheet, header in forms:
+        pdf = _form_document(sheet, header, lang, rigorous)
+        singles.append(bytes(pdf.output()))
+        combined.append_pages(pdf)
+    return singles, bytes(combined.output())
 
 
 def forms_pdf(
@@ -421,14 +423,6 @@ def forms_pdf(
     date: str,
     lang: str = "en",
     rigorous: bool = False,
-    sizes: Sequence[float] | None = None,
 ) -> bytes:
-    """The forms of many pairs in one PDF (the combined print of a block); ``sizes``: their
-    page-1 font sizes from :func:`page1_sizes` (found here when not given)."""
-    check_language(lang)
-    sizes = page1_sizes(forms, lang, rigorous) if sizes is None else sizes
-    pdf = Form(date, term("page", lang))
-    pdf.set_title(title)
-    for (sheet, header), size in zip(forms, sizes, strict=True):
-        _add_form(pdf, sheet, header, lang, rigorous, size)
-    return bytes(pdf.output())
+    """The forms of many pairs in one PDF (the combined print of a block)."""
+    return form_pdfs(forms, title, date, lang, rigorous)[1]

@@ -25,7 +25,7 @@ from stereoplotter import __version__
 from stereoplotter.glossary import check_language, term
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
-from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdf, forms_pdf, page1_sizes
+from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdfs
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupSheet
 from stereoplotter.spec.instrument_spec import InstrumentSpec
@@ -234,12 +234,11 @@ def job_files(result: JobResult, lang: str = "en", rigorous: bool = False) -> di
         files[f"{p.pair.name}/sheet.pdf"] = b""  # in the order of the files before
         forms.append((p.sheet, header))
         names.append(p.pair.name)
-    sizes = page1_sizes(forms, lang, rigorous)  # once: each form is then laid out once per PDF
-    for name, (sheet, header), size in zip(names, forms, sizes, strict=True):
-        files[f"{name}/sheet.pdf"] = form_pdf(sheet, header, lang, rigorous, size)
-    if forms:
+    if forms:  # each form laid out once, for its sheet.pdf and for forms.pdf
         title = f"{term('setup_data', lang)}: {result.job.name}"
-        files["forms.pdf"] = forms_pdf(forms, title, result.job.date, lang, rigorous, sizes)
+        singles, files["forms.pdf"] = form_pdfs(forms, title, result.job.date, lang, rigorous)
+        for name, data in zip(names, singles, strict=True):
+            files[f"{name}/sheet.pdf"] = data
     files["block.csv"] = block_csv(result).encode("utf-8")
     files["refused.md"] = refused_markdown(result).encode("utf-8")
     return files

@@ -427,17 +427,18 @@ def sheet_corner_instrument_coordinates(
 
 def corner_offsets_mm(
     corners_ground_m: ArrayLike,
-    horizontal_scale_denominator: float,
+    horizontal_scale_denominator: ArrayLike,
     origin_m: ArrayLike = (0.0, 0.0),
 ) -> NDArray[np.float64]:
     r"""The scaling half of Eq. (6.7): x′, y′ of corners already on the ground by (6.8).
 
     ``corners_ground_m`` shape (..., 2): X_Ф, Y_Ф of the corners [m] (the sheet computes them
-    once for the carriage extent and the readings); returns x′, y′ [mm] as
+    once for the carriage extent and the readings); ``horizontal_scale_denominator`` M_г, one or
+    one per pair (broadcast against the corners); returns x′, y′ [mm] as
     :func:`sheet_corner_instrument_coordinates`.
     """
     xy = _a(corners_ground_m) - _a(origin_m)
-    return xy * MM_PER_M / float(horizontal_scale_denominator)
+    return xy * MM_PER_M / _a(horizontal_scale_denominator)
 
 
 def sheet_corner_instrument_coordinates_book_form(
@@ -461,11 +462,12 @@ def sheet_corner_instrument_coordinates_book_form(
 
 def corner_offsets_book_form_mm(
     corners_ground_m: ArrayLike,
-    n: float,
-    photo_scale_denominator: float,
+    n: ArrayLike,
+    photo_scale_denominator: ArrayLike,
     origin_m: ArrayLike = (0.0, 0.0),
 ) -> NDArray[np.float64]:
     """The printed (6.7) of corners already on the ground by (6.8), as
-    :func:`sheet_corner_instrument_coordinates_book_form`. [mm]"""
+    :func:`sheet_corner_instrument_coordinates_book_form` (``n`` and the denominator one or one
+    per pair, broadcast against the corners). [mm]"""
     xy = _a(corners_ground_m) - _a(origin_m)
-    return float(n) * xy * MM_PER_M / float(photo_scale_denominator)
+    return _a(n) * xy * MM_PER_M / _a(photo_scale_denominator)

@@ -16,20 +16,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M
-from stereoplotter.errors import StereoplotterError
-from stereoplotter.geometry.rotation import rotation_z
-from stereoplotter.geometry.similarity import (
-    SimilarityFit,
-    apply_similarity,
-    fit_similarity_with_reflection,
-)
 from stereoplotter.scenario.exterior import known_exterior_orientation
 from stereoplotter.scenario.model import MapSheet, Point, Scenario
 from stereoplotter.scenario.summary import flying_height_and_relief
@@ -37,11 +30,7 @@ from stereoplotter.scenario.synthetic import (
     synthesize_measurements,
     working_area_grid_m,
 )
-from stereoplotter.setup.equations import (
-    corner_offsets_book_form_mm,
-    corner_offsets_mm,
-    decentration,
-)
+from stereoplotter.setup.equations import decentration
 from stereoplotter.setup.readings import stage_readings
 from stereoplotter.setup.records import (
     PhotoSetup,
@@ -50,14 +39,14 @@ from stereoplotter.setup.records import (
     SetupRefusal,
     SetupSheet,
 )
-from stereoplotter.setup.scale_choice import candidate_scales, describe_candidate
+from stereoplotter.setup.scale_choice import describe_candidate
+from stereoplotter.setup.sheet_block import CORNER_ORDER, SheetBlock, compute_sheet_block
 from stereoplotter.setup.table24 import (
     SCALE_FLAGS,
     X_MARK_NAME,
     BlockResult,
     Refusal,
-    compute_table24,
-    instrument_frames,
+    instrument_frame_m,
 )
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.spec.limits import (
@@ -79,77 +68,13 @@ __all__ = [
     "compute_sheet_from_measurements",
     "compute_sheets_from_measurements",
     "instrument_frame_m",
+    "sheet_of_block",
 ]
 
-#: Sheet-corner numbering (decision, docs/setup-data.md): 1 = lower left, then counter-clockwise
-#: in map view, north up. The scenario stores corners NW, NE, SE, SW; this maps 1..4 to them.
-CORNER_ORDER = {"1": 3, "2": 2, "3": 1, "4": 0}
 CORNER_NAMES = {"1": "SW", "2": "SE", "3": "NE", "4": "NW"}
 
 
 # --- helpers --------------------------------------------------------------------------------
-
-
-def instrument_frame_m(
-    points_m: ArrayLike, frame_origin_m: ArrayLike, frame_rotation: float, *, inverse: bool = False
-) -> NDArray[np.float64]:
-    r"""Ground points in the instrument frame of the setup sheet (or back).
-
-    Parameters
-    ----------
-    points_m : array_like, shape (..., 3)
-        X, Y, Z in the photogrammetric frame of the scenario (``inverse=False``) or in the
-        instrument frame (``inverse=True``). [m]
-    frame_origin_m : array_like, shape (3,)
-        S_л, the origin of the instrument frame in the photogrammetric frame. [m]
-    frame_rotation : float
-        θ, the azimuth of the horizontal base in the photogrammetric frame. [rad]
-    inverse : bool
-        Map instrument-frame points back to the photogrammetric frame.
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        The points in the other frame. [m]
-
-    Notes
-    -----
-    ``docs/setup-data.md``, "The frame turn": the photogrammetric frame moved to S_л and turned
-    by −θ about Z, p = R_Z(−θ)(P − S_л), so that the base runs along +X.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> p = instrument_frame_m([10.0, 10.0, 0.0], [0.0, 0.0, 100.0], np.pi / 4)
-    >>> (np.round(p, 6) + 0.0).tolist()
-    [14.142136, 0.0, -100.0]
-    >>> back = instrument_frame_m(p, [0.0, 0.0, 100.0], np.pi / 4, inverse=True)
-    >>> (np.round(back, 9) + 0.0).tolist()
-    [10.0, 10.0, 0.0]
-    """
-    origin = np.asarray(frame_origin_m, float)
-    if inverse:
-        return np.asarray(points_m, float) @ rotation_z(frame_rotation).T + origin
-    return (np.asarray(points_m, float) - origin) @ rotation_z(-frame_rotation).T
-
-
-def _sheet_corners_gk(sheet: MapSheet) -> NDArray:
-    return np.array([sheet.corners_sk42_m[CORNER_ORDER[k]] for k in ("1", "2", "3", "4")])
-
-
-def _candidate_grid(
-    spec: InstrumentSpec, options: SetupOptions, map_scale: int | None
-) -> NDArray[np.float64]:
-    """Item 1 of §26: the (M_г, M_в) candidates (:mod:`stereoplotter.setup.scale_choice`)."""
-    try:
-        return candidate_scales(
-            spec,
-            map_scale,
-            options.horizontal_scale_denominator,
-            options.vertical_scale_denominator,
-        )
-    except StereoplotterError as exc:
-        raise SetupRefusal(f"{exc} (--horizontal-scale)") from None
 
 
 def _refuse_scales(table: BlockResult, extent_m: NDArray) -> None:
@@ -217,68 +142,45 @@ def _check_settings(table: BlockResult) -> None:
 def _photo_setups(table: BlockResult, marks_mm: NDArray) -> tuple[PhotoSetup, ...]:
     """The per-photo settings of pair 0 of ``table``; ``marks_mm`` shape (2, 4, 2)."""
     photos = []
+    marks = marks_mm.tolist()
+    angles, fid = table.angles[0].tolist(), table.fiducials_transformed_mm[0].tolist()
+    rigorous, spans = table.fiducials_rigorous_mm[0].tolist(), table.mark_span_mm[0].tolist()
+    dec, incl = table.decentration_mm[0].tolist(), table.correction_inclination[0].tolist()
     for j, (name, n) in enumerate((("left", table.n_left[0]), ("right", table.n_right[0]))):
         x_mark = X_MARK_NAME[j]
-        fid = table.fiducials_transformed_mm[0, j]
         photos.append(
             PhotoSetup(
                 name,
-                *(float(v) for v in table.angles[0, j]),
-                {str(i + 1): (float(m[0]), float(m[1])) for i, m in enumerate(marks_mm[j])},
-                {f"x{x_mark}": float(fid[0]), "y3": float(fid[1]), "y4": float(fid[2])},
-                {
-                    key: tuple(float(v) for v in table.fiducials_rigorous_mm[0, j, m])
-                    for m, key in enumerate((x_mark, "3", "4"))
-                },
-                float(table.mark_span_mm[0, j]),
-                tuple(float(v) for v in table.decentration_mm[0, j]),
-                tuple(float(v) for v in table.correction_inclination[0, j]),
+                *angles[j],
+                {str(i + 1): (m[0], m[1]) for i, m in enumerate(marks[j])},
+                {f"x{x_mark}": fid[j][0], "y3": fid[j][1], "y4": fid[j][2]},
+                {key: tuple(rigorous[j][m]) for m, key in enumerate((x_mark, "3", "4"))},
+                spans[j],
+                tuple(dec[j]),
+                tuple(incl[j]),
                 float(n),
             )
         )
     return tuple(photos)
 
 
-def _plan_control(
-    points: tuple[Point, ...], map_sheet: MapSheet | None, points_m: NDArray
-) -> tuple[SimilarityFit | None, list[int], NDArray | None, NDArray]:
-    """(6.8): the similarity from Gauss–Krüger to the instrument frame over the plan control, and
-    the sheet corners on the ground (empty without a map sheet or two plan points)."""
-    corners_gk = _sheet_corners_gk(map_sheet) if map_sheet is not None else None
-    plan = [
-        i
-        for i, p in enumerate(points)
-        if p.role == "control" and p.kind in ("full", "plan") and p.sk42_m is not None
-    ]
-    fit = None
-    corners_m = np.zeros((0, 2))
-    if corners_gk is not None and len(plan) >= 2:
-        north = np.array([points[i].sk42_m[0] for i in plan])
-        east = np.array([points[i].sk42_m[1] for i in plan])
-        fit = fit_similarity_with_reflection(north, east, points_m[plan, 0], points_m[plan, 1])
-        corners_m = apply_similarity(fit, corners_gk[:, 0], corners_gk[:, 1])  # (6.8), ground m
-    return fit, plan, corners_gk, corners_m
-
-
-def _corners(
-    corners_gk: NDArray | None, corners_m: NDArray, mg: int, n_left: float
-) -> tuple[dict[str, object], ...]:
-    """(6.7): the sheet corners in instrument coordinates from the left plumb, from their ground
-    X, Y by (6.8) (computed once, in :func:`_plan_control`)."""
-    if corners_gk is None or len(corners_m) == 0:
+def _corners(block: SheetBlock, i: int) -> tuple[dict[str, object], ...]:
+    """(6.7): pair ``i``'s sheet corners in instrument coordinates from the left plumb, from their
+    ground X, Y by (6.8), both computed for the block (:func:`compute_sheet_block`)."""
+    if block.inputs[i]["map_sheet"] is None or block.fit_row[i] < 0:
         return ()
-    xy = corner_offsets_mm(corners_m, mg)
-    xy_book = corner_offsets_book_form_mm(corners_m, n_left, n_left * mg)
+    gk = block.corners_gk[i].tolist()
+    xy, xy_book = block.corners_mm[i].tolist(), block.corners_book_form_mm[i].tolist()
     return tuple(
         {
             "corner": key,
             "position": CORNER_NAMES[key],
-            "gk_north_m": float(corners_gk[j, 0]),
-            "gk_east_m": float(corners_gk[j, 1]),
-            "x_mm": float(xy[j, 0]),
-            "y_mm": float(xy[j, 1]),
-            "x_book_form_mm": float(xy_book[j, 0]),
-            "y_book_form_mm": float(xy_book[j, 1]),
+            "gk_north_m": gk[j][0],
+            "gk_east_m": gk[j][1],
+            "x_mm": xy[j][0],
+            "y_mm": xy[j][1],
+            "x_book_form_mm": xy_book[j][0],
+            "y_book_form_mm": xy_book[j][1],
         }
         for j, key in enumerate(("1", "2", "3", "4"))
     )
@@ -293,12 +195,12 @@ def _points_model(points: tuple[Point, ...], points_m: NDArray, mg: int) -> tupl
     )
 
 
-def _tolerances(spec: InstrumentSpec, n_left: float, depths_m: NDArray) -> dict[str, float]:
+def _tolerances(spec: InstrumentSpec, n_left: float, depth_mean_m: float) -> dict[str, float]:
     return {
         "mark_span_mm": spec.tolerance_L_numerator_mm / n_left,
         "mark_fit_mm": spec.tolerance_mark_fit_per_n_mm * n_left,
         "residual_y_parallax_mm": spec.residual_q_fraction_of_mark * spec.mark_diameter_mm,
-        "control_height_m": spec.control_height_fraction_of_H * float(np.mean(depths_m)),
+        "control_height_m": spec.control_height_fraction_of_H * depth_mean_m,
         "corner_mm": spec.corner_tolerance_mm,
     }
 
@@ -405,162 +307,42 @@ def compute_setup_sheet(
     return sheet
 
 
-@dataclass(frozen=True, slots=True)
-class _Prepared:
-    """One pair's measured inputs turned into what Table 24 and the sheet need (no scales yet)."""
-
-    name: str
-    spec: InstrumentSpec
-    options: SetupOptions
-    focal_length_corrected_mm: float
-    focal_length_corrected_per_photo_mm: tuple[float, ...]
-    marks_mm: NDArray  # (2, 4, 2)
-    centres_m: NDArray  # (2, 3)
-    rotations: NDArray  # (2, 3, 3)
-    frames: tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]]  # of a block of one
-    points: tuple[Point, ...]
-    points_m: NDArray  # (p, 3) in the instrument frame
-    heights: tuple[Point, ...]
-    depths_m: NDArray  # (g,) Z_Sл − Z of the ground samples and points
-    depth_m: NDArray  # (2,) the shallowest, deepest
-    extent_m: NDArray  # (2, 2)
-    similarity: SimilarityFit | None
-    plan: list[int]
-    corners_gk: NDArray | None
-    corners_m: NDArray  # (4, 2) the sheet corners on the ground by (6.8), or (0, 2)
-    map_scale: int | None
-    grid: NDArray  # (C, 2)
-    exterior_sources: tuple[str, ...]
-
-
-def _prepare(
-    *,
-    name: str,
-    source: str,
-    spec: InstrumentSpec,
-    options: SetupOptions,
-    focal_length_corrected_mm: float,
-    focal_length_corrected_per_photo_mm: tuple[float, ...],
-    marks_mm: NDArray,
-    centres_m: NDArray,
-    rotations: NDArray,
-    points: tuple[Point, ...],
-    working_area_m: NDArray,
-    map_sheet: MapSheet | None,
-    exterior_sources: tuple[str, ...],
-    grids: dict[int | None, NDArray] | None = None,
-) -> _Prepared:
-    """The frame, the ground in it, the plan control (6.8) and the scale candidates of one pair
-    (``grids``: the candidates already built, by map scale, shared by the pairs of a call)."""
-    centres = np.asarray(centres_m, float)[None]  # (1, 2, 3)
-    rots = np.asarray(rotations, float)[None]  # (1, 2, 3, 3)
-    frames = instrument_frames(centres, rots)  # once: Table 24 takes it from here
-    theta = float(frames[0][0])
-    points_m = instrument_frame_m(
-        np.array([p.local_m for p in points], float).reshape(-1, 3), centres[0, 0], theta
-    )
-    grid_m = instrument_frame_m(working_area_m, centres[0, 0], theta)
-    ground = np.vstack([grid_m, points_m])
-    depths_m = -ground[:, 2]  # Z_Sл − Z (S_л is the origin)
-    fit, plan, corners_gk, corners_m = _plan_control(points, map_sheet, points_m)
-    offsets_m = np.vstack([ground[:, :2], corners_m])
-    map_scale = map_sheet.scale_denominator if map_sheet else None
-    if map_scale is None and options.horizontal_scale_denominator is None:
-        raise SetupRefusal(
-            f"{source}: map_sheet: expected a map sheet, whose scale chooses the "
-            "horizontal model scale M_г from the coordinatograph gears, found nothing (or force "
-            "M_г with --horizontal-scale)"
-        )
-    grids = {} if grids is None else grids
-    if map_scale not in grids:
-        grids[map_scale] = _candidate_grid(spec, options, map_scale)
-    grid = grids[map_scale]
-    return _Prepared(
-        name=name,
-        spec=spec,
-        options=options,
-        focal_length_corrected_mm=float(focal_length_corrected_mm),
-        focal_length_corrected_per_photo_mm=tuple(focal_length_corrected_per_photo_mm),
-        marks_mm=np.asarray(marks_mm, float),
-        centres_m=centres[0],
-        rotations=rots[0],
-        frames=frames,
-        points=tuple(points),
-        points_m=points_m,
-        heights=tuple(
-            p for p in points if p.role == "control" and p.kind in ("full", "height")
-        ),
-        depths_m=depths_m,
-        depth_m=np.array([depths_m.min(), depths_m.max()]),
-        extent_m=np.array([[offsets_m[:, j].min(), offsets_m[:, j].max()] for j in (0, 1)]),
-        similarity=fit,
-        plan=plan,
-        corners_gk=corners_gk,
-        corners_m=corners_m,
-        map_scale=map_scale,
-        grid=grid,
-        exterior_sources=tuple(exterior_sources),
-    )
-
-
-def _table24(pairs: Sequence[_Prepared], name: str) -> BlockResult:
-    """Table 24 of pairs that share the instrument, the options and the scale candidates, in one
-    :func:`compute_table24` call (per-pair f′ and marks)."""
-    first = pairs[0]
-    width = max(len(p.heights) for p in pairs)
-    heights = np.full((len(pairs), width), np.nan)
-    for i, p in enumerate(pairs):
-        heights[i, : len(p.heights)] = [h.local_m[2] for h in p.heights]
-    return compute_table24(
-        np.array([p.focal_length_corrected_mm for p in pairs]),
-        np.array([p.marks_mm for p in pairs]),
-        np.array([p.centres_m for p in pairs]),
-        np.array([p.rotations for p in pairs]),
-        np.array([p.depth_m for p in pairs]),
-        first.grid,
-        first.spec,
-        heights_m=heights,
-        extent_m=np.array([p.extent_m for p in pairs]),
-        map_scale_denominator=first.map_scale,
-        book_sign=first.options.book_sign_n_right,
-        model_names=tuple(p.name for p in pairs),
-        height_point_ids=tuple(tuple(h.id for h in p.heights) for p in pairs),
-        name=name,
-        frames=(
-            np.concatenate([p.frames[0] for p in pairs]),
-            np.concatenate([p.frames[1] for p in pairs]),
-            tuple(np.concatenate([p.frames[2][j] for p in pairs]) for j in range(3)),
-        ),
-    )
-
-
-def _finish(
-    prep: _Prepared, table: BlockResult, assumed: dict[str, tuple[str, ...]] | None = None
+def sheet_of_block(
+    block: SheetBlock, i: int, assumed: dict[str, tuple[str, ...]] | None = None
 ) -> SetupSheet:
-    """The sheet of a prepared pair from its Table 24 (a block of one), or its refusal.
+    """The sheet of pair ``i`` of a block (:func:`compute_sheet_block`), built from its columns
+    with the stage readings, or its refusal (raised).
 
     The range checks are Table 24's reason code, computed once for all pairs: only a refused
     pair goes through the checks again, for the words of its refusal."""
+    refusal = block.refusals[i]
+    if refusal is not None:
+        raise refusal
+    group, row = (int(v) for v in block.table_of[i])
+    table = block.tables[group].take(row)
+    extent = block.extent_m[i]
     code = int(table.reason_code[0])
     if code & SCALE_FLAGS:
-        _refuse_scales(table, prep.extent_m[None])
-    if code or float(np.abs(table.angles[0, :, :2]).max()) > prep.spec.tilt_max:
+        _refuse_scales(table, extent[None])
+    spec, options, inputs = block.spec, block.options, block.inputs[i]
+    if code or float(np.abs(table.angles[0, :, :2]).max()) > spec.tilt_max:
         _check_settings(table)  # the words of the refusal (_check_tilt has no slack)
-    spec, options, points, points_m = prep.spec, prep.options, prep.points, prep.points_m
+    points, points_m = tuple(inputs["points"]), block.points_of(i)
     mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
     n_left = float(table.n_left[0])
-    tolerances = _tolerances(spec, n_left, prep.depths_m)
-    assumed = assumed_parameters(spec) if assumed is None else assumed
+    fit = None if block.fits is None or block.fit_row[i] < 0 else block.fits.fit(block.fit_row[i])
+    centre_z = float(np.asarray(inputs["centres_m"], float)[0, 2])
+    heights_mm = table.control_heights_model_mm[0].tolist()
     sheet = SetupSheet(
-        scenario=prep.name,
+        scenario=inputs["name"],
         instrument=spec.key,
         instrument_title=spec.title,
         instrument_principle=spec.principle,
         frame_rotation=float(table.frame_rotation[0]),
         frame_origin_m=tuple(float(v) for v in table.frame_origin_m[0]),
         focal_length_corrected_mm=table.focal_length_of(0),
-        focal_length_corrected_per_photo_mm=prep.focal_length_corrected_per_photo_mm,
-        map_scale_denominator=prep.map_scale,
+        focal_length_corrected_per_photo_mm=tuple(inputs["focal_length_corrected_per_photo_mm"]),
+        map_scale_denominator=block.map_scales[i],
         horizontal_scale_denominator=mg,
         vertical_scale_denominator=mv,
         f_instrument_mm=float(table.f_instrument_mm[0]),
@@ -568,25 +350,25 @@ def _finish(
         n_left=n_left,
         n_right=float(table.n_right[0]),
         base_mm=tuple(float(v) for v in table.base_mm[0]),
-        photos=_photo_setups(table, prep.marks_mm),
+        photos=_photo_setups(table, np.asarray(inputs["marks_mm"], float)),
         control_heights=tuple(
             {
                 "id": p.id,
                 "Z_m": p.local_m[2],
-                "flying_height_m": float(prep.centres_m[0, 2] - p.local_m[2]),
+                "flying_height_m": float(centre_z - p.local_m[2]),
                 "model_height_mm": float(z),
             }
-            for p, z in zip(prep.heights, table.control_heights_model_mm[0], strict=True)
+            for p, z in zip(block.heights[i], heights_mm, strict=True)
         ),  # (6.6)
-        similarity=prep.similarity,
-        similarity_point_ids=tuple(points[i].id for i in prep.plan),
-        corners=_corners(prep.corners_gk, prep.corners_m, mg, n_left),
+        similarity=fit,
+        similarity_point_ids=tuple(points[j].id for j in block.plan[i]),
+        corners=_corners(block, i),
         readings=(),
-        tolerances=tolerances,
-        assumed=assumed,
+        tolerances=_tolerances(spec, n_left, float(block.depth_mean_m[i])),
+        assumed=assumed_parameters(spec) if assumed is None else assumed,
         options=options,
         depth_range_used_mm=tuple(float(v) for v in table.depth_range_mm[0]),
-        exterior_sources=prep.exterior_sources,
+        exterior_sources=tuple(inputs["exterior_sources"]),
         points_model_mm=_points_model(points, points_m, mg),
         table24=table,
     )
@@ -614,7 +396,7 @@ def compute_sheet_from_measurements(
     :func:`compute_setup_sheet` calls it with the synthetic measurements of a scenario; a
     production job (``stereoplotter.io.job_file``) with the measured fiducial spans and the
     exterior orientation of the aerotriangulation. No random numbers: the same inputs give the
-    same sheet.
+    same sheet. A block of one (:func:`compute_sheet_block`).
 
     Parameters
     ----------
@@ -642,23 +424,20 @@ def compute_sheet_from_measurements(
     exterior_sources : tuple of str
         Where each photo's exterior orientation came from (printed on the sheet).
     """
-    prep = _prepare(
-        name=name,
-        source=source,
-        spec=spec,
-        options=options,
-        focal_length_corrected_mm=focal_length_corrected_mm,
-        focal_length_corrected_per_photo_mm=focal_length_corrected_per_photo_mm,
-        marks_mm=marks_mm,
-        centres_m=centres_m,
-        rotations=rotations,
-        points=points,
-        working_area_m=working_area_m,
-        map_sheet=map_sheet,
-        exterior_sources=exterior_sources,
-    )
-    table = _table24([prep], name)
-    return _finish(prep, table)
+    pair = {
+        "name": name,
+        "focal_length_corrected_mm": focal_length_corrected_mm,
+        "focal_length_corrected_per_photo_mm": focal_length_corrected_per_photo_mm,
+        "marks_mm": marks_mm,
+        "centres_m": centres_m,
+        "rotations": rotations,
+        "points": points,
+        "working_area_m": working_area_m,
+        "map_sheet": map_sheet,
+        "exterior_sources": exterior_sources,
+    }
+    block = compute_sheet_block([pair], spec=spec, options=options, source=source, name=name)
+    return sheet_of_block(block, 0)
 
 
 def compute_sheets_from_measurements(
@@ -669,7 +448,8 @@ def compute_sheets_from_measurements(
     source: str,
     name: str = "job",
 ) -> list[SetupSheet | SetupRefusal]:
-    """The sheets of many pairs from their measurements, Table 24 of all of them in one call.
+    """The sheets of many pairs from their measurements: the block's columns in one pass
+    (:func:`compute_sheet_block`), then each pair's sheet built from them.
 
     Parameters
     ----------
@@ -685,30 +465,17 @@ def compute_sheets_from_measurements(
     -------
     list of SetupSheet or SetupRefusal
         In the order of ``pairs``: the sheet, or the refusal
-        :func:`compute_sheet_from_measurements` would raise for that pair. Each sheet is the one
-        :func:`compute_sheet_from_measurements` gives for the pair alone, to the bit: the pairs
-        go through :func:`compute_table24` together (one call per set of scale candidates, i.e.
-        per map scale) and each is taken out as a block of one (:meth:`BlockResult.take`).
+        :func:`compute_sheet_from_measurements` would raise for that pair.
     """
-    out: list[SetupSheet | SetupRefusal | None] = [None] * len(pairs)
-    groups: dict[bytes, list[tuple[int, _Prepared]]] = {}
-    grids: dict[int | None, NDArray] = {}  # the scale candidates of each map scale, once
+    block = compute_sheet_block(pairs, spec=spec, options=options, source=source, name=name)
     assumed = assumed_parameters(spec)
-    for i, arguments in enumerate(pairs):
+    out: list[SetupSheet | SetupRefusal] = []
+    for i in range(len(block)):
         try:
-            prep = _prepare(spec=spec, options=options, source=source, grids=grids, **arguments)
+            out.append(sheet_of_block(block, i, assumed))
         except SetupRefusal as exc:
-            out[i] = exc
-            continue
-        groups.setdefault(prep.grid.tobytes(), []).append((i, prep))
-    for members in groups.values():
-        table = _table24([p for _, p in members], name)
-        for j, (i, prep) in enumerate(members):
-            try:
-                out[i] = _finish(prep, table.take(j), assumed)
-            except SetupRefusal as exc:
-                out[i] = exc
-    return [r for r in out if r is not None]
+            out.append(exc)
+    return out
 
 
 def assumed_parameters(spec: InstrumentSpec) -> dict[str, tuple[str, ...]]:

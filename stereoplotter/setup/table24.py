@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.geometry.grouped import group_sums
 from stereoplotter.geometry.rotation import angles_from_matrix, rotation_matrix, rotation_z
 from stereoplotter.geometry.transformed import (
     transformed_coordinates,
@@ -68,10 +69,13 @@ __all__ = [
     "SCALE_FLAGS",
     "X_MARK_NAME",
     "BlockResult",
+    "PairFrames",
     "Refusal",
     "candidates_of",
     "compute_table24",
+    "instrument_frame_m",
     "instrument_frames",
+    "pair_frames",
     "reason_text",
 ]
 
@@ -273,12 +277,144 @@ def instrument_frames(
     (alpha, omega, kappa) : ndarrays, shape (N, 2)
         Angles of M′ = R_Z(−θ)·M. [rad]
     """
+    theta, _, base_m, angles = _turns(centres_m, rotations)
+    return theta, base_m, angles
+
+
+def _turns(
+    centres_m: NDArray, rotations: NDArray
+) -> tuple[NDArray, NDArray, NDArray, tuple[NDArray, NDArray, NDArray]]:
+    """θ, R_Z(−θ), the base and the angles of :func:`instrument_frames`."""
     base_vector = centres_m[:, 1] - centres_m[:, 0]
     theta = np.arctan2(base_vector[:, 1], base_vector[:, 0])
     turn = rotation_z(-theta)  # (N, 3, 3)
     angles = angles_from_matrix(turn[:, None] @ rotations)
     base_m = (turn @ base_vector[:, :, None])[:, :, 0]  # not einsum: it rounds differently
-    return theta, base_m, angles
+    return theta, turn, base_m, angles
+
+
+def instrument_frame_m(
+    points_m: ArrayLike,
+    frame_origin_m: ArrayLike,
+    frame_rotation: ArrayLike,
+    *,
+    inverse: bool = False,
+) -> NDArray[np.float64]:
+    r"""Ground points in the instrument frame of the setup sheet (or back).
+
+    Parameters
+    ----------
+    points_m : array_like, shape (..., 3)
+        X, Y, Z in the photogrammetric frame of the scenario (``inverse=False``) or in the
+        instrument frame (``inverse=True``). [m]
+    frame_origin_m : array_like, shape (3,) or (..., 3)
+        S_л, the origin of the instrument frame in the photogrammetric frame: one, or one per
+        point (the points of many pairs at once). [m]
+    frame_rotation : float or array_like, shape (...)
+        θ, the azimuth of the horizontal base in the photogrammetric frame: one, or one per
+        point. [rad]
+    inverse : bool
+        Map instrument-frame points back to the photogrammetric frame.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        The points in the other frame. [m]
+
+    Notes
+    -----
+    ``docs/setup-data.md``, "The frame turn": the photogrammetric frame moved to S_л and turned
+    by −θ about Z, p = R_Z(−θ)(P − S_л), so that the base runs along +X.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p = instrument_frame_m([10.0, 10.0, 0.0], [0.0, 0.0, 100.0], np.pi / 4)
+    >>> (np.round(p, 6) + 0.0).tolist()
+    [14.142136, 0.0, -100.0]
+    >>> back = instrument_frame_m(p, [0.0, 0.0, 100.0], np.pi / 4, inverse=True)
+    >>> (np.round(back, 9) + 0.0).tolist()
+    [10.0, 10.0, 0.0]
+    """
+    origin = np.asarray(frame_origin_m, float)
+    theta = np.asarray(frame_rotation, float)
+    points = np.asarray(points_m, float)
+    if theta.ndim == 0:
+        if inverse:
+            return points @ rotation_z(float(theta)).T + origin
+        return (points - origin) @ rotation_z(-float(theta)).T
+    turn = rotation_z(theta if inverse else -theta)  # (..., 3, 3), one per point
+    if inverse:
+        return (turn @ points[..., :, None])[..., 0] + origin
+    return (turn @ (points - origin)[..., :, None])[..., 0]
+
+
+@dataclass(frozen=True, slots=True)
+class PairFrames:
+    """The instrument frames of N pairs and their ground in them (:func:`pair_frames`).
+
+    ``theta`` (N,) [rad], ``base_m`` (N, 3) [m], ``angles`` α, ω, κ each (N, 2) [rad] as
+    :func:`instrument_frames` gives them; ``ground_m`` the runs of ground points in their pair's
+    frame [m]; ``depth_m`` (N, 2) Z_Sл − Z of each pair's shallowest and deepest ground and
+    ``depth_mean_m`` (N,) its mean [m].
+    """
+
+    theta: NDArray[np.float64]
+    base_m: NDArray[np.float64]
+    angles: tuple[NDArray, NDArray, NDArray]
+    ground_m: NDArray[np.float64]
+    depth_m: NDArray[np.float64]
+    depth_mean_m: NDArray[np.float64]
+
+    def take(self, rows: NDArray) -> tuple[NDArray, NDArray, tuple[NDArray, NDArray, NDArray]]:
+        """(θ, base, angles) of the pairs ``rows``: the ``frames`` argument of
+        :func:`compute_table24`."""
+        return self.theta[rows], self.base_m[rows], tuple(a[rows] for a in self.angles)
+
+
+def pair_frames(
+    centres_m: NDArray, rotations: NDArray, ground_local_m: NDArray, run_start: NDArray
+) -> PairFrames:
+    """The instrument frame of each pair (:func:`instrument_frames`) and its ground in it.
+
+    Parameters
+    ----------
+    centres_m, rotations : ndarray, shape (N, 2, 3) and (N, 2, 3, 3)
+        As for :func:`instrument_frames`.
+    ground_local_m : ndarray, shape (g, 3)
+        Ground points of the pairs in the photogrammetric frame, in runs: pair ``i``'s are the
+        runs ``r·i`` to ``r·i + r − 1`` (``r`` runs a pair, e.g. its working area and its
+        points), run ``k`` the rows ``run_start[k]`` to ``run_start[k + 1]``. [m]
+    run_start : ndarray of int, shape (r·N + 1,)
+
+    Returns
+    -------
+    PairFrames
+
+    Notes
+    -----
+    Each run is turned by :func:`instrument_frame_m`'s product p = (P − S_л)·R_Z(−θ)ᵀ of that
+    run alone: a product over all runs at once, or over another number of rows, rounds
+    differently in the last bit (the residuals of an exact (6.8) fit then print −0.000 for
+    +0.000, ``jobs/block3x6``). The mean depth is ``numpy.mean`` of the pair alone, to the bit.
+    """
+    theta, turn, base_m, angles = _turns(centres_m, rotations)
+    count = len(theta)
+    runs = max((len(run_start) - 1) // max(count, 1), 1)
+    out = np.empty_like(ground_local_m)
+    transposed = turn.transpose(0, 2, 1)  # R_Z(−θ)ᵀ of each pair
+    origins = centres_m[:, 0]
+    for k, (a, b) in enumerate(zip(run_start[:-1].tolist(), run_start[1:].tolist(), strict=True)):
+        if b > a:
+            out[a:b] = (ground_local_m[a:b] - origins[k // runs]) @ transposed[k // runs]
+    start = run_start[::runs]
+    depths = -out[:, 2]  # Z_Sл − Z (S_л is the origin)
+    cuts = start[:-1]
+    if count == 0:  # no pair: reduceat takes no empty list of cuts
+        return PairFrames(theta, base_m, angles, out, np.zeros((0, 2)), np.zeros(0))
+    depth = np.stack([np.minimum.reduceat(depths, cuts), np.maximum.reduceat(depths, cuts)], -1)
+    mean = group_sums(depths, start) / np.diff(start)
+    return PairFrames(theta, base_m, angles, out, depth, mean)
 
 
 def _inside_with_slack(v: NDArray, lo: float, hi: float) -> NDArray[np.bool_]:
