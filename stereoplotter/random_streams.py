@@ -50,15 +50,26 @@ def keyed_draws(seed: int, key: str, start: int, stop: int, draw: Draw) -> NDArr
     if not 0 <= start <= stop:
         raise ValueError(f"trial range: expected 0 ≤ start ≤ stop, found [{start}, {stop})")
     code = key_code(key)
+    seed = int(seed)
+    first_block, last_block = start // BLOCK, (stop - 1) // BLOCK
+    if stop > start and first_block == last_block and start % BLOCK == 0:
+        return draw(_generator(seed, code, first_block), stop - start)  # one block, from its start
     out = np.empty(stop - start)
     t = start
     while t < stop:
         block = t // BLOCK
-        seeds = [int(seed), code] if block == 0 else [int(seed), code, block]
-        rng = np.random.default_rng(seeds)
         first = block * BLOCK
         end = min(stop, first + BLOCK)
-        values = draw(rng, end - first)
+        values = draw(_generator(seed, code, block), end - first)
         out[t - start : end - start] = values[t - first :]
         t = end
     return out
+
+
+def _generator(seed: int, code: int, block: int) -> np.random.Generator:
+    """The generator of block ``block`` of the stream (seed, key code): what
+    ``numpy.random.default_rng([seed, code(, block)])`` returns, built without its argument
+    checks (≈ 5 µs of the ≈ 15 µs per block, 8 000 blocks per chunk of the conventional
+    method)."""
+    seeds = [seed, code] if block == 0 else [seed, code, block]
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seeds)))

@@ -63,6 +63,7 @@ __all__ = [
     "rod_from_counters",
     "rod_from_photo",
     "rods_intersection",
+    "rods_intersection_xy",
     "rods_y_parallax",
     "set_decentrations",
     "turn_correction_knob",
@@ -644,9 +645,27 @@ def rods_intersection(
     (t_л = n_л, so n·q is the parallax in model mm). Rods parallel in X give inf/NaN.
     """
     rl, rr = _a(rod_left_mm), _a(rod_right_mm)
+    return rods_intersection_xy((rl[..., 0], rl[..., 1]), (rr[..., 0], rr[..., 1]), setting)
+
+
+def rods_intersection_xy(
+    rod_left: tuple[ArrayLike, ArrayLike],
+    rod_right: tuple[ArrayLike, ArrayLike],
+    setting: InstrumentSetting,
+) -> StereoReading:
+    """:func:`rods_intersection` with the rods as (ξ, η) pairs of arrays (the same arithmetic).
+
+    Examples
+    --------
+    >>> s = InstrumentSetting(130.0, base_x_mm=90.0, base_y_mm=0.5)
+    >>> a = rods_intersection([45.0, 3.0], [-45.0, 2.0], s)
+    >>> bool(rods_intersection_xy((45.0, 3.0), (-45.0, 2.0), s) == a)
+    True
+    """
+    xi_l, eta_l = (_a(v) for v in rod_left)
+    xi_r, eta_r = (_a(v) for v in rod_right)
     f = _a(setting.f_instrument_mm)
-    xi_l, eta_l = rl[..., 0], rl[..., 1]
-    t_l, y_l, y_r, q = _rays(xi_l, eta_l, rr[..., 0], rr[..., 1], setting)
+    t_l, y_l, y_r, q = _rays(xi_l, eta_l, xi_r, eta_r, setting)
     x = _a(setting.model_origin_x_mm) + t_l * xi_l
     y = _a(setting.model_origin_y_mm) + 0.5 * (y_l + y_r)
     return StereoReading(*np.broadcast_arrays(x, y, t_l * f, q))

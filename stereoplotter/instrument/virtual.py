@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, Final, Literal, get_args
 
 import numpy as np
@@ -139,16 +139,19 @@ class Scale:
     ratio_error: Any
     least_count: float
     sense: int = 1
+    #: sense·(1 + ratio_error), the scale's gain, computed once (per trial when the ratio error is)
+    gain: Any = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "gain", self.sense * (1.0 + self.ratio_error))
 
     def reading(self, position: ArrayLike) -> NDArray[np.float64]:
         """The exact reading of a position. [mm]"""
-        return np.asarray(
-            self.zero + self.sense * (1.0 + self.ratio_error) * np.asarray(position, float)
-        )
+        return np.asarray(self.zero + self.gain * np.asarray(position, float))
 
     def position(self, reading: ArrayLike) -> NDArray[np.float64]:
         """The position that shows a reading. [mm]"""
-        return (np.asarray(reading, float) - self.zero) / (self.sense * (1.0 + self.ratio_error))
+        return (np.asarray(reading, float) - self.zero) / self.gain
 
     def rounded(self, reading: ArrayLike) -> NDArray[np.float64]:
         """A reading as the operator sees it: to the least count."""
@@ -406,7 +409,11 @@ class Instrument:
             return
         if control in self._axes:
             nut = self._scales[control].position(reading)
-            self._axes[control].approach(self._arg(nut), side)
+            axis = self._axes[control]
+            if isinstance(axis, PlayAxis):  # the same move, its carriages not copied out
+                axis.move(self._arg(nut), side)
+            else:
+                axis.approach(self._arg(nut), side)
             return
         value = np.asarray(reading, float)
         if control == "f_instrument":

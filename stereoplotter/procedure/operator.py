@@ -27,7 +27,7 @@ from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     UnitMap,
     rod_frame,
-    rods_intersection,
+    rods_intersection_xy,
     rods_y_parallax,
     turn_correction_knob,
 )
@@ -427,6 +427,8 @@ class Operator:
         """A value in the run's shape: (T,) or ()."""
         a = np.asarray(x, float)
         if self.trials:
+            if a.shape == (self.trials,):
+                return a.copy()
             return np.broadcast_to(a, (self.trials,)).copy()
         return a.reshape(-1)[0] + np.zeros(()) if a.size == 1 else a
 
@@ -500,16 +502,17 @@ class Operator:
             self._stops[control] = stops
         low, high = stops
         beyond = (reading < low) | (reading > high)
-        if np.any(beyond):
+        if beyond.any():
             self.stopped[control] = self.stopped.get(control, np.zeros_like(beyond)) | beyond
-        return np.clip(reading, low, high)
+        return np.minimum(np.maximum(reading, low), high)  # np.clip's values, less overhead
 
     # --- turning while looking ---------------------------------------------------------------
 
     def physical(self, control: DrivenControl) -> NDArray[np.float64]:
         """Where a control physically is (what the eye judges in the eyepiece)."""
         if control in _SCREWS:
-            return self.v(self.inst.position(control))
+            now = self.inst.position(control)  # a copy of the carriages
+            return now if self.trials and np.shape(now) == (self.trials,) else self.v(now)
         if control.startswith("kappa_"):
             return self.v(self.inst.unit(control.split("_")[1]).kappa)
         if control in _KNOBS:
@@ -533,6 +536,9 @@ class Operator:
         if not np.any(active):
             return
         target = self.v(target)
+        if self.trials and control in _SCREWS:
+            self._drive_screw(control, target, active)
+            return
         for _ in range(self.passes):
             now = self.physical(control)
             err = np.where(active, target - now, 0.0)
@@ -547,6 +553,14 @@ class Operator:
                 cmd = self.commanded.get(control, now) + err
                 self.inst.set(control, cmd)
                 self.commanded[control] = cmd
+
+    def _drive_screw(self, control: ScrewName, target, active) -> None:
+        """:meth:`drive` of a lead screw over T trials: the same passes and arithmetic, without
+        re-shaping the instrument's (T,) readings and positions."""
+        inst, side = self.inst, self.model.finish_side
+        for _ in range(self.passes):
+            err = np.where(active, target - inst.position(control), 0.0)
+            inst.set(control, self._at_stop(control, inst.read(control, exact=True) + err), side)
 
     # --- looking ------------------------------------------------------------------------------
 
@@ -626,12 +640,12 @@ class Operator:
         ey = self.noise.normal(f"mono/{key}/y", self.model.monocular_sigma_mm)
         ep = self.noise.normal(f"stereo/{key}", self.model.stereo_sigma_mm)
         eq = self.noise.normal(f"q/{key}", self.model.y_parallax_sigma_mm)
-        shift = np.stack([ex, ey], axis=-1)
-        pl = np.asarray(pl, float) + shift + np.stack([ep, 0.0 * ep], axis=-1)
-        pr = np.asarray(pr, float) + shift
-        r = rods_intersection(
-            self.unit_map("left").rod_from_photo(pl),
-            self.unit_map("right").rod_from_photo(pr),
+        pl, pr = np.asarray(pl, float), np.asarray(pr, float)
+        # the marks at the photo points shifted by (ex, ey) on both photos and by ep in x on the
+        # left: by component (the y of the left mark + 0·ep is that y, to the bit)
+        r = rods_intersection_xy(
+            self.unit_map("left").rod_xy(pl[..., 0] + ex + ep, pl[..., 1] + ey),
+            self.unit_map("right").rod_xy(pr[..., 0] + ex, pr[..., 1] + ey),
             self.inst.setting,
         )
         if move:

@@ -25,7 +25,7 @@ from stereoplotter.instrument.mechanics.base import (
     Side,
     check_side,
     check_travel,
-    pre_position,
+    detour_start,
 )
 
 __all__ = ["PlayAxis", "play"]
@@ -170,13 +170,21 @@ class PlayAxis:
         TravelRefusal
             If the target or a needed pre-position is beyond the range stops (nothing moves).
         """
+        self.move(target, side)
+        return self._car.copy()
+
+    def move(self, target: ArrayLike, side: Side = None) -> None:
+        """:meth:`approach` without returning the carriages (the same arithmetic)."""
         check_side(side)
         check_travel(self.params, target, "target")
-        s = np.broadcast_to(np.asarray(target, float), self.h.shape)
-        pre = pre_position(self._nut, s, side, self.params.overtravel_mm)
-        detour = ~np.isnan(pre)
-        check_travel(self.params, pre[detour], "pre-position")
-        x = np.where(detour, play(self._car, pre, self.h, self.c), self._car)
+        s = np.asarray(target, float)
+        if s.shape != self.h.shape:
+            s = np.broadcast_to(s, self.h.shape)
+        x = self._car
+        if side is not None:  # pre_position: a detour to the final stroke's start where needed
+            start, detour = detour_start(self._nut, s, side, self.params.overtravel_mm)
+            if detour.any():
+                check_travel(self.params, start[detour], "pre-position")
+                x = np.where(detour, play(x, start, self.h, self.c), x)
         self._car = play(x, s, self.h, self.c)
         self._nut = s.copy()
-        return self._car.copy()
