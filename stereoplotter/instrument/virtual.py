@@ -375,7 +375,7 @@ class Instrument:
             raise StereoplotterError(f"no scale {control!r}; scales: {', '.join(self._scales)}")
         scale = self._scales[control]
         if control in self._axes:
-            reading = scale.reading(self._axes[control].nut)
+            reading = scale.reading(_nut(self._axes[control]))
         else:
             side = control.split("_")[1]
             unit = self._units[side]
@@ -411,7 +411,7 @@ class Instrument:
             nut = self._scales[control].position(reading)
             axis = self._axes[control]
             if isinstance(axis, PlayAxis):  # the same move, its carriages not copied out
-                axis.move(self._arg(nut), side)
+                axis.move(self._arg(nut), side, owned=nut.shape == axis.h.shape)
             else:
                 axis.approach(self._arg(nut), side)
             return
@@ -566,7 +566,7 @@ class Instrument:
         return self._height_gear
 
     def _height_reading(self) -> NDArray[np.float64]:
-        depth = np.asarray(self._scales["Z"].reading(self._axes["Z"].nut), float)
+        depth = np.asarray(self._scales["Z"].reading(_nut(self._axes["Z"])), float)
         return self._height_slip - depth * self._gear() / 1000.0
 
     def _round_height(self, reading: NDArray) -> NDArray[np.float64]:
@@ -775,6 +775,12 @@ class Instrument:
         if self.trials is None and v.size == 1:
             return float(v.reshape(-1)[0])
         return v
+
+
+def _nut(axis: Any) -> Any:
+    """The nut positions of an axis to compute with (not to keep): a PlayAxis's own array,
+    which it replaces and never writes into, instead of the copy of ``axis.nut``."""
+    return axis._nut if isinstance(axis, PlayAxis) else axis.nut
 
 
 def _replace(unit: CorrectionUnit, **changes: Any) -> CorrectionUnit:

@@ -501,10 +501,12 @@ class Operator:
             stops = np.minimum(r_lo, r_hi), np.maximum(r_lo, r_hi)
             self._stops[control] = stops
         low, high = stops
-        beyond = (reading < low) | (reading > high)
-        if beyond.any():
-            self.stopped[control] = self.stopped.get(control, np.zeros_like(beyond)) | beyond
-        return np.minimum(np.maximum(reading, low), high)  # np.clip's values, less overhead
+        out = np.minimum(np.maximum(reading, low), high)  # np.clip's values, less overhead
+        if (out != reading).any():  # beyond a stop (or NaN)
+            beyond = (reading < low) | (reading > high)
+            if beyond.any():
+                self.stopped[control] = self.stopped.get(control, np.zeros_like(beyond)) | beyond
+        return out
 
     # --- turning while looking ---------------------------------------------------------------
 

@@ -365,7 +365,8 @@ def detour_start(nut, target, side: str, overtravel_mm: float):
     final stroke and where the nut must first go there (arrays of one shape, no checks)."""
     sign = 1.0 if side == "below" else -1.0
     start = target - sign * overtravel_mm
-    return start, sign * (nut - start) > 0.0
+    # sign·(nut − start) > 0 to the bit: nut − start is ±0 only where nut = start
+    return start, (nut > start) if side == "below" else (nut < start)
 
 
 @runtime_checkable

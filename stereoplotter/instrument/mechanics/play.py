@@ -173,18 +173,30 @@ class PlayAxis:
         self.move(target, side)
         return self._car.copy()
 
-    def move(self, target: ArrayLike, side: Side = None) -> None:
-        """:meth:`approach` without returning the carriages (the same arithmetic)."""
+    def move(self, target: ArrayLike, side: Side = None, *, owned: bool = False) -> None:
+        """:meth:`approach` without returning the carriages (the same arithmetic).
+
+        ``owned``: ``target`` is a new array of shape (T,) that the caller hands over (kept as
+        the nuts without a copy)."""
         check_side(side)
-        check_travel(self.params, target, "target")
         s = np.asarray(target, float)
+        lo, hi = self.params.range_mm
+        s_min, s_max = s.min(), s.max()
+        if not (s_min >= lo and s_max <= hi):  # NaN fails both
+            check_travel(self.params, s, "target")
         if s.shape != self.h.shape:
             s = np.broadcast_to(s, self.h.shape)
+            owned = False
         x = self._car
         if side is not None:  # pre_position: a detour to the final stroke's start where needed
-            start, detour = detour_start(self._nut, s, side, self.params.overtravel_mm)
+            ot = self.params.overtravel_mm
+            start, detour = detour_start(self._nut, s, side, ot)
             if detour.any():
-                check_travel(self.params, start[detour], "pre-position")
+                # the starts are t ∓ overtravel, rounded monotonically: inside the stops when the
+                # extreme target's is, else checked where a detour is made
+                edge = s_min - ot if side == "below" else s_max + ot
+                if not lo <= edge <= hi:
+                    check_travel(self.params, start[detour], "pre-position")
                 x = np.where(detour, play(x, start, self.h, self.c), x)
         self._car = play(x, s, self.h, self.c)
-        self._nut = s.copy()
+        self._nut = s if owned else s.copy()
