@@ -69,7 +69,15 @@ def keyed_draws(seed: int, key: str, start: int, stop: int, draw: Draw) -> NDArr
 def _generator(seed: int, code: int, block: int) -> np.random.Generator:
     """The generator of block ``block`` of the stream (seed, key code): what
     ``numpy.random.default_rng([seed, code(, block)])`` returns, built without its argument
-    checks (≈ 5 µs of the ≈ 15 µs per block, 8 000 blocks per chunk of the conventional
-    method)."""
+    checks (≈ 7 µs instead of ≈ 15 µs per block; a chunk of the conventional method builds
+    8 000).
+
+    ``SeedSequence`` turns each integer of a list into its 32-bit words (one word for
+    0 ≤ n < 2³², 0 included), so the list's entropy *is* the uint32 array of the same numbers,
+    which it takes without converting."""
     seeds = [seed, code] if block == 0 else [seed, code, block]
-    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seeds)))
+    if 0 <= seed < 2**32 and block < 2**32:  # code < 2³² (CRC-32)
+        entropy: object = np.array(seeds, dtype=np.uint32)
+    else:  # a seed of more than one word (or a negative one, refused): the list
+        entropy = seeds
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(entropy)))
