@@ -503,6 +503,13 @@ class Instrument:
         """The direction of a counter (+1 or −1)."""
         return self._scales[control].sense
 
+    def screw(self, control: ScrewName) -> tuple[Scale, PlayAxis] | None:
+        """The counter's scale and the closed-form axis of a lead screw, for a caller that
+        repeats :meth:`read` and :meth:`set` on them with the same arithmetic (the operator's
+        look-and-correct passes); None for a pymunk axis."""
+        axis = self._axes[control]
+        return (self._scales[control], axis) if isinstance(axis, PlayAxis) else None
+
     def travel_mm(self, control: ScrewName) -> tuple[float, float]:
         """The range stops of a lead-screw axis (nut positions). [mm]
 

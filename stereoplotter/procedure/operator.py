@@ -491,6 +491,14 @@ class Operator:
         beyond it becomes the stop's reading, and the trial is flagged in :attr:`stopped`."""
         if control == HEIGHT_SCALE:
             return reading
+        low, high = self._stop_readings(control)
+        out = np.minimum(np.maximum(reading, low), high)  # np.clip's values, less overhead
+        if (out != reading).any():  # beyond a stop (or NaN)
+            self._flag_stopped(control, (reading < low) | (reading > high))
+        return out
+
+    def _stop_readings(self, control: ScrewName) -> tuple[NDArray, NDArray]:
+        """The readings of the two stops of a lead screw (low, high), cached."""
         stops = self._stops.get(control)
         if stops is None:
             lo, hi = self.inst.travel_mm(control)
@@ -500,13 +508,11 @@ class Operator:
             )
             stops = np.minimum(r_lo, r_hi), np.maximum(r_lo, r_hi)
             self._stops[control] = stops
-        low, high = stops
-        out = np.minimum(np.maximum(reading, low), high)  # np.clip's values, less overhead
-        if (out != reading).any():  # beyond a stop (or NaN)
-            beyond = (reading < low) | (reading > high)
-            if beyond.any():
-                self.stopped[control] = self.stopped.get(control, np.zeros_like(beyond)) | beyond
-        return out
+        return stops
+
+    def _flag_stopped(self, control: str, beyond: NDArray[np.bool_]) -> None:
+        if beyond.any():
+            self.stopped[control] = self.stopped.get(control, np.zeros_like(beyond)) | beyond
 
     # --- turning while looking ---------------------------------------------------------------
 
@@ -557,12 +563,28 @@ class Operator:
                 self.commanded[control] = cmd
 
     def _drive_screw(self, control: ScrewName, target, active) -> None:
-        """:meth:`drive` of a lead screw over T trials: the same passes and arithmetic, without
-        re-shaping the instrument's (T,) readings and positions."""
-        inst, side = self.inst, self.model.finish_side
+        """:meth:`drive` of a lead screw over T trials: the same passes and arithmetic
+        (``Instrument.read`` exact, :meth:`_at_stop`, ``Instrument.set``) on the closed-form
+        axis's own (T,) arrays, without the copies and checks of each call."""
+        side = self.model.finish_side
+        parts = self.inst.screw(control)
+        if parts is None:
+            for _ in range(self.passes):
+                err = np.where(active, target - self.physical(control), 0.0)
+                read = self.inst.read(control, exact=True)
+                self.inst.set(control, self._at_stop(control, read + err), side)
+            return
+        scale, axis = parts
+        zero, gain = scale.zero, scale.gain
+        low, high = self._stop_readings(control)
         for _ in range(self.passes):
-            err = np.where(active, target - inst.position(control), 0.0)
-            inst.set(control, self._at_stop(control, inst.read(control, exact=True) + err), side)
+            err = np.where(active, target - axis._car, 0.0)
+            reading = np.asarray(zero + gain * axis._nut) + err  # the exact reading + error
+            cmd = np.minimum(np.maximum(reading, low), high)  # at the stops (_at_stop)
+            if (cmd != reading).any():
+                self._flag_stopped(control, (reading < low) | (reading > high))
+            nut = (cmd - zero) / gain  # Scale.position
+            axis.move(nut, side, owned=nut.shape == axis.h.shape)
 
     # --- looking ------------------------------------------------------------------------------
 
