@@ -741,8 +741,11 @@ def counters_from_homologous_points(
     >>> [float(v) for v in r]
     [45.0, 0.0, 130.0, 0.0]
     """
-    return rods_intersection(
-        rod_from_photo(photo_left_mm, left), rod_from_photo(photo_right_mm, right), setting
+    pl, pr = _a(photo_left_mm), _a(photo_right_mm)
+    return rods_intersection_xy(  # rod_from_photo of each photo, not stacked into pairs
+        UnitMap(left).rod_xy(pl[..., 0], pl[..., 1]),
+        UnitMap(right).rod_xy(pr[..., 0], pr[..., 1]),
+        setting,
     )
 
 

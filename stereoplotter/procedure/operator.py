@@ -333,6 +333,10 @@ class Scene:
     grid_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]] | None = field(
         init=False, repr=False
     )
+    #: Images of the ground points asked for before (:meth:`images`), kept for the scene's life.
+    _images: dict[bytes, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
+        init=False, repr=False, compare=False, default_factory=dict
+    )
 
     def __post_init__(self) -> None:
         # frozen: set once here, so that dataclasses.replace (new standard points) recomputes them
@@ -389,7 +393,15 @@ class Scene:
 
         ``read_only``: the arrays refuse writes (images kept for the whole run)."""
         pts = np.asarray(points_m, float)
-        out = tuple(photo_points_mm(self.camera, self.photo(n), pts) for n in ("left", "right"))
+        key = pts.tobytes() + repr(pts.shape).encode()
+        known = self._images.get(key)
+        if known is None:  # the few control points a procedure fuses on, again and again
+            known = tuple(
+                photo_points_mm(self.camera, self.photo(n), pts) for n in ("left", "right")
+            )
+            if pts.size <= 30:
+                self._images[key] = known
+        out = tuple(a.copy() for a in known)
         for a in out if read_only else ():
             a.setflags(write=False)
         return out
