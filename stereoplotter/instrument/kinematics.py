@@ -423,6 +423,59 @@ class UnitMap:
         out.ms = -out.s
         return out
 
+    def with_knob(self, axis: str, tan_tilt: ArrayLike, linkage: str = "L") -> UnitMap:
+        """The map of ``turn_correction_knob(self.unit, axis, tan_tilt, linkage)`` with κ kept:
+        the same arithmetic as ``UnitMap(turn_correction_knob(...), self.trig)``, from this
+        map's fields, without building the turned :class:`CorrectionUnit` (an operator's 1-D
+        solve on a knob evaluates a dozen turns).
+
+        Examples
+        --------
+        >>> unit = unit_for_orientation(0.02, -0.01, 0.003, 100.0)
+        >>> m = UnitMap(unit)
+        >>> a = m.with_knob("omega", 0.03).rod_xy(40.0, 30.0)
+        >>> b = UnitMap(turn_correction_knob(unit, "omega", 0.03), m.trig).rod_xy(40.0, 30.0)
+        >>> a == b
+        True
+        """
+        unit = self.unit
+        if unit is None:
+            raise StereoplotterError("with_knob: a map of a unit is needed (not a turned map)")
+        if linkage not in LINKAGES:
+            raise StereoplotterError(f"linkage must be one of {LINKAGES}, found {linkage!r}")
+        t_new = _a(tan_tilt)
+        f, ta, to, ex, ey = self.f, self.ta, self.to, self.ex, self.ey
+        cx, cy = unit.plane_decentration_mm
+        if axis == "alpha":
+            delta = f * (t_new - ta)
+            ta = t_new
+            if linkage in ("L", "A"):
+                ex = ex + delta
+            if linkage == "L":
+                cx = cx + delta
+        elif axis == "omega":
+            delta = f * (t_new - to)
+            to = t_new
+            if linkage in ("L", "A"):
+                ey = ey + delta
+            if linkage == "L":
+                cy = cy + delta
+        else:
+            raise StereoplotterError(f"axis must be 'alpha' or 'omega', found {axis!r}")
+        out = object.__new__(UnitMap)
+        out.unit, out.strict, out.f, out.ta, out.to, out.ex, out.ey = (
+            None, self.strict, f, ta, to, ex, ey
+        )  # fmt: skip
+        if self.strict:
+            out.kx, out.ky, out.num = f + cx * ta, f + cy * to, None
+        else:
+            out.num, out.kx, out.ky = f + cx * ta + cy * to, None, None
+        out.mech = None
+        if unit.mechanism is not None:
+            out.mech = unit.mechanism.scale(f, ta, to, ex, ey)
+        out.c, out.s, out.ms = self.c, self.s, self.ms
+        return out
+
     def photo_xy(self, xi: ArrayLike, eta: ArrayLike) -> tuple[NDArray, NDArray]:
         """:func:`photo_from_rod` on separate ξ, η arrays, returning (x, y) separately."""
         f, ta, to = self.f, self.ta, self.to

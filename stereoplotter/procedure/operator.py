@@ -710,12 +710,11 @@ class Operator:
             def turned(value):
                 return base.with_kappa(value)
         else:
-            unit = self.inst.unit(side)
             axis = control.split("_")[1]
             linkage = self.inst.variant.linkage
 
             def turned(value):
-                return UnitMap(turn_correction_knob(unit, axis, value, linkage=linkage), base.trig)
+                return base.with_knob(axis, value, linkage)
 
         def q(value):
             moving = turned(value).rod_xy(x, y)
