@@ -51,7 +51,7 @@ from stereoplotter.procedure.evaluation import (
 )
 from stereoplotter.procedure.eye import EYE_MODES, LEGACY_SIGMA_MM, Eye, ObservationSystem
 from stereoplotter.procedure.transcript import Transcript
-from stereoplotter.random_streams import keyed_draws
+from stereoplotter.random_streams import keyed_standard_normal
 from stereoplotter.scenario.model import Camera, Photo, Point, Scenario
 from stereoplotter.scenario.summary import mean_flying_height_m
 from stereoplotter.scenario.synthetic import film_deformed
@@ -252,15 +252,11 @@ class Noise:
         if sigma == 0.0:
             z = np.zeros(stop - start)
         else:
-            z = keyed_draws(self.seed, key, start, stop, _standard_normal)
+            z = keyed_standard_normal(self.seed, key, start, stop)
             z *= sigma
         if self.trial is not None or not self.trials:
             return np.asarray(z[0])
         return z
-
-
-def _standard_normal(rng: np.random.Generator, n: int) -> NDArray[np.float64]:
-    return rng.standard_normal(n)
 
 
 def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: float = 1e-6):
