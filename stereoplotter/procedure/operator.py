@@ -263,6 +263,9 @@ def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: floa
     """x with fun(x) = target by a fixed number of Newton steps (central differences).
 
     A fixed count (no early exit) keeps a vectorised run and a per-trial loop bit-identical.
+    A ``fun`` with the attribute ``stacked`` set is evaluated once per step on x, x + h, x − h
+    stacked on a new leading axis (it must give each the bits it gives alone: element-wise
+    IEEE arithmetic and square roots only).
 
     Examples
     --------
@@ -271,9 +274,15 @@ def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: floa
     """
     x = np.asarray(x0, float) + 0.0
     t = np.asarray(target, float)
+    stacked = getattr(fun, "stacked", False)
     for _ in range(iterations):
-        r = fun(x) - t
-        d = (fun(x + h) - fun(x - h)) / (2.0 * h)
+        if stacked:
+            v = fun(np.stack([x, x + h, x - h]))
+            r = v[0] - t
+            d = (v[1] - v[2]) / (2.0 * h)
+        else:
+            r = fun(x) - t
+            d = (fun(x + h) - fun(x - h)) / (2.0 * h)
         with np.errstate(divide="ignore", invalid="ignore"):
             step = np.where(d != 0.0, r / d, 0.0)
         x = x - step
@@ -718,6 +727,10 @@ class Operator:
                 return rods_y_parallax(moving, fixed, setting)
             return rods_y_parallax(fixed, moving, setting)
 
+        # a knob's turn at one point is element-wise arithmetic and square roots (the mechanisms'
+        # scales too), no cos, sin, whose vectorised loops may round differently by position:
+        # x, x ± h at once
+        q.stacked = not control.startswith("kappa_") and np.ndim(x) == 0 and np.ndim(y) == 0
         return q
 
     def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):
