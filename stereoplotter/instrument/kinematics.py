@@ -665,9 +665,13 @@ def marks_from_counters(
     >>> pl.tolist(), pr.tolist()
     ([45.0, 0.0], [-45.0, 0.0])
     """
-    pl = photo_from_rod(rod_from_counters(x_mm, y_mm, depth_mm, setting, "left"), left)
-    pr = photo_from_rod(rod_from_counters(x_mm, y_mm, depth_mm, setting, "right"), right)
-    return pl, pr
+    out = []
+    for side, unit in (("left", left), ("right", right)):
+        # rod_from_counters, then photo_from_rod: the rod not stacked into pairs in between
+        sx, sy, n = rod_frame(setting, side, depth_mm)
+        xi, eta = (_a(x_mm) - sx) / n, (_a(y_mm) - sy) / n
+        out.append(_pair(*UnitMap(unit).photo_xy(xi, eta)))
+    return out[0], out[1]
 
 
 def rods_intersection(
