@@ -19,6 +19,7 @@ vectorised: every state is an array of shape (T,) when ``trials`` is given).
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any, Final, Literal, get_args
@@ -289,6 +290,8 @@ class Instrument:
         }
         #: Per side, the UnitMap of the present unit (rebuilt when the unit is replaced).
         self._unit_maps: dict[str, UnitMap] = {}
+        #: The last :attr:`setting` and the arrays it was built from (f_пр, the base carriages).
+        self._setting_cache: tuple[tuple[Any, ...], InstrumentSetting] | None = None
         self._travel: dict[str, tuple[float, float]] = {}
 
     # --- construction --------------------------------------------------------------------
@@ -585,11 +588,18 @@ class Instrument:
     @property
     def setting(self) -> InstrumentSetting:
         """The physical setting: f_пр, base and the plumb of S_л at X = Y = 0."""
+        axes = [self._axes[n] for n in ("bx", "by", "bz")]
+        key = (self._f_instrument, *(a._car if isinstance(a, PlayAxis) else None for a in axes))
+        cached = self._setting_cache
+        if cached is not None and all(map(operator.is_, key, cached[0])) and key[-1] is not None:
+            return cached[1]  # f_пр and the base carriages as they were (arrays are replaced)
         if np.any(np.isnan(self._f_instrument)):
             raise StereoplotterError("f_пр has not been set (set('f_instrument', …) first)")
-        return InstrumentSetting(
+        setting = InstrumentSetting(
             self._f_instrument, self._pos("bx"), self._pos("by"), self._pos("bz"), 0.0, 0.0
         )
+        self._setting_cache = (key, setting)
+        return setting
 
     def _pos(self, name: str) -> NDArray[np.float64]:
         return self._out(self._axes[name].position)

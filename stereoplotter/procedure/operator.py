@@ -560,10 +560,13 @@ class Operator:
         active = self.all() if active is None else active
         if not np.any(active):
             return
-        target = self.v(target)
         if self.trials and control in _SCREWS:
+            target = np.asarray(target, float)  # only read: no copy of a (T,) target
+            if target.shape != (self.trials,):
+                target = self.v(target)
             self._drive_screw(control, target, active)
             return
+        target = self.v(target)
         for _ in range(self.passes):
             now = self.physical(control)
             err = np.where(active, target - now, 0.0)
