@@ -51,11 +51,12 @@ __all__ = [
     "trial_columns",
 ]
 
-#: Peak working memory per trial of one chunk (simulation and evaluation), measured on pair60
-#: (setup ≈ 20 kB with ``benchmarks/bench_simulate_scale.py``; conventional 14.6 kB, the rise of
-#: ``ru_maxrss`` over one chunk of 4 096, 8 192 and 16 384 trials, issue 26) and rounded up for
-#: safety by the same factor ≈ 1.6. [bytes]
-BYTES_PER_TRIAL = {"setup": 32_000, "conventional": 24_000}
+#: Peak working memory per trial of one chunk (simulation and evaluation), rounded up for
+#: safety. Setup: ≈ 20 kB on pair60 (``benchmarks/bench_simulate_scale.py``). Conventional:
+#: 14.6 kB on pair60 and pair80, 12.8 kB on mountain60 (the rise of ``ru_maxrss`` over one chunk
+#: of 4 096, 8 192 and 16 384 trials, SC-1, issue 26; 7.8 kB of it without the evaluation), so a
+#: chunk of 12 288 trials stays under 180 MB of the default 256 MB. [bytes]
+BYTES_PER_TRIAL = {"setup": 32_000, "conventional": 20_000}
 
 #: Default memory budget of one chunk (a convention: leaves room on a 1 GiB allowance for the
 #: interpreter, the libraries and the columns of the current chunk). [MB]
@@ -76,7 +77,7 @@ def chunk_trials_for(memory_budget_mb: float, method: str) -> int:
     Examples
     --------
     >>> chunk_trials_for(256, "setup"), chunk_trials_for(256, "conventional")
-    (8000, 8192)
+    (8000, 12288)
     """
     if not memory_budget_mb > 0:
         raise ValueError(f"memory budget: expected > 0 MB, found {memory_budget_mb}")
