@@ -43,6 +43,7 @@ __all__ = [
     "default_workers",
     "iter_chunk_columns",
     "iter_trial_chunks",
+    "own_chunks",
     "run_header",
     "run_info",
     "split_chunk",
@@ -165,8 +166,10 @@ def iter_chunk_columns(
     :func:`trial_columns`.
 
     With ``workers`` > 1 the chunks after the first run in that many forked processes while
-    this one runs the first. Every draw is keyed by the trial, so the columns are the same
-    whatever the workers and the chunks.
+    this one runs a few of the last (:func:`own_chunks`: its share of the trials, so that no
+    process is left with one chunk more at the end) and then the first. ``progress`` counts
+    each chunk when it is done, in any order. Every draw is keyed by
+    the trial, so the columns are the same whatever the workers and the chunks.
     """
     if trials < 1:
         raise ValueError(f"trials: expected ≥ 1, found {trials}")
@@ -175,31 +178,66 @@ def iter_chunk_columns(
     starts = list(range(0, trials, chunk_trials))
     sizes = [min(chunk_trials, trials - f) for f in starts]
     pool = None
-    futures: list[Future] = []
+    futures: dict[int, Future] = {}
+    own: list[int] = []
     if workers > 1 and len(starts) > 1 and "fork" in multiprocessing.get_all_start_methods():
+        own = own_chunks(sizes, workers)
+        rest = [k for k in range(1, len(starts)) if k not in own]
         _PREPARED[:] = [(prep, evaluate)]  # inherited by the forked workers
         context = multiprocessing.get_context("fork")
-        pool = ProcessPoolExecutor(max_workers=min(workers, len(starts) - 1), mp_context=context)
-        rest = zip(starts[1:], sizes[1:], strict=True)
-        futures = [pool.submit(_chunk_columns, f, n) for f, n in rest]
+        pool = ProcessPoolExecutor(max_workers=min(workers, len(rest)), mp_context=context)
+        futures = {k: pool.submit(_chunk_columns, starts[k], sizes[k]) for k in rest}
     try:
+        mine = {}
+        for k in own:  # first, so that no chunk's whole result is held meanwhile
+            mine[k] = _columns_here(prep, starts[k], sizes[k], evaluate)
+            if progress is not None:
+                progress(sizes[k])
         result = run_trials_chunk(prep, 0, sizes[0], evaluate=evaluate, transcript=True)
         yield result, trial_columns(result)
         del result  # the caller keeps what it needs of the first chunk
         if progress is not None:
             progress(sizes[0])
-        for k, (first, n) in enumerate(zip(starts[1:], sizes[1:], strict=True)):
+        for k in range(1, len(starts)):
+            if k in mine:
+                yield None, mine.pop(k)
+                continue
             if pool is None:
-                columns = _columns_here(prep, first, n, evaluate)
+                columns = _columns_here(prep, starts[k], sizes[k], evaluate)
             else:
                 columns = futures[k].result()
             yield None, columns
             if progress is not None:
-                progress(n)
+                progress(sizes[k])
     finally:
         if pool is not None:
             pool.shutdown(cancel_futures=True)
             _PREPARED.clear()
+
+
+def own_chunks(sizes: list[int], workers: int) -> list[int]:
+    """The chunks after the first that the process running the first runs too: the last ones,
+    while it holds at most its share T/(workers + 1) of the trials (the others go to the
+    ``workers`` forked processes). At least one chunk is left to them.
+
+    Examples
+    --------
+    10⁵ trials of the conventional method in chunks of 12 288 on two processors: this process
+    runs chunks 0, 7 and 8 (26 272 trials), each worker three of chunks 1–6 (36 864):
+
+    >>> own_chunks([12288] * 8 + [1696], 2)
+    [7, 8]
+    >>> own_chunks([5000, 5000], 2)
+    []
+    """
+    share = sum(sizes) / (workers + 1)
+    total, own = sizes[0], []
+    for k in range(len(sizes) - 1, 1, -1):  # never chunk 1: the workers keep at least one
+        if total + sizes[k] > share:
+            break
+        own.append(k)
+        total += sizes[k]
+    return sorted(own)
 
 
 def _columns_here(prep: PreparedRun, first: int, n: int, evaluate: bool) -> dict[str, NDArray]:
