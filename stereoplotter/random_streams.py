@@ -47,22 +47,13 @@ def keyed_draws(seed: int, key: str, start: int, stop: int, draw: Draw) -> NDArr
     >>> bool(np.array_equal(whole[4000:4200], part))
     True
     """
-    if not 0 <= start <= stop:
-        raise ValueError(f"trial range: expected 0 ≤ start ≤ stop, found [{start}, {stop})")
-    code = key_code(key)
-    seed = int(seed)
-    first_block, last_block = start // BLOCK, (stop - 1) // BLOCK
-    if stop > start and first_block == last_block and start % BLOCK == 0:
-        return draw(_generator(seed, code, first_block), stop - start)  # one block, from its start
+    blocks = list(_blocks(seed, key, start, stop))
+    if len(blocks) == 1 and blocks[0][1] == 0:  # one block, from its start: no copy
+        rng, _, _, n = blocks[0]
+        return draw(rng, n)
     out = np.empty(stop - start)
-    t = start
-    while t < stop:
-        block = t // BLOCK
-        first = block * BLOCK
-        end = min(stop, first + BLOCK)
-        values = draw(_generator(seed, code, block), end - first)
-        out[t - start : end - start] = values[t - first :]
-        t = end
+    for rng, skip, at, n in blocks:
+        out[at : at + n - skip] = draw(rng, n)[skip:]
     return out
 
 
@@ -77,23 +68,29 @@ def keyed_standard_normal(seed: int, key: str, start: int, stop: int) -> NDArray
     >>> bool(np.array_equal(a, keyed_standard_normal(5, "x", 1000, 9000)))
     True
     """
+    out = np.empty(stop - start)
+    for rng, skip, at, n in _blocks(seed, key, start, stop):
+        if skip:
+            out[at : at + n - skip] = rng.standard_normal(n)[skip:]
+        else:
+            rng.standard_normal(n, out=out[at : at + n])
+    return out
+
+
+def _blocks(seed: int, key: str, start: int, stop: int):
+    """Per block of trials ``start … stop−1``: its generator, the trials of its prefix before
+    ``start`` (drawn and dropped), where its values go in the result, and how many to draw."""
     if not 0 <= start <= stop:
         raise ValueError(f"trial range: expected 0 ≤ start ≤ stop, found [{start}, {stop})")
     code = key_code(key)
     seed = int(seed)
-    out = np.empty(stop - start)
     t = start
     while t < stop:
         block = t // BLOCK
         first = block * BLOCK
         end = min(stop, first + BLOCK)
-        rng = _generator(seed, code, block)
-        if t == first:
-            rng.standard_normal(end - first, out=out[t - start : end - start])
-        else:
-            out[t - start : end - start] = rng.standard_normal(end - first)[t - first :]
+        yield _generator(seed, code, block), t - first, t - start, end - first
         t = end
-    return out
 
 
 def _generator(seed: int, code: int, block: int) -> np.random.Generator:

@@ -443,25 +443,19 @@ class UnitMap:
             raise StereoplotterError("with_knob: a map of a unit is needed (not a turned map)")
         if linkage not in LINKAGES:
             raise StereoplotterError(f"linkage must be one of {LINKAGES}, found {linkage!r}")
-        t_new = _a(tan_tilt)
-        f, ta, to, ex, ey = self.f, self.ta, self.to, self.ex, self.ey
-        cx, cy = unit.plane_decentration_mm
-        if axis == "alpha":
-            delta = f * (t_new - ta)
-            ta = t_new
-            if linkage in ("L", "A"):
-                ex = ex + delta
-            if linkage == "L":
-                cx = cx + delta
-        elif axis == "omega":
-            delta = f * (t_new - to)
-            to = t_new
-            if linkage in ("L", "A"):
-                ey = ey + delta
-            if linkage == "L":
-                cy = cy + delta
-        else:
+        if axis not in ("alpha", "omega"):
             raise StereoplotterError(f"axis must be 'alpha' or 'omega', found {axis!r}")
+        i = 0 if axis == "alpha" else 1  # (T_α, e_x, c_x) or (T_ω, e_y, c_y) move
+        f, t, e = self.f, [self.ta, self.to], [self.ex, self.ey]
+        c = list(unit.plane_decentration_mm)
+        t_new = _a(tan_tilt)
+        delta = f * (t_new - t[i])
+        t[i] = t_new
+        if linkage in ("L", "A"):
+            e[i] = e[i] + delta
+        if linkage == "L":
+            c[i] = c[i] + delta
+        (ta, to), (ex, ey), (cx, cy) = t, e, c
         out = object.__new__(UnitMap)
         out.unit, out.strict, out.f, out.ta, out.to, out.ex, out.ey = (
             None, self.strict, f, ta, to, ex, ey
