@@ -45,6 +45,8 @@ ROWS = (
                                  "--json", "-q"], 100_000),
     ("conventional 10⁴", ["simulate", "pair60", "--instrument", "sc1", "--method",
                           "conventional", "--trials", "10000", "--json", "-q"], 10_000),
+    ("conventional 10⁵", ["simulate", "pair60", "--instrument", "sc1", "--method",
+                          "conventional", "--trials", "100000", "--json", "-q"], 100_000),
     ("verify (defaults)", ["verify", "-q"], None),
 )  # fmt: skip
 

@@ -19,7 +19,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["BLOCK", "key_code", "keyed_draws"]
+__all__ = ["BLOCK", "key_code", "keyed_draws", "keyed_standard_normal"]
 
 #: Trials per keyed block (a convention: large enough that a block's generator costs little per
 #: trial, small enough that a per-trial oracle draws few unused numbers).
@@ -47,18 +47,64 @@ def keyed_draws(seed: int, key: str, start: int, stop: int, draw: Draw) -> NDArr
     >>> bool(np.array_equal(whole[4000:4200], part))
     True
     """
+    blocks = list(_blocks(seed, key, start, stop))
+    if len(blocks) == 1 and blocks[0][1] == 0:  # one block, from its start: no copy
+        rng, _, _, n = blocks[0]
+        return draw(rng, n)
+    out = np.empty(stop - start)
+    for rng, skip, at, n in blocks:
+        out[at : at + n - skip] = draw(rng, n)[skip:]
+    return out
+
+
+def keyed_standard_normal(seed: int, key: str, start: int, stop: int) -> NDArray[np.float64]:
+    """:func:`keyed_draws` of ``rng.standard_normal``, each block drawn straight into the result
+    where the range covers the block from its start (the same numbers, without a copy).
+
+    Examples
+    --------
+    >>> normal = lambda rng, n: rng.standard_normal(n)
+    >>> a = keyed_draws(5, "x", 1000, 9000, normal)
+    >>> bool(np.array_equal(a, keyed_standard_normal(5, "x", 1000, 9000)))
+    True
+    """
+    out = np.empty(stop - start)
+    for rng, skip, at, n in _blocks(seed, key, start, stop):
+        if skip:
+            out[at : at + n - skip] = rng.standard_normal(n)[skip:]
+        else:
+            rng.standard_normal(n, out=out[at : at + n])
+    return out
+
+
+def _blocks(seed: int, key: str, start: int, stop: int):
+    """Per block of trials ``start … stop−1``: its generator, the trials of its prefix before
+    ``start`` (drawn and dropped), where its values go in the result, and how many to draw."""
     if not 0 <= start <= stop:
         raise ValueError(f"trial range: expected 0 ≤ start ≤ stop, found [{start}, {stop})")
     code = key_code(key)
-    out = np.empty(stop - start)
+    seed = int(seed)
     t = start
     while t < stop:
         block = t // BLOCK
-        seeds = [int(seed), code] if block == 0 else [int(seed), code, block]
-        rng = np.random.default_rng(seeds)
         first = block * BLOCK
         end = min(stop, first + BLOCK)
-        values = draw(rng, end - first)
-        out[t - start : end - start] = values[t - first :]
+        yield _generator(seed, code, block), t - first, t - start, end - first
         t = end
-    return out
+
+
+def _generator(seed: int, code: int, block: int) -> np.random.Generator:
+    """The generator of block ``block`` of the stream (seed, key code): what
+    ``numpy.random.default_rng([seed, code(, block)])`` returns, built without its argument
+    checks (≈ 7 µs instead of ≈ 15 µs per block; a chunk of the conventional method builds
+    8 000).
+
+    ``SeedSequence`` turns each integer of a list into its 32-bit words (one word for
+    0 ≤ n < 2³², 0 included), so the list's entropy *is* the uint32 array of the same numbers,
+    which it takes without converting."""
+    seeds = [seed, code] if block == 0 else [seed, code, block]
+    if 0 <= seed < 2**32 and block < 2**32:  # code < 2³² (CRC-32)
+        entropy: object = np.array(seeds, dtype=np.uint32)
+    else:  # a seed of more than one word (or a negative one, refused): the list
+        entropy = seeds
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(entropy)))

@@ -63,6 +63,7 @@ __all__ = [
     "rod_from_counters",
     "rod_from_photo",
     "rods_intersection",
+    "rods_intersection_xy",
     "rods_y_parallax",
     "set_decentrations",
     "turn_correction_knob",
@@ -422,6 +423,53 @@ class UnitMap:
         out.ms = -out.s
         return out
 
+    def with_knob(self, axis: str, tan_tilt: ArrayLike, linkage: str = "L") -> UnitMap:
+        """The map of ``turn_correction_knob(self.unit, axis, tan_tilt, linkage)`` with κ kept:
+        the same arithmetic as ``UnitMap(turn_correction_knob(...), self.trig)``, from this
+        map's fields, without building the turned :class:`CorrectionUnit` (an operator's 1-D
+        solve on a knob evaluates a dozen turns).
+
+        Examples
+        --------
+        >>> unit = unit_for_orientation(0.02, -0.01, 0.003, 100.0)
+        >>> m = UnitMap(unit)
+        >>> a = m.with_knob("omega", 0.03).rod_xy(40.0, 30.0)
+        >>> b = UnitMap(turn_correction_knob(unit, "omega", 0.03), m.trig).rod_xy(40.0, 30.0)
+        >>> a == b
+        True
+        """
+        unit = self.unit
+        if unit is None:
+            raise StereoplotterError("with_knob: a map of a unit is needed (not a turned map)")
+        if linkage not in LINKAGES:
+            raise StereoplotterError(f"linkage must be one of {LINKAGES}, found {linkage!r}")
+        if axis not in ("alpha", "omega"):
+            raise StereoplotterError(f"axis must be 'alpha' or 'omega', found {axis!r}")
+        i = 0 if axis == "alpha" else 1  # (T_α, e_x, c_x) or (T_ω, e_y, c_y) move
+        f, t, e = self.f, [self.ta, self.to], [self.ex, self.ey]
+        c = list(unit.plane_decentration_mm)
+        t_new = _a(tan_tilt)
+        delta = f * (t_new - t[i])
+        t[i] = t_new
+        if linkage in ("L", "A"):
+            e[i] = e[i] + delta
+        if linkage == "L":
+            c[i] = c[i] + delta
+        (ta, to), (ex, ey), (cx, cy) = t, e, c
+        out = object.__new__(UnitMap)
+        out.unit, out.strict, out.f, out.ta, out.to, out.ex, out.ey = (
+            None, self.strict, f, ta, to, ex, ey
+        )  # fmt: skip
+        if self.strict:
+            out.kx, out.ky, out.num = f + cx * ta, f + cy * to, None
+        else:
+            out.num, out.kx, out.ky = f + cx * ta + cy * to, None, None
+        out.mech = None
+        if unit.mechanism is not None:
+            out.mech = unit.mechanism.scale(f, ta, to, ex, ey)
+        out.c, out.s, out.ms = self.c, self.s, self.ms
+        return out
+
     def photo_xy(self, xi: ArrayLike, eta: ArrayLike) -> tuple[NDArray, NDArray]:
         """:func:`photo_from_rod` on separate ξ, η arrays, returning (x, y) separately."""
         f, ta, to = self.f, self.ta, self.to
@@ -611,9 +659,13 @@ def marks_from_counters(
     >>> pl.tolist(), pr.tolist()
     ([45.0, 0.0], [-45.0, 0.0])
     """
-    pl = photo_from_rod(rod_from_counters(x_mm, y_mm, depth_mm, setting, "left"), left)
-    pr = photo_from_rod(rod_from_counters(x_mm, y_mm, depth_mm, setting, "right"), right)
-    return pl, pr
+    out = []
+    for side, unit in (("left", left), ("right", right)):
+        # rod_from_counters, then photo_from_rod: the rod not stacked into pairs in between
+        sx, sy, n = rod_frame(setting, side, depth_mm)
+        xi, eta = (_a(x_mm) - sx) / n, (_a(y_mm) - sy) / n
+        out.append(_pair(*UnitMap(unit).photo_xy(xi, eta)))
+    return out[0], out[1]
 
 
 def rods_intersection(
@@ -644,9 +696,27 @@ def rods_intersection(
     (t_л = n_л, so n·q is the parallax in model mm). Rods parallel in X give inf/NaN.
     """
     rl, rr = _a(rod_left_mm), _a(rod_right_mm)
+    return rods_intersection_xy((rl[..., 0], rl[..., 1]), (rr[..., 0], rr[..., 1]), setting)
+
+
+def rods_intersection_xy(
+    rod_left: tuple[ArrayLike, ArrayLike],
+    rod_right: tuple[ArrayLike, ArrayLike],
+    setting: InstrumentSetting,
+) -> StereoReading:
+    """:func:`rods_intersection` with the rods as (ξ, η) pairs of arrays (the same arithmetic).
+
+    Examples
+    --------
+    >>> s = InstrumentSetting(130.0, base_x_mm=90.0, base_y_mm=0.5)
+    >>> a = rods_intersection([45.0, 3.0], [-45.0, 2.0], s)
+    >>> bool(rods_intersection_xy((45.0, 3.0), (-45.0, 2.0), s) == a)
+    True
+    """
+    xi_l, eta_l = (_a(v) for v in rod_left)
+    xi_r, eta_r = (_a(v) for v in rod_right)
     f = _a(setting.f_instrument_mm)
-    xi_l, eta_l = rl[..., 0], rl[..., 1]
-    t_l, y_l, y_r, q = _rays(xi_l, eta_l, rr[..., 0], rr[..., 1], setting)
+    t_l, y_l, y_r, q = _rays(xi_l, eta_l, xi_r, eta_r, setting)
     x = _a(setting.model_origin_x_mm) + t_l * xi_l
     y = _a(setting.model_origin_y_mm) + 0.5 * (y_l + y_r)
     return StereoReading(*np.broadcast_arrays(x, y, t_l * f, q))
@@ -722,8 +792,11 @@ def counters_from_homologous_points(
     >>> [float(v) for v in r]
     [45.0, 0.0, 130.0, 0.0]
     """
-    return rods_intersection(
-        rod_from_photo(photo_left_mm, left), rod_from_photo(photo_right_mm, right), setting
+    pl, pr = _a(photo_left_mm), _a(photo_right_mm)
+    return rods_intersection_xy(  # rod_from_photo of each photo, not stacked into pairs
+        UnitMap(left).rod_xy(pl[..., 0], pl[..., 1]),
+        UnitMap(right).rod_xy(pr[..., 0], pr[..., 1]),
+        setting,
     )
 
 

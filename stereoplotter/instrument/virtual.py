@@ -19,8 +19,9 @@ vectorised: every state is an array of shape (T,) when ``trials`` is given).
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, Final, Literal, get_args
 
 import numpy as np
@@ -139,16 +140,19 @@ class Scale:
     ratio_error: Any
     least_count: float
     sense: int = 1
+    #: sense·(1 + ratio_error), the scale's gain, computed once (per trial when the ratio error is)
+    gain: Any = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "gain", self.sense * (1.0 + self.ratio_error))
 
     def reading(self, position: ArrayLike) -> NDArray[np.float64]:
         """The exact reading of a position. [mm]"""
-        return np.asarray(
-            self.zero + self.sense * (1.0 + self.ratio_error) * np.asarray(position, float)
-        )
+        return np.asarray(self.zero + self.gain * np.asarray(position, float))
 
     def position(self, reading: ArrayLike) -> NDArray[np.float64]:
         """The position that shows a reading. [mm]"""
-        return (np.asarray(reading, float) - self.zero) / (self.sense * (1.0 + self.ratio_error))
+        return (np.asarray(reading, float) - self.zero) / self.gain
 
     def rounded(self, reading: ArrayLike) -> NDArray[np.float64]:
         """A reading as the operator sees it: to the least count."""
@@ -286,6 +290,8 @@ class Instrument:
         }
         #: Per side, the UnitMap of the present unit (rebuilt when the unit is replaced).
         self._unit_maps: dict[str, UnitMap] = {}
+        #: The last :attr:`setting` and the arrays it was built from (f_пр, the base carriages).
+        self._setting_cache: tuple[tuple[Any, ...], InstrumentSetting] | None = None
         self._travel: dict[str, tuple[float, float]] = {}
 
     # --- construction --------------------------------------------------------------------
@@ -372,7 +378,7 @@ class Instrument:
             raise StereoplotterError(f"no scale {control!r}; scales: {', '.join(self._scales)}")
         scale = self._scales[control]
         if control in self._axes:
-            reading = scale.reading(self._axes[control].nut)
+            reading = scale.reading(_nut(self._axes[control]))
         else:
             side = control.split("_")[1]
             unit = self._units[side]
@@ -406,7 +412,11 @@ class Instrument:
             return
         if control in self._axes:
             nut = self._scales[control].position(reading)
-            self._axes[control].approach(self._arg(nut), side)
+            axis = self._axes[control]
+            if isinstance(axis, PlayAxis):  # the same move, its carriages not copied out
+                axis.move(self._arg(nut), side, owned=nut.shape == axis.h.shape)
+            else:
+                axis.approach(self._arg(nut), side)
             return
         value = np.asarray(reading, float)
         if control == "f_instrument":
@@ -496,6 +506,13 @@ class Instrument:
         """The direction of a counter (+1 or −1)."""
         return self._scales[control].sense
 
+    def screw(self, control: ScrewName) -> tuple[Scale, PlayAxis] | None:
+        """The counter's scale and the closed-form axis of a lead screw, for a caller that
+        repeats :meth:`read` and :meth:`set` on them with the same arithmetic (the operator's
+        look-and-correct passes); None for a pymunk axis."""
+        axis = self._axes[control]
+        return (self._scales[control], axis) if isinstance(axis, PlayAxis) else None
+
     def travel_mm(self, control: ScrewName) -> tuple[float, float]:
         """The range stops of a lead-screw axis (nut positions). [mm]
 
@@ -559,7 +576,7 @@ class Instrument:
         return self._height_gear
 
     def _height_reading(self) -> NDArray[np.float64]:
-        depth = np.asarray(self._scales["Z"].reading(self._axes["Z"].nut), float)
+        depth = np.asarray(self._scales["Z"].reading(_nut(self._axes["Z"])), float)
         return self._height_slip - depth * self._gear() / 1000.0
 
     def _round_height(self, reading: NDArray) -> NDArray[np.float64]:
@@ -571,11 +588,18 @@ class Instrument:
     @property
     def setting(self) -> InstrumentSetting:
         """The physical setting: f_пр, base and the plumb of S_л at X = Y = 0."""
+        axes = [self._axes[n] for n in ("bx", "by", "bz")]
+        key = (self._f_instrument, *(a._car if isinstance(a, PlayAxis) else None for a in axes))
+        cached = self._setting_cache
+        if cached is not None and all(map(operator.is_, key, cached[0])) and key[-1] is not None:
+            return cached[1]  # f_пр and the base carriages as they were (arrays are replaced)
         if np.any(np.isnan(self._f_instrument)):
             raise StereoplotterError("f_пр has not been set (set('f_instrument', …) first)")
-        return InstrumentSetting(
+        setting = InstrumentSetting(
             self._f_instrument, self._pos("bx"), self._pos("by"), self._pos("bz"), 0.0, 0.0
         )
+        self._setting_cache = (key, setting)
+        return setting
 
     def _pos(self, name: str) -> NDArray[np.float64]:
         return self._out(self._axes[name].position)
@@ -768,6 +792,12 @@ class Instrument:
         if self.trials is None and v.size == 1:
             return float(v.reshape(-1)[0])
         return v
+
+
+def _nut(axis: Any) -> Any:
+    """The nut positions of an axis to compute with (not to keep): a PlayAxis's own array,
+    which it replaces and never writes into, instead of the copy of ``axis.nut``."""
+    return axis._nut if isinstance(axis, PlayAxis) else axis.nut
 
 
 def _replace(unit: CorrectionUnit, **changes: Any) -> CorrectionUnit:

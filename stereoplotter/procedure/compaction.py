@@ -49,6 +49,9 @@ COMPACT_MAX_SHARE = 0.8
 
 #: Instrument attributes without per-trial state (not walked).
 _FIXED = frozenset({"spec", "errors", "options", "variant", "backend", "ideal_mechanics"})
+#: Instrument caches of its own state (emptied in a sub-run, the parent's kept: each is checked
+#: against the state it was built from).
+_CACHES = frozenset({"_unit_maps", "_setting_cache"})
 
 
 class SubsetNoise(Noise):
@@ -193,10 +196,11 @@ def _sub_run(run: Run, index: NDArray[np.intp], memo: Memo) -> Run:
     op, trials = run.op, run.op.trials
     inst = copy.copy(op.inst)
     for name, value in vars(op.inst).items():
-        if name not in _FIXED and name != "_unit_maps":
+        if name not in _FIXED and name not in _CACHES:
             setattr(inst, name, _take(value, index, trials, memo))
     inst.trials = len(index)
-    inst._unit_maps = {}  # a cache of the parent's units
+    inst._unit_maps = {}  # caches of the parent's state
+    inst._setting_cache = None
     log = Transcript(enabled=False)
     where = np.flatnonzero(index == op.log.shown)
     if op.log.enabled and where.size:
@@ -222,7 +226,7 @@ def _sub_run(run: Run, index: NDArray[np.intp], memo: Memo) -> Run:
 def _merge(run: Run, sub: Run, index: NDArray[np.intp], memo: Memo) -> None:
     op, trials = run.op, run.op.trials
     for name, value in vars(sub.op.inst).items():
-        if name in _FIXED or name in ("trials", "_unit_maps"):
+        if name in _FIXED or name in _CACHES or name == "trials":
             continue
         setattr(op.inst, name, scatter(getattr(op.inst, name, None), value, index, trials, memo))
     # the parent's unit maps stay: each is checked against its unit (by identity) when used

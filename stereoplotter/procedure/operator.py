@@ -27,7 +27,7 @@ from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     UnitMap,
     rod_frame,
-    rods_intersection,
+    rods_intersection_xy,
     rods_y_parallax,
     turn_correction_knob,
 )
@@ -51,7 +51,7 @@ from stereoplotter.procedure.evaluation import (
 )
 from stereoplotter.procedure.eye import EYE_MODES, LEGACY_SIGMA_MM, Eye, ObservationSystem
 from stereoplotter.procedure.transcript import Transcript
-from stereoplotter.random_streams import keyed_draws
+from stereoplotter.random_streams import keyed_standard_normal
 from stereoplotter.scenario.model import Camera, Photo, Point, Scenario
 from stereoplotter.scenario.summary import mean_flying_height_m
 from stereoplotter.scenario.synthetic import film_deformed
@@ -252,21 +252,20 @@ class Noise:
         if sigma == 0.0:
             z = np.zeros(stop - start)
         else:
-            z = keyed_draws(self.seed, key, start, stop, _standard_normal)
+            z = keyed_standard_normal(self.seed, key, start, stop)
             z *= sigma
         if self.trial is not None or not self.trials:
             return np.asarray(z[0])
         return z
 
 
-def _standard_normal(rng: np.random.Generator, n: int) -> NDArray[np.float64]:
-    return rng.standard_normal(n)
-
-
 def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: float = 1e-6):
     """x with fun(x) = target by a fixed number of Newton steps (central differences).
 
     A fixed count (no early exit) keeps a vectorised run and a per-trial loop bit-identical.
+    A ``fun`` with the attribute ``stacked`` set is evaluated once per step on x, x + h, x − h
+    stacked on a new leading axis (it must give each the bits it gives alone: element-wise
+    IEEE arithmetic and square roots only).
 
     Examples
     --------
@@ -275,9 +274,15 @@ def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: floa
     """
     x = np.asarray(x0, float) + 0.0
     t = np.asarray(target, float)
+    stacked = getattr(fun, "stacked", False)
     for _ in range(iterations):
-        r = fun(x) - t
-        d = (fun(x + h) - fun(x - h)) / (2.0 * h)
+        if stacked:
+            v = fun(np.stack([x, x + h, x - h]))
+            r = v[0] - t
+            d = (v[1] - v[2]) / (2.0 * h)
+        else:
+            r = fun(x) - t
+            d = (fun(x + h) - fun(x - h)) / (2.0 * h)
         with np.errstate(divide="ignore", invalid="ignore"):
             step = np.where(d != 0.0, r / d, 0.0)
         x = x - step
@@ -332,6 +337,10 @@ class Scene:
     standard: tuple[NDArray[np.float64], NDArray[np.float64]] = field(init=False, repr=False)
     grid_images_mm: tuple[NDArray[np.float64], NDArray[np.float64]] | None = field(
         init=False, repr=False
+    )
+    #: Images of the ground points asked for before (:meth:`images`), kept for the scene's life.
+    _images: dict[bytes, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
+        init=False, repr=False, compare=False, default_factory=dict
     )
 
     def __post_init__(self) -> None:
@@ -389,7 +398,15 @@ class Scene:
 
         ``read_only``: the arrays refuse writes (images kept for the whole run)."""
         pts = np.asarray(points_m, float)
-        out = tuple(photo_points_mm(self.camera, self.photo(n), pts) for n in ("left", "right"))
+        key = pts.tobytes() + repr(pts.shape).encode()
+        known = self._images.get(key)
+        if known is None:  # the few control points a procedure fuses on, again and again
+            known = tuple(
+                photo_points_mm(self.camera, self.photo(n), pts) for n in ("left", "right")
+            )
+            if pts.size <= 30:
+                self._images[key] = known
+        out = tuple(a.copy() for a in known)
         for a in out if read_only else ():
             a.setflags(write=False)
         return out
@@ -427,6 +444,8 @@ class Operator:
         """A value in the run's shape: (T,) or ()."""
         a = np.asarray(x, float)
         if self.trials:
+            if a.shape == (self.trials,):
+                return a.copy()
             return np.broadcast_to(a, (self.trials,)).copy()
         return a.reshape(-1)[0] + np.zeros(()) if a.size == 1 else a
 
@@ -489,6 +508,14 @@ class Operator:
         beyond it becomes the stop's reading, and the trial is flagged in :attr:`stopped`."""
         if control == HEIGHT_SCALE:
             return reading
+        low, high = self._stop_readings(control)
+        out = np.minimum(np.maximum(reading, low), high)  # np.clip's values, less overhead
+        if (out != reading).any():  # beyond a stop (or NaN)
+            self._flag_stopped(control, (reading < low) | (reading > high))
+        return out
+
+    def _stop_readings(self, control: ScrewName) -> tuple[NDArray, NDArray]:
+        """The readings of the two stops of a lead screw (low, high), cached."""
         stops = self._stops.get(control)
         if stops is None:
             lo, hi = self.inst.travel_mm(control)
@@ -498,18 +525,19 @@ class Operator:
             )
             stops = np.minimum(r_lo, r_hi), np.maximum(r_lo, r_hi)
             self._stops[control] = stops
-        low, high = stops
-        beyond = (reading < low) | (reading > high)
-        if np.any(beyond):
+        return stops
+
+    def _flag_stopped(self, control: str, beyond: NDArray[np.bool_]) -> None:
+        if beyond.any():
             self.stopped[control] = self.stopped.get(control, np.zeros_like(beyond)) | beyond
-        return np.clip(reading, low, high)
 
     # --- turning while looking ---------------------------------------------------------------
 
     def physical(self, control: DrivenControl) -> NDArray[np.float64]:
         """Where a control physically is (what the eye judges in the eyepiece)."""
         if control in _SCREWS:
-            return self.v(self.inst.position(control))
+            now = self.inst.position(control)  # a copy of the carriages
+            return now if self.trials and np.shape(now) == (self.trials,) else self.v(now)
         if control.startswith("kappa_"):
             return self.v(self.inst.unit(control.split("_")[1]).kappa)
         if control in _KNOBS:
@@ -532,6 +560,12 @@ class Operator:
         active = self.all() if active is None else active
         if not np.any(active):
             return
+        if self.trials and control in _SCREWS:
+            target = np.asarray(target, float)  # only read: no copy of a (T,) target
+            if target.shape != (self.trials,):
+                target = self.v(target)
+            self._drive_screw(control, target, active)
+            return
         target = self.v(target)
         for _ in range(self.passes):
             now = self.physical(control)
@@ -547,6 +581,30 @@ class Operator:
                 cmd = self.commanded.get(control, now) + err
                 self.inst.set(control, cmd)
                 self.commanded[control] = cmd
+
+    def _drive_screw(self, control: ScrewName, target, active) -> None:
+        """:meth:`drive` of a lead screw over T trials: the same passes and arithmetic
+        (``Instrument.read`` exact, :meth:`_at_stop`, ``Instrument.set``) on the closed-form
+        axis's own (T,) arrays, without the copies and checks of each call."""
+        side = self.model.finish_side
+        parts = self.inst.screw(control)
+        if parts is None:
+            for _ in range(self.passes):
+                err = np.where(active, target - self.physical(control), 0.0)
+                read = self.inst.read(control, exact=True)
+                self.inst.set(control, self._at_stop(control, read + err), side)
+            return
+        scale, axis = parts
+        zero, gain = scale.zero, scale.gain
+        low, high = self._stop_readings(control)
+        for _ in range(self.passes):
+            err = np.where(active, target - axis._car, 0.0)
+            reading = np.asarray(zero + gain * axis._nut) + err  # the exact reading + error
+            cmd = np.minimum(np.maximum(reading, low), high)  # at the stops (_at_stop)
+            if (cmd != reading).any():
+                self._flag_stopped(control, (reading < low) | (reading > high))
+            nut = (cmd - zero) / gain  # Scale.position
+            axis.move(nut, side, owned=nut.shape == axis.h.shape)
 
     # --- looking ------------------------------------------------------------------------------
 
@@ -626,12 +684,12 @@ class Operator:
         ey = self.noise.normal(f"mono/{key}/y", self.model.monocular_sigma_mm)
         ep = self.noise.normal(f"stereo/{key}", self.model.stereo_sigma_mm)
         eq = self.noise.normal(f"q/{key}", self.model.y_parallax_sigma_mm)
-        shift = np.stack([ex, ey], axis=-1)
-        pl = np.asarray(pl, float) + shift + np.stack([ep, 0.0 * ep], axis=-1)
-        pr = np.asarray(pr, float) + shift
-        r = rods_intersection(
-            self.unit_map("left").rod_from_photo(pl),
-            self.unit_map("right").rod_from_photo(pr),
+        pl, pr = np.asarray(pl, float), np.asarray(pr, float)
+        # the marks at the photo points shifted by (ex, ey) on both photos and by ep in x on the
+        # left: by component (the y of the left mark + 0·ep is that y, to the bit)
+        r = rods_intersection_xy(
+            self.unit_map("left").rod_xy(pl[..., 0] + ex + ep, pl[..., 1] + ey),
+            self.unit_map("right").rod_xy(pr[..., 0] + ex, pr[..., 1] + ey),
             self.inst.setting,
         )
         if move:
@@ -660,12 +718,11 @@ class Operator:
             def turned(value):
                 return base.with_kappa(value)
         else:
-            unit = self.inst.unit(side)
             axis = control.split("_")[1]
             linkage = self.inst.variant.linkage
 
             def turned(value):
-                return UnitMap(turn_correction_knob(unit, axis, value, linkage=linkage), base.trig)
+                return base.with_knob(axis, value, linkage)
 
         def q(value):
             moving = turned(value).rod_xy(x, y)
@@ -673,6 +730,10 @@ class Operator:
                 return rods_y_parallax(moving, fixed, setting)
             return rods_y_parallax(fixed, moving, setting)
 
+        # a knob's turn at one point is element-wise arithmetic and square roots (the mechanisms'
+        # scales too), no cos, sin, whose vectorised loops may round differently by position:
+        # x, x ± h at once
+        q.stacked = not control.startswith("kappa_") and np.ndim(x) == 0 and np.ndim(y) == 0
         return q
 
     def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):

@@ -15,11 +15,13 @@ Carlo standard errors (:mod:`stereoplotter.statistics`), never per-trial arrays.
 
 from __future__ import annotations
 
+import collections
+import itertools
 import math
 import multiprocessing
 import os
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,6 +31,7 @@ from numpy.typing import NDArray
 from stereoplotter.constants import MM_PER_M, UM_PER_MM
 from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.simulate import SimulationResult, run_trials_chunk
+from stereoplotter.random_streams import BLOCK
 from stereoplotter.statistics import scale_summary, summarise_flags, summarise_values
 
 __all__ = [
@@ -40,6 +43,7 @@ __all__ = [
     "default_workers",
     "iter_chunk_columns",
     "iter_trial_chunks",
+    "own_chunks",
     "run_header",
     "run_info",
     "split_chunk",
@@ -48,10 +52,12 @@ __all__ = [
     "trial_columns",
 ]
 
-#: Peak working memory per trial of one chunk (simulation and evaluation), measured with
-#: ``benchmarks/bench_simulate_scale.py`` on pair60 (setup ≈ 20 kB, conventional ≈ 25 kB) and
-#: rounded up for safety. [bytes]
-BYTES_PER_TRIAL = {"setup": 32_000, "conventional": 40_000}
+#: Peak working memory per trial of one chunk (simulation and evaluation), rounded up for
+#: safety. Setup: ≈ 20 kB on pair60 (``benchmarks/bench_simulate_scale.py``). Conventional:
+#: 14.6 kB on pair60 and pair80, 12.8 kB on mountain60 (the rise of ``ru_maxrss`` over one chunk
+#: of 4 096, 8 192 and 16 384 trials, SC-1, issue 26; 7.8 kB of it without the evaluation), so a
+#: chunk of 12 288 trials stays under 180 MB of the default 256 MB. [bytes]
+BYTES_PER_TRIAL = {"setup": 32_000, "conventional": 20_000}
 
 #: Default memory budget of one chunk (a convention: leaves room on a 1 GiB allowance for the
 #: interpreter, the libraries and the columns of the current chunk). [MB]
@@ -64,15 +70,23 @@ MIN_CHUNK = 256
 def chunk_trials_for(memory_budget_mb: float, method: str) -> int:
     """Trials per chunk so that one chunk stays within the memory budget.
 
+    A chunk of at least two keyed blocks (:data:`~stereoplotter.random_streams.BLOCK`) is cut
+    down to whole blocks, so that every chunk starts at a block's start: a chunk starting inside
+    a block draws that block's prefix for nothing, on every stream it reads (at 6 400 trials a
+    chunk the conventional method drew 23 % of its normals for nothing at 10⁵ trials, issue 26).
+
     Examples
     --------
-    >>> chunk_trials_for(256, "setup")
-    8000
+    >>> chunk_trials_for(256, "setup"), chunk_trials_for(256, "conventional")
+    (8000, 12288)
     """
     if not memory_budget_mb > 0:
         raise ValueError(f"memory budget: expected > 0 MB, found {memory_budget_mb}")
     per_trial = BYTES_PER_TRIAL.get(method, max(BYTES_PER_TRIAL.values()))
-    return max(MIN_CHUNK, int(memory_budget_mb * 1e6 // per_trial))
+    n = int(memory_budget_mb * 1e6 // per_trial)
+    if n >= 2 * BLOCK:
+        n -= n % BLOCK
+    return max(MIN_CHUNK, n)
 
 
 def iter_trial_chunks(
@@ -152,8 +166,10 @@ def iter_chunk_columns(
     :func:`trial_columns`.
 
     With ``workers`` > 1 the chunks after the first run in that many forked processes while
-    this one runs the first. Every draw is keyed by the trial, so the columns are the same
-    whatever the workers and the chunks.
+    this one runs a few of the last (:func:`own_chunks`: its share of the trials, so that no
+    process is left with one chunk more at the end) and then the first. ``progress`` counts
+    each chunk when it is done, in any order. Every draw is keyed by
+    the trial, so the columns are the same whatever the workers and the chunks.
     """
     if trials < 1:
         raise ValueError(f"trials: expected ≥ 1, found {trials}")
@@ -162,31 +178,66 @@ def iter_chunk_columns(
     starts = list(range(0, trials, chunk_trials))
     sizes = [min(chunk_trials, trials - f) for f in starts]
     pool = None
-    futures: list[Future] = []
+    futures: dict[int, Future] = {}
+    own: list[int] = []
     if workers > 1 and len(starts) > 1 and "fork" in multiprocessing.get_all_start_methods():
+        own = own_chunks(sizes, workers)
+        rest = [k for k in range(1, len(starts)) if k not in own]
         _PREPARED[:] = [(prep, evaluate)]  # inherited by the forked workers
         context = multiprocessing.get_context("fork")
-        pool = ProcessPoolExecutor(max_workers=min(workers, len(starts) - 1), mp_context=context)
-        rest = zip(starts[1:], sizes[1:], strict=True)
-        futures = [pool.submit(_chunk_columns, f, n) for f, n in rest]
+        pool = ProcessPoolExecutor(max_workers=min(workers, len(rest)), mp_context=context)
+        futures = {k: pool.submit(_chunk_columns, starts[k], sizes[k]) for k in rest}
     try:
+        mine = {}
+        for k in own:  # first, so that no chunk's whole result is held meanwhile
+            mine[k] = _columns_here(prep, starts[k], sizes[k], evaluate)
+            if progress is not None:
+                progress(sizes[k])
         result = run_trials_chunk(prep, 0, sizes[0], evaluate=evaluate, transcript=True)
         yield result, trial_columns(result)
         del result  # the caller keeps what it needs of the first chunk
         if progress is not None:
             progress(sizes[0])
-        for k, (first, n) in enumerate(zip(starts[1:], sizes[1:], strict=True)):
+        for k in range(1, len(starts)):
+            if k in mine:
+                yield None, mine.pop(k)
+                continue
             if pool is None:
-                columns = _columns_here(prep, first, n, evaluate)
+                columns = _columns_here(prep, starts[k], sizes[k], evaluate)
             else:
                 columns = futures[k].result()
             yield None, columns
             if progress is not None:
-                progress(n)
+                progress(sizes[k])
     finally:
         if pool is not None:
             pool.shutdown(cancel_futures=True)
             _PREPARED.clear()
+
+
+def own_chunks(sizes: list[int], workers: int) -> list[int]:
+    """The chunks after the first that the process running the first runs too: the last ones,
+    while it holds at most its share T/(workers + 1) of the trials (the others go to the
+    ``workers`` forked processes). At least one chunk is left to them.
+
+    Examples
+    --------
+    10⁵ trials of the conventional method in chunks of 12 288 on two processors: this process
+    runs chunks 0, 7 and 8 (26 272 trials), each worker three of chunks 1–6 (36 864):
+
+    >>> own_chunks([12288] * 8 + [1696], 2)
+    [7, 8]
+    >>> own_chunks([5000, 5000], 2)
+    []
+    """
+    share = sum(sizes) / (workers + 1)
+    total, own = sizes[0], []
+    for k in range(len(sizes) - 1, 1, -1):  # never chunk 1: the workers keep at least one
+        if total + sizes[k] > share:
+            break
+        own.append(k)
+        total += sizes[k]
+    return sorted(own)
 
 
 def _columns_here(prep: PreparedRun, first: int, n: int, evaluate: bool) -> dict[str, NDArray]:
@@ -282,11 +333,15 @@ def _derived(key: str, summary: dict[str, Any], info: RunInfo) -> dict[str, dict
 def summarise_columns(
     info: RunInfo, columns: Iterable[tuple[str, NDArray[Any]]], extra: dict[str, Any] | None = None
 ) -> dict[str, Any]:
-    """The JSON-ready summary of a run from its whole columns (one at a time is enough).
+    """The JSON-ready summary of a run from its whole columns (a few at a time are enough).
 
     Per check: pass rate, residual, tolerance and iterations; per stage: iterations; the true
     residual y-parallax; per point set of the evaluation: each max/RMS error (and in ‰ H or map
     mm). Every figure with its Monte Carlo standard error or 95 % interval.
+
+    Columns of at least :data:`THREADED_SUMMARY_TRIALS` trials are summarised on two threads
+    (their sorts and reductions release the GIL; 0.7 s of one core at 10⁵ trials of the
+    conventional method, issue 26), a few columns ahead of the one being assembled.
     """
     out: dict[str, Any] = {**info.header, **(extra or {})}
     checks: dict[str, dict[str, Any]] = {}
@@ -297,40 +352,81 @@ def summarise_columns(
     }
     evaluation: dict[str, dict[str, Any]] = {}
     remedies: dict[str, dict[str, Any]] = {}
-    for name, values in columns:
+    for name, figure in _column_figures(columns):
         kind, _, rest = name.partition("/")
         if kind == "check":
             check, _, field = rest.rpartition("/")
             entry = checks.setdefault(check, {"unit": info.check_units.get(check)})
-            if field == "passed":
-                entry["pass_rate"] = summarise_flags(values)
-            else:
-                entry[field] = summarise_values(values)
+            entry["pass_rate" if field == "passed" else field] = figure
         elif kind == "remedy":
             rem, _, field = rest.rpartition("/")
             entry = remedies.setdefault(rem, {})
-            if field == "applied":
-                entry["applied_rate"] = summarise_flags(values)
-            elif field == "passed_after":
-                done = values[~np.isnan(values)]
-                flags = done.astype(bool)
-                entry["passed_after_rate"] = summarise_flags(flags) if done.size else None
-            else:
-                entry[field] = summarise_values(values)
+            key = {"applied": "applied_rate", "passed_after": "passed_after_rate"}.get(field, field)
+            entry[key] = figure
         elif kind == "evaluation":
             set_name, _, key = rest.partition("/")
             s = evaluation.setdefault(set_name, {"n_points": info.points_per_set.get(set_name)})
-            s[key] = summarise_values(values)
+            s[key] = figure
             s.update(_derived(key, s[key], info))
-        elif kind in groups:
-            groups[kind][rest] = summarise_values(values)
-        else:  # pragma: no cover - trial_columns makes only these kinds
-            raise ValueError(f"unknown column {name!r}")
+        else:
+            groups[kind][rest] = figure
     out["checks"] = checks
     out["remedies"] = remedies
     out.update(groups)
     out["evaluation"] = evaluation or None
     return out
+
+
+#: Trials from which :func:`summarise_columns` summarises columns on two threads (below, a
+#: thread's start costs about what it saves). [trials]
+THREADED_SUMMARY_TRIALS = 50_000
+
+
+#: Column kinds summarised as values (those of :func:`trial_columns`).
+_VALUE_KINDS = (
+    "check", "remedy", "evaluation", "iterations", "zero_reading", "residual_y_parallax"
+)  # fmt: skip
+
+
+def _column_figure(name: str, values: NDArray[Any]) -> dict[str, Any] | None:
+    """The summary of one column: a rate for a yes/no column, else the values' figures."""
+    kind, _, rest = name.partition("/")
+    field = rest.rpartition("/")[2]
+    if kind == "check" and field == "passed":
+        return summarise_flags(values)
+    if kind == "remedy" and field == "applied":
+        return summarise_flags(values)
+    if kind == "remedy" and field == "passed_after":
+        done = values[~np.isnan(values)]
+        return summarise_flags(done.astype(bool)) if done.size else None
+    if kind in _VALUE_KINDS:
+        return summarise_values(values)
+    raise ValueError(f"unknown column {name!r}")  # pragma: no cover - trial_columns makes these
+
+
+def _column_figures(
+    columns: Iterable[tuple[str, NDArray[Any]]], ahead: int = 4
+) -> Iterator[tuple[str, dict[str, Any] | None]]:
+    """(name, :func:`_column_figure`) in the columns' order; long columns on two threads, at
+    most ``ahead`` columns read before the one yielded."""
+    items = iter(columns)
+    first = next(items, None)
+    if first is None:
+        return
+    if len(first[1]) < THREADED_SUMMARY_TRIALS or default_workers() < 2:
+        for name, values in itertools.chain([first], items):
+            yield name, _column_figure(name, values)
+        return
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        pending: collections.deque = collections.deque()
+        for name, values in itertools.chain([first], items):
+            pending.append((name, pool.submit(_column_figure, name, values)))
+            if len(pending) > ahead:
+                done_name, future = pending.popleft()
+                yield done_name, future.result()
+        while pending:
+            done_name, future = pending.popleft()
+            yield done_name, future.result()
 
 
 def summarise_result(result: SimulationResult) -> dict[str, Any]:

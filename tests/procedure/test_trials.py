@@ -72,7 +72,9 @@ def test_single_run_is_trial_zero_of_a_vectorised_run(pair):
 
 def test_chunk_size_follows_the_memory_budget():
     assert chunk_trials_for(256, "setup") == 8000
-    assert chunk_trials_for(512, "conventional") == 12800
+    assert chunk_trials_for(512, "conventional") == 24576  # 25 600 cut to whole keyed blocks
+    assert chunk_trials_for(256, "conventional") == 12288
+    assert chunk_trials_for(150, "conventional") == 7500  # under two blocks: not cut
     assert chunk_trials_for(1, "setup") == 256  # the smallest useful chunk
     with pytest.raises(ValueError):
         chunk_trials_for(0, "setup")

@@ -45,6 +45,7 @@ __all__ = [
     "TravelRefusal",
     "check_side",
     "check_travel",
+    "detour_start",
     "pre_position",
 ]
 
@@ -301,6 +302,8 @@ def check_travel(params: AxisParams, value: ArrayLike, what: str = "setting") ->
     """  # noqa: E501
     lo, hi = params.range_mm
     v = np.asarray(value, dtype=float)
+    if v.size == 0 or (v.min() >= lo and v.max() <= hi):  # NaN fails both: refused below
+        return
     bad = ~((v >= lo) & (v <= hi))  # NaN is refused too
     if not bad.any():
         return
@@ -353,9 +356,17 @@ def pre_position(nut_mm: ArrayLike, target_mm: ArrayLike, side: Side, overtravel
     )
     if side is None:
         return np.full(nut.shape, np.nan)
+    start, detour = detour_start(nut, target, side, overtravel_mm)
+    return np.where(detour, start, np.nan)
+
+
+def detour_start(nut, target, side: str, overtravel_mm: float):
+    """(start, detour) of :func:`pre_position` for ``side`` "below"/"above": the start of the
+    final stroke and where the nut must first go there (arrays of one shape, no checks)."""
     sign = 1.0 if side == "below" else -1.0
     start = target - sign * overtravel_mm
-    return np.where(sign * (nut - start) > 0.0, start, np.nan)
+    # sign·(nut − start) > 0 to the bit: nut − start is ±0 only where nut = start
+    return start, (nut > start) if side == "below" else (nut < start)
 
 
 @runtime_checkable

@@ -25,7 +25,7 @@ from stereoplotter.instrument.mechanics.base import (
     Side,
     check_side,
     check_travel,
-    pre_position,
+    detour_start,
 )
 
 __all__ = ["PlayAxis", "play"]
@@ -170,13 +170,33 @@ class PlayAxis:
         TravelRefusal
             If the target or a needed pre-position is beyond the range stops (nothing moves).
         """
-        check_side(side)
-        check_travel(self.params, target, "target")
-        s = np.broadcast_to(np.asarray(target, float), self.h.shape)
-        pre = pre_position(self._nut, s, side, self.params.overtravel_mm)
-        detour = ~np.isnan(pre)
-        check_travel(self.params, pre[detour], "pre-position")
-        x = np.where(detour, play(self._car, pre, self.h, self.c), self._car)
-        self._car = play(x, s, self.h, self.c)
-        self._nut = s.copy()
+        self.move(target, side)
         return self._car.copy()
+
+    def move(self, target: ArrayLike, side: Side = None, *, owned: bool = False) -> None:
+        """:meth:`approach` without returning the carriages (the same arithmetic).
+
+        ``owned``: ``target`` is a new array of shape (T,) that the caller hands over (kept as
+        the nuts without a copy)."""
+        check_side(side)
+        s = np.asarray(target, float)
+        lo, hi = self.params.range_mm
+        s_min, s_max = s.min(), s.max()
+        if not (s_min >= lo and s_max <= hi):  # NaN fails both
+            check_travel(self.params, s, "target")
+        if s.shape != self.h.shape:
+            s = np.broadcast_to(s, self.h.shape)
+            owned = False
+        x = self._car
+        if side is not None:  # pre_position: a detour to the final stroke's start where needed
+            ot = self.params.overtravel_mm
+            start, detour = detour_start(self._nut, s, side, ot)
+            if detour.any():
+                # the starts are t ∓ overtravel, rounded monotonically: inside the stops when the
+                # extreme target's is, else checked where a detour is made
+                edge = s_min - ot if side == "below" else s_max + ot
+                if not lo <= edge <= hi:
+                    check_travel(self.params, start[detour], "pre-position")
+                x = np.where(detour, play(x, start, self.h, self.c), x)
+        self._car = play(x, s, self.h, self.c)
+        self._nut = s if owned else s.copy()
