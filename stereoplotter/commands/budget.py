@@ -15,7 +15,7 @@ from stereoplotter.commands.arguments import LibraryDefault, bounded_int, seed_i
 __all__ = ["MAX_BUDGET_TRIALS", "add_arguments", "run"]
 
 #: Trials per configuration of ``budget``: one configuration's trials run in one chunk of the
-#: default memory budget (``procedure.trials.chunk_trials_for``: 8 000 setup, 6 400 conventional).
+#: default memory budget (``procedure.trials.chunk_trials_for``: 8 000 setup, 12 288 conventional).
 MAX_BUDGET_TRIALS = 6000
 #: The library's default trials per configuration (read when shown or used).
 BUDGET_TRIALS = LibraryDefault("stereoplotter.verification.budget", "DEFAULT_BUDGET_TRIALS")
