@@ -31,8 +31,8 @@ from stereoplotter.instrument.kinematics import (
     counters_from_homologous_points,
     marks_from_counters,
     photo_from_rod,
-    unit_for_orientation,
 )
+from stereoplotter.instrument.knobs import unit_for_orientation
 from stereoplotter.procedure.selftest import run_kinematic_selftest
 
 

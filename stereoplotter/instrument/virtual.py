@@ -35,8 +35,8 @@ from stereoplotter.instrument.kinematics import (
     UnitMap,
     decentration_variant,
     marks_from_counters,
-    turn_correction_knob,
 )
+from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
 from stereoplotter.instrument.mechanics.play import PlayAxis
 from stereoplotter.instrument.principles import mechanism_for

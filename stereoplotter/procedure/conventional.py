@@ -34,8 +34,8 @@ from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
     counters_from_homologous_points,
-    turn_correction_knob,
 )
+from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.operator import solve_1d

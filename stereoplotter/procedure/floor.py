@@ -15,8 +15,8 @@ from stereoplotter.instrument.kinematics import (
     InstrumentSetting,
     UnitMap,
     rods_intersection,
-    unit_for_orientation,
 )
+from stereoplotter.instrument.knobs import unit_for_orientation
 from stereoplotter.procedure.operator import Scene
 from stereoplotter.procedure.records import ControlHeight
 from stereoplotter.setup.records import SetupRefusal

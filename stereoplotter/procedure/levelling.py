@@ -17,8 +17,8 @@ from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
     counters_from_homologous_points,
-    turn_correction_knob,
 )
+from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.procedure.floor import ControlHeights, sheet_settings
 from stereoplotter.procedure.operator import Scene
 from stereoplotter.setup.sheet import SetupSheet

@@ -29,8 +29,8 @@ from stereoplotter.instrument.kinematics import (
     rod_frame,
     rods_intersection_xy,
     rods_y_parallax,
-    turn_correction_knob,
 )
+from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.virtual import (
     HEIGHT_SCALE,
     KNOBS,

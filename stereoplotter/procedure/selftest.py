@@ -52,6 +52,8 @@ from stereoplotter.instrument.kinematics import (
     photo_from_rod,
     rod_from_photo,
     rods_intersection,
+)
+from stereoplotter.instrument.knobs import (
     set_decentrations,
     turn_correction_knob,
     unit_for_orientation,

@@ -16,7 +16,7 @@ import re
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.kinematics import unit_for_orientation
+from stereoplotter.instrument.knobs import unit_for_orientation
 from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario

@@ -19,7 +19,8 @@ from conftest import m, mm, um
 from numpy.testing import assert_allclose, assert_array_equal
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.instrument.kinematics import InstrumentSetting, unit_for_orientation
+from stereoplotter.instrument.kinematics import InstrumentSetting
+from stereoplotter.instrument.knobs import unit_for_orientation
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure.evaluation import (

@@ -199,10 +199,8 @@ def test_q_turning_equals_the_plain_kinematics(runs, control):
     ``counters_from_homologous_points`` on the units with the control turned."""
     from dataclasses import replace
 
-    from stereoplotter.instrument.kinematics import (
-        counters_from_homologous_points,
-        turn_correction_knob,
-    )
+    from stereoplotter.instrument.kinematics import counters_from_homologous_points
+    from stereoplotter.instrument.knobs import turn_correction_knob
     from stereoplotter.procedure import Noise, OperatorModel, Transcript
     from stereoplotter.procedure.operator import Operator
 
