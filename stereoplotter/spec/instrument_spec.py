@@ -442,7 +442,7 @@ def format_instrument(spec: InstrumentSpec, *, notes: bool = True) -> str:
     >>> from stereoplotter.io.instrument_file import load_instrument
     >>> text = format_instrument(load_instrument("sc1"))
     >>> print(text.splitlines()[2])  # doctest: +ELLIPSIS
-    values: 20 documented, 46 assumed (ASSUMED: no source states it for this instrument; edit ...
+    values: 20 documented, 47 assumed (ASSUMED: no source states it for this instrument; edit ...
     >>> [line.strip() for line in text.splitlines() if line.startswith("  distance_max_mm")]
     ['distance_max_mm = 185 mm  [documented: SEED6]']
     """
