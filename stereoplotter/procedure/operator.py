@@ -560,11 +560,12 @@ class Operator:
         active = self.all() if active is None else active
         if not np.any(active):
             return
-        if self.trials and control in _SCREWS:
+        parts = self.inst.screw(control) if self.trials and control in _SCREWS else None
+        if parts is not None:  # a closed-form lead screw over T trials
             target = np.asarray(target, float)  # only read: no copy of a (T,) target
             if target.shape != (self.trials,):
                 target = self.v(target)
-            self._drive_screw(control, target, active)
+            self._drive_screw(control, target, active, parts)
             return
         target = self.v(target)
         for _ in range(self.passes):
@@ -582,27 +583,18 @@ class Operator:
                 self.inst.set(control, cmd)
                 self.commanded[control] = cmd
 
-    def _drive_screw(self, control: ScrewName, target, active) -> None:
-        """:meth:`drive` of a lead screw over T trials: the same passes and arithmetic
-        (``Instrument.read`` exact, :meth:`_at_stop`, ``Instrument.set``) on the closed-form
-        axis's own (T,) arrays, without the copies and checks of each call."""
+    def _drive_screw(self, control: ScrewName, target, active, parts) -> None:
+        """:meth:`drive` of a closed-form lead screw over T trials (``parts``: its scale and
+        axis, ``Instrument.screw``): the same passes and arithmetic (``Instrument.read`` exact,
+        :meth:`_at_stop`, ``Instrument.set``) on the axis's own (T,) arrays, without the copies
+        and checks of each call."""
         side = self.model.finish_side
-        parts = self.inst.screw(control)
-        if parts is None:
-            for _ in range(self.passes):
-                err = np.where(active, target - self.physical(control), 0.0)
-                read = self.inst.read(control, exact=True)
-                self.inst.set(control, self._at_stop(control, read + err), side)
-            return
         scale, axis = parts
         zero, gain = scale.zero, scale.gain
-        low, high = self._stop_readings(control)
         for _ in range(self.passes):
             err = np.where(active, target - axis._car, 0.0)
             reading = np.asarray(zero + gain * axis._nut) + err  # the exact reading + error
-            cmd = np.minimum(np.maximum(reading, low), high)  # at the stops (_at_stop)
-            if (cmd != reading).any():
-                self._flag_stopped(control, (reading < low) | (reading > high))
+            cmd = self._at_stop(control, reading)
             nut = (cmd - zero) / gain  # Scale.position
             axis.move(nut, side, owned=nut.shape == axis.h.shape)
 

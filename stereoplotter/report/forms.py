@@ -38,7 +38,7 @@ from stereoplotter.report.form_layout import FONT, Form, LabelPlacer, heading, p
 from stereoplotter.report.sheet import instrument_settings
 from stereoplotter.setup.records import SetupSheet
 
-__all__ = ["FormHeader", "LeastCounts", "form_pdf", "form_pdfs", "forms_pdf"]
+__all__ = ["FormHeader", "LeastCounts", "form_pdf", "form_pdfs"]
 
 #: Font sizes of page 1 tried in turn until the readings summary ends on page 1.
 _PAGE1_SIZES = (6.5, 6.0, 5.5, 5.0, 4.5)
@@ -415,14 +415,3 @@ def form_pdfs(
         singles.append(bytes(pdf.output()))
         combined.append_pages(pdf)
     return singles, bytes(combined.output())
-
-
-def forms_pdf(
-    forms: Sequence[tuple[SetupSheet, FormHeader]],
-    title: str,
-    date: str,
-    lang: str = "en",
-    rigorous: bool = False,
-) -> bytes:
-    """The forms of many pairs in one PDF (the combined print of a block)."""
-    return form_pdfs(forms, title, date, lang, rigorous)[1]
