@@ -33,6 +33,7 @@ from stereoplotter.instrument.sc1_complex import (
 )
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.evaluation import ModelTruth, model_truth
+from stereoplotter.procedure.fidelity import Fidelity
 from stereoplotter.procedure.floor import (
     ControlHeights,
     control_heights_of,
@@ -97,6 +98,8 @@ class Run:
     level : LevelDesign or None
         Remedy R3's levelling design at the sheet's own settings (setup-data method; prepared
         once per run).
+    fidelity : Fidelity
+        The mechanism switches (:mod:`~stereoplotter.procedure.fidelity`).
     """
 
     op: Operator
@@ -110,6 +113,7 @@ class Run:
     remedies: dict[str, Remedy] = field(default_factory=dict)
     heights: ControlHeights | None = None
     level: LevelDesign | None = None
+    fidelity: Fidelity = field(default_factory=Fidelity)
     readings: SheetReadings = field(init=False)
 
     def __post_init__(self) -> None:
@@ -200,6 +204,8 @@ class PreparedRun:
     #: Remedy R3's levelling design at the sheet's own settings, once per run (setup-data
     #: method; None for the conventional method).
     level: LevelDesign | None = None
+    #: The mechanism switches of the procedure (:mod:`~stereoplotter.procedure.fidelity`).
+    fidelity: Fidelity = field(default_factory=Fidelity)
 
 
 @dataclass(frozen=True)
@@ -343,7 +349,9 @@ def build_run(
         noise = Noise(prep.seed, trials, None, first)
     op = Operator(inst, prep.operator, noise, Transcript(enabled=transcript))
     log_options(op, prep)
-    run = Run(op, prep.sheet, prep.scene, heights=prep.heights, level=prep.level)
+    run = Run(
+        op, prep.sheet, prep.scene, heights=prep.heights, level=prep.level, fidelity=prep.fidelity
+    )
     run.practice = prep.practice if practice is None else practice
     return run
 

@@ -41,6 +41,7 @@ __all__ = [
     "Q_ELEMENTS",
     "check_standard_points",
     "clear_kappa",
+    "kappa_from_fiducials",
     "refine_relative_orientation",
     "refine_scale_and_level",
     "run_setup_method",
@@ -75,7 +76,8 @@ def stage1_scale_coefficient(run: Run) -> None:
     op, sheet = run.op, run.sheet
     log = op.log
     steps.interior_orientation(run, "1")
-    o_bx = run.target("O_bx", NOMINAL_ZERO["bx"])  # MO_bx: the scale's place of zero
+    run.zero["MO_bx"] = _bx_zero(run)
+    o_bx = run.target("O_bx", run.zero["MO_bx"])
     op.set("bx", o_bx, "1/bx")
     log.add(
         "1",
@@ -115,6 +117,30 @@ def stage1_scale_coefficient(run: Run) -> None:
     if run.remedial:
         run.record_remedy("R1 stage 1: repeat the setting", name, failed, r_its * failed)
     _record_stage1_zeros(run)
+
+
+def _bx_zero(run: Run):
+    """MO_bx, b_x's place of zero (switch ``bx_zero``, :mod:`~stereoplotter.procedure.fidelity`):
+    "two_pointings" ((6.38), m_bx = √2·m_x/n): found as MO_by is, the left mark monocularly on
+    the left cassette centre, the right mark on the right one, each pointing with σ_mono along
+    x at photo scale, so MO_bx carries n_л·(e_п − e_л); "exact": the scale's nominal place of
+    zero. [mm]"""
+    op = run.op
+    if run.fidelity.bx_zero == "exact":
+        return op.v(NOMINAL_ZERO["bx"])
+    sigma = op.model.monocular_sigma_mm
+    e = [op.noise.normal(f"mono/1/MObx/{side}", sigma) for side in ("left", "right")]
+    zero = NOMINAL_ZERO["bx"] + run.sheet.n_left * (e[1] - e[0])
+    op.log.add(
+        "1",
+        "MO_bx: the left mark on the left cassette centre, the right mark on the right one "
+        "(two monocular pointings along x)",
+        "bx",
+        reading=zero,
+        judgment_error=e[1] - e[0],
+        equation="(6.38)",
+    )
+    return zero
 
 
 def _record_stage1_zeros(run: Run) -> None:
@@ -247,8 +273,36 @@ def stage2_transform(run: Run) -> None:
     bz = run.target("O_bz")
     op.set("bz", bz, "2/bz")
     op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
-    clear_kappa(run, "2")
+    if run.fidelity.kappa == "fiducials":
+        kappa_from_fiducials(run, "2")
+    else:
+        clear_kappa(run, "2")
     check_standard_points(run, "2")
+
+
+def kappa_from_fiducials(run: Run, stage: str) -> None:
+    """κ of each photo from its fiducials (switch ``kappa`` "fiducials", (6.36), OCR L3761):
+    the x-readings of marks 3 and 4 (at y = ±l) made equal, each a monocular pointing with
+    σ_mono along x; κ is the sheet's κ of the photo plus (e₃ − e₄)/(y₃ − y₄), so
+    m_κ = m_x/(√2·l·n) at counter scale. No y-parallax is judged. [rad]"""
+    op = run.op
+    sigma = op.model.monocular_sigma_mm
+    for side, photo in zip(("left", "right"), run.sheet.photos, strict=True):
+        span = fiducial_mm(run, side, "3")[1] - fiducial_mm(run, side, "4")[1]
+        e3, e4 = (op.noise.normal(f"mono/{stage}/kappa/{side}/{m}", sigma) for m in "34")
+        control = f"kappa_{side}"
+        before = op.physical(control)
+        op.drive(control, photo.kappa + (e3 - e4) / span)
+        op.log.add(
+            stage,
+            f"κ_{_SIDE[side]} from the fiducials: marks 3 and 4 at equal x-readings",
+            control,
+            before=before,
+            after=op.physical(control),
+            unit="rad",
+            judgment_error=e3 - e4,
+            equation="(6.36)",
+        )
 
 
 def _set_computed_decentrations(run: Run) -> None:
@@ -657,6 +711,37 @@ def refine_scale_and_level(
     return rounds, worst
 
 
+def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
+    """Stage 3's scaling (switch ``stage3`` "fuse"): the mark fused on the height control point
+    ``pid`` by turning b_x, then κ cleared again (D10)."""
+    op = run.op
+    op.mark_on("left", left_img, "3/left")
+    e = op.noise.normal("stereo/3/bx", op.model.stereo_sigma_mm)
+    right_map = op.unit_map("right")
+    xi_r = right_map.rod_from_photo(right_img + np.stack([e, 0.0 * e], axis=-1))[..., 0]
+    n_r = (op.physical("Z") + op.physical("bz")) / op.inst.setting.f_instrument_mm
+    before = op.read("bx", "3/bx/before")
+    op.drive("bx", op.physical("X") - n_r * xi_r)
+    after = op.read("bx", "3/bx/after")
+    op.log.add(
+        "3",
+        f"fuse the mark on point {pid} by turning b_x",
+        "bx",
+        before=before,
+        after=after,
+        reading=after,
+        judgment_error=e,
+        equation="stage 3",
+    )
+    # Decision D10 (docs/procedure.md): the b_x change moves the rods' meeting depth and with it
+    # q where η_л ≠ η_п, so κ is cleared again (D8) *before* the heights are read: they are then
+    # read on the model that is kept. Read before it (pair80: b_x 57.6 mm, κ absorbing f·ω/b),
+    # they differed from the final model's by 0.14 m of the 0.465 m tolerance. κ from the
+    # fiducials (switch ``kappa``) is not refined: the fiducials do not move with b_x.
+    if run.fidelity.kappa != "fiducials":
+        clear_kappa(run, "3")
+
+
 def stage3_scale_model(run: Run) -> None:
     """Stage 3: (6.15) at a height control point, b_x until the mark fuses, slip the height
     scale, check the other control heights (H/3000), re-check κ and the residual y-parallax."""
@@ -676,29 +761,8 @@ def stage3_scale_model(run: Run) -> None:
         equation="(6.15)",
     )
     pl, pr = run.scene.images(p0[None, :])
-    op.mark_on("left", pl[0], "3/left")
-    e = op.noise.normal("stereo/3/bx", op.model.stereo_sigma_mm)
-    right_map = op.unit_map("right")
-    xi_r = right_map.rod_from_photo(pr[0] + np.stack([e, 0.0 * e], axis=-1))[..., 0]
-    n_r = (op.physical("Z") + op.physical("bz")) / op.inst.setting.f_instrument_mm
-    before = op.read("bx", "3/bx/before")
-    op.drive("bx", op.physical("X") - n_r * xi_r)
-    after = op.read("bx", "3/bx/after")
-    op.log.add(
-        "3",
-        f"fuse the mark on point {h0.id} by turning b_x",
-        "bx",
-        before=before,
-        after=after,
-        reading=after,
-        judgment_error=e,
-        equation="stage 3",
-    )
-    # Decision D10 (docs/procedure.md): the b_x change moves the rods' meeting depth and with it
-    # q where η_л ≠ η_п, so κ is cleared again (D8) *before* the heights are read: they are then
-    # read on the model that is kept. Read before it (pair80: b_x 57.6 mm, κ absorbing f·ω/b),
-    # they differed from the final model's by 0.14 m of the 0.465 m tolerance.
-    clear_kappa(run, "3")
+    if run.fidelity.stage3 == "fuse":
+        _fuse_bx(run, h0.id, pl[0], pr[0])
     op.fuse(p0, (pl[0], pr[0]), "3/refuse")
     op.inst.slip_height_scale(p0[2])
     op.log.add(

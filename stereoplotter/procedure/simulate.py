@@ -10,6 +10,7 @@ runs long runs in chunks.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -24,6 +25,7 @@ from stereoplotter.instrument.sc1_complex import (
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
 from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_against
+from stereoplotter.procedure.fidelity import Fidelity
 from stereoplotter.procedure.operator import Noise, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, StageRecord
 from stereoplotter.procedure.run import (
@@ -191,6 +193,7 @@ def prepare_run(
     relative: str = "elements",
     practice: str = "operator",
     options: SC1Options | None = None,
+    fidelity: Fidelity | None = None,
 ) -> PreparedRun:
     """The fixed part of a run (arguments as :func:`simulate`).
 
@@ -211,12 +214,18 @@ def prepare_run(
         raise StereoplotterError(
             f"practice: expected one of {', '.join(PRACTICES)}, found {practice!r}"
         )
+    fidelity = Fidelity() if fidelity is None else fidelity
+    variant = fidelity.variant(variant)
     pair = prepare_pair(scenario, spec, method, variant)
+    sheet, operator = _with_passes(pair.sheet, operator, fidelity.passes)
+    if fidelity.bottom_stop == "free":  # the sheet as computed, the carriage without its stop
+        low, high = spec.projection_distance_range_mm
+        spec = replace(spec, projection_distance_range_mm=(low, high + FREE_STOP_MM))
     return PreparedRun(
         scenario,
         spec,
         method,
-        pair.sheet,
+        sheet,
         _errors(spec, errors),
         operator,
         pair.scene,
@@ -233,7 +242,23 @@ def prepare_run(
         pair.truth,
         pair.heights,
         pair.level,
+        fidelity,
     )
+
+
+#: ``bottom_stop="free"``: the carriage's bottom stop moved this far below D_max (the sheet
+#: keeps D_max): far beyond any correction of the stage-1 L-check (≈ 0.1 mm). [mm]
+FREE_STOP_MM = 20.0
+
+
+def _with_passes(sheet: SetupSheet, operator: OperatorModel, passes: int | None):
+    """Switch ``passes`` (:mod:`~stereoplotter.procedure.fidelity`): every tolerance loop makes
+    ``passes`` passes — no check ever passes (its tolerance −∞, so the checks report failed)
+    and ``max_iterations`` = ``passes``; None: the sheet and operator as they are."""
+    if passes is None:
+        return sheet, operator
+    never = dict.fromkeys(sheet.tolerances, -math.inf)
+    return replace(sheet, tolerances=never), replace(operator, max_iterations=int(passes))
 
 
 def _run_one(
@@ -322,6 +347,7 @@ def simulate(
     first_trial: int = 0,
     practice: str = "operator",
     options: SC1Options | None = None,
+    fidelity: Fidelity | None = None,
 ) -> SimulationResult:
     """Run the setup-data or the conventional method on a virtual instrument.
 
@@ -360,6 +386,9 @@ def simulate(
     options : SC1Options, optional
         The SC complex's options on the SC-1 (off by default): the error-correction unit
         (:func:`apply_correction_unit`) and the automatic coordinatograph (stages 4–5).
+    fidelity : Fidelity, optional
+        The mechanism switches (:mod:`~stereoplotter.procedure.fidelity`); default: the
+        competent operator's.
 
     Returns
     -------
@@ -378,6 +407,7 @@ def simulate(
         relative=relative,
         practice=practice,
         options=options,
+        fidelity=fidelity,
     )
     return run_trials_chunk(prep, first_trial, trials, evaluate=evaluate)
 

@@ -41,20 +41,10 @@ def _measure_span(run: Run, side: str, key: str, active, pointings: int = 1) -> 
 
 
 def _spans(run: Run, units_at_zero: bool) -> tuple[float, float]:
-    """The L to compare with: the sheet's L_л, L_п (6.5), or with the units at zero
-    n·(y₃ − y₄) of the measured marks (decision D5, ``kinematics.md`` §4.3: the literal (6.5)
-    would bias n by tan²ω(1 + l²/f′²) and can drive D beyond D_max).
-
-    The D5 span is a comparison value, not a reading set on a scale; the sheet does not print
-    it, so it is formed here from the sheet's measured marks and n.
-    """
-    if not units_at_zero:
-        return run.readings["L_л"].value, run.readings["L_п"].value
-    out = []
-    for photo in run.sheet.photos:
-        m = photo.marks_measured_mm
-        out.append(photo.n * (m["3"][1] - m["4"][1]))
-    return out[0], out[1]
+    """The L to compare with, as the sheet prints it: L⁰_л, L⁰_п with the correction units at
+    zero (stage 1: n·(y₃ − y₄) of the measured marks, decision D5), else L_л, L_п of (6.5)."""
+    name = "L⁰" if units_at_zero else "L"
+    return run.readings[f"{name}_л"].value, run.readings[f"{name}_п"].value
 
 
 def span_loop(
@@ -106,8 +96,7 @@ def _span_round(
     for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
         op.log.add(
             stage,
-            f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} "
-            f"= {span:.3f} mm",
+            f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} = {span:.3f} mm",
             "Y",
             reading=meas,
             residual=d,
@@ -142,37 +131,58 @@ def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy:
     )
 
 
-def _past_bottom_stop(op, stage: str, k: str, it: int, active, depth, dz_mm, remedy: str):
-    """Decision (docs/procedure.md): the carriage sits at D_max, the bottom stop, so a correction
-    that asks for a deeper carriage cannot be set there. The operator reaches the same
-    n = D/f_пр by shortening f_пр in the ratio D/(D + ΔD) instead.
+def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_mm, remedy: str):
+    """The carriage at its bottom stop D_max (switch ``bottom_stop``,
+    :mod:`~stereoplotter.procedure.fidelity`).
 
-    Returns the trials past the stop, f′_пр/f_пр of this correction (1 elsewhere) and ΔZ left
-    to set (0 past the stop). [—, mm]
+    "both_ways" (the book's (6.11), O′_Z = O_Z + ΔZ either way): a correction that asks for a
+    deeper carriage than the stop reaches the same n = D/f_пр by shortening f_пр in the ratio
+    D/(D + ΔD); one that asks for a shallower carriage while f_пр is short of the sheet's value
+    first lengthens f_пр back (at most to the sheet's value), and the rest raises the carriage.
+    "one_way": f_пр is shortened at the stop and never lengthened. "free": no stop, every ΔZ on
+    Z (f_пр stays at the sheet's value).
+
+    Returns the trials whose f_пр changed, f′_пр/f_пр of this correction (1 elsewhere) and ΔZ
+    left to set on Z. [—, —, mm]
     """
+    op = run.op
+    mode = run.fidelity.bottom_stop
     f_ratio = op.v(1.0)
+    if mode == "free":
+        return np.zeros(np.shape(active), bool), f_ratio, dz_mm
     stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
+    f_set = op.commanded["f_instrument"]
     beyond = active & (depth + dz_mm > stop)
+    # the n this correction asks for, n′ = (D + ΔD)/f_пр, reached with D at the stop
+    f_new = np.where(beyond, f_set * depth / (depth + dz_mm), f_set)
+    rest = np.where(beyond, 0.0, dz_mm)
+    if mode == "both_ways":
+        f_sheet = run.target("f_пр")
+        back = active & ~beyond & (dz_mm < 0.0) & (f_set < f_sheet)
+        # lengthen f_пр towards the sheet's value; what it cannot take raises the carriage
+        f_back = np.minimum(f_sheet, f_set * depth / (depth + dz_mm))
+        f_new = np.where(back, f_back, f_new)
+        whole = (depth + dz_mm) * f_sheet / f_set - depth  # ΔZ left once f_пр is the sheet's
+        rest = np.where(back, np.where(f_back < f_sheet, 0.0, whole), rest)
+        beyond = beyond | back
     if np.any(beyond):
-        f_set = op.commanded["f_instrument"]
-        f_new = f_set * depth / (depth + dz_mm)
-        f_ratio = np.where(beyond, depth / (depth + dz_mm), 1.0)
+        f_ratio = np.where(beyond, f_new / f_set, 1.0)
         op.set("f_instrument", f_new, f"{k}/setf", beyond)
         op.log.add(
             stage,
-            "ΔZ would take the carriage past its bottom stop (D_max): n = D/f_пр "
-            "reached by f_пр instead, f′_пр = f_пр·D/(D + ΔD)",
+            "n = D/f_пр at the carriage's bottom stop (D_max): f′_пр = f_пр·D/(D + ΔD), "
+            "shortened for a deeper carriage, lengthened back (to the sheet's f_пр at most) "
+            "for a shallower one",
             "f_instrument",
             before=f_set,
             after=f_new,
             reading=f_new,
             iteration=it,
-            equation="(6.3), (6.9)",
+            equation="(6.3), (6.9), (6.11)",
             remedy=remedy,
             when=beyond if remedy else None,
         )
-        dz_mm = np.where(beyond, 0.0, dz_mm)
-    return beyond, f_ratio, dz_mm
+    return beyond, f_ratio, rest
 
 
 def _correct_span(
@@ -198,10 +208,10 @@ def _correct_span(
     depth = op.read("Z", f"{k}/Z")
     dz_m = height_correction(depth, dl, meas_l, sheet.vertical_scale_denominator)
     dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
-    beyond, f_ratio, dz_mm = _past_bottom_stop(op, stage, k, it, active, depth, dz_mm, remedy)
-    op.set("Z", depth + dz_mm, f"{k}/setZ", active & ~beyond)
-    shown = op.log.shown if np.ndim(beyond) else 0
-    if not np.ravel(beyond)[shown]:
+    _, f_ratio, dz_mm = _past_bottom_stop(run, stage, k, it, active, depth, dz_mm, remedy)
+    op.set("Z", depth + dz_mm, f"{k}/setZ", active & (dz_mm != 0.0))
+    shown = op.log.shown if np.ndim(dz_mm) else 0
+    if np.ravel(dz_mm)[shown if np.size(dz_mm) > 1 else 0] != 0.0:
         _log_delta_z(
             op,
             stage,

@@ -126,6 +126,10 @@ _STEPS_RU = (
     (r"^O_bx$", "базисная каретка b_x"),
     (r"^O_by$", "базисная каретка b_y (MO_by по центрам кассет)"),
     (r"^O_Z$", "опустить базисную каретку до D_max: абсолютный счётчик высот"),
+    (r"^L⁰_л$", "контроль расстояния между метками 3–4, левый снимок (коррекционные механизмы "
+     "на нулях)"),
+    (r"^L⁰_п$", "контроль расстояния между метками 3–4, правый снимок (коррекционные механизмы "
+     "на нулях)"),
     (r"^L_л$", "контроль расстояния между метками 3–4, левый снимок"),
     (r"^L_п$", "контроль расстояния между метками 3–4, правый снимок"),
     (r"^MO_bz$", "записать место нуля b_z"),
@@ -254,20 +258,19 @@ def correction_rows(sheet: SetupSheet, lang: str, rigorous: bool = False) -> lis
     """
     left, right = sheet.photos
     d = sheet.n_left * sheet.f_instrument_mm
-    spans = {"L_л": left.mark_span_mm, "L_п": right.mark_span_mm}
-    if rigorous:
-        spans = {k: _rigorous_value(sheet, k) or v for k, v in spans.items()}
-    ll, lr = spans["L_л"], spans["L_п"]
+    # stage 1 compares with L⁰ (units at zero, decision D5), the sheet's printed value; it has
+    # no transformed y⁰, so the rigorous form is the same number
+    ll, lr = left.mark_span_at_zero_mm, right.mark_span_at_zero_mm
     mv = sheet.vertical_scale_denominator
     sign = "+" if sheet.options.bz_scale_sense > 0 else "−"
     blank = "__________"
     return [
-        ("L′_л", term("corr_L_left", lang), f"L_л (6.5) = {ll:.3f} mm", "", f"{blank} mm"),
+        ("L′_л", term("corr_L_left", lang), f"L⁰_л (D5) = {ll:.3f} mm", "", f"{blank} mm"),
         ("ΔZ", term("corr_dz", lang), "ΔZ = D·(L_л − L′_л)·M_в/(1000·L_л)",
          f"{d * mv / (1000.0 * ll):.4f} m/mm", f"{blank} m"),
         ("O′_Z", term("corr_dz_counter", lang), "O′_Z = O_Z + D·(L_л − L′_л)/L_л",
          f"{d / ll:.5f}", f"{blank} mm"),
-        ("L′_п", term("corr_L_right", lang), f"L_п (6.5) = {lr:.3f} mm", "", f"{blank} mm"),
+        ("L′_п", term("corr_L_right", lang), f"L⁰_п (D5) = {lr:.3f} mm", "", f"{blank} mm"),
         ("Δb_z", term("corr_dbz", lang), "Δb_z = D·(L_п − L′_п)/L_п", f"{d / lr:.5f}",
          f"{blank} mm"),
         ("O′_bz", term("corr_bz", lang), f"O′_bz = O_bz {sign} Δb_z", "", f"{blank} mm"),

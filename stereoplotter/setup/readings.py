@@ -105,30 +105,42 @@ def _stage1_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
             "(6.3)",
             note="D = n_л·f_пр = D_max",
         ),
-        _r(
-            1,
-            "check the span of marks 3–4, left photo",
-            "L_л",
-            "",
-            left.mark_span_mm,
-            "mm",
-            "(6.5)",
-            tolerance=tol["mark_span_mm"],
-            note="correct with ΔZ (6.9) and repeat until |L − L′| ≤ tolerance",
-        ),
-        _r(
-            1,
-            "check the span of marks 3–4, right photo",
-            "L_п",
-            "",
-            right.mark_span_mm,
-            "mm",
-            "(6.5)",
-            tolerance=tol["mark_span_mm"],
-            note=(
-                f"correct with Δb_z (6.10): O′_bz = O_bz {'+' if sense > 0 else '−'} Δb_z "
-                f"(6.11, b_z scale sense {sense:+d})"
-            ),
+        *(
+            _r(
+                1,
+                f"check the span of marks 3–4, {photo.name} photo{when}",
+                f"{name}_{side}",
+                "",
+                value,
+                "mm",
+                eq,
+                tolerance=tol["mark_span_mm"],
+                note=(
+                    "correct with ΔZ (6.9) and repeat until |L − L′| ≤ tolerance"
+                    if side == "л"
+                    else f"correct with Δb_z (6.10): O′_bz = O_bz {'+' if sense > 0 else '−'} "
+                    f"Δb_z (6.11, b_z scale sense {sense:+d})"
+                )
+                + extra,
+            )
+            for name, when, eq, extra, spans in (
+                (
+                    "L⁰",
+                    " (correction units at zero: compare L′ with this)",
+                    "(6.5), decision D5",
+                    "; L⁰ = n·(y₃ − y₄) of the measured marks: with the units at zero the "
+                    "counters show the photo's own span, not (6.5)'s of the transformed y⁰",
+                    (left.mark_span_at_zero_mm, right.mark_span_at_zero_mm),
+                ),
+                (
+                    "L",
+                    " (with the correction units set: the check repeated in stage 2)",
+                    "(6.5)",
+                    "",
+                    (left.mark_span_mm, right.mark_span_mm),
+                ),
+            )
+            for photo, side, value in ((left, "л", spans[0]), (right, "п", spans[1]))
         ),
         _r(
             1,

@@ -66,6 +66,14 @@ class PhotoSetup:
     correction_inclination: tuple[float, float]
     n: float
 
+    @property
+    def mark_span_at_zero_mm(self) -> float:
+        """L⁰ = n·(y₃ − y₄) of the measured marks: the span L′ of marks 3–4 the counters show
+        with the correction units at zero (stage 1), which the stage-1 check compares with
+        (decision D5: (6.5)'s L, of the transformed y⁰, holds once the units are set; compared
+        with it at zero units the check would bias n by tan²ω(1 + l²/f′²)). [mm]"""
+        return self.n * (self.marks_measured_mm["3"][1] - self.marks_measured_mm["4"][1])
+
 
 @dataclass(frozen=True, slots=True)
 class SetupSheet:

@@ -39,7 +39,7 @@ def _expected(key: str, sheet) -> tuple[str, str | float | None] | None:
     first_height = sheet.control_heights[0]["id"]
     fixed = {
         "1/f": ("f_пр", None),
-        "1/bx": ("O_bx", NOMINAL_ZERO["bx"]),
+        "1/bx": ("O_bx", "MO_bx"),  # MO_bx from two pointings, (6.38)
         "1/Z": ("O_Z", None),
         "1/by": ("O_by", "MO_by"),
         "2/bz": ("O_bz", "MO_bz"),
