@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from importlib import import_module
 from typing import Any
 
@@ -16,8 +17,10 @@ __all__ = [
     "MAX_SCALE_DENOMINATOR",
     "MAX_SEED",
     "LibraryDefault",
+    "add_fidelity_arguments",
     "bounded_float",
     "bounded_int",
+    "fidelity_from_args",
     "non_negative_int",
     "positive_int",
     "scale_denominator",
@@ -91,3 +94,62 @@ class LibraryDefault:
     def of(value: Any) -> Any:
         """``value`` itself, or the constant a :class:`LibraryDefault` stands for."""
         return value.value() if isinstance(value, LibraryDefault) else value
+
+
+#: The mechanism switches of ``procedure.fidelity`` as options: flag → (dest, choices, what the
+#: choices mean). Declared there (basis, default, the formula's setting); the parser repeats
+#: only the names so that building it loads no library module.
+_FIDELITY_FLAGS = (
+    ("--bottom-stop", "bottom_stop", ("both_ways", "one_way", "free")),
+    ("--bx-zero", "bx_zero", ("two_pointings", "exact")),
+    ("--kappa", "kappa", ("y_parallax", "fiducials")),
+    ("--stage3", "stage3", ("fuse", "none")),
+)
+
+
+def add_fidelity_arguments(p: argparse.ArgumentParser, linkage: bool = True) -> None:
+    """The setup-data procedure's mechanism switches (``procedure.fidelity.MECHANISMS``):
+    ``--as-formula`` sets every one to the formula's assumption, a flag each overrides it.
+    ``linkage``: add ``--linkage`` too (``verify`` has its own)."""
+    g = p.add_argument_group(
+        "mechanism switches of the setup-data procedure (docs/accuracy.md: each with its basis "
+        "and the setting the formulas (6.39)–(6.44) assume)"
+    )
+    g.add_argument(
+        "--as-formula",
+        action="store_true",
+        help="every switch at the formula's assumption (bottom stop free, b_x zero from two "
+        "pointings, κ from the fiducials, no stage-3 scaling, one pass per loop, independent "
+        "linkage); a flag below overrides one",
+    )
+    for flag, dest, choices in _FIDELITY_FLAGS:
+        g.add_argument(
+            flag, dest=dest, choices=choices, default=None, help=f"default: {choices[0]}"
+        )
+    g.add_argument(
+        "--passes",
+        type=positive_int,
+        default=None,
+        help="every tolerance loop makes this many passes, no check stops it (default: until "
+        "a check passes)",
+    )
+    if linkage:
+        g.add_argument(
+            "--linkage",
+            choices=("drag", "independent"),
+            default=None,
+            help="knob–decentration linkage (default: the instrument file's)",
+        )
+
+
+def fidelity_from_args(args: argparse.Namespace) -> Any:
+    """The :class:`~stereoplotter.procedure.fidelity.Fidelity` of the parsed switches."""
+    from stereoplotter.procedure.fidelity import Fidelity
+
+    base = Fidelity.as_formula() if getattr(args, "as_formula", False) else Fidelity()
+    changes = {
+        dest: getattr(args, dest)
+        for dest in (*(d for _, d, _ in _FIDELITY_FLAGS), "passes", "linkage")
+        if getattr(args, dest, None) is not None
+    }
+    return replace(base, **changes)

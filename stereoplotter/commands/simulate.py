@@ -18,7 +18,9 @@ from typing import Any
 
 from stereoplotter.commands.arguments import (
     LibraryDefault,
+    add_fidelity_arguments,
     bounded_float,
+    fidelity_from_args,
     positive_int,
     seed_int,
 )
@@ -103,6 +105,7 @@ def add_arguments(sub: Any) -> None:
         help="language of transcript.txt: ru (the book's terms, every record rendered through "
         "the glossary) or en (default)",
     )
+    add_fidelity_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -129,6 +132,7 @@ def run(args: argparse.Namespace) -> int:
             progress=advance,
             lang=args.lang,
             workers=args.workers,
+            fidelity=fidelity_from_args(args),
         )
     sys.stdout.write(json_text(outcome.summary) if args.json else outcome.text)
     return 0

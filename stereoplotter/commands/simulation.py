@@ -30,6 +30,7 @@ from stereoplotter.io.operator_file import load_operator_model
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.trial_store import TrialStore
 from stereoplotter.io.yaml_output import yaml_text
+from stereoplotter.procedure.fidelity import Fidelity
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import (
@@ -117,6 +118,7 @@ def run_simulation_command(
     options: Sequence[str] = (),
     lang: str = "en",
     workers: int | None = None,
+    fidelity: Fidelity | None = None,
 ) -> SimulationOutcome:
     """What ``stereoplotter simulate`` does: run, summarise, write the files if ``output``.
 
@@ -130,7 +132,8 @@ def run_simulation_command(
     ``automatic_coordinatograph``; :class:`~stereoplotter.instrument.sc1_complex.SC1Options`).
     ``lang`` (``"ru"``/``"en"``) is the language of the transcript. ``workers``: processes for
     the chunks (default :func:`~stereoplotter.procedure.trials.default_workers`; the results do
-    not depend on it).
+    not depend on it). ``fidelity``: the setup-data procedure's mechanism switches
+    (:mod:`~stereoplotter.procedure.fidelity`; None: the defaults).
     """
     scenario = load_scenario(scenario_path)
     spec = load_instrument(instrument)
@@ -146,6 +149,7 @@ def run_simulation_command(
         operator=load_operator_model(operator),
         practice=practice,
         options=fitted,
+        fidelity=fidelity,
     )
     out = None if output is None else Path(output)
     if trials is None:

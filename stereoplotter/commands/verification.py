@@ -15,6 +15,7 @@ import sys
 import time
 from pathlib import Path
 
+from stereoplotter.commands.arguments import fidelity_from_args
 from stereoplotter.io.atomic_write import write_files
 from stereoplotter.io.book_setting import BOOK_INSTRUMENT, book_instrument, book_scenarios
 from stereoplotter.io.geometry_file import geometry_from_file
@@ -103,19 +104,22 @@ def write_verification(
 
 
 def start_book_procedure_mc(
-    trials, seed, scenarios=None, instrument=BOOK_INSTRUMENT, linkage=None
+    trials, seed, scenarios=None, instrument=BOOK_INSTRUMENT, linkage=None, fidelity=None
 ):
     """:func:`stereoplotter.verification.table.start_procedure_mc` on loaded inputs:
     ``scenarios`` ("60"/"80" → Scenario or None) default to the book's (:func:`book_scenarios`),
     the instrument is loaded by name (default the book's SC-1) when a slot runs. ``trials``:
     None for the per-configuration defaults, 0 for none. ``linkage``: "drag", "independent"
-    or None (the instrument file's)."""
+    or None (the instrument file's). ``fidelity``: the setup method's mechanism switches
+    (:class:`~stereoplotter.procedure.fidelity.Fidelity`, None: the defaults)."""
     if trials == 0:
         return start_procedure_mc(0, seed, {})
     if scenarios is None:
         scenarios = book_scenarios()
     spec = book_instrument(instrument) if any(scenarios.values()) else None
-    return start_procedure_mc(trials, seed, scenarios, instrument=spec, linkage=linkage)
+    return start_procedure_mc(
+        trials, seed, scenarios, instrument=spec, linkage=linkage, fidelity=fidelity
+    )
 
 
 def _figures(rows: list[dict], proc: dict, seed: int, geometry) -> dict[str, bytes]:
@@ -148,7 +152,12 @@ def run_verify_command(args: argparse.Namespace) -> int:
     # processes while the linear rows are computed
     t0 = time.perf_counter()
     pending = start_book_procedure_mc(
-        args.procedure_trials, args.seed, scenarios, args.instrument, args.linkage
+        args.procedure_trials,
+        args.seed,
+        scenarios,
+        args.instrument,
+        args.linkage,
+        fidelity_from_args(args),
     )
     with step_progress("verify") as progress:
         rows, seconds = verify(

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from stereoplotter.commands.arguments import bounded_int, seed_int
+from stereoplotter.commands.arguments import add_fidelity_arguments, bounded_int, seed_int
 
 __all__ = ["MAX_VERIFY_TRIALS", "add_arguments", "run"]
 
@@ -50,6 +50,7 @@ def add_arguments(sub: Any) -> None:
         "k_ω moves the decentrations, decision D1) or independent (decentrations set before "
         "the k fits); default: the instrument file's correction.decentration_linkage",
     )
+    add_fidelity_arguments(p, linkage=False)
     p.add_argument(
         "--geometry",
         metavar="FILE",

@@ -100,15 +100,45 @@ _STEP_HEAD = {
 
 
 def decomposition_markdown(rows) -> list[str]:
-    """The decomposition of each procedure row (``decomposition`` of the rows, one line per
-    row): the formula at the book geometry, each step's contribution ± CI (99.9 %) and its
-    share of the formula at the simulated geometry, the sum and the row's procedure value."""
+    """Each procedure row against its formula: the procedure with every mechanism switch at the
+    formula's assumption (``as_formula``: value ± CI, ratio to the formula at the simulated
+    geometry), the steps from it to the row's run, one switch each (contribution ± CI, 99.9 %,
+    share of the formula), their sum and the row's value; then the first-order breakdown of the
+    row's own trials (``decomposition.first_order``)."""
     rows = [r for r in rows if r.get("decomposition")]
     if not rows:
         return []
     out = [
         "",
         "## Decomposition of the procedure rows",
+        "",
+        "As formula: the procedure with every mechanism switch at the formula's assumption "
+        "(`--as-formula`); ratio to the formula at the simulated geometry. Steps: from it to the "
+        "row's run, one switch each (`switch`: the flag that removes the step), paired on the "
+        "same trials, ± CI (99.9 %). *closes*: as formula + Σ steps agrees with the row's value "
+        "within the CIs. Conventional rows: their run is the as-formula one (no step).",
+        "",
+        "| eq | as formula | ratio | steps | sum | procedure MC | closes |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        a, d = r["as_formula"], r["decomposition"]
+        steps = (
+            "; ".join(
+                f"{s['switch']} {s['contribution']:+.4f} ± {s['ci']:.4f} ({s['relative']:+.1%})"
+                for s in d["steps"]
+            )
+            or "—"
+        )
+        out.append(
+            f"| {r['eq']} | {a['value']:.4f} ± {a['ci']:.4f} | {a['ratio']:.4f}"
+            f"{'' if a['agrees'] else ' (differs)'} | {steps} | {d['sum']:.4f} | "
+            f"{d['procedure']['value']:.4f} ± {d['procedure']['ci']:.4f} | "
+            f"{'yes' if d['closes'] else 'NO'} |"
+        )
+    out += [
+        "",
+        "### First order of the row's own trials",
         "",
         "Formula at the book geometry → at the simulated geometry → first order of each "
         "trial's own errors (the (6.22) elements, then f_пр, then the decentrations and model "
@@ -120,7 +150,7 @@ def decomposition_markdown(rows) -> list[str]:
         "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
-        d = r["decomposition"]
+        d = r["decomposition"]["first_order"]
         steps = "; ".join(
             f"{_STEP_HEAD.get(s['step'], s['step'])} {s['contribution']:+.4f} ± {s['ci']:.4f} "
             f"({s['relative']:+.1%})"

@@ -44,6 +44,8 @@ __all__ = [
     "STATE",
     "at_book",
     "linear_fields",
+    "paired_step",
+    "rms_ci",
     "rms_steps",
     "state_deltas",
     "state_jacobian",
@@ -158,6 +160,19 @@ def _diff_ci(ms_to: np.ndarray, ms_from: np.ndarray) -> tuple[float, float]:
     r0, _ = _rms_ci(ms_from)
     d = ms_to / (2.0 * r1) - ms_from / (2.0 * r0)
     return r1 - r0, CI_Z * float(np.std(d, ddof=1)) / math.sqrt(len(d))
+
+
+def paired_step(ms_to: np.ndarray, ms_from: np.ndarray, unit: float) -> tuple[float, float]:
+    """RMS(to) − RMS(from) per ``unit`` and its CI from the paired per-trial mean squares of
+    two runs on the same trials (a switch step of ``verify --json``)."""
+    c, h = _diff_ci(np.asarray(ms_to, float), np.asarray(ms_from, float))
+    return c / unit, h / unit
+
+
+def rms_ci(ms: np.ndarray, unit: float) -> tuple[float, float]:
+    """The RMS of per-trial mean squares ``ms`` per ``unit`` and its CI."""
+    r, h = _rms_ci(np.asarray(ms, float))
+    return r / unit, h / unit
 
 
 #: Step names in order, with what each adds (the mechanism is named by the caller only where a

@@ -69,6 +69,7 @@ from stereoplotter.instrument.virtual import HEIGHT_SCALE
 from stereoplotter.procedure import conventional as cv
 from stereoplotter.procedure import evaluation as ev
 from stereoplotter.procedure.evaluation import instrument_frame_m
+from stereoplotter.procedure.fidelity import LINKAGE_VARIANTS, Fidelity
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import (
@@ -215,13 +216,6 @@ def _dp_state(model, gl, gr, setting, left, right):
     return np.asarray(dp, float)
 
 
-#: ``procedure_mc(linkage=…)`` → the instrument's decentration variant
-#: (:data:`~stereoplotter.instrument.kinematics.DECENTRATION_VARIANTS`): "drag", the knob drags
-#: the photo and plane decentrations (D1, "L"); "independent", the decentrations stay where
-#: they are set, and are set before the k_ω, k_α fits ("B2": set after them, as in the book's
-#: order, they would leave the fits made at zero decentration).
-LINKAGE_VARIANTS = {"drag": "L", "independent": "B2"}
-
 #: ``procedure_mc(sources=…)`` of the conventional method: which judgment errors are on.
 SOURCES = ("both", "y_parallax", "stereo")
 
@@ -339,7 +333,8 @@ def _setup_fields(sc, zero_run, g, xr, grid):
             result.instrument.setting, {s: units[s] for s in ("left", "right")}, *state0, trials
         )
         noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
-        out = {}
+        # each (6.22) element's error (instrument units: mm, tangent, rad), squared per trial
+        out = {("element", f"{o}.{f}"): deltas[i] ** 2 for i, (o, f) in enumerate(dc.ELEMENTS)}
         for step, d in dc.linear_fields(jac, deltas):
             r = readings(d)
             r["observed"] = r["levelled"] + noise
@@ -393,8 +388,8 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
 
 def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
     """The prepared run of the procedure MC: real mechanics only with instrument errors; the
-    standard points at a = c − p (``standard_points`` "book"); ``passes``: no check ever passes,
-    so every loop runs that many times."""
+    standard points at a = c − p (``standard_points`` "book"); ``kw["fidelity"]`` the mechanism
+    switches (its ``passes``: no check ever passes, so every loop runs that many times)."""
     instrument = bool(options.get("instrument")) and errors != "zero"
     prep = prepare_run(
         sc, spec, base, errors, seed, operator=operator, ideal_mechanics=not instrument, **kw
@@ -403,14 +398,6 @@ def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
         tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
         prep = _standard_points_at_a(prep, g)
         prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
-    passes = options.get("passes")
-    if passes:
-        never = {k: -math.inf for k in prep.sheet.tolerances}
-        prep = replace(
-            prep,
-            sheet=replace(prep.sheet, tolerances=never),
-            operator=replace(prep.operator, max_iterations=int(passes)),
-        )
     return prep
 
 
@@ -555,6 +542,8 @@ def _rms_ci(ms, unit):
     """(RMS, CI half-width) per ``unit`` from per-trial mean squares (``CI_Z`` s.e.)."""
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(max(mean_ms, 0.0))
+    if rms == 0.0:  # a controlled mean ≤ 0 (a handful of trials): no CI
+        return rms, math.inf
     half = CI_Z * (float(np.std(ms, ddof=1)) / math.sqrt(len(ms))) / (2.0 * rms)
     return rms / unit, half / unit
 
@@ -660,10 +649,14 @@ class ProcedureOptions:
         (:mod:`~stereoplotter.verification.control_variate`; unbiased, its CI ≈ 10–40×
         narrower); False: the plain mean.
     passes : int or None
-        Every loop makes this many passes (no check ever passes); None: as built.
+        Every loop makes this many passes (no check ever passes); None: as ``fidelity`` says.
     linkage : {"drag", "independent"} or None
-        The knob–decentration linkage (:data:`LINKAGE_VARIANTS`); None: the instrument's
-        ``correction.decentration_linkage``.
+        The knob–decentration linkage (:data:`LINKAGE_VARIANTS`); None: as ``fidelity`` says
+        (its None: the instrument's ``correction.decentration_linkage``).
+    fidelity : Fidelity or None
+        The mechanism switches of the setup-data procedure
+        (:mod:`~stereoplotter.procedure.fidelity`); None: the defaults. ``passes`` and
+        ``linkage``, where given, override its own.
     """
 
     sigma_mm: float = 0.01
@@ -678,6 +671,15 @@ class ProcedureOptions:
     control_variate: bool = True
     passes: int | None = None
     linkage: str | None = None
+    fidelity: Fidelity | None = None
+
+    def switches(self, spec) -> Fidelity:
+        """The run's :class:`Fidelity`, ``passes`` and ``linkage`` applied, the linkage
+        resolved (None: the instrument's)."""
+        f = self.fidelity or Fidelity()
+        passes = f.passes if self.passes is None else self.passes
+        linkage = self.linkage or f.linkage or spec.decentration_linkage
+        return replace(f, passes=passes, linkage=linkage)
 
 
 def procedure_mc(
@@ -727,7 +729,7 @@ def procedure_mc(
         **{k: getattr(o, k) for k in ("sources", "control")},
     )
     g = scenario_geometry(scenario, spec)
-    linkage = o.linkage or spec.decentration_linkage
+    linkage = o.switches(spec).linkage
     plain, controlled, d_zero, units = _run(scenario, spec, method, trials, seed, o, g, linkage)
     out = _result(scenario, spec, method, o, g, linkage, (plain, controlled, d_zero, units))
     return {**out, "trials": int(trials), "seed": int(seed), "seconds": time.perf_counter() - t0}
@@ -750,6 +752,7 @@ def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
         "instrument": bool(o.instrument),
         "instrument_key": spec.key,
         "linkage": linkage,
+        "fidelity": o.switches(spec),
         "control_variate": bool(controlled),
         "coefficient": coefficient,
         "ci": ci,
@@ -794,7 +797,7 @@ def conventional_sources_mc(
     o = ProcedureOptions(**options)
     _check_options("conventional", **{k: getattr(o, k) for k in ("quantity", "standard_points")})
     g = scenario_geometry(scenario, spec)
-    linkage = o.linkage or spec.decentration_linkage
+    linkage = o.switches(spec).linkage
     names = list(trials)
     bounds = np.cumsum([0] + [int(trials[k]) for k in names])
     off_of = {
@@ -826,9 +829,9 @@ def _run(scenario, spec, method, trials, seed, o, g, linkage, off=None):
     has every source on)."""
     sources = "both" if off else o.sources
     zero, op, xr, unit, kw = _configuration(method, o.sigma_mm, g["c"], g["p"], g["n"], sources)
-    kw = {**kw, "variant": LINKAGE_VARIANTS[linkage]}
+    fidelity = o.switches(spec)
+    kw = {**kw, "variant": LINKAGE_VARIANTS[linkage], "fidelity": fidelity}
     options = {"instrument": o.instrument, "control_variate": o.control_variate}
-    options["passes"] = o.passes
     if method == "conventional":
         options["standard_points"] = o.standard_points
         units = dict.fromkeys(("parallax", "slip", "plane", "book"), unit)
@@ -841,6 +844,11 @@ def _run(scenario, spec, method, trials, seed, o, g, linkage, off=None):
         scenario, spec_c, method, seed, trials, zero, op, xr, g, o.grid, kw, options
     )
     return plain, controlled, d_zero, units
+
+
+def _keyed(ms: dict, kind: str):
+    """The items of ``ms`` whose key is a tuple (``kind``, name)."""
+    return [(k, v) for k, v in ms.items() if isinstance(k, tuple) and k[0] == kind]
 
 
 def _extras(scenario, spec, method, o, g, plain, best, units):
@@ -868,8 +876,13 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
             "plain": _rms_ci(plain[key], units[key]),
             "formula": ref,
             "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
+            "mean_squares": plain[key],  # per trial, photo mm² (paired switch steps)
+            "unit": units[key],
         }
     extra = {"fields": fields}
+    extra["element_rms"] = {
+        name: float(np.sqrt(np.mean(v))) for (kind, name), v in _keyed(plain, "element")
+    }
     if method == "setup_control":
         extra["control"] = o.control
     return extra

@@ -22,10 +22,13 @@ import math
 import multiprocessing
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import replace
 
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from stereoplotter.accuracy.setup_accuracy import setup_element_sigmas
+from stereoplotter.procedure.fidelity import MECHANISMS, Fidelity, mechanism
 from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
@@ -72,10 +75,11 @@ ROW_KEYS = (
     "mc_procedure_instrument_ci",
     "verdict",
     "note",
+    "as_formula",
     "decomposition",
 )
-#: The columns of the CSV (the nested ``decomposition`` block is in the JSON only).
-CSV_KEYS = tuple(k for k in ROW_KEYS if k != "decomposition")
+#: The columns of the CSV (the nested ``as_formula``, ``decomposition`` blocks: JSON only).
+CSV_KEYS = tuple(k for k in ROW_KEYS if k not in ("as_formula", "decomposition"))
 PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this quantity)"
 #: Procedure-MC configurations: name → :func:`procedure_mc` keyword arguments. "setup" is one
 #: run of the setup-data method with three readings (§27 task 1, and task 2: levelled on
@@ -97,6 +101,15 @@ PROCEDURE_CONFIGS = {
 #: ``docs/accuracy.md``). The setup method's loops stop when a check passes, which makes its
 #: δp not linear in the draws and the control variate weak there: 45 000 trials.
 PROCEDURE_TRIALS = {"setup": 45000, "conventional": 1500, "y_parallax": 3000, "stereo": 300}
+#: The setup method with every mechanism switch at the formula's assumption
+#: (:meth:`~stereoplotter.procedure.fidelity.Fidelity.as_formula`; the ``as_formula`` block of
+#: the setup rows), and the steps of the ``decomposition`` from it to the run as configured,
+#: one switch each: run on the first trials of the "setup" run's seed (paired trials, so each
+#: step's CI is that of a paired difference). Every element is then set once from linear
+#: pointings: the control variate holds the as-formula value to < 0.1 % with 2 000 trials, which
+#: also pair with the first step.
+FORMULA_TRIALS = 2000
+STEP_TRIALS = 2000
 #: Trials of the runs with every instrument error term at its σ (``mc_procedure_instrument``;
 #: a comparison with the ideal instrument, not held to 1 %).
 INSTRUMENT_TRIALS = {"setup": 4000, "conventional": 600, "y_parallax": 600, "stereo": 300}
@@ -224,7 +237,7 @@ def _job_at(i):
 
 def _job(args):
     """A job's results, configuration → :func:`procedure_mc` result."""
-    scenario, spec, configs, trials, seed, instrument, linkage = args
+    scenario, spec, configs, trials, seed, instrument, linkage, options = args
     if len(configs) == 1:
         (config,) = configs
         res = procedure_mc(
@@ -234,12 +247,12 @@ def _job(args):
             seed=seed,
             instrument=instrument,
             linkage=linkage,
-            **PROCEDURE_CONFIGS[config],
+            **options[config],
         )
         return {config: res}
-    passes = {PROCEDURE_CONFIGS[c]["passes"] for c in configs}
+    passes = {options[c]["passes"] for c in configs}
     (passes,) = passes  # the shared run makes one number of passes
-    by_source = {PROCEDURE_CONFIGS[c].get("sources", "both"): c for c in configs}
+    by_source = {options[c].get("sources", "both"): c for c in configs}
     out = conventional_sources_mc(
         scenario,
         spec=spec,
@@ -253,9 +266,52 @@ def _job(args):
 
 
 def _trials_of(trials, config, instrument):
+    if config == "setup_formula" or config.startswith("setup_step"):
+        cap = FORMULA_TRIALS if config == "setup_formula" else STEP_TRIALS
+        main = _trials_of(trials, "setup", instrument)
+        return min(cap, main)
     if isinstance(trials, int):
         return trials
     return (INSTRUMENT_TRIALS if instrument else PROCEDURE_TRIALS)[config]
+
+
+def switch_chain(fidelity: Fidelity | None = None) -> list[str]:
+    """The switches that take the setup method from the formula's assumptions to ``fidelity``
+    (default: the competent operator's), in :data:`~stereoplotter.procedure.fidelity.MECHANISMS`
+    order; the linkage left None counts as the instrument's (never the formula's)."""
+    f = fidelity or Fidelity()
+    return [
+        m.name
+        for m in MECHANISMS
+        if getattr(f, m.name) != m.as_formula or (m.name == "linkage" and f.linkage is None)
+    ]
+
+
+def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, dict]:
+    """The configurations of a ``verify`` run: :data:`PROCEDURE_CONFIGS` with the setup method
+    at ``fidelity``, "setup_formula" (every switch at the formula's assumption) and
+    "setup_step_i" (the formula's setting with the first i switches of :func:`switch_chain`
+    at ``fidelity``'s, i = 1 … k − 1; the k-th is "setup" itself)."""
+    f = fidelity or Fidelity()
+    base = PROCEDURE_CONFIGS["setup"]
+    out = {**PROCEDURE_CONFIGS, "setup": {**base, "fidelity": f}}
+    formula = Fidelity.as_formula()
+    out["setup_formula"] = {**base, "fidelity": formula}
+    chain = switch_chain(f)
+    step = formula
+    for i, name in enumerate(chain[:-1], 1):
+        value = getattr(f, name)
+        step = replace(step, **{name: value})
+        if name == "linkage" and value is None:
+            step = replace(step, linkage=None)
+        out[f"setup_step_{i}"] = {**base, "fidelity": step}
+    return out
+
+
+def _stream(config: str) -> str:
+    """The configuration whose seed a configuration's run takes (the as-formula and step
+    runs take the setup run's: their trials are its first trials)."""
+    return "setup" if config.startswith("setup") else config
 
 
 def run_procedure_mc(
@@ -268,6 +324,7 @@ def run_procedure_mc(
     with_instrument=True,
     workers=2,
     linkage=None,
+    fidelity=None,
 ):
     """:func:`start_procedure_mc` and wait for its result (arguments as there)."""
     return start_procedure_mc(
@@ -278,6 +335,7 @@ def run_procedure_mc(
         with_instrument=with_instrument,
         workers=workers,
         linkage=linkage,
+        fidelity=fidelity,
     ).result(progress)
 
 
@@ -290,6 +348,7 @@ def start_procedure_mc(
     with_instrument=True,
     workers=2,
     linkage=None,
+    fidelity=None,
 ) -> PendingProcedureMC:
     """The procedure MC of :mod:`stereoplotter.verification.procedure_mc` for every
     configuration of :data:`PROCEDURE_CONFIGS` at each overlap slot, on the ideal instrument and
@@ -308,7 +367,10 @@ def start_procedure_mc(
     per-act work for the three).
     ``linkage``: the knob–decentration linkage of the runs, "drag" or "independent" (None: the
     instrument's ``correction.decentration_linkage``;
-    :data:`~stereoplotter.verification.procedure_mc.LINKAGE_VARIANTS`).
+    :data:`~stereoplotter.verification.procedure_mc.LINKAGE_VARIANTS`). ``fidelity``: the
+    setup method's mechanism switches (:class:`~stereoplotter.procedure.fidelity.Fidelity`,
+    None: the defaults); the as-formula run and the steps to it (:func:`procedure_configs`)
+    run on the ideal instrument beside it.
 
     Returns
     -------
@@ -319,12 +381,16 @@ def start_procedure_mc(
     """
     if trials == 0 or not scenarios:
         return PendingProcedureMC([], [], 1)
+    if linkage is not None:
+        fidelity = replace(fidelity or Fidelity(), linkage=linkage)
+    configs = procedure_configs(fidelity)
     todo = [
         (s, c, inst)
         for inst in ((False, True) if with_instrument else (False,))
         for s in ("60", "80")
         if scenarios.get(s)
-        for c in PROCEDURE_CONFIGS
+        for c in configs
+        if not (inst and c not in PROCEDURE_CONFIGS)  # the switch runs: ideal instrument only
     ]
     if todo and instrument is None:
         raise ValueError("instrument: expected the InstrumentSpec of the procedure MC, found None")
@@ -339,9 +405,10 @@ def start_procedure_mc(
             instrument,
             tuple(cs),
             {c: _trials_of(trials, c, inst) for c in cs},
-            seed + 7 * (2 * names.index(lead) + (s == "80")) + 1,
+            seed + 7 * (2 * names.index(_stream(lead)) + (s == "80")) + 1,
             inst,
-            linkage,
+            None if "fidelity" in configs[lead] else linkage,  # else the fidelity's
+            {c: configs[c] for c in cs},
         )
         for (s, lead, inst), cs in groups.items()
     ]
@@ -355,7 +422,7 @@ def start_procedure_mc(
 def _cost(job) -> float:
     """Estimated cost of a job in setup trials (:data:`TRIAL_COST`)."""
     configs, trials = job[2], job[3]
-    method = PROCEDURE_CONFIGS[configs[0]]["method"]
+    method = job[7][configs[0]]["method"]
     return TRIAL_COST.get(method, 1.0) * sum(trials.values())
 
 
@@ -536,7 +603,11 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
         if pr is not None:
             v, h, ref = procedure_value(pr, field, scaled)
             r["mc_procedure"], r["mc_procedure_ci"], r["mc_procedure_formula"] = v, h, ref
-            r["decomposition"] = row_decomposition(r["rigorous"], pr, field, scaled)
+            first = row_decomposition(r["rigorous"], pr, field, scaled)
+            r["as_formula"] = as_formula_block(r["eq"], proc, slot, config, field, scaled)
+            r["decomposition"] = switch_decomposition(proc, slot, field, scaled, r["as_formula"])
+            r["decomposition"]["first_order"] = first
+            r["decomposition"]["linkage"] = first["linkage"]
             r["note"] = r["note"].replace(
                 PROCEDURE_NOTE, _procedure_note(r["eq"], pr, field, scaled)
             )
@@ -551,14 +622,167 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
     return rows
 
 
+#: The departures a conventional row's run keeps from its formula where it differs beyond the
+#: CI (its configuration is the formula's otherwise: σ_q, σ_p as the formula, the relative
+#: orientation by the six measured q and (5.11), 3 fixed passes, standard points at a = c − p),
+#: each with the run that showed it; configuration → text.
+_TILTED = (
+    "the scenario's tilted photos and relief: on vertical photos over flat terrain "
+    "(procedure_mc on idealised_geometry, python3 docs/make_verification_switches.py item 3) "
+    "the σ_q part is the formula within its CI"
+)
+CONVENTIONAL_REST = {
+    "y_parallax": _TILTED,
+    "conventional": "its σ_q part (the y_parallax row, σ_q only): " + _TILTED,
+}
+
+
+def as_formula_block(eq, proc, slot, config, field, scaled) -> dict | None:
+    """The ``as_formula`` block of a procedure row: ``value``, ``ci``, ``ci_rel``, ``formula``
+    (the rigorous formula at the simulated geometry), ``ratio``, ``agrees`` (|value − formula|
+    ≤ CI), ``fidelity`` (the switches), ``trials``; where it does not agree, ``mechanism`` (what
+    still differs, with the run that shows it; setup rows: ``elements``, each (6.22) element's
+    RMS error in the as-formula run against (6.32)–(6.38)).
+
+    Setup rows: the setup method with every switch at the formula's assumption
+    (:meth:`Fidelity.as_formula`, configuration "setup_formula"). Conventional rows: the row's
+    own run, whose configuration is the formula's (:data:`PROCEDURE_CONFIGS`)."""
+    if field is not None:
+        res = proc.get((slot, "setup_formula"))
+        if res is None:
+            return None
+        fidelity = {m.name: m.as_formula for m in MECHANISMS}
+    else:
+        res, fidelity = proc[(slot, config)], None
+    v, h, ref = procedure_value(res, field, scaled)
+    out = {
+        "value": v,
+        "ci": h,
+        "ci_rel": h / v,
+        "formula": ref,
+        "ratio": v / ref,
+        "agrees": bool(abs(v - ref) <= h),
+        "trials": res["trials"],
+        "fidelity": fidelity,
+        "mechanism": None,
+    }
+    if field is not None:
+        out["elements"] = element_ratios(res)
+        if not out["agrees"]:
+            out["mechanism"] = _formula_rest(out["elements"])
+    elif not out["agrees"]:
+        out["mechanism"] = CONVENTIONAL_REST.get(config, "not traced (no switch run yet)")
+    return out
+
+
+def element_ratios(res: dict) -> dict:
+    """Each (6.22) element's RMS error in a setup run against (6.32)–(6.38) with the least-squares
+    m_ω and the unit-consistent m_bz (``setup_element_sigmas(mode="rigorous")``), at m_x = m_y
+    = n_л·σ, photo scale: element → (``procedure``, ``formula``, ``ratio``). b_y has no term
+    in (6.22) and is left out."""
+    n, f, fi = res["n"], res["f"], res["f_instrument"]
+    sig = setup_element_sigmas(f, res["l"], n, n * res["sigma_mm"], mode="rigorous")
+    rms = res["element_rms"]
+    photo = {  # instrument units → photo scale
+        "setting.base_x_mm": ("base_x", 1.0 / n),
+        "setting.base_z_mm": ("base_z", f / (fi * n)),
+        **{f"{s}.tan_{a}": (a, 1.0) for s in ("left", "right") for a in ("alpha", "omega")},
+        **{f"{s}.kappa": ("kappa", 1.0) for s in ("left", "right")},
+    }
+    out = {}
+    for key, (name, k) in photo.items():
+        value, formula = rms[key] * k, float(sig[name])
+        out[key] = {"procedure": value, "formula": formula, "ratio": value / formula}
+    return out
+
+
+def _formula_rest(elements: dict) -> str:
+    """What still differs in the as-formula run: the elements whose RMS error departs from
+    (6.32)–(6.38) by more than 5 %, from the run itself."""
+    off = [
+        f"{k.replace('setting.', '')} ×{e['ratio']:.2f}"
+        for k, e in elements.items()
+        if abs(e["ratio"] - 1.0) > 0.05
+    ]
+    what = ", ".join(off) if off else "no element beyond 5 %"
+    return (
+        "the procedure's own way of setting the elements, in this as-formula run: RMS error "
+        f"against (6.32)–(6.38): {what} (α by one knob fit at mark 2 against the counters at "
+        "MO_X + n·x⁰, not (6.31)'s pair; ω at mark 3 with the mark-4 check, not (6.33)'s least "
+        "squares; the counters' n shared by the fits, so the tilt errors correlate with b_z); "
+        "the rest: the scenario's tilted photos and relief, which (6.22) does not carry"
+    )
+
+
+def switch_decomposition(proc, slot, field, scaled, as_formula) -> dict:
+    """The ``decomposition`` block: from the ``as_formula`` run to the row's run, one switch a
+    step (:func:`switch_chain`), each step a paired difference of RMS values on the first
+    :data:`STEP_TRIALS` trials of the setup run's seed, with its CI; ``sum`` = the as-formula
+    value on those trials + Σ steps (= the row's run on them, plain mean), ``closes``: the sum
+    agrees with the row's value within the two CIs. Conventional rows: no step (their run is
+    the as-formula one)."""
+    if field is None or as_formula is None:
+        v = as_formula["value"] if as_formula else None
+        h = as_formula["ci"] if as_formula else None
+        return {
+            "as_formula": {"value": v, "ci": h},
+            "steps": [],
+            "sum": v,
+            "procedure": {"value": v, "ci": h},
+            "closes": True,
+        }
+    main = proc[(slot, "setup")]
+    runs = [proc[(slot, "setup_formula")]] + [proc[(slot, c)] for c in _step_names(proc, slot)]
+    runs.append(main)
+    k = main["f"] / main["p"] if scaled else 1.0
+    fields = [r["fields"][field] for r in runs]
+    t = min(len(f["mean_squares"]) for f in fields)
+    unit = fields[0]["unit"] / k
+    ms = [np.asarray(f["mean_squares"][:t], float) for f in fields]
+    start, start_ci = dc.rms_ci(ms[0], unit)
+    ref = as_formula["formula"]
+    steps = []
+    for i, name in enumerate(switch_chain(main.get("fidelity"))):
+        c, h = dc.paired_step(ms[i + 1], ms[i], unit)
+        m = mechanism(name)
+        steps.append({
+            "step": name,
+            "switch": m.option(m.as_formula),
+            "to": getattr(main.get("fidelity"), name, None),
+            "text": m.basis,
+            "contribution": c,
+            "ci": h,
+            "relative": c / ref,
+        })  # fmt: skip
+    _, end_ci = dc.rms_ci(ms[-1], unit)
+    value, ci, _ = procedure_value(main, field, scaled)
+    total = start + sum(s["contribution"] for s in steps)
+    return {
+        "as_formula": {"value": start, "ci": start_ci, "trials": t},
+        "steps": steps,
+        "sum": total,
+        "sum_ci": end_ci,
+        "procedure": {"value": value, "ci": ci},
+        "closes": bool(abs(total - value) <= end_ci + ci),
+        "linkage": main.get("linkage"),
+    }
+
+
+def _step_names(proc, slot) -> list[str]:
+    """The step configurations run at ``slot``, in order."""
+    names = [k[1] for k in proc if len(k) == 2 and k[0] == slot and k[1].startswith("setup_step")]
+    return sorted(names, key=lambda c: int(c.rsplit("_", 1)[1]))
+
+
 #: Mechanisms of decomposition steps, each shown by a switch run that removes it
 #: (``docs/accuracy.md``, "Decomposition of the procedure rows"), on the book's scenarios with
 #: the SC-1 and the dragging linkage only: step → text. Attached only to runs of that setting.
-MECHANISMS = {
+FIRST_ORDER_MECHANISMS = {
     "element_errors": "the knob–decentration linkage: switched to independent "
     "(verify --linkage independent) the step changes sign (levelled rows −35 % → +8 %)",
-    "principal_distance": "the loops' stop when a check passes (f_пр is set by the stage-1 "
-    "L-check): with every loop at a fixed 2 or 4 passes the step is 0 within its CI",
+    "principal_distance": "the L-check's correction at the carriage's bottom stop, which "
+    "reaches n = D/f_пр by f_пр: with --bottom-stop free f_пр stays at the sheet's value and "
+    "the step is 0; the decomposition's bottom_stop step is its size in the RMS",
     "levelling_points": "the procedure's levelling points: re-levelled at Fig. 39's points "
     "(procedure_mc levelling='book') the run is the formula there within its CI",
     "procedure": "σ_q part: the scenario's tilted photos and relief (on vertical photos over "
@@ -569,14 +793,12 @@ MECHANISM_SETTING = ({"pair60", "pair80"}, "sc1", "drag")
 
 def _mechanism(res: dict, step: str, field: str | None) -> str | None:
     names, key, linkage = MECHANISM_SETTING
-    if step == "principal_distance" and field != "parallax":  # the switch run read δp only
-        return None
     shown = res.get("scenario") in names and res.get("instrument_key") == key
     if not shown or res.get("linkage") != linkage or res.get("instrument"):
         return None
     if step == "procedure" and res.get("sources") != "y_parallax":
         return None
-    return MECHANISMS.get(step)
+    return FIRST_ORDER_MECHANISMS.get(step)
 
 
 def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -> dict:
@@ -617,8 +839,13 @@ def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -
             ref = book if a == "book_geometry" else levels["simulated_geometry"][0]
             name = "geometry" if a == "book_geometry" else b
             steps.append(
-                {"step": name, "text": text, "contribution": c, "ci": levels[b][1],
-                 "relative": c / ref}
+                {
+                    "step": name,
+                    "text": text,
+                    "contribution": c,
+                    "ci": levels[b][1],
+                    "relative": c / ref,
+                }
             )
         out = {
             "values": {n: {"value": v, "ci": h} for n, (v, h) in levels.items()},
@@ -717,6 +944,7 @@ def _row(e: Entry, trials, rng, at_book: bool = True) -> dict:
         "mc_procedure_instrument_ci": None,
         "verdict": verdict,
         "note": note + "; " + PROCEDURE_NOTE,
+        "as_formula": None,
         "decomposition": None,
     }
 

@@ -259,7 +259,7 @@ def test_verify_decomposes_every_procedure_row():
     rows = [r for r in rows if r["mc_procedure"] is not None]
     assert len(rows) == 23
     for r in rows:
-        d = r["decomposition"]
+        d = r["decomposition"]["first_order"]
         assert d["linkage"] == "independent" and d["closes"], r["eq"]
         steps = {s["step"]: s for s in d["steps"]}
         if "non_linear" in steps:
