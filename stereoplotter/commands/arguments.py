@@ -103,6 +103,8 @@ _FIDELITY_FLAGS = (
     ("--bottom-stop", "bottom_stop", ("both_ways", "one_way", "free")),
     ("--bx-zero", "bx_zero", ("two_pointings", "exact")),
     ("--kappa", "kappa", ("y_parallax", "fiducials")),
+    ("--tilts", "tilts", ("knob_fit", "least_squares")),
+    ("--fit-scale", "fit_scale", ("as_set", "exact")),
     ("--stage3", "stage3", ("fuse", "none")),
 )
 
@@ -119,8 +121,8 @@ def add_fidelity_arguments(p: argparse.ArgumentParser, linkage: bool = True) -> 
         "--as-formula",
         action="store_true",
         help="every switch at the formula's assumption (bottom stop free, b_x zero from two "
-        "pointings, κ from the fiducials, no stage-3 scaling, one pass per loop, independent "
-        "linkage); a flag below overrides one",
+        "pointings, κ from the fiducials, k_ω by least squares, the fits at the exact n, no "
+        "stage-3 scaling, one pass per loop, independent linkage); a flag below overrides one",
     )
     for flag, dest, choices in _FIDELITY_FLAGS:
         g.add_argument(

@@ -88,6 +88,31 @@ MECHANISMS = (
         "(6.36): κ from the fiducials, m_κ = m_x/(√2·l_y·n), independent of the other elements",
     ),
     Mechanism(
+        "tilts",
+        "--tilts",
+        ("knob_fit", "least_squares"),
+        "knob_fit",
+        "the book's stage 2 (OCR L3781–3787): k_ω fitted at mark 3 with the counter at "
+        "MO_Y + n·y⁰₃, mark 4 checked (refit while it is off), k_α at mark 2 (1 on the right). "
+        "'least_squares': k_ω fitted at mark 3 and at mark 4 and set to the mean of the two "
+        "fits — with the zero reading at the cassette centre the least-squares solution of "
+        "(6.33), Q_ωω = 3/(2a²) for a = l²/f",
+        "least_squares",
+        "(6.33)–(6.35): ω from the centre and marks 3, 4 by least squares",
+    ),
+    Mechanism(
+        "fit_scale",
+        "--fit-scale",
+        ("as_set", "exact"),
+        "as_set",
+        "the book's stage 2 (OCR L3781, L3787): the fits' counter targets MO + n·x⁰, n·y⁰ are "
+        "read on counters whose scale n = D/f_пр the stage-1 L-check set, with its error "
+        "(δn/n ≈ √2·m/L from two pointings). 'exact': the targets scaled by the n the "
+        "instrument actually has, so a fit carries only its own pointings",
+        "exact",
+        "(6.31)–(6.35): the tilts from the pointings at the centre and the marks, n exact",
+    ),
+    Mechanism(
         "stage3",
         "--stage3",
         ("fuse", "none"),
@@ -140,6 +165,8 @@ class Fidelity:
     bottom_stop : {"both_ways", "one_way", "free"}
     bx_zero : {"two_pointings", "exact"}
     kappa : {"y_parallax", "fiducials"}
+    tilts : {"knob_fit", "least_squares"}
+    fit_scale : {"as_set", "exact"}
     stage3 : {"fuse", "none"}
     passes : int or None
         Every tolerance loop makes this many passes (no check stops it); None: until a check
@@ -152,12 +179,14 @@ class Fidelity:
     >>> Fidelity.as_formula().departures()
     ()
     >>> Fidelity().departures()
-    ('bottom_stop', 'kappa', 'stage3', 'passes', 'linkage')
+    ('bottom_stop', 'kappa', 'tilts', 'fit_scale', 'stage3', 'passes', 'linkage')
     """
 
     bottom_stop: str = "both_ways"
     bx_zero: str = "two_pointings"
     kappa: str = "y_parallax"
+    tilts: str = "knob_fit"
+    fit_scale: str = "as_set"
     stage3: str = "fuse"
     passes: int | None = None
     linkage: str | None = None

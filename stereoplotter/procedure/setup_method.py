@@ -193,9 +193,10 @@ def _zero_readings(run: Run, key: str) -> None:
         )
 
 
-def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> None:
+def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active):
     """Set the counter to MO + n·(x⁰ or y⁰), the other handwheel onto the fiducial line, turn
-    the knob until the fiducial is under the mark ((6.12) or (6.13))."""
+    the knob until the fiducial is under the mark ((6.12) or (6.13)); the knob's tangent
+    after the turn. [—]"""
     op = run.op
     sfx = "" if side == "left" else ",п"
     fid = fiducial_mm(run, side, mark)
@@ -205,7 +206,7 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
     else:
         counter, free, comp = "X", "Y", 0
         eq = "(6.13)"
-    value = run.target(f"O_{counter}{mark},{_SIDE[side]}")  # MO (+ ,п) + n·x⁰ or n·y⁰
+    value = _fit_target(run, side, f"O_{counter}{mark},{_SIDE[side]}")
     op.set(counter, value, f"{key}/set", active)
     op.mark_on(side, fid, f"{key}/line", active, free=free)
     e = op.noise.normal(f"mono/{key}/knob", op.model.monocular_sigma_mm)
@@ -230,6 +231,44 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active) -> No
         unit="tan",
         judgment_error=e,
         equation=eq,
+    )
+    return op.physical(knob)
+
+
+def _fit_target(run: Run, side: str, name: str):
+    """The counter target MO (+ ,п) + n·x⁰ or n·y⁰ of a fit (switch ``fit_scale``): the sheet's
+    reading ("as_set"), or its value scaled by n_true/n of the sheet, n_true = D/f_пр of the
+    instrument as it is (D + b_z on the right; "exact"). [mm]"""
+    value = run.target(name)
+    if run.fidelity.fit_scale != "exact":
+        return value
+    op, sheet = run.op, run.sheet
+    depth = op.physical("Z") + (op.physical("bz") if side == "right" else 0.0)
+    n_true = depth / op.inst.setting.f_instrument_mm
+    n_sheet = sheet.n_left if side == "left" else sheet.n_right
+    reading = run.readings[name]
+    return value + reading.value * (n_true / n_sheet - 1.0)
+
+
+def _fit_omega(run: Run, side: str, key: str, active) -> None:
+    """k_ω of ``side`` (switch ``tilts``): fitted at mark 3 ("knob_fit"), or at marks 3 and 4
+    and set to the mean of the two fits ("least_squares", (6.33))."""
+    t3 = _fit_knob(run, side, "omega", "3", key, active)
+    if run.fidelity.tilts != "least_squares":
+        return
+    op = run.op
+    t4 = _fit_knob(run, side, "omega", "4", f"{key}/4", active)
+    knob = f"k_omega_{side}"
+    before = op.physical(knob)
+    op.drive(knob, 0.5 * (t3 + t4), active)
+    op.log.add(
+        "2",
+        f"{side} photo: k_ω to the mean of its fits at marks 3 and 4 (least squares)",
+        knob,
+        before=before,
+        after=op.physical(knob),
+        unit="tan",
+        equation="(6.33)",
     )
 
 
@@ -343,7 +382,7 @@ def _stage2_round(run: Run, it: int, active, tol4: float):
             _set_computed_decentrations(run)
     seen = []
     for side in ("left", "right"):
-        _fit_knob(run, side, "omega", "3", f"2/{it}/{side}/omega", active)
+        _fit_omega(run, side, f"2/{it}/{side}/omega", active)
         m4 = _mark4(run, side, f"2/{it}/{side}/m4", active)
         seen.append(m4)
         op.log.add(

@@ -167,6 +167,8 @@ def _scenario_geometry(scenario, spec):
         "a": c - p,
         "overlap": overlap,
         "flying_height_m": height,
+        # the terrain's depth in the model, H̄/M_в, against the carriage's D = n_л·f_пр
+        "terrain_depth_mm": height * 1000.0 / float(sheet.vertical_scale_denominator),
     }
 
 

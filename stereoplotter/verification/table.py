@@ -32,7 +32,11 @@ from stereoplotter.procedure.fidelity import MECHANISMS, Fidelity, mechanism
 from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
-from stereoplotter.verification.procedure_mc import conventional_sources_mc, procedure_mc
+from stereoplotter.verification.procedure_mc import (
+    conventional_sources_mc,
+    idealised_geometry,
+    procedure_mc,
+)
 from stereoplotter.verification.rows_chapter5 import chapter5_entries
 from stereoplotter.verification.rows_levelled import (
     closing_entries,
@@ -240,6 +244,9 @@ def _job(args):
     scenario, spec, configs, trials, seed, instrument, linkage, options = args
     if len(configs) == 1:
         (config,) = configs
+        kw = dict(options[config])
+        if kw.pop("idealised", False):  # vertical photos over flat terrain
+            scenario = idealised_geometry(scenario)
         res = procedure_mc(
             scenario,
             spec=spec,
@@ -247,7 +254,7 @@ def _job(args):
             seed=seed,
             instrument=instrument,
             linkage=linkage,
-            **options[config],
+            **kw,
         )
         return {config: res}
     passes = {options[c]["passes"] for c in configs}
@@ -266,8 +273,8 @@ def _job(args):
 
 
 def _trials_of(trials, config, instrument):
-    if config == "setup_formula" or config.startswith("setup_step"):
-        cap = FORMULA_TRIALS if config == "setup_formula" else STEP_TRIALS
+    if config.startswith(("setup_formula", "setup_step")):
+        cap = FORMULA_TRIALS if config.startswith("setup_formula") else STEP_TRIALS
         main = _trials_of(trials, "setup", instrument)
         return min(cap, main)
     if isinstance(trials, int):
@@ -297,6 +304,7 @@ def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, dict]:
     out = {**PROCEDURE_CONFIGS, "setup": {**base, "fidelity": f}}
     formula = Fidelity.as_formula()
     out["setup_formula"] = {**base, "fidelity": formula}
+    out["setup_formula_flat"] = {**base, "fidelity": formula, "idealised": True}
     chain = switch_chain(f)
     step = formula
     for i, name in enumerate(chain[:-1], 1):
@@ -668,8 +676,11 @@ def as_formula_block(eq, proc, slot, config, field, scaled) -> dict | None:
     }
     if field is not None:
         out["elements"] = element_ratios(res)
+        flat = proc.get((slot, "setup_formula_flat"))
+        if flat is not None:
+            out["vertical_flat"] = vertical_flat_block(flat, field, scaled)
         if not out["agrees"]:
-            out["mechanism"] = _formula_rest(out["elements"])
+            out["mechanism"] = _formula_rest(out)
     elif not out["agrees"]:
         out["mechanism"] = CONVENTIONAL_REST.get(config, "not traced (no switch run yet)")
     return out
@@ -696,22 +707,52 @@ def element_ratios(res: dict) -> dict:
     return out
 
 
-def _formula_rest(elements: dict) -> str:
-    """What still differs in the as-formula run: the elements whose RMS error departs from
-    (6.32)–(6.38) by more than 5 %, from the run itself."""
+def vertical_flat_block(res: dict, field: str, scaled: bool) -> dict:
+    """The as-formula run on the scenario with vertical photos over flat terrain
+    (:func:`~stereoplotter.verification.procedure_mc.idealised_geometry`), against the formula
+    there; for the unlevelled reading ("parallax", (6.39)–(6.44)) also against the formula with
+    b_x's coefficient taken at the terrain's depth: the model of the terrain lies at
+    D_t = H̄/M_в, not at the carriage's D = n_л·f_пр where the counters (and the formula's n)
+    are, so δp/δb_x = f_пр/D_t = (D/D_t)/n_л; m_p² + (√2·m_x/n_л)²·((D/D_t)² − 1), per m_xy.
+    ``value``, ``ci``, ``formula``, ``ratio``, ``depth_ratio`` (D/D_t), ``formula_at_depth``
+    and ``ratio_at_depth``; ``elements`` as :func:`element_ratios`."""
+    v, h, ref = procedure_value(res, field, scaled)
+    out = {"value": v, "ci": h, "formula": ref, "ratio": v / ref, "trials": res["trials"]}
+    if field == "parallax":
+        k = res["n"] * res["f_instrument"] / res["terrain_depth_mm"]
+        bx = math.sqrt(2.0) / res["n"]  # m_bx of (6.38) per m_xy = n_л·σ, photo scale
+        at_depth = math.sqrt(ref**2 + bx**2 * (k**2 - 1.0))
+        out.update(depth_ratio=k, formula_at_depth=at_depth, ratio_at_depth=v / at_depth)
+    out["elements"] = element_ratios(res)
+    return out
+
+
+def _formula_rest(block: dict) -> str:
+    """What still differs in the as-formula run, from the runs themselves: the elements whose
+    RMS error departs from (6.32)–(6.38) by more than 5 %, and the run on vertical photos over
+    flat terrain."""
     off = [
         f"{k.replace('setting.', '')} ×{e['ratio']:.2f}"
-        for k, e in elements.items()
+        for k, e in block["elements"].items()
         if abs(e["ratio"] - 1.0) > 0.05
     ]
-    what = ", ".join(off) if off else "no element beyond 5 %"
-    return (
-        "the procedure's own way of setting the elements, in this as-formula run: RMS error "
-        f"against (6.32)–(6.38): {what} (α by one knob fit at mark 2 against the counters at "
-        "MO_X + n·x⁰, not (6.31)'s pair; ω at mark 3 with the mark-4 check, not (6.33)'s least "
-        "squares; the counters' n shared by the fits, so the tilt errors correlate with b_z); "
-        "the rest: the scenario's tilted photos and relief, which (6.22) does not carry"
+    what = ", ".join(off) if off else "none beyond 5 %"
+    text = f"elements' RMS errors against (6.32)–(6.38): {what}"
+    flat = block.get("vertical_flat")
+    if flat is None:
+        return text + "; not traced further (no run on vertical photos over flat terrain)"
+    text += (
+        f"; the scenario's tilted photos and relief: on vertical photos over flat terrain "
+        f"the as-formula run is {flat['ratio']:.4f} of the formula there"
     )
+    if "ratio_at_depth" in flat:
+        text += (
+            f", and {flat['ratio_at_depth']:.4f} of it with b_x's coefficient at the terrain's "
+            f"depth (the carriage at D = {flat['depth_ratio']:.4f}·H̄/M_в: the sheet's D_max "
+            "and the round vertical scale M_в put the terrain's model above the counters' "
+            "depth, which (6.22)/(6.38) take as one n)"
+        )
+    return text
 
 
 def switch_decomposition(proc, slot, field, scaled, as_formula) -> dict:
