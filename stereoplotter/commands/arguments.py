@@ -105,7 +105,7 @@ _FIDELITY_FLAGS = (
     ("--kappa", "kappa", ("y_parallax", "fiducials")),
     ("--tilts", "tilts", ("knob_fit", "least_squares")),
     ("--fit-scale", "fit_scale", ("as_set", "exact")),
-    ("--stage3", "stage3", ("fuse", "none")),
+    ("--stage3", "stage3", ("fuse", "bx_only", "none")),
 )
 
 

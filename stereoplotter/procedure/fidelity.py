@@ -115,11 +115,12 @@ MECHANISMS = (
     Mechanism(
         "stage3",
         "--stage3",
-        ("fuse", "none"),
+        ("fuse", "bx_only", "none"),
         "fuse",
         "the book's stage 3 (OCR L3803–3805): b_x until the mark fuses on a height control "
         "point at O_Z (6.15), then the orientation along the initial direction refined (D10). "
-        "'none': the model is left as stage 2 built it (only the heights are read)",
+        "'bx_only': b_x fused, κ not cleared again; 'none': the model is left as stage 2 "
+        "built it (only the heights are read)",
         "none",
         "§27 task 1: the elements entered independently, the geodetic orientation not refined "
         "(b_x from (6.38), κ from (6.36))",
@@ -167,7 +168,7 @@ class Fidelity:
     kappa : {"y_parallax", "fiducials"}
     tilts : {"knob_fit", "least_squares"}
     fit_scale : {"as_set", "exact"}
-    stage3 : {"fuse", "none"}
+    stage3 : {"fuse", "bx_only", "none"}
     passes : int or None
         Every tolerance loop makes this many passes (no check stops it); None: until a check
         passes.

@@ -751,8 +751,8 @@ def refine_scale_and_level(
 
 
 def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
-    """Stage 3's scaling (switch ``stage3`` "fuse"): the mark fused on the height control point
-    ``pid`` by turning b_x, then κ cleared again (D10)."""
+    """Stage 3's scaling (switch ``stage3``): the mark fused on the height control point ``pid``
+    by turning b_x, then ("fuse") κ cleared again (D10)."""
     op = run.op
     op.mark_on("left", left_img, "3/left")
     e = op.noise.normal("stereo/3/bx", op.model.stereo_sigma_mm)
@@ -777,7 +777,7 @@ def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
     # read on the model that is kept. Read before it (pair80: b_x 57.6 mm, κ absorbing f·ω/b),
     # they differed from the final model's by 0.14 m of the 0.465 m tolerance. κ from the
     # fiducials (switch ``kappa``) is not refined: the fiducials do not move with b_x.
-    if run.fidelity.kappa != "fiducials":
+    if run.fidelity.kappa != "fiducials" and run.fidelity.stage3 == "fuse":
         clear_kappa(run, "3")
 
 
@@ -800,7 +800,7 @@ def stage3_scale_model(run: Run) -> None:
         equation="(6.15)",
     )
     pl, pr = run.scene.images(p0[None, :])
-    if run.fidelity.stage3 == "fuse":
+    if run.fidelity.stage3 != "none":
         _fuse_bx(run, h0.id, pl[0], pr[0])
     op.fuse(p0, (pl[0], pr[0]), "3/refuse")
     op.inst.slip_height_scale(p0[2])
