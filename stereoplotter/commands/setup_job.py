@@ -201,11 +201,8 @@ def _summary(result: JobResult, report: OutputReport, out: Path) -> str:
         f"block.csv, refused.md, manifest.json in {out}"
     )
     if report.removed:
-        lines.append(
-            f"removed {len(report.removed)} stale files of the previous run: "
-            + ", ".join(report.removed[:6])
-            + (" …" if len(report.removed) > 6 else "")
-        )
+        lines.append(f"removed {len(report.removed)} stale files of the previous run: "
+                     + ", ".join(report.removed[:6]) + (" …" if len(report.removed) > 6 else ""))
     if report.kept_foreign:
         lines.append(f"left in place: {report.kept_foreign} file(s) no job run wrote")
     return "\n".join(lines) + "\n"

@@ -141,7 +141,8 @@ MECHANISMS = (
         "--linkage",
         (None, "drag", "independent"),
         None,
-        "the instrument file's correction.decentration_linkage (the SC-1's: drag, decision D1)",
+        "assumed: the instrument file's correction.decentration_linkage (the SC-1's: drag, "
+        "decision D1; no source documents how the SC-1's knob moves its decentration)",
         "independent",
         "(6.21)→(6.22): the decentration errors are dropped (they are 'largely removed by the "
         "scaling'): the decentrations stay where they are set",

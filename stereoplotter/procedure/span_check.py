@@ -136,11 +136,12 @@ def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_m
     :mod:`~stereoplotter.procedure.fidelity`).
 
     "both_ways" (the book's (6.11), O′_Z = O_Z + ΔZ either way): a correction that asks for a
-    deeper carriage than the stop reaches the same n = D/f_пр by shortening f_пр in the ratio
-    D/(D + ΔD); one that asks for a shallower carriage while f_пр is short of the sheet's value
-    first lengthens f_пр back (at most to the sheet's value), and the rest raises the carriage.
-    "one_way": f_пр is shortened at the stop and never lengthened. "free": no stop, every ΔZ on
-    Z (f_пр stays at the sheet's value).
+    deeper carriage than the stop lowers it to the stop and reaches the rest of n = D/f_пр by
+    shortening f_пр in the ratio D_stop/(D + ΔD); one that asks for a shallower carriage while
+    f_пр is short of the sheet's value first lengthens f_пр back (at most to the sheet's
+    value), and the rest raises the carriage. "one_way": a correction past the stop is taken
+    whole by f_пр, f_пр·D/(D + ΔD), wherever the carriage is, and f_пр is never lengthened.
+    "free": no stop, every ΔZ on Z (f_пр stays at the sheet's value).
 
     Returns the trials whose f_пр changed, f′_пр/f_пр of this correction (1 elsewhere) and ΔZ
     left to set on Z. [—, —, mm]
@@ -153,9 +154,12 @@ def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_m
     stop = op.v(op.inst.reading_of("Z", op.inst.travel_mm("Z")[1]))
     f_set = op.commanded["f_instrument"]
     beyond = active & (depth + dz_mm > stop)
-    # the n this correction asks for, n′ = (D + ΔD)/f_пр, reached with D at the stop
-    f_new = np.where(beyond, f_set * depth / (depth + dz_mm), f_set)
-    rest = np.where(beyond, 0.0, dz_mm)
+    # the n this correction asks for, n′ = (D + ΔD)/f_пр, reached with D at the stop: "both_ways"
+    # lowers the carriage to the stop and takes the rest by f_пр; "one_way" takes all of it by
+    # f_пр wherever the carriage is
+    floor = stop if mode == "both_ways" else depth
+    f_new = np.where(beyond, f_set * floor / (depth + dz_mm), f_set)
+    rest = np.where(beyond, floor - depth, dz_mm)
     if mode == "both_ways":
         f_sheet = run.target("f_пр")
         back = active & ~beyond & (dz_mm < 0.0) & (f_set < f_sheet)
