@@ -1,4 +1,4 @@
-"""The switch runs of the decomposition of the procedure rows (issue 25, ``docs/accuracy.md``).
+"""The switch runs behind the decomposition of the procedure rows (``docs/accuracy.md``).
 
 Run from the repository root::
 
@@ -6,17 +6,21 @@ Run from the repository root::
 
 Prints, on the book's scenarios pair60/pair80 and the SC-1:
 
-0. the scatter and mean of f_пр as set by the setup method, against the error-free run (pair60,
-   monocular σ = 10 µm only, ideal mechanics, 500 trials, seed 3);
-1. the setup rows' decomposition (δp on the (6.27) domain) as built and with every loop at a
-   fixed 2 and 4 passes (3 000 trials, seed 5, 8 × 16 grid): the f_пр step and the element step;
+0. f_пр as set by the setup method minus the sheet's, under the bottom-stop rule both ways (the
+   book's (6.11), the default) and one way (f_пр shortened at the stop, never lengthened),
+   pair60, monocular σ = 10 µm only, ideal mechanics, 500 trials, seed 3;
+1. stage 3's part of the setup rows (δp on the (6.27) domain, paired on 2 000 trials, seed 5,
+   8 × 16 grid): stage 3 off → b_x fused on control point 1 → + κ cleared again (D10), at the
+   default switches and at the switches where the decomposition of ``verify --json`` flips
+   stage 3 (κ by y-parallax, one pass, linkage independent), with the RMS error of b_x;
 2. the conventional σ_q part at 3, 6 and 10 passes (1 500 trials, seed 21) against the formula
    with the plane at the procedure's levelling points;
 3. the same σ_q part on the scenario with vertical photos over flat terrain
    (``idealised_geometry``), also re-levelled at Fig. 39's points against (5.54).
 
-The rows of ``verify`` itself (both linkages) are printed by ``stereoplotter verify -o DIR``
-and ``stereoplotter verify --linkage independent -o DIR``.
+The rows of ``verify`` itself, with their ``as_formula`` blocks and the decomposition from it
+to the default one switch a step, are printed by ``stereoplotter verify -o DIR`` (and
+``--json``).
 """
 
 from __future__ import annotations
@@ -26,49 +30,72 @@ from dataclasses import replace
 import numpy as np
 
 from stereoplotter.io.book_setting import book_instrument, book_scenarios
+from stereoplotter.procedure.fidelity import Fidelity
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import simulate
+from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification.procedure_mc import idealised_geometry, procedure_mc
 
 
-def principal_distance_scatter() -> str:
-    """f_пр of the setup method's trials minus the error-free run's: mean and σ [µm]."""
+def principal_distance_scatter(rule: str) -> str:
+    """f_пр of the setup method's trials minus the sheet's under bottom-stop ``rule``: mean and
+    σ [µm]."""
     sc, spec = book_scenarios()["60"], book_instrument()
     zero = OperatorModel().zero()
-    kw = dict(errors="zero", ideal_mechanics=True, practice="book", seed=3)
-    r0 = simulate(sc, spec, operator=zero, trials=1, **kw)
-    r = simulate(sc, spec, operator=replace(zero, monocular_sigma_mm=0.01), trials=500, **kw)
-    f0 = float(np.ravel(r0.instrument.setting.f_instrument_mm)[0])
-    d = (np.asarray(r.instrument.setting.f_instrument_mm, float) - f0) * 1000.0
+    kw = dict(errors="zero", ideal_mechanics=True, practice="book", seed=3, evaluate=False)
+    r = simulate(
+        sc, spec, operator=replace(zero, monocular_sigma_mm=0.01), trials=500,
+        fidelity=Fidelity(bottom_stop=rule), **kw,
+    )  # fmt: skip
+    d = (np.asarray(r.instrument.setting.f_instrument_mm, float) - r.sheet.f_instrument_mm) * 1e3
     return f"mean {np.mean(d):+.1f} µm, σ {np.std(d):.1f} µm"
 
 
-def _steps(r: dict) -> str:
-    d = r["fields"]["parallax"]["decomposition"]
-    ref = d["values"]["simulated_geometry"]["value"]
-    return "  ".join(
-        f"{s['step']} {100 * s['relative']:+.1f} ± {100 * s['ci'] / ref:.1f} %" for s in d["steps"]
-    )
-
-
-def main() -> None:
+def stage3_trace(base: Fidelity, label: str) -> None:
+    """Stage 3 off → b_x fused → + κ cleared again, paired, at switches ``base``."""
     scenarios, spec = book_scenarios(), book_instrument()
-    print(f"0. f_пр as set minus the error-free run's, pair60: {principal_distance_scatter()}")
-    print("1. setup rows, δp on the (6.27) domain: steps as shares of the formula")
     for slot in ("60", "80"):
-        for passes in (None, 2, 4):
-            r = procedure_mc(
+        runs = {
+            s: procedure_mc(
                 scenarios[slot],
                 "setup",
                 spec=spec,
-                trials=3000,
+                trials=2000,
                 seed=5,
                 grid=(8, 16),
-                passes=passes,
+                fidelity=replace(base, stage3=s),
             )
-            f = r["fields"]["parallax"]
-            label = "as built" if passes is None else f"{passes} passes"
-            print(f"  {slot} % {label:9s} {f['coefficient']:.4f} ± {f['ci']:.4f}  {_steps(r)}")
+            for s in ("none", "bx_only", "fuse")
+        }
+        f = runs["fuse"]["fields"]["parallax"]
+        ref, unit = f["formula"], f["unit"]
+        parts = []
+        for a, b in (("none", "bx_only"), ("bx_only", "fuse")):
+            c, h = dc.paired_step(
+                runs[b]["fields"]["parallax"]["mean_squares"],
+                runs[a]["fields"]["parallax"]["mean_squares"],
+                unit,
+            )
+            parts.append(f"{a} → {b} {100 * c / ref:+.1f} ± {100 * h / ref:.1f} %")
+        bx = "  ".join(f"{s} {runs[s]['element_rms']['setting.base_x_mm'] * 1e3:.1f}" for s in runs)
+        print(f"  {label}, {slot} %: {'; '.join(parts)} of the formula; b_x RMS [µm] {bx}")
+
+
+def main() -> None:
+    print("0. f_пр as set minus the sheet's, pair60:")
+    for rule in ("both_ways", "one_way"):
+        print(f"  {rule}: {principal_distance_scatter(rule)}")
+    print("1. stage 3's part of the setup rows (δp on the (6.27) domain):")
+    stage3_trace(Fidelity(), "default switches")
+    chain = replace(
+        Fidelity.as_formula(),
+        bottom_stop="both_ways",
+        kappa="y_parallax",
+        tilts="knob_fit",
+        fit_scale="as_set",
+    )
+    stage3_trace(chain, "the decomposition's stage-3 step (one pass, linkage independent)")
+    scenarios, spec = book_scenarios(), book_instrument()
     print("2. conventional σ_q part against the formula at the procedure's levelling points")
     for slot in ("60", "80"):
         for passes in (3, 6, 10):
