@@ -116,13 +116,23 @@ def decomposition_markdown(rows) -> list[str]:
         "(`--as-formula`); ratio to the formula at the simulated geometry. Steps: from it to the "
         "row's run, one switch each (`switch`: the flag that removes the step), paired on the "
         "same trials, ± CI (99.9 %). *closes*: as formula + Σ steps agrees with the row's value "
-        "within the CIs. Conventional rows: their run is the as-formula one (no step).",
+        "within the CIs. Vertical photos, flat terrain: the as-formula run's ratio to the "
+        "formula on the scenario's vertical-photo, flat-terrain twin (and, unlevelled rows, with "
+        "b_x's coefficient at the terrain's model depth H̄/M_в). Conventional rows: their run is "
+        "the as-formula one (no step).",
         "",
-        "| eq | as formula | ratio | steps | sum | procedure MC | closes |",
-        "|---|---|---|---|---|---|---|",
+        "| eq | as formula | ratio | vertical photos, flat terrain | steps | sum | procedure MC "
+        "| closes |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         a, d = r["as_formula"], r["decomposition"]
+        flat = a.get("vertical_flat")
+        shown = "—"
+        if flat is not None:
+            shown = f"{flat['ratio']:.4f}"
+            if "ratio_at_depth" in flat:
+                shown += f"; b_x at the terrain's depth {flat['ratio_at_depth']:.4f}"
         steps = (
             "; ".join(
                 f"{s['switch']} {s['contribution']:+.4f} ± {s['ci']:.4f} ({s['relative']:+.1%})"
@@ -132,7 +142,7 @@ def decomposition_markdown(rows) -> list[str]:
         )
         out.append(
             f"| {r['eq']} | {a['value']:.4f} ± {a['ci']:.4f} | {a['ratio']:.4f}"
-            f"{'' if a['agrees'] else ' (differs)'} | {steps} | {d['sum']:.4f} | "
+            f"{'' if a['agrees'] else ' (differs)'} | {shown} | {steps} | {d['sum']:.4f} | "
             f"{d['procedure']['value']:.4f} ± {d['procedure']['ci']:.4f} | "
             f"{'yes' if d['closes'] else 'NO'} |"
         )
