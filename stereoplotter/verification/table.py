@@ -505,6 +505,13 @@ _FIELD_TEXT = {
 }
 
 
+def _switches_text(fidelity) -> str:
+    """``name=value`` of each mechanism switch of a run's :class:`Fidelity`."""
+    if fidelity is None:
+        return "the defaults"
+    return ", ".join(f"{m.name}={getattr(fidelity, m.name)}" for m in MECHANISMS)
+
+
 def _procedure_note(eq, res, field, scaled):
     """The note of a procedure-MC row: the run, the formula at the simulated geometry, their
     ratio and the mismatches of assumptions."""
@@ -519,11 +526,11 @@ def _procedure_note(eq, res, field, scaled):
     if res["method"] != "conventional":
         return (
             f"{head}. Measured: {_FIELD_TEXT[field]}; bias of the error-free run "
-            f"{res['bias_mm'] * 1000:.1f} µm removed. Mismatches: only the monocular pointing σ "
-            "of the operator; κ is cleared by y-parallax at standard points 1-2 (D8), not from "
-            "the fiducial readings of (6.36); ω, α by one knob setting per photo, not least "
-            "squares of (6.31)/(6.33); the loops stop when a check passes; tilted photos and "
-            "relief of the scenario"
+            f"{res['bias_mm'] * 1000:.1f} µm removed. Only the monocular pointing σ of the "
+            "operator; the mechanisms by which the procedure departs from the formula's "
+            f"assumptions, switched as {_switches_text(res.get('fidelity'))} "
+            "(procedure.fidelity; the as_formula block: all at the formula's; the decomposition: "
+            "one switch a step); tilted photos and relief of the scenario"
         )
     part = {
         "both": "σ_q = σ_p = σ",
