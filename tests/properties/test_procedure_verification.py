@@ -12,9 +12,11 @@ import pytest
 from stereoplotter.accuracy.chapter5 import geodetic_orientation_parallax_rms
 from stereoplotter.instrument.error_model import ErrorModel, ErrorTerm
 from stereoplotter.io.book_setting import book_instrument, book_scenarios
+from stereoplotter.procedure.fidelity import MECHANISMS, Fidelity
 from stereoplotter.verification import control_variate as cvar
 from stereoplotter.verification.linear_mc import CI_Z
 from stereoplotter.verification.procedure_mc import procedure_mc
+from stereoplotter.verification.table import PROCEDURE_ROWS
 
 
 def _term(name, distribution, scale):
@@ -239,12 +241,14 @@ def test_verify_decomposes_every_procedure_row():
     """The rows of ``verify --linkage independent``: every procedure row carries a
     decomposition under the linkage asked for; its steps add up to the procedure's value
     within the CIs (``closes``), and on the setup rows the non-linear rest is ≤ 1 % of the
-    value (issue 25's acceptance; measured ≤ 0.02 % at 45 000 trials). The runs without
-    instrument errors, 200 trials each."""
+    value (measured ≤ 0.02 % at 45 000 trials). The runs without instrument errors, 200
+    trials each. Every row also carries the as-formula and switch blocks
+    (:func:`_check_switch_blocks`)."""
     from stereoplotter.verification.table import (
         attach_procedure_mc,
         run_procedure_mc,
         run_verification,
+        switch_chain,
     )
 
     proc = run_procedure_mc(
@@ -264,3 +268,53 @@ def test_verify_decomposes_every_procedure_row():
         steps = {s["step"]: s for s in d["steps"]}
         if "non_linear" in steps:
             assert abs(steps["non_linear"]["contribution"]) <= 0.01 * r["mc_procedure"], r["eq"]
+    _check_switch_blocks(rows, switch_chain(Fidelity(linkage="independent")))
+
+
+def _check_switch_blocks(rows, chain):
+    """``as_formula`` (value, CI, ratio to the formula at the simulated geometry; setup rows
+    also the twin on vertical photos over flat terrain) and a ``decomposition`` from it to the
+    row's run, one step per switch of the chain, each named by its flag, on paired trials: the
+    as-formula value plus the steps is the row's run on those trials exactly, and agrees with
+    the row's value within the CIs."""
+    flags = {m.name: m.flag for m in MECHANISMS}
+    for r in rows:
+        a, d = r["as_formula"], r["decomposition"]
+        assert a["ratio"] == pytest.approx(a["value"] / a["formula"]), r["eq"]
+        assert a["agrees"] == (abs(a["value"] - a["formula"]) <= a["ci"]), r["eq"]
+        assert a["agrees"] or a["mechanism"], r["eq"]
+        if PROCEDURE_ROWS[r["eq"]][2] is None:  # conventional: the run is the as-formula one
+            assert d["steps"] == [] and a["value"] == r["mc_procedure"]
+            continue
+        assert "vertical_flat" in a
+        assert [s["step"] for s in d["steps"]] == chain
+        assert all(s["switch"].startswith(flags[s["step"]] + " ") for s in d["steps"])
+        total = d["as_formula"]["value"] + sum(s["contribution"] for s in d["steps"])
+        assert total == pytest.approx(d["sum"], rel=1e-12)
+        assert d["closes"], r["eq"]
+
+
+@pytest.mark.parametrize("slot", ["60", "80"])
+def test_as_formula_reproduces_the_formula_on_vertical_photos_over_flat_terrain(slot):
+    """The setup method with every mechanism switch at the formula's assumption, on the
+    scenario's twin with vertical photos over flat terrain (the geometry (6.22) is derived
+    for): the levelled and observed rows ((6.47)–(6.50), (6.58), (6.59)) are the formula, and
+    the unlevelled rows ((6.39)–(6.44)) are it with b_x's coefficient taken at the terrain's
+    model depth D_t = H̄/M_в instead of the carriage's D = n_л·f_пр (δp/δb_x = f_пр/D_t). The
+    run is linear in its pointings (control-variate CI < 1e-4); the tolerance 0.5 % is that of
+    the elements' RMS errors against (6.32)–(6.38) in such a run (b_z by the L-check's ratio
+    form, D9, 1–2 % above (6.37), a term ≤ 10 % of the variance)."""
+    from stereoplotter.verification.procedure_mc import idealised_geometry
+    from stereoplotter.verification.table import vertical_flat_block
+
+    sc = idealised_geometry(book_scenarios()[slot])
+    r = procedure_mc(
+        sc, "setup", spec=book_instrument(), trials=600, seed=4,
+        fidelity=Fidelity.as_formula(), grid=(8, 16),
+    )  # fmt: skip
+    for field in ("parallax", "levelled", "observed"):
+        b = vertical_flat_block(r, field, False)
+        ratio = b.get("ratio_at_depth", b["ratio"])
+        assert abs(ratio - 1.0) < 0.005, (field, ratio)
+    # the depth ratio is the sheet's D_max over the terrain's model depth
+    assert r["n"] * r["f_instrument"] / r["terrain_depth_mm"] == pytest.approx(185 / 175)
