@@ -94,6 +94,8 @@ class SimulationResult:
         Remedies after a failed check ("operator") or none (§27 task 1, "book").
     remedies : dict
         Remedy name → :class:`~stereoplotter.procedure.records.Remedy` (operator practice).
+    fidelity : Fidelity
+        The mechanism switches the run used (:mod:`~stereoplotter.procedure.fidelity`).
     """
 
     method: str
@@ -115,6 +117,7 @@ class SimulationResult:
     first_trial: int = 0
     practice: str = "book"
     remedies: dict[str, Remedy] = field(default_factory=dict)
+    fidelity: Fidelity = field(default_factory=Fidelity)
 
     @property
     def iterations(self) -> dict[str, np.ndarray]:
@@ -327,6 +330,7 @@ def run_trials_chunk(
         first_trial,
         run.practice,
         run.remedies,
+        prep.fidelity,
     )
 
 

@@ -159,7 +159,10 @@ def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_m
     # f_пр wherever the carriage is
     floor = stop if mode == "both_ways" else depth
     f_new = np.where(beyond, f_set * floor / (depth + dz_mm), f_set)
-    rest = np.where(beyond, floor - depth, dz_mm)
+    # to the stop; none where the carriage already stands at it (within the Z counter's least
+    # count, which is all the operator can read of it)
+    lower = floor - depth
+    rest = np.where(beyond, np.where(lower > op.inst.spec.z_least_count_mm, lower, 0.0), dz_mm)
     if mode == "both_ways":
         f_sheet = run.target("f_пр")
         back = active & ~beyond & (dz_mm < 0.0) & (f_set < f_sheet)
@@ -216,10 +219,11 @@ def _correct_span(
     op.set("Z", depth + dz_mm, f"{k}/setZ", active & (dz_mm != 0.0))
     shown = op.log.shown if np.ndim(dz_mm) else 0
     if np.ravel(dz_mm)[shown if np.size(dz_mm) > 1 else 0] != 0.0:
+        set_m = dz_mm * sheet.vertical_scale_denominator / 1000.0  # ΔZ set on Z [m]
         _log_delta_z(
             op,
             stage,
-            float(np.ravel(dz_m)[shown if dz_m.size > 1 else 0]),
+            float(np.ravel(set_m)[shown if np.size(set_m) > 1 else 0]),
             depth,
             dz_mm,
             it,

@@ -490,4 +490,5 @@ def run_header(r: SimulationResult) -> dict[str, Any]:
         "instrument": r.sheet.instrument,
         "instrument_options": list(r.instrument.options.names),
         "operator": r.operator_model.to_dict(),
+        "fidelity": {k: getattr(r.fidelity, k) for k in r.fidelity.__dataclass_fields__},
     }
