@@ -409,10 +409,19 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
      "опустить каретку до O_Z = n_л·f_пр (счётчик абсолютных высот)"),
     (f"measure L′_(?P<s>[лп]) \\(marks 3, 4\\), compare with L_(?P<t>[лп]) = {_N.format('v')} mm",
      "измерить L′_{s} (метки 3, 4), сравнить с L_{t} = {v} mm"),
-    ("ΔZ would take the carriage past its bottom stop \\(D_max\\): n = D/f_пр reached by f_пр "
-     "instead, f′_пр = f_пр·D/\\(D \\+ ΔD\\)",
-     "ΔZ вывел бы каретку за нижний упор (D_max): n = D/f_пр достигается изменением f_пр, "
-     "f′_пр = f_пр·D/(D + ΔD)"),
+    ("n = D/f_пр at the carriage's bottom stop \\(D_max\\): f′_пр = f_пр·D/\\(D \\+ ΔD\\), "
+     "shortened for a deeper carriage, lengthened back \\(to the sheet's f_пр at most\\) for a "
+     "shallower one",
+     "n = D/f_пр у нижнего упора каретки (D_max): f′_пр = f_пр·D/(D + ΔD), уменьшить для более "
+     "глубокой каретки, вернуть обратно (не более f_пр листа) для менее глубокой"),
+    ("MO_bx: the left mark on the left cassette centre, the right mark on the right one "
+     "\\(two monocular pointings along x\\)",
+     "MO_bx: левая марка на центр левой кассеты, правая — на центр правой (два монокулярных "
+     "наведения по x)"),
+    ("κ_(?P<s>[лп]) from the fiducials: marks 3 and 4 at equal x-readings",
+     "κ_{s} по координатным меткам: равные отсчёты x на метках 3 и 4"),
+    ("(?P<p>left|right) photo: k_ω to the mean of its fits at marks 3 and 4 \\(least squares\\)",
+     "{p} снимок: k_ω на среднее установок по меткам 3 и 4 (метод наименьших квадратов)"),
     ("Δb_z \\(6.10\\), ratio form with D_п = D \\+ b_z and L′_п \\(decision D9\\): "
      "O′_bz = O_bz \\+ Δb_z",
      "Δb_z (6.10) в форме отношения с D_п = D + b_z и L′_п (решение D9): O′_bz = O_bz + Δb_z"),

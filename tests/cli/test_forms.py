@@ -95,13 +95,15 @@ def test_gear_zero_readings_corrections_stage5_and_signatures(forms, job, lang):
     assert r == 1.25 and r in result.spec.coordinatograph_ratios
     for mo in ("MO_X", "MO_Y", "MO_Z", "MO_bx", "MO_by", "MO_bz", "MO_dx", "MO_dy"):
         assert f"{mo} = ________" in flat, mo
-    # (6.9)-(6.11): D = n_л·f_пр = D_max (6.3); the factors the operator multiplies ΔL by
+    # (6.9)-(6.11): D = n_л·f_пр = D_max (6.3); the factors the operator multiplies ΔL by, with
+    # the L stage 1 compares with (units at zero: L⁰ of the measured marks)
     d = result.spec.projection_distance_max_mm
     left, right = s.photos
     for expected in (
         "L′_л", "L′_п", "ΔZ = D·(L_л − L′_л)·M_в/(1000·L_л)", "Δb_z = D·(L_п − L′_п)/L_п",
-        f"{d * s.vertical_scale_denominator / (1000 * left.mark_span_mm):.4f} m/mm",
-        f"{d / left.mark_span_mm:.5f}", f"{d / right.mark_span_mm:.5f}", "O′_bz = O_bz + Δb_z",
+        f"{d * s.vertical_scale_denominator / (1000 * left.mark_span_at_zero_mm):.4f} m/mm",
+        f"{d / left.mark_span_at_zero_mm:.5f}", f"{d / right.mark_span_at_zero_mm:.5f}",
+        "O′_bz = O_bz + Δb_z",
     ):  # fmt: skip
         assert expected in flat, expected
     # stage 5: every plan control and check point with its x′, y′ readings
