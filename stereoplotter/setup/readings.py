@@ -68,12 +68,55 @@ def _r(
     return row
 
 
-def _stage1_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
-    """Stage 1: f_пр, the base, D_max, the mark spans and the zero readings."""
+def _span_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """Stage 1's span checks: L⁰ (units at zero, the stage-1 comparison, decision D5) and
+    (6.5)'s L (the check repeated in stage 2 with the units set), left then right."""
     tol = sheet.tolerances
     sense = sheet.options.bz_scale_sense
-    bx, by, bz = sheet.base_mm
     left, right = sheet.photos
+    return [
+        _r(
+            1,
+            f"check the span of marks 3–4, {photo.name} photo{when}",
+            f"{name}_{side}",
+            "",
+            value,
+            "mm",
+            eq,
+            tolerance=tol["mark_span_mm"],
+            note=(
+                "correct with ΔZ (6.9) and repeat until |L − L′| ≤ tolerance"
+                if side == "л"
+                else f"correct with Δb_z (6.10): O′_bz = O_bz {'+' if sense > 0 else '−'} "
+                f"Δb_z (6.11, b_z scale sense {sense:+d})"
+            )
+            + extra,
+        )
+        for name, when, eq, extra, spans in (
+            (
+                "L⁰",
+                " (correction units at zero: compare L′ with this)",
+                "(6.5), decision D5",
+                "; L⁰ = n·(y₃ − y₄) of the measured marks: with the units at zero the "
+                "counters show the photo's own span, not (6.5)'s of the transformed y⁰",
+                (left.mark_span_at_zero_mm, right.mark_span_at_zero_mm),
+            ),
+            (
+                "L",
+                " (with the correction units set: the check repeated in stage 2)",
+                "(6.5)",
+                "",
+                (left.mark_span_mm, right.mark_span_mm),
+            ),
+        )
+        for photo, side, value in ((left, "л", spans[0]), (right, "п", spans[1]))
+    ]
+
+
+def _stage1_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
+    """Stage 1: f_пр, the base, D_max, the mark spans and the zero readings."""
+    sense = sheet.options.bz_scale_sense
+    bx, by, bz = sheet.base_mm
     n_l = sheet.n_left
     rows = [
         _r(
@@ -105,43 +148,7 @@ def _stage1_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
             "(6.3)",
             note="D = n_л·f_пр = D_max",
         ),
-        *(
-            _r(
-                1,
-                f"check the span of marks 3–4, {photo.name} photo{when}",
-                f"{name}_{side}",
-                "",
-                value,
-                "mm",
-                eq,
-                tolerance=tol["mark_span_mm"],
-                note=(
-                    "correct with ΔZ (6.9) and repeat until |L − L′| ≤ tolerance"
-                    if side == "л"
-                    else f"correct with Δb_z (6.10): O′_bz = O_bz {'+' if sense > 0 else '−'} "
-                    f"Δb_z (6.11, b_z scale sense {sense:+d})"
-                )
-                + extra,
-            )
-            for name, when, eq, extra, spans in (
-                (
-                    "L⁰",
-                    " (correction units at zero: compare L′ with this)",
-                    "(6.5), decision D5",
-                    "; L⁰ = n·(y₃ − y₄) of the measured marks: with the units at zero the "
-                    "counters show the photo's own span, not (6.5)'s of the transformed y⁰",
-                    (left.mark_span_at_zero_mm, right.mark_span_at_zero_mm),
-                ),
-                (
-                    "L",
-                    " (with the correction units set: the check repeated in stage 2)",
-                    "(6.5)",
-                    "",
-                    (left.mark_span_mm, right.mark_span_mm),
-                ),
-            )
-            for photo, side, value in ((left, "л", spans[0]), (right, "п", spans[1]))
-        ),
+        *_span_rows(sheet),
         _r(
             1,
             "record the zero readings",

@@ -74,9 +74,7 @@ class SourceNoise(RecordingNoise):
     other draws keyed as ever), so one run holds the blocks of several source configurations
     (``procedure_mc.conventional_sources_mc``); the recorded z are the masked ones."""
 
-    def __init__(
-        self, seed: int, trials: int, first_trial: int, off: dict[str, NDArray[np.bool_]]
-    ):
+    def __init__(self, seed: int, trials: int, first_trial: int, off: dict[str, NDArray[np.bool_]]):
         super().__init__(seed, trials, first_trial)
         self.off = off
 

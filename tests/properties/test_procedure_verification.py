@@ -244,11 +244,11 @@ def test_verify_decomposes_every_procedure_row():
     value (measured ≤ 0.02 % at 45 000 trials). The runs without instrument errors, 200
     trials each. Every row also carries the as-formula and switch blocks
     (:func:`_check_switch_blocks`)."""
+    from stereoplotter.verification.as_formula import switch_chain
     from stereoplotter.verification.table import (
         attach_procedure_mc,
         run_procedure_mc,
         run_verification,
-        switch_chain,
     )
 
     proc = run_procedure_mc(
@@ -304,8 +304,8 @@ def test_as_formula_reproduces_the_formula_on_vertical_photos_over_flat_terrain(
     run is linear in its pointings (control-variate CI < 1e-4); the tolerance 0.5 % is that of
     the elements' RMS errors against (6.32)–(6.38) in such a run (b_z by the L-check's ratio
     form, D9, 1–2 % above (6.37), a term ≤ 10 % of the variance)."""
+    from stereoplotter.verification.as_formula import vertical_flat_block
     from stereoplotter.verification.procedure_mc import idealised_geometry
-    from stereoplotter.verification.table import vertical_flat_block
 
     sc = idealised_geometry(book_scenarios()[slot])
     r = procedure_mc(
