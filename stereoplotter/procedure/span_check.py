@@ -159,10 +159,7 @@ def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_m
     # f_пр wherever the carriage is
     floor = stop if mode == "both_ways" else depth
     f_new = np.where(beyond, f_set * floor / (depth + dz_mm), f_set)
-    # to the stop; none where the carriage already stands at it (within the Z counter's least
-    # count, which is all the operator can read of it)
-    lower = floor - depth
-    rest = np.where(beyond, np.where(lower > op.inst.spec.z_least_count_mm, lower, 0.0), dz_mm)
+    rest = np.where(beyond, floor - depth, dz_mm)  # "both_ways": down to the stop first
     if mode == "both_ways":
         f_sheet = run.target("f_пр")
         back = active & ~beyond & (dz_mm < 0.0) & (f_set < f_sheet)
@@ -218,7 +215,9 @@ def _correct_span(
     _, f_ratio, dz_mm = _past_bottom_stop(run, stage, k, it, active, depth, dz_mm, remedy)
     op.set("Z", depth + dz_mm, f"{k}/setZ", active & (dz_mm != 0.0))
     shown = op.log.shown if np.ndim(dz_mm) else 0
-    if np.ravel(dz_mm)[shown if np.size(dz_mm) > 1 else 0] != 0.0:
+    # logged where the ΔZ set is one the counter shows (not the carriage's last least count
+    # down to the stop)
+    if abs(np.ravel(dz_mm)[shown if np.size(dz_mm) > 1 else 0]) >= op.inst.spec.z_least_count_mm:
         set_m = dz_mm * sheet.vertical_scale_denominator / 1000.0  # ΔZ set on Z [m]
         _log_delta_z(
             op,
