@@ -36,7 +36,15 @@ from stereoplotter.io.validation import (
 )
 from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB, chunk_trials_for
-from stereoplotter.study.design import AXES, OPERATORS, GEOMETRY_AXES, MEASURES, Axis, Sample, StudyDesign
+from stereoplotter.study.design import (
+    AXES,
+    GEOMETRY_AXES,
+    MEASURES,
+    OPERATORS,
+    Axis,
+    Sample,
+    StudyDesign,
+)
 
 __all__ = [
     "STUDY_FORMAT",

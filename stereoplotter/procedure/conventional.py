@@ -9,7 +9,9 @@ over-correction factor — are :mod:`~stereoplotter.procedure.relative_equations
 * C2 relative orientation at the six standard points, element by element with over-correction
   (``relative="elements"``) or by the six measured q and (5.11) (``relative="equations"``);
 * C3 absolute orientation by control points: scale with b_x, levelling by a common tilt;
-* C4 the sheet on the coordinatograph and its checks (stages 4–5 of the setup-data method).
+* C4 the sheet on the coordinatograph, oriented on its plotted plan control points (the book's
+  conventional method, ``sheet_on="control"``, default) or on the setup sheet's corners
+  (stage 4 of the setup-data method, ``sheet_on="corners"``), and the checks of stage 5.
 
 The mapping between the book's dependent elements α′₁, α′₂, ω′₂, κ′₁, κ′₂ and the instrument's
 controls is found numerically (:func:`calibrate`), never by hand.
@@ -29,6 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -39,11 +42,14 @@ from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.operator import solve_1d
+from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.relative_equations import (
     overcorrection_factor,
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
+from stereoplotter.procedure.sheet_stages import _needle as sheet_needle
+from stereoplotter.procedure.sheet_stages import _table as sheet_table
 from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.steps import (
     REPEAT_POINTINGS,
@@ -58,6 +64,7 @@ from stereoplotter.procedure.steps import (
     slip_height_scale_on_mean,
     zero_base_y,
 )
+from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
 __all__ = [
     "ELEMENTS",
@@ -70,6 +77,10 @@ __all__ = [
 
 #: The two ways of relative orientation offered (``procedure.md``, the conventional method).
 RELATIVE_OPTIONS = ("elements", "equations")
+#: How C4 puts the map sheet on the coordinatograph: "control" on its plotted plan control
+#: points (scale with b_x, then the sheet turned and shifted onto them, the book's conventional
+#: method); "corners" on the setup sheet's corners (stage 4 of the setup-data method).
+SHEET_OPTIONS = ("control", "corners")
 
 #: Book element (basis system, (5.10)) → the instrument control that realises it.
 ELEMENTS = {
@@ -894,20 +905,165 @@ def _masked(run, active, relative_fn, cal, key0):
     return cut.put(np.zeros(np.shape(active), int), its), cut.put(run.op.v(np.nan), worst)
 
 
-def c4_sheet(run) -> None:
-    """C4: the sheet on the coordinatograph, corner 4 and the plotted plan control — stages 4–5
-    of the setup-data method reused, with the corner coordinates of the setup sheet."""
+def _plotted_mm(run, pid: str) -> NDArray[np.float64]:
+    """A plan control point as plotted on the sheet: its instrument coordinates (6.7) from its
+    SK-42 coordinates by the sheet's similarity. [mm]"""
+    sheet = run.sheet
+    p = run.scene.point(pid)
+    xy = sheet_corner_instrument_coordinates(
+        sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
+    )
+    return np.asarray(xy, float).reshape(2)
+
+
+def connect_coordinatograph(run) -> None:
+    """The coordinatograph connected at the sheet's ratio M_г/M_map (and, with the SC
+    complex's automatic coordinatograph, its photo → map enlargement), as stage 4 does."""
+    op, sheet = run.op, run.sheet
+    ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
+    enlargement = None
+    if op.inst.options.automatic_coordinatograph:
+        scene = run.scene
+        photo_scale = MM_PER_M * scene.flying_height_m / float(scene.camera.focal_length_mm)
+        enlargement = photo_scale / sheet.map_scale_denominator
+    op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
+
+
+def _needles_on(run, ids, key: str) -> NDArray[np.float64]:
+    """Fuse on each plan control point and put the needle down: table positions (T, n, 2)."""
+    out = []
+    for pid in ids:
+        fuse_and_read(run, control_point_m(run, pid), f"{key}/{pid}", None, ())
+        out.append(sheet_needle(run, f"{key}/{pid}"))
+    return np.stack(out, axis=-2)
+
+
+def sheet_on_control(run) -> None:
+    """C4 (``sheet_on="control"``): the map sheet on its plotted plan control points, as the
+    conventional method does (ch. 5, §24: the model is brought to the scale of the plotted
+    control and the sheet turned and shifted until the plotted points lie under the needle).
+
+    (1) Scale: fuse on each plan control point, put the needle down, compare the spread of the
+    needle positions about their centroid with the spread of the plotted points (the scale of
+    the least-squares similarity) and turn b_x in proportion, as C3 does with two points.
+    (2) Place: fuse on each point again and lay the sheet so that the plotted points lie on the
+    needle positions in the least-squares sense (rigid: centroid on centroid, the rotation of
+    the closed-form 2-D fit), with the sheet placement error (injected) and the operator's
+    monocular σ at the centroid and across the points' spread. Units: mm on the table.
+    """
+    op, sheet = run.op, run.sheet
+    ids = tuple(sheet.similarity_point_ids)
+    if sheet.similarity is None or len(ids) < 2:
+        stage4_orient_sheet(run)
+        return
+    connect_coordinatograph(run)
+    plotted = np.stack([sheet_table(run, _plotted_mm(run, pid)) for pid in ids])  # (n, 2)
+    centre = plotted.mean(axis=0)
+    d_plot = plotted - centre
+    spread_plot = float(np.sqrt((d_plot**2).sum(axis=-1).mean()))
+    needles = _needles_on(run, ids, "4/scale")
+    d_needle = needles - needles.mean(axis=-2, keepdims=True)
+    spread = np.sqrt((d_needle**2).sum(axis=-1).mean(axis=-1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(spread > 0, spread_plot / spread, 1.0)
+    bx = op.read("bx", "4/scale/bx")
+    new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio  # MO_bx + b_x·ratio
+    op.set("bx", new, "4/scale/setbx")
+    op.log.add(
+        "4",
+        "scale: fuse on the plan control points, needle spread against the plotted points' "
+        f"{spread_plot:.3f} mm; turn b_x in proportion",
+        "bx",
+        before=bx,
+        after=new,
+        reading=new,
+        residual=spread - spread_plot,
+        equation="conventional method: the model to the scale of the plotted control",
+    )
+    needles = _needles_on(run, ids, "4/place")
+    n_centre = needles.mean(axis=-2)
+    d_needle = needles - n_centre[..., None, :]
+    cross = (d_plot[..., 0] * d_needle[..., 1] - d_plot[..., 1] * d_needle[..., 0]).sum(-1)
+    dot = (d_plot[..., 0] * d_needle[..., 0] + d_plot[..., 1] * d_needle[..., 1]).sum(-1)
+    inj = op.inst.injected
+    place = np.stack(
+        [
+            op.v(inj["coordinatograph.sheet_placement_x"]),
+            op.v(inj["coordinatograph.sheet_placement_y"]),
+        ],
+        axis=-1,
+    )
+    sigma = op.model.monocular_sigma_mm
+    e = np.stack([op.noise.normal(f"mono/4/place/{a}", sigma) for a in "xy"], axis=-1)
+    e_turn = op.noise.normal("mono/4/place/turn", sigma) / spread_plot
+    angle = np.arctan2(cross, dot) + e_turn
+    run.sheet_pose = SheetPose(angle, centre + place + e, n_centre)
+    op.log.add(
+        "4",
+        "lay the sheet on the needle positions of the plan control points (least squares: "
+        "centroid on centroid, turned onto them)",
+        "",
+        reading=None,
+        equation="conventional method: the sheet on the plotted control",
+    )
+    run.record_stage("4", op.v(2).astype(int))
+
+
+def plan_control_check(run) -> None:
+    """The check of a sheet laid on its plan control: fuse on each plan control point, the
+    needle against the plotted point; the largest distance against the corner tolerance (the
+    same comparison as stage 5's, its tolerance 0.3 mm). Corner 4 is not checked: its counter
+    readings are those of the setup-data model, which the conventional method does not build.
+    """
+    op, sheet = run.op, run.sheet
+    pose = run.sheet_pose
+    if pose is None or sheet.similarity is None:
+        return
+    errs = []
+    for pid in sheet.similarity_point_ids:
+        fuse_and_read(run, control_point_m(run, pid), f"5/plan/{pid}", None, ())
+        needle = sheet_needle(run, f"5/plan/{pid}")
+        plotted = pose.table_of(sheet_table(run, _plotted_mm(run, pid)))
+        err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
+        errs.append(err)
+        op.log.add(
+            "5",
+            f"plan control point {pid}: fuse, needle against the plotted point",
+            "",
+            residual=err,
+            equation="stage 5",
+        )
+    run.check(
+        "stage 5: plan control points (needle − plotted)",
+        np.max(np.stack(errs, axis=-1), axis=-1),
+        sheet.tolerances["corner_mm"],
+    )
+    run.record_stage("5", op.v(1).astype(int))
+
+
+def c4_sheet(run, sheet_on: str = "control") -> None:
+    """C4: the sheet on the coordinatograph — on its plotted plan control points
+    (:func:`sheet_on_control`, default) or on the setup sheet's corners (stage 4 of the
+    setup-data method) — then corner 4 and the plotted plan control (stage 5)."""
+    if sheet_on not in SHEET_OPTIONS:
+        raise StereoplotterError(
+            f"sheet_on: expected one of {', '.join(SHEET_OPTIONS)}, found {sheet_on!r}"
+        )
     log = run.op.log
     start = len(log.records)
-    stage4_orient_sheet(run)
-    stage5_check(run)
+    if sheet_on == "control":
+        sheet_on_control(run)
+        plan_control_check(run)
+    else:
+        stage4_orient_sheet(run)
+        stage5_check(run)
     log.records[start:] = [replace(r, stage="C4") for r in log.records[start:]]
     for old, new in (("4", "C4"), ("5", "C4/check")):
         if old in run.stages:
             run.record_stage(new, run.stages.pop(old).iterations)
 
 
-def run_conventional_method(run, relative: str = "elements"):
+def run_conventional_method(run, relative: str = "elements", sheet_on: str = "control"):
     """The conventional method on a virtual instrument: C1–C4 in order.
 
     Parameters
@@ -917,6 +1073,9 @@ def run_conventional_method(run, relative: str = "elements"):
     relative : {"elements", "equations"}
         Relative orientation element by element with over-correction, or by the six measured
         q and (5.11).
+    sheet_on : {"control", "corners"}
+        C4 puts the map sheet on its plotted plan control points (the book's conventional
+        method) or on the setup sheet's corners (:data:`SHEET_OPTIONS`).
 
     Returns
     -------
@@ -936,5 +1095,5 @@ def run_conventional_method(run, relative: str = "elements"):
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     run.check("C2: residual y-parallax (6 points)", worst, tol, iterations=its)
     c3_absolute(run, cal, level_ids, relative_fn)
-    c4_sheet(run)
+    c4_sheet(run, sheet_on)
     return run

@@ -13,11 +13,11 @@ import pytest
 
 pytest.importorskip("xarray")
 
-from stereoplotter.io.instrument_file import load_instrument  # noqa: E402
-from stereoplotter.io.study_file import study_from_mapping  # noqa: E402
-from stereoplotter.procedure.operator import OperatorModel  # noqa: E402
-from stereoplotter.study.cells import cell_run  # noqa: E402
-from stereoplotter.study.runner import run_study, study_checks  # noqa: E402
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.study_file import study_from_mapping
+from stereoplotter.procedure.operator import OperatorModel
+from stereoplotter.study.cells import cell_run
+from stereoplotter.study.runner import run_study, study_checks
 
 TRIALS = 200
 SEED = 20261122  # pair60's own seed, the one `simulate` uses without --seed
@@ -49,9 +49,23 @@ def test_study_cell_and_simulate_give_the_same_pass_rates():
     study = dict(zip(checks, got[0]["pass_rate"], strict=True))
     study_se = dict(zip(checks, got[0]["pass_rate_se"], strict=True))
     out = subprocess.run(
-        [sys.executable, "-m", "stereoplotter", "simulate", "pair60", "--instrument", "sc1",
-         "--trials", str(TRIALS), "--json", "--workers", "1"],
-        capture_output=True, text=True, check=True,
+        [
+            sys.executable,
+            "-m",
+            "stereoplotter",
+            "simulate",
+            "pair60",
+            "--instrument",
+            "sc1",
+            "--trials",
+            str(TRIALS),
+            "--json",
+            "--workers",
+            "1",
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
     )
     sim = json.loads(out.stdout)["checks"]
     compared = 0
