@@ -8,7 +8,8 @@ over-correction factor — are :mod:`~stereoplotter.procedure.relative_equations
 * C1 interior orientation as in stage 1 of the setup-data method, without computed data;
 * C2 relative orientation at the six standard points, element by element with over-correction
   (``relative="elements"``) or by the six measured q and (5.11) (``relative="equations"``);
-* C3 absolute orientation by control points: scale with b_x, levelling by a common tilt;
+* C3 absolute orientation by control points: scale with b_x (on the plotted plan control, or on
+  two points' ground distance with ``sheet_on="corners"``), levelling by a common tilt;
 * C4 the sheet on the coordinatograph, oriented on its plotted plan control points (the book's
   conventional method, ``sheet_on="control"``, default) or on the setup sheet's corners
   (stage 4 of the setup-data method, ``sheet_on="corners"``), and the checks of stage 5.
@@ -77,9 +78,10 @@ __all__ = [
 
 #: The two ways of relative orientation offered (``procedure.md``, the conventional method).
 RELATIVE_OPTIONS = ("elements", "equations")
-#: How C4 puts the map sheet on the coordinatograph: "control" on its plotted plan control
-#: points (scale with b_x, then the sheet turned and shifted onto them, the book's conventional
-#: method); "corners" on the setup sheet's corners (stage 4 of the setup-data method).
+#: How the model meets the map sheet: "control" — C3 scales the model on the plotted plan
+#: control (all its points) and C4 turns and shifts the sheet onto them (the book's conventional
+#: method); "corners" — C3 scales on two points' ground distance and C4 lays the sheet on the
+#: setup sheet's corners (stage 4 of the setup-data method).
 SHEET_OPTIONS = ("control", "corners")
 
 #: Book element (basis system, (5.10)) → the instrument control that realises it.
@@ -774,7 +776,58 @@ def _level(
 
 # long: the book's items of absolute orientation (scale, levelling, repeated relative orientation,
 # final levelling) in their order, one bounded loop; split, the loop state would pass through each.
-def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=None) -> None:
+def _plotted_control(run) -> dict[str, NDArray[np.float64]] | None:
+    """The plan control points as plotted on the sheet, id → instrument coordinates (6.7)
+    [mm]; None where the sheet has fewer than two (then C3 scales on two points' ground
+    distance)."""
+    sheet = run.sheet
+    ids = tuple(sheet.similarity_point_ids)
+    if sheet.similarity is None or len(ids) < 2:
+        return None
+    return {pid: _plotted_mm(run, pid) for pid in ids}
+
+
+def scale_on_plotted_control(run, plotted, key: str, active, it: int) -> None:
+    """C3's scale on the plotted plan control (``sheet_on="control"``): fuse on every plan
+    control point, read X, Y, compare the spread of the counters about their centroid (RMS
+    distance) with the spread of the plotted points (6.7) — the scale of the least-squares
+    similarity between them — and turn b_x in proportion, O′_bx = MO_bx + b_x·ratio. [mm]"""
+    op = run.op
+    pts = np.stack(list(plotted.values()))
+    spread_plot = float(np.sqrt(((pts - pts.mean(axis=0)) ** 2).sum(axis=-1).mean()))
+    xy = []
+    for pid in plotted:
+        r = fuse_and_read(run, control_point_m(run, pid), f"{key}/scale/{pid}", active, ("X", "Y"))
+        xy.append(np.stack([r["X"], r["Y"]], axis=-1))
+    xy = np.stack(xy, axis=-2)
+    d = xy - xy.mean(axis=-2, keepdims=True)
+    spread = np.sqrt((d**2).sum(axis=-1).mean(axis=-1))
+    with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
+        ratio = np.where(active, spread_plot / spread, 1.0)
+    bx = op.read("bx", f"{key}/bx")
+    new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio
+    op.set("bx", new, f"{key}/setbx", active)
+    op.log.add(
+        "C3",
+        f"scale: fuse on the {len(plotted)} plan control points, counters' spread against the "
+        f"plotted points' {spread_plot:.3f} mm; turn b_x in proportion",
+        "bx",
+        before=bx,
+        after=new,
+        reading=new,
+        residual=spread - spread_plot,
+        iteration=it,
+        equation="conventional method: the model to the scale of the plotted control",
+    )
+
+
+def c3_absolute(
+    run,
+    cal: Calibration,
+    level_ids: tuple[str, ...],
+    relative_fn=None,
+    sheet_on: str = "control",
+) -> None:
     """C3: absolute orientation by control points, iterated until the levelling points agree in
     height within H/3000 with the first of them (where the height scale is slipped); then slip
     the height scale there and check all control heights, and the six standard points again.
@@ -806,23 +859,27 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     its = np.zeros(np.shape(active), int)
     ro_its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
+    plotted = _plotted_control(run) if sheet_on == "control" else None
     for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
-        bx, new, d_model = scale_by_two_points(
-            run, (a_id, pa), (b_id, pb), d_true, f"C3/{it}", active
-        )
-        op.log.add(
-            "C3",
-            f"scale: fuse on {a_id} and {b_id}, model distance against {d_true:.3f} mm; "
-            "turn b_x in proportion",
-            "bx",
-            before=bx,
-            after=new,
-            reading=new,
-            residual=d_model - d_true,
-            iteration=it,
-            equation="scale by b_x",
-        )
+        if plotted is not None:
+            scale_on_plotted_control(run, plotted, f"C3/{it}", active, it)
+        else:
+            bx, new, d_model = scale_by_two_points(
+                run, (a_id, pa), (b_id, pb), d_true, f"C3/{it}", active
+            )
+            op.log.add(
+                "C3",
+                f"scale: fuse on {a_id} and {b_id}, model distance against {d_true:.3f} mm; "
+                "turn b_x in proportion",
+                "bx",
+                before=bx,
+                after=new,
+                reading=new,
+                residual=d_model - d_true,
+                iteration=it,
+                equation="scale by b_x",
+            )
         resid = _level(run, cal, rows, f"C3/{it}", active, 1, it)
         worst = np.where(active, _worst(resid), worst)
         # every trial still iterating levels on these heights (the least-squares plane of the
@@ -939,17 +996,13 @@ def _needles_on(run, ids, key: str) -> NDArray[np.float64]:
 
 
 def sheet_on_control(run) -> None:
-    """C4 (``sheet_on="control"``): the map sheet on its plotted plan control points, as the
-    conventional method does (ch. 5, §24: the model is brought to the scale of the plotted
-    control and the sheet turned and shifted until the plotted points lie under the needle).
-
-    (1) Scale: fuse on each plan control point, put the needle down, compare the spread of the
-    needle positions about their centroid with the spread of the plotted points (the scale of
-    the least-squares similarity) and turn b_x in proportion, as C3 does with two points.
-    (2) Place: fuse on each point again and lay the sheet so that the plotted points lie on the
-    needle positions in the least-squares sense (rigid: centroid on centroid, the rotation of
-    the closed-form 2-D fit), with the sheet placement error (injected) and the operator's
-    monocular σ at the centroid and across the points' spread. Units: mm on the table.
+    """C4 (``sheet_on="control"``): the map sheet laid on its plotted plan control points, as
+    the conventional method does (the model was brought to the scale of the plotted control in
+    C3, :func:`scale_on_plotted_control`): fuse on each plan control point, put the needle down,
+    and lay the sheet so that the plotted points lie on the needle positions in the
+    least-squares sense (rigid: centroid on centroid, the rotation of the closed-form 2-D fit),
+    with the sheet placement error (injected) and the operator's monocular σ at the centroid and
+    across the points' spread. Units: mm on the table.
     """
     op, sheet = run.op, run.sheet
     ids = tuple(sheet.similarity_point_ids)
@@ -960,26 +1013,6 @@ def sheet_on_control(run) -> None:
     plotted = np.stack([sheet_table(run, _plotted_mm(run, pid)) for pid in ids])  # (n, 2)
     centre = plotted.mean(axis=0)
     d_plot = plotted - centre
-    spread_plot = float(np.sqrt((d_plot**2).sum(axis=-1).mean()))
-    needles = _needles_on(run, ids, "4/scale")
-    d_needle = needles - needles.mean(axis=-2, keepdims=True)
-    spread = np.sqrt((d_needle**2).sum(axis=-1).mean(axis=-1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(spread > 0, spread_plot / spread, 1.0)
-    bx = op.read("bx", "4/scale/bx")
-    new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio  # MO_bx + b_x·ratio
-    op.set("bx", new, "4/scale/setbx")
-    op.log.add(
-        "4",
-        "scale: fuse on the plan control points, needle spread against the plotted points' "
-        f"{spread_plot:.3f} mm; turn b_x in proportion",
-        "bx",
-        before=bx,
-        after=new,
-        reading=new,
-        residual=spread - spread_plot,
-        equation="conventional method: the model to the scale of the plotted control",
-    )
     needles = _needles_on(run, ids, "4/place")
     n_centre = needles.mean(axis=-2)
     d_needle = needles - n_centre[..., None, :]
@@ -995,6 +1028,7 @@ def sheet_on_control(run) -> None:
     )
     sigma = op.model.monocular_sigma_mm
     e = np.stack([op.noise.normal(f"mono/4/place/{a}", sigma) for a in "xy"], axis=-1)
+    spread_plot = float(np.sqrt((d_plot**2).sum(axis=-1).mean()))
     e_turn = op.noise.normal("mono/4/place/turn", sigma) / spread_plot
     angle = np.arctan2(cross, dot) + e_turn
     run.sheet_pose = SheetPose(angle, centre + place + e, n_centre)
@@ -1074,8 +1108,9 @@ def run_conventional_method(run, relative: str = "elements", sheet_on: str = "co
         Relative orientation element by element with over-correction, or by the six measured
         q and (5.11).
     sheet_on : {"control", "corners"}
-        C4 puts the map sheet on its plotted plan control points (the book's conventional
-        method) or on the setup sheet's corners (:data:`SHEET_OPTIONS`).
+        C3 scales the model on the plotted plan control and C4 lays the sheet on it (the
+        book's conventional method), or C3 scales on two points' ground distance and C4 lays
+        the sheet on the setup sheet's corners (:data:`SHEET_OPTIONS`).
 
     Returns
     -------
@@ -1094,6 +1129,6 @@ def run_conventional_method(run, relative: str = "elements", sheet_on: str = "co
     run.record_stage("C2", its)
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     run.check("C2: residual y-parallax (6 points)", worst, tol, iterations=its)
-    c3_absolute(run, cal, level_ids, relative_fn)
+    c3_absolute(run, cal, level_ids, relative_fn, sheet_on)
     c4_sheet(run, sheet_on)
     return run
