@@ -1,4 +1,4 @@
-"""``stereoplotter study run|report|eye-range``: studies over the design space (``docs/studies.md``).
+"""``stereoplotter study run|report|eye-range``: studies over the design space (docs/studies.md).
 
 ``study run STUDY.yaml -o RESULTS.zarr [--scheduler ADDRESS] [--workers N]`` runs a study on
 dask.distributed — an embedded ``LocalCluster`` (processes, one per core) by default, the
