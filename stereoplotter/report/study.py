@@ -131,11 +131,45 @@ def _markdown(ds: xr.Dataset, summary: dict[str, Any], figures: list[str], note:
         ]
         for m, counts in summary["dominant_terms"].items():
             lines.append(f"| {m} | " + ", ".join(f"{t}: {n}" for t, n in counts.items()) + " |")
+    lines += _methods_table(ds)
     if summary["refusals"]:
         lines += ["", "## Refused cells", ""] + [f"- {_message(m)}" for m in summary["refusals"]]
     lines += ["", "Every cell's figures: [cells.md](cells.md).", "", "## Figures", ""]
     lines += [f"![{f}]({f})" for f in figures]
     return "\n".join(lines) + "\n"
+
+
+def _methods_table(ds: xr.Dataset) -> list[str]:
+    """The setup-data method's height RMS against the conventional one's at each configuration
+    both ran (the book's comparison of the methods), with their ratio; empty without both."""
+    if "method" not in ds.coords or "height_rms_permille" not in ds:
+        return []
+    methods = ds.method.values
+    if not {"setup", "conventional"} <= {str(m) for m in methods}:
+        return []
+    others = [n for n in AXES if n in ds.coords and n != "method"]
+    keys = [tuple(ds[n].values[i].item() for n in others) for i in range(ds.sizes["cell"])]
+    by = {(k, str(methods[i])): i for i, k in enumerate(keys)}
+    h, se = ds.height_rms_permille.values, ds.height_rms_permille_se.values
+    out = [
+        "",
+        "## Setup data against the conventional method",
+        "",
+        "Height RMS on the working-area grid, ‰ H (mean ± SE), and setup / conventional.",
+        "",
+        "| " + " | ".join(others) + " | setup | conventional | setup / conventional |",
+        "|" + "---|" * (len(others) + 3),
+    ]
+    for k in dict.fromkeys(keys):
+        i, j = by.get((k, "setup")), by.get((k, "conventional"))
+        if i is None or j is None or not (np.isfinite(h[i]) and np.isfinite(h[j])):
+            continue
+        axes = " | ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in k)
+        out.append(
+            f"| {axes} | {h[i]:.4f} ± {se[i]:.4f} | {h[j]:.4f} ± {se[j]:.4f} | "
+            f"{h[i] / h[j]:.2f} |"
+        )
+    return out
 
 
 def _cell(text: str) -> str:

@@ -20,11 +20,11 @@ import pytest
 
 pytest.importorskip("xarray")
 
-from stereoplotter.commands.study import add_arguments, reduced  # noqa: E402
-from stereoplotter.io.study_file import load_study, study_from_mapping  # noqa: E402
-from stereoplotter.study.cells import VALUE_MEASURES, run_task  # noqa: E402
-from stereoplotter.study.design import Task  # noqa: E402
-from stereoplotter.study.runner import study_checks  # noqa: E402
+from stereoplotter.commands.study import add_arguments, reduced
+from stereoplotter.io.study_file import load_study, study_from_mapping
+from stereoplotter.study.cells import VALUE_MEASURES, run_task
+from stereoplotter.study.design import Task
+from stereoplotter.study.runner import study_checks
 
 ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "studies.md"
