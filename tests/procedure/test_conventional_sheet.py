@@ -94,6 +94,7 @@ def test_the_remaining_plan_error_is_second_order_in_the_tilts():
     assert _plan(sc, ideal_mechanics=True) == pytest.approx(full, rel=1e-3)
     films = tuple(replace(p, film_deformation_ppm=(0.0, 0.0)) for p in sc.photos)
     assert _plan(replace(sc, photos=films)) == pytest.approx(full, rel=0.02)
+    assert _plan(sc, relative="equations") == pytest.approx(full, rel=0.02)
 
 
 def test_the_remaining_plan_error_is_the_built_models_shear():
