@@ -19,7 +19,7 @@ from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.study.cells import cell_run
 from stereoplotter.study.runner import run_study, study_checks
 
-TRIALS = 200
+TRIALS = 100
 SEED = 20261122  # pair60's own seed, the one `simulate` uses without --seed
 
 

@@ -99,3 +99,28 @@ def test_two_cells_are_the_current_code():
             k = len(checks) + j
             d = _DECIMALS[v]
             assert f"{m.mean[k]:.{d}f} ± {se[k]:.{d}f}" == printed[v], (cell, v)
+
+
+def test_the_book_pairs_row_of_pair60_is_the_current_code(capsys):
+    """§The book's pairs: pair60's row (both methods' height RMS ± SE, their ratio, the plan
+    RMS) is what the printed `simulate` commands give now."""
+    import json
+
+    from stereoplotter.cli import main
+
+    text = DOC.read_text(encoding="utf-8").split("### The book's pairs", 1)[1]
+    row = next(x for x in text.splitlines() if x.startswith("| pair60 |"))
+    got = {}
+    for method in ("setup", "conventional"):
+        args = ["simulate", "pair60", "--instrument", "sc1", "--method", method]
+        assert f"stereoplotter {' '.join(args)} --trials 2000 --json" in text
+        assert main([*args, "--trials", "2000", "--json", "--workers", "1", "-q"]) == 0
+        grid = json.loads(capsys.readouterr().out)["evaluation"]["grid"]
+        got[method] = (grid["height_error_rms_permille"], grid["plan_error_rms_map_mm"])
+    (hs, ps), (hc, pc) = got["setup"], got["conventional"]
+    want = (
+        f"| pair60 | {hs['mean']:.4f} ± {hs['mean_se']:.4f} | {hc['mean']:.4f} ± "
+        f"{hc['mean_se']:.4f} | {hs['mean'] / hc['mean']:.2f} | {ps['mean']:.4f} / "
+        f"{pc['mean']:.4f} |"
+    )
+    assert row == want
