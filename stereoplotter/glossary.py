@@ -403,6 +403,14 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
      "счётчики на угол {a}: несовпадение иглы и угла {b}"),
     (f"plan control point {_ID.format('p')}: fuse, needle against the plotted point",
      "плановая опорная точка {p}: навести марку, игла против нанесённой точки"),
+    (f"scale: fuse on the {_N.format('n')} plan control points, counters' spread against the "
+     f"plotted points' {_N.format('d')} mm; turn b_x in proportion",
+     "масштаб: навести марку на {n} плановых опорных точек, разброс по счётчикам против {d} mm "
+     "нанесённых точек; изменить b_x пропорционально"),
+    ("lay the sheet on the needle positions of the plan control points \\(least squares: "
+     "centroid on centroid, turned onto them\\)",
+     "уложить лист на положения иглы на плановых опорных точках (МНК: центр на центр, "
+     "с поворотом)"),
     # the setup-data method (§26): stages 1–3 from the sheet
     ("base carriage: O_bx = MO_bx \\+ b_x", "базисная каретка: O_bx = MO_bx + b_x"),
     ("lower the carriage to O_Z = n_л·f_пр \\(absolute height counter\\)",
@@ -484,6 +492,10 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
     (f"stage {_ID.format('s')}", "этап {s}"),
     (f"decision {_ID.format('d')}", "решение {d}"),
     ("scale by b_x", "масштаб по b_x"),
+    ("conventional method: the model to the scale of the plotted control",
+     "обычный способ: модель в масштаб нанесённых опорных точек"),
+    ("conventional method: the sheet on the plotted control",
+     "обычный способ: лист по нанесённым опорным точкам"),
     ("assumption", "допущение"),
     ("levelling \\(assumption\\)", "горизонтирование (допущение)"),
     ("stopping rule", "правило остановки"),

@@ -1,10 +1,12 @@
-"""``stereoplotter study run|report``: studies over the design space (``docs/studies.md``).
+"""``stereoplotter study run|report|eye-range``: studies over the design space (docs/studies.md).
 
 ``study run STUDY.yaml -o RESULTS.zarr [--scheduler ADDRESS] [--workers N]`` runs a study on
 dask.distributed — an embedded ``LocalCluster`` (processes, one per core) by default, the
 scheduler at ``ADDRESS`` when given, in this process with ``--workers 0`` — and writes each
 cell to the Zarr store as it finishes; run again, it skips the finished cells.
 ``study report RESULTS.zarr -o DIR`` draws the figures and writes the Markdown summary.
+``study eye-range [SCENARIO …]`` prints the pass rates of the book's checks across the published
+range of the operator's σ_q, σ_p (``procedure.eye_range``).
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from stereoplotter.commands.arguments import bounded_int
 _non_negative = bounded_int(0)
 _positive = bounded_int(1)
 
-__all__ = ["add_arguments", "run", "run_report", "run_study_command"]
+__all__ = ["add_arguments", "run", "run_eye_range", "run_report", "run_study_command"]
 
 
 def add_arguments(sub: Any) -> None:
@@ -61,11 +63,39 @@ def add_arguments(sub: Any) -> None:
     rep.add_argument("results", help="the results store (RESULTS.zarr)")
     rep.add_argument("-o", "--output", required=True, help="folder for the report")
     rep.set_defaults(func=run_report)
+    eye = actions.add_parser(
+        "eye-range",
+        help="pass rates of the book's checks across the published range of the operator's "
+        "σ_q, σ_p (the table of docs/procedure.md)",
+    )
+    eye.add_argument("scenarios", nargs="*", default=["pair60", "pair80"])
+    eye.add_argument("--instrument", default="sc1")
+    eye.add_argument("--trials", type=_positive, default=500, help="trials per table cell")
+    eye.set_defaults(func=run_eye_range)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the chosen action (``study run`` or ``study report``)."""
+    """Run the chosen action (``study run``, ``study report`` or ``study eye-range``)."""
+    if args.study_command == "eye-range":
+        return run_eye_range(args)
     return run_report(args) if args.study_command == "report" else run_study_command(args)
+
+
+def run_eye_range(args: argparse.Namespace) -> int:
+    """``study eye-range``: the pass-rate table over the operator's published σ range."""
+    from stereoplotter.io.instrument_file import load_instrument
+    from stereoplotter.io.scenario_file import load_scenario
+    from stereoplotter.procedure.eye_range import pass_rate_table, table_markdown
+
+    spec = load_instrument(args.instrument)
+    scenarios = [load_scenario(s) for s in args.scenarios]
+    rows = pass_rate_table(scenarios, spec, args.trials)
+    sys.stdout.write(
+        f"{args.trials} trials per cell, {spec.key}, default instrument errors, the scenarios' "
+        "seeds; every check passed ± SE (the check passed least, its rate)\n\n"
+    )
+    sys.stdout.write(table_markdown(rows, scenarios))
+    return 0
 
 
 def reduced(data: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:

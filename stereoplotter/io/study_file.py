@@ -36,7 +36,15 @@ from stereoplotter.io.validation import (
 )
 from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB, chunk_trials_for
-from stereoplotter.study.design import AXES, GEOMETRY_AXES, MEASURES, Axis, Sample, StudyDesign
+from stereoplotter.study.design import (
+    AXES,
+    GEOMETRY_AXES,
+    MEASURES,
+    OPERATORS,
+    Axis,
+    Sample,
+    StudyDesign,
+)
 
 __all__ = [
     "STUDY_FORMAT",
@@ -98,7 +106,11 @@ def _kind(v: Any) -> str:
 def _axis_type(name: str) -> Any:
     """A list of values, or (numeric axes) a range."""
     if AXES[name].categorical:
-        words = {"method": ("setup", "conventional"), "practice": ("operator", "book")}
+        words = {
+            "method": ("setup", "conventional"),
+            "practice": ("operator", "book"),
+            "operator": OPERATORS,
+        }
         item = one_of(*words[name]) if name in words else text
         return sequence(item, 1)
     return Annotated[
@@ -121,6 +133,7 @@ class AxesModel(FileModel):
     instrument: _axis_type("instrument") | None = None  # type: ignore[valid-type]
     method: _axis_type("method") | None = None  # type: ignore[valid-type]
     practice: _axis_type("practice") | None = None  # type: ignore[valid-type]
+    operator: _axis_type("operator") | None = None  # type: ignore[valid-type]
     judgement_scale: _axis_type("judgement_scale") | None = None  # type: ignore[valid-type]
     instrument_error_scale: _axis_type("instrument_error_scale") | None = None  # type: ignore[valid-type]
 

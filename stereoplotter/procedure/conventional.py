@@ -8,8 +8,12 @@ over-correction factor — are :mod:`~stereoplotter.procedure.relative_equations
 * C1 interior orientation as in stage 1 of the setup-data method, without computed data;
 * C2 relative orientation at the six standard points, element by element with over-correction
   (``relative="elements"``) or by the six measured q and (5.11) (``relative="equations"``);
-* C3 absolute orientation by control points: scale with b_x, levelling by a common tilt;
-* C4 the sheet on the coordinatograph and its checks (stages 4–5 of the setup-data method).
+* C3 absolute orientation by control points: scale with b_x (on the plotted plan control, or on
+  two points' ground distance with ``sheet_on="corners"``), levelling by a common tilt;
+* C4 the sheet on the coordinatograph, oriented on its plotted plan control points (the book's
+  conventional method, ``sheet_on="control"``, default) or on the setup sheet's corners
+  (stage 4 of the setup-data method, ``sheet_on="corners"``), and the checks of stage 5
+  (:mod:`~stereoplotter.procedure.conventional_sheet`).
 
 The mapping between the book's dependent elements α′₁, α′₂, ω′₂, κ′₁, κ′₂ and the instrument's
 controls is found numerically (:func:`calibrate`), never by hand.
@@ -38,13 +42,18 @@ from stereoplotter.instrument.kinematics import (
 from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 from stereoplotter.procedure.compaction import compacted
+from stereoplotter.procedure.conventional_sheet import (
+    SHEET_OPTIONS,
+    c4_sheet,
+    plotted_control,
+    scale_on_plotted_control,
+)
 from stereoplotter.procedure.operator import solve_1d
 from stereoplotter.procedure.relative_equations import (
     overcorrection_factor,
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
-from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.steps import (
     REPEAT_POINTINGS,
     control_point_m,
@@ -62,7 +71,9 @@ from stereoplotter.procedure.steps import (
 __all__ = [
     "ELEMENTS",
     "RELATIVE_OPTIONS",
+    "SHEET_OPTIONS",
     "Calibration",
+    "c4_sheet",
     "calibrate",
     "control_sensitivity",
     "run_conventional_method",
@@ -763,7 +774,31 @@ def _level(
 
 # long: the book's items of absolute orientation (scale, levelling, repeated relative orientation,
 # final levelling) in their order, one bounded loop; split, the loop state would pass through each.
-def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=None) -> None:
+def _scale_on_two_points(run, a, b, d_true: float, active, it: int) -> None:
+    """C3's scale with ``sheet_on="corners"``: the two plan control points farthest apart,
+    their counter distance against the ground distance/M_г, b_x in proportion. [mm]"""
+    bx, new, d_model = scale_by_two_points(run, a, b, d_true, f"C3/{it}", active)
+    run.op.log.add(
+        "C3",
+        f"scale: fuse on {a[0]} and {b[0]}, model distance against {d_true:.3f} mm; "
+        "turn b_x in proportion",
+        "bx",
+        before=bx,
+        after=new,
+        reading=new,
+        residual=d_model - d_true,
+        iteration=it,
+        equation="scale by b_x",
+    )
+
+
+def c3_absolute(
+    run,
+    cal: Calibration,
+    level_ids: tuple[str, ...],
+    relative_fn=None,
+    sheet_on: str = "control",
+) -> None:
     """C3: absolute orientation by control points, iterated until the levelling points agree in
     height within H/3000 with the first of them (where the height scale is slipped); then slip
     the height scale there and check all control heights, and the six standard points again.
@@ -795,23 +830,13 @@ def c3_absolute(run, cal: Calibration, level_ids: tuple[str, ...], relative_fn=N
     its = np.zeros(np.shape(active), int)
     ro_its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
+    plotted = plotted_control(run) if sheet_on == "control" else None
     for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
-        bx, new, d_model = scale_by_two_points(
-            run, (a_id, pa), (b_id, pb), d_true, f"C3/{it}", active
-        )
-        op.log.add(
-            "C3",
-            f"scale: fuse on {a_id} and {b_id}, model distance against {d_true:.3f} mm; "
-            "turn b_x in proportion",
-            "bx",
-            before=bx,
-            after=new,
-            reading=new,
-            residual=d_model - d_true,
-            iteration=it,
-            equation="scale by b_x",
-        )
+        if plotted is not None:
+            scale_on_plotted_control(run, plotted, f"C3/{it}", active, it)
+        else:
+            _scale_on_two_points(run, (a_id, pa), (b_id, pb), d_true, active, it)
         resid = _level(run, cal, rows, f"C3/{it}", active, 1, it)
         worst = np.where(active, _worst(resid), worst)
         # every trial still iterating levels on these heights (the least-squares plane of the
@@ -894,20 +919,7 @@ def _masked(run, active, relative_fn, cal, key0):
     return cut.put(np.zeros(np.shape(active), int), its), cut.put(run.op.v(np.nan), worst)
 
 
-def c4_sheet(run) -> None:
-    """C4: the sheet on the coordinatograph, corner 4 and the plotted plan control — stages 4–5
-    of the setup-data method reused, with the corner coordinates of the setup sheet."""
-    log = run.op.log
-    start = len(log.records)
-    stage4_orient_sheet(run)
-    stage5_check(run)
-    log.records[start:] = [replace(r, stage="C4") for r in log.records[start:]]
-    for old, new in (("4", "C4"), ("5", "C4/check")):
-        if old in run.stages:
-            run.record_stage(new, run.stages.pop(old).iterations)
-
-
-def run_conventional_method(run, relative: str = "elements"):
+def run_conventional_method(run, relative: str = "elements", sheet_on: str = "control"):
     """The conventional method on a virtual instrument: C1–C4 in order.
 
     Parameters
@@ -917,6 +929,10 @@ def run_conventional_method(run, relative: str = "elements"):
     relative : {"elements", "equations"}
         Relative orientation element by element with over-correction, or by the six measured
         q and (5.11).
+    sheet_on : {"control", "corners"}
+        C3 scales the model on the plotted plan control and C4 lays the sheet on it (the
+        book's conventional method), or C3 scales on two points' ground distance and C4 lays
+        the sheet on the setup sheet's corners (:data:`SHEET_OPTIONS`).
 
     Returns
     -------
@@ -935,6 +951,6 @@ def run_conventional_method(run, relative: str = "elements"):
     run.record_stage("C2", its)
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     run.check("C2: residual y-parallax (6 points)", worst, tol, iterations=its)
-    c3_absolute(run, cal, level_ids, relative_fn)
-    c4_sheet(run)
+    c3_absolute(run, cal, level_ids, relative_fn, sheet_on)
+    c4_sheet(run, sheet_on)
     return run

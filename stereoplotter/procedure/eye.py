@@ -23,8 +23,14 @@ The two judgements of the procedure (``procedure.operator``):
 
 The acuity is taken as one standard deviation of the judgement (the 84 % point of the
 psychometric function Φ(s/σ)), an **assumed** reading of the textbook's "smallest difference
-perceived". The mapping of the two kinds to the two judgements is a decision of this project
-(**assumed**); the book's own m_p = √2·m_q (ch. 5, used with (5.54)) orders them the same way.
+perceived" (a threshold, not a σ). The mapping of the two kinds to the two judgements is a
+decision of this project (**assumed**: no source maps the lines' 10″ to y-parallax); the book's
+own m_p = √2·m_q (ch. 5, used with (5.54)) orders them the same way. Published measurements on
+analog plotters (``docs/procedure.md``, §The eye's figures against published measurements): the
+standard error of a y-parallax measurement is "normally 0.01 mm or less" on precision plotters
+and the book's m_q is 0.015 mm — σ_q = 2.02 µm is below that range; a point's setting error
+from repeated settings is 4 µm, the order of σ_p = 6.06 µm. ``procedure.eye_range`` measures the
+pass rates across that range.
 
 A check is a detection: at a point with true y-parallax q the operator *sees* y-parallax over the
 tolerance T (¼ of the mark) when |q + e| > T, e ~ N(0, σ_q): the psychometric function
@@ -32,7 +38,8 @@ tolerance T (¼ of the mark) when |q + e| > T, e ~ N(0, σ_q): the psychometric 
     P_look(q) = Φ((−T − q)/σ_q) + Φ((q − T)/σ_q).                                (eye 2)
 
 A competent operator looks again (a new pointing, a new judgement) before declaring a failure:
-the point fails when both looks see it, P_fail(q) = P_look(q)² (:data:`LOOKS`).
+the point fails when both looks see it, P_fail(q) = P_look(q)² (:data:`LOOKS`; **assumed**, no
+published detection rule was found).
 
 Units: mm on the photo, radians inside, arcseconds in the constants.
 """

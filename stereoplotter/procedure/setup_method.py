@@ -541,13 +541,79 @@ def refine_relative_orientation(
     return rounds, worst
 
 
+#: Damping ladder of R2's least-squares turns: λ of (JᵀJ + λ·diag JᵀJ) δ = −Jᵀq, tried in
+#: order per trial until every element's target lies in its range (Levenberg–Marquardt). λ = 0
+#: is the plain least squares, which a well-conditioned pair always takes.
+R2_DAMPING = (0.0, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0)
+#: Fraction of an element's range R2 may use: the rest is the margin for the knob's or
+#: cassette's own setting error, which the stop sees on top of the operator's target. [—]
+R2_RANGE_FRACTION = 0.98
+
+
+def r2_element_bounds(spec) -> dict[str, tuple[float, float]]:
+    """Where R2 may drive each of :data:`Q_ELEMENTS`: the instrument's κ range [rad] and its
+    correction range ±tilt_max as tan of the tilt [—], each shrunk to
+    :data:`R2_RANGE_FRACTION` (the stops are the instrument file's
+    ``orientation.kappa_deg`` and ``correction.tilt_max_deg``)."""
+    lo_k, hi_k = spec.kappa_range
+    mid, half = 0.5 * (lo_k + hi_k), 0.5 * (hi_k - lo_k) * R2_RANGE_FRACTION
+    t = float(np.tan(spec.tilt_max * R2_RANGE_FRACTION))
+    return {
+        name: (mid - half, mid + half) if name.startswith("kappa") else (-t, t)
+        for name in Q_ELEMENTS
+    }
+
+
+def r2_turns(jac, seen, before, bounds) -> NDArray[np.float64]:
+    """R2's turns δ of :data:`Q_ELEMENTS` from the six q seen (..., 6) and the Jacobian
+    (..., 6, 5): the least squares −(JᵀJ)⁻¹Jᵀq where it keeps every element inside ``bounds``,
+    else damped (Levenberg–Marquardt, the first λ of :data:`R2_DAMPING` that keeps them
+    inside), else the most damped step clipped to the bounds. ``before``: the elements now
+    (..., 5). Near-collinear elements (the two k_α at a narrow base) are what the damping
+    tames: the plain solution turns them far apart in opposite senses.
+
+    Examples
+    --------
+    >>> jac = np.array([[1.0, 1.0 + 1e-9]] * 3)          # two collinear elements
+    >>> r2_turns(jac, np.array([0.1, 0.1, 0.1]), np.zeros(2), [(-1, 1), (-1, 1)]).round(3)
+    array([-0.05, -0.05])
+    """
+    jt = np.swapaxes(jac, -1, -2)
+    a = jt @ jac
+    g = (jt @ seen[..., None])[..., 0]
+    lo = np.array([b[0] for b in bounds])
+    hi = np.array([b[1] for b in bounds])
+    diag = np.einsum("...ii->...i", a)
+    out = None
+    done = None
+    for lam in R2_DAMPING:
+        m = a + lam * (diag[..., :, None] * np.eye(a.shape[-1]))
+        with np.errstate(all="ignore"):
+            try:
+                delta = -np.linalg.solve(m, g[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                delta = -(np.linalg.pinv(m) @ g[..., None])[..., 0]
+        target = before + delta
+        inside = np.all(np.isfinite(target) & (target >= lo) & (target <= hi), axis=-1)
+        if out is None:
+            out, done = delta, inside
+        else:
+            out = np.where(done[..., None], out, delta)
+            done = done | inside
+        if np.all(done):
+            return out
+    # the most damped step, clipped where still outside: the element stops at its range
+    return np.where(done[..., None], out, np.clip(before + out, lo, hi) - before)
+
+
 def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArray[np.float64]:
-    """One round of R2 on ``active``: the least-squares turns from the six q seen, then the six
-    points judged again; the q seen, (..., 6). [mm]"""
+    """One round of R2 on ``active``: the bounded least-squares turns (:func:`r2_turns`) from
+    the six q seen, then the six points judged again; the q seen, (..., 6). [mm]"""
     op = run.op
     jac = _q_jacobian(run, run.scene.standard)
-    jt = np.swapaxes(jac, -1, -2)
-    delta = -np.linalg.solve(jt @ jac, (jt @ seen[..., None]))[..., 0]
+    bounds = r2_element_bounds(op.inst.spec)
+    before = np.stack([op.physical(c) for c in Q_ELEMENTS], axis=-1)
+    delta = r2_turns(jac, seen, before, [bounds[c] for c in Q_ELEMENTS])
     for j, control in enumerate(Q_ELEMENTS):
         before = op.physical(control)
         op.drive(control, before + delta[..., j], active)

@@ -14,6 +14,7 @@ file whole (temp file + rename) after all are rendered.
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -22,7 +23,14 @@ import xarray as xr
 from stereoplotter.study.design import AXES
 from stereoplotter.study.results import STATUS, dominant_term
 
-__all__ = ["study_report_files", "study_summary"]
+__all__ = ["cells_markdown", "study_report_files", "study_summary"]
+
+#: Decimals of each per-cell value in ``cells.md`` (the figures docs/studies.md quotes).
+_CELL_DECIMALS = {
+    "y_parallax_rms_um": 2,
+    "height_rms_permille": 4,
+    "plan_rms_map_mm": 4,
+}
 
 
 def study_summary(ds: xr.Dataset) -> dict[str, Any]:
@@ -123,10 +131,45 @@ def _markdown(ds: xr.Dataset, summary: dict[str, Any], figures: list[str], note:
         ]
         for m, counts in summary["dominant_terms"].items():
             lines.append(f"| {m} | " + ", ".join(f"{t}: {n}" for t, n in counts.items()) + " |")
+    lines += _methods_table(ds)
     if summary["refusals"]:
-        lines += ["", "## Refused cells", ""] + [f"- {m}" for m in summary["refusals"]]
-    lines += ["", "## Figures", ""] + [f"![{f}]({f})" for f in figures]
+        lines += ["", "## Refused cells", ""] + [f"- {_message(m)}" for m in summary["refusals"]]
+    lines += ["", "Every cell's figures: [cells.md](cells.md).", "", "## Figures", ""]
+    lines += [f"![{f}]({f})" for f in figures]
     return "\n".join(lines) + "\n"
+
+
+def _methods_table(ds: xr.Dataset) -> list[str]:
+    """The setup-data method's height RMS against the conventional one's at each configuration
+    both ran (the book's comparison of the methods), with their ratio; empty without both."""
+    if "method" not in ds.coords or "height_rms_permille" not in ds:
+        return []
+    methods = ds.method.values
+    if not {"setup", "conventional"} <= {str(m) for m in methods}:
+        return []
+    others = [n for n in AXES if n in ds.coords and n != "method"]
+    keys = [tuple(ds[n].values[i].item() for n in others) for i in range(ds.sizes["cell"])]
+    by = {(k, str(methods[i])): i for i, k in enumerate(keys)}
+    h, se = ds.height_rms_permille.values, ds.height_rms_permille_se.values
+    out = [
+        "",
+        "## Setup data against the conventional method",
+        "",
+        "Height RMS on the working-area grid, ‰ H (mean ± SE), and setup / conventional.",
+        "",
+        "| " + " | ".join(others) + " | setup | conventional | setup / conventional |",
+        "|" + "---|" * (len(others) + 3),
+    ]
+    for k in dict.fromkeys(keys):
+        i, j = by.get((k, "setup")), by.get((k, "conventional"))
+        if i is None or j is None or not (np.isfinite(h[i]) and np.isfinite(h[j])):
+            continue
+        axes = " | ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in k)
+        out.append(
+            f"| {axes} | {h[i]:.4f} ± {se[i]:.4f} | {h[j]:.4f} ± {se[j]:.4f} | "
+            f"{h[i] / h[j]:.2f} |"
+        )
+    return out
 
 
 def _cell(text: str) -> str:
@@ -138,10 +181,81 @@ def _values(values: np.ndarray) -> str:
     return ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in np.unique(values))
 
 
+def _message(text: str) -> str:
+    """A refusal's line with an instrument file's absolute path cut to its name."""
+    return re.sub(r"(?<!\S)(?:[^\s/]*/)+(\w+\.yaml)", r"\1", text)
+
+
+def cells_markdown(ds: xr.Dataset) -> str:
+    """``cells.md``: one row per cell — its axes, status, the mean ± SE of each measure, each
+    check's pass rate and each outcome row's ratio procedure/formula — and the refusal of each
+    refused cell: every figure a text may quote, as the results store holds it."""
+    axes = [n for n in AXES if n in ds.coords]
+    values = [v for v in _CELL_DECIMALS if v in ds]
+    checks = [str(c) for c in ds.check.values] if "pass_rate" in ds else []
+    rows = [str(r) for r in ds.row.values] if "ratio" in ds else []
+    head = (
+        ["cell", *axes, "status"]
+        + values
+        + [f"pass: {_cell(c)}" for c in checks]
+        + [f"ratio: {r}" for r in rows]
+    )
+    lines = [
+        f"# Study {ds.attrs.get('study')}: every cell",
+        "",
+        "Mean ± Monte Carlo SE per cell; pass rates ± their SE; ratio = procedure / formula at "
+        "the cell's geometry ± SE. Status: done, refused (the message below), not run.",
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+    ]
+    names = {v: k for k, v in STATUS.items()}
+    refusals = []
+    for i in range(ds.sizes["cell"]):
+        c = ds.isel(cell=i)
+        status = names.get(int(c.status.values), "?")
+        out = [str(i)] + [_axis_value(c[a].values) for a in axes] + [status]
+        for v in values:
+            d = _CELL_DECIMALS[v]
+            out.append(_pm(c[v].values, c[f"{v}_se"].values, d))
+        for check in checks:
+            out.append(
+                _pm(
+                    c.pass_rate.sel(check=check).values,
+                    c.pass_rate_se.sel(check=check).values,
+                    3,
+                )
+            )
+        for row in rows:
+            out.append(_pm(c.ratio.sel(row=row).values, c.ratio_se.sel(row=row).values, 3))
+        lines.append("| " + " | ".join(out) + " |")
+        if status == "refused":
+            refusals.append(f"- cell {i}: {_message(str(c.message.values))}")
+    if refusals:
+        lines += ["", "## Refused cells", "", *refusals]
+    return "\n".join(lines) + "\n"
+
+
+def _pm(value: Any, se: Any, decimals: int) -> str:
+    v, e = float(value), float(se)
+    if not np.isfinite(v):
+        return "—"
+    return f"{v:.{decimals}f} ± {e:.{decimals}f}" if np.isfinite(e) else f"{v:.{decimals}f}"
+
+
+def _axis_value(v: Any) -> str:
+    v = v.item() if hasattr(v, "item") else v
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
 def study_report_files(
     ds: xr.Dataset, figures: dict[str, bytes], note: str = ""
 ) -> dict[str, bytes]:
     """``study.md`` beside the figures (name → PNG bytes, from
     :func:`stereoplotter.plotting.study_figures.study_figures`): name → bytes, figures first."""
     text = _markdown(ds, study_summary(ds), list(figures), note)
-    return {**figures, "study.md": text.encode("utf-8")}
+    return {
+        **figures,
+        "study.md": text.encode("utf-8"),
+        "cells.md": cells_markdown(ds).encode("utf-8"),
+    }

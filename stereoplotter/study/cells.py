@@ -50,6 +50,7 @@ __all__ = [
     "OUTCOME_ROWS",
     "CellRun",
     "Moments",
+    "cell_operator",
     "cell_run",
     "combine_chunks",
     "run_task",
@@ -81,20 +82,48 @@ class CellRun:
     judgement_scale: float
 
 
-def cell_run(design: StudyDesign, cell: int, config: dict[str, Any]) -> CellRun:
-    """The scenario, instrument, method, operator and error model of a cell's configuration."""
-    config = design.config(config)
-    spec = design.instruments[str(config.get("instrument", next(iter(design.instruments))))]
-    judgement = float(config.get("judgement_scale", 1.0))
-    # judgement_scale multiplies the free σ of 10 µm (docs/studies.md), judged in one look: the
-    # operator of the studies' figures, not the eye-derived default (issue 25)
-    base = OperatorModel(eye="sigma", remeasure=False).for_instrument(spec)
-    operator = replace(
+def cell_operator(name: str, spec: InstrumentSpec, judgement: float) -> OperatorModel:
+    """The operator of a cell: ``name`` a value of the ``operator`` axis
+    (:data:`~stereoplotter.study.design.OPERATORS`), resolved for the instrument, its σ of
+    pointing, x- and y-parallax judgement multiplied by ``judgement``.
+
+    "eye" is :class:`OperatorModel`'s default — the operator of ``simulate``, ``verify``'s checks,
+    ``budget`` and the trainer.
+
+    Examples
+    --------
+    >>> from stereoplotter.io.instrument_file import load_instrument
+    >>> sc1 = load_instrument("sc1")
+    >>> cell_operator("eye", sc1, 1.0) == OperatorModel().for_instrument(sc1)
+    True
+    >>> round(cell_operator("sigma", sc1, 2.0).y_parallax_sigma_mm, 3)
+    0.02
+    """
+    if name == "eye":
+        base = OperatorModel().for_instrument(spec)
+    elif name == "sigma":
+        base = OperatorModel(eye="sigma", remeasure=False).for_instrument(spec)
+    elif name == "zero":
+        return OperatorModel().for_instrument(spec).zero()
+    else:
+        raise StereoplotterError(f"operator: expected one of eye, sigma, zero, found {name!r}")
+    if judgement == 1.0:
+        return base
+    assert base.stereo_sigma_mm is not None and base.y_parallax_sigma_mm is not None
+    return replace(
         base,
         monocular_sigma_mm=base.monocular_sigma_mm * judgement,
         stereo_sigma_mm=base.stereo_sigma_mm * judgement,
         y_parallax_sigma_mm=base.y_parallax_sigma_mm * judgement,
     )
+
+
+def cell_run(design: StudyDesign, cell: int, config: dict[str, Any]) -> CellRun:
+    """The scenario, instrument, method, operator and error model of a cell's configuration."""
+    config = design.config(config)
+    spec = design.instruments[str(config.get("instrument", next(iter(design.instruments))))]
+    judgement = float(config.get("judgement_scale", 1.0))
+    operator = cell_operator(str(config.get("operator", "eye")), spec, judgement)
     errors = error_model_from_spec(spec).scaled(float(config.get("instrument_error_scale", 1.0)))
     return CellRun(
         cell_scenario(design.base, config, f"{design.base.name} cell {cell}"),

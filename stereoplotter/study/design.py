@@ -30,6 +30,7 @@ __all__ = [
     "AXES",
     "GEOMETRY_AXES",
     "MEASURES",
+    "OPERATORS",
     "Axis",
     "Sample",
     "StudyDesign",
@@ -61,11 +62,22 @@ AXES: dict[str, AxisInfo] = {
     "instrument": AxisInfo("", "instrument (shipped key or user instrument)", True),
     "method": AxisInfo("", "setup (setup data) or conventional", True),
     "practice": AxisInfo("", "operator (remedies after a failed check) or book (none)", True),
+    "operator": AxisInfo(
+        "",
+        "the operator model: eye (default, as simulate), sigma (free 10 µm σ, one look) or zero",
+        True,
+    ),
     "judgement_scale": AxisInfo(
         "×", "factor on the operator's σ of pointing, x- and y-parallax judgement"
     ),
     "instrument_error_scale": AxisInfo("×", "factor on every instrument error term's σ"),
 }
+
+#: Values of the ``operator`` axis: "eye" the default operator of ``simulate``, ``verify``'s
+#: checks, ``budget`` and the trainer (σ_p, σ_q from the eye, a remeasure before a failure);
+#: "sigma" the free σ = 10 µm of pointing, x- and y-parallax judgement in one look; "zero" no
+#: judgement, reading or setting error.
+OPERATORS = ("eye", "sigma", "zero")
 
 #: The axes that change the scenario.
 GEOMETRY_AXES = (

@@ -544,9 +544,9 @@ def _rms_ci(ms, unit):
     """(RMS, CI half-width) per ``unit`` from per-trial mean squares (``CI_Z`` s.e.)."""
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(max(mean_ms, 0.0))
-    if rms == 0.0:  # a controlled mean ≤ 0 (a handful of trials): no CI
-        return rms, math.inf
-    half = CI_Z * (float(np.std(ms, ddof=1)) / math.sqrt(len(ms))) / (2.0 * rms)
+    se = float(np.std(ms, ddof=1)) / math.sqrt(len(ms))
+    # a mean square at or below zero (a control-variate estimate can be): RMS 0, CI unbounded
+    half = CI_Z * se / (2.0 * rms) if rms > 0.0 else math.inf
     return rms / unit, half / unit
 
 

@@ -58,7 +58,10 @@ def test_zero_errors_absolute_orientation_within_h_over_3000(ideal60):
     assert bool(c3.passed)
     assert float(c3.residual) <= tol
     assert bool(ideal60.checks["C3: levelling points (against the first)"].passed)
-    assert float(ideal60.checks["stage 5: corner 4"].residual) < 1e-9
+    # C4 lays the sheet on its plotted plan control (no corner-4 counter check: the corner
+    # readings are the setup-data model's)
+    assert "stage 5: corner 4" not in ideal60.checks
+    assert bool(ideal60.checks["stage 5: plan control points (needle − plotted)"].passed)
     stages = {r.stage for r in ideal60.transcript.records}
     assert {"C1", "C2", "C3", "C4"} <= stages
 

@@ -1,0 +1,222 @@
+"""The conventional method's map sheet: the model scaled on the plotted plan control (C3) and
+the sheet laid on it (C4), as the book's conventional method does; or the setup sheet's corners
+(stages 4–5 of the setup-data method, ``sheet_on="corners"``).
+
+The plotted points are the plan control points' instrument coordinates (6.7), computed from
+their SK-42 coordinates by the sheet's similarity. Units: mm (model, table, sheet).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stereoplotter.constants import MM_PER_M
+from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.virtual import NOMINAL_ZERO
+from stereoplotter.procedure.records import SheetPose
+from stereoplotter.procedure.sheet_stages import _needle as sheet_needle
+from stereoplotter.procedure.sheet_stages import _table as sheet_table
+from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.steps import control_point_m, fuse_and_read
+from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
+
+__all__ = [
+    "SHEET_OPTIONS",
+    "c4_sheet",
+    "connect_coordinatograph",
+    "plan_control_check",
+    "plotted_control",
+    "scale_on_plotted_control",
+    "sheet_on_control",
+]
+
+#: How the model meets the map sheet: "control" — C3 scales the model on the plotted plan
+#: control (all its points) and C4 turns and shifts the sheet onto them (the book's conventional
+#: method); "corners" — C3 scales on two points' ground distance and C4 lays the sheet on the
+#: setup sheet's corners (stage 4 of the setup-data method).
+SHEET_OPTIONS = ("control", "corners")
+
+
+def plotted_control(run) -> dict[str, NDArray[np.float64]] | None:
+    """The plan control points as plotted on the sheet, id → instrument coordinates (6.7)
+    [mm]; None where the sheet has fewer than two (then C3 scales on two points' ground
+    distance)."""
+    sheet = run.sheet
+    ids = tuple(sheet.similarity_point_ids)
+    if sheet.similarity is None or len(ids) < 2:
+        return None
+    return {pid: _plotted_mm(run, pid) for pid in ids}
+
+
+def scale_on_plotted_control(run, plotted, key: str, active, it: int) -> None:
+    """C3's scale on the plotted plan control (``sheet_on="control"``): fuse on every plan
+    control point, read X, Y, compare the spread of the counters about their centroid (RMS
+    distance) with the spread of the plotted points (6.7) — the scale of the least-squares
+    similarity between them — and turn b_x in proportion, O′_bx = MO_bx + b_x·ratio. [mm]"""
+    op = run.op
+    pts = np.stack(list(plotted.values()))
+    spread_plot = float(np.sqrt(((pts - pts.mean(axis=0)) ** 2).sum(axis=-1).mean()))
+    xy = []
+    for pid in plotted:
+        r = fuse_and_read(run, control_point_m(run, pid), f"{key}/scale/{pid}", active, ("X", "Y"))
+        xy.append(np.stack([r["X"], r["Y"]], axis=-1))
+    xy = np.stack(xy, axis=-2)
+    d = xy - xy.mean(axis=-2, keepdims=True)
+    spread = np.sqrt((d**2).sum(axis=-1).mean(axis=-1))
+    with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
+        ratio = np.where(active, spread_plot / spread, 1.0)
+    bx = op.read("bx", f"{key}/bx")
+    new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio
+    op.set("bx", new, f"{key}/setbx", active)
+    op.log.add(
+        "C3",
+        f"scale: fuse on the {len(plotted)} plan control points, counters' spread against the "
+        f"plotted points' {spread_plot:.3f} mm; turn b_x in proportion",
+        "bx",
+        before=bx,
+        after=new,
+        reading=new,
+        residual=spread - spread_plot,
+        iteration=it,
+        equation="conventional method: the model to the scale of the plotted control",
+    )
+
+
+def _plotted_mm(run, pid: str) -> NDArray[np.float64]:
+    """A plan control point as plotted on the sheet: its instrument coordinates (6.7) from its
+    SK-42 coordinates by the sheet's similarity. [mm]"""
+    sheet = run.sheet
+    p = run.scene.point(pid)
+    xy = sheet_corner_instrument_coordinates(
+        sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
+    )
+    return np.asarray(xy, float).reshape(2)
+
+
+def connect_coordinatograph(run) -> None:
+    """The coordinatograph connected at the sheet's ratio M_г/M_map (and, with the SC
+    complex's automatic coordinatograph, its photo → map enlargement), as stage 4 does."""
+    op, sheet = run.op, run.sheet
+    ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
+    enlargement = None
+    if op.inst.options.automatic_coordinatograph:
+        scene = run.scene
+        photo_scale = MM_PER_M * scene.flying_height_m / float(scene.camera.focal_length_mm)
+        enlargement = photo_scale / sheet.map_scale_denominator
+    op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
+
+
+def _needles_on(run, ids, key: str) -> NDArray[np.float64]:
+    """Fuse on each plan control point and put the needle down: table positions (T, n, 2)."""
+    out = []
+    for pid in ids:
+        fuse_and_read(run, control_point_m(run, pid), f"{key}/{pid}", None, ())
+        out.append(sheet_needle(run, f"{key}/{pid}"))
+    return np.stack(out, axis=-2)
+
+
+def sheet_on_control(run) -> None:
+    """C4 (``sheet_on="control"``): the map sheet laid on its plotted plan control points, as
+    the conventional method does (the model was brought to the scale of the plotted control in
+    C3, :func:`scale_on_plotted_control`): fuse on each plan control point, put the needle down,
+    and lay the sheet so that the plotted points lie on the needle positions in the
+    least-squares sense (rigid: centroid on centroid, the rotation of the closed-form 2-D fit),
+    with the sheet placement error (injected) and the operator's monocular σ at the centroid and
+    across the points' spread. Units: mm on the table.
+    """
+    op, sheet = run.op, run.sheet
+    ids = tuple(sheet.similarity_point_ids)
+    if sheet.similarity is None or len(ids) < 2:
+        stage4_orient_sheet(run)
+        return
+    connect_coordinatograph(run)
+    plotted = np.stack([sheet_table(run, _plotted_mm(run, pid)) for pid in ids])  # (n, 2)
+    centre = plotted.mean(axis=0)
+    d_plot = plotted - centre
+    needles = _needles_on(run, ids, "4/place")
+    n_centre = needles.mean(axis=-2)
+    d_needle = needles - n_centre[..., None, :]
+    cross = (d_plot[..., 0] * d_needle[..., 1] - d_plot[..., 1] * d_needle[..., 0]).sum(-1)
+    dot = (d_plot[..., 0] * d_needle[..., 0] + d_plot[..., 1] * d_needle[..., 1]).sum(-1)
+    inj = op.inst.injected
+    place = np.stack(
+        [
+            op.v(inj["coordinatograph.sheet_placement_x"]),
+            op.v(inj["coordinatograph.sheet_placement_y"]),
+        ],
+        axis=-1,
+    )
+    sigma = op.model.monocular_sigma_mm
+    e = np.stack([op.noise.normal(f"mono/4/place/{a}", sigma) for a in "xy"], axis=-1)
+    spread_plot = float(np.sqrt((d_plot**2).sum(axis=-1).mean()))
+    e_turn = op.noise.normal("mono/4/place/turn", sigma) / spread_plot
+    angle = np.arctan2(cross, dot) + e_turn
+    run.sheet_pose = SheetPose(angle, centre + place + e, n_centre)
+    op.log.add(
+        "4",
+        "lay the sheet on the needle positions of the plan control points (least squares: "
+        "centroid on centroid, turned onto them)",
+        "",
+        reading=None,
+        equation="conventional method: the sheet on the plotted control",
+    )
+    run.record_stage("4", op.v(2).astype(int))
+
+
+def plan_control_check(run) -> None:
+    """The check of a sheet laid on its plan control: fuse on each plan control point, the
+    needle against the plotted point; the largest distance against the corner tolerance (the
+    same comparison as stage 5's, its tolerance 0.3 mm). Corner 4 is not checked: its counter
+    readings are those of the setup-data model, which the conventional method does not build.
+    """
+    op, sheet = run.op, run.sheet
+    pose = run.sheet_pose
+    if pose is None or sheet.similarity is None:
+        return
+    errs = []
+    for pid in sheet.similarity_point_ids:
+        fuse_and_read(run, control_point_m(run, pid), f"5/plan/{pid}", None, ())
+        needle = sheet_needle(run, f"5/plan/{pid}")
+        plotted = pose.table_of(sheet_table(run, _plotted_mm(run, pid)))
+        err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
+        errs.append(err)
+        op.log.add(
+            "5",
+            f"plan control point {pid}: fuse, needle against the plotted point",
+            "",
+            residual=err,
+            equation="stage 5",
+        )
+    run.check(
+        "stage 5: plan control points (needle − plotted)",
+        np.max(np.stack(errs, axis=-1), axis=-1),
+        sheet.tolerances["corner_mm"],
+    )
+    run.record_stage("5", op.v(1).astype(int))
+
+
+def c4_sheet(run, sheet_on: str = "control") -> None:
+    """C4: the sheet on the coordinatograph — on its plotted plan control points
+    (:func:`sheet_on_control`, default) or on the setup sheet's corners (stage 4 of the
+    setup-data method) — then corner 4 and the plotted plan control (stage 5)."""
+    if sheet_on not in SHEET_OPTIONS:
+        raise StereoplotterError(
+            f"sheet_on: expected one of {', '.join(SHEET_OPTIONS)}, found {sheet_on!r}"
+        )
+    log = run.op.log
+    start = len(log.records)
+    if sheet_on == "control":
+        sheet_on_control(run)
+        plan_control_check(run)
+    else:
+        stage4_orient_sheet(run)
+        stage5_check(run)
+    log.records[start:] = [replace(r, stage="C4") for r in log.records[start:]]
+    for old, new in (("4", "C4"), ("5", "C4/check")):
+        if old in run.stages:
+            run.record_stage(new, run.stages.pop(old).iterations)
+
+
