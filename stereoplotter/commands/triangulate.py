@@ -52,6 +52,20 @@ def add_arguments(sub: Any) -> None:
         default=3,
         help="strip method: degree of the strip polynomials (default 3)",
     )
+    p.add_argument(
+        "--reject",
+        action="store_true",
+        help="bundle: remove the observations data snooping flags and readjust (default: "
+        "flag them in report.md and flagged.csv, keep them in the solution)",
+    )
+    p.add_argument(
+        "--alpha0",
+        type=bounded_float(1e-12, 0.5),
+        default=None,
+        metavar="A",
+        help="bundle: level of one w-test (default: family-wise 5 %% over all observations "
+        "by Šidák; Baarda's classical value is 0.001)",
+    )
     p.set_defaults(func=run)
     b = sub.add_parser("block", help="blocks of comparator measurements (docs/triangulation.md)")
     acts = b.add_subparsers(dest="block_command", required=True, metavar="ACTION")
@@ -96,19 +110,20 @@ def add_arguments(sub: Any) -> None:
     s.set_defaults(func=run_synth)
 
 
-def _solve(block: Any, args: argparse.Namespace) -> Any:
+def _solve(block: Any, args: argparse.Namespace) -> tuple[Any, Any]:
+    """The solution and, for the bundle, its data snooping (else None)."""
     # imported here: the CLI starts without loading scipy's sparse solvers
     if args.method == "bundle":
-        from stereoplotter.triangulation.bundle import bundle_block
+        from stereoplotter.triangulation.reliability import snooped_block
 
-        return bundle_block(block)
+        return snooped_block(block, reject=args.reject, alpha0=args.alpha0)
     from stereoplotter.triangulation import strip
 
     if args.method == "strip":
-        return strip.strip_block(block, args.models, args.degree)
+        return strip.strip_block(block, args.models, args.degree), None
     from stereoplotter.triangulation.polygon_block import polygon_block
 
-    return polygon_block(block)
+    return polygon_block(block), None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -117,11 +132,18 @@ def run(args: argparse.Namespace) -> int:
     from stereoplotter.io.block_measurements_file import load_block_measurements
     from stereoplotter.io.triangulated_job import job_files
     from stereoplotter.plotting.triangulation import residual_figure_png
-    from stereoplotter.report.triangulation import orientation_csv, report_markdown, residual_csv
+    from stereoplotter.report.triangulation import (
+        flagged_csv,
+        observations_csv,
+        orientation_csv,
+        points_csv,
+        report_markdown,
+        residual_csv,
+    )
     from stereoplotter.triangulation.solution import catalogue_residuals
 
     block, production = load_block_measurements(args.block)
-    solution = _solve(block, args)
+    solution, snooping = _solve(block, args)
     residuals = catalogue_residuals(block, solution)
     files: dict[str, str | bytes] = {}
     if production is not None:  # first: a photo number the job cannot take stops everything
@@ -136,17 +158,33 @@ def run(args: argparse.Namespace) -> int:
         )
     files["orientations.csv"] = orientation_csv(block, solution)
     files["residuals.csv"] = residual_csv(block, residuals)
+    files["points.csv"] = points_csv(block, solution)
     files["residuals.png"] = residual_figure_png(block, solution, residuals)
-    files["report.md"] = report_markdown(block, solution, residuals, args.block)
+    if snooping is not None:
+        files["flagged.csv"] = flagged_csv(snooping.flags)
+        last = args.reject
+        files["observations.csv"] = observations_csv(
+            block,
+            snooping.problem_last if last else snooping.problem_first,
+            snooping.reliability if last else snooping.reliability_first,
+        )
+    files["report.md"] = report_markdown(
+        block, solution, residuals, args.block, snooping, args.reject
+    )
     out = Path(args.output)
     encoded = {n: c if isinstance(c, bytes) else c.encode("utf-8") for n, c in files.items()}
     write_files(out, encoded)  # every file whole or not at all
     rms = residuals.rms(block, "check")
     job = f"; job file {out / 'job.yaml'}" if production is not None else ""
+    flagged = ""
+    if snooping is not None:
+        what = "removed" if args.reject else "kept; --reject removes them"
+        flagged = f"; {len(snooping.flags)} observations flagged ({what})"
     print(
         f"block {block.name}: {len(block.photos)} photos by {args.method} in "
         f"{solution.iterations} iterations, σ₀ = {solution.sigma0:.3f}; RMS at check points "
-        f"X {rms[0]:.3f}, Y {rms[1]:.3f}, Z {rms[2]:.3f} m; report {out / 'report.md'}{job}"
+        f"X {rms[0]:.3f}, Y {rms[1]:.3f}, Z {rms[2]:.3f} m{flagged}; report "
+        f"{out / 'report.md'}{job}"
     )
     if production is None:
         print("no production section in the block file: no job file written", file=sys.stderr)

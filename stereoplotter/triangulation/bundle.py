@@ -25,7 +25,6 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
@@ -38,14 +37,20 @@ from stereoplotter.triangulation.block import (
     interior_orientation,
     photo_coordinates,
 )
+from stereoplotter.triangulation.selected_inverse import SelectedInverse, selected_inverse
 from stereoplotter.triangulation.solution import BlockSolution, sparse_least_squares
 
 __all__ = [
+    "Adjusted",
     "BundleProblem",
+    "Normals",
     "bundle_adjust",
+    "bundle_adjusted",
     "bundle_block",
     "initial_approximation",
     "interior_orientation_covariance",
+    "normals",
+    "point_cofactors",
     "problem",
 ]
 
@@ -57,7 +62,8 @@ class BundleProblem:
     ``xy_mm`` (n_obs, 2) photo coordinates relative to the principal point; ``obs_photo``,
     ``obs_point`` their photo and point; ``control_point`` (n_c,) the points with catalogue
     coordinates ``control_m`` (n_c, 3) and weights ``control_weight`` (n_c, 3) [1/m², 0 where a
-    coordinate is not given]; ``f_mm``; ``sigma_photo_mm``.
+    coordinate is not given]; ``f_mm``; ``sigma_photo_mm``; ``point_ids`` and ``photo_ids``
+    (for messages); ``obs_index`` each measurement's row in the block.
     """
 
     xy_mm: NDArray[np.float64]
@@ -71,6 +77,18 @@ class BundleProblem:
     f_mm: float
     sigma_photo_mm: float
     point_ids: tuple[str, ...] = ()
+    photo_ids: tuple[str, ...] = ()
+    obs_index: NDArray[np.int64] | None = None
+
+    def __post_init__(self) -> None:
+        if self.obs_index is None:  # the measurements of the block, in its order
+            object.__setattr__(self, "obs_index", np.arange(self.obs_photo.size))
+
+    def photo_ids_of(self, photos: NDArray) -> str:
+        """The photo numbers of indices, comma-separated (``#j`` where the problem has none)."""
+        return ", ".join(
+            self.photo_ids[j] if self.photo_ids else f"#{j}" for j in np.asarray(photos).ravel()
+        )
 
 
 def problem(block: Block) -> BundleProblem:
@@ -102,6 +120,8 @@ def problem(block: Block) -> BundleProblem:
         f_mm=block.camera.focal_length_mm,
         sigma_photo_mm=s.photo_mm,
         point_ids=block.point_ids,
+        photo_ids=block.photos,
+        obs_index=np.flatnonzero(keep),
     )
 
 
@@ -203,9 +223,38 @@ def _pairs(obs_point: NDArray) -> _Pairs:
     return _Pairs(first, second)
 
 
-# long: one Gauss–Newton step: normal blocks, point elimination, reduced solve, back-substitution
-def _step(p, orient, points, pairs, factor_only=False):
-    """One Gauss–Newton step: corrections of orientations and points, [vv], and the factor."""
+@dataclass(frozen=True, slots=True)
+class Normals:
+    """The normal equations of one linearisation, the points eliminated (σ-free: weights 1/σ²).
+
+    ``v`` (n_obs, 2) photo residuals [mm]; ``jc`` (n_obs, 2, 6) ∂(x, y)/∂(photo elements) and
+    ``jp`` (n_obs, 2, 3) ∂(x, y)/∂(X, Y, Z) of Eq. (2.53); ``ncp`` (n_obs, 6, 3) each
+    measurement's Jcᵀ·w·Jp; ``pinv`` (n_points, 3, 3) the inverse point blocks N_pp⁻¹ (control
+    weights included); ``reduced`` the reduced matrix N_cc − N_cp·N_pp⁻¹·N_pc (sparse, 6 × 6
+    blocks); ``rhs`` its right side (n_photos, 6); ``bp`` the points' right side; ``vv`` [pvv].
+    """
+
+    v: NDArray[np.float64]
+    jc: NDArray[np.float64]
+    jp: NDArray[np.float64]
+    ncp: NDArray[np.float64]
+    pinv: NDArray[np.float64]
+    reduced: sp.csc_matrix
+    rhs: NDArray[np.float64]
+    bp: NDArray[np.float64]
+    vv: float
+    unused: NDArray[np.bool_]
+
+
+# long: normal blocks, point elimination and the reduced matrix in one pass over the measurements
+def normals(p: BundleProblem, orient: NDArray, points: NDArray, pairs: _Pairs) -> Normals:
+    """The reduced normal equations of the bundle at (orient, points) (:class:`Normals`).
+
+    Raises
+    ------
+    GeometryError
+        A point whose rays do not fix it (names the point and its photos).
+    """
     v, jc = _linearise(p, orient, points)
     w = 1.0 / p.sigma_photo_mm**2
     jp = -jc[:, :, 3:]
@@ -227,10 +276,13 @@ def _step(p, orient, points, pairs, factor_only=False):
     scale3 = np.einsum("nii->n", npp) ** 3
     weak = np.flatnonzero(~(np.abs(det) > 1e-12 * scale3))
     if weak.size:
-        name = p.point_ids[weak[0]] if p.point_ids else f"#{weak[0]}"
+        i = weak[0]
+        name = p.point_ids[i] if p.point_ids else f"#{i}"
+        seen = p.photo_ids_of(p.obs_photo[p.obs_point == i])
         raise GeometryError(
-            f"point {name}: its rays do not fix it (measured on photos that see "
-            "it along one line?): check the point identification"
+            f"point {name}: its {seen.count(',') + 1 if seen else 0} rays (photos {seen}) do not "
+            "fix it (they lie along one line): expected rays from two photos at an angle; check "
+            "the point identification"
         )
     pinv = np.linalg.inv(npp)
     ncp = w * np.einsum("nki,nkj->nij", jc, jp)  # per measurement, 6 × 3
@@ -257,6 +309,13 @@ def _step(p, orient, points, pairs, factor_only=False):
     reduced_p = np.einsum("nij,nj->ni", pinv, bp)
     rhs = bc.copy()
     np.add.at(rhs, p.obs_photo, -np.einsum("nij,nj->ni", ncp, reduced_p[p.obs_point]))
+    return Normals(v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused)
+
+
+def _step(p, orient, points, pairs):
+    """One Gauss–Newton step: corrections of orientations and points, [vv], the normals."""
+    n = normals(p, orient, points, pairs)
+    s = n.reduced
     scale = 1.0 / np.sqrt(s.diagonal())
     d = sp.diags(scale)
     try:
@@ -265,53 +324,83 @@ def _step(p, orient, points, pairs, factor_only=False):
     except RuntimeError as exc:
         raise GeometryError(
             f"the reduced normal equations are singular ({exc}): expected "
-            "every photo tied to the block and at least 3 control points"
+            "every photo tied to the block and at least 3 control points" + weakest_photos(p, s)
         ) from None
-    delta_c = (scale * lu.solve(scale * rhs.ravel())).reshape(-1, 6)
-    back = bp.copy()
-    np.add.at(back, p.obs_point, -np.einsum("nji,nj->ni", ncp, delta_c[p.obs_photo]))
-    delta_p = np.einsum("nij,nj->ni", pinv, back)
-    delta_p[unused] = 0.0
-    return delta_c, delta_p, vv, (lu, scale, scaled)
+    delta_c = (scale * lu.solve(scale * n.rhs.ravel())).reshape(-1, 6)
+    back = n.bp.copy()
+    np.add.at(back, p.obs_point, -np.einsum("nji,nj->ni", n.ncp, delta_c[p.obs_photo]))
+    delta_p = np.einsum("nij,nj->ni", n.pinv, back)
+    delta_p[n.unused] = 0.0
+    return delta_c, delta_p, n.vv, n
 
 
-#: Above this many photo unknowns the inverse is not formed densely (8 · n² bytes: 288 MB at
-#: 6000, i.e. 1000 photos) but column by column from the sparse factor (slow: minutes).
-DENSE_INVERSE_LIMIT = 6000
+def weakest_photos(p: BundleProblem, reduced: sp.spmatrix, count: int = 4) -> str:
+    """``": weakest photos …"``: the photos whose own 6 × 6 block of the reduced matrix (at unit
+    diagonal) has the largest condition number, with it, for a message."""
+    n = p.n_photos
+    d = reduced.diagonal()
+    scale = 1.0 / np.sqrt(np.where(d > 0, d, 1.0))
+    blocks = np.zeros((n, 6, 6))
+    coo = sp.coo_matrix(reduced)
+    mine = coo.row // 6 == coo.col // 6
+    np.add.at(
+        blocks,
+        (coo.row[mine] // 6, coo.row[mine] % 6, coo.col[mine] % 6),
+        coo.data[mine] * scale[coo.row[mine]] * scale[coo.col[mine]],
+    )
+    with np.errstate(all="ignore"):
+        cond = np.linalg.cond(blocks)
+    cond = np.where(np.isfinite(cond), cond, np.inf)
+    worst = np.argsort(-cond, kind="stable")[:count]
+    text = ", ".join(f"{p.photo_ids_of([j])} (condition {cond[j]:.1e})" for j in worst)
+    return f"; weakest photos {text}"
 
 
-def _covariances(factor, n_photos: int, sigma0: float, chunk: int = 64) -> tuple[NDArray, NDArray]:
-    """σ₀²·(the 6 × 6 diagonal blocks of the inverse reduced matrix) and σ₀²·its blocks
-    (j + 1, j) (photo j + 1 against photo j). Up to :data:`DENSE_INVERSE_LIMIT` unknowns by a
-    dense Cholesky inverse (LAPACK potrf/potri: 1000 photos in about 20 s); beyond, in chunks
-    of photos from the sparse factor (memory 6n × 6·chunk)."""
-    lu, scale, scaled = factor
-    if 6 * n_photos <= DENSE_INVERSE_LIMIT:
-        c, _ = sla.cho_factor(scaled.toarray(), lower=True, overwrite_a=True, check_finite=False)
-        inv, info = sla.lapack.dpotri(c, lower=1, overwrite_c=1)
-        if info != 0:
-            raise GeometryError(f"the reduced normal matrix is not positive definite ({info})")
-        inv *= scale[:, None]  # in place: one n × n array; the lower triangle holds the inverse
-        inv *= scale[None, :]
-        k = np.arange(n_photos)
-        blocks = inv.reshape(n_photos, 6, n_photos, 6)
-        diag = np.tril(blocks[k, :, k, :]) + np.swapaxes(np.tril(blocks[k, :, k, :], -1), 1, 2)
-        after = np.zeros((n_photos, 6, 6))
-        after[:-1] = blocks[k[1:], :, k[:-1], :]
-        return sigma0**2 * diag, sigma0**2 * after
-    out = np.empty((n_photos, 6, 6))
+def _photo_covariances(sel: SelectedInverse, n_photos: int, sigma0: float):
+    """σ₀²·(the 6 × 6 diagonal blocks of S⁻¹) and σ₀²·its blocks (j + 1, j) (photo j + 1
+    against photo j; zero for the last), from the selected inverse (no dense inverse)."""
+    k = np.arange(n_photos)
+    diag = sel.blocks(k, k)
     after = np.zeros((n_photos, 6, 6))
-    for start in range(0, n_photos, chunk):
-        stop = min(n_photos, start + chunk)
-        k = np.arange(stop - start)
-        cols = np.arange(6 * start, 6 * stop)
-        e = np.zeros((6 * n_photos, cols.size))
-        e[cols, np.arange(cols.size)] = scale[cols]
-        x = (scale[:, None] * lu.solve(e)).reshape(n_photos, 6, stop - start, 6)
-        out[start:stop] = x[start + k, :, k, :]
-        nxt = k[start + k + 1 < n_photos]
-        after[start + nxt] = x[start + nxt + 1, :, nxt, :]
-    return sigma0**2 * out, sigma0**2 * after
+    if n_photos > 1:
+        after[:-1] = sel.blocks(k[1:], k[:-1])
+    return sigma0**2 * diag, sigma0**2 * after
+
+
+def point_cofactors(
+    p: BundleProblem, n: Normals, sel: SelectedInverse, pairs: _Pairs
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    r"""Q_pp (n_points, 3, 3) of every point and Q_cp (n_obs, 6, 3) of each measurement's photo
+    against its point: the blocks of N⁻¹ (σ-free) by block elimination of the points,
+
+        Q_c_j,p_i = −Σ_k (S⁻¹)_jk · N_c_k,p_i · N_pp,i⁻¹,
+        Q_pp,i = N_pp,i⁻¹ + N_pp,i⁻¹ · (Σ_j,k N_p_i,c_j · (S⁻¹)_jk · N_c_k,p_i) · N_pp,i⁻¹,
+
+    the sums over the photos j, k that measured point i (every such pair is in the selected
+    inverse). Unused points: NaN."""
+    qcc = sel.blocks(p.obs_photo[pairs.first], p.obs_photo[pairs.second])
+    t = np.zeros((p.obs_photo.size, 6, 3))
+    np.add.at(t, pairs.first, np.einsum("nij,njk->nik", qcc, n.ncp[pairs.second]))
+    inner = np.zeros((p.n_points, 3, 3))
+    np.add.at(inner, p.obs_point, np.einsum("nji,njk->nik", n.ncp, t))
+    qpp = n.pinv + np.einsum("nij,njk,nkl->nil", n.pinv, inner, n.pinv)
+    qpp[n.unused] = np.nan
+    qcp = -np.einsum("nij,njk->nik", t, n.pinv[p.obs_point])
+    return qpp, qcp
+
+
+@dataclass(frozen=True, slots=True)
+class Adjusted:
+    """A converged bundle adjustment with what its precision and reliability are computed from:
+    the solution, the normals at it, the selected inverse of the reduced matrix (None without
+    covariances), the measurement pairs, the redundancy and Q_cp (n_obs, 6, 3)."""
+
+    solution: BlockSolution
+    normals: Normals
+    inverse: SelectedInverse | None
+    pairs: _Pairs
+    redundancy: int
+    qcp: NDArray[np.float64] | None
 
 
 def bundle_adjust(
@@ -336,9 +425,9 @@ def bundle_adjust(
     position_tolerance_m : float
         … and every |δX_S|, |δY_S|, |δZ_S| and point correction ≤ it (ε₂, ε₃). [m]
     covariance : bool
-        Compute σ₀²·N⁻¹'s 6 × 6 blocks of the photos (Eq. (3.11)); the block of 1,000 photos
-        took 2.8 s more than its adjustment (3.7 s) in ``benchmarks/bench_triangulation.py``,
-        with a dense inverse of 8·(6n)² bytes (288 MB): see :data:`DENSE_INVERSE_LIMIT`.
+        Compute σ₀²·N⁻¹'s 6 × 6 blocks of the photos (Eq. (3.11)) and the 3 × 3 blocks of every
+        point, from the selected inverse of the reduced matrix
+        (:mod:`~stereoplotter.triangulation.selected_inverse`; no dense inverse).
 
     Returns
     -------
@@ -348,14 +437,36 @@ def bundle_adjust(
     Raises
     ------
     GeometryError
-        No convergence, a singular system or too little control.
+        No convergence (names the photos of worst condition), a singular system or too little
+        control.
     """
+    return bundle_adjusted(
+        p,
+        initial,
+        max_iterations=max_iterations,
+        angle_tolerance=angle_tolerance,
+        position_tolerance_m=position_tolerance_m,
+        covariance=covariance,
+    ).solution
+
+
+def bundle_adjusted(
+    p: BundleProblem,
+    initial: tuple[NDArray, NDArray] | None = None,
+    *,
+    max_iterations: int = 30,
+    angle_tolerance: float = 1e-8,
+    position_tolerance_m: float = 1e-4,
+    covariance: bool = True,
+) -> Adjusted:
+    """:func:`bundle_adjust` with the normals and the selected inverse at the solution
+    (:class:`Adjusted`)."""
     orient, points = initial if initial is not None else initial_approximation(p)
     orient, points = orient.copy(), points.copy()
     pairs = _pairs(p.obs_point)
     converged = False
     for it in range(1, max_iterations + 1):  # noqa: B007 (reported after the loop)
-        dc, dp, _, factor = _step(p, orient, points, pairs)
+        dc, dp, _, n = _step(p, orient, points, pairs)
         orient += dc
         points += dp
         if (
@@ -368,18 +479,31 @@ def bundle_adjust(
     if not converged:
         raise GeometryError(
             f"the bundle adjustment did not converge in {max_iterations} iterations (last "
-            f"corrections {np.max(np.abs(dc[:, :3])):.3g} rad, {np.max(np.abs(dp)):.3g} m): "
-            "check the point identification and the control"
+            f"corrections {np.max(np.abs(dc[:, :3])):.3g} rad, {np.max(np.abs(dp)):.3g} m)"
+            + weakest_photos(p, n.reduced)
+            + ": expected each of them to see well-spread points; check the point "
+            "identification and the control"
         )
-    _, _, vv, factor = _step(p, orient, points, pairs)
-    used = np.bincount(p.obs_point, minlength=p.n_points) > 0
+    n = normals(p, orient, points, pairs)
+    used = ~n.unused
     n_obs = 2 * p.obs_photo.size + int(np.count_nonzero(p.control_weight))
     redundancy = n_obs - 6 * p.n_photos - 3 * int(used.sum())
-    sigma0 = float(np.sqrt(vv / redundancy)) if redundancy > 0 else float("nan")
+    sigma0 = float(np.sqrt(n.vv / redundancy)) if redundancy > 0 else float("nan")
     points[~used] = np.nan
-    cov, after = _covariances(factor, p.n_photos, sigma0) if covariance else (None, None)
     notes = (f"redundancy {redundancy}",)
-    return BlockSolution("bundle", orient, cov, points, it, sigma0, notes, after)
+    if not covariance:
+        s = BlockSolution("bundle", orient, None, points, it, sigma0, notes)
+        return Adjusted(s, n, None, pairs, redundancy, None)
+    try:
+        sel = selected_inverse(n.reduced)
+    except GeometryError as exc:
+        raise GeometryError(f"{exc}{weakest_photos(p, n.reduced)}") from None
+    cov, after = _photo_covariances(sel, p.n_photos, sigma0)
+    qpp, qcp = point_cofactors(p, n, sel, pairs)
+    s = BlockSolution(
+        "bundle", orient, cov, points, it, sigma0, notes, after, point_covariances=sigma0**2 * qpp
+    )
+    return Adjusted(s, n, sel, pairs, redundancy, qcp)
 
 
 def interior_orientation_covariance(
@@ -395,8 +519,7 @@ def interior_orientation_covariance(
     orientation the adjustment used) and G = (JᵀJ)⁻¹Jᵀ the least-squares map of photo
     residuals to the elements (J of Eq. (2.53) at the solution).
     """
-    keep = np.bincount(block.obs_point, minlength=len(block.point_ids))[block.obs_point] >= 2
-    rows_all = np.flatnonzero(keep)
+    rows_all = p.obs_index
     _, jac = _linearise(p, solution.orientations, np.nan_to_num(solution.points_m))
     out = np.zeros((p.n_photos, 6, 6))
     h = 1e-3  # mm: the interior orientation is linear in the marks to far below this

@@ -47,7 +47,10 @@ def test_triangulate_writes_orientations_residuals_report_and_job(chain):
         "residuals.png",
         "job.yaml",
         "fiducials.csv",
+        "control_points.csv",
         "points.csv",
+        "flagged.csv",
+        "observations.csv",
     } <= names
     with open(chain / "tri" / "orientations.csv", encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
@@ -128,3 +131,27 @@ def test_leading_zero_photo_numbers_pass_through_to_the_job(chain, tmp_path):
     job = load_job(tmp_path / "tri" / "job.yaml")
     assert next(iter(job.photos)) == "0101" and "101" not in job.photos
     assert job.pairs[0].name == "0101-102"
+
+
+def test_outputs_hold_no_nan_and_name_a_point_of_one_photo_not_intersected(chain, tmp_path):
+    # the polygon report's σ₀ is a number; a check point on one photo is "not intersected"
+    for method in ("bundle", "polygon"):
+        out = tmp_path / method
+        argv = ["triangulate", str(chain / "block" / "block.yaml"), "--method", method]
+        assert main([*argv, "-o", str(out)]) == 0
+        for name in ("report.md", "residuals.csv", "points.csv", "orientations.csv"):
+            assert "nan" not in (out / name).read_text(encoding="utf-8").lower(), (method, name)
+        with open(out / "residuals.csv", encoding="utf-8") as f:
+            rows = list(csv.DictReader(f))
+        single = [r for r in rows if r["rays"] == "1"]
+        assert single and all(r["note"].startswith("not intersected") for r in single)
+    assert "σ₀ = 1." in (tmp_path / "polygon" / "report.md").read_text(encoding="utf-8")
+
+
+def test_points_csv_gives_every_point_with_its_sigma(chain):
+    with open(chain / "tri" / "points.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    roles = {r["role"] for r in rows}
+    assert roles == {"tie", "control", "check"} or roles == {"control", "check"}
+    fixed = [r for r in rows if r["X_m"]]
+    assert fixed and all(float(r["s_Z_m"]) > 0 for r in fixed)

@@ -1,0 +1,373 @@
+r"""Blunder detection and reliability of a bundle adjustment after Baarda.
+
+Reference
+---------
+.. [1] W. Baarda, *A testing procedure for use in geodetic networks*, Netherlands Geodetic
+   Commission, Publications on Geodesy 2(5), 1968 (data snooping, the B-method, internal and
+   external reliability).
+
+Every observation l (a photo coordinate x or y of a point measurement, a catalogue X, Y or height
+of a control point) with a priori σ_l gets, from the cofactor matrix of its residual
+Q_vv = Q_ll − A·N⁻¹·Aᵀ (its diagonal element from the selected inverse, no dense inverse):
+
+* the redundancy number r = q_vv/σ_l² (0 < r ≤ 1; Σr = the redundancy of the adjustment);
+* the standardized residual w = v/√q_vv (the a priori σ₀ = 1: Baarda's w-test), N(0, 1) when
+  the observation holds no blunder;
+* the minimal detectable blunder MDB = δ₀·σ_l/√r, δ₀ = k + z_{β₀}, k = z_{1−α₀/2}: a blunder
+  of that size is found with probability β₀ (internal reliability);
+* its effect on the point's coordinates, ∇X = Q_xx·Aᵀ·P·e·MDB (external reliability) [m], and
+  Baarda's factor δ̄₀ = δ₀·√((1 − r)/r).
+
+The test level α₀ of one w-test: by default chosen so that the block of n tested observations
+has a family-wise error rate α = 5 % (Šidák: α₀ = 1 − (1 − α)^(1/n); k ≈ 4.4 for 2 000
+observations) — with the classical α₀ = 0.001 (k = 3.29) a block of 2 000 observations flags
+two good ones on average. β₀ = 80 % (Baarda's value). The global test of σ₀: [pvv] ~ χ²(r)
+when the a priori σ hold.
+
+Data snooping is iterated: the observation of largest |w| above k is removed (a photo
+measurement with both its coordinates, a control coordinate alone; a point left with one ray
+loses it too), the block readjusted from the previous solution, and the test repeated until no
+|w| exceeds k.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+
+from stereoplotter.triangulation.block import Block
+from stereoplotter.triangulation.bundle import (
+    Adjusted,
+    BundleProblem,
+    bundle_adjusted,
+    interior_orientation_covariance,
+    problem,
+)
+from stereoplotter.triangulation.solution import BlockSolution
+
+__all__ = [
+    "Flag",
+    "GlobalTest",
+    "ObservationReliability",
+    "SnoopingResult",
+    "critical_values",
+    "global_test",
+    "observation_reliability",
+    "snoop",
+    "snooped_block",
+]
+
+#: Names of the control observations by coordinate (local X, Y and Z; Z is the height the
+#: catalogue's σ_height applies to).
+CONTROL_NAMES = ("X_m", "Y_m", "height_m")
+PHOTO_NAMES = ("x_mm", "y_mm")
+#: |ρ| of two w above which the two blunders cannot be told apart (Baarda's separability).
+INSEPARABLE = 0.99
+
+
+def _w_correlations(p: BundleProblem, adj: Adjusted, o: int, c: int) -> tuple[NDArray, NDArray]:
+    """ρ of w of photo coordinate (o, c) with every coordinate of the other measurements of its
+    point, (m, 2), and those measurements' rows. Q_vv,ab = −A_a·N⁻¹·A_bᵀ (a ≠ b)."""
+    n = adj.normals
+    i = p.obs_point[o]
+    rows = np.flatnonzero(p.obs_point == i)
+    qpp = adj.solution.point_covariances[i] / adj.solution.sigma0**2
+    qcc = adj.inverse.blocks(np.full(rows.size, p.obs_photo[o]), p.obs_photo[rows])
+    qcp = adj.qcp
+    ja, pa = n.jc[o, c], n.jp[o, c]
+    # A_a·N⁻¹·A_bᵀ for every b: Jc_a Qcc_ab Jc_bᵀ + Jc_a Q_c_a,p Jp_bᵀ + Jp_a Q_p,c_b Jc_bᵀ + …
+    cross = (
+        np.einsum("i,nij,nkj->nk", ja, qcc, n.jc[rows])
+        + np.einsum("i,ij,nkj->nk", ja, qcp[o], n.jp[rows])
+        + np.einsum("i,nji,nkj->nk", pa, qcp[rows], n.jc[rows])
+        + np.einsum("i,ij,nkj->nk", pa, qpp, n.jp[rows])
+    )
+    sig2 = p.sigma_photo_mm**2
+    qvv = -cross
+    own = rows == o
+    qvv[own, c] += sig2
+    diag = sig2 - np.einsum(
+        "nki,nij,nkj->nk",
+        n.jc[rows],
+        adj.inverse.blocks(p.obs_photo[rows], p.obs_photo[rows]),
+        n.jc[rows],
+    )
+    diag -= 2.0 * np.einsum("nki,nij,nkj->nk", n.jc[rows], qcp[rows], n.jp[rows])
+    diag -= np.einsum("nki,ij,nkj->nk", n.jp[rows], qpp, n.jp[rows])
+    rho = qvv / np.sqrt(np.maximum(diag, 1e-12 * sig2) * max(diag[own, c][0], 1e-12 * sig2))
+    return rho, rows
+
+
+def critical_values(n_tests: int, alpha: float = 0.05, beta0: float = 0.80, alpha0=None):
+    """(α₀, k, δ₀): the level of one w-test, its critical value and the non-centrality of a
+    blunder found with probability β₀. α₀ by Šidák from the family-wise α over ``n_tests``
+    unless given."""
+    if alpha0 is None:
+        alpha0 = 1.0 - (1.0 - alpha) ** (1.0 / max(1, n_tests))
+    k = float(stats.norm.isf(alpha0 / 2.0))
+    return float(alpha0), k, k + float(stats.norm.ppf(beta0))
+
+
+@dataclass(frozen=True, slots=True)
+class GlobalTest:
+    """The χ² test of σ₀: [pvv] against χ²(r) at level α (two-sided): ``sigma0``, the
+    ``redundancy``, ``p_value`` (of a σ₀ at least this far from 1), the acceptance interval
+    of σ₀ (``low``, ``high``) and ``passed``."""
+
+    sigma0: float
+    redundancy: int
+    p_value: float
+    low: float
+    high: float
+    passed: bool
+
+
+def global_test(sigma0: float, redundancy: int, alpha: float = 0.05) -> GlobalTest:
+    """:class:`GlobalTest` of σ₀ on ``redundancy`` degrees of freedom."""
+    chi = sigma0**2 * redundancy
+    lo = float(np.sqrt(stats.chi2.ppf(alpha / 2, redundancy) / redundancy))
+    hi = float(np.sqrt(stats.chi2.isf(alpha / 2, redundancy) / redundancy))
+    p = 2.0 * min(float(stats.chi2.cdf(chi, redundancy)), float(stats.chi2.sf(chi, redundancy)))
+    return GlobalTest(sigma0, redundancy, p, lo, hi, lo <= sigma0 <= hi)
+
+
+@dataclass(frozen=True, slots=True)
+class ObservationReliability:
+    """Per observation of a bundle problem.
+
+    Photo coordinates, shape (n_obs, 2) for x, y: ``photo_v`` [mm], ``photo_r`` [—],
+    ``photo_w`` [—], ``photo_mdb`` [mm], ``photo_effect`` (n_obs, 2) |∇X| of the point
+    [m]; control coordinates, shape (n_control, 3) for X, Y, Z (NaN where not given):
+    ``control_v`` [m], ``control_r``, ``control_w``, ``control_mdb`` [m],
+    ``control_effect`` [m]. ``delta0`` and ``k`` of :func:`critical_values`.
+    """
+
+    photo_v: NDArray[np.float64]
+    photo_r: NDArray[np.float64]
+    photo_w: NDArray[np.float64]
+    photo_mdb: NDArray[np.float64]
+    photo_effect: NDArray[np.float64]
+    control_v: NDArray[np.float64]
+    control_r: NDArray[np.float64]
+    control_w: NDArray[np.float64]
+    control_mdb: NDArray[np.float64]
+    control_effect: NDArray[np.float64]
+    alpha0: float
+    k: float
+    delta0: float
+
+    @property
+    def n_tests(self) -> int:
+        return int(self.photo_w.size + np.count_nonzero(np.isfinite(self.control_w)))
+
+
+# long: Q_vv of the photo and control observations, then w, r, MDB and the effect, vectorised
+def observation_reliability(
+    p: BundleProblem, adj: Adjusted, alpha: float = 0.05, beta0: float = 0.80, alpha0=None
+) -> ObservationReliability:
+    """:class:`ObservationReliability` of every observation of a converged adjustment (with
+    covariances)."""
+    if adj.inverse is None or adj.qcp is None:
+        raise ValueError("the adjustment was made without covariances")
+    n, s = adj.normals, adj.solution
+    sig2 = p.sigma_photo_mm**2
+    qpp = s.point_covariances / s.sigma0**2
+    qcc = adj.inverse.blocks(p.obs_photo, p.obs_photo)
+    jc, jp, qcp = n.jc, n.jp, adj.qcp
+    qpi = qpp[p.obs_point]
+    # A·Q·Aᵀ per measurement (2 × 2), its diagonal: Jc·Qcc·Jcᵀ + 2·Jc·Qcp·Jpᵀ + Jp·Qpp·Jpᵀ
+    hat = (
+        np.einsum("nki,nij,nkj->nk", jc, qcc, jc)
+        + 2.0 * np.einsum("nki,nij,nkj->nk", jc, qcp, jp)
+        + np.einsum("nki,nij,nkj->nk", jp, qpi, jp)
+    )
+    qvv = np.maximum(sig2 - hat, 1e-12 * sig2)
+    pr = qvv / sig2
+    pv = n.v
+    effect = (np.einsum("nji,nkj->nki", qcp, jc) + np.einsum("nij,nkj->nki", qpi, jp)) / sig2
+    nc = p.control_point.size
+    with np.errstate(divide="ignore", invalid="ignore"):
+        given = p.control_weight > 0
+        sc2 = np.where(given, 1.0 / np.where(given, p.control_weight, 1.0), np.nan)
+        qc = qpp[p.control_point]
+        cq = np.where(given, np.maximum(sc2 - np.einsum("nii->ni", qc), 1e-12 * sc2), np.nan)
+        cr = cq / sc2
+        cv = np.where(given, p.control_m - s.points_m[p.control_point], np.nan)
+        ceff = np.where(given[:, :, None], np.swapaxes(qc, 1, 2) / sc2[:, :, None], np.nan)
+    n_tests = pv.size + int(np.count_nonzero(given))
+    a0, k, d0 = critical_values(n_tests, alpha, beta0, alpha0)
+    pmdb = d0 * np.sqrt(sig2 / pr)
+    with np.errstate(invalid="ignore"):
+        cmdb = d0 * np.sqrt(sc2 / cr)
+        c_effect = np.linalg.norm(ceff, axis=2) * cmdb if nc else np.zeros((0, 3))
+    return ObservationReliability(
+        pv,
+        pr,
+        pv / np.sqrt(qvv),
+        pmdb,
+        np.linalg.norm(effect, axis=2) * pmdb,
+        cv,
+        cr,
+        cv / np.sqrt(cq),
+        cmdb,
+        c_effect,
+        a0,
+        k,
+        d0,
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class Flag:
+    """An observation data snooping found: ``photo`` ('' for a catalogue observation),
+    ``point``, ``observation`` (x_mm, y_mm, X_m, Y_m, height_m), ``w`` and ``mdb`` (in the
+    observation's unit) when it was the largest |w| above k, ``round`` of the snooping;
+    ``inseparable`` the other observations of the point whose w correlates with this one's by
+    |ρ| ≥ :data:`INSEPARABLE` ("photo x_mm"): the blunder is found but cannot be told from
+    them (e.g. x on a point of three photos of one strip), and all of them were removed."""
+
+    photo: str
+    point: str
+    observation: str
+    w: float
+    mdb: float
+    round: int
+    inseparable: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class SnoopingResult:
+    """Iterated data snooping: the first adjustment (all observations) and the last (the flagged
+    ones removed), their problems, the flags in order, the reliability of the last, its global
+    test, of the measurements of the first problem those kept in the last (``kept``), and the
+    reliability and global test of the first."""
+
+    first: Adjusted
+    last: Adjusted
+    problem_first: BundleProblem
+    problem_last: BundleProblem
+    flags: tuple[Flag, ...]
+    reliability: ObservationReliability
+    global_test: GlobalTest
+    kept: NDArray[np.bool_]
+    reliability_first: ObservationReliability
+    global_test_first: GlobalTest
+
+
+def _remove_measurement(p: BundleProblem, keep: NDArray[np.bool_]) -> BundleProblem:
+    """The problem with the measurements of ``keep`` only; points left with one ray lose it,
+    control of points without two rays is dropped."""
+    rays = np.bincount(p.obs_point[keep], minlength=p.n_points)
+    keep = keep & (rays[p.obs_point] >= 2)
+    rays = np.bincount(p.obs_point[keep], minlength=p.n_points)
+    ck = rays[p.control_point] >= 2
+    return dataclasses.replace(
+        p,
+        xy_mm=p.xy_mm[keep],
+        obs_photo=p.obs_photo[keep],
+        obs_point=p.obs_point[keep],
+        obs_index=p.obs_index[keep],
+        control_point=p.control_point[ck],
+        control_m=p.control_m[ck],
+        control_weight=p.control_weight[ck],
+    )
+
+
+# long: the loop of data snooping: test, remove the largest, readjust, until none is above k
+def snoop(
+    p: BundleProblem,
+    *,
+    alpha: float = 0.05,
+    beta0: float = 0.80,
+    alpha0: float | None = None,
+    max_rounds: int = 50,
+    first: Adjusted | None = None,
+) -> SnoopingResult:
+    """Iterated data snooping of a bundle problem (module docstring). k is fixed by the number of
+    observations of the first adjustment."""
+    adj0 = first if first is not None else bundle_adjusted(p)
+    rel = rel0 = observation_reliability(p, adj0, alpha, beta0, alpha0)
+    a0 = rel.alpha0
+    adj, q, flags = adj0, p, []
+    for rnd in range(1, max_rounds + 1):
+        pw = np.abs(rel.photo_w)
+        cw = np.nan_to_num(np.abs(rel.control_w), nan=0.0)
+        best_p = np.unravel_index(int(np.argmax(pw)), pw.shape) if pw.size else None
+        best_c = np.unravel_index(int(np.argmax(cw)), cw.shape) if cw.size else None
+        wp = pw[best_p] if best_p is not None else 0.0
+        wc = cw[best_c] if best_c is not None else 0.0
+        if max(wp, wc) <= rel.k:
+            break
+        if wp >= wc:
+            o, c = best_p
+            rho, rows = _w_correlations(q, adj, o, c)
+            alike = np.abs(rho) >= INSEPARABLE
+            alike[rows == o, c] = False
+            others = tuple(
+                f"{q.photo_ids[q.obs_photo[rows[b]]]} {PHOTO_NAMES[d]}"
+                for b, d in zip(*np.nonzero(alike), strict=True)
+            )
+            flags.append(
+                Flag(
+                    q.photo_ids[q.obs_photo[o]],
+                    q.point_ids[q.obs_point[o]],
+                    PHOTO_NAMES[c],
+                    float(rel.photo_w[o, c]),
+                    float(rel.photo_mdb[o, c]),
+                    rnd,
+                    others,
+                )
+            )
+            keep = np.ones(q.obs_photo.size, bool)
+            keep[o] = False
+            keep[rows[np.any(alike, axis=1)]] = False
+            q = _remove_measurement(q, keep)
+        else:
+            k, c = best_c
+            flags.append(
+                Flag(
+                    "",
+                    q.point_ids[q.control_point[k]],
+                    CONTROL_NAMES[c],
+                    float(rel.control_w[k, c]),
+                    float(rel.control_mdb[k, c]),
+                    rnd,
+                )
+            )
+            weight = q.control_weight.copy()
+            weight[k, c] = 0.0
+            q = dataclasses.replace(q, control_weight=weight)
+        s = adj.solution
+        start = (s.orientations, np.where(np.isfinite(s.points_m), s.points_m, 0.0))
+        adj = bundle_adjusted(q, start)
+        rel = observation_reliability(q, adj, alpha, beta0, a0)
+    kept = np.isin(p.obs_index, q.obs_index)
+    g = global_test(adj.solution.sigma0, adj.redundancy, alpha)
+    g0 = global_test(adj0.solution.sigma0, adj0.redundancy, alpha)
+    return SnoopingResult(adj0, adj, p, q, tuple(flags), rel, g, kept, rel0, g0)
+
+
+def snooped_block(
+    block: Block,
+    *,
+    reject: bool = False,
+    alpha: float = 0.05,
+    alpha0: float | None = None,
+) -> tuple[BlockSolution, SnoopingResult]:
+    """Bundle adjustment of a block with iterated data snooping: the solution of all
+    observations, or with ``reject`` the one without the flagged observations; each photo's
+    covariance includes its interior orientation's, as :func:`~stereoplotter.triangulation.
+    bundle.bundle_block` gives it."""
+    p = problem(block)
+    result = snoop(p, alpha=alpha, alpha0=alpha0)
+    adj, q = (result.last, result.problem_last) if reject else (result.first, p)
+    s = adj.solution
+    extra = interior_orientation_covariance(block, q, s)
+    notes = (*s.notes, "σ of the elements include the interior orientation's (4 marks per photo)")
+    if reject and result.flags:
+        notes = (*notes, f"{len(result.flags)} flagged observations removed (--reject)")
+    return dataclasses.replace(s, covariances=s.covariances + extra, notes=notes), result
