@@ -248,7 +248,7 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
         stats_row("photo x, y", rel.photo_r, rel.photo_mdb, rel.photo_effect, "µm", 1000.0),
         stats_row(
             "control X, Y, height", rel.control_r, rel.control_mdb, rel.control_effect, "m", 1.0
-        ),  # fmt: skip
+        ),
         "",
     ]
     worst = int(np.argmax(rel.photo_effect.max(axis=1))) if rel.photo_r.size else 0
@@ -388,7 +388,7 @@ def report_markdown(
             "observations: `flagged.csv`."
             if snooping is not None
             else "."
-        ),  # fmt: skip
+        ),
         "",
     ]
     return "\n".join(lines)
