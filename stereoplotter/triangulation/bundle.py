@@ -335,8 +335,10 @@ def _step(p, orient, points, pairs):
 
 
 def weakest_photos(p: BundleProblem, reduced: sp.spmatrix, count: int = 4) -> str:
-    """``": weakest photos …"``: the photos whose own 6 × 6 block of the reduced matrix (at unit
-    diagonal) has the largest condition number, with it, for a message."""
+    """``"; weakest photos …"`` for a message: the photos whose own 6 × 6 block of the reduced
+    matrix (at unit diagonal) is worst conditioned — those beyond 10⁴ times the median
+    condition (at most ``count``; else the worst one) — each with its condition and the number
+    of points it measured."""
     n = p.n_photos
     d = reduced.diagonal()
     scale = 1.0 / np.sqrt(np.where(d > 0, d, 1.0))
@@ -351,9 +353,26 @@ def weakest_photos(p: BundleProblem, reduced: sp.spmatrix, count: int = 4) -> st
     with np.errstate(all="ignore"):
         cond = np.linalg.cond(blocks)
     cond = np.where(np.isfinite(cond), cond, np.inf)
-    worst = np.argsort(-cond, kind="stable")[:count]
-    text = ", ".join(f"{p.photo_ids_of([j])} (condition {cond[j]:.1e})" for j in worst)
+    order = np.argsort(-cond, kind="stable")
+    bad = order[cond[order] > 1e4 * np.median(cond)][:count]
+    worst = bad if bad.size else order[:1]
+    points = np.bincount(p.obs_photo, minlength=n)
+    text = ", ".join(
+        f"{p.photo_ids_of([j])} (condition {cond[j]:.1e}, {points[j]} points)" for j in worst
+    )
     return f"; weakest photos {text}"
+
+
+def _check_photos(p: BundleProblem) -> None:
+    """Refuse a photo that measured fewer than 3 points (its six elements are not fixed)."""
+    points = np.bincount(p.obs_photo, minlength=p.n_photos)
+    few = np.flatnonzero(points < 3)
+    if few.size:
+        raise GeometryError(
+            f"photo {p.photo_ids_of(few[:1])} measured {points[few[0]]} points of two or more "
+            f"photos: expected at least 3, well spread, to fix its six elements"
+            + (f" (also photos {p.photo_ids_of(few[1:6])})" if few.size > 1 else "")
+        )
 
 
 def _photo_covariances(sel: SelectedInverse, n_photos: int, sigma0: float):
@@ -461,6 +480,7 @@ def bundle_adjusted(
 ) -> Adjusted:
     """:func:`bundle_adjust` with the normals and the selected inverse at the solution
     (:class:`Adjusted`)."""
+    _check_photos(p)
     orient, points = initial if initial is not None else initial_approximation(p)
     orient, points = orient.copy(), points.copy()
     pairs = _pairs(p.obs_point)
