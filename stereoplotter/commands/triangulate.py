@@ -100,6 +100,21 @@ def add_arguments(sub: Any) -> None:
         metavar="MM",
         help="σ of a comparator coordinate [mm] (default 0.005: a stereocomparator)",
     )
+    s.add_argument(
+        "--centres",
+        type=bounded_float(1e-6, 100.0),
+        default=None,
+        metavar="SIGMA_M",
+        help="also measure every photo's projection centre (GNSS antenna) with this σ [m]",
+    )
+    s.add_argument(
+        "--lever-arm",
+        type=float,
+        nargs=3,
+        default=(0.0, 0.0, 0.0),
+        metavar=("X", "Y", "Z"),
+        help="the antenna in the camera system [m] (with --centres; default 0 0 0)",
+    )
     s.add_argument("--name", default="synthetic", help="name of the block")
     s.add_argument("--instrument", default="sc1", help="instrument of the production job")
     s.add_argument(
@@ -225,6 +240,8 @@ def run_synth(args: argparse.Namespace) -> int:
         name=args.name,
         control_every_bases=args.control_every,
         sigma_photo_mm=args.sigma_photo,
+        centre_sigma_m=args.centres,
+        lever_arm_m=tuple(args.lever_arm),
     )
     rng = np.random.default_rng([args.seed, key_code("block synth")])
     block, truth = synthesize_block(spec, rng)

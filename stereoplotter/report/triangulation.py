@@ -209,11 +209,13 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
             "|---:|---|---|---|---:|---:|---|",
         ]
         for f in sn.flags:
-            unit = "µm" if f.photo else "m"
-            mdb = f.mdb * 1000 if f.photo else f.mdb
+            photo_mm = f.observation.endswith("_mm")
+            unit = "µm" if photo_mm else "m"
+            mdb = f.mdb * 1000 if photo_mm else f.mdb
             lines.append(
-                f"| {f.round} | {f.photo or '(catalogue)'} | {f.point} | {f.observation} | "
-                f"{f.w:.1f} | {mdb:.3g} {unit} | {', '.join(f.inseparable) or '—'} |"
+                f"| {f.round} | {f.photo or '(catalogue)'} | {f.point or '(centre)'} | "
+                f"{f.observation} | {f.w:.1f} | {mdb:.3g} {unit} | "
+                f"{', '.join(f.inseparable) or '—'} |"
             )
         lines += [
             "",
@@ -236,7 +238,8 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
         weak = int(np.count_nonzero(r < 0.01))
         return (
             f"| {name} | {r.size} | {r.min():.3f} | {r.mean():.3f} | {weak} | "
-            f"{np.median(mdb) * k:.3g} {unit} | {_num(np.max(effect, initial=0.0), '.3f')} m |"
+            f"{np.median(mdb) * k:.3g} {unit} | "
+            + (f"{np.max(effect):.3f} m |" if effect.size else "— |")
         )
 
     lines += [
@@ -249,8 +252,11 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
         stats_row(
             "control X, Y, height", rel.control_r, rel.control_mdb, rel.control_effect, "m", 1.0
         ),
-        "",
     ]
+    if rel.centre_r.size:
+        none = np.full_like(rel.centre_r, np.nan)
+        lines.append(stats_row("projection centres", rel.centre_r, rel.centre_mdb, none, "m", 1.0))
+    lines.append("")
     worst = int(np.argmax(rel.photo_effect.max(axis=1))) if rel.photo_r.size else 0
     pr = rel.photo_r
     lines += [

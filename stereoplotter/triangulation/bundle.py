@@ -31,9 +31,11 @@ from numpy.typing import NDArray
 
 from stereoplotter.errors import GeometryError
 from stereoplotter.geometry.resection import _model_and_jacobian
+from stereoplotter.geometry.rotation import rotation_matrix
 from stereoplotter.triangulation.block import (
     Block,
     catalogue_local,
+    centres_local,
     interior_orientation,
     photo_coordinates,
 )
@@ -63,7 +65,9 @@ class BundleProblem:
     ``obs_point`` their photo and point; ``control_point`` (n_c,) the points with catalogue
     coordinates ``control_m`` (n_c, 3) and weights ``control_weight`` (n_c, 3) [1/m², 0 where a
     coordinate is not given]; ``f_mm``; ``sigma_photo_mm``; ``point_ids`` and ``photo_ids``
-    (for messages); ``obs_index`` each measurement's row in the block.
+    (for messages); ``obs_index`` each measurement's row in the block; ``centre_photo`` (n_g,)
+    the photos with a measured projection centre (GNSS antenna) ``centre_m`` (n_g, 3), weights
+    ``centre_weight`` (n_g, 3) [1/m²], ``lever_arm_m`` (3,) the antenna in the camera system.
     """
 
     xy_mm: NDArray[np.float64]
@@ -79,6 +83,12 @@ class BundleProblem:
     point_ids: tuple[str, ...] = ()
     photo_ids: tuple[str, ...] = ()
     obs_index: NDArray[np.int64] | None = None
+    centre_photo: NDArray[np.int64] = dataclasses.field(
+        default_factory=lambda: np.zeros(0, np.int64)
+    )
+    centre_m: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
+    centre_weight: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
+    lever_arm_m: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self) -> None:
         if self.obs_index is None:  # the measurements of the block, in its order
@@ -108,6 +118,7 @@ def problem(block: Block) -> BundleProblem:
         cp.append(where[p.id])
         cm.append(local[k])
         cw.append((plan, plan, height))
+    gp, gm = centres_local(block)
     return BundleProblem(
         xy_mm=interior_orientation(block)[keep],
         obs_photo=block.obs_photo[keep],
@@ -122,6 +133,13 @@ def problem(block: Block) -> BundleProblem:
         point_ids=block.point_ids,
         photo_ids=block.photos,
         obs_index=np.flatnonzero(keep),
+        centre_photo=gp,
+        centre_m=gm,
+        centre_weight=np.tile(
+            [1.0 / s.centre_plan_m**2, 1.0 / s.centre_plan_m**2, 1.0 / s.centre_height_m**2],
+            (gp.size, 1),
+        ),
+        lever_arm_m=np.asarray(block.lever_arm_m, float),
     )
 
 
@@ -130,20 +148,27 @@ def initial_approximation(p: BundleProblem) -> tuple[NDArray, NDArray]:
 
     Every photo taken as vertical: its plan is a similarity of the photo coordinates,
     X + iY = A·(x + iy) + C (A = (Z_S − Z)/f·e^{iκ}, Eq. (2.52) with α = ω = 0), one A and C per
-    photo, tied by the common points and to the plan control; all in one sparse linear least
-    squares. Then κ = arg A, (X_S, Y_S) = C, Z_S = Z̄ + |A|·f with Z̄ the mean control height, and
-    every point at Z̄. This is an assumption of this package (the photo-mosaic start of block
-    adjustments), not a method of the book.
+    photo, tied by the common points and to the plan control and the measured centres' plan;
+    all in one sparse linear least squares. Then κ = arg A, (X_S, Y_S) = C, Z_S = Z̄ + |A|·f
+    with Z̄ the mean control height (without height control: the mean of Z_S − |A|·f of the
+    measured centres), a measured centre's Z_S its own, and every point at Z̄. This is an
+    assumption of this package (the photo-mosaic start of block adjustments), not a method of
+    the book.
 
     Raises
     ------
     GeometryError
-        Fewer than two plan control points, or a block whose photos are not all connected.
+        Fewer than two plan control points and measured centres, or a block whose photos are
+        not all connected.
     """
     n_obs, npho = p.obs_photo.size, p.n_photos
     plan = np.flatnonzero(p.control_weight[:, 0] > 0)
-    if plan.size < 2:
-        raise GeometryError(f"the block has {plan.size} plan control points: expected at least 2")
+    gj = p.centre_photo
+    if plan.size + gj.size < 2:
+        raise GeometryError(
+            f"the block has {plan.size} plan control points and {gj.size} measured projection "
+            "centres: expected at least 2 of them"
+        )
     # unknowns: per photo (A_re, A_im, C_re, C_im), per point (X, Y)
     x, y = p.xy_mm[:, 0], p.xy_mm[:, 1]
     j4, i2 = 4 * p.obs_photo, 4 * npho + 2 * p.obs_point
@@ -152,13 +177,15 @@ def initial_approximation(p: BundleProblem) -> tuple[NDArray, NDArray]:
     vals = np.concatenate(
         [x, -y, np.ones(n_obs), -np.ones(n_obs), y, x, np.ones(n_obs), -np.ones(n_obs)]
     )
-    cidx = 4 * npho + 2 * p.control_point[plan]
-    w = 1e3  # control as strong observations: the plan datum of the mosaic
-    nc = plan.size
+    # control and measured centres as strong observations: the plan datum of the mosaic
+    w = 1e3
+    cidx = np.concatenate([4 * npho + 2 * p.control_point[plan], 4 * gj + 2])
+    target = np.concatenate([p.control_m[plan, :2], p.centre_m[:, :2]])
+    nc = cidx.size
     rows = np.concatenate([rows, 2 * n_obs + np.arange(2 * nc)])
     cols = np.concatenate([cols, cidx, cidx + 1])
     vals = np.concatenate([vals, np.full(2 * nc, w)])
-    rhs = np.concatenate([np.zeros(2 * n_obs), w * p.control_m[plan, 0], w * p.control_m[plan, 1]])
+    rhs = np.concatenate([np.zeros(2 * n_obs), w * target[:, 0], w * target[:, 1]])
     a = sp.csr_matrix((vals, (rows, cols)), shape=(2 * n_obs + 2 * nc, 4 * npho + 2 * p.n_points))
     used = np.zeros(a.shape[1], bool)
     used[cols] = True
@@ -172,14 +199,17 @@ def initial_approximation(p: BundleProblem) -> tuple[NDArray, NDArray]:
         ) from None
     A = sol[0 : 4 * npho : 4] + 1j * sol[1 : 4 * npho : 4]
     C = sol[2 : 4 * npho : 4] + 1j * sol[3 : 4 * npho : 4]
-    zbar = (
-        float(np.mean(p.control_m[p.control_weight[:, 2] > 0, 2]))
-        if np.any(p.control_weight[:, 2] > 0)
-        else 0.0
-    )
+    heights = p.control_weight[:, 2] > 0
+    if np.any(heights):
+        zbar = float(np.mean(p.control_m[heights, 2]))
+    elif gj.size:  # the ground below the measured centres
+        zbar = float(np.mean(p.centre_m[:, 2] - np.abs(A[gj]) * p.f_mm))
+    else:
+        zbar = 0.0
     orient = np.column_stack(
         [np.zeros(npho), np.zeros(npho), np.angle(A), C.real, C.imag, zbar + np.abs(A) * p.f_mm]
     )
+    orient[gj, 5] = p.centre_m[:, 2]
     pts = sol[4 * npho :].reshape(-1, 2)
     points = np.column_stack([pts, np.full(p.n_points, zbar)])
     return orient, points
@@ -202,6 +232,27 @@ def _linearise(p: BundleProblem, orient: NDArray, points: NDArray) -> tuple[NDAr
         v[rows] = p.xy_mm[rows] - computed
         jac[rows] = jj
     return v, jac
+
+
+def centre_residuals(p: BundleProblem, orient: NDArray) -> tuple[NDArray, NDArray]:
+    """Residuals v = measured − computed (n_g, 3) [m] of the measured projection centres and
+    their Jacobian ∂(antenna)/∂(photo elements) (n_g, 3, 6): antenna = S + M·e, M of
+    Eq. (2.50), e the lever arm (∂M/∂angles by central differences, h = 10⁻⁶ rad: error
+    ~10⁻¹² of |e|)."""
+    o = orient[p.centre_photo]
+    e = p.lever_arm_m
+    m = rotation_matrix(o[:, 0], o[:, 1], o[:, 2])
+    computed = o[:, 3:] + m @ e
+    jac = np.zeros((o.shape[0], 3, 6))
+    jac[:, :, 3:] = np.eye(3)
+    h = 1e-6
+    for k in range(3):
+        d = np.zeros(3)
+        d[k] = h
+        plus = rotation_matrix(o[:, 0] + d[0], o[:, 1] + d[1], o[:, 2] + d[2])
+        minus = rotation_matrix(o[:, 0] - d[0], o[:, 1] - d[1], o[:, 2] - d[2])
+        jac[:, :, k] = (plus - minus) @ e / (2 * h)
+    return p.centre_m - computed, jac
 
 
 @dataclass(frozen=True, slots=True)
@@ -270,6 +321,12 @@ def normals(p: BundleProblem, orient: NDArray, points: NDArray, pairs: _Pairs) -
     npp[p.control_point] += np.einsum("ni,ij->nij", p.control_weight, np.eye(3))
     bp[p.control_point] += p.control_weight * dc
     vv = float(np.sum(v**2) * w + np.sum(p.control_weight * dc**2))
+    if p.centre_photo.size:
+        vg, jg = centre_residuals(p, orient)
+        wg = p.centre_weight
+        np.add.at(ncc, p.centre_photo, np.einsum("nki,nk,nkj->nij", jg, wg, jg))
+        np.add.at(bc, p.centre_photo, np.einsum("nki,nk,nk->ni", jg, wg, vg))
+        vv += float(np.sum(wg * vg**2))
     unused = np.bincount(p.obs_point, minlength=p.n_points) == 0
     npp[unused] = np.eye(3)
     det = np.linalg.det(npp)
@@ -506,7 +563,11 @@ def bundle_adjusted(
         )
     n = normals(p, orient, points, pairs)
     used = ~n.unused
-    n_obs = 2 * p.obs_photo.size + int(np.count_nonzero(p.control_weight))
+    n_obs = (
+        2 * p.obs_photo.size
+        + int(np.count_nonzero(p.control_weight))
+        + int(np.count_nonzero(p.centre_weight))
+    )
     redundancy = n_obs - 6 * p.n_photos - 3 * int(used.sum())
     sigma0 = float(np.sqrt(n.vv / redundancy)) if redundancy > 0 else float("nan")
     points[~used] = np.nan

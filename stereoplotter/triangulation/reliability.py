@@ -44,6 +44,7 @@ from stereoplotter.triangulation.bundle import (
     Adjusted,
     BundleProblem,
     bundle_adjusted,
+    centre_residuals,
     interior_orientation_covariance,
     problem,
 )
@@ -65,6 +66,8 @@ __all__ = [
 #: catalogue's σ_height applies to).
 CONTROL_NAMES = ("X_m", "Y_m", "height_m")
 PHOTO_NAMES = ("x_mm", "y_mm")
+#: … and of the measured projection centres (local X, Y, Z of the antenna).
+CENTRE_NAMES = ("centre_X_m", "centre_Y_m", "centre_Z_m")
 #: |ρ| of two w above which the two blunders cannot be told apart (Baarda's separability).
 INSEPARABLE = 0.99
 
@@ -143,7 +146,9 @@ class ObservationReliability:
     ``photo_w`` [—], ``photo_mdb`` [mm], ``photo_effect`` (n_obs, 2) |∇X| of the point
     [m]; control coordinates, shape (n_control, 3) for X, Y, Z (NaN where not given):
     ``control_v`` [m], ``control_r``, ``control_w``, ``control_mdb`` [m],
-    ``control_effect`` [m]. ``delta0`` and ``k`` of :func:`critical_values`.
+    ``control_effect`` [m]; measured projection centres, shape (n_centres, 3) for X, Y, Z:
+    ``centre_v`` [m], ``centre_r``, ``centre_w``, ``centre_mdb`` [m]. ``delta0`` and ``k`` of
+    :func:`critical_values`.
     """
 
     photo_v: NDArray[np.float64]
@@ -156,13 +161,21 @@ class ObservationReliability:
     control_w: NDArray[np.float64]
     control_mdb: NDArray[np.float64]
     control_effect: NDArray[np.float64]
+    centre_v: NDArray[np.float64]
+    centre_r: NDArray[np.float64]
+    centre_w: NDArray[np.float64]
+    centre_mdb: NDArray[np.float64]
     alpha0: float
     k: float
     delta0: float
 
     @property
     def n_tests(self) -> int:
-        return int(self.photo_w.size + np.count_nonzero(np.isfinite(self.control_w)))
+        return int(
+            self.photo_w.size
+            + np.count_nonzero(np.isfinite(self.control_w))
+            + np.count_nonzero(np.isfinite(self.centre_w))
+        )
 
 
 # long: Q_vv of the photo and control observations, then w, r, MDB and the effect, vectorised
@@ -198,7 +211,8 @@ def observation_reliability(
         cr = cq / sc2
         cv = np.where(given, p.control_m - s.points_m[p.control_point], np.nan)
         ceff = np.where(given[:, :, None], np.swapaxes(qc, 1, 2) / sc2[:, :, None], np.nan)
-    n_tests = pv.size + int(np.count_nonzero(given))
+    gv, gr, gq, gs2 = _centre_cofactors(p, adj)
+    n_tests = pv.size + int(np.count_nonzero(given)) + int(np.count_nonzero(np.isfinite(gq)))
     a0, k, d0 = critical_values(n_tests, alpha, beta0, alpha0)
     pmdb = d0 * np.sqrt(sig2 / pr)
     with np.errstate(invalid="ignore"):
@@ -215,16 +229,37 @@ def observation_reliability(
         cv / np.sqrt(cq),
         cmdb,
         c_effect,
+        gv,
+        gr,
+        gv / np.sqrt(gq),
+        d0 * np.sqrt(gs2 / gr),
         a0,
         k,
         d0,
     )
 
 
+def _centre_cofactors(p: BundleProblem, adj: Adjusted):
+    """Residual, redundancy number, q_vv and a priori variance (n_centres, 3) of the measured
+    projection centres (NaN where a coordinate is not weighted)."""
+    if not p.centre_photo.size:
+        empty = np.zeros((0, 3))
+        return empty, empty, empty, empty
+    v, jg = centre_residuals(p, adj.solution.orientations)
+    qcc = adj.inverse.blocks(p.centre_photo, p.centre_photo)
+    hat = np.einsum("nki,nij,nkj->nk", jg, qcc, jg)
+    given = p.centre_weight > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s2 = np.where(given, 1.0 / np.where(given, p.centre_weight, 1.0), np.nan)
+        q = np.where(given, np.maximum(s2 - hat, 1e-12 * s2), np.nan)
+    return np.where(given, v, np.nan), q / s2, q, s2
+
+
 @dataclass(frozen=True, slots=True)
 class Flag:
     """An observation data snooping found: ``photo`` ('' for a catalogue observation),
-    ``point``, ``observation`` (x_mm, y_mm, X_m, Y_m, height_m), ``w`` and ``mdb`` (in the
+    ``point`` ('' for a measured projection centre), ``observation`` (x_mm, y_mm, X_m, Y_m,
+    height_m, centre_X_m, centre_Y_m, centre_Z_m), ``w`` and ``mdb`` (in the
     observation's unit) when it was the largest |w| above k, ``round`` of the snooping;
     ``inseparable`` the other observations of the point whose w correlates with this one's by
     |ρ| ≥ :data:`INSEPARABLE` ("photo x_mm"): the blunder is found but cannot be told from
@@ -298,11 +333,29 @@ def snoop(
         cw = np.nan_to_num(np.abs(rel.control_w), nan=0.0)
         best_p = np.unravel_index(int(np.argmax(pw)), pw.shape) if pw.size else None
         best_c = np.unravel_index(int(np.argmax(cw)), cw.shape) if cw.size else None
+        gw = np.nan_to_num(np.abs(rel.centre_w), nan=0.0)
+        best_g = np.unravel_index(int(np.argmax(gw)), gw.shape) if gw.size else None
         wp = pw[best_p] if best_p is not None else 0.0
         wc = cw[best_c] if best_c is not None else 0.0
-        if max(wp, wc) <= rel.k:
+        wg = gw[best_g] if best_g is not None else 0.0
+        if max(wp, wc, wg) <= rel.k:
             break
-        if wp >= wc:
+        if wg > max(wp, wc):
+            g, c = best_g
+            flags.append(
+                Flag(
+                    q.photo_ids[q.centre_photo[g]],
+                    "",
+                    CENTRE_NAMES[c],
+                    float(rel.centre_w[g, c]),
+                    float(rel.centre_mdb[g, c]),
+                    rnd,
+                )
+            )
+            weight = q.centre_weight.copy()
+            weight[g, c] = 0.0
+            q = dataclasses.replace(q, centre_weight=weight)
+        elif wp >= wc:
             o, c = best_p
             rho, rows = _w_correlations(q, adj, o, c)
             alike = np.abs(rho) >= INSEPARABLE

@@ -52,7 +52,8 @@ class SynthSpec:
     nadir must stay in the usable field), σ 5 µm per comparator coordinate (a
     stereocomparator), control to 5 cm. ``control_stations`` (base numbers 0 … n_bases along
     every strip) replaces the regular ``control_every_bases`` (e.g.
-    :func:`control_stations_for_degree`).
+    :func:`control_stations_for_degree`). ``centre_sigma_m``: every photo's GNSS antenna
+    (S + M·``lever_arm_m``) measured with this σ on each axis (None: no centres).
     """
 
     strips: int = 4
@@ -72,6 +73,8 @@ class SynthSpec:
     sigma_photo_mm: float = 0.005
     sigma_control_m: float = 0.05
     film_deformation_ppm: float = 50.0
+    centre_sigma_m: float | None = None
+    lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     origin_sk42_m: tuple[float, float, float] = DEFAULT_ORIGIN_SK42_M
     name: str = "synthetic"
 
@@ -246,5 +249,21 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
         for i, s in zip(in_catalogue, sk42, strict=True)
     )
     sigmas = Sigmas(spec.sigma_photo_mm, spec.sigma_control_m, spec.sigma_control_m)
-    block = dataclasses.replace(block0, catalogue=catalogue, sigmas=sigmas)
+    centres: tuple = ()
+    if spec.centre_sigma_m is not None:
+        sigmas = dataclasses.replace(
+            sigmas, centre_plan_m=spec.centre_sigma_m, centre_height_m=spec.centre_sigma_m
+        )
+        antenna = stations[:, 3:] + rot @ np.asarray(spec.lever_arm_m)
+        antenna += rng.normal(0.0, spec.centre_sigma_m, antenna.shape)
+        geo = sk42_from_block_local(block0, antenna)
+        photos = [p for strip in strips for p in strip]
+        centres = tuple((p, tuple(map(float, g))) for p, g in zip(photos, geo, strict=True))
+    block = dataclasses.replace(
+        block0,
+        catalogue=catalogue,
+        sigmas=sigmas,
+        centres=centres,
+        lever_arm_m=tuple(map(float, spec.lever_arm_m)),
+    )
     return block, Truth(stations, points, terrain)
