@@ -66,6 +66,13 @@ def add_arguments(sub: Any) -> None:
         help="bundle: level of one w-test (default: family-wise 5 %% over all observations "
         "by Šidák; Baarda's classical value is 0.001)",
     )
+    p.add_argument(
+        "--self-calibrate",
+        default="",
+        metavar="PARAMS",
+        help="bundle: adjust camera parameters with the block, comma-separated among "
+        "f,x0,y0,k1,k2,p1,p2 or 'all' (default none: the certificate holds)",
+    )
     p.set_defaults(func=run)
     b = sub.add_parser("block", help="blocks of comparator measurements (docs/triangulation.md)")
     acts = b.add_subparsers(dest="block_command", required=True, metavar="ACTION")
@@ -125,13 +132,35 @@ def add_arguments(sub: Any) -> None:
     s.set_defaults(func=run_synth)
 
 
+def _camera_parameters(text: str) -> tuple[str, ...]:
+    """``--self-calibrate``'s list: names of the camera model, or ``all``."""
+    from stereoplotter.triangulation.camera_model import CAMERA_PARAMETERS
+
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    if names == ("all",):
+        return CAMERA_PARAMETERS
+    bad = [n for n in names if n not in CAMERA_PARAMETERS]
+    if bad:
+        from stereoplotter.errors import ConfigError
+
+        raise ConfigError(
+            "--self-calibrate", "(option)", "names among " + ",".join(CAMERA_PARAMETERS), bad[0]
+        )
+    return names
+
+
 def _solve(block: Any, args: argparse.Namespace) -> tuple[Any, Any]:
     """The solution and, for the bundle, its data snooping (else None)."""
     # imported here: the CLI starts without loading scipy's sparse solvers
     if args.method == "bundle":
         from stereoplotter.triangulation.reliability import snooped_block
 
-        return snooped_block(block, reject=args.reject, alpha0=args.alpha0)
+        return snooped_block(
+            block,
+            reject=args.reject,
+            alpha0=args.alpha0,
+            self_calibration=_camera_parameters(args.self_calibrate),
+        )
     from stereoplotter.triangulation import strip
 
     if args.method == "strip":

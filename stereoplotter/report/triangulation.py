@@ -19,6 +19,7 @@ from stereoplotter.constants import ARCSEC_PER_RAD
 from stereoplotter.triangulation.block import Block, sk42_from_block_local
 from stereoplotter.triangulation.bundle import BundleProblem
 from stereoplotter.triangulation.reliability import Flag, ObservationReliability, SnoopingResult
+from stereoplotter.triangulation.self_calibration import CameraCalibration, camera_calibration
 from stereoplotter.triangulation.solution import (
     BlockSolution,
     CatalogueResiduals,
@@ -275,6 +276,31 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
     return lines
 
 
+def _camera_lines(c: CameraCalibration) -> list[str]:
+    verdict = "significant" if c.group_significant else "not significant"
+    lines = [
+        "## Self-calibration of the camera",
+        "",
+        f"Group test of all {len(c.names)} parameters against the certificate: F = "
+        f"{c.f_statistic:.2f}, critical F = {c.f_critical:.2f} (α = {c.alpha:g}), p = "
+        f"{c.p_value:.2g}: **{verdict}**. Each alone: |t| against {c.t_critical:.2f} "
+        f"(α = {c.alpha:g} shared by the {len(c.names)}, Bonferroni).",
+        "",
+        "| parameter | certificate | adjusted | σ | t | significant |",
+        "|---|---:|---:|---:|---:|---|",
+    ]
+    for k, name in enumerate(c.names):
+        lines.append(
+            f"| {name} [{c.units[k]}] | {c.certificate[k]:.6g} | {c.values[k]:.6g} | "
+            f"{c.sigma[k]:.3g} | {c.t[k]:+.2f} | {'yes' if c.significant[k] else 'no'} |"
+        )
+    lines += ["", "Correlations:", "", "| | " + " | ".join(c.names) + " |",
+              "|---|" + "---:|" * len(c.names)]  # fmt: skip
+    for k, name in enumerate(c.names):
+        lines.append(f"| {name} | " + " | ".join(f"{v:+.2f}" for v in c.correlation[k]) + " |")
+    return [*lines, ""]
+
+
 # long: the report's sections one after the other (block, tests, residuals, precision, photos)
 def report_markdown(
     block: Block,
@@ -307,6 +333,10 @@ def report_markdown(
     ]
     if snooping is not None:
         lines += _snooping_lines(block, snooping, reject)
+        prob = snooping.problem_last if reject else snooping.problem_first
+        if prob.camera_free:
+            adj = snooping.last if reject else snooping.first
+            lines += _camera_lines(camera_calibration(prob, adj))
     lines += [
         "## Residuals at control and check points (triangulated − catalogue) [m]",
         "",

@@ -39,6 +39,7 @@ from stereoplotter.triangulation.block import (
     interior_orientation,
     photo_coordinates,
 )
+from stereoplotter.triangulation.camera_model import CAMERA_PARAMETERS, camera_image
 from stereoplotter.triangulation.selected_inverse import SelectedInverse, selected_inverse
 from stereoplotter.triangulation.solution import BlockSolution, sparse_least_squares
 
@@ -46,12 +47,14 @@ __all__ = [
     "Adjusted",
     "BundleProblem",
     "Normals",
+    "PhotoCofactors",
     "bundle_adjust",
     "bundle_adjusted",
     "bundle_block",
     "initial_approximation",
     "interior_orientation_covariance",
     "normals",
+    "photo_cofactors",
     "point_cofactors",
     "problem",
 ]
@@ -67,7 +70,9 @@ class BundleProblem:
     coordinate is not given]; ``f_mm``; ``sigma_photo_mm``; ``point_ids`` and ``photo_ids``
     (for messages); ``obs_index`` each measurement's row in the block; ``centre_photo`` (n_g,)
     the photos with a measured projection centre (GNSS antenna) ``centre_m`` (n_g, 3), weights
-    ``centre_weight`` (n_g, 3) [1/m²], ``lever_arm_m`` (3,) the antenna in the camera system.
+    ``centre_weight`` (n_g, 3) [1/m²], ``lever_arm_m`` (3,) the antenna in the camera system;
+    ``camera_free`` the camera parameters adjusted with the block (self-calibration, names of
+    :data:`~stereoplotter.triangulation.camera_model.CAMERA_PARAMETERS`; none by default).
     """
 
     xy_mm: NDArray[np.float64]
@@ -89,6 +94,16 @@ class BundleProblem:
     centre_m: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
     centre_weight: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
     lever_arm_m: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros(3))
+    camera_free: tuple[str, ...] = ()
+
+    @property
+    def free(self) -> NDArray[np.int64]:
+        """Indices into :data:`CAMERA_PARAMETERS` of the camera parameters adjusted."""
+        return np.array([CAMERA_PARAMETERS.index(n) for n in self.camera_free], np.int64)
+
+    def camera0(self) -> NDArray[np.float64]:
+        """The certificate's camera: f and zero principal point offset and distortion."""
+        return np.array([self.f_mm, 0, 0, 0, 0, 0, 0], float)
 
     def __post_init__(self) -> None:
         if self.obs_index is None:  # the measurements of the block, in its order
@@ -101,9 +116,17 @@ class BundleProblem:
         )
 
 
-def problem(block: Block) -> BundleProblem:
+def problem(block: Block, self_calibration: tuple[str, ...] = ()) -> BundleProblem:
     """The bundle problem of a block: interior orientation applied, control in the local system,
-    points measured on fewer than two photos left out (they add nothing)."""
+    points measured on fewer than two photos left out (they add nothing); the camera parameters
+    of ``self_calibration`` (names of :data:`~stereoplotter.triangulation.camera_model.
+    CAMERA_PARAMETERS`) adjusted with the block."""
+    unknown = [n for n in self_calibration if n not in CAMERA_PARAMETERS]
+    if unknown:
+        raise GeometryError(
+            f"self-calibration: expected parameters among {', '.join(CAMERA_PARAMETERS)}, "
+            f"found {unknown[0]!r}"
+        )
     rays = np.bincount(block.obs_point, minlength=len(block.point_ids))
     keep = rays[block.obs_point] >= 2
     where = {pid: i for i, pid in enumerate(block.point_ids)}
@@ -140,6 +163,7 @@ def problem(block: Block) -> BundleProblem:
             (gp.size, 1),
         ),
         lever_arm_m=np.asarray(block.lever_arm_m, float),
+        camera_free=tuple(n for n in CAMERA_PARAMETERS if n in self_calibration),
     )
 
 
@@ -215,23 +239,34 @@ def initial_approximation(p: BundleProblem) -> tuple[NDArray, NDArray]:
     return orient, points
 
 
-def _linearise(p: BundleProblem, orient: NDArray, points: NDArray) -> tuple[NDArray, NDArray]:
-    """Residuals v = measured − computed (n_obs, 2) [mm] and Jacobians ∂(x, y)/∂(photo elements)
-    (n_obs, 2, 6) of Eq. (2.53), photo by photo (∂/∂(X, Y, Z) = −∂/∂(X_S, Y_S, Z_S))."""
+def _linearise(
+    p: BundleProblem, orient: NDArray, points: NDArray, camera: NDArray | None = None
+) -> tuple[NDArray, NDArray, NDArray]:
+    """Residuals v = measured − computed (n_obs, 2) [mm], Jacobians ∂(x, y)/∂(photo elements)
+    (n_obs, 2, 6) of Eq. (2.53), photo by photo (∂/∂(X, Y, Z) = −∂/∂(X_S, Y_S, Z_S)), and
+    ∂(x, y)/∂(free camera parameters) (n_obs, 2, n_free) (:mod:`~stereoplotter.triangulation.
+    camera_model`; the certificate's camera by default)."""
+    cam = p.camera0() if camera is None else camera
     v = np.empty_like(p.xy_mm)
     jac = np.empty((p.xy_mm.shape[0], 2, 6))
+    jg = np.empty((p.xy_mm.shape[0], 2, p.free.size))
     order = np.argsort(p.obs_photo, kind="stable")
     bounds = np.searchsorted(p.obs_photo[order], np.arange(p.n_photos + 1))
+    plain = not p.camera_free and np.all(cam[1:] == 0.0)
     for j in range(p.n_photos):
         rows = order[bounds[j] : bounds[j + 1]]
         if rows.size == 0:
             continue
         computed, jj = _model_and_jacobian(
-            orient[j], points[p.obs_point[rows]], p.f_mm, np.zeros(2)
+            orient[j], points[p.obs_point[rows]], float(cam[0]), np.zeros(2)
         )
+        if not plain:
+            computed, d, jcam = camera_image(computed, cam)
+            jj = np.einsum("nij,njk->nik", d, jj)
+            jg[rows] = jcam[:, :, p.free]
         v[rows] = p.xy_mm[rows] - computed
         jac[rows] = jj
-    return v, jac
+    return v, jac, jg
 
 
 def centre_residuals(p: BundleProblem, orient: NDArray) -> tuple[NDArray, NDArray]:
@@ -283,6 +318,9 @@ class Normals:
     measurement's Jcᵀ·w·Jp; ``pinv`` (n_points, 3, 3) the inverse point blocks N_pp⁻¹ (control
     weights included); ``reduced`` the reduced matrix N_cc − N_cp·N_pp⁻¹·N_pc (sparse, 6 × 6
     blocks); ``rhs`` its right side (n_photos, 6); ``bp`` the points' right side; ``vv`` [pvv].
+    With free camera parameters (n_g of them) the border: ``jg`` (n_obs, 2, n_g) their
+    Jacobian, ``ngp`` (n_obs, n_g, 3) each measurement's Jgᵀ·w·Jp, ``sgc`` (n_g, 6·n_photos)
+    and ``sgg`` (n_g, n_g) the reduced border, ``rg`` (n_g,) its right side.
     """
 
     v: NDArray[np.float64]
@@ -295,18 +333,29 @@ class Normals:
     bp: NDArray[np.float64]
     vv: float
     unused: NDArray[np.bool_]
+    jg: NDArray[np.float64] | None = None
+    ngp: NDArray[np.float64] | None = None
+    sgc: NDArray[np.float64] | None = None
+    sgg: NDArray[np.float64] | None = None
+    rg: NDArray[np.float64] | None = None
 
 
 # long: normal blocks, point elimination and the reduced matrix in one pass over the measurements
-def normals(p: BundleProblem, orient: NDArray, points: NDArray, pairs: _Pairs) -> Normals:
-    """The reduced normal equations of the bundle at (orient, points) (:class:`Normals`).
+def normals(
+    p: BundleProblem,
+    orient: NDArray,
+    points: NDArray,
+    pairs: _Pairs,
+    camera: NDArray | None = None,
+) -> Normals:
+    """The reduced normal equations of the bundle at (orient, points, camera) (:class:`Normals`).
 
     Raises
     ------
     GeometryError
         A point whose rays do not fix it (names the point and its photos).
     """
-    v, jc = _linearise(p, orient, points)
+    v, jc, jg = _linearise(p, orient, points, camera)
     w = 1.0 / p.sigma_photo_mm**2
     jp = -jc[:, :, 3:]
     ncc = np.zeros((p.n_photos, 6, 6))
@@ -366,12 +415,28 @@ def normals(p: BundleProblem, orient: NDArray, points: NDArray, pairs: _Pairs) -
     reduced_p = np.einsum("nij,nj->ni", pinv, bp)
     rhs = bc.copy()
     np.add.at(rhs, p.obs_photo, -np.einsum("nij,nj->ni", ncp, reduced_p[p.obs_point]))
-    return Normals(v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused)
+    if not p.camera_free:
+        return Normals(v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused)
+    ng = jg.shape[2]
+    ngp = w * np.einsum("nki,nkj->nij", jg, jp)
+    ngc = w * np.einsum("nki,nkj->nij", jg, jc)
+    sgc = np.zeros((ng, p.n_photos, 6))
+    np.add.at(sgc, (slice(None), p.obs_photo), np.swapaxes(ngc, 0, 1))
+    cross = np.einsum("nij,njk,nlk->nil", ngp[pairs.first], pinv[pt], ncp[pairs.second])
+    np.add.at(sgc, (slice(None), js), -np.swapaxes(cross, 0, 1))
+    sgg = w * np.einsum("nki,nkj->ij", jg, jg)
+    sgg -= np.einsum("nij,njk,nlk->il", ngp[pairs.first], pinv[pt], ngp[pairs.second])
+    rg = w * np.einsum("nki,nk->i", jg, v) - np.einsum("nij,nj->i", ngp, reduced_p[p.obs_point])
+    return Normals(
+        v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused, jg, ngp, sgc.reshape(ng, -1), sgg, rg
+    )
 
 
-def _step(p, orient, points, pairs):
-    """One Gauss–Newton step: corrections of orientations and points, [vv], the normals."""
-    n = normals(p, orient, points, pairs)
+def _step(p, orient, points, pairs, camera=None):
+    """One Gauss–Newton step: corrections of orientations, points and the free camera
+    parameters, [vv], the normals. The camera's border by its Schur complement:
+    X = S⁻¹·S_cg, (S_gg − S_gc·X)·δg = r_g − S_gc·S⁻¹·r_c, δc = S⁻¹·r_c − X·δg."""
+    n = normals(p, orient, points, pairs, camera)
     s = n.reduced
     scale = 1.0 / np.sqrt(s.diagonal())
     d = sp.diags(scale)
@@ -383,12 +448,20 @@ def _step(p, orient, points, pairs):
             f"the reduced normal equations are singular ({exc}): expected "
             "every photo tied to the block and at least 3 control points" + weakest_photos(p, s)
         ) from None
-    delta_c = (scale * lu.solve(scale * n.rhs.ravel())).reshape(-1, 6)
+    delta_c = scale * lu.solve(scale * n.rhs.ravel())
+    delta_g = np.zeros(0)
+    if n.sgc is not None:
+        x = scale[:, None] * lu.solve(scale[:, None] * n.sgc.T)
+        delta_g = np.linalg.solve(n.sgg - n.sgc @ x, n.rg - n.sgc @ delta_c)
+        delta_c = delta_c - x @ delta_g
+    delta_c = delta_c.reshape(-1, 6)
     back = n.bp.copy()
     np.add.at(back, p.obs_point, -np.einsum("nji,nj->ni", n.ncp, delta_c[p.obs_photo]))
+    if n.ngp is not None:
+        np.add.at(back, p.obs_point, -np.einsum("nji,j->ni", n.ngp, delta_g))
     delta_p = np.einsum("nij,nj->ni", n.pinv, back)
     delta_p[n.unused] = 0.0
-    return delta_c, delta_p, n.vv, n
+    return delta_c, delta_p, n.vv, n, delta_g
 
 
 def weakest_photos(p: BundleProblem, reduced: sp.spmatrix, count: int = 4) -> str:
@@ -432,51 +505,105 @@ def _check_photos(p: BundleProblem) -> None:
         )
 
 
-def _photo_covariances(sel: SelectedInverse, n_photos: int, sigma0: float):
-    """σ₀²·(the 6 × 6 diagonal blocks of S⁻¹) and σ₀²·its blocks (j + 1, j) (photo j + 1
+@dataclass(frozen=True, slots=True)
+class PhotoCofactors:
+    """Q of the photos' elements (σ-free), with the camera's border when it is adjusted:
+    Q_cc = S⁻¹ + X·Q_gg·Xᵀ, Q_cg = −X·Q_gg, Q_gg = (S_gg − S_gc·X)⁻¹, X = S⁻¹·S_cg.
+
+    ``inverse`` the selected inverse of S; ``x`` (n_photos, 6, n_g) and ``qgg`` (n_g, n_g),
+    None without free camera parameters."""
+
+    inverse: SelectedInverse
+    x: NDArray[np.float64] | None = None
+    qgg: NDArray[np.float64] | None = None
+
+    def blocks(self, a: NDArray, b: NDArray) -> NDArray[np.float64]:
+        """Q_cc of photos a and b, (m, 6, 6)."""
+        out = self.inverse.blocks(a, b)
+        if self.x is not None:
+            out = out + np.einsum("nij,jk,nlk->nil", self.x[a], self.qgg, self.x[b])
+        return out
+
+    def cg(self, a: NDArray) -> NDArray[np.float64]:
+        """Q_cg of photos a against the camera, (m, 6, n_g)."""
+        return -np.einsum("nij,jk->nik", self.x[a], self.qgg)
+
+
+def photo_cofactors(p: BundleProblem, n: Normals) -> PhotoCofactors:
+    """:class:`PhotoCofactors` at the normals ``n``."""
+    sel = selected_inverse(n.reduced)
+    if n.sgc is None:
+        return PhotoCofactors(sel)
+    s = n.reduced
+    scale = 1.0 / np.sqrt(s.diagonal())
+    d = sp.diags(scale)
+    lu = spla.splu((d @ s @ d).tocsc(), permc_spec="COLAMD")
+    x = scale[:, None] * lu.solve(scale[:, None] * n.sgc.T)
+    qgg = np.linalg.inv(n.sgg - n.sgc @ x)
+    return PhotoCofactors(sel, x.reshape(p.n_photos, 6, -1), (qgg + qgg.T) / 2.0)
+
+
+def _photo_covariances(q: PhotoCofactors, n_photos: int, sigma0: float):
+    """σ₀²·(the 6 × 6 diagonal blocks of Q_cc) and σ₀²·its blocks (j + 1, j) (photo j + 1
     against photo j; zero for the last), from the selected inverse (no dense inverse)."""
     k = np.arange(n_photos)
-    diag = sel.blocks(k, k)
+    diag = q.blocks(k, k)
     after = np.zeros((n_photos, 6, 6))
     if n_photos > 1:
-        after[:-1] = sel.blocks(k[1:], k[:-1])
+        after[:-1] = q.blocks(k[1:], k[:-1])
     return sigma0**2 * diag, sigma0**2 * after
 
 
 def point_cofactors(
-    p: BundleProblem, n: Normals, sel: SelectedInverse, pairs: _Pairs
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    r"""Q_pp (n_points, 3, 3) of every point and Q_cp (n_obs, 6, 3) of each measurement's photo
-    against its point: the blocks of N⁻¹ (σ-free) by block elimination of the points,
+    p: BundleProblem, n: Normals, q: PhotoCofactors, pairs: _Pairs
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
+    r"""Q_pp (n_points, 3, 3) of every point, Q_cp (n_obs, 6, 3) of each measurement's photo
+    against its point and Q_gp (n_points, n_g, 3) of the camera against the points (None
+    without free camera parameters): the blocks of N⁻¹ (σ-free) by block elimination of the
+    points,
 
-        Q_c_j,p_i = −Σ_k (S⁻¹)_jk · N_c_k,p_i · N_pp,i⁻¹,
-        Q_pp,i = N_pp,i⁻¹ + N_pp,i⁻¹ · (Σ_j,k N_p_i,c_j · (S⁻¹)_jk · N_c_k,p_i) · N_pp,i⁻¹,
+        Q_c_j,p_i = −Σ_k (Q_c_j,c_k·N_c_k,p_i + Q_c_j,g·N_g,p_i)·N_pp,i⁻¹,
+        Q_pp,i = N_pp,i⁻¹ + N_pp,i⁻¹·(Σ_j,k N_p_i,x_j·Q_x_j,x_k·N_x_k,p_i)·N_pp,i⁻¹,
 
-    the sums over the photos j, k that measured point i (every such pair is in the selected
-    inverse). Unused points: NaN."""
-    qcc = sel.blocks(p.obs_photo[pairs.first], p.obs_photo[pairs.second])
+    the sums over the photos j, k that measured point i (x = photo elements and camera; every
+    such pair is in the selected inverse). Unused points: NaN."""
+    qcc = q.blocks(p.obs_photo[pairs.first], p.obs_photo[pairs.second])
     t = np.zeros((p.obs_photo.size, 6, 3))
     np.add.at(t, pairs.first, np.einsum("nij,njk->nik", qcc, n.ncp[pairs.second]))
     inner = np.zeros((p.n_points, 3, 3))
+    tg = None
+    if n.ngp is not None:
+        ng = n.ngp.shape[1]
+        g_i = np.zeros((p.n_points, ng, 3))
+        np.add.at(g_i, p.obs_point, n.ngp)
+        qcg = q.cg(p.obs_photo)
+        t += np.einsum("nij,njk->nik", qcg, g_i[p.obs_point])
+        tg = np.einsum("ij,njk->nik", q.qgg, g_i)
+        np.add.at(tg, p.obs_point, np.einsum("nji,njk->nik", qcg, n.ncp))
+        inner += np.einsum("nji,njk->nik", g_i, tg)
     np.add.at(inner, p.obs_point, np.einsum("nji,njk->nik", n.ncp, t))
     qpp = n.pinv + np.einsum("nij,njk,nkl->nil", n.pinv, inner, n.pinv)
     qpp[n.unused] = np.nan
     qcp = -np.einsum("nij,njk->nik", t, n.pinv[p.obs_point])
-    return qpp, qcp
+    qgp = -np.einsum("nij,njk->nik", tg, n.pinv) if tg is not None else None
+    return qpp, qcp, qgp
 
 
 @dataclass(frozen=True, slots=True)
 class Adjusted:
     """A converged bundle adjustment with what its precision and reliability are computed from:
-    the solution, the normals at it, the selected inverse of the reduced matrix (None without
-    covariances), the measurement pairs, the redundancy and Q_cp (n_obs, 6, 3)."""
+    the solution, the normals at it, the photos' cofactors (None without covariances), the
+    measurement pairs, the redundancy, Q_cp (n_obs, 6, 3), Q_gp (n_points, n_g, 3) and the
+    camera (f, x₀, y₀, k₁, k₂, p₁, p₂; the certificate's unless self-calibrated)."""
 
     solution: BlockSolution
     normals: Normals
-    inverse: SelectedInverse | None
+    inverse: PhotoCofactors | None
     pairs: _Pairs
     redundancy: int
     qcp: NDArray[np.float64] | None
+    qgp: NDArray[np.float64] | None = None
+    camera: NDArray[np.float64] | None = None
 
 
 def bundle_adjust(
@@ -540,16 +667,22 @@ def bundle_adjusted(
     _check_photos(p)
     orient, points = initial if initial is not None else initial_approximation(p)
     orient, points = orient.copy(), points.copy()
+    camera = p.camera0()
+    r = float(np.max(np.linalg.norm(p.xy_mm, axis=1))) if p.xy_mm.size else 1.0
+    # a camera correction's largest effect on a photo coordinate, per unit [mm]
+    reach = np.array([r / p.f_mm, 1.0, 1.0, r**3, r**5, 3 * r**2, 3 * r**2])[p.free]
     pairs = _pairs(p.obs_point)
     converged = False
     for it in range(1, max_iterations + 1):  # noqa: B007 (reported after the loop)
-        dc, dp, _, n = _step(p, orient, points, pairs)
+        dc, dp, _, n, dg = _step(p, orient, points, pairs, camera)
         orient += dc
         points += dp
+        camera[p.free] += dg
         if (
             np.all(np.abs(dc[:, :3]) <= angle_tolerance)
             and max(float(np.max(np.abs(dc[:, 3:]))), float(np.max(np.abs(dp))))
             <= position_tolerance_m
+            and np.all(np.abs(dg) * reach <= 1e-5)  # 0.01 µm on the photo
         ):
             converged = True
             break
@@ -561,30 +694,30 @@ def bundle_adjusted(
             + ": expected each of them to see well-spread points; check the point "
             "identification and the control"
         )
-    n = normals(p, orient, points, pairs)
+    n = normals(p, orient, points, pairs, camera)
     used = ~n.unused
     n_obs = (
         2 * p.obs_photo.size
         + int(np.count_nonzero(p.control_weight))
         + int(np.count_nonzero(p.centre_weight))
     )
-    redundancy = n_obs - 6 * p.n_photos - 3 * int(used.sum())
+    redundancy = n_obs - 6 * p.n_photos - 3 * int(used.sum()) - p.free.size
     sigma0 = float(np.sqrt(n.vv / redundancy)) if redundancy > 0 else float("nan")
     points[~used] = np.nan
     notes = (f"redundancy {redundancy}",)
     if not covariance:
         s = BlockSolution("bundle", orient, None, points, it, sigma0, notes)
-        return Adjusted(s, n, None, pairs, redundancy, None)
+        return Adjusted(s, n, None, pairs, redundancy, None, None, camera)
     try:
-        sel = selected_inverse(n.reduced)
-    except GeometryError as exc:
+        q = photo_cofactors(p, n)
+    except (GeometryError, np.linalg.LinAlgError) as exc:
         raise GeometryError(f"{exc}{weakest_photos(p, n.reduced)}") from None
-    cov, after = _photo_covariances(sel, p.n_photos, sigma0)
-    qpp, qcp = point_cofactors(p, n, sel, pairs)
+    cov, after = _photo_covariances(q, p.n_photos, sigma0)
+    qpp, qcp, qgp = point_cofactors(p, n, q, pairs)
     s = BlockSolution(
         "bundle", orient, cov, points, it, sigma0, notes, after, point_covariances=sigma0**2 * qpp
     )
-    return Adjusted(s, n, sel, pairs, redundancy, qcp)
+    return Adjusted(s, n, q, pairs, redundancy, qcp, qgp, camera)
 
 
 def interior_orientation_covariance(
@@ -601,7 +734,7 @@ def interior_orientation_covariance(
     residuals to the elements (J of Eq. (2.53) at the solution).
     """
     rows_all = p.obs_index
-    _, jac = _linearise(p, solution.orientations, np.nan_to_num(solution.points_m))
+    _, jac, _ = _linearise(p, solution.orientations, np.nan_to_num(solution.points_m))
     out = np.zeros((p.n_photos, 6, 6))
     h = 1e-3  # mm: the interior orientation is linear in the marks to far below this
     for j in range(p.n_photos):

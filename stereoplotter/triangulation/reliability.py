@@ -72,35 +72,42 @@ CENTRE_NAMES = ("centre_X_m", "centre_Y_m", "centre_Z_m")
 INSEPARABLE = 0.99
 
 
-def _w_correlations(p: BundleProblem, adj: Adjusted, o: int, c: int) -> tuple[NDArray, NDArray]:
-    """ρ of w of photo coordinate (o, c) with every coordinate of the other measurements of its
-    point, (m, 2), and those measurements' rows. Q_vv,ab = −A_a·N⁻¹·A_bᵀ (a ≠ b)."""
+def _cross(p: BundleProblem, adj: Adjusted, a: NDArray, b: NDArray) -> NDArray[np.float64]:
+    """A_a·N⁻¹·A_bᵀ (m, 2, 2) for pairs of measurements a, b of the same point, A = [J_c, J_p,
+    J_g] (photo elements, point, free camera parameters), from the blocks of N⁻¹ (σ-free)."""
     n = adj.normals
-    i = p.obs_point[o]
-    rows = np.flatnonzero(p.obs_point == i)
+    i = p.obs_point[a]
     qpp = adj.solution.point_covariances[i] / adj.solution.sigma0**2
-    qcc = adj.inverse.blocks(np.full(rows.size, p.obs_photo[o]), p.obs_photo[rows])
-    qcp = adj.qcp
-    ja, pa = n.jc[o, c], n.jp[o, c]
-    # A_a·N⁻¹·A_bᵀ for every b: Jc_a Qcc_ab Jc_bᵀ + Jc_a Q_c_a,p Jp_bᵀ + Jp_a Q_p,c_b Jc_bᵀ + …
-    cross = (
-        np.einsum("i,nij,nkj->nk", ja, qcc, n.jc[rows])
-        + np.einsum("i,ij,nkj->nk", ja, qcp[o], n.jp[rows])
-        + np.einsum("i,nji,nkj->nk", pa, qcp[rows], n.jc[rows])
-        + np.einsum("i,ij,nkj->nk", pa, qpp, n.jp[rows])
+    q = adj.inverse
+    jca, jcb, jpa, jpb = n.jc[a], n.jc[b], n.jp[a], n.jp[b]
+    out = (
+        np.einsum("nki,nij,nlj->nkl", jca, q.blocks(p.obs_photo[a], p.obs_photo[b]), jcb)
+        + np.einsum("nki,nij,nlj->nkl", jca, adj.qcp[a], jpb)
+        + np.einsum("nki,nji,nlj->nkl", jpa, adj.qcp[b], jcb)
+        + np.einsum("nki,nij,nlj->nkl", jpa, qpp, jpb)
     )
+    if n.jg is not None and adj.qgp is not None:
+        jga, jgb = n.jg[a], n.jg[b]
+        qgp = adj.qgp[i]
+        out += (
+            np.einsum("nki,nij,nlj->nkl", jca, q.cg(p.obs_photo[a]), jgb)
+            + np.einsum("nki,nji,nlj->nkl", jga, q.cg(p.obs_photo[b]), jcb)
+            + np.einsum("nki,nji,nlj->nkl", jpa, qgp, jgb)
+            + np.einsum("nki,nij,nlj->nkl", jga, qgp, jpb)
+            + np.einsum("nki,ij,nlj->nkl", jga, q.qgg, jgb)
+        )
+    return out
+
+
+def _w_correlations(p: BundleProblem, adj: Adjusted, o: int, c: int) -> tuple[NDArray, NDArray]:
+    """ρ of w of photo coordinate (o, c) with every coordinate of the measurements of its
+    point, (m, 2), and those measurements' rows. Q_vv,ab = Q_ll,ab − A_a·N⁻¹·A_bᵀ."""
+    rows = np.flatnonzero(p.obs_point == p.obs_point[o])
     sig2 = p.sigma_photo_mm**2
-    qvv = -cross
+    qvv = -_cross(p, adj, np.full(rows.size, o), rows)[:, c, :]
     own = rows == o
     qvv[own, c] += sig2
-    diag = sig2 - np.einsum(
-        "nki,nij,nkj->nk",
-        n.jc[rows],
-        adj.inverse.blocks(p.obs_photo[rows], p.obs_photo[rows]),
-        n.jc[rows],
-    )
-    diag -= 2.0 * np.einsum("nki,nij,nkj->nk", n.jc[rows], qcp[rows], n.jp[rows])
-    diag -= np.einsum("nki,ij,nkj->nk", n.jp[rows], qpp, n.jp[rows])
+    diag = sig2 - np.einsum("nkk->nk", _cross(p, adj, rows, rows))
     rho = qvv / np.sqrt(np.maximum(diag, 1e-12 * sig2) * max(diag[own, c][0], 1e-12 * sig2))
     return rho, rows
 
@@ -189,19 +196,18 @@ def observation_reliability(
     n, s = adj.normals, adj.solution
     sig2 = p.sigma_photo_mm**2
     qpp = s.point_covariances / s.sigma0**2
-    qcc = adj.inverse.blocks(p.obs_photo, p.obs_photo)
     jc, jp, qcp = n.jc, n.jp, adj.qcp
     qpi = qpp[p.obs_point]
-    # A·Q·Aᵀ per measurement (2 × 2), its diagonal: Jc·Qcc·Jcᵀ + 2·Jc·Qcp·Jpᵀ + Jp·Qpp·Jpᵀ
-    hat = (
-        np.einsum("nki,nij,nkj->nk", jc, qcc, jc)
-        + 2.0 * np.einsum("nki,nij,nkj->nk", jc, qcp, jp)
-        + np.einsum("nki,nij,nkj->nk", jp, qpi, jp)
-    )
+    every = np.arange(p.obs_photo.size)
+    hat = np.einsum("nkk->nk", _cross(p, adj, every, every))  # diag of A·Q·Aᵀ per measurement
     qvv = np.maximum(sig2 - hat, 1e-12 * sig2)
     pr = qvv / sig2
     pv = n.v
-    effect = (np.einsum("nji,nkj->nki", qcp, jc) + np.einsum("nij,nkj->nki", qpi, jp)) / sig2
+    # the point's shift by a unit error of each coordinate: Q_p,x·Aᵀ·P·e
+    effect = np.einsum("nji,nkj->nki", qcp, jc) + np.einsum("nij,nkj->nki", qpi, jp)
+    if n.jg is not None and adj.qgp is not None:
+        effect += np.einsum("nji,nkj->nki", adj.qgp[p.obs_point], n.jg)
+    effect /= sig2
     nc = p.control_point.size
     with np.errstate(divide="ignore", invalid="ignore"):
         given = p.control_weight > 0
@@ -410,12 +416,14 @@ def snooped_block(
     reject: bool = False,
     alpha: float = 0.05,
     alpha0: float | None = None,
+    self_calibration: tuple[str, ...] = (),
 ) -> tuple[BlockSolution, SnoopingResult]:
     """Bundle adjustment of a block with iterated data snooping: the solution of all
     observations, or with ``reject`` the one without the flagged observations; each photo's
     covariance includes its interior orientation's, as :func:`~stereoplotter.triangulation.
-    bundle.bundle_block` gives it."""
-    p = problem(block)
+    bundle.bundle_block` gives it. ``self_calibration``: the camera parameters adjusted with the
+    block (:func:`~stereoplotter.triangulation.bundle.problem`)."""
+    p = problem(block, self_calibration)
     result = snoop(p, alpha=alpha, alpha0=alpha0)
     adj, q = (result.last, result.problem_last) if reject else (result.first, p)
     s = adj.solution

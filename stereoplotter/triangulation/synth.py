@@ -33,6 +33,7 @@ from stereoplotter.triangulation.block import (
     block_frame,
     sk42_from_block_local,
 )
+from stereoplotter.triangulation.camera_model import camera_image
 from stereoplotter.triangulation.control_spacing import choose_control_spacing
 
 __all__ = ["SynthSpec", "Truth", "control_stations_for_degree", "synthesize_block"]
@@ -54,6 +55,9 @@ class SynthSpec:
     every strip) replaces the regular ``control_every_bases`` (e.g.
     :func:`control_stations_for_degree`). ``centre_sigma_m``: every photo's GNSS antenna
     (S + M·``lever_arm_m``) measured with this σ on each axis (None: no centres).
+    ``camera_error``: the true camera differs from its certificate by Δf, x₀, y₀ and has the
+    distortion k₁, k₂, p₁, p₂ (:mod:`~stereoplotter.triangulation.camera_model`).
+    ``sigma_fiducial_mm``: σ of a fiducial mark's reading (default: that of a point).
     """
 
     strips: int = 4
@@ -75,6 +79,8 @@ class SynthSpec:
     film_deformation_ppm: float = 50.0
     centre_sigma_m: float | None = None
     lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    camera_error: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    sigma_fiducial_mm: float | None = None
     origin_sk42_m: tuple[float, float, float] = DEFAULT_ORIGIN_SK42_M
     name: str = "synthetic"
 
@@ -208,9 +214,16 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
     )
     ids = tuple(f"P{int(rr) + 1}.{int(cc) + 1}" for rr, cc in zip(r, c, strict=True))
     rot = rotation_matrix(stations[:, 0], stations[:, 1], stations[:, 2])
-    photo = object_to_photo(points[None], stations[:, None, 3:], rot[:, None], cam.focal_length_mm)
+    true = np.array(spec.camera_error, float)
+    true[0] += cam.focal_length_mm
+    photo = object_to_photo(points[None], stations[:, None, 3:], rot[:, None], true[0])
     with np.errstate(invalid="ignore"):
         seen = np.all(np.abs(photo) <= 0.47 * spec.format_mm, axis=-1)
+    if np.any(true[1:] != 0.0):
+        flat = photo.reshape(-1, 2)
+        ok = np.all(np.isfinite(flat), axis=1)
+        flat[ok] = camera_image(flat[ok], true)[0]
+        photo = flat.reshape(photo.shape)
     obs_photo, obs_point = np.nonzero(seen)
     n_photos, n_obs = stations.shape[0], obs_photo.size
     # the diapositive on the comparator: film deformation, a turn and a shift per photo
@@ -226,7 +239,8 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
     marks = cam.fiducial_array_mm()
     jj = np.repeat(np.arange(n_photos), 4)
     fiducials = comparator(jj, np.tile(marks, (n_photos, 1))).reshape(n_photos, 4, 2)
-    fiducials += rng.normal(0.0, spec.sigma_photo_mm, fiducials.shape)
+    sf = spec.sigma_photo_mm if spec.sigma_fiducial_mm is None else spec.sigma_fiducial_mm
+    fiducials += rng.normal(0.0, sf, fiducials.shape)
     role, kind = _roles(spec, c, r)
     in_catalogue = np.flatnonzero(np.isin(np.arange(len(ids)), obs_point))
     block0 = Block(

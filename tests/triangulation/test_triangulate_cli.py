@@ -155,3 +155,12 @@ def test_points_csv_gives_every_point_with_its_sigma(chain):
     assert roles == {"tie", "control", "check"} or roles == {"control", "check"}
     fixed = [r for r in rows if r["X_m"]]
     assert fixed and all(float(r["s_Z_m"]) > 0 for r in fixed)
+
+
+def test_self_calibration_from_the_command_line(chain, tmp_path, capsys):
+    argv = ["triangulate", str(chain / "block" / "block.yaml"), "-o", str(tmp_path)]
+    assert main([*argv, "--self-calibrate", "f,x0,y0,k1"]) == 0
+    text = (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert "## Self-calibration of the camera" in text and "| k1 [mm⁻²] |" in text
+    assert main([*argv, "--self-calibrate", "f,z9"]) == 1
+    assert "--self-calibrate" in capsys.readouterr().err
