@@ -175,7 +175,11 @@ def run(args: argparse.Namespace) -> int:
     from stereoplotter.io.atomic_write import write_files
     from stereoplotter.io.block_measurements_file import load_block_measurements
     from stereoplotter.io.triangulated_job import job_files
-    from stereoplotter.plotting.triangulation import residual_figure_png
+    from stereoplotter.plotting.triangulation import (
+        photo_residual_figure_png,
+        precision_figure_png,
+        residual_figure_png,
+    )
     from stereoplotter.report.triangulation import (
         flagged_csv,
         observations_csv,
@@ -204,6 +208,9 @@ def run(args: argparse.Namespace) -> int:
     files["residuals.csv"] = residual_csv(block, residuals)
     files["points.csv"] = points_csv(block, solution)
     files["residuals.png"] = residual_figure_png(block, solution, residuals)
+    files["photo_residuals.png"] = photo_residual_figure_png(block, solution)
+    if solution.point_covariances is not None:
+        files["precision.png"] = precision_figure_png(block, solution)
     if snooping is not None:
         files["flagged.csv"] = flagged_csv(snooping.flags)
         last = args.reject

@@ -370,7 +370,8 @@ def report_markdown(
                 lines.append(f"| {role} | {int(m.sum())} | " + " | ".join(f"{x:.3f}" for x in rms)
                              + " |")  # fmt: skip
         lines += ["", "σ = σ₀·√(diagonal of N⁻¹), from the selected inverse of the normal "
-                  "equations (no dense inverse).", ""]  # fmt: skip
+                  "equations (no dense inverse). Plan σ ellipses and σ_Z over the block:", "",
+                  "![precision of the points](precision.png)", ""]  # fmt: skip
     if se is not None:
         mean = np.sqrt(np.mean(se**2, axis=0))
         lines += [
@@ -405,6 +406,8 @@ def report_markdown(
     lines += [
         "",
         "## Photo residuals photo by photo (RMS, measured − computed) [µm]",
+        "",
+        "![photo residuals](photo_residuals.png)",
         "",
         "| photo | strip | points | RMS x | RMS y |",
         "|---|---:|---:|---:|---:|",

@@ -51,6 +51,8 @@ def test_triangulate_writes_orientations_residuals_report_and_job(chain):
         "points.csv",
         "flagged.csv",
         "observations.csv",
+        "photo_residuals.png",
+        "precision.png",
     } <= names
     with open(chain / "tri" / "orientations.csv", encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
