@@ -435,8 +435,16 @@ def strip_block(block: Block, models: str = "independent", degree: int = 3) -> B
         f"each strip: 7-parameter absolute orientation on its control; strip deformation by "
         f"polynomials of degree {degree}, all strips at once",
         "each photo's orientation: space resection on the adjusted points (no σ propagated)",
+        "σ of the points: propagated through the polynomial adjustment with its a posteriori σ₀ "
+        "(model coordinates independent; X, Y, Z uncorrelated)",
     )
+    cov = None
+    if poly.sigma_m is not None:
+        cov = np.einsum("ni,ij->nij", poly.sigma_m**2, np.eye(3))
     sol = BlockSolution("strip", orient, None, poly.points_m, iterations, float("nan"), notes)
     v = photo_residuals(block, sol)
-    sigma0 = float(np.sqrt(np.nanmean(v**2))) / block.sigmas.photo_mm
-    return BlockSolution("strip", orient, None, poly.points_m, iterations, sigma0, notes)
+    ok = np.all(np.isfinite(v), axis=1)
+    sigma0 = float(np.sqrt(np.mean(v[ok] ** 2))) / block.sigmas.photo_mm
+    return BlockSolution(
+        "strip", orient, None, poly.points_m, iterations, sigma0, notes, point_covariances=cov
+    )
