@@ -369,8 +369,14 @@ def report_markdown(
                 rms = np.sqrt(np.mean(pse[m] ** 2, axis=0))
                 lines.append(f"| {role} | {int(m.sum())} | " + " | ".join(f"{x:.3f}" for x in rms)
                              + " |")  # fmt: skip
-        lines += ["", "σ = σ₀·√(diagonal of N⁻¹), from the selected inverse of the normal "
-                  "equations (no dense inverse). Plan σ ellipses and σ_Z over the block:", "",
+        how = (
+            "σ = σ₀·√(diagonal of N⁻¹), from the selected inverse of the normal equations (no "
+            "dense inverse)."
+            if solution.method == "bundle"
+            else "σ propagated through the polynomial adjustment with its a posteriori σ₀ "
+            "(model coordinates independent)."
+        )
+        lines += ["", f"{how} Plan σ ellipses and σ_Z over the block:", "",
                   "![precision of the points](precision.png)", ""]  # fmt: skip
     if se is not None:
         mean = np.sqrt(np.mean(se**2, axis=0))
