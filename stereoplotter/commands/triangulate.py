@@ -67,6 +67,14 @@ def add_arguments(sub: Any) -> None:
         "by Šidák; Baarda's classical value is 0.001)",
     )
     p.add_argument(
+        "--robust",
+        choices=("huber", "danish"),
+        default=None,
+        help="bundle: robust re-weighting instead of data snooping (Danish: weight × "
+        "exp(1 − |t|/k) beyond the critical value k; Huber: × k/|t|); the solution is the "
+        "re-weighted one, flagged.csv the observations it down-weighted",
+    )
+    p.add_argument(
         "--self-calibrate",
         default="",
         metavar="PARAMS",
@@ -160,6 +168,7 @@ def _solve(block: Any, args: argparse.Namespace) -> tuple[Any, Any]:
             reject=args.reject,
             alpha0=args.alpha0,
             self_calibration=_camera_parameters(args.self_calibrate),
+            robust_method=args.robust,
         )
     from stereoplotter.triangulation import strip
 
@@ -213,14 +222,14 @@ def run(args: argparse.Namespace) -> int:
         files["precision.png"] = precision_figure_png(block, solution)
     if snooping is not None:
         files["flagged.csv"] = flagged_csv(snooping.flags)
-        last = args.reject
+        last = args.reject or args.robust is not None
         files["observations.csv"] = observations_csv(
             block,
             snooping.problem_last if last else snooping.problem_first,
             snooping.reliability if last else snooping.reliability_first,
         )
     files["report.md"] = report_markdown(
-        block, solution, residuals, args.block, snooping, args.reject
+        block, solution, residuals, args.block, snooping, args.reject or args.robust is not None
     )
     out = Path(args.output)
     encoded = {n: c if isinstance(c, bytes) else c.encode("utf-8") for n, c in files.items()}
@@ -229,7 +238,13 @@ def run(args: argparse.Namespace) -> int:
     job = f"; job file {out / 'job.yaml'}" if production is not None else ""
     flagged = ""
     if snooping is not None:
-        what = "removed" if args.reject else "kept; --reject removes them"
+        what = (
+            "down-weighted"
+            if args.robust
+            else "removed"
+            if args.reject
+            else "kept; --reject removes them"
+        )
         flagged = f"; {len(snooping.flags)} observations flagged ({what})"
     print(
         f"block {block.name}: {len(block.photos)} photos by {args.method} in "

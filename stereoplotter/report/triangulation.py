@@ -194,12 +194,24 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
         "",
         f"Global test of σ₀ (χ², two-sided, α = 5 %): σ₀ = {g.sigma0:.3f} on a redundancy of "
         f"{g.redundancy}; acceptance interval {g.low:.3f}–{g.high:.3f}, p = {g.p_value:.2g}: "
-        f"{verdict}" + (" (after the flagged observations were removed)." if reject else "."),
+        f"{verdict}"
+        + (
+            ("." if not reject else " (after the flagged observations were removed).")
+            if sn.method == "snooping"
+            else " (after the re-weighting)."
+        ),
         "",
         f"Data snooping (w-test, a priori σ₀ = 1) on {rel.n_tests} observations: α₀ = "
         f"{rel.alpha0:.2e} per test (family-wise 5 % by Šidák), critical value k = {rel.k:.2f}; "
-        f"β₀ = 80 %, δ₀ = {rel.delta0:.2f}. Iterated: the largest |w| above k removed and the "
-        "block readjusted, until none is above k.",
+        f"β₀ = 80 %, δ₀ = {rel.delta0:.2f}. "
+        + (
+            "Iterated: the largest |w| above k removed and the block readjusted, until none is "
+            "above k."
+            if sn.method == "snooping"
+            else f"Instead of removing: {sn.method} re-weighting, t = v/(σ·√r) with the a "
+            "priori σ, weight × exp(1 − |t|/k) (Danish) or × k/|t| (Huber) beyond k, until the "
+            "weights settle; the table lists the down-weighted observations with their t."
+        ),
         "",
     ]
     if not sn.flags:

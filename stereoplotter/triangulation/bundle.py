@@ -72,7 +72,8 @@ class BundleProblem:
     the photos with a measured projection centre (GNSS antenna) ``centre_m`` (n_g, 3), weights
     ``centre_weight`` (n_g, 3) [1/m²], ``lever_arm_m`` (3,) the antenna in the camera system;
     ``camera_free`` the camera parameters adjusted with the block (self-calibration, names of
-    :data:`~stereoplotter.triangulation.camera_model.CAMERA_PARAMETERS`; none by default).
+    :data:`~stereoplotter.triangulation.camera_model.CAMERA_PARAMETERS`; none by default);
+    ``photo_factor`` (n_obs, 2) factors of the photo coordinates' weights (None: all 1).
     """
 
     xy_mm: NDArray[np.float64]
@@ -95,6 +96,13 @@ class BundleProblem:
     centre_weight: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
     lever_arm_m: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros(3))
     camera_free: tuple[str, ...] = ()
+    photo_factor: NDArray[np.float64] | None = None
+
+    def photo_weights(self) -> NDArray[np.float64]:
+        """Weight of each photo coordinate, (n_obs, 2) [1/mm²]: 1/σ² times ``photo_factor``
+        (robust re-weighting; 1 by default)."""
+        w = np.full(self.xy_mm.shape, 1.0 / self.sigma_photo_mm**2)
+        return w if self.photo_factor is None else w * self.photo_factor
 
     @property
     def free(self) -> NDArray[np.int64]:
@@ -356,20 +364,20 @@ def normals(
         A point whose rays do not fix it (names the point and its photos).
     """
     v, jc, jg = _linearise(p, orient, points, camera)
-    w = 1.0 / p.sigma_photo_mm**2
+    w = p.photo_weights()  # (n_obs, 2) [1/mm²]
     jp = -jc[:, :, 3:]
     ncc = np.zeros((p.n_photos, 6, 6))
-    np.add.at(ncc, p.obs_photo, w * np.einsum("nki,nkj->nij", jc, jc))
+    np.add.at(ncc, p.obs_photo, np.einsum("nki,nk,nkj->nij", jc, w, jc))
     bc = np.zeros((p.n_photos, 6))
-    np.add.at(bc, p.obs_photo, w * np.einsum("nki,nk->ni", jc, v))
+    np.add.at(bc, p.obs_photo, np.einsum("nki,nk,nk->ni", jc, w, v))
     npp = np.zeros((p.n_points, 3, 3))
-    np.add.at(npp, p.obs_point, w * np.einsum("nki,nkj->nij", jp, jp))
+    np.add.at(npp, p.obs_point, np.einsum("nki,nk,nkj->nij", jp, w, jp))
     bp = np.zeros((p.n_points, 3))
-    np.add.at(bp, p.obs_point, w * np.einsum("nki,nk->ni", jp, v))
+    np.add.at(bp, p.obs_point, np.einsum("nki,nk,nk->ni", jp, w, v))
     dc = p.control_m - points[p.control_point]
     npp[p.control_point] += np.einsum("ni,ij->nij", p.control_weight, np.eye(3))
     bp[p.control_point] += p.control_weight * dc
-    vv = float(np.sum(v**2) * w + np.sum(p.control_weight * dc**2))
+    vv = float(np.sum(w * v**2) + np.sum(p.control_weight * dc**2))
     if p.centre_photo.size:
         vg, jg = centre_residuals(p, orient)
         wg = p.centre_weight
@@ -391,7 +399,7 @@ def normals(
             "the point identification"
         )
     pinv = np.linalg.inv(npp)
-    ncp = w * np.einsum("nki,nkj->nij", jc, jp)  # per measurement, 6 × 3
+    ncp = np.einsum("nki,nk,nkj->nij", jc, w, jp)  # per measurement, 6 × 3
     pt = p.obs_point[pairs.first]
     blocks = np.einsum("nij,njk,nlk->nil", ncp[pairs.first], pinv[pt], ncp[pairs.second])
     jf, js = p.obs_photo[pairs.first], p.obs_photo[pairs.second]
@@ -418,15 +426,15 @@ def normals(
     if not p.camera_free:
         return Normals(v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused)
     ng = jg.shape[2]
-    ngp = w * np.einsum("nki,nkj->nij", jg, jp)
-    ngc = w * np.einsum("nki,nkj->nij", jg, jc)
+    ngp = np.einsum("nki,nk,nkj->nij", jg, w, jp)
+    ngc = np.einsum("nki,nk,nkj->nij", jg, w, jc)
     sgc = np.zeros((ng, p.n_photos, 6))
     np.add.at(sgc, (slice(None), p.obs_photo), np.swapaxes(ngc, 0, 1))
     cross = np.einsum("nij,njk,nlk->nil", ngp[pairs.first], pinv[pt], ncp[pairs.second])
     np.add.at(sgc, (slice(None), js), -np.swapaxes(cross, 0, 1))
-    sgg = w * np.einsum("nki,nkj->ij", jg, jg)
+    sgg = np.einsum("nki,nk,nkj->ij", jg, w, jg)
     sgg -= np.einsum("nij,njk,nlk->il", ngp[pairs.first], pinv[pt], ngp[pairs.second])
-    rg = w * np.einsum("nki,nk->i", jg, v) - np.einsum("nij,nj->i", ngp, reduced_p[p.obs_point])
+    rg = np.einsum("nki,nk,nk->i", jg, w, v) - np.einsum("nij,nj->i", ngp, reduced_p[p.obs_point])
     return Normals(
         v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused, jg, ngp, sgc.reshape(ng, -1), sgg, rg
     )

@@ -51,13 +51,16 @@ from stereoplotter.triangulation.bundle import (
 from stereoplotter.triangulation.solution import BlockSolution
 
 __all__ = [
+    "ROBUST",
     "Flag",
     "GlobalTest",
     "ObservationReliability",
+    "RobustResult",
     "SnoopingResult",
     "critical_values",
     "global_test",
     "observation_reliability",
+    "robust",
     "snoop",
     "snooped_block",
 ]
@@ -103,12 +106,12 @@ def _w_correlations(p: BundleProblem, adj: Adjusted, o: int, c: int) -> tuple[ND
     """ρ of w of photo coordinate (o, c) with every coordinate of the measurements of its
     point, (m, 2), and those measurements' rows. Q_vv,ab = Q_ll,ab − A_a·N⁻¹·A_bᵀ."""
     rows = np.flatnonzero(p.obs_point == p.obs_point[o])
-    sig2 = p.sigma_photo_mm**2
+    sig2 = 1.0 / p.photo_weights()[rows]
     qvv = -_cross(p, adj, np.full(rows.size, o), rows)[:, c, :]
     own = rows == o
-    qvv[own, c] += sig2
-    diag = sig2 - np.einsum("nkk->nk", _cross(p, adj, rows, rows))
-    rho = qvv / np.sqrt(np.maximum(diag, 1e-12 * sig2) * max(diag[own, c][0], 1e-12 * sig2))
+    qvv[own, c] += sig2[own, c]
+    diag = np.maximum(sig2 - np.einsum("nkk->nk", _cross(p, adj, rows, rows)), 1e-12 * sig2)
+    rho = qvv / np.sqrt(diag * diag[own, c][0])
     return rho, rows
 
 
@@ -194,7 +197,7 @@ def observation_reliability(
     if adj.inverse is None or adj.qcp is None:
         raise ValueError("the adjustment was made without covariances")
     n, s = adj.normals, adj.solution
-    sig2 = p.sigma_photo_mm**2
+    sig2 = 1.0 / p.photo_weights()  # (n_obs, 2) [mm²]
     qpp = s.point_covariances / s.sigma0**2
     jc, jp, qcp = n.jc, n.jp, adj.qcp
     qpi = qpp[p.obs_point]
@@ -207,7 +210,7 @@ def observation_reliability(
     effect = np.einsum("nji,nkj->nki", qcp, jc) + np.einsum("nij,nkj->nki", qpi, jp)
     if n.jg is not None and adj.qgp is not None:
         effect += np.einsum("nji,nkj->nki", adj.qgp[p.obs_point], n.jg)
-    effect /= sig2
+    effect /= sig2[:, :, None]
     nc = p.control_point.size
     with np.errstate(divide="ignore", invalid="ignore"):
         given = p.control_weight > 0
@@ -297,6 +300,7 @@ class SnoopingResult:
     kept: NDArray[np.bool_]
     reliability_first: ObservationReliability
     global_test_first: GlobalTest
+    method: str = "snooping"
 
 
 def _remove_measurement(p: BundleProblem, keep: NDArray[np.bool_]) -> BundleProblem:
@@ -312,6 +316,7 @@ def _remove_measurement(p: BundleProblem, keep: NDArray[np.bool_]) -> BundleProb
         obs_photo=p.obs_photo[keep],
         obs_point=p.obs_point[keep],
         obs_index=p.obs_index[keep],
+        photo_factor=None if p.photo_factor is None else p.photo_factor[keep],
         control_point=p.control_point[ck],
         control_m=p.control_m[ck],
         control_weight=p.control_weight[ck],
@@ -417,18 +422,128 @@ def snooped_block(
     alpha: float = 0.05,
     alpha0: float | None = None,
     self_calibration: tuple[str, ...] = (),
+    robust_method: str | None = None,
 ) -> tuple[BlockSolution, SnoopingResult]:
     """Bundle adjustment of a block with iterated data snooping: the solution of all
     observations, or with ``reject`` the one without the flagged observations; each photo's
     covariance includes its interior orientation's, as :func:`~stereoplotter.triangulation.
     bundle.bundle_block` gives it. ``self_calibration``: the camera parameters adjusted with the
-    block (:func:`~stereoplotter.triangulation.bundle.problem`)."""
+    block (:func:`~stereoplotter.triangulation.bundle.problem`). ``robust_method`` (one of
+    :data:`ROBUST`): robust re-weighting instead of data snooping; its solution is the
+    re-weighted one (``reject`` implied) and its flags the observations it down-weighted."""
     p = problem(block, self_calibration)
-    result = snoop(p, alpha=alpha, alpha0=alpha0)
+    if robust_method is not None:
+        first = bundle_adjusted(p)
+        rb = robust(p, robust_method, alpha=alpha, alpha0=alpha0, first=first)
+        rel0 = observation_reliability(p, first, alpha, 0.80, alpha0)
+        result = SnoopingResult(
+            first,
+            rb.adjusted,
+            p,
+            rb.problem,
+            rb.flags,
+            rb.reliability,
+            global_test(rb.adjusted.solution.sigma0, rb.adjusted.redundancy, alpha),
+            np.ones(p.obs_photo.size, bool),
+            rel0,
+            global_test(first.solution.sigma0, first.redundancy, alpha),
+            f"robust ({robust_method}, {rb.iterations} rounds)",
+        )
+        reject = True
+    else:
+        result = snoop(p, alpha=alpha, alpha0=alpha0)
     adj, q = (result.last, result.problem_last) if reject else (result.first, p)
     s = adj.solution
     extra = interior_orientation_covariance(block, q, s)
     notes = (*s.notes, "σ of the elements include the interior orientation's (4 marks per photo)")
-    if reject and result.flags:
+    if robust_method is not None:
+        notes = (*notes, f"{result.method}: {len(result.flags)} observations down-weighted")
+    elif reject and result.flags:
         notes = (*notes, f"{len(result.flags)} flagged observations removed (--reject)")
     return dataclasses.replace(s, covariances=s.covariances + extra, notes=notes), result
+
+
+#: The robust weight functions of the standardized residual t (c the critical value k):
+#: Huber f = min(1, c/|t|); Danish (exponential) f = 1 for |t| ≤ c, exp(1 − |t|/c) beyond.
+ROBUST = ("huber", "danish")
+
+
+def _robust_factor(t: NDArray, c: float, method: str) -> NDArray:
+    a = np.abs(np.nan_to_num(t, nan=0.0))
+    if method == "huber":
+        return np.minimum(1.0, c / np.maximum(a, 1e-300))
+    return np.where(a <= c, 1.0, np.exp(1.0 - a / c))
+
+
+@dataclass(frozen=True, slots=True)
+class RobustResult:
+    """Robust re-weighting: the last adjustment and its problem (weights scaled), the weight
+    factors of the photo coordinates (n_obs, 2) and control coordinates (n_control, 3), the
+    standardized residuals t of the last adjustment with the a priori σ, the observations
+    whose factor fell below 1 as :class:`Flag` (w = t), its reliability and iterations."""
+
+    adjusted: Adjusted
+    problem: BundleProblem
+    photo_factor: NDArray[np.float64]
+    control_factor: NDArray[np.float64]
+    flags: tuple[Flag, ...]
+    reliability: ObservationReliability
+    iterations: int
+
+
+# long: iteratively re-weighted least squares with the tests' standardized residuals
+def robust(
+    p: BundleProblem,
+    method: str = "danish",
+    *,
+    alpha: float = 0.05,
+    beta0: float = 0.80,
+    alpha0: float | None = None,
+    max_iterations: int = 20,
+    first: Adjusted | None = None,
+) -> RobustResult:
+    """Robust re-weighting of a bundle problem (iteratively re-weighted least squares).
+
+    Each round: t = v/(σ·√r) with the a priori σ of each observation and its redundancy number
+    r in the current adjustment (the w-test's statistic had the observation its a priori weight);
+    the weight factor f(t) of :data:`ROBUST` with c = k of :func:`critical_values`; readjust,
+    until no factor changes by more than 0.01 (at most ``max_iterations`` rounds). Photo and
+    control coordinates are re-weighted; measured centres keep their weights.
+    """
+    if method not in ROBUST:
+        raise ValueError(f"robust: expected one of {', '.join(ROBUST)}, found {method!r}")
+    adj = first if first is not None else bundle_adjusted(p)
+    rel = observation_reliability(p, adj, alpha, beta0, alpha0)
+    k = rel.k
+    fp = np.ones(p.xy_mm.shape)
+    fc = np.ones(p.control_weight.shape)
+    q = p
+    for it in range(1, max_iterations + 1):  # noqa: B007 (reported after the loop)
+        # t = v/(σ·√r): w = v/√q_vv had σ²/f for the weight, so t = w/√f
+        tp = rel.photo_w / np.sqrt(fp)
+        with np.errstate(invalid="ignore"):
+            tc = rel.control_w / np.sqrt(fc)
+        new_p = _robust_factor(tp, k, method)
+        new_c = np.where(p.control_weight > 0, _robust_factor(tc, k, method), 1.0)
+        change = max(float(np.max(np.abs(new_p - fp), initial=0.0)),
+                     float(np.max(np.abs(new_c - fc), initial=0.0)))  # fmt: skip
+        fp, fc = new_p, new_c
+        q = dataclasses.replace(p, photo_factor=fp, control_weight=p.control_weight * fc)
+        s = adj.solution
+        start = (s.orientations, np.where(np.isfinite(s.points_m), s.points_m, 0.0))
+        adj = bundle_adjusted(q, start)
+        rel = observation_reliability(q, adj, alpha, beta0, rel.alpha0)
+        if change <= 0.01:
+            break
+    flags = [
+        Flag(q.photo_ids[q.obs_photo[o]], q.point_ids[q.obs_point[o]], PHOTO_NAMES[c],
+             float(rel.photo_w[o, c] / np.sqrt(fp[o, c])), float(rel.photo_mdb[o, c]), it)
+        for o, c in zip(*np.nonzero(fp < 1.0), strict=True)
+    ]  # fmt: skip
+    flags += [
+        Flag("", q.point_ids[q.control_point[j]], CONTROL_NAMES[c],
+             float(rel.control_w[j, c] / np.sqrt(fc[j, c])), float(rel.control_mdb[j, c]), it)
+        for j, c in zip(*np.nonzero(fc < 1.0), strict=True)
+    ]  # fmt: skip
+    flags.sort(key=lambda f: -abs(f.w))
+    return RobustResult(adj, q, fp, fc, tuple(flags), rel, it)

@@ -113,3 +113,19 @@ def test_point_sigma_matches_the_errors_at_check_points():
         z.append((s.points_m[idx] - truth.points_m[idx]) / s.point_standard_errors[idx])
     rms = np.sqrt(np.mean(np.vstack(z) ** 2, axis=0))
     assert np.all((rms > 0.9) & (rms < 1.1)), rms
+
+
+def test_danish_reweighting_down_weights_the_two_blunders_only():
+    from stereoplotter.triangulation.reliability import robust
+
+    block, _ = block6x15(0)
+    bad, (photo, point, control) = _with_blunders(block, 1)
+    r = robust(problem(bad), "danish")
+    assert [(f.photo, f.point, f.observation) for f in r.flags] == [
+        (photo, point, "y_mm"),
+        ("", control, "height_m"),
+    ]
+    assert r.photo_factor.min() < 0.01 and r.control_factor.min() < 0.01  # < 1 % of the weight
+    clean = catalogue_residuals(block, bundle_adjust(problem(block))).rms(block, "check")
+    got = catalogue_residuals(block, r.adjusted.solution).rms(block, "check")
+    np.testing.assert_allclose(got, clean, rtol=0.10)
