@@ -166,3 +166,33 @@ def test_self_calibration_from_the_command_line(chain, tmp_path, capsys):
     assert "## Self-calibration of the camera" in text and "| k1 [mm⁻²] |" in text
     assert main([*argv, "--self-calibrate", "f,z9"]) == 1
     assert "--self-calibrate" in capsys.readouterr().err
+
+
+def test_reject_from_the_command_line_names_the_blunders_in_flagged_csv(tmp_path):
+    import dataclasses
+
+    import numpy as np
+
+    from stereoplotter.io.block_measurements_file import write_block_measurements
+    from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
+
+    block, _ = synthesize_block(SynthSpec(strips=3, photos_per_strip=6), np.random.default_rng(4))
+    rays = np.bincount(block.obs_point)
+    o = int(np.flatnonzero(rays[block.obs_point] == 3)[4])
+    comparator = block.comparator_mm.copy()
+    comparator[o, 1] += 0.5
+    cat = list(block.catalogue)
+    k = next(i for i, c in enumerate(cat) if c.role == "control" and c.kind == "height")
+    north, east, h = cat[k].sk42_m
+    cat[k] = dataclasses.replace(cat[k], sk42_m=(north, east, h + 2.0))
+    bad = dataclasses.replace(block, comparator_mm=comparator, catalogue=tuple(cat))
+    write_block_measurements(tmp_path / "b", bad)
+    assert main(["triangulate", str(tmp_path / "b" / "block.yaml"), "-o", str(tmp_path / "t"),
+                 "--reject"]) == 0  # fmt: skip
+    with open(tmp_path / "t" / "flagged.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    got = {(r["photo"], r["point"], r["observation"]) for r in rows}
+    photo, point = block.photos[block.obs_photo[o]], block.point_ids[block.obs_point[o]]
+    assert got == {(photo, point, "y_mm"), ("", cat[k].id, "height_m")}
+    assert all(abs(float(r["w"])) > 4 and float(r["mdb"]) > 0 for r in rows)
+    assert "removed and the block readjusted" in (tmp_path / "t" / "report.md").read_text("utf-8")
