@@ -387,6 +387,8 @@ def report_markdown(
             if solution.method == "bundle"
             else "σ propagated through the polynomial adjustment with its a posteriori σ₀ "
             "(model coordinates independent)."
+            if solution.method == "strip"
+            else "σ by an empirical rule: the RMS residual at the control points, per axis."
         )
         lines += ["", f"{how} Plan σ ellipses and σ_Z over the block:", "",
                   "![precision of the points](precision.png)", ""]  # fmt: skip

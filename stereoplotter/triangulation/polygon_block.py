@@ -29,6 +29,7 @@ from stereoplotter.triangulation.block import Block
 from stereoplotter.triangulation.polygon import PolygonNetwork, adjust_polygons
 from stereoplotter.triangulation.solution import (
     BlockSolution,
+    catalogue_residuals,
     forward_intersection,
     photo_residuals,
 )
@@ -101,6 +102,14 @@ def polygon_block(block: Block, method: str = "least_squares") -> BlockSolution:
     sol = dataclasses.replace(sol, points_m=points)
     v = photo_residuals(block, sol)
     sigma0 = float(np.sqrt(np.mean(v[np.all(np.isfinite(v), axis=1)] ** 2))) / block.sigmas.photo_mm
+    # empirical σ of every point: the RMS residual at the control points per axis (the polygon
+    # adjustment holds only the four corner photos; the control enters through the strips'
+    # absolute orientation, and its residuals after the polygon adjustment are of the size of
+    # the check points')
+    rms = catalogue_residuals(block, sol).rms(block, "control")
+    cov = None
+    if np.all(np.isfinite(rms)):
+        cov = np.where(np.isfinite(points)[:, :, None], np.diag(rms**2)[None], np.nan)
     notes = (
         f"polygon network: {len(block.photos)} centres, {len(sides)} sides (models along the "
         "strips, strip connections across), the block's four corner photos fixed",
@@ -108,7 +117,16 @@ def polygon_block(block: Block, method: str = "least_squares") -> BlockSolution:
         "pair) and 7-parameter absolute orientation",
         "points intersected from the adjusted orientations (two rays); σ₀ = RMS photo residual "
         "/ σ_photo (empirical: no adjustment of the rays)",
+        "σ of the points: an empirical rule, the RMS residual at the control points per axis, "
+        "for every point",
     )
     return BlockSolution(
-        "polygon", orient, None, points, int(np.max(result.iterations)), sigma0, notes
+        "polygon",
+        orient,
+        None,
+        points,
+        int(np.max(result.iterations)),
+        sigma0,
+        notes,
+        point_covariances=cov,
     )
