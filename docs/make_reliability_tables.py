@@ -82,6 +82,37 @@ def blunders() -> None:
           f"{r.global_test.low:.3f}–{r.global_test.high:.3f})")  # fmt: skip
 
 
+def robust_weights() -> None:
+    from stereoplotter.triangulation.reliability import robust
+
+    block, _ = synthesize_block(
+        SynthSpec(strips=6, photos_per_strip=15), np.random.default_rng([0, 39])
+    )
+    clean = catalogue_residuals(block, bundle_adjust(problem(block))).rms(block, "check")
+    rays = np.bincount(block.obs_point)
+    strip = block.strip_of_photo
+    three = [
+        o
+        for o in np.flatnonzero(rays[block.obs_point] == 3)
+        if np.unique(strip[block.obs_photo[block.obs_point == block.obs_point[o]]]).size == 1
+    ]
+    o = three[len(three) // 2]
+    comparator = block.comparator_mm.copy()
+    comparator[o, 1] += 0.5
+    cat = list(block.catalogue)
+    k = [i for i, c in enumerate(cat) if c.role == "control" and c.kind == "height"][2]
+    north, east, h = cat[k].sk42_m
+    cat[k] = dataclasses.replace(cat[k], sk42_m=(north, east, h + 2.0))
+    bad = dataclasses.replace(block, comparator_mm=comparator, catalogue=tuple(cat))
+    print("\n| robust method | rounds | down-weighted | RMS check X, Y, Z / clean block |")
+    print("|---|---:|---:|---|")
+    for method in ("danish", "huber"):
+        r = robust(problem(bad), method)
+        got = catalogue_residuals(block, r.adjusted.solution).rms(block, "check") / clean
+        print(f"| {method} | {r.iterations} | {len(r.flags)} | {got[0]:.3f}, {got[1]:.3f}, "
+              f"{got[2]:.3f} |")  # fmt: skip
+
+
 def fiducials() -> None:
     print("\n| fiducial marks read with | σ₀ of the clean 6 × 15 block |")
     print("|---|---:|")
@@ -154,6 +185,7 @@ def centres() -> None:
 
 if __name__ == "__main__":
     blunders()
+    robust_weights()
     fiducials()
     point_sigma()
     self_calibration()
