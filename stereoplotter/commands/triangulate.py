@@ -190,6 +190,7 @@ def run(args: argparse.Namespace) -> int:
         residual_figure_png,
     )
     from stereoplotter.report.triangulation import (
+        catalogue_observations_csv,
         flagged_csv,
         observations_csv,
         orientation_csv,
@@ -223,11 +224,10 @@ def run(args: argparse.Namespace) -> int:
     if snooping is not None:
         files["flagged.csv"] = flagged_csv(snooping.flags)
         last = args.reject or args.robust is not None
-        files["observations.csv"] = observations_csv(
-            block,
-            snooping.problem_last if last else snooping.problem_first,
-            snooping.reliability if last else snooping.reliability_first,
-        )
+        prob = snooping.problem_last if last else snooping.problem_first
+        rel = snooping.reliability if last else snooping.reliability_first
+        files["observations.csv"] = observations_csv(block, prob, rel)
+        files["catalogue_observations.csv"] = catalogue_observations_csv(prob, rel)
     files["report.md"] = report_markdown(
         block, solution, residuals, args.block, snooping, args.reject or args.robust is not None
     )

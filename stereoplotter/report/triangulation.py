@@ -18,7 +18,13 @@ from stereoplotter import __version__
 from stereoplotter.constants import ARCSEC_PER_RAD
 from stereoplotter.triangulation.block import Block, sk42_from_block_local
 from stereoplotter.triangulation.bundle import BundleProblem
-from stereoplotter.triangulation.reliability import Flag, ObservationReliability, SnoopingResult
+from stereoplotter.triangulation.reliability import (
+    CENTRE_NAMES,
+    CONTROL_NAMES,
+    Flag,
+    ObservationReliability,
+    SnoopingResult,
+)
 from stereoplotter.triangulation.self_calibration import CameraCalibration, camera_calibration
 from stereoplotter.triangulation.solution import (
     BlockSolution,
@@ -27,6 +33,7 @@ from stereoplotter.triangulation.solution import (
 )
 
 __all__ = [
+    "catalogue_observations_csv",
     "flagged_csv",
     "observations_csv",
     "orientation_csv",
@@ -133,6 +140,35 @@ def flagged_csv(flags: tuple[Flag, ...]) -> str:
     for f in flags:
         w.writerow((f.photo, f.point, f.observation, f"{f.w:.2f}", f"{f.mdb:.4f}",
                     "; ".join(f.inseparable)))  # fmt: skip
+    return buf.getvalue()
+
+
+def catalogue_observations_csv(problem: BundleProblem, rel: ObservationReliability) -> str:
+    """One row per catalogue coordinate of a control point and per coordinate of a measured
+    projection centre: residual v = measured − adjusted [m], w, r, MDB [m] and (control) the
+    MDB's effect on the point [m]; the photo empty for a control point, the point for a centre."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(("photo", "point", "observation", "v_m", "w", "r", "mdb_m", "effect_m"))
+    for j in range(problem.control_point.size):
+        for c, name in enumerate(CONTROL_NAMES):
+            if problem.control_weight[j, c] <= 0:
+                continue
+            w.writerow((
+                "", problem.point_ids[problem.control_point[j]], name,
+                f"{rel.control_v[j, c]:.4f}", f"{rel.control_w[j, c]:.2f}",
+                f"{rel.control_r[j, c]:.3f}", f"{rel.control_mdb[j, c]:.3f}",
+                f"{rel.control_effect[j, c]:.3f}",
+            ))  # fmt: skip
+    for g in range(problem.centre_photo.size):
+        for c, name in enumerate(CENTRE_NAMES):
+            if problem.centre_weight[g, c] <= 0:
+                continue
+            w.writerow((
+                problem.photo_ids[problem.centre_photo[g]], "", name,
+                f"{rel.centre_v[g, c]:.4f}", f"{rel.centre_w[g, c]:.2f}",
+                f"{rel.centre_r[g, c]:.3f}", f"{rel.centre_mdb[g, c]:.3f}", "",
+            ))  # fmt: skip
     return buf.getvalue()
 
 
@@ -443,7 +479,8 @@ def report_markdown(
         "Orientations with their σ: `orientations.csv`; points with their σ: `points.csv`; "
         "residuals at catalogue points: `residuals.csv`"
         + (
-            "; every measurement's residual, w, r and MDB: `observations.csv`; flagged "
+            "; every observation's residual, w, r and MDB: `observations.csv` (photo "
+            "coordinates) and `catalogue_observations.csv` (control and centres); flagged "
             "observations: `flagged.csv`."
             if snooping is not None
             else "."

@@ -51,6 +51,7 @@ def test_triangulate_writes_orientations_residuals_report_and_job(chain):
         "points.csv",
         "flagged.csv",
         "observations.csv",
+        "catalogue_observations.csv",
         "photo_residuals.png",
         "precision.png",
     } <= names
