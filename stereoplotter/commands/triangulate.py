@@ -140,6 +140,28 @@ def add_arguments(sub: Any) -> None:
     s.set_defaults(func=run_synth)
 
 
+def _calibrated(block: Any, snooping: Any, args: argparse.Namespace) -> Any:
+    """The block whose camera the job carries: with self-calibration the adjusted f and
+    principal point (x₀, y₀ added to the certificate's); the distortion has no place in a job
+    and is reported only."""
+    if snooping is None:
+        return block
+    last = args.reject or args.robust is not None
+    prob = snooping.problem_last if last else snooping.problem_first
+    if not prob.camera_free:
+        return block
+    import dataclasses
+
+    cam = (snooping.last if last else snooping.first).camera
+    x0, y0 = block.camera.principal_point_mm
+    camera = dataclasses.replace(
+        block.camera,
+        focal_length_mm=float(cam[0]),
+        principal_point_mm=(float(x0 + cam[1]), float(y0 + cam[2])),
+    )
+    return dataclasses.replace(block, camera=camera)
+
+
 def _camera_parameters(text: str) -> tuple[str, ...]:
     """``--self-calibrate``'s list: names of the camera model, or ``all``."""
     from stereoplotter.triangulation.camera_model import CAMERA_PARAMETERS
@@ -204,6 +226,7 @@ def run(args: argparse.Namespace) -> int:
     solution, snooping = _solve(block, args)
     residuals = catalogue_residuals(block, solution)
     files: dict[str, str | bytes] = {}
+    job_block = _calibrated(block, snooping, args)
     if production is not None:  # first: a photo number the job cannot take stops everything
         description = (
             f"Exterior orientation of block {block.name} by stereoplotter triangulate "
@@ -211,7 +234,11 @@ def run(args: argparse.Namespace) -> int:
         )
         files.update(
             job_files(
-                block, production, solution.orientations, source=args.block, description=description
+                job_block,
+                production,
+                solution.orientations,
+                source=args.block,
+                description=description,
             )
         )
     files["orientations.csv"] = orientation_csv(block, solution)

@@ -334,6 +334,9 @@ def _camera_lines(c: CameraCalibration) -> list[str]:
         f"{c.p_value:.2g}: **{verdict}**. Each alone: |t| against {c.t_critical:.2f} "
         f"(α = {c.alpha:g} shared by the {len(c.names)}, Bonferroni).",
         "",
+        "The production job (`job.yaml`) carries the adjusted f and principal point; the "
+        "distortion parameters have no place in a job and are given here only.",
+        "",
         "| parameter | certificate | adjusted | σ | t | significant |",
         "|---|---:|---:|---:|---:|---|",
     ]

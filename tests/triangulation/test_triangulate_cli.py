@@ -165,6 +165,13 @@ def test_self_calibration_from_the_command_line(chain, tmp_path, capsys):
     assert main([*argv, "--self-calibrate", "f,x0,y0,k1"]) == 0
     text = (tmp_path / "report.md").read_text(encoding="utf-8")
     assert "## Self-calibration of the camera" in text and "| k1 [mm⁻²] |" in text
+    from stereoplotter.io.job_file import load_job
+
+    f_row = next(line for line in text.splitlines() if line.startswith("| f [mm] |"))
+    adjusted = float(f_row.split("|")[3])
+    job = load_job(tmp_path / "job.yaml")  # the job carries the adjusted f
+    assert job.camera.focal_length_mm == pytest.approx(adjusted, abs=5e-6 * adjusted)
+    assert job.camera.focal_length_mm != 70.0
     assert main([*argv, "--self-calibrate", "f,z9"]) == 1
     assert "--self-calibrate" in capsys.readouterr().err
 
