@@ -105,8 +105,8 @@ def test_an_x_blunder_on_a_point_of_one_strip_is_found_but_not_told_from_its_nei
 
 def test_point_sigma_matches_the_errors_at_check_points():
     # RMS(error/σ) per axis over the check points of 4 blocks of 352: the blocks' values
-    # spread by ≈ 0.07 per axis (correlated points), so the mean of 4 has SE ≈ 0.035 and
-    # 0.9–1.1 is ± 2.9 SE
+    # spread by ≈ 0.06 per axis (correlated points), so the mean of 4 has SE ≈ 0.03 and
+    # 0.9–1.1 is ± 3.3 SE
     z = []
     for seed in range(4):
         block, truth = block6x15(seed)
