@@ -52,6 +52,35 @@ def add_arguments(sub: Any) -> None:
         default=3,
         help="strip method: degree of the strip polynomials (default 3)",
     )
+    p.add_argument(
+        "--reject",
+        action="store_true",
+        help="bundle: remove the observations data snooping flags and readjust (default: "
+        "flag them in report.md and flagged.csv, keep them in the solution)",
+    )
+    p.add_argument(
+        "--alpha0",
+        type=bounded_float(1e-12, 0.5),
+        default=None,
+        metavar="A",
+        help="bundle: level of one w-test (default: family-wise 5 %% over all observations "
+        "by Šidák; Baarda's classical value is 0.001)",
+    )
+    p.add_argument(
+        "--robust",
+        choices=("huber", "danish"),
+        default=None,
+        help="bundle: robust re-weighting instead of data snooping (Danish: weight × "
+        "exp(1 − |t|/k) beyond the critical value k; Huber: × k/|t|); the solution is the "
+        "re-weighted one, flagged.csv the observations it down-weighted",
+    )
+    p.add_argument(
+        "--self-calibrate",
+        default="",
+        metavar="PARAMS",
+        help="bundle: adjust camera parameters with the block, comma-separated among "
+        "f,x0,y0,k1,k2,p1,p2 or 'all' (default none: the certificate holds)",
+    )
     p.set_defaults(func=run)
     b = sub.add_parser("block", help="blocks of comparator measurements (docs/triangulation.md)")
     acts = b.add_subparsers(dest="block_command", required=True, metavar="ACTION")
@@ -86,6 +115,21 @@ def add_arguments(sub: Any) -> None:
         metavar="MM",
         help="σ of a comparator coordinate [mm] (default 0.005: a stereocomparator)",
     )
+    s.add_argument(
+        "--centres",
+        type=bounded_float(1e-6, 100.0),
+        default=None,
+        metavar="SIGMA_M",
+        help="also measure every photo's projection centre (GNSS antenna) with this σ [m]",
+    )
+    s.add_argument(
+        "--lever-arm",
+        type=float,
+        nargs=3,
+        default=(0.0, 0.0, 0.0),
+        metavar=("X", "Y", "Z"),
+        help="the antenna in the camera system [m] (with --centres; default 0 0 0)",
+    )
     s.add_argument("--name", default="synthetic", help="name of the block")
     s.add_argument("--instrument", default="sc1", help="instrument of the production job")
     s.add_argument(
@@ -96,19 +140,65 @@ def add_arguments(sub: Any) -> None:
     s.set_defaults(func=run_synth)
 
 
-def _solve(block: Any, args: argparse.Namespace) -> Any:
+def _calibrated(block: Any, snooping: Any, args: argparse.Namespace) -> Any:
+    """The block whose camera the job carries: with self-calibration the adjusted f and
+    principal point (x₀, y₀ added to the certificate's); the distortion has no place in a job
+    and is reported only."""
+    if snooping is None:
+        return block
+    last = args.reject or args.robust is not None
+    prob = snooping.problem_last if last else snooping.problem_first
+    if not prob.camera_free:
+        return block
+    import dataclasses
+
+    cam = (snooping.last if last else snooping.first).camera
+    x0, y0 = block.camera.principal_point_mm
+    camera = dataclasses.replace(
+        block.camera,
+        focal_length_mm=float(cam[0]),
+        principal_point_mm=(float(x0 + cam[1]), float(y0 + cam[2])),
+    )
+    return dataclasses.replace(block, camera=camera)
+
+
+def _camera_parameters(text: str) -> tuple[str, ...]:
+    """``--self-calibrate``'s list: names of the camera model, or ``all``."""
+    from stereoplotter.triangulation.camera_model import CAMERA_PARAMETERS
+
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    if names == ("all",):
+        return CAMERA_PARAMETERS
+    bad = [n for n in names if n not in CAMERA_PARAMETERS]
+    if bad:
+        from stereoplotter.errors import ConfigError
+
+        raise ConfigError(
+            "--self-calibrate", "(option)", "names among " + ",".join(CAMERA_PARAMETERS), bad[0]
+        )
+    return names
+
+
+def _solve(block: Any, args: argparse.Namespace) -> tuple[Any, Any]:
+    """The solution and, for the bundle, its data snooping (else None)."""
     # imported here: the CLI starts without loading scipy's sparse solvers
     if args.method == "bundle":
-        from stereoplotter.triangulation.bundle import bundle_block
+        from stereoplotter.triangulation.reliability import snooped_block
 
-        return bundle_block(block)
+        return snooped_block(
+            block,
+            reject=args.reject,
+            alpha0=args.alpha0,
+            self_calibration=_camera_parameters(args.self_calibrate),
+            robust_method=args.robust,
+        )
     from stereoplotter.triangulation import strip
 
     if args.method == "strip":
-        return strip.strip_block(block, args.models, args.degree)
+        return strip.strip_block(block, args.models, args.degree), None
     from stereoplotter.triangulation.polygon_block import polygon_block
 
-    return polygon_block(block)
+    return polygon_block(block), None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -116,14 +206,27 @@ def run(args: argparse.Namespace) -> int:
     from stereoplotter.io.atomic_write import write_files
     from stereoplotter.io.block_measurements_file import load_block_measurements
     from stereoplotter.io.triangulated_job import job_files
-    from stereoplotter.plotting.triangulation import residual_figure_png
-    from stereoplotter.report.triangulation import orientation_csv, report_markdown, residual_csv
+    from stereoplotter.plotting.triangulation import (
+        photo_residual_figure_png,
+        precision_figure_png,
+        residual_figure_png,
+    )
+    from stereoplotter.report.triangulation import (
+        catalogue_observations_csv,
+        flagged_csv,
+        observations_csv,
+        orientation_csv,
+        points_csv,
+        report_markdown,
+        residual_csv,
+    )
     from stereoplotter.triangulation.solution import catalogue_residuals
 
     block, production = load_block_measurements(args.block)
-    solution = _solve(block, args)
+    solution, snooping = _solve(block, args)
     residuals = catalogue_residuals(block, solution)
     files: dict[str, str | bytes] = {}
+    job_block = _calibrated(block, snooping, args)
     if production is not None:  # first: a photo number the job cannot take stops everything
         description = (
             f"Exterior orientation of block {block.name} by stereoplotter triangulate "
@@ -131,22 +234,50 @@ def run(args: argparse.Namespace) -> int:
         )
         files.update(
             job_files(
-                block, production, solution.orientations, source=args.block, description=description
+                job_block,
+                production,
+                solution.orientations,
+                source=args.block,
+                description=description,
             )
         )
     files["orientations.csv"] = orientation_csv(block, solution)
     files["residuals.csv"] = residual_csv(block, residuals)
+    files["points.csv"] = points_csv(block, solution)
     files["residuals.png"] = residual_figure_png(block, solution, residuals)
-    files["report.md"] = report_markdown(block, solution, residuals, args.block)
+    files["photo_residuals.png"] = photo_residual_figure_png(block, solution)
+    if solution.point_covariances is not None:
+        files["precision.png"] = precision_figure_png(block, solution)
+    if snooping is not None:
+        files["flagged.csv"] = flagged_csv(snooping.flags)
+        last = args.reject or args.robust is not None
+        prob = snooping.problem_last if last else snooping.problem_first
+        rel = snooping.reliability if last else snooping.reliability_first
+        files["observations.csv"] = observations_csv(block, prob, rel)
+        files["catalogue_observations.csv"] = catalogue_observations_csv(prob, rel)
+    files["report.md"] = report_markdown(
+        block, solution, residuals, args.block, snooping, args.reject or args.robust is not None
+    )
     out = Path(args.output)
     encoded = {n: c if isinstance(c, bytes) else c.encode("utf-8") for n, c in files.items()}
     write_files(out, encoded)  # every file whole or not at all
     rms = residuals.rms(block, "check")
     job = f"; job file {out / 'job.yaml'}" if production is not None else ""
+    flagged = ""
+    if snooping is not None:
+        what = (
+            "down-weighted"
+            if args.robust
+            else "removed"
+            if args.reject
+            else "kept; --reject removes them"
+        )
+        flagged = f"; {len(snooping.flags)} observations flagged ({what})"
     print(
         f"block {block.name}: {len(block.photos)} photos by {args.method} in "
         f"{solution.iterations} iterations, σ₀ = {solution.sigma0:.3f}; RMS at check points "
-        f"X {rms[0]:.3f}, Y {rms[1]:.3f}, Z {rms[2]:.3f} m; report {out / 'report.md'}{job}"
+        f"X {rms[0]:.3f}, Y {rms[1]:.3f}, Z {rms[2]:.3f} m{flagged}; report "
+        f"{out / 'report.md'}{job}"
     )
     if production is None:
         print("no production section in the block file: no job file written", file=sys.stderr)
@@ -187,6 +318,8 @@ def run_synth(args: argparse.Namespace) -> int:
         name=args.name,
         control_every_bases=args.control_every,
         sigma_photo_mm=args.sigma_photo,
+        centre_sigma_m=args.centres,
+        lever_arm_m=tuple(args.lever_arm),
     )
     rng = np.random.default_rng([args.seed, key_code("block synth")])
     block, truth = synthesize_block(spec, rng)

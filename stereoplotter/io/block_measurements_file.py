@@ -11,7 +11,10 @@ A YAML file (pydantic models on :mod:`stereoplotter.io.validation`; JSON Schema
     strips: [["101", "102", "103"], ["201", "202", "203"]]              # photo numbers, text
     measurements_csv: measurements.csv   # photo,point,kind,x_mm,y_mm  (kind: fiducial | point)
     control_csv: control.csv             # id,role,kind,north_m,east_m,height_m  (SK-42)
-    sigma: {photo_mm: 0.005, control_plan_m: 0.05, control_height_m: 0.05}
+    sigma: {photo_mm: 0.005, control_plan_m: 0.05, control_height_m: 0.05,
+            centre_plan_m: 0.1, centre_height_m: 0.15}
+    centres_csv: centres.csv             # optional: photo,north_m,east_m,height_m (GNSS, SK-42)
+    lever_arm_m: [0.0, 0.0, 1.2]         # optional: the antenna in the camera system
     production: {instrument: sc1, date: "2026-11-26", map_sheets: [...]}  # for the job file
 
 Photo numbers and point ids are text everywhere (``0415`` is not ``415``): in YAML they must be
@@ -61,6 +64,7 @@ __all__ = [
 FORMAT = "stereoplotter-block-measurements/1"
 MEASUREMENT_COLUMNS = ("photo", "point", "kind", "x_mm", "y_mm")
 CONTROL_COLUMNS = ("id", "role", "kind", "north_m", "east_m", "height_m")
+CENTRE_COLUMNS = ("photo", "north_m", "east_m", "height_m")
 
 
 def _identifier(v: Any) -> str:
@@ -75,6 +79,8 @@ class SigmaModel(FileModel):
     photo_mm: number("mm", 0.0, 1.0, low_open=True) = 0.005  # type: ignore[valid-type]
     control_plan_m: number("m", 0.0, 100.0, low_open=True) = 0.05  # type: ignore[valid-type]
     control_height_m: number("m", 0.0, 100.0, low_open=True) = 0.05  # type: ignore[valid-type]
+    centre_plan_m: number("m", 0.0, 100.0, low_open=True) = 0.1  # type: ignore[valid-type]
+    centre_height_m: number("m", 0.0, 100.0, low_open=True) = 0.15  # type: ignore[valid-type]
 
 
 class BlockFrame(FileModel):
@@ -112,6 +118,11 @@ class BlockMeasurementsFile(FileModel):
     measurements_csv: text  # type: ignore[valid-type]
     control_csv: text  # type: ignore[valid-type]
     sigma: SigmaModel = SigmaModel()
+    centres_csv: text | None = None  # type: ignore[valid-type]
+    lever_arm_m: sequence(number("m", -100.0, 100.0), min_length=3, max_length=3) = Field(  # type: ignore[valid-type]
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description="the GNSS antenna in the camera system (x, y, z) [m]",
+    )
     production: ProductionModel | None = None
 
     @field_validator("strips", mode="before")
@@ -238,6 +249,23 @@ def _catalogue(path: Path, zone: int) -> tuple[CataloguePoint, ...]:
     return tuple(out.values())
 
 
+def _centres(path: Path, photos: dict[str, int], zone: int) -> tuple:
+    """The measured projection centres: (photo, (north, east, height)) per row, SK-42 [m]."""
+    out: dict[str, tuple[float, float, float]] = {}
+    for where, row in _read_csv(path, CENTRE_COLUMNS):
+        photo = row["photo"]
+        if photo not in photos or photo in out:
+            raise ConfigError(where, "photo", "a photo number of strips, once", repr(photo))
+        north = _number(where, "north_m", row["north_m"], 0.0, 1.0e7, "m")
+        east = _number(where, "east_m", row["east_m"], 1.0e6, 61.0e6, "m (conventional)")
+        height = _number(where, "height_m", row["height_m"], -500.0, 20000.0, "m")
+        z, _ = frame_tie.check_conventional_ordinate(east)
+        if z != zone:
+            raise ConfigError(where, "east_m", f"a point in the origin's zone {zone}", f"zone {z}")
+        out[photo] = (north, east, height)
+    return tuple(out.items())
+
+
 def load_block_measurements(path: str | os.PathLike[str]) -> tuple[Block, Production | None]:
     """Read and validate a block measurements file (CSV files relative to it).
 
@@ -266,6 +294,7 @@ def load_block_measurements(path: str | os.PathLike[str]) -> tuple[Block, Produc
             photos[p] = len(photos)
     fid, obs_photo, obs_point, xy, ids = _measurements(folder / doc.measurements_csv, photos)
     catalogue = _catalogue(folder / doc.control_csv, zone)
+    centres = _centres(folder / doc.centres_csv, photos, zone) if doc.centres_csv else ()
     s = doc.sigma
     block = Block(
         name=doc.name,
@@ -278,7 +307,11 @@ def load_block_measurements(path: str | os.PathLike[str]) -> tuple[Block, Produc
         point_ids=ids,
         catalogue=catalogue,
         origin_sk42_m=(o.north_m, o.east_m, o.height_m),
-        sigmas=Sigmas(s.photo_mm, s.control_plan_m, s.control_height_m),
+        sigmas=Sigmas(
+            s.photo_mm, s.control_plan_m, s.control_height_m, s.centre_plan_m, s.centre_height_m
+        ),
+        centres=centres,
+        lever_arm_m=tuple(float(v) for v in doc.lever_arm_m),  # type: ignore[arg-type]
     )
     prod = doc.production
     production = Production(prod.instrument, prod.date, tuple(prod.map_sheets)) if prod else None
@@ -378,12 +411,22 @@ def write_block_measurements(
                 "photo_mm": float(s.photo_mm),
                 "control_plan_m": float(s.control_plan_m),
                 "control_height_m": float(s.control_height_m),
+                "centre_plan_m": float(s.centre_plan_m),
+                "centre_height_m": float(s.centre_height_m),
             }
         ),
     }
+    files = {}
+    if block.centres:
+        doc["centres_csv"] = "centres.csv"
+        doc["lever_arm_m"] = Flow([float(v) for v in block.lever_arm_m])
+        files["centres.csv"] = _csv_text(
+            CENTRE_COLUMNS,
+            [(p, *(f"{v:.3f}" for v in xyz)) for p, xyz in block.centres],
+        )
     if production is not None:
         doc["production"] = production
-    files = {
+    files |= {
         "measurements.csv": _csv_text(MEASUREMENT_COLUMNS, rows),
         "control.csv": _csv_text(CONTROL_COLUMNS, control),
         "block.yaml": yaml_document(doc),

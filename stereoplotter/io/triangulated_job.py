@@ -2,7 +2,7 @@
 
 The job is written in the block's own local system of §10 (``frame: {kind: local, origin: …}``):
 the centres X_S, Y_S, Z_S and the angles α, ω, κ of Eq. (2.50) exactly as the triangulation gives
-them, the control and check points of the catalogue in the same system (``points.csv``), the
+them, the control and check points of the catalogue in the same system (``control_points.csv``), the
 fiducial distances 1–2 and 3–4 measured on the comparator (``fiducials.csv``), the camera
 certificate, the instrument, date and map sheets of the block's ``production`` section, and one
 pair per two consecutive photos of a strip, each on the map sheet that holds the pair's centre.
@@ -144,7 +144,7 @@ def job_files(
     source: str,
     description: str,
 ) -> dict[str, str]:
-    """The text of ``job.yaml``, ``fiducials.csv`` and ``points.csv`` of the triangulated block
+    """The text of ``job.yaml``, ``fiducials.csv`` and ``control_points.csv`` of the block
     (orientations (n_photos, 6): α, ω, κ [rad], X_S, Y_S, Z_S [m] local; centres written to
     1 mm, angles to 10⁻⁶°, as a listing prints them). ``job.yaml`` goes through the safe YAML
     emitter (:func:`~stereoplotter.io.yaml_output.yaml_document`): names and photo numbers read
@@ -169,7 +169,7 @@ def job_files(
         "frame": {"kind": "local", "origin": origin_data(block.origin_sk42_m)},
         "photos": [_photo_row(n, o) for n, o in zip(numbers, orientations, strict=True)],
         "fiducial_distances_csv": "fiducials.csv",
-        "points_csv": Flow(["points.csv"]),
+        "points_csv": Flow(["control_points.csv"]),
         "map_sheets": _sheets_data(production),
         "pairs": pairs,
     }
@@ -190,7 +190,7 @@ def job_files(
         (c.id, c.role, c.kind, *(f"{v:.3f}" for v in xyz))
         for c, xyz in zip(block.catalogue, local, strict=True)
     )
-    return {"fiducials.csv": fid.getvalue(), "points.csv": pts.getvalue(), "job.yaml": text}
+    return {"fiducials.csv": fid.getvalue(), "control_points.csv": pts.getvalue(), "job.yaml": text}
 
 
 def write_triangulated_job(

@@ -35,6 +35,7 @@ __all__ = [
     "Sigmas",
     "block_frame",
     "catalogue_local",
+    "centres_local",
     "interior_orientation",
     "photo_coordinates",
     "sk42_from_block_local",
@@ -55,11 +56,16 @@ class Sigmas:
         One comparator coordinate of a point, after interior orientation. [mm]
     control_plan_m, control_height_m : float
         Catalogue X, Y and Z of a control point. [m]
+    centre_plan_m, centre_height_m : float
+        A measured projection centre (GNSS antenna) in plan and height. [m] (default 0.1 and
+        0.15: kinematic carrier-phase GNSS of an aerial survey, height the weaker)
     """
 
     photo_mm: float = 0.005
     control_plan_m: float = 0.05
     control_height_m: float = 0.05
+    centre_plan_m: float = 0.1
+    centre_height_m: float = 0.15
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,6 +104,13 @@ class Block:
     origin_sk42_m : tuple of float
         Origin of the local system of §10 (x north, ȳ, H). [m]
     sigmas : Sigmas
+    centres : tuple of (str, (float, float, float))
+        Measured projection centres (GNSS antenna positions): photo number and SK-42 (x north,
+        ȳ, H) [m]; empty when the block has none.
+    lever_arm_m : tuple of float
+        The antenna's offset from the projection centre in the camera system (x, y along the
+        photo's axes, z along the optical axis towards the sky): antenna = S + M·e (M of
+        Eq. (2.50)). [m]
     """
 
     name: str
@@ -111,6 +124,8 @@ class Block:
     catalogue: tuple[CataloguePoint, ...]
     origin_sk42_m: tuple[float, float, float]
     sigmas: Sigmas = field(default_factory=Sigmas)
+    centres: tuple[tuple[str, tuple[float, float, float]], ...] = ()
+    lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     @property
     def photos(self) -> tuple[str, ...]:
@@ -186,6 +201,19 @@ def catalogue_local(block: Block) -> NDArray[np.float64]:
         )
     X, Y, Z = local_from_gauss_kruger(lf, sk42[:, 0], np.asarray(y, float), sk42[:, 2])
     return np.stack([X, Y, Z], axis=-1)
+
+
+def centres_local(block: Block) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Photo indices (n,) and local X, Y, Z [m] (n, 3) of the measured projection centres."""
+    index = {p: j for j, p in enumerate(block.photos)}
+    if not block.centres:
+        return np.zeros(0, np.int64), np.zeros((0, 3))
+    lf = block_frame(block)
+    sk42 = np.array([c for _, c in block.centres], float).reshape(-1, 3)
+    _, y = split_conventional_ordinate(sk42[:, 1])
+    X, Y, Z = local_from_gauss_kruger(lf, sk42[:, 0], np.asarray(y, float), sk42[:, 2])
+    photos = np.array([index[p] for p, _ in block.centres], np.int64)
+    return photos, np.stack([X, Y, Z], axis=-1)
 
 
 def sk42_from_block_local(block: Block, xyz_m: NDArray[np.float64]) -> NDArray[np.float64]:

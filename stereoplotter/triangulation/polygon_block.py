@@ -19,13 +19,20 @@ intersected from the adjusted orientations).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.geometry.rotation import angles_from_matrix
 from stereoplotter.triangulation.block import Block
 from stereoplotter.triangulation.polygon import PolygonNetwork, adjust_polygons
-from stereoplotter.triangulation.solution import BlockSolution
+from stereoplotter.triangulation.solution import (
+    BlockSolution,
+    catalogue_residuals,
+    forward_intersection,
+    photo_residuals,
+)
 from stereoplotter.triangulation.strip import OrientedStrip, oriented_strips
 
 __all__ = ["polygon_block", "polygon_sides"]
@@ -88,13 +95,38 @@ def polygon_block(block: Block, method: str = "least_squares") -> BlockSolution:
     network = PolygonNetwork(block.photos, tuple(sides), np.array(values), fixed=fixed)
     result = adjust_polygons(network, method=method)
     orient = np.array([result.centre_elements[p] for p in block.photos])
-    points = np.full((len(block.point_ids), 3), np.nan)
+    sol = BlockSolution("polygon", orient, None, np.full((len(block.point_ids), 3), np.nan), 0, 1.0)
+    # every point measured twice: intersected from the adjusted orientations (its two most
+    # distant rays), so that the photo residuals and σ₀ = RMS(v)/σ_photo are numbers
+    points = forward_intersection(block, sol, np.arange(len(block.point_ids)))
+    sol = dataclasses.replace(sol, points_m=points)
+    v = photo_residuals(block, sol)
+    sigma0 = float(np.sqrt(np.mean(v[np.all(np.isfinite(v), axis=1)] ** 2))) / block.sigmas.photo_mm
+    # empirical σ of every point: the RMS residual at the control points per axis (the polygon
+    # adjustment holds only the four corner photos; the control enters through the strips'
+    # absolute orientation, and its residuals after the polygon adjustment are of the size of
+    # the check points')
+    rms = catalogue_residuals(block, sol).rms(block, "control")
+    cov = None
+    if np.all(np.isfinite(rms)):
+        cov = np.where(np.isfinite(points)[:, :, None], np.diag(rms**2)[None], np.nan)
     notes = (
         f"polygon network: {len(block.photos)} centres, {len(sides)} sides (models along the "
         "strips, strip connections across), the block's four corner photos fixed",
         f"adjustment: {method}; strips by independent models (≤ {iterations} iterations per "
         "pair) and 7-parameter absolute orientation",
+        "points intersected from the adjusted orientations (two rays); σ₀ = RMS photo residual "
+        "/ σ_photo (empirical: no adjustment of the rays)",
+        "σ of the points: an empirical rule, the RMS residual at the control points per axis, "
+        "for every point",
     )
     return BlockSolution(
-        "polygon", orient, None, points, int(np.max(result.iterations)), float("nan"), notes
+        "polygon",
+        orient,
+        None,
+        points,
+        int(np.max(result.iterations)),
+        sigma0,
+        notes,
+        point_covariances=cov,
     )

@@ -34,6 +34,7 @@ __all__ = [
     "adjust_strip_polynomials",
     "height_terms",
     "plan_terms",
+    "point_sigmas",
 ]
 
 
@@ -71,13 +72,16 @@ def height_terms(u: NDArray, v: NDArray, degree: int) -> NDArray[np.float64]:
 @dataclass(frozen=True, slots=True)
 class StripPolynomials:
     """Adjusted polynomials: ``plan`` (n_strips, 2(n+1)), ``height`` (n_strips, 2n+1); the
-    ground ``points_m`` (n_points, 3) (NaN where no strip measured the point)."""
+    ground ``points_m`` (n_points, 3) (NaN where no strip measured the point) and their σ
+    ``sigma_m`` (n_points, 3) propagated through the polynomial adjustment
+    (:func:`point_sigmas`)."""
 
     degree: int
     axes: tuple[StripAxes, ...]
     plan: NDArray[np.float64]
     height: NDArray[np.float64]
     points_m: NDArray[np.float64]
+    sigma_m: NDArray[np.float64] | None = None
 
     def correct(self, strip: int, xyz: NDArray) -> NDArray[np.float64]:
         """Strip coordinates (n, 3) with the strip's polynomial corrections added. [m]"""
@@ -158,13 +162,49 @@ def adjust_strip_polynomials(
         used[cols_a] = True
         x = np.full(a.shape[1], np.nan)
         try:
-            x[used] = sparse_least_squares(a[:, used], np.concatenate(rhs))
+            au, bu = a[:, used], np.concatenate(rhs)
+            x[used] = sparse_least_squares(au, bu)
+            sig = np.full(a.shape[1], np.nan)
+            sig[used] = point_sigmas(au, bu, x[used], int(np.count_nonzero(used[: ns * nt])))
         except RuntimeError:
             raise GeometryError(
                 f"strip polynomials of degree {degree}: the control does not fix them (a "
                 "singular system): give more control or a lower degree"
             ) from None
-        results.append((x[: ns * nt].reshape(ns, nt), x[ns * nt :].reshape(n_points, nd)))
-    (plan, plan_pts), (height, height_pts) = results
+        results.append(
+            (
+                x[: ns * nt].reshape(ns, nt),
+                x[ns * nt :].reshape(n_points, nd),
+                sig[ns * nt :].reshape(n_points, nd),
+            )
+        )
+    (plan, plan_pts, plan_sig), (height, height_pts, height_sig) = results
     points = np.column_stack([plan_pts, height_pts])
-    return StripPolynomials(degree, axes, plan, height, points)
+    return StripPolynomials(
+        degree, axes, plan, height, points, np.column_stack([plan_sig, height_sig])
+    )
+
+
+def point_sigmas(a: sp.spmatrix, b: NDArray, x: NDArray, n_coefficients: int) -> NDArray:
+    """σ of every unknown of a weighted linear least squares whose first ``n_coefficients``
+    unknowns are the polynomials' and the rest points' coordinates (each point coordinate's
+    normal block is one number: N_pp diagonal): σ₀·√diag(N⁻¹) by block elimination of the
+    points, σ₀ = √([vv]/r) a posteriori (the model coordinates' σ is a rule of thumb; the
+    residuals say what it is). The coefficients' σ are returned as NaN.
+
+    Raises RuntimeError when the polynomials' reduced matrix is singular."""
+    n = (a.T @ a).tocsr()
+    k = n_coefficients
+    d = n.diagonal()[k:]
+    bcp = n[:k, k:].toarray()
+    m = bcp / d  # N_cp·N_pp⁻¹
+    s = n[:k, :k].toarray() - m @ bcp.T
+    try:
+        qcc = np.linalg.inv(s)
+    except np.linalg.LinAlgError as exc:
+        raise RuntimeError(str(exc)) from None
+    q_points = 1.0 / d + np.einsum("ij,ij->j", m, qcc @ m)
+    v = a @ x - b
+    r = a.shape[0] - a.shape[1]
+    sigma0 = float(np.sqrt(v @ v / r)) if r > 0 else float("nan")
+    return np.concatenate([np.full(k, np.nan), sigma0 * np.sqrt(q_points)])

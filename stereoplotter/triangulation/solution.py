@@ -21,6 +21,7 @@ __all__ = [
     "BlockSolution",
     "CatalogueResiduals",
     "catalogue_residuals",
+    "forward_intersection",
     "photo_residuals",
     "sparse_least_squares",
 ]
@@ -50,6 +51,9 @@ class BlockSolution:
     next_covariances : ndarray, shape (n_photos, 6, 6), or None
         Covariance of photo j + 1 against photo j (the next in ``Block.photos``; zero for the
         last), for the pairs of the setup; None where the method gives none.
+    point_covariances : ndarray, shape (n_points, 3, 3), or None
+        Covariance of each object point's X, Y, Z [m²] (NaN where the method determines the
+        point not); None where the method gives none.
     """
 
     method: str
@@ -60,6 +64,15 @@ class BlockSolution:
     sigma0: float
     notes: tuple[str, ...] = ()
     next_covariances: NDArray[np.float64] | None = None
+    point_covariances: NDArray[np.float64] | None = None
+
+    @property
+    def point_standard_errors(self) -> NDArray[np.float64] | None:
+        """σ of each point's X, Y, Z, shape (n_points, 3) [m] (NaN where undetermined), or None."""
+        if self.point_covariances is None:
+            return None
+        with np.errstate(invalid="ignore"):
+            return np.sqrt(np.einsum("nii->ni", self.point_covariances))
 
     def pair_covariance(self, j: int) -> NDArray[np.float64] | None:
         """12 × 12 covariance of photos j and j + 1 (rad, m), or None."""
@@ -119,13 +132,16 @@ def photo_residuals(block: Block, solution: BlockSolution) -> NDArray[np.float64
     return xy - computed
 
 
-def _forward_intersection(block: Block, solution: BlockSolution, points: NDArray) -> NDArray:
-    """Each point from the first two photos that measured it, by Eq. (2.52) (space intersection)."""
+def forward_intersection(block: Block, solution: BlockSolution, points: NDArray) -> NDArray:
+    """Each point (indices into ``Block.point_ids``) from the first and last photos that measured
+    it, by Eq. (2.52) (space intersection); NaN for a point measured on fewer than two photos."""
     xy = interior_orientation(block)
     out = np.full((points.size, 3), np.nan)
     f = block.camera.focal_length_mm
+    order = np.argsort(block.obs_point, kind="stable")
+    bounds = np.searchsorted(block.obs_point[order], np.arange(len(block.point_ids) + 1))
     for k, i in enumerate(points):
-        rows = np.flatnonzero(block.obs_point == i)
+        rows = order[bounds[i] : bounds[i + 1]]
         if rows.size < 2:
             continue
         a, b = rows[0], rows[-1]
@@ -148,7 +164,7 @@ def catalogue_residuals(block: Block, solution: BlockSolution) -> CatalogueResid
     computed = solution.points_m[points].copy()
     missing = np.flatnonzero(np.any(~np.isfinite(computed), axis=1))
     if missing.size:
-        computed[missing] = _forward_intersection(block, solution, points[missing])
+        computed[missing] = forward_intersection(block, solution, points[missing])
     local = catalogue_local(block)[index]
     rays = np.bincount(block.obs_point, minlength=len(block.point_ids))[points]
     return CatalogueResiduals(index, computed, local, computed - local, rays)

@@ -23,6 +23,7 @@ from stereoplotter.triangulation.control_spacing import (
     simulate_residual_variance,
 )
 from stereoplotter.triangulation.spacing_printed import (
+    OCR_READINGS,
     RECOMMENDED_LINKS,
     TABLE_1,
     TABLE_1_MEAN_SQUARE,
@@ -33,6 +34,11 @@ __all__ = ["Cell", "main", "table_cells"]
 
 #: Half a unit of the printed last digit (0.01) plus float slack.
 PRINTED_HALF_UNIT = 0.005 + 1e-9
+#: The line between rounding and misprint: half a unit of the printed 0.01 plus half a unit of
+#: the next digit (0.0005), the most a value carried to three decimals before its rounding to two
+#: can move it. A cell off by more than half a unit but not more than this is "rounding" (the
+#: paper's arithmetic at a rounding boundary), beyond it a "misprint".
+ROUNDING_LIMIT = 0.0055 + 1e-9
 
 
 @dataclass(frozen=True)
@@ -45,14 +51,29 @@ class Cell:
     paper: float  # |σ_η² − σ_p²|·σ_ε² (the paper's Eq. (1))
     signed: float  # σ_η² − σ_p², signed
     actual: float  # var(η − p)·σ_ε²
+    read: float | None = None  # the printed value as read (an OCR reading), else the printed
+
+    @property
+    def value(self) -> float | None:
+        """The printed value as read."""
+        return self.printed if self.read is None else self.read
 
     @property
     def agrees(self) -> bool:
-        return self.printed is None or abs(self.printed - self.paper) <= PRINTED_HALF_UNIT
+        """Within half a unit of the printed 0.01 (after the OCR reading)."""
+        return self.value is None or abs(self.value - self.paper) <= PRINTED_HALF_UNIT
+
+    @property
+    def kind(self) -> str:
+        """``agrees``, ``rounding`` (≤ :data:`ROUNDING_LIMIT` off) or ``misprint``."""
+        if self.agrees:
+            return "agrees"
+        return "rounding" if abs(self.value - self.paper) <= ROUNDING_LIMIT else "misprint"
 
 
 def table_cells(table: dict, degree: int) -> list[Cell]:
-    """Every entry of a printed table beside its reproduction (σ_ε² = 0.01)."""
+    """Every entry of a printed table beside its reproduction (σ_ε² = 0.01), OCR readings of
+    :data:`~stereoplotter.triangulation.spacing_printed.OCR_READINGS` applied."""
     out = []
     for control, printed in table.items():
         n_bases = control[-1] - 1
@@ -60,31 +81,56 @@ def table_cells(table: dict, degree: int) -> list[Cell]:
         signed = paper_residual_variance(n_bases, base, degree) * PAPER_PER_BASE_VARIANCE
         actual = residual_variance(n_bases, base, degree) * PAPER_PER_BASE_VARIANCE
         for b in range(n_bases + 1):
+            read = OCR_READINGS.get((control, b + 1))
             out.append(
-                Cell(control, b + 1, printed[b], abs(signed[b]), float(signed[b]), float(actual[b]))
+                Cell(
+                    control,
+                    b + 1,
+                    printed[b],
+                    abs(signed[b]),
+                    float(signed[b]),
+                    float(actual[b]),
+                    read,
+                )
             )
     return out
 
 
 def _print_table(name: str, table: dict, degree: int) -> None:
-    print(f"\n{name} (degree {degree}): printed | |σ_η²−σ_p²| (Eq. 1) | var(η−p); '*' differs")
+    print(
+        f"\n{name} (degree {degree}): printed | |σ_η²−σ_p²| (Eq. 1) | var(η−p); "
+        "r rounding, * misprint"
+    )
     cells = table_cells(table, degree)
     for control in table:
         row = [c for c in cells if c.control == control]
         text = " ".join(
             ("  —  " if c.printed is None else f"{c.printed:5.2f}")
             + f"|{c.paper:5.3f}|{c.actual:5.3f}"
-            + ("*" if not c.agrees else " ")
+            + {"agrees": " ", "rounding": "r", "misprint": "*"}[c.kind]
             for c in row
         )
         print(f"  {'-'.join(map(str, control)):>10}: {text}")
-    bad = [c for c in cells if not c.agrees]
-    print(f"  {len(bad)} of {sum(c.printed is not None for c in cells)} printed cells differ:")
-    for c in bad:
-        print(
-            f"    {'-'.join(map(str, c.control))} point {c.point}: printed {c.printed:.2f}, "
-            f"Eq. (1) {c.signed:+.4f}, actual residual {c.actual:.4f}"
-        )
+    legible = sum(c.printed is not None for c in cells)
+    kinds = [c.kind for c in cells if c.printed is not None]
+    print(
+        f"  {kinds.count('agrees')} of {legible} printed cells agree within half a unit (0.005), "
+        f"{kinds.count('rounding')} more within {ROUNDING_LIMIT:.4f} (rounding, 'r'), "
+        f"{kinds.count('misprint')} misprints ('*'):"
+    )
+    for c in cells:
+        if c.read is not None:
+            print(
+                f"    {'-'.join(map(str, c.control))} point {c.point}: printed {c.printed:.3f} "
+                f"read {c.read:.2f} (OCR), Eq. (1) {c.signed:+.4f}: {c.kind}"
+            )
+    for c in cells:
+        if c.kind != "agrees":
+            print(
+                f"    {'-'.join(map(str, c.control))} point {c.point}: printed {c.value:.2f}, "
+                f"Eq. (1) {c.signed:+.4f}, off {abs(c.value - c.paper):.4f}: {c.kind}; actual "
+                f"residual {c.actual:.4f}"
+            )
 
 
 def _print_mean_square() -> None:

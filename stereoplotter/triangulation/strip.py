@@ -198,45 +198,88 @@ def _known(strip: StripModel, ids: NDArray) -> tuple[NDArray, NDArray]:
 
 
 def form_strip(
-    xy: NDArray, rows_of: list[dict[int, int]], photos: list[int], f: float, models: str
+    xy: NDArray,
+    rows_of: list[dict[int, int]],
+    photos: list[int],
+    f: float,
+    models: str,
+    names: tuple[str, ...] = (),
+    point_ids: tuple[str, ...] = (),
 ) -> StripModel:
     """The strip of ``photos`` (indices in flight order) in the system of its first model.
 
     ``xy`` photo coordinates of every measurement [mm]; ``rows_of[j]`` point → measurement row
-    of photo j; ``models``: ``"independent"`` or ``"dependent"``. The first model is an
-    independent pair with a base of 1000 units.
+    of photo j; ``models``: ``"independent"`` or ``"dependent"``; ``names`` the photo numbers
+    and ``point_ids`` the point ids (for messages). The first model is an independent pair with
+    a base of 1000 units.
+
+    Raises
+    ------
+    GeometryError
+        A model that cannot be oriented or connected: names the model, its photos, the points
+        they share and what is missing.
     """
     strip = StripModel()
     for k, (a, b) in enumerate(pairwise(photos)):
-        ids, xa, xb = _common(xy, rows_of, a, b)
-        if k == 0 or models == "independent":
-            m1, m2, direction, it = relative_orientation(xa, xb, f)
-            s1, s2 = np.zeros(3), 1000.0 * direction
-            pts = space_intersection(xa, xb, s1, m1, s2, m2, f).points_m
-            if k == 0:
-                strip.centres += [s1, s2]
-                strip.rotations += [m1, m2]
-            else:  # connection by the 7-parameter similarity on common points and centre
-                have, known = _known(strip, ids)
-                t = fit_similarity7(
-                    np.vstack([pts[have], s1]), np.vstack([known, strip.centres[-1]])
-                )
-                pts = apply_similarity7(t, pts)
-                strip.centres.append(apply_similarity7(t, s2))
-                strip.rotations.append(t.rotation @ m2)
-        else:
-            m1, s1 = strip.rotations[-1], strip.centres[-1]
-            _, m2, direction, it = relative_orientation(xa, xb, f, m1)
-            trial = space_intersection(xa, xb, s1, m1, s1 + direction, m2, f).points_m
-            have, known = _known(strip, ids)
-            ratio = np.linalg.norm(known - s1, axis=1) / np.linalg.norm(trial[have] - s1, axis=1)
-            s2 = s1 + float(np.median(ratio)) * direction  # the model's scale: its base length
-            pts = space_intersection(xa, xb, s1, m1, s2, m2, f).points_m
-            strip.centres.append(s2)
-            strip.rotations.append(m2)
-        strip.iterations = max(strip.iterations, it)
-        strip.add_points(ids, pts)
+        try:
+            _add_model(strip, xy, rows_of, photos, k, a, b, f, models)
+        except GeometryError as exc:
+            raise GeometryError(_model_message(exc, rows_of, photos, k, names, point_ids)) from None
     return strip
+
+
+def _model_message(exc, rows_of, photos, k, names, point_ids) -> str:
+    """``exc`` with the model, its photos and the points they share (and with the previous
+    photo, the model's tie to the strip)."""
+
+    def name(j: int) -> str:
+        return names[photos.index(j)] if names else f"#{j}"
+
+    def ids(points: set[int]) -> str:
+        shown = sorted(point_ids[i] if point_ids else f"#{i}" for i in points)
+        return ", ".join(shown[:8]) + (" …" if len(shown) > 8 else "") if shown else "none"
+
+    a, b = photos[k], photos[k + 1]
+    common = set(rows_of[a]) & set(rows_of[b])
+    text = f"model {name(a)}–{name(b)}: {exc}; points on photos {name(a)} and {name(b)}: "
+    text += f"{len(common)} ({ids(common)})"
+    if k > 0:
+        three = common & set(rows_of[photos[k - 1]])
+        text += (
+            f"; also on photo {name(photos[k - 1])} (the tie to the strip): {len(three)} "
+            f"({ids(three)}): measure more points in the triple overlap"
+        )
+    return text
+
+
+def _add_model(strip, xy, rows_of, photos, k, a, b, f, models) -> None:
+    """Model k (photos a, b) oriented and connected to the strip (:func:`form_strip`)."""
+    ids, xa, xb = _common(xy, rows_of, a, b)
+    if k == 0 or models == "independent":
+        m1, m2, direction, it = relative_orientation(xa, xb, f)
+        s1, s2 = np.zeros(3), 1000.0 * direction
+        pts = space_intersection(xa, xb, s1, m1, s2, m2, f).points_m
+        if k == 0:
+            strip.centres += [s1, s2]
+            strip.rotations += [m1, m2]
+        else:  # connection by the 7-parameter similarity on common points and centre
+            have, known = _known(strip, ids)
+            t = fit_similarity7(np.vstack([pts[have], s1]), np.vstack([known, strip.centres[-1]]))
+            pts = apply_similarity7(t, pts)
+            strip.centres.append(apply_similarity7(t, s2))
+            strip.rotations.append(t.rotation @ m2)
+    else:
+        m1, s1 = strip.rotations[-1], strip.centres[-1]
+        _, m2, direction, it = relative_orientation(xa, xb, f, m1)
+        trial = space_intersection(xa, xb, s1, m1, s1 + direction, m2, f).points_m
+        have, known = _known(strip, ids)
+        ratio = np.linalg.norm(known - s1, axis=1) / np.linalg.norm(trial[have] - s1, axis=1)
+        s2 = s1 + float(np.median(ratio)) * direction  # the model's scale: its base length
+        pts = space_intersection(xa, xb, s1, m1, s2, m2, f).points_m
+        strip.centres.append(s2)
+        strip.rotations.append(m2)
+    strip.iterations = max(strip.iterations, it)
+    strip.add_points(ids, pts)
 
 
 def _rows_of(block: Block) -> list[dict[int, int]]:
@@ -284,7 +327,9 @@ def oriented_strips(block: Block, models: str = "independent") -> tuple[list[Ori
     out, iterations = [], 0
     for s, names in enumerate(block.strips):
         photos = [index[p] for p in names]
-        sm = form_strip(xy, rows_of, photos, block.camera.focal_length_mm, models)
+        sm = form_strip(
+            xy, rows_of, photos, block.camera.focal_length_mm, models, names, block.point_ids
+        )
         iterations = max(iterations, sm.iterations)
         ids, pts = sm.points()
         where = {i: k for k, i in enumerate(ids.tolist())}
@@ -390,8 +435,16 @@ def strip_block(block: Block, models: str = "independent", degree: int = 3) -> B
         f"each strip: 7-parameter absolute orientation on its control; strip deformation by "
         f"polynomials of degree {degree}, all strips at once",
         "each photo's orientation: space resection on the adjusted points (no σ propagated)",
+        "σ of the points: propagated through the polynomial adjustment with its a posteriori σ₀ "
+        "(model coordinates independent; X, Y, Z uncorrelated)",
     )
+    cov = None
+    if poly.sigma_m is not None:
+        cov = np.einsum("ni,ij->nij", poly.sigma_m**2, np.eye(3))
     sol = BlockSolution("strip", orient, None, poly.points_m, iterations, float("nan"), notes)
     v = photo_residuals(block, sol)
-    sigma0 = float(np.sqrt(np.nanmean(v**2))) / block.sigmas.photo_mm
-    return BlockSolution("strip", orient, None, poly.points_m, iterations, sigma0, notes)
+    ok = np.all(np.isfinite(v), axis=1)
+    sigma0 = float(np.sqrt(np.mean(v[ok] ** 2))) / block.sigmas.photo_mm
+    return BlockSolution(
+        "strip", orient, None, poly.points_m, iterations, sigma0, notes, point_covariances=cov
+    )

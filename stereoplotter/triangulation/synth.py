@@ -33,6 +33,7 @@ from stereoplotter.triangulation.block import (
     block_frame,
     sk42_from_block_local,
 )
+from stereoplotter.triangulation.camera_model import camera_image
 from stereoplotter.triangulation.control_spacing import choose_control_spacing
 
 __all__ = ["SynthSpec", "Truth", "control_stations_for_degree", "synthesize_block"]
@@ -52,7 +53,11 @@ class SynthSpec:
     nadir must stay in the usable field), σ 5 µm per comparator coordinate (a
     stereocomparator), control to 5 cm. ``control_stations`` (base numbers 0 … n_bases along
     every strip) replaces the regular ``control_every_bases`` (e.g.
-    :func:`control_stations_for_degree`).
+    :func:`control_stations_for_degree`). ``centre_sigma_m``: every photo's GNSS antenna
+    (S + M·``lever_arm_m``) measured with this σ on each axis (None: no centres).
+    ``camera_error``: the true camera differs from its certificate by Δf, x₀, y₀ and has the
+    distortion k₁, k₂, p₁, p₂ (:mod:`~stereoplotter.triangulation.camera_model`).
+    ``sigma_fiducial_mm``: σ of a fiducial mark's reading (default: that of a point).
     """
 
     strips: int = 4
@@ -72,6 +77,10 @@ class SynthSpec:
     sigma_photo_mm: float = 0.005
     sigma_control_m: float = 0.05
     film_deformation_ppm: float = 50.0
+    centre_sigma_m: float | None = None
+    lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    camera_error: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    sigma_fiducial_mm: float | None = None
     origin_sk42_m: tuple[float, float, float] = DEFAULT_ORIGIN_SK42_M
     name: str = "synthetic"
 
@@ -205,9 +214,16 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
     )
     ids = tuple(f"P{int(rr) + 1}.{int(cc) + 1}" for rr, cc in zip(r, c, strict=True))
     rot = rotation_matrix(stations[:, 0], stations[:, 1], stations[:, 2])
-    photo = object_to_photo(points[None], stations[:, None, 3:], rot[:, None], cam.focal_length_mm)
+    true = np.array(spec.camera_error, float)
+    true[0] += cam.focal_length_mm
+    photo = object_to_photo(points[None], stations[:, None, 3:], rot[:, None], true[0])
     with np.errstate(invalid="ignore"):
         seen = np.all(np.abs(photo) <= 0.47 * spec.format_mm, axis=-1)
+    if np.any(true[1:] != 0.0):
+        flat = photo.reshape(-1, 2)
+        ok = np.all(np.isfinite(flat), axis=1)
+        flat[ok] = camera_image(flat[ok], true)[0]
+        photo = flat.reshape(photo.shape)
     obs_photo, obs_point = np.nonzero(seen)
     n_photos, n_obs = stations.shape[0], obs_photo.size
     # the diapositive on the comparator: film deformation, a turn and a shift per photo
@@ -223,7 +239,8 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
     marks = cam.fiducial_array_mm()
     jj = np.repeat(np.arange(n_photos), 4)
     fiducials = comparator(jj, np.tile(marks, (n_photos, 1))).reshape(n_photos, 4, 2)
-    fiducials += rng.normal(0.0, spec.sigma_photo_mm, fiducials.shape)
+    sf = spec.sigma_photo_mm if spec.sigma_fiducial_mm is None else spec.sigma_fiducial_mm
+    fiducials += rng.normal(0.0, sf, fiducials.shape)
     role, kind = _roles(spec, c, r)
     in_catalogue = np.flatnonzero(np.isin(np.arange(len(ids)), obs_point))
     block0 = Block(
@@ -246,5 +263,21 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
         for i, s in zip(in_catalogue, sk42, strict=True)
     )
     sigmas = Sigmas(spec.sigma_photo_mm, spec.sigma_control_m, spec.sigma_control_m)
-    block = dataclasses.replace(block0, catalogue=catalogue, sigmas=sigmas)
+    centres: tuple = ()
+    if spec.centre_sigma_m is not None:
+        sigmas = dataclasses.replace(
+            sigmas, centre_plan_m=spec.centre_sigma_m, centre_height_m=spec.centre_sigma_m
+        )
+        antenna = stations[:, 3:] + rot @ np.asarray(spec.lever_arm_m)
+        antenna += rng.normal(0.0, spec.centre_sigma_m, antenna.shape)
+        geo = sk42_from_block_local(block0, antenna)
+        photos = [p for strip in strips for p in strip]
+        centres = tuple((p, tuple(map(float, g))) for p, g in zip(photos, geo, strict=True))
+    block = dataclasses.replace(
+        block0,
+        catalogue=catalogue,
+        sigmas=sigmas,
+        centres=centres,
+        lever_arm_m=tuple(map(float, spec.lever_arm_m)),
+    )
     return block, Truth(stations, points, terrain)

@@ -53,7 +53,7 @@ def _dense_covariance(p, orient, points):
     normal = a.T @ a
     for k, i in enumerate(p.control_point):
         normal[col[i] : col[i] + 3, col[i] : col[i] + 3] += np.diag(p.control_weight[k])
-    return np.linalg.inv(normal)[: 6 * p.n_photos, : 6 * p.n_photos]
+    return np.linalg.inv(normal), col
 
 
 def test_covariance_equals_the_dense_inverse_of_the_full_normal_matrix():
@@ -62,13 +62,16 @@ def test_covariance_equals_the_dense_inverse_of_the_full_normal_matrix():
     )
     p = problem(block)
     s = bundle_adjust(p)
-    dense = s.sigma0**2 * _dense_covariance(p, s.orientations, np.nan_to_num(s.points_m))
+    full, col = _dense_covariance(p, s.orientations, np.nan_to_num(s.points_m))
+    dense = s.sigma0**2 * full
     blocks = np.array([dense[6 * j : 6 * j + 6, 6 * j : 6 * j + 6] for j in range(p.n_photos)])
     after = np.array(
         [dense[6 * j + 6 : 6 * j + 12, 6 * j : 6 * j + 6] for j in range(p.n_photos - 1)]
     )
     np.testing.assert_allclose(s.covariances, blocks, rtol=1e-4, atol=1e-14)
     np.testing.assert_allclose(s.next_covariances[:-1], after, rtol=1e-4, atol=1e-14)
+    points = np.array([dense[c : c + 3, c : c + 3] for c in col.values()])
+    np.testing.assert_allclose(s.point_covariances[list(col)], points, rtol=1e-4, atol=1e-14)
 
 
 def test_noisy_block_errors_match_the_propagated_sigma():
@@ -90,16 +93,21 @@ def test_too_little_control_is_refused():
         bundle_adjust(problem(no_control))
 
 
-def test_sparse_and_dense_inverses_give_the_same_covariances(monkeypatch):
-    # above DENSE_INVERSE_LIMIT the blocks come column by column from the sparse factor
-    from stereoplotter.triangulation import bundle
+def test_selected_inverse_equals_the_dense_inverse_of_the_reduced_matrix():
+    # every 6 × 6 block of S⁻¹ the band recursion holds, and the far pairs from the LU factor
+    from stereoplotter.triangulation.bundle import _pairs, normals
+    from stereoplotter.triangulation.selected_inverse import selected_inverse
 
-    block, _ = exact_block()
+    block, _ = block10x4()
     p = problem(block)
-    dense = bundle_adjust(p)
-    monkeypatch.setattr(bundle, "DENSE_INVERSE_LIMIT", 0)
-    sparse = bundle_adjust(p)
-    np.testing.assert_allclose(sparse.covariances, dense.covariances, rtol=1e-6, atol=1e-30)
-    np.testing.assert_allclose(
-        sparse.next_covariances, dense.next_covariances, rtol=1e-6, atol=1e-30
-    )
+    s = bundle_adjust(p, covariance=False)
+    n = normals(p, s.orientations, np.nan_to_num(s.points_m), _pairs(p.obs_point))
+    sel = selected_inverse(n.reduced)
+    dense = np.linalg.inv(n.reduced.toarray())
+    a, b = np.meshgrid(np.arange(p.n_photos), np.arange(p.n_photos), indexing="ij")
+    got = sel.blocks(a.ravel(), b.ravel())
+    want = dense.reshape(p.n_photos, 6, p.n_photos, 6).transpose(0, 2, 1, 3).reshape(-1, 6, 6)
+    sd = np.sqrt(np.diag(dense)).reshape(-1, 6)
+    norm = sd[a.ravel()][:, :, None] * sd[b.ravel()][:, None, :]  # |correlation| ≤ 1
+    assert sel.width < p.n_photos // 2  # the band recursion, not one dense block
+    assert np.max(np.abs(got - want) / norm) < 1e-8

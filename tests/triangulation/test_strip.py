@@ -91,3 +91,26 @@ def test_polynomials_remove_a_known_bend_and_twist():
         truth[control], np.full((control.size, 3), 1e4), 0.1, 2,
     )  # fmt: skip
     assert np.max(np.abs(poly.points_m - truth)) < 1e-5 * m
+
+
+def test_strip_method_point_sigma_matches_the_errors_at_check_points():
+    # σ propagated through the polynomial adjustment (a posteriori σ₀): RMS(error/σ) over the
+    # check points of 4 blocks of 4 × 10; the blocks' values spread by ≈ 0.17 per axis, so
+    # 0.8–1.2 pooled over the axes is ± 4 SE and 0.7–1.3 per axis ± 3.5 SE
+    from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
+
+    z = []
+    for seed in range(4):
+        block, truth = synthesize_block(SynthSpec(), np.random.default_rng([seed, 7]))
+        s = strip_block(block)
+        se = s.point_standard_errors
+        check = {c.id for c in block.catalogue if c.role == "check"}
+        idx = [
+            i
+            for i, pid in enumerate(block.point_ids)
+            if pid in check and np.all(np.isfinite(s.points_m[i]))
+        ]
+        z.append((s.points_m[idx] - truth.points_m[idx]) / se[idx])
+    z = np.vstack(z)
+    per_axis = np.sqrt(np.mean(z**2, axis=0))
+    assert 0.8 < np.sqrt(np.mean(z**2)) < 1.2 and np.all((per_axis > 0.7) & (per_axis < 1.3))

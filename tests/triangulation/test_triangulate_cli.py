@@ -47,7 +47,13 @@ def test_triangulate_writes_orientations_residuals_report_and_job(chain):
         "residuals.png",
         "job.yaml",
         "fiducials.csv",
+        "control_points.csv",
         "points.csv",
+        "flagged.csv",
+        "observations.csv",
+        "catalogue_observations.csv",
+        "photo_residuals.png",
+        "precision.png",
     } <= names
     with open(chain / "tri" / "orientations.csv", encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
@@ -128,3 +134,73 @@ def test_leading_zero_photo_numbers_pass_through_to_the_job(chain, tmp_path):
     job = load_job(tmp_path / "tri" / "job.yaml")
     assert next(iter(job.photos)) == "0101" and "101" not in job.photos
     assert job.pairs[0].name == "0101-102"
+
+
+def test_outputs_hold_no_nan_and_name_a_point_of_one_photo_not_intersected(chain, tmp_path):
+    # the polygon report's σ₀ is a number; a check point on one photo is "not intersected"
+    for method in ("bundle", "polygon"):
+        out = tmp_path / method
+        argv = ["triangulate", str(chain / "block" / "block.yaml"), "--method", method]
+        assert main([*argv, "-o", str(out)]) == 0
+        for name in ("report.md", "residuals.csv", "points.csv", "orientations.csv"):
+            assert "nan" not in (out / name).read_text(encoding="utf-8").lower(), (method, name)
+        with open(out / "residuals.csv", encoding="utf-8") as f:
+            rows = list(csv.DictReader(f))
+        single = [r for r in rows if r["rays"] == "1"]
+        assert single and all(r["note"].startswith("not intersected") for r in single)
+    assert "σ₀ = 1." in (tmp_path / "polygon" / "report.md").read_text(encoding="utf-8")
+
+
+def test_points_csv_gives_every_point_with_its_sigma(chain):
+    with open(chain / "tri" / "points.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    roles = {r["role"] for r in rows}
+    assert roles == {"tie", "control", "check"} or roles == {"control", "check"}
+    fixed = [r for r in rows if r["X_m"]]
+    assert fixed and all(float(r["s_Z_m"]) > 0 for r in fixed)
+
+
+def test_self_calibration_from_the_command_line(chain, tmp_path, capsys):
+    argv = ["triangulate", str(chain / "block" / "block.yaml"), "-o", str(tmp_path)]
+    assert main([*argv, "--self-calibrate", "f,x0,y0,k1"]) == 0
+    text = (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert "## Self-calibration of the camera" in text and "| k1 [mm⁻²] |" in text
+    from stereoplotter.io.job_file import load_job
+
+    f_row = next(line for line in text.splitlines() if line.startswith("| f [mm] |"))
+    adjusted = float(f_row.split("|")[3])
+    job = load_job(tmp_path / "job.yaml")  # the job carries the adjusted f
+    assert job.camera.focal_length_mm == pytest.approx(adjusted, abs=5e-6 * adjusted)
+    assert job.camera.focal_length_mm != 70.0
+    assert main([*argv, "--self-calibrate", "f,z9"]) == 1
+    assert "--self-calibrate" in capsys.readouterr().err
+
+
+def test_reject_from_the_command_line_names_the_blunders_in_flagged_csv(tmp_path):
+    import dataclasses
+
+    import numpy as np
+
+    from stereoplotter.io.block_measurements_file import write_block_measurements
+    from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
+
+    block, _ = synthesize_block(SynthSpec(strips=3, photos_per_strip=6), np.random.default_rng(4))
+    rays = np.bincount(block.obs_point)
+    o = int(np.flatnonzero(rays[block.obs_point] == 3)[4])
+    comparator = block.comparator_mm.copy()
+    comparator[o, 1] += 0.5
+    cat = list(block.catalogue)
+    k = next(i for i, c in enumerate(cat) if c.role == "control" and c.kind == "height")
+    north, east, h = cat[k].sk42_m
+    cat[k] = dataclasses.replace(cat[k], sk42_m=(north, east, h + 2.0))
+    bad = dataclasses.replace(block, comparator_mm=comparator, catalogue=tuple(cat))
+    write_block_measurements(tmp_path / "b", bad)
+    assert main(["triangulate", str(tmp_path / "b" / "block.yaml"), "-o", str(tmp_path / "t"),
+                 "--reject"]) == 0  # fmt: skip
+    with open(tmp_path / "t" / "flagged.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    got = {(r["photo"], r["point"], r["observation"]) for r in rows}
+    photo, point = block.photos[block.obs_photo[o]], block.point_ids[block.obs_point[o]]
+    assert got == {(photo, point, "y_mm"), ("", cat[k].id, "height_m")}
+    assert all(abs(float(r["w"])) > 4 and float(r["mdb"]) > 0 for r in rows)
+    assert "removed and the block readjusted" in (tmp_path / "t" / "report.md").read_text("utf-8")
