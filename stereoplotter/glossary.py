@@ -12,7 +12,17 @@ from __future__ import annotations
 import re
 from types import MappingProxyType
 
-__all__ = ["LANGUAGES", "PHRASES", "TERMS", "check_language", "term", "translate"]
+__all__ = [
+    "LANGUAGES",
+    "PHRASES",
+    "TERMS",
+    "check_language",
+    "instrument_name",
+    "localize",
+    "parameter_name",
+    "term",
+    "translate",
+]
 
 #: The languages of the outputs (``--lang``).
 LANGUAGES = ("ru", "en")
@@ -45,7 +55,7 @@ _TABLE: dict[str, tuple[str, str]] = {
         "* the value rests on instrument parameters that no source documents "
         "(assumed, docs/instruments.md)",
         "* значение опирается на параметры прибора, не подтверждённые источником "
-        "(приняты, docs/instruments.md)",
+        "(приняты; см. описание приборов)",
     ),
     "none": ("none", "нет"),
     "no_map_sheet": ("none (scales forced)", "нет (масштабы заданы)"),
@@ -196,24 +206,40 @@ _TABLE: dict[str, tuple[str, str]] = {
     "limit_exceeds": ("exceeds the tolerance", "больше допуска"),
     "limit_within": ("within the tolerance", "в допуске"),
     "limit_choice_book": (
-        "The values to set are the book's (6.1)/(6.2), (6.5); where they exceed "
-        "the tolerance the instrument needs the rigorous values (--rigorous).",
-        "Для установки даны значения по (6.1)/(6.2), (6.5) книги; где разность "
-        "больше допуска, прибору нужны строгие значения (--rigorous).",
+        "The values to set are the book's (6.1)/(6.2), (6.5): each is within its stage "
+        "tolerance of the rigorous (3.17) (table of the method's limits).",
+        "Для установки даны значения книги (6.1)/(6.2), (6.5): каждое отличается от строгого "
+        "(3.17) в пределах допуска этапа (таблица пределов метода).",
+    ),
+    "limit_choice_mixed": (
+        "The values to set: a photo's marks and span by the book's (6.1)/(6.2), (6.5) where "
+        "all of them are within their stage tolerance, else all by the rigorous (3.17), "
+        "marked (3.17), the book's in brackets beside them.",
+        "Для установки: метки и расстояние L снимка — по формулам книги (6.1)/(6.2), (6.5), "
+        "если все они в пределах допуска этапа, иначе все строгие (3.17), с пометкой (3.17) "
+        "и значением книги рядом в скобках.",
     ),
     "limit_choice_rigorous": (
-        "The values to set are the rigorous (3.17) ones (--rigorous); the "
-        "book's are printed beside them.",
-        "Для установки даны строгие значения (3.17) (--rigorous); значения книги приведены рядом.",
+        "The marks and spans to set are the rigorous (3.17) ones for both photos (as asked, "
+        "--rigorous); the book's are in brackets beside them.",
+        "Метки и расстояния L для установки — строгие (3.17) для обоих снимков (по заказу); "
+        "значения книги — рядом в скобках.",
     ),
     "limit_warning": (
-        "WARNING: the book's (6.1)/(6.2), (6.5) deviate from the rigorous (3.17) "
-        "by more than the stage tolerance; set the rigorous values (table of the "
-        "limits).",
-        "ВНИМАНИЕ: формулы книги (6.1)/(6.2), (6.5) отличаются от строгих (3.17) "
-        "больше допуска этапа; устанавливайте строгие значения (таблица пределов "
-        "метода).",
+        "WARNING: for the {photos} the book's (6.1)/(6.2), (6.5) leave the stage tolerance "
+        "(table of the method's limits): the tables give the rigorous (3.17) values to set, "
+        "the book's in brackets beside them.",
+        "ВНИМАНИЕ: для {photos} значения книги (6.1)/(6.2), (6.5) выходят из допуска этапа "
+        "(таблица пределов метода): в таблицах для установки даны строгие значения (3.17), "
+        "значения книги — рядом в скобках.",
     ),
+    "photo_left": ("left photo", "левого снимка"),
+    "photo_right": ("right photo", "правого снимка"),
+    "side_left": ("left", "лев."),
+    "side_right": ("right", "прав."),
+    "residual_q": ("residual q", "остаточный параллакс q"),
+    "fiducials_distances": ("distances", "расстояния"),
+    "fiducials_coordinates": ("coordinates", "координаты"),
     # sheet.md (the English entries are the text sheet.md always had)
     "md_title": ("Setup sheet", "Установочные данные"),
     "md_on": ("on", "на приборе"),
@@ -481,6 +507,7 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
     ("≤ ¼ mark", "≤ ¼ марки"),
     ("\\(6.5\\), decision D5", "(6.5), решение D5"),
     ("f′·tan (?P<a>[αω]) \\(§2.4\\)", "f′·tan {a} (§2.4)"),
+    ("f′·tan (?P<a>[αω]) \\(kinematics §2.4\\)", "f′·tan {a} (§2.4)"),
     ("§26 stages 2, 3: κ along the initial direction; refine k_ω",
      "§26, этапы 2, 3: κ по начальному направлению; уточнить k_ω"),
     ("§26 stage 3: scaling refined \\(b_x\\)", "§26, этап 3: уточнение масштаба (b_x)"),
@@ -536,6 +563,92 @@ def translate(text: str, lang: str) -> str:
         if (first, second) != (head, rest):
             return f"{first}: {second}"
     return text
+
+
+#: The instruments by their shipped key, as the Russian forms name them (the English forms print
+#: the instrument file's own ``name``).
+_INSTRUMENTS_RU = {
+    "sc1": "стереограф СЦ-1",
+    "spr3": "стереопроектор СПР-3 Г. В. Романовского",
+    "sd3": "стереограф СД-3 Ф. В. Дробышева",
+}
+
+
+def instrument_name(key: str, title: str, lang: str) -> str:
+    """The instrument's name in ``lang``: the file's ``title`` in English; in Russian the book's
+    name of a shipped instrument, else the Cyrillic part of the title (a user's instrument file
+    names itself)."""
+    if check_language(lang) == "en":
+        return title
+    if key in _INSTRUMENTS_RU:
+        return _INSTRUMENTS_RU[key]
+    head = title.split(" (")[0].split(",")[0]
+    return head if re.search("[А-Яа-яЁё]", head) else "прибор"
+
+
+#: The instrument file's parameters an outputs may list as assumed, in Russian.
+_PARAMETERS_RU = {
+    "gears.coordinatograph_ratios": "передачи координатографа",
+    "gears.vertical_scale_denominators": "знаменатели вертикального масштаба",
+    "gears.max_photo_to_map_enlargement": "наибольшее увеличение снимка до карты",
+    "mark.diameter_mm": "диаметр марки",
+    "model.x_offset_mm": "смещение модели по X",
+    "model.y_offset_mm": "смещение модели по Y",
+    "projection.distance_mm": "проектирующие расстояния",
+    "projection.distance_max_mm": "наибольшее проектирующее расстояние",
+    "projection.f_instrument_mm": "диапазон f_пр",
+    "base.x_mm": "диапазон b_x",
+    "base.y_mm": "диапазон b_y",
+    "base.z_mm": "диапазон b_z",
+    "orientation.kappa_deg": "диапазон κ",
+    "correction.tilt_max_deg": "наибольший наклон",
+    "correction.decentration_mm": "диапазон децентраций",
+    "counters.xy_least_count_mm": "цена деления счётчиков X, Y",
+    "counters.z_abs_least_count_mm": "цена деления счётчика высот",
+    "counters.height_scale_least_count_m": "цена деления шкалы высот",
+    "counters.scale_least_count_mm": "цена деления шкал",
+    "tolerances.corner4_mm": "допуск угла 4",
+    "tolerances.L_check_times_n_mm": "допуск |L − L′|",
+    "tolerances.mark_fit_per_n_mm": "допуск метки 4",
+    "tolerances.residual_q_fraction_of_mark": "допуск остаточного параллакса",
+    "tolerances.control_height_denominator": "допуск высот опорных точек",
+}
+
+
+def parameter_name(key: str, lang: str) -> str:
+    """An instrument file's dotted key in ``lang``: the key itself in English, its Russian name
+    (or "параметр прибора" for a key outside :data:`_PARAMETERS_RU`) in Russian."""
+    if check_language(lang) == "en":
+        return key
+    return _PARAMETERS_RU.get(key, "параметр прибора")
+
+
+#: The units, compass corners and abbreviations of a finished text, English → Russian
+#: (:func:`localize`): each a whole token (no letter on either side).
+_LOCAL_RU = (
+    (r"µm", "мкм"), (r"mrad", "мрад"), (r"mm", "мм"), (r"m", "м"), (r"tan", "tg"),
+    (r"SW", "ЮЗ"), (r"SE", "ЮВ"), (r"NE", "СВ"), (r"NW", "СЗ"), (r"RMS", "СКО"),
+    (r"MO", "МО"), (r"Gauss–Krüger", "Гаусса–Крюгера"), (r"map", "карты"),
+)  # fmt: skip
+_LOCAL_RU_PATTERN = re.compile(
+    r"(?<![A-Za-zА-Яа-яЁё])(" + "|".join(a for a, _ in _LOCAL_RU) + r")(?![A-Za-zА-Яа-яЁё])"
+)
+_LOCAL_RU_MAP = dict(_LOCAL_RU)
+
+
+def localize(text: str, lang: str) -> str:
+    """A finished text of an output with its units (mm → мм, m → м, µm → мкм), compass
+    corners (SW → ЮЗ …), the zero reading МО, tan → tg and RMS → СКО in ``lang``: the
+    symbols a Russian reader writes in Cyrillic, each replaced only as a whole token (a
+    letter on neither side, so ``M_map`` → ``M_карты`` and ``m/mm`` → ``м/мм``, never inside a
+    word). English is returned as it is.
+
+    >>> localize("L = 287.70 mm, ΔZ 5.14 m/mm, corner 4 NW, MO_X", "ru")
+    'L = 287.70 мм, ΔZ 5.14 м/мм, corner 4 СЗ, МО_X'
+    """
+    if check_language(lang) == "en" or not text:
+        return text
+    return _LOCAL_RU_PATTERN.sub(lambda m: _LOCAL_RU_MAP[m.group(1)], text)
 
 
 def check_language(lang: str) -> str:

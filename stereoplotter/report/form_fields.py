@@ -13,7 +13,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from stereoplotter.glossary import term
+from stereoplotter.glossary import term, translate
 from stereoplotter.setup.records import SetupSheet
 
 __all__ = [
@@ -22,6 +22,7 @@ __all__ = [
     "limit_rows",
     "limits_exceeded",
     "reading_rows",
+    "rigorous_sides",
     "set_value",
     "signature_rows",
     "stage5_rows",
@@ -119,6 +120,46 @@ def limits_exceeded(sheet: SetupSheet) -> bool:
     return any(row["exceeds"] for row in limit_rows(sheet))
 
 
+def rigorous_sides(sheet: SetupSheet, rigorous: bool = False) -> tuple[str, ...]:
+    """The photos ("left", "right") whose mark targets and span the form gives to set from the
+    rigorous (3.17): both with ``rigorous``; else each photo one of whose book values
+    ((6.1)/(6.2) targets, (6.5) span) leaves its stage tolerance (:func:`limit_rows`).
+
+    A photo is taken whole: its k_ω target (mark 3), its check (mark 4), its k_α target and its
+    span L are one fit of one photo carrier, so they come from one computation — setting mark 3
+    by the book and checking mark 4 against the rigorous value would check one model against
+    another.
+    """
+    if rigorous:
+        return ("left", "right")
+    bad = {row["reading"][-1] for row in limit_rows(sheet) if row["exceeds"]}
+    return tuple(side for side, mark in (("left", "л"), ("right", "п")) if mark in bad)
+
+
+def _side(reading: str) -> str | None:
+    """The photo ("left"/"right") of a mark target or span reading, else None."""
+    if _rigorous_name(reading):
+        return "left" if reading.endswith("л") else "right"
+    return None
+
+
+def _rigorous_name(reading: str) -> bool:
+    return reading in ("L_л", "L_п") or _MARK.match(reading) is not None
+
+
+def value_to_set(
+    sheet: SetupSheet, row: dict[str, Any], sides: tuple[str, ...]
+) -> tuple[float, float | None]:
+    """(the value a reading row gives to set, the book's value beside it or None): the
+    rigorous (3.17) value of a mark target or span of a photo in ``sides``
+    (:func:`rigorous_sides`), else the row's own value."""
+    side = _side(row["reading"])
+    if side is None or side not in sides:
+        return row["value"], None
+    rig = _rigorous_value(sheet, row["reading"])
+    return (row["value"], None) if rig is None else (rig, row["value"])
+
+
 # --- readings -------------------------------------------------------------------------------------
 
 _STEPS_RU = (
@@ -157,12 +198,26 @@ def step_text(row: dict[str, Any], lang: str) -> str:
     return str(row["step"])  # pragma: no cover - every reading of stages 1–5 is listed above
 
 
+def zero_of(row: dict[str, Any]) -> str:
+    """The zero reading of a row; a decentration's is its own projector's (MO_dx,л, MO_dx,п):
+    each projector has its own decentration scales, so each has its own place of zero."""
+    zero, reading = str(row["zero_reading"]), str(row["reading"])
+    if zero in ("MO_dx", "MO_dy") and reading[-2:] in (",л", ",п"):
+        return zero + reading[-2:]
+    return zero
+
+
+def _residual_text(row: dict[str, Any], lang: str) -> str:
+    text = str(row["formula"])
+    return text.replace("residual q", term("residual_q", lang))
+
+
 def _reading_text(row: dict[str, Any], value: float, lc: LeastCounts, lang: str) -> str:
     kind = lc.of(row["reading"])
-    name, zero, unit = row["reading"], row["zero_reading"], row["unit"]
-    name = name.replace("corner", term("corner", lang))
+    name, zero, unit = row["reading"], zero_of(row), row["unit"]
+    name = name.replace("corner", term("corner", lang)).replace(" ", "\u00a0")
     if kind is None:
-        return str(row["formula"])
+        return _residual_text(row, lang)
     step = kind[1]
     if zero:
         return f"{name} = {zero} {_signed(value, step)} {unit}"
@@ -182,25 +237,31 @@ def _tolerance_text(row: dict[str, Any]) -> str:
     return f"± {row['tolerance']:.4g} {row['unit']}" if "tolerance" in row else ""
 
 
+def _book_text(row: dict[str, Any], book: float | None, lc: LeastCounts, lang: str) -> str:
+    """" (book: …)" beside a rigorous value to set, at the same least count."""
+    if book is None:
+        return ""
+    kind = lc.of(row["reading"])
+    step = kind[1] if kind else 0.001
+    return f" ({term('limit_book', lang)}: {set_value(book, step)})"
+
+
 def reading_rows(
     sheet: SetupSheet, lc: LeastCounts, lang: str, rigorous: bool = False
 ) -> list[tuple[str, ...]]:
     """Every reading of stages 1–4 (stage 5 is :func:`stage5_rows`): stage, step, the value to
-    set at its least count (the rigorous one for marks and spans when ``rigorous``, the book's
-    beside it), the least count, the equation, the tolerance and an empty column to write in."""
+    set at its least count (:func:`value_to_set`: the rigorous one, the book's beside it, for
+    the marks and span of a photo of :func:`rigorous_sides`), the least count, the equation,
+    the tolerance and an empty column to write in."""
+    sides = rigorous_sides(sheet, rigorous)
     rows = []
     for r in sheet.readings:
         if r["stage"] == 5:
             continue
-        value, equation, extra = r["value"], r["equation"], ""
-        rig = _rigorous_value(sheet, r["reading"]) if rigorous else None
-        if rig is not None:
-            kind = lc.of(r["reading"])
-            step = kind[1] if kind else 0.001
-            extra = f" ({term('limit_book', lang)}: {set_value(value, step)})"
-            value, equation = rig, "(3.17)"
-        equation = equation.replace("item 1", term("item1", lang))
-        rows.append((str(r["stage"]), step_text(r, lang), _reading_text(r, value, lc, lang) + extra,
+        value, book = value_to_set(sheet, r, sides)
+        equation = "(3.17)" if book is not None else translate(str(r["equation"]), lang)
+        rows.append((str(r["stage"]), step_text(r, lang),
+                     _reading_text(r, value, lc, lang) + _book_text(r, book, lc, lang),
                      _least_count_text(r, lc), equation, _tolerance_text(r), ""))  # fmt: skip
     return rows
 
@@ -208,15 +269,17 @@ def reading_rows(
 def summary_rows(
     sheet: SetupSheet, lc: LeastCounts, lang: str, rigorous: bool = False
 ) -> list[tuple[str, str]]:
-    """The compact readings of page 1: one row per stage, every value at its least count."""
+    """The compact readings of page 1: one row per stage, every value at its least count (the
+    same values as :func:`reading_rows`, the book's beside a rigorous one)."""
+    sides = rigorous_sides(sheet, rigorous)
     out = []
     for stage in range(1, 6):
         texts, tolerances = [], {}
         for r in sheet.readings:
             if r["stage"] != stage:
                 continue
-            rig = _rigorous_value(sheet, r["reading"]) if rigorous else None
-            texts.append(_reading_text(r, r["value"] if rig is None else rig, lc, lang))
+            value, book = value_to_set(sheet, r, sides)
+            texts.append(_reading_text(r, value, lc, lang) + _book_text(r, book, lc, lang))
             if "tolerance" in r and r["reading"] != "residual q":
                 name = re.sub(r"\d+$", "i", r["reading"]) if stage == 3 else r["reading"]
                 name = name.replace("corner", term("corner", lang))
@@ -226,7 +289,7 @@ def summary_rows(
                          + ", ".join(str(p["id"]) for p in _stage5_points(sheet)))  # fmt: skip
         tol = "; ".join(f"{', '.join(dict.fromkeys(n))} {t}" for t, n in tolerances.items())
         if texts:
-            tail = f". {term('tolerance', lang)}: {tol}" if tol else ""
+            tail = f". {term('tolerance', lang).capitalize()}: {tol}" if tol else ""
             out.append((term(f"stage_{stage}", lang), "; ".join(texts) + tail))
     return out
 
@@ -238,7 +301,10 @@ def zero_reading_names(sheet: SetupSheet) -> list[str]:
     """The zero readings every reading depends on, in the order the readings use them."""
     names = dict.fromkeys(["MO_X", "MO_Y", "MO_Z"])
     for r in sheet.readings:
-        zero = r["zero_reading"]
+        zero = zero_of(r)
+        if zero.startswith(("MO_dx,", "MO_dy,")):
+            names.setdefault(zero)
+            continue
         if zero.startswith("MO") and "," not in zero:
             names.setdefault(zero)
     names.setdefault("MO_bz")
@@ -254,20 +320,22 @@ def correction_rows(sheet: SetupSheet, lang: str, rigorous: bool = False) -> lis
     """
     left, right = sheet.photos
     d = sheet.n_left * sheet.f_instrument_mm
+    sides = rigorous_sides(sheet, rigorous)
     spans = {"L_л": left.mark_span_mm, "L_п": right.mark_span_mm}
-    if rigorous:
-        spans = {k: _rigorous_value(sheet, k) or v for k, v in spans.items()}
+    spans = {k: (_rigorous_value(sheet, k) or v) if _side(k) in sides else v
+             for k, v in spans.items()}  # fmt: skip
     ll, lr = spans["L_л"], spans["L_п"]
+    _eq = lambda k: "(3.17)" if _side(k) in sides else "(6.5)"  # noqa: E731 - a local shorthand
     mv = sheet.vertical_scale_denominator
     sign = "+" if sheet.options.bz_scale_sense > 0 else "−"
     blank = "__________"
     return [
-        ("L′_л", term("corr_L_left", lang), f"L_л (6.5) = {ll:.3f} mm", "", f"{blank} mm"),
+        ("L′_л", term("corr_L_left", lang), f"L_л {_eq('L_л')} = {ll:.3f} mm", "", f"{blank} mm"),
         ("ΔZ", term("corr_dz", lang), "ΔZ = D·(L_л − L′_л)·M_в/(1000·L_л)",
          f"{d * mv / (1000.0 * ll):.4f} m/mm", f"{blank} m"),
         ("O′_Z", term("corr_dz_counter", lang), "O′_Z = O_Z + D·(L_л − L′_л)/L_л",
          f"{d / ll:.5f}", f"{blank} mm"),
-        ("L′_п", term("corr_L_right", lang), f"L_п (6.5) = {lr:.3f} mm", "", f"{blank} mm"),
+        ("L′_п", term("corr_L_right", lang), f"L_п {_eq('L_п')} = {lr:.3f} mm", "", f"{blank} mm"),
         ("Δb_z", term("corr_dbz", lang), "Δb_z = D·(L_п − L′_п)/L_п", f"{d / lr:.5f}",
          f"{blank} mm"),
         ("O′_bz", term("corr_bz", lang), f"O′_bz = O_bz {sign} Δb_z", "", f"{blank} mm"),
@@ -282,11 +350,11 @@ def stage5_rows(sheet: SetupSheet, lc: LeastCounts, lang: str) -> list[tuple[str
     """Stage 5: corner 4 and the x′, y′ readings of the plan control and check points, at the
     counters' least count, with the coordinatograph tolerance of corner 4 and fields to write."""
     step = lc.counter_mm
-    tol = f"± {sheet.tolerances['corner_mm']:.2g} mm"
+    tol = f"±\u00a0{sheet.tolerances['corner_mm']:.2g}\u00a0mm"
     rows = []
     for c in sheet.corners:
         if c["corner"] == "4":
-            rows.append((f"{term('corner', lang)} 4", c["position"],
+            rows.append((f"{term('corner', lang)}\u00a04", c["position"],
                          f"O_X = MO_X {_signed(c['x_mm'], step)}",
                          f"O_Y = MO_Y {_signed(c['y_mm'], step)}", tol, "", ""))  # fmt: skip
     for p in _stage5_points(sheet):

@@ -22,9 +22,10 @@ from typing import Any
 import numpy as np
 
 from stereoplotter import __version__
-from stereoplotter.glossary import check_language, term
+from stereoplotter.glossary import TERMS, check_language, term
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
+from stereoplotter.report.form_layout import literal, localized_text, plain
 from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdfs
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupSheet
@@ -106,9 +107,12 @@ def form_header(
     sheet_text = term("no_map_sheet", lang) if sheet is None else (
         f"{sheet.nomenclature or 'given by corners'}, 1:{sheet.scale_denominator}"
     )  # fmt: skip
-    camera = (f"{job.camera_name + ': ' if job.camera_name else ''}f = {cam.focal_length_mm:.3f} "
-              f"mm, x₀, y₀ = {cam.principal_point_mm[0]:.3f}, {cam.principal_point_mm[1]:.3f} mm, "
-              f"{term('fiducials_given_as', lang)} {cam.fiducials_given_as}")  # fmt: skip
+    given = f"fiducials_{cam.fiducials_given_as}"
+    given = term(given, lang) if given in TERMS else literal(cam.fiducials_given_as)
+    camera = (f"{literal(job.camera_name) + ': ' if job.camera_name else ''}f = "
+              f"{cam.focal_length_mm:.3f} mm, x₀, y₀ = {cam.principal_point_mm[0]:.3f}, "
+              f"{cam.principal_point_mm[1]:.3f} mm, {term('fiducials_given_as', lang)} "
+              f"{given}")  # fmt: skip
     return FormHeader(
         job=job.name,
         job_file=Path(job.source).name,
@@ -167,7 +171,7 @@ def _markdown(job: Job, p: PairResult, lang: str = "en") -> str:
     assert p.sheet is not None
     text = sheet_markdown(p.sheet, lang)
     title, rest = text.split("\n", 1)
-    return f"{title}\n\n{head}{rest.lstrip()}"
+    return plain(localized_text(f"{title}\n\n{head}{rest.lstrip()}", lang))
 
 
 _CSV = (

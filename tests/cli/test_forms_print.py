@@ -1,0 +1,166 @@
+"""The strip8 job's forms as printed: one language per form, and page 1 as an office prints it.
+
+The text of every page is read back from the PDF with pdfium (``pypdfium2``), character by
+character with its font size, so that a subscript (a smaller run: the пр of f_пр) is a word of
+its own. A Russian form holds no Latin word of two letters or more outside :data:`SYMBOLS`
+(the book's formula letters and subscripts) and the job's own texts (its name, file, camera:
+user text printed as written). Page 1 of every form, Russian and English: no character below
+7.5 pt but the subscripts (0.72 of their text, lowered), no two text boxes overlapping, none
+outside the page's margins, no id left at a line's end without its value; the drawing's marks
+print dark on the rendered page.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pypdfium2 as pdfium
+import pypdfium2.raw as raw
+import pytest
+
+from stereoplotter.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+JOB = ROOT / "jobs" / "strip8" / "job.yaml"
+#: Latin words a Russian form may hold: tg (the tangent), formula subscripts (O_bx, d_x …,
+#: D_max, O_Zi), and the program's name.
+SYMBOLS = {"tg", "max", "bx", "by", "bz", "dx", "dy", "Zi", "stereoplotter"}
+#: The job's own texts, printed as written (strip8's job name, file and camera).
+JOB_TEXTS = {"strip", "job", "yaml", "AFA", "TE", "No", "invented"}
+MM = 25.4 / 72.0
+
+
+@pytest.fixture(scope="module")
+def forms(tmp_path_factory) -> dict[str, Path]:
+    out = {}
+    for lang in ("ru", "en"):
+        folder = tmp_path_factory.mktemp(lang)
+        assert main(["setup", str(JOB), "-o", str(folder), "--lang", lang, "-q"]) == 0
+        out[lang] = folder
+    return out
+
+
+def _chars(page) -> list[tuple[str, float, tuple[float, float, float, float]]]:
+    """(character, font size pt, box l, b, r, t in pt) of a page's drawn characters."""
+    text = page.get_textpage()
+    out = []
+    left, bottom, right, top = (pdfium_double() for _ in range(4))
+    for i in range(text.count_chars()):
+        if raw.FPDFText_IsGenerated(text.raw, i):
+            continue
+        char = chr(raw.FPDFText_GetUnicode(text.raw, i))
+        raw.FPDFText_GetCharBox(text.raw, i, left, right, bottom, top)
+        out.append((char, raw.FPDFText_GetFontSize(text.raw, i),
+                    (left.value, bottom.value, right.value, top.value)))  # fmt: skip
+    return out
+
+
+def pdfium_double():
+    import ctypes
+
+    return ctypes.c_double()
+
+
+def _words(chars) -> list[str]:
+    """The words of a page: runs of adjacent letters of one font size (a subscript is a word;
+    two cells' texts side by side are two words)."""
+    words, current, last = [], "", None
+    for char, size, box in chars:
+        joined = (last is not None and abs(size - last[0]) < 0.05
+                  and abs(box[0] - last[1][2]) < 0.25 * size)  # fmt: skip
+        if char.isalpha() and current and joined:
+            current += char
+        else:
+            if current:
+                words.append(current)
+            current = char if char.isalpha() else ""
+        last = (size, box)
+    if current:
+        words.append(current)
+    return words
+
+
+def _latin(word: str) -> bool:
+    return len(word) >= 2 and re.fullmatch("[A-Za-z]+", word) is not None
+
+
+def test_a_russian_form_holds_no_latin_word_but_the_books_symbols(forms):
+    pdf = pdfium.PdfDocument(forms["ru"] / "forms.pdf")
+    found: dict[str, int] = {}
+    for i in range(len(pdf)):
+        for word in _words(_chars(pdf[i])):
+            if _latin(word) and word not in SYMBOLS | JOB_TEXTS:
+                found[word] = found.get(word, 0) + 1
+    assert len(pdf) >= 8 * 4
+    assert found == {}
+    md = (forms["ru"] / "101-102" / "sheet.md").read_text("utf-8")
+    for unit in (" mm", " µm", " m ", " m,", "SW", "NE"):
+        assert unit not in md, unit
+
+
+def _overlap(a, b, slack: float = 0.3) -> bool:
+    return (min(a[2], b[2]) - max(a[0], b[0]) > slack
+            and min(a[3], b[3]) - max(a[1], b[1]) > slack)  # fmt: skip
+
+
+def _boxes(chars) -> list[tuple[float, float, float, float]]:
+    """Each run of characters on one baseline and size (a word or a subscript) as one box."""
+    boxes: list[list[float]] = []
+    last = None
+    for char, size, (l, b, r, t) in chars:
+        if char.isspace() or r <= l:
+            last = None
+            continue
+        if last is not None and abs(last[1] - size) < 0.05 and abs(last[0] - b) < 0.5 and (
+                0 <= l - boxes[-1][2] < 1.0):  # fmt: skip
+            box = boxes[-1]
+            box[1], box[2], box[3] = min(box[1], b), r, max(box[3], t)
+        else:
+            boxes.append([l, b, r, t])
+        last = (b, size)
+    return [tuple(b) for b in boxes]
+
+
+@pytest.mark.parametrize("lang", ["ru", "en"])
+def test_page_one_of_every_form_is_legible_and_nothing_overlaps_or_is_clipped(forms, lang):
+    for pair in sorted(p.name for p in forms[lang].iterdir() if p.is_dir()):
+        pdf = pdfium.PdfDocument(forms[lang] / pair / "sheet.pdf")
+        page = pdf[0]
+        width, height = page.get_size()
+        chars = _chars(page)
+        sizes = [c[1] for c in chars if not c[0].isspace()]
+        assert min(sizes) >= 0.72 * 7.5 - 0.05, pair
+        for k, (char, size, box) in enumerate(chars):
+            if size < 7.45 and not char.isspace():  # a subscript: smaller than its symbol
+                base = next(c for c in reversed(chars[:k]) if c[1] >= 7.45)
+                assert abs(size - 0.72 * base[1]) < 0.1 and box[1] < base[2][1] + 0.5 * size, (
+                    pair, char, size)
+        boxes = _boxes(chars)
+        for box in boxes:  # inside the paper with its margins (12 mm top, 15–20 mm sides)
+            assert box[0] >= 10 / MM and box[2] <= width - 10 / MM, (pair, box)
+            assert box[1] >= 5 / MM and box[3] <= height - 10 / MM, (pair, box)
+        clashes = [(a, b) for i, a in enumerate(boxes) for b in boxes[i + 1:] if _overlap(a, b)]
+        assert clashes == [], (pair, clashes[:3])
+        text = page.get_textpage().get_text_range()
+        assert not re.search(r"(^|\s)[\w-]+:\s*$", text, re.M), pair  # an id without its value
+        assert len(pdf) <= 6 and len(_chars(pdf[len(pdf) - 1])) > 100  # no orphan last page
+
+
+def test_the_drawing_prints_dark(forms):
+    """On the drawing page rendered without smoothing (each pixel its mark's own grey), no
+    drawn pixel is paler than grey 110 of 255: a grey fill of 225 (pale circles nearly
+    invisible on a copier) gave 18 % of them."""
+    heading = {"ru": "Рамка трапеции", "en": "Sheet frame and control"}
+    for lang in ("ru", "en"):
+        pdf = pdfium.PdfDocument(forms[lang] / "101-102" / "sheet.pdf")
+        page = pdf[len(pdf) - 1]
+        text = page.get_textpage()
+        start = text.get_text_range().find(heading[lang])
+        assert start >= 0
+        top = text.get_charbox(start)[3]  # pt from the page's foot: the drawing is below it
+        image = page.render(scale=2, no_smoothtext=True, no_smoothpath=True).to_pil()
+        below = image.convert("L").crop((0, int(2 * (page.get_height() - top)), image.width,
+                                         image.height))  # fmt: skip
+        counts = below.histogram()  # pixels by grey level 0–255
+        assert sum(counts[110:250]) / sum(counts[:250]) < 0.01
