@@ -27,7 +27,7 @@ from typing import Any
 
 from fontTools import ttLib
 from fpdf import FPDF
-from fpdf.enums import TextMode, XPos, YPos
+from fpdf.enums import TextMode
 from fpdf.fonts import SubsetMap, TTFFont
 from fpdf.util import escape_parens
 
@@ -41,8 +41,8 @@ __all__ = [
     "heading",
     "literal",
     "localized_text",
-    "plain",
     "paragraph",
+    "plain",
     "rich_runs",
     "table",
 ]
