@@ -516,8 +516,11 @@ def table_height(
     line = 1.22 * size * _PT + 0.5
     head = [_wrap(pdf, localized(pdf, str(h)), w - 2 * _PAD, "B", size)
             for h, w in zip(header, cols, strict=True)]  # fmt: skip
-    total = sum(_row_height([_wrap(pdf, localized(pdf, str(c)), w - 2 * _PAD, "", size)
-                             for c, w in zip(r, cols, strict=True)], line) for r in rows)  # fmt: skip
+    total = sum(
+        _row_height([_wrap(pdf, localized(pdf, str(c)), w - 2 * _PAD, "", size)
+                     for c, w in zip(r, cols, strict=True)], line)
+        for r in rows
+    )  # fmt: skip
     return total + (_row_height(head, line) if any(header) else 0.0)
 
 

@@ -108,17 +108,17 @@ def _boxes(chars) -> list[tuple[float, float, float, float]]:
     """Each run of characters on one baseline and size (a word or a subscript) as one box."""
     boxes: list[list[float]] = []
     last = None
-    for char, size, (l, b, r, t) in chars:
-        if char.isspace() or r <= l:
+    for char, size, (x0, y0, x1, y1) in chars:
+        if char.isspace() or x1 <= x0:
             last = None
             continue
-        if last is not None and abs(last[1] - size) < 0.05 and abs(last[0] - b) < 0.5 and (
-                0 <= l - boxes[-1][2] < 1.0):  # fmt: skip
+        if last is not None and abs(last[1] - size) < 0.05 and abs(last[0] - y0) < 0.5 and (
+                0 <= x0 - boxes[-1][2] < 1.0):  # fmt: skip
             box = boxes[-1]
-            box[1], box[2], box[3] = min(box[1], b), r, max(box[3], t)
+            box[1], box[2], box[3] = min(box[1], y0), x1, max(box[3], y1)
         else:
-            boxes.append([l, b, r, t])
-        last = (b, size)
+            boxes.append([x0, y0, x1, y1])
+        last = (y0, size)
     return [tuple(b) for b in boxes]
 
 
