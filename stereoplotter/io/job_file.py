@@ -912,7 +912,10 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
 
 
 def _suspects(
-    job: Job, pair: JobPair, points: tuple[Point, ...], stations: tuple[tuple[NDArray, NDArray], ...]
+    job: Job,
+    pair: JobPair,
+    points: tuple[Point, ...],
+    stations: tuple[tuple[NDArray, NDArray], ...],
 ) -> str:
     """Which input of a pair without imaged control looks wrong, and why, as "; suspicious: …"
     (empty when nothing does): a photo at or below the control's median height; two photos
@@ -928,8 +931,9 @@ def _suspects(
     heights = [float(c[2]) - ground for c, _ in stations]
     for name, h in zip(names, heights, strict=True):
         if h <= 0:
-            out.append(f"photo {name} at {round(h + ground, 1) + 0.0:.1f} m is not above the control's median "
-                       f"height {ground:.1f} m (check its height)")  # fmt: skip
+            z = round(h + ground, 1) + 0.0  # no "-0.0"
+            out.append(f"photo {name} at {z:.1f} m is not above the control's median height "
+                       f"{ground:.1f} m (check its height)")  # fmt: skip
     if min(heights) > 0:
         base = float(np.hypot(*(stations[0][0][:2] - stations[1][0][:2])))
         footprint = cam.format_mm / f * float(np.mean(heights))
