@@ -291,6 +291,33 @@ _TABLE: dict[str, tuple[str, str]] = {
         "Эти значения не подтверждены источником; исправьте их в YAML-файле "
         "прибора, если ваш прибор отличается",
     ),
+    "md_controls": ("controls", "органы управления"),
+    "md_settings_of": ("Settings of the", "Установки прибора"),
+    "md_settings_depend": (
+        "settings depend on φ, ω", "установок зависят от φ, ω",
+    ),
+    "md_order": ("Order", "Порядок"),
+    "md_documented": ("documented", "документировано"),
+    "md_assumed_upper": ("ASSUMED", "ПРИНЯТО"),
+    "md_settings_header": (
+        "| setting | symbol | kind | formula | left | right | unit |",
+        "| установка | обозн. | вид | формула | лев. | прав. | ед. |",
+    ),
+    "md_similarity": ("Similarity (6.8)", "Преобразование подобия (6.8)"),
+    "md_control_points": ("control points", "опорных точек"),
+    "md_reflection": ("reflection", "отражение"),
+    "md_rms_residual": ("RMS residual", "СКО остатков"),
+    "md_residuals": ("residuals", "остатки"),
+    "md_marks_intro": (
+        "Transformed mark coordinates: the book's single-axis (6.1)/(6.2) against the "
+        "rigorous (3.17) (κ = 0):",
+        "Трансформированные координаты меток: одноосные (6.1)/(6.2) книги против строгих "
+        "(3.17) (κ = 0):",
+    ),
+    "md_marks_header": (
+        "| photo | mark | (6.1)/(6.2) mm | (3.17) x⁰, y⁰ mm | difference µm |",
+        "| снимок | метка | (6.1)/(6.2) мм | (3.17) x⁰, y⁰ мм | разность, мкм |",
+    ),
     "md_table24_header": (
         "| quantity | symbol | value | unit | equation |",
         "| величина | обозн. | значение | ед. | формула |",
@@ -531,6 +558,65 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
     ("control heights", "высоты опорных точек"),
     (f"corner {_ID.format('c')}", "угол {c}"),
     ("plan control points \\(needle − plotted\\)", "плановые опорные точки (игла − нанесённая)"),
+    # the instruments' settings and controls (sheet.md: the settings of the instrument)
+    ("2 tilts on the k_α, k_ω scales and 2 decentrations per photo",
+     "2 наклона по шкалам k_α, k_ω и 2 децентрации на снимок"),
+    ("not documented for the SC-1; the book's §26 names the k_α, k_ω scales of the correction "
+     "mechanisms and the decentration scales of each photo",
+     "для СЦ-1 не документировано; в §26 книги названы шкалы k_α, k_ω коррекционных механизмов "
+     "и шкалы децентраций каждого снимка"),
+    ("tilt each photo carrier on its k_α, k_ω scales \\(stage 2 fits them on the fiducial "
+     "marks\\)",
+     "наклонить каждый снимкодержатель по шкалам k_α, k_ω (на этапе 2 они подбираются по "
+     "координатным меткам)"),
+    ("set the decentrations d_x, d_y on their scales \\(stage 2, after the fit\\)",
+     "установить децентрации d_x, d_y по их шкалам (этап 2, после подбора)"),
+    ("photo-carrier tilt (?P<a>[αω]) \\(gimbal, (?P<k>k_[αω]) scale\\)",
+     "наклон снимкодержателя {a} (карданный подвес, шкала {k})"),
+    ("the 3 kinds of decentration \\(photo, correction mechanism, follower\\) × x, y × 2 "
+     "photos, set after kα, kω are introduced",
+     "3 вида децентраций (снимка, коррекционного механизма, копира) × x, y × 2 снимка, "
+     "устанавливаемых после введения kα, kω"),
+    ("documented for the SPR-2 \\(12 settings depending on φ, ω: photo decentrations, "
+     "decentrations of the correction mechanisms and of the followers\\); taken for the SPR-3",
+     "документировано для СПР-2 (12 установок, зависящих от φ, ω: децентрации снимков, "
+     "коррекционных механизмов и копиров); принято для СПР-3"),
+    ("introduce dφ, dω: set kα, kω on the lens-shift mechanisms of each photo \\(stage 2 fits "
+     "them on the fiducial marks\\)",
+     "ввести dφ, dω: установить kα, kω на механизмах смещения объектива каждого снимка (на "
+     "этапе 2 они подбираются по координатным меткам)"),
+    ("from the tables \\(arguments dφ, dω\\) set the photo-carriage decentrations e, the "
+     "correction-mechanism decentrations c and the followers' decentrations u, all f′·tan α, "
+     "f′·tan ω",
+     "по таблицам (аргументы dφ, dω) установить децентрации кареток снимков e, коррекционных "
+     "механизмов c и копиров u, все f′·tan α, f′·tan ω"),
+    ("repeat the cycle until the check passes \\(the photo moves under the fixed marks\\)",
+     "повторять цикл до выполнения контроля (снимок перемещается под неподвижными марками)"),
+    ("lens-shift mechanism (?P<a>k[αω])", "механизм смещения объектива {a}"),
+    ("correction-mechanism decentration (?P<a>[xy])", "децентрация коррекционного механизма {a}"),
+    ("follower decentration (?P<a>[xy]) \\(correction plate\\)",
+     "децентрация копира {a} (коррекционная пластина)"),
+    ("2 plate inclinations \\(primary\\) and 2 photo decentrations \\(derived\\) per photo",
+     "2 наклона пластин (основные) и 2 децентрации снимка (производные) на снимок"),
+    ("SD stereograph: 8 setting elements, the plate inclinations primary, the photo "
+     "decentrations mediated \\(report on the Soviet affine plotters, ISP Comm. II\\)",
+     "стереограф СД: 8 установочных элементов, наклоны пластин — основные, децентрации "
+     "снимков — опосредованные (доклад о советских аффинных приборах, МОФ, комиссия II)"),
+    ("incline the correction plates of each photo to θ_α, θ_ω \\(stage 2 fits them on the "
+     "fiducial marks: the k_α, k_ω knobs\\)",
+     "наклонить коррекционные пластины каждого снимка на θ_α, θ_ω (на этапе 2 они "
+     "подбираются по координатным меткам: рукоятки k_α, k_ω)"),
+    ("the photo decentrations follow from the plate settings, d = \\(f′/k\\)·tan θ \\(on the "
+     "virtual SD-3 the linkage carries them, decision D1\\); check their scales",
+     "децентрации снимков следуют из установки пластин, d = (f′/k)·tan θ (на виртуальном "
+     "СД-3 их передаёт связь, решение D1); проверить их шкалы"),
+    ("correction-plate inclination \\((?P<a>[αω])\\)", "наклон коррекционной пластины ({a})"),
+    ("photo decentration (?P<a>[xy]) \\(from the plate\\)", "децентрация снимка {a} (от пластины)"),
+    ("primary", "основная"),
+    ("derived", "производная"),
+    ("mark (?P<m>\\w+) is under the measuring mark", "метка {m} под измерительной маркой"),
+    ("the photo carriage brings mark (?P<m>\\w+) under the fixed measuring mark",
+     "каретка снимка подводит метку {m} под неподвижную измерительную марку"),
 )  # fmt: skip
 
 #: The record texts' templates, compiled: (pattern, Russian).
@@ -630,8 +716,10 @@ _LOCAL_RU = (
     (r"SW", "ЮЗ"), (r"SE", "ЮВ"), (r"NE", "СВ"), (r"NW", "СЗ"), (r"RMS", "СКО"),
     (r"MO", "МО"), (r"Gauss–Krüger", "Гаусса–Крюгера"), (r"map", "карты"),
 )  # fmt: skip
-_LOCAL_RU_PATTERN = re.compile(
-    r"(?<![A-Za-zА-Яа-яЁё])(" + "|".join(a for a, _ in _LOCAL_RU) + r")(?![A-Za-zА-Яа-яЁё])"
+_LOCAL_RU_PATTERN = re.compile(  # a unit is no part of an identifier (``distance_mm``)
+    r"(?<![A-Za-zА-Яа-яЁё_.])(" + "|".join(a for a, _ in _LOCAL_RU if a not in ("map", "MO"))
+    + r")(?![A-Za-zА-Яа-яЁё_])|(?<=_)(map)(?![A-Za-zА-Яа-яЁё_])"
+    r"|(?<![A-Za-zА-Яа-яЁё_.])(MO)(?![A-Za-zА-Яа-яЁё])"
 )
 _LOCAL_RU_MAP = dict(_LOCAL_RU)
 
@@ -640,15 +728,16 @@ def localize(text: str, lang: str) -> str:
     """A finished text of an output with its units (mm → мм, m → м, µm → мкм), compass
     corners (SW → ЮЗ …), the zero reading МО, tan → tg and RMS → СКО in ``lang``: the
     symbols a Russian reader writes in Cyrillic, each replaced only as a whole token (a
-    letter on neither side, so ``M_map`` → ``M_карты`` and ``m/mm`` → ``м/мм``, never inside a
-    word). English is returned as it is.
+    letter on neither side, so ``m/mm`` → ``м/мм``, never inside a word or an identifier such
+    as ``distance_mm``); the subscript of ``M_map`` → ``M_карты``. English is returned as it
+    is.
 
     >>> localize("L = 287.70 mm, ΔZ 5.14 m/mm, corner 4 NW, MO_X", "ru")
     'L = 287.70 мм, ΔZ 5.14 м/мм, corner 4 СЗ, МО_X'
     """
     if check_language(lang) == "en" or not text:
         return text
-    return _LOCAL_RU_PATTERN.sub(lambda m: _LOCAL_RU_MAP[m.group(1)], text)
+    return _LOCAL_RU_PATTERN.sub(lambda m: _LOCAL_RU_MAP[m.group(m.lastindex or 1)], text)
 
 
 def check_language(lang: str) -> str:

@@ -25,6 +25,7 @@ from stereoplotter import __version__
 from stereoplotter.glossary import TERMS, check_language, term
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
+from stereoplotter.report.form_fields import rigorous_sides
 from stereoplotter.report.form_layout import literal, localized_text, plain
 from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdfs
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
@@ -159,7 +160,7 @@ def _plain(value: Any) -> Any:
     raise TypeError(type(value).__name__)
 
 
-def _markdown(job: Job, p: PairResult, lang: str = "en") -> str:
+def _markdown(job: Job, p: PairResult, lang: str = "en", rigorous: bool = False) -> str:
     h = form_header(job, p, lang=lang)
     t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     head = (
@@ -169,7 +170,7 @@ def _markdown(job: Job, p: PairResult, lang: str = "en") -> str:
         f"{t('date')} {h.date}; {h.program}.\n\n"
     )
     assert p.sheet is not None
-    text = sheet_markdown(p.sheet, lang)
+    text = sheet_markdown(p.sheet, lang, rigorous_sides(p.sheet, rigorous))
     title, rest = text.split("\n", 1)
     return plain(localized_text(f"{title}\n\n{head}{rest.lstrip()}", lang))
 
@@ -234,7 +235,7 @@ def job_files(result: JobResult, lang: str = "en", rigorous: bool = False) -> di
         if p.sheet is None:
             continue
         header = form_header(result.job, p, result.spec, lang)
-        files[f"{p.pair.name}/sheet.md"] = _markdown(result.job, p, lang).encode("utf-8")
+        files[f"{p.pair.name}/sheet.md"] = _markdown(result.job, p, lang, rigorous).encode("utf-8")
         files[f"{p.pair.name}/sheet.pdf"] = b""  # in the order of the files before
         forms.append((p.sheet, header))
         names.append(p.pair.name)
