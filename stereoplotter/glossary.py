@@ -141,12 +141,15 @@ _TABLE: dict[str, tuple[str, str]] = {
     "readings": ("Readings, stage by stage (6.9)–(6.18)", "Отсчёты по этапам (6.9)–(6.18)"),
     "readings_intro": (
         "Each value is rounded to the least count of its counter or scale (the "
-        "value "
-        "to set). The right photo's zero readings: MO_X,п = MO_X + b_x, "
-        "MO_Y,п = MO_Y + b_y. Write the reading actually set in the last column.",
+        "value to set). Write the reading actually set in the last column.",
         "Каждое значение округлено до цены деления счётчика или шкалы (значение "
-        "для установки). Места нуля правого снимка: MO_X,п = MO_X + b_x, "
-        "MO_Y,п = MO_Y + b_y. В последнюю графу записывается фактический отсчёт.",
+        "для установки). В последнюю графу записывается фактический отсчёт.",
+    ),
+    "zero_readings_right": (
+        "The right photo's zero readings: MO_X,п = MO_X + b_x, MO_Y,п = MO_Y + b_y; each "
+        "projector has its own decentration scales and zeros MO_dx, MO_dy.",
+        "Места нуля правого снимка: MO_X,п = MO_X + b_x, MO_Y,п = MO_Y + b_y; у каждого "
+        "проектора свои шкалы децентраций и свои места нуля MO_dx, MO_dy.",
     ),
     "step": ("step", "действие"),
     "reading": ("reading to set", "отсчёт для установки"),
@@ -534,7 +537,7 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
     ("≤ ¼ mark", "≤ ¼ марки"),
     ("\\(6.5\\), decision D5", "(6.5), решение D5"),
     ("f′·tan (?P<a>[αω]) \\(§2.4\\)", "f′·tan {a} (§2.4)"),
-    ("f′·tan (?P<a>[αω]) \\(kinematics §2.4\\)", "f′·tan {a} (§2.4)"),
+    ("f′·tan (?P<a>[αω]) \\(kinematics §2.4\\)", "f′·tan {a}"),
     ("§26 stages 2, 3: κ along the initial direction; refine k_ω",
      "§26, этапы 2, 3: κ по начальному направлению; уточнить k_ω"),
     ("§26 stage 3: scaling refined \\(b_x\\)", "§26, этап 3: уточнение масштаба (b_x)"),

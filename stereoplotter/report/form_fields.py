@@ -237,6 +237,12 @@ def _tolerance_text(row: dict[str, Any]) -> str:
     return f"± {row['tolerance']:.4g} {row['unit']}" if "tolerance" in row else ""
 
 
+def _equation_text(row: dict[str, Any], lang: str) -> str:
+    """A reading's equation in ``lang``, without the pointer into the program's own notes (the
+    form names the book's equations only)."""
+    return translate(str(row["equation"]), lang).replace(" (kinematics §2.4)", "")
+
+
 def _book_text(row: dict[str, Any], book: float | None, lc: LeastCounts, lang: str) -> str:
     """" (book: …)" beside a rigorous value to set, at the same least count."""
     if book is None:
@@ -259,7 +265,7 @@ def reading_rows(
         if r["stage"] == 5:
             continue
         value, book = value_to_set(sheet, r, sides)
-        equation = "(3.17)" if book is not None else translate(str(r["equation"]), lang)
+        equation = "(3.17)" if book is not None else _equation_text(r, lang)
         rows.append((str(r["stage"]), step_text(r, lang),
                      _reading_text(r, value, lc, lang) + _book_text(r, book, lc, lang),
                      _least_count_text(r, lc), equation, _tolerance_text(r), ""))  # fmt: skip

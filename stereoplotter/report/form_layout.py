@@ -439,11 +439,16 @@ def heading(pdf: Form, text: str, size: float = 11.0, keep: float = 0.0) -> None
 
 
 def paragraph(pdf: Form, text: str, size: float = 7.5) -> None:
-    """Text over the page width, broken into lines at spaces (:func:`_wrap`), left-aligned,
-    continued on the next page when the page is full."""
+    """Text over the page width, broken into lines at spaces (:func:`_wrap`), left-aligned, on
+    the next page when it does not fit the rest of this one (continued over a page only when
+    it is longer than a page)."""
     pdf.set_font(FONT, "", size)
     line = 1.3 * size * _PT
-    for text_line in _wrap(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "", size):
+    lines = _wrap(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "", size)
+    if not fits(pdf, len(lines) * line) and pdf.get_y() > pdf.t_margin + 1.0:
+        pdf.add_page()  # a paragraph is whole on a page (none of the forms' runs over a page)
+        pdf.set_font(FONT, "", size)
+    for text_line in lines:
         if pdf.get_y() + line > pdf.page_break_trigger:
             pdf.add_page()
             pdf.set_font(FONT, "", size)

@@ -51,9 +51,12 @@ from stereoplotter.setup.records import SetupSheet
 __all__ = ["FormHeader", "LeastCounts", "form_pdf", "form_pdfs"]
 
 #: Type sizes (pt): running text and notes, the tables, the headings. The body is at least
-#: 8 pt and the number tables 7.5 pt (a form of the period: a typewritten or typeset
+#: 8 pt and the tables 7.5 pt (a form of the period: a typewritten or typeset
 #: instruction, read at arm's length at the instrument); subscripts are 0.72 of their text.
 _BODY, _TABLE, _HEAD = 8.0, 7.5, 10.5
+#: The long number table of the working sheet (every reading of stages 1–4): 7 pt, so that it
+#: is whole on one page for strip8 (40 rows).
+_NUMBERS = 7.0
 #: A non-breaking space: an id and its value, a corner and its reading are never split.
 _NB = "\u00a0"
 
@@ -226,16 +229,19 @@ def _page_readings(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigor
     zero_rows = [tuple(cells[i : i + 4] + [""] * (4 - len(cells[i : i + 4])))
                  for i in range(0, len(cells), 4)]  # fmt: skip
     heading(pdf, t("zero_readings"), _HEAD, keep=len(zero_rows) * 6.0)
-    table(pdf, ("",) * 4, zero_rows, (1, 1, 1, 1), size=_BODY)
+    table(pdf, ("",) * 4, zero_rows, (1, 1, 1, 1), size=_BODY, gap=0.5)
+    paragraph(pdf, t("zero_readings_right"), _BODY)
+    pdf.ln(2)
     rows = reading_rows(sheet, lc, lang, rigorous)
-    widths = (9, 47, 50, 15, 22, 19, 13)
+    widths = (6, 62, 44, 16, 14, 17, 16)
     header = (t("stage"), t("step"), t("reading"), t("least_count"), t("equation"),
               t("tolerance"), t("set"))  # fmt: skip
-    height = table_height(pdf, header, rows, widths, _TABLE) + 12.0  # with the intro
+    height = table_height(pdf, header, rows, widths, _NUMBERS)
     page = pdf.page_break_trigger - pdf.t_margin - 8.0
     heading(pdf, t("readings"), _HEAD, keep=height if height <= page else 60.0)
+    table(pdf, header, rows, widths, size=_NUMBERS, gap=0.5)
     paragraph(pdf, t("readings_intro"), _BODY)
-    table(pdf, header, rows, widths, size=_TABLE)
+    pdf.ln(1.5)
     rows = correction_rows(sheet, lang, rigorous)
     widths, header = (12, 45, 58, 22, 38), (t("symbol"), t("quantity"), t("formula"),
                                             t("factor"), t("result"))  # fmt: skip
