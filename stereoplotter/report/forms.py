@@ -161,8 +161,8 @@ def _table24_rows(sheet: SetupSheet, lang: str) -> list[tuple[str, ...]]:
 
 def _header_rows(sheet: SetupSheet, h: FormHeader, lang: str) -> list[tuple[str, str]]:
     t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
-    assumed = sorted({literal(parameter_name(p, lang)) for ps in sheet.assumed.values()
-                      for p in ps})  # fmt: skip
+    named = parameter_name if lang == "ru" else lambda key, _: literal(key)  # keys as written
+    assumed = sorted({named(p, lang) for ps in sheet.assumed.values() for p in ps})
     theta = math.degrees(sheet.frame_rotation)
     return [
         (f"{t('job')}, {t('pair')}", f"{literal(h.job)} ({literal(h.job_file)}) · {t('pair')} "

@@ -67,8 +67,3 @@ def test_a_photo_below_the_ground_is_named(tmp_path, capsys):
     assert main(["setup", str(path), "-o", str(tmp_path / "out"), "-q"]) == 0
     err = capsys.readouterr().err
     assert err.count("photo 102 at 0.0 m is not above the control's median height") == 2
-
-
-def test_quiet_prints_nothing_for_a_job_set_up_whole(tmp_path, capsys):
-    assert main(["setup", str(STRIP8 / "job.yaml"), "-o", str(tmp_path / "out"), "-q"]) == 0
-    assert capsys.readouterr() == ("", "")
