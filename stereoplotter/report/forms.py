@@ -5,15 +5,21 @@ One form per stereopair, A4 portrait (document and drawing primitives:
 :mod:`stereoplotter.report.form_fields`; every label from :mod:`stereoplotter.glossary`). The
 output is byte-identical for the same sheet, header and language.
 
-Pages: (1) the header, Table 24 with the coordinatograph gear r, and every reading to set at its
-least count, one row per stage (always on page 1: the fonts shrink until it fits), with the
-warning when the book's (6.1)/(6.2), (6.5) exceed a stage tolerance; (2) the working sheet: the
-zero readings MO to write in, every reading of stages 1–4 with its least count, tolerance and a
-column to write in, the (6.9)–(6.11) corrections from the measured L′ (factor, formula, field),
-stage 5 on corner 4, the plan control and the check points, the signatures; (3) the method's
-limits (book against rigorous (3.17) on the counters), angles, settings, height control, sheet
-corners, similarity (6.8), distortion, tolerances; (4) the sheet frame and the control points in
-instrument coordinates, labels placed so that none overlaps another.
+Parts, in order, each table whole on a page with its heading (a table longer than a page
+continues under its header), body 8 pt, tables 7.5 pt (the readings of stages 1–4: 7 pt), the
+book's symbols with their subscripts typeset and the job's own texts printed as written: (1) the
+header, Table 24 with the coordinatograph gear r, which values are given to set (the warning
+and the note agree with the tables: a photo's marks and span by the book where all of them are
+within their stage tolerance, else by the rigorous (3.17), the book's beside them,
+:func:`~stereoplotter.report.form_fields.rigorous_sides`), and every reading to set at its
+least count, one row per stage; (2) the working sheet: the zero readings MO to write in (the
+decentration zeros per projector), every reading of stages 1–4 with its least count, tolerance
+and a column to write in, the (6.9)–(6.11) corrections from the measured L′ (factor, formula,
+field), stage 5 on corner 4, the plan control and the check points, the signatures; (3) the
+method's limits (book against rigorous (3.17) on the counters), angles, settings, height
+control, sheet corners, similarity (6.8), distortion, tolerances; (4) the sheet frame and the
+control points in instrument coordinates, drawn black, labels placed so that none overlaps
+another.
 """
 
 from __future__ import annotations
