@@ -537,7 +537,7 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
     ("≤ ¼ mark", "≤ ¼ марки"),
     ("\\(6.5\\), decision D5", "(6.5), решение D5"),
     ("f′·tan (?P<a>[αω]) \\(§2.4\\)", "f′·tan {a} (§2.4)"),
-    ("f′·tan (?P<a>[αω]) \\(kinematics §2.4\\)", "f′·tan {a}"),
+    ("f′·tan (?P<a>[αω]) \\(kinematics §2.4\\)", "f′·tan {a} (описание кинематики, §2.4)"),
     ("§26 stages 2, 3: κ along the initial direction; refine k_ω",
      "§26, этапы 2, 3: κ по начальному направлению; уточнить k_ω"),
     ("§26 stage 3: scaling refined \\(b_x\\)", "§26, этап 3: уточнение масштаба (b_x)"),

@@ -166,7 +166,7 @@ _STEPS_RU = (
     (r"^f_пр$", "установить фокусное расстояние прибора f_пр"),
     (r"^O_bx$", "базисная каретка b_x"),
     (r"^O_by$", "базисная каретка b_y (MO_by по центрам кассет)"),
-    (r"^O_Z$", "опустить базисную каретку до D_max: абсолютный счётчик высот"),
+    (r"^O_Z$", "опустить базисную каретку (ножной штурвал) до D_max: абсолютный счётчик высот"),
     (r"^L_л$", "контроль расстояния между метками 3–4, левый снимок"),
     (r"^L_п$", "контроль расстояния между метками 3–4, правый снимок"),
     (r"^MO_bz$", "записать место нуля b_z"),
@@ -182,8 +182,8 @@ _STEPS_RU = (
     (r"^d_y,п$", "правый снимок: шкала децентрации y"),
     (r"^O_bz$", "вертикальная составляющая базиса"),
     (r"^residual q$", "κ_л, κ_п по начальным направлениям; остаточный поперечный параллакс"),
-    (r"^O_Z(?P<id>.+)$", "высотная опорная точка {id}: совместить марку с точкой"),
-    (r"^corner (?P<id>\d)", "угол трапеции {id}"),
+    (r"^O_Z(?P<id>.+)$", "высотная опорная точка {id}: совместить марку с точкой вращением b_x"),
+    (r"^corner (?P<id>\d)", "угол трапеции {id}{position}"),
 )
 
 
@@ -191,10 +191,11 @@ def step_text(row: dict[str, Any], lang: str) -> str:
     """What the operator does for a reading row, in ``lang``."""
     if lang == "en":
         return str(row["step"])
+    where = re.search(r" \((SW|SE|NE|NW)\)$", str(row["step"]))  # a corner's position
     for pattern, text in _STEPS_RU:
         m = re.match(pattern, row["reading"])
         if m:
-            return text.format(**m.groupdict())
+            return text.format(**m.groupdict(), position=f" ({where[1]})" if where else "")
     return str(row["step"])  # pragma: no cover - every reading of stages 1–5 is listed above
 
 
@@ -240,7 +241,7 @@ def _tolerance_text(row: dict[str, Any]) -> str:
 def _equation_text(row: dict[str, Any], lang: str) -> str:
     """A reading's equation in ``lang``, without the pointer into the program's own notes (the
     form names the book's equations only)."""
-    return translate(str(row["equation"]), lang).replace(" (kinematics §2.4)", "")
+    return translate(str(row["equation"]).replace(" (kinematics §2.4)", ""), lang)
 
 
 def _book_text(row: dict[str, Any], book: float | None, lc: LeastCounts, lang: str) -> str:

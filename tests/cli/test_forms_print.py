@@ -19,6 +19,7 @@ import numpy as np
 import pypdfium2 as pdfium
 import pypdfium2.raw as raw
 import pytest
+import yaml
 
 from stereoplotter.cli import main
 
@@ -27,8 +28,9 @@ JOB = ROOT / "jobs" / "strip8" / "job.yaml"
 #: Latin words a Russian form may hold: tg (the tangent), formula subscripts (O_bx, d_x …,
 #: D_max, O_Zi), and the program's name.
 SYMBOLS = {"tg", "max", "bx", "by", "bz", "dx", "dy", "Zi", "stereoplotter"}
-#: The job's own texts, printed as written (strip8's job name, file and camera).
-JOB_TEXTS = {"strip", "job", "yaml", "AFA", "TE", "No", "invented"}
+#: The job's own texts, printed as written: the words of its name, its file's name and its camera.
+_JOB = yaml.safe_load(JOB.read_text("utf-8"))
+JOB_TEXTS = set(re.findall("[A-Za-z]+", f"{_JOB['name']} {JOB.name} {_JOB['camera']['camera']}"))
 MM = 25.4 / 72.0
 
 
