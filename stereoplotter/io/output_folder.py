@@ -26,11 +26,11 @@ import glob
 import hashlib
 import json
 import os
+import secrets
 import shutil
 import signal
 import stat
 import sys
-import tempfile
 import threading
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
@@ -116,19 +116,20 @@ def write_outputs(
         ``folder`` is a file, or holds files and ``force`` is not given (one line; nothing is
         written).
     """
-    out = Path(folder)
+    shown = Path(folder)
+    out = Path(os.path.realpath(folder))  # "." or a link: the folder itself, beside its parent
     _recover(out)
     if out.exists() and not out.is_dir():
-        raise StereoplotterError(f"{out}: -o: expected a folder, found a file")
+        raise StereoplotterError(f"{shown}: -o: expected a folder, found a file")
     present = _entries(out) if out.exists() else []
     previous, who = _previous(out) if present else (set(), "")
     if present and not force:
         raise StereoplotterError(
-            f"{out}: -o: expected a new or empty output folder, found {len(present)} files "
+            f"{shown}: -o: expected a new or empty output folder, found {len(present)} files "
             f"({who}): give --force to replace them, or another folder"
         )
     out.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.staging-", dir=out.parent))
+    staging = _new_folder(out.parent, f".{out.name}.staging-")
     try:
         mine = set(files) | previous | {MANIFEST}
         foreign = [p for p in present if _name(p, out) not in mine]
@@ -137,10 +138,8 @@ def write_outputs(
         for path in foreign:  # the operator's own files go on living in the new folder
             _link(path, staging / path.relative_to(out))
         write_files(staging, {**files, MANIFEST: manifest_bytes(files, about)})
-        if out.exists():
+        if out.exists():  # the folder keeps the permissions it had
             os.chmod(staging, stat.S_IMODE(out.stat().st_mode))
-        else:
-            os.chmod(staging, 0o777 & ~_umask())
         with _signals_held():  # a signal meanwhile is delivered after the swap
             _swap(staging, out)
             shutil.rmtree(staging, ignore_errors=True)  # the previous run
@@ -154,10 +153,17 @@ def _name(path: Path, top: Path) -> str:
     return str(path.relative_to(top)).replace(os.sep, "/")
 
 
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
+def _new_folder(parent: Path, prefix: str) -> Path:
+    """A new empty folder ``prefix`` + 12 hex digits in ``parent``, mode 0o777 less the umask
+    (as any folder the user makes)."""
+    for _ in range(100):
+        path = parent / f"{prefix}{secrets.token_hex(6)}"
+        try:
+            path.mkdir(0o777)
+            return path
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"{parent}: no free name for a staging folder")
 
 
 def _link(source: Path, target: Path) -> None:
