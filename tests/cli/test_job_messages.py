@@ -67,3 +67,10 @@ def test_a_photo_below_the_ground_is_named(tmp_path, capsys):
     assert main(["setup", str(path), "-o", str(tmp_path / "out"), "-q"]) == 0
     err = capsys.readouterr().err
     assert err.count("photo 102 at 0.0 m is not above the control's median height") == 2
+
+
+def test_quiet_job_to_scenario_prints_nothing(tmp_path, capsys):
+    out = tmp_path / "pair.yaml"
+    assert main(["job", "to-scenario", str(STRIP8 / "job.yaml"), "101-102", "-o", str(out),
+                 "-q"]) == 0  # fmt: skip
+    assert capsys.readouterr() == ("", "") and out.is_file()
