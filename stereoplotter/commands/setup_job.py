@@ -129,12 +129,11 @@ def run(args: argparse.Namespace) -> int:
         signal.signal(signal.SIGTERM, _interrupt)
     try:
         return _run(args)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # one line, the exit code of an interrupt (128 + SIGINT)
         out = getattr(args, "output", None) or "stereoplotter-setup"
-        raise StereoplotterError(
-            f"{out}: interrupted: the folder holds the previous run or this one, each whole "
-            "(never a mix of the two)"
-        ) from None
+        sys.stderr.write(f"error: {out}: interrupted: the folder holds the previous run or this "
+                         "one, each whole (never a mix of the two)\n")  # fmt: skip
+        return 130
     finally:
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGTERM, previous)

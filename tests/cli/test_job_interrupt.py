@@ -138,5 +138,5 @@ def test_ctrl_c_ends_the_command_in_one_line(runs, tmp_path, monkeypatch, capsys
     _signal_after(monkeypatch, atomic_write, "atomic_write_bytes", 3, signal.SIGINT)
     code = main(["setup", str(JOB), "-o", str(out), "--force", "--lang", "ru"])
     err = capsys.readouterr().err
-    assert code == 1 and err.count("\n") == 1 and err.startswith(f"error: {out}: interrupted")
+    assert code == 130 and err.count("\n") == 1 and err.startswith(f"error: {out}: interrupted")
     assert _snapshot(out) == _snapshot(old) and _hidden(tmp_path) == []
