@@ -428,13 +428,15 @@ def fits(pdf: Form, height: float) -> bool:
 
 def heading(pdf: Form, text: str, size: float = 11.0, keep: float = 0.0) -> None:
     """A bold line; on the next page when it and ``keep`` mm after it do not fit here."""
-    height = 1.5 * size * _PT + 1.0
-    if not fits(pdf, height + keep) and pdf.get_y() > pdf.t_margin + 1.0:
+    lines = _wrap(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "B", size)
+    line = 1.5 * size * _PT + 1.0
+    if not fits(pdf, len(lines) * line + keep) and pdf.get_y() > pdf.t_margin + 1.0:
         pdf.add_page()
     pdf.set_font(FONT, "B", size)
-    pdf.rich_text(pdf.l_margin + pdf.c_margin, pdf.get_y() + 0.5 * height + 0.3 * pdf.font_size,
-                  localized(pdf, text))  # fmt: skip
-    pdf.set_xy(pdf.l_margin, pdf.get_y() + height)
+    for text_line in lines:  # within the margins, broken at spaces when wider
+        pdf.rich_text(pdf.l_margin + pdf.c_margin,
+                      pdf.get_y() + 0.5 * line + 0.3 * pdf.font_size, text_line)  # fmt: skip
+        pdf.set_xy(pdf.l_margin, pdf.get_y() + line)
     pdf.set_font(FONT, "", 8)
 
 
@@ -628,9 +630,14 @@ class LabelPlacer:
     earlier box is taken, else the one that overlaps least.
     """
 
-    def __init__(self, pdf: Form) -> None:
+    def __init__(
+        self, pdf: Form, bounds: tuple[float, float, float, float] | None = None
+    ) -> None:
         self.pdf = pdf
         self.boxes: list[tuple[float, float, float, float]] = []
+        #: The area labels stay inside (the drawing's frame): a place outside costs more than
+        #: any overlap.
+        self.bounds = bounds
 
     def _box(self, x: float, y: float, width: float) -> tuple[float, float, float, float]:
         size = self.pdf.font_size  # mm
@@ -638,6 +645,10 @@ class LabelPlacer:
 
     def _overlap(self, box: tuple[float, float, float, float]) -> float:
         total = 0.0
+        if self.bounds is not None:
+            x0, y0, x1, y1 = self.bounds
+            if box[0] < x0 or box[1] < y0 or box[2] > x1 or box[3] > y1:
+                total += 1e6
         for b in self.boxes:
             w = min(box[2], b[2]) - max(box[0], b[0])
             h = min(box[3], b[3]) - max(box[1], b[1])

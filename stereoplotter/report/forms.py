@@ -400,7 +400,7 @@ def _page_drawing(pdf: Form, sheet: SetupSheet, lang: str) -> None:
     pdf.set_draw_color(0)
     pdf.set_fill_color(0)
     pdf.set_font(FONT, "", _BODY)
-    labels = LabelPlacer(pdf)
+    labels = LabelPlacer(pdf, (x0 + 0.5, y0 + 0.5, x0 + box_w - 0.5, y0 + box_h - 0.5))
     points = [(at(p["x_mm"], p["y_mm"]), p) for p in sheet.points_model_mm]
     for (px, py), _ in points:  # every symbol is kept free of labels before any label is placed
         labels.reserve((px - 1.5, py - 1.6, px + 1.5, py + 1.1))

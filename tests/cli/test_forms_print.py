@@ -159,6 +159,30 @@ def test_page_one_of_every_form_is_legible_and_nothing_overlaps_or_is_clipped(fo
         assert len(pdf) <= 6 and len(_chars(pdf[len(pdf) - 1])) > 100  # no orphan last page
 
 
+@pytest.mark.parametrize("lang", ["ru", "en"])
+def test_every_page_keeps_its_margins_and_no_text_overlaps(forms, lang):
+    """Every page of the forms of 101-102 (the largest tilts) and 104-105 (the most height
+    control): text boxes inside the margins (20 mm left, 15 mm right, 10 mm top), none
+    overlapping another, no character under 7 pt but a subscript (the readings of stages 1–4
+    are 7 pt, everything else 7.5 pt or more)."""
+    for pair in ("101-102", "104-105"):
+        _every_page(pdfium.PdfDocument(forms[lang] / pair / "sheet.pdf"))
+
+
+def _every_page(pdf) -> None:
+    for i in range(len(pdf)):
+        page = pdf[i]
+        width, height = page.get_size()
+        chars = _chars(page)
+        boxes = _boxes(chars)
+        outside = [b for b in boxes if b[0] < 20 / MM - 1 or b[2] > width - 15 / MM + 1
+                   or b[3] > height - 10 / MM]  # fmt: skip
+        assert outside == [] and _clashes(boxes) == [], (i + 1, outside[:2])
+        sizes = {round(c[1], 2) for c in chars if not c[0].isspace()}
+        assert min(s for s in sizes if s > 6.0) >= 7.0 and min(sizes) >= 0.72 * 7.0 - 0.01, (
+            i + 1, sorted(sizes))
+
+
 def test_the_drawing_prints_dark(forms):
     """On the drawing page rendered without smoothing (each pixel its mark's own grey), no
     drawn pixel is paler than grey 110 of 255: a grey fill of 225 (pale circles nearly
