@@ -71,9 +71,12 @@ def set_value(value: float, step: float) -> str:
     return ("-" if rounded < 0 and float(text) != 0.0 else "") + text
 
 
+_NB = "\u00a0"  # a non-breaking space: a sign, its value and its unit stay on one line
+
+
 def _signed(value: float, step: float) -> str:
     text = set_value(value, step)
-    return f"− {text[1:]}" if text.startswith("-") else f"+ {text}"
+    return f"−{_NB}{text[1:]}" if text.startswith("-") else f"+{_NB}{text}"
 
 
 # --- rigorous values --------------------------------------------------------------------------
@@ -221,8 +224,8 @@ def _reading_text(row: dict[str, Any], value: float, lc: LeastCounts, lang: str)
         return _residual_text(row, lang)
     step = kind[1]
     if zero:
-        return f"{name} = {zero} {_signed(value, step)} {unit}"
-    return f"{name} = {set_value(value, step)} {unit}"
+        return f"{name} = {zero} {_signed(value, step)}{_NB}{unit}"
+    return f"{name} = {set_value(value, step)}{_NB}{unit}"
 
 
 def _least_count_text(row: dict[str, Any], lc: LeastCounts) -> str:
@@ -235,7 +238,7 @@ def _least_count_text(row: dict[str, Any], lc: LeastCounts) -> str:
 
 
 def _tolerance_text(row: dict[str, Any]) -> str:
-    return f"± {row['tolerance']:.4g} {row['unit']}" if "tolerance" in row else ""
+    return f"±{_NB}{row['tolerance']:.4g}{_NB}{row['unit']}" if "tolerance" in row else ""
 
 
 def _equation_text(row: dict[str, Any], lang: str) -> str:
@@ -290,7 +293,7 @@ def summary_rows(
             if "tolerance" in r and r["reading"] != "residual q":
                 name = re.sub(r"\d+$", "i", r["reading"]) if stage == 3 else r["reading"]
                 name = name.replace("corner", term("corner", lang))
-                tolerances.setdefault(f"±{r['tolerance']:.3g} {r['unit']}", []).append(name)
+                tolerances.setdefault(f"±{r['tolerance']:.3g}{_NB}{r['unit']}", []).append(name)
         if stage == 5:
             texts.append(f"{term('points_stage5', lang)}: "
                          + ", ".join(str(p["id"]) for p in _stage5_points(sheet)))  # fmt: skip
