@@ -20,13 +20,14 @@ __all__ = [
     "LeastCounts",
     "correction_rows",
     "limit_rows",
-    "limits_exceeded",
     "reading_rows",
     "rigorous_sides",
     "set_value",
     "signature_rows",
     "stage5_rows",
     "summary_rows",
+    "value_to_set",
+    "zero_of",
     "zero_reading_names",
 ]
 
@@ -116,11 +117,6 @@ def limit_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
             "equation": "(6.5)" if span else r["equation"],
         })  # fmt: skip
     return out
-
-
-def limits_exceeded(sheet: SetupSheet) -> bool:
-    """True when any book value deviates from the rigorous one by more than its tolerance."""
-    return any(row["exceeds"] for row in limit_rows(sheet))
 
 
 def rigorous_sides(sheet: SetupSheet, rigorous: bool = False) -> tuple[str, ...]:
