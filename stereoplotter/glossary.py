@@ -156,6 +156,7 @@ _TABLE: dict[str, tuple[str, str]] = {
     "least_count": ("least count", "цена деления"),
     "tolerance": ("tolerance", "допуск"),
     "set": ("set", "факт."),
+    "to_set": ("to set", "установить"),
     "tolerances": ("tolerances", "допуски"),
     "counters": ("counters", "счётчики"),
     "scales": ("scales", "шкалы"),

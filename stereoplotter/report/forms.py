@@ -38,6 +38,7 @@ from stereoplotter.report.form_fields import (
     signature_rows,
     stage5_rows,
     summary_rows,
+    value_to_set,
     zero_reading_names,
 )
 from stereoplotter.report.form_layout import (
@@ -116,8 +117,34 @@ def _instrument_text(sheet: SetupSheet, lang: str) -> str:
     return name if lang == "ru" else f"{name} ({sheet.instrument})"
 
 
-def _table24_rows(sheet: SetupSheet, lang: str) -> list[tuple[str, ...]]:
+def _rigorous_marks(
+    sheet: SetupSheet, side: int, keys: tuple[str, ...], sides: tuple[str, ...], lang: str
+) -> str:
+    """The rigorous (3.17) marks beside the book's in Table 24, for a photo whose marks the
+    form gives to set from (3.17) (:func:`rigorous_sides`)."""
+    photo = sheet.photos[side]
+    if photo.name not in sides:
+        return ""
+    rig = photo.transformed_rigorous_mm
+    values = ", ".join(_f(rig[k[1:]][0 if k[0] == "x" else 1]) for k in keys)
+    return f"\n{term('to_set', lang)} (3.17): {values}"
+
+
+def _rigorous_spans(sheet: SetupSheet, sides: tuple[str, ...], lang: str) -> str:
+    """The rigorous (3.17) spans of the photos of ``sides`` beside the book's (6.5)."""
+    spans = []
+    for p, mark in zip(sheet.photos, ("л", "п"), strict=True):
+        if p.name in sides:
+            value = value_to_set(sheet, {"reading": f"L_{mark}", "value": 0.0}, sides)[0]
+            spans.append(f"L_{mark}{_NB}={_NB}{_f(value)}")
+    return f"\n{term('to_set', lang)} (3.17): {', '.join(spans)}" if spans else ""
+
+
+def _table24_rows(
+    sheet: SetupSheet, lang: str, rigorous: bool = False
+) -> list[tuple[str, ...]]:
     left, right = sheet.photos
+    sides = rigorous_sides(sheet, rigorous)
     t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     item = t("item1")
     rows: list[tuple[str, ...]] = [
@@ -138,14 +165,16 @@ def _table24_rows(sheet: SetupSheet, lang: str) -> list[tuple[str, ...]]:
         ("7", t("counter_coefficients"), "n_л, n_п", f"{sheet.n_left:.5f}, {sheet.n_right:.5f}"
          + _flag(sheet, "n_left"), "—", "(6.3), (6.4)", t("note_n")),
         ("8", t("marks_left"), "(x⁰₂)_л, (y⁰₃)_л, (y⁰₄)_л",
-         ", ".join(_f(left.transformed_book_mm[k]) for k in ("x2", "y3", "y4")), "mm",
+         ", ".join(_f(left.transformed_book_mm[k]) for k in ("x2", "y3", "y4"))
+         + _rigorous_marks(sheet, 0, ("x2", "y3", "y4"), sides, lang), "mm",
          "(6.1)/(6.2)", t("note_marks")),
         ("9", t("marks_right"), "(x⁰₁)_п, (y⁰₃)_п, (y⁰₄)_п",
-         ", ".join(_f(right.transformed_book_mm[k]) for k in ("x1", "y3", "y4")), "mm",
+         ", ".join(_f(right.transformed_book_mm[k]) for k in ("x1", "y3", "y4"))
+         + _rigorous_marks(sheet, 1, ("x1", "y3", "y4"), sides, lang), "mm",
          "(6.1)/(6.2)", t("note_marks")),
         ("10", t("mark_spans"), "L_л, L_п",
-         f"{_f(left.mark_span_mm)}, {_f(right.mark_span_mm)}" + _flag(sheet, "L_mm"), "mm",
-         "(6.5)", t("note_L")),
+         f"{_f(left.mark_span_mm)}, {_f(right.mark_span_mm)}" + _flag(sheet, "L_mm")
+         + _rigorous_spans(sheet, sides, lang), "mm", "(6.5)", t("note_L")),
         ("11", t("decentrations"), "d_x, d_y",
          "; ".join(f"{_f(p.decentration_mm[0])}, {_f(p.decentration_mm[1])}" for p in sheet.photos),
          "mm", "f′·tan α, f′·tan ω", t("note_d")),
@@ -201,7 +230,7 @@ def _page_summary(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigoro
         pdf,
         (term("no", lang), term("quantity", lang), term("symbol", lang),
          term("value", lang), term("unit", lang), term("equation", lang), term("notes", lang)),
-        _table24_rows(sheet, lang), (6, 30, 22, 52, 7, 17, 41), size=_TABLE, gap=1.0,
+        _table24_rows(sheet, lang, rigorous), (6, 30, 22, 52, 7, 17, 41), size=_TABLE, gap=1.0,
     )  # fmt: skip
     _choice(pdf, sheet, lang, rigorous)
     rows = summary_rows(sheet, h.least_counts, lang, rigorous)
