@@ -263,6 +263,8 @@ def test_book_limits_warned_and_rigorous_values_on_request(forms, job):
     assert f"Lл = {rig:.2f} mm (book: {left.mark_span_mm:.2f}) 0.01 mm * (3.17)" in flat
     assert f"Lп = {right.mark_span_mm:.2f} mm 0.01 mm * (6.5)" in flat
     assert "WARNING: for the left photo the book's" in flat
+    page1 = forms["en"][2][0]  # Table 24: the span to set under the book's, the left photo's only
+    assert f"to set (3.17): Lл = {rig:.3f}" in page1 and "Lп = " not in page1
 
 
 def test_setup_command_writes_the_same_bytes_in_ru(forms, tmp_path, job):
