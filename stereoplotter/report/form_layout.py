@@ -325,7 +325,7 @@ class Form(FPDF):
     def footer(self) -> None:
         self.page_ends[self.page] = (bytes(self.pages[self.page].contents), self._state())
         self.set_y(-MARGIN_BOTTOM + 5)
-        self.set_font(FONT, "", 7.5)
+        self.set_font(FONT, "", 8)
         self.set_text_color(60)
         self.rich_text(self.l_margin, self.get_y() + 2.0 + 0.3 * self.font_size,
                        localized(self, self.footer_text))  # fmt: skip

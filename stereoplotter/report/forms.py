@@ -57,8 +57,9 @@ from stereoplotter.setup.records import SetupSheet
 
 __all__ = ["FormHeader", "LeastCounts", "form_pdf", "form_pdfs"]
 
-#: Type sizes (pt): running text and notes, the tables, the headings. The body is at least
-#: 8 pt and the tables 7.5 pt (a form of the period: a typewritten or typeset
+#: Type sizes (pt): running text, notes and the tables of words (the header, Table 24, the
+#: readings summary), the number tables, the headings. The body is at least 8 pt and the
+#: number tables 7.5 pt (a form of the period: a typewritten or typeset
 #: instruction, read at arm's length at the instrument); subscripts are 0.72 of their text.
 _BODY, _TABLE, _HEAD = 8.0, 7.5, 10.5
 #: The long number table of the working sheet (every reading of stages 1–4): 7 pt, so that it
@@ -225,19 +226,19 @@ def _page_summary(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigoro
     """Page 1: header, Table 24, which values are to be set, the readings, one row per stage."""
     heading(pdf, f"{term('setup_data', lang)} ({term('table24', lang)}) — "
                  f"{term('stereopair', lang)} {literal(h.pair)}", _HEAD + 1.5)  # fmt: skip
-    table(pdf, ("", ""), _header_rows(sheet, h, lang), (26, 149), size=_TABLE, gap=1.0)
+    table(pdf, ("", ""), _header_rows(sheet, h, lang), (26, 149), size=_BODY, gap=1.0)
     table(
         pdf,
         (term("no", lang), term("quantity", lang), term("symbol", lang),
          term("value", lang), term("unit", lang), term("equation", lang), term("notes", lang)),
-        _table24_rows(sheet, lang, rigorous), (6, 30, 22, 52, 7, 17, 41), size=_TABLE, gap=1.0,
+        _table24_rows(sheet, lang, rigorous), (6, 30, 22, 52, 7, 17, 41), size=_BODY, gap=1.0,
     )  # fmt: skip
     _choice(pdf, sheet, lang, rigorous)
     rows = summary_rows(sheet, h.least_counts, lang, rigorous)
     heading(pdf, term("readings_summary", lang), _HEAD,
-            keep=table_height(pdf, ("", ""), rows, (26, 149), _TABLE) + 10)  # fmt: skip
+            keep=table_height(pdf, ("", ""), rows, (26, 149), _BODY) + 10)  # fmt: skip
     paragraph(pdf, _least_count_line(h, lang), _BODY)
-    table(pdf, (term("stage", lang), ""), rows, (26, 149), size=_TABLE, gap=1.0)
+    table(pdf, (term("stage", lang), ""), rows, (26, 149), size=_BODY, gap=1.0)
 
 
 def _choice(pdf: Form, sheet: SetupSheet, lang: str, rigorous: bool) -> None:
