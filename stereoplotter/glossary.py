@@ -128,6 +128,7 @@ _TABLE: dict[str, tuple[str, str]] = {
     "note_corner": ("stage 4; corner 4 checks in stage 5", "этап 4; угол 4 — контроль, этап 5"),
     # stages
     "stage": ("stage", "этап"),
+    "stage_short": ("st.", "эт."),
     "stage_1": ("1 · scales, base, spans", "1 · масштабы, базис, метки"),
     "stage_2": ("2 · tilts, decentrations", "2 · наклоны, децентрации"),
     "stage_3": ("3 · height control", "3 · высотные опорные точки"),

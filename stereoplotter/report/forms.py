@@ -231,7 +231,7 @@ def _page_summary(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigoro
         pdf,
         (term("no", lang), term("quantity", lang), term("symbol", lang),
          term("value", lang), term("unit", lang), term("equation", lang), term("notes", lang)),
-        _table24_rows(sheet, lang, rigorous), (6, 30, 22, 52, 7, 17, 41), size=_BODY, gap=1.0,
+        _table24_rows(sheet, lang, rigorous), (7, 33, 21, 48, 8, 17, 41), size=_BODY, gap=1.0,
     )  # fmt: skip
     _choice(pdf, sheet, lang, rigorous)
     rows = summary_rows(sheet, h.least_counts, lang, rigorous)
@@ -269,8 +269,8 @@ def _page_readings(pdf: Form, sheet: SetupSheet, h: FormHeader, lang: str, rigor
     paragraph(pdf, t("zero_readings_right"), _BODY)
     pdf.ln(2)
     rows = reading_rows(sheet, lc, lang, rigorous)
-    widths = (6, 62, 44, 16, 14, 17, 16)
-    header = (t("stage"), t("step"), t("reading"), t("least_count"), t("equation"),
+    widths = (6, 56, 44, 16, 15, 23, 15)
+    header = (t("stage_short"), t("step"), t("reading"), t("least_count"), t("equation"),
               t("tolerance"), t("set"))  # fmt: skip
     height = table_height(pdf, header, rows, widths, _NUMBERS)
     page = pdf.page_break_trigger - pdf.t_margin - 8.0

@@ -206,7 +206,7 @@ def test_the_drawing_prints_dark(forms):
 def test_no_table_is_split_unless_longer_than_a_page(monkeypatch):
     """Every table of every strip8 form, ru and en, starts and ends on one page (a table taller
     than a page would continue on the next; none is, for strip8: the readings of stages 1–4
-    are set at 7 pt)."""
+    are set at 7 pt), and no word is wider than its cell (none broken between letters)."""
     from stereoplotter.commands.setup_job import compute_job
     from stereoplotter.io.job_file import load_job
     from stereoplotter.report import form_layout, forms
@@ -224,9 +224,20 @@ def test_no_table_is_split_unless_longer_than_a_page(monkeypatch):
         return height
 
     monkeypatch.setattr(forms, "table", recording)
+    wide = set()
+    wrap, width = form_layout._wrap, form_layout._width
+
+    def checking(pdf, text, room, style, size):
+        wide.update((word, size) for line in text.split("\n") for word in line.split(" ")
+                    if word and width(pdf, word, style, size) > room)  # fmt: skip
+        return wrap(pdf, text, room, style, size)
+
+    monkeypatch.setattr(form_layout, "_wrap", checking)
+    monkeypatch.setattr(form_layout, "_LINES", {})  # every cell's lines found again
     result = compute_job(load_job(JOB))
     for lang in ("ru", "en"):
         for p in result.pairs:
             forms.form_pdf(p.sheet, form_header(result.job, p, result.spec, lang), lang)
     assert len(drawn) >= 2 * 8 * 12  # a dozen tables a form
     assert [d for d in drawn if not d[0]] == []
+    assert wide == set()
