@@ -249,7 +249,7 @@ def _book_text(row: dict[str, Any], book: float | None, lc: LeastCounts, lang: s
         return ""
     kind = lc.of(row["reading"])
     step = kind[1] if kind else 0.001
-    return f" ({term('limit_book', lang)}: {set_value(book, step)})"
+    return f" ({term('limit_book', lang)}: {set_value(book, step).replace('-', '−')})"
 
 
 def reading_rows(
