@@ -141,11 +141,18 @@ def _resolve_data_arguments(args: argparse.Namespace) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``stereoplotter`` command. Returns the exit code."""
-    args = _full_parser().parse_args(argv)
+    try:
+        args = _full_parser().parse_args(argv)
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
     configure_logging(getattr(args, "verbose", 0), getattr(args, "quiet", False))
     try:
         _resolve_data_arguments(args)
         return args.func(args)
+    except KeyboardInterrupt:  # Ctrl-C: one line (a command that writes says what it kept)
+        print("error: interrupted", file=sys.stderr)
+        return 130
     except StereoplotterError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

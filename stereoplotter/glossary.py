@@ -12,7 +12,17 @@ from __future__ import annotations
 import re
 from types import MappingProxyType
 
-__all__ = ["LANGUAGES", "PHRASES", "TERMS", "check_language", "term", "translate"]
+__all__ = [
+    "LANGUAGES",
+    "PHRASES",
+    "TERMS",
+    "check_language",
+    "instrument_name",
+    "localize",
+    "parameter_name",
+    "term",
+    "translate",
+]
 
 #: The languages of the outputs (``--lang``).
 LANGUAGES = ("ru", "en")
@@ -45,7 +55,7 @@ _TABLE: dict[str, tuple[str, str]] = {
         "* the value rests on instrument parameters that no source documents "
         "(assumed, docs/instruments.md)",
         "* значение опирается на параметры прибора, не подтверждённые источником "
-        "(приняты, docs/instruments.md)",
+        "(приняты; см. описание приборов)",
     ),
     "none": ("none", "нет"),
     "no_map_sheet": ("none (scales forced)", "нет (масштабы заданы)"),
@@ -118,6 +128,7 @@ _TABLE: dict[str, tuple[str, str]] = {
     "note_corner": ("stage 4; corner 4 checks in stage 5", "этап 4; угол 4 — контроль, этап 5"),
     # stages
     "stage": ("stage", "этап"),
+    "stage_short": ("st.", "эт."),
     "stage_1": ("1 · scales, base, spans", "1 · масштабы, базис, метки"),
     "stage_2": ("2 · tilts, decentrations", "2 · наклоны, децентрации"),
     "stage_3": ("3 · height control", "3 · высотные опорные точки"),
@@ -131,18 +142,22 @@ _TABLE: dict[str, tuple[str, str]] = {
     "readings": ("Readings, stage by stage (6.9)–(6.18)", "Отсчёты по этапам (6.9)–(6.18)"),
     "readings_intro": (
         "Each value is rounded to the least count of its counter or scale (the "
-        "value "
-        "to set). The right photo's zero readings: MO_X,п = MO_X + b_x, "
-        "MO_Y,п = MO_Y + b_y. Write the reading actually set in the last column.",
+        "value to set). Write the reading actually set in the last column.",
         "Каждое значение округлено до цены деления счётчика или шкалы (значение "
-        "для установки). Места нуля правого снимка: MO_X,п = MO_X + b_x, "
-        "MO_Y,п = MO_Y + b_y. В последнюю графу записывается фактический отсчёт.",
+        "для установки). В последнюю графу записывается фактический отсчёт.",
+    ),
+    "zero_readings_right": (
+        "The right photo's zero readings: MO_X,п = MO_X + b_x, MO_Y,п = MO_Y + b_y; each "
+        "projector has its own decentration scales and zeros MO_dx, MO_dy.",
+        "Места нуля правого снимка: MO_X,п = MO_X + b_x, MO_Y,п = MO_Y + b_y; у каждого "
+        "проектора свои шкалы децентраций и свои места нуля MO_dx, MO_dy.",
     ),
     "step": ("step", "действие"),
     "reading": ("reading to set", "отсчёт для установки"),
     "least_count": ("least count", "цена деления"),
     "tolerance": ("tolerance", "допуск"),
     "set": ("set", "факт."),
+    "to_set": ("to set", "установить"),
     "tolerances": ("tolerances", "допуски"),
     "counters": ("counters", "счётчики"),
     "scales": ("scales", "шкалы"),
@@ -196,24 +211,40 @@ _TABLE: dict[str, tuple[str, str]] = {
     "limit_exceeds": ("exceeds the tolerance", "больше допуска"),
     "limit_within": ("within the tolerance", "в допуске"),
     "limit_choice_book": (
-        "The values to set are the book's (6.1)/(6.2), (6.5); where they exceed "
-        "the tolerance the instrument needs the rigorous values (--rigorous).",
-        "Для установки даны значения по (6.1)/(6.2), (6.5) книги; где разность "
-        "больше допуска, прибору нужны строгие значения (--rigorous).",
+        "The values to set are the book's (6.1)/(6.2), (6.5): each is within its stage "
+        "tolerance of the rigorous (3.17) (table of the method's limits).",
+        "Для установки даны значения книги (6.1)/(6.2), (6.5): каждое отличается от строгого "
+        "(3.17) в пределах допуска этапа (таблица пределов метода).",
+    ),
+    "limit_choice_mixed": (
+        "The values to set: a photo's marks and span by the book's (6.1)/(6.2), (6.5) where "
+        "all of them are within their stage tolerance, else all by the rigorous (3.17), "
+        "marked (3.17), the book's in brackets beside them.",
+        "Для установки: метки и расстояние L снимка — по формулам книги (6.1)/(6.2), (6.5), "
+        "если все они в пределах допуска этапа, иначе все строгие (3.17), с пометкой (3.17) "
+        "и значением книги рядом в скобках.",
     ),
     "limit_choice_rigorous": (
-        "The values to set are the rigorous (3.17) ones (--rigorous); the "
-        "book's are printed beside them.",
-        "Для установки даны строгие значения (3.17) (--rigorous); значения книги приведены рядом.",
+        "The marks and spans to set are the rigorous (3.17) ones for both photos (as asked, "
+        "--rigorous); the book's are in brackets beside them.",
+        "Метки и расстояния L для установки — строгие (3.17) для обоих снимков (по заказу); "
+        "значения книги — рядом в скобках.",
     ),
     "limit_warning": (
-        "WARNING: the book's (6.1)/(6.2), (6.5) deviate from the rigorous (3.17) "
-        "by more than the stage tolerance; set the rigorous values (table of the "
-        "limits).",
-        "ВНИМАНИЕ: формулы книги (6.1)/(6.2), (6.5) отличаются от строгих (3.17) "
-        "больше допуска этапа; устанавливайте строгие значения (таблица пределов "
-        "метода).",
+        "WARNING: for the {photos} the book's (6.1)/(6.2), (6.5) leave the stage tolerance "
+        "(table of the method's limits): the tables give the rigorous (3.17) values to set, "
+        "the book's in brackets beside them.",
+        "ВНИМАНИЕ: для {photos} значения книги (6.1)/(6.2), (6.5) выходят из допуска этапа "
+        "(таблица пределов метода): в таблицах для установки даны строгие значения (3.17), "
+        "значения книги — рядом в скобках.",
     ),
+    "photo_left": ("left photo", "левого снимка"),
+    "photo_right": ("right photo", "правого снимка"),
+    "side_left": ("left", "лев."),
+    "side_right": ("right", "прав."),
+    "residual_q": ("residual q", "остаточный параллакс q"),
+    "fiducials_distances": ("distances", "расстояния"),
+    "fiducials_coordinates": ("coordinates", "координаты"),
     # sheet.md (the English entries are the text sheet.md always had)
     "md_title": ("Setup sheet", "Установочные данные"),
     "md_on": ("on", "на приборе"),
@@ -264,6 +295,33 @@ _TABLE: dict[str, tuple[str, str]] = {
         "instrument YAML if yours differs",
         "Эти значения не подтверждены источником; исправьте их в YAML-файле "
         "прибора, если ваш прибор отличается",
+    ),
+    "md_controls": ("controls", "органы управления"),
+    "md_settings_of": ("Settings of the", "Установки прибора"),
+    "md_settings_depend": (
+        "settings depend on φ, ω", "установок зависят от φ, ω",
+    ),
+    "md_order": ("Order", "Порядок"),
+    "md_documented": ("documented", "документировано"),
+    "md_assumed_upper": ("ASSUMED", "ПРИНЯТО"),
+    "md_settings_header": (
+        "| setting | symbol | kind | formula | left | right | unit |",
+        "| установка | обозн. | вид | формула | лев. | прав. | ед. |",
+    ),
+    "md_similarity": ("Similarity (6.8)", "Преобразование подобия (6.8)"),
+    "md_control_points": ("control points", "опорных точек"),
+    "md_reflection": ("reflection", "отражение"),
+    "md_rms_residual": ("RMS residual", "СКО остатков"),
+    "md_residuals": ("residuals", "остатки"),
+    "md_marks_intro": (
+        "Transformed mark coordinates: the book's single-axis (6.1)/(6.2) against the "
+        "rigorous (3.17) (κ = 0):",
+        "Трансформированные координаты меток: одноосные (6.1)/(6.2) книги против строгих "
+        "(3.17) (κ = 0):",
+    ),
+    "md_marks_header": (
+        "| photo | mark | (6.1)/(6.2) mm | (3.17) x⁰, y⁰ mm | difference µm |",
+        "| снимок | метка | (6.1)/(6.2) мм | (3.17) x⁰, y⁰ мм | разность, мкм |",
     ),
     "md_table24_header": (
         "| quantity | symbol | value | unit | equation |",
@@ -502,6 +560,7 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
     ("≤ ¼ mark", "≤ ¼ марки"),
     ("\\(6.5\\), decision D5", "(6.5), решение D5"),
     ("f′·tan (?P<a>[αω]) \\(§2.4\\)", "f′·tan {a} (§2.4)"),
+    ("f′·tan (?P<a>[αω]) \\(kinematics §2.4\\)", "f′·tan {a} (описание кинематики, §2.4)"),
     ("§26 stages 2, 3: κ along the initial direction; refine k_ω",
      "§26, этапы 2, 3: κ по начальному направлению; уточнить k_ω"),
     ("§26 stage 3: scaling refined \\(b_x\\)", "§26, этап 3: уточнение масштаба (b_x)"),
@@ -525,6 +584,65 @@ _PHRASE_TABLE: tuple[tuple[str, str], ...] = (
     ("control heights", "высоты опорных точек"),
     (f"corner {_ID.format('c')}", "угол {c}"),
     ("plan control points \\(needle − plotted\\)", "плановые опорные точки (игла − нанесённая)"),
+    # the instruments' settings and controls (sheet.md: the settings of the instrument)
+    ("2 tilts on the k_α, k_ω scales and 2 decentrations per photo",
+     "2 наклона по шкалам k_α, k_ω и 2 децентрации на снимок"),
+    ("not documented for the SC-1; the book's §26 names the k_α, k_ω scales of the correction "
+     "mechanisms and the decentration scales of each photo",
+     "для СЦ-1 не документировано; в §26 книги названы шкалы k_α, k_ω коррекционных механизмов "
+     "и шкалы децентраций каждого снимка"),
+    ("tilt each photo carrier on its k_α, k_ω scales \\(stage 2 fits them on the fiducial "
+     "marks\\)",
+     "наклонить каждый снимкодержатель по шкалам k_α, k_ω (на этапе 2 они подбираются по "
+     "координатным меткам)"),
+    ("set the decentrations d_x, d_y on their scales \\(stage 2, after the fit\\)",
+     "установить децентрации d_x, d_y по их шкалам (этап 2, после подбора)"),
+    ("photo-carrier tilt (?P<a>[αω]) \\(gimbal, (?P<k>k_[αω]) scale\\)",
+     "наклон снимкодержателя {a} (карданный подвес, шкала {k})"),
+    ("the 3 kinds of decentration \\(photo, correction mechanism, follower\\) × x, y × 2 "
+     "photos, set after kα, kω are introduced",
+     "3 вида децентраций (снимка, коррекционного механизма, копира) × x, y × 2 снимка, "
+     "устанавливаемых после введения kα, kω"),
+    ("documented for the SPR-2 \\(12 settings depending on φ, ω: photo decentrations, "
+     "decentrations of the correction mechanisms and of the followers\\); taken for the SPR-3",
+     "документировано для СПР-2 (12 установок, зависящих от φ, ω: децентрации снимков, "
+     "коррекционных механизмов и копиров); принято для СПР-3"),
+    ("introduce dφ, dω: set kα, kω on the lens-shift mechanisms of each photo \\(stage 2 fits "
+     "them on the fiducial marks\\)",
+     "ввести dφ, dω: установить kα, kω на механизмах смещения объектива каждого снимка (на "
+     "этапе 2 они подбираются по координатным меткам)"),
+    ("from the tables \\(arguments dφ, dω\\) set the photo-carriage decentrations e, the "
+     "correction-mechanism decentrations c and the followers' decentrations u, all f′·tan α, "
+     "f′·tan ω",
+     "по таблицам (аргументы dφ, dω) установить децентрации кареток снимков e, коррекционных "
+     "механизмов c и копиров u, все f′·tan α, f′·tan ω"),
+    ("repeat the cycle until the check passes \\(the photo moves under the fixed marks\\)",
+     "повторять цикл до выполнения контроля (снимок перемещается под неподвижными марками)"),
+    ("lens-shift mechanism (?P<a>k[αω])", "механизм смещения объектива {a}"),
+    ("correction-mechanism decentration (?P<a>[xy])", "децентрация коррекционного механизма {a}"),
+    ("follower decentration (?P<a>[xy]) \\(correction plate\\)",
+     "децентрация копира {a} (коррекционная пластина)"),
+    ("2 plate inclinations \\(primary\\) and 2 photo decentrations \\(derived\\) per photo",
+     "2 наклона пластин (основные) и 2 децентрации снимка (производные) на снимок"),
+    ("SD stereograph: 8 setting elements, the plate inclinations primary, the photo "
+     "decentrations mediated \\(report on the Soviet affine plotters, ISP Comm. II\\)",
+     "стереограф СД: 8 установочных элементов, наклоны пластин — основные, децентрации "
+     "снимков — опосредованные (доклад о советских аффинных приборах, МОФ, комиссия II)"),
+    ("incline the correction plates of each photo to θ_α, θ_ω \\(stage 2 fits them on the "
+     "fiducial marks: the k_α, k_ω knobs\\)",
+     "наклонить коррекционные пластины каждого снимка на θ_α, θ_ω (на этапе 2 они "
+     "подбираются по координатным меткам: рукоятки k_α, k_ω)"),
+    ("the photo decentrations follow from the plate settings, d = \\(f′/k\\)·tan θ \\(on the "
+     "virtual SD-3 the linkage carries them, decision D1\\); check their scales",
+     "децентрации снимков следуют из установки пластин, d = (f′/k)·tan θ (на виртуальном "
+     "СД-3 их передаёт связь, решение D1); проверить их шкалы"),
+    ("correction-plate inclination \\((?P<a>[αω])\\)", "наклон коррекционной пластины ({a})"),
+    ("photo decentration (?P<a>[xy]) \\(from the plate\\)", "децентрация снимка {a} (от пластины)"),
+    ("primary", "основная"),
+    ("derived", "производная"),
+    ("mark (?P<m>\\w+) is under the measuring mark", "метка {m} под измерительной маркой"),
+    ("the photo carriage brings mark (?P<m>\\w+) under the fixed measuring mark",
+     "каретка снимка подводит метку {m} под неподвижную измерительную марку"),
 )  # fmt: skip
 
 #: The record texts' templates, compiled: (pattern, Russian).
@@ -557,6 +675,95 @@ def translate(text: str, lang: str) -> str:
         if (first, second) != (head, rest):
             return f"{first}: {second}"
     return text
+
+
+#: The instruments by their shipped key, as the Russian forms name them (the English forms print
+#: the instrument file's own ``name``).
+_INSTRUMENTS_RU = {
+    "sc1": "стереограф СЦ-1",
+    "spr3": "стереопроектор СПР-3 Г. В. Романовского",
+    "sd3": "стереограф СД-3 Ф. В. Дробышева",
+}
+
+
+def instrument_name(key: str, title: str, lang: str) -> str:
+    """The instrument's name in ``lang``: the file's ``title`` in English; in Russian the book's
+    name of a shipped instrument, else the Cyrillic part of the title (a user's instrument file
+    names itself)."""
+    if check_language(lang) == "en":
+        return title
+    if key in _INSTRUMENTS_RU:
+        return _INSTRUMENTS_RU[key]
+    head = title.split(" (")[0].split(",")[0]
+    return head if re.search("[А-Яа-яЁё]", head) else "прибор"
+
+
+#: The instrument file's parameters an outputs may list as assumed, in Russian.
+_PARAMETERS_RU = {
+    "gears.coordinatograph_ratios": "передачи координатографа",
+    "gears.vertical_scale_denominators": "знаменатели вертикального масштаба",
+    "gears.max_photo_to_map_enlargement": "наибольшее увеличение снимка до карты",
+    "mark.diameter_mm": "диаметр марки",
+    "model.x_offset_mm": "смещение модели по X",
+    "model.y_offset_mm": "смещение модели по Y",
+    "projection.distance_mm": "проектирующие расстояния",
+    "projection.distance_max_mm": "наибольшее проектирующее расстояние",
+    "projection.f_instrument_mm": "диапазон f_пр",
+    "base.x_mm": "диапазон b_x",
+    "base.y_mm": "диапазон b_y",
+    "base.z_mm": "диапазон b_z",
+    "orientation.kappa_deg": "диапазон κ",
+    "correction.tilt_max_deg": "наибольший наклон",
+    "correction.decentration_mm": "диапазон децентраций",
+    "counters.xy_least_count_mm": "цена деления счётчиков X, Y",
+    "counters.z_abs_least_count_mm": "цена деления счётчика высот",
+    "counters.height_scale_least_count_m": "цена деления шкалы высот",
+    "counters.scale_least_count_mm": "цена деления шкал",
+    "tolerances.corner4_mm": "допуск угла 4",
+    "tolerances.L_check_times_n_mm": "допуск |L − L′|",
+    "tolerances.mark_fit_per_n_mm": "допуск метки 4",
+    "tolerances.residual_q_fraction_of_mark": "допуск остаточного параллакса",
+    "tolerances.control_height_denominator": "допуск высот опорных точек",
+}
+
+
+def parameter_name(key: str, lang: str) -> str:
+    """An instrument file's dotted key in ``lang``: the key itself in English, its Russian name
+    (or "параметр прибора" for a key outside :data:`_PARAMETERS_RU`) in Russian."""
+    if check_language(lang) == "en":
+        return key
+    return _PARAMETERS_RU.get(key, "параметр прибора")
+
+
+#: The units, compass corners and abbreviations of a finished text, English → Russian
+#: (:func:`localize`): each a whole token (no letter on either side).
+_LOCAL_RU = (
+    (r"µm", "мкм"), (r"mrad", "мрад"), (r"mm", "мм"), (r"m", "м"), (r"tan", "tg"),
+    (r"SW", "ЮЗ"), (r"SE", "ЮВ"), (r"NE", "СВ"), (r"NW", "СЗ"), (r"RMS", "СКО"),
+    (r"MO", "МО"), (r"Gauss–Krüger", "Гаусса–Крюгера"), (r"map", "карты"),
+)  # fmt: skip
+_LOCAL_RU_PATTERN = re.compile(  # a unit is no part of an identifier (``distance_mm``)
+    r"(?<![A-Za-zА-Яа-яЁё_.])(" + "|".join(a for a, _ in _LOCAL_RU if a not in ("map", "MO"))
+    + r")(?![A-Za-zА-Яа-яЁё_])|(?<=_)(map)(?![A-Za-zА-Яа-яЁё_])"
+    r"|(?<![A-Za-zА-Яа-яЁё_.])(MO)(?![A-Za-zА-Яа-яЁё])"
+)
+_LOCAL_RU_MAP = dict(_LOCAL_RU)
+
+
+def localize(text: str, lang: str) -> str:
+    """A finished text of an output with its units (mm → мм, m → м, µm → мкм), compass
+    corners (SW → ЮЗ …), the zero reading МО, tan → tg and RMS → СКО in ``lang``: the
+    symbols a Russian reader writes in Cyrillic, each replaced only as a whole token (a
+    letter on neither side, so ``m/mm`` → ``м/мм``, never inside a word or an identifier such
+    as ``distance_mm``); the subscript of ``M_map`` → ``M_карты``. English is returned as it
+    is.
+
+    >>> localize("L = 287.70 mm, ΔZ 5.14 m/mm, corner 4 NW, MO_X", "ru")
+    'L = 287.70 мм, ΔZ 5.14 м/мм, corner 4 СЗ, МО_X'
+    """
+    if check_language(lang) == "en" or not text:
+        return text
+    return _LOCAL_RU_PATTERN.sub(lambda m: _LOCAL_RU_MAP[m.group(m.lastindex or 1)], text)
 
 
 def check_language(lang: str) -> str:

@@ -30,6 +30,8 @@ def run(args: argparse.Namespace) -> int:
     from stereoplotter.io.job_scenario import write_job_scenario
 
     doc, fit = write_job_scenario(load_job(args.job), args.pair, args.output)
+    if getattr(args, "quiet", False):  # -q: warnings and errors only
+        return 0
     sys.stdout.write(
         f"scenario {doc['name']}: {len(doc['points'])} points, terrain {fit.kind} fitted to "
         f"{fit.points} control heights (rms {fit.rms_m:.3f} m, max {fit.max_m:.3f} m)\n"

@@ -75,8 +75,9 @@ def add_arguments(sub: Any) -> None:
     p.add_argument(
         "--rigorous",
         action="store_true",
-        help="job forms: print the rigorous (3.17) mark targets and spans as the values to set "
-        "(default: the book's (6.1)/(6.2), (6.5), with a warning where they exceed a tolerance)",
+        help="job forms: print the rigorous (3.17) mark targets and spans of both photos as the "
+        "values to set (default: the book's (6.1)/(6.2), (6.5); the rigorous ones, the book's "
+        "beside them, for a photo whose book values leave their tolerance)",
     )
     p.set_defaults(func=run)
 

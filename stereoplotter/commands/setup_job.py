@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
+import threading
 from pathlib import Path
 
 from stereoplotter.errors import ConfigError, StereoplotterError
@@ -119,7 +121,29 @@ def write_job(
 
 
 def run(args: argparse.Namespace) -> int:
-    """``setup`` on a job file: every pair's sheet and printable form."""
+    """``setup`` on a job file: every pair's sheet and printable form. An interrupt (Ctrl-C,
+    SIGTERM) ends in one line; the output folder holds the previous run or this one whole
+    (:func:`stereoplotter.io.output_folder.write_outputs`)."""
+    previous = signal.getsignal(signal.SIGTERM)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        return _run(args)
+    except KeyboardInterrupt:  # one line, the exit code of an interrupt (128 + SIGINT)
+        out = getattr(args, "output", None) or "stereoplotter-setup"
+        sys.stderr.write(f"error: {out}: interrupted: the folder holds the previous run or this "
+                         "one, each whole (never a mix of the two)\n")  # fmt: skip
+        return 130
+    finally:
+        if threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
+def _run(args: argparse.Namespace) -> int:
     given = [
         o
         for o, v in (
@@ -154,8 +178,12 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write(
             json_text({"job": job.name, "instrument": result.spec.key, "pairs": pairs})
         )
-    elif report is not None and out is not None:
+    elif report is not None and out is not None and not getattr(args, "quiet", False):
         sys.stdout.write(_summary(result, report, out))
+    elif getattr(args, "quiet", False):  # warnings and errors only: the refused pairs
+        for p in result.pairs:
+            if not p.accepted:
+                sys.stderr.write(f"warning: {p.pair.name}: refused: {p.reason}\n")
     _refusals(result, out, strict=getattr(args, "strict", False))
     return 0
 

@@ -414,12 +414,32 @@ def _unquoted_identifiers(text: str, source: str) -> None:
                     continue  # quoted, or not a scalar (the validation names it)
                 number = v.tag in ("tag:yaml.org,2002:int", "tag:yaml.org,2002:float")
                 if number and not re.fullmatch(r"[1-9][0-9]*|0", v.value):
+                    expected, found = _misread(v.value)
                     raise ConfigError(
-                        source, f"{key.value}[{i}].{k.value}",
-                        f'an identifier as text: quote it ("{v.value}"), or YAML reads it as '
-                        "another number", f"{v.value} unquoted (line {v.start_mark.line + 1}, "
-                        f"column {v.start_mark.column + 1})",
+                        source, f"{key.value}[{i}].{k.value}", expected,
+                        f"{found} (line {v.start_mark.line + 1}, column "
+                        f"{v.start_mark.column + 1})",
                     )  # fmt: skip
+
+
+def _misread(text: str) -> tuple[str, str]:
+    """(expected, found) for an unquoted identifier YAML read as a number: the advice to quote
+    it only where YAML 1.1 read it as another number (a leading zero: octal; a colon:
+    sexagesimal; an underscore or a base prefix); a signed or decimal number is no identifier
+    an office writes, and is said to be one."""
+    value = yaml.safe_load(text)
+    kinds = (
+        (r"[-+]?0[0-7_]+", "octal"), (r"[-+]?0[0-9_]+", "decimal"),
+        (r"[-+]?0[xob][0-9a-fA-F_]+", "base-prefixed"), (r".*:.*", "sexagesimal"),
+        (r".*_.*", "underscore-grouped"),
+    )  # fmt: skip
+    for pattern, kind in kinds:
+        if re.fullmatch(pattern, text) and str(value) != text:
+            return (f'an identifier as text: quote it ("{text}"), since YAML 1.1 reads it as '
+                    f"another number", f"{text} unquoted, read as the {kind} number "
+                    f"{value}")  # fmt: skip
+    return ("an identifier: text, or an unquoted whole number of digits (101)",
+            f"the number {text}")  # fmt: skip
 
 
 def _origin(source: str, model: FrameModel) -> tuple[float, float, float] | None:
@@ -854,6 +874,7 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
         xy = object_to_photo(xyz, c, m, f, cam.principal_point_mm)
         with np.errstate(invalid="ignore"):
             inside &= np.all(np.abs(xy) <= half, axis=-1)
+    every_point = points
     points = tuple(p for p, ok in zip(points, inside, strict=True) if ok)
     heights = [p.local_m[2] for p in points if p.kind != "plan"] or [p.local_m[2] for p in points]
     if pair.working_area_m is not None:
@@ -864,6 +885,7 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
         raise SetupRefusal(
             "no control point imaged on both photos and no working_area (lowest_m, highest_m) "
             "of the pair: nothing fixes the heights of its model"
+            + _suspects(job, pair, every_point, ((c_l, m_l), (c_r, m_r)))
         )
     z0 = (lowest + highest) / 2.0
     corners = np.array([[half, half], [-half, half], [-half, -half], [half, -half]])
@@ -887,6 +909,61 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
         working_area_m=area,
         map_sheet=pair.map_sheet,
     )
+
+
+def _suspects(
+    job: Job,
+    pair: JobPair,
+    points: tuple[Point, ...],
+    stations: tuple[tuple[NDArray, NDArray], ...],
+) -> str:
+    """Which input of a pair without imaged control looks wrong, and why, as "; suspicious: …"
+    (empty when nothing does): a photo at or below the control's median height; two photos
+    whose footprints cannot overlap (the base longer than a footprint); the control point
+    nearest to being imaged, with how far its projection falls outside the format on each
+    photo (or that it lies above the camera)."""
+    cam, f = job.camera, job.camera.focal_length_mm
+    half = cam.format_mm / 2.0
+    names = (pair.left, pair.right)
+    out = []
+    xyz = np.array([p.local_m for p in points], float).reshape(-1, 3)
+    ground = float(np.median(xyz[:, 2])) if len(points) else 0.0
+    heights = [float(c[2]) - ground for c, _ in stations]
+    for name, h in zip(names, heights, strict=True):
+        if h <= 0:
+            z = round(h + ground, 1) + 0.0  # no "-0.0"
+            out.append(f"photo {name} at {z:.1f} m is not above the control's median height "
+                       f"{ground:.1f} m (check its height)")  # fmt: skip
+    if min(heights) > 0:
+        base = float(np.hypot(*(stations[0][0][:2] - stations[1][0][:2])))
+        footprint = cam.format_mm / f * float(np.mean(heights))
+        if base > footprint:
+            far = ""
+            if len(points):
+                near = [float(np.min(np.hypot(*(xyz[:, :2] - c[:2]).T))) for c, _ in stations]
+                lost = [n for n, d in zip(names, near, strict=True) if d > footprint]
+                if len(lost) == 1:
+                    far = (f"; photo {lost[0]} is {max(near) / 1000:.1f} km from the nearest "
+                           f"control point, the other {min(near) / 1000:.1f} km")  # fmt: skip
+            out.append(f"photos {names[0]} and {names[1]} are {base:.0f} m apart, more than a "
+                       f"footprint ({footprint:.0f} m at {np.mean(heights):.0f} m above the "
+                       f"control): they cannot overlap (check their coordinates){far}")  # fmt: skip
+    if len(points) and min(heights) > 0:
+        outside = []
+        for c, m in stations:
+            xy = object_to_photo(xyz, c, m, f, cam.principal_point_mm)
+            beyond = np.max(np.abs(xy), axis=-1) - half
+            beyond[xyz[:, 2] >= c[2]] = np.inf  # above the camera: never imaged
+            outside.append(np.where(np.isfinite(beyond), np.maximum(beyond, 0.0), np.inf))
+        worst = np.max(outside, axis=0)
+        i = int(np.argmin(worst))
+        where = [("above the camera" if not np.isfinite(o[i]) else
+                  "inside the format" if o[i] == 0 else f"{o[i]:.1f} mm outside the format")
+                 + f" on photo {n}" for o, n in zip(outside, names, strict=True)]  # fmt: skip
+        out.append(f"the control point nearest to being imaged, {points[i].id}, falls "
+                   f"{' and '.join(where)} ({cam.format_mm:g} mm; check its coordinates or the "
+                   "photos' orientation)")  # fmt: skip
+    return "; suspicious: " + "; ".join(out) if out else ""
 
 
 def _local_heights(

@@ -7,12 +7,13 @@ sub-folder such as ``101-102/sheet.pdf``) into a folder:
 * a new or empty folder is written;
 * a folder that holds anything is refused (one line) unless ``force``: its files may be another
   job's or an earlier run's, and mixing them with this run's leaves a folder nobody can read;
-* with ``force`` the previous outputs are replaced as a whole: every new file is written (each
-  whole or not at all, :mod:`stereoplotter.io.atomic_write`), then every file the previous run
-  wrote that this one does not (by the previous manifest; without one, the pair folders of an
-  earlier version: a folder holding only ``sheet.*`` files) is removed, with the folders that it
-  leaves empty, and the manifest is written last. Files no run of ours wrote are left alone and
-  counted.
+* with ``force`` the previous outputs are replaced as a whole: the new run (every file and the
+  manifest) is written into a staging folder beside the target, the files no run of ours wrote
+  (not in the previous manifest; without one, not in the pair folders of an earlier version: a
+  folder holding only ``sheet.*`` files) are linked into it and counted, and the staging folder
+  takes the target's place in one step; the previous run's files this one does not write are
+  gone with the old folder. An interrupt at any moment leaves the previous complete run or the
+  new one, never a mix, and no temporary file (:func:`write_outputs`).
 
 The manifest (:data:`MANIFEST`, JSON) lists every file with its size and SHA-256 and who wrote
 it; it holds no clock, so the same job gives the same manifest, byte for byte.
@@ -20,16 +21,25 @@ it; it holds no clock, so the same job gives the same manifest, byte for byte.
 
 from __future__ import annotations
 
+import ctypes
+import glob
 import hashlib
 import json
 import os
-from collections.abc import Mapping
+import secrets
+import shutil
+import signal
+import stat
+import sys
+import threading
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.io.atomic_write import atomic_write_bytes, write_files
+from stereoplotter.io.atomic_write import write_files
 
 __all__ = ["MANIFEST", "OutputReport", "manifest_bytes", "write_outputs"]
 
@@ -92,7 +102,13 @@ def write_outputs(
     *,
     force: bool = False,
 ) -> OutputReport:
-    """Write ``files`` and their manifest into ``folder`` (the rules in the module docstring).
+    """Write ``files`` and their manifest into ``folder`` (the rules in the module docstring),
+    all old or all new: the run is written into a staging folder beside ``folder``
+    (``.NAME.staging-XXXX``), the files no run wrote are linked into it, and it takes the place
+    of ``folder`` in one step (:func:`_swap`, with SIGINT and SIGTERM held back), so an
+    interrupt at any moment leaves the previous complete run or the new one. An interrupted
+    run's staging folder is removed on the way out, and any left by a killed run is removed (an
+    old folder moved aside and not yet replaced is put back) by the next run.
 
     Raises
     ------
@@ -100,31 +116,154 @@ def write_outputs(
         ``folder`` is a file, or holds files and ``force`` is not given (one line; nothing is
         written).
     """
-    out = Path(folder)
+    shown = Path(folder)
+    out = Path(os.path.realpath(folder))  # "." or a link: the folder itself, beside its parent
+    _recover(out)
     if out.exists() and not out.is_dir():
-        raise StereoplotterError(f"{out}: -o: expected a folder, found a file")
+        raise StereoplotterError(f"{shown}: -o: expected a folder, found a file")
     present = _entries(out) if out.exists() else []
     previous, who = _previous(out) if present else (set(), "")
     if present and not force:
         raise StereoplotterError(
-            f"{out}: -o: expected a new or empty output folder, found {len(present)} files "
+            f"{shown}: -o: expected a new or empty output folder, found {len(present)} files "
             f"({who}): give --force to replace them, or another folder"
         )
-    write_files(out, files)
-    removed = []
-    for name in sorted(previous - set(files) - {MANIFEST}):
-        path = out / name
-        if path.is_file() or path.is_symlink():
-            path.unlink()
-            removed.append(name)
-            _remove_empty_parents(path.parent, out)
-    atomic_write_bytes(out / MANIFEST, manifest_bytes(files, about))
-    mine = set(files) | set(removed) | {MANIFEST}
-    foreign = sum(str(p.relative_to(out)).replace(os.sep, "/") not in mine for p in present)
-    return OutputReport(tuple(files), tuple(removed), foreign)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    staging = _new_folder(out.parent, f".{out.name}.staging-")
+    try:
+        mine = set(files) | previous | {MANIFEST}
+        foreign = [p for p in present if _name(p, out) not in mine]
+        removed = sorted(n for n in previous - set(files) - {MANIFEST}
+                         if (out / n).is_file() or (out / n).is_symlink())  # fmt: skip
+        for path in foreign:  # the operator's own files go on living in the new folder
+            _link(path, staging / path.relative_to(out))
+        write_files(staging, {**files, MANIFEST: manifest_bytes(files, about)})
+        if out.exists():  # the folder keeps the permissions it had
+            os.chmod(staging, stat.S_IMODE(out.stat().st_mode))
+        with _signals_held():  # a signal meanwhile is delivered after the swap
+            _swap(staging, out)
+            shutil.rmtree(staging, ignore_errors=True)  # the previous run
+    finally:
+        with _signals_held():  # nor is the clean-up of an interrupted run cut short
+            shutil.rmtree(staging, ignore_errors=True)
+    return OutputReport(tuple(files), tuple(removed), len(foreign))
 
 
-def _remove_empty_parents(folder: Path, top: Path) -> None:
-    while folder != top and folder.is_dir() and not any(folder.iterdir()):
-        folder.rmdir()
-        folder = folder.parent
+def _name(path: Path, top: Path) -> str:
+    return str(path.relative_to(top)).replace(os.sep, "/")
+
+
+def _new_folder(parent: Path, prefix: str) -> Path:
+    """A new empty folder ``prefix`` + 12 hex digits in ``parent``, mode 0o777 less the umask
+    (as any folder the user makes)."""
+    for _ in range(100):
+        path = parent / f"{prefix}{secrets.token_hex(6)}"
+        try:
+            path.mkdir(0o777)
+            return path
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"{parent}: no free name for a staging folder")
+
+
+def _link(source: Path, target: Path) -> None:
+    """``target`` the same file as ``source`` (a hard link; a copy where links are refused)."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        os.link(source, target, follow_symlinks=False)
+    except OSError:
+        shutil.copy2(source, target, follow_symlinks=False)
+
+
+_ASIDE = ".old-"
+
+
+def _recover(out: Path) -> None:
+    """Undo what a killed run left beside ``out``: its staging folders are removed; a previous
+    run moved aside (``.NAME.old-XXXX``) is put back when ``out`` is missing, else removed."""
+    parent = out.parent
+    if not parent.is_dir():
+        return
+    for path in sorted(parent.glob(f".{glob.escape(out.name)}.*")):
+        rest = path.name[len(out.name) + 2 :]
+        if not path.is_dir() or path.is_symlink():
+            continue
+        if rest.startswith("old-") and not out.exists():
+            os.replace(path, out)
+        elif rest.startswith(("staging-", "old-")):
+            shutil.rmtree(path, ignore_errors=True)
+
+
+def _swap(staging: Path, out: Path) -> None:
+    """``staging`` takes the place of ``out`` in one step, the previous folder left at
+    ``staging`` (removed by the caller): an exchange of the two names where the system has one
+    (Linux renameat2 RENAME_EXCHANGE), else ``out`` moved aside and ``staging`` renamed onto it
+    (a kill between the two renames is undone by :func:`_recover`). The caller holds SIGINT and
+    SIGTERM back meanwhile (:func:`_signals_held`)."""
+    if not out.exists():
+        os.rename(staging, out)
+        staging.mkdir()  # an empty one for the caller to remove
+    elif not _exchange(staging, out):
+        aside = out.parent / f".{out.name}{_ASIDE}{staging.name.rsplit('-', 1)[-1]}"
+        os.rename(out, aside)
+        os.rename(staging, out)
+        os.rename(aside, staging)
+    _fsync_folder(out.parent)
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM held back inside the block and delivered after it (to the handlers
+    they had): the Python handlers swapped for ones that remember the signal (in the main
+    thread, where Python handles signals; elsewhere nothing is held)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got: list[int] = []
+    handlers = {s: signal.signal(s, lambda n, f: got.append(n))
+                for s in (signal.SIGINT, signal.SIGTERM)}  # fmt: skip
+    try:
+        yield
+    finally:
+        for s, handler in handlers.items():
+            signal.signal(s, handler)
+        if got:
+            handler = handlers[got[0]]
+            if callable(handler):
+                handler(got[0], None)
+            elif handler == signal.SIG_DFL:
+                signal.raise_signal(got[0])
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Exchange the names ``a`` and ``b`` atomically (Linux ``renameat2``); False where the
+    system has no such call."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd, rename_exchange = -100, 2
+    done = renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange)
+    if done != 0:
+        errno = ctypes.get_errno()
+        if errno in (38, 22, 95):  # ENOSYS, EINVAL, EOPNOTSUPP: no exchange on this system
+            return False
+        raise OSError(errno, os.strerror(errno), str(b))
+    return True
+
+
+def _fsync_folder(folder: Path) -> None:
+    """Make the swap in ``folder`` durable where the platform allows it (best effort)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)

@@ -13,19 +13,21 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from stereoplotter.glossary import term
+from stereoplotter.glossary import term, translate
 from stereoplotter.setup.records import SetupSheet
 
 __all__ = [
     "LeastCounts",
     "correction_rows",
     "limit_rows",
-    "limits_exceeded",
     "reading_rows",
+    "rigorous_sides",
     "set_value",
     "signature_rows",
     "stage5_rows",
     "summary_rows",
+    "value_to_set",
+    "zero_of",
     "zero_reading_names",
 ]
 
@@ -70,9 +72,12 @@ def set_value(value: float, step: float) -> str:
     return ("-" if rounded < 0 and float(text) != 0.0 else "") + text
 
 
+_NB = "\u00a0"  # a non-breaking space: a sign, its value and its unit stay on one line
+
+
 def _signed(value: float, step: float) -> str:
     text = set_value(value, step)
-    return f"− {text[1:]}" if text.startswith("-") else f"+ {text}"
+    return f"−{_NB}{text[1:]}" if text.startswith("-") else f"+{_NB}{text}"
 
 
 # --- rigorous values --------------------------------------------------------------------------
@@ -114,9 +119,44 @@ def limit_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
     return out
 
 
-def limits_exceeded(sheet: SetupSheet) -> bool:
-    """True when any book value deviates from the rigorous one by more than its tolerance."""
-    return any(row["exceeds"] for row in limit_rows(sheet))
+def rigorous_sides(sheet: SetupSheet, rigorous: bool = False) -> tuple[str, ...]:
+    """The photos ("left", "right") whose mark targets and span the form gives to set from the
+    rigorous (3.17): both with ``rigorous``; else each photo one of whose book values
+    ((6.1)/(6.2) targets, (6.5) span) leaves its stage tolerance (:func:`limit_rows`).
+
+    A photo is taken whole: its k_ω target (mark 3), its check (mark 4), its k_α target and its
+    span L are one fit of one photo carrier, so they come from one computation — setting mark 3
+    by the book and checking mark 4 against the rigorous value would check one model against
+    another.
+    """
+    if rigorous:
+        return ("left", "right")
+    bad = {row["reading"][-1] for row in limit_rows(sheet) if row["exceeds"]}
+    return tuple(side for side, mark in (("left", "л"), ("right", "п")) if mark in bad)
+
+
+def _side(reading: str) -> str | None:
+    """The photo ("left"/"right") of a mark target or span reading, else None."""
+    if _rigorous_name(reading):
+        return "left" if reading.endswith("л") else "right"
+    return None
+
+
+def _rigorous_name(reading: str) -> bool:
+    return reading in ("L_л", "L_п") or _MARK.match(reading) is not None
+
+
+def value_to_set(
+    sheet: SetupSheet, row: dict[str, Any], sides: tuple[str, ...]
+) -> tuple[float, float | None]:
+    """(the value a reading row gives to set, the book's value beside it or None): the
+    rigorous (3.17) value of a mark target or span of a photo in ``sides``
+    (:func:`rigorous_sides`), else the row's own value."""
+    side = _side(row["reading"])
+    if side is None or side not in sides:
+        return row["value"], None
+    rig = _rigorous_value(sheet, row["reading"])
+    return (row["value"], None) if rig is None else (rig, row["value"])
 
 
 # --- readings -------------------------------------------------------------------------------------
@@ -125,7 +165,7 @@ _STEPS_RU = (
     (r"^f_пр$", "установить фокусное расстояние прибора f_пр"),
     (r"^O_bx$", "базисная каретка b_x"),
     (r"^O_by$", "базисная каретка b_y (MO_by по центрам кассет)"),
-    (r"^O_Z$", "опустить базисную каретку до D_max: абсолютный счётчик высот"),
+    (r"^O_Z$", "опустить базисную каретку (ножной штурвал) до D_max: абсолютный счётчик высот"),
     (r"^L⁰_л$", "контроль расстояния между метками 3–4, левый снимок (коррекционные механизмы "
      "на нулях)"),
     (r"^L⁰_п$", "контроль расстояния между метками 3–4, правый снимок (коррекционные механизмы "
@@ -145,8 +185,8 @@ _STEPS_RU = (
     (r"^d_y,п$", "правый снимок: шкала децентрации y"),
     (r"^O_bz$", "вертикальная составляющая базиса"),
     (r"^residual q$", "κ_л, κ_п по начальным направлениям; остаточный поперечный параллакс"),
-    (r"^O_Z(?P<id>.+)$", "высотная опорная точка {id}: совместить марку с точкой"),
-    (r"^corner (?P<id>\d)", "угол трапеции {id}"),
+    (r"^O_Z(?P<id>.+)$", "высотная опорная точка {id}: совместить марку с точкой вращением b_x"),
+    (r"^corner (?P<id>\d)", "угол трапеции {id}{position}"),
 )
 
 
@@ -154,23 +194,38 @@ def step_text(row: dict[str, Any], lang: str) -> str:
     """What the operator does for a reading row, in ``lang``."""
     if lang == "en":
         return str(row["step"])
+    where = re.search(r" \((SW|SE|NE|NW)\)$", str(row["step"]))  # a corner's position
     for pattern, text in _STEPS_RU:
         m = re.match(pattern, row["reading"])
         if m:
-            return text.format(**m.groupdict())
+            return text.format(**m.groupdict(), position=f" ({where[1]})" if where else "")
     return str(row["step"])  # pragma: no cover - every reading of stages 1–5 is listed above
+
+
+def zero_of(row: dict[str, Any]) -> str:
+    """The zero reading of a row; a decentration's is its own projector's (MO_dx,л, MO_dx,п):
+    each projector has its own decentration scales, so each has its own place of zero."""
+    zero, reading = str(row["zero_reading"]), str(row["reading"])
+    if zero in ("MO_dx", "MO_dy") and reading[-2:] in (",л", ",п"):
+        return zero + reading[-2:]
+    return zero
+
+
+def _residual_text(row: dict[str, Any], lang: str) -> str:
+    text = str(row["formula"])
+    return text.replace("residual q", term("residual_q", lang))
 
 
 def _reading_text(row: dict[str, Any], value: float, lc: LeastCounts, lang: str) -> str:
     kind = lc.of(row["reading"])
-    name, zero, unit = row["reading"], row["zero_reading"], row["unit"]
-    name = name.replace("corner", term("corner", lang))
+    name, zero, unit = row["reading"], zero_of(row), row["unit"]
+    name = name.replace("corner", term("corner", lang)).replace(" ", "\u00a0")
     if kind is None:
-        return str(row["formula"])
+        return _residual_text(row, lang)
     step = kind[1]
     if zero:
-        return f"{name} = {zero} {_signed(value, step)} {unit}"
-    return f"{name} = {set_value(value, step)} {unit}"
+        return f"{name} = {zero} {_signed(value, step)}{_NB}{unit}"
+    return f"{name} = {set_value(value, step)}{_NB}{unit}"
 
 
 def _least_count_text(row: dict[str, Any], lc: LeastCounts) -> str:
@@ -183,28 +238,40 @@ def _least_count_text(row: dict[str, Any], lc: LeastCounts) -> str:
 
 
 def _tolerance_text(row: dict[str, Any]) -> str:
-    return f"± {row['tolerance']:.4g} {row['unit']}" if "tolerance" in row else ""
+    return f"±{_NB}{row['tolerance']:.4g}{_NB}{row['unit']}" if "tolerance" in row else ""
+
+
+def _equation_text(row: dict[str, Any], lang: str) -> str:
+    """A reading's equation in ``lang``, without the pointer into the program's own notes (the
+    form names the book's equations only)."""
+    return translate(str(row["equation"]).replace(" (kinematics §2.4)", ""), lang)
+
+
+def _book_text(row: dict[str, Any], book: float | None, lc: LeastCounts, lang: str) -> str:
+    """" (book: …)" beside a rigorous value to set, at the same least count."""
+    if book is None:
+        return ""
+    kind = lc.of(row["reading"])
+    step = kind[1] if kind else 0.001
+    return f" ({term('limit_book', lang)}: {set_value(book, step).replace('-', '−')})"
 
 
 def reading_rows(
     sheet: SetupSheet, lc: LeastCounts, lang: str, rigorous: bool = False
 ) -> list[tuple[str, ...]]:
     """Every reading of stages 1–4 (stage 5 is :func:`stage5_rows`): stage, step, the value to
-    set at its least count (the rigorous one for marks and spans when ``rigorous``, the book's
-    beside it), the least count, the equation, the tolerance and an empty column to write in."""
+    set at its least count (:func:`value_to_set`: the rigorous one, the book's beside it, for
+    the marks and span of a photo of :func:`rigorous_sides`), the least count, the equation,
+    the tolerance and an empty column to write in."""
+    sides = rigorous_sides(sheet, rigorous)
     rows = []
     for r in sheet.readings:
         if r["stage"] == 5:
             continue
-        value, equation, extra = r["value"], r["equation"], ""
-        rig = _rigorous_value(sheet, r["reading"]) if rigorous else None
-        if rig is not None:
-            kind = lc.of(r["reading"])
-            step = kind[1] if kind else 0.001
-            extra = f" ({term('limit_book', lang)}: {set_value(value, step)})"
-            value, equation = rig, "(3.17)"
-        equation = equation.replace("item 1", term("item1", lang))
-        rows.append((str(r["stage"]), step_text(r, lang), _reading_text(r, value, lc, lang) + extra,
+        value, book = value_to_set(sheet, r, sides)
+        equation = "(3.17)" if book is not None else _equation_text(r, lang)
+        rows.append((str(r["stage"]), step_text(r, lang),
+                     _reading_text(r, value, lc, lang) + _book_text(r, book, lc, lang),
                      _least_count_text(r, lc), equation, _tolerance_text(r), ""))  # fmt: skip
     return rows
 
@@ -212,25 +279,27 @@ def reading_rows(
 def summary_rows(
     sheet: SetupSheet, lc: LeastCounts, lang: str, rigorous: bool = False
 ) -> list[tuple[str, str]]:
-    """The compact readings of page 1: one row per stage, every value at its least count."""
+    """The compact readings of page 1: one row per stage, every value at its least count (the
+    same values as :func:`reading_rows`, the book's beside a rigorous one)."""
+    sides = rigorous_sides(sheet, rigorous)
     out = []
     for stage in range(1, 6):
         texts, tolerances = [], {}
         for r in sheet.readings:
             if r["stage"] != stage:
                 continue
-            rig = _rigorous_value(sheet, r["reading"]) if rigorous else None
-            texts.append(_reading_text(r, r["value"] if rig is None else rig, lc, lang))
+            value, book = value_to_set(sheet, r, sides)
+            texts.append(_reading_text(r, value, lc, lang) + _book_text(r, book, lc, lang))
             if "tolerance" in r and r["reading"] != "residual q":
                 name = re.sub(r"\d+$", "i", r["reading"]) if stage == 3 else r["reading"]
                 name = name.replace("corner", term("corner", lang))
-                tolerances.setdefault(f"±{r['tolerance']:.3g} {r['unit']}", []).append(name)
+                tolerances.setdefault(f"±{r['tolerance']:.3g}{_NB}{r['unit']}", []).append(name)
         if stage == 5:
             texts.append(f"{term('points_stage5', lang)}: "
                          + ", ".join(str(p["id"]) for p in _stage5_points(sheet)))  # fmt: skip
         tol = "; ".join(f"{', '.join(dict.fromkeys(n))} {t}" for t, n in tolerances.items())
         if texts:
-            tail = f". {term('tolerance', lang)}: {tol}" if tol else ""
+            tail = f". {term('tolerance', lang).capitalize()}: {tol}" if tol else ""
             out.append((term(f"stage_{stage}", lang), "; ".join(texts) + tail))
     return out
 
@@ -242,14 +311,17 @@ def zero_reading_names(sheet: SetupSheet) -> list[str]:
     """The zero readings every reading depends on, in the order the readings use them."""
     names = dict.fromkeys(["MO_X", "MO_Y", "MO_Z"])
     for r in sheet.readings:
-        zero = r["zero_reading"]
+        zero = zero_of(r)
+        if zero.startswith(("MO_dx,", "MO_dy,")):
+            names.setdefault(zero)
+            continue
         if zero.startswith("MO") and "," not in zero:
             names.setdefault(zero)
     names.setdefault("MO_bz")
     return list(names)
 
 
-def correction_rows(sheet: SetupSheet, lang: str, rigorous: bool = False) -> list[tuple[str, ...]]:
+def correction_rows(sheet: SetupSheet, lang: str) -> list[tuple[str, ...]]:
     """Rows of the (6.9)–(6.11) corrections: symbol, quantity, formula, factor, field.
 
     D = n_л·f_пр is the absolute height reading of stage 1 (6.3); the factors are those of
@@ -285,11 +357,11 @@ def stage5_rows(sheet: SetupSheet, lc: LeastCounts, lang: str) -> list[tuple[str
     """Stage 5: corner 4 and the x′, y′ readings of the plan control and check points, at the
     counters' least count, with the coordinatograph tolerance of corner 4 and fields to write."""
     step = lc.counter_mm
-    tol = f"± {sheet.tolerances['corner_mm']:.2g} mm"
+    tol = f"±\u00a0{sheet.tolerances['corner_mm']:.2g}\u00a0mm"
     rows = []
     for c in sheet.corners:
         if c["corner"] == "4":
-            rows.append((f"{term('corner', lang)} 4", c["position"],
+            rows.append((f"{term('corner', lang)}\u00a04", c["position"],
                          f"O_X = MO_X {_signed(c['x_mm'], step)}",
                          f"O_Y = MO_Y {_signed(c['y_mm'], step)}", tol, "", ""))  # fmt: skip
     for p in _stage5_points(sheet):

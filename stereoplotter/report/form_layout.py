@@ -27,11 +27,25 @@ from typing import Any
 
 from fontTools import ttLib
 from fpdf import FPDF
-from fpdf.enums import TextMode, XPos, YPos
+from fpdf.enums import TextMode
 from fpdf.fonts import SubsetMap, TTFFont
 from fpdf.util import escape_parens
 
-__all__ = ["FONT", "Form", "LabelPlacer", "font_path", "heading", "paragraph", "table"]
+from stereoplotter.glossary import localize
+
+__all__ = [
+    "FONT",
+    "Form",
+    "LabelPlacer",
+    "font_path",
+    "heading",
+    "literal",
+    "localized_text",
+    "paragraph",
+    "plain",
+    "rich_runs",
+    "table",
+]
 
 FONT = "DejaVu"
 MARGIN_LEFT, MARGIN_RIGHT, MARGIN_TOP, MARGIN_BOTTOM = 20.0, 15.0, 12.0, 16.0
@@ -138,8 +152,9 @@ class Form(FPDF):
     the same inputs give the same bytes.
     """
 
-    def __init__(self, date: str, page_word: str = "page") -> None:
+    def __init__(self, date: str, page_word: str = "page", lang: str = "en") -> None:
         super().__init__(orientation="P", unit="mm", format="A4")
+        self.lang = lang
         for style in ("", "B"):
             self.fonts[f"{FONT.lower()}{style}"] = _document_font(style, len(self.fonts) + 1)
         self.set_margins(MARGIN_LEFT, MARGIN_TOP, MARGIN_RIGHT)
@@ -187,6 +202,20 @@ class Form(FPDF):
         if self.fill_color != self.text_color:
             line = f"q {self.text_color.serialize().lower()} {line} Q"
         self._out(line)
+
+    def rich_text(self, x: float, y: float, text: str) -> float:
+        """Draw ``text`` (a form text: :func:`rich_runs`) with its baseline at (x, y) in the
+        current font, each subscript smaller and lowered; returns the width drawn (mm)."""
+        size, style = self.font_size_pt, self.font_style
+        for run, sub in rich_runs(text):
+            run_size = size * _SUB if sub else size
+            if run_size != self.font_size_pt:
+                self.set_font(FONT, style, run_size)
+            self.text(x, y + (_SUB_DROP * size * _PT if sub else 0.0), run)
+            x += _plain_width(self, run, style, run_size)
+        if self.font_size_pt != size:
+            self.set_font(FONT, style, size)
+        return x
 
     def append_pages(self, source: Form) -> None:
         """Append the pages of ``source`` (a :class:`Form` already output) as drawn there: each
@@ -296,9 +325,10 @@ class Form(FPDF):
     def footer(self) -> None:
         self.page_ends[self.page] = (bytes(self.pages[self.page].contents), self._state())
         self.set_y(-MARGIN_BOTTOM + 5)
-        self.set_font(FONT, "", 7)
-        self.set_text_color(90)
-        self.cell(0, 4, self.footer_text, align="L")
+        self.set_font(FONT, "", 8)
+        self.set_text_color(60)
+        self.rich_text(self.l_margin, self.get_y() + 2.0 + 0.3 * self.font_size,
+                       localized(self, self.footer_text))  # fmt: skip
         self.set_x(self.l_margin)
         self.cell(0, 4, f"{self.page_word} {self.page_no()}", align="R")
         self.set_text_color(0)
@@ -324,24 +354,109 @@ def _operand(codes: str) -> str:
     return f"({escape_parens(codes.encode('utf-16-be').decode('latin-1'))}) Tj"
 
 
-def heading(pdf: Form, text: str, size: float = 11.0) -> None:
+#: A subscript's size (× the text's) and its drop below the baseline (× the text's size).
+_SUB, _SUB_DROP = 0.72, 0.28
+#: Where user text (a job's name, a camera, an id) begins and ends inside a form text: drawn
+#: as written, no subscript and no localisation (:func:`literal`).
+_OPEN, _CLOSE = "\x1e", "\x1f"
+_LITERAL = re.compile(f"{_OPEN}([^{_CLOSE}]*){_CLOSE}?")
+#: A subscript: after "_" that follows a symbol's character, up to a space, a bracket, an
+#: operator, or a comma followed by a space ("O_Y3,л", "θ_α, θ_ω", "f_пр/f′", "M_map").
+_SUBSCRIPT = re.compile(r"(?<=[^\s_])_((?:[^\s()=;·/+−:,_\u2009]|,(?=[^\s,]))+)")
+
+
+def plain(text: str) -> str:
+    """A form text with the marks of :func:`literal` taken out (for a text file)."""
+    return text.replace(_OPEN, "").replace(_CLOSE, "")
+
+
+def literal(text: object) -> str:
+    """User text inside a form text: drawn as written (an "_" stays an underscore, no unit is
+    localised); each word marked alone, so that a line break between words keeps the marks."""
+    return " ".join(f"{_OPEN}{w}{_CLOSE}" if w else w for w in str(text).split(" "))
+
+
+def rich_runs(text: str) -> list[tuple[str, bool]]:
+    """``text`` as (run, is a subscript) in order: the book's symbols typeset (``f_пр`` → f with
+    the subscript пр), user text (:func:`literal`) as written."""
+    out: list[tuple[str, bool]] = []
+    pos = 0
+    for m in _LITERAL.finditer(text):
+        out += _sub_runs(text[pos : m.start()])
+        if m.group(1):
+            out.append((m.group(1), False))
+        pos = m.end()
+    out += _sub_runs(text[pos:].replace(_CLOSE, "").replace(_OPEN, ""))
+    return [r for r in out if r[0]]
+
+
+def _sub_runs(text: str) -> list[tuple[str, bool]]:
+    text = text.replace(_CLOSE, "")
+    out: list[tuple[str, bool]] = []
+    pos = 0
+    for m in _SUBSCRIPT.finditer(text):
+        out.append((text[pos : m.start()], False))
+        out.append((m.group(1), True))
+        pos = m.end()
+    out.append((text[pos:], False))
+    return out
+
+
+def localized(pdf: Form, text: str) -> str:
+    """``text`` in the form's language (:func:`localized_text`)."""
+    return localized_text(text, pdf.lang)
+
+
+def localized_text(text: str, lang: str) -> str:
+    """``text`` in ``lang`` (:func:`stereoplotter.glossary.localize`) outside the user texts it
+    holds (:func:`literal`), which keep their marks."""
+    if lang == "en" or not text:
+        return text
+    out, pos = [], 0
+    for m in _LITERAL.finditer(text):
+        out.append(localize(text[pos : m.start()], lang))
+        out.append(m.group(0))
+        pos = m.end()
+    out.append(localize(text[pos:], lang))
+    return "".join(out)
+
+
+def fits(pdf: Form, height: float) -> bool:
+    """True when ``height`` mm still fits on the current page."""
+    return pdf.get_y() + height <= pdf.page_break_trigger
+
+
+def heading(pdf: Form, text: str, size: float = 11.0, keep: float = 0.0) -> None:
+    """A bold line; on the next page when it and ``keep`` mm after it do not fit here."""
+    lines = _wrap(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "B", size)
+    line = 1.5 * size * _PT + 1.0
+    if not fits(pdf, len(lines) * line + keep) and pdf.get_y() > pdf.t_margin + 1.0:
+        pdf.add_page()
     pdf.set_font(FONT, "B", size)
-    pdf.cell(0, 1.5 * size * _PT + 1.0, text, new_x=XPos.LMARGIN, new_y=YPos.NEXT)
+    for text_line in lines:  # within the margins, broken at spaces when wider
+        pdf.rich_text(pdf.l_margin + pdf.c_margin,
+                      pdf.get_y() + 0.5 * line + 0.3 * pdf.font_size, text_line)  # fmt: skip
+        pdf.set_xy(pdf.l_margin, pdf.get_y() + line)
     pdf.set_font(FONT, "", 8)
 
 
 def paragraph(pdf: Form, text: str, size: float = 7.5) -> None:
-    """Text over the page width, broken into lines at spaces (:func:`_wrap`), left-aligned,
-    continued on the next page when the page is full."""
+    """Text over the page width, broken into lines at spaces (:func:`_wrap`), left-aligned, on
+    the next page when it does not fit the rest of this one (continued over a page only when
+    it is longer than a page)."""
     pdf.set_font(FONT, "", size)
     line = 1.3 * size * _PT
-    for text_line in _wrap(pdf, text, pdf.epw - 2 * pdf.c_margin, "", size):
+    lines = _wrap(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "", size)
+    if not fits(pdf, len(lines) * line) and pdf.get_y() > pdf.t_margin + 1.0:
+        pdf.add_page()  # a paragraph is whole on a page (none of the forms' runs over a page)
+        pdf.set_font(FONT, "", size)
+    for text_line in lines:
         if pdf.get_y() + line > pdf.page_break_trigger:
             pdf.add_page()
             pdf.set_font(FONT, "", size)
         if text_line:
-            pdf.text(pdf.l_margin + pdf.c_margin, pdf.get_y() + 0.5 * line + 0.3 * pdf.font_size,
-                     text_line)  # fmt: skip
+            pdf.rich_text(pdf.l_margin + pdf.c_margin,
+                          pdf.get_y() + 0.5 * line + 0.3 * pdf.font_size, text_line)  # fmt: skip
         pdf.set_xy(pdf.l_margin, pdf.get_y() + line)
 
 
@@ -353,9 +468,12 @@ def table(
     size: float = 7.5,
     aligns: Sequence[str] | None = None,
     gap: float = 2.0,
-) -> None:
-    """A table over the page width; rows that do not fit continue on the next page, under the
-    header again.
+    keep: float = 0.0,
+) -> float:
+    """A table over the page width, on the next page when it fits a page but not the rest of
+    this one; a table longer than a page continues on the next, under the header again (a row
+    is never split). ``keep``: mm that must fit on the page before the table (its heading).
+    Returns the table's height.
 
     Laid out here in one pass (each cell's lines broken at spaces by the font's advance widths,
     remembered per string), drawn with the document's low-level text and line calls: the look
@@ -367,9 +485,15 @@ def table(
     lefts = [pdf.l_margin + sum(cols[:j]) for j in range(len(cols))]
     aligns = tuple(aligns) if aligns else ("LEFT",) * len(cols)
     line = 1.22 * size * _PT + 0.5
-    head = [_wrap(pdf, str(h), w - 2 * _PAD, "B", size) for h, w in zip(header, cols, strict=True)]
-    body = [[_wrap(pdf, str(c), w - 2 * _PAD, "", size) for c, w in zip(r, cols, strict=True)]
-            for r in rows]  # fmt: skip
+    head = [_wrap(pdf, localized(pdf, str(h)), w - 2 * _PAD, "B", size)
+            for h, w in zip(header, cols, strict=True)]  # fmt: skip
+    body = [[_wrap(pdf, localized(pdf, str(c)), w - 2 * _PAD, "", size)
+             for c, w in zip(r, cols, strict=True)] for r in rows]  # fmt: skip
+    total = sum(_row_height(cells, line) for cells in body)
+    total += _row_height(head, line) if any(header) else 0.0
+    page = pdf.page_break_trigger - pdf.t_margin
+    if not fits(pdf, total) and total + keep <= page:
+        pdf.add_page()
     if any(header):  # the header stays with the first row
         first = _row_height(body[0], line) if body else 0.0
         if pdf.get_y() + _row_height(head, line) + first > pdf.page_break_trigger:
@@ -383,6 +507,28 @@ def table(
         _draw_row(pdf, cells, lefts, cols, aligns, line, size, "")
     pdf.set_font(FONT, "", size)
     pdf.set_xy(pdf.l_margin, pdf.get_y() + gap)
+    return total
+
+
+def table_height(
+    pdf: Form,
+    header: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    widths: Sequence[float],
+    size: float = 7.5,
+) -> float:
+    """The height (mm) :func:`table` would give these rows."""
+    scale = pdf.epw / sum(widths)
+    cols = [w * scale for w in widths]
+    line = 1.22 * size * _PT + 0.5
+    head = [_wrap(pdf, localized(pdf, str(h)), w - 2 * _PAD, "B", size)
+            for h, w in zip(header, cols, strict=True)]  # fmt: skip
+    total = sum(
+        _row_height([_wrap(pdf, localized(pdf, str(c)), w - 2 * _PAD, "", size)
+                     for c, w in zip(r, cols, strict=True)], line)
+        for r in rows
+    )  # fmt: skip
+    return total + (_row_height(head, line) if any(header) else 0.0)
 
 
 _PAD = 0.5  # mm, the cell padding of the tables
@@ -390,10 +536,16 @@ _PAD = 0.5  # mm, the cell padding of the tables
 _LINES: dict[tuple[str, float, float, str], tuple[str, ...]] = {}
 
 
-def _width(pdf: Form, text: str, style: str, size: float) -> float:
+def _plain_width(pdf: Form, text: str, style: str, size: float) -> float:
     """The advance width of ``text`` in mm at ``size`` pt (remembered, :data:`_WIDTHS`)."""
     _, points = pdf.fonts[f"{FONT.lower()}{style}"].get_text_width(text, size, None)
     return points / pdf.k
+
+
+def _width(pdf: Form, text: str, style: str, size: float) -> float:
+    """The advance width of a form text as drawn (:func:`rich_runs`), in mm."""
+    return sum(_plain_width(pdf, run, style, size * _SUB if sub else size)
+               for run, sub in rich_runs(text))  # fmt: skip
 
 
 def _wrap(pdf: Form, text: str, width: float, style: str, size: float) -> tuple[str, ...]:
@@ -454,7 +606,7 @@ def _draw_row(
                 if align[0] in "RC":
                     free = w - 2 * _PAD - _width(pdf, text, style, size)
                     dx += free if align[0] == "R" else free / 2
-                pdf.text(x + dx, y + 0.5 * line + 0.3 * size / pdf.k, text)
+                pdf.rich_text(x + dx, y + 0.5 * line + 0.3 * size / pdf.k, text)
             y += line
     if style == "B":
         pdf.line(pdf.l_margin, top + height, pdf.l_margin + sum(cols), top + height)
@@ -478,9 +630,14 @@ class LabelPlacer:
     earlier box is taken, else the one that overlaps least.
     """
 
-    def __init__(self, pdf: Form) -> None:
+    def __init__(
+        self, pdf: Form, bounds: tuple[float, float, float, float] | None = None
+    ) -> None:
         self.pdf = pdf
         self.boxes: list[tuple[float, float, float, float]] = []
+        #: The area labels stay inside (the drawing's frame): a place outside costs more than
+        #: any overlap.
+        self.bounds = bounds
 
     def _box(self, x: float, y: float, width: float) -> tuple[float, float, float, float]:
         size = self.pdf.font_size  # mm
@@ -488,6 +645,10 @@ class LabelPlacer:
 
     def _overlap(self, box: tuple[float, float, float, float]) -> float:
         total = 0.0
+        if self.bounds is not None:
+            x0, y0, x1, y1 = self.bounds
+            if box[0] < x0 or box[1] < y0 or box[2] > x1 or box[3] > y1:
+                total += 1e6
         for b in self.boxes:
             w = min(box[2], b[2]) - max(box[0], b[0])
             h = min(box[3], b[3]) - max(box[1], b[1])
@@ -499,14 +660,19 @@ class LabelPlacer:
         """Keep labels off an area (a symbol, the scale bar)."""
         self.boxes.append(box)
 
+    def _label_width(self, label: str) -> float:
+        return _width(self.pdf, label, self.pdf.font_style, self.pdf.font_size_pt)
+
     def text(self, x: float, y: float, label: str) -> None:
         """Write at (x, y) as baseline start, and reserve its box (no choice of place)."""
-        self.boxes.append(self._box(x, y, self.pdf.get_string_width(label)))
-        self.pdf.text(x, y, label)
+        label = localized(self.pdf, label)
+        self.boxes.append(self._box(x, y, self._label_width(label)))
+        self.pdf.rich_text(x, y, label)
 
     def label(self, px: float, py: float, label: str) -> None:
         """Write ``label`` beside the point (px, py) where it overlaps no earlier label."""
-        width, size = self.pdf.get_string_width(label), self.pdf.font_size
+        label = localized(self.pdf, label)
+        width, size = self._label_width(label), self.pdf.font_size
         best: tuple[float, float, float] | None = None
         for dx, dy, shift in _PLACES:
             x, y = px + dx * size - shift * width, py + dy * size

@@ -22,9 +22,11 @@ from typing import Any
 import numpy as np
 
 from stereoplotter import __version__
-from stereoplotter.glossary import check_language, term
+from stereoplotter.glossary import TERMS, check_language, term
 from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
+from stereoplotter.report.form_fields import rigorous_sides
+from stereoplotter.report.form_layout import literal, localized_text, plain
 from stereoplotter.report.forms import FormHeader, LeastCounts, form_pdfs
 from stereoplotter.report.sheet import sheet_markdown, sheet_to_dict
 from stereoplotter.setup.records import SetupSheet
@@ -106,9 +108,12 @@ def form_header(
     sheet_text = term("no_map_sheet", lang) if sheet is None else (
         f"{sheet.nomenclature or 'given by corners'}, 1:{sheet.scale_denominator}"
     )  # fmt: skip
-    camera = (f"{job.camera_name + ': ' if job.camera_name else ''}f = {cam.focal_length_mm:.3f} "
-              f"mm, x₀, y₀ = {cam.principal_point_mm[0]:.3f}, {cam.principal_point_mm[1]:.3f} mm, "
-              f"{term('fiducials_given_as', lang)} {cam.fiducials_given_as}")  # fmt: skip
+    given = f"fiducials_{cam.fiducials_given_as}"
+    given = term(given, lang) if given in TERMS else literal(cam.fiducials_given_as)
+    camera = (f"{literal(job.camera_name) + ': ' if job.camera_name else ''}f = "
+              f"{cam.focal_length_mm:.3f} mm, x₀, y₀ = {cam.principal_point_mm[0]:.3f}, "
+              f"{cam.principal_point_mm[1]:.3f} mm, {term('fiducials_given_as', lang)} "
+              f"{given}")  # fmt: skip
     return FormHeader(
         job=job.name,
         job_file=Path(job.source).name,
@@ -155,7 +160,7 @@ def _plain(value: Any) -> Any:
     raise TypeError(type(value).__name__)
 
 
-def _markdown(job: Job, p: PairResult, lang: str = "en") -> str:
+def _markdown(job: Job, p: PairResult, lang: str = "en", rigorous: bool = False) -> str:
     h = form_header(job, p, lang=lang)
     t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     head = (
@@ -165,9 +170,9 @@ def _markdown(job: Job, p: PairResult, lang: str = "en") -> str:
         f"{t('date')} {h.date}; {h.program}.\n\n"
     )
     assert p.sheet is not None
-    text = sheet_markdown(p.sheet, lang)
+    text = sheet_markdown(p.sheet, lang, rigorous_sides(p.sheet, rigorous))
     title, rest = text.split("\n", 1)
-    return f"{title}\n\n{head}{rest.lstrip()}"
+    return plain(localized_text(f"{title}\n\n{head}{rest.lstrip()}", lang))
 
 
 _CSV = (
@@ -230,7 +235,7 @@ def job_files(result: JobResult, lang: str = "en", rigorous: bool = False) -> di
         if p.sheet is None:
             continue
         header = form_header(result.job, p, result.spec, lang)
-        files[f"{p.pair.name}/sheet.md"] = _markdown(result.job, p, lang).encode("utf-8")
+        files[f"{p.pair.name}/sheet.md"] = _markdown(result.job, p, lang, rigorous).encode("utf-8")
         files[f"{p.pair.name}/sheet.pdf"] = b""  # in the order of the files before
         forms.append((p.sheet, header))
         names.append(p.pair.name)

@@ -13,14 +13,21 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stereoplotter.glossary import check_language, term
+from stereoplotter.glossary import (
+    check_language,
+    instrument_name,
+    localize,
+    parameter_name,
+    term,
+    translate,
+)
 from stereoplotter.instrument.principles import (
     control_name,
     mark_phrase,
     sequence_for,
     setting_values,
 )
-from stereoplotter.report.form_fields import step_text
+from stereoplotter.report.form_fields import step_text, value_to_set
 from stereoplotter.setup.sheet import SetupSheet, assumed_parameters
 from stereoplotter.setup.table24 import X_MARK_NAME, BlockResult, candidates_of
 
@@ -322,58 +329,71 @@ def _pm(value: float) -> str:
     return f"{round(value, 3) + 0.0:+.3f}"
 
 
-def _controls_rows(sheet: SetupSheet) -> list[str]:
-    """The instrument's own names of the correction controls (issue 11), one row per photo."""
+def _controls_rows(sheet: SetupSheet, lang: str = "en") -> list[str]:
+    """The instrument's own names of the correction controls, one row per photo (in Russian the
+    names translated, each control's identifier kept)."""
     principle = sheet.instrument_principle
     rows = []
     for p in sheet.photos:
-        names = ", ".join(
-            control_name(principle, f"{c}_{p.name}") for c in ("k_alpha", "k_omega", "dx", "dy")
-        )
+        names = [control_name(principle, f"{c}_{p.name}") for c in ("k_alpha", "k_omega", "dx",
+                                                                     "dy")]  # fmt: skip
         how = mark_phrase(principle, "N")
-        rows.append(f"| controls, {p.name} | — | {names} | — | stage 2: {how} |")
+        if lang == "en":
+            rows.append(f"| controls, {p.name} | — | {', '.join(names)} | — | stage 2: {how} |")
+            continue
+        own = []
+        for n in names:
+            text, sep, ident = n.rpartition(" (")
+            own.append(f"{translate(text, lang)} ({ident}" if sep else n)
+        rows.append(f"| {term('md_controls', lang)}, {term(p.name, lang)} | — | {', '.join(own)} "
+                    f"| — | {term('stage', lang)} 2: {translate(how, lang)} |")  # fmt: skip
     return rows
 
 
-def _settings_lines(settings: dict[str, Any] | None, title: str) -> list[str]:
-    """The instrument's own settings (issue 11) as a Markdown section."""
+def _settings_lines(
+    settings: dict[str, Any] | None, title: str, lang: str = "en"
+) -> list[str]:
+    """The instrument's own settings as a Markdown section (in ``lang``)."""
     if settings is None:
         return []
-    status = "documented" if settings["count_status"] == "documented" else "ASSUMED"
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
+    tr = lambda text: translate(str(text), lang)  # noqa: E731 - the same
+    status = t("md_documented") if settings["count_status"] == "documented" else t(
+        "md_assumed_upper")  # fmt: skip
     lines = [
         "",
-        f"## Settings of the {title}",
+        f"## {t('md_settings_of')} {title}" if lang == "en" else f"## {t('md_settings_of')}: "
+        f"{title}",
         "",
-        f"{settings['phi_omega_dependent']} settings depend on φ, ω ({settings['counted']}; "
-        f"{status}: {settings['count_basis']}). Order:",
+        f"{settings['phi_omega_dependent']} {t('md_settings_depend')} "
+        f"({tr(settings['counted'])}; {status}: {tr(settings['count_basis'])}). {t('md_order')}:",
         "",
     ]
-    lines += [f"{n}. {step}" for n, step in enumerate(settings["sequence"], 1)]
-    lines += [
-        "",
-        "| setting | symbol | kind | formula | left | right | unit |",
-        "|---|---|---|---|---|---|---|",
-    ]
+    lines += [f"{n}. {tr(step)}" for n, step in enumerate(settings["sequence"], 1)]
+    lines += ["", t("md_settings_header"), "|---|---|---|---|---|---|---|"]
     for s in settings["settings"]:
         digits = 4 if s["unit"] == "deg" else 3
         lines.append(
-            f"| {s['name']} | {s['symbol']} | {s['kind']} | {s['formula']} | "
+            f"| {tr(s['name'])} | {s['symbol']} | {tr(s['kind'])} | {s['formula']} | "
             f"{_fmt(s['left'], digits)} | {_fmt(s['right'], digits)} | "
             f"{'°' if s['unit'] == 'deg' else 'mm'} |"
         )
     return lines
 
 
-def sheet_markdown(sheet: SetupSheet, lang: str = "en") -> str:
+def sheet_markdown(sheet: SetupSheet, lang: str = "en", sides: tuple[str, ...] = ()) -> str:
     """Table 24 and the stage-by-stage list of readings, as Markdown in ``lang`` (``"ru"`` uses
     the book's terms, :mod:`stereoplotter.glossary`)."""
     check_language(lang)
     d = sheet_to_dict(sheet)
-    lines = _intro_lines(sheet, lang) + _table24_lines(sheet, lang) + _similarity_lines(d)
-    lines += _mark_comparison_lines(sheet)
-    lines += _settings_lines(d["instrument_settings"], sheet.instrument_title)
-    lines += _readings_lines(sheet, lang)
-    return "\n".join(lines) + "\n"
+    lines = _intro_lines(sheet, lang) + _table24_lines(sheet, lang) + _similarity_lines(d, lang)
+    lines += _mark_comparison_lines(sheet, lang)
+    title = instrument_name(sheet.instrument, sheet.instrument_title, lang)
+    lines += _settings_lines(d["instrument_settings"], title, lang)
+    lines += _readings_lines(sheet, lang, sides)
+    if lang == "en":
+        return "\n".join(lines) + "\n"
+    return "\n".join(localize(line, lang) for line in lines) + "\n"  # units, corners, МО, tg
 
 
 def _intro_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
@@ -388,7 +408,9 @@ def _intro_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
         f"({t('md_ratio')} {sheet.horizontal_scale_denominator / m_map:g})"
     )  # fmt: skip
     return [
-        f"# {t('md_title')} — {sheet.scenario} {t('md_on')} {sheet.instrument_title}",
+        f"# {t('md_title')} — {sheet.scenario} {t('md_on')} {sheet.instrument_title}"
+        if lang == "en" else f"# {t('md_title')} — {sheet.scenario}, "
+        f"{instrument_name(sheet.instrument, sheet.instrument_title, lang)}",
         "",
         t("md_computed"),
         "",
@@ -442,7 +464,7 @@ def _table24_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
             f"| {t('md_decentrations')}, {side} | d_x, d_y | {_fmt(p.decentration_mm[0])}, "
             f"{_fmt(p.decentration_mm[1])} | mm | f′·tan α, f′·tan ω |"
         )
-    lines += _controls_rows(sheet)
+    lines += _controls_rows(sheet, lang)
     for h in sheet.control_heights:
         lines.append(
             f"| {t('md_model_height')} {h['id']} | Z_{h['id']} | "
@@ -457,49 +479,49 @@ def _table24_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
     return lines
 
 
-def _similarity_lines(d: dict[str, Any]) -> list[str]:
+def _similarity_lines(d: dict[str, Any], lang: str = "en") -> list[str]:
     """The similarity (6.8) on the control points, if the sheet has a map."""
+    t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     lines: list[str] = []
     if d["similarity"]:
         s = d["similarity"]
         lines += [
             "",
-            f"Similarity (6.8), {len(s['residuals_m'])} control points: "
+            f"{t('md_similarity')}, {len(s['residuals_m'])} {t('md_control_points')}: "
             f"a = {s['a']:.6e}, b = {s['b']:.9f}, c_X = {s['cx_m']:.3f} m, "
-            f"c_Y = {s['cy_m']:.3f} m (det {s['determinant']:.6f} < 0: reflection); "
-            f"RMS residual {s['rms_m']:.3f} m; residuals "
+            f"c_Y = {s['cy_m']:.3f} m (det {s['determinant']:.6f} < 0: {t('md_reflection')}); "
+            f"{t('md_rms_residual')} {s['rms_m']:.3f} m; {t('md_residuals')} "
             + ", ".join(f"{k}: ({_pm(v[0])}, {_pm(v[1])})" for k, v in s["residuals_m"].items())
             + " m.",
         ]
     return lines
 
 
-def _mark_comparison_lines(sheet: SetupSheet) -> list[str]:
+def _mark_comparison_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
     """The book's single-axis (6.1)/(6.2) marks against the rigorous (3.17)."""
-    lines = [
-        "",
-        "Transformed mark coordinates: the book's single-axis (6.1)/(6.2) against the "
-        "rigorous (3.17) (κ = 0):",
-        "",
-        "| photo | mark | (6.1)/(6.2) mm | (3.17) x⁰, y⁰ mm | difference µm |",
-        "|---|---|---|---|---|",
-    ]
+    lines = ["", term("md_marks_intro", lang), "", term("md_marks_header", lang),
+             "|---|---|---|---|---|"]  # fmt: skip
     for p in sheet.photos:
         for key, value in p.transformed_book_mm.items():
             mark = key[1:]
             rig = p.transformed_rigorous_mm[mark]
             axis = 0 if key[0] == "x" else 1
             lines.append(
-                f"| {p.name} | {key} | {value:.4f} | {rig[0]:.4f}, {rig[1]:.4f} | "
+                f"| {p.name if lang == 'en' else term(p.name, lang)} | {key} | {value:.4f} | "
+                f"{rig[0]:.4f}, {rig[1]:.4f} | "
                 f"{(value - rig[axis]) * 1000:+.2f} |"
             )
     return lines
 
 
-def _readings_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
-    """Every reading stage by stage, and the assumed parameters used."""
+def _readings_lines(sheet: SetupSheet, lang: str = "en", sides: tuple[str, ...] = ()) -> list[str]:
+    """Every reading stage by stage, and the assumed parameters used. The mark targets and span
+    of a photo in ``sides`` are the rigorous (3.17) ones, the book's beside them (the values a
+    job's form gives to set, :func:`~stereoplotter.report.form_fields.rigorous_sides`)."""
     t = lambda key: term(key, lang)  # noqa: E731 - a local shorthand for the many labels
     lines = ["", f"## {t('md_readings')}", "", t("md_readings_intro"), ""]
+    if sides:
+        lines += [t("limit_choice_mixed"), ""]
     stage = None
     for r in sheet.readings:
         if r["stage"] != stage:
@@ -509,16 +531,26 @@ def _readings_lines(sheet: SetupSheet, lang: str = "en") -> list[str]:
         tol = f"± {r['tolerance']:.4g} {r['unit']}" if "tolerance" in r else ""
         book = f" ({t('md_book')}: {r['book_form']})" if "book_form" in r else ""
         formula = r["formula"] + book
+        value, book_value = value_to_set(sheet, r, sides)
+        if book_value is not None:  # the rigorous value to set, the book's beside it
+            sign = "−" if value < 0 else "+"
+            formula = (f"{r['reading']} = {r['zero_reading']} {sign} {abs(value):.3f} {r['unit']}"
+                       if r["zero_reading"] else f"{r['reading']} = {value:.3f} {r['unit']}")
+            formula += f" ({t('md_book')}: {book_value:.3f})"
         if lang != "en":
-            formula = formula.replace("corner", t("corner"))
-        equation = r["equation"] if lang == "en" else r["equation"].replace("item 1", t("item1"))
+            formula = formula.replace("corner", t("corner")).replace("residual q",
+                                                                      t("residual_q"))  # fmt: skip
+        equation = r["equation"] if lang == "en" else translate(str(r["equation"]), lang)
+        equation = "(3.17)" if book_value is not None else equation
         lines.append(f"| {step_text(r, lang)} | {formula} | {equation} | {tol} |")
     if any(sheet.assumed.values()):
         params = sorted({p for ps in sheet.assumed.values() for p in ps})
+        shown = [f"`{p}`" if lang == "en" else f"{parameter_name(p, lang)} (`{p}`)"
+                 for p in params]  # fmt: skip
         lines += [
             "",
             f"## {t('md_assumed_params')}",
             "",
-            f"{t('md_assumed_params_text')}: " + ", ".join(f"`{p}`" for p in params) + ".",
+            f"{t('md_assumed_params_text')}: " + ", ".join(shown) + ".",
         ]
     return lines

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.glossary import check_language, term, translate
+from stereoplotter.glossary import check_language, localize, term, translate
 from stereoplotter.procedure.eye import look_probability
 from stereoplotter.procedure.simulate import SimulationResult
 from stereoplotter.procedure.transcript import Record
@@ -366,7 +366,7 @@ def closing_summary(result: SimulationResult, lang: str = "en") -> str:
                 f"- {_stage_words(name, lang)}: {tr('cs_still_outside')}"
                 f"{after} → {_advice(name, lang)}."
             )
-    return "\n".join(lines) + "\n"
+    return "\n".join(localize(line, lang) for line in lines) + "\n"
 
 
 def _stage_words(text: str, lang: str) -> str:
@@ -429,7 +429,11 @@ def _records_text(result: SimulationResult, lang: str) -> str:
 def transcript_text(result: SimulationResult, lang: str = "en") -> str:
     """The learner's transcript: the numbered records, then :func:`closing_summary`."""
     check_language(lang)
-    return _records_text(result, lang) + "\n" + closing_summary(result, lang)
+    text = _records_text(result, lang) + "\n" + closing_summary(result, lang)
+    if lang == "en":
+        return text
+    # the units, МО and tg in Russian, line by line (a control's identifier is left as it is)
+    return "\n".join(localize(line, lang) for line in text.split("\n"))
 
 
 def trial0_texts(result: SimulationResult, lang: str = "en") -> dict[str, bytes]:

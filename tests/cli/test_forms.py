@@ -17,6 +17,7 @@ from stereoplotter.cli import main
 from stereoplotter.commands.setup_job import compute_job
 from stereoplotter.glossary import TERMS
 from stereoplotter.io.job_file import load_job
+from stereoplotter.report.form_fields import rigorous_sides, value_to_set, zero_of
 from stereoplotter.report.form_layout import FONT, MARGIN_BOTTOM, Form
 from stereoplotter.report.forms import form_pdf
 from stereoplotter.report.job import form_header, least_counts
@@ -50,6 +51,18 @@ def _flat(forms, lang: str) -> str:
     return " ".join(forms[lang][2])
 
 
+_RU = {"µm": "мкм", "mm": "мм", "m": "м", "MO": "МО", "NW": "СЗ", "tan": "tg"}
+
+
+def _printed(text: str, lang: str) -> str:
+    """A text as the form prints it: a symbol's subscript typeset (read back without its "_"),
+    and in Russian the units, corners, МО and tg."""
+    if lang == "ru":
+        text = re.sub(r"(?<![A-Za-zА-яЁё])(µm|mm|m|MO|NW|tan)(?![A-Za-zА-яЁё])",
+                      lambda m: _RU[m[1]], text)  # fmt: skip
+    return re.sub(r"(?<=[^\s_])_(?=[^\s_])", "", text)
+
+
 def _at(value: float, decimals: int) -> str:
     """A signed reading at the least count, by plain formatting (sign as the book prints it)."""
     text = f"{abs(value):.{decimals}f}"
@@ -60,13 +73,14 @@ def _readings_to_set(sheet, lang: str):
     """(row, text) of every reading of stages 1–5 at the shipped least counts: 0.01 mm on the
     counters and scales, 0.1 m on the height scale."""
     decimals = {"mm": 2, "m": 1}
+    sides = rigorous_sides(sheet)
     for r in sheet.readings:
         if r["reading"] == "residual q":
             continue
         name = r["reading"].replace("corner", TERMS["corner"][lang])
-        value = _at(r["value"], decimals[r["unit"]])
-        yield r, (f"{name} = {r['zero_reading']} {value} {r['unit']}" if r["zero_reading"]
-                  else f"{name} = {value[2:]} {r['unit']}")  # fmt: skip
+        value = _at(value_to_set(sheet, r, sides)[0], decimals[r["unit"]])
+        yield r, _printed(f"{name} = {zero_of(r)} {value} {r['unit']}" if r["zero_reading"]
+                          else f"{name} = {value[2:]} {r['unit']}", lang)  # fmt: skip
 
 
 @pytest.mark.parametrize("lang", ["ru", "en"])
@@ -81,8 +95,8 @@ def test_every_reading_is_printed_at_its_least_count(forms, job, lang):
     for r, expected in _readings_to_set(p.sheet, lang):
         assert expected in flat, expected
         assert r["formula"] not in forms[lang][2][1], r  # no 0.001 mm to set
-    assert "0.01 mm *" in flat and "0.1 m *" in flat
-    assert f"{TERMS['least_count'][lang]}:" in forms[lang][2][0]
+    assert _printed("0.01 mm *", lang) in flat and _printed("0.1 m *", lang) in flat
+    assert f"{TERMS['least_count'][lang]}:" in flat
 
 
 @pytest.mark.parametrize("lang", ["ru", "en"])
@@ -91,10 +105,13 @@ def test_gear_zero_readings_corrections_stage5_and_signatures(forms, job, lang):
     s = p.sheet
     flat = _flat(forms, lang)
     r = s.horizontal_scale_denominator / s.map_scale_denominator  # 12500 / 10000
-    assert f"r = {r:g} (M_г = r·M_map, 1:{s.map_scale_denominator})" in forms[lang][2][0]
+    gear = f"r = {r:g} (M_г = r·M_map, 1:{s.map_scale_denominator})"
+    assert _printed(gear, lang).replace("map", "карты" if lang == "ru" else "map") in flat
     assert r == 1.25 and r in result.spec.coordinatograph_ratios
-    for mo in ("MO_X", "MO_Y", "MO_Z", "MO_bx", "MO_by", "MO_bz", "MO_dx", "MO_dy"):
-        assert f"{mo} = ________" in flat, mo
+    for mo in ("MO_X", "MO_Y", "MO_Z", "MO_bx", "MO_by", "MO_bz", "MO_dx,л", "MO_dy,л",
+               "MO_dx,п", "MO_dy,п"):  # each projector its own decentration zeros
+        assert _printed(f"{mo} = ________", lang) in flat, mo
+    assert _printed("MO_dx = ", lang) not in flat
     # (6.9)-(6.11): D = n_л·f_пр = D_max (6.3); the factors the operator multiplies ΔL by, with
     # the L stage 1 compares with (units at zero: L⁰ of the measured marks)
     d = result.spec.projection_distance_max_mm
@@ -105,25 +122,25 @@ def test_gear_zero_readings_corrections_stage5_and_signatures(forms, job, lang):
         f"{d / left.mark_span_at_zero_mm:.5f}", f"{d / right.mark_span_at_zero_mm:.5f}",
         "O′_bz = O_bz + Δb_z",
     ):  # fmt: skip
-        assert expected in flat, expected
+        assert _printed(expected, lang) in flat, expected
     # stage 5: every plan control and check point with its x′, y′ readings
     points = [q for q in s.points_model_mm if q["role"] == "check" or q["kind"] != "height"]
     assert {q["role"] for q in points} == {"control", "check"}
     for q in points:
         role = TERMS["check_point" if q["role"] == "check" else "plan_control"][lang]
-        assert (
-            f"{q['id']} {role} O_X = MO_X {_at(q['x_mm'], 2)} O_Y = MO_Y {_at(q['y_mm'], 2)}"
-        ) in flat, q
+        assert _printed(
+            f"{q['id']} {role} O_X = MO_X {_at(q['x_mm'], 2)} O_Y = MO_Y {_at(q['y_mm'], 2)}",
+            lang) in flat, q
     for key in ("signatures", "operator", "checker", "name", "signature", "date"):
         assert TERMS[key][lang] in flat, key
 
 
 def test_russian_form_uses_the_books_terms_and_embeds_cyrillic(forms):
     _data, reader, pages = forms["ru"]
-    for expected in ("Установочные данные (Таблица 24) — стереопара 101-102", "n_л, n_п", "f_пр",
+    for expected in ("Установочные данные (Таблица 24) — стереопара 101-102", "nл, nп", "fпр",
                      "горизонтальный масштаб модели", "Места нуля МО", "исполнитель",
                      "Пределы метода"):  # fmt: skip
-        assert expected in pages[0] + pages[1] + pages[2] + pages[3], expected
+        assert expected in " ".join(pages), expected
     assert "Setup data" not in " ".join(pages)
     assert "Setup data (Table 24) — stereopair 101-102" in forms["en"][2][0]
     assert not re.search("[А-Яа-яЁё]{4,}", re.sub(r"N-35-14-А-а-4|СЦ-1|[a-zA-Z_]+[лп]\b", "",
@@ -150,18 +167,20 @@ def _texts(page) -> list[tuple[str, float, float, float]]:
     return runs
 
 
-def test_page_one_holds_the_readings_summary_and_the_page_count(forms, job):
-    """The readings summary ends on page 1 above the footer; strip8 gives 5 pages; a pair with
-    three times the height control still fits page 1 (the fonts shrink)."""
+def test_the_readings_summary_is_whole_on_one_page_and_the_page_count(forms, job):
+    """The readings summary (one row per stage) is on one page, whole, after Table 24 (on
+    page 1 or at the top of page 2); strip8 gives 6 pages in either language; a pair with
+    three times the height control still prints every stage-3 reading."""
     result, p = job
-    for lang in ("ru", "en"):
+    for lang, count in (("ru", 6), ("en", 6)):
         reader = forms[lang][1]
-        assert len(reader.pages) == 5
-        runs = _texts(reader.pages[0])
-        stage5 = [y for t, _, y, _ in runs if t.startswith(TERMS["stage_5"][lang][:5])]
-        assert stage5 and max(stage5) < A4_HEIGHT_MM - MARGIN_BOTTOM
-        assert TERMS["stage_5"][lang].split(" · ")[0] + " ·" in forms[lang][2][0]
-        assert TERMS["stage_1"][lang] not in forms[lang][2][1]
+        assert len(reader.pages) == count
+        holding = [i for i, text in enumerate(forms[lang][2])
+                   if TERMS["readings_summary"][lang] in text]  # fmt: skip
+        assert holding in ([0], [1])
+        page = forms[lang][2][holding[0]]
+        for stage in range(1, 6):
+            assert TERMS[f"stage_{stage}"][lang] in page, stage
     heights = tuple(_renamed(h, "id", k) for k in range(3) for h in p.sheet.control_heights)
     stage3 = [r for r in p.sheet.readings if r["stage"] == 3]
     readings = (*(r for r in p.sheet.readings if r["stage"] < 3),
@@ -169,8 +188,9 @@ def test_page_one_holds_the_readings_summary_and_the_page_count(forms, job):
                 *(r for r in p.sheet.readings if r["stage"] > 3))  # fmt: skip
     sheet = replace(p.sheet, control_heights=heights, readings=readings)
     data = form_pdf(sheet, form_header(result.job, p, result.spec, "ru"), "ru")
-    page1 = re.sub(r"\s+", " ", pypdf.PdfReader(io.BytesIO(data)).pages[0].extract_text())
-    assert "5 · угол 4" in page1 and "O_Z25c" in page1
+    flat = re.sub(r"\s+", " ", " ".join(q.extract_text() for q in pypdf.PdfReader(
+        io.BytesIO(data)).pages))  # fmt: skip
+    assert "5 · угол 4" in flat and "OZ25c" in flat
 
 
 def _renamed(row: dict, key: str, k: int) -> dict:
@@ -179,12 +199,15 @@ def _renamed(row: dict, key: str, k: int) -> dict:
 
 
 def _label_boxes(page) -> list[tuple[str, float, float, float, float]]:
-    """The drawing's labels (7 pt, above the footer) with their boxes in mm: advance width from
-    the font's metrics, ascent 0.8 and descent 0.25 of the size."""
+    """The drawing's labels (8 pt, inside the drawing's 150 mm frame under its 10.5 pt heading;
+    a subscript a run of its own) with their boxes in mm: advance width from the font's
+    metrics, ascent 0.8 and descent 0.25 of the size."""
     widths = Form("2026-01-01")
     boxes = []
-    for text, x, y, size in _texts(page):
-        if size != 7 or y > A4_HEIGHT_MM - MARGIN_BOTTOM:  # the labels, not the footer
+    runs = _texts(page)
+    top = max((y for _, _, y, size in runs if size == 10.5), default=A4_HEIGHT_MM)
+    for text, x, y, size in runs:
+        if size != 8 or not top < y < top + 155 or y > A4_HEIGHT_MM - MARGIN_BOTTOM:
             continue
         widths.set_font(FONT, "", size)
         h = size * PT
@@ -206,8 +229,8 @@ def _overlapping(boxes) -> list[tuple]:
 def test_drawing_labels_do_not_overlap(forms):
     """The text boxes of the drawing's labels pairwise do not overlap (pair 101-102, where the
     labels of 16 and K1 ran together before)."""
-    boxes = _label_boxes(forms["en"][1].pages[4])
-    assert {"11", "16", "K1", "S_л", "S_п", "4 (NW)"} <= {b[0] for b in boxes}
+    boxes = _label_boxes(forms["en"][1].pages[-1])
+    assert {"11", "16", "K1", "S", "4 (NW)"} <= {b[0] for b in boxes}
     assert _overlapping(boxes) == []
 
 
@@ -222,15 +245,25 @@ def test_book_limits_warned_and_rigorous_values_on_request(forms, job):
     diff = left.mark_span_mm - rig
     assert abs(diff) > s.tolerances["mark_span_mm"] == pytest.approx(0.03 / s.n_left)
     assert "ВНИМАНИЕ" in forms["ru"][2][0] and "WARNING" in forms["en"][2][0]
-    assert f"L_л (6.5) {left.mark_span_mm:.3f} {rig:.3f} {diff * 1000:+.1f} µm" in _flat(
+    assert f"Lл (6.5) {left.mark_span_mm:.3f} {rig:.3f} {diff * 1000:+.1f} µm" in _flat(
         forms, "en"
     )
     data = form_pdf(s, form_header(result.job, p, result.spec, "en"), "en", rigorous=True)
     pages = [re.sub(r"\s+", " ", q.extract_text()) for q in pypdf.PdfReader(io.BytesIO(data)).pages]
-    assert f"L_л = {rig:.2f} mm (book: {left.mark_span_mm:.2f}) 0.01 mm * (3.17)" in pages[1]
+    flat = " ".join(pages)
+    assert f"Lл = {rig:.2f} mm (book: {left.mark_span_mm:.2f}) 0.01 mm * (3.17)" in flat
     y3 = s.n_left * left.transformed_rigorous_mm["3"][1]
-    assert f"O_Y3,л = MO_Y {_at(y3, 2)} mm (book:" in pages[1]
-    assert f"L_л = {rig:.2f} mm" in pages[0]
+    assert f"OY3,л = MOY {_at(y3, 2)} mm (book:" in flat
+    right = s.photos[1]  # within its tolerance, yet rigorous as asked
+    y3 = s.n_right * right.transformed_rigorous_mm["3"][1]
+    assert f"OY3,п = MOY,п {_at(y3, 2)} mm (book:" in flat
+    # by default only the photo whose book values leave their tolerance: the left
+    flat = _flat(forms, "en")
+    assert f"Lл = {rig:.2f} mm (book: {left.mark_span_mm:.2f}) 0.01 mm * (3.17)" in flat
+    assert f"Lп = {right.mark_span_mm:.2f} mm 0.01 mm * (6.5)" in flat
+    assert "WARNING: for the left photo the book's" in flat
+    page1 = forms["en"][2][0]  # Table 24: the span to set under the book's, the left photo's only
+    assert f"to set (3.17): Lл = {rig:.3f}" in page1 and "Lп = " not in page1
 
 
 def test_setup_command_writes_the_same_bytes_in_ru(forms, tmp_path, job):

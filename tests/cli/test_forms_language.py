@@ -36,7 +36,7 @@ def sheet():
 def test_sheet_markdown_in_russian_uses_the_books_terms(sheet):
     ru, en = sheet_markdown(sheet, "ru"), sheet_markdown(sheet, "en")
     assert en == sheet_markdown(sheet)  # English is the default
-    assert ru.startswith("# Установочные данные — pair60 на приборе СЦ-1")
+    assert ru.startswith("# Установочные данные — pair60, стереограф СЦ-1")
     for expected in ("## Таблица 24", "| фокусное расстояние прибора | f_пр |",
                      "| коэффициенты счётчиков | n_л, n_п |", "## Отсчёты по этапам",
                      "### Этап 2", "левый снимок: k_ω по метке 3", "**(принято)**"):  # fmt: skip

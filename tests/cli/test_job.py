@@ -18,6 +18,7 @@ from stereoplotter.cli import main
 from stereoplotter.commands.setup_job import compute_job
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import load_job, measured_pair
+from stereoplotter.report.form_fields import rigorous_sides, value_to_set
 from stereoplotter.report.job import pair_dict
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import (
@@ -28,6 +29,12 @@ from stereoplotter.setup.sheet import (
 ROOT = Path(__file__).resolve().parents[2]
 JOB = ROOT / "jobs" / "strip8" / "job.yaml"
 PAIRS = ["101-102", "102-103", "103-104", "104-105", "105-106", "106-107", "107-108", "108-109"]
+
+
+@pytest.fixture(scope="module")
+def sheets():
+    """Each pair's sheet by name (which values the form gives to set: book or (3.17))."""
+    return {p.pair.name: p.sheet for p in compute_job(load_job(JOB)).pairs}
 
 
 @pytest.fixture(scope="module")
@@ -100,7 +107,7 @@ def test_f_prime_is_from_the_measured_fiducial_distances(written):
     assert 69.9960 < expected < 69.9982
 
 
-def test_pdf_text_has_header_photo_numbers_and_readings(written):
+def test_pdf_text_has_header_photo_numbers_and_readings(written, sheets):
     sheet = yaml.safe_load((written / "104-105" / "sheet.yaml").read_text("utf-8"))
     reader = pypdf.PdfReader(written / "104-105" / "sheet.pdf")
     text = "\n".join(page.extract_text() for page in reader.pages)
@@ -113,7 +120,7 @@ def test_pdf_text_has_header_photo_numbers_and_readings(written):
         "СЦ-1 (SC-1)",
         "2026-11-24 (from the job file)",
         f"stereoplotter {__version__}",
-        "gears.coordinatograph_ratios",  # an assumed parameter
+        "gears.coordinatograph_ratios",  # an assumed parameter, printed as its key
         f"1:{sheet['scale_horizontal']}",
         f"{sheet['f_instrument_mm']:.3f}",
         f"{sheet['base_mm']['bx']:.3f}",
@@ -123,7 +130,7 @@ def test_pdf_text_has_header_photo_numbers_and_readings(written):
     readings = sheet["readings"]
     assert len(readings) >= 30
     for r in readings:  # every stage reading (6.9)–(6.18), at its least count (test_forms.py)
-        assert _at_least_count(r) in flat, r["formula"]
+        assert _at_least_count(r, sheets["104-105"]) in flat, r["formula"]
     for corner in sheet["sheet_corners_mm"].values():
         assert f"{corner['x']:.3f}, {corner['y']:.3f}" in flat
     for z in sheet["control_heights_model_mm"].values():
@@ -131,12 +138,12 @@ def test_pdf_text_has_header_photo_numbers_and_readings(written):
 
 
 @pytest.mark.parametrize("pair", PAIRS)
-def test_first_page_has_header_table24_and_every_reading(written, pair):
-    """Page 1 alone (what the acceptance renders): the header, the Table 24 values and every
-    stage reading (6.9)–(6.18) as sheet.yaml has it."""
+def test_first_page_has_header_table24_and_every_reading(written, sheets, pair):
+    """Page 1 and the summary after it (on page 1 or at the top of page 2, whole): the header,
+    the Table 24 values and every stage reading (6.9)–(6.18) as sheet.yaml has it."""
     sheet = yaml.safe_load((written / pair / "sheet.yaml").read_text("utf-8"))
     reader = pypdf.PdfReader(written / pair / "sheet.pdf")
-    flat = re.sub(r"\s+", " ", reader.pages[0].extract_text())
+    flat = re.sub(r"\s+", " ", reader.pages[0].extract_text() + reader.pages[1].extract_text())
     left, right = pair.split("-")
     for expected in (
         f"Setup data (Table 24) — stereopair {pair}",
@@ -150,7 +157,7 @@ def test_first_page_has_header_table24_and_every_reading(written, pair):
     ):
         assert expected in flat, expected
     for r in sheet["readings"]:
-        assert _at_least_count(r) in flat, r["formula"]
+        assert _at_least_count(r, sheets[pair]) in flat, r["formula"]
     for corner in sheet["sheet_corners_mm"].values():  # sheet.yaml keeps 6 decimals: ±1e-6
         assert any(f"{_3(corner['x'], dx)}, {_3(corner['y'], dy)}" in flat
                    for dx in (-1, 1) for dy in (-1, 1)), corner  # fmt: skip
@@ -158,12 +165,14 @@ def test_first_page_has_header_table24_and_every_reading(written, pair):
         assert _3(z, -1) in flat or _3(z, 1) in flat
 
 
-def _at_least_count(r: dict) -> str:
+def _at_least_count(r: dict, sheet) -> str:
     """A reading's value as the form sets it: 0.01 mm on the counters and scales, 0.1 m on the
-    height scale (sc1.yaml); the residual q is a bound, printed as sheet.yaml has it."""
+    height scale (sc1.yaml); the residual q is a bound, printed as sheet.yaml has it. A mark
+    target or span of a photo whose book values leave their tolerance is set from (3.17)."""
     if r["reading"] == "residual q":
         return re.sub(r"\s+", " ", r["formula"])
-    return f"{abs(r['value']):.{2 if r['unit'] == 'mm' else 1}f} {r['unit']}"
+    value = value_to_set(sheet, r, rigorous_sides(sheet))[0]
+    return f"{abs(value):.{2 if r['unit'] == 'mm' else 1}f} {r['unit']}"
 
 
 def _3(value: float, side: int) -> str:

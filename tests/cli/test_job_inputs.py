@@ -122,7 +122,8 @@ def test_unquoted_number_with_a_leading_zero_is_refused(tmp_path, capsys, text, 
     line = _error(capsys)
     assert f'job.yaml: {field}: expected an identifier as text: quote it ("{shown}")' in line
     lineno = next(i for i, t in enumerate(path.read_text("utf-8").splitlines(), 1) if text in t)
-    assert f"found {shown} unquoted (line {lineno}, column" in line
+    assert f"found {shown} unquoted, read as the " in line
+    assert f"(line {lineno}, column" in line
     assert not (tmp_path / "out").exists()
 
 

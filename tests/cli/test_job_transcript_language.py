@@ -5,8 +5,8 @@ the one glossary (``stereoplotter.glossary``).
 "No untranslated English sentence" is checked line by line: with the control identifiers
 (``kappa_right``, ``k_alpha_left``: names of the instrument's controls, the same in both
 languages) and ``tan`` (the scale unit) taken out, a line holds no Latin word of three letters
-or more, and no two Latin words in a row; the symbols of the book (``MO_X``, ``b_x``, ``f_пр``,
-``C3``, ``R2``) and the units (``mm``, ``µm``, ``m``) pass.
+or more, and no two Latin words in a row; the symbols of the book (``b_x``, ``f_пр``, ``C3``,
+``R2``) pass, and the units are Russian (мм, мкм, м: no line holds mm, µm or m).
 """
 
 from __future__ import annotations
@@ -50,6 +50,8 @@ def _check(text: str, records: list[dict]) -> None:
     assert all(re.search("[а-яА-Я]", line) for line in numbered)
     left = {line: words for line in lines if (words := _english(line, controls))}
     assert left == {}
+    units = re.compile(r"(?<![A-Za-z_])(mm|µm|m)(?![A-Za-z_])")  # Russian: мм, мкм, м
+    assert [line for line in lines if units.search(line)] == []
 
 
 def test_russian_transcript_of_strip8_first_pair(tmp_path: Path) -> None:
