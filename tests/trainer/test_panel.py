@@ -59,10 +59,10 @@ def test_the_overview_places_the_points_and_the_mark_on_the_photos(e07):
     assert mark["diameter_mm"] == e07.exercise.spec.mark_diameter_mm
 
 
-def test_the_checklist_ticks_a_step_when_its_controls_are_used():
+def test_the_checklist_ticks_a_step_when_its_target_is_met():
     s = Session.start(load_exercise("e01-setup-stage1"), trainee="ann")
     first = checklist(s)["steps"][0]
-    assert first["rule"] == "controls" and not first["done"]
+    assert first["rule"] == "target" and not first["done"]
     for action in show_me_actions(s)[:2]:  # the operator's own first two: f_пр and the gear
         s.act(action)
     c = checklist(s)
