@@ -74,8 +74,8 @@ from stereoplotter.trainer.step_words import step_words
 __all__ = [
     "MOVER_TEXT",
     "NEAR_MM",
-    "SHOWN",
     "SHEET_PARTS",
+    "SHOWN",
     "checklist",
     "checklist_ticks",
     "coupled_motion",
