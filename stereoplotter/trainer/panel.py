@@ -231,14 +231,17 @@ def step_rules(par: Any, stage: str) -> list[dict[str, Any]]:
         elif kind == "set" and isinstance(action.get("value"), (int, float)):
             entry["targets"][name] = float(action["value"])
     out = []
+    looked: set[str] = set()  # controls set by looking: later values are relative to them
     for entry in steps.values():
         named = _NAMED.search(entry["text"])
         judged = bool(_JUDGED.search(entry["text"]))
         measuring = any(c in ("X", "Y") for c in entry["reads"])
+        if judged or measuring:
+            looked.update(entry["needs"])
         entry["targets"] = {
             c: v
             for c, v in entry["targets"].items()
-            if not judged and not measuring and c not in ("X", "Y")
+            if not judged and not measuring and c not in ("X", "Y") and c not in looked
         }
         clears = _CLEARS_AT.search(entry["text"])
         entry["conditional"] = bool(_CONDITIONAL.search(entry["text"]))

@@ -1,0 +1,113 @@
+"""The trainee's own stereo acuity: an adaptive staircase on x-parallax (depth: which of two marks
+is nearer) and on visible y-parallax (which way the right image is offset across the base).
+
+The page shows the stimulus, the trainee answers; the staircase sets the next disparity. The
+rule (Kaernbach's weighted up-down): after a right answer the disparity is divided by
+:data:`STEP`, after a wrong one multiplied by ``STEP**3``: it settles where right answers are
+three in four (P = 0.75). The judgement is taken as eye.py reads the textbook's acuity: a
+sign judgement with Gaussian error, P(right | s) = Φ(s/σ), the acuity the σ (the 84 % point);
+so σ = s₇₅ / Φ⁻¹(0.75). The estimate is the geometric mean of the disparities at the
+reversals after the first :data:`DISCARD`; its standard error (relative) the standard deviation
+of their logarithms over √(reversals/4): neighbouring reversals are not independent, and the
+divisor is the one that makes the stated error the spread of the estimate over runs of a
+simulated observer (``tests/trainer/test_acuity.py``: about 39 trials a run, ±44 % in σ).
+
+A disparity on the screen is an angle at the eye: s_px · pixel pitch / viewing distance; the
+result in µm of photo at a magnification V is ``procedure.eye.angle_to_photo_mm`` (eye 1,
+referred to 250 mm). Pure numpy; the page runs the same rule (``static/acuity.js``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from stereoplotter.procedure.eye import DEFAULT_VIEWING_DISTANCE_MM, angle_to_photo_mm
+
+__all__ = [
+    "ACUITY_RECORDS",
+    "DISCARD",
+    "MAGNIFICATIONS",
+    "REVERSALS",
+    "STEP",
+    "Z75",
+    "Staircase",
+    "photo_um",
+    "simulated_observer",
+]
+
+#: Down step (a ratio) after a right answer; a wrong answer goes up by STEP³. [—]
+STEP = 1.25
+#: Reversals that end a run, and the first ones left out of the estimate (the approach).
+REVERSALS = 12
+DISCARD = 3
+#: Trials at most (a run that does not settle ends here). [—]
+MAX_TRIALS = 100
+#: Φ⁻¹(0.75): the 75 % point of Φ(s/σ) in σ. [—]
+Z75 = 0.6744897501960817
+#: Magnifications the result is given at (the page's eyepiece ×2 … ×20). [×]
+MAGNIFICATIONS = (2.0, 6.0, 20.0)
+#: Session-log record names the page writes the result under → the instructor's column.
+ACUITY_RECORDS = {
+    "stereo acuity x (arcsec)": "x_arcsec",
+    "stereo acuity y (arcsec)": "y_arcsec",
+}
+
+
+@dataclass
+class Staircase:
+    """One run: ``level`` the disparity to show next [″]; :meth:`answer` the trainee's answer."""
+
+    start: float
+    floor: float = 0.5
+    ceiling: float = 3600.0
+    level: float = field(init=False)
+    trials: int = field(default=0, init=False)
+    reversal_levels: list[float] = field(default_factory=list, init=False)
+    _last: int = field(default=0, init=False)  # +1 going up, −1 going down
+
+    def __post_init__(self) -> None:
+        self.level = float(self.start)
+
+    @property
+    def done(self) -> bool:
+        return len(self.reversal_levels) >= REVERSALS or self.trials >= MAX_TRIALS
+
+    def answer(self, right: bool) -> None:
+        self.trials += 1
+        move = -1 if right else 1
+        if self._last and move != self._last:
+            self.reversal_levels.append(self.level)
+        self._last = move
+        self.level *= STEP ** -1 if right else STEP**3
+        self.level = min(max(self.level, self.floor), self.ceiling)
+
+    def estimate(self) -> tuple[float, float]:
+        """(σ [″], its relative standard error): see the module docstring."""
+        used = np.log(np.asarray(self.reversal_levels[DISCARD:], float))
+        if used.size < 2:
+            return math.nan, math.nan
+        s75 = float(np.exp(used.mean()))
+        se = float(used.std(ddof=1) / math.sqrt(used.size / 4.0))
+        return s75 / Z75, se
+
+
+def simulated_observer(sigma: float, rng: np.random.Generator):
+    """An observer whose judgement at disparity s is right with probability Φ(s/σ)."""
+
+    def judge(level: float) -> bool:
+        return bool(level / sigma + rng.standard_normal() > 0.0)
+
+    return judge
+
+
+def photo_um(
+    arcsec: float, magnifications=MAGNIFICATIONS, viewing_distance_mm=DEFAULT_VIEWING_DISTANCE_MM
+) -> dict[str, float]:
+    """An acuity at the eye as µm on the photo at each magnification (eye 1). [µm]"""
+    return {
+        f"{m:g}": angle_to_photo_mm(arcsec, m, viewing_distance_mm) * 1000.0
+        for m in magnifications
+    }
