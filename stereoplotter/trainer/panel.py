@@ -365,7 +365,8 @@ def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
     for entry in rules:
         if entry["rule"] == "target":
             ok = _target_met(session, entry["targets"])
-            if not ok and entry["corrected"] and not fails:
+            touched = all(c in used for c in entry["corrected"]) or SHOWN in used
+            if not ok and entry["corrected"] and touched and not fails:
                 ok = _target_met(session, entry["targets"], frozenset(entry["corrected"]))
         elif entry["rule"] == "parallax":
             n = entry["clears_point"]

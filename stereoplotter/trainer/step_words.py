@@ -86,6 +86,22 @@ SHEET_ROWS: dict[str, tuple[str, str, str]] = {
     "connect": ("interior", "scale_map", "ratio M_г/M_map"),
 }
 
+#: A sheet row is named for a control only where the step sets that control to the sheet's
+#: value, as its text says (a step to the places of zero, or one finding a place of zero by
+#: looking, takes nothing from the sheet).
+_MENTION: dict[str, str] = {
+    "f_instrument": r"f_пр",
+    "gear": r"M_в",
+    "bx": r"O_bx|b_x of the sheet",
+    "by": r"O_by",
+    "bz": r"O_bz|O′_bz",
+    "Z": r"= n_л·f_пр",
+    "connect": r"coordinatograph",
+    **{c: rf"\({c}\)" for c in ("dx_left", "dy_left", "dx_right", "dy_right")},
+    **{c: rf"\({c}\)" for c in ("k_alpha_left", "k_omega_left", "k_alpha_right", "k_omega_right")},
+}
+_NO_SHEET = re.compile(r"zero place|^MO_")
+
 _W = r"(?<![\w\u0400-\u04FF])"  # not inside a longer word (Latin or Cyrillic)
 _E = r"(?![\w\u0400-\u04FF])"
 #: Symbol of :data:`SYMBOLS` → the pattern (JavaScript and Python alike) the page finds it by.
@@ -162,7 +178,10 @@ def step_words(session: Any, entry: dict[str, Any], given: list[str]) -> dict[st
     sheet gives that part (``given``: the parts the exercise's sheet gives)."""
     names = [CONTROL_NAMES.get(c, c) for c in entry["controls"]]
     rows = []
+    text = entry["text"]
     for c in [*entry["needs"], *entry["targets"]]:
+        if _NO_SHEET.search(text) or not re.search(_MENTION.get(c, "^$"), text):
+            continue
         if c in SHEET_ROWS and SHEET_ROWS[c][0] in given:
             part, key, use = SHEET_ROWS[c]
             row = {"control": CONTROL_NAMES.get(c, c), "part": part, "key": key, "use": use}

@@ -110,3 +110,10 @@ def test_a_symbol_is_not_found_inside_a_longer_word():
     assert not re.search(SYMBOL_PATTERNS["D"], "D_max and DEM")
     assert not re.search(SYMBOL_PATTERNS["C2"], "C24")
     assert re.search(SYMBOL_PATTERNS["D"], "D = n·f_пр")
+
+
+def test_nothing_is_ticked_for_a_control_never_set(e01):
+    ticks = dict(zip((st["text"] for st in checklist(e01)["steps"]),
+                     e01.state()["checklist_ticks"]["done"], strict=True))
+    assert not ticks["set the instrument principal distance f_пр"]
+    assert not next(v for t, v in ticks.items() if t.startswith("lower the carriage"))

@@ -6,6 +6,7 @@ import { Wheels, LABELS, decimals } from "./wheels.js";
 import { el, sessionKey } from "./dom.js";
 import { buildActions, describe, parseCommand, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
 import { Overview } from "./overview.js";
+import { loadGlossary, glossaryBox, withTerms, termEl, names } from "./words.js";
 
 const sid = location.pathname.split("/").pop();
 const key = sessionKey.get(sid);
@@ -142,6 +143,7 @@ function drawEyes() {
     else { ctx.drawImage(off[flickerSide], 0, 0); }
   }
   if (overview) overview.draw(marks, mag);
+  zoomNote(marks, mag);
   window.__frames = (window.__frames || 0) + 1;
 }
 setInterval(() => {
@@ -209,9 +211,10 @@ function drawStage() {
   $("mode").className = `badge ${hello.demonstration ? "demonstration" : state.mode}`;
   const ul = $("checks"); ul.replaceChildren();
   for (const ch of state.checks) {
-    const li = document.createElement("li");
-    li.textContent = `${ch.name}: tolerance ${ch.tolerance === null ? "—" : ch.tolerance.toPrecision(3)} ${ch.unit}`;
-    ul.appendChild(li);
+    const lc = ch.unit === "mm" && state.counters.X ? state.counters.X.least_count : null;
+    const fine = lc && ch.tolerance !== null && ch.tolerance < 2 * lc
+      ? ` — finer than the counters show (least count ${lc} mm): judge it in the eyepieces` : "";
+    ul.appendChild(termEl("li", {}, `${ch.name}: tolerance ${ch.tolerance === null ? "—" : ch.tolerance.toPrecision(3)} ${ch.unit}${fine}`));
   }
   const allowed = new Set(state.allowed);
   const demo = hello.demonstration;
@@ -264,7 +267,7 @@ function handle(msg) {
     scale.formatMm = hello.format_mm;
     $("who").textContent = `${hello.trainee} · ${hello.exercise}`;
     $("title").textContent = "Stereoplotter trainer";
-    $("instructions").textContent = hello.description;
+    $("instructions").replaceChildren(...withTerms(hello.description));
     waiting.clear();
     buildActions($("actions"), hello.actions || [], Object.keys(msg.state.controls), send, message);
     loadOverview();
@@ -279,22 +282,50 @@ function handle(msg) {
   else if (!msg.hello) message("");
   if (!msg.hello && !msg.error) {
     showResult($("result"), action, msg.result);
+    afterClaim(action, msg.result);
+    if (action && action.kind === "record") message(`recorded: ${describe(action)} (kept in your session's record)`);
     showCoupled($("coupled"), action, before, msg.state, msg.state && msg.state.events);
   }
   if (msg.demo) $("demo-count").textContent = `${msg.demo.done} / ${msg.demo.of}`;
   if (msg.seq !== undefined && waiting.has(msg.seq)) { waiting.get(msg.seq)(performance.now()); waiting.delete(msg.seq); }
   document.body.dataset.ready = "1";
 }
+await loadGlossary();
+Object.assign(LABELS, names.controls);
+glossaryBox($("term-box"));
 if (key) connect();
 else {
   message("this browser holds no key for this session: start a session from the exercises page", "error");
   document.body.dataset.ready = "1";
 }
 
-$("claim").onclick = () => send({ kind: "claim", step: state.stage });
+// In practice a claim is checked first: a failing check is named with the likely wrong setting,
+// and the trainee may fix it before claiming (or claim anyway).
+$("claim").onclick = async () => {
+  if (!state || hello.demonstration) return;
+  if (state.mode === "practice") {
+    const fb = await feedbackOf("now");
+    if (fb && !fb.passed) {
+      showFeedback(fb, "Before you claim:", [
+        ["Fix it first", () => { $("feedback").hidden = true; }],
+        ["Claim anyway", () => { $("feedback").hidden = true; send({ kind: "claim", step: state.stage }); }],
+      ]);
+      return;
+    }
+  }
+  send({ kind: "claim", step: state.stage });
+};
 $("undo").onclick = () => send({ kind: "undo" });
 $("redo").onclick = () => send({ kind: "redo" });
-for (const b of $("hints").querySelectorAll("button")) b.onclick = () => send({ kind: "hint", level: Number(b.dataset.level) });
+for (const b of $("hints").querySelectorAll("button[data-level]")) {
+  b.onclick = () => {
+    const level = Number(b.dataset.level);
+    if (level < 3) { send({ kind: "hint", level }); return; }
+    confirmBox(`Hint 3: the simulated operator does the whole of stage ${state.stage} on your instrument at once `
+      + `(${words ? words.show_me_actions : "its"} actions), and it costs ${hintCost(3)}. `
+      + "Your own settings of the stage are replaced by the operator's.", () => send({ kind: "hint", level: 3 }));
+  };
+}
 $("command").addEventListener("keydown", (e) => {
   if (e.key !== "Enter" || !state) return;
   const names = [...Object.keys(withHeightScale(state)), ...Object.keys(state.counters)];
@@ -308,8 +339,13 @@ let playing = null, showing = null;
 // "Show me", animated: the operator's actions of the stage sent one by one at the chosen speed
 // (the eyepieces, wheels and counters move as they go), then hint 3 logged (its cost; it
 // applies the same settings again, which the instrument already shows).
-$("show-me").onclick = async () => {
+$("show-me").onclick = () => {
   if (showing) { clearInterval(showing); showing = null; $("show-me").textContent = "Show me"; return; }
+  confirmBox(`Show me: the simulated operator does stage ${state.stage} on your instrument, one action at a time `
+    + `(${words ? words.show_me_actions : "its"} actions at the speed chosen below; Stop ends it). It costs as hint 3: `
+    + `${hintCost(3)}.`, showMe);
+};
+async function showMe() {
   const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/showme`, { headers: auth() });
   const body = await r.json();
   if (!r.ok) { message(body.error, "error"); return; }
@@ -326,7 +362,7 @@ $("show-me").onclick = async () => {
     $("show-me-count").textContent = `show me ${i} / ${actions.length}: ${describe(a)}`;
     send(a);
   }, 1000 / Number($("demo-speed").value));
-};
+}
 $("demo-step").onclick = sendDemo;
 function play() {
   if (playing) clearInterval(playing);
@@ -347,11 +383,13 @@ async function tickChecklist(ticks) {
     checklistFor = ticks.stage;
     const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/checklist`, { headers: auth() });
     checklist = r.ok ? await r.json() : null;
+    loadWords();
   }
   if (!checklist || checklist.stage !== ticks.stage) return;
-  checklist.steps.forEach((s, i) => { s.done = !!ticks.done[i]; });
-  checklist.done = ticks.done.filter(Boolean).length;
-  showChecklist($("checklist"), checklist);
+  checklist.steps.forEach((s, i) => { s.done = !!ticks.done[i]; s.shown = ticks.shown ? !!ticks.shown[i] : true; });
+  checklist.done = checklist.steps.filter((s) => s.shown && s.done).length;
+  checklist.total = checklist.steps.filter((s) => s.shown).length;
+  showChecklist($("checklist"), checklist, sheetData);
   $("checklist-count").textContent = `${checklist.done} / ${checklist.total}`;
 }
 
@@ -362,6 +400,7 @@ async function loadOverview() {
   const data = await r.json();
   if (!r.ok) { $("overview-note").textContent = data.error; return; }
   overview = new Overview($("overview-svg"), (xy) => {
+    if ($("click-mode").value === "drive") { goTo({ x: xy[0], y: xy[1] }); return; }
     const n = $("substitute-for").value;
     if (!n) { $("overview-note").textContent = "no standard point of this exercise needs a substitute"; return; }
     send({ kind: "record", name: `substitute ${n}`, value: xy });
@@ -371,6 +410,8 @@ async function loadOverview() {
     ? data.photos.left.standard_points.filter((p) => p.usable === false).map((p) => p.id) : data.unusable || [];
   $("substitute-for").replaceChildren(...unusable.map((n) => el("option", { value: String(n), text: String(n) })));
   $("overview-note").textContent = unusable.length ? `unusable: ${unusable.join(", ")} (on water or outside the overlap)` : "";
+  if (unusable.length) $("click-mode").value = "substitute";
+  overviewData = data;
   document.body.dataset.overview = "1";
   drawEyes();
 }
@@ -412,3 +453,85 @@ window.trainer = {
     return new Promise((res) => waiting.set(s, (t) => requestAnimationFrame(() => res(t - t0))));
   },
 };
+
+// --- words, feedback, navigation ------------------------------------------------------------
+let words = null, sheetData = null, overviewData = null;
+async function loadWords() {
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/words`, { headers: auth() });
+  if (r.ok) words = await r.json();
+  for (const b of $("hints").querySelectorAll("button[data-level]")) {
+    b.title = `hint ${b.dataset.level}: costs ${hintCost(Number(b.dataset.level))} (the highest level asked in a stage counts)`;
+  }
+  if (!sheetData) {
+    const s = await fetch(`/api/sessions/${encodeURIComponent(sid)}/sheet`, { headers: auth() });
+    if (s.ok) { sheetData = await s.json(); if (checklist) showChecklist($("checklist"), checklist, sheetData); }
+  }
+}
+function hintCost(level) {
+  const p = words && words.hint_points ? words.hint_points[String(level)] : null;
+  return p === null || p === undefined ? "a part of the points" : `${p} of the exercise's 100 points`;
+}
+
+function confirmBox(text, yes) {
+  const box = $("confirm");
+  box.replaceChildren(termEl("p", {}, text), el("div", { class: "row" },
+    el("button", { class: "primary", id: "confirm-yes", text: "Yes, do it", onclick: () => { box.hidden = true; yes(); } }),
+    el("button", { id: "confirm-no", text: "Cancel", onclick: () => { box.hidden = true; } })));
+  box.hidden = false;
+}
+
+async function feedbackOf(which) {
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/feedback?stage=${which}`, { headers: auth() });
+  return r.ok ? r.json() : null;
+}
+function showFeedback(fb, title, buttons) {
+  const box = $("feedback");
+  box.replaceChildren(el("b", { text: title }), ...fb.lines.map((line) => termEl("p", {}, line)));
+  if (buttons.length) box.append(el("div", { class: "row" }, ...buttons.map(([t, f]) => el("button", { text: t, onclick: f }))));
+  box.hidden = false;
+}
+// After a claim whose checks failed (practice): the likely wrong setting, and the way back.
+async function afterClaim(action, result) {
+  if (!action || action.kind !== "claim" || !result || !result.measures) return;
+  if (result.measures.every((m) => m.passed)) { $("feedback").hidden = true; return; }
+  const fb = await feedbackOf("last");
+  if (!fb) return;
+  const back = state && !state.done && (state.allowed || []).includes("undo");
+  showFeedback(fb, `Stage ${fb.stage} claimed, not within its tolerance.`, back
+    ? [["Undo the claim, fix it and claim again (an undo costs no points; the grade takes your last claim)", () => { $("feedback").hidden = true; send({ kind: "undo" }); }]]
+    : []);
+}
+
+// "Go to": the X, Y settings that put the left mark on the point, sent as the trainee's own.
+async function goTo(where) {
+  const q = where.point ? `point=${encodeURIComponent(where.point)}` : `x=${where.x}&y=${where.y}`;
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/goto?${q}`, { headers: auth() });
+  const body = await r.json();
+  if (!r.ok) { message(body.error, "error"); return; }
+  for (const a of body.actions) send(a);
+  message(`${body.actions.map(describe).join(", ")}${where.point ? ` (standard point ${where.point})` : ""}`);
+}
+for (const b of $("goto").querySelectorAll("button[data-point]")) b.onclick = () => goTo({ point: b.dataset.point });
+
+// Where the detail matching the left mark lies outside the right eyepiece's field: say so.
+function zoomNote(marks, mag) {
+  const box = $("zoom-note");
+  if (!marks || !overviewData || !overviewData.photos) { box.hidden = true; return; }
+  const L = overviewData.photos.left.standard_points, R = overviewData.photos.right.standard_points;
+  let best = null;
+  L.forEach((p, i) => {
+    const d = Math.hypot(p.x_mm - marks.left.x_mm, p.y_mm - marks.left.y_mm);
+    if (!best || d < best.d) best = { d, i };
+  });
+  const field = 256 / (scale.pxPerMmAt1x * mag); // mm of photo across an eyepiece
+  if (!best || best.d > field) { box.hidden = true; return; }
+  const p = L[best.i], r = R[best.i];
+  const want = { x: r.x_mm + (marks.left.x_mm - p.x_mm), y: r.y_mm + (marks.left.y_mm - p.y_mm) };
+  const off = Math.hypot(want.x - marks.right.x_mm, want.y - marks.right.y_mm);
+  if (off <= field / 2) { box.hidden = true; return; }
+  const fits = [2, 6, 20].filter((m) => off <= 256 / (scale.pxPerMmAt1x * m) / 2);
+  box.textContent = `At standard point ${p.id} the detail under the left mark is ${off.toFixed(2)} mm from the right mark: `
+    + `outside the right eyepiece's field at ×${mag} (${(field / 2).toFixed(2)} mm). Zoom out`
+    + (fits.length ? ` to ×${Math.max(...fits)}` : "") + " to find it, then clear the parallax and zoom in again.";
+  box.hidden = false;
+}
