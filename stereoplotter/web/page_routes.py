@@ -25,6 +25,7 @@ from stereoplotter.trainer.feedback import stage_feedback
 from stereoplotter.trainer.grade_tables import FULL_POINTS, HINT_COST
 from stereoplotter.trainer.navigation import goto_actions
 from stereoplotter.trainer.step_words import CONTROL_NAMES, SHEET_NAMES, glossary
+from stereoplotter.trainer.tour import tour_of
 from stereoplotter.web.guard import Refused
 from stereoplotter.web.routes import _instructor_only, _own_or_instructor, _web
 
@@ -58,12 +59,14 @@ def _words(session) -> dict[str, Any]:
         "stage": stage,
         "hint_points": {str(k): round(share * v, 2) for k, v in HINT_COST.items()},
         "show_me_actions": n,
+        "tour": tour_of(session.exercise.name),
     }
 
 
 async def words(request: Request) -> Response:
     """What hints cost in this exercise (points of the grade, per level) and how many actions
-    show-me plays in the stage in hand: the page says both before they run."""
+    show-me plays in the stage in hand (the page says both before they run); the exercise's
+    newcomer's tour (:mod:`stereoplotter.trainer.tour`)."""
     reg, live, _ = await _live(request)
     return JSONResponse(await _on_actor(reg, _words, live.session), headers=_NO_STORE)
 

@@ -53,6 +53,7 @@ function pump() {
 }
 
 function send(action) {
+  tourEvent(action.kind, action);
   seq += 1;
   if (!ws || ws.readyState !== WebSocket.OPEN) {
     message("not connected to the server: this action was not sent (reconnecting…)", "error");
@@ -149,7 +150,7 @@ function drawEyes() {
 setInterval(() => {
   if ($("view").value === "flicker") { flickerSide = flickerSide === "left" ? "right" : "left"; drawEyes(); }
 }, 125);
-for (const id of ["view", "colours", "mag"]) $(id).addEventListener("change", drawEyes);
+for (const id of ["view", "colours", "mag"]) $(id).addEventListener("change", () => { drawEyes(); tourEvent("mag", { value: Number($("mag").value) }); });
 
 // --- coordinatograph -----------------------------------------------------------------------
 const NS = "http://www.w3.org/2000/svg";
@@ -459,6 +460,7 @@ let words = null, sheetData = null, overviewData = null;
 async function loadWords() {
   const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/words`, { headers: auth() });
   if (r.ok) words = await r.json();
+  if (words && words.tour && words.tour.length && tourAt === null) { $("tour-btn").hidden = false; showTour(0); }
   for (const b of $("hints").querySelectorAll("button[data-level]")) {
     b.title = `hint ${b.dataset.level}: costs ${hintCost(Number(b.dataset.level))} (the highest level asked in a stage counts)`;
   }
@@ -509,6 +511,7 @@ async function goTo(where) {
   const body = await r.json();
   if (!r.ok) { message(body.error, "error"); return; }
   for (const a of body.actions) send(a);
+  tourEvent("goto", where);
   message(`${body.actions.map(describe).join(", ")}${where.point ? ` (standard point ${where.point})` : ""}`);
 }
 for (const b of $("goto").querySelectorAll("button[data-point]")) b.onclick = () => goTo({ point: b.dataset.point });
@@ -535,3 +538,33 @@ function zoomNote(marks, mag) {
     + (fits.length ? ` to ×${Math.max(...fits)}` : "") + " to find it, then clear the parallax and zoom in again.";
   box.hidden = false;
 }
+
+// --- the newcomer's tour: one card at a time, each on one part of the page ----------------------
+let tourAt = null;
+function showTour(i) {
+  document.querySelectorAll(".tour-target").forEach((e) => e.classList.remove("tour-target"));
+  const cards = (words && words.tour) || [];
+  const box = $("tour");
+  if (i === null || i >= cards.length) { tourAt = cards.length; box.hidden = true; return; }
+  tourAt = i;
+  const c = cards[i];
+  const target = $(c.target);
+  if (target) { target.classList.add("tour-target"); target.scrollIntoView({ block: "nearest" }); }
+  box.replaceChildren(el("h3", { text: c.title }), termEl("p", {}, c.text), el("p", { class: "meta", text: `Try: ${c.try}` }),
+    el("div", { class: "row" },
+      el("button", { id: "tour-next", class: "primary", text: i + 1 < cards.length ? "Next" : "Close", onclick: () => showTour(i + 1) }),
+      el("button", { text: "Close the cards", onclick: () => showTour(null) }),
+      el("span", { class: "meta", text: `${i + 1} / ${cards.length}` })));
+  box.hidden = false;
+  box.dataset.card = String(i);
+}
+function tourEvent(kind, detail) {
+  const cards = (words && words.tour) || [];
+  if (tourAt === null || tourAt >= cards.length) return;
+  const want = cards[tourAt].done;
+  const met = (want.kind === "mag" && kind === "mag" && detail.value === want.value)
+    || (want.kind === "set" && (kind === "set" || kind === "turn") && detail.control === want.control)
+    || (want.kind === "read" && kind === "read") || (want.kind === "goto" && kind === "goto");
+  if (met) setTimeout(() => showTour(tourAt + 1), 400);
+}
+$("tour-btn").onclick = () => showTour(0);
