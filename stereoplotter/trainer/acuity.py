@@ -20,11 +20,19 @@ referred to 250 mm). Pure numpy; the page runs the same rule (``static/acuity.js
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
-from stereoplotter.procedure.eye import DEFAULT_VIEWING_DISTANCE_MM, angle_to_photo_mm
+from stereoplotter.procedure.eye import (
+    ACUITY_FIRST_KIND_ARCSEC,
+    ACUITY_SECOND_KIND_ARCSEC,
+    DEFAULT_VIEWING_DISTANCE_MM,
+    Eye,
+    ObservationSystem,
+    angle_to_photo_mm,
+)
 
 __all__ = [
     "ACUITY_RECORDS",
@@ -34,8 +42,11 @@ __all__ = [
     "STEP",
     "Z75",
     "Staircase",
+    "acuity_note",
     "photo_um",
     "simulated_observer",
+    "trainee_acuity",
+    "with_acuity",
 ]
 
 #: Down step (a ratio) after a right answer; a wrong answer goes up by STEP³. [—]
@@ -111,3 +122,52 @@ def photo_um(
         f"{m:g}": angle_to_photo_mm(arcsec, m, viewing_distance_mm) * 1000.0
         for m in magnifications
     }
+
+
+def trainee_acuity(records: dict[str, Any]) -> dict[str, float] | None:
+    """The acuity the page's test recorded in a session (``{"x_arcsec", "y_arcsec"}``), or None
+    when not measured (or a value is not a positive number). [″]"""
+    out = {}
+    for name, key in ACUITY_RECORDS.items():
+        v = records.get(name)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v < 3600:
+            return None
+        out[key] = float(v)
+    return out
+
+
+def with_acuity(prep: Any, acuity: dict[str, float]) -> Any:
+    """The prepared run with its simulated operators given the trainee's acuity: the x-parallax
+    (depth) threshold as the first kind (σ_p, the fused mark), the y-parallax one as the second
+    kind (σ_q), through the instrument's observation system (procedure.eye, (eye 1))."""
+    system = prep.operator.observation or ObservationSystem.from_spec(prep.spec)
+    eye = Eye(system, acuity["x_arcsec"], acuity["y_arcsec"])
+    operator = replace(
+        prep.operator,
+        stereo_sigma_mm=eye.stereo_sigma_mm,
+        y_parallax_sigma_mm=eye.y_parallax_sigma_mm,
+        observation=system,
+    )
+    return replace(prep, operator=operator)
+
+
+def acuity_note(acuity: dict[str, float] | None, prep: Any) -> dict[str, Any]:
+    """What the grade's population was given for the eye, said in one line (``text``)."""
+    op = prep.operator
+    if acuity is None:
+        x, y, whose = ACUITY_FIRST_KIND_ARCSEC, ACUITY_SECOND_KIND_ARCSEC, "the textbook's"
+    else:
+        x, y, whose = acuity["x_arcsec"], acuity["y_arcsec"], "your measured"
+    system = op.observation or ObservationSystem.from_spec(prep.spec)
+    eye = Eye(system, x, y)
+    text = (
+        f"Compared with simulated operators of {whose} stereo acuity: {x:.1f}″ in depth "
+        f"(σ_p {eye.stereo_sigma_mm * 1000:.2f} µm) and {y:.1f}″ across the base (σ_q "
+        f"{eye.y_parallax_sigma_mm * 1000:.2f} µm) through the instrument's ×"
+        f"{system.magnification:g}"
+    )
+    if acuity is None:
+        text += " (your own was not measured: the page's acuity test measures it)"
+    return {"measured": acuity is not None, "x_arcsec": x, "y_arcsec": y,
+            "stereo_sigma_um": eye.stereo_sigma_mm * 1000, "y_parallax_sigma_um":
+            eye.y_parallax_sigma_mm * 1000, "text": text}
