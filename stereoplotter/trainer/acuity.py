@@ -38,6 +38,7 @@ __all__ = [
     "ACUITY_RECORDS",
     "DISCARD",
     "MAGNIFICATIONS",
+    "PLAUSIBLE",
     "REVERSALS",
     "STEP",
     "Z75",
@@ -60,6 +61,10 @@ MAX_TRIALS = 100
 Z75 = 0.6744897501960817
 #: Magnifications the result is given at (the page's eyepiece ×2 … ×20). [×]
 MAGNIFICATIONS = (2.0, 6.0, 20.0)
+#: A recorded acuity outside this range is taken as not measured (assumed: human stereo
+#: acuities run from about 2″ to a few arc-minutes; the value comes from the trainee's page and
+#: is not trusted beyond that). [″]
+PLAUSIBLE = (2.0, 600.0)
 #: Session-log record names the page writes the result under → the instructor's column.
 ACUITY_RECORDS = {
     "stereo acuity x (arcsec)": "x_arcsec",
@@ -126,11 +131,12 @@ def photo_um(
 
 def trainee_acuity(records: dict[str, Any]) -> dict[str, float] | None:
     """The acuity the page's test recorded in a session (``{"x_arcsec", "y_arcsec"}``), or None
-    when not measured (or a value is not a positive number). [″]"""
+    when not measured (or a value is not a number within :data:`PLAUSIBLE`). [″]"""
     out = {}
     for name, key in ACUITY_RECORDS.items():
         v = records.get(name)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v < 3600:
+        number = isinstance(v, (int, float)) and not isinstance(v, bool)
+        if not number or not PLAUSIBLE[0] <= v <= PLAUSIBLE[1]:
             return None
         out[key] = float(v)
     return out

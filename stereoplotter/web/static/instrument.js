@@ -7,6 +7,7 @@ import { el, sessionKey } from "./dom.js";
 import { buildActions, describe, parseCommand, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
 import { Overview } from "./overview.js";
 import { loadGlossary, glossaryBox, withTerms, termEl, names } from "./words.js";
+import { AcuityTest, acuityPanel } from "./acuity.js";
 
 const sid = location.pathname.split("/").pop();
 const key = sessionKey.get(sid);
@@ -568,3 +569,9 @@ function tourEvent(kind, detail) {
   if (met) setTimeout(() => showTour(tourAt + 1), 400);
 }
 $("tour-btn").onclick = () => showTour(0);
+
+// --- the trainee's stereo acuity ----------------------------------------------------------------
+$("acuity").append(acuityPanel());
+const acuityTest = new AcuityTest($("acuity"), send, () => (hello ? hello.screen_pixel_mm : 0.1));
+$("acuity-open").onclick = () => { $("acuity-body").hidden = !$("acuity-body").hidden; };
+window.acuityTest = acuityTest;
