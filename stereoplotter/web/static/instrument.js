@@ -225,6 +225,8 @@ function drawStage() {
   $("redo").disabled = demo || !allowed.has("redo");
   $("hints").hidden = !allowed.has("hint");
   $("claim").disabled = demo || !allowed.has("claim");
+  $("check").hidden = state.mode !== "practice" || demo;
+  $("check").disabled = !allowed.has("claim");
   $("demo").hidden = !demo;
   $("done").hidden = !state.done;
   $("grade-link").href = `/grade/${encodeURIComponent(sid)}`;
@@ -301,23 +303,19 @@ else {
   document.body.dataset.ready = "1";
 }
 
-// In practice a claim is checked first: a failing check is named with the likely wrong setting,
-// and the trainee may fix it before claiming (or claim anyway).
-$("claim").onclick = async () => {
-  if (!state || hello.demonstration) return;
-  if (state.mode === "practice") {
-    const fb = await feedbackOf("now");
-    if (fb && !fb.passed) {
-      showFeedback(fb, "Before you claim:", [
-        ["Fix it first", () => { $("feedback").hidden = true; }],
-        ["Claim anyway", () => { $("feedback").hidden = true; send({ kind: "claim", step: state.stage }); }],
-      ]);
-      return;
-    }
-  }
-  send({ kind: "claim", step: state.stage });
-};
-$("undo").onclick = () => send({ kind: "undo" });
+$("claim").onclick = () => send({ kind: "claim", step: state.stage });
+// In practice the stage may be checked before it is claimed: a failing check is named with its
+// measured and allowed values and the likely wrong setting; fix it, then claim.
+$("check").onclick = async () => {
+  if (!state || hello.demonstration || state.mode !== "practice") return;
+  const fb = await feedbackOf("now");
+  if (!fb) return;
+  if (fb.passed) { showFeedback({ lines: ["Every check of the stage is within its tolerance: claim it."] }, `Stage ${fb.stage}:`, []); return; }
+  showFeedback(fb, `Stage ${fb.stage} is not yet within its tolerance:`, [
+    ["Fix it first", () => { $("feedback").hidden = true; }],
+    ["Claim anyway", () => { $("feedback").hidden = true; send({ kind: "claim", step: state.stage }); }],
+  ]);
+};$("undo").onclick = () => send({ kind: "undo" });
 $("redo").onclick = () => send({ kind: "redo" });
 for (const b of $("hints").querySelectorAll("button[data-level]")) {
   b.onclick = () => {
@@ -535,8 +533,9 @@ function zoomNote(marks, mag) {
   if (off <= field / 2) { box.hidden = true; return; }
   const fits = [2, 6, 20].filter((m) => off <= 256 / (scale.pxPerMmAt1x * m) / 2);
   box.textContent = `At standard point ${p.id} the detail under the left mark is ${off.toFixed(2)} mm from the right mark: `
-    + `outside the right eyepiece's field at ×${mag} (${(field / 2).toFixed(2)} mm). Zoom out`
-    + (fits.length ? ` to ×${Math.max(...fits)}` : "") + " to find it, then clear the parallax and zoom in again.";
+    + `outside the right eyepiece's field at ×${mag} (${(field / 2).toFixed(2)} mm). `
+    + (fits.length ? `Zoom out to ×${Math.max(...fits)} to find it, then clear the parallax and zoom in again.`
+      : "Even ×2 does not reach it: clear the y-parallax roughly at standard points 1 and 2 first, then come back.");
   box.hidden = false;
 }
 
