@@ -61,6 +61,7 @@ counters that moved although the action did not name them.
 from __future__ import annotations
 
 import re
+import weakref
 from typing import Any
 
 import numpy as np
@@ -340,15 +341,56 @@ def _target_met(
     return True
 
 
+#: Session → (the settings the L-check depends on, its last answer): X and Y do not change the
+#: span (the check puts the mark on the fiducials itself), so a run of pointings asks once; the
+#: same for the y-parallax at the standard points (X, Y, Z do not change it).
+_SPAN_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_SPAN_SCALES = ("bx", "by", "bz", *DECENTRATIONS)
+
+
+_Q_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _settings_key(session: Any, *more: str) -> tuple:
+    """What the model's shape depends on: every setting but the pointing screws X, Y, Z (the
+    y-parallax is taken at the points themselves, wherever the mark is), and the screws
+    ``more`` (the span of the L-check depends on Z, the projection distance)."""
+    inst = session.inst
+    return (
+        tuple(sorted(session.commanded.items())),
+        tuple(control_value(inst, c, session.commanded) for c in (*_SPAN_SCALES, *more)),
+        inst._height_gear,
+    )
+
+
+def _standard_q(session: Any) -> np.ndarray:
+    """|q| at the six standard points on the instrument as it stands (cached while only X, Y,
+    Z move). [mm]"""
+    key = _settings_key(session)
+    hit = _Q_CACHE.get(session)
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    q = np.abs(np.asarray(standard_q(session.inst, session.prep), float).reshape(-1))
+    _Q_CACHE[session] = (key, q)
+    return q
+
+
 def _span_fails(session: Any) -> bool:
     """The L-check's condition: |L − L′| (true) outside its tolerance on the instrument as it
     stands (False before f_пр is set: nothing to check yet)."""
     if "f_instrument" not in session.commanded:
         return False
-    for m in stage_measures(session.inst, session.prep, "1"):
+    inst = session.inst
+    key = _settings_key(session, "Z")
+    hit = _SPAN_CACHE.get(session)
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    fails = False
+    for m in stage_measures(inst, session.prep, "1"):
         if m.name.startswith("scale coefficient"):
-            return bool(np.max(m.value) > m.tolerance)
-    return False
+            fails = bool(np.max(m.value) > m.tolerance)
+    _SPAN_CACHE[session] = (key, fails)
+    return fails
 
 
 def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
@@ -358,7 +400,7 @@ def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
     rules = session.step_rules(stage)
     q = None
     if any(e["rule"] == "parallax" for e in rules) and "f_instrument" in session.commanded:
-        q = np.abs(np.asarray(standard_q(session.inst, session.prep), float).reshape(-1))
+        q = _standard_q(session)
     tol_q = float(session.prep.sheet.tolerances["residual_y_parallax_mm"])
     fails = _span_fails(session) if any(e["conditional"] for e in rules) else False
     done, shown = [], []

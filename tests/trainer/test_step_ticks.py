@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
+
 import pytest
 
 from stereoplotter.io.exercise_file import load_exercise
@@ -117,3 +119,23 @@ def test_nothing_is_ticked_for_a_control_never_set(e01):
                      e01.state()["checklist_ticks"]["done"], strict=True))
     assert not ticks["set the instrument principal distance f_пр"]
     assert not next(v for t, v in ticks.items() if t.startswith("lower the carriage"))
+
+
+def test_the_cached_checks_follow_z_and_the_orientation():
+    from stereoplotter.trainer.outcome import stage_measures, standard_q
+    from stereoplotter.trainer.panel import _span_fails, _standard_q
+
+    s = Session.start(load_exercise("e01-setup-stage1"), trainee="ann")
+    s.act({"kind": "set", "control": "f_instrument", "value": 109.3748})
+    tol = s.prep.sheet.tolerances["mark_span_mm"]
+    for z in (185.0, 184.0, 185.0):  # Z is the projection distance: the span follows it
+        s.act({"kind": "set", "control": "Z", "value": z})
+        span = float(stage_measures(s.inst, s.prep, "1")[0].value)
+        assert _span_fails(s) == (span > tol)
+    c2 = Session.start(load_exercise("e05-conventional-c2"), trainee="ann")
+    for action in (
+        {"kind": "set", "control": "X", "value": 250.0},  # a pointing: q stays
+        {"kind": "set", "control": "kappa_right", "value": 0.002},  # an element: q changes
+    ):
+        c2.act(action)
+        np.testing.assert_array_equal(_standard_q(c2), np.abs(standard_q(c2.inst, c2.prep)))
