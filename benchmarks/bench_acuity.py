@@ -43,7 +43,8 @@ def staircase_figures() -> None:
 def population_figures() -> None:
     s = Session.start(load_exercise("e05-conventional-c2"), trainee="ann")
     name = "residual y-parallax at the 6 standard points (true)"
-    for acuity in (None, {"x_arcsec": 30.0, "y_arcsec": 10.0}, {"x_arcsec": 60.0, "y_arcsec": 40.0}):
+    eyes = (None, {"x_arcsec": 30.0, "y_arcsec": 10.0}, {"x_arcsec": 60.0, "y_arcsec": 40.0})
+    for acuity in eyes:
         prep = with_acuity(s.prep, acuity) if acuity else s.prep
         pop = population_measures(prep, s.seed, s.exercise.stages, 128, s.inst.injected)
         q = np.median(pop["C2"][name]) * 1000.0

@@ -46,7 +46,9 @@ def test_the_tour_and_the_glossary_guide_a_newcomer(page, server, artefacts):
 
 def test_hint_3_says_what_it_does_and_costs_then_ticks_the_stage(page, server):
     _start(page, server, "e01-setup-stage1", trainee="helped")
-    page.wait_for_function("() => document.querySelector('#hints button[data-level=\"3\"]').title.includes('75')")
+    page.wait_for_function(
+        "() => document.querySelector('#hints button[data-level=\"3\"]').title.includes('75')"
+    )
     page.click("#hints button[data-level='3']")
     text = page.inner_text("#confirm")
     assert "does the whole of stage 1" in text and "75 of the exercise's 100 points" in text
@@ -55,7 +57,9 @@ def test_hint_3_says_what_it_does_and_costs_then_ticks_the_stage(page, server):
     page.click("#hints button[data-level='3']")
     page.click("#confirm-yes")
     _settle(page, 1)
-    page.wait_for_function("() => document.querySelector('#checklist-count').textContent === '11 / 11'")
+    page.wait_for_function(
+        "() => document.querySelector('#checklist-count').textContent === '11 / 11'"
+    )
 
 
 def test_a_stage_checked_names_the_check_and_the_likely_wrong_setting(page, server):
