@@ -191,6 +191,28 @@ def _step_of(action: dict[str, Any], step: str, texts: list[str]) -> str:
     return step
 
 
+def _add_silent_records(par: Any, stage: str, steps: dict[str, dict[str, Any]]) -> None:
+    """Steps of the operator's transcript that no action of its own precedes (the right photo's
+    L′, measured together with the left one before either is written down), placed after the
+    step written before them; a measurement of L′ reads Y."""
+    records = getattr(getattr(getattr(par, "run", None), "op", None), "log", None)
+    if records is None:
+        return
+    order = list(dict.fromkeys(r.step for r in records.records if r.stage == stage and r.step))
+    for i, text in enumerate(order):
+        if text in steps:
+            continue
+        entry = {"text": text, "controls": [], "needs": [], "reads": [], "targets": {}}
+        if text.startswith("measure L′"):
+            entry["controls"], entry["reads"] = ["Y"], ["Y"]
+        before = next((t for t in reversed(order[:i]) if t in steps), None)
+        items = list(steps.items())
+        at = next((j + 1 for j, (t, _) in enumerate(items) if t == before), len(items))
+        items.insert(at, (text, entry))
+        steps.clear()
+        steps.update(items)
+
+
 def least_count(spec: Any, control: str) -> float:
     """The least count of a control's scale, as the session's controls give it. [its unit]"""
     if control == "Z":
@@ -231,6 +253,7 @@ def step_rules(par: Any, stage: str) -> list[dict[str, Any]]:
             entry["targets"]["gear"] = float(action["value"])
         elif kind == "set" and isinstance(action.get("value"), (int, float)):
             entry["targets"][name] = float(action["value"])
+    _add_silent_records(par, stage, steps)
     out = []
     looked: set[str] = set()  # controls set by looking: later values are relative to them
     for entry in steps.values():

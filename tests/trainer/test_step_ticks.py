@@ -66,8 +66,8 @@ def test_the_corrections_show_only_when_the_l_check_fails(e01):
 def test_hint_3_ticks_every_step_it_did(e01):
     e01.act({"kind": "hint", "level": 3})
     c = checklist(e01)
-    assert c["done"] == c["total"] == 11
-    assert e01.state()["checklist_ticks"]["done"].count(True) == 11
+    assert c["done"] == c["total"] == 13
+    assert e01.state()["checklist_ticks"]["done"].count(True) == 13
 
 
 def test_the_l_step_and_the_sheet_l_are_both_shown_with_the_reason(e01):
