@@ -82,7 +82,7 @@ export function buildActions(root, catalogue, controls, send, say) {
 }
 
 const fmt = (v) => (typeof v !== "number" ? String(v)
-  : Number.isInteger(v) ? String(v) : Math.abs(v) >= 1e-3 ? v.toFixed(4) : v.toExponential(2));
+  : Number.isInteger(v) ? String(v) : Math.abs(v) >= 1e-3 ? String(Number(v.toFixed(6))) : v.toExponential(2));
 
 // What an action answered, as readable text and tables (never a JSON dump).
 export function showResult(root, action, result) {
