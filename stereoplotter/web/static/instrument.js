@@ -189,7 +189,9 @@ function drawCounters() {
   if (body.dataset.names !== names) {
     body.replaceChildren(); body.dataset.names = names;
     for (const name of Object.keys(state.counters)) {
-      const tr = el("tr", { "data-counter": name }, el("td", { text: LABELS[name] || name }),
+      const zero = name.startsWith("dx") || name.startsWith("dy")
+        ? "a decentration counter: at its place of zero (MO_dx, MO_dy) it reads 20.00 mm" : null;
+      const tr = el("tr", { "data-counter": name, title: zero }, el("td", { text: LABELS[name] || name }),
         el("td", { class: "num" }), el("td"),
         el("td", {}, el("button", { class: "dir", title: "reverse the counter's direction", text: "±" })),
         el("td", {}, el("button", { class: "read", text: "read" })));
