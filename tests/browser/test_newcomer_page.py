@@ -110,7 +110,7 @@ def test_the_acuity_test_recovers_a_simulated_eye_and_the_instructor_sees_it(pag
     value = page.evaluate("window.trainer.state().records['stereo acuity y (arcsec)']")
     assert 15.0 / 3 < value < 15.0 * 3  # one run: ± 0.44 in log σ (test_acuity), 2.5 SD
     assert "µm of photo through the instrument" in page.inner_text("#acuity-result-y")
-    rows = page.evaluate(
-        f"fetch('/api/instructor/acuity?token={TOKEN}').then(r => r.json())"
-    )
-    assert any(r["id"] == sid and r["y_arcsec"] == value for r in rows)
+    page.goto(f"{server}/instructor?token={TOKEN}")
+    row = page.locator(f"#acuities tr[data-id='{sid}']")
+    row.wait_for()
+    assert row.locator("td").nth(3).inner_text() == f"{value:.1f}"
