@@ -75,8 +75,8 @@ PROBE = 2e-4
 
 def relative_orientation(r: Reader, tolerance_um: float, cycles: int = 8) -> list[float]:
     """Clear the y-parallax point by point with the elements the steps name (secant on the
-    read-out), cycle until every standard point reads within ``tolerance_um`` / 2; returns the
-    last |q| read at the six points. [µm]"""
+    read-out), cycle until a cycle changes nothing and every standard point then reads within
+    ``tolerance_um`` / 2; returns the last |q| read at the six points. [µm]"""
     pairs = []
     for text in r.steps():
         m = _ELEMENT.search(text)
@@ -85,34 +85,49 @@ def relative_orientation(r: Reader, tolerance_um: float, cycles: int = 8) -> lis
     assert pairs, "no step names an element to clear the y-parallax with"
     last: list[float] = []
     typed: dict[str, float] = {}
+    slope: dict[str, float] = {}  # µm of q per unit of the element, learnt by a probe turn
     for _ in range(cycles):
+        moved = False
         for point, label in pairs:
             r.go_to(point)
-            if abs(r.q_um()[1]) < tolerance_um / 4:
+            q = r.q_um()[1]
+            if abs(q) < tolerance_um / 4:
                 continue
+            moved = True
             if label in typed:  # what the robot typed last (the wheel shows it rounded)
                 a = typed[label]
             else:  # as the wheel shows it: set it so, then read q there
                 a = r.wheel_value(label)
                 r.set(label, a)
-            qa = r.q_um()[1]
-            b = a + PROBE
-            r.set(label, b)
-            qb = r.q_um()[1]
-            for _ in range(6):  # the secant on the read-out
-                if abs(qb) < tolerance_um / 6 or qb == qa:
-                    break
-                a, qa, b = b, qb, b - qb * (b - a) / (qb - qa)
+                q = r.q_um()[1]
+            if label not in slope:
+                r.set(label, a + PROBE)
+                slope[label] = (r.q_um()[1] - q) / PROBE
+                if slope[label] == 0:
+                    continue
+            for _ in range(4):  # Newton on the read-out, the slope refined by each step
+                b = a - q / slope[label]
                 r.set(label, b)
                 qb = r.q_um()[1]
-            typed[label] = b
+                if qb != q and b != a:
+                    slope[label] = (qb - q) / (b - a)
+                a, q = b, qb
+                if abs(q) < tolerance_um / 6:
+                    break
+            typed[label] = a
         r.cycles = getattr(r, "cycles", 0) + 1
+        if moved:  # the six points are looked at once a cycle changes nothing
+            continue
         last = []
         for point in range(1, 7):
             r.go_to(point)
             last.append(abs(r.q_um()[1]))
         if max(last) < tolerance_um / 2:
             break
+    if not last:  # every cycle still changed something: what the six points read now
+        for point in range(1, 7):
+            r.go_to(point)
+            last.append(abs(r.q_um()[1]))
     return last
 
 

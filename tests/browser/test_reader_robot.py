@@ -23,7 +23,7 @@ def test_the_reader_robot_clears_the_y_parallax_of_c2_from_the_page(page, server
     row = page.locator("#result tr", has_text="residual y-parallax")
     assert "within" in row.inner_text()
     assert page.evaluate("window.trainer.state().done")
-    print(f"reader robot on e05: {r.sent} actions, worst |q| {max(q):.2f} µm at the claim")
+    print(f"reader robot on e05: {r.sent} actions, {r.cycles} cycles, worst |q| {max(q):.2f} µm")
     page.screenshot(path=str(artefacts / "reader-c2.png"), full_page=True)
 
 
