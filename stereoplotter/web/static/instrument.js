@@ -216,8 +216,8 @@ function drawStage() {
   const ul = $("checks"); ul.replaceChildren();
   for (const ch of state.checks) {
     const lc = ch.unit === "mm" && state.counters.X ? state.counters.X.least_count : null;
-    const fine = lc && ch.tolerance !== null && ch.tolerance < 2 * lc
-      ? ` — finer than the counters show (least count ${lc} mm): judge it in the eyepieces` : "";
+    const fine = lc && ch.tolerance !== null && ch.tolerance > lc * 1.0001 && ch.tolerance < 2 * lc
+      ? ` — under two least counts of the counters (${lc} mm): point carefully in the eyepieces, read twice` : "";
     ul.appendChild(termEl("li", {}, `${ch.name}: tolerance ${ch.tolerance === null ? "—" : ch.tolerance.toPrecision(3)} ${ch.unit}${fine}`));
   }
   const allowed = new Set(state.allowed);
@@ -531,13 +531,17 @@ function zoomNote(marks, mag) {
   if (!best || best.d > field) { box.hidden = true; return; }
   const p = L[best.i], r = R[best.i];
   const want = { x: r.x_mm + (marks.left.x_mm - p.x_mm), y: r.y_mm + (marks.left.y_mm - p.y_mm) };
-  const off = Math.hypot(want.x - marks.right.x_mm, want.y - marks.right.y_mm);
+  const dx = want.x - marks.right.x_mm, dy = want.y - marks.right.y_mm;
+  const off = Math.hypot(dx, dy);
   if (off <= field / 2) { box.hidden = true; return; }
   const fits = [2, 6, 20].filter((m) => off <= 256 / (scale.pxPerMmAt1x * m) / 2);
-  box.textContent = `At standard point ${p.id} the detail under the left mark is ${off.toFixed(2)} mm from the right mark: `
-    + `outside the right eyepiece's field at ×${mag} (${(field / 2).toFixed(2)} mm). `
+  const why = Math.abs(dx) >= Math.abs(dy)
+    ? "mostly along the base (x-parallax): turn Z, the foot wheel, to bring it in"
+    : "mostly across the base (y-parallax): clear it roughly at standard points 1 and 2 first";
+  box.textContent = `At standard point ${p.id} the detail under the left mark is ${off.toFixed(2)} mm from the right mark, `
+    + `${why}; it is outside the right eyepiece's field at ×${mag} (${(field / 2).toFixed(2)} mm). `
     + (fits.length ? `Zoom out to ×${Math.max(...fits)} to find it, then clear the parallax and zoom in again.`
-      : "Even ×2 does not reach it: clear the y-parallax roughly at standard points 1 and 2 first, then come back.");
+      : "Even ×2 does not reach it.");
   box.hidden = false;
 }
 
