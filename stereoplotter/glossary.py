@@ -15,6 +15,7 @@ from types import MappingProxyType
 __all__ = [
     "LANGUAGES",
     "PHRASES",
+    "SYMBOLS",
     "TERMS",
     "check_language",
     "instrument_name",
@@ -778,3 +779,194 @@ def check_language(lang: str) -> str:
 def term(key: str, lang: str) -> str:
     """The term ``key`` in ``lang`` (``"ru"`` or ``"en"``); an unknown key is a KeyError."""
     return TERMS[key][check_language(lang)]
+
+
+# --- the symbols a trainee meets on the page: what each means, in plain words -------------------
+
+#: Symbol (as the page and the operator's steps write it) → (English, Russian) explanation. The
+#: page finds these in every text it shows and puts the explanation one hover or tap away.
+#: Longer symbols first where one contains another (``MO_bx`` before ``MO``).
+_SYMBOL_TABLE: dict[str, tuple[str, str]] = {
+    "MO": (
+        "place of zero (место нуля): what a counter reads when its element stands at its zero "
+        "position (e.g. the mark exactly on the cassette centre). A setting from the sheet is "
+        "then made as MO + value; MO_X, MO_Y, MO_bx, MO_by, MO_bz, MO_Z, MO_dx are those of X, "
+        "Y, b_x, b_y, b_z, Z and the decentrations.",
+        "место нуля (МО): отсчёт счётчика при нулевом положении элемента (например, марка точно "
+        "на центре кассеты). Установка по листу делается как МО + величина; MO_X, MO_Y, MO_bx, "
+        "MO_by, MO_bz, MO_Z, MO_dx — места нуля X, Y, b_x, b_y, b_z, Z и децентраций.",
+    ),
+    "O_": (
+        "O (отсчёт): the reading to set on a counter, e.g. O_bx = MO_bx + b_x; O′ is the "
+        "reading after a correction, O′ = O + Δ (6.11).",
+        "O (отсчёт): отсчёт, устанавливаемый на счётчике, например O_bx = MO_bx + b_x; O′ — "
+        "отсчёт после поправки, O′ = O + Δ (6.11).",
+    ),
+    "M_в": (
+        "vertical scale of the model 1:M_в (the heights' scale). The height counter is geared "
+        "for it (the 'gear' action) so that the metre height scale H reads ground heights.",
+        "вертикальный масштаб модели 1:M_в (масштаб высот). На него настраивается счётчик "
+        "высот (действие 'gear'), чтобы шкала высот H показывала высоты местности в метрах.",
+    ),
+    "M_г": (
+        "horizontal scale of the model 1:M_г (the plan scale of the model in the instrument).",
+        "горизонтальный масштаб модели 1:M_г (масштаб модели в плане).",
+    ),
+    "n_л": (
+        "scale coefficient of the left photo: how many times the model is larger than the "
+        "photo, n_л = D/f_пр (projection distance over the instrument principal distance). "
+        "n_п is the right photo's.",
+        "коэффициент масштаба левого снимка: во сколько раз модель крупнее снимка, "
+        "n_л = D/f_пр (проектирующее расстояние на фокусное расстояние прибора). n_п — правого.",
+    ),
+    "n_п": (
+        "scale coefficient of the right photo, n_п = D_п/f_пр (see n_л).",
+        "коэффициент масштаба правого снимка, n_п = D_п/f_пр (см. n_л).",
+    ),
+    "f_пр": (
+        "instrument principal distance (фокусное расстояние прибора): the distance set in the "
+        "instrument between the projection centre and the photo, f_пр = k·f′. Control "
+        "'f_пр'; sheet row 'f_пр' of the interior part.",
+        "фокусное расстояние прибора: расстояние между центром проекции и снимком, "
+        "устанавливаемое в приборе, f_пр = k·f′. Орган 'f_пр'; строка 'f_пр' листа.",
+    ),
+    "f′": (
+        "the camera's focal length corrected for film deformation (the certificate's f).",
+        "фокусное расстояние камеры, исправленное за деформацию плёнки (f паспорта).",
+    ),
+    "D": (
+        "projection distance: from the projection centre to the model, read on the Z counter; "
+        "D = n·f_пр.",
+        "проектирующее расстояние: от центра проекции до модели, отсчитывается по счётчику Z; "
+        "D = n·f_пр.",
+    ),
+    "L-check": (
+        "the check of the scale coefficient n in stage 1: put the mark on fiducial marks 3 and 4 "
+        "of a photo, read Y at each; their difference L′ must equal L (the sheet's span, (6.5)) "
+        "within 0.03/n_л mm. If not, raise or lower the carriage by ΔZ (6.9) and correct b_z "
+        "by Δb_z (6.10).",
+        "L-контроль коэффициента масштаба n на этапе 1: навести марку на координатные метки 3 и "
+        "4 снимка, отсчитать Y; разность L′ должна равняться L (по листу, (6.5)) с допуском "
+        "0.03/n_л мм. Иначе поднять или опустить каретку на ΔZ (6.9) и исправить b_z на Δb_z "
+        "(6.10).",
+    ),
+    "L′": (
+        "the span between fiducial marks 3 and 4 as measured on the Y counter (L′_л left, "
+        "L′_п right).",
+        "расстояние между метками 3 и 4, измеренное по счётчику Y (L′_л левый, L′_п правый).",
+    ),
+    "L_л": (
+        "the span between fiducial marks 3 and 4 the model should show on the Y counter (left "
+        "photo); L_п the right photo's. The sheet gives (6.5) with the transformed marks; the "
+        "step with the correction units at zero compares with n·(y₃ − y₄) of the measured marks "
+        "(decision D5), which differs by a few hundredths of a mm.",
+        "расстояние между метками 3 и 4, которое должна показать модель по счётчику Y (левый "
+        "снимок); L_п — правый. Лист даёт (6.5) по трансформированным меткам; шаг с "
+        "коррекционными устройствами в нуле сравнивает с n·(y₃ − y₄) измеренных меток "
+        "(решение D5); разница — сотые доли мм.",
+    ),
+    "ΔZ": (
+        "correction of the projection distance (6.9): the carriage is raised or lowered by ΔZ "
+        "when the L-check fails.",
+        "поправка проектирующего расстояния (6.9): каретку поднимают или опускают на ΔZ, если "
+        "L-контроль не выполнен.",
+    ),
+    "Δb_z": (
+        "correction of the base component b_z (6.10) when the right photo's L-check fails.",
+        "поправка составляющей базиса b_z (6.10), если L-контроль правого снимка не выполнен.",
+    ),
+    "b_x": (
+        "base component along X: the distance between the two projection centres in the "
+        "instrument, b_x = B/M_г. Control 'b_x'.",
+        "составляющая базиса по X: расстояние между центрами проекции в приборе, b_x = B/M_г. "
+        "Орган 'b_x'.",
+    ),
+    "b_y": ("base component along Y (control 'b_y').", "составляющая базиса по Y (орган 'b_y')."),
+    "b_z": ("base component along Z (control 'b_z').", "составляющая базиса по Z (орган 'b_z')."),
+    "κ": (
+        "kappa: the turn of a cassette (photo) in its own plane (controls 'κ left', 'κ right').",
+        "каппа: поворот кассеты (снимка) в своей плоскости (органы 'κ left', 'κ right').",
+    ),
+    "k_α": (
+        "correction knob α: tilts the photo carrier along the base (its scale in tan α; "
+        "controls 'k_α left', 'k_α right').",
+        "коррекционный винт α: наклон снимкодержателя вдоль базиса (шкала в tan α; органы "
+        "'k_α left', 'k_α right').",
+    ),
+    "k_ω": (
+        "correction knob ω: tilts the photo carrier across the base (its scale in tan ω; "
+        "controls 'k_ω left', 'k_ω right').",
+        "коррекционный винт ω: наклон снимкодержателя поперёк базиса (шкала в tan ω; органы "
+        "'k_ω left', 'k_ω right').",
+    ),
+    "decentration": (
+        "decentration: the shift of the photo carrier in its plane (controls 'dx left', "
+        "'dy left', …) that goes with a tilt, d = f′·tan α; its counters read 20.00 mm at their "
+        "place of zero MO_dx, MO_dy.",
+        "децентрация: сдвиг снимкодержателя в своей плоскости (органы 'dx left', 'dy left', …), "
+        "сопровождающий наклон, d = f′·tan α; в месте нуля MO_dx, MO_dy счётчики показывают "
+        "20.00 мм.",
+    ),
+    "y-parallax": (
+        "y-parallax q: the vertical offset between what the left and the right eye see at a "
+        "point; the model is relatively oriented when q ≈ 0 at the six standard points.",
+        "поперечный параллакс q: вертикальное расхождение изображений для левого и правого глаза "
+        "в точке; модель взаимно ориентирована, когда q ≈ 0 в шести стандартных точках.",
+    ),
+    "x-parallax": (
+        "x-parallax p: the offset along the base; the mark sits on the ground when p = 0 "
+        "(turn Z, the foot wheel, to fuse the mark).",
+        "продольный параллакс p: расхождение вдоль базиса; марка на поверхности при p = 0 "
+        "(вращать Z, ножной штурвал, до слияния марки).",
+    ),
+    "standard point": (
+        "standard points 1–6: the six places of the overlap where the y-parallax is cleared "
+        "(1, 2 near the principal points, 3–6 above and below them).",
+        "стандартные точки 1–6: шесть мест зоны перекрытия, где устраняют поперечный параллакс "
+        "(1, 2 у главных точек, 3–6 над и под ними).",
+    ),
+    "least count": (
+        "least count: the smallest step a counter shows (0.01 mm on X, Y): a tolerance below "
+        "it cannot be seen on the counter, only in the eyepieces.",
+        "цена деления: наименьший шаг, который показывает счётчик (0.01 мм по X, Y): допуск "
+        "меньше неё виден не на счётчике, а только в окулярах.",
+    ),
+    "decision": (
+        "decision D1…D10: a choice this program made where the book is silent or ambiguous "
+        "(listed in docs/procedure.md and docs/instruments.md).",
+        "решение D1…D10: выбор программы там, где книга молчит или неоднозначна (перечислены в "
+        "docs/procedure.md и docs/instruments.md).",
+    ),
+    "(6.": (
+        "an equation number of Kushtin & Lyskov (1984), chapter 6: (6.5) the span L of marks "
+        "3–4, (6.7) the model scale by b_x, (6.9) ΔZ, (6.10) Δb_z, (6.11) O′ = O + Δ, "
+        "(6.12)/(6.13) the mark coordinates.",
+        "номер формулы Куштин, Лысков (1984), гл. 6: (6.5) расстояние L меток 3–4, (6.7) "
+        "масштаб модели по b_x, (6.9) ΔZ, (6.10) Δb_z, (6.11) O′ = O + Δ, (6.12)/(6.13) "
+        "координаты меток.",
+    ),
+    "C1": (
+        "conventional method, stage C1: interior orientation (f_пр, photos on their fiducials, "
+        "correction elements at zero).",
+        "обычный способ, этап C1: внутреннее ориентирование.",
+    ),
+    "C2": (
+        "conventional method, stage C2: relative orientation, clearing the y-parallax at the "
+        "six standard points element by element.",
+        "обычный способ, этап C2: взаимное ориентирование по шести стандартным точкам.",
+    ),
+    "C3": (
+        "conventional method, stage C3: absolute orientation (scale by b_x, levelling on the "
+        "control heights).",
+        "обычный способ, этап C3: внешнее ориентирование (масштаб по b_x, горизонтирование).",
+    ),
+    "C4": (
+        "conventional method, stage C4: the coordinatograph and the map sheet.",
+        "обычный способ, этап C4: координатограф и лист карты.",
+    ),
+}
+
+#: The symbols and their explanations (read only): symbol → {"en": …, "ru": …}.
+SYMBOLS = MappingProxyType(
+    {k: MappingProxyType({"en": en, "ru": ru}) for k, (en, ru) in _SYMBOL_TABLE.items()}
+)

@@ -36,6 +36,7 @@ from stereoplotter.instrument.virtual import SCREWS
 from stereoplotter.procedure.operator import Noise
 from stereoplotter.procedure.run import PreparedRun, build_run
 from stereoplotter.trainer.actions import apply
+from stereoplotter.trainer.acuity import acuity_note, trainee_acuity, with_acuity
 from stereoplotter.trainer.exercise import Exercise
 from stereoplotter.trainer.grade_tables import (
     PASS_POINTS,
@@ -298,9 +299,11 @@ def grade(
     ex = session.exercise
     par = _par_measures(session)
     t0 = time.perf_counter()
+    acuity = trainee_acuity(session.records)
+    pop_prep = with_acuity(session.prep, acuity) if acuity else session.prep
     pop = (
         population_measures(
-            session.prep,
+            pop_prep,
             session.seed,
             ex.stages,
             population,
@@ -355,6 +358,7 @@ def grade(
                 "operators": population,
                 "seconds": round(pop_seconds, 3),
                 "same_instrument": True,
+                "acuity": acuity_note(acuity, pop_prep),
             },
         }
     )

@@ -22,16 +22,28 @@ All functions return plain JSON data (numbers as floats, ids as text). Units: mm
 
     {"stage": "2", "done": 3, "total": 21,
      "steps": [{"n": 1, "text": "left mark on the left cassette centre → MO_X",
-                "controls": ["X", "Y"], "done": true, "rule": "pointed"}, …]}
+                "controls": ["X", "Y"], "done": true, "rule": "pointed", "shown": true,
+                "conditional": false, "targets": {}, "control_names": ["X", "Y"],
+                "sheet_rows": [], "note": null, "condition": null}, …]}
 
 A step is the simulated operator's step of the stage (its transcript, each once in the order
-first taken). It ticks from the session's own records of the stage in hand (refused actions do
-not count; an undo does not untick): ``rule`` ``"controls"`` — the step turns controls other
-than the pointing screws X, Y, Z (or gears, slips, connects, lowers the needle): done when the
-trainee has used every one of them in the stage; ``"pointed"`` — the step names a standard or
-control point and only points and reads: done when the trainee read a counter with the left
-mark within :data:`NEAR_MM` of that point's image on the left photo; ``"reading"`` — otherwise:
-done when the trainee read any counter the step reads.
+first taken; a gear or a zero place the operator set beside another step's record gets its own
+step or the zero-place step). It is ticked when its target is met on the instrument as it stands,
+recomputed after every action, hint and show-me: ``rule`` ``"target"`` — the step sets controls
+from the sheet (not by looking): done when each shows the operator's value within the least
+count of its scale (:func:`least_count`; the gear: the same ratio), or, for a value a later
+correction of the stage changes (ΔZ, Δb_z, f_пр), where the correction left it once the L-check
+holds; ``"parallax"`` — the step clears the y-parallax at standard point n: done when the true
+|q| there is within the residual y-parallax tolerance and its element was turned; ``"controls"``
+— the step finds its value by looking (a place of zero, a levelling turn): done when the
+trainee has used every control it sets; ``"pointed"`` — the step names a standard or control
+point and only points and reads: done when the trainee read a counter with the left mark within
+:data:`NEAR_MM` of that point's image on the left photo; ``"reading"`` — otherwise: done when
+the trainee read any counter the step reads. After hint 3 (the operator did the stage on this
+instrument) every step but a target is done. A ``conditional`` step (the L-check's corrections)
+is ``shown`` only while its condition holds (|L − L′| outside its tolerance) and is not counted
+otherwise. Each step also carries its words (:func:`~stereoplotter.trainer.step_words.step_words`:
+the page's control names, the sheet rows its values come from, a note, its condition).
 
 :func:`sheet_parts` ``(exercise)`` → ``{"given": [...], "withheld": {part: reason}}``, parts
 ``certificate`` (the camera: f, principal point, format, fiducials), ``interior`` (f_пр, the
@@ -49,19 +61,26 @@ counters that moved although the action did not name them.
 from __future__ import annotations
 
 import re
+import weakref
 from typing import Any
 
 import numpy as np
 
 from stereoplotter.instrument.virtual import DECENTRATIONS, HEIGHT_SCALE, KNOBS
+from stereoplotter.trainer.actions import control_value
 from stereoplotter.trainer.exercise import Exercise
+from stereoplotter.trainer.outcome import stage_measures, standard_q
+from stereoplotter.trainer.step_words import step_words
 
 __all__ = [
+    "MOVER_TEXT",
     "NEAR_MM",
     "SHEET_PARTS",
+    "SHOWN",
     "checklist",
     "checklist_ticks",
     "coupled_motion",
+    "least_count",
     "note_progress",
     "overview",
     "sheet_parts",
@@ -74,6 +93,8 @@ __all__ = [
 #: on the left photo (assumed: a few mark diameters; the operator's pointing is far finer). [mm]
 NEAR_MM = 0.5
 _POINTING = ("X", "Y", "Z")
+#: Noted among a stage's used controls when hint 3 had the operator do the stage.
+SHOWN = "hint 3"
 _MOVERS = ("gear", "slip", "connect", "needle")
 _NAMED = re.compile(r"\b(standard|control) point (\w+)")
 
@@ -135,14 +156,89 @@ def overview(session: Any) -> dict[str, Any]:
     }
 
 
+#: Steps whose values are the operator's own judgment (clearing the y-parallax, levelling by
+#: common tilts, the least-squares clearing): their controls have no fixed target; the
+#: y-parallax steps tick on the true y-parallax instead (:func:`_ticks`).
+_JUDGED = re.compile(r"clear(ing)? (of )?the (y-parallax|six q)|common tilt|level|fuse|turn \w+ by")
+#: A standard point whose y-parallax a step clears.
+_CLEARS_AT = re.compile(r"standard point (\d): clear the y-parallax")
+#: Steps the operator took only because a check failed (the L-check's corrections): shown when
+#: their condition holds on the trainee's instrument.
+_CONDITIONAL = re.compile(r"^(ΔZ|Δb_z)\b|would take the carriage")
+#: Controls that follow from the sheet in a step that names another control: the zero places
+#: of the correction mechanisms and decentrations (set together in the step that names them).
+_ZERO_PLACE_FAMILY = tuple(KNOBS) + tuple(DECENTRATIONS)
+#: What a mover action does, as a step of its own when the operator's record of the step names
+#: something else (the gear is set with f_пр but recorded later).
+MOVER_TEXT = {
+    "gear": "gear the height counter to the vertical scale 1:M_в",
+    "connect": "connect the coordinatograph",
+}
+
+
+def _step_of(action: dict[str, Any], step: str, texts: list[str]) -> str:
+    """The step an action belongs to: its record's, but a mover that record does not name
+    gets a step of its own, and a zero place set beside another cassette goes to the stage's
+    zero-place step."""
+    kind = action["kind"]
+    if kind in MOVER_TEXT and kind not in step:
+        return MOVER_TEXT[kind]
+    name = action.get("control")
+    if kind == "set" and name in _ZERO_PLACE_FAMILY and "cassette" in step:
+        home = next((t for t in texts if "zero places" in t), None)
+        if home is not None:
+            return home
+    return step
+
+
+def _add_silent_records(par: Any, stage: str, steps: dict[str, dict[str, Any]]) -> None:
+    """Steps of the operator's transcript that no action of its own precedes (the right photo's
+    L′, measured together with the left one before either is written down), placed after the
+    step written before them; a measurement of L′ reads Y."""
+    records = getattr(getattr(getattr(par, "run", None), "op", None), "log", None)
+    if records is None:
+        return
+    order = list(dict.fromkeys(r.step for r in records.records if r.stage == stage and r.step))
+    for i, text in enumerate(order):
+        if text in steps:
+            continue
+        entry = {"text": text, "controls": [], "needs": [], "reads": [], "targets": {}}
+        if text.startswith("measure L′"):
+            entry["controls"], entry["reads"] = ["Y"], ["Y"]
+        before = next((t for t in reversed(order[:i]) if t in steps), None)
+        items = list(steps.items())
+        at = next((j + 1 for j, (t, _) in enumerate(items) if t == before), len(items))
+        items.insert(at, (text, entry))
+        steps.clear()
+        steps.update(items)
+
+
+def least_count(spec: Any, control: str) -> float:
+    """The least count of a control's scale, as the session's controls give it. [its unit]"""
+    if control == "Z":
+        return float(spec.z_least_count_mm)
+    if control == HEIGHT_SCALE:
+        return float(spec.height_scale_least_count_m)
+    if control in KNOBS:
+        return 1e-5
+    if control.startswith("kappa"):
+        return 1e-4
+    return float(spec.xy_least_count_mm)
+
+
 def step_rules(par: Any, stage: str) -> list[dict[str, Any]]:
     """The operator's steps of a stage with the rule each ticks by (see the module docstring):
-    ``{"text", "controls": [...], "rule", "needs": [...], "point": (role, id) | None}``."""
+    ``{"text", "controls": [...], "rule", "needs": [...], "point": (role, id) | None,
+    "targets": {control: value}, "conditional": bool}``."""
+    texts = [s for a, s in zip(par.actions, par.steps, strict=True) if a["stage"] == stage and s]
     steps: dict[str, dict[str, Any]] = {}
     for action, step in zip(par.actions, par.steps, strict=True):
         if action["stage"] != stage or not step:
             continue
-        entry = steps.setdefault(step, {"text": step, "controls": [], "needs": [], "reads": []})
+        step = _step_of(action, step, texts)
+        entry = steps.setdefault(
+            step, {"text": step, "controls": [], "needs": [], "reads": [], "targets": {}}
+        )
         kind = action["kind"]
         name = action.get("control") or action.get("counter") or kind
         if name not in entry["controls"]:
@@ -153,16 +249,41 @@ def step_rules(par: Any, stage: str) -> list[dict[str, Any]]:
         elif kind in _MOVERS or (kind == "set" and name not in _POINTING):
             if name not in entry["needs"]:
                 entry["needs"].append(name)
+        if kind == "gear":
+            entry["targets"]["gear"] = float(action["value"])
+        elif kind == "set" and isinstance(action.get("value"), (int, float)):
+            entry["targets"][name] = float(action["value"])
+    _add_silent_records(par, stage, steps)
     out = []
+    looked: set[str] = set()  # controls set by looking: later values are relative to them
     for entry in steps.values():
         named = _NAMED.search(entry["text"])
-        if entry["needs"]:
+        judged = bool(_JUDGED.search(entry["text"]))
+        measuring = any(c in ("X", "Y") for c in entry["reads"])
+        if judged or measuring:
+            looked.update(entry["needs"])
+        entry["targets"] = {
+            c: v
+            for c, v in entry["targets"].items()
+            if not judged and not measuring and c not in ("X", "Y") and c not in looked
+        }
+        clears = _CLEARS_AT.search(entry["text"])
+        entry["conditional"] = bool(_CONDITIONAL.search(entry["text"]))
+        entry["clears_point"] = int(clears.group(1)) if clears else None
+        if entry["clears_point"] is not None:
+            entry["rule"], entry["point"] = "parallax", None
+        elif entry["targets"] and not entry["conditional"]:
+            entry["rule"], entry["point"] = "target", None
+        elif entry["needs"]:
             entry["rule"], entry["point"] = "controls", None
         elif named:
             entry["rule"], entry["point"] = "pointed", (named.group(1), named.group(2))
         else:
             entry["rule"], entry["point"] = "reading", None
         out.append(entry)
+    for i, entry in enumerate(out):  # a target a later correction changes: met once corrected
+        later = {c for e in out[i + 1 :] if e["conditional"] for c in [*e["needs"], *e["targets"]]}
+        entry["corrected"] = sorted(later & set(entry["targets"]))
     return out
 
 
@@ -195,6 +316,8 @@ def note_progress(
     :data:`NEAR_MM` of the left mark): what :func:`checklist` ticks from."""
     used, read, near = progress.setdefault(stage, (set(), set(), set()))
     kind = action.get("kind")
+    if kind == "hint" and action.get("level") == 3:
+        used.add(SHOWN)
     if kind in ("turn", "set"):
         used.add(str(action["control"]))
     elif kind in _MOVERS:
@@ -219,26 +342,123 @@ def step_targets(session: Any, stage: str) -> dict[tuple[str, str], np.ndarray]:
     return out
 
 
-def _ticks(session: Any, stage: str) -> list[bool]:
+def _target_met(
+    session: Any, targets: dict[str, float], corrected: frozenset[str] = frozenset()
+) -> bool:
+    """Every control of ``targets`` shows its target within the least count of its scale (the
+    gear: the same ratio); a control of ``corrected`` (a later correction of the stage changes
+    it) may instead stand where the correction left it."""
+    inst = session.inst
+    for control, target in targets.items():
+        if control in corrected:
+            continue
+        if control == "gear":
+            if inst._height_gear is None or float(inst._height_gear) != target:
+                return False
+            continue
+        value = control_value(inst, control, session.commanded)
+        if value is None or not np.isfinite(value):
+            return False
+        if abs(float(value) - target) > least_count(inst.spec, control) * (1 + 1e-9):
+            return False
+    return True
+
+
+#: Session → (the settings the L-check depends on, its last answer): X and Y do not change the
+#: span (the check puts the mark on the fiducials itself), so a run of pointings asks once; the
+#: same for the y-parallax at the standard points (X, Y, Z do not change it).
+_SPAN_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_SPAN_SCALES = ("bx", "by", "bz", *DECENTRATIONS)
+
+
+_Q_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _settings_key(session: Any, *more: str) -> tuple:
+    """What the model's shape depends on: every setting but the pointing screws X, Y, Z (the
+    y-parallax is taken at the points themselves, wherever the mark is), and the screws
+    ``more`` (the span of the L-check depends on Z, the projection distance)."""
+    inst = session.inst
+    return (
+        tuple(sorted(session.commanded.items())),
+        tuple(control_value(inst, c, session.commanded) for c in (*_SPAN_SCALES, *more)),
+        inst._height_gear,
+    )
+
+
+def _standard_q(session: Any) -> np.ndarray:
+    """|q| at the six standard points on the instrument as it stands (cached while only X, Y,
+    Z move). [mm]"""
+    key = _settings_key(session)
+    hit = _Q_CACHE.get(session)
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    q = np.abs(np.asarray(standard_q(session.inst, session.prep), float).reshape(-1))
+    _Q_CACHE[session] = (key, q)
+    return q
+
+
+def _span_fails(session: Any) -> bool:
+    """The L-check's condition: |L − L′| (true) outside its tolerance on the instrument as it
+    stands (False before f_пр is set: nothing to check yet)."""
+    if "f_instrument" not in session.commanded:
+        return False
+    inst = session.inst
+    key = _settings_key(session, "Z")
+    hit = _SPAN_CACHE.get(session)
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    fails = False
+    for m in stage_measures(inst, session.prep, "1"):
+        if m.name.startswith("scale coefficient"):
+            fails = bool(np.max(m.value) > m.tolerance)
+    _SPAN_CACHE[session] = (key, fails)
+    return fails
+
+
+def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
+    """(done, shown) per step of the stage: done when its target is met (see the module
+    docstring); shown unless it is conditional and its condition does not hold."""
     used, read, near = session.progress_of(stage)
-    out = []
-    for entry in session.step_rules(stage):
-        if entry["rule"] == "controls":
-            done = all(c in used for c in entry["needs"])
+    rules = session.step_rules(stage)
+    q = None
+    if any(e["rule"] == "parallax" for e in rules) and "f_instrument" in session.commanded:
+        q = _standard_q(session)
+    tol_q = float(session.prep.sheet.tolerances["residual_y_parallax_mm"])
+    fails = _span_fails(session) if any(e["conditional"] for e in rules) else False
+    done, shown = [], []
+    for entry in rules:
+        if entry["rule"] == "target":
+            ok = _target_met(session, entry["targets"])
+            touched = all(c in used for c in entry["corrected"]) or SHOWN in used
+            if not ok and entry["corrected"] and touched and not fails:
+                ok = _target_met(session, entry["targets"], frozenset(entry["corrected"]))
+        elif entry["rule"] == "parallax":
+            n = entry["clears_point"]
+            ok = q is not None and bool(q[n - 1] <= tol_q) and entry["needs"][0] in used
+        elif SHOWN in used:  # the operator did the stage on this instrument (hint 3)
+            ok = True
+        elif entry["rule"] == "controls":
+            ok = all(c in used for c in entry["needs"])
         elif entry["rule"] == "pointed":
-            done = entry["point"] in near
+            ok = entry["point"] in near
         else:
-            done = any(c in read for c in entry["reads"]) if entry["reads"] else bool(read)
-        out.append(bool(done))
-    return out
+            ok = any(c in read for c in entry["reads"]) if entry["reads"] else bool(read)
+        see = not entry["conditional"] or fails
+        done.append(bool(ok) and see)
+        shown.append(see)
+    return done, shown
 
 
 def checklist_ticks(session: Any) -> dict[str, Any] | None:
-    """The stage in hand's done flags, in the order of :func:`checklist`'s steps (what the
-    session state carries on every action: ``{"stage", "done": [bool, …]}``); None when every
-    stage is claimed."""
+    """The stage in hand's done and shown flags, in the order of :func:`checklist`'s steps
+    (what the session state carries on every action: ``{"stage", "done": [bool, …], "shown":
+    [bool, …]}``); None when every stage is claimed."""
     stage = session.stage
-    return None if stage is None else {"stage": stage, "done": _ticks(session, stage)}
+    if stage is None:
+        return None
+    done, shown = _ticks(session, stage)
+    return {"stage": stage, "done": done, "shown": shown}
 
 
 def checklist(session: Any) -> dict[str, Any] | None:
@@ -248,8 +468,10 @@ def checklist(session: Any) -> dict[str, Any] | None:
     if stage is None:
         return None
     steps = []
-    ticks = _ticks(session, stage)
-    for n, (entry, done) in enumerate(zip(session.step_rules(stage), ticks, strict=True), 1):
+    ticks, shown = _ticks(session, stage)
+    rules = session.step_rules(stage)
+    given = sheet_parts(session.exercise)["given"]
+    for n, (entry, done, see) in enumerate(zip(rules, ticks, shown, strict=True), 1):
         steps.append(
             {
                 "n": n,
@@ -257,12 +479,16 @@ def checklist(session: Any) -> dict[str, Any] | None:
                 "controls": entry["controls"],
                 "done": bool(done),
                 "rule": entry["rule"],
+                "shown": bool(see),
+                "conditional": entry["conditional"],
+                "targets": dict(entry["targets"]),
+                **step_words(session, entry, given),
             }
         )
     return {
         "stage": stage,
-        "done": sum(s["done"] for s in steps),
-        "total": len(steps),
+        "done": sum(s["done"] for s in steps if s["shown"]),
+        "total": sum(s["shown"] for s in steps),
         "steps": steps,
     }
 

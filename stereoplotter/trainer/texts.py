@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from stereoplotter.trainer.step_words import CONTROL_NAMES
+
 __all__ = ["ERROR_TERMS", "announced_row", "claim_text", "hint_lines", "measure_line"]
 
 #: An injected error's term (before the dot) → (what it is, its unit in the text, factor from
@@ -83,15 +85,31 @@ def claim_text(step: str, measures: list[dict[str, Any]]) -> str:
 
 
 def hint_lines(hint: dict[str, Any]) -> list[str]:
-    """A hint as lines: its text, the operator's steps numbered, the controls (level 2), the
-    actions applied (level 3)."""
+    """A hint as lines: its text; level 1 points to the stage's checklist rather than repeating
+    it; level 2 the controls in the order the operator first uses them, by the names the page
+    gives them (a control that appears only later says when); level 3 the actions applied."""
     lines = [str(hint["text"])]
-    steps = hint.get("steps") or []
-    if steps:
-        lines.append("Steps:")
-        lines += [f"{i}. {s}" for i, s in enumerate(steps, start=1)]
+    level = hint.get("level")
+    if level == 1 and hint.get("steps"):
+        lines.append(
+            "The steps of the stage are the checklist beside this text, in order; each names "
+            "its control and the sheet row its value comes from."
+        )
     if hint.get("controls"):
-        lines.append("Controls, in order: " + ", ".join(hint["controls"]))
+        names = [_control_name(c) for c in hint["controls"]]
+        lines.append("Controls, in order: " + ", ".join(names))
     if "applied" in hint:
         lines.append(f"The simulated operator took {hint['applied']} actions on your instrument.")
     return lines
+
+
+def _control_name(control: str) -> str:
+    """A control (or action kind) as the page names it, with where to find it."""
+    name = CONTROL_NAMES.get(control, control)
+    if control == "H":
+        return f"{name} (its wheel appears once the height counter is geared)"
+    if control in ("gear", "slip", "connect", "needle", "record"):
+        return f"{control} (a form under 'Instrument and sheet actions')"
+    if control in ("X", "Y", "Z", "bx", "by", "bz") or control.startswith(("k", "d", "f_")):
+        return f"{name} (wheel)"
+    return name

@@ -34,7 +34,7 @@ from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket
 
 from stereoplotter.io.session_store import SessionStore
-from stereoplotter.web import core, routes
+from stereoplotter.web import core, page_routes, routes
 from stereoplotter.web.guard import BURST, RATE, Guard, Refused, error, local_names
 from stereoplotter.web.registry import Registry
 from stereoplotter.web.routes import START_LIMIT, Web
@@ -92,6 +92,7 @@ ROUTES = [
     Route("/api/instructor/replay/{sid}", routes.replay_states),
     Route("/api/instructor/grant", routes.grant, methods=["POST"]),
     Route("/api/instructor/exercises", routes.upload, methods=["POST"]),
+    *page_routes.ROUTES,
     WebSocketRoute("/ws-instructor", _ws_instructor),
     WebSocketRoute("/ws/{sid}", _ws_trainee),
     Mount("/static", StaticFiles(directory=str(STATIC)), name="static"),

@@ -25,6 +25,9 @@ $("overall").append(
     ` (simulated operator ${o.par_score.toFixed(3)}), percentile ${o.percentile.toFixed(1)} ± `
     + `${o.percentile_se.toFixed(1)} among simulated operators`),
   el("p", { class: "meta", text: grade.title }));
+if (grade.population && grade.population.acuity) {
+  $("overall").append(el("p", { class: "meta", id: "acuity-note", text: grade.population.acuity.text }));
+}
 $("md").addEventListener("click", (e) => {
   e.preventDefault(); download(`/api/sessions/${sid}/grade.md`, auth, `grade-${sid}.md`);
 });

@@ -123,3 +123,17 @@ $("upload").addEventListener("submit", async (e) => {
   const j = await r.json();
   $("upload-result").textContent = r.ok ? `added ${j.name}: ${j.title}` : j.error;
 });
+
+// The class's stereo acuities (recorded in the sessions by the trainees' acuity tests).
+async function loadAcuities() {
+  const r = await fetch("/api/instructor/acuity", { headers: auth });
+  if (!r.ok) return;
+  const rows = await r.json();
+  const fmt = (v) => (v === undefined ? "—" : v.toFixed(1));
+  $("acuities").tBodies[0].replaceChildren(...rows.map((a) => el("tr", { "data-id": a.id },
+    el("td", { text: a.trainee }), el("td", { text: a.id }),
+    el("td", { class: "num", text: fmt(a.x_arcsec) }), el("td", { class: "num", text: fmt(a.y_arcsec) }))));
+  document.body.dataset.acuities = String(rows.length);
+}
+$("acuity-refresh").addEventListener("click", loadAcuities);
+loadAcuities();

@@ -6,6 +6,8 @@ import { Wheels, LABELS, decimals } from "./wheels.js";
 import { el, sessionKey } from "./dom.js";
 import { buildActions, describe, parseCommand, showResult, showChecklist, showAnnounced, showCoupled, showSheet } from "./panels.js";
 import { Overview } from "./overview.js";
+import { loadGlossary, glossaryBox, withTerms, termEl, names } from "./words.js";
+import { AcuityTest, acuityPanel } from "./acuity.js";
 
 const sid = location.pathname.split("/").pop();
 const key = sessionKey.get(sid);
@@ -52,6 +54,7 @@ function pump() {
 }
 
 function send(action) {
+  tourEvent(action.kind, action);
   seq += 1;
   if (!ws || ws.readyState !== WebSocket.OPEN) {
     message("not connected to the server: this action was not sent (reconnecting…)", "error");
@@ -142,12 +145,13 @@ function drawEyes() {
     else { ctx.drawImage(off[flickerSide], 0, 0); }
   }
   if (overview) overview.draw(marks, mag);
+  zoomNote(marks, mag);
   window.__frames = (window.__frames || 0) + 1;
 }
 setInterval(() => {
   if ($("view").value === "flicker") { flickerSide = flickerSide === "left" ? "right" : "left"; drawEyes(); }
 }, 125);
-for (const id of ["view", "colours", "mag"]) $(id).addEventListener("change", drawEyes);
+for (const id of ["view", "colours", "mag"]) $(id).addEventListener("change", () => { drawEyes(); tourEvent("mag", { value: Number($("mag").value) }); });
 
 // --- coordinatograph -----------------------------------------------------------------------
 const NS = "http://www.w3.org/2000/svg";
@@ -185,7 +189,9 @@ function drawCounters() {
   if (body.dataset.names !== names) {
     body.replaceChildren(); body.dataset.names = names;
     for (const name of Object.keys(state.counters)) {
-      const tr = el("tr", { "data-counter": name }, el("td", { text: LABELS[name] || name }),
+      const zero = name.startsWith("dx") || name.startsWith("dy")
+        ? "a decentration counter: at its place of zero (MO_dx, MO_dy) it reads 20.00 mm" : null;
+      const tr = el("tr", { "data-counter": name, title: zero }, el("td", { text: LABELS[name] || name }),
         el("td", { class: "num" }), el("td"),
         el("td", {}, el("button", { class: "dir", title: "reverse the counter's direction", text: "±" })),
         el("td", {}, el("button", { class: "read", text: "read" })));
@@ -209,9 +215,10 @@ function drawStage() {
   $("mode").className = `badge ${hello.demonstration ? "demonstration" : state.mode}`;
   const ul = $("checks"); ul.replaceChildren();
   for (const ch of state.checks) {
-    const li = document.createElement("li");
-    li.textContent = `${ch.name}: tolerance ${ch.tolerance === null ? "—" : ch.tolerance.toPrecision(3)} ${ch.unit}`;
-    ul.appendChild(li);
+    const lc = ch.unit === "mm" && state.counters.X ? state.counters.X.least_count : null;
+    const fine = lc && ch.tolerance !== null && ch.tolerance > lc * 1.0001 && ch.tolerance < 2 * lc
+      ? ` — under two least counts of the counters (${lc} mm): point carefully in the eyepieces, read twice` : "";
+    ul.appendChild(termEl("li", {}, `${ch.name}: tolerance ${ch.tolerance === null ? "—" : ch.tolerance.toPrecision(3)} ${ch.unit}${fine}`));
   }
   const allowed = new Set(state.allowed);
   const demo = hello.demonstration;
@@ -220,6 +227,8 @@ function drawStage() {
   $("redo").disabled = demo || !allowed.has("redo");
   $("hints").hidden = !allowed.has("hint");
   $("claim").disabled = demo || !allowed.has("claim");
+  $("check").hidden = state.mode !== "practice" || demo;
+  $("check").disabled = !allowed.has("claim");
   $("demo").hidden = !demo;
   $("done").hidden = !state.done;
   $("grade-link").href = `/grade/${encodeURIComponent(sid)}`;
@@ -264,7 +273,7 @@ function handle(msg) {
     scale.formatMm = hello.format_mm;
     $("who").textContent = `${hello.trainee} · ${hello.exercise}`;
     $("title").textContent = "Stereoplotter trainer";
-    $("instructions").textContent = hello.description;
+    $("instructions").replaceChildren(...withTerms(hello.description));
     waiting.clear();
     buildActions($("actions"), hello.actions || [], Object.keys(msg.state.controls), send, message);
     loadOverview();
@@ -279,12 +288,17 @@ function handle(msg) {
   else if (!msg.hello) message("");
   if (!msg.hello && !msg.error) {
     showResult($("result"), action, msg.result);
+    afterClaim(action, msg.result);
+    if (action && action.kind === "record") message(`recorded: ${describe(action)} (kept in your session's record)`);
     showCoupled($("coupled"), action, before, msg.state, msg.state && msg.state.events);
   }
   if (msg.demo) $("demo-count").textContent = `${msg.demo.done} / ${msg.demo.of}`;
   if (msg.seq !== undefined && waiting.has(msg.seq)) { waiting.get(msg.seq)(performance.now()); waiting.delete(msg.seq); }
   document.body.dataset.ready = "1";
 }
+await loadGlossary();
+Object.assign(LABELS, names.controls);
+glossaryBox($("term-box"));
 if (key) connect();
 else {
   message("this browser holds no key for this session: start a session from the exercises page", "error");
@@ -292,9 +306,28 @@ else {
 }
 
 $("claim").onclick = () => send({ kind: "claim", step: state.stage });
-$("undo").onclick = () => send({ kind: "undo" });
+// In practice the stage may be checked before it is claimed: a failing check is named with its
+// measured and allowed values and the likely wrong setting; fix it, then claim.
+$("check").onclick = async () => {
+  if (!state || hello.demonstration || state.mode !== "practice") return;
+  const fb = await feedbackOf("now");
+  if (!fb) return;
+  if (fb.passed) { showFeedback({ lines: ["Every check of the stage is within its tolerance: claim it."] }, `Stage ${fb.stage}:`, []); return; }
+  showFeedback(fb, `Stage ${fb.stage} is not yet within its tolerance:`, [
+    ["Fix it first", () => { $("feedback").hidden = true; }],
+    ["Claim anyway", () => { $("feedback").hidden = true; send({ kind: "claim", step: state.stage }); }],
+  ]);
+};$("undo").onclick = () => send({ kind: "undo" });
 $("redo").onclick = () => send({ kind: "redo" });
-for (const b of $("hints").querySelectorAll("button")) b.onclick = () => send({ kind: "hint", level: Number(b.dataset.level) });
+for (const b of $("hints").querySelectorAll("button[data-level]")) {
+  b.onclick = () => {
+    const level = Number(b.dataset.level);
+    if (level < 3) { send({ kind: "hint", level }); return; }
+    confirmBox(`Hint 3: the simulated operator does the whole of stage ${state.stage} on your instrument at once `
+      + `(${words ? words.show_me_actions : "its"} actions), and it costs ${hintCost(3)}. `
+      + "Your own settings of the stage are replaced by the operator's.", () => send({ kind: "hint", level: 3 }));
+  };
+}
 $("command").addEventListener("keydown", (e) => {
   if (e.key !== "Enter" || !state) return;
   const names = [...Object.keys(withHeightScale(state)), ...Object.keys(state.counters)];
@@ -308,8 +341,13 @@ let playing = null, showing = null;
 // "Show me", animated: the operator's actions of the stage sent one by one at the chosen speed
 // (the eyepieces, wheels and counters move as they go), then hint 3 logged (its cost; it
 // applies the same settings again, which the instrument already shows).
-$("show-me").onclick = async () => {
+$("show-me").onclick = () => {
   if (showing) { clearInterval(showing); showing = null; $("show-me").textContent = "Show me"; return; }
+  confirmBox(`Show me: the simulated operator does stage ${state.stage} on your instrument, one action at a time `
+    + `(${words ? words.show_me_actions : "its"} actions at the speed chosen below; Stop ends it). It costs as hint 3: `
+    + `${hintCost(3)}.`, showMe);
+};
+async function showMe() {
   const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/showme`, { headers: auth() });
   const body = await r.json();
   if (!r.ok) { message(body.error, "error"); return; }
@@ -326,7 +364,7 @@ $("show-me").onclick = async () => {
     $("show-me-count").textContent = `show me ${i} / ${actions.length}: ${describe(a)}`;
     send(a);
   }, 1000 / Number($("demo-speed").value));
-};
+}
 $("demo-step").onclick = sendDemo;
 function play() {
   if (playing) clearInterval(playing);
@@ -347,11 +385,13 @@ async function tickChecklist(ticks) {
     checklistFor = ticks.stage;
     const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/checklist`, { headers: auth() });
     checklist = r.ok ? await r.json() : null;
+    loadWords();
   }
   if (!checklist || checklist.stage !== ticks.stage) return;
-  checklist.steps.forEach((s, i) => { s.done = !!ticks.done[i]; });
-  checklist.done = ticks.done.filter(Boolean).length;
-  showChecklist($("checklist"), checklist);
+  checklist.steps.forEach((s, i) => { s.done = !!ticks.done[i]; s.shown = ticks.shown ? !!ticks.shown[i] : true; });
+  checklist.done = checklist.steps.filter((s) => s.shown && s.done).length;
+  checklist.total = checklist.steps.filter((s) => s.shown).length;
+  showChecklist($("checklist"), checklist, sheetData);
   $("checklist-count").textContent = `${checklist.done} / ${checklist.total}`;
 }
 
@@ -362,6 +402,7 @@ async function loadOverview() {
   const data = await r.json();
   if (!r.ok) { $("overview-note").textContent = data.error; return; }
   overview = new Overview($("overview-svg"), (xy) => {
+    if ($("click-mode").value === "drive") { goTo({ x: xy[0], y: xy[1] }); return; }
     const n = $("substitute-for").value;
     if (!n) { $("overview-note").textContent = "no standard point of this exercise needs a substitute"; return; }
     send({ kind: "record", name: `substitute ${n}`, value: xy });
@@ -371,6 +412,8 @@ async function loadOverview() {
     ? data.photos.left.standard_points.filter((p) => p.usable === false).map((p) => p.id) : data.unusable || [];
   $("substitute-for").replaceChildren(...unusable.map((n) => el("option", { value: String(n), text: String(n) })));
   $("overview-note").textContent = unusable.length ? `unusable: ${unusable.join(", ")} (on water or outside the overlap)` : "";
+  if (unusable.length) $("click-mode").value = "substitute";
+  overviewData = data;
   document.body.dataset.overview = "1";
   drawEyes();
 }
@@ -412,3 +455,128 @@ window.trainer = {
     return new Promise((res) => waiting.set(s, (t) => requestAnimationFrame(() => res(t - t0))));
   },
 };
+
+// --- words, feedback, navigation ------------------------------------------------------------
+let words = null, sheetData = null, overviewData = null;
+async function loadWords() {
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/words`, { headers: auth() });
+  if (r.ok) words = await r.json();
+  if (words && words.tour && words.tour.length && tourAt === null) { $("tour-btn").hidden = false; showTour(0); }
+  for (const b of $("hints").querySelectorAll("button[data-level]")) {
+    b.title = `hint ${b.dataset.level}: costs ${hintCost(Number(b.dataset.level))} (the highest level asked in a stage counts)`;
+  }
+  if (!sheetData) {
+    const s = await fetch(`/api/sessions/${encodeURIComponent(sid)}/sheet`, { headers: auth() });
+    if (s.ok) { sheetData = await s.json(); if (checklist) showChecklist($("checklist"), checklist, sheetData); }
+  }
+}
+function hintCost(level) {
+  const p = words && words.hint_points ? words.hint_points[String(level)] : null;
+  return p === null || p === undefined ? "a part of the points" : `${p} of the exercise's 100 points`;
+}
+
+function confirmBox(text, yes) {
+  const box = $("confirm");
+  box.replaceChildren(termEl("p", {}, text), el("div", { class: "row" },
+    el("button", { class: "primary", id: "confirm-yes", text: "Yes, do it", onclick: () => { box.hidden = true; yes(); } }),
+    el("button", { id: "confirm-no", text: "Cancel", onclick: () => { box.hidden = true; } })));
+  box.hidden = false;
+}
+
+async function feedbackOf(which) {
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/feedback?stage=${which}`, { headers: auth() });
+  return r.ok ? r.json() : null;
+}
+function showFeedback(fb, title, buttons) {
+  const box = $("feedback");
+  box.replaceChildren(el("b", { text: title }), ...fb.lines.map((line) => termEl("p", {}, line)));
+  if (buttons.length) box.append(el("div", { class: "row" }, ...buttons.map(([t, f]) => el("button", { text: t, onclick: f }))));
+  box.hidden = false;
+}
+// After a claim whose checks failed (practice): the likely wrong setting, and the way back.
+async function afterClaim(action, result) {
+  if (!action || action.kind !== "claim" || !result || !result.measures) return;
+  if (result.measures.every((m) => m.passed)) { $("feedback").hidden = true; return; }
+  const fb = await feedbackOf("last");
+  if (!fb) return;
+  const back = state && !state.done && (state.allowed || []).includes("undo");
+  showFeedback(fb, `Stage ${fb.stage} claimed, not within its tolerance.`, back
+    ? [["Undo the claim, fix it and claim again (an undo costs no points; the grade takes your last claim)", () => { $("feedback").hidden = true; send({ kind: "undo" }); }]]
+    : []);
+}
+
+// "Go to": the X, Y settings that put the left mark on the point, sent as the trainee's own.
+async function goTo(where) {
+  const q = where.point ? `point=${encodeURIComponent(where.point)}` : `x=${where.x}&y=${where.y}`;
+  const r = await fetch(`/api/sessions/${encodeURIComponent(sid)}/goto?${q}`, { headers: auth() });
+  const body = await r.json();
+  if (!r.ok) { message(body.error, "error"); return; }
+  for (const a of body.actions) send(a);
+  tourEvent("goto", where);
+  message(`${body.actions.map(describe).join(", ")}${where.point ? ` (standard point ${where.point})` : ""}`);
+}
+for (const b of $("goto").querySelectorAll("button[data-point]")) b.onclick = () => goTo({ point: b.dataset.point });
+
+// Where the detail matching the left mark lies outside the right eyepiece's field: say so.
+function zoomNote(marks, mag) {
+  const box = $("zoom-note");
+  if (!marks || !overviewData || !overviewData.photos) { box.hidden = true; return; }
+  const L = overviewData.photos.left.standard_points, R = overviewData.photos.right.standard_points;
+  let best = null;
+  L.forEach((p, i) => {
+    const d = Math.hypot(p.x_mm - marks.left.x_mm, p.y_mm - marks.left.y_mm);
+    if (!best || d < best.d) best = { d, i };
+  });
+  const field = 256 / (scale.pxPerMmAt1x * mag); // mm of photo across an eyepiece
+  if (!best || best.d > field) { box.hidden = true; return; }
+  const p = L[best.i], r = R[best.i];
+  const want = { x: r.x_mm + (marks.left.x_mm - p.x_mm), y: r.y_mm + (marks.left.y_mm - p.y_mm) };
+  const dx = want.x - marks.right.x_mm, dy = want.y - marks.right.y_mm;
+  const off = Math.hypot(dx, dy);
+  if (off <= field / 2) { box.hidden = true; return; }
+  const fits = [2, 6, 20].filter((m) => off <= 256 / (scale.pxPerMmAt1x * m) / 2);
+  const why = Math.abs(dx) >= Math.abs(dy)
+    ? "mostly along the base (x-parallax): turn Z, the foot wheel, to bring it in"
+    : "mostly across the base (y-parallax): clear it roughly at standard points 1 and 2 first";
+  box.textContent = `At standard point ${p.id} the detail under the left mark is ${off.toFixed(2)} mm from the right mark, `
+    + `${why}; it is outside the right eyepiece's field at ×${mag} (${(field / 2).toFixed(2)} mm). `
+    + (fits.length ? `Zoom out to ×${Math.max(...fits)} to find it, then clear the parallax and zoom in again.`
+      : "Even ×2 does not reach it.");
+  box.hidden = false;
+}
+
+// --- the newcomer's tour: one card at a time, each on one part of the page ----------------------
+let tourAt = null;
+function showTour(i) {
+  document.querySelectorAll(".tour-target").forEach((e) => e.classList.remove("tour-target"));
+  const cards = (words && words.tour) || [];
+  const box = $("tour");
+  if (i === null || i >= cards.length) { tourAt = cards.length; box.hidden = true; return; }
+  tourAt = i;
+  const c = cards[i];
+  const target = $(c.target);
+  if (target) { target.classList.add("tour-target"); target.scrollIntoView({ block: "nearest" }); }
+  box.replaceChildren(el("h3", { text: c.title }), termEl("p", {}, c.text), el("p", { class: "meta", text: `Try: ${c.try}` }),
+    el("div", { class: "row" },
+      el("button", { id: "tour-next", class: "primary", text: i + 1 < cards.length ? "Next" : "Close", onclick: () => showTour(i + 1) }),
+      el("button", { text: "Close the cards", onclick: () => showTour(null) }),
+      el("span", { class: "meta", text: `${i + 1} / ${cards.length}` })));
+  box.hidden = false;
+  box.dataset.card = String(i);
+}
+function tourEvent(kind, detail) {
+  const cards = (words && words.tour) || [];
+  if (tourAt === null || tourAt >= cards.length) return;
+  const want = cards[tourAt].done;
+  const met = (want.kind === "mag" && kind === "mag" && detail.value === want.value)
+    || (want.kind === "set" && (kind === "set" || kind === "turn") && detail.control === want.control)
+    || (want.kind === "read" && kind === "read") || (want.kind === "goto" && kind === "goto");
+  if (met) setTimeout(() => showTour(tourAt + 1), 400);
+}
+$("tour-btn").onclick = () => showTour(0);
+
+// --- the trainee's stereo acuity ----------------------------------------------------------------
+$("acuity").append(acuityPanel());
+const acuityTest = new AcuityTest($("acuity"), send, () => (hello ? hello.screen_pixel_mm : 0.1));
+$("acuity-open").onclick = () => { $("acuity-body").hidden = !$("acuity-body").hidden; };
+window.acuityTest = acuityTest;

@@ -3,6 +3,7 @@
 // coupled motions and the setup sheet. DOM from elements and text nodes only (issue 22).
 import { el } from "./dom.js";
 import { LABELS } from "./wheels.js";
+import { withTerms, termEl, names, sheetValue } from "./words.js";
 
 // Kinds with their own widgets elsewhere on the page: wheels (turn, set), the counters table
 // (direction, read), the stage panel (claim, undo, redo, hint).
@@ -81,7 +82,7 @@ export function buildActions(root, catalogue, controls, send, say) {
 }
 
 const fmt = (v) => (typeof v !== "number" ? String(v)
-  : Number.isInteger(v) ? String(v) : Math.abs(v) >= 1e-3 ? v.toFixed(4) : v.toExponential(2));
+  : Number.isInteger(v) ? String(v) : Math.abs(v) >= 1e-3 ? String(Number(v.toFixed(6))) : v.toExponential(2));
 
 // What an action answered, as readable text and tables (never a JSON dump).
 export function showResult(root, action, result) {
@@ -100,13 +101,13 @@ export function showResult(root, action, result) {
   }
   if (result.claimed && !result.text) root.append(el("p", { class: "big", text: `Stage ${result.claimed} claimed.` }));
   if (result.level) root.append(el("h3", { text: `Hint ${result.level}` }));
-  if (Array.isArray(result.text)) for (const line of result.text) root.append(el("p", { text: String(line) }));
-  else if (result.lines && result.lines.length) for (const line of result.lines) root.append(el("p", { text: typeof line === "string" ? line : line.text || "" }));
-  else if (result.text) for (const para of String(result.text).split(/\n\s*\n/)) root.append(el("p", { text: para }));
+  if (Array.isArray(result.text)) for (const line of result.text) root.append(termEl("p", {}, String(line)));
+  else if (result.lines && result.lines.length) for (const line of result.lines) root.append(termEl("p", {}, typeof line === "string" ? line : line.text || ""));
+  else if (result.text) for (const para of String(result.text).split(/\n\s*\n/)) root.append(termEl("p", {}, para));
   if (result.cost !== undefined && result.cost !== null) root.append(el("p", { class: "meta", text: `this hint costs ${fmt(result.cost)} of the score` }));
   if (result.steps && result.steps.length && !(result.lines && result.lines.length)) {
     root.append(el("p", { class: "meta", text: "the simulated operator's steps in this stage:" }),
-      el("ol", {}, ...result.steps.map((s) => el("li", { text: typeof s === "string" ? s : s.text || s.name || "" }))));
+      el("ol", {}, ...result.steps.map((s) => termEl("li", {}, typeof s === "string" ? s : s.text || s.name || ""))));
   }
   if (result.controls && result.controls.length) {
     root.append(el("p", { text: `controls the operator uses here: ${result.controls.map((c) => LABELS[c] || c).join(", ")}` }));
@@ -114,20 +115,34 @@ export function showResult(root, action, result) {
   if (result.applied) root.append(el("p", { text: `the operator's ${result.applied} actions of the stage were carried out on your instrument` }));
   if (result.measures && result.measures.length) {
     root.append(el("table", {}, el("tr", {}, ...["measure", "value", "tolerance", ""].map((h) => el("th", { text: h }))),
-      ...result.measures.map((m) => el("tr", {}, el("td", { text: m.name }), el("td", { class: "num", text: `${fmt(m.value)} ${m.unit}` }),
+      ...result.measures.map((m) => el("tr", {}, termEl("td", {}, m.name), el("td", { class: "num", text: `${fmt(m.value)} ${m.unit}` }),
         el("td", { class: "num", text: `${fmt(m.tolerance)} ${m.unit}` }),
         el("td", { class: m.passed ? "pass" : "fail", text: m.passed ? "within" : "outside" })))));
   }
 }
 
-// The stage's steps as a checklist (the core's, ticked as the trainee goes).
-export function showChecklist(root, list) {
+// The stage's steps as a checklist (the core's, ticked when their targets are met): each step
+// with the controls it uses, the sheet rows its values come from (with the values, where the
+// exercise's sheet gives them), a note where its number differs from the sheet's; a step taken
+// only when a check fails is shown only while it fails, marked with its condition.
+export function showChecklist(root, list, sheet) {
   const items = Array.isArray(list) ? list : list ? list.steps : [];
   root.dataset.done = list && list.done !== undefined ? `${list.done}/${list.total}` : "";
-  root.replaceChildren(...(items || []).map((it) => {
+  root.replaceChildren(...(items || []).filter((it) => it.shown !== false).map((it) => {
     const done = !!(it.done || it.ticked);
-    return el("li", { class: done ? "done" : "", "data-done": done ? "1" : "0" },
-      el("span", { class: "tick", text: done ? "☑ " : "☐ " }), it.text || it.step || it.name || "");
+    const li = el("li", { class: done ? "done" : it.conditional ? "conditional" : "", "data-done": done ? "1" : "0", "data-n": String(it.n ?? "") },
+      el("span", { class: "tick", text: done ? "☑ " : "☐ " }), ...withTerms(it.text || it.step || it.name || ""));
+    if (it.condition) li.append(termEl("div", { class: "step-condition" }, `if needed: ${it.condition}`));
+    const uses = it.control_names && it.control_names.length ? it.control_names : null;
+    if (uses) li.append(termEl("div", { class: "step-uses" }, `controls: ${uses.join(", ")}`));
+    for (const row of it.sheet_rows || []) {
+      const v = sheetValue(sheet, row.part, row.key);
+      const where = `${SHEET_PARTS[row.part] || row.part} → ${names.sheet[row.key.split(".")[0]] || row.key}${row.key.includes(".") ? ` (${row.key.split(".").slice(1).join(" ")})` : ""}`;
+      const value = v === undefined ? "" : ` = ${fmt(v)}`;
+      li.append(termEl("div", { class: "step-sheet", "data-key": row.key }, `sheet: ${where}${value} — ${row.control}: ${row.use}`));
+    }
+    if (it.note) li.append(termEl("div", { class: "step-note" }, it.note));
+    return li;
   }));
 }
 
