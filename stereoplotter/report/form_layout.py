@@ -4,12 +4,12 @@ labels placed so that none overlaps another (the drawing's point and corner labe
 fpdf2 (a document library: real text that can be searched and extracted, vector drawing,
 embedded TrueType subsets), through its low-level calls for the tables and paragraphs: their
 lines are broken here by the font's advance widths, remembered per string, and drawn with
-``text`` and ``line`` — fpdf2's own ``table`` and ``multi_cell`` measured every fragment again at
-each character (≈ 80 % of a form's time in the profile of issue 27). The fonts are parsed once
-per process and each font subset compiled once per set of glyphs (:meth:`Form.output`). A
-document of many forms takes each form's pages as drawn for the form alone, their text
-re-encoded to its own font subsets and their footers numbered in it (:meth:`Form.append_pages`):
-no form is laid out twice. The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
+``text`` and ``line`` — fpdf2's own ``table`` and ``multi_cell`` measure every fragment again at
+each character (the cost: ``bench_job_sheets.py`` in ``benchmarks/README.md``). The fonts are
+parsed once per process and each font subset compiled once per set of glyphs
+(:meth:`Form.output`). A document of many forms takes each form's pages as drawn for the form
+alone, their text re-encoded to its own font subsets and their footers numbered in it
+(:meth:`Form.append_pages`): no form is laid out twice. The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
 font that ships inside matplotlib (``mpl-data/fonts/ttf``), found without importing matplotlib,
 so no system font is read.
 """
@@ -176,8 +176,7 @@ class Form(FPDF):
     def text(self, x: float, y: float, text: str = "") -> None:
         """fpdf2's ``text`` for what the forms draw (filled text, no underline, a TrueType
         font): the same bytes, each text encoded once per document (fpdf2 maps every character
-        through its subset again at every call; its ``text`` was 36 % of ``job_files``' time,
-        its ``encode_text`` 17 %, by cProfile of strip8 × 5, issue 27)."""
+        through its subset again at every call)."""
         font = self.current_font
         if (not self.page or not self.font_family or self.buffer or self.underline
                 or self.strikethrough or self.text_mode != TextMode.FILL

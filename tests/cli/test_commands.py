@@ -1,4 +1,4 @@
-"""The commands layer (issue 23): the CLI starts without the library, every command module
+"""The commands layer: the CLI starts without the library, every command module
 follows the protocol (``add_arguments``, ``run``), the one figure encoder is reproducible."""
 
 from __future__ import annotations

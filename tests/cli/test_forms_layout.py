@@ -1,4 +1,4 @@
-"""The forms' own table layout and the per-process font memory (issue 27, deliverable 7): a form's
+"""The forms' own table layout and the per-process font memory: a form's
 bytes do not depend on what the process rendered before it; a table that runs over a page
 continues under its header again, the header never left alone at a page's foot; a cell's text
 is broken at spaces into lines within its column."""

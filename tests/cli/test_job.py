@@ -1,4 +1,4 @@
-"""`stereoplotter setup JOB`: the production job of issue 12 (jobs/strip8), its forms and files."""
+"""`stereoplotter setup JOB`: the production job jobs/strip8, its forms and files."""
 
 from __future__ import annotations
 
@@ -69,7 +69,7 @@ def test_same_job_gives_byte_identical_files(written, tmp_path):
     assert main(["setup", str(JOB), "-o", str(tmp_path)]) == 0
     first, second = _files(written), _files(tmp_path)
     assert sorted(first) == sorted(second)
-    assert len(first) == 8 * 3 + 4  # + manifest.json (issue 27)
+    assert len(first) == 8 * 3 + 4  # + manifest.json
     for name in first:
         assert first[name] == second[name], name
 
@@ -99,7 +99,7 @@ def test_f_prime_is_from_the_measured_fiducial_distances(written):
         expected = 70.0 * np.mean([*spans[left], *spans[right]]) / 170.0
         sheet = yaml.safe_load((written / pair / "sheet.yaml").read_text("utf-8"))
         assert sheet["focal_length_corrected_mm"] == pytest.approx(expected, abs=1e-6)
-        # photo numbers are text (issue 27)
+        # photo numbers are text
         assert sheet["job"]["photos"] == {"left": str(left), "right": str(right)}
         per_photo = sheet["focal_length_corrected_per_photo_mm"]
         assert per_photo[0] == pytest.approx(70.0 * np.mean(spans[left]) / 170.0, abs=1e-6)
@@ -306,7 +306,7 @@ def test_shipped_job_validates_against_its_schema():
     assert any("lefft" in e.message for e in validator.iter_errors(doc))
 
 
-# --- job to-scenario (issue 12, deliverable 3) ---------------------------------------------------
+# --- job to-scenario -----------------------------------------------------------------------------
 
 
 def test_job_to_scenario_loads_simulates_and_keeps_the_pair(tmp_path, capsys):
@@ -351,9 +351,8 @@ def test_job_to_scenario_loads_simulates_and_keeps_the_pair(tmp_path, capsys):
     assert summary["evaluation"]["horizontal_scale_denominator"] == sheet["scale_horizontal"]
     assert summary["evaluation"]["vertical_scale_denominator"] == sheet["scale_vertical"]
     assert all(c["passed"] for c in summary["checks"].values())
-    # zero errors: the mechanism's own. Issue 11: SC-1's own mechanism (gimbal offset h = 20 mm,
-    # assumed) raises it from 1.10 µm (canonical unit, h = 0) to 6.04 µm on this pair; bound: the
-    # book's residual y-parallax tolerance, ¼ of the 0.05 mm mark
+    # zero errors: what is left is the mechanism's own (SC-1's gimbal offset h = 20 mm, assumed);
+    # bound: the book's residual y-parallax tolerance, ¼ of the 0.05 mm mark
     assert summary["residual_y_parallax_um"]["grid_max"] < 12.5
 
 

@@ -1,5 +1,5 @@
 """Job inputs that keep every identifier, messages that point to the cell, a pair refused alone,
-output folders that behave (issue 27, deliverables 4–6), on copies of jobs/strip8."""
+output folders that behave, on copies of jobs/strip8."""
 
 from __future__ import annotations
 
@@ -59,7 +59,7 @@ def _error(capsys) -> str:
 
 
 def test_acceptance_ids_stay_distinct_photo_number_prints_as_written(tmp_path, capsys):
-    """Issue 27 acceptance: ids 0415 and 415, photo number "012417" quoted, a comment line in
+    """Ids 0415 and 415, photo number "012417" quoted, a comment line in
     the CSV; then an error on the CSV's line 5 is reported at line 5."""
 
     def edit(doc):
@@ -128,7 +128,7 @@ def test_unquoted_number_with_a_leading_zero_is_refused(tmp_path, capsys, text, 
 
 
 def test_unquoted_plain_numbers_are_their_digits(tmp_path):
-    """``number: 101`` unquoted (as jobs written before issue 27) is the photo '101'."""
+    """``number: 101`` unquoted (as older jobs write it) is the photo '101'."""
     path = _job(tmp_path)
     path.write_text(re.sub(r"'(1\d\d)'", r"\1", path.read_text("utf-8")), "utf-8")
     assert "number: 101\n" in path.read_text("utf-8")

@@ -1,6 +1,6 @@
 """`study run` on a reduced grid of the shipped formula-validity study: the Dataset of 2 Dask
 workers (one of them killed mid-run) is identical to the serial run, bit for bit, and so is a
-run resumed after its process was killed (issue 28, acceptance)."""
+run resumed after its process was killed."""
 
 from __future__ import annotations
 

@@ -23,7 +23,7 @@ VALID = {
 }
 
 
-def test_shipped_studies_have_the_issue_s_size():
+def test_shipped_studies_have_their_grid_sizes():
     fv, _ = load_study("formula-validity")
     assert len(fv.cells()) == 4 * 5 * 4 * 4 * 4 * 3 * 2  # 7 680 configurations
     assert fv.procedures() == 76_800_000

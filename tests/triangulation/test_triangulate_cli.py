@@ -116,7 +116,7 @@ def test_bad_block_file_is_one_error_line(tmp_path, capsys):
 
 
 def test_leading_zero_photo_numbers_pass_through_to_the_job(chain, tmp_path):
-    """Photo numbers are text in the job (issue 27): a block whose photo 101 is numbered 0101
+    """Photo numbers are text in the job: a block whose photo 101 is numbered 0101
     gives a job whose photo and pair keep 0101 (the job format took integers and the writer
     refused it)."""
     import shutil
