@@ -90,9 +90,9 @@ def _parse_yaml(text: str, source: str) -> Any:
     """``yaml.safe_load`` with the document checked (:func:`_check_document`) before it is
     constructed, and every failure as a :class:`ConfigError`.
 
-    Read with libyaml where PyYAML has it (:func:`_parse_fast`, ≈ 10× faster: the shipped
-    files are ≈ 60 % of ``stereoplotter info``); a document libyaml refuses, or that fails a
-    check, is read again by the pure-Python loader, whose messages (line, column, the
+    Read with libyaml where PyYAML has it (:func:`_parse_fast`, PyYAML's C parser: reading the
+    shipped files is much of ``stereoplotter info``); a document libyaml refuses, or that fails
+    a check, is read again by the pure-Python loader, whose messages (line, column, the
     offending character) are the ones reported.
     """
     found = _parse_fast(text, source)

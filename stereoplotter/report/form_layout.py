@@ -9,9 +9,9 @@ each character (the cost: ``bench_job_sheets.py`` in ``benchmarks/README.md``). 
 parsed once per process and each font subset compiled once per set of glyphs
 (:meth:`Form.output`). A document of many forms takes each form's pages as drawn for the form
 alone, their text re-encoded to its own font subsets and their footers numbered in it
-(:meth:`Form.append_pages`): no form is laid out twice. The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
-font that ships inside matplotlib (``mpl-data/fonts/ttf``), found without importing matplotlib,
-so no system font is read.
+(:meth:`Form.append_pages`): no form is laid out twice. The Cyrillic and Greek symbols need a
+Unicode font: DejaVu Sans, the font that ships inside matplotlib (``mpl-data/fonts/ttf``), found
+without importing matplotlib, so no system font is read.
 """
 
 from __future__ import annotations

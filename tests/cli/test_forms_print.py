@@ -186,8 +186,8 @@ def _every_page(pdf) -> None:
 
 def test_the_drawing_prints_dark(forms):
     """On the drawing page rendered without smoothing (each pixel its mark's own grey), no
-    drawn pixel is paler than grey 110 of 255: a grey fill of 225 (pale circles nearly
-    invisible on a copier) gave 18 % of them."""
+    drawn pixel is paler than grey 110 of 255 (a pale grey fill, such as 225, is nearly
+    invisible on a copier)."""
     heading = {"ru": "Рамка трапеции", "en": "Sheet frame and control"}
     for lang in ("ru", "en"):
         pdf = pdfium.PdfDocument(forms[lang] / "101-102" / "sheet.pdf")

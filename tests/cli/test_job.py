@@ -384,12 +384,12 @@ def test_fit_terrain_recovers_plane_and_hill():
     assert (two.kind, two.section) == ("flat", {"base_height_m": 102.0})
 
 
-# --- two formatting defects seen on job and scenario sheets ---------------------------------------
+# --- formatting of job and scenario sheets --------------------------------------------------------
 
 
 def test_sheet_without_a_map_sheet_writes_its_markdown(tmp_path, capsys):
-    """`setup --horizontal-scale` on a scenario without a map sheet: sheet_markdown divided by
-    the missing map scale (TypeError, exit 3); now the scale chain says there is no map."""
+    """`setup --horizontal-scale` on a scenario without a map sheet writes sheet.md, its scale
+    chain saying there is no map (the missing map scale is not divided by)."""
     doc = yaml.safe_load((ROOT / "stereoplotter" / "data" / "scenarios" / "pair60.yaml")
                          .read_text("utf-8"))  # fmt: skip
     del doc["map_sheet"]
@@ -404,7 +404,8 @@ def test_sheet_without_a_map_sheet_writes_its_markdown(tmp_path, capsys):
 
 
 def test_no_negative_zero_in_readings_or_residuals(tmp_path):
-    """Pair 101-102 of strip8 has b_y = −0.0003 mm: its zero reading read "MO_Y + -0.000"."""
+    """Pair 101-102 of strip8 has b_y = −0.0003 mm: its zero reading prints "MO_Y + 0.000",
+    never "MO_Y + -0.000"."""
     from stereoplotter.report.sheet import _pm, sheet_markdown
     from stereoplotter.setup.readings import _signed
 
