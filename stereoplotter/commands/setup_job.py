@@ -30,7 +30,7 @@ from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
-__all__ = ["compute_job", "run", "run_job", "write_job"]
+__all__ = ["compute_job", "run", "write_job"]
 
 
 def _instrument(job: Job) -> InstrumentSpec:
@@ -89,19 +89,6 @@ def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
         else:
             out.append(PairResult(pair, m, sheet, ""))
     return JobResult(job, spec, tuple(out))
-
-
-def run_job(
-    path: str | os.PathLike[str],
-    output_dir: str | os.PathLike[str] | None = None,
-    *,
-    force: bool = False,
-) -> JobResult:
-    """Load a job file, compute every pair and optionally write the files (:func:`write_job`)."""
-    result = compute_job(load_job(path))
-    if output_dir is not None:
-        write_job(result, output_dir, force=force)
-    return result
 
 
 def write_job(
