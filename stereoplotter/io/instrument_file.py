@@ -511,6 +511,8 @@ def _check_mechanics(spec: InstrumentSpec) -> None:
     (``mechanics.md``): μ ≥ 1 on the vertical Z axis, or a dead band 2h = b + 2μmg/k that the
     0.5 mm overtravel of the unidirectional approach does not clear. The axes are built as the
     virtual instrument builds them, so a file that loads also runs."""
+    # imported here: ``info`` lists the instrument files through this module without loading
+    # the instrument's mechanics (pymunk)
     from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
     from stereoplotter.instrument.mechanics.coordinatograph import CoordinatographParams
 
