@@ -15,12 +15,7 @@ import yaml
 
 from stereoplotter.errors import ConfigError
 
-__all__ = [
-    "MAX_YAML_DEPTH",
-    "MAX_YAML_NODES",
-    "load_yaml_mapping",
-    "read_text_file",
-]
+__all__ = ["MAX_YAML_DEPTH", "MAX_YAML_NODES", "load_yaml_mapping", "parse_yaml", "read_text_file"]
 
 #: Bounds of an input document, far above any real scenario, instrument or block file. A
 #: document beyond them is refused before anything walks it: YAML aliases let a few hundred bytes
@@ -57,7 +52,7 @@ def load_yaml_mapping(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str
     """
     source = str(path)
     text = read_text_file(path)
-    data = _parse_yaml(text, source)
+    data = parse_yaml(text, source)
     if data is None:
         raise ConfigError(source, "(top level)", "a mapping of fields", "an empty document")
     if not isinstance(data, dict):
@@ -86,7 +81,7 @@ class _BoundedLoader(yaml.SafeLoader):
             self._depth -= 1
 
 
-def _parse_yaml(text: str, source: str) -> Any:
+def parse_yaml(text: str, source: str) -> Any:
     """``yaml.safe_load`` with the document checked (:func:`_check_document`) before it is
     constructed, and every failure as a :class:`ConfigError`.
 
@@ -139,7 +134,7 @@ def _parse_fast(text: str, source: str) -> Any:
 
 
 def _parse_python(text: str, source: str) -> Any:
-    """:func:`_parse_yaml` by PyYAML's pure-Python loader, bounded (:class:`_BoundedLoader`)."""
+    """:func:`parse_yaml` by PyYAML's pure-Python loader, bounded (:class:`_BoundedLoader`)."""
     try:
         loader = _BoundedLoader(text)  # the reader refuses control characters here
     except yaml.YAMLError as exc:

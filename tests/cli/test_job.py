@@ -406,11 +406,13 @@ def test_sheet_without_a_map_sheet_writes_its_markdown(tmp_path, capsys):
 def test_no_negative_zero_in_readings_or_residuals(tmp_path):
     """Pair 101-102 of strip8 has b_y = −0.0003 mm: its zero reading prints "MO_Y + 0.000",
     never "MO_Y + -0.000"."""
-    from stereoplotter.report.sheet import _pm, sheet_markdown
-    from stereoplotter.setup.readings import _signed
+    from stereoplotter.report.sheet import sheet_markdown, signed_m
+    from stereoplotter.setup.readings import signed_text
 
-    assert (_signed(-0.0004), _signed(-0.0006), _signed(2.5)) == ("+ 0.000", "− 0.001", "+ 2.500")
-    assert (_pm(-0.0004), _pm(-0.0006), _pm(0.0123)) == ("+0.000", "-0.001", "+0.012")
+    texts = signed_text(-0.0004), signed_text(-0.0006), signed_text(2.5)
+    assert texts == ("+ 0.000", "− 0.001", "+ 2.500")
+    metres = signed_m(-0.0004), signed_m(-0.0006), signed_m(0.0123)
+    assert metres == ("+0.000", "-0.001", "+0.012")
     sheet = compute_job(load_job(JOB)).pairs[0].sheet
     assert -5e-4 < sheet.base_mm[1] < 0
     defs = [r["zero_reading_definition"] for r in sheet.readings if "zero_reading_definition" in r]
