@@ -30,7 +30,7 @@ from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
-__all__ = ["compute_job", "run", "write_job"]
+__all__ = ["compute_job", "raise_keyboard_interrupt", "run", "write_job"]
 
 
 def _instrument(job: Job) -> InstrumentSpec:
@@ -113,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
     (:func:`stereoplotter.io.output_folder.write_outputs`)."""
     previous = signal.getsignal(signal.SIGTERM)
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _interrupt)
+        signal.signal(signal.SIGTERM, raise_keyboard_interrupt)
     try:
         return _run(args)
     except KeyboardInterrupt:  # one line, the exit code of an interrupt (128 + SIGINT)
@@ -126,7 +126,8 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
-def _interrupt(signum: int, frame: object) -> None:
+def raise_keyboard_interrupt(signum: int, frame: object) -> None:
+    """The SIGTERM handler of :func:`run`: a termination ends the run as Ctrl-C does."""
     raise KeyboardInterrupt
 
 

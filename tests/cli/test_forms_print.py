@@ -225,15 +225,15 @@ def test_no_table_is_split_unless_longer_than_a_page(monkeypatch):
 
     monkeypatch.setattr(forms, "table", recording)
     wide = set()
-    wrap, width = form_layout._wrap, form_layout._width
+    wrap, width = form_layout.wrap_lines, form_layout.text_width
 
     def checking(pdf, text, room, style, size):
         wide.update((word, size) for line in text.split("\n") for word in line.split(" ")
                     if word and width(pdf, word, style, size) > room)  # fmt: skip
         return wrap(pdf, text, room, style, size)
 
-    monkeypatch.setattr(form_layout, "_wrap", checking)
-    monkeypatch.setattr(form_layout, "_LINES", {})  # every cell's lines found again
+    monkeypatch.setattr(form_layout, "wrap_lines", checking)
+    form_layout.forget_layout()  # every cell's lines found again
     result = compute_job(load_job(JOB))
     for lang in ("ru", "en"):
         for p in result.pairs:
