@@ -13,6 +13,7 @@ drawing's marks print dark on the rendered page.
 
 from __future__ import annotations
 
+import ctypes
 import re
 from pathlib import Path
 
@@ -23,6 +24,10 @@ import pytest
 import yaml
 
 from stereoplotter.cli import main
+from stereoplotter.commands.setup_job import compute_job
+from stereoplotter.io.job_file import load_job
+from stereoplotter.report import form_layout
+from stereoplotter.report.job import form_header
 
 ROOT = Path(__file__).resolve().parents[2]
 JOB = ROOT / "jobs" / "strip8" / "job.yaml"
@@ -61,8 +66,6 @@ def _chars(page) -> list[tuple[str, float, tuple[float, float, float, float]]]:
 
 
 def pdfium_double():
-    import ctypes
-
     return ctypes.c_double()
 
 
@@ -207,10 +210,7 @@ def test_no_table_is_split_unless_longer_than_a_page(monkeypatch):
     """Every table of every strip8 form, ru and en, starts and ends on one page (a table taller
     than a page would continue on the next; none is, for strip8: the readings of stages 1–4
     are set at 7 pt), and no word is wider than its cell (none broken between letters)."""
-    from stereoplotter.commands.setup_job import compute_job
-    from stereoplotter.io.job_file import load_job
-    from stereoplotter.report import form_layout, forms
-    from stereoplotter.report.job import form_header
+    from stereoplotter.report import forms  # here: the name is also this module's fixture
 
     drawn = []
     real = form_layout.table

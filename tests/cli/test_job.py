@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import re
 from dataclasses import replace
 from pathlib import Path
 
+import jsonschema
 import numpy as np
 import pypdf
 import pytest
@@ -18,8 +20,12 @@ from stereoplotter.cli import main
 from stereoplotter.commands.setup_job import compute_job
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import load_job, measured_pair
+from stereoplotter.io.job_scenario import fit_terrain
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.report.form_fields import rigorous_sides, value_to_set
 from stereoplotter.report.job import pair_dict
+from stereoplotter.report.sheet import sheet_markdown, signed_m
+from stereoplotter.setup.readings import signed_text
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import (
     compute_sheet_from_measurements,
@@ -294,10 +300,6 @@ def test_bad_job_is_one_line(tmp_path, capsys, edit, where, field):
 
 
 def test_shipped_job_validates_against_its_schema():
-    import json
-
-    import jsonschema
-
     schema = json.loads((ROOT / "docs" / "schemas" / "job.schema.json").read_text("utf-8"))
     doc = yaml.safe_load(JOB.read_text("utf-8"))
     validator = jsonschema.Draft202012Validator(schema)
@@ -313,9 +315,6 @@ def test_job_to_scenario_loads_simulates_and_keeps_the_pair(tmp_path, capsys):
     """Pair 102-103 as a scenario: it loads, the zero-error simulation runs on it and sets the
     job's scales, and the scenario's photos and points are the job's in the pair's frame (points
     to 1 mm, centres to 1 mm, rotations to 1e-7)."""
-    import json
-
-    from stereoplotter.io.scenario_file import load_scenario
 
     path = tmp_path / "pair.yaml"
     assert main(["job", "to-scenario", str(JOB), "102-103", "-o", str(path)]) == 0
@@ -366,8 +365,6 @@ def test_job_to_scenario_unknown_pair_is_one_line(tmp_path, capsys):
 def test_fit_terrain_recovers_plane_and_hill():
     """4 points of a plane: the plane exactly; 8 points of plane + the fitter's own hill shape
     (centre at the centroid, radius 1.5 × the farthest): the hill's height; 2 points: flat."""
-    from stereoplotter.io.job_scenario import fit_terrain
-
     xy = np.array([[-900.0, 1500.0], [900.0, 1500.0], [900.0, -1500.0], [-900.0, -1500.0]])
     plane = np.column_stack([xy, 150.0 + 0.004 * xy[:, 0] - 0.002 * xy[:, 1]])
     fit = fit_terrain(plane)
@@ -406,9 +403,6 @@ def test_sheet_without_a_map_sheet_writes_its_markdown(tmp_path, capsys):
 def test_no_negative_zero_in_readings_or_residuals(tmp_path):
     """Pair 101-102 of strip8 has b_y = −0.0003 mm: its zero reading prints "MO_Y + 0.000",
     never "MO_Y + -0.000"."""
-    from stereoplotter.report.sheet import sheet_markdown, signed_m
-    from stereoplotter.setup.readings import signed_text
-
     texts = signed_text(-0.0004), signed_text(-0.0006), signed_text(2.5)
     assert texts == ("+ 0.000", "− 0.001", "+ 2.500")
     metres = signed_m(-0.0004), signed_m(-0.0006), signed_m(0.0123)

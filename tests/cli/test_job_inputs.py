@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from stereoplotter.cli import main
-from stereoplotter.commands.setup_job import compute_job
+from stereoplotter.commands.setup_job import compute_job, write_job
 from stereoplotter.io.job_file import load_job, measured_pair
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -253,8 +253,6 @@ def test_force_removes_pair_folders_of_a_run_without_manifest(tmp_path, capsys):
         (out / name).parent.mkdir(parents=True, exist_ok=True)
         (out / name).write_text("old", "utf-8")
     job = load_job(_job(tmp_path, lambda d: d.update(pairs=d["pairs"][:1])))
-    from stereoplotter.commands.setup_job import write_job
-
     report = write_job(compute_job(job), out, force=True)
     assert report.removed == ("099-100/sheet.md", "099-100/sheet.yaml")
     assert report.kept_foreign == 2 and not (out / "099-100").exists()

@@ -64,6 +64,7 @@ def test_serial_run_fills_every_cell_with_finite_measures(serial):
 
 
 def test_two_workers_one_killed_give_the_serial_dataset(serial, tmp_path):
+    # imported here: the extra `study`, present once the module's importorskip has passed
     from distributed import Client, LocalCluster
 
     cluster = LocalCluster(
