@@ -96,8 +96,8 @@ def _blocks(seed: int, key: str, start: int, stop: int):
 def _generator(seed: int, code: int, block: int) -> np.random.Generator:
     """The generator of block ``block`` of the stream (seed, key code): what
     ``numpy.random.default_rng([seed, code(, block)])`` returns, built without its argument
-    checks (≈ 7 µs instead of ≈ 15 µs per block; a chunk of the conventional method builds
-    8 000).
+    checks, which cost about as much as the building (the times: ``benchmarks/README.md``,
+    keyed streams) and a chunk of the conventional method builds thousands.
 
     ``SeedSequence`` turns each integer of a list into its 32-bit words (one word for
     0 ≤ n < 2³², 0 included), so the list's entropy *is* the uint32 array of the same numbers,

@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "check_mode",
     "cofactor_alpha_relative",
     "cofactor_kappa_relative",
     "cofactor_omega_relative",
@@ -48,7 +49,7 @@ __all__ = [
 _MODES = ("printed", "book", "rigorous")
 
 
-def _check_mode(mode: str) -> None:
+def check_mode(mode: str) -> None:
     if mode not in _MODES:
         raise ValueError(f"mode = {mode!r} is not one of {_MODES}")
 
@@ -268,7 +269,7 @@ def relative_orientation_residual_sigma(
     >>> round(float(s), 4)
     0.25
     """
-    _check_mode(mode)
+    check_mode(mode)
     x = np.asarray(x_right_mm, float)
     y = np.asarray(y_mm, float)
     shift = c_mm / 2.0 if mode != "rigorous" else (c_mm - a_mm) / 2.0
@@ -313,7 +314,7 @@ def relative_orientation_parallax_rms(a_mm, c_mm, x_parallax_mm, sigma_y_paralla
     >>> round(float(relative_orientation_parallax_rms(0.0, 70.0, 70.0, 1.0)), 4)
     0.2327
     """
-    _check_mode(mode)
+    check_mode(mode)
     a, c, p = a_mm, c_mm, x_parallax_mm
     alpha_term = (6 * c**2 + 10 * a * c - 5 * p * (2 * a + c)) / (30.0 * (a + c) ** 2)
     if mode == "rigorous":
@@ -385,7 +386,7 @@ def geodetic_orientation_parallax_rms(
     >>> round(float(geodetic_orientation_parallax_rms(0.0, 70.0, 70.0, 70.0, 1.0, "book")), 4)
     0.6455
     """
-    _check_mode(mode)
+    check_mode(mode)
     a, c, p, f = a_mm, c_mm, x_parallax_mm, focal_length_mm
     if mode == "printed":
         k2 = (7 * a**2 + 11 * c**2 - 4 * a * c) / (12.0 * (a + c) ** 2)
@@ -417,7 +418,7 @@ def single_model_height_rms(
     >>> round(float(single_model_height_rms(0.0, 70.0, 70.0, 70.0, 1.0, "printed")), 4)
     1.3844
     """
-    _check_mode(mode)
+    check_mode(mode)
     mp = sigma_x_parallax_mm
     go = geodetic_orientation_parallax_rms(a_mm, c_mm, x_parallax_mm, focal_length_mm, mp, mode)
     if mode == "printed":

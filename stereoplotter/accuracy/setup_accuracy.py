@@ -25,8 +25,8 @@ from __future__ import annotations
 import numpy as np
 
 from stereoplotter.accuracy.chapter5 import (
-    _check_mode,
     _mean_shifted_square,
+    check_mode,
     geodetic_orientation_parallax_rms,
     relative_orientation_parallax_rms,
 )
@@ -274,7 +274,7 @@ def sigma_omega_setup(focal_length_mm, mark_distance_mm, n, sigma_counter_mm, mo
     >>> round(float(r), 6)
     1.414214
     """
-    _check_mode(mode)
+    check_mode(mode)
     k = np.sqrt(3.0) / 2.0 if mode == "printed" else np.sqrt(1.5)
     return k * focal_length_mm / (mark_distance_mm**2 * n) * sigma_counter_mm
 
@@ -543,7 +543,7 @@ def setup_relative_residual_rms(
         return setup_relative_residual_rms_printed(
             a_mm, c_mm, mark_distance_mm, n, sigma_counter_mm
         )
-    _check_mode(mode)
+    check_mode(mode)
     a, c, f = a_mm, c_mm, focal_length_mm
     m_a = sigma_alpha_setup(f, mark_distance_mm, n, sigma_counter_mm)
     m_w = sigma_omega_setup(

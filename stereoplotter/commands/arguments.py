@@ -146,6 +146,7 @@ def add_fidelity_arguments(p: argparse.ArgumentParser, linkage: bool = True) -> 
 
 def fidelity_from_args(args: argparse.Namespace) -> Any:
     """The :class:`~stereoplotter.procedure.fidelity.Fidelity` of the parsed switches."""
+    # imported here: every command imports this module while the CLI builds its parser
     from stereoplotter.procedure.fidelity import Fidelity
 
     base = Fidelity.as_formula() if getattr(args, "as_formula", False) else Fidelity()

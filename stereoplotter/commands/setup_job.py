@@ -30,7 +30,7 @@ from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
-__all__ = ["compute_job", "run", "run_job", "write_job"]
+__all__ = ["compute_job", "raise_keyboard_interrupt", "run", "write_job"]
 
 
 def _instrument(job: Job) -> InstrumentSpec:
@@ -91,19 +91,6 @@ def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
     return JobResult(job, spec, tuple(out))
 
 
-def run_job(
-    path: str | os.PathLike[str],
-    output_dir: str | os.PathLike[str] | None = None,
-    *,
-    force: bool = False,
-) -> JobResult:
-    """Load a job file, compute every pair and optionally write the files (:func:`write_job`)."""
-    result = compute_job(load_job(path))
-    if output_dir is not None:
-        write_job(result, output_dir, force=force)
-    return result
-
-
 def write_job(
     result: JobResult,
     output_dir: str | os.PathLike[str],
@@ -126,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
     (:func:`stereoplotter.io.output_folder.write_outputs`)."""
     previous = signal.getsignal(signal.SIGTERM)
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _interrupt)
+        signal.signal(signal.SIGTERM, raise_keyboard_interrupt)
     try:
         return _run(args)
     except KeyboardInterrupt:  # one line, the exit code of an interrupt (128 + SIGINT)
@@ -139,7 +126,8 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
-def _interrupt(signum: int, frame: object) -> None:
+def raise_keyboard_interrupt(signum: int, frame: object) -> None:
+    """The SIGTERM handler of :func:`run`: a termination ends the run as Ctrl-C does."""
     raise KeyboardInterrupt
 
 

@@ -83,6 +83,7 @@ def run(args: argparse.Namespace) -> int:
 
 def run_eye_range(args: argparse.Namespace) -> int:
     """``study eye-range``: the pass-rate table over the operator's published σ range."""
+    # imported here: the CLI loads no library module until a command runs (it starts fast)
     from stereoplotter.io.instrument_file import load_instrument
     from stereoplotter.io.scenario_file import load_scenario
     from stereoplotter.procedure.eye_range import pass_rate_table, table_markdown

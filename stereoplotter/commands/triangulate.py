@@ -12,6 +12,7 @@ the residuals at control and check points (``residuals.csv``), a report (``repor
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 from pathlib import Path
@@ -150,8 +151,6 @@ def _calibrated(block: Any, snooping: Any, args: argparse.Namespace) -> Any:
     prob = snooping.problem_last if last else snooping.problem_first
     if not prob.camera_free:
         return block
-    import dataclasses
-
     cam = (snooping.last if last else snooping.first).camera
     x0, y0 = block.camera.principal_point_mm
     camera = dataclasses.replace(
@@ -164,6 +163,7 @@ def _calibrated(block: Any, snooping: Any, args: argparse.Namespace) -> Any:
 
 def _camera_parameters(text: str) -> tuple[str, ...]:
     """``--self-calibrate``'s list: names of the camera model, or ``all``."""
+    # imported here: the CLI loads no library module until a command runs (it starts fast)
     from stereoplotter.triangulation.camera_model import CAMERA_PARAMETERS
 
     names = tuple(n.strip() for n in text.split(",") if n.strip())
@@ -171,7 +171,7 @@ def _camera_parameters(text: str) -> tuple[str, ...]:
         return CAMERA_PARAMETERS
     bad = [n for n in names if n not in CAMERA_PARAMETERS]
     if bad:
-        from stereoplotter.errors import ConfigError
+        from stereoplotter.errors import ConfigError  # a command's top imports argparse only
 
         raise ConfigError(
             "--self-calibrate", "(option)", "names among " + ",".join(CAMERA_PARAMETERS), bad[0]
@@ -181,8 +181,8 @@ def _camera_parameters(text: str) -> tuple[str, ...]:
 
 def _solve(block: Any, args: argparse.Namespace) -> tuple[Any, Any]:
     """The solution and, for the bundle, its data snooping (else None)."""
-    # imported here: the CLI starts without loading scipy's sparse solvers
     if args.method == "bundle":
+        # imported here: the CLI starts without loading scipy's sparse solvers
         from stereoplotter.triangulation.reliability import snooped_block
 
         return snooped_block(
@@ -192,11 +192,11 @@ def _solve(block: Any, args: argparse.Namespace) -> tuple[Any, Any]:
             self_calibration=_camera_parameters(args.self_calibrate),
             robust_method=args.robust,
         )
-    from stereoplotter.triangulation import strip
+    from stereoplotter.triangulation import strip  # only the method asked for is loaded
 
     if args.method == "strip":
         return strip.strip_block(block, args.models, args.degree), None
-    from stereoplotter.triangulation.polygon_block import polygon_block
+    from stereoplotter.triangulation.polygon_block import polygon_block  # as above
 
     return polygon_block(block), None
 
@@ -304,12 +304,14 @@ def run_synth(args: argparse.Namespace) -> int:
     )
     from stereoplotter.io.triangulated_job import write_triangulated_job
     from stereoplotter.random_streams import key_code
-    from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
+    from stereoplotter.triangulation.synth import (
+        SynthSpec,
+        control_stations_for_degree,
+        synthesize_block,
+    )
 
     stations = None
     if args.control_degree is not None:
-        from stereoplotter.triangulation.synth import control_stations_for_degree
-
         stations = control_stations_for_degree(args.photos - 1, args.control_degree)
     spec = SynthSpec(
         control_stations=stations,

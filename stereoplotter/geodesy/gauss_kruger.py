@@ -47,6 +47,7 @@ __all__ = [
     "MAX_DISTANCE_FROM_AXIAL_MERIDIAN",
     "GeodesyRangeError",
     "axial_meridian",
+    "check_zone",
     "conventional_from_geographic",
     "conventional_ordinate",
     "gauss_kruger_from_geographic",
@@ -92,7 +93,7 @@ class GeodesyRangeError(StereoplotterError):
 # validation helpers
 
 
-def _check_zone(zone: object, allowed: range | None = None) -> int:
+def check_zone(zone: object, allowed: range | None = None) -> int:
     lo, hi = (_ZONE_MIN, _ZONE_MAX) if allowed is None else (allowed.start, allowed.stop - 1)
     text = f"{lo}…{hi} (integer 6° zone number)"
     if isinstance(zone, bool) or not isinstance(zone, int | np.integer):
@@ -194,7 +195,7 @@ def axial_meridian(zone: int) -> float:
     >>> round(math.degrees(axial_meridian(32)), 9)
     -171.0
     """
-    n = _check_zone(zone)
+    n = check_zone(zone)
     degrees = 6.0 * n - 3.0
     if degrees > 180.0:
         degrees -= 360.0
@@ -261,7 +262,7 @@ def conventional_ordinate(zone: ArrayLike, y_east_m: ArrayLike) -> NDArray[np.fl
     if not np.issubdtype(zones.dtype, np.integer):
         raise GeodesyRangeError("zone", zone, f"{_ZONE_MIN}…{_ZONE_MAX} (integer 6° zone number)")
     for n in np.unique(zones):
-        _check_zone(int(n))
+        check_zone(int(n))
     y = np.asarray(y_east_m, dtype=float)
     bad = ~(np.abs(y) < _FALSE_EASTING_M)
     if np.any(bad):
@@ -362,7 +363,7 @@ def gauss_kruger_from_geographic(
     >>> round(float(x), 3), round(float(y), 3)
     (6101455.311, 191955.601)
     """
-    n = _check_zone(zone)
+    n = check_zone(zone)
     lat, lon = np.broadcast_arrays(
         np.asarray(latitude, dtype=float), np.asarray(longitude, dtype=float)
     )
@@ -413,7 +414,7 @@ def geographic_from_gauss_kruger(
     >>> round(math.degrees(float(b)), 8), round(math.degrees(float(l)), 8)
     (55.33375, 24.71883334)
     """
-    n = _check_zone(zone)
+    n = check_zone(zone)
     north, east = np.broadcast_arrays(
         np.asarray(gk_north_m, dtype=float), np.asarray(gk_east_m, dtype=float)
     )
@@ -465,7 +466,7 @@ def meridian_convergence(
     >>> round(math.degrees(float(meridian_convergence(b, l, 4))) * 3600 - 11000, 3)
     16.223
     """
-    n = _check_zone(zone)
+    n = check_zone(zone)
     lat = np.asarray(latitude, dtype=float)
     lon = np.asarray(longitude, dtype=float)
     _check_latitude(lat)
@@ -530,7 +531,7 @@ def conventional_from_geographic(
     north = np.empty(lat.shape)
     ybar = np.empty(lat.shape)
     for n in np.unique(zones):
-        n = _check_zone(int(n), CONVENTIONAL_EPSG_ZONES)
+        n = check_zone(int(n), CONVENTIONAL_EPSG_ZONES)
         sel = zones == n
         _check_longitude_in_zone(lon[sel], n)
         e, nn = _conventional_transformer(n).transform(
@@ -590,7 +591,7 @@ def geographic_from_conventional(
     lat = np.empty(north.shape)
     lon = np.empty(north.shape)
     for n in np.unique(zones):
-        n = _check_zone(int(n), CONVENTIONAL_EPSG_ZONES)
+        n = check_zone(int(n), CONVENTIONAL_EPSG_ZONES)
         sel = zones == n
         lo, la = _conventional_transformer(n).transform(
             ybar[sel], north[sel], direction="INVERSE", errcheck=True

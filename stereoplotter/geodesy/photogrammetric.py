@@ -51,7 +51,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.constants import KRASOVSKY
 from stereoplotter.geodesy.gauss_kruger import (
-    _check_zone,
+    check_zone,
     gauss_kruger_from_geographic,
     geographic_from_gauss_kruger,
     meridian_convergence,
@@ -123,7 +123,7 @@ class LocalFrame:
         >>> round(float(np.degrees(frame.convergence)), 7)
         3.0600618
         """
-        n = _check_zone(zone)
+        n = check_zone(zone)
         b0, l0 = geographic_from_gauss_kruger(gk_north_m, gk_east_m, n)
         gamma = meridian_convergence(b0, l0, n)
         return cls(
@@ -141,7 +141,7 @@ class LocalFrame:
         cls, latitude: float, longitude: float, height_m: float, zone: int
     ) -> LocalFrame:
         """Frame with its origin at geodetic B₀ [rad], L₀ [rad], H₀ [m]; GK of zone N."""
-        n = _check_zone(zone)
+        n = check_zone(zone)
         x0, y0 = gauss_kruger_from_geographic(latitude, longitude, n)
         return cls(
             zone=n,

@@ -43,6 +43,7 @@ from stereoplotter.geometry.rotation import (
 __all__ = [
     "ResectionResult",
     "initial_exterior_orientation",
+    "model_and_jacobian",
     "space_resection",
 ]
 
@@ -196,7 +197,7 @@ def initial_exterior_orientation(
     return np.array([0.0, 0.0, float(np.angle(a)), b.real, b.imag, height])
 
 
-def _model_and_jacobian(
+def model_and_jacobian(
     params: NDArray[np.float64],
     points: NDArray[np.float64],
     f: float,
@@ -363,7 +364,7 @@ def _initial_params(photo, points, f, pp, initial) -> NDArray[np.float64]:
 
 def _gauss_newton_step(params, photo, points, f, pp) -> NDArray[np.float64]:
     """The least-squares correction of the linearised system (3.6) at ``params``."""
-    computed, jac = _model_and_jacobian(params, points, f, pp)
+    computed, jac = model_and_jacobian(params, points, f, pp)
     v = (photo - computed).reshape(-1)
     a = jac.reshape(-1, 6)
     # Column scaling: angles (rad) and positions (m) differ by orders of magnitude.
@@ -387,7 +388,7 @@ def _resection_result(params, photo, points, f, pp, iterations, converged) -> Re
     # Re-express the angles in their principal range via the matrix (α, κ in (−π, π]).
     alpha, omega, kappa = (float(t) for t in angles_from_matrix(rotation_matrix(*params[:3])))
     params[:3] = (alpha, omega, kappa)
-    computed, jac = _model_and_jacobian(params, points, f, pp)
+    computed, jac = model_and_jacobian(params, points, f, pp)
     residuals = photo - computed
     rms = float(np.sqrt(np.mean(residuals**2)))
     redundancy = 2 * n - 6

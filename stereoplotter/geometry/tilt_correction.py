@@ -11,11 +11,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.geometry.arrays import floats
+
 __all__ = ["correction_inclination", "decentration"]
-
-
-def _a(v: ArrayLike) -> NDArray[np.float64]:
-    return np.asarray(v, dtype=float)
 
 
 def decentration(focal_length_corrected_mm: ArrayLike, tilt: ArrayLike) -> NDArray[np.float64]:
@@ -40,7 +38,7 @@ def decentration(focal_length_corrected_mm: ArrayLike, tilt: ArrayLike) -> NDArr
     exact value follows from the correction-plane geometry (``kinematics.md`` §2.4,
     e = c = f·tan α); to first order it is the book's fα = Δx (OCR L3843).
     """
-    return _a(focal_length_corrected_mm) * np.tan(_a(tilt))
+    return floats(focal_length_corrected_mm) * np.tan(floats(tilt))
 
 
 def correction_inclination(
@@ -60,4 +58,4 @@ def correction_inclination(
     ndarray
         θ. [rad] (Not set from a scale: the book fits k_α, k_ω on the fiducials in stage 2.)
     """
-    return np.arctan(_a(transformation_coefficient_k) * np.tan(_a(tilt)))
+    return np.arctan(floats(transformation_coefficient_k) * np.tan(floats(tilt)))

@@ -1,12 +1,12 @@
-"""Tile pyramid and view cache: eyepiece views of both photos in well under 100 ms.
+"""Tile pyramid and view cache: eyepiece views of both photos sampled from rendered tiles.
 
 Level k of the pyramid is the photo rendered at pixel ``pixel_mm``·2ᵏ (k = 0 … until the pixel
 exceeds :data:`EAGER_PIXEL_MM`·2). Each level is rendered directly at its pixel size (the
 texture fades detail finer than the pixel), not averaged down, so every level is exact
 collinearity. Levels with a pixel of :data:`EAGER_PIXEL_MM` or more are rendered whole when
 the cache is built (the "rasters once"); finer levels are rendered lazily in
-:data:`TILE`² tiles the first time a view needs them and kept (a 0.02 mm photo is 9 300² px,
-a minute to render whole; a view at ×6 needs at most 4 tiles of it). A view samples the level
+:data:`TILE`² tiles the first time a view needs them and kept (a 0.02 mm photo is 9 300² px;
+a view at ×6 needs at most 4 tiles of it). A view samples the level
 whose pixel is the largest not exceeding the view's pixel (0.1 mm / magnification), bilinearly.
 Finished views are kept in a small LRU cache. Tile, level and view are pure functions of
 (scenario, seed, pixel_mm), so the order in which views are requested never changes a byte.
@@ -66,7 +66,7 @@ class ViewCache:
 
     def prefetch(self, side: str, x_mm: float, y_mm: float, radius_mm: float = 3.0) -> int:
         """Render the finest level's tiles within ``radius_mm`` of photo point x, y [mm] ahead of
-        use (a cold ×6 view costs 150–250 ms, a view on rendered tiles under 15 ms:
+        use (a view whose tiles are rendered only samples them; the times of both:
         benchmarks/bench_imagery.py). Returns the number of tiles rendered now."""
         geo = self.levels[side][0]
         grid = PhotoRaster(np.zeros((0, 0), np.uint8), geo.pixel_mm, geo.origin_mm, side)

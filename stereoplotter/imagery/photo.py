@@ -128,10 +128,10 @@ def render_photo(
     """Render photo ``side`` ("left"/"right") of ``scenario`` at ``pixel_mm`` [mm].
 
     ``seed`` (default ``scenario.seed``) fixes the ground texture; the same seed gives the same
-    image byte for byte (both photos of a pair share one texture: one ground). Cost: about
-    0.6 µs per pixel on one core (benchmarks/bench_imagery.py), so 3.6 s at 0.08 mm and about a
-    minute at 0.02 mm (9 300² px); :class:`~stereoplotter.imagery.cache.ViewCache` renders the
-    fine levels lazily by tiles with :func:`render_region` instead.
+    image byte for byte (both photos of a pair share one texture: one ground). The cost grows
+    with the pixel count (9 300² px at 0.02 mm; the times: benchmarks/bench_imagery.py), so
+    :class:`~stereoplotter.imagery.cache.ViewCache` renders the fine levels lazily by tiles with
+    :func:`render_region` instead.
     """
     geo = photo_geometry(scenario, side, pixel_mm, seed)
     raster = geo.empty_raster()

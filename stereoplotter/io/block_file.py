@@ -23,8 +23,8 @@ from stereoplotter.errors import ConfigError
 from stereoplotter.io.scenario_file import MAX_TILT_DEG, CameraModel, camera_from_model
 from stereoplotter.io.validation import (
     FileModel,
-    _fail,
     integer,
+    invalid,
     number,
     sequence,
     text,
@@ -140,7 +140,7 @@ class ModelEntry(FileModel):
     @classmethod
     def _folder_name(cls, name: str) -> str:
         if not _NAME_RE.match(name) or name in (".", ".."):
-            raise _fail("a model name usable as a folder name (letters, digits, _ . + -)", name)
+            raise invalid("a model name usable as a folder name (letters, digits, _ . + -)", name)
         return name
 
     @model_validator(mode="after")
@@ -148,7 +148,7 @@ class ModelEntry(FileModel):
         seen: set[str] = set()
         for j, p in enumerate(self.height_points):
             if p.id in seen:
-                raise _fail("a unique point id", p.id, at=("height_points", j, "id"))
+                raise invalid("a unique point id", p.id, at=("height_points", j, "id"))
             seen.add(p.id)
         return self
 
@@ -185,7 +185,7 @@ class BlockFile(FileModel):
             given = [k for k in ("models", "models_csv") if v.get(k) is not None]
             if len(given) != 1:
                 found = "both" if given else "neither"
-                raise _fail("exactly one of models, models_csv", found, at=("models",))
+                raise invalid("exactly one of models, models_csv", found, at=("models",))
         return v
 
     @model_validator(mode="after")
@@ -193,7 +193,7 @@ class BlockFile(FileModel):
         seen: set[str] = set()
         for i, m in enumerate(self.models or ()):
             if m.name in seen:
-                raise _fail("a unique model name", m.name, at=("models", i, "name"))
+                raise invalid("a unique model name", m.name, at=("models", i, "name"))
             seen.add(m.name)
         return self
 

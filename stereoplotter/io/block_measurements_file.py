@@ -40,9 +40,18 @@ from pydantic import ConfigDict, Field, field_validator
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.geometry.film import fiducial_spans_mm
 from stereoplotter.io.atomic_write import write_files
-from stereoplotter.io.job_file import Certificate, NamedSheet, _check_date
+from stereoplotter.io.job_file import Certificate, NamedSheet
 from stereoplotter.io.scenario_file import Origin, camera_from_model
-from stereoplotter.io.validation import FileModel, _fail, number, one_of, sequence, text, validate
+from stereoplotter.io.validation import (
+    FileModel,
+    check_date,
+    invalid,
+    number,
+    one_of,
+    sequence,
+    text,
+    validate,
+)
 from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.io.yaml_output import Flow, Folded, Quoted, yaml_document
 from stereoplotter.scenario import frame as frame_tie
@@ -69,7 +78,8 @@ CENTRE_COLUMNS = ("photo", "north_m", "east_m", "height_m")
 
 def _identifier(v: Any) -> str:
     if not isinstance(v, str) or not v.strip() or v != v.strip():
-        raise _fail('a photo number as quoted text ("0415"; YAML reads 0415 as a number)', repr(v))
+        expected = 'a photo number as quoted text ("0415"; YAML reads 0415 as a number)'
+        raise invalid(expected, repr(v))
     return v
 
 
@@ -99,7 +109,7 @@ class ProductionModel(FileModel):
     @field_validator("date", mode="before")
     @classmethod
     def _date(cls, v: Any) -> str:
-        return _check_date(v)
+        return check_date(v)
 
 
 class BlockMeasurementsFile(FileModel):

@@ -26,10 +26,17 @@ from pydantic_core import PydanticCustomError
 from stereoplotter.errors import ConfigError, StereoplotterError, describe_value, did_you_mean
 from stereoplotter.instrument.principles import PRINCIPLES
 from stereoplotter.io.paths import data_dir, find_data_file, list_data_files
-from stereoplotter.io.validation import FileModel, _bounds, _fail, check_number, text, validate
+from stereoplotter.io.validation import (
+    FileModel,
+    check_number,
+    invalid,
+    schema_bounds,
+    text,
+    validate,
+)
 from stereoplotter.io.yaml_input import load_yaml_mapping
 from stereoplotter.spec.instrument_spec import (
-    _ATTRIBUTES,
+    ATTRIBUTE_KEYS,
     DECENTRATION_LINKAGES,
     STATUSES,
     InstrumentSpec,
@@ -161,7 +168,7 @@ _STATUS_HINT = (
 def _at(exc: PydanticCustomError, at: tuple[str | int, ...]) -> PydanticCustomError:
     """The same error one level down (``value[3]``)."""
     ctx = exc.context or {}
-    return _fail(ctx["expected"], ctx["found"], ctx.get("hint", ""), at)
+    return invalid(ctx["expected"], ctx["found"], ctx.get("hint", ""), at)
 
 
 def _number(value: Any, leaf: _Leaf, at: tuple[str | int, ...] = ()) -> float:
@@ -178,16 +185,16 @@ def _check_value(leaf: _Leaf, raw: Any) -> Any:
     kind = leaf.kind
     if kind == "text":
         if isinstance(raw, bool) or not isinstance(raw, str | int) or str(raw) == "":
-            raise _fail("a non-empty text", describe_value(raw))
+            raise invalid("a non-empty text", describe_value(raw))
         return str(raw)
     if kind == "bool":
         if not isinstance(raw, bool):
-            raise _fail("true or false", describe_value(raw))
+            raise invalid("true or false", describe_value(raw))
         return raw
     if kind == "int":
         lo, hi = int(leaf.low), int(leaf.high)
         if isinstance(raw, bool) or not isinstance(raw, int) or not lo <= raw <= hi:
-            raise _fail(f"an integer in [{lo}, {hi}]", describe_value(raw))
+            raise invalid(f"an integer in [{lo}, {hi}]", describe_value(raw))
         return raw
     if kind == "number":
         return _number(raw, leaf)
@@ -201,12 +208,12 @@ def _check_tuple(leaf: _Leaf, raw: Any) -> tuple[float, ...]:
     length = 3 if kind == "triple" else 2
     if not isinstance(raw, list) or len(raw) != length:
         what = "[lo, hi]" if kind == "range" else f"{length} numbers"
-        raise _fail(f"a list of {what} [{leaf.unit}]", describe_value(raw))
+        raise invalid(f"a list of {what} [{leaf.unit}]", describe_value(raw))
     numbers = tuple(_number(v, leaf, (i,)) for i, v in enumerate(raw))
     if kind == "range" and numbers[0] > numbers[1]:
-        raise _fail("a range [lo, hi] with lo ≤ hi", list(numbers), "the ends are reversed")
+        raise invalid("a range [lo, hi] with lo ≤ hi", list(numbers), "the ends are reversed")
     if leaf.contains_zero and not numbers[0] <= 0.0 <= numbers[1]:
-        raise _fail(
+        raise invalid(
             "a range that contains 0",
             list(numbers),
             "the zero position (scales near their zeros, mark on the left plumb point) "
@@ -218,28 +225,28 @@ def _check_tuple(leaf: _Leaf, raw: Any) -> tuple[float, ...]:
 def _check_gear_set(leaf: _Leaf, raw: Any) -> tuple[Any, ...]:
     """int_list, number_list: gear sets, at least one entry, strictly increasing."""
     if not isinstance(raw, list):
-        raise _fail("a list", describe_value(raw))
+        raise invalid("a list", describe_value(raw))
     if not raw:
-        raise _fail("a list of at least 1 entries", "0 entries")
+        raise invalid("a list of at least 1 entries", "0 entries")
     out: list[Any] = []
     for i, v in enumerate(raw):
         if leaf.kind == "int_list":
             if isinstance(v, bool) or not isinstance(v, int) or not leaf.low <= v <= leaf.high:
-                raise _fail(
+                raise invalid(
                     f"an integer in [{leaf.low:g}, {leaf.high:g}]", describe_value(v), at=(i,)
                 )
             out.append(v)
         else:
             out.append(_number(v, leaf, (i,)))
         if i and out[-1] <= out[-2]:
-            raise _fail(f"a value above the previous one ({out[-2]:g})", v, at=(i,))
+            raise invalid(f"a value above the previous one ({out[-2]:g})", v, at=(i,))
     return tuple(out)
 
 
 def _value_schema(leaf: _Leaf) -> dict[str, Any]:
     """The JSON Schema of the ``value`` of one leaf (the check is :func:`_check_value`)."""
     unit = f"[{leaf.unit}]" if leaf.unit and leaf.unit != "—" else None
-    bounds = _bounds(leaf.low, leaf.high, leaf.low_open, False)
+    bounds = schema_bounds(leaf.low, leaf.high, leaf.low_open, False)
     number: dict[str, Any] = {"type": "number", **bounds}
     kind = leaf.kind
     if kind == "text":
@@ -268,20 +275,20 @@ def _value_schema(leaf: _Leaf) -> dict[str, Any]:
 
 def _check_status(v: Any) -> str:
     if v not in STATUSES:
-        raise _fail("documented or assumed", describe_value(v), _STATUS_HINT)
+        raise invalid("documented or assumed", describe_value(v), _STATUS_HINT)
     return v
 
 
 def _check_sources(raw: Any) -> tuple[str, ...]:
     items = raw if isinstance(raw, list) else [raw]
     if not items or any(not isinstance(s, str) or not s.strip() for s in items):
-        raise _fail("a source key or a list of source keys", describe_value(raw))
+        raise invalid("a source key or a list of source keys", describe_value(raw))
     return tuple(s.strip() for s in items)
 
 
 def _check_note(raw: Any) -> str:
     if not isinstance(raw, str) or not raw.strip():
-        raise _fail("a non-empty text", describe_value(raw))
+        raise invalid("a non-empty text", describe_value(raw))
     return raw.strip()
 
 
@@ -322,32 +329,32 @@ class LeafBase(FileModel):
     @classmethod
     def _shape(cls, v: Any) -> Any:
         if not isinstance(v, dict) or v.get("value") is None:
-            raise _fail(
+            raise invalid(
                 _LEAF_SHAPE,
                 describe_value(v),
                 "every value says whether a source documents it (see docs/instruments.md)",
             )
         if v.get("status") is None and set(v) <= set(_LEAF_KEYS):
-            raise _fail("documented or assumed", "nothing", _STATUS_HINT, at=("status",))
+            raise invalid("documented or assumed", "nothing", _STATUS_HINT, at=("status",))
         return v
 
     @_model_validator(mode="after")
     def _provenance(self) -> LeafBase:
         if self.status == "documented" and not self.src:
-            raise _fail(
+            raise invalid(
                 "the source key(s) of a documented value (e.g. SEED6)",
                 "nothing",
                 "a value without a source must be status: assumed with a basis",
                 at=("src",),
             )
         if self.status == "documented" and self.basis:
-            raise _fail(
+            raise invalid(
                 "no basis for a documented value (basis is for assumed ones; use note)",
                 self.basis,
                 at=("basis",),
             )
         if self.status == "assumed" and not self.basis:
-            raise _fail(
+            raise invalid(
                 "a basis for an assumed value (why this value was chosen)", "nothing", at=("basis",)
             )
         return self
@@ -490,7 +497,7 @@ def instrument_from_mapping(
         )
     _cross_check(params, source)
     values: dict[str, Any] = {}
-    for attribute, (dotted, convert) in _ATTRIBUTES.items():
+    for attribute, (dotted, convert) in ATTRIBUTE_KEYS.items():
         values[attribute] = convert(params[dotted].value) if dotted in params else None
     if values["decentration_linkage"] is None:  # files without the leaf: decision D1
         values["decentration_linkage"] = DECENTRATION_LINKAGES[0]
@@ -511,6 +518,8 @@ def _check_mechanics(spec: InstrumentSpec) -> None:
     (``mechanics.md``): μ ≥ 1 on the vertical Z axis, or a dead band 2h = b + 2μmg/k that the
     0.5 mm overtravel of the unidirectional approach does not clear. The axes are built as the
     virtual instrument builds them, so a file that loads also runs."""
+    # imported here: ``info`` lists the instrument files through this module without loading
+    # the instrument's mechanics (pymunk)
     from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
     from stereoplotter.instrument.mechanics.coordinatograph import CoordinatographParams
 

@@ -28,7 +28,6 @@ The passage to the photogrammetric frame (``frame.kind``)
 from __future__ import annotations
 
 import csv
-import datetime as _dt
 import math
 import os
 import re
@@ -58,8 +57,9 @@ from stereoplotter.io.scenario_file import (
 )
 from stereoplotter.io.validation import (
     FileModel,
-    _fail,
+    check_date,
     integer,
+    invalid,
     number,
     one_of,
     sequence,
@@ -102,7 +102,7 @@ def _check_identifier(v: Any) -> str:
     its digits (an unquoted number with a leading zero is refused before this, by
     :func:`_unquoted_identifiers`: YAML has already read it as another number)."""
     if isinstance(v, bool) or not isinstance(v, str | int) or str(v).strip() == "":
-        raise _fail("an identifier as text (quote it: \"0415\")", describe_value(v))
+        raise invalid("an identifier as text (quote it: \"0415\")", describe_value(v))
     return str(v).strip()
 
 
@@ -126,7 +126,7 @@ _PHOTO_NUMBER = r"[^./\\\x00-\x1f\x7f][^/\\\x00-\x1f\x7f]*"
 def _check_photo_number(v: Any) -> str:
     v = _check_identifier(v)
     if not re.fullmatch(_PHOTO_NUMBER, v):
-        raise _fail(
+        raise invalid(
             "a photo number usable in a folder name (no / or \\, no leading dot, no control "
             "character)", describe_value(v),
         )  # fmt: skip
@@ -144,14 +144,6 @@ photo_number = Annotated[
         "unquoted number with a leading zero is refused; it names the pair's output folder",
     ),
 ]
-
-
-def _check_date(v: Any) -> str:
-    if isinstance(v, _dt.date) and not isinstance(v, _dt.datetime):  # an unquoted YAML date
-        v = v.isoformat()
-    if not isinstance(v, str) or not re.fullmatch(r"\d{4}-\d{2}-\d{2}", v):
-        raise _fail("a date YYYY-MM-DD (printed on the forms; the clock is never read)", repr(v))
-    return v
 
 
 class Certificate(FileModel):
@@ -262,7 +254,7 @@ class JobFile(FileModel):
     @field_validator("date", mode="before")
     @classmethod
     def _date(cls, v: Any) -> str:
-        return _check_date(v)
+        return check_date(v)
 
 
 # --- the job as data ----------------------------------------------------------------------------

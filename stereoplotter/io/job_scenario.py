@@ -1,4 +1,4 @@
-"""A job's pair as a scenario: production data for the simulator (issue 12, deliverable 3).
+"""A job's pair as a scenario: production data for the simulator.
 
 A job has no ground truth; a scenario is one. :func:`job_pair_scenario` writes the scenario
 (``docs/scenarios.md``) that the simulator can treat as the truth of one pair of a job:

@@ -37,7 +37,7 @@ def load_operator_model(value: str | Path | OperatorModel | None) -> OperatorMod
         return value
     if str(value) == "zero":
         return OperatorModel().zero()
-    if str(value) == "sigma":  # the operator before the eye model (issue 25)
+    if str(value) == "sigma":  # the free σ of one look, no eye model
         return OperatorModel(eye="sigma", remeasure=False)
 
     data, source = load_yaml_mapping(value)

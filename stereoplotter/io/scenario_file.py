@@ -19,9 +19,9 @@ from stereoplotter.geometry.collinearity import object_to_photo
 from stereoplotter.io.paths import resolve_data_file
 from stereoplotter.io.validation import (
     FileModel,
-    _fail,
     check_number,
     integer,
+    invalid,
     number,
     number_at,
     one_of,
@@ -204,7 +204,7 @@ class Fiducials(FileModel):
         if isinstance(v, dict) and not set(v) - {"coordinates_mm", "distances_mm"}:
             if ("coordinates_mm" in v) == ("distances_mm" in v):
                 found = ", ".join(v) or "neither"
-                raise _fail("exactly one of coordinates_mm, distances_mm", found)
+                raise invalid("exactly one of coordinates_mm, distances_mm", found)
         return v
 
 
@@ -294,7 +294,7 @@ class PointModel(FileModel):
         v = _present(v)
         if isinstance(v, dict) and ("local" in v) == ("sk42" in v):
             if not set(v) - {"id", "role", "kind", "local", "sk42"} and "id" in v:
-                raise _fail("exactly one of local, sk42", "both" if "local" in v else "neither")
+                raise invalid("exactly one of local, sk42", "both" if "local" in v else "neither")
         return v
 
 
@@ -309,7 +309,7 @@ class MapSheetModel(FileModel):
         v = _present(v)
         if isinstance(v, dict) and not set(v) - {"scale", "nomenclature", "corners"}:
             if "scale" in v and ("nomenclature" in v) == ("corners" in v):
-                raise _fail(
+                raise invalid(
                     "exactly one of nomenclature, corners",
                     "both" if "corners" in v else "neither",
                 )
@@ -352,7 +352,7 @@ class ScenarioFile(FileModel):
     @classmethod
     def _one_or_two(cls, v: Any) -> Any:
         if not isinstance(v, list) or not 1 <= len(v) <= 2:
-            raise _fail(
+            raise invalid(
                 "a list of 1 photo or 2 photos named left and right",
                 f"a list of {len(v)}" if isinstance(v, list) else describe_value(v),
             )

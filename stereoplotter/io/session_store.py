@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from stereoplotter.errors import ConfigError
-from stereoplotter.io.yaml_input import _parse_yaml
+from stereoplotter.io.yaml_input import parse_yaml
 
 __all__ = [
     "DB_NAME",
@@ -98,7 +98,7 @@ def secret_hash(secret: str) -> str:
 def exercise_upload(text: str) -> dict[str, Any]:
     """The mapping of an uploaded exercise file (YAML or JSON text); one-line ConfigError
     naming "uploaded exercise" (never a path) otherwise."""
-    data = _parse_yaml(text, "uploaded exercise")
+    data = parse_yaml(text, "uploaded exercise")
     if not isinstance(data, dict):
         found = "an empty document" if data is None else type(data).__name__
         raise ConfigError("uploaded exercise", "(top level)", "a mapping of fields", found)

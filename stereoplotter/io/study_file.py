@@ -26,8 +26,8 @@ from stereoplotter.io.paths import shipped_root
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.validation import (
     FileModel,
-    _fail,
     integer,
+    invalid,
     number,
     one_of,
     sequence,
@@ -80,7 +80,7 @@ def _num(name: str) -> Any:
 
 def _ordered(self: Any) -> Any:
     if not self.from_ < self.to:
-        raise _fail(f"a value above from = {self.from_:g}", self.to, at=("to",))
+        raise invalid(f"a value above from = {self.from_:g}", self.to, at=("to",))
     return self
 
 
@@ -165,7 +165,7 @@ class BaseModelFile(FileModel):
     def _one(self) -> BaseModelFile:
         if (self.scenario is None) == (self.normal_case is None):
             found = "both" if self.scenario is not None else "neither"
-            raise _fail("exactly one of scenario, normal_case", found)
+            raise invalid("exactly one of scenario, normal_case", found)
         return self
 
 
@@ -179,7 +179,7 @@ class SampleModel(FileModel):
     @model_validator(mode="after")
     def _power_of_two(self) -> SampleModel:
         if self.method == "sobol" and self.points & (self.points - 1):
-            raise _fail("a power of 2 for a Sobol sample", self.points, at=("points",))
+            raise invalid("a power of 2 for a Sobol sample", self.points, at=("points",))
         return self
 
 

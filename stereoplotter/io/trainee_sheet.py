@@ -1,4 +1,4 @@
-"""Reading a trainee's own setup sheet (``stereoplotter check-sheet``, issue 13 deliverable 5).
+"""Reading a trainee's own setup sheet (``stereoplotter check-sheet``).
 
 The trainee sheet has the layout of the program's ``sheet.yaml``
 (:func:`stereoplotter.report.sheet.setup_dict`); every value may be missing (left out or

@@ -15,7 +15,9 @@ dataclasses (on a dataclass with slots those are descriptors).
 
 from __future__ import annotations
 
+import datetime as _dt
 import math
+import re
 import typing
 from collections.abc import Callable, Mapping
 from typing import Annotated, Any, TypeVar
@@ -34,12 +36,15 @@ from stereoplotter.errors import ConfigError, describe_value, did_you_mean
 
 __all__ = [
     "FileModel",
+    "check_date",
     "check_number",
     "field_path",
     "integer",
+    "invalid",
     "number",
     "number_at",
     "one_of",
+    "schema_bounds",
     "sequence",
     "text",
     "validate",
@@ -64,7 +69,7 @@ class FileModel(BaseModel):
         return v
 
 
-def _fail(
+def invalid(
     expected: str, found: object, hint: str = "", at: tuple[str | int, ...] = ()
 ) -> PydanticCustomError:
     """The error a check raises: ``expected``, ``found`` and a ``hint``; ``at`` is the place of
@@ -115,19 +120,28 @@ def check_number(
     """A finite real number inside the range, or a :class:`PydanticCustomError`."""
     expected = f"a number {range_text(unit, low, high, low_open, high_open)}".rstrip()
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise _fail(expected, describe_value(value))
+        raise invalid(expected, describe_value(value))
     try:
         value = float(value)
     except OverflowError:  # an integer beyond the float range
-        raise _fail(expected, "an integer too large for a float", basis) from None
+        raise invalid(expected, "an integer too large for a float", basis) from None
     too_low = value < low or (low_open and value == low)
     too_high = value > high or (high_open and value == high)
     if not math.isfinite(value) or too_low or too_high:
-        raise _fail(expected, value, basis)
+        raise invalid(expected, value, basis)
     return value
 
 
-def _bounds(low: float, high: float, low_open: bool, high_open: bool) -> dict[str, float]:
+def check_date(v: Any) -> str:
+    """A date as text ``YYYY-MM-DD`` (an unquoted YAML date is taken as its ISO text)."""
+    if isinstance(v, _dt.date) and not isinstance(v, _dt.datetime):  # an unquoted YAML date
+        v = v.isoformat()
+    if not isinstance(v, str) or not re.fullmatch(r"\d{4}-\d{2}-\d{2}", v):
+        raise invalid("a date YYYY-MM-DD (printed on the forms; the clock is never read)", repr(v))
+    return v
+
+
+def schema_bounds(low: float, high: float, low_open: bool, high_open: bool) -> dict[str, float]:
     """JSON Schema keywords of a range (the check itself is :func:`check_number`)."""
     out: dict[str, float] = {}
     if math.isfinite(low):
@@ -161,7 +175,7 @@ def number(
         BeforeValidator(check),
         Field(
             description=text or None,
-            json_schema_extra=_bounds(low, high, low_open, high_open),
+            json_schema_extra=schema_bounds(low, high, low_open, high_open),
         ),
     ]
 
@@ -171,7 +185,7 @@ def integer(low: int, high: int, description: str = "") -> Any:
 
     def check(v: Any) -> int:
         if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
-            raise _fail(f"an integer in [{low}, {high}]", describe_value(v))
+            raise invalid(f"an integer in [{low}, {high}]", describe_value(v))
         return v
 
     return Annotated[
@@ -183,7 +197,7 @@ def integer(low: int, high: int, description: str = "") -> Any:
 
 def _check_text(v: Any) -> str:
     if isinstance(v, bool) or not isinstance(v, str | int) or str(v) == "":
-        raise _fail("a non-empty text", describe_value(v))
+        raise invalid("a non-empty text", describe_value(v))
     return str(v)
 
 
@@ -196,7 +210,7 @@ def one_of(*words: str, expected: str = "") -> Any:
 
     def check(v: Any) -> str:
         if not isinstance(v, str) or v not in words:
-            raise _fail(expected or "one of " + ", ".join(words), describe_value(v))
+            raise invalid(expected or "one of " + ", ".join(words), describe_value(v))
         return v
 
     return Annotated[typing.Literal[words], BeforeValidator(check)]  # type: ignore[valid-type]
@@ -211,7 +225,7 @@ def vector(
 
     def check(v: Any) -> Any:
         if not isinstance(v, list | tuple) or len(v) != length:
-            raise _fail(expected, describe_value(v))
+            raise invalid(expected, describe_value(v))
         return v
 
     return Annotated[
@@ -225,11 +239,11 @@ def sequence(item: Any, min_length: int = 0, max_length: int | None = None) -> A
 
     def check(v: Any) -> Any:
         if not isinstance(v, list):
-            raise _fail("a list", describe_value(v))
+            raise invalid("a list", describe_value(v))
         if len(v) < min_length:
-            raise _fail(f"a list of at least {min_length} entries", f"{len(v)} entries")
+            raise invalid(f"a list of at least {min_length} entries", f"{len(v)} entries")
         if max_length is not None and len(v) > max_length:
-            raise _fail(f"a list of at most {max_length} entries", f"{len(v)} entries")
+            raise invalid(f"a list of at most {max_length} entries", f"{len(v)} entries")
         return v
 
     return Annotated[

@@ -16,7 +16,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.verification import linear_mc as mc
+from stereoplotter.verification.entry import BOOK, both_photos
 
 __all__ = ["plot_error_maps", "plot_mc_histogram", "plot_mc_histograms", "plot_verification_chart"]
 
@@ -37,11 +39,8 @@ def plot_error_maps(
     -------
     matplotlib.figure.Figure
     """
-    from stereoplotter.accuracy.setup_accuracy import setup_element_sigmas
-    from stereoplotter.verification.entry import both_photos as _both
-
     if sigmas is None:
-        sigmas = _both(setup_element_sigmas(focal_length_mm, 85.0, 1.42, 0.01))
+        sigmas = both_photos(sa.setup_element_sigmas(focal_length_mm, 85.0, 1.42, 0.01))
     names = [k for k in mc.SETUP_SOURCES if sigmas.get(k, 0.0)]
     fig, axes = plt.subplots(
         2, (len(names) + 1) // 2, figsize=(3 * len(names) / 2 + 1, 6), squeeze=False
@@ -132,8 +131,6 @@ def plot_verification_chart(rows, ax=None):
 
 def _procedure_reference(res) -> float:
     """The rigorous formula at the procedure's simulated geometry (f, p, c, a, l, n of the run)."""
-    from stereoplotter.accuracy import setup_accuracy as sa
-
     if res["method"] == "setup":
         return float(
             sa.setup_parallax_rms_from_pointing(
@@ -164,14 +161,10 @@ def plot_mc_histograms(rows, procedure=None, trials=4000, seed=0, geometry=None)
     -------
     matplotlib.figure.Figure
     """
-    from stereoplotter.accuracy import setup_accuracy as sa
-    from stereoplotter.verification.entry import BOOK
-    from stereoplotter.verification.entry import both_photos as _both
-
     by = {r["eq"]: r for r in rows}
     panels = []
     g = {**BOOK, **(geometry or {})}
-    sb = _both(sa.setup_element_sigmas(g["f"], g["l"], g["n"], 1.0, mode="rigorous"))
+    sb = both_photos(sa.setup_element_sigmas(g["f"], g["l"], g["n"], 1.0, mode="rigorous"))
     for eq, p, a in (("(6.43)", g["p60"], g["a60"]), ("(6.44)", g["p80"], g["a80"])):
         m = mc.setup_model(g["f"], p, a, g["c"], sb, levelled=False)
         panels.append(("linear", eq, m, by[eq]["rigorous"]))

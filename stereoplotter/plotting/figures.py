@@ -1,6 +1,8 @@
-"""Figures. The only module that imports matplotlib (non-interactive Agg backend).
+"""Figures of a scenario and its setup: the plan layout, the setup sheet, the residual y-parallax of
+a run (matplotlib, non-interactive Agg back-end).
 
-Every function takes an optional ``ax`` and returns the Figure, so tests can inspect the artists.
+Every function returns the Figure, so tests can inspect the artists; the plots of one axes take an
+optional ``ax`` to draw into, the setup sheet an optional ``figure``.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import numpy as np
 from stereoplotter.scenario.model import Scenario
 from stereoplotter.scenario.synthetic import footprint_m
 
-__all__ = ["plot_residual_y_parallax", "plot_scenario_layout"]
+__all__ = ["plot_residual_y_parallax", "plot_scenario_layout", "plot_setup_sheet"]
 
 
 def plot_scenario_layout(

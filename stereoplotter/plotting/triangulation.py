@@ -1,4 +1,5 @@
-"""Figures of a triangulated block (Agg backend; return PNG bytes, no file I/O).
+"""Figures of a triangulated block (Agg back-end: Figures, and PNG bytes from the ``*_png``
+functions; no file I/O).
 
 ``residuals.png``: plan residuals (triangulated − catalogue) of control and check points as
 arrows, exaggerated by a stated factor, over the photo centres of each strip; height residuals

@@ -4,14 +4,14 @@ labels placed so that none overlaps another (the drawing's point and corner labe
 fpdf2 (a document library: real text that can be searched and extracted, vector drawing,
 embedded TrueType subsets), through its low-level calls for the tables and paragraphs: their
 lines are broken here by the font's advance widths, remembered per string, and drawn with
-``text`` and ``line`` — fpdf2's own ``table`` and ``multi_cell`` measured every fragment again at
-each character (≈ 80 % of a form's time in the profile of issue 27). The fonts are parsed once
-per process and each font subset compiled once per set of glyphs (:meth:`Form.output`). A
-document of many forms takes each form's pages as drawn for the form alone, their text
-re-encoded to its own font subsets and their footers numbered in it (:meth:`Form.append_pages`):
-no form is laid out twice. The Cyrillic and Greek symbols need a Unicode font: DejaVu Sans, the
-font that ships inside matplotlib (``mpl-data/fonts/ttf``), found without importing matplotlib,
-so no system font is read.
+``text`` and ``line`` — fpdf2's own ``table`` and ``multi_cell`` measure every fragment again at
+each character (the cost: ``bench_job_sheets.py`` in ``benchmarks/README.md``). The fonts are
+parsed once per process and each font subset compiled once per set of glyphs
+(:meth:`Form.output`). A document of many forms takes each form's pages as drawn for the form
+alone, their text re-encoded to its own font subsets and their footers numbered in it
+(:meth:`Form.append_pages`): no form is laid out twice. The Cyrillic and Greek symbols need a
+Unicode font: DejaVu Sans, the font that ships inside matplotlib (``mpl-data/fonts/ttf``), found
+without importing matplotlib, so no system font is read.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ __all__ = [
     "Form",
     "LabelPlacer",
     "font_path",
+    "forget_layout",
     "heading",
     "literal",
     "localized_text",
@@ -45,6 +46,8 @@ __all__ = [
     "plain",
     "rich_runs",
     "table",
+    "text_width",
+    "wrap_lines",
 ]
 
 FONT = "DejaVu"
@@ -176,8 +179,7 @@ class Form(FPDF):
     def text(self, x: float, y: float, text: str = "") -> None:
         """fpdf2's ``text`` for what the forms draw (filled text, no underline, a TrueType
         font): the same bytes, each text encoded once per document (fpdf2 maps every character
-        through its subset again at every call; its ``text`` was 36 % of ``job_files``' time,
-        its ``encode_text`` 17 %, by cProfile of strip8 × 5, issue 27)."""
+        through its subset again at every call)."""
         font = self.current_font
         if (not self.page or not self.font_family or self.buffer or self.underline
                 or self.strikethrough or self.text_mode != TextMode.FILL
@@ -428,7 +430,7 @@ def fits(pdf: Form, height: float) -> bool:
 
 def heading(pdf: Form, text: str, size: float = 11.0, keep: float = 0.0) -> None:
     """A bold line; on the next page when it and ``keep`` mm after it do not fit here."""
-    lines = _wrap(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "B", size)
+    lines = wrap_lines(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "B", size)
     line = 1.5 * size * _PT + 1.0
     if not fits(pdf, len(lines) * line + keep) and pdf.get_y() > pdf.t_margin + 1.0:
         pdf.add_page()
@@ -441,12 +443,12 @@ def heading(pdf: Form, text: str, size: float = 11.0, keep: float = 0.0) -> None
 
 
 def paragraph(pdf: Form, text: str, size: float = 7.5) -> None:
-    """Text over the page width, broken into lines at spaces (:func:`_wrap`), left-aligned, on
+    """Text over the page width, broken into lines at spaces (:func:`wrap_lines`), left-aligned, on
     the next page when it does not fit the rest of this one (continued over a page only when
     it is longer than a page)."""
     pdf.set_font(FONT, "", size)
     line = 1.3 * size * _PT
-    lines = _wrap(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "", size)
+    lines = wrap_lines(pdf, localized(pdf, text), pdf.epw - 2 * pdf.c_margin, "", size)
     if not fits(pdf, len(lines) * line) and pdf.get_y() > pdf.t_margin + 1.0:
         pdf.add_page()  # a paragraph is whole on a page (none of the forms' runs over a page)
         pdf.set_font(FONT, "", size)
@@ -485,9 +487,9 @@ def table(
     lefts = [pdf.l_margin + sum(cols[:j]) for j in range(len(cols))]
     aligns = tuple(aligns) if aligns else ("LEFT",) * len(cols)
     line = 1.22 * size * _PT + 0.5
-    head = [_wrap(pdf, localized(pdf, str(h)), w - 2 * _PAD, "B", size)
+    head = [wrap_lines(pdf, localized(pdf, str(h)), w - 2 * _PAD, "B", size)
             for h, w in zip(header, cols, strict=True)]  # fmt: skip
-    body = [[_wrap(pdf, localized(pdf, str(c)), w - 2 * _PAD, "", size)
+    body = [[wrap_lines(pdf, localized(pdf, str(c)), w - 2 * _PAD, "", size)
              for c, w in zip(r, cols, strict=True)] for r in rows]  # fmt: skip
     total = sum(_row_height(cells, line) for cells in body)
     total += _row_height(head, line) if any(header) else 0.0
@@ -521,10 +523,10 @@ def table_height(
     scale = pdf.epw / sum(widths)
     cols = [w * scale for w in widths]
     line = 1.22 * size * _PT + 0.5
-    head = [_wrap(pdf, localized(pdf, str(h)), w - 2 * _PAD, "B", size)
+    head = [wrap_lines(pdf, localized(pdf, str(h)), w - 2 * _PAD, "B", size)
             for h, w in zip(header, cols, strict=True)]  # fmt: skip
     total = sum(
-        _row_height([_wrap(pdf, localized(pdf, str(c)), w - 2 * _PAD, "", size)
+        _row_height([wrap_lines(pdf, localized(pdf, str(c)), w - 2 * _PAD, "", size)
                      for c, w in zip(r, cols, strict=True)], line)
         for r in rows
     )  # fmt: skip
@@ -536,19 +538,29 @@ _PAD = 0.5  # mm, the cell padding of the tables
 _LINES: dict[tuple[str, float, float, str], tuple[str, ...]] = {}
 
 
+def forget_layout() -> None:
+    """Forget what the process remembers of the fonts and texts (the parsed fonts, their
+    compiled subsets, the text widths, the lines of each cell), as a fresh process starts: the
+    next form is laid out from nothing, to the same bytes."""
+    for font in [*_PARSED.values(), *_SUBSETS.values()]:
+        font.close()
+    for memory in (_PARSED, _SUBSETS, _WIDTHS, _LINES):
+        memory.clear()
+
+
 def _plain_width(pdf: Form, text: str, style: str, size: float) -> float:
     """The advance width of ``text`` in mm at ``size`` pt (remembered, :data:`_WIDTHS`)."""
     _, points = pdf.fonts[f"{FONT.lower()}{style}"].get_text_width(text, size, None)
     return points / pdf.k
 
 
-def _width(pdf: Form, text: str, style: str, size: float) -> float:
+def text_width(pdf: Form, text: str, style: str, size: float) -> float:
     """The advance width of a form text as drawn (:func:`rich_runs`), in mm."""
     return sum(_plain_width(pdf, run, style, size * _SUB if sub else size)
                for run, sub in rich_runs(text))  # fmt: skip
 
 
-def _wrap(pdf: Form, text: str, width: float, style: str, size: float) -> tuple[str, ...]:
+def wrap_lines(pdf: Form, text: str, width: float, style: str, size: float) -> tuple[str, ...]:
     """The lines of ``text`` in a cell ``width`` mm wide: at its newlines, then greedily at
     spaces (a word wider than the cell is broken between characters)."""
     key = (style, size, round(width, 6), text)
@@ -560,14 +572,14 @@ def _wrap(pdf: Form, text: str, width: float, style: str, size: float) -> tuple[
         current = ""
         for word in paragraph_.split(" "):
             trial = f"{current} {word}" if current else word
-            if _width(pdf, trial, style, size) <= width or not current:
+            if text_width(pdf, trial, style, size) <= width or not current:
                 current = trial
             else:
                 out.append(current)
                 current = word
-            while _width(pdf, current, style, size) > width and len(current) > 1:
+            while text_width(pdf, current, style, size) > width and len(current) > 1:
                 cut = len(current) - 1
-                while cut > 1 and _width(pdf, current[:cut], style, size) > width:
+                while cut > 1 and text_width(pdf, current[:cut], style, size) > width:
                     cut -= 1
                 out.append(current[:cut])
                 current = current[cut:]
@@ -604,7 +616,7 @@ def _draw_row(
             if text:
                 dx = _PAD
                 if align[0] in "RC":
-                    free = w - 2 * _PAD - _width(pdf, text, style, size)
+                    free = w - 2 * _PAD - text_width(pdf, text, style, size)
                     dx += free if align[0] == "R" else free / 2
                 pdf.rich_text(x + dx, y + 0.5 * line + 0.3 * size / pdf.k, text)
             y += line
@@ -661,7 +673,7 @@ class LabelPlacer:
         self.boxes.append(box)
 
     def _label_width(self, label: str) -> float:
-        return _width(self.pdf, label, self.pdf.font_style, self.pdf.font_size_pt)
+        return text_width(self.pdf, label, self.pdf.font_style, self.pdf.font_size_pt)
 
     def text(self, x: float, y: float, label: str) -> None:
         """Write at (x, y) as baseline start, and reserve its box (no choice of place)."""

@@ -37,6 +37,7 @@ __all__ = [
     "setup_dict",
     "sheet_markdown",
     "sheet_to_dict",
+    "signed_m",
 ]
 
 #: Unit, equation and meaning of each top-level value of the sheet.
@@ -324,7 +325,7 @@ def _fmt(value: float, digits: int = 3) -> str:
     return f"{value:.{digits}f}"
 
 
-def _pm(value: float) -> str:
+def signed_m(value: float) -> str:
     """A signed value to 1 mm; one that rounds to zero is +0.000 (never -0.000). [m]"""
     return f"{round(value, 3) + 0.0:+.3f}"
 
@@ -491,7 +492,9 @@ def _similarity_lines(d: dict[str, Any], lang: str = "en") -> list[str]:
             f"a = {s['a']:.6e}, b = {s['b']:.9f}, c_X = {s['cx_m']:.3f} m, "
             f"c_Y = {s['cy_m']:.3f} m (det {s['determinant']:.6f} < 0: {t('md_reflection')}); "
             f"{t('md_rms_residual')} {s['rms_m']:.3f} m; {t('md_residuals')} "
-            + ", ".join(f"{k}: ({_pm(v[0])}, {_pm(v[1])})" for k, v in s["residuals_m"].items())
+            + ", ".join(
+                f"{k}: ({signed_m(v[0])}, {signed_m(v[1])})" for k, v in s["residuals_m"].items()
+            )
             + " m.",
         ]
     return lines

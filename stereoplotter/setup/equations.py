@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.constants import MM_PER_M
+from stereoplotter.geometry.arrays import floats
 from stereoplotter.geometry.similarity import SimilarityFit, apply_similarity
 from stereoplotter.geometry.tilt_correction import correction_inclination, decentration
 
@@ -51,10 +52,6 @@ __all__ = [
     "sheet_corner_instrument_coordinates_book_form",
     "transformation_coefficient",
 ]
-
-
-def _a(v: ArrayLike) -> NDArray[np.float64]:
-    return np.asarray(v, dtype=float)
 
 
 def instrument_principal_distance(
@@ -87,9 +84,9 @@ def instrument_principal_distance(
     109.375
     """
     return (
-        _a(focal_length_corrected_mm)
-        * _a(horizontal_scale_denominator)
-        / _a(vertical_scale_denominator)
+        floats(focal_length_corrected_mm)
+        * floats(horizontal_scale_denominator)
+        / floats(vertical_scale_denominator)
     )
 
 
@@ -97,7 +94,7 @@ def transformation_coefficient(
     f_instrument_mm: ArrayLike, focal_length_corrected_mm: ArrayLike
 ) -> NDArray[np.float64]:
     """k = f_пр / f′, the vertical exaggeration of the model (DRO60 "F/f_k"). [—]"""
-    return _a(f_instrument_mm) / _a(focal_length_corrected_mm)
+    return floats(f_instrument_mm) / floats(focal_length_corrected_mm)
 
 
 def counter_scale_left(
@@ -127,7 +124,7 @@ def counter_scale_left(
     >>> round(float(counter_scale_left(185.0, 130.0)), 4)  # the book's SC-1 example, n ≈ 1.42
     1.4231
     """
-    return _a(projection_distance_max_mm) / _a(f_instrument_mm)
+    return floats(projection_distance_max_mm) / floats(f_instrument_mm)
 
 
 def counter_scale_right(
@@ -180,10 +177,11 @@ def counter_scale_right(
     ...             - 1.4231), 4)
     -0.0308
     """
-    dz = _a(projection_centre_height_right_m) - _a(projection_centre_height_left_m)
+    dz = floats(projection_centre_height_right_m) - floats(projection_centre_height_left_m)
     if book_sign:
         dz = -dz
-    return _a(n_left) + dz * MM_PER_M / (_a(f_instrument_mm) * _a(vertical_scale_denominator))
+    scale = floats(f_instrument_mm) * floats(vertical_scale_denominator)
+    return floats(n_left) + dz * MM_PER_M / scale
 
 
 def mark_span(
@@ -208,7 +206,7 @@ def mark_span(
     Implements Eq. (6.5) of [1]_ (OCR L3725). The printed (6.1)/(6.2) already contain n and (6.5)
     multiplies by n again; n is applied exactly once here (``docs/setup-data.md``).
     """
-    return _a(n) * (_a(y3_transformed_mm) - _a(y4_transformed_mm))
+    return floats(n) * (floats(y3_transformed_mm) - floats(y4_transformed_mm))
 
 
 def model_height(
@@ -237,7 +235,7 @@ def model_height(
     >>> float(model_height(1400.0, 8000))
     175.0
     """
-    return _a(flying_height_above_point_m) * MM_PER_M / _a(vertical_scale_denominator)
+    return floats(flying_height_above_point_m) * MM_PER_M / floats(vertical_scale_denominator)
 
 
 #: The same relation read the other way: the projection distance D of a ground point [mm].
@@ -270,9 +268,9 @@ def base_components(
     at the vertical scale (``docs/setup-data.md``, item 1). b_z′ > 0 when the right station is
     higher.
     """
-    d = _a(centre_right_m) - _a(centre_left_m)
-    mg = _a(horizontal_scale_denominator)[..., None]
-    mv = _a(vertical_scale_denominator)
+    d = floats(centre_right_m) - floats(centre_left_m)
+    mg = floats(horizontal_scale_denominator)[..., None]
+    mv = floats(vertical_scale_denominator)
     out = d * MM_PER_M / mg
     out[..., 2] = d[..., 2] * MM_PER_M / mv
     return out
@@ -309,10 +307,10 @@ def height_correction(
     by ΔZ (``docs/setup-data.md``, stage readings).
     """
     return (
-        _a(projection_distance_mm)
-        * _a(mark_span_error_left_mm)
-        * _a(vertical_scale_denominator)
-        / (MM_PER_M * _a(mark_span_left_mm))
+        floats(projection_distance_mm)
+        * floats(mark_span_error_left_mm)
+        * floats(vertical_scale_denominator)
+        / (MM_PER_M * floats(mark_span_left_mm))
     )
 
 
@@ -343,7 +341,11 @@ def base_z_correction(
     pivot rises, the new reading is O′_bz = O_bz **+** Δb_z; the printed minus of (6.11) belongs
     to a scale counting the other way (option ``bz_scale_sense = -1``, ``docs/setup-data.md``).
     """
-    return _a(projection_distance_mm) * _a(mark_span_error_right_mm) / _a(mark_span_right_mm)
+    return (
+        floats(projection_distance_mm)
+        * floats(mark_span_error_right_mm)
+        / floats(mark_span_right_mm)
+    )
 
 
 def height_scale_reading(
@@ -375,9 +377,9 @@ def height_scale_reading(
     (``docs/setup-data.md``). The height scale reads const − D·M_в/1000, hence the minus.
     """
     return (
-        _a(zero_reading_height_scale_m)
-        - (_a(model_height_mm) - _a(n_left) * _a(f_instrument_mm))
-        * _a(vertical_scale_denominator)
+        floats(zero_reading_height_scale_m)
+        - (floats(model_height_mm) - floats(n_left) * floats(f_instrument_mm))
+        * floats(vertical_scale_denominator)
         / MM_PER_M
     )
 
@@ -437,8 +439,8 @@ def corner_offsets_mm(
     one per pair (broadcast against the corners); returns x′, y′ [mm] as
     :func:`sheet_corner_instrument_coordinates`.
     """
-    xy = _a(corners_ground_m) - _a(origin_m)
-    return xy * MM_PER_M / _a(horizontal_scale_denominator)
+    xy = floats(corners_ground_m) - floats(origin_m)
+    return xy * MM_PER_M / floats(horizontal_scale_denominator)
 
 
 def sheet_corner_instrument_coordinates_book_form(
@@ -469,5 +471,5 @@ def corner_offsets_book_form_mm(
     """The printed (6.7) of corners already on the ground by (6.8), as
     :func:`sheet_corner_instrument_coordinates_book_form` (``n`` and the denominator one or one
     per pair, broadcast against the corners). [mm]"""
-    xy = _a(corners_ground_m) - _a(origin_m)
-    return _a(n) * xy * MM_PER_M / _a(photo_scale_denominator)
+    xy = floats(corners_ground_m) - floats(origin_m)
+    return floats(n) * xy * MM_PER_M / floats(photo_scale_denominator)

@@ -17,10 +17,10 @@ import numpy as np
 from stereoplotter.setup.equations import height_scale_reading
 from stereoplotter.setup.records import SetupSheet
 
-__all__ = ["stage_readings"]
+__all__ = ["signed_text", "stage_readings"]
 
 
-def _signed(value: float, digits: int = 3) -> str:
+def signed_text(value: float, digits: int = 3) -> str:
     """``+ 1.234`` or ``− 1.234`` [as given]; a value that rounds to zero is ``+ 0.000`` (never
     ``+ -0.000`` or ``− 0.000``)."""
     text = f"{abs(value):.{digits}f}"
@@ -43,7 +43,7 @@ def _r(
     value = 0.0 if abs(value) < 5e-7 else value  # no "−0.000"
     relation = extra.pop("relation", "=")
     if zero:
-        formula = f"{name} = {zero} {_signed(value)} {unit}"
+        formula = f"{name} = {zero} {signed_text(value)} {unit}"
     else:
         formula = (
             f"{name} {relation} {value:.4g} {unit}"
@@ -181,8 +181,8 @@ def _mark_rows(sheet: SetupSheet) -> list[dict[str, Any]]:
             {}
             if photo.name == "left"
             else {
-                "zero_reading_definition": f"MO_X,п = MO_X + b_x = MO_X {_signed(bx)}; "
-                f"MO_Y,п = MO_Y + b_y = MO_Y {_signed(by)}"
+                "zero_reading_definition": f"MO_X,п = MO_X + b_x = MO_X {signed_text(bx)}; "
+                f"MO_Y,п = MO_Y + b_y = MO_Y {signed_text(by)}"
             }
         )
         rows += [

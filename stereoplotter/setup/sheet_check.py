@@ -1,4 +1,4 @@
-"""A trainee's setup sheet checked against the program's (issue 13, deliverable 5).
+"""A trainee's setup sheet checked against the program's.
 
 Pure comparison and diagnosis, no file I/O: the trainee's values come as a flat mapping
 ``key → value or None`` (keys as in ``sheet.yaml``: ``n_right``, ``L_mm.left``,

@@ -27,6 +27,7 @@ from types import MappingProxyType
 from typing import Any, ClassVar
 
 __all__ = [
+    "ATTRIBUTE_KEYS",
     "DECENTRATION_LINKAGES",
     "STATUSES",
     "InstrumentSpec",
@@ -97,7 +98,7 @@ def _deg_range(v: tuple[float, float]) -> tuple[float, float]:
 
 
 #: attribute → (dotted key, converter from the YAML value to the attribute's unit).
-_ATTRIBUTES: dict[str, tuple[str, Callable[[Any], Any]]] = {
+ATTRIBUTE_KEYS: dict[str, tuple[str, Callable[[Any], Any]]] = {
     "title": ("name", _same),
     "principle": ("principle", _same),
     "photo_format_mm": ("photo.format_mm", _same),
@@ -294,7 +295,7 @@ class InstrumentSpec:
     #: Typed attribute → dotted YAML key. ``projection_distance_max_mm`` falls back to
     #: ``projection.distance_mm`` when the file has no separate D_max (see :meth:`key_of`).
     KEYS: ClassVar[Mapping[str, str]] = MappingProxyType(
-        {name: key for name, (key, _) in _ATTRIBUTES.items()}
+        {name: key for name, (key, _) in ATTRIBUTE_KEYS.items()}
     )
 
     def key_of(self, attribute_name: str) -> str:

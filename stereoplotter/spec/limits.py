@@ -1,4 +1,4 @@
-"""Documented limits of an instrument on the material it is given (issue 11, deliverable 3).
+"""Documented limits of an instrument on the material it is given.
 
 A scenario outside a documented limit is refused like a mechanical stop, with one line naming the
 file, the key, the limit and its status (:class:`~stereoplotter.spec.range_checks.RangeRefusal`).

@@ -1,4 +1,4 @@
-"""Analytic phototriangulation upstream of the setup sheet (issue 29).
+"""Analytic phototriangulation upstream of the setup sheet.
 
 A *block* (:mod:`~stereoplotter.triangulation.block`) holds what a triangulation office has: the
 camera certificate, the photo numbers by strip, comparator measurements of fiducials and of tie,

@@ -30,7 +30,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from stereoplotter.errors import GeometryError
-from stereoplotter.geometry.resection import _model_and_jacobian
+from stereoplotter.geometry.resection import model_and_jacobian
 from stereoplotter.geometry.rotation import rotation_matrix
 from stereoplotter.triangulation.block import (
     Block,
@@ -46,6 +46,7 @@ from stereoplotter.triangulation.solution import BlockSolution, sparse_least_squ
 __all__ = [
     "Adjusted",
     "BundleProblem",
+    "MeasurementPairs",
     "Normals",
     "PhotoCofactors",
     "bundle_adjust",
@@ -53,6 +54,7 @@ __all__ = [
     "bundle_block",
     "initial_approximation",
     "interior_orientation_covariance",
+    "measurement_pairs",
     "normals",
     "photo_cofactors",
     "point_cofactors",
@@ -265,7 +267,7 @@ def _linearise(
         rows = order[bounds[j] : bounds[j + 1]]
         if rows.size == 0:
             continue
-        computed, jj = _model_and_jacobian(
+        computed, jj = model_and_jacobian(
             orient[j], points[p.obs_point[rows]], float(cam[0]), np.zeros(2)
         )
         if not plain:
@@ -299,14 +301,16 @@ def centre_residuals(p: BundleProblem, orient: NDArray) -> tuple[NDArray, NDArra
 
 
 @dataclass(frozen=True, slots=True)
-class _Pairs:
+class MeasurementPairs:
     """Every ordered pair of measurements of the same point (the blocks of the reduced matrix)."""
 
     first: NDArray[np.int64]
     second: NDArray[np.int64]
 
 
-def _pairs(obs_point: NDArray) -> _Pairs:
+def measurement_pairs(obs_point: NDArray) -> MeasurementPairs:
+    """Every ordered pair (itself included) of the observations of each point, ``obs_point``
+    being each observation's point index."""
     order = np.argsort(obs_point, kind="stable")
     counts = np.bincount(obs_point)
     start = np.concatenate([[0], np.cumsum(counts)[:-1]])
@@ -314,7 +318,7 @@ def _pairs(obs_point: NDArray) -> _Pairs:
     first = np.repeat(order, k)
     offset = np.arange(first.size) - np.repeat(np.cumsum(k) - k, k)
     second = order[start[obs_point[first]] + offset]
-    return _Pairs(first, second)
+    return MeasurementPairs(first, second)
 
 
 @dataclass(frozen=True, slots=True)
@@ -353,7 +357,7 @@ def normals(
     p: BundleProblem,
     orient: NDArray,
     points: NDArray,
-    pairs: _Pairs,
+    pairs: MeasurementPairs,
     camera: NDArray | None = None,
 ) -> Normals:
     """The reduced normal equations of the bundle at (orient, points, camera) (:class:`Normals`).
@@ -563,7 +567,7 @@ def _photo_covariances(q: PhotoCofactors, n_photos: int, sigma0: float):
 
 
 def point_cofactors(
-    p: BundleProblem, n: Normals, q: PhotoCofactors, pairs: _Pairs
+    p: BundleProblem, n: Normals, q: PhotoCofactors, pairs: MeasurementPairs
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
     r"""Q_pp (n_points, 3, 3) of every point, Q_cp (n_obs, 6, 3) of each measurement's photo
     against its point and Q_gp (n_points, n_g, 3) of the camera against the points (None
@@ -607,7 +611,7 @@ class Adjusted:
     solution: BlockSolution
     normals: Normals
     inverse: PhotoCofactors | None
-    pairs: _Pairs
+    pairs: MeasurementPairs
     redundancy: int
     qcp: NDArray[np.float64] | None
     qgp: NDArray[np.float64] | None = None
@@ -679,7 +683,7 @@ def bundle_adjusted(
     r = float(np.max(np.linalg.norm(p.xy_mm, axis=1))) if p.xy_mm.size else 1.0
     # a camera correction's largest effect on a photo coordinate, per unit [mm]
     reach = np.array([r / p.f_mm, 1.0, 1.0, r**3, r**5, 3 * r**2, 3 * r**2])[p.free]
-    pairs = _pairs(p.obs_point)
+    pairs = measurement_pairs(p.obs_point)
     converged = False
     for it in range(1, max_iterations + 1):  # noqa: B007 (reported after the loop)
         dc, dp, _, n, dg = _step(p, orient, points, pairs, camera)

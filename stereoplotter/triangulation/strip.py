@@ -53,7 +53,9 @@ from stereoplotter.triangulation.solution import BlockSolution, photo_residuals
 
 __all__ = [
     "StripModel",
+    "common_points",
     "form_strip",
+    "measurement_rows",
     "relative_orientation",
     "strip_block",
     "y_parallax",
@@ -176,7 +178,9 @@ class StripModel:
         return ids, np.array([self.sums[i] / self.counts[i] for i in ids.tolist()]).reshape(-1, 3)
 
 
-def _common(block_xy, rows_of, a: int, b: int) -> tuple[NDArray, NDArray, NDArray]:
+def common_points(block_xy, rows_of, a: int, b: int) -> tuple[NDArray, NDArray, NDArray]:
+    """The points measured on both photos ``a`` and ``b``: their ids (ascending) and their
+    coordinates of ``block_xy`` on ``a`` and on ``b`` (rows as :func:`measurement_rows` gives)."""
     ra, rb = rows_of[a], rows_of[b]
     ids = np.array(sorted(set(ra) & set(rb)), dtype=np.int64)
     return (
@@ -254,7 +258,7 @@ def _model_message(exc, rows_of, photos, k, names, point_ids) -> str:
 
 def _add_model(strip, xy, rows_of, photos, k, a, b, f, models) -> None:
     """Model k (photos a, b) oriented and connected to the strip (:func:`form_strip`)."""
-    ids, xa, xb = _common(xy, rows_of, a, b)
+    ids, xa, xb = common_points(xy, rows_of, a, b)
     if k == 0 or models == "independent":
         m1, m2, direction, it = relative_orientation(xa, xb, f)
         s1, s2 = np.zeros(3), 1000.0 * direction
@@ -282,7 +286,8 @@ def _add_model(strip, xy, rows_of, photos, k, a, b, f, models) -> None:
     strip.add_points(ids, pts)
 
 
-def _rows_of(block: Block) -> list[dict[int, int]]:
+def measurement_rows(block: Block) -> list[dict[int, int]]:
+    """Per photo, point index → the row of its measurement in the block's observations."""
     out: list[dict[int, int]] = [{} for _ in block.photos]
     for row, (j, i) in enumerate(
         zip(block.obs_photo.tolist(), block.obs_point.tolist(), strict=True)
@@ -321,7 +326,7 @@ def oriented_strips(block: Block, models: str = "independent") -> tuple[list[Ori
     if models not in MODELS:
         raise GeometryError(f"strip models: expected one of {', '.join(MODELS)}, found {models!r}")
     xy = interior_orientation(block)
-    rows_of = _rows_of(block)
+    rows_of = measurement_rows(block)
     prob = problem(block)
     index = {p: j for j, p in enumerate(block.photos)}
     out, iterations = [], 0
@@ -398,7 +403,7 @@ def strip_block(block: Block, models: str = "independent", degree: int = 3) -> B
     _check_height_stations(block, strips, degree)
     xy = interior_orientation(block)
     f = block.camera.focal_length_mm
-    rows_of = _rows_of(block)
+    rows_of = measurement_rows(block)
     prob = problem(block)
     initial = {}
     for s, st in enumerate(strips):

@@ -8,14 +8,13 @@ import pytest
 
 import stereoplotter
 from stereoplotter.cli import main
+from stereoplotter.commands.verification import verify
+from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.procedure.simulate import simulate
+from stereoplotter.setup.sheet import compute_setup_sheet
 
 
 def test_public_names_resolve_to_their_modules():
-    from stereoplotter.commands.verification import verify
-    from stereoplotter.io.scenario_file import load_scenario
-    from stereoplotter.procedure.simulate import simulate
-    from stereoplotter.setup.sheet import compute_setup_sheet
-
     assert stereoplotter.load_scenario is load_scenario
     assert stereoplotter.compute_setup_sheet is compute_setup_sheet
     assert stereoplotter.simulate is simulate
@@ -27,6 +26,7 @@ def test_public_names_resolve_to_their_modules():
 
 def test_api_sheet_equals_the_cli_sheet(capsys):
     """The sheet computed through the API is the one `setup --json` prints (same f_пр, n_л, n_п)."""
+    # imported here: the package's lazy public names, resolved as a user's import resolves them
     from stereoplotter import compute_setup_sheet, load_instrument, load_scenario
 
     sheet = compute_setup_sheet(load_scenario("pair60"), load_instrument("sc1"))

@@ -16,16 +16,26 @@ import pytest
 import yaml
 
 from stereoplotter.cli import _parser, main
+from stereoplotter.commands.arguments import (
+    MAX_SEED,
+    bounded_float,
+    non_negative_int,
+    positive_int,
+    seed_int,
+)
 from stereoplotter.errors import ConfigError
+from stereoplotter.instrument.error_model import error_model_from_spec
+from stereoplotter.io.geometry_file import geometry_from_file
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.paths import data_dir
 from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.io.yaml_input import load_yaml_mapping
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _shipped(kind: str, name: str) -> Path:
     try:
-        from stereoplotter.io.paths import data_dir
-
         folder = data_dir(kind)
         if folder is not None and (Path(folder) / name).is_file():
             return Path(folder) / name
@@ -139,14 +149,6 @@ def test_every_numeric_option_is_range_checked():
 
 
 def test_the_range_types_accept_their_ends():
-    from stereoplotter.commands.arguments import (
-        MAX_SEED,
-        bounded_float,
-        non_negative_int,
-        positive_int,
-        seed_int,
-    )
-
     assert positive_int("1") == 1 and non_negative_int("0") == 0
     assert seed_int(str(MAX_SEED)) == MAX_SEED
     assert bounded_float(-15.0, 15.0)("-15") == -15.0
@@ -202,23 +204,16 @@ def test_geometry_file_with_a_typo_names_file_and_field(tmp_path, capsys):
     ],
 )
 def test_geometry_file_values_are_checked(tmp_path, text, message):
-    from stereoplotter.io.geometry_file import geometry_from_file
-
     with pytest.raises(ConfigError, match=r"geometry\.yaml: " + message):
         geometry_from_file(_write(tmp_path, text, "geometry.yaml"))
 
 
 def test_geometry_from_a_single_photo_scenario_is_refused(capsys):
-    from stereoplotter.io.geometry_file import geometry_from_file
-
     with pytest.raises(ConfigError, match=r"photos: expected a stereopair .*found 1 photo"):
         geometry_from_file(SINGLE)
 
 
 def test_errors_file_unknown_term_and_bad_values(tmp_path):
-    from stereoplotter.instrument.error_model import error_model_from_spec
-    from stereoplotter.io.instrument_file import load_instrument
-
     model = error_model_from_spec(load_instrument("sc1"))
     with pytest.raises(ConfigError, match=r"e\.yaml: backlash\.x: expected an error term .*"
                        r"did you mean backlash\.X\?"):
@@ -304,8 +299,6 @@ def test_setup_refusals_name_the_scenario_file(tmp_path, capsys):
     ],
 )
 def test_yaml_problems_are_config_errors(tmp_path, text, message):
-    from stereoplotter.io.yaml_input import load_yaml_mapping
-
     path = _write(tmp_path, text, "doc.yaml")
     t0 = time.perf_counter()
     with pytest.raises(ConfigError, match=r"doc\.yaml: " + message):
@@ -347,8 +340,6 @@ def _doc_bytes(path: Path) -> bytes:
     ],
 )
 def test_instrument_mechanics_that_cannot_run_are_refused(tmp_path, section, key, value, message):
-    from stereoplotter.io.instrument_file import load_instrument
-
     doc = _doc(_shipped("instruments", "sc1.yaml"))
     doc[section][key]["value"] = value
     path = _write(tmp_path, doc, "sc1.yaml")

@@ -9,6 +9,9 @@ from pathlib import Path
 
 import pytest
 
+import stereoplotter.cli as cli
+import stereoplotter.commands.info as info_command
+import stereoplotter.io.atomic_write as yamlio
 from stereoplotter.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -115,9 +118,6 @@ def test_python_dash_m_runs():
 
 
 def test_unexpected_error_is_one_line_exit_3(monkeypatch, capsys):
-    import stereoplotter.cli as cli
-    import stereoplotter.commands.info as info_command
-
     def broken():
         raise ZeroDivisionError("boom")
 
@@ -130,8 +130,6 @@ def test_unexpected_error_is_one_line_exit_3(monkeypatch, capsys):
 
 
 def test_atomic_write_leaves_old_file_when_writing_fails(tmp_path, monkeypatch):
-    import stereoplotter.io.atomic_write as yamlio
-
     target = tmp_path / "out.txt"
     yamlio.atomic_write_text(target, "old")
 

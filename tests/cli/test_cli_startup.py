@@ -1,4 +1,4 @@
-"""A command line that starts at once (issue 26): the CLI and the quick commands import only
+"""A command line that starts at once: the CLI and the quick commands import only
 what they use. Checked on ``sys.modules`` of a fresh interpreter (nothing about time here: speed
 is measured in ``benchmarks/``)."""
 

@@ -1,4 +1,4 @@
-"""The commands layer (issue 23): the CLI starts without the library, every command module
+"""The commands layer: the CLI starts without the library, every command module
 follows the protocol (``add_arguments``, ``run``), the one figure encoder is reproducible."""
 
 from __future__ import annotations
@@ -9,8 +9,13 @@ import sys
 from typing import Any
 
 import pytest
+from matplotlib.figure import Figure
 
 from stereoplotter.cli import COMMANDS, _parser
+from stereoplotter.commands.arguments import LibraryDefault
+from stereoplotter.plotting.encode import figure_bytes
+from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB
+from stereoplotter.verification.budget import DEFAULT_BUDGET_TRIALS
 
 #: What building the parser must not load (the CLI starts fast; the web is an optional extra).
 HEAVY = ("scipy", "matplotlib", "starlette", "pydantic", "yaml", "pyproj", "fpdf")
@@ -49,10 +54,6 @@ def test_every_command_has_a_run_and_every_leaf_calls_one():
 
 
 def test_a_library_default_is_shown_and_used_as_the_library_has_it(capsys):
-    from stereoplotter.commands.arguments import LibraryDefault
-    from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB
-    from stereoplotter.verification.budget import DEFAULT_BUDGET_TRIALS
-
     args = _parser().parse_args(["simulate", "pair60", "--instrument", "sc1"])
     assert LibraryDefault.of(args.memory_mb) == DEFAULT_MEMORY_BUDGET_MB
     args = _parser().parse_args(["budget", "pair60", "--instrument", "sc1"])
@@ -64,11 +65,7 @@ def test_a_library_default_is_shown_and_used_as_the_library_has_it(capsys):
 
 
 def test_the_figure_encoder_gives_the_same_bytes_without_date_or_program():
-    from stereoplotter.plotting.encode import figure_bytes
-
     def figure():
-        from matplotlib.figure import Figure
-
         fig = Figure(figsize=(2, 2))
         fig.add_subplot().plot([0, 1], [1, 0])
         return fig

@@ -1,4 +1,4 @@
-"""The setup form an operator sets the instrument from (issue 27, deliverables 1–3): every reading
+"""The setup form an operator sets the instrument from: every reading
 at its least count, the gear r, the zero-reading and L′ fields with the (6.9)–(6.11) rows, stage 5,
 the signatures, page 1 holding the readings, labels that do not overlap, Russian and English,
 fonts embedded, the book's limits flagged."""

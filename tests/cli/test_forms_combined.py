@@ -1,5 +1,5 @@
-"""forms.pdf of a job takes each pair's pages as drawn for its sheet.pdf (issue 27, deliverable
-7: each form laid out once): the text of every page of forms.pdf, as pypdf extracts it, is the
+"""forms.pdf of a job takes each pair's pages as drawn for its sheet.pdf (each form laid out
+once): the text of every page of forms.pdf, as pypdf extracts it, is the
 text of the pairs' own forms page by page, only the page number in the footer counted through
 the whole document; each page names its own pair in the footer; the fonts each page uses are
 in its resources (text extraction decodes through them)."""

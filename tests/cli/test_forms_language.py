@@ -1,4 +1,4 @@
-"""One glossary for every output (issue 27, deliverable 2): sheet.md and the transcript's closing
+"""One glossary for every output: sheet.md and the transcript's closing
 summary in Russian and English, every key in both languages, a bad language refused."""
 
 from __future__ import annotations

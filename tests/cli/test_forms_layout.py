@@ -1,4 +1,4 @@
-"""The forms' own table layout and the per-process font memory (issue 27, deliverable 7): a form's
+"""The forms' own table layout and the per-process font memory: a form's
 bytes do not depend on what the process rendered before it; a table that runs over a page
 continues under its header again, the header never left alone at a page's foot; a cell's text
 is broken at spaces into lines within its column."""
@@ -35,11 +35,7 @@ def _form(result, i: int) -> bytes:
 def test_a_forms_bytes_do_not_depend_on_the_forms_before_it(result):
     """Pair 2's form from a process that remembers nothing equals the one rendered after pairs
     0 and 1 (the parsed fonts, their subsets and the text widths are remembered in between)."""
-    for font in [*form_layout._PARSED.values(), *form_layout._SUBSETS.values()]:
-        font.close()  # forgotten as a fresh process would not have them
-    for memory in (form_layout._PARSED, form_layout._SUBSETS, form_layout._WIDTHS,
-                   form_layout._LINES):  # fmt: skip
-        memory.clear()
+    form_layout.forget_layout()
     fresh = _form(result, 2)
     _form(result, 0)
     _form(result, 1)
@@ -85,7 +81,7 @@ def test_a_cells_text_is_broken_into_lines_within_its_column():
     pdf.set_font(form_layout.FONT, "", 7.5)
     text = "O_Y3,л = MO_Y + 139.49 mm; O_Y4,л = MO_Y − 148.22 mm; O_X2,л = MO_X + 148.31 mm"
     width = 40.0
-    lines = form_layout._wrap(pdf, text, width, "", 7.5)
+    lines = form_layout.wrap_lines(pdf, text, width, "", 7.5)
     assert len(lines) > 1
     assert " ".join(lines) == text
 

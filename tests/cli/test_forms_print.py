@@ -13,6 +13,7 @@ drawing's marks print dark on the rendered page.
 
 from __future__ import annotations
 
+import ctypes
 import re
 from pathlib import Path
 
@@ -23,6 +24,10 @@ import pytest
 import yaml
 
 from stereoplotter.cli import main
+from stereoplotter.commands.setup_job import compute_job
+from stereoplotter.io.job_file import load_job
+from stereoplotter.report import form_layout
+from stereoplotter.report.job import form_header
 
 ROOT = Path(__file__).resolve().parents[2]
 JOB = ROOT / "jobs" / "strip8" / "job.yaml"
@@ -61,8 +66,6 @@ def _chars(page) -> list[tuple[str, float, tuple[float, float, float, float]]]:
 
 
 def pdfium_double():
-    import ctypes
-
     return ctypes.c_double()
 
 
@@ -186,8 +189,8 @@ def _every_page(pdf) -> None:
 
 def test_the_drawing_prints_dark(forms):
     """On the drawing page rendered without smoothing (each pixel its mark's own grey), no
-    drawn pixel is paler than grey 110 of 255: a grey fill of 225 (pale circles nearly
-    invisible on a copier) gave 18 % of them."""
+    drawn pixel is paler than grey 110 of 255 (a pale grey fill, such as 225, is nearly
+    invisible on a copier)."""
     heading = {"ru": "Рамка трапеции", "en": "Sheet frame and control"}
     for lang in ("ru", "en"):
         pdf = pdfium.PdfDocument(forms[lang] / "101-102" / "sheet.pdf")
@@ -207,10 +210,7 @@ def test_no_table_is_split_unless_longer_than_a_page(monkeypatch):
     """Every table of every strip8 form, ru and en, starts and ends on one page (a table taller
     than a page would continue on the next; none is, for strip8: the readings of stages 1–4
     are set at 7 pt), and no word is wider than its cell (none broken between letters)."""
-    from stereoplotter.commands.setup_job import compute_job
-    from stereoplotter.io.job_file import load_job
-    from stereoplotter.report import form_layout, forms
-    from stereoplotter.report.job import form_header
+    from stereoplotter.report import forms  # here: the name is also this module's fixture
 
     drawn = []
     real = form_layout.table
@@ -225,15 +225,15 @@ def test_no_table_is_split_unless_longer_than_a_page(monkeypatch):
 
     monkeypatch.setattr(forms, "table", recording)
     wide = set()
-    wrap, width = form_layout._wrap, form_layout._width
+    wrap, width = form_layout.wrap_lines, form_layout.text_width
 
     def checking(pdf, text, room, style, size):
         wide.update((word, size) for line in text.split("\n") for word in line.split(" ")
                     if word and width(pdf, word, style, size) > room)  # fmt: skip
         return wrap(pdf, text, room, style, size)
 
-    monkeypatch.setattr(form_layout, "_wrap", checking)
-    monkeypatch.setattr(form_layout, "_LINES", {})  # every cell's lines found again
+    monkeypatch.setattr(form_layout, "wrap_lines", checking)
+    form_layout.forget_layout()  # every cell's lines found again
     result = compute_job(load_job(JOB))
     for lang in ("ru", "en"):
         for p in result.pairs:

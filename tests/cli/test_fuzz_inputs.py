@@ -49,7 +49,22 @@ import pytest
 import yaml
 from conftest import node_paths, value_at
 
-from stereoplotter.errors import StereoplotterError
+from stereoplotter.cli import main
+from stereoplotter.commands.setup_job import compute_job
+from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.instrument.error_model import error_model_from_spec
+from stereoplotter.io.block_file import CSV_COLUMNS, load_block
+from stereoplotter.io.exercise_file import load_exercise
+from stereoplotter.io.geometry_file import geometry_from_file
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.job_file import load_job
+from stereoplotter.io.paths import data_dir
+from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.io.yaml_input import MAX_YAML_NODES, load_yaml_mapping
+from stereoplotter.report.job import pair_dict
+from stereoplotter.scenario import summarize_scenario
+from stereoplotter.spec.instrument_spec import format_instrument, instrument_to_dict
+from stereoplotter.verification.table import BOOK
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = int(os.environ.get("STEREOPLOTTER_FUZZ_SEED", "20240607"))
@@ -72,8 +87,6 @@ def _shipped_dir(kind: str) -> Path:
     """The shipped ``kind`` folder: through :mod:`stereoplotter.io.paths` where it says, else the
     checkout's ``kind/`` folder."""
     try:
-        from stereoplotter.io.paths import data_dir
-
         folder = data_dir(kind)
         if folder is not None and Path(folder).is_dir():
             return Path(folder)
@@ -113,11 +126,6 @@ def corpus() -> dict[str, list[Seed]]:
     global _CORPUS
     if _CORPUS is not None:
         return _CORPUS
-    from stereoplotter.instrument.error_model import error_model_from_spec
-    from stereoplotter.io.block_file import CSV_COLUMNS
-    from stereoplotter.io.instrument_file import load_instrument
-    from stereoplotter.verification.table import BOOK
-
     scenarios, instruments = _shipped_dir("scenarios"), _shipped_dir("instruments")
     out: dict[str, list[Seed]] = {k: [] for k in ("scenario", "block", "instrument")}
     for path in sorted(scenarios.glob("*.yaml")):
@@ -494,29 +502,17 @@ class Outcome:
 def _load(kind: str, path: Path) -> Any:
     """The library loader of a kind, and everything derived from what it loaded."""
     if kind == "scenario":
-        from stereoplotter.io.scenario_file import load_scenario
-        from stereoplotter.scenario import summarize_scenario
-
         scenario = load_scenario(path)
         json.dumps(summarize_scenario(scenario), default=float)
         return scenario
     if kind in ("block", "block_csv", "csv"):
-        from stereoplotter.io.block_file import load_block
-
         return load_block(path)
     if kind == "instrument":
-        from stereoplotter.io.instrument_file import load_instrument
-        from stereoplotter.spec.instrument_spec import format_instrument, instrument_to_dict
-
         spec = load_instrument(path)
         format_instrument(spec).encode("utf-8")
         json.dumps(instrument_to_dict(spec), ensure_ascii=False).encode("utf-8")
         return spec
     if kind == "errors":
-        from stereoplotter.instrument.error_model import error_model_from_spec
-        from stereoplotter.io.instrument_file import load_instrument
-        from stereoplotter.io.yaml_input import load_yaml_mapping
-
         data, source = load_yaml_mapping(path)
         base = error_model_from_spec(load_instrument(_shipped_dir("instruments") / "sc1.yaml"))
         model = base.with_overrides(data, source)
@@ -524,20 +520,12 @@ def _load(kind: str, path: Path) -> Any:
         assert all(np.all(np.isfinite(v)) for v in draws.values()), "non-finite draw"
         return model
     if kind == "exercise":
-        from stereoplotter.io.exercise_file import load_exercise
-
         exercise = load_exercise(path)
         assert exercise.stages and exercise.preset_stages == exercise.preset_stages
         return exercise
     if kind == "geometry":
-        from stereoplotter.io.geometry_file import geometry_from_file
-
         return geometry_from_file(path)
     if kind in ("job", "job_csv"):
-        from stereoplotter.commands.setup_job import compute_job
-        from stereoplotter.io.job_file import load_job
-        from stereoplotter.report.job import pair_dict
-
         job = load_job(path)
         result = compute_job(job)
         json.dumps([pair_dict(job, p) for p in result.pairs], ensure_ascii=False).encode("utf-8")
@@ -546,8 +534,6 @@ def _load(kind: str, path: Path) -> Any:
 
 
 def _run_cli(argv: list[str]) -> tuple[int | str, str, str, list[str]]:
-    from stereoplotter.cli import main
-
     out, err = io.StringIO(), io.StringIO()
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")
@@ -630,8 +616,6 @@ def _names_file_and_field(message: str, files: list[str], folder: str) -> bool:
 
 def _scenario_problem(path: str) -> str:
     """Why the scenario that ``job to-scenario`` wrote does not load ('' when it does)."""
-    from stereoplotter.io.scenario_file import load_scenario
-
     try:
         load_scenario(path)
     except BaseException as exc:  # the point of the check
@@ -784,9 +768,6 @@ def test_mutated_inputs_never_crash(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("raw", [_bomb_flow(), _bomb_flow(12, 6), _CLASSIC_BOMB])
 def test_alias_bombs_are_refused_quickly(tmp_path, raw):
-    from stereoplotter.errors import ConfigError
-    from stereoplotter.io.yaml_input import MAX_YAML_NODES, load_yaml_mapping
-
     path = tmp_path / "bomb.yaml"
     path.write_text(raw if raw.startswith("a0:") else f"name: x\nvalue: {raw}\n", encoding="utf-8")
     t0 = time.perf_counter()

@@ -1,13 +1,15 @@
-"""`stereoplotter setup JOB`: the production job of issue 12 (jobs/strip8), its forms and files."""
+"""`stereoplotter setup JOB`: the production job jobs/strip8, its forms and files."""
 
 from __future__ import annotations
 
 import csv
 import io
+import json
 import re
 from dataclasses import replace
 from pathlib import Path
 
+import jsonschema
 import numpy as np
 import pypdf
 import pytest
@@ -18,8 +20,12 @@ from stereoplotter.cli import main
 from stereoplotter.commands.setup_job import compute_job
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import load_job, measured_pair
+from stereoplotter.io.job_scenario import fit_terrain
+from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.report.form_fields import rigorous_sides, value_to_set
 from stereoplotter.report.job import pair_dict
+from stereoplotter.report.sheet import sheet_markdown, signed_m
+from stereoplotter.setup.readings import signed_text
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import (
     compute_sheet_from_measurements,
@@ -69,7 +75,7 @@ def test_same_job_gives_byte_identical_files(written, tmp_path):
     assert main(["setup", str(JOB), "-o", str(tmp_path)]) == 0
     first, second = _files(written), _files(tmp_path)
     assert sorted(first) == sorted(second)
-    assert len(first) == 8 * 3 + 4  # + manifest.json (issue 27)
+    assert len(first) == 8 * 3 + 4  # + manifest.json
     for name in first:
         assert first[name] == second[name], name
 
@@ -99,7 +105,7 @@ def test_f_prime_is_from_the_measured_fiducial_distances(written):
         expected = 70.0 * np.mean([*spans[left], *spans[right]]) / 170.0
         sheet = yaml.safe_load((written / pair / "sheet.yaml").read_text("utf-8"))
         assert sheet["focal_length_corrected_mm"] == pytest.approx(expected, abs=1e-6)
-        # photo numbers are text (issue 27)
+        # photo numbers are text
         assert sheet["job"]["photos"] == {"left": str(left), "right": str(right)}
         per_photo = sheet["focal_length_corrected_per_photo_mm"]
         assert per_photo[0] == pytest.approx(70.0 * np.mean(spans[left]) / 170.0, abs=1e-6)
@@ -294,10 +300,6 @@ def test_bad_job_is_one_line(tmp_path, capsys, edit, where, field):
 
 
 def test_shipped_job_validates_against_its_schema():
-    import json
-
-    import jsonschema
-
     schema = json.loads((ROOT / "docs" / "schemas" / "job.schema.json").read_text("utf-8"))
     doc = yaml.safe_load(JOB.read_text("utf-8"))
     validator = jsonschema.Draft202012Validator(schema)
@@ -306,16 +308,13 @@ def test_shipped_job_validates_against_its_schema():
     assert any("lefft" in e.message for e in validator.iter_errors(doc))
 
 
-# --- job to-scenario (issue 12, deliverable 3) ---------------------------------------------------
+# --- job to-scenario -----------------------------------------------------------------------------
 
 
 def test_job_to_scenario_loads_simulates_and_keeps_the_pair(tmp_path, capsys):
     """Pair 102-103 as a scenario: it loads, the zero-error simulation runs on it and sets the
     job's scales, and the scenario's photos and points are the job's in the pair's frame (points
     to 1 mm, centres to 1 mm, rotations to 1e-7)."""
-    import json
-
-    from stereoplotter.io.scenario_file import load_scenario
 
     path = tmp_path / "pair.yaml"
     assert main(["job", "to-scenario", str(JOB), "102-103", "-o", str(path)]) == 0
@@ -351,9 +350,8 @@ def test_job_to_scenario_loads_simulates_and_keeps_the_pair(tmp_path, capsys):
     assert summary["evaluation"]["horizontal_scale_denominator"] == sheet["scale_horizontal"]
     assert summary["evaluation"]["vertical_scale_denominator"] == sheet["scale_vertical"]
     assert all(c["passed"] for c in summary["checks"].values())
-    # zero errors: the mechanism's own. Issue 11: SC-1's own mechanism (gimbal offset h = 20 mm,
-    # assumed) raises it from 1.10 µm (canonical unit, h = 0) to 6.04 µm on this pair; bound: the
-    # book's residual y-parallax tolerance, ¼ of the 0.05 mm mark
+    # zero errors: what is left is the mechanism's own (SC-1's gimbal offset h = 20 mm, assumed);
+    # bound: the book's residual y-parallax tolerance, ¼ of the 0.05 mm mark
     assert summary["residual_y_parallax_um"]["grid_max"] < 12.5
 
 
@@ -367,8 +365,6 @@ def test_job_to_scenario_unknown_pair_is_one_line(tmp_path, capsys):
 def test_fit_terrain_recovers_plane_and_hill():
     """4 points of a plane: the plane exactly; 8 points of plane + the fitter's own hill shape
     (centre at the centroid, radius 1.5 × the farthest): the hill's height; 2 points: flat."""
-    from stereoplotter.io.job_scenario import fit_terrain
-
     xy = np.array([[-900.0, 1500.0], [900.0, 1500.0], [900.0, -1500.0], [-900.0, -1500.0]])
     plane = np.column_stack([xy, 150.0 + 0.004 * xy[:, 0] - 0.002 * xy[:, 1]])
     fit = fit_terrain(plane)
@@ -385,12 +381,12 @@ def test_fit_terrain_recovers_plane_and_hill():
     assert (two.kind, two.section) == ("flat", {"base_height_m": 102.0})
 
 
-# --- two formatting defects seen on job and scenario sheets ---------------------------------------
+# --- formatting of job and scenario sheets --------------------------------------------------------
 
 
 def test_sheet_without_a_map_sheet_writes_its_markdown(tmp_path, capsys):
-    """`setup --horizontal-scale` on a scenario without a map sheet: sheet_markdown divided by
-    the missing map scale (TypeError, exit 3); now the scale chain says there is no map."""
+    """`setup --horizontal-scale` on a scenario without a map sheet writes sheet.md, its scale
+    chain saying there is no map (the missing map scale is not divided by)."""
     doc = yaml.safe_load((ROOT / "stereoplotter" / "data" / "scenarios" / "pair60.yaml")
                          .read_text("utf-8"))  # fmt: skip
     del doc["map_sheet"]
@@ -405,12 +401,12 @@ def test_sheet_without_a_map_sheet_writes_its_markdown(tmp_path, capsys):
 
 
 def test_no_negative_zero_in_readings_or_residuals(tmp_path):
-    """Pair 101-102 of strip8 has b_y = −0.0003 mm: its zero reading read "MO_Y + -0.000"."""
-    from stereoplotter.report.sheet import _pm, sheet_markdown
-    from stereoplotter.setup.readings import _signed
-
-    assert (_signed(-0.0004), _signed(-0.0006), _signed(2.5)) == ("+ 0.000", "− 0.001", "+ 2.500")
-    assert (_pm(-0.0004), _pm(-0.0006), _pm(0.0123)) == ("+0.000", "-0.001", "+0.012")
+    """Pair 101-102 of strip8 has b_y = −0.0003 mm: its zero reading prints "MO_Y + 0.000",
+    never "MO_Y + -0.000"."""
+    texts = signed_text(-0.0004), signed_text(-0.0006), signed_text(2.5)
+    assert texts == ("+ 0.000", "− 0.001", "+ 2.500")
+    metres = signed_m(-0.0004), signed_m(-0.0006), signed_m(0.0123)
+    assert metres == ("+0.000", "-0.001", "+0.012")
     sheet = compute_job(load_job(JOB)).pairs[0].sheet
     assert -5e-4 < sheet.base_mm[1] < 0
     defs = [r["zero_reading_definition"] for r in sheet.readings if "zero_reading_definition" in r]

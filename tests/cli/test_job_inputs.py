@@ -1,5 +1,5 @@
 """Job inputs that keep every identifier, messages that point to the cell, a pair refused alone,
-output folders that behave (issue 27, deliverables 4–6), on copies of jobs/strip8."""
+output folders that behave, on copies of jobs/strip8."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from stereoplotter.cli import main
-from stereoplotter.commands.setup_job import compute_job
+from stereoplotter.commands.setup_job import compute_job, write_job
 from stereoplotter.io.job_file import load_job, measured_pair
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -59,7 +59,7 @@ def _error(capsys) -> str:
 
 
 def test_acceptance_ids_stay_distinct_photo_number_prints_as_written(tmp_path, capsys):
-    """Issue 27 acceptance: ids 0415 and 415, photo number "012417" quoted, a comment line in
+    """Ids 0415 and 415, photo number "012417" quoted, a comment line in
     the CSV; then an error on the CSV's line 5 is reported at line 5."""
 
     def edit(doc):
@@ -128,7 +128,7 @@ def test_unquoted_number_with_a_leading_zero_is_refused(tmp_path, capsys, text, 
 
 
 def test_unquoted_plain_numbers_are_their_digits(tmp_path):
-    """``number: 101`` unquoted (as jobs written before issue 27) is the photo '101'."""
+    """``number: 101`` unquoted (as older jobs write it) is the photo '101'."""
     path = _job(tmp_path)
     path.write_text(re.sub(r"'(1\d\d)'", r"\1", path.read_text("utf-8")), "utf-8")
     assert "number: 101\n" in path.read_text("utf-8")
@@ -253,8 +253,6 @@ def test_force_removes_pair_folders_of_a_run_without_manifest(tmp_path, capsys):
         (out / name).parent.mkdir(parents=True, exist_ok=True)
         (out / name).write_text("old", "utf-8")
     job = load_job(_job(tmp_path, lambda d: d.update(pairs=d["pairs"][:1])))
-    from stereoplotter.commands.setup_job import write_job
-
     report = write_job(compute_job(job), out, force=True)
     assert report.removed == ("099-100/sheet.md", "099-100/sheet.yaml")
     assert report.kept_foreign == 2 and not (out / "099-100").exists()

@@ -79,7 +79,7 @@ def test_an_interrupt_after_any_write_leaves_the_old_or_the_new_run(runs, tmp_pa
     old, new, files, about = runs
     states = {"old": _snapshot(old), "new": _snapshot(new)}
     assert states["old"] != states["new"] and "notes.txt" in states["new"]
-    previous = signal.signal(signal.SIGTERM, setup_job._interrupt)
+    previous = signal.signal(signal.SIGTERM, setup_job.raise_keyboard_interrupt)
     seen = []
     try:
         k, writes = 1, len(files) + 1 + 1  # the files, the manifest, one past the last

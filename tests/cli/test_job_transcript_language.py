@@ -1,4 +1,4 @@
-"""The transcript in Russian (issue 27, deliverable 2): ``simulate --lang ru`` renders every
+"""The transcript in Russian: ``simulate --lang ru`` renders every
 record — its step, remedy, equation, the words around its values — and the closing summary from
 the one glossary (``stereoplotter.glossary``).
 

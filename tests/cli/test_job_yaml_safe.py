@@ -1,4 +1,4 @@
-"""block.yaml and the triangulated job.yaml through the safe YAML emitter (issue 27): a name with
+"""block.yaml and the triangulated job.yaml through the safe YAML emitter: a name with
 YAML syntax and a photo number with a leading zero read back as the same text."""
 
 from __future__ import annotations

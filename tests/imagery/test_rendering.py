@@ -1,4 +1,4 @@
-"""Acceptance of the synthetic photographs (issue 13, deliverable 3).
+"""Acceptance of the synthetic photographs.
 
 Independent computation: the target centroids measured in rendered eyepiece views are compared
 with Eq. (2.53) (``object_to_photo``) of the true ground point plus the film deformation — the

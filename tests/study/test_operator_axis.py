@@ -13,6 +13,7 @@ import pytest
 
 pytest.importorskip("xarray")
 
+from stereoplotter.errors import ConfigError
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.study_file import study_from_mapping
 from stereoplotter.procedure.operator import OperatorModel
@@ -97,8 +98,6 @@ def test_operator_axis_defaults_to_the_simulate_operator_and_offers_the_free_sig
 
 
 def test_a_bad_operator_name_is_one_line_naming_the_axis():
-    from stereoplotter.errors import ConfigError
-
     with pytest.raises(ConfigError) as exc:
         study_from_mapping(one_cell(["eyes"]), "s.yaml")
     assert "axes.operator" in str(exc.value) and "\n" not in str(exc.value)

@@ -1,6 +1,6 @@
 """`study run` on a reduced grid of the shipped formula-validity study: the Dataset of 2 Dask
 workers (one of them killed mid-run) is identical to the serial run, bit for bit, and so is a
-run resumed after its process was killed (issue 28, acceptance)."""
+run resumed after its process was killed."""
 
 from __future__ import annotations
 
@@ -64,6 +64,7 @@ def test_serial_run_fills_every_cell_with_finite_measures(serial):
 
 
 def test_two_workers_one_killed_give_the_serial_dataset(serial, tmp_path):
+    # imported here: the extra `study`, present once the module's importorskip has passed
     from distributed import Client, LocalCluster
 
     cluster = LocalCluster(

@@ -12,6 +12,7 @@ holds for them — a stale figure fails.
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import shlex
 from pathlib import Path
@@ -20,6 +21,7 @@ import pytest
 
 pytest.importorskip("xarray")
 
+from stereoplotter.cli import main
 from stereoplotter.commands.study import add_arguments, reduced
 from stereoplotter.io.study_file import load_study, study_from_mapping
 from stereoplotter.study.cells import VALUE_MEASURES, run_task
@@ -104,9 +106,6 @@ def test_two_cells_are_the_current_code():
 def test_the_book_pairs_row_of_pair60_is_the_current_code(capsys):
     """§The book's pairs: pair60's row (both methods' height RMS ± SE, their ratio, the plan
     RMS) is what the printed `simulate` commands give now."""
-    import json
-
-    from stereoplotter.cli import main
 
     text = DOC.read_text(encoding="utf-8").split("### The book's pairs", 1)[1]
     row = next(x for x in text.splitlines() if x.startswith("| pair60 |"))

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from stereoplotter.cli import main
 from stereoplotter.errors import ConfigError
 from stereoplotter.io.study_file import load_study, study_from_mapping, study_schema_text
 
@@ -23,7 +24,7 @@ VALID = {
 }
 
 
-def test_shipped_studies_have_the_issue_s_size():
+def test_shipped_studies_have_their_grid_sizes():
     fv, _ = load_study("formula-validity")
     assert len(fv.cells()) == 4 * 5 * 4 * 4 * 4 * 3 * 2  # 7 680 configurations
     assert fv.procedures() == 76_800_000
@@ -98,8 +99,6 @@ def test_shipped_studies_validate_against_the_schema():
 
 
 def test_cli_answers_a_bad_study_with_one_error_line(tmp_path, capsys):
-    from stereoplotter.cli import main
-
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump({**VALID, "trials": 1}), encoding="utf-8")
     code = main(["study", "run", str(bad), "-o", str(tmp_path / "r.zarr"), "--workers", "0"])

@@ -95,13 +95,13 @@ def test_too_little_control_is_refused():
 
 def test_selected_inverse_equals_the_dense_inverse_of_the_reduced_matrix():
     # every 6 × 6 block of S⁻¹ the band recursion holds, and the far pairs from the LU factor
-    from stereoplotter.triangulation.bundle import _pairs, normals
+    from stereoplotter.triangulation.bundle import measurement_pairs, normals
     from stereoplotter.triangulation.selected_inverse import selected_inverse
 
     block, _ = block10x4()
     p = problem(block)
     s = bundle_adjust(p, covariance=False)
-    n = normals(p, s.orientations, np.nan_to_num(s.points_m), _pairs(p.obs_point))
+    n = normals(p, s.orientations, np.nan_to_num(s.points_m), measurement_pairs(p.obs_point))
     sel = selected_inverse(n.reduced)
     dense = np.linalg.inv(n.reduced.toarray())
     a, b = np.meshgrid(np.arange(p.n_photos), np.arange(p.n_photos), indexing="ij")

@@ -11,6 +11,7 @@ from stereoplotter.io.block_measurements_file import (
     write_block_measurements,
 )
 from stereoplotter.triangulation.bundle import bundle_adjust, problem
+from stereoplotter.triangulation.reliability import snoop
 from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
 
 LEVER = (0.2, -0.5, 1.5)
@@ -74,8 +75,6 @@ def test_centres_and_lever_arm_round_trip_through_the_block_file(tmp_path):
 
 
 def test_a_blunder_on_a_measured_centre_is_flagged_by_photo():
-    from stereoplotter.triangulation.reliability import snoop
-
     block, _ = synthesize_block(
         SynthSpec(strips=3, photos_per_strip=6, centre_sigma_m=0.1, lever_arm_m=LEVER),
         np.random.default_rng(4),

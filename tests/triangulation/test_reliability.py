@@ -10,7 +10,7 @@ import pytest
 from scipy import stats
 
 from stereoplotter.triangulation.bundle import bundle_adjust, problem
-from stereoplotter.triangulation.reliability import critical_values, global_test, snoop
+from stereoplotter.triangulation.reliability import critical_values, global_test, robust, snoop
 from stereoplotter.triangulation.solution import catalogue_residuals
 from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
 
@@ -123,8 +123,6 @@ def test_point_sigma_matches_the_errors_at_check_points():
 
 
 def test_danish_reweighting_down_weights_the_two_blunders_only():
-    from stereoplotter.triangulation.reliability import robust
-
     block, _ = block6x15(0)
     bad, (photo, point, control) = _with_blunders(block, 1)
     r = robust(problem(bad), "danish")

@@ -13,7 +13,12 @@ from stereoplotter.triangulation.absolute import apply_similarity7, fit_similari
 from stereoplotter.triangulation.block import interior_orientation
 from stereoplotter.triangulation.polynomial import StripAxes, adjust_strip_polynomials
 from stereoplotter.triangulation.solution import catalogue_residuals
-from stereoplotter.triangulation.strip import _common, _rows_of, strip_block, y_parallax
+from stereoplotter.triangulation.strip import (
+    common_points,
+    measurement_rows,
+    strip_block,
+    y_parallax,
+)
 
 
 @pytest.mark.parametrize("models", ["independent", "dependent"])
@@ -29,8 +34,8 @@ def test_error_free_block_gives_the_true_orientations(models):
 def test_true_orientation_clears_the_y_parallax():
     # (5.10): the y-parallax of a pair at its true relative orientation is zero at every point
     block, truth = exact_block()
-    xy, rows = interior_orientation(block), _rows_of(block)
-    _, a, b = _common(xy, rows, 0, 1)
+    xy, rows = interior_orientation(block), measurement_rows(block)
+    _, a, b = common_points(xy, rows, 0, 1)
     o = truth.orientations
     q = y_parallax(
         a,

@@ -9,7 +9,7 @@ from synthetic_blocks import block10x4, exact_block
 from stereoplotter.geometry.collinearity import object_to_photo
 from stereoplotter.geometry.rotation import rotation_matrix
 from stereoplotter.triangulation.block import catalogue_local, interior_orientation
-from stereoplotter.triangulation.strip import _rows_of
+from stereoplotter.triangulation.strip import measurement_rows
 
 
 def test_interior_orientation_gives_the_collinearity_image_of_the_truth():
@@ -35,7 +35,7 @@ def test_catalogue_in_sk42_returns_to_the_local_truth():
 def test_layout_every_model_has_points_common_to_three_photos():
     # model connection needs ≥ 2 points on photos k, k+1, k+2 (the nadir column of k+1)
     block, _ = block10x4()
-    rows = _rows_of(block)
+    rows = measurement_rows(block)
     index = {p: j for j, p in enumerate(block.photos)}
     for strip in block.strips:
         j = [index[p] for p in strip]

@@ -7,13 +7,21 @@ tests/cli/test_job.py; here the sheets of the triangulated job are computed in p
 from __future__ import annotations
 
 import csv
+import dataclasses
+import shutil
 
+import numpy as np
 import pytest
 
 from stereoplotter.cli import main
 from stereoplotter.commands.triangulation_chain import chain_comparison
-from stereoplotter.io.block_measurements_file import load_block_measurements
+from stereoplotter.io.block_measurements_file import (
+    load_block_measurements,
+    write_block_measurements,
+)
+from stereoplotter.io.job_file import load_job
 from stereoplotter.triangulation.bundle import bundle_block
+from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
 
 
 @pytest.fixture(scope="module")
@@ -116,12 +124,9 @@ def test_bad_block_file_is_one_error_line(tmp_path, capsys):
 
 
 def test_leading_zero_photo_numbers_pass_through_to_the_job(chain, tmp_path):
-    """Photo numbers are text in the job (issue 27): a block whose photo 101 is numbered 0101
+    """Photo numbers are text in the job: a block whose photo 101 is numbered 0101
     gives a job whose photo and pair keep 0101 (the job format took integers and the writer
     refused it)."""
-    import shutil
-
-    from stereoplotter.io.job_file import load_job
 
     block = tmp_path / "block"
     shutil.copytree(chain / "block", block)
@@ -165,8 +170,6 @@ def test_self_calibration_from_the_command_line(chain, tmp_path, capsys):
     assert main([*argv, "--self-calibrate", "f,x0,y0,k1"]) == 0
     text = (tmp_path / "report.md").read_text(encoding="utf-8")
     assert "## Self-calibration of the camera" in text and "| k1 [mm⁻²] |" in text
-    from stereoplotter.io.job_file import load_job
-
     f_row = next(line for line in text.splitlines() if line.startswith("| f [mm] |"))
     adjusted = float(f_row.split("|")[3])
     job = load_job(tmp_path / "job.yaml")  # the job carries the adjusted f
@@ -177,13 +180,6 @@ def test_self_calibration_from_the_command_line(chain, tmp_path, capsys):
 
 
 def test_reject_from_the_command_line_names_the_blunders_in_flagged_csv(tmp_path):
-    import dataclasses
-
-    import numpy as np
-
-    from stereoplotter.io.block_measurements_file import write_block_measurements
-    from stereoplotter.triangulation.synth import SynthSpec, synthesize_block
-
     block, _ = synthesize_block(SynthSpec(strips=3, photos_per_strip=6), np.random.default_rng(4))
     rays = np.bincount(block.obs_point)
     o = int(np.flatnonzero(rays[block.obs_point] == 3)[4])
