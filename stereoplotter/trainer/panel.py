@@ -164,7 +164,7 @@ _JUDGED = re.compile(r"clear(ing)? (of )?the (y-parallax|six q)|common tilt|leve
 _CLEARS_AT = re.compile(r"standard point (\d): clear the y-parallax")
 #: Steps the operator took only because a check failed (the L-check's corrections): shown when
 #: their condition holds on the trainee's instrument.
-_CONDITIONAL = re.compile(r"^(ΔZ|Δb_z)\b|would take the carriage")
+_CONDITIONAL = re.compile(r"^(ΔZ|Δb_z)\b|would take the carriage|at the carriage's bottom stop")
 #: Controls that follow from the sheet in a step that names another control: the zero places
 #: of the correction mechanisms and decentrations (set together in the step that names them).
 _ZERO_PLACE_FAMILY = tuple(KNOBS) + tuple(DECENTRATIONS)
