@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import asyncio
 import csv
-import hmac
 import io
 import json
 import math
@@ -36,7 +35,7 @@ from stereoplotter.web.guard import (
     trainee_name,
 )
 from stereoplotter.web.registry import Registry
-from stereoplotter.web.sockets import PATCH_PX
+from stereoplotter.web.sockets import PATCH_PX, address_of
 
 __all__ = [
     "CSV_FIELDS",
@@ -97,9 +96,7 @@ def bearer(conn: HTTPConnection) -> str | None:
 
 
 def _is_instructor(request: Request) -> bool:
-    given = request.query_params.get("token") or bearer(request)
-    token = _web(request).reg.token
-    return isinstance(given, str) and hmac.compare_digest(given.encode(), token.encode())
+    return _web(request).reg.is_instructor(request.query_params.get("token") or bearer(request))
 
 
 def _instructor_only(request: Request) -> None:
@@ -139,7 +136,7 @@ def _start_allowed(request: Request) -> None:
     web = _web(request)
     if len(web.starts) > 10_000:  # forget old addresses rather than grow without bound
         web.starts.clear()
-    addr = request.client.host if request.client else "?"
+    addr = address_of(request)
     if not web.starts.setdefault(addr, RateLimit(*web.start_limit)).allow():
         raise Refused(429, "too many sessions started from this address: wait a moment")
 
@@ -182,7 +179,7 @@ async def sheet(request: Request) -> Response:
     web = _web(request)
     name = row["exercise"]
     if name not in web.sheets:
-        ex = web.catalogue.get(name)
+        ex = web.catalogue.known(name)
         if ex is None:  # an uploaded exercise of an earlier store, not known now
             raise Refused(404, "exercise: no longer known to this server")
         web.sheets[name] = scrub_paths(await run_in_threadpool(core.sheet_of, ex))
@@ -194,8 +191,8 @@ async def overview(request: Request) -> Response:
     sid, _ = _own_or_instructor(request)
     reg = _web(request).reg
     live = await run_in_threadpool(reg.resume, sid)
-    body = await asyncio.get_running_loop().run_in_executor(
-        reg.actor, core.overview_of, live.session
+    body = await asyncio.wrap_future(
+        reg.run(reg.actor, address_of(request), sid, core.overview_of, live.session)
     )
     return JSONResponse(body, headers=_NO_STORE)
 
@@ -205,22 +202,36 @@ async def checklist(request: Request) -> Response:
     sid, _ = _own_or_instructor(request)
     reg = _web(request).reg
     live = await run_in_threadpool(reg.resume, sid)
-    loop = asyncio.get_running_loop()
-    body = await loop.run_in_executor(reg.actor, core.checklist_of, live.session)
+    body = await asyncio.wrap_future(
+        reg.run(reg.actor, address_of(request), sid, core.checklist_of, live.session)
+    )
     return JSONResponse(body, headers=_NO_STORE)
 
 
 async def show_me(request: Request) -> Response:
-    """The operator's actions of the stage in hand, for an animated "show me" (hint 3): given
-    only where the exercise allows hints, never in a demonstration."""
+    """The operator's actions of the stage in hand, for an animated "show me": charged as the
+    hint of level 3 it is (logged before the actions are given, so it shows on the grade);
+    given only where the exercise allows hints, never in a demonstration."""
     sid, row = _own_or_instructor(request)
     reg = _web(request).reg
     live = await run_in_threadpool(reg.resume, sid)
     if live.demonstration or not live.session.exercise.allows("hints") or row["mode"] == "exam":
         raise Refused(403, "show me: this exercise gives no hints")
-    loop = asyncio.get_running_loop()
-    actions = await loop.run_in_executor(reg.actor, core.show_me, live.session)
-    return JSONResponse({"stage": live.session.stage, "actions": actions}, headers=_NO_STORE)
+
+    def charge_and_show() -> tuple[dict[str, Any], list[dict[str, Any]]]:
+        stage = live.session.stage
+        reply = reg.act(live, {"kind": "hint", "level": 3, "animated": True})
+        return reply, ([] if reply.get("error") else core.show_me(live.session, stage))
+
+    reply, actions = await asyncio.wrap_future(
+        reg.run(reg.actor, address_of(request), sid, charge_and_show)
+    )
+    if reply.get("error"):
+        raise Refused(409, f"show me: {reply['error']}")
+    return JSONResponse(
+        {"stage": live.session.stage, "actions": actions, "charged": {"hint": 3}},
+        headers=_NO_STORE,
+    )
 
 
 async def _grade(request: Request) -> tuple[dict[str, Any], dict[str, Any]]:
@@ -252,15 +263,16 @@ async def patch_png(request: Request) -> Response:
     _, row = _own_or_instructor(request)
     side, x, y, mag, size = _patch_query(request)
     web = _web(request)
-    ex = web.catalogue.get(row["exercise"])
+    ex = web.catalogue.known(row["exercise"])
+    if ex is None:
+        raise Refused(404, "exercise: no longer known to this server")
+    if not web.reg.patch_allowed(row["id"], address_of(request)):
+        raise Refused(429, "too many photo patches: wait a moment")
     cache = await asyncio.wrap_future(web.reg.photos(ex))
-    lock = web.reg.photo_locks[core.photo_key(ex)]
-
-    def render() -> bytes:
-        with lock:
-            return core.photo_patch(cache, side, x, y, mag, size)
-
-    png = await run_in_threadpool(render)
+    png = await asyncio.wrap_future(
+        web.reg.run(web.reg.patcher, address_of(request), row["id"], core.photo_patch,
+                    cache, side, x, y, mag, size)
+    )
     return Response(png, media_type="image/png", headers={"Cache-Control": "private, max-age=3600"})
 
 
@@ -337,14 +349,35 @@ async def upload(request: Request) -> Response:
 
     def check() -> Any:
         data = exercise_upload(text)
-        ex = web.catalogue.add_upload(data)
-        web.reg.store.add_exercise(ex.name, data)
+        ex = web.catalogue.check_upload(data)
+        if not web.reg.store.add_exercise(ex.name, data):  # another upload took the name
+            raise core.NameInUse(f"uploaded exercise: name: {ex.name} is in use")
+        web.catalogue.add(ex)
         web.reg.photos(ex)
         return ex
 
-    ex = await run_in_threadpool(check)
+    try:
+        ex = await run_in_threadpool(check)
+    except core.NameInUse as exc:
+        raise Refused(409, str(exc)) from None
     web.reg.version += 1
     return JSONResponse({"name": ex.name, "title": ex.title})
+
+
+async def retire(request: Request) -> Response:
+    """Offer an uploaded exercise no more (``DELETE /api/instructor/exercises/NAME``): new
+    sessions are refused; its sessions still resume, and its name stays used."""
+    _instructor_only(request)
+    name = request.path_params["name"]
+    web = _web(request)
+    if name in web.catalogue.shipped:
+        raise Refused(403, f"exercise {name}: a shipped exercise cannot be retired")
+    ex = web.catalogue.retire(name)
+    if ex is None:
+        raise Refused(404, f"exercise: no uploaded exercise named {name[:66]!r} is offered")
+    await run_in_threadpool(web.reg.store.retire_exercise, name)
+    web.reg.version += 1
+    return JSONResponse({"name": name, "retired": True})
 
 
 # --- exports ----------------------------------------------------------------------------------
