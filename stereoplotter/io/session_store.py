@@ -308,7 +308,8 @@ class SessionStore:
             cur.execute("BEGIN IMMEDIATE")
             try:
                 found = cur.execute(
-                    "SELECT 1 FROM exercises WHERE name=? AND name NOT IN (SELECT name FROM retired)",
+                    "SELECT 1 FROM exercises WHERE name=? "
+                    "AND name NOT IN (SELECT name FROM retired)",
                     (name,),
                 ).fetchone()
                 if found:

@@ -9,9 +9,9 @@ Who may see what:
   of the stage for an animated "show me" where the exercise gives hints; its grade and log once
   every stage is claimed;
 - the instructor's token (``?token=`` or ``Authorization: Bearer``): every session's table,
-  grade, log and replay, the results CSV, an archive of the logs, extra exam attempts, and
-  uploading an exercise and retiring an upload. The grade of an exam that is not finished is given to nobody (it
-  would read out the true outcome of stages not yet claimed).
+  grade, log and replay, the results CSV, an archive of the logs, extra exam attempts,
+  uploading an exercise and retiring an upload. The grade of an exam that is not finished is
+  given to nobody (it would read out the true outcome of stages not yet claimed).
 
 Every refusal is ``{"error": "one line"}`` with 400, 403, 404, 405 or 413 (:mod:`.guard`).
 """

@@ -420,7 +420,9 @@ MAX_NUMBER = 1e7
 def _scalar(value: Any) -> bool:
     if isinstance(value, bool) or value is None:
         return True
-    if isinstance(value, (int, float)):
+    if isinstance(value, int):  # a huge integer overflows a float: compared as an integer
+        return abs(value) <= MAX_NUMBER
+    if isinstance(value, float):
         return math.isfinite(value) and abs(value) <= MAX_NUMBER
     return isinstance(value, str) and len(value) <= 64 and text_ok(value)
 

@@ -22,7 +22,7 @@ from starlette.concurrency import run_in_threadpool
 from starlette.requests import HTTPConnection, Request
 from starlette.responses import JSONResponse, Response
 
-from stereoplotter.io.session_store import exercise_upload
+from stereoplotter.io.session_store import exercise_upload, storable
 from stereoplotter.web import core
 from stereoplotter.web.guard import (
     RateLimit,
@@ -349,6 +349,8 @@ async def upload(request: Request) -> Response:
 
     def check() -> Any:
         data = exercise_upload(text)
+        if not storable(data):
+            raise Refused(400, "uploaded exercise: expected UTF-8 text (no lone surrogate)")
         ex = web.catalogue.check_upload(data)
         if not web.reg.store.add_exercise(ex.name, data):  # another upload took the name
             raise core.NameInUse(f"uploaded exercise: name: {ex.name} is in use")

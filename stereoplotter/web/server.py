@@ -13,7 +13,7 @@ from stereoplotter.io.session_store import SessionStore, default_data_dir
 from stereoplotter.web.app import create_app
 from stereoplotter.web.guard import public_origin
 
-__all__ = ["listen", "serve"]
+__all__ = ["listen", "serve", "uvicorn_config"]
 
 
 def listen(host: str = "127.0.0.1", port: int = 0) -> socket.socket:
@@ -83,11 +83,18 @@ def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
         print(f"instructor page: {base}/instructor?token=… (the token printed when it was made; "
               "a new one: --rotate-token)", flush=True)
     print(f"data folder:     {folder}", flush=True)
-    config = uvicorn.Config(
+    uvicorn.Server(uvicorn_config(app, public_url, trusted_proxies)).run(sockets=[sock])
+
+
+def uvicorn_config(app, public_url: str | None = None,
+                   trusted_proxies: str = "127.0.0.1") -> uvicorn.Config:
+    """The server's uvicorn settings: behind a reverse proxy (``public_url``) the client's
+    address and scheme are the X-Forwarded-For and X-Forwarded-Proto of a proxy connecting
+    from ``trusted_proxies`` (the per-address limits then count trainees, not the proxy)."""
+    return uvicorn.Config(
         app,
         log_level="warning",
         ws_max_size=WS_MAX_SIZE,
         proxy_headers=public_url is not None,
         forwarded_allow_ips=trusted_proxies,
     )
-    uvicorn.Server(config).run(sockets=[sock])
