@@ -293,15 +293,46 @@ def sheet_of(exercise: Exercise) -> dict[str, Any]:
     return _jsonable(exercise_sheet(exercise))
 
 
+#: Grid of the overview's point positions where the parallax read-out is hidden (an exam, or
+#: practice with the read-out off): a glance finds a point to 0.5 mm, the eye sets the mark on
+#: it, and the exact images (which with the marks would give the parallax to 0.1 µm) are not
+#: sent. [mm]
+HIDDEN_GRID_MM = 0.5
+
+
 def overview_of(session: Session) -> dict[str, Any]:
-    """Both photos at a glance (``trainer.panel.overview``; run on the actor thread)."""
-    return _jsonable(overview(session))
+    """Both photos at a glance (``trainer.panel.overview``; run on the actor thread). Where
+    the parallax read-out is hidden, the points are given on a :data:`HIDDEN_GRID_MM` grid and
+    the fiducials as the camera's certificate gives them (not where they lie on the photo)."""
+    body = _jsonable(overview(session))
+    if session.exercise.allows("parallax_readout"):
+        return body
+    certificate = session.prep.scene.camera.fiducial_array_mm()
+    for photo in body["photos"].values():
+        for k, fid in enumerate(photo["fiducials"]):
+            fid["x_mm"], fid["y_mm"] = (float(v) for v in certificate[k])
+        for key in ("standard_points", "control_points", "check_points"):
+            for point in photo[key]:
+                for axis in ("x_mm", "y_mm"):
+                    point[axis] = _on_grid(point[axis])
+    return body
+
+
+def _on_grid(value: float | None) -> float | None:
+    if value is None:
+        return None
+    return round(round(value / HIDDEN_GRID_MM) * HIDDEN_GRID_MM, 3)
 
 
 def checklist_of(session: Session) -> dict[str, Any] | None:
     """The stage in hand's steps with their done flags (``trainer.panel.checklist``; the state
-    carries only the flags on every action; run on the actor thread)."""
-    return _jsonable(checklist(session))
+    carries only the flags on every action; run on the actor thread). Where the exercise gives
+    no hints, the steps do not name their controls (that is hint 2)."""
+    body = _jsonable(checklist(session))
+    if body is not None and not session.exercise.allows("hints"):
+        for step in body["steps"]:
+            step.pop("controls", None)
+    return body
 
 
 def show_me(session: Session, stage: str | None = None) -> list[dict[str, Any]]:
