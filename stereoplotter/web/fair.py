@@ -47,10 +47,10 @@ class FairPool:
             key = (address, session)
             if key not in self._jobs:
                 self._jobs[key] = deque()
-                if address not in self._sessions:
+                if address not in self._sessions:  # a newcomer is next in turn
                     self._sessions[address] = deque()
-                    self._addresses.append(address)
-                self._sessions[address].append(session)
+                    self._addresses.appendleft(address)
+                self._sessions[address].appendleft(session)
             self._jobs[key].append((fut, fn, args))
             self._cv.notify()
         return fut
