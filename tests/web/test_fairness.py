@@ -22,7 +22,7 @@ def test_a_second_socket_replaces_the_first(tmp_path):
     with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
         sid, secret = start(c, PRACTICE, trainee="twice")
         ws1, conn1, _ = open_socket(c, sid, secret)
-        ws2, conn2, hello2 = open_socket(c, sid, secret)
+        ws2, conn2, _ = open_socket(c, sid, secret)
         try:
             with pytest.raises(WebSocketDisconnect) as closed:
                 conn1.receive_text()
