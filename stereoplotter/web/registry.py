@@ -172,6 +172,16 @@ class Registry:
         """``fn(*args)`` on a fair pool, queued under the client address and the session."""
         return pool.submit(address, session, fn, *args)
 
+    def read(self, live: Live, address: str, fn, *args) -> Future:
+        """``fn(*args)`` reading the session on the actor pool, never while an action changes
+        it (the session's lock: a page and the instructor may ask from two addresses)."""
+
+        def locked():
+            with live.lock:
+                return fn(*args)
+
+        return self.run(self.actor, address, live.id, locked)
+
     # --- starting -----------------------------------------------------------------------------
 
     def start(

@@ -192,7 +192,7 @@ async def overview(request: Request) -> Response:
     reg = _web(request).reg
     live = await run_in_threadpool(reg.resume, sid)
     body = await asyncio.wrap_future(
-        reg.run(reg.actor, address_of(request), sid, core.overview_of, live.session)
+        reg.read(live, address_of(request), core.overview_of, live.session)
     )
     return JSONResponse(body, headers=_NO_STORE)
 
@@ -203,7 +203,7 @@ async def checklist(request: Request) -> Response:
     reg = _web(request).reg
     live = await run_in_threadpool(reg.resume, sid)
     body = await asyncio.wrap_future(
-        reg.run(reg.actor, address_of(request), sid, core.checklist_of, live.session)
+        reg.read(live, address_of(request), core.checklist_of, live.session)
     )
     return JSONResponse(body, headers=_NO_STORE)
 

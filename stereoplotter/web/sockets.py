@@ -118,10 +118,11 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         "rate": list(reg.message_limit),
         "mode": ex.mode,
     }
-    state = await _on_actor(reg, live, live.session.state)  # not while an action changes it
-    hello = scrub_paths(hello)
     address = address_of(websocket)
     live.address = address
+    # not while an action changes it
+    state = await asyncio.wrap_future(reg.read(live, address, live.session.state))
+    hello = scrub_paths(hello)
     older, live.socket = live.socket, websocket
     if older is not None:  # one live socket per session: the newer one replaces it
         try:
