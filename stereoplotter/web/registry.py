@@ -57,8 +57,13 @@ RANGE_SLACK = 0.01
 #: address together (a class of 40 behind one address). [1/s], [patches]
 PATCH_LIMIT = (10.0, 30)
 PATCH_ADDRESS_LIMIT = (200.0, 400)
-#: Worker threads of the fair pools (actions; photo patches). [threads]
-ACTORS, PATCHERS = 2, 2
+#: Worker threads of the fair pools (actions; photo patches). One patch thread: a render holds
+#: the interpreter's lock for most of its 0.1–0.3 s, and two renders at once only share it (an
+#: honest trainee's patch would wait for one render and then run beside another). [threads]
+ACTORS, PATCHERS = 2, 1
+#: Sockets a session may open (a page reconnects after a dropped network or a reload): a rate
+#: and a burst; beyond, a socket is closed (4429) before any work is done for it. [1/s], [—]
+CONNECT_LIMIT = (1.0, 5)
 
 
 def token_hash(token: str) -> str:
@@ -86,6 +91,8 @@ class Live:
     address: str = "?"
     #: Messages the session may send, whichever socket it uses (``guard.RateLimit``).
     limit: Any = None
+    #: Sockets the session may open (``CONNECT_LIMIT``).
+    connects: Any = None
     #: Its last action could not be stored: the store's log is the session; reconnect.
     broken: bool = False
 

@@ -38,7 +38,7 @@ from stereoplotter.web.guard import (
     parse_message,
     scrub_paths,
 )
-from stereoplotter.web.registry import Registry
+from stereoplotter.web.registry import CONNECT_LIMIT, Registry
 
 __all__ = ["AUTH_TIMEOUT_S", "PUSH_S", "instructor_socket", "trainee_socket"]
 
@@ -103,6 +103,11 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     except Exception as exc:  # a log that no longer replays: refused in one line, logged
         log.warning("session %s does not resume: %s", sid, exc)
         return await _refuse(websocket, "this session cannot be resumed", 4500)
+    if live.connects is None:
+        live.connects = RateLimit(*CONNECT_LIMIT)
+    if not live.connects.allow():
+        return await _refuse(websocket, "too many connections of this session: wait a moment",
+                             4429)
     ex = live.session.exercise
     hello = {
         "exercise": live.exercise,

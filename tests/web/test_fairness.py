@@ -5,6 +5,7 @@ without one shared lock and limited per session. Speeds are measured in
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 
@@ -24,7 +25,8 @@ def test_a_second_socket_replaces_the_first(tmp_path):
         ws1, conn1, _ = open_socket(c, sid, secret)
         ws2, conn2, _ = open_socket(c, sid, secret)
         try:
-            with pytest.raises(WebSocketDisconnect) as closed:
+            with pytest.raises(WebSocketDisconnect) as closed:  # closed before the hello of 2
+                conn1.send_text(json.dumps({"action": {"kind": "read", "counter": "X"}}))
                 conn1.receive_text()
             assert closed.value.code == 4409
             assert ask(conn2, {"action": {"kind": "read", "counter": "X"}})["error"] is None
@@ -119,3 +121,17 @@ def test_patches_render_in_parallel_and_are_limited_per_session(tmp_path, monkey
         other, other_secret = start(c, PRACTICE, trainee="patcher 2")  # its own allowance
         r = c.get(f"/api/sessions/{other}/patch.png", params={**q, "x": 0, "key": other_secret})
         assert r.status_code == 200
+
+
+def test_a_session_opens_only_so_many_sockets(tmp_path):
+    """Sockets replacing one another in a loop would cost the server a hello each: beyond a
+    burst of 5 (then one a second) a session's new socket is closed before any work."""
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        sid, secret = start(c, PRACTICE, trainee="reconnecting")
+        hellos = []
+        for _ in range(7):
+            with c.websocket_connect(f"/ws/{sid}") as conn:
+                conn.send_text(json.dumps({"auth": secret}))
+                hellos.append(json.loads(conn.receive_text()))
+        assert all("hello" in h for h in hellos[:5]), hellos[:5]
+        assert "too many connections" in hellos[6]["error"], hellos[6]
