@@ -123,3 +123,31 @@ def test_a_session_with_refused_input_resumes_after_a_restart(tmp_path):
             assert hello["error"] is None and hello["n"] == 1
         finally:
             ws.__exit__(None, None, None)
+
+
+def test_an_action_the_store_did_not_keep_does_not_count(tmp_path, monkeypatch):
+    """The store fails on one append (a full disk): the action is answered with an error, the
+    session in memory is dropped and the page, reconnecting, resumes from the store's log."""
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        sid, secret = start(c, PRACTICE, trainee="full disk")
+        store = c.app.state.registry.store
+        ws, conn, _ = open_socket(c, sid, secret)
+        try:
+            assert ask(conn, {"action": {"kind": "read", "counter": "X"}})["n"] == 1
+            real = store.append_action
+
+            def full(*args, **kw):
+                raise OSError("disk full")
+
+            monkeypatch.setattr(store, "append_action", full)
+            reply = ask(conn, {"action": {"kind": "read", "counter": "Y"}})
+            assert "could not be kept" in reply["error"]
+            monkeypatch.setattr(store, "append_action", real)
+        finally:
+            ws.__exit__(None, None, None)
+        ws, conn, hello = open_socket(c, sid, secret)
+        try:
+            assert hello["n"] == 1  # what the store holds, not what memory had counted
+            assert ask(conn, {"action": {"kind": "read", "counter": "Y"}})["n"] == 2
+        finally:
+            ws.__exit__(None, None, None)
