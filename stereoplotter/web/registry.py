@@ -64,6 +64,9 @@ ACTORS, PATCHERS = 2, 1
 #: Sockets a session may open (a page reconnects after a dropped network or a reload): a rate
 #: and a burst; beyond, a socket is closed (4429) before any work is done for it. [1/s], [—]
 CONNECT_LIMIT = (1.0, 5)
+#: Sockets one client address may open, checked before the socket is accepted (a class of 40
+#: behind one address reconnecting after a restart has room). [1/s], [—]
+ADDRESS_CONNECT_LIMIT = (20.0, 80)
 
 
 def token_hash(token: str) -> str:
@@ -130,6 +133,7 @@ class Registry:
         self.address_limit = address_limit
         self.address_limits: dict[str, Any] = {}
         self.patch_limits: dict[tuple[str, str], RateLimit] = {}
+        self.connect_limits: dict[str, RateLimit] = {}
         #: The threads that carry out the sessions' actions (round-robin by client address and
         #: session: a flood from one client does not queue the others behind it), and render
         #: photo patches.
@@ -174,6 +178,13 @@ class Registry:
         mine = self.patch_limits.setdefault(("s", sid), RateLimit(*PATCH_LIMIT))
         theirs = self.patch_limits.setdefault(("a", address), RateLimit(*PATCH_ADDRESS_LIMIT))
         return mine.allow() and theirs.allow()
+
+    def connect_allowed(self, address: str) -> bool:
+        """Whether a client address may open another socket now (``ADDRESS_CONNECT_LIMIT``)."""
+        if len(self.connect_limits) > 10_000:
+            self.connect_limits.clear()
+        bucket = self.connect_limits.setdefault(address, RateLimit(*ADDRESS_CONNECT_LIMIT))
+        return bucket.allow()
 
     def run(self, pool: FairPool, address: str, session: str, fn, *args) -> Future:
         """``fn(*args)`` on a fair pool, queued under the client address and the session."""

@@ -92,6 +92,9 @@ async def _refuse(websocket: WebSocket, text: str, code: int = 4403) -> None:
 
 async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     sid = websocket.path_params["sid"]
+    if not reg.connect_allowed(address_of(websocket)):  # refused before any work (HTTP 403)
+        await websocket.close(4429)
+        return
     await websocket.accept()
     secret = await _auth(websocket)
     if sid not in reg.rows or not reg.check(sid, secret):

@@ -135,3 +135,17 @@ def test_a_session_opens_only_so_many_sockets(tmp_path):
                 hellos.append(json.loads(conn.receive_text()))
         assert all("hello" in h for h in hellos[:5]), hellos[:5]
         assert "too many connections" in hellos[6]["error"], hellos[6]
+
+
+def test_an_address_opens_only_so_many_sockets(tmp_path, monkeypatch):
+    monkeypatch.setattr(registry, "ADDRESS_CONNECT_LIMIT", (0.01, 3))
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        sid, secret = start(c, PRACTICE, trainee="churn")
+        for _ in range(3):
+            ws, _, hello = open_socket(c, sid, secret)
+            ws.__exit__(None, None, None)
+            assert "hello" in hello
+        with pytest.raises(WebSocketDisconnect) as refused:
+            with c.websocket_connect(f"/ws/{sid}") as conn:
+                conn.receive_text()
+        assert refused.value.code == 4429
