@@ -84,7 +84,7 @@ def test_unstorable_input_is_refused_before_it_counts_and_nothing_is_logged(tmp_
                 assert "\n" not in (reply.get("error") or "") and "Traceback" not in str(reply)
                 assert "could not carry this out" not in (reply.get("error") or ""), text[:80]
                 counted = reply["n"]
-            # the issue's own case: a lone surrogate as the control's name is refused
+            # a lone surrogate as the control's name is refused, and so is a 4 000-digit delta
             before = counted
             reply = ask(conn, json.dumps({"action": {"kind": "turn", "control": SURROGATE,
                                                      "delta": 1}}))
