@@ -15,6 +15,17 @@ sessions (computed on demand) in a loop (``--instructor-pause`` s between rounds
 turn-to-state round trip (median, p95, max) and the first-view times.
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py [--trainees 20] [--seconds 30]
+
+``--abuser``: fairness under abuse instead. Each honest trainee connects from its own loopback
+address (127.0.0.10, .11, …: a class of machines), turns a handwheel ``--rate`` times a second,
+and trainee 0 also fetches a sharp ×6 eyepiece patch (768 px, a new position each time) twice
+a second. Phase 1 (idle) times them alone; phase 2 the same while one abuser (its own process,
+one address, 127.0.0.250) opens ``--abuse-sockets`` sockets over ``--abuse-sessions`` sessions,
+each sending turns as fast as its answers come (reconnecting when a newer socket replaces it),
+and ``--abuse-patchers`` clients fetch patches as fast as they are answered. Prints each
+phase's round trip (median, p95) and patch median, and what the abuser got served.
+
+    PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20]
 """
 
 from __future__ import annotations
@@ -187,6 +198,171 @@ async def instructor(host, http, stop: float, replay_sid: str, stats: dict, paus
     await ws.close()
 
 
+# --- fairness under abuse -----------------------------------------------------------------------
+
+
+def _local(n: int) -> str:
+    return f"127.0.0.{n}"
+
+
+async def _open_from(host: str, sid: str, secret: str, address: str):
+    ws = await connect(f"ws://{host}/ws/{sid}", max_size=2**24, local_addr=(address, 0))
+    await ws.send(json.dumps({"auth": secret}))
+    hello = json.loads(await ws.recv())
+    return ws, hello
+
+
+async def honest(host, n: int, stop: float, rtt: list, patches: list | None, pause: float):
+    address = _local(10 + n)
+    transport = httpx.AsyncHTTPTransport(local_address=address)
+    async with httpx.AsyncClient(base_url=f"http://{host}", transport=transport,
+                                 timeout=120) as http:
+        sid, secret = await _session(http, "e01-setup-stage1", f"honest-{n:02d}")
+        ws, hello = await _open_from(host, sid, secret, address)
+        f = hello["state"]["controls"]["f_instrument"]
+        state = (await _ask(ws, {"action": {"kind": "set", "control": "f_instrument",
+                                            "value": round((f["min"] + f["max"]) / 2, 2)}}))
+        state = state["state"]
+
+        async def patch_loop():
+            k = 0
+            while time.monotonic() < stop:
+                m = state["marks"]["left"]
+                t0 = time.perf_counter()
+                r = await http.get(f"/api/sessions/{sid}/patch.png", params={
+                    "side": "left", "x": f"{m['x_mm'] + 0.37 * (k % 40 - 20):.3f}",
+                    "y": f"{m['y_mm']:.3f}", "mag": 6, "size": 768, "key": secret})
+                if r.status_code == 200:
+                    patches.append((time.perf_counter() - t0) * 1e3)
+                k += 1
+                await asyncio.sleep(0.5)
+
+        task = asyncio.create_task(patch_loop()) if patches is not None else None
+        i = 0
+        while time.monotonic() < stop:
+            t0 = time.perf_counter()
+            reply = await _ask(ws, {"action": {"kind": "turn", "control": "X",
+                                               "delta": 0.05 if i % 2 else -0.05}, "seq": i})
+            if reply.get("error") is None:
+                rtt.append((time.perf_counter() - t0) * 1e3)
+            i += 1
+            await asyncio.sleep(pause)
+        if task is not None:
+            await task
+        await ws.close()
+
+
+async def _abuse(host: str, stop: float, sockets: int, sessions: int, patchers: int) -> dict:
+    address = _local(250)
+    got = {"served": 0, "refused": 0, "replaced": 0, "patches": 0, "patches_refused": 0}
+    transport = httpx.AsyncHTTPTransport(local_address=address, limits=httpx.Limits(
+        max_connections=patchers + 4))
+    async with httpx.AsyncClient(base_url=f"http://{host}", transport=transport,
+                                 timeout=120) as http:
+        owned = []
+        for k in range(sessions):
+            r = await http.post("/api/sessions", json={"exercise": "e01-setup-stage1",
+                                                       "trainee": f"abuser-{k}"})
+            if r.status_code == 200:
+                owned.append((r.json()["id"], r.json()["secret"]))
+        if not owned:
+            return got
+
+        async def flood(j: int):
+            sid, secret = owned[j % len(owned)]
+            while time.monotonic() < stop:
+                try:
+                    ws, _ = await _open_from(host, sid, secret, address)
+                    while time.monotonic() < stop:
+                        await ws.send(json.dumps({"action": {"kind": "turn", "control": "X",
+                                                             "delta": 0.01}}))
+                        reply = json.loads(await ws.recv())
+                        got["served" if reply.get("error") is None else "refused"] += 1
+                except Exception:  # replaced by a newer socket of the same session
+                    got["replaced"] += 1
+                    await asyncio.sleep(0.01)
+
+        async def patch_flood(j: int):
+            sid, secret = owned[j % len(owned)]
+            k = 0
+            while time.monotonic() < stop:
+                r = await http.get(f"/api/sessions/{sid}/patch.png", params={
+                    "side": "right", "x": f"{(k * 7 + j * 13) % 120 - 60:.3f}", "y": "1.0",
+                    "mag": 6, "size": 768, "key": secret})
+                got["patches" if r.status_code == 200 else "patches_refused"] += 1
+                k += 1
+
+        await asyncio.gather(*(flood(j) for j in range(sockets)),
+                             *(patch_flood(j) for j in range(patchers)))
+    return got
+
+
+def _abuser_process(host, stop_in, sockets, sessions, patchers, queue) -> None:
+    stop = time.monotonic() + stop_in
+    queue.put(asyncio.run(_abuse(host, stop, sockets, sessions, patchers)))
+
+
+def _summary(name: str, rtt: list[float], patches: list[float]) -> str:
+    rtt = sorted(rtt)
+    p95 = rtt[int(0.95 * (len(rtt) - 1))] if rtt else math.nan
+    return (f"{name}: turns answered {len(rtt)}, round trip median "
+            f"{statistics.median(rtt or [math.nan]):.1f} ms, p95 {p95:.1f} ms; patches "
+            f"{len(patches)}, median {statistics.median(patches or [math.nan]):.0f} ms")
+
+
+async def abuse_async(args) -> None:
+    import multiprocessing
+
+    with tempfile.TemporaryDirectory() as data:
+        proc, host = _start_server(data)
+        try:
+            async with httpx.AsyncClient(base_url=f"http://{host}", timeout=900) as http:
+                t0 = time.perf_counter()  # the photos of every exercise built at start-up
+                await first_view(http, host, (await http.get("/api/exercises")).json()[-1]["name"],
+                                 0)
+                print(f"photos prepared {time.perf_counter() - t0:.1f} s after start-up")
+            results = {}
+            for phase in ("idle", "abuse"):
+                rtt: list[float] = []
+                patches: list[float] = []
+                stop = time.monotonic() + args.seconds
+                abuser = queue = None
+                if phase == "abuse":
+                    ctx = multiprocessing.get_context("spawn")
+                    queue = ctx.Queue()
+                    abuser = ctx.Process(target=_abuser_process, args=(
+                        host, args.seconds + 2, args.abuse_sockets, args.abuse_sessions,
+                        args.abuse_patchers, queue))
+                    abuser.start()
+                    await asyncio.sleep(2.0)  # the abuser's sockets open first
+                    stop = time.monotonic() + args.seconds
+                await asyncio.gather(*(
+                    honest(host, n + (100 if phase == "abuse" else 0), stop, rtt,
+                           patches if n == 0 else None, 1 / args.rate)
+                    for n in range(args.trainees)))
+                if abuser is not None:
+                    results["abuser"] = queue.get(timeout=60)
+                    abuser.join(30)
+                results[phase] = (rtt, patches)
+                print(_summary(phase, rtt, patches), flush=True)
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+    a = results["abuser"]
+    idle_patch = statistics.median(results["idle"][1] or [math.nan])
+    abuse_patch = statistics.median(results["abuse"][1] or [math.nan])
+    print(f"abuser ({args.abuse_sockets} sockets on {args.abuse_sessions} sessions, "
+          f"{args.abuse_patchers} patch clients): turns served {a['served']}, refused "
+          f"{a['refused']}, sockets replaced {a['replaced']}, patches {a['patches']} served, "
+          f"{a['patches_refused']} refused")
+    print(f"patch median under abuse / idle: {abuse_patch / idle_patch:.2f} "
+          f"(os.cpu_count() = {os.cpu_count()}, 1-minute load average at the end "
+          f"{os.getloadavg()[0]:.1f})")
+
+
 async def main_async(args) -> None:
     with tempfile.TemporaryDirectory() as data:
         proc, host = _start_server(data)
@@ -280,12 +456,18 @@ def main() -> None:
         action="store_true",
         help="trainees only: no replays nor on-demand grades (a baseline)",
     )
+    ap.add_argument("--abuser", action="store_true",
+                    help="fairness: honest trainees alone, then beside one abuser")
+    ap.add_argument("--abuse-sockets", type=int, default=100)
+    ap.add_argument("--abuse-sessions", type=int, default=10)
+    ap.add_argument("--abuse-patchers", type=int, default=8)
     ap.add_argument(
         "--skip-first-view",
         action="store_true",
         help="no first-view times (the photos are still prepared before the load)",
     )
-    asyncio.run(main_async(ap.parse_args()))
+    args = ap.parse_args()
+    asyncio.run(abuse_async(args) if args.abuser else main_async(args))
 
 
 if __name__ == "__main__":

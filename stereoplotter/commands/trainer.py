@@ -25,7 +25,22 @@ def add_arguments(sub: Any) -> None:
         default=0,
         help="port (default: 0, a free port chosen by the system; the address is printed)",
     )
-    p.add_argument("--token", help="the instructor's token (default: a random one, printed)")
+    p.add_argument(
+        "--token",
+        help="the instructor's token (default: the one kept hashed in the data folder; made "
+        "and printed on the first start)",
+    )
+    p.add_argument(
+        "--rotate-token",
+        action="store_true",
+        help="make a new instructor token (printed once; the old one stops working)",
+    )
+    p.add_argument(
+        "--public-url",
+        metavar="URL",
+        help="the address trainees use behind a reverse proxy, e.g. https://class.example "
+        "(its Host and Origin accepted, X-Forwarded-* headers of a local proxy trusted)",
+    )
     p.add_argument(
         "--data-dir",
         metavar="DIR",
@@ -47,7 +62,8 @@ def run(args: argparse.Namespace) -> int:
         )
         return 1
     try:
-        serve(args.host, args.port, args.token, args.data_dir)
+        serve(args.host, args.port, args.token, args.data_dir, public_url=args.public_url,
+              rotate_token=args.rotate_token)
     except OSError as exc:
         print(
             f"error: trainer: cannot listen on {args.host}:{args.port} ({exc.strerror or exc})",

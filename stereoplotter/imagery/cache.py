@@ -14,6 +14,7 @@ Finished views are kept in a small LRU cache. Tile, level and view are pure func
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 
 import numpy as np
@@ -50,6 +51,7 @@ class ViewCache:
         self._tiles: dict[tuple[str, int, int, int], NDArray[np.uint8]] = {}
         self._whole: dict[tuple[str, int], PhotoRaster] = {}
         self._views: OrderedDict[tuple, NDArray[np.uint8]] = OrderedDict()
+        self._lock = threading.Lock()  # the views' LRU order; tiles are only ever added
         for side in self.sides:
             levels, p = [], pixel_mm
             while True:
@@ -63,6 +65,15 @@ class ViewCache:
                     raster = geo.empty_raster()
                     raster.image[:] = render_region(geo, 0, geo.size_px, 0, geo.size_px)
                     self._whole[(side, k)] = raster
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        del state["_lock"]
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._lock = threading.Lock()
 
     def prefetch(self, side: str, x_mm: float, y_mm: float, radius_mm: float = 3.0) -> int:
         """Render the finest level's tiles within ``radius_mm`` of photo point x, y [mm] ahead of
@@ -136,9 +147,10 @@ class ViewCache:
         """Eyepiece view as :func:`~stereoplotter.imagery.eyepiece.eyepiece_view` of the level
         for ``magnification`` (uint8, size_px × size_px)."""
         key = (side, float(x_mm), float(y_mm), float(kappa_rad), float(magnification), int(size_px))
-        if key in self._views:
-            self._views.move_to_end(key)
-            return self._views[key]
+        with self._lock:
+            if key in self._views:
+                self._views.move_to_end(key)
+                return self._views[key]
         check_view(magnification, size_px)
         if side not in self.levels:
             raise StereoplotterError(
@@ -162,7 +174,8 @@ class ViewCache:
             output=np.float32,
         )
         view = np.round(np.clip(out, 0, 255)).astype(np.uint8).reshape(size_px, size_px)
-        self._views[key] = view
-        if len(self._views) > _VIEWS_KEPT:
-            self._views.popitem(last=False)
+        with self._lock:
+            self._views[key] = view
+            if len(self._views) > _VIEWS_KEPT:
+                self._views.popitem(last=False)
         return view

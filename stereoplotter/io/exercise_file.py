@@ -43,6 +43,7 @@ from stereoplotter.trainer.exercise import (
 
 __all__ = [
     "RELIEF_CLASSES",
+    "TEXT_LIMITS",
     "TILT_TARGET_DEG",
     "AssistsModel",
     "ExerciseFile",
@@ -52,6 +53,9 @@ __all__ = [
     "write_exercise",
 ]
 
+#: Longest name, title and description of an exercise (a page shows them whole; the shipped
+#: ones are at most 30, 74 and 220). [characters]
+TEXT_LIMITS = {"name": 64, "title": 160, "description": 2_000}
 #: The largest |α|, |ω| of the photos in each tilt class (assumed: the book's "small tilts"
 #: of a few tenths of a degree up to about 2.5°, inside the ±3° correction range of the
 #: instruments after the frame rotation of the sheet). [degrees]
@@ -91,6 +95,14 @@ class ExerciseFile(FileModel):
     assists: AssistsModel = Field(default_factory=AssistsModel)
     mode: one_of(*MODES) = "practice"  # type: ignore[valid-type]
     seed: int | str = Field("per-trainee", description="an integer, or 'per-trainee'")
+
+    @field_validator("name", "title", "description")
+    @classmethod
+    def _short(cls, v: str, info: Any) -> str:
+        limit = TEXT_LIMITS[info.field_name]
+        if len(v) > limit:
+            raise ValueError(f"text of at most {limit} characters, found {len(v)}")
+        return v
 
     @field_validator("seed")
     @classmethod

@@ -17,6 +17,7 @@ import hashlib
 import hmac
 import json
 import os
+import secrets
 import sqlite3
 import threading
 import time
@@ -32,6 +33,7 @@ __all__ = [
     "default_data_dir",
     "exercise_upload",
     "secret_hash",
+    "storable",
 ]
 
 #: The database file inside the data folder.
@@ -66,6 +68,8 @@ CREATE TABLE IF NOT EXISTS grants (
     PRIMARY KEY (trainee_key, exercise)
 );
 CREATE TABLE IF NOT EXISTS exercises (name TEXT PRIMARY KEY, source TEXT NOT NULL, added REAL);
+CREATE TABLE IF NOT EXISTS retired (name TEXT PRIMARY KEY, retired REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS server_keys (name TEXT PRIMARY KEY, value TEXT NOT NULL);
 """
 
 _ROW = (
@@ -107,6 +111,16 @@ def exercise_upload(text: str) -> dict[str, Any]:
 
 def _dumps(value: Any) -> str:
     return json.dumps(value, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
+
+
+def storable(value: Any) -> bool:
+    """Whether ``value`` can be kept as a record: JSON without NaN or infinity whose text is
+    valid UTF-8 (a lone surrogate is not)."""
+    try:
+        _dumps(value).encode("utf-8")
+    except (TypeError, ValueError, RecursionError, UnicodeEncodeError):
+        return False
+    return True
 
 
 class SessionStore:
@@ -266,11 +280,70 @@ class SessionStore:
 
     # --- uploaded exercises -------------------------------------------------------------------
 
-    def add_exercise(self, name: str, source: dict[str, Any]) -> None:
-        self._run(
-            "INSERT OR REPLACE INTO exercises VALUES (?,?,?)", (name, _dumps(source), time.time())
-        )
+    def add_exercise(self, name: str, source: dict[str, Any]) -> bool:
+        """Keep an uploaded exercise under a name never used before (a retired upload's name
+        stays used: its sessions replay from their logs); returns whether it was added."""
+        with self._lock:
+            cur = self._db.cursor()
+            cur.execute("BEGIN IMMEDIATE")
+            try:
+                used = cur.execute("SELECT 1 FROM exercises WHERE name=?", (name,)).fetchone()
+                if used:
+                    cur.execute("ROLLBACK")
+                    return False
+                cur.execute(
+                    "INSERT INTO exercises VALUES (?,?,?)", (name, _dumps(source), time.time())
+                )
+                cur.execute("COMMIT")
+            except BaseException:
+                cur.execute("ROLLBACK")
+                raise
+        return True
 
-    def exercises(self) -> dict[str, dict[str, Any]]:
-        """Uploaded exercises: name → file content."""
-        return {n: json.loads(s) for n, s in self._run("SELECT name, source FROM exercises")}
+    def retire_exercise(self, name: str) -> bool:
+        """Take an uploaded exercise off the list of those offered (its content is kept, for its
+        sessions to resume and replay; its name stays used); whether it was offered."""
+        with self._lock:
+            cur = self._db.cursor()
+            cur.execute("BEGIN IMMEDIATE")
+            try:
+                found = cur.execute(
+                    "SELECT 1 FROM exercises WHERE name=? "
+                    "AND name NOT IN (SELECT name FROM retired)",
+                    (name,),
+                ).fetchone()
+                if found:
+                    cur.execute("INSERT INTO retired VALUES (?,?)", (name, time.time()))
+                cur.execute("COMMIT")
+            except BaseException:
+                cur.execute("ROLLBACK")
+                raise
+        return bool(found)
+
+    def exercises(self, retired: bool = False) -> dict[str, dict[str, Any]]:
+        """Uploaded exercises offered (``retired``: those retired instead): name → content."""
+        op = "IN" if retired else "NOT IN"
+        rows = self._run(
+            f"SELECT name, source FROM exercises WHERE name {op} (SELECT name FROM retired)"
+        )
+        return {n: json.loads(s) for n, s in rows}
+
+    # --- the server's own secrets ---------------------------------------------------------------
+
+    def server_key(self, name: str) -> bytes:
+        """A random 32-byte key of the server's, made on first use and kept in the store (the
+        data folder): e.g. what exam seeds are derived from. Never sent to a client."""
+        fresh = secrets.token_hex(32)
+        with self._lock:
+            self._db.execute("INSERT OR IGNORE INTO server_keys VALUES (?,?)", (name, fresh))
+            (value,) = self._db.execute(
+                "SELECT value FROM server_keys WHERE name=?", (name,)
+            ).fetchone()
+        return bytes.fromhex(value)
+
+    def get_value(self, name: str) -> str | None:
+        got = self._run("SELECT value FROM server_keys WHERE name=?", (name,))
+        return got[0][0] if got else None
+
+    def put_value(self, name: str, value: str) -> None:
+        self._run("INSERT OR REPLACE INTO server_keys VALUES (?,?)", (name, value))

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import hmac
 import json
 import math
 import time
@@ -66,6 +67,7 @@ __all__ = [
     "Session",
     "check_stage",
     "json_finite",
+    "secret_seed",
     "state_digest",
 ]
 
@@ -286,6 +288,14 @@ class Session:
                 "step": 1e-5,
             }
         return out
+
+    def control_range(self, name: str) -> tuple[float, float] | None:
+        """The values a control can be set to (its stops, as its scale reads), or None for a
+        control without stops. [the control's unit]"""
+        got = self._controls().get(name)
+        if got is None or got["min"] is None or got["max"] is None:
+            return None
+        return float(got["min"]), float(got["max"])
 
     def _marks(self) -> dict[str, Any] | None:
         """Where each mark stands on its photo; None before f_пр is set (no projection yet)."""
@@ -526,7 +536,7 @@ class Session:
             self._restore(self._redo.pop())
             return None
         if kind == "hint":
-            return self._hint(int(action["level"]))
+            return self._hint(int(action["level"]), animated=action.get("animated") is True)
         if kind in ("turn", "set") and action["control"] in self.locked:
             raise TrainerError(f"action {kind}: {action['control']} is locked")
         undoable = self.exercise.allows("undo") and kind != "read"
@@ -579,7 +589,10 @@ class Session:
             out["text"] = claim_text(step, out["measures"])
         return out
 
-    def _hint(self, level: int) -> dict[str, Any]:
+    def _hint(self, level: int, animated: bool = False) -> dict[str, Any]:
+        """A hint of the stage in hand. Level 3 with ``animated``: "show me" played by the page
+        (it sends the operator's actions itself, one by one): charged as level 3, nothing
+        applied here."""
         stage = self.stage
         assert stage is not None
         self.hints_used.append(level)
@@ -590,7 +603,9 @@ class Session:
         }
         # the operator's steps of the stage, each once, in the order first taken
         out["steps"] = list(dict.fromkeys(self.par.stage_steps(stage)))
-        if level == 3:  # show me: the simulated operator does the stage on this instrument
+        if level == 3 and animated:  # the page plays the actions: charged, not applied
+            out["animated"] = len(actions)
+        elif level == 3:  # show me: the simulated operator does the stage on this instrument
             for a in actions:
                 apply(self.inst, a, self.commanded)
             out["applied"] = len(actions)
@@ -620,6 +635,15 @@ class Session:
                     script.append({"kind": "record", "name": f"substitute {n}", "value": xy})
             script.append({"kind": "claim", "step": stage})
         return script
+
+
+def secret_seed(key: bytes, exercise: str, trainee: str, attempt: int) -> int:
+    """A trainee's seed known only to whoever holds ``key`` (the server's secret): HMAC-SHA-256
+    of exercise, trainee and attempt number, its first 8 bytes as a non-negative int below
+    2**63. Nothing public (the names) gives it: an exam cannot be answered offline."""
+    message = "\x00".join((exercise, trainee, str(int(attempt)))).encode("utf-8")
+    digest = hmac.new(key, message, hashlib.sha256).digest()
+    return int.from_bytes(digest[:8], "big") >> 1
 
 
 def _is_point(value: Any) -> bool:

@@ -9,9 +9,9 @@ Who may see what:
   of the stage for an animated "show me" where the exercise gives hints; its grade and log once
   every stage is claimed;
 - the instructor's token (``?token=`` or ``Authorization: Bearer``): every session's table,
-  grade, log and replay, the results CSV, an archive of the logs, extra exam attempts, and
-  uploading an exercise. The grade of an exam that is not finished is given to nobody (it
-  would read out the true outcome of stages not yet claimed).
+  grade, log and replay, the results CSV, an archive of the logs, extra exam attempts,
+  uploading an exercise and retiring an upload. The grade of an exam that is not finished is
+  given to nobody (it would read out the true outcome of stages not yet claimed).
 
 Every refusal is ``{"error": "one line"}`` with 400, 403, 404, 405 or 413 (:mod:`.guard`).
 """
@@ -19,10 +19,12 @@ Every refusal is ``{"error": "one line"}`` with 400, 403, 404, 405 or 413 (:mod:
 from __future__ import annotations
 
 import logging
+import os
 from concurrent.futures import Executor, ProcessPoolExecutor, ThreadPoolExecutor
 from contextlib import asynccontextmanager
 from importlib import resources
 from multiprocessing import get_context
+from urllib.parse import urlsplit
 
 from starlette.applications import Starlette
 from starlette.exceptions import HTTPException
@@ -35,10 +37,20 @@ from starlette.websockets import WebSocket
 
 from stereoplotter.io.session_store import SessionStore
 from stereoplotter.web import core, page_routes, routes
-from stereoplotter.web.guard import BURST, RATE, Guard, Refused, error, local_names
+from stereoplotter.web.guard import (
+    BURST,
+    RATE,
+    Guard,
+    Refused,
+    error,
+    local_names,
+    public_origin,
+    server_roots,
+)
 from stereoplotter.web.registry import Registry
 from stereoplotter.web.routes import START_LIMIT, Web
-from stereoplotter.web.sockets import instructor_socket, trainee_socket
+from stereoplotter.web.sockets import ADDRESS_LIMIT, instructor_socket, trainee_socket
+from stereoplotter.web.workers import watch_parent
 
 __all__ = ["create_app"]
 
@@ -58,7 +70,12 @@ def _page(name: str):
 
 def _executor(processes: bool) -> Executor:
     if processes:  # spawn: the server's threads are never forked
-        return ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"))
+        return ProcessPoolExecutor(
+            max_workers=1,
+            mp_context=get_context("spawn"),
+            initializer=watch_parent,
+            initargs=(os.getpid(),),
+        )
     return ThreadPoolExecutor(max_workers=1)
 
 
@@ -92,6 +109,7 @@ ROUTES = [
     Route("/api/instructor/replay/{sid}", routes.replay_states),
     Route("/api/instructor/grant", routes.grant, methods=["POST"]),
     Route("/api/instructor/exercises", routes.upload, methods=["POST"]),
+    Route("/api/instructor/exercises/{name}", routes.retire, methods=["DELETE"]),
     *page_routes.ROUTES,
     WebSocketRoute("/ws-instructor", _ws_instructor),
     WebSocketRoute("/ws/{sid}", _ws_trainee),
@@ -108,6 +126,8 @@ def create_app(
     hosts: tuple[str, ...] = (),
     start_limit: tuple[float, int] = START_LIMIT,
     message_limit: tuple[float, int] = (RATE, BURST),
+    address_limit: tuple[float, int] = ADDRESS_LIMIT,
+    public_url: str | None = None,
 ) -> Starlette:
     """The application.
 
@@ -117,12 +137,26 @@ def create_app(
     building every exercise's photos at start-up; ``hosts`` are names besides localhost, this
     machine's name and IP addresses that pages may use to reach the server; ``start_limit``
     the sessions a client address may start (a rate [1/s] and a burst); ``message_limit`` the
-    socket messages one page may send (a rate [1/s] and a burst; the page paces itself by it).
+    socket messages one session may send (a rate [1/s] and a burst; the page paces itself by
+    it), ``address_limit`` those of all sessions of one client address; ``public_url`` the
+    address trainees use behind a reverse proxy (``https://class.example``): its Host and
+    Origin are this server's. ``token`` None keeps the data folder's instructor token (its
+    hash), or makes one (``registry.new_token``, to print).
     """
+    public = public_origin(public_url)
+    if public is not None:
+        hosts = (*hosts, urlsplit(public).hostname or "")
     store = SessionStore(data_dir)
-    catalogue = core.Catalogue(store.exercises())
+    server_roots(data_dir)
+    catalogue = core.Catalogue(store.exercises(), store.exercises(retired=True))
     reg = Registry(
-        token, store, catalogue, _executor(processes), _executor(processes), message_limit
+        token,
+        store,
+        catalogue,
+        _executor(processes),
+        _executor(processes),
+        message_limit,
+        address_limit,
     )
     if prepare_photos:
         reg.prepare_photos()
@@ -137,11 +171,12 @@ def create_app(
             for proc in workers:
                 proc.terminate()
         reg.actor.shutdown(wait=True)
+        reg.patcher.shutdown(wait=True)
         store.close()
 
     app = Starlette(
         routes=ROUTES,
-        middleware=[Middleware(Guard, names=local_names(hosts))],
+        middleware=[Middleware(Guard, names=local_names(hosts), public=public)],
         exception_handlers={
             Refused: _refused,
             HTTPException: _http_error,

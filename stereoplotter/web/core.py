@@ -35,6 +35,7 @@ __all__ = [
     "SCREEN_PIXEL_MM",
     "Catalogue",
     "CoreError",
+    "NameInUse",
     "TrainerError",
     "action_catalogue",
     "build_view_cache",
@@ -74,21 +75,35 @@ UPLOAD_NAME = re.compile(r"[a-z0-9][a-z0-9_-]{0,63}")
 
 class Catalogue:
     """The exercises the server knows: the shipped ones (by name, read once) and those the
-    instructor uploaded (validated, kept in the store). Nothing else is ever opened."""
+    instructor uploaded (validated, kept in the store); a retired upload is offered no more
+    but still known to its sessions. Nothing else is ever opened."""
 
-    def __init__(self, uploaded: dict[str, dict[str, Any]] | None = None):
+    def __init__(
+        self,
+        uploaded: dict[str, dict[str, Any]] | None = None,
+        retired: dict[str, dict[str, Any]] | None = None,
+    ):
         self.by_name: dict[str, Exercise] = {}
+        self.retired: dict[str, Exercise] = {}
         self.shipped: set[str] = set()
         for path in shipped_exercises():
             ex = load_exercise(path)
             self.by_name[ex.name] = ex
             self.shipped.add(ex.name)
-        for name, source in (uploaded or {}).items():
-            if name not in self.by_name:
-                self.by_name[name] = exercise_from_mapping(source, f"uploaded exercise {name}")
+        for target, found in ((self.by_name, uploaded), (self.retired, retired)):
+            for name, source in (found or {}).items():
+                if name not in self.shipped:
+                    target[name] = exercise_from_mapping(source, f"uploaded exercise {name}")
 
     def get(self, name: Any) -> Exercise | None:
+        """An exercise offered (a session may start on it)."""
         return self.by_name.get(name) if isinstance(name, str) else None
+
+    def known(self, name: Any) -> Exercise | None:
+        """An exercise offered or retired (its sessions resume)."""
+        if not isinstance(name, str):
+            return None
+        return self.by_name.get(name) or self.retired.get(name)
 
     def listing(self) -> list[dict[str, Any]]:
         """The exercises, easiest first: name, title, level, mode, description."""
@@ -107,24 +122,66 @@ class Catalogue:
         ]
         return sorted(out, key=lambda e: (e["level"], e["name"]))
 
-    def add_upload(self, data: dict[str, Any]) -> Exercise:
+    def check_upload(self, data: dict[str, Any]) -> Exercise:
         """Validate an uploaded exercise's content: its name new and plain, its instrument and
-        scenario shipped names (never a path), the rest as an exercise file."""
+        scenario shipped names (never a path), the rest as an exercise file, an exam's seed the
+        server's, and a session can start on it. Does not add it (:meth:`add`)."""
         name = data.get("name")
         if not isinstance(name, str) or not UPLOAD_NAME.fullmatch(name):
-            raise CoreError("uploaded exercise: name: expected 1 to 64 of a-z, 0-9, '-', '_'")
+            raise CoreError(
+                "uploaded exercise: name: expected 1 to 64 of a-z, 0-9, '-', '_', "
+                f"found {_quote(name)}"
+            )
         if name in self.shipped:
-            raise CoreError(f"uploaded exercise: name: {name} is a shipped exercise")
+            raise NameInUse(f"uploaded exercise: name: {name} is a shipped exercise")
+        if name in self.by_name or name in self.retired:
+            raise NameInUse(
+                f"uploaded exercise: name: {name} is in use (its sessions replay from it): "
+                "upload under a new name"
+            )
         for kind, field in (("instruments", "instrument"), ("scenarios", "scenario")):
             value = data.get(field)
             if value not in available_names(kind):
                 raise CoreError(
                     f"uploaded exercise: {field}: expected one of "
-                    f"{', '.join(available_names(kind))}, found {str(value)[:40]!r}"
+                    f"{', '.join(available_names(kind))}, found {_quote(value)}"
                 )
         ex = exercise_from_mapping(data, "uploaded exercise")
-        self.by_name[name] = ex
+        if ex.mode == "exam" and ex.seed is not None:
+            raise CoreError(
+                "uploaded exercise: seed: an exam's seed is per-trainee (the server's own); "
+                f"a fixed seed is known to anyone who sees the file, found {ex.seed}"
+            )
+        try:  # every session starts as this one would (the operator's run on a seed)
+            Session.start(ex, trainee="upload check", seed=0 if ex.seed is None else None)
+        except StereoplotterError as exc:
+            raise CoreError(f"uploaded exercise: no session can start on it: {exc}") from None
+        except (ArithmeticError, ValueError) as exc:  # numpy's LinAlgError is a ValueError
+            raise CoreError(
+                f"uploaded exercise: no session can start on it ({type(exc).__name__}: {exc})"
+            ) from None
         return ex
+
+    def add(self, ex: Exercise) -> None:
+        self.by_name[ex.name] = ex
+
+    def retire(self, name: str) -> Exercise | None:
+        """Offer an uploaded exercise no more (its sessions still resume); the exercise, or
+        None when no upload of that name is offered."""
+        if name in self.shipped or name not in self.by_name:
+            return None
+        ex = self.by_name.pop(name)
+        self.retired[name] = ex
+        return ex
+
+
+class NameInUse(CoreError):
+    """An uploaded exercise's name is taken (answered 409)."""
+
+
+def _quote(value: Any, limit: int = 42) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
 def start(exercise: Exercise, trainee: str, seed: int | None = None) -> Session:
@@ -236,21 +293,53 @@ def sheet_of(exercise: Exercise) -> dict[str, Any]:
     return _jsonable(exercise_sheet(exercise))
 
 
+#: Grid of the overview's point positions where the parallax read-out is hidden (an exam, or
+#: practice with the read-out off): a glance finds a point to 0.5 mm, the eye sets the mark on
+#: it, and the exact images (which with the marks would give the parallax to 0.1 µm) are not
+#: sent. [mm]
+HIDDEN_GRID_MM = 0.5
+
+
 def overview_of(session: Session) -> dict[str, Any]:
-    """Both photos at a glance (``trainer.panel.overview``; run on the actor thread)."""
-    return _jsonable(overview(session))
+    """Both photos at a glance (``trainer.panel.overview``; run on the actor thread). Where
+    the parallax read-out is hidden, the points are given on a :data:`HIDDEN_GRID_MM` grid and
+    the fiducials as the camera's certificate gives them (not where they lie on the photo)."""
+    body = _jsonable(overview(session))
+    if session.exercise.allows("parallax_readout"):
+        return body
+    certificate = session.prep.scene.camera.fiducial_array_mm()
+    for photo in body["photos"].values():
+        for k, fid in enumerate(photo["fiducials"]):
+            fid["x_mm"], fid["y_mm"] = (float(v) for v in certificate[k])
+        for key in ("standard_points", "control_points", "check_points"):
+            for point in photo[key]:
+                for axis in ("x_mm", "y_mm"):
+                    point[axis] = _on_grid(point[axis])
+    return body
+
+
+def _on_grid(value: float | None) -> float | None:
+    if value is None:
+        return None
+    return round(round(value / HIDDEN_GRID_MM) * HIDDEN_GRID_MM, 3)
 
 
 def checklist_of(session: Session) -> dict[str, Any] | None:
     """The stage in hand's steps with their done flags (``trainer.panel.checklist``; the state
-    carries only the flags on every action; run on the actor thread)."""
-    return _jsonable(checklist(session))
+    carries only the flags on every action; run on the actor thread). Where the exercise gives
+    no hints, the steps do not name their controls (that is hint 2)."""
+    body = _jsonable(checklist(session))
+    if body is not None and not session.exercise.allows("hints"):
+        for step in body["steps"]:
+            step.pop("controls", None)
+    return body
 
 
-def show_me(session: Session) -> list[dict[str, Any]]:
-    """The simulated operator's actions of the stage in hand (what hint 3 applies at once), for
-    the page to play one by one at its chosen speed ("show me", animated)."""
-    return show_me_actions(session)
+def show_me(session: Session, stage: str | None = None) -> list[dict[str, Any]]:
+    """The simulated operator's actions of a stage (default: the stage in hand; what hint 3
+    applies at once), for the page to play one by one at its chosen speed ("show me",
+    animated)."""
+    return show_me_actions(session, stage)
 
 
 def action_catalogue() -> list[dict[str, Any]]:

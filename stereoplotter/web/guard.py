@@ -13,8 +13,11 @@ from __future__ import annotations
 import ipaddress
 import json
 import math
+import os
 import re
 import socket
+import sys
+import tempfile
 import time
 import unicodedata
 from typing import Any
@@ -38,8 +41,12 @@ __all__ = [
     "one_line",
     "origin_ok",
     "parse_message",
+    "public_origin",
+    "quote",
     "scrub_paths",
     "seed_value",
+    "server_roots",
+    "text_ok",
     "trainee_key",
     "trainee_name",
 ]
@@ -70,13 +77,43 @@ MAX_RECORDS = 64
 #: 30 notches a second; assumed ample for a person, small for a flood). [1/s], [messages]
 RATE, BURST = 60.0, 120
 
-_PATH = re.compile(r"(?:[A-Za-z]:)?[\w.\-~]*(?:[\\/][\w.\-~ ]+){2,}[\\/]?")
+#: Folders of this server whose paths an error text must not show (a refusal quoting what a
+#: client sent is never rewritten: only these prefixes are). Registered by the application.
+_SERVER_ROOTS: set[str] = set()
+
+
+def server_roots(*folders: Any) -> None:
+    """Add folders (the data folder, the package, the interpreter's) whose paths are shown by
+    their file names only."""
+    for f in folders:
+        if f:
+            text = str(f).rstrip("\\/")
+            if len(text) > 1:
+                _SERVER_ROOTS.add(text)
+
+
+def _default_roots() -> None:
+    import stereoplotter
+
+    here = os.path.dirname(os.path.dirname(os.path.abspath(stereoplotter.__file__)))
+    server_roots(here, sys.prefix, sys.base_prefix, os.path.expanduser("~"), os.getcwd(),
+                 tempfile.gettempdir())
+
+
+_default_roots()
+
+
+def _path_pattern() -> re.Pattern:
+    roots = sorted(_SERVER_ROOTS, key=len, reverse=True)
+    alts = "|".join(re.escape(r) for r in roots)
+    return re.compile(rf"(?:{alts})(?:[\\/][^\s'\"]*)?")
 
 
 def _file_name(match: re.Match) -> str:
     """A server path as the name of its file only (``…/instruments/sc1.yaml`` → ``file
     sc1.yaml``): what it names stays readable, where it lies is not shown."""
-    return "file " + re.split(r"[\\/]", match.group(0).rstrip("\\/").strip())[-1]
+    name = re.split(r"[\\/]", match.group(0).rstrip("\\/").strip())[-1]
+    return f"file {name}" if name else "a server folder"
 
 
 class Refused(Exception):
@@ -88,17 +125,36 @@ class Refused(Exception):
 
 
 def one_line(text: object) -> str:
-    """``text`` as one line, each server path replaced by its file's name, at most 300
-    characters."""
+    """``text`` as one line, each path into a server folder replaced by its file's name (what
+    a client sent is quoted as sent), at most 300 characters, valid UTF-8 (a lone surrogate
+    quoted from a client shows as U+FFFD)."""
     s = " ".join(str(text).split())
-    s = _PATH.sub(_file_name, s)
+    s = _path_pattern().sub(_file_name, s)
+    s = s.encode("utf-8", "replace").decode("utf-8")
     return s if len(s) <= 300 else s[:299] + "…"
+
+
+def quote(value: Any, limit: int = 40) -> str:
+    """What a client sent, quoted for an error text: its repr, shortened to ``limit``."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def text_ok(value: Any) -> bool:
+    """Whether ``value`` is text that can be stored: valid UTF-8 (no lone surrogate)."""
+    if not isinstance(value, str):
+        return False
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 def scrub_paths(value: Any) -> Any:
     """``value`` (JSON-like) with every server path in its text replaced by its file's name."""
     if isinstance(value, str):
-        return _PATH.sub(_file_name, value)
+        return _path_pattern().sub(_file_name, value)
     if isinstance(value, dict):
         return {k: scrub_paths(v) for k, v in value.items()}
     if isinstance(value, list):
@@ -121,7 +177,8 @@ def _hostname(host: str) -> str:
     host = host.strip().lower()
     if host.startswith("["):
         return host[1:].split("]", 1)[0]
-    return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+    name = host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+    return name[:-1] if name.endswith(".") else name  # the root's dot: localhost. is localhost
 
 
 def _is_ip(name: str) -> bool:
@@ -136,7 +193,7 @@ def local_names(extra: tuple[str, ...] = ()) -> frozenset[str]:
     """Names a page may reach this server by (an IP address always may): localhost, this
     machine's host name (and ``.local``), and ``extra`` (the ``--host`` given)."""
     me = socket.gethostname().lower()
-    return frozenset({"localhost", me, f"{me}.local", *(e.lower() for e in extra)})
+    return frozenset({"localhost", me, f"{me}.local", *(e.lower().rstrip(".") for e in extra)})
 
 
 def host_ok(host: str | None, names: frozenset[str]) -> bool:
@@ -148,27 +205,59 @@ def host_ok(host: str | None, names: frozenset[str]) -> bool:
     return _is_ip(name) or name in names
 
 
-def origin_ok(headers: Headers) -> bool:
+def public_origin(url: str | None) -> str | None:
+    """The origin (``scheme://host[:port]``, lower case) of the address trainees use when the
+    server runs behind a reverse proxy (``--public-url``); ValueError for anything else."""
+    if not url:
+        return None
+    parts = urlsplit(url.strip())
+    if parts.scheme not in ("http", "https") or not parts.hostname:
+        raise ValueError(f"public URL: expected http(s)://host[:port], found {quote(url)}")
+    default = {"http": 80, "https": 443}[parts.scheme]
+    port = f":{parts.port}" if parts.port and parts.port != default else ""
+    host = f"[{parts.hostname}]" if ":" in parts.hostname else parts.hostname
+    return f"{parts.scheme}://{host.rstrip('.')}{port}".lower()
+
+
+def _same_host(a: str, b: str) -> bool:
+    """Two Host/netloc values naming the same host and port (a trailing dot ignored)."""
+    def norm(v: str) -> str:
+        v = v.strip().lower()
+        name, _, port = v.rpartition(":") if v.count(":") == 1 else (v, "", "")
+        return f"{name.rstrip('.')}:{port}" if name else v.rstrip(".")
+
+    return norm(a) == norm(b)
+
+
+def origin_ok(headers: Headers, public: str | None = None) -> bool:
     """A browser's request from this server's own pages: the Origin, when sent, has the
-    request's Host (scheme http or https). A client that sends no Origin is not a browser
-    page (it cannot be made to act for someone else) and passes."""
+    request's Host (scheme http or https), or is the public origin the server is reached by
+    behind a reverse proxy (``public``; the proxy may rewrite Host, never the Origin). When the
+    proxy says which scheme the page used (``X-Forwarded-Proto``), the Origin's must be it. A
+    client that sends no Origin is not a browser page (it cannot be made to act for someone
+    else) and passes."""
     origin = headers.get("origin")
     if origin is None:
         return True
     parts = urlsplit(origin)
-    return (
-        parts.scheme in ("http", "https")
-        and parts.netloc.lower() == (headers.get("host") or "").lower()
-    )
+    if parts.scheme not in ("http", "https"):
+        return False
+    if public is not None and origin.strip().lower().rstrip("/") == public:
+        return True
+    proto = headers.get("x-forwarded-proto")
+    if proto is not None and proto.split(",")[0].strip().lower() != parts.scheme:
+        return False
+    return _same_host(parts.netloc, headers.get("host") or "")
 
 
 class Guard:
     """ASGI middleware: Host check (HTTP and WebSocket), Origin check on state-changing
     requests, and the security headers on every response."""
 
-    def __init__(self, app, names: frozenset[str]):
+    def __init__(self, app, names: frozenset[str], public: str | None = None):
         self.app = app
         self.names = names
+        self.public = public
 
     async def __call__(self, scope, receive, send):
         if scope["type"] not in ("http", "websocket"):
@@ -183,10 +272,10 @@ class Guard:
                 "unknown Host: use this server's address or an IP address",
             )
         if scope["type"] == "websocket":
-            if not origin_ok(headers):
+            if not origin_ok(headers, self.public):
                 return await self._refuse(scope, receive, send, 403, "wrong Origin")
             return await self.app(scope, receive, send)
-        if scope["method"] not in ("GET", "HEAD") and not origin_ok(headers):
+        if scope["method"] not in ("GET", "HEAD") and not origin_ok(headers, self.public):
             return await self._refuse(scope, receive, send, 403, "wrong Origin")
 
         async def send_with_headers(message):
@@ -248,12 +337,39 @@ def trainee_name(value: Any) -> str:
         raise Refused(400, f"trainee: expected 1 to {MAX_NAME} characters, found {len(name)}")
     if any(unicodedata.category(c)[0] == "C" for c in name):
         raise Refused(400, "trainee: expected printable characters")
+    if not trainee_key(name):
+        raise Refused(400, "trainee: expected visible characters")
     return name
 
 
+#: Characters no one sees that are not default-ignorable in Unicode's own list (they render
+#: as blank space): the Hangul fillers and the braille blank.
+_BLANKS = dict.fromkeys(map(ord, "\u115f\u1160\u3164\uffa0\u2800"))
+
+
+def _visible(text: str) -> str:
+    """``text`` less its default-ignorable code points (Unicode's
+    Default_Ignorable_Code_Point: format characters, variation selectors, U+034F, …) and the
+    blank-rendering fillers."""
+    return "".join(
+        c for c in text.translate(_BLANKS)
+        if unicodedata.category(c) != "Cf"
+        and not 0xFE00 <= ord(c) <= 0xFE0F
+        and not 0xE0100 <= ord(c) <= 0xE01EF
+        and c != "\u034f"
+    )
+
+
 def trainee_key(name: str) -> str:
-    """The name an exam attempt is counted under (case and compatibility forms folded)."""
-    return unicodedata.normalize("NFKC", name).casefold()
+    """The name an exam attempt is counted under: two names a reader cannot tell apart get the
+    same key. NFKC (compatibility forms: fullwidth, ligatures), case fold, default-ignorable
+    and invisible characters removed, spaces collapsed, then the Unicode TR 39 confusable
+    skeleton (``disarm.skeleton_key``: Cyrillic а is Latin a)."""
+    from disarm import skeleton_key  # the trainer extra: imported where names are compared
+
+    text = _visible(unicodedata.normalize("NFKC", name).casefold())
+    text = " ".join(text.split())
+    return skeleton_key(text)
 
 
 def seed_value(value: Any) -> int | None:
@@ -261,7 +377,7 @@ def seed_value(value: Any) -> int | None:
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < 2**63:
-        raise Refused(400, f"seed: expected an integer from 0 to 2^63 - 1, found {value!r:.40}")
+        raise Refused(400, f"seed: expected an integer from 0 to 2^63 - 1, found {quote(value)}")
     return value
 
 
@@ -286,7 +402,7 @@ def parse_message(text: Any) -> dict[str, Any]:
         raise Refused(400, f"message: expected a JSON object, found {type(msg).__name__}")
     extra = set(msg) - _MESSAGE_KEYS
     if extra:
-        raise Refused(400, f"message: unknown field {sorted(extra)[0]!r:.40}")
+        raise Refused(400, f"message: unknown field {quote(sorted(extra)[0])}")
     seq = msg.get("seq")
     if seq is not None and (
         isinstance(seq, bool) or not isinstance(seq, int) or not 0 <= seq < 2**53
@@ -295,14 +411,20 @@ def parse_message(text: Any) -> dict[str, Any]:
     return msg
 
 
+#: Largest number any field of an action may hold (a scale denominator M_в of a few
+#: thousand, readings of a few hundred mm; the control's own range is checked when the action
+#: is carried out). Beyond it, or not finite: refused before anything counts.
+MAX_NUMBER = 1e7
+
+
 def _scalar(value: Any) -> bool:
+    if isinstance(value, bool) or value is None:
+        return True
+    if isinstance(value, int):  # a huge integer overflows a float: compared as an integer
+        return abs(value) <= MAX_NUMBER
     if isinstance(value, float):
-        return math.isfinite(value)
-    return (
-        value is None
-        or isinstance(value, (bool, int))
-        or (isinstance(value, str) and len(value) <= 64)
-    )
+        return math.isfinite(value) and abs(value) <= MAX_NUMBER
+    return isinstance(value, str) and len(value) <= 64 and text_ok(value)
 
 
 def clean_action(action: Any, records: dict[str, Any]) -> dict[str, Any]:
@@ -313,13 +435,16 @@ def clean_action(action: Any, records: dict[str, Any]) -> dict[str, Any]:
         raise Refused(400, "action: expected a JSON object with a kind")
     kind = action.get("kind")
     if not isinstance(kind, str) or kind not in ACTION_FIELDS:
-        raise Refused(400, f"action kind: expected one of {', '.join(ACTION_FIELDS)}")
+        raise Refused(
+            400, f"action kind: expected one of {', '.join(ACTION_FIELDS)}, found {quote(kind)}"
+        )
     allowed = {"kind", *ACTION_FIELDS[kind], *_OPTIONAL}
     extra = set(action) - allowed
     if extra:
         raise Refused(
             400,
-            f"action {kind}: unknown field {sorted(extra)[0]!r:.40} (the time t is the server's)",
+            f"action {kind}: unknown field {quote(sorted(map(str, extra))[0])} "
+            "(the time t is the server's)",
         )
     for key, value in action.items():
         if kind == "record" and key == "value":
@@ -338,11 +463,12 @@ def clean_action(action: Any, records: dict[str, Any]) -> dict[str, Any]:
         if not ok:
             raise Refused(
                 400,
-                f"action {kind}: {key}: expected a number, short text or a short list of numbers",
+                f"action {kind}: {key}: expected a number within ±{MAX_NUMBER:g}, short text "
+                f"(UTF-8) or a short list of numbers, found {quote(value)}",
             )
     if kind == "record":
         name = action.get("name")
-        if not isinstance(name, str) or not 1 <= len(name) <= 64:
+        if not isinstance(name, str) or not 1 <= len(name) <= 64 or not text_ok(name):
             raise Refused(400, "action record: name: expected text of 1 to 64 characters")
         if name not in records and len(records) >= MAX_RECORDS:
             raise Refused(400, f"action record: at most {MAX_RECORDS} names per session")

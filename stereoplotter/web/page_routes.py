@@ -27,7 +27,7 @@ from stereoplotter.trainer.navigation import goto_actions
 from stereoplotter.trainer.step_words import CONTROL_NAMES, SHEET_NAMES, glossary
 from stereoplotter.trainer.tour import tour_of
 from stereoplotter.web.guard import Refused
-from stereoplotter.web.routes import _instructor_only, _own_or_instructor, _web
+from stereoplotter.web.routes import instructor_only, own_or_instructor, web_of
 
 __all__ = ["ROUTES"]
 
@@ -41,8 +41,8 @@ async def glossary_json(request: Request) -> Response:
 
 
 async def _live(request: Request):
-    sid, row = _own_or_instructor(request)  # the credential before anything else is looked at
-    reg = _web(request).reg
+    sid, row = own_or_instructor(request)  # the credential before anything else is looked at
+    reg = web_of(request).reg
     live = await run_in_threadpool(reg.resume, sid)
     return reg, live, row
 
@@ -79,7 +79,7 @@ async def goto(request: Request) -> Response:
     """The X, Y settings that put the left mark on a point (``?point=3``, a standard point or a
     control point's id) or on a place of the left photo (``?x=…&y=…`` mm): the page sends them
     as the trainee's actions."""
-    _own_or_instructor(request)
+    own_or_instructor(request)
     q = request.query_params
     point = q.get("point")
     xy = None
@@ -117,7 +117,7 @@ async def feedback(request: Request) -> Response:
     """A stage's checks and the likely wrong setting (practice only): ``?stage=now`` the stage
     in hand on the instrument as it stands (before claiming), ``?stage=last`` the last stage
     claimed, on the instrument as it stood at its claim."""
-    _own_or_instructor(request)
+    own_or_instructor(request)
     which = request.query_params.get("stage", "last")
     if which not in ("now", "last"):
         raise Refused(400, "feedback: stage: expected now or last")
@@ -146,8 +146,8 @@ def _acuity_of(records: list[dict[str, Any]]) -> dict[str, float]:
 async def class_acuity(request: Request) -> Response:
     """The instructor's view of the class's stereo acuities: per session the trainee's measured
     thresholds (recorded by the page's acuity test in the session log). [arc-seconds]"""
-    _instructor_only(request)
-    reg = _web(request).reg
+    instructor_only(request)
+    reg = web_of(request).reg
 
     def collect() -> list[dict[str, Any]]:
         rows = []

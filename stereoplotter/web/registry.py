@@ -16,21 +16,62 @@ computed once, when its last stage is claimed, and kept in the store.
 
 from __future__ import annotations
 
+import hashlib
+import hmac
+import logging
 import secrets
 import threading
 import time
-from concurrent.futures import Executor, Future, ThreadPoolExecutor
+from concurrent.futures import Executor, Future
 from dataclasses import dataclass, field
 from typing import Any
 
-from stereoplotter.io.session_store import SessionStore
+from stereoplotter.io.session_store import SessionStore, storable
+from stereoplotter.trainer.session import secret_seed
 from stereoplotter.web import core
-from stereoplotter.web.guard import BURST, RATE, Refused, trainee_key
+from stereoplotter.web.fair import FairPool
+from stereoplotter.web.guard import (
+    BURST,
+    RATE,
+    RateLimit,
+    Refused,
+    quote,
+    text_ok,
+    trainee_key,
+)
 
-__all__ = ["MAX_ACTIONS", "Live", "Registry"]
+__all__ = ["MAX_ACTIONS", "RANGE_SLACK", "Live", "Registry", "token_hash"]
 
-#: Actions a session may hold (a full setup takes about 600; assumed: ten times that).
+log = logging.getLogger(__name__)
+
+#: Actions a session may hold (a full setup takes about 1 400 with the exact operator;
+#: assumed: several times that).
 MAX_ACTIONS = 6_000
+#: The store's entries: the key exam seeds derive from, the instructor token's hash.
+SEED_KEY, TOKEN_HASH = "exam-seed-key", "instructor-token-sha256"
+#: A set value may lie this share of the control's travel beyond a stop (a page rounds to the
+#: least count; the instrument clips at the stop itself). [—]
+RANGE_SLACK = 0.01
+#: Photo patches a session may ask for (the page asks one when the mark leaves the patch it
+#: has: a few a second while driving fast; assumed ample), and all sessions of one client
+#: address together (a class of 40 behind one address). [1/s], [patches]
+PATCH_LIMIT = (10.0, 30)
+PATCH_ADDRESS_LIMIT = (200.0, 400)
+#: Worker threads of the fair pools (actions; photo patches). One patch thread: a render holds
+#: the interpreter's lock for most of its 0.1–0.3 s, and two renders at once only share it (an
+#: honest trainee's patch would wait for one render and then run beside another). [threads]
+ACTORS, PATCHERS = 2, 1
+#: Sockets a session may open (a page reconnects after a dropped network or a reload): a rate
+#: and a burst; beyond, a socket is closed (4429) before any work is done for it. [1/s], [—]
+CONNECT_LIMIT = (1.0, 5)
+#: Sockets one client address may open, checked before the socket is accepted (a class of 40
+#: behind one address reconnecting after a restart has room). [1/s], [—]
+ADDRESS_CONNECT_LIMIT = (20.0, 80)
+
+
+def token_hash(token: str) -> str:
+    """SHA-256 (hex) of the instructor's token: what the data folder keeps."""
+    return hashlib.sha256(token.encode("utf-8", "replace")).hexdigest()
 
 
 @dataclass
@@ -47,6 +88,16 @@ class Live:
     demo_next: int = 0
     last_error: str | None = None
     lock: threading.Lock = field(default_factory=threading.Lock)
+    #: The session's one live socket (a newer one replaces it), and the owner its jobs are
+    #: queued under in the fair pools (the client address).
+    socket: Any = None
+    address: str = "?"
+    #: Messages the session may send, whichever socket it uses (``guard.RateLimit``).
+    limit: Any = None
+    #: Sockets the session may open (``CONNECT_LIMIT``).
+    connects: Any = None
+    #: Its last action could not be stored: the store's log is the session; reconnect.
+    broken: bool = False
 
 
 class Registry:
@@ -60,16 +111,35 @@ class Registry:
         grader: Executor,
         imager: Executor,
         message_limit: tuple[float, int] = (RATE, BURST),
+        address_limit: tuple[float, int] = (1_200.0, 2_400),
     ):
-        self.token = token or secrets.token_urlsafe(16)
         self.store = store
+        #: A token made now (printed once by the server), or None when the stored one is kept.
+        self.new_token: str | None = None
+        if token is not None:
+            self._token_hash = token_hash(token)
+        else:
+            kept = store.get_value(TOKEN_HASH) if store.path is not None else None
+            if kept is None:
+                self.rotate_token()
+            else:
+                self._token_hash = kept
         self.catalogue = catalogue
         self.grader = grader
         self.imager = imager
         #: Socket messages one page may send: a rate [1/s] and a burst (``guard.RATE``, ``BURST``).
         self.message_limit = message_limit
-        #: The thread that carries out every session's actions, one at a time.
-        self.actor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="trainer-actor")
+        #: Socket messages all sessions of one client address may send (``sockets``).
+        self.address_limit = address_limit
+        self.address_limits: dict[str, Any] = {}
+        self.patch_limits: dict[tuple[str, str], RateLimit] = {}
+        self.connect_limits: dict[str, RateLimit] = {}
+        #: The threads that carry out the sessions' actions (round-robin by client address and
+        #: session: a flood from one client does not queue the others behind it), and render
+        #: photo patches.
+        self.actor = FairPool(ACTORS, "trainer-actor")
+        self.patcher = FairPool(PATCHERS, "trainer-patch")
+        self._seed_key = store.server_key(SEED_KEY)
         self.rows: dict[str, dict[str, Any]] = {r["id"]: r for r in store.sessions()}
         self.grades: dict[str, dict[str, Any]] = store.grades()
         self.live: dict[str, Live] = {}
@@ -77,11 +147,58 @@ class Registry:
         self.version = 0
         self._grading: dict[str, Future] = {}
         self._photos: dict[tuple, Future] = {}
-        self.photo_locks: dict[tuple, threading.Lock] = {}
         self._resume_lock = threading.Lock()
         for sid, row in self.rows.items():  # finished before a restart, not yet graded
             if row["done"] and sid not in self.grades:
                 self._grade_later(sid)
+
+    # --- the instructor's token ---------------------------------------------------------------
+
+    def rotate_token(self) -> str:
+        """A new instructor token: its hash replaces the kept one (the old token stops working);
+        returned once, to be printed."""
+        token = secrets.token_urlsafe(24)
+        self._token_hash = token_hash(token)
+        if self.store.path is not None:
+            self.store.put_value(TOKEN_HASH, self._token_hash)
+        self.new_token = token
+        return token
+
+    def is_instructor(self, given: Any) -> bool:
+        """Whether ``given`` is the instructor's token (compared by hash, in constant time)."""
+        if not isinstance(given, str) or not 1 <= len(given) <= 200:
+            return False
+        return hmac.compare_digest(token_hash(given), self._token_hash)
+
+    def patch_allowed(self, sid: str, address: str) -> bool:
+        """Whether a session and its client address may have another photo patch now
+        (:data:`PATCH_LIMIT` each session, :data:`PATCH_ADDRESS_LIMIT` each address)."""
+        if len(self.patch_limits) > 20_000:
+            self.patch_limits.clear()
+        mine = self.patch_limits.setdefault(("s", sid), RateLimit(*PATCH_LIMIT))
+        theirs = self.patch_limits.setdefault(("a", address), RateLimit(*PATCH_ADDRESS_LIMIT))
+        return mine.allow() and theirs.allow()
+
+    def connect_allowed(self, address: str) -> bool:
+        """Whether a client address may open another socket now (``ADDRESS_CONNECT_LIMIT``)."""
+        if len(self.connect_limits) > 10_000:
+            self.connect_limits.clear()
+        bucket = self.connect_limits.setdefault(address, RateLimit(*ADDRESS_CONNECT_LIMIT))
+        return bucket.allow()
+
+    def run(self, pool: FairPool, address: str, session: str, fn, *args) -> Future:
+        """``fn(*args)`` on a fair pool, queued under the client address and the session."""
+        return pool.submit(address, session, fn, *args)
+
+    def read(self, live: Live, address: str, fn, *args) -> Future:
+        """``fn(*args)`` reading the session on the actor pool, never while an action changes
+        it (the session's lock: a page and the instructor may ask from two addresses)."""
+
+        def locked():
+            with live.lock:
+                return fn(*args)
+
+        return self.run(self.actor, address, live.id, locked)
 
     # --- starting -----------------------------------------------------------------------------
 
@@ -91,7 +208,7 @@ class Registry:
         """A new session (run in a worker thread); returns it and its secret."""
         ex = self.catalogue.get(exercise)
         if ex is None:
-            raise Refused(404, f"exercise: no exercise named {str(exercise)[:64]!r}")
+            raise Refused(404, f"exercise: no exercise named {quote(exercise, 66)}")
         key = trainee_key(trainee)
         exam = ex.mode == "exam"
         if exam and seed is not None:
@@ -106,6 +223,8 @@ class Registry:
                     f"exam {ex.name}: {trainee} has had the attempt allowed; "
                     "the instructor may grant another",
                 )
+            # the server's own seed: nothing public (the names) gives it
+            seed = secret_seed(self._seed_key, ex.name, key, used)
         session = core.start(ex, trainee, seed)
         live = Live(
             id=secrets.token_hex(8),
@@ -147,7 +266,7 @@ class Registry:
     def check(self, sid: str, secret: Any) -> bool:
         """Whether ``secret`` is session ``sid``'s own."""
         return (
-            isinstance(secret, str)
+            text_ok(secret)
             and len(secret) < 200
             and sid in self.rows
             and self.store.check_secret(sid, secret)
@@ -164,8 +283,8 @@ class Registry:
             records = self.store.records(sid)
             row = self.rows[sid]
             head = records[0]
-            ex = self.catalogue.get(head.get("exercise_name"))
-            session = core.Session.replay(records, ex)
+            ex = self.catalogue.known(head.get("exercise_name"))
+            session = core.replay(records) if ex is None else core.Session.replay(records, ex)
             live = Live(
                 id=sid,
                 exercise=row["exercise"],
@@ -184,11 +303,21 @@ class Registry:
     # --- acting -------------------------------------------------------------------------------
 
     def act(self, live: Live, action: dict[str, Any]) -> dict[str, Any]:
-        """Carry out one action at the server's time (worker thread); the page's message."""
+        """Carry out one action at the server's time (worker thread); the page's message.
+
+        An action that could not be stored (text that is not UTF-8, a number beyond its
+        control's stops) is refused before it counts; if the store fails, the session in
+        memory is dropped and resumes from the store's log (nothing counts that is not kept).
+        """
         with live.lock:
             session = live.session
+            if live.broken:
+                return {"error": "this session must be resumed: reconnect"}
             if len(session.log) >= MAX_ACTIONS:
                 return {"error": f"this session holds its {MAX_ACTIONS} actions: start a new one"}
+            refusal = _unstorable(session, action)
+            if refusal is not None:
+                return {"state": session.state(), "error": refusal}
             was_done = session.stage is None
             before = len(session.log)
             timed = dict(action, t=round(time.time() - live.started, 3))
@@ -202,7 +331,13 @@ class Registry:
             record = session.log[-1] if len(session.log) > before else None
             if record is not None:
                 done = session.stage is None
-                self.store.append_action(live.id, record, session.stage, done)
+                try:
+                    self.store.append_action(live.id, record, session.stage, done)
+                except Exception as exc:  # not kept: not counted either
+                    log.warning("session %s: action not stored (%s)", live.id, type(exc).__name__)
+                    self.live.pop(live.id, None)
+                    live.broken = True
+                    return {"error": "this action could not be kept: reconnect to resume"}
                 row = self.rows[live.id]
                 row.update(stage=session.stage, done=done, actions=len(session.log))
                 self.version += 1
@@ -266,7 +401,6 @@ class Registry:
         if fut is None:
             fut = self.imager.submit(core.build_view_cache, exercise.source)
             self._photos[key] = fut
-            self.photo_locks[key] = threading.Lock()  # a ViewCache is not thread-safe
         return fut
 
     def prepare_photos(self) -> None:
@@ -302,3 +436,24 @@ class Registry:
                 )
             out.append(row)
         return out
+
+
+def _unstorable(session: Any, action: dict[str, Any]) -> str | None:
+    """Why an action may not count (one line), or None: its record could not be stored, or a
+    set value or turn lies beyond what its control's stops allow."""
+    if not storable(action):
+        return f"action {action.get('kind')}: expected UTF-8 text and finite numbers"
+    kind, control = action.get("kind"), action.get("control")
+    if kind not in ("set", "turn") or not isinstance(control, str):
+        return None
+    rng = session.control_range(control)
+    number = action.get("value" if kind == "set" else "delta")
+    if rng is None or not isinstance(number, (int, float)):
+        return None
+    lo, hi = rng
+    slack = RANGE_SLACK * (hi - lo)
+    if kind == "set" and not lo - slack <= number <= hi + slack:
+        return f"action set: {control}: expected a value from {lo:g} to {hi:g}, found {number:g}"
+    if kind == "turn" and abs(number) > (hi - lo) + slack:
+        return f"action turn: {control}: expected a delta within ±{hi - lo:g}, found {number:g}"
+    return None

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import asyncio
 import csv
-import hmac
 import io
 import json
 import math
@@ -23,7 +22,7 @@ from starlette.concurrency import run_in_threadpool
 from starlette.requests import HTTPConnection, Request
 from starlette.responses import JSONResponse, Response
 
-from stereoplotter.io.session_store import exercise_upload
+from stereoplotter.io.session_store import exercise_upload, storable
 from stereoplotter.web import core
 from stereoplotter.web.guard import (
     RateLimit,
@@ -36,7 +35,7 @@ from stereoplotter.web.guard import (
     trainee_name,
 )
 from stereoplotter.web.registry import Registry
-from stereoplotter.web.sockets import PATCH_PX
+from stereoplotter.web.sockets import PATCH_PX, address_of
 
 __all__ = [
     "CSV_FIELDS",
@@ -46,7 +45,10 @@ __all__ = [
     "Web",
     "archive",
     "bearer",
+    "instructor_only",
+    "own_or_instructor",
     "results_csv_text",
+    "web_of",
 ]
 
 #: The results table the instructor downloads (one row per session).
@@ -87,7 +89,7 @@ class Web:
     sheets: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
-def _web(conn: HTTPConnection) -> Web:
+def web_of(conn: HTTPConnection) -> Web:
     return conn.app.state.web
 
 
@@ -97,29 +99,27 @@ def bearer(conn: HTTPConnection) -> str | None:
 
 
 def _is_instructor(request: Request) -> bool:
-    given = request.query_params.get("token") or bearer(request)
-    token = _web(request).reg.token
-    return isinstance(given, str) and hmac.compare_digest(given.encode(), token.encode())
+    return web_of(request).reg.is_instructor(request.query_params.get("token") or bearer(request))
 
 
-def _instructor_only(request: Request) -> None:
+def instructor_only(request: Request) -> None:
     if not _is_instructor(request):
         raise Refused(403, "instructor token required")
 
 
 def _session_row(request: Request) -> tuple[str, dict[str, Any]]:
     sid = request.path_params["sid"]
-    rows = _web(request).reg.rows
+    rows = web_of(request).reg.rows
     if sid not in rows:
         raise Refused(404, "no such session")
     return sid, rows[sid]
 
 
-def _own_or_instructor(request: Request) -> tuple[str, dict[str, Any]]:
+def own_or_instructor(request: Request) -> tuple[str, dict[str, Any]]:
     """The session of the request, which holds its key or the instructor's token."""
     sid, row = _session_row(request)
     key = request.query_params.get("key") or bearer(request)
-    if not (_is_instructor(request) or _web(request).reg.check(sid, key)):
+    if not (_is_instructor(request) or web_of(request).reg.check(sid, key)):
         raise Refused(403, "this session's key is required")
     return sid, row
 
@@ -129,17 +129,17 @@ def _may_read(request: Request, sid: str, row: dict[str, Any]) -> None:
     if _is_instructor(request):
         return
     key = request.query_params.get("key") or bearer(request)
-    if not _web(request).reg.check(sid, key):
+    if not web_of(request).reg.check(sid, key):
         raise Refused(403, "this session's key or the instructor's token is required")
     if not row["done"]:
         raise Refused(403, "the grade and the log are given when every stage is claimed")
 
 
 def _start_allowed(request: Request) -> None:
-    web = _web(request)
+    web = web_of(request)
     if len(web.starts) > 10_000:  # forget old addresses rather than grow without bound
         web.starts.clear()
-    addr = request.client.host if request.client else "?"
+    addr = address_of(request)
     if not web.starts.setdefault(addr, RateLimit(*web.start_limit)).allow():
         raise Refused(429, "too many sessions started from this address: wait a moment")
 
@@ -156,7 +156,7 @@ def _attachment(body: bytes | str, media: str, name: str) -> Response:
 
 
 async def exercises(request: Request) -> Response:
-    return JSONResponse(_web(request).catalogue.listing())
+    return JSONResponse(web_of(request).catalogue.listing())
 
 
 async def new_session(request: Request) -> Response:
@@ -171,18 +171,18 @@ async def new_session(request: Request) -> Response:
     if not isinstance(demo, bool):
         raise Refused(400, "demonstration: expected true or false")
     live, secret = await run_in_threadpool(
-        _web(request).reg.start, exercise, trainee, seed=seed, demonstration=demo
+        web_of(request).reg.start, exercise, trainee, seed=seed, demonstration=demo
     )
     return JSONResponse({"id": live.id, "secret": secret}, headers=_NO_STORE)
 
 
 async def sheet(request: Request) -> Response:
     """The exercise's setup sheet (the data the trainee works from), for the sheet panel."""
-    _, row = _own_or_instructor(request)
-    web = _web(request)
+    _, row = own_or_instructor(request)
+    web = web_of(request)
     name = row["exercise"]
     if name not in web.sheets:
-        ex = web.catalogue.get(name)
+        ex = web.catalogue.known(name)
         if ex is None:  # an uploaded exercise of an earlier store, not known now
             raise Refused(404, "exercise: no longer known to this server")
         web.sheets[name] = scrub_paths(await run_in_threadpool(core.sheet_of, ex))
@@ -191,36 +191,50 @@ async def sheet(request: Request) -> Response:
 
 async def overview(request: Request) -> Response:
     """Both photos at a glance: fiducials, standard, control and check points, the marks."""
-    sid, _ = _own_or_instructor(request)
-    reg = _web(request).reg
+    sid, _ = own_or_instructor(request)
+    reg = web_of(request).reg
     live = await run_in_threadpool(reg.resume, sid)
-    body = await asyncio.get_running_loop().run_in_executor(
-        reg.actor, core.overview_of, live.session
+    body = await asyncio.wrap_future(
+        reg.read(live, address_of(request), core.overview_of, live.session)
     )
     return JSONResponse(body, headers=_NO_STORE)
 
 
 async def checklist(request: Request) -> Response:
     """The steps of the stage in hand (their texts; the state ticks them on every action)."""
-    sid, _ = _own_or_instructor(request)
-    reg = _web(request).reg
+    sid, _ = own_or_instructor(request)
+    reg = web_of(request).reg
     live = await run_in_threadpool(reg.resume, sid)
-    loop = asyncio.get_running_loop()
-    body = await loop.run_in_executor(reg.actor, core.checklist_of, live.session)
+    body = await asyncio.wrap_future(
+        reg.read(live, address_of(request), core.checklist_of, live.session)
+    )
     return JSONResponse(body, headers=_NO_STORE)
 
 
 async def show_me(request: Request) -> Response:
-    """The operator's actions of the stage in hand, for an animated "show me" (hint 3): given
-    only where the exercise allows hints, never in a demonstration."""
-    sid, row = _own_or_instructor(request)
-    reg = _web(request).reg
+    """The operator's actions of the stage in hand, for an animated "show me": charged as the
+    hint of level 3 it is (logged before the actions are given, so it shows on the grade);
+    given only where the exercise allows hints, never in a demonstration."""
+    sid, row = own_or_instructor(request)
+    reg = web_of(request).reg
     live = await run_in_threadpool(reg.resume, sid)
     if live.demonstration or not live.session.exercise.allows("hints") or row["mode"] == "exam":
         raise Refused(403, "show me: this exercise gives no hints")
-    loop = asyncio.get_running_loop()
-    actions = await loop.run_in_executor(reg.actor, core.show_me, live.session)
-    return JSONResponse({"stage": live.session.stage, "actions": actions}, headers=_NO_STORE)
+
+    def charge_and_show() -> tuple[dict[str, Any], list[dict[str, Any]]]:
+        stage = live.session.stage
+        reply = reg.act(live, {"kind": "hint", "level": 3, "animated": True})
+        return reply, ([] if reply.get("error") else core.show_me(live.session, stage))
+
+    reply, actions = await asyncio.wrap_future(
+        reg.run(reg.actor, address_of(request), sid, charge_and_show)
+    )
+    if reply.get("error"):
+        raise Refused(409, f"show me: {reply['error']}")
+    return JSONResponse(
+        {"stage": live.session.stage, "actions": actions, "charged": {"hint": 3}},
+        headers=_NO_STORE,
+    )
 
 
 async def _grade(request: Request) -> tuple[dict[str, Any], dict[str, Any]]:
@@ -228,7 +242,7 @@ async def _grade(request: Request) -> tuple[dict[str, Any], dict[str, Any]]:
     _may_read(request, sid, row)
     if row["mode"] == "exam" and not row["done"]:
         raise Refused(403, "an exam is graded when every stage is claimed")
-    return row, await asyncio.wrap_future(_web(request).reg.grade(sid))
+    return row, await asyncio.wrap_future(web_of(request).reg.grade(sid))
 
 
 async def grade_json(request: Request) -> Response:
@@ -244,23 +258,24 @@ async def grade_md(request: Request) -> Response:
 async def log_jsonl(request: Request) -> Response:
     sid, row = _session_row(request)
     _may_read(request, sid, row)
-    body = core.log_bytes(_web(request).reg.store.records(sid))
+    body = core.log_bytes(web_of(request).reg.store.records(sid))
     return _attachment(body, "application/x-ndjson", f"session-{sid}.jsonl")
 
 
 async def patch_png(request: Request) -> Response:
-    _, row = _own_or_instructor(request)
+    _, row = own_or_instructor(request)
     side, x, y, mag, size = _patch_query(request)
-    web = _web(request)
-    ex = web.catalogue.get(row["exercise"])
+    web = web_of(request)
+    ex = web.catalogue.known(row["exercise"])
+    if ex is None:
+        raise Refused(404, "exercise: no longer known to this server")
+    if not web.reg.patch_allowed(row["id"], address_of(request)):
+        raise Refused(429, "too many photo patches: wait a moment")
     cache = await asyncio.wrap_future(web.reg.photos(ex))
-    lock = web.reg.photo_locks[core.photo_key(ex)]
-
-    def render() -> bytes:
-        with lock:
-            return core.photo_patch(cache, side, x, y, mag, size)
-
-    png = await run_in_threadpool(render)
+    png = await asyncio.wrap_future(
+        web.reg.run(web.reg.patcher, address_of(request), row["id"], core.photo_patch,
+                    cache, side, x, y, mag, size)
+    )
     return Response(png, media_type="image/png", headers={"Cache-Control": "private, max-age=3600"})
 
 
@@ -291,34 +306,34 @@ def _patch_query(request: Request) -> tuple[str, float, float, float, int]:
 
 
 async def live_sessions(request: Request) -> Response:
-    _instructor_only(request)
-    return JSONResponse(_web(request).reg.table(), headers=_NO_STORE)
+    instructor_only(request)
+    return JSONResponse(web_of(request).reg.table(), headers=_NO_STORE)
 
 
 async def results_csv(request: Request) -> Response:
-    _instructor_only(request)
-    body = results_csv_text(_web(request).reg.table())
+    instructor_only(request)
+    body = results_csv_text(web_of(request).reg.table())
     return _attachment(body, "text/csv; charset=utf-8", "results.csv")
 
 
 async def archive_zip(request: Request) -> Response:
-    _instructor_only(request)
-    data = await run_in_threadpool(archive, _web(request).reg)
+    instructor_only(request)
+    data = await run_in_threadpool(archive, web_of(request).reg)
     return _attachment(data, "application/zip", "class.zip")
 
 
 async def replay_states(request: Request) -> Response:
-    _instructor_only(request)
+    instructor_only(request)
     sid, _ = _session_row(request)
-    body = await asyncio.wrap_future(_web(request).reg.replay_json(sid))
+    body = await asyncio.wrap_future(web_of(request).reg.replay_json(sid))
     return Response(body, media_type="application/json", headers=_NO_STORE)
 
 
 async def grant(request: Request) -> Response:
-    _instructor_only(request)
+    instructor_only(request)
     body = await read_json(request)
     trainee = trainee_name(body.get("trainee"))
-    web = _web(request)
+    web = web_of(request)
     ex = web.catalogue.get(body.get("exercise"))
     if ex is None:
         raise Refused(404, "exercise: no such exercise")
@@ -327,24 +342,47 @@ async def grant(request: Request) -> Response:
 
 
 async def upload(request: Request) -> Response:
-    _instructor_only(request)
+    instructor_only(request)
     raw = await read_body(request)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
         raise Refused(400, "uploaded exercise: expected UTF-8 text") from None
-    web = _web(request)
+    web = web_of(request)
 
     def check() -> Any:
         data = exercise_upload(text)
-        ex = web.catalogue.add_upload(data)
-        web.reg.store.add_exercise(ex.name, data)
+        if not storable(data):
+            raise Refused(400, "uploaded exercise: expected UTF-8 text (no lone surrogate)")
+        ex = web.catalogue.check_upload(data)
+        if not web.reg.store.add_exercise(ex.name, data):  # another upload took the name
+            raise core.NameInUse(f"uploaded exercise: name: {ex.name} is in use")
+        web.catalogue.add(ex)
         web.reg.photos(ex)
         return ex
 
-    ex = await run_in_threadpool(check)
+    try:
+        ex = await run_in_threadpool(check)
+    except core.NameInUse as exc:
+        raise Refused(409, str(exc)) from None
     web.reg.version += 1
     return JSONResponse({"name": ex.name, "title": ex.title})
+
+
+async def retire(request: Request) -> Response:
+    """Offer an uploaded exercise no more (``DELETE /api/instructor/exercises/NAME``): new
+    sessions are refused; its sessions still resume, and its name stays used."""
+    instructor_only(request)
+    name = request.path_params["name"]
+    web = web_of(request)
+    if name in web.catalogue.shipped:
+        raise Refused(403, f"exercise {name}: a shipped exercise cannot be retired")
+    ex = web.catalogue.retire(name)
+    if ex is None:
+        raise Refused(404, f"exercise: no uploaded exercise named {name[:66]!r} is offered")
+    await run_in_threadpool(web.reg.store.retire_exercise, name)
+    web.reg.version += 1
+    return JSONResponse({"name": name, "retired": True})
 
 
 # --- exports ----------------------------------------------------------------------------------

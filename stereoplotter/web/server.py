@@ -11,8 +11,9 @@ import uvicorn
 
 from stereoplotter.io.session_store import SessionStore, default_data_dir
 from stereoplotter.web.app import create_app
+from stereoplotter.web.guard import public_origin
 
-__all__ = ["listen", "serve"]
+__all__ = ["listen", "serve", "uvicorn_config"]
 
 
 def listen(host: str = "127.0.0.1", port: int = 0) -> socket.socket:
@@ -38,10 +39,17 @@ WS_MAX_SIZE = 4 * 1024 * 1024
 
 
 def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
-          data_dir: str | None = None) -> None:
+          data_dir: str | None = None, *, public_url: str | None = None,
+          rotate_token: bool = False, trusted_proxies: str = "127.0.0.1") -> None:
     """Serve until interrupted; prints the trainee and instructor addresses with the port
-    actually bound (the instructor's token is random unless given) and the data folder.
-    Sessions, logs and grades are kept in ``data_dir`` (default: the per-user folder)."""
+    actually bound and the data folder. Sessions, logs, grades, the exam-seed key and the
+    instructor token's hash are kept in ``data_dir`` (default: the per-user folder).
+
+    The instructor token: ``token`` when given; else the one kept (hashed) in the data folder,
+    printed only when it is made (the first start, or ``rotate_token``: a new one replaces
+    it). ``public_url``: the address trainees use behind a reverse proxy (its Host, Origin and
+    X-Forwarded-Proto accepted; the client's address taken from X-Forwarded-For when the
+    proxy is one of ``trusted_proxies``)."""
     folder = Path(data_dir) if data_dir else default_data_dir()
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -52,15 +60,41 @@ def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
     if token is not None and len(token) < 16:
         print("warning: trainer: --token is shorter than 16 characters: easy to guess",
               file=sys.stderr)
+    try:
+        public_origin(public_url)
+    except ValueError as exc:
+        print(f"error: trainer: --public-url: {exc}", file=sys.stderr)
+        raise SystemExit(1) from None
     sock = listen(host, port)
     bound = sock.getsockname()[1]
     names = (host,) if host not in ("0.0.0.0", "::", "") else ()
-    app = create_app(token, folder, processes=True, prepare_photos=True, hosts=names)
+    app = create_app(token, folder, processes=True, prepare_photos=True, hosts=names,
+                     public_url=public_url)
     reg = app.state.registry
+    if rotate_token and token is None:
+        reg.rotate_token()
     shown = "localhost" if host in ("127.0.0.1", "0.0.0.0") else host
     shown = f"[{shown}]" if ":" in shown else shown
-    print(f"trainee page:    http://{shown}:{bound}/", flush=True)
-    print(f"instructor page: http://{shown}:{bound}/instructor?token={reg.token}", flush=True)
+    base = public_url.rstrip("/") if public_url else f"http://{shown}:{bound}"
+    print(f"trainee page:    {base}/", flush=True)
+    if token is not None or reg.new_token is not None:
+        print(f"instructor page: {base}/instructor?token={token or reg.new_token}", flush=True)
+    else:
+        print(f"instructor page: {base}/instructor?token=… (the token printed when it was made; "
+              "a new one: --rotate-token)", flush=True)
     print(f"data folder:     {folder}", flush=True)
-    config = uvicorn.Config(app, log_level="warning", ws_max_size=WS_MAX_SIZE)
-    uvicorn.Server(config).run(sockets=[sock])
+    uvicorn.Server(uvicorn_config(app, public_url, trusted_proxies)).run(sockets=[sock])
+
+
+def uvicorn_config(app, public_url: str | None = None,
+                   trusted_proxies: str = "127.0.0.1") -> uvicorn.Config:
+    """The server's uvicorn settings: behind a reverse proxy (``public_url``) the client's
+    address and scheme are the X-Forwarded-For and X-Forwarded-Proto of a proxy connecting
+    from ``trusted_proxies`` (the per-address limits then count trainees, not the proxy)."""
+    return uvicorn.Config(
+        app,
+        log_level="warning",
+        ws_max_size=WS_MAX_SIZE,
+        proxy_headers=public_url is not None,
+        forwarded_allow_ips=trusted_proxies,
+    )

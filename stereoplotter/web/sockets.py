@@ -9,6 +9,11 @@ frame also carries ``"hello"``. A malformed, oversized or too frequent message g
 ``{"error": "one line"}`` and the socket stays open. A page that reconnects (a dropped
 network, a restarted server) sends its secret again and resumes where the log ends.
 
+One live socket per session: a newer one (the page reloaded, or opened twice) replaces the
+older, which is closed with code 4409. Messages are limited per session (however many sockets
+it opens one after the other) and per client address (:data:`ADDRESS_LIMIT`: a class behind
+one address has room), and carried out on the registry's fair pool.
+
 Instructor socket: first ``{"auth": TOKEN}``; the server then pushes ``{"sessions": [...]}``
 whenever a row changes (an action, a new session, a stored grade), at most every
 :data:`PUSH_S` seconds. Nothing is regraded for it: rows carry the grade stored at the end.
@@ -17,7 +22,6 @@ whenever a row changes (an action, a new session, a stored grade), at most every
 from __future__ import annotations
 
 import asyncio
-import hmac
 import json
 import logging
 from typing import Any
@@ -34,7 +38,7 @@ from stereoplotter.web.guard import (
     parse_message,
     scrub_paths,
 )
-from stereoplotter.web.registry import Registry
+from stereoplotter.web.registry import CONNECT_LIMIT, Registry
 
 __all__ = ["AUTH_TIMEOUT_S", "PUSH_S", "instructor_socket", "trainee_socket"]
 
@@ -46,6 +50,23 @@ AUTH_TIMEOUT_S = 10.0
 PUSH_S = 0.5
 #: Patch side the page composites from [px]: three eyepiece fields (256 px) across.
 PATCH_PX = 768
+#: Socket messages all sessions of one client address may send together: a sustained rate and
+#: a burst (assumed: a class of 40 behind one address acting at once). [1/s], [messages]
+ADDRESS_LIMIT = (1_200.0, 2_400)
+#: Addresses whose limits are remembered (beyond: forgotten, rather than grow without bound).
+MAX_ADDRESSES = 10_000
+
+
+def address_of(conn) -> str:
+    """The client's address (the proxy's X-Forwarded-For where the server trusts it: uvicorn's
+    proxy headers)."""
+    return conn.client.host if conn.client else "?"
+
+
+def address_limit(reg: Registry, address: str, table: dict[str, RateLimit]) -> RateLimit:
+    if len(table) > MAX_ADDRESSES:
+        table.clear()
+    return table.setdefault(address, RateLimit(*reg.address_limit))
 
 
 def _dump(body: dict[str, Any]) -> str:
@@ -71,6 +92,9 @@ async def _refuse(websocket: WebSocket, text: str, code: int = 4403) -> None:
 
 async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     sid = websocket.path_params["sid"]
+    if not reg.connect_allowed(address_of(websocket)):  # refused before any work (HTTP 403)
+        await websocket.close(4429)
+        return
     await websocket.accept()
     secret = await _auth(websocket)
     if sid not in reg.rows or not reg.check(sid, secret):
@@ -82,6 +106,11 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     except Exception as exc:  # a log that no longer replays: refused in one line, logged
         log.warning("session %s does not resume: %s", sid, exc)
         return await _refuse(websocket, "this session cannot be resumed", 4500)
+    if live.connects is None:
+        live.connects = RateLimit(*CONNECT_LIMIT)
+    if not live.connects.allow():
+        return await _refuse(websocket, "too many connections of this session: wait a moment",
+                             4429)
     ex = live.session.exercise
     hello = {
         "exercise": live.exercise,
@@ -97,39 +126,61 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         "rate": list(reg.message_limit),
         "mode": ex.mode,
     }
-    state = await _on_actor(reg, live.session.state)  # not while an action changes it
+    address = address_of(websocket)
+    live.address = address
+    # not while an action changes it
+    state = await asyncio.wrap_future(reg.read(live, address, live.session.state))
     hello = scrub_paths(hello)
-    limit = RateLimit(*reg.message_limit)
+    older, live.socket = live.socket, websocket
+    if older is not None:  # one live socket per session: the newer one replaces it
+        try:
+            await older.close(4409)
+        except (RuntimeError, OSError, WebSocketDisconnect):
+            pass
+    if live.limit is None:
+        live.limit = RateLimit(*reg.message_limit)
+    limits = (live.limit, address_limit(reg, address, reg.address_limits))
     try:
         await websocket.send_text(
             _dump({"hello": hello, "state": state, "error": None, "n": len(live.session.log)})
         )
         while True:
             message = await websocket.receive()
-            if message["type"] == "websocket.disconnect":
+            if message["type"] == "websocket.disconnect" or live.socket is not websocket:
                 return
-            reply = await _answer(reg, live, message, limit)
+            reply = await _answer(reg, live, message, limits)
             if reply.get("error"):  # an instrument's refusal may name a file: never shown
                 reply["error"] = one_line(reply["error"])
             reply["n"] = len(live.session.log)
             await websocket.send_text(_dump(reply))
-    except (WebSocketDisconnect, OSError):  # the page went away (uvicorn: ClientDisconnected)
+            if live.broken:  # not stored: the page reconnects and resumes from the store
+                await websocket.close(4503)
+                return
+    except (WebSocketDisconnect, OSError, RuntimeError):  # the page went away, or replaced
         return
+    finally:
+        if live.socket is websocket:
+            live.socket = None
 
 
-async def _answer(reg: Registry, live, message: dict[str, Any], limit: RateLimit) -> dict:
+async def _answer(reg: Registry, live, message: dict[str, Any], limits) -> dict:
     """The reply to one message: the new state, or one line of refusal."""
     seq = None
     try:
-        if not limit.allow():
-            raise Refused(429, "too many messages: at most 60 a second")
+        session_limit, address_limit_ = limits
+        if not session_limit.allow():
+            raise Refused(
+                429, f"too many messages: at most {session_limit.rate:g} a second a session"
+            )
+        if not address_limit_.allow():
+            raise Refused(429, "too many messages from this address: wait a moment")
         msg = parse_message(message.get("text"))
         seq = msg.get("seq")
         if msg.get("demo") == "step" and live.demonstration:
-            reply = await _on_actor(reg, reg.demo_step, live)
+            reply = await _on_actor(reg, live, reg.demo_step, live)
         elif "action" in msg and not live.demonstration:
             action = clean_action(msg["action"], live.session.records)
-            reply = await _on_actor(reg, reg.act, live, action)
+            reply = await _on_actor(reg, live, reg.act, live, action)
         elif "action" in msg:
             raise Refused(400, "a demonstration takes demonstration steps, not actions")
         else:
@@ -144,17 +195,16 @@ async def _answer(reg: Registry, live, message: dict[str, Any], limit: RateLimit
     return reply
 
 
-async def _on_actor(reg: Registry, fn, *args):
-    """Run an action on the registry's one actor thread: actions of all sessions one after the
-    other (first come, first served) instead of threads that share the interpreter's lock and
-    all finish late together."""
-    return await asyncio.get_running_loop().run_in_executor(reg.actor, fn, *args)
+async def _on_actor(reg: Registry, live, fn, *args):
+    """Run an action on the registry's fair pool of actor threads, queued under the session's
+    client address and the session (a flood from one client waits behind itself)."""
+    return await asyncio.wrap_future(reg.run(reg.actor, live.address, live.id, fn, *args))
 
 
 async def instructor_socket(websocket: WebSocket, reg: Registry) -> None:
     await websocket.accept()
     token = await _auth(websocket)
-    if not isinstance(token, str) or not hmac.compare_digest(token.encode(), reg.token.encode()):
+    if not reg.is_instructor(token):
         return await _refuse(websocket, "instructor token required")
     seen = -1
     try:

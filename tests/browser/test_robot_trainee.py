@@ -21,7 +21,10 @@ from playwright.sync_api import Error as PlaywrightError
 
 from stereoplotter.io.exercise_file import exercise_from_mapping, load_exercise, shipped_exercises
 from stereoplotter.trainer.grading import grade
+from stereoplotter.trainer.robot import robot_script
+from stereoplotter.trainer.session import Session
 from stereoplotter.web.core import GRADE_POPULATION
+from tests.browser.conftest import TOKEN
 from tests.browser.robot import Hands, script_for
 
 SHIPPED = shipped_exercises()
@@ -92,6 +95,10 @@ def test_robot_trainee_completes_the_exercise_through_the_page(
     page.wait_for_selector("body[data-ready='1']")
     page.wait_for_selector("body[data-overview='1']")
     sid = page.url.rsplit("/", 1)[1]
+    if ex.mode == "exam":  # the seed is the server's own: the instructor reads it in the log
+        head = json.loads(_get(page, f"{server}/api/sessions/{sid}/log.jsonl?token={TOKEN}",
+                               TOKEN).splitlines()[0])
+        script = robot_script(Session.start(ex, trainee=TRAINEE, seed=head["seed"]))
     hands = Hands(page)
     for action in script:
         hands.do(action)

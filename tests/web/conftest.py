@@ -68,3 +68,27 @@ def claim_all(client, sid, secret):
         assert reply["error"] is None and reply["state"]["done"], reply
     finally:
         ws.__exit__(None, None, None)
+
+
+_PHOTOS: dict[str, object] = {}
+_PHOTOS_LOCK = __import__("threading").Lock()
+
+
+@pytest.fixture(autouse=True, scope="session")
+def photos_built_once():
+    """Every test server of the run shares the photos of an exercise, built once (a build is
+    seconds of CPU; the tests' servers are many)."""
+    from stereoplotter.web import core
+
+    build = core.build_view_cache
+
+    def shared(source):
+        key = json.dumps(source, sort_keys=True, default=str)
+        with _PHOTOS_LOCK:
+            if key not in _PHOTOS:
+                _PHOTOS[key] = build(source)
+            return _PHOTOS[key]
+
+    core.build_view_cache = shared
+    yield
+    core.build_view_cache = build

@@ -56,7 +56,7 @@ def _one_line_error(r):
 def test_every_route_answers_bad_requests_with_one_line(client):
     sid, secret = start(client, trainee="walker")
     _, other_secret = start(client, trainee="another walker")
-    paths = {"sid": sid}
+    paths = {"sid": sid, "name": "no-such-upload"}
     routes = [r for r in client.app.routes if isinstance(r, Route)]
     seen = set()
     for route in routes:
@@ -193,8 +193,12 @@ def test_a_stops_refusal_names_the_file_not_its_path(client):
     ws, conn, hello = open_socket(client, sid, secret)
     try:
         assert [t for t in _texts(hello) if SERVER_PATH.search(t)] == []
-        reply = ask(conn, {"action": {"kind": "set", "control": "Z", "value": 1e4}, "seq": 1})
+        z = hello["state"]["controls"]["Z"]
+        beyond = z["max"] + 0.005 * (z["max"] - z["min"])  # past the stop, within the slack
+        reply = ask(conn, {"action": {"kind": "set", "control": "Z", "value": beyond}, "seq": 1})
         assert "refused" in reply["error"] and not SERVER_PATH.search(reply["error"]), reply
+        reply = ask(conn, {"action": {"kind": "set", "control": "Z", "value": 1e4}, "seq": 2})
+        assert "expected a value from" in reply["error"] and reply["n"] == 1, reply
         kinds = {a["kind"] for a in hello["hello"]["actions"]}
         assert {"record", "connect", "slip", "needle", "lock", "gear"} <= kinds
     finally:

@@ -339,8 +339,8 @@ $("command").addEventListener("keydown", (e) => {
 
 let playing = null, showing = null;
 // "Show me", animated: the operator's actions of the stage sent one by one at the chosen speed
-// (the eyepieces, wheels and counters move as they go), then hint 3 logged (its cost; it
-// applies the same settings again, which the instrument already shows).
+// (the eyepieces, wheels and counters move as they go); the server charged it as hint 3 when it
+// handed out the actions.
 $("show-me").onclick = () => {
   if (showing) { clearInterval(showing); showing = null; $("show-me").textContent = "Show me"; return; }
   confirmBox(`Show me: the simulated operator does stage ${state.stage} on your instrument, one action at a time `
@@ -357,7 +357,6 @@ async function showMe() {
   showing = setInterval(() => {
     if (i >= actions.length) {
       clearInterval(showing); showing = null; $("show-me").textContent = "Show me";
-      send({ kind: "hint", level: 3 });
       return;
     }
     const a = actions[i++];

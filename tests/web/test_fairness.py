@@ -1,0 +1,151 @@
+"""Fair under abuse: one live socket per session, message limits per session and per address,
+work served round-robin by client (a flood waits behind itself), photo patches rendered
+without one shared lock and limited per session. Speeds are measured in
+``benchmarks/bench_trainer_load.py``; here the rules themselves are tried."""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+
+import numpy as np
+import pytest
+from starlette.websockets import WebSocketDisconnect
+
+from stereoplotter.web import registry
+from stereoplotter.web.app import create_app
+from stereoplotter.web.fair import FairPool
+from tests.web.conftest import PRACTICE, TOKEN, ask, make_test_client, open_socket, start
+
+
+def test_a_second_socket_replaces_the_first(tmp_path):
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        sid, secret = start(c, PRACTICE, trainee="twice")
+        ws1, conn1, _ = open_socket(c, sid, secret)
+        ws2, conn2, _ = open_socket(c, sid, secret)
+        try:
+            with pytest.raises(WebSocketDisconnect) as closed:  # closed before the hello of 2
+                conn1.send_text(json.dumps({"action": {"kind": "read", "counter": "X"}}))
+                conn1.receive_text()
+            assert closed.value.code == 4409
+            assert ask(conn2, {"action": {"kind": "read", "counter": "X"}})["error"] is None
+        finally:
+            ws2.__exit__(None, None, None)
+            ws1.__exit__(None, None, None)
+
+
+def test_the_message_limit_is_the_sessions_and_the_addresses(tmp_path):
+    app = create_app(TOKEN, tmp_path, hosts=("testserver",), message_limit=(0.01, 5),
+                     address_limit=(0.01, 8))
+    read = {"action": {"kind": "read", "counter": "X"}}
+    with make_test_client(app) as c:
+        sid, secret = start(c, PRACTICE, trainee="limited")
+        ws, conn, _ = open_socket(c, sid, secret)
+        errors = [ask(conn, read)["error"] for _ in range(5)]
+        ws.__exit__(None, None, None)
+        assert errors == [None] * 5
+        ws, conn, _ = open_socket(c, sid, secret)  # a new socket is no new allowance
+        try:
+            assert "too many messages" in ask(conn, read)["error"]
+        finally:
+            ws.__exit__(None, None, None)
+        other, other_secret = start(c, PRACTICE, trainee="same address")
+        ws, conn, _ = open_socket(c, other, other_secret)
+        try:  # the address has sent 5 of its 8 (a refused message counts for neither)
+            errors = [ask(conn, read)["error"] for _ in range(4)]
+        finally:
+            ws.__exit__(None, None, None)
+        assert errors[:3] == [None] * 3 and "from this address" in errors[3], errors
+
+
+def test_work_is_served_round_robin_by_address():
+    """One worker; an abuser queues 40 jobs from 10 sessions, then a trainee queues one: the
+    trainee's job runs second (after the job already running), not 41st."""
+    pool = FairPool(1, "test")
+    order: list[str] = []
+    gate = threading.Event()
+
+    def job(name: str) -> str:
+        gate.wait(5)
+        order.append(name)
+        time.sleep(0.001)
+        return name
+
+    try:
+        futures = [pool.submit("10.0.0.66", f"s{k % 10}", job, f"abuse{k}") for k in range(40)]
+        time.sleep(0.05)  # the first abuse job has started and waits at the gate
+        honest = pool.submit("10.0.0.7", "mine", job, "honest")
+        gate.set()
+        assert honest.result(5) == "honest"
+        for f in futures:
+            f.result(5)
+    finally:
+        pool.shutdown()
+    assert order.index("honest") <= 1, order[:5]
+    # a session's jobs keep their order
+    abuse = [int(n[5:]) for n in order if n.startswith("abuse")]
+    for s in range(10):
+        mine = [k for k in abuse if k % 10 == s]
+        assert mine == sorted(mine)
+
+
+def test_patches_render_in_parallel_and_are_limited_per_session(tmp_path, monkeypatch):
+    monkeypatch.setattr(registry, "PATCH_LIMIT", (0.01, 5))  # a slow machine refills no token
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        sid, secret = start(c, PRACTICE, trainee="patcher")
+        reg = c.app.state.registry
+        ex = reg.catalogue.get(PRACTICE)
+        cache = reg.photos(ex).result(120)
+        assert not hasattr(reg, "photo_locks")
+        spots = [("left", x, 1.0, 6.0) for x in np.linspace(-5, 5, 12)]
+        serial = [cache.view(side, x, y, 0.0, mag, 128).tobytes() for side, x, y, mag in spots]
+        cache._views.clear()
+        got: dict[int, bytes] = {}
+
+        def render(k: int) -> None:
+            side, x, y, mag = spots[k]
+            got[k] = cache.view(side, x, y, 0.0, mag, 128).tobytes()
+
+        threads = [threading.Thread(target=render, args=(k,)) for k in range(len(spots))]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert [got[k] for k in range(len(spots))] == serial
+        q = {"side": "left", "y": 0, "mag": 0.625, "size": 16, "key": secret}
+        answers = [c.get(f"/api/sessions/{sid}/patch.png", params={**q, "x": k / 10})
+                   for k in range(7)]
+        assert [r.status_code for r in answers] == [200] * 5 + [429] * 2
+        assert answers[-1].json()["error"].startswith("too many photo patches")
+        other, other_secret = start(c, PRACTICE, trainee="patcher 2")  # its own allowance
+        r = c.get(f"/api/sessions/{other}/patch.png", params={**q, "x": 0, "key": other_secret})
+        assert r.status_code == 200
+
+
+def test_a_session_opens_only_so_many_sockets(tmp_path):
+    """Sockets replacing one another in a loop would cost the server a hello each: beyond a
+    burst of 5 (then one a second) a session's new socket is closed before any work."""
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        sid, secret = start(c, PRACTICE, trainee="reconnecting")
+        hellos = []
+        for _ in range(7):
+            with c.websocket_connect(f"/ws/{sid}") as conn:
+                conn.send_text(json.dumps({"auth": secret}))
+                hellos.append(json.loads(conn.receive_text()))
+        assert all("hello" in h for h in hellos[:5]), hellos[:5]
+        assert "too many connections" in hellos[6]["error"], hellos[6]
+
+
+def test_an_address_opens_only_so_many_sockets(tmp_path, monkeypatch):
+    monkeypatch.setattr(registry, "ADDRESS_CONNECT_LIMIT", (0.01, 3))
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        sid, secret = start(c, PRACTICE, trainee="churn")
+        for _ in range(3):
+            ws, _, hello = open_socket(c, sid, secret)
+            ws.__exit__(None, None, None)
+            assert "hello" in hello
+        with pytest.raises(WebSocketDisconnect) as refused:
+            with c.websocket_connect(f"/ws/{sid}") as conn:
+                conn.receive_text()
+        assert refused.value.code == 4429
