@@ -5,7 +5,7 @@ Who may see what (as :mod:`stereoplotter.web.app`): the glossary is public; the 
 session's key or the instructor's token; the class's acuities the instructor's token. Feedback
 on a stage (its checks and the likely wrong setting) is given in practice only: an exam's
 outcome is the grade's. Every refusal is one line of JSON (:class:`~.guard.Refused`); the
-session's work runs on the registry's actor thread.
+session's work runs on the registry's fair actor pool.
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from stereoplotter.trainer.step_words import CONTROL_NAMES, SHEET_NAMES, glossar
 from stereoplotter.trainer.tour import tour_of
 from stereoplotter.web.guard import Refused
 from stereoplotter.web.routes import instructor_only, own_or_instructor, web_of
+from stereoplotter.web.sockets import address_of
 
 __all__ = ["ROUTES"]
 
@@ -47,8 +48,10 @@ async def _live(request: Request):
     return reg, live, row
 
 
-async def _on_actor(reg, fn, *args):
-    return await asyncio.get_running_loop().run_in_executor(reg.actor, fn, *args)
+async def _on_actor(request: Request, reg, live, fn, *args):
+    """``fn(*args)`` on the session's fair actor pool (queued under the client's address and
+    the session, under the session's lock), awaited off the event loop."""
+    return await asyncio.wrap_future(reg.read(live, address_of(request), fn, *args))
 
 
 def _words(session) -> dict[str, Any]:
@@ -68,7 +71,8 @@ async def words(request: Request) -> Response:
     show-me plays in the stage in hand (the page says both before they run); the exercise's
     newcomer's tour (:mod:`stereoplotter.trainer.tour`)."""
     reg, live, _ = await _live(request)
-    return JSONResponse(await _on_actor(reg, _words, live.session), headers=_NO_STORE)
+    body = await _on_actor(request, reg, live, _words, live.session)
+    return JSONResponse(body, headers=_NO_STORE)
 
 
 def _goto(session, point: str | None, xy: list[float] | None) -> list[dict[str, Any]]:
@@ -96,7 +100,7 @@ async def goto(request: Request) -> Response:
     if live.demonstration:
         raise Refused(403, "go to: a demonstration takes no actions")
     try:
-        actions = await _on_actor(reg, _goto, live.session, point, xy)
+        actions = await _on_actor(request, reg, live, _goto, live.session, point, xy)
     except TrainerError as exc:
         raise Refused(400, str(exc)) from None
     return JSONResponse({"actions": actions}, headers=_NO_STORE)
@@ -125,7 +129,7 @@ async def feedback(request: Request) -> Response:
     if row["mode"] == "exam":
         raise Refused(403, "feedback: an exam's outcome is given by its grade")
     try:
-        body = await _on_actor(reg, _feedback, live.session, which)
+        body = await _on_actor(request, reg, live, _feedback, live.session, which)
     except TrainerError as exc:
         raise Refused(400, str(exc)) from None
     return JSONResponse(body, headers=_NO_STORE)
