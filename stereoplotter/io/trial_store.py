@@ -15,6 +15,7 @@ do not compress); each member ``<measure>.npy`` is one column of shape (T,).
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 import zipfile
 from collections.abc import Iterator, Mapping
@@ -28,6 +29,9 @@ from stereoplotter.errors import StereoplotterError
 from stereoplotter.io.atomic_write import atomic_stream
 
 __all__ = ["TrialStore"]
+
+#: Bytes copied at a time from a spool file into ``trials.npz``.
+_COPY_BLOCK = 1 << 20
 
 
 class TrialStore:
@@ -78,15 +82,26 @@ class TrialStore:
             yield name, self.column(name)
 
     def write_npz(self, path: str | os.PathLike[str]) -> None:
-        """Write ``trials.npz`` (one member per column), whole or not at all."""
+        """Write ``trials.npz`` (one member per column), whole or not at all.
+
+        Each member is the ``.npy`` header and then the spool file copied a block at a time,
+        so that memory holds no whole column (10⁷ trials are 80 MB a column).
+        """
         with (
             atomic_stream(path) as f,
             zipfile.ZipFile(f, "w", zipfile.ZIP_STORED, allowZip64=True) as zf,
         ):
-            for name, values in self.columns():
+            for i, name in enumerate(self.names):
+                header = {
+                    "descr": np.lib.format.dtype_to_descr(self.dtypes[name]),
+                    "fortran_order": False,
+                    "shape": (self.trials,),
+                }
                 info = zipfile.ZipInfo(name + ".npy", date_time=(1980, 1, 1, 0, 0, 0))
                 with zf.open(info, "w", force_zip64=True) as member:
-                    np.lib.format.write_array(member, values, allow_pickle=False)
+                    np.lib.format.write_array_header_1_0(member, header)
+                    with open(self._file(i), "rb") as column:
+                        shutil.copyfileobj(column, member, _COPY_BLOCK)
 
     def close(self) -> None:
         """Remove the spool files (and the temporary folder)."""
