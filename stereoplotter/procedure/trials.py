@@ -146,12 +146,9 @@ def split_chunk(trials: int, chunk_trials: int, workers: int) -> int:
 _PREPARED: list[tuple[PreparedRun, bool]] = []
 
 #: Chunks a worker process has queued or done ahead of the one this process yields (a
-#: convention: two keep a worker busy while this process runs a chunk of its own; more only
-#: hold more finished columns here). [chunks]
+#: convention: two keep a worker busy while this process takes a chunk; more only hold more
+#: finished columns here). [chunks]
 QUEUED_PER_WORKER = 2
-
-#: Chunks this process runs ahead of the one it yields, while it waits for a worker. [chunks]
-OWN_AHEAD = 1
 
 
 def _chunk_columns(first: int, n: int) -> dict[str, NDArray[Any]]:
@@ -174,11 +171,11 @@ def iter_chunk_columns(
 
     With ``workers`` > 1 the chunks after the first run in that many forked processes, each
     given the next chunk in trial order and at most :data:`QUEUED_PER_WORKER` ahead of the one
-    yielded; while this process waits for the chunk it yields next, it runs the next chunk not
-    yet given (at most :data:`OWN_AHEAD` ahead). So this process holds the columns of a fixed
-    number of chunks whatever the trials, and no process is idle while chunks are left.
-    ``progress`` counts each chunk when it is yielded. Every draw is keyed by the trial, so the
-    columns are the same whatever the workers and the chunks.
+    yielded, while this process runs the first and then only collects: it holds the columns of
+    a fixed number of chunks, never a share of the run, so its memory does not grow with the
+    trials (the forked processes keep the cores busy). ``progress`` counts each chunk when it
+    is yielded. Every draw is keyed by the trial, so the columns are the same whatever the
+    workers and the chunks.
     """
     if trials < 1:
         raise ValueError(f"trials: expected ≥ 1, found {trials}")
@@ -194,8 +191,7 @@ def iter_chunk_columns(
         processes = min(workers, count - 1)
         pool = ProcessPoolExecutor(max_workers=processes, mp_context=context)
         depth = QUEUED_PER_WORKER * processes
-    # each chunk after the first: a Future of a worker's columns, or this process's columns
-    given: dict[int, Future | dict[str, NDArray[Any]]] = {}
+    given: dict[int, Future] = {}  # each chunk after the first: its worker's columns
     given_next = 1  # the first chunk not yet given to a process
 
     def give_workers(yielding: int) -> None:
@@ -217,19 +213,7 @@ def iter_chunk_columns(
                 columns = _columns_here(prep, starts[k], sizes[k], evaluate)
             else:
                 give_workers(k)
-                while (
-                    isinstance(given[k], Future)
-                    and not given[k].done()
-                    and given_next < count
-                    and given_next - k < depth + OWN_AHEAD
-                ):
-                    own = given_next
-                    given_next += 1
-                    given[own] = _columns_here(prep, starts[own], sizes[own], evaluate)
-                    give_workers(k)
-                done = given.pop(k)
-                columns = done.result() if isinstance(done, Future) else done
-                del done
+                columns = given.pop(k).result()
             yield None, columns
             del columns
             if progress is not None:
