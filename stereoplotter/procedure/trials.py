@@ -146,8 +146,8 @@ def split_chunk(trials: int, chunk_trials: int, workers: int) -> int:
 _PREPARED: list[tuple[PreparedRun, bool]] = []
 
 #: Chunks a worker process has queued or done ahead of the one this process yields (a
-#: convention: two keep a worker busy while this process takes a chunk; more only hold more
-#: finished columns here). [chunks]
+#: convention: two keep a worker busy while this process hands a chunk's columns on; more only
+#: hold more finished columns here). [chunks]
 QUEUED_PER_WORKER = 2
 
 
