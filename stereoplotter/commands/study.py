@@ -13,7 +13,6 @@ import argparse
 import copy
 import functools
 import sys
-from concurrent.futures import Future
 from contextlib import nullcontext
 from typing import Any
 
@@ -150,7 +149,7 @@ def run_study_command(args: argparse.Namespace) -> int:
     # Imported here: dask.distributed (the extra `study`) loads in seconds; `--help` must not.
     from stereoplotter.io.study_file import load_study
     from stereoplotter.progress import progress_bar
-    from stereoplotter.study.runner import start_local_client
+    from stereoplotter.study.runner import start_local_client, started_client
 
     _, data = load_study(args.study)
     data = reduced(data, args)
@@ -168,8 +167,7 @@ def run_study_command(args: argparse.Namespace) -> int:
         bar = functools.partial(progress_bar, description="study", unit="task")
         cells, ran = run_into_store(data, args.study, args.output, client, bar)
     finally:
-        if isinstance(client, Future):
-            client = None if client.exception() is not None else client.result()
+        client = started_client(client)
         if client is not None:
             cluster = None if args.scheduler else client.cluster
             client.close()

@@ -47,6 +47,7 @@ __all__ = [
     "run_chunks",
     "run_study",
     "start_local_client",
+    "started_client",
     "study_checks",
     "study_terms",
 ]
@@ -130,6 +131,14 @@ def start_local_client(workers: int | None = None, dashboard: bool = True) -> Fu
 
     threading.Thread(target=start, name="cluster-start", daemon=True).start()
     return started
+
+
+def started_client(client: Any) -> Any:
+    """The client itself, or the one of a Future (:func:`start_local_client`; None if it did not
+    start): what is to be closed after a run."""
+    if isinstance(client, Future):
+        return None if client.exception() is not None else client.result()
+    return client
 
 
 def chunk_batches(tasks: list[Task], batch_trials: int) -> list[list[Task]]:
@@ -257,8 +266,7 @@ def run_study(
             progress(1)
 
     token = uuid.uuid4().hex[:8]
-    if isinstance(client, Future):
-        client = client.result()
+    client = client.result() if isinstance(client, Future) else client
     if client is None:
         size = _batch_trials(design, len(pending), 1)
         try:
