@@ -1,14 +1,19 @@
 """Scale of `stereoplotter study run`: procedures/s serial, on 1 and 2 local Dask workers, memory
 per worker, and a paper estimate of a 10⁸-procedure study on a cluster.
 
-python benchmarks/bench_study.py                      # 4 cells × 2000 trials, chunks of 1000
-python benchmarks/bench_study.py --trials 4000 --chunk 2000 --nodes 32 --cores-per-node 32
+python benchmarks/bench_study.py                      # 8 cells × 4000 trials, chunks of 1000
+python benchmarks/bench_study.py --trials 2000 --chunk 1000 --cells 4
+python benchmarks/bench_study.py --warm               # the cluster started before the clock
 
-The study: the shipped formula-validity file on f = 70, 140 mm × overlap 60, 80 %, SC-1, setup
-data, the chunked measures only (checks, y-parallax, heights, plan): 2·T/C chunk tasks of C
-trials each. Each configuration (serial; 1 worker; 2 workers) writes a fresh Zarr store; the
-cluster is started and warmed (the library imported on every worker) before the clock starts.
-The Datasets of the three runs are compared bit for bit.
+The study: the shipped formula-validity file on f = 70, 140 mm × overlap 60, 80 % (× α 0, 1°
+for 8 cells), SC-1, setup data, the chunked measures only (checks, y-parallax, heights, plan):
+cells·T/C chunk tasks of C trials each. Each configuration (serial; 1 worker; 2 workers) writes
+a fresh Zarr store. By default the clock includes the embedded cluster's start, as ``study
+run --workers N`` pays it (started by ``study.runner.start_local_client`` while the study is
+prepared); with ``--warm`` the cluster is started and the library loaded on every worker
+before the clock starts. CPU seconds: this process's during the run and the workers' whole
+lives (their start included unless ``--warm``), which a loaded machine stretches far less than
+the wall seconds. The Datasets of the three runs are compared bit for bit.
 
 Peak memory per worker: the worker's maximum resident set size after the run (ru_maxrss), to be
 read against the chunk's budget (C × BYTES_PER_TRIAL of procedure.trials, plus the interpreter
@@ -42,10 +47,14 @@ from stereoplotter.procedure.trials import BYTES_PER_TRIAL  # noqa: E402
 SCHEDULER_SECONDS_PER_TASK = 1e-3
 
 
-def study(trials: int, chunk: int) -> dict:
+def study(trials: int, chunk: int, cells: int) -> dict:
     data = yaml.safe_load((ROOT / "studies" / "formula-validity.yaml").read_text("utf-8"))
     data["axes"] = {"f_mm": [70, 140], "overlap": [0.6, 0.8], "instrument": ["sc1"],
                     "method": ["setup"]}  # fmt: skip
+    if cells == 8:
+        data["axes"]["alpha_deg"] = [0, 1]
+    elif cells != 4:
+        raise SystemExit("--cells: 4 or 8")
     data.update(trials=trials, chunk_trials=chunk,
                 measures=["checks", "y_parallax", "heights", "plan"])  # fmt: skip
     return data
@@ -57,42 +66,68 @@ def _peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
+def _cpu_seconds() -> float:
+    import resource
+
+    me = resource.getrusage(resource.RUSAGE_SELF)
+    return me.ru_utime + me.ru_stime
+
+
 def _warm() -> None:
     import stereoplotter.study.cells  # noqa: F401 - the library loaded before the clock starts
 
 
-def timed(data: dict, out: Path, workers: int | None):
-    client = cluster = None
-    if workers:
-        from distributed import Client, LocalCluster
+def _start(workers: int):
+    try:
+        from stereoplotter.study.runner import start_local_client
+    except ImportError:  # an older tree (before/after figures): started as `study run` did
+        from stereoplotter.study.runner import local_client
 
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None)  # fmt: skip
-        client = Client(cluster)
+        return local_client(workers, dashboard=False)
+    return start_local_client(workers, dashboard=False)
+
+
+def timed(data: dict, out: Path, workers: int | None, warm: bool):
+    from stereoplotter.study.runner import local_client
+
+    client = None
+    if workers and warm:
+        client = local_client(workers, dashboard=False)
         client.run(_warm)
     try:
         t0 = time.perf_counter()
+        c0 = time.process_time()
+        if workers and not warm:
+            client = _start(workers)
         run_into_store(data, "bench", str(out), client)
         wall = time.perf_counter() - t0
+        cpu = time.process_time() - c0
+        if hasattr(client, "result"):  # a Future of the client
+            client = client.result()
         rss = list(client.run(_peak_rss_mb).values()) if client else [_peak_rss_mb()]
+        if client:  # the workers' CPU seconds (with their start when not --warm)
+            cpu += sum(client.run(_cpu_seconds).values())
     finally:
-        if client:
+        if client is not None:
+            cluster = client.cluster
             client.close()
             cluster.close()
-    return wall, rss
+    return wall, cpu, rss
 
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--trials", type=int, default=2000, help="trials per cell")
+    ap.add_argument("--trials", type=int, default=4000, help="trials per cell")
+    ap.add_argument("--cells", type=int, default=8, help="cells: 4 or 8")
+    ap.add_argument("--warm", action="store_true", help="start the cluster before the clock")
     ap.add_argument("--chunk", type=int, default=1000, help="trials per task")
     ap.add_argument("--nodes", type=int, default=32)
     ap.add_argument("--cores-per-node", type=int, default=32)
     ap.add_argument("--procedures", type=float, default=1e8)
     a = ap.parse_args()
     print(f"cpu_count={os.cpu_count()} numpy={np.__version__} load={os.getloadavg()[0]:.1f}")
-    data = study(a.trials, a.chunk)
-    cells = 4
+    data = study(a.trials, a.chunk, a.cells)
+    cells = a.cells
     procedures = cells * a.trials
     tasks = cells * -(-a.trials // a.chunk)
     tmp = Path(tempfile.mkdtemp(prefix="bench_study_"))
@@ -100,16 +135,18 @@ def main():
     try:
         for label, workers in (("serial", None), ("1 worker", 1), ("2 workers", 2)):
             out = tmp / f"{label.replace(' ', '_')}.zarr"
-            wall, rss = timed(data, out, workers)
+            wall, cpu, rss = timed(data, out, workers, a.warm)
             rates[label] = procedures / wall
             results[label] = open_results(out)
-            print(f"{label:10s}: {wall:6.1f} s, {rates[label]:7.0f} procedures/s, "
+            print(f"{label:10s}: {wall:6.1f} s (CPU {cpu:5.1f} s), "
+                  f"{rates[label]:7.0f} procedures/s, "
                   f"{tasks} tasks of {a.chunk} trials, peak RSS per process "
                   + ", ".join(f"{r:.0f} MB" for r in rss))  # fmt: skip
         same = all(results["serial"].identical(r) for r in results.values())
         print(f"Datasets identical to the serial run: {same}")
         speedup = rates["2 workers"] / rates["1 worker"]
-        print(f"speed-up 2 workers / 1 worker: {speedup:.2f}; chunk budget "
+        print(f"speed-up 2 workers / 1 worker: {speedup:.2f}, 2 workers / serial: "
+              f"{rates['2 workers'] / rates['serial']:.2f}; chunk budget "
               f"{a.chunk * BYTES_PER_TRIAL['setup'] / 1e6:.0f} MB per task")  # fmt: skip
         per_cell = results["serial"].nbytes / cells  # uncompressed, coordinates included
         per_task_s = 1.0 / rates["serial"] * a.chunk

@@ -132,7 +132,8 @@ def run_into_store(
     progress: Any = None,
 ) -> tuple[int, int]:
     """Run the study document ``data`` into the store ``output`` (created or resumed), serially
-    (``client`` None) or on a Dask client. ``bar(total)``: a context manager giving the
+    (``client`` None) or on a Dask client (or a Future of one, taken once the study is
+    prepared). ``bar(total)``: a context manager giving the
     progress callback (``stereoplotter.progress.progress_bar``); ``progress(n)``: another
     callback (tests). Returns (cells of the study, cells run now)."""
     # Imported here: xarray and zarr (the extra `study`) load in seconds; `--help` must not.
@@ -179,23 +180,25 @@ def run_study_command(args: argparse.Namespace) -> int:
     # Imported here: dask.distributed (the extra `study`) loads in seconds; `--help` must not.
     from stereoplotter.io.study_file import load_study
     from stereoplotter.progress import progress_bar
-    from stereoplotter.study.runner import local_client
+    from stereoplotter.study.runner import start_local_client, started_client
 
     _, data = load_study(args.study)
     data = reduced(data, args)
-    client = None
+    client: Any = None
     try:
         if args.scheduler:
             from distributed import Client  # the extra `study`, loaded only to run on Dask
 
             client = Client(args.scheduler)
+            _print_dashboard(client)
         elif args.workers != 0:
-            client = local_client(args.workers)
-        if client is not None and client.dashboard_link:
-            print(f"Dask dashboard: {client.dashboard_link}", file=sys.stderr)
+            # the embedded cluster comes up on a thread while the study is prepared
+            client = start_local_client(args.workers)
+            client.add_done_callback(lambda f: f.exception() or _print_dashboard(f.result()))
         bar = functools.partial(progress_bar, description="study", unit="task")
         cells, ran = run_into_store(data, args.study, args.output, client, bar)
     finally:
+        client = started_client(client)
         if client is not None:
             cluster = None if args.scheduler else client.cluster
             client.close()
@@ -203,6 +206,11 @@ def run_study_command(args: argparse.Namespace) -> int:
                 cluster.close()
     print(f"study: {ran} of {cells} cells run now; results in {args.output}", file=sys.stderr)
     return 0
+
+
+def _print_dashboard(client: Any) -> None:
+    if client.dashboard_link:
+        print(f"Dask dashboard: {client.dashboard_link}", file=sys.stderr)
 
 
 def run_report(args: argparse.Namespace) -> int:

@@ -43,7 +43,6 @@ __all__ = [
     "default_workers",
     "iter_chunk_columns",
     "iter_trial_chunks",
-    "own_chunks",
     "run_header",
     "run_info",
     "split_chunk",
@@ -146,6 +145,11 @@ def split_chunk(trials: int, chunk_trials: int, workers: int) -> int:
 #: The prepared run of the forked chunk workers (set before the pool forks).
 _PREPARED: list[tuple[PreparedRun, bool]] = []
 
+#: Chunks a worker process has queued or done ahead of the one this process yields (a
+#: convention: two keep a worker busy while this process hands a chunk's columns on; more only
+#: hold more finished columns here). [chunks]
+QUEUED_PER_WORKER = 2
+
 
 def _chunk_columns(first: int, n: int) -> dict[str, NDArray[Any]]:
     prep, evaluate = _PREPARED[0]
@@ -165,11 +169,13 @@ def iter_chunk_columns(
     :class:`SimulationResult` (with trial 0's transcript) and then None, and each chunk's
     :func:`trial_columns`.
 
-    With ``workers`` > 1 the chunks after the first run in that many forked processes while
-    this one runs a few of the last (:func:`own_chunks`: its share of the trials, so that no
-    process is left with one chunk more at the end) and then the first. ``progress`` counts
-    each chunk when it is done, in any order. Every draw is keyed by
-    the trial, so the columns are the same whatever the workers and the chunks.
+    With ``workers`` > 1 the chunks after the first run in that many forked processes, each
+    given the next chunk in trial order and at most :data:`QUEUED_PER_WORKER` ahead of the one
+    yielded, while this process runs the first and then only collects: it holds the columns of
+    a fixed number of chunks, never a share of the run, so its memory does not grow with the
+    trials (the forked processes keep the cores busy). ``progress`` counts each chunk when it
+    is yielded. Every draw is keyed by the trial, so the columns are the same whatever the
+    workers and the chunks.
     """
     if trials < 1:
         raise ValueError(f"trials: expected ≥ 1, found {trials}")
@@ -177,67 +183,45 @@ def iter_chunk_columns(
         raise ValueError(f"chunk_trials: expected ≥ 1, found {chunk_trials}")
     starts = list(range(0, trials, chunk_trials))
     sizes = [min(chunk_trials, trials - f) for f in starts]
+    count = len(starts)
     pool = None
-    futures: dict[int, Future] = {}
-    own: list[int] = []
-    if workers > 1 and len(starts) > 1 and "fork" in multiprocessing.get_all_start_methods():
-        own = own_chunks(sizes, workers)
-        rest = [k for k in range(1, len(starts)) if k not in own]
+    if workers > 1 and count > 1 and "fork" in multiprocessing.get_all_start_methods():
         _PREPARED[:] = [(prep, evaluate)]  # inherited by the forked workers
         context = multiprocessing.get_context("fork")
-        pool = ProcessPoolExecutor(max_workers=min(workers, len(rest)), mp_context=context)
-        futures = {k: pool.submit(_chunk_columns, starts[k], sizes[k]) for k in rest}
+        processes = min(workers, count - 1)
+        pool = ProcessPoolExecutor(max_workers=processes, mp_context=context)
+        depth = QUEUED_PER_WORKER * processes
+    given: dict[int, Future] = {}  # each chunk after the first: its worker's columns
+    given_next = 1  # the first chunk not yet given to a process
+
+    def give_workers(yielding: int) -> None:
+        nonlocal given_next
+        while given_next < count and given_next - yielding < depth:
+            given[given_next] = pool.submit(_chunk_columns, starts[given_next], sizes[given_next])
+            given_next += 1
+
     try:
-        mine = {}
-        for k in own:  # first, so that no chunk's whole result is held meanwhile
-            mine[k] = _columns_here(prep, starts[k], sizes[k], evaluate)
-            if progress is not None:
-                progress(sizes[k])
+        if pool is not None:
+            give_workers(1)
         result = run_trials_chunk(prep, 0, sizes[0], evaluate=evaluate, transcript=True)
         yield result, trial_columns(result)
         del result  # the caller keeps what it needs of the first chunk
         if progress is not None:
             progress(sizes[0])
-        for k in range(1, len(starts)):
-            if k in mine:
-                yield None, mine.pop(k)
-                continue
+        for k in range(1, count):
             if pool is None:
                 columns = _columns_here(prep, starts[k], sizes[k], evaluate)
             else:
-                columns = futures[k].result()
+                give_workers(k)
+                columns = given.pop(k).result()
             yield None, columns
+            del columns
             if progress is not None:
                 progress(sizes[k])
     finally:
         if pool is not None:
             pool.shutdown(cancel_futures=True)
             _PREPARED.clear()
-
-
-def own_chunks(sizes: list[int], workers: int) -> list[int]:
-    """The chunks after the first that the process running the first runs too: the last ones,
-    while it holds at most its share T/(workers + 1) of the trials (the others go to the
-    ``workers`` forked processes). At least one chunk is left to them.
-
-    Examples
-    --------
-    10⁵ trials of the conventional method in chunks of 12 288 on two processors: this process
-    runs chunks 0, 7 and 8 (26 272 trials), each worker three of chunks 1–6 (36 864):
-
-    >>> own_chunks([12288] * 8 + [1696], 2)
-    [7, 8]
-    >>> own_chunks([5000, 5000], 2)
-    []
-    """
-    share = sum(sizes) / (workers + 1)
-    total, own = sizes[0], []
-    for k in range(len(sizes) - 1, 1, -1):  # never chunk 1: the workers keep at least one
-        if total + sizes[k] > share:
-            break
-        own.append(k)
-        total += sizes[k]
-    return sorted(own)
 
 
 def _columns_here(prep: PreparedRun, first: int, n: int, evaluate: bool) -> dict[str, NDArray]:

@@ -4,7 +4,12 @@ The same code runs on a laptop and a cluster: :func:`run_study` takes a ``dask.d
 ``Client`` (an embedded :func:`local_client`, or one connected to a scheduler's address) or
 None for a serial run in this process. Tasks are (cell, chunk of trials), (cell, procedure MC)
 and (cell, budget) (:meth:`StudyDesign.tasks`); they are submitted cell by cell, so cells finish
-roughly in order and a killed study loses at most the cells in flight. A cell is handed to
+roughly in order and a killed study loses at most the cells in flight. A cell's consecutive
+chunks run as one batch (:func:`chunk_batches`: one pass of the procedure over their trials,
+up to the memory budget's chunk, its fixed cost paid once), each chunk still reduced to its own
+moments; a process keeps the prepared run of the cell it last ran (:func:`run_chunks`), not one
+per task. :func:`start_local_client` starts an embedded cluster on a thread, so that it comes
+up while the study is being prepared. A cell is handed to
 ``sink(cell, values)`` as soon as its last task returns; ``done`` cells (already in the store)
 are skipped — that is how a study resumes.
 
@@ -15,20 +20,37 @@ combined in trial order (:func:`~stereoplotter.study.cells.combine_chunks`).
 
 from __future__ import annotations
 
+import threading
 import uuid
 from collections.abc import Callable, Iterable
+from concurrent.futures import Future
 from typing import Any
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.error_model import error_model_from_spec
 from stereoplotter.procedure.operator import OperatorModel
+from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
-from stereoplotter.study.cells import cell_run, run_task
+from stereoplotter.procedure.trials import (
+    DEFAULT_MEMORY_BUDGET_MB,
+    chunk_trials_for,
+    trial_columns,
+)
+from stereoplotter.study.cells import CellRun, Moments, cell_run, chunk_measures, run_task
 from stereoplotter.study.design import StudyDesign, Task
 from stereoplotter.study.results import cell_values
 from stereoplotter.verification.budget import budget_terms
 
-__all__ = ["local_client", "run_study", "study_checks", "study_terms"]
+__all__ = [
+    "chunk_batches",
+    "local_client",
+    "run_chunks",
+    "run_study",
+    "start_local_client",
+    "started_client",
+    "study_checks",
+    "study_terms",
+]
 
 Sink = Callable[[int, dict[str, Any]], None]
 
@@ -72,17 +94,149 @@ def study_terms(design: StudyDesign) -> tuple[str, ...]:
 
 def local_client(workers: int | None = None, dashboard: bool = True):
     """An embedded ``LocalCluster``: ``workers`` processes (default one per core), one thread
-    each, and its client."""
+    each, and its client. The workers' statistical profiler is off (it samples the task's
+    thread every 10 ms and competes with it for the interpreter)."""
     # Imported here: dask.distributed is the optional extra `study` and takes a second to load.
+    import dask
     from distributed import Client, LocalCluster
 
-    cluster = LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0" if dashboard else None,
-    )
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        cluster = LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0" if dashboard else None,
+        )
     return Client(cluster)
+
+
+def _load_library() -> None:
+    # imported here: run on each worker as it starts, so that its first task does not pay it
+    import stereoplotter.study.runner  # noqa: F401
+
+
+def start_local_client(workers: int | None = None, dashboard: bool = True) -> Future:
+    """:func:`local_client` started on a thread, each worker loading the library: a Future of
+    the client, to be taken once the study is prepared (the two overlap)."""
+    started: Future = Future()
+
+    def start() -> None:
+        try:
+            client = local_client(workers, dashboard)
+            client.run(_load_library)
+        except BaseException as exc:  # handed to whoever takes the client
+            started.set_exception(exc)
+        else:
+            started.set_result(client)
+
+    threading.Thread(target=start, name="cluster-start", daemon=True).start()
+    return started
+
+
+def started_client(client: Any) -> Any:
+    """The client itself, or the one of a Future (:func:`start_local_client`; None if it did not
+    start): what is to be closed after a run."""
+    if isinstance(client, Future):
+        return None if client.exception() is not None else client.result()
+    return client
+
+
+def chunk_batches(tasks: list[Task], batch_trials: int) -> list[list[Task]]:
+    """A cell's tasks in batches: consecutive chunks while their trials stay within
+    ``batch_trials`` (at least one chunk a batch); every other task alone.
+
+    Examples
+    --------
+    >>> chunks = [Task("chunk", 0, f, 1000) for f in range(0, 4000, 1000)]
+    >>> [len(b) for b in chunk_batches(chunks + [Task("procedure", 0, 0, 50)], 2500)]
+    [2, 2, 1]
+    """
+    out: list[list[Task]] = []
+    batch: list[Task] = []
+    for task in tasks:
+        if batch and (
+            task.kind != "chunk" or sum(t.trials for t in batch) + task.trials > batch_trials
+        ):
+            out.append(batch)
+            batch = []
+        if task.kind != "chunk":
+            out.append([task])
+        else:
+            batch.append(task)
+    if batch:
+        out.append(batch)
+    return out
+
+
+def _batch_trials(design: StudyDesign, cells: int, processes: int) -> int:
+    """Trials of a batch: the memory budget's chunk of the study's method (the largest of its
+    methods' chunks is not taken: a batch stays within any method's budget), but small enough
+    that each process gets two batches, and not below the study's chunk."""
+    budget = min(chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, m) for m in ("setup", "conventional"))
+    share = cells * design.trials // (2 * max(1, processes))
+    return max(design.chunk_trials, min(budget, share))
+
+
+#: The prepared run of the cell this process ran last: (run key, cell) → (CellRun, PreparedRun).
+_PREPARED: dict[tuple[str, int], tuple[CellRun, PreparedRun]] = {}
+
+
+def _prepared(design: StudyDesign, config: dict[str, Any], cell: int, key: str):
+    if (key, cell) not in _PREPARED:
+        run = cell_run(design, cell, config)
+        prep = prepare_run(
+            run.scenario,
+            run.spec,
+            run.method,
+            run.errors,
+            design.seed,
+            operator=run.operator,
+            practice=run.practice,
+        )
+        _PREPARED.clear()  # one cell at a time: cells are submitted in order
+        _PREPARED[(key, cell)] = (run, prep)
+    return _PREPARED[(key, cell)]
+
+
+def run_chunks(
+    design: StudyDesign,
+    config: dict[str, Any],
+    batch: list[Task],
+    checks: tuple[str, ...],
+    key: str = "",
+) -> list[tuple[Task, Any]]:
+    """Run a batch of one cell's consecutive chunk tasks in one pass of the procedure; each
+    chunk's moments (the same as :func:`~stereoplotter.study.cells.run_task` gives it: every
+    draw is keyed by the trial), or each ``("refused", message)``. The cell's prepared run is
+    kept for the next batch of the run ``key``; other tasks go to ``run_task``."""
+    if batch[0].kind != "chunk":
+        return [run_task(design, config, task, checks) for task in batch]
+    cell, first = batch[0].cell, batch[0].first
+    try:
+        run, prep = _prepared(design, config, cell, key)
+        total = sum(t.trials for t in batch)
+        result = run_trials_chunk(prep, first, total, evaluate=True, transcript=False)
+        assert result.evaluation is not None
+        height_m = float(result.evaluation.flying_height_m)
+        rows = chunk_measures(run, checks, trial_columns(result), height_m)
+    except StereoplotterError as exc:
+        return [(task, ("refused", str(exc).splitlines()[0])) for task in batch]
+    out = []
+    for task in batch:
+        start = task.first - first
+        out.append((task, Moments.of(rows[:, start : start + task.trials])))
+    return out
+
+
+def _batch_key(token: str, batch: list[Task]) -> str:
+    return f"study-{token}-{batch[0].key}-{len(batch)}"
+
+
+def _client_processes(client: Any) -> int:
+    try:
+        return max(1, sum(client.nthreads().values()))
+    except Exception:  # a client that cannot say: as on one process
+        return 1
 
 
 def run_study(
@@ -97,7 +251,8 @@ def run_study(
     progress: Callable[[int], None] | None = None,
 ) -> int:
     """Run every task of the cells not ``done``; call ``sink`` per finished cell. Returns the
-    number of cells run. ``progress(n)``: n more tasks finished."""
+    number of cells run. ``progress(n)``: n more tasks finished. ``client``: a Dask client, a
+    Future of one (:func:`start_local_client`), or None (serial, in this process)."""
     skip = set(done)
     pending = {i: design.tasks(i) for i in range(len(cells)) if i not in skip}
     parts: dict[int, list[tuple[Task, Any]]] = {}
@@ -110,22 +265,30 @@ def run_study(
         if progress is not None:
             progress(1)
 
+    token = uuid.uuid4().hex[:8]
+    client = client.result() if isinstance(client, Future) else client
     if client is None:
-        for i, tasks in pending.items():
-            for task in tasks:
-                finish(*run_task(design, cells[i], task, checks))
+        size = _batch_trials(design, len(pending), 1)
+        try:
+            for i, tasks in pending.items():
+                for batch in chunk_batches(tasks, size):
+                    for task, result in run_chunks(design, cells[i], batch, checks, token):
+                        finish(task, result)
+        finally:
+            _PREPARED.clear()
         return len(pending)
     # Imported here: dask.distributed is the optional extra `study`.
     from distributed import as_completed
 
+    size = _batch_trials(design, len(pending), _client_processes(client))
     shared = client.scatter(design, broadcast=True)
-    token = uuid.uuid4().hex[:8]
+    batches = [(i, b) for i, tasks in pending.items() for b in chunk_batches(tasks, size)]
     futures = [
-        client.submit(run_task, shared, cells[i], t, checks, key=f"study-{token}-{t.key}")
-        for i, tasks in pending.items()
-        for t in tasks
+        client.submit(run_chunks, shared, cells[i], b, checks, token, key=_batch_key(token, b))
+        for i, b in batches
     ]
-    for future, (task, result) in as_completed(futures, with_results=True):
-        finish(task, result)
+    for future, results in as_completed(futures, with_results=True):
+        for task, result in results:
+            finish(task, result)
         future.release()
     return len(pending)
