@@ -38,7 +38,12 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
+from stereoplotter.instrument.mechanics.coordinatograph import (
+    Coordinatograph,
+    CoordinatographParams,
+)
 from stereoplotter.instrument.mechanics.play import PlayAxis
+from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis
 from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import AutomaticCoordinatograph, SC1Options
 from stereoplotter.spec.instrument_spec import InstrumentSpec
@@ -352,8 +357,6 @@ class Instrument:
         lo, hi = params.range_mm
         start = 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi)
         if self.backend == "pymunk" and name in ("X", "Y", "Z"):
-            from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis
-
             return PymunkAxis(params, start_mm=start)
         axis = PlayAxis(params, trials=self.trials if self.trials is not None else 1)
         axis.place(start)
@@ -683,11 +686,6 @@ class Instrument:
             A ratio that is not one of the gears; with the automatic coordinatograph an
             enlargement beyond its documented limit.
         """
-        from stereoplotter.instrument.mechanics.coordinatograph import (
-            Coordinatograph,
-            CoordinatographParams,
-        )
-
         check_in_range(self.spec, "coordinatograph_ratios", float(ratio), "coordinatograph ratio")
         if self.options.automatic_coordinatograph:
             self._servo = AutomaticCoordinatograph.from_spec(self.spec)

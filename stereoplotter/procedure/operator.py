@@ -15,8 +15,7 @@ one seed, so that a vectorised run and a per-trial loop draw identical numbers f
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -113,8 +112,8 @@ class OperatorModel:
         never silent). A convention (6), not a figure of the book.
     eye : {"physiological", "sigma"}
         How σ_p and σ_q left None are resolved for an instrument (:meth:`for_instrument`):
-        "physiological" (default) from the eye; "sigma" the free σ = 0.010 mm of the operator
-        before issue 25 (kept selectable, ``simulate --operator`` file ``eye: sigma``).
+        "physiological" (default) from the eye; "sigma" a free σ = 0.010 mm without the eye
+        model (``simulate --operator`` file ``eye: sigma``).
     remeasure : bool
         Habit: a point whose y-parallax is seen over ¼ mark is looked at again (a new pointing
         and judgement) before it is declared failed (default True, a competent operator).
@@ -767,16 +766,9 @@ def _given(value: float | None, derived: float) -> float:
 
 def _column(obj):
     """A frozen unit/setting with every per-trial field (T,) turned into a column (T, 1)."""
-    from dataclasses import fields
-
     changes = {}
     for f in fields(obj):
         v = getattr(obj, f.name)
         if isinstance(v, np.ndarray) and v.ndim == 1:
             changes[f.name] = v[:, None]
     return replace(obj, **changes)
-
-
-def degrees(value: float) -> float:
-    """Radians to degrees (for messages)."""
-    return math.degrees(value)

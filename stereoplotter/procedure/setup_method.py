@@ -63,8 +63,7 @@ _TILT = {"alpha": "α", "omega": "ω"}
 #: photos' α, the xy/f pattern at points 3–6 ("the relative orientation is checked over the
 #: whole stereopair", stage 3). Not b_y (a constant q, dependent on κ_л, κ_п at six points),
 #: not b_z (it carries n_п, set by the stage-1 L-check, and moves the model's longitudinal
-#: tilt). With three elements (κ_л, κ_п, k_ω,п) and an operator without σ_q the true q at the
-#: standard points still exceeded ¼ mark in 41 % of pair60/SC-1 runs; with the five, in 0.1 %.
+#: tilt).
 Q_ELEMENTS = ("kappa_left", "kappa_right", "k_omega_right", "k_alpha_left", "k_alpha_right")
 
 

@@ -84,9 +84,9 @@ from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification.linear_mc import (
     CI_Z,
     LinearModel,
-    _relative_field_basis,
     covariance_rms,
     grid_chapter5,
+    relative_field_basis,
 )
 
 if TYPE_CHECKING:
@@ -172,7 +172,7 @@ def _scenario_geometry(scenario, spec):
     }
 
 
-def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
+def domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
     """Ground points (instrument frame) under a midpoint grid of left-photo (x_л, y) [mm]."""
 
     nx, ny = grid
@@ -191,7 +191,7 @@ def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)
     return instrument_frame_m(local, origin, theta)
 
 
-def _dp(scenario, sheet, inst, frame_pts):
+def dp_at(scenario, sheet, inst, frame_pts):
     """δp [photo mm] of the built instrument ``inst`` at ``frame_pts`` (ideal model position)."""
     units = inst.state()["units"]
     return _dp_of(scenario, sheet, frame_pts)(inst.setting, units["left"], units["right"])
@@ -211,9 +211,9 @@ def _dp_of(scenario, sheet, frame_pts):
 
 
 def _dp_state(model, gl, gr, setting, left, right):
-    if ev._trial_count(setting, (left, right)) is not None:
-        setting = ev._with_point_axis(setting)
-        left, right = ev._with_point_axis(left), ev._with_point_axis(right)
+    if ev.trial_count(setting, (left, right)) is not None:
+        setting = ev.with_point_axis(setting)
+        left, right = ev.with_point_axis(left), ev.with_point_axis(right)
     dp, _ = ev.parallax_errors_at_ideal(model, gl, gr, setting, left, right)
     return np.asarray(dp, float)
 
@@ -266,9 +266,9 @@ def _height_errors_parallax(sc, sheet, inst, frame_pts):
         np.asarray(inst.read(HEIGHT_SCALE, exact=True), float)
         + np.asarray(inst.read("Z", exact=True), float) * gear / 1000.0
     )
-    if ev._trial_count(setting, (left, right)) is not None:
-        setting = ev._with_point_axis(setting)
-        left, right = ev._with_point_axis(left), ev._with_point_axis(right)
+    if ev.trial_count(setting, (left, right)) is not None:
+        setting = ev.with_point_axis(setting)
+        left, right = ev.with_point_axis(left), ev.with_point_axis(right)
         slip = slip[:, None]
     depth = counters_from_homologous_points(gl, gr, setting, left, right).depth_mm
     dh = slip - depth * gear / 1000.0 - local[:, 2]
@@ -297,15 +297,15 @@ def _setup_fields(sc, zero_run, g, xr, grid):
 
     f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
     sheet = zero_run.sheet
-    pts = _domain_points(sc, sheet, xr, c, p, f, h, grid)
-    lev = _domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
-    book, _, _ = _control_frame_points(sc, sheet, g)
+    pts = domain_points(sc, sheet, xr, c, p, f, h, grid)
+    lev = domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
+    book, _, _ = control_frame_points(sc, sheet, g)
     n, nl = len(pts), len(lev)
     # below 70 % overlap c = p: the two domains are one (60 %: x_л ∈ [0, p]), δp computed once
     same = pts.shape == lev.shape and np.array_equal(pts, lev)
     allp = np.vstack([pts, book] if same else [pts, lev, book])
     first_lev, first_ctl = (0, n) if same else (n, n + nl)
-    zero = _dp(sc, sheet, zero_run.instrument, allp)
+    zero = dp_at(sc, sheet, zero_run.instrument, allp)
     refit = levelling_design(lev[:, 0], lev[:, 1]) @ np.linalg.pinv(
         levelling_design(book[:, 0], book[:, 1])
     )
@@ -315,7 +315,7 @@ def _setup_fields(sc, zero_run, g, xr, grid):
         return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
 
     def fields(result, noise, sigma_control=0.0):
-        d = _dp(sc, result.sheet, result.instrument, allp) - zero
+        d = dp_at(sc, result.sheet, result.instrument, allp) - zero
         out = readings(d)
         obs = np.stack(
             [noise.normal(f"mc/control/{i}", sigma_control) for i in range(len(book))], -1
@@ -357,10 +357,10 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
 
     f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
     sheet = zero_run.sheet
-    pts = _domain_points(sc, sheet, xr, c, p, f, h, grid)
-    d_zero = _dp(sc, sheet, zero_run.instrument, pts)
+    pts = domain_points(sc, sheet, xr, c, p, f, h, grid)
+    d_zero = dp_at(sc, sheet, zero_run.instrument, pts)
     _, lev = _levelling_frame_points(zero_prep)
-    book, _, _ = _control_frame_points(sc, sheet, g)
+    book, _, _ = control_frame_points(sc, sheet, g)
     allp = np.vstack([pts, lev, book])
     k = (p * h / f) * f / allp[:, 2] ** 2  # photo mm of x-parallax per m of height
     h_zero = _height_errors_parallax(sc, sheet, zero_run.instrument, allp)
@@ -370,7 +370,7 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
     )
 
     def fields(result, noise):
-        d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
+        d = dp_at(sc, result.sheet, result.instrument, pts) - d_zero
         e = (_height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
         obs = e[:, n : n + nl] + np.stack(
             [noise.normal(f"mc/datum/{i}", sigma_p) for i in range(nl)], -1
@@ -398,7 +398,7 @@ def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
     )
     if options.get("standard_points") == "book":
         tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
-        prep = _standard_points_at_a(prep, g)
+        prep = standard_points_at_a(prep, g)
         prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
     return prep
 
@@ -518,9 +518,9 @@ def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
     out = {}
     for name, sq, sp in (("y_parallax", 1.0, 0.0), ("stereo", 0.0, 1.0), ("both", 1.0, 1.0)):
         model = LinearModel(
-            _relative_field_basis(xg, yg, p, f),
+            relative_field_basis(xg, yg, p, f),
             lsq * sq,
-            _relative_field_basis(xc, yc, p, f),
+            relative_field_basis(xc, yc, p, f),
             fit,
             sp,
             0.0,
@@ -917,7 +917,7 @@ def idealised_geometry(scenario: Scenario) -> Scenario:
     return replace(scenario, terrain=Terrain(scenario.terrain.base_height_m), photos=photos)
 
 
-def _standard_points_at_a(prep, g):
+def standard_points_at_a(prep, g):
     """The prepared run with standard points 1, 3, 5 moved by −a and 2, 4, 6 by +a along the
     base (Fig. 39, x_л ∈ {−a, p + a}, a = c − p) and the C2 tolerance 0, so every trial makes
     the same number of passes (no 'stop when satisfied' selection, which (5.54) does not model)."""
@@ -938,7 +938,7 @@ def _standard_points_at_a(prep, g):
     )
 
 
-def _control_frame_points(scenario, sheet, g):
+def control_frame_points(scenario, sheet, g):
     """The four levelling control points of (5.54), x_п ∈ {−c, a}, y = ±c, on the ground; with
     their (x_п, y) [mm]."""
 

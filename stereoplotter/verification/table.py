@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import multiprocessing
+import warnings
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
@@ -155,8 +156,6 @@ def check_geometry(fields, geometry: dict) -> None:
     Last, every formula is evaluated with floating-point errors raised, so nothing undefined
     reaches the Monte Carlo.
     """
-    import warnings
-
     g = _normalise_geometry(geometry)
     for ov in ("60", "80"):
         a, c, p = g[f"a{ov}"], g["c"], g[f"p{ov}"]
@@ -369,8 +368,8 @@ def start_procedure_mc(
     slot is run. ``workers``: processes (the runs are independent; 1 runs them here). The
     configurations of :data:`SHARED_RUNS` at a slot are one run (one job) with a block of trials
     each: the conventional one on trials 0 … T − 1 of its seed as before, σ_q only and σ_p only
-    on the trials after it (issue 26: one error-free run, one linearisation and the procedure's
-    per-act work for the three).
+    on the trials after it (one error-free run, one linearisation and the procedure's per-act
+    work for the three).
     ``linkage``: the knob–decentration linkage of the runs, "drag" or "independent" (None: the
     instrument's ``correction.decentration_linkage``;
     :data:`~stereoplotter.verification.procedure_mc.LINKAGE_VARIANTS`). ``fidelity``: the

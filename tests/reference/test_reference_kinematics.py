@@ -228,7 +228,7 @@ def test_instrument_spec_supplies_d_max():
     spec = load_instrument("sc1")
     r = run_kinematic_selftest(tilts=[1.0 * deg], variants=("L",), instrument=spec)
     assert r["data"]["projection_distance_max_mm"] == spec.projection_distance_max_mm
-    # one row per unit: the canonical, the strict per-axis and the SC-1's own mechanism (issue 11)
+    # one row per unit: the canonical, the strict per-axis and the SC-1's own mechanism
     rows = [(row["unit"], row["tilt_deg"]) for row in r["residuals"]]
     assert rows == [
         ("canonical", 1.0),
