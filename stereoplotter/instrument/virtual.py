@@ -97,10 +97,9 @@ SCREWS: Final[tuple[ScrewName, ...]] = get_args(ScrewName)
 CASSETTES: Final[tuple[CassetteName, ...]] = get_args(CassetteName)
 DECENTRATIONS: Final[tuple[DecentrationName, ...]] = get_args(DecentrationName)
 KNOBS: Final[tuple[KnobName, ...]] = get_args(KnobName)
-_SCREWS = SCREWS
 _SET: tuple[SetControl, ...] = get_args(SetControl)
 #: Every control an operator can turn to a reading.
-CONTROLS = _SCREWS + _SET
+CONTROLS = SCREWS + _SET
 #: The metre height scale geared to the Z screw: reading = slip − D·M_в/1000 [m].
 HEIGHT_SCALE: Final[HeightScaleName] = "H"
 #: Reading of the height scale at D = 0 before the operator slips it (arbitrary constant). [m]
@@ -274,7 +273,7 @@ class Instrument:
             return np.broadcast_to(np.asarray(v, float), shape).copy()
 
         self._scales = _scales(spec, e, full)
-        self._axes = {name: self._make_axis(name) for name in _SCREWS}
+        self._axes = {name: self._make_axis(name) for name in SCREWS}
         self.focal_length_mm = float(focal_length_mm)
         self._f_instrument = full(math.nan)
         self._kappa = {"left": full(0.0), "right": full(0.0)}
@@ -509,12 +508,33 @@ class Instrument:
         """The direction of a counter (+1 or −1)."""
         return self._scales[control].sense
 
-    def screw(self, control: ScrewName) -> tuple[Scale, PlayAxis] | None:
-        """The counter's scale and the closed-form axis of a lead screw, for a caller that
-        repeats :meth:`read` and :meth:`set` on them with the same arithmetic (the operator's
-        look-and-correct passes); None for a pymunk axis."""
+    def drive_screw(
+        self,
+        control: ScrewName,
+        target: NDArray[np.float64],
+        active: NDArray[np.bool_],
+        passes: int,
+        limit: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+        side: str | None = None,
+    ) -> bool:
+        """Look-and-correct passes of a lead screw over T trials: each pass reads the counter
+        exactly, adds the carriage's error from ``target`` on the ``active`` trials, passes the
+        reading through ``limit`` (the caller's stop rule) and sets it from ``side`` — the
+        arithmetic of :meth:`read` (exact) and :meth:`set`, on the axis's own (T,) arrays
+        without the copies and checks of each call. False (nothing done) for a pymunk axis or a
+        single instrument, which the caller drives by :meth:`read` and :meth:`set`. [mm]"""
         axis = self._axes[control]
-        return (self._scales[control], axis) if isinstance(axis, PlayAxis) else None
+        if not self.trials or not isinstance(axis, PlayAxis):
+            return False
+        scale = self._scales[control]
+        zero, gain = scale.zero, scale.gain
+        for _ in range(passes):
+            err = np.where(active, target - axis.position_view, 0.0)
+            reading = np.asarray(zero + gain * axis.nut_view) + err  # the exact reading + error
+            cmd = limit(reading)
+            nut = (cmd - zero) / gain  # Scale.position
+            axis.move(nut, side, owned=nut.shape == axis.h.shape)
+        return True
 
     def travel_mm(self, control: ScrewName) -> tuple[float, float]:
         """The range stops of a lead-screw axis (nut positions). [mm]
@@ -592,7 +612,10 @@ class Instrument:
     def setting(self) -> InstrumentSetting:
         """The physical setting: f_пр, base and the plumb of S_л at X = Y = 0."""
         axes = [self._axes[n] for n in ("bx", "by", "bz")]
-        key = (self._f_instrument, *(a._car if isinstance(a, PlayAxis) else None for a in axes))
+        key = (
+            self._f_instrument,
+            *(a.position_view if isinstance(a, PlayAxis) else None for a in axes),
+        )
         cached = self._setting_cache
         if cached is not None and all(map(operator.is_, key, cached[0])) and key[-1] is not None:
             return cached[1]  # f_пр and the base carriages as they were (arrays are replaced)
@@ -795,7 +818,7 @@ class Instrument:
 def _nut(axis: Any) -> Any:
     """The nut positions of an axis to compute with (not to keep): a PlayAxis's own array,
     which it replaces and never writes into, instead of the copy of ``axis.nut``."""
-    return axis._nut if isinstance(axis, PlayAxis) else axis.nut
+    return axis.nut_view if isinstance(axis, PlayAxis) else axis.nut
 
 
 def _replace(unit: CorrectionUnit, **changes: Any) -> CorrectionUnit:

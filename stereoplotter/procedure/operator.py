@@ -16,7 +16,7 @@ one seed, so that a vectorised run and a per-trial loop draw identical numbers f
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields, replace
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -70,9 +70,6 @@ __all__ = [
 DrivenControl = Literal[ScrewName, CassetteName, KnobName]
 #: Controls the operator sets to a computed reading on their scale (:meth:`Operator.set`).
 SetControlName = Literal[ScrewName, SetControl, HeightScaleName]
-
-_SCREWS = SCREWS
-_KNOBS = KNOBS
 
 
 @dataclass(frozen=True, slots=True)
@@ -485,7 +482,7 @@ class Operator:
         if not np.any(active):
             return self.v(value)
         value = self.v(value)
-        if control in _SCREWS or control == HEIGHT_SCALE:
+        if control in SCREWS or control == HEIGHT_SCALE:
             lc = self.least_count(control)
             cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
             prev = self.v(self.inst.read(control, exact=True))
@@ -534,12 +531,12 @@ class Operator:
 
     def physical(self, control: DrivenControl) -> NDArray[np.float64]:
         """Where a control physically is (what the eye judges in the eyepiece)."""
-        if control in _SCREWS:
+        if control in SCREWS:
             now = self.inst.position(control)  # a copy of the carriages
             return now if self.trials and np.shape(now) == (self.trials,) else self.v(now)
         if control.startswith("kappa_"):
             return self.v(self.inst.unit(control.split("_")[1]).kappa)
-        if control in _KNOBS:
+        if control in KNOBS:
             _, axis, side = control.split("_")
             unit = self.inst.unit(side)
             return self.v(unit.tan_alpha if axis == "alpha" else unit.tan_omega)
@@ -559,21 +556,24 @@ class Operator:
         active = self.all() if active is None else active
         if not np.any(active):
             return
-        parts = self.inst.screw(control) if self.trials and control in _SCREWS else None
-        if parts is not None:  # a closed-form lead screw over T trials
+        if self.trials and control in SCREWS:  # a lead screw over T trials: the fast path
+            screw = cast(ScrewName, control)
             target = np.asarray(target, float)  # only read: no copy of a (T,) target
             if target.shape != (self.trials,):
                 target = self.v(target)
-            self._drive_screw(control, target, active, parts)
-            return
+            side = self.model.finish_side
+            if self.inst.drive_screw(
+                screw, target, active, self.passes, lambda r: self._at_stop(screw, r), side
+            ):
+                return
         target = self.v(target)
         for _ in range(self.passes):
             now = self.physical(control)
             err = np.where(active, target - now, 0.0)
-            if control in _SCREWS:
+            if control in SCREWS:
                 cmd = self._at_stop(control, self.v(self.inst.read(control, exact=True)) + err)
                 self.inst.set(control, cmd, side=self.model.finish_side)
-            elif control in _KNOBS:
+            elif control in KNOBS:
                 cmd = self.commanded.get(control, now) + err
                 self.inst.turn_knob(control, cmd)
                 self.commanded[control] = cmd
@@ -581,21 +581,6 @@ class Operator:
                 cmd = self.commanded.get(control, now) + err
                 self.inst.set(control, cmd)
                 self.commanded[control] = cmd
-
-    def _drive_screw(self, control: ScrewName, target, active, parts) -> None:
-        """:meth:`drive` of a closed-form lead screw over T trials (``parts``: its scale and
-        axis, ``Instrument.screw``): the same passes and arithmetic (``Instrument.read`` exact,
-        :meth:`_at_stop`, ``Instrument.set``) on the axis's own (T,) arrays, without the copies
-        and checks of each call."""
-        side = self.model.finish_side
-        scale, axis = parts
-        zero, gain = scale.zero, scale.gain
-        for _ in range(self.passes):
-            err = np.where(active, target - axis._car, 0.0)
-            reading = np.asarray(zero + gain * axis._nut) + err  # the exact reading + error
-            cmd = self._at_stop(control, reading)
-            nut = (cmd - zero) / gain  # Scale.position
-            axis.move(nut, side, owned=nut.shape == axis.h.shape)
 
     # --- looking ------------------------------------------------------------------------------
 
