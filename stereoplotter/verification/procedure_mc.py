@@ -50,10 +50,12 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.accuracy.chapter5 import (
@@ -289,11 +291,27 @@ def _levelling_frame_points(prep):
     return ids, instrument_frame_m(local, origin, float(prep.sheet.frame_rotation))
 
 
-def _setup_fields(sc, zero_run, g, xr, grid):
+#: A run's fields: (result, noise) → field name → per-trial values over the domain, (T, n).
+Fields = Callable[[Any, Any], dict[str, NDArray[np.float64]]]
+#: The decomposition's mean squares: (result, the run's fields) → (reading, level) → (T,).
+Decompose = Callable[[Any, dict[str, NDArray[np.float64]]], dict[tuple[str, str], Any]]
+
+
+@dataclass(frozen=True)
+class FieldMaker:
+    """What a method's procedure MC measures on a run: its ``fields`` and, for the setup-data
+    method, the per-trial mean squares of their first-order ``decompose`` (None: none)."""
+
+    fields: Fields
+    decompose: Decompose | None = None
+
+
+def _setup_fields(sc, zero_run, g, xr, grid, sigma_control: float = 0.0):
     """Field makers of the setup-data method: δp on the (6.27) domain ("parallax", task 1), and
     on the chapter-5 domain after levelling on Fig. 39's four control points (task 2,
     :data:`METHODS` "setup_control"): "levelled" with exact control heights, "observed" with
-    each control height's parallax observed with σ_c (keyed draws ``mc/control/i``)."""
+    each control height's parallax observed with σ_c = ``sigma_control`` (keyed draws
+    ``mc/control/i``)."""
 
     f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
     sheet = zero_run.sheet
@@ -314,7 +332,7 @@ def _setup_fields(sc, zero_run, g, xr, grid):
         dom, ctl = d[:, first_lev : first_lev + nl], d[:, first_ctl:]
         return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
 
-    def fields(result, noise, sigma_control=0.0):
+    def fields(result, noise):
         d = dp_at(sc, result.sheet, result.instrument, allp) - zero
         out = readings(d)
         obs = np.stack(
@@ -343,8 +361,7 @@ def _setup_fields(sc, zero_run, g, xr, grid):
             out.update({(key, step): np.mean(v**2, axis=-1) for key, v in r.items()})
         return out
 
-    fields.decompose = decompose
-    return fields, zero[:n]
+    return FieldMaker(fields, decompose), zero[:n]
 
 
 def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
@@ -385,7 +402,7 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
             "book": e[:, :n] - ctl @ refit.T,
         }
 
-    return fields, d_zero
+    return FieldMaker(fields), d_zero
 
 
 def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
@@ -429,15 +446,10 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
     zero_prep = prepared(zero)
     zero_run = run_trials_chunk(zero_prep, 0, None, evaluate=False, transcript=False)
     if base == "setup":
-        make, d_zero = _setup_fields(sc, zero_run, g, xr, grid)
-        sc_sigma = float(options.get("sigma_control", 0.0))
-
-        def fields(result, noise):
-            return make(result, noise, sc_sigma)
-
-        fields.decompose = make.decompose
+        sigma_control = float(options.get("sigma_control", 0.0))
+        maker, d_zero = _setup_fields(sc, zero_run, g, xr, grid, sigma_control)
     else:
-        fields, d_zero = _conventional_fields(
+        maker, d_zero = _conventional_fields(
             sc, zero_prep, zero_run, g, xr, grid, op.stereo_sigma_mm
         )
     prep = prepared(op, None if instrument else "zero")
@@ -447,7 +459,7 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         result = run_trials_chunk(
             prep, 0, n, evaluate=False, transcript=False, injected=injected, noise=noise
         )
-        return fields(result, noise)
+        return maker.fields(result, noise)
 
     lin = cvar.linear_control(run, model) if options.get("control_variate", True) else None
     chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, base)
@@ -465,12 +477,12 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         result = run_trials_chunk(
             prep, first, m, evaluate=False, transcript=False, injected=injected, noise=noise
         )
-        fs = fields(result, noise)
+        fs = maker.fields(result, noise)
         on = _inputs_on(lin, part, m) if lin and off else None
         cv = cvar.per_trial_controlled(fs, lin, noise, injected, model, on) if lin else {}
         ms = {name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()}
-        if hasattr(fields, "decompose"):  # already mean squares
-            ms.update(fields.decompose(result, fs))
+        if maker.decompose is not None:  # already mean squares
+            ms.update(maker.decompose(result, fs))
         for name, v in ms.items():
             plain.setdefault(name, np.empty(int(trials)))[first : first + m] = v
             if lin and name in cv:
