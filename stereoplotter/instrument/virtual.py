@@ -53,6 +53,7 @@ __all__ = [
     "BACKENDS",
     "CASSETTES",
     "CONTROLS",
+    "CONTROL_INFO",
     "DECENTRATIONS",
     "HEIGHT_SCALE",
     "KNOBS",
@@ -60,6 +61,8 @@ __all__ = [
     "SCREWS",
     "CassetteName",
     "Control",
+    "ControlInfo",
+    "ControlKind",
     "DecentrationName",
     "HeightScaleName",
     "Instrument",
@@ -69,6 +72,9 @@ __all__ = [
     "ScrewName",
     "SetControl",
     "Side",
+    "control_axis",
+    "control_kind",
+    "control_side",
 ]
 
 #: Mechanics back-ends of the lead-screw axes.
@@ -100,6 +106,82 @@ KNOBS: Final[tuple[KnobName, ...]] = get_args(KnobName)
 _SET: tuple[SetControl, ...] = get_args(SetControl)
 #: Every control an operator can turn to a reading.
 CONTROLS = SCREWS + _SET
+
+#: What a control is: a lead screw with its counter, the principal-distance scale, a cassette
+#: rotation, a decentration scale, a correction knob or the height scale.
+ControlKind = Literal[
+    "screw", "principal_distance", "cassette", "decentration", "knob", "height_scale"
+]
+
+
+@dataclass(frozen=True, slots=True)
+class ControlInfo:
+    """One control of the instrument, declared once (:data:`CONTROL_INFO`).
+
+    Attributes
+    ----------
+    name : str
+        The control's name (:data:`Control`).
+    kind : ControlKind
+    unit : str
+        Unit of its setting: "mm" (screws, f_пр, decentrations), "rad" (cassettes), "tan" (a
+        knob: the tangent of the tilt it represents), "m" (the height scale).
+    side : {"left", "right"} or None
+        The photo it acts on (None: both, the carriages and the base).
+    axis : str or None
+        A decentration's "x" or "y", a knob's "alpha" or "omega" (None: none).
+    """
+
+    name: str
+    kind: ControlKind
+    unit: str
+    side: Side | None = None
+    axis: str | None = None
+
+
+def _control_table() -> dict[str, ControlInfo]:
+    out = {name: ControlInfo(name, "screw", "mm") for name in SCREWS}
+    out["f_instrument"] = ControlInfo("f_instrument", "principal_distance", "mm")
+    out["H"] = ControlInfo("H", "height_scale", "m")
+    sides: tuple[Side, ...] = ("left", "right")
+    for side in sides:
+        out[f"kappa_{side}"] = ControlInfo(f"kappa_{side}", "cassette", "rad", side)
+        for axis in ("x", "y"):
+            name = f"d{axis}_{side}"
+            out[name] = ControlInfo(name, "decentration", "mm", side, axis)
+        for axis in ("alpha", "omega"):
+            name = f"k_{axis}_{side}"
+            out[name] = ControlInfo(name, "knob", "tan", side, axis)
+    return out
+
+
+#: Every control → its :class:`ControlInfo`: the instrument and the operator dispatch on its
+#: ``kind`` and take its ``side`` and ``axis`` from here, never from the name's spelling.
+CONTROL_INFO: Final[dict[str, ControlInfo]] = _control_table()
+
+
+def control_kind(control: str) -> ControlKind | None:
+    """The kind of ``control`` (None: not a control of the instrument)."""
+    info = CONTROL_INFO.get(control)
+    return None if info is None else info.kind
+
+
+def control_side(control: str) -> Side:
+    """The photo a cassette, decentration or knob acts on."""
+    side = CONTROL_INFO[control].side
+    if side is None:
+        raise StereoplotterError(f"{control!r} acts on no single photo")
+    return side
+
+
+def control_axis(control: str) -> str:
+    """A decentration's "x" or "y", a knob's "alpha" or "omega"."""
+    axis = CONTROL_INFO[control].axis
+    if axis is None:
+        raise StereoplotterError(f"{control!r} has no axis")
+    return axis
+
+
 #: The metre height scale geared to the Z screw: reading = slip − D·M_в/1000 [m].
 HEIGHT_SCALE: Final[HeightScaleName] = "H"
 #: Reading of the height scale at D = 0 before the operator slips it (arbitrary constant). [m]
@@ -382,9 +464,9 @@ class Instrument:
         if control in self._axes:
             reading = scale.reading(_nut(self._axes[control]))
         else:
-            side = control.split("_")[1]
-            unit = self._units[side]
-            value = unit.decentration_x_mm if control.startswith("dx") else unit.decentration_y_mm
+            unit = self._units[control_side(control)]
+            x = control_axis(control) == "x"
+            value = unit.decentration_x_mm if x else unit.decentration_y_mm
             reading = scale.reading(value)
         out = reading if exact else scale.rounded(reading)
         return self._out(out)
@@ -425,14 +507,14 @@ class Instrument:
             check_in_range(self.spec, "f_instrument_range_mm", float(np.max(value)), "f_пр")
             check_in_range(self.spec, "f_instrument_range_mm", float(np.min(value)), "f_пр")
             self._f_instrument = value + self.injected["setting.f_instrument"]
-        elif control.startswith("kappa_"):
-            side_name = control.split("_")[1]
+        elif control_kind(control) == "cassette":
+            side_name = control_side(control)
             for v in (np.min(value), np.max(value)):
                 check_in_range(self.spec, "kappa_range", float(v), f"κ_{side_name}")
             self._kappa[side_name] = value + self.injected[f"setting.kappa_{side_name}"]
             self._units[side_name] = _replace(self._units[side_name], kappa=self._kappa[side_name])
-        elif control in ("dx_left", "dy_left", "dx_right", "dy_right"):
-            axis, side_name = control.split("_")
+        elif control_kind(control) == "decentration":
+            axis, side_name = f"d{control_axis(control)}", control_side(control)
             d = self._scales[control].position(value) + self.injected[f"setting.{control}"]
             for v in (np.min(d), np.max(d)):
                 check_in_range(
@@ -496,10 +578,9 @@ class Instrument:
         if control in self._axes:
             position = np.asarray(self._axes[control].nut, float).reshape(np.shape(scale.zero))
         else:
-            unit = self._units[control.split("_")[1]]
-            position = (
-                unit.decentration_x_mm if control.startswith("dx") else unit.decentration_y_mm
-            )
+            unit = self._units[control_side(control)]
+            x = control_axis(control) == "x"
+            position = unit.decentration_x_mm if x else unit.decentration_y_mm
         now = scale.reading(position)
         zero = now - sense * (1.0 + scale.ratio_error) * np.asarray(position, float)
         self._scales[control] = replace(scale, zero=zero, sense=sense)

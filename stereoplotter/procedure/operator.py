@@ -42,6 +42,9 @@ from stereoplotter.instrument.virtual import (
     ScrewName,
     SetControl,
     Side,
+    control_axis,
+    control_kind,
+    control_side,
 )
 from stereoplotter.procedure.evaluation import (
     instrument_frame_m,
@@ -489,7 +492,8 @@ class Operator:
             cmd = self._at_stop(control, cmd)
             self.inst.set(control, np.where(active, cmd, prev), side=self.model.finish_side)
         else:
-            lc = self.inst.spec.xy_least_count_mm if control.startswith(("d", "f_")) else 0.0
+            on_xy_scale = control_kind(control) in ("decentration", "principal_distance")
+            lc = self.inst.spec.xy_least_count_mm if on_xy_scale else 0.0
             cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
             prev = self.commanded.get(control, cmd)
             cmd = np.where(active, cmd, prev)
@@ -534,10 +538,10 @@ class Operator:
         if control in SCREWS:
             now = self.inst.position(control)  # a copy of the carriages
             return now if self.trials and np.shape(now) == (self.trials,) else self.v(now)
-        if control.startswith("kappa_"):
-            return self.v(self.inst.unit(control.split("_")[1]).kappa)
+        if control_kind(control) == "cassette":
+            return self.v(self.inst.unit(control_side(control)).kappa)
         if control in KNOBS:
-            _, axis, side = control.split("_")
+            axis, side = control_axis(control), control_side(control)
             unit = self.inst.unit(side)
             return self.v(unit.tan_alpha if axis == "alpha" else unit.tan_omega)
         raise StereoplotterError(f"cannot drive {control!r}")
@@ -682,19 +686,20 @@ class Operator:
         units with the control turned; the other photo's rod and cos κ, sin κ of a knob's unit
         are computed once.
         """
-        side = control.split("_")[-1]
+        side = control_side(control)
         other = "right" if side == "left" else "left"
         pts = {"left": np.asarray(images[0], float), "right": np.asarray(images[1], float)}
         setting = self.inst.setting
         fixed = self.unit_map(other).rod_xy(pts[other][..., 0], pts[other][..., 1])
         base = self.unit_map(side)
         x, y = pts[side][..., 0], pts[side][..., 1]
-        if control.startswith("kappa_"):
+        cassette = control_kind(control) == "cassette"
+        if cassette:
 
             def turned(value):
                 return base.with_kappa(value)
         else:
-            axis = control.split("_")[1]
+            axis = control_axis(control)
             linkage = self.inst.variant.linkage
 
             def turned(value):
@@ -709,7 +714,7 @@ class Operator:
         # a knob's turn at one point is element-wise arithmetic and square roots (the mechanisms'
         # scales too), no cos, sin, whose vectorised loops may round differently by position:
         # x, x ± h at once
-        q.stacked = not control.startswith("kappa_") and np.ndim(x) == 0 and np.ndim(y) == 0
+        q.stacked = not cassette and np.ndim(x) == 0 and np.ndim(y) == 0
         return q
 
     def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):
@@ -730,7 +735,7 @@ class Operator:
 
         A 1-D Newton solve on the unit model with the instrument's own linkage (D1).
         """
-        _, axis, side = knob.split("_")
+        axis, side = control_axis(knob), control_side(knob)
         linkage = self.inst.variant.linkage
         trig = self.unit_map(side, unit).trig  # κ stays while the knob turns
         rod = np.asarray(rod, float)

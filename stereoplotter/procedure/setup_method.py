@@ -22,7 +22,13 @@ from numpy.typing import NDArray
 
 from stereoplotter.instrument.kinematics import rod_from_counters
 from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
+from stereoplotter.instrument.virtual import (
+    CONTROL_INFO,
+    HEIGHT_SCALE,
+    NOMINAL_ZERO,
+    Side,
+    control_kind,
+)
 from stereoplotter.procedure import steps
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.levelling import LevelDesign
@@ -558,7 +564,7 @@ def r2_element_bounds(spec) -> dict[str, tuple[float, float]]:
     mid, half = 0.5 * (lo_k + hi_k), 0.5 * (hi_k - lo_k) * R2_RANGE_FRACTION
     t = float(np.tan(spec.tilt_max * R2_RANGE_FRACTION))
     return {
-        name: (mid - half, mid + half) if name.startswith("kappa") else (-t, t)
+        name: (mid - half, mid + half) if control_kind(name) == "cassette" else (-t, t)
         for name in Q_ELEMENTS
     }
 
@@ -622,7 +628,7 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
             control,
             before=before,
             after=op.physical(control),
-            unit="rad" if control.startswith("kappa") else "tan",
+            unit=CONTROL_INFO[control].unit,
             iteration=it,
             equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
             remedy=remedy,
@@ -707,7 +713,7 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
                 control,
                 before=before,
                 after=after,
-                unit="mm" if control == "bz" else ("rad" if control.startswith("kappa") else "tan"),
+                unit=CONTROL_INFO[control].unit,
                 iteration=it,
                 equation="levelling on control (assumption, q-neutral common tilt)",
                 remedy=remedy,
