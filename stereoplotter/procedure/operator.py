@@ -15,6 +15,7 @@ one seed, so that a vectorised run and a per-trial loop draw identical numbers f
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 from typing import Any, Literal, cast
 
@@ -60,6 +61,7 @@ from stereoplotter.scenario.synthetic import film_deformed
 
 __all__ = [
     "DrivenControl",
+    "Look",
     "Noise",
     "Operator",
     "OperatorModel",
@@ -258,13 +260,26 @@ class Noise:
         return z
 
 
+@dataclass(frozen=True)
+class Look:
+    """The operator's 1-D look: ``fn(value)`` is what is seen with a control at ``value``.
+    ``stacked``: ``fn`` may be given x, x + h, x − h stacked on a new leading axis
+    (:func:`solve_1d`)."""
+
+    fn: Callable[[Any], NDArray[np.float64]]
+    stacked: bool = False
+
+    def __call__(self, value: Any) -> NDArray[np.float64]:
+        return self.fn(value)
+
+
 def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: float = 1e-6):
     """x with fun(x) = target by a fixed number of Newton steps (central differences).
 
     A fixed count (no early exit) keeps a vectorised run and a per-trial loop bit-identical.
-    A ``fun`` with the attribute ``stacked`` set is evaluated once per step on x, x + h, x − h
-    stacked on a new leading axis (it must give each the bits it gives alone: element-wise
-    IEEE arithmetic and square roots only).
+    A :class:`Look` with ``stacked`` set is evaluated once per step on x, x + h, x − h stacked
+    on a new leading axis (it must give each the bits it gives alone: element-wise IEEE
+    arithmetic and square roots only).
 
     Examples
     --------
@@ -273,7 +288,7 @@ def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: floa
     """
     x = np.asarray(x0, float) + 0.0
     t = np.asarray(target, float)
-    stacked = getattr(fun, "stacked", False)
+    stacked = isinstance(fun, Look) and fun.stacked
     for _ in range(iterations):
         if stacked:
             v = fun(np.stack([x, x + h, x - h]))
@@ -677,7 +692,9 @@ class Operator:
                 self.drive(axis, value, active)
         return r.y_parallax_mm + eq, r.y_parallax_mm
 
-    def q_turning(self, control: CassetteName | KnobName, images: tuple[ArrayLike, ArrayLike]):
+    def q_turning(
+        self, control: CassetteName | KnobName, images: tuple[ArrayLike, ArrayLike]
+    ) -> Look:
         """q at homologous points as a function of where ``control`` (a cassette κ or a
         correction knob) would be, the rest of the instrument as it is now: the operator's 1-D
         look for :func:`solve_1d`.
@@ -714,8 +731,7 @@ class Operator:
         # a knob's turn at one point is element-wise arithmetic and square roots (the mechanisms'
         # scales too), no cos, sin, whose vectorised loops may round differently by position:
         # x, x ± h at once
-        q.stacked = not cassette and np.ndim(x) == 0 and np.ndim(y) == 0
-        return q
+        return Look(q, stacked=not cassette and np.ndim(x) == 0 and np.ndim(y) == 0)
 
     def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):
         """The true y-parallax of the present model at ground points (no judgment). [mm]"""
