@@ -552,7 +552,7 @@ def levelling_points_photo(scenario: Scenario, spec: InstrumentSpec, g: dict):
     return lev[:, 0] * s - g["p"], lev[:, 1] * s
 
 
-def _rms_ci(ms, unit):
+def rms_ci(ms, unit):
     """(RMS, CI half-width) per ``unit`` from per-trial mean squares (``CI_Z`` s.e.)."""
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(max(mean_ms, 0.0))
@@ -744,7 +744,9 @@ def procedure_mc(
     )
     g = scenario_geometry(scenario, spec)
     linkage = o.switches(spec).linkage
-    plain, controlled, d_zero, units = _run(scenario, spec, method, trials, seed, o, g, linkage)
+    plain, controlled, d_zero, units = run_configuration(
+        scenario, spec, method, trials, seed, o, g, linkage
+    )
     out = _result(scenario, spec, method, o, g, linkage, (plain, controlled, d_zero, units))
     return {**out, "trials": int(trials), "seed": int(seed), "seconds": time.perf_counter() - t0}
 
@@ -755,7 +757,7 @@ def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
     name = _field_name(method, o.quantity, o.levelling, o.datum, o.control)
     best = controlled or plain
     unit = units[name]
-    coefficient, ci = _rms_ci(best[name], unit)
+    coefficient, ci = rms_ci(best[name], unit)
     if formulas is None:
         formulas = _formulas(method, scenario, spec, g, o.sources, o.control)
     out = {
@@ -770,7 +772,7 @@ def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
         "control_variate": bool(controlled),
         "coefficient": coefficient,
         "ci": ci,
-        "plain": _rms_ci(plain[name], unit),
+        "plain": rms_ci(plain[name], unit),
         "formula": formulas,
         "rms_mm": coefficient * unit,
         "bias_mm": float(np.sqrt(np.mean(d_zero**2))),
@@ -819,7 +821,7 @@ def conventional_sources_mc(
         for src, prefixes in SOURCE_PREFIXES.items()
         for prefix in prefixes
     }
-    plain, controlled, d_zero, units = _run(
+    plain, controlled, d_zero, units = run_configuration(
         scenario, spec, "conventional", int(bounds[-1]), seed, o, g, linkage, off_of
     )
     lev = levelling_formula(g, *levelling_points_photo(scenario, spec, g))
@@ -836,7 +838,7 @@ def conventional_sources_mc(
     return {k: {**v, "seconds": seconds} for k, v in out.items()}
 
 
-def _run(scenario, spec, method, trials, seed, o, g, linkage, off=None):
+def run_configuration(scenario, spec, method, trials, seed, o, g, linkage, off=None):
     """The runs of :func:`procedure_mc`: per-trial mean squares (plain, controlled), the
     error-free δp and the unit of each field [photo mm]. ``off``: key prefix → (trials,) mask of
     the trials whose acts of that prefix draw 0 (:func:`conventional_sources_mc`; the run then
@@ -871,7 +873,7 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
     if method == "conventional":
         unit = units["plane"]
         return {
-            "by_datum": {k: _rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
+            "by_datum": {k: rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
             **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
             "sources": o.sources,
         }
@@ -881,13 +883,13 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
         ("levelled", "setup_control", "exact"),
         ("observed", "setup_control", "observed"),
     ):
-        cf, h = _rms_ci(best[key], units[key])
+        cf, h = rms_ci(best[key], units[key])
         ref = _formulas(m, scenario, spec, g, o.sources, c)["rigorous"]
         ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
         fields[key] = {
             "coefficient": cf,
             "ci": h,
-            "plain": _rms_ci(plain[key], units[key]),
+            "plain": rms_ci(plain[key], units[key]),
             "formula": ref,
             "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
             "mean_squares": plain[key],  # per trial, photo mm² (paired switch steps)

@@ -5,7 +5,7 @@ book-mode and rigorous values, the linear Monte Carlo RMS with its CI half-width
 covariance propagation on the same grid, a verdict and a note. The rows are data: each is an
 :class:`~stereoplotter.verification.entry.Entry` built by a small named function of a topic module
 (``rows_chapter5``: Tables 19, 20 and chapter 5; ``rows_setup_elements``: (6.28)–(6.38);
-``rows_outcomes``: (6.39)–(6.46); ``rows_levelled``: (6.47)–(6.61)); :func:`_row_specs` lists
+``rows_outcomes``: (6.39)–(6.46); ``rows_levelled``: (6.47)–(6.61)); :func:`row_entries` lists
 them in order. :func:`closing_comparison` is the book's closing claim (setup data vs the
 conventional method at 60 % and 80 %). Rendered by
 :mod:`stereoplotter.report.verification`, written by
@@ -130,7 +130,7 @@ STEP_TRIALS = 2000
 INSTRUMENT_TRIALS = {"setup": 4000, "conventional": 600, "y_parallax": 600, "stereo": 300}
 
 
-def _row_specs(g) -> list[Entry]:
+def row_entries(g) -> list[Entry]:
     """Every row of the table as an :class:`~stereoplotter.verification.entry.Entry`, in the
     table's order (a row's random stream is keyed by its identity, not by its place)."""
     s = Setting.from_mapping(g)
@@ -177,7 +177,7 @@ def check_geometry(fields, geometry: dict) -> None:
     try:
         with np.errstate(all="raise"), warnings.catch_warnings():
             warnings.simplefilter("error", RuntimeWarning)
-            specs = _row_specs(g)
+            specs = row_entries(g)
     except (ArithmeticError, ValueError, np.linalg.LinAlgError, RuntimeWarning) as exc:
         raise fields.error(
             "(geometry)",
@@ -581,7 +581,7 @@ def run_verification(
     pending = start_procedure_mc(
         procedure_trials, seed, procedure_scenarios, instrument=instrument, linkage=linkage
     )  # in worker processes while the linear rows are computed here
-    specs = _row_specs(g)
+    specs = row_entries(g)
     rows = _rows(specs, trials, seed, progress, Setting.from_mapping(g).is_book)
     attach_procedure_mc(rows, pending.result())
     return rows

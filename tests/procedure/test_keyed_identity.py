@@ -66,7 +66,7 @@ def test_an_inserted_step_changes_no_other_result(monkeypatch, method, module, b
 
 
 def _linear_rows(monkeypatch, insert: bool) -> list[dict]:
-    specs = table._row_specs
+    specs = table.row_entries
 
     def with_dummy(g):
         rows = specs(g)
@@ -74,7 +74,7 @@ def _linear_rows(monkeypatch, insert: bool) -> list[dict]:
         return [rows[0], dummy, *rows[1:]]
 
     if insert:
-        monkeypatch.setattr(table, "_row_specs", with_dummy)
+        monkeypatch.setattr(table, "row_entries", with_dummy)
     return table.run_verification(trials=300, seed=5, procedure_trials=0)
 
 
@@ -89,7 +89,7 @@ def test_an_inserted_verification_row_changes_no_other_row(monkeypatch):
 
 
 def test_two_rows_of_one_identity_are_refused(monkeypatch):
-    specs = table._row_specs
-    monkeypatch.setattr(table, "_row_specs", lambda g: [*specs(g), specs(g)[3]])
+    specs = table.row_entries
+    monkeypatch.setattr(table, "row_entries", lambda g: [*specs(g), specs(g)[3]])
     with pytest.raises(ValueError, match="share the identity"):
         table.run_verification(trials=10, seed=5, procedure_trials=0)
