@@ -372,7 +372,20 @@ class UnitMap:
     """
 
     __slots__ = (
-        "c", "ex", "ey", "f", "kx", "ky", "mech", "ms", "num", "s", "strict", "ta", "to", "unit"
+        "c",
+        "ex",
+        "ey",
+        "f",
+        "kx",
+        "ky",
+        "mech",
+        "ms",
+        "num",
+        "s",
+        "strict",
+        "ta",
+        "to",
+        "unit",
     )
 
     def __init__(

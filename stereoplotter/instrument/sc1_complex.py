@@ -1,4 +1,4 @@
-r"""Options of the SC complex built around the SC-1 (issue 11, deliverable 4); off by default.
+r"""Options of the SC complex built around the SC-1; off by default.
 
 * The systematic-error correction unit: corrects symmetric and asymmetric image errors
   (distortion, film deformation) within ±100 µm with an instrumental RMS of ±3 µm (documented,

@@ -38,7 +38,12 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.mechanics.base import N_PER_UM, AxisParams
+from stereoplotter.instrument.mechanics.coordinatograph import (
+    Coordinatograph,
+    CoordinatographParams,
+)
 from stereoplotter.instrument.mechanics.play import PlayAxis
+from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis
 from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import AutomaticCoordinatograph, SC1Options
 from stereoplotter.spec.instrument_spec import InstrumentSpec
@@ -48,6 +53,7 @@ __all__ = [
     "BACKENDS",
     "CASSETTES",
     "CONTROLS",
+    "CONTROL_INFO",
     "DECENTRATIONS",
     "HEIGHT_SCALE",
     "KNOBS",
@@ -55,6 +61,8 @@ __all__ = [
     "SCREWS",
     "CassetteName",
     "Control",
+    "ControlInfo",
+    "ControlKind",
     "DecentrationName",
     "HeightScaleName",
     "Instrument",
@@ -64,6 +72,9 @@ __all__ = [
     "ScrewName",
     "SetControl",
     "Side",
+    "control_axis",
+    "control_kind",
+    "control_side",
 ]
 
 #: Mechanics back-ends of the lead-screw axes.
@@ -92,10 +103,85 @@ SCREWS: Final[tuple[ScrewName, ...]] = get_args(ScrewName)
 CASSETTES: Final[tuple[CassetteName, ...]] = get_args(CassetteName)
 DECENTRATIONS: Final[tuple[DecentrationName, ...]] = get_args(DecentrationName)
 KNOBS: Final[tuple[KnobName, ...]] = get_args(KnobName)
-_SCREWS = SCREWS
 _SET: tuple[SetControl, ...] = get_args(SetControl)
 #: Every control an operator can turn to a reading.
-CONTROLS = _SCREWS + _SET
+CONTROLS = SCREWS + _SET
+
+#: What a control is: a lead screw with its counter, the principal-distance scale, a cassette
+#: rotation, a decentration scale, a correction knob or the height scale.
+ControlKind = Literal[
+    "screw", "principal_distance", "cassette", "decentration", "knob", "height_scale"
+]
+
+
+@dataclass(frozen=True, slots=True)
+class ControlInfo:
+    """One control of the instrument, declared once (:data:`CONTROL_INFO`).
+
+    Attributes
+    ----------
+    name : str
+        The control's name (:data:`Control`).
+    kind : ControlKind
+    unit : str
+        Unit of its setting: "mm" (screws, f_пр, decentrations), "rad" (cassettes), "tan" (a
+        knob: the tangent of the tilt it represents), "m" (the height scale).
+    side : {"left", "right"} or None
+        The photo it acts on (None: both, the carriages and the base).
+    axis : str or None
+        A decentration's "x" or "y", a knob's "alpha" or "omega" (None: none).
+    """
+
+    name: str
+    kind: ControlKind
+    unit: str
+    side: Side | None = None
+    axis: str | None = None
+
+
+def _control_table() -> dict[str, ControlInfo]:
+    out = {name: ControlInfo(name, "screw", "mm") for name in SCREWS}
+    out["f_instrument"] = ControlInfo("f_instrument", "principal_distance", "mm")
+    out["H"] = ControlInfo("H", "height_scale", "m")
+    sides: tuple[Side, ...] = ("left", "right")
+    for side in sides:
+        out[f"kappa_{side}"] = ControlInfo(f"kappa_{side}", "cassette", "rad", side)
+        for axis in ("x", "y"):
+            name = f"d{axis}_{side}"
+            out[name] = ControlInfo(name, "decentration", "mm", side, axis)
+        for axis in ("alpha", "omega"):
+            name = f"k_{axis}_{side}"
+            out[name] = ControlInfo(name, "knob", "tan", side, axis)
+    return out
+
+
+#: Every control → its :class:`ControlInfo`: the instrument and the operator dispatch on its
+#: ``kind`` and take its ``side`` and ``axis`` from here, never from the name's spelling.
+CONTROL_INFO: Final[dict[str, ControlInfo]] = _control_table()
+
+
+def control_kind(control: str) -> ControlKind | None:
+    """The kind of ``control`` (None: not a control of the instrument)."""
+    info = CONTROL_INFO.get(control)
+    return None if info is None else info.kind
+
+
+def control_side(control: str) -> Side:
+    """The photo a cassette, decentration or knob acts on."""
+    side = CONTROL_INFO[control].side
+    if side is None:
+        raise StereoplotterError(f"{control!r} acts on no single photo")
+    return side
+
+
+def control_axis(control: str) -> str:
+    """A decentration's "x" or "y", a knob's "alpha" or "omega"."""
+    axis = CONTROL_INFO[control].axis
+    if axis is None:
+        raise StereoplotterError(f"{control!r} has no axis")
+    return axis
+
+
 #: The metre height scale geared to the Z screw: reading = slip − D·M_в/1000 [m].
 HEIGHT_SCALE: Final[HeightScaleName] = "H"
 #: Reading of the height scale at D = 0 before the operator slips it (arbitrary constant). [m]
@@ -269,7 +355,7 @@ class Instrument:
             return np.broadcast_to(np.asarray(v, float), shape).copy()
 
         self._scales = _scales(spec, e, full)
-        self._axes = {name: self._make_axis(name) for name in _SCREWS}
+        self._axes = {name: self._make_axis(name) for name in SCREWS}
         self.focal_length_mm = float(focal_length_mm)
         self._f_instrument = full(math.nan)
         self._kappa = {"left": full(0.0), "right": full(0.0)}
@@ -352,8 +438,6 @@ class Instrument:
         lo, hi = params.range_mm
         start = 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi)
         if self.backend == "pymunk" and name in ("X", "Y", "Z"):
-            from stereoplotter.instrument.mechanics.pymunk_axis import PymunkAxis
-
             return PymunkAxis(params, start_mm=start)
         axis = PlayAxis(params, trials=self.trials if self.trials is not None else 1)
         axis.place(start)
@@ -380,9 +464,9 @@ class Instrument:
         if control in self._axes:
             reading = scale.reading(_nut(self._axes[control]))
         else:
-            side = control.split("_")[1]
-            unit = self._units[side]
-            value = unit.decentration_x_mm if control.startswith("dx") else unit.decentration_y_mm
+            unit = self._units[control_side(control)]
+            x = control_axis(control) == "x"
+            value = unit.decentration_x_mm if x else unit.decentration_y_mm
             reading = scale.reading(value)
         out = reading if exact else scale.rounded(reading)
         return self._out(out)
@@ -423,14 +507,14 @@ class Instrument:
             check_in_range(self.spec, "f_instrument_range_mm", float(np.max(value)), "f_пр")
             check_in_range(self.spec, "f_instrument_range_mm", float(np.min(value)), "f_пр")
             self._f_instrument = value + self.injected["setting.f_instrument"]
-        elif control.startswith("kappa_"):
-            side_name = control.split("_")[1]
+        elif control_kind(control) == "cassette":
+            side_name = control_side(control)
             for v in (np.min(value), np.max(value)):
                 check_in_range(self.spec, "kappa_range", float(v), f"κ_{side_name}")
             self._kappa[side_name] = value + self.injected[f"setting.kappa_{side_name}"]
             self._units[side_name] = _replace(self._units[side_name], kappa=self._kappa[side_name])
-        elif control in ("dx_left", "dy_left", "dx_right", "dy_right"):
-            axis, side_name = control.split("_")
+        elif control_kind(control) == "decentration":
+            axis, side_name = f"d{control_axis(control)}", control_side(control)
             d = self._scales[control].position(value) + self.injected[f"setting.{control}"]
             for v in (np.min(d), np.max(d)):
                 check_in_range(
@@ -494,10 +578,9 @@ class Instrument:
         if control in self._axes:
             position = np.asarray(self._axes[control].nut, float).reshape(np.shape(scale.zero))
         else:
-            unit = self._units[control.split("_")[1]]
-            position = (
-                unit.decentration_x_mm if control.startswith("dx") else unit.decentration_y_mm
-            )
+            unit = self._units[control_side(control)]
+            x = control_axis(control) == "x"
+            position = unit.decentration_x_mm if x else unit.decentration_y_mm
         now = scale.reading(position)
         zero = now - sense * (1.0 + scale.ratio_error) * np.asarray(position, float)
         self._scales[control] = replace(scale, zero=zero, sense=sense)
@@ -506,12 +589,33 @@ class Instrument:
         """The direction of a counter (+1 or −1)."""
         return self._scales[control].sense
 
-    def screw(self, control: ScrewName) -> tuple[Scale, PlayAxis] | None:
-        """The counter's scale and the closed-form axis of a lead screw, for a caller that
-        repeats :meth:`read` and :meth:`set` on them with the same arithmetic (the operator's
-        look-and-correct passes); None for a pymunk axis."""
+    def drive_screw(
+        self,
+        control: ScrewName,
+        target: NDArray[np.float64],
+        active: NDArray[np.bool_],
+        passes: int,
+        limit: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+        side: str | None = None,
+    ) -> bool:
+        """Look-and-correct passes of a lead screw over T trials: each pass reads the counter
+        exactly, adds the carriage's error from ``target`` on the ``active`` trials, passes the
+        reading through ``limit`` (the caller's stop rule) and sets it from ``side`` — the
+        arithmetic of :meth:`read` (exact) and :meth:`set`, on the axis's own (T,) arrays
+        without the copies and checks of each call. False (nothing done) for a pymunk axis or a
+        single instrument, which the caller drives by :meth:`read` and :meth:`set`. [mm]"""
         axis = self._axes[control]
-        return (self._scales[control], axis) if isinstance(axis, PlayAxis) else None
+        if not self.trials or not isinstance(axis, PlayAxis):
+            return False
+        scale = self._scales[control]
+        zero, gain = scale.zero, scale.gain
+        for _ in range(passes):
+            err = np.where(active, target - axis.position_view, 0.0)
+            reading = np.asarray(zero + gain * axis.nut_view) + err  # the exact reading + error
+            cmd = limit(reading)
+            nut = (cmd - zero) / gain  # Scale.position
+            axis.move(nut, side, owned=nut.shape == axis.h.shape)
+        return True
 
     def travel_mm(self, control: ScrewName) -> tuple[float, float]:
         """The range stops of a lead-screw axis (nut positions). [mm]
@@ -589,7 +693,10 @@ class Instrument:
     def setting(self) -> InstrumentSetting:
         """The physical setting: f_пр, base and the plumb of S_л at X = Y = 0."""
         axes = [self._axes[n] for n in ("bx", "by", "bz")]
-        key = (self._f_instrument, *(a._car if isinstance(a, PlayAxis) else None for a in axes))
+        key = (
+            self._f_instrument,
+            *(a.position_view if isinstance(a, PlayAxis) else None for a in axes),
+        )
         cached = self._setting_cache
         if cached is not None and all(map(operator.is_, key, cached[0])) and key[-1] is not None:
             return cached[1]  # f_пр and the base carriages as they were (arrays are replaced)
@@ -683,11 +790,6 @@ class Instrument:
             A ratio that is not one of the gears; with the automatic coordinatograph an
             enlargement beyond its documented limit.
         """
-        from stereoplotter.instrument.mechanics.coordinatograph import (
-            Coordinatograph,
-            CoordinatographParams,
-        )
-
         check_in_range(self.spec, "coordinatograph_ratios", float(ratio), "coordinatograph ratio")
         if self.options.automatic_coordinatograph:
             self._servo = AutomaticCoordinatograph.from_spec(self.spec)
@@ -797,7 +899,7 @@ class Instrument:
 def _nut(axis: Any) -> Any:
     """The nut positions of an axis to compute with (not to keep): a PlayAxis's own array,
     which it replaces and never writes into, instead of the copy of ``axis.nut``."""
-    return axis._nut if isinstance(axis, PlayAxis) else axis.nut
+    return axis.nut_view if isinstance(axis, PlayAxis) else axis.nut
 
 
 def _replace(unit: CorrectionUnit, **changes: Any) -> CorrectionUnit:

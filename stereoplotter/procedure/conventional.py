@@ -40,7 +40,14 @@ from stereoplotter.instrument.kinematics import (
     counters_from_homologous_points,
 )
 from stereoplotter.instrument.knobs import turn_correction_knob
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.instrument.virtual import (
+    CONTROL_INFO,
+    HEIGHT_SCALE,
+    NOMINAL_ZERO,
+    control_axis,
+    control_kind,
+    control_side,
+)
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.conventional_sheet import (
     SHEET_OPTIONS,
@@ -108,6 +115,9 @@ _CONTROLS = (
     "bz",
 )
 
+#: Unit of a control's line in the transcript of a common tilt (the cassettes' turns: none).
+_TRANSFER_UNIT = {"screw": "mm", "knob": "tan"}
+
 
 def _perturb(
     setting: InstrumentSetting,
@@ -122,11 +132,11 @@ def _perturb(
         if control in ("by", "bz"):
             name = "base_y_mm" if control == "by" else "base_z_mm"
             setting = replace(setting, **{name: np.asarray(getattr(setting, name)) + delta})
-        elif control.startswith("kappa_"):
-            side = control.split("_")[1]
+        elif control_kind(control) == "cassette":
+            side = control_side(control)
             units[side] = replace(units[side], kappa=np.asarray(units[side].kappa) + delta)
-        elif control.startswith("k_"):
-            _, axis, side = control.split("_")
+        elif control_kind(control) == "knob":
+            axis, side = control_axis(control), control_side(control)
             now = units[side].tan_alpha if axis == "alpha" else units[side].tan_omega
             units[side] = turn_correction_knob(
                 units[side], axis, np.asarray(now) + delta, linkage=linkage
@@ -403,9 +413,7 @@ def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
                 control,
                 before=before,
                 after=after,
-                unit="mm"
-                if control in ("by", "bz")
-                else ("tan" if control.startswith("k_") else "—"),
+                unit=_TRANSFER_UNIT.get(control_kind(control), "—"),
                 iteration=it,
                 equation="common tilt (q-neutral)",
             )
@@ -479,7 +487,7 @@ def _turn(op, control: str, target, active) -> None:
     """Turn a knob or cassette while looking, no further than its stop (2 % short of the
     tilt limit, 1 % of the κ range): a trial that needed more is flagged in ``op.stopped``."""
     spec = op.inst.spec
-    if control.startswith("kappa_"):
+    if control_kind(control) == "cassette":
         lo, hi = spec.kappa_range
         lo, hi = lo + 0.01 * (hi - lo), hi - 0.01 * (hi - lo)
     else:
@@ -565,7 +573,7 @@ def _c2_pass(run, stage: str, key0: str, it: int, active, prev_rms, over: float)
             control,
             before=before,
             after=op.physical(control),
-            unit="rad" if control.startswith("kappa") else "tan",
+            unit=CONTROL_INFO[control].unit,
             judgment_error=target,
             residual=q_seen,
             true=q_true,
@@ -633,7 +641,7 @@ def c2_relative_by_equations(
                 control,
                 before=before,
                 after=op.physical(control),
-                unit="rad" if control.startswith("kappa") else "tan",
+                unit=CONTROL_INFO[control].unit,
                 iteration=it,
                 equation="(5.11)",
             )
@@ -761,9 +769,7 @@ def _level(
                 control,
                 before=before,
                 after=after,
-                unit="mm"
-                if control in ("by", "bz")
-                else ("tan" if control.startswith("k_") else "—"),
+                unit=_TRANSFER_UNIT.get(control_kind(control), "—"),
                 iteration=it,
                 equation="levelling (assumption)",
                 remedy=remedy,

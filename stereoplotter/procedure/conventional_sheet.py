@@ -17,9 +17,12 @@ from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.virtual import NOMINAL_ZERO
 from stereoplotter.procedure.records import SheetPose
-from stereoplotter.procedure.sheet_stages import _needle as sheet_needle
-from stereoplotter.procedure.sheet_stages import _table as sheet_table
-from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.sheet_stages import (
+    sheet_needle,
+    sheet_table,
+    stage4_orient_sheet,
+    stage5_check,
+)
 from stereoplotter.procedure.steps import control_point_m, fuse_and_read
 from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
@@ -218,5 +221,3 @@ def c4_sheet(run, sheet_on: str = "control") -> None:
     for old, new in (("4", "C4"), ("5", "C4/check")):
         if old in run.stages:
             run.record_stage(new, run.stages.pop(old).iterations)
-
-

@@ -1,5 +1,5 @@
 r"""Evaluation of a built stereo model against the ground truth (``procedure.md``, "What a run
-returns"; issue 5, item 5).
+returns").
 
 The instrument is described only by its physical kinematic state, an
 :class:`~stereoplotter.instrument.kinematics.InstrumentSetting` and the two
@@ -354,7 +354,7 @@ def plane_residuals(
 # --------------------------------------------------------------------------------------------
 
 
-def _trial_count(setting: InstrumentSetting, units: Sequence[CorrectionUnit]) -> int | None:
+def trial_count(setting: InstrumentSetting, units: Sequence[CorrectionUnit]) -> int | None:
     """T when any field carries a trial dimension (shape (T,)), else None."""
     trials: set[int] = set()
     for obj in (setting, *units):
@@ -380,7 +380,7 @@ def _trial_count(setting: InstrumentSetting, units: Sequence[CorrectionUnit]) ->
     return trials.pop() if trials else None
 
 
-def _with_point_axis(obj: Any) -> Any:
+def with_point_axis(obj: Any) -> Any:
     """The dataclass with every (T,) field reshaped to (T, 1) to broadcast against (n,) points."""
     changes = {}
     for f in fields(obj):
@@ -738,10 +738,10 @@ def evaluate_against(
     identical to a loop over single instruments.
     """
     units = (left_unit, right_unit)
-    trials = _trial_count(setting, units)
+    trials = trial_count(setting, units)
     if trials is not None:
-        setting = _with_point_axis(setting)
-        units = tuple(_with_point_axis(u) for u in units)
+        setting = with_point_axis(setting)
+        units = tuple(with_point_axis(u) for u in units)
     h0 = truth.frame_origin_m[2] if height_zero is None else np.asarray(height_zero, float)
     _check_trial_shapes(trials, height_zero=h0, corner4_misclosure_mm=corner4_misclosure_mm)
     h0_b = h0[:, None] if np.ndim(h0) == 1 else h0

@@ -20,8 +20,6 @@ __all__ = ["ModelEvaluation", "PointSetEvaluation"]
 _F = NDArray[np.float64]
 
 
-
-
 def _rms(v: _F) -> _F:
     return np.sqrt(np.mean(np.square(v), axis=-1))
 

@@ -74,8 +74,8 @@ DEFAULT_MAGNIFICATION = 6.0
 #: Viewing distance to which a magnification is referred, the conventional distance of
 #: distinct vision (assumed where the instrument file gives none). [mm]
 DEFAULT_VIEWING_DISTANCE_MM = 250.0
-#: The free σ of the operator before the eye model (issue 25): σ_p = σ_q = 0.010 mm, kept
-#: selectable as ``OperatorModel(eye="sigma")``. [mm]
+#: The free σ of an operator without the eye model: σ_p = σ_q = 0.010 mm,
+#: ``OperatorModel(eye="sigma")``. [mm]
 LEGACY_SIGMA_MM = 0.010
 #: "physiological": σ_p, σ_q from the eye (default); "sigma": the legacy free σ.
 EYE_MODES = ("physiological", "sigma")

@@ -19,6 +19,7 @@ from stereoplotter.instrument.kinematics import (
     counters_from_homologous_points,
 )
 from stereoplotter.instrument.knobs import turn_correction_knob
+from stereoplotter.instrument.virtual import control_axis, control_kind, control_side
 from stereoplotter.procedure.floor import ControlHeights, sheet_settings
 from stereoplotter.procedure.operator import Scene
 from stereoplotter.setup.sheet import SetupSheet
@@ -73,11 +74,11 @@ def _turned(
     for control, d in changes.items():
         if control == "bz":
             setting = replace(setting, base_z_mm=np.asarray(setting.base_z_mm) + d)
-        elif control.startswith("kappa_"):
-            side = control.split("_")[1]
+        elif control_kind(control) == "cassette":
+            side = control_side(control)
             units[side] = replace(units[side], kappa=np.asarray(units[side].kappa) + d)
         else:
-            _, axis, side = control.split("_")
+            axis, side = control_axis(control), control_side(control)
             now = units[side].tan_alpha if axis == "alpha" else units[side].tan_omega
             units[side] = turn_correction_knob(
                 units[side], axis, np.asarray(now) + d, linkage=linkage

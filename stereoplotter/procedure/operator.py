@@ -15,9 +15,9 @@ one seed, so that a vectorised run and a per-trial loop draw identical numbers f
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field, replace
-from typing import Any, Literal
+from collections.abc import Callable
+from dataclasses import dataclass, field, fields, replace
+from typing import Any, Literal, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -43,6 +43,9 @@ from stereoplotter.instrument.virtual import (
     ScrewName,
     SetControl,
     Side,
+    control_axis,
+    control_kind,
+    control_side,
 )
 from stereoplotter.procedure.evaluation import (
     instrument_frame_m,
@@ -58,6 +61,7 @@ from stereoplotter.scenario.synthetic import film_deformed
 
 __all__ = [
     "DrivenControl",
+    "Look",
     "Noise",
     "Operator",
     "OperatorModel",
@@ -71,9 +75,6 @@ __all__ = [
 DrivenControl = Literal[ScrewName, CassetteName, KnobName]
 #: Controls the operator sets to a computed reading on their scale (:meth:`Operator.set`).
 SetControlName = Literal[ScrewName, SetControl, HeightScaleName]
-
-_SCREWS = SCREWS
-_KNOBS = KNOBS
 
 
 @dataclass(frozen=True, slots=True)
@@ -113,8 +114,8 @@ class OperatorModel:
         never silent). A convention (6), not a figure of the book.
     eye : {"physiological", "sigma"}
         How σ_p and σ_q left None are resolved for an instrument (:meth:`for_instrument`):
-        "physiological" (default) from the eye; "sigma" the free σ = 0.010 mm of the operator
-        before issue 25 (kept selectable, ``simulate --operator`` file ``eye: sigma``).
+        "physiological" (default) from the eye; "sigma" a free σ = 0.010 mm without the eye
+        model (``simulate --operator`` file ``eye: sigma``).
     remeasure : bool
         Habit: a point whose y-parallax is seen over ¼ mark is looked at again (a new pointing
         and judgement) before it is declared failed (default True, a competent operator).
@@ -259,13 +260,26 @@ class Noise:
         return z
 
 
+@dataclass(frozen=True)
+class Look:
+    """The operator's 1-D look: ``fn(value)`` is what is seen with a control at ``value``.
+    ``stacked``: ``fn`` may be given x, x + h, x − h stacked on a new leading axis
+    (:func:`solve_1d`)."""
+
+    fn: Callable[[Any], NDArray[np.float64]]
+    stacked: bool = False
+
+    def __call__(self, value: Any) -> NDArray[np.float64]:
+        return self.fn(value)
+
+
 def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: float = 1e-6):
     """x with fun(x) = target by a fixed number of Newton steps (central differences).
 
     A fixed count (no early exit) keeps a vectorised run and a per-trial loop bit-identical.
-    A ``fun`` with the attribute ``stacked`` set is evaluated once per step on x, x + h, x − h
-    stacked on a new leading axis (it must give each the bits it gives alone: element-wise
-    IEEE arithmetic and square roots only).
+    A :class:`Look` with ``stacked`` set is evaluated once per step on x, x + h, x − h stacked
+    on a new leading axis (it must give each the bits it gives alone: element-wise IEEE
+    arithmetic and square roots only).
 
     Examples
     --------
@@ -274,7 +288,7 @@ def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: floa
     """
     x = np.asarray(x0, float) + 0.0
     t = np.asarray(target, float)
-    stacked = getattr(fun, "stacked", False)
+    stacked = isinstance(fun, Look) and fun.stacked
     for _ in range(iterations):
         if stacked:
             v = fun(np.stack([x, x + h, x - h]))
@@ -486,14 +500,15 @@ class Operator:
         if not np.any(active):
             return self.v(value)
         value = self.v(value)
-        if control in _SCREWS or control == HEIGHT_SCALE:
+        if control in SCREWS or control == HEIGHT_SCALE:
             lc = self.least_count(control)
             cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
             prev = self.v(self.inst.read(control, exact=True))
             cmd = self._at_stop(control, cmd)
             self.inst.set(control, np.where(active, cmd, prev), side=self.model.finish_side)
         else:
-            lc = self.inst.spec.xy_least_count_mm if control.startswith(("d", "f_")) else 0.0
+            on_xy_scale = control_kind(control) in ("decentration", "principal_distance")
+            lc = self.inst.spec.xy_least_count_mm if on_xy_scale else 0.0
             cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
             prev = self.commanded.get(control, cmd)
             cmd = np.where(active, cmd, prev)
@@ -535,13 +550,13 @@ class Operator:
 
     def physical(self, control: DrivenControl) -> NDArray[np.float64]:
         """Where a control physically is (what the eye judges in the eyepiece)."""
-        if control in _SCREWS:
+        if control in SCREWS:
             now = self.inst.position(control)  # a copy of the carriages
             return now if self.trials and np.shape(now) == (self.trials,) else self.v(now)
-        if control.startswith("kappa_"):
-            return self.v(self.inst.unit(control.split("_")[1]).kappa)
-        if control in _KNOBS:
-            _, axis, side = control.split("_")
+        if control_kind(control) == "cassette":
+            return self.v(self.inst.unit(control_side(control)).kappa)
+        if control in KNOBS:
+            axis, side = control_axis(control), control_side(control)
             unit = self.inst.unit(side)
             return self.v(unit.tan_alpha if axis == "alpha" else unit.tan_omega)
         raise StereoplotterError(f"cannot drive {control!r}")
@@ -560,21 +575,24 @@ class Operator:
         active = self.all() if active is None else active
         if not np.any(active):
             return
-        parts = self.inst.screw(control) if self.trials and control in _SCREWS else None
-        if parts is not None:  # a closed-form lead screw over T trials
+        if self.trials and control in SCREWS:  # a lead screw over T trials: the fast path
+            screw = cast(ScrewName, control)
             target = np.asarray(target, float)  # only read: no copy of a (T,) target
             if target.shape != (self.trials,):
                 target = self.v(target)
-            self._drive_screw(control, target, active, parts)
-            return
+            side = self.model.finish_side
+            if self.inst.drive_screw(
+                screw, target, active, self.passes, lambda r: self._at_stop(screw, r), side
+            ):
+                return
         target = self.v(target)
         for _ in range(self.passes):
             now = self.physical(control)
             err = np.where(active, target - now, 0.0)
-            if control in _SCREWS:
+            if control in SCREWS:
                 cmd = self._at_stop(control, self.v(self.inst.read(control, exact=True)) + err)
                 self.inst.set(control, cmd, side=self.model.finish_side)
-            elif control in _KNOBS:
+            elif control in KNOBS:
                 cmd = self.commanded.get(control, now) + err
                 self.inst.turn_knob(control, cmd)
                 self.commanded[control] = cmd
@@ -582,21 +600,6 @@ class Operator:
                 cmd = self.commanded.get(control, now) + err
                 self.inst.set(control, cmd)
                 self.commanded[control] = cmd
-
-    def _drive_screw(self, control: ScrewName, target, active, parts) -> None:
-        """:meth:`drive` of a closed-form lead screw over T trials (``parts``: its scale and
-        axis, ``Instrument.screw``): the same passes and arithmetic (``Instrument.read`` exact,
-        :meth:`_at_stop`, ``Instrument.set``) on the axis's own (T,) arrays, without the copies
-        and checks of each call."""
-        side = self.model.finish_side
-        scale, axis = parts
-        zero, gain = scale.zero, scale.gain
-        for _ in range(self.passes):
-            err = np.where(active, target - axis._car, 0.0)
-            reading = np.asarray(zero + gain * axis._nut) + err  # the exact reading + error
-            cmd = self._at_stop(control, reading)
-            nut = (cmd - zero) / gain  # Scale.position
-            axis.move(nut, side, owned=nut.shape == axis.h.shape)
 
     # --- looking ------------------------------------------------------------------------------
 
@@ -689,7 +692,9 @@ class Operator:
                 self.drive(axis, value, active)
         return r.y_parallax_mm + eq, r.y_parallax_mm
 
-    def q_turning(self, control: CassetteName | KnobName, images: tuple[ArrayLike, ArrayLike]):
+    def q_turning(
+        self, control: CassetteName | KnobName, images: tuple[ArrayLike, ArrayLike]
+    ) -> Look:
         """q at homologous points as a function of where ``control`` (a cassette κ or a
         correction knob) would be, the rest of the instrument as it is now: the operator's 1-D
         look for :func:`solve_1d`.
@@ -698,19 +703,20 @@ class Operator:
         units with the control turned; the other photo's rod and cos κ, sin κ of a knob's unit
         are computed once.
         """
-        side = control.split("_")[-1]
+        side = control_side(control)
         other = "right" if side == "left" else "left"
         pts = {"left": np.asarray(images[0], float), "right": np.asarray(images[1], float)}
         setting = self.inst.setting
         fixed = self.unit_map(other).rod_xy(pts[other][..., 0], pts[other][..., 1])
         base = self.unit_map(side)
         x, y = pts[side][..., 0], pts[side][..., 1]
-        if control.startswith("kappa_"):
+        cassette = control_kind(control) == "cassette"
+        if cassette:
 
             def turned(value):
                 return base.with_kappa(value)
         else:
-            axis = control.split("_")[1]
+            axis = control_axis(control)
             linkage = self.inst.variant.linkage
 
             def turned(value):
@@ -725,8 +731,7 @@ class Operator:
         # a knob's turn at one point is element-wise arithmetic and square roots (the mechanisms'
         # scales too), no cos, sin, whose vectorised loops may round differently by position:
         # x, x ± h at once
-        q.stacked = not control.startswith("kappa_") and np.ndim(x) == 0 and np.ndim(y) == 0
-        return q
+        return Look(q, stacked=not cassette and np.ndim(x) == 0 and np.ndim(y) == 0)
 
     def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):
         """The true y-parallax of the present model at ground points (no judgment). [mm]"""
@@ -746,7 +751,7 @@ class Operator:
 
         A 1-D Newton solve on the unit model with the instrument's own linkage (D1).
         """
-        _, axis, side = knob.split("_")
+        axis, side = control_axis(knob), control_side(knob)
         linkage = self.inst.variant.linkage
         trig = self.unit_map(side, unit).trig  # κ stays while the knob turns
         rod = np.asarray(rod, float)
@@ -767,16 +772,9 @@ def _given(value: float | None, derived: float) -> float:
 
 def _column(obj):
     """A frozen unit/setting with every per-trial field (T,) turned into a column (T, 1)."""
-    from dataclasses import fields
-
     changes = {}
     for f in fields(obj):
         v = getattr(obj, f.name)
         if isinstance(v, np.ndarray) and v.ndim == 1:
             changes[f.name] = v[:, None]
     return replace(obj, **changes)
-
-
-def degrees(value: float) -> float:
-    """Radians to degrees (for messages)."""
-    return math.degrees(value)

@@ -247,7 +247,7 @@ def y_parallax(
 _TOUCH_UP_STEPS = np.array([1e-6, 1e-6, 1e-6, 1e-4, 1e-4])
 
 
-def _apply_touch_up(p, setting, left, right, linkage):
+def apply_touch_up(p, setting, left, right, linkage):
     left = replace(left, kappa=left.kappa + p[..., 1:2])
     right = replace(right, kappa=right.kappa + p[..., 0:1])
     right = turn_correction_knob(right, "omega", right.tan_omega + p[..., 2:3], linkage)
@@ -314,7 +314,7 @@ def touch_up(
     p = np.zeros((nb, 5))
 
     def q_of(params):
-        s, lu, ru = _apply_touch_up(params, setting, left, right, linkage)
+        s, lu, ru = apply_touch_up(params, setting, left, right, linkage)
         return y_parallax(photo_left, photo_right, s, lu, ru).y_parallax_mm
 
     r = q_of(p)
@@ -343,7 +343,7 @@ def touch_up(
                 break
         if np.all(np.max(np.abs(step) / _TOUCH_UP_STEPS, axis=-1) < 1e-3):
             break
-    s, lu, ru = _apply_touch_up(p, setting, left, right, linkage)
+    s, lu, ru = apply_touch_up(p, setting, left, right, linkage)
     reading = y_parallax(photo_left, photo_right, s, lu, ru)
     return reading.y_parallax_mm, reading, p
 
@@ -387,7 +387,7 @@ def height_deformation_permille(
 # --------------------------------------------------------------------------------------------
 
 
-def _true_units(pair: SyntheticPair, tilts: NDArray, strict: bool):
+def true_units(pair: SyntheticPair, tilts: NDArray, strict: bool):
     t = tilts[..., None]  # broadcast against the points
     f = pair.focal_length_mm
     left = unit_for_orientation(
@@ -442,7 +442,7 @@ def residual_table(
         for t_deg in tilts_deg:
             tilts = signs * (t_deg * _DEG)
             pl, pr = pair.photos(tilts)
-            left, right = _true_units(pair, tilts, strict)
+            left, right = true_units(pair, tilts, strict)
             if mech is not None:
                 left, right = replace(left, mechanism=mech), replace(right, mechanism=mech)
             reading = y_parallax(pl, pr, setting, left, right)
@@ -714,7 +714,7 @@ def sanity_checks(pair: SyntheticPair | None = None, tilt_deg: float = 1.0) -> d
         axis=-1,
     )
     measured = np.stack([exact.x_mm, exact.y_mm, exact.depth_mm], axis=-1)
-    left, right = _true_units(pair, tilts, strict=False)
+    left, right = true_units(pair, tilts, strict=False)
     back = photo_from_rod(rod_from_photo(pl, left), left)
     ml, mr = marks_from_counters(exact.x_mm, exact.y_mm, exact.depth_mm, setting, left, right)
     again = rods_intersection(rod_from_photo(ml, left), rod_from_photo(mr, right), setting)

@@ -22,7 +22,13 @@ from numpy.typing import NDArray
 
 from stereoplotter.instrument.kinematics import rod_from_counters
 from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, Side
+from stereoplotter.instrument.virtual import (
+    CONTROL_INFO,
+    HEIGHT_SCALE,
+    NOMINAL_ZERO,
+    Side,
+    control_kind,
+)
 from stereoplotter.procedure import steps
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.levelling import LevelDesign
@@ -63,8 +69,7 @@ _TILT = {"alpha": "α", "omega": "ω"}
 #: photos' α, the xy/f pattern at points 3–6 ("the relative orientation is checked over the
 #: whole stereopair", stage 3). Not b_y (a constant q, dependent on κ_л, κ_п at six points),
 #: not b_z (it carries n_п, set by the stage-1 L-check, and moves the model's longitudinal
-#: tilt). With three elements (κ_л, κ_п, k_ω,п) and an operator without σ_q the true q at the
-#: standard points still exceeded ¼ mark in 41 % of pair60/SC-1 runs; with the five, in 0.1 %.
+#: tilt).
 Q_ELEMENTS = ("kappa_left", "kappa_right", "k_omega_right", "k_alpha_left", "k_alpha_right")
 
 
@@ -559,7 +564,7 @@ def r2_element_bounds(spec) -> dict[str, tuple[float, float]]:
     mid, half = 0.5 * (lo_k + hi_k), 0.5 * (hi_k - lo_k) * R2_RANGE_FRACTION
     t = float(np.tan(spec.tilt_max * R2_RANGE_FRACTION))
     return {
-        name: (mid - half, mid + half) if name.startswith("kappa") else (-t, t)
+        name: (mid - half, mid + half) if control_kind(name) == "cassette" else (-t, t)
         for name in Q_ELEMENTS
     }
 
@@ -623,7 +628,7 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
             control,
             before=before,
             after=op.physical(control),
-            unit="rad" if control.startswith("kappa") else "tan",
+            unit=CONTROL_INFO[control].unit,
             iteration=it,
             equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
             remedy=remedy,
@@ -708,7 +713,7 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
                 control,
                 before=before,
                 after=after,
-                unit="mm" if control == "bz" else ("rad" if control.startswith("kappa") else "tan"),
+                unit=CONTROL_INFO[control].unit,
                 iteration=it,
                 equation="levelling on control (assumption, q-neutral common tilt)",
                 remedy=remedy,

@@ -19,7 +19,7 @@ from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 __all__ = ["stage4_orient_sheet", "stage5_check"]
 
 
-def _table(run: Run, xy_mm) -> NDArray[np.float64]:
+def sheet_table(run: Run, xy_mm) -> NDArray[np.float64]:
     """Ideal table position of a model position (x′, y′) for the coordinatograph's origin."""
     return run.op.inst.table_position_mm(xy_mm)
 
@@ -29,10 +29,10 @@ def _needle_at(run: Run, corner: str, key: str) -> NDArray[np.float64]:
     op = run.op
     op.set("X", run.target(f"corner {corner}: O_X"), f"{key}/X")
     op.set("Y", run.target(f"corner {corner}: O_Y"), f"{key}/Y")
-    return _needle(run, key)
+    return sheet_needle(run, key)
 
 
-def _needle(run: Run, key: str) -> NDArray[np.float64]:
+def sheet_needle(run: Run, key: str) -> NDArray[np.float64]:
     """The needle on the table; with the SC complex's automatic coordinatograph, its settled
     servo noise drawn from the run's keyed streams (σ_s per axis)."""
     op = run.op
@@ -62,7 +62,7 @@ def stage4_orient_sheet(run: Run) -> None:
         enlargement = photo_scale / sheet.map_scale_denominator
     op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
-    ideal = {k: _table(run, v) for k, v in corners.items()}
+    ideal = {k: sheet_table(run, v) for k, v in corners.items()}
     inj = op.inst.injected
     place = np.stack(
         [
@@ -114,7 +114,7 @@ def stage5_check(run: Run) -> None:
         return
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
     n4 = _needle_at(run, "4", "5/c4")
-    mark4 = pose.table_of(_table(run, corners["4"]))
+    mark4 = pose.table_of(sheet_table(run, corners["4"]))
     mis = np.hypot(*np.moveaxis(mark4 - n4, -1, 0))
     tol = sheet.tolerances["corner_mm"]
     op.log.add(
@@ -139,8 +139,8 @@ def stage5_check(run: Run) -> None:
         )
         img = run.scene.images(np.asarray(p.local_m, float)[None, :])
         op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
-        needle = _needle(run, f"5/plan/{pid}")
-        plotted = pose.table_of(_table(run, np.asarray(xy, float).reshape(2)))
+        needle = sheet_needle(run, f"5/plan/{pid}")
+        plotted = pose.table_of(sheet_table(run, np.asarray(xy, float).reshape(2)))
         err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
         errs.append(err)
         op.log.add(

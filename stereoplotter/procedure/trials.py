@@ -54,7 +54,7 @@ __all__ = [
 #: Peak working memory per trial of one chunk (simulation and evaluation), rounded up for
 #: safety. Setup: ≈ 20 kB on pair60 (``benchmarks/bench_simulate_scale.py``). Conventional:
 #: 14.6 kB on pair60 and pair80, 12.8 kB on mountain60 (the rise of ``ru_maxrss`` over one chunk
-#: of 4 096, 8 192 and 16 384 trials, SC-1, issue 26; 7.8 kB of it without the evaluation), so a
+#: of 4 096, 8 192 and 16 384 trials, SC-1; 7.8 kB of it without the evaluation), so a
 #: chunk of 12 288 trials stays under 180 MB of the default 256 MB. [bytes]
 BYTES_PER_TRIAL = {"setup": 32_000, "conventional": 20_000}
 
@@ -71,8 +71,7 @@ def chunk_trials_for(memory_budget_mb: float, method: str) -> int:
 
     A chunk of at least two keyed blocks (:data:`~stereoplotter.random_streams.BLOCK`) is cut
     down to whole blocks, so that every chunk starts at a block's start: a chunk starting inside
-    a block draws that block's prefix for nothing, on every stream it reads (at 6 400 trials a
-    chunk the conventional method drew 23 % of its normals for nothing at 10⁵ trials, issue 26).
+    a block draws that block's prefix for nothing, on every stream it reads.
 
     Examples
     --------
@@ -325,7 +324,7 @@ def summarise_columns(
 
     Columns of at least :data:`THREADED_SUMMARY_TRIALS` trials are summarised on two threads
     (their sorts and reductions release the GIL; 0.7 s of one core at 10⁵ trials of the
-    conventional method, issue 26), a few columns ahead of the one being assembled.
+    conventional method), a few columns ahead of the one being assembled.
     """
     out: dict[str, Any] = {**info.header, **(extra or {})}
     checks: dict[str, dict[str, Any]] = {}

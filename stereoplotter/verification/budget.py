@@ -1,4 +1,4 @@
-"""Per-part error budget of a simulated procedure (issue 10, deliverable 5).
+"""Per-part error budget of a simulated procedure.
 
 For every named instrument error term (:mod:`stereoplotter.instrument.error_model`, at its
 configured σ) and every operator error (:class:`~stereoplotter.procedure.operator.OperatorModel`:
@@ -25,7 +25,7 @@ are varied run by run.
 The contribution is reported as an RMS, sign(Δ)·√|Δ| (a negative Δ: switching the term on made
 the measure smaller), with SE = half the width of √ over Δ ± SE(Δ).
 
-Predicted column ("linear", issue 25): the σ² order of Δ from a smooth expansion of the
+Predicted column ("linear"): the σ² order of Δ from a smooth expansion of the
 error-free procedure with its decisions held fixed. Differences at ±ε, ±2ε with ε = 0.001 σ
 (:data:`LINEARISATION_STEP`, far inside every loop's pass/fail jump of the error-free run) give
 the derivative g and the curvature h at each grid point p; for a zero-mean error of variance
@@ -85,7 +85,7 @@ DEFAULT_BUDGET_TRIALS = 2000
 #: Step of the numerical linearisation, in σ of the term (central differences). Small enough
 #: that no decision of the error-free procedure (a loop's pass count, a check's pass/fail, a
 #: remedy) changes within it: the derivative is the procedure's with its decisions held fixed
-#: (issue 25; the 0.1 σ of issue 10 crossed the loops' pass/fail jumps). [—]
+#: (a step of 0.1 σ crosses the loops' pass/fail jumps). [—]
 LINEARISATION_STEP = 1e-3
 #: A second step: a term whose predicted Δ differs between the two steps by more than
 #: :data:`STEP_AGREEMENT` (relative) is not smooth about zero error — a branch or a kink within

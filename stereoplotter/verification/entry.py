@@ -83,6 +83,13 @@ class Entry:
         object.__setattr__(self, "book", float(self.book))
         object.__setattr__(self, "rigorous", float(self.rigorous))
 
+    @property
+    def identity(self) -> str:
+        """The row's identity, the key of its linear Monte Carlo stream: its equation and its
+        quantity (unique in the table), so that adding, removing or reordering rows leaves every
+        other row's draws as they were."""
+        return f"{self.eq} | {self.quantity}"
+
 
 def both_photos(s: dict) -> dict:
     """Setup-element σ's of one photo (keys of :data:`GENERIC_SIGMAS`) for both photos."""

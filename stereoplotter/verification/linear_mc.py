@@ -170,7 +170,7 @@ def setup_model(
     return LinearModel(G, M, Gc, _plane_fit_operator(xr, y, a_mm, c_mm), sigma_control_mm)
 
 
-def _relative_field_basis(xr, y, p, f):
+def relative_field_basis(xr, y, p, f):
     # (5.13), first order, right-photo elements τ, ν, Δα, Δω, Δκ (sign of (3.22)).
     return np.stack([-p * np.ones_like(xr), -p * xr / f, -(xr**2) / f, -xr * y / f, y])
 
@@ -201,9 +201,9 @@ def relative_orientation_model(
     xr, y = grid_chapter5(c, *grid)
     xc, yc = control_points(a, c)
     return LinearModel(
-        _relative_field_basis(xr, y, p, f),
+        relative_field_basis(xr, y, p, f),
         M,
-        _relative_field_basis(xc, yc, p, f),
+        relative_field_basis(xc, yc, p, f),
         _plane_fit_operator(xr, y, a, c),
         sigma_control_mm,
         sigma_white_mm,

@@ -50,10 +50,12 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.accuracy.chapter5 import (
@@ -84,9 +86,9 @@ from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification.linear_mc import (
     CI_Z,
     LinearModel,
-    _relative_field_basis,
     covariance_rms,
     grid_chapter5,
+    relative_field_basis,
 )
 
 if TYPE_CHECKING:
@@ -172,7 +174,7 @@ def _scenario_geometry(scenario, spec):
     }
 
 
-def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
+def domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
     """Ground points (instrument frame) under a midpoint grid of left-photo (x_л, y) [mm]."""
 
     nx, ny = grid
@@ -191,7 +193,7 @@ def _domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)
     return instrument_frame_m(local, origin, theta)
 
 
-def _dp(scenario, sheet, inst, frame_pts):
+def dp_at(scenario, sheet, inst, frame_pts):
     """δp [photo mm] of the built instrument ``inst`` at ``frame_pts`` (ideal model position)."""
     units = inst.state()["units"]
     return _dp_of(scenario, sheet, frame_pts)(inst.setting, units["left"], units["right"])
@@ -211,9 +213,9 @@ def _dp_of(scenario, sheet, frame_pts):
 
 
 def _dp_state(model, gl, gr, setting, left, right):
-    if ev._trial_count(setting, (left, right)) is not None:
-        setting = ev._with_point_axis(setting)
-        left, right = ev._with_point_axis(left), ev._with_point_axis(right)
+    if ev.trial_count(setting, (left, right)) is not None:
+        setting = ev.with_point_axis(setting)
+        left, right = ev.with_point_axis(left), ev.with_point_axis(right)
     dp, _ = ev.parallax_errors_at_ideal(model, gl, gr, setting, left, right)
     return np.asarray(dp, float)
 
@@ -266,9 +268,9 @@ def _height_errors_parallax(sc, sheet, inst, frame_pts):
         np.asarray(inst.read(HEIGHT_SCALE, exact=True), float)
         + np.asarray(inst.read("Z", exact=True), float) * gear / 1000.0
     )
-    if ev._trial_count(setting, (left, right)) is not None:
-        setting = ev._with_point_axis(setting)
-        left, right = ev._with_point_axis(left), ev._with_point_axis(right)
+    if ev.trial_count(setting, (left, right)) is not None:
+        setting = ev.with_point_axis(setting)
+        left, right = ev.with_point_axis(left), ev.with_point_axis(right)
         slip = slip[:, None]
     depth = counters_from_homologous_points(gl, gr, setting, left, right).depth_mm
     dh = slip - depth * gear / 1000.0 - local[:, 2]
@@ -289,23 +291,39 @@ def _levelling_frame_points(prep):
     return ids, instrument_frame_m(local, origin, float(prep.sheet.frame_rotation))
 
 
-def _setup_fields(sc, zero_run, g, xr, grid):
+#: A run's fields: (result, noise) → field name → per-trial values over the domain, (T, n).
+Fields = Callable[[Any, Any], dict[str, NDArray[np.float64]]]
+#: The decomposition's mean squares: (result, the run's fields) → (reading, level) → (T,).
+Decompose = Callable[[Any, dict[str, NDArray[np.float64]]], dict[tuple[str, str], Any]]
+
+
+@dataclass(frozen=True)
+class FieldMaker:
+    """What a method's procedure MC measures on a run: its ``fields`` and, for the setup-data
+    method, the per-trial mean squares of their first-order ``decompose`` (None: none)."""
+
+    fields: Fields
+    decompose: Decompose | None = None
+
+
+def _setup_fields(sc, zero_run, g, xr, grid, sigma_control: float = 0.0):
     """Field makers of the setup-data method: δp on the (6.27) domain ("parallax", task 1), and
     on the chapter-5 domain after levelling on Fig. 39's four control points (task 2,
     :data:`METHODS` "setup_control"): "levelled" with exact control heights, "observed" with
-    each control height's parallax observed with σ_c (keyed draws ``mc/control/i``)."""
+    each control height's parallax observed with σ_c = ``sigma_control`` (keyed draws
+    ``mc/control/i``)."""
 
     f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
     sheet = zero_run.sheet
-    pts = _domain_points(sc, sheet, xr, c, p, f, h, grid)
-    lev = _domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
-    book, _, _ = _control_frame_points(sc, sheet, g)
+    pts = domain_points(sc, sheet, xr, c, p, f, h, grid)
+    lev = domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
+    book, _, _ = control_frame_points(sc, sheet, g)
     n, nl = len(pts), len(lev)
     # below 70 % overlap c = p: the two domains are one (60 %: x_л ∈ [0, p]), δp computed once
     same = pts.shape == lev.shape and np.array_equal(pts, lev)
     allp = np.vstack([pts, book] if same else [pts, lev, book])
     first_lev, first_ctl = (0, n) if same else (n, n + nl)
-    zero = _dp(sc, sheet, zero_run.instrument, allp)
+    zero = dp_at(sc, sheet, zero_run.instrument, allp)
     refit = levelling_design(lev[:, 0], lev[:, 1]) @ np.linalg.pinv(
         levelling_design(book[:, 0], book[:, 1])
     )
@@ -314,8 +332,8 @@ def _setup_fields(sc, zero_run, g, xr, grid):
         dom, ctl = d[:, first_lev : first_lev + nl], d[:, first_ctl:]
         return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
 
-    def fields(result, noise, sigma_control=0.0):
-        d = _dp(sc, result.sheet, result.instrument, allp) - zero
+    def fields(result, noise):
+        d = dp_at(sc, result.sheet, result.instrument, allp) - zero
         out = readings(d)
         obs = np.stack(
             [noise.normal(f"mc/control/{i}", sigma_control) for i in range(len(book))], -1
@@ -343,8 +361,7 @@ def _setup_fields(sc, zero_run, g, xr, grid):
             out.update({(key, step): np.mean(v**2, axis=-1) for key, v in r.items()})
         return out
 
-    fields.decompose = decompose
-    return fields, zero[:n]
+    return FieldMaker(fields, decompose), zero[:n]
 
 
 def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
@@ -357,10 +374,10 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
 
     f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
     sheet = zero_run.sheet
-    pts = _domain_points(sc, sheet, xr, c, p, f, h, grid)
-    d_zero = _dp(sc, sheet, zero_run.instrument, pts)
+    pts = domain_points(sc, sheet, xr, c, p, f, h, grid)
+    d_zero = dp_at(sc, sheet, zero_run.instrument, pts)
     _, lev = _levelling_frame_points(zero_prep)
-    book, _, _ = _control_frame_points(sc, sheet, g)
+    book, _, _ = control_frame_points(sc, sheet, g)
     allp = np.vstack([pts, lev, book])
     k = (p * h / f) * f / allp[:, 2] ** 2  # photo mm of x-parallax per m of height
     h_zero = _height_errors_parallax(sc, sheet, zero_run.instrument, allp)
@@ -370,7 +387,7 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
     )
 
     def fields(result, noise):
-        d = _dp(sc, result.sheet, result.instrument, pts) - d_zero
+        d = dp_at(sc, result.sheet, result.instrument, pts) - d_zero
         e = (_height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
         obs = e[:, n : n + nl] + np.stack(
             [noise.normal(f"mc/datum/{i}", sigma_p) for i in range(nl)], -1
@@ -385,7 +402,7 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
             "book": e[:, :n] - ctl @ refit.T,
         }
 
-    return fields, d_zero
+    return FieldMaker(fields), d_zero
 
 
 def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
@@ -398,7 +415,7 @@ def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
     )
     if options.get("standard_points") == "book":
         tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
-        prep = _standard_points_at_a(prep, g)
+        prep = standard_points_at_a(prep, g)
         prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
     return prep
 
@@ -429,15 +446,10 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
     zero_prep = prepared(zero)
     zero_run = run_trials_chunk(zero_prep, 0, None, evaluate=False, transcript=False)
     if base == "setup":
-        make, d_zero = _setup_fields(sc, zero_run, g, xr, grid)
-        sc_sigma = float(options.get("sigma_control", 0.0))
-
-        def fields(result, noise):
-            return make(result, noise, sc_sigma)
-
-        fields.decompose = make.decompose
+        sigma_control = float(options.get("sigma_control", 0.0))
+        maker, d_zero = _setup_fields(sc, zero_run, g, xr, grid, sigma_control)
     else:
-        fields, d_zero = _conventional_fields(
+        maker, d_zero = _conventional_fields(
             sc, zero_prep, zero_run, g, xr, grid, op.stereo_sigma_mm
         )
     prep = prepared(op, None if instrument else "zero")
@@ -447,7 +459,7 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         result = run_trials_chunk(
             prep, 0, n, evaluate=False, transcript=False, injected=injected, noise=noise
         )
-        return fields(result, noise)
+        return maker.fields(result, noise)
 
     lin = cvar.linear_control(run, model) if options.get("control_variate", True) else None
     chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, base)
@@ -465,12 +477,12 @@ def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, opt
         result = run_trials_chunk(
             prep, first, m, evaluate=False, transcript=False, injected=injected, noise=noise
         )
-        fs = fields(result, noise)
+        fs = maker.fields(result, noise)
         on = _inputs_on(lin, part, m) if lin and off else None
         cv = cvar.per_trial_controlled(fs, lin, noise, injected, model, on) if lin else {}
         ms = {name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()}
-        if hasattr(fields, "decompose"):  # already mean squares
-            ms.update(fields.decompose(result, fs))
+        if maker.decompose is not None:  # already mean squares
+            ms.update(maker.decompose(result, fs))
         for name, v in ms.items():
             plain.setdefault(name, np.empty(int(trials)))[first : first + m] = v
             if lin and name in cv:
@@ -518,9 +530,9 @@ def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
     out = {}
     for name, sq, sp in (("y_parallax", 1.0, 0.0), ("stereo", 0.0, 1.0), ("both", 1.0, 1.0)):
         model = LinearModel(
-            _relative_field_basis(xg, yg, p, f),
+            relative_field_basis(xg, yg, p, f),
             lsq * sq,
-            _relative_field_basis(xc, yc, p, f),
+            relative_field_basis(xc, yc, p, f),
             fit,
             sp,
             0.0,
@@ -540,7 +552,7 @@ def levelling_points_photo(scenario: Scenario, spec: InstrumentSpec, g: dict):
     return lev[:, 0] * s - g["p"], lev[:, 1] * s
 
 
-def _rms_ci(ms, unit):
+def rms_ci(ms, unit):
     """(RMS, CI half-width) per ``unit`` from per-trial mean squares (``CI_Z`` s.e.)."""
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(max(mean_ms, 0.0))
@@ -732,7 +744,9 @@ def procedure_mc(
     )
     g = scenario_geometry(scenario, spec)
     linkage = o.switches(spec).linkage
-    plain, controlled, d_zero, units = _run(scenario, spec, method, trials, seed, o, g, linkage)
+    plain, controlled, d_zero, units = run_configuration(
+        scenario, spec, method, trials, seed, o, g, linkage
+    )
     out = _result(scenario, spec, method, o, g, linkage, (plain, controlled, d_zero, units))
     return {**out, "trials": int(trials), "seed": int(seed), "seconds": time.perf_counter() - t0}
 
@@ -743,7 +757,7 @@ def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
     name = _field_name(method, o.quantity, o.levelling, o.datum, o.control)
     best = controlled or plain
     unit = units[name]
-    coefficient, ci = _rms_ci(best[name], unit)
+    coefficient, ci = rms_ci(best[name], unit)
     if formulas is None:
         formulas = _formulas(method, scenario, spec, g, o.sources, o.control)
     out = {
@@ -758,7 +772,7 @@ def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
         "control_variate": bool(controlled),
         "coefficient": coefficient,
         "ci": ci,
-        "plain": _rms_ci(plain[name], unit),
+        "plain": rms_ci(plain[name], unit),
         "formula": formulas,
         "rms_mm": coefficient * unit,
         "bias_mm": float(np.sqrt(np.mean(d_zero**2))),
@@ -807,7 +821,7 @@ def conventional_sources_mc(
         for src, prefixes in SOURCE_PREFIXES.items()
         for prefix in prefixes
     }
-    plain, controlled, d_zero, units = _run(
+    plain, controlled, d_zero, units = run_configuration(
         scenario, spec, "conventional", int(bounds[-1]), seed, o, g, linkage, off_of
     )
     lev = levelling_formula(g, *levelling_points_photo(scenario, spec, g))
@@ -824,7 +838,7 @@ def conventional_sources_mc(
     return {k: {**v, "seconds": seconds} for k, v in out.items()}
 
 
-def _run(scenario, spec, method, trials, seed, o, g, linkage, off=None):
+def run_configuration(scenario, spec, method, trials, seed, o, g, linkage, off=None):
     """The runs of :func:`procedure_mc`: per-trial mean squares (plain, controlled), the
     error-free δp and the unit of each field [photo mm]. ``off``: key prefix → (trials,) mask of
     the trials whose acts of that prefix draw 0 (:func:`conventional_sources_mc`; the run then
@@ -859,7 +873,7 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
     if method == "conventional":
         unit = units["plane"]
         return {
-            "by_datum": {k: _rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
+            "by_datum": {k: rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
             **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
             "sources": o.sources,
         }
@@ -869,13 +883,13 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
         ("levelled", "setup_control", "exact"),
         ("observed", "setup_control", "observed"),
     ):
-        cf, h = _rms_ci(best[key], units[key])
+        cf, h = rms_ci(best[key], units[key])
         ref = _formulas(m, scenario, spec, g, o.sources, c)["rigorous"]
         ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
         fields[key] = {
             "coefficient": cf,
             "ci": h,
-            "plain": _rms_ci(plain[key], units[key]),
+            "plain": rms_ci(plain[key], units[key]),
             "formula": ref,
             "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
             "mean_squares": plain[key],  # per trial, photo mm² (paired switch steps)
@@ -917,7 +931,7 @@ def idealised_geometry(scenario: Scenario) -> Scenario:
     return replace(scenario, terrain=Terrain(scenario.terrain.base_height_m), photos=photos)
 
 
-def _standard_points_at_a(prep, g):
+def standard_points_at_a(prep, g):
     """The prepared run with standard points 1, 3, 5 moved by −a and 2, 4, 6 by +a along the
     base (Fig. 39, x_л ∈ {−a, p + a}, a = c − p) and the C2 tolerance 0, so every trial makes
     the same number of passes (no 'stop when satisfied' selection, which (5.54) does not model)."""
@@ -938,7 +952,7 @@ def _standard_points_at_a(prep, g):
     )
 
 
-def _control_frame_points(scenario, sheet, g):
+def control_frame_points(scenario, sheet, g):
     """The four levelling control points of (5.54), x_п ∈ {−c, a}, y = ±c, on the ground; with
     their (x_п, y) [mm]."""
 

@@ -19,12 +19,12 @@ from stereoplotter.procedure.run import build_run
 from stereoplotter.procedure.simulate import prepare_run
 from stereoplotter.verification.linear_mc import CI_Z
 from stereoplotter.verification.procedure_mc import (
-    _control_frame_points,
-    _domain_points,
-    _dp,
-    _standard_points_at_a,
+    control_frame_points,
+    domain_points,
+    dp_at,
     idealised_geometry,
     scenario_geometry,
+    standard_points_at_a,
 )
 
 if TYPE_CHECKING:
@@ -90,7 +90,7 @@ def relative_orientation_mc(
     spec = replace(spec, standard_points_c_mm=g["c"])
     zero = OperatorModel().zero()
     preps = [
-        _standard_points_at_a(
+        standard_points_at_a(
             prepare_run(sc, spec, "conventional", "zero", seed, operator=o, ideal_mechanics=True),
             g,
         )
@@ -98,11 +98,11 @@ def relative_orientation_mc(
     ]
     run0 = _relative_only(preps[0], 0, None)
     sheet = run0.sheet
-    pts = _domain_points(
+    pts = domain_points(
         sc, sheet, (g["p"] - g["c"], g["p"]), g["c"], g["p"], g["f"], g["flying_height_m"], grid
     )
-    cpts, xc, yc = _control_frame_points(sc, sheet, g)
-    d0, d0c = (_dp(sc, sheet, run0.op.inst, q) for q in (pts, cpts))
+    cpts, xc, yc = control_frame_points(sc, sheet, g)
+    d0, d0c = (dp_at(sc, sheet, run0.op.inst, q) for q in (pts, cpts))
     xg, yg = _midpoint_grid(g["c"], grid)
     plane = levelling_design(xg, yg) @ np.linalg.pinv(levelling_design(xc, yc))
     ms = np.empty(int(trials))
@@ -110,8 +110,8 @@ def relative_orientation_mc(
     for first in range(0, int(trials), int(chunk)):
         n = min(int(chunk), int(trials) - first)
         run = _relative_only(preps[1], first, n)
-        d = _dp(sc, sheet, run.op.inst, pts) - d0
-        dc = _dp(sc, sheet, run.op.inst, cpts) - d0c
+        d = dp_at(sc, sheet, run.op.inst, pts) - d0
+        dc = dp_at(sc, sheet, run.op.inst, cpts) - d0c
         ms[first : first + n] = np.mean((d - dc @ plane.T) ** 2, axis=-1)
         raw[first : first + n] = np.mean(d**2, axis=-1)
     mean_ms = float(np.mean(ms))

@@ -86,7 +86,7 @@ def _book_point(s: Setting):
 
 
 def _at_point(model, a, c, p, f, pt):
-    G = mc._relative_field_basis(pt[0], pt[1], p, f)
+    G = mc.relative_field_basis(pt[0], pt[1], p, f)
     Hg = c5.levelling_design(*pt)
     Ac = c5.levelling_design(*c5.control_points(a, c))
     return mc.LinearModel(G, model.M, model.Gc, Hg @ np.linalg.pinv(Ac))

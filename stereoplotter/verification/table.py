@@ -5,7 +5,7 @@ book-mode and rigorous values, the linear Monte Carlo RMS with its CI half-width
 covariance propagation on the same grid, a verdict and a note. The rows are data: each is an
 :class:`~stereoplotter.verification.entry.Entry` built by a small named function of a topic module
 (``rows_chapter5``: Tables 19, 20 and chapter 5; ``rows_setup_elements``: (6.28)–(6.38);
-``rows_outcomes``: (6.39)–(6.46); ``rows_levelled``: (6.47)–(6.61)); :func:`_row_specs` lists
+``rows_outcomes``: (6.39)–(6.46); ``rows_levelled``: (6.47)–(6.61)); :func:`row_entries` lists
 them in order. :func:`closing_comparison` is the book's closing claim (setup data vs the
 conventional method at 60 % and 80 %). Rendered by
 :mod:`stereoplotter.report.verification`, written by
@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import multiprocessing
+import warnings
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
@@ -28,6 +29,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from stereoplotter.procedure.fidelity import MECHANISMS, Fidelity
+from stereoplotter.random_streams import key_code
 from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.as_formula import (
@@ -105,6 +107,10 @@ PROCEDURE_CONFIGS = {
     "y_parallax": {"method": "conventional", "sources": "y_parallax", "passes": 3},
     "stereo": {"method": "conventional", "sources": "stereo", "passes": 3},
 }
+#: The seed stream of each configuration's runs, declared (not its place in
+#: :data:`PROCEDURE_CONFIGS`): a run of configuration c at overlap slot s takes the seed
+#: ``seed + 7·(2·CONFIG_STREAM[c] + (s == "80")) + 1``. A new configuration takes a new number.
+CONFIG_STREAM = {"setup": 0, "conventional": 1, "y_parallax": 2, "stereo": 3}
 #: Default trials per configuration: the fewest that keep every row's 99.9 % CI ≤ 1 % of its
 #: value at the book's scenarios (``benchmarks/bench_procedure_verify.py``; measured CIs in
 #: ``docs/accuracy.md``). The setup method's loops stop when a check passes, which makes its
@@ -124,9 +130,9 @@ STEP_TRIALS = 2000
 INSTRUMENT_TRIALS = {"setup": 4000, "conventional": 600, "y_parallax": 600, "stereo": 300}
 
 
-def _row_specs(g) -> list[Entry]:
-    """Every row of the table as an :class:`~stereoplotter.verification.entry.Entry`, in order
-    (the order fixes each row's random stream)."""
+def row_entries(g) -> list[Entry]:
+    """Every row of the table as an :class:`~stereoplotter.verification.entry.Entry`, in the
+    table's order (a row's random stream is keyed by its identity, not by its place)."""
     s = Setting.from_mapping(g)
     return [
         *chapter5_entries(s),
@@ -150,8 +156,6 @@ def check_geometry(fields, geometry: dict) -> None:
     Last, every formula is evaluated with floating-point errors raised, so nothing undefined
     reaches the Monte Carlo.
     """
-    import warnings
-
     g = _normalise_geometry(geometry)
     for ov in ("60", "80"):
         a, c, p = g[f"a{ov}"], g["c"], g[f"p{ov}"]
@@ -173,7 +177,7 @@ def check_geometry(fields, geometry: dict) -> None:
     try:
         with np.errstate(all="raise"), warnings.catch_warnings():
             warnings.simplefilter("error", RuntimeWarning)
-            specs = _row_specs(g)
+            specs = row_entries(g)
     except (ArithmeticError, ValueError, np.linalg.LinAlgError, RuntimeWarning) as exc:
         raise fields.error(
             "(geometry)",
@@ -364,8 +368,8 @@ def start_procedure_mc(
     slot is run. ``workers``: processes (the runs are independent; 1 runs them here). The
     configurations of :data:`SHARED_RUNS` at a slot are one run (one job) with a block of trials
     each: the conventional one on trials 0 … T − 1 of its seed as before, σ_q only and σ_p only
-    on the trials after it (issue 26: one error-free run, one linearisation and the procedure's
-    per-act work for the three).
+    on the trials after it (one error-free run, one linearisation and the procedure's per-act
+    work for the three).
     ``linkage``: the knob–decentration linkage of the runs, "drag" or "independent" (None: the
     instrument's ``correction.decentration_linkage``;
     :data:`~stereoplotter.verification.procedure_mc.LINKAGE_VARIANTS`). ``fidelity``: the
@@ -395,7 +399,6 @@ def start_procedure_mc(
     ]
     if todo and instrument is None:
         raise ValueError("instrument: expected the InstrumentSpec of the procedure MC, found None")
-    names = list(PROCEDURE_CONFIGS)
     shared = {c: lead for lead, cs in SHARED_RUNS.items() for c in cs}
     groups: dict = {}
     for s, c, inst in todo:  # the configurations of one procedure go into one job
@@ -406,7 +409,7 @@ def start_procedure_mc(
             instrument,
             tuple(cs),
             {c: _trials_of(trials, c, inst) for c in cs},
-            seed + 7 * (2 * names.index(_stream(lead)) + (s == "80")) + 1,
+            seed + 7 * (2 * CONFIG_STREAM[_stream(lead)] + (s == "80")) + 1,
             inst,
             None if "fidelity" in configs[lead] else linkage,  # else the fidelity's
             {c: configs[c] for c in cs},
@@ -545,7 +548,8 @@ def run_verification(
         Monte Carlo trials per row (60 000 gives half-widths ≤ 1.4 % at 99.9 %, ≤ 0.8 % at
         95 %; most rows, with several sources, are tighter).
     seed : int
-        Seed of the ``numpy.random.Generator`` (one child stream per row).
+        Seed of the linear Monte Carlo (one stream per row, keyed by the row's identity:
+        :func:`row_stream`).
     geometry : mapping, optional
         Overrides of :data:`BOOK` (keys f, l, n, c, p60, a60, p80, a80).
     progress : callable, optional
@@ -577,7 +581,7 @@ def run_verification(
     pending = start_procedure_mc(
         procedure_trials, seed, procedure_scenarios, instrument=instrument, linkage=linkage
     )  # in worker processes while the linear rows are computed here
-    specs = _row_specs(g)
+    specs = row_entries(g)
     rows = _rows(specs, trials, seed, progress, Setting.from_mapping(g).is_book)
     attach_procedure_mc(rows, pending.result())
     return rows
@@ -730,11 +734,21 @@ def _fmt_printed(v) -> str:
     return "—" if v is None else f"{v:g}"
 
 
+def row_stream(seed: int, entry: Entry) -> np.random.Generator:
+    """The generator of ``entry``'s linear Monte Carlo: seeded with ``[seed, crc32(identity)]``
+    (:attr:`~stereoplotter.verification.entry.Entry.identity`; the keys of
+    :mod:`stereoplotter.random_streams`), whatever rows come before it."""
+    return np.random.default_rng([seed, key_code(entry.identity)])
+
+
 def _rows(specs: list[Entry], trials, seed, progress, at_book: bool = True):
-    rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(specs))]
+    seen: dict[str, int] = {}
+    for i, e in enumerate(specs):
+        if seen.setdefault(e.identity, i) != i:
+            raise ValueError(f"two rows of the table share the identity {e.identity!r}")
     rows = []
     for i, e in enumerate(specs):
-        rows.append(_row(e, trials, rngs[i], at_book))
+        rows.append(_row(e, trials, row_stream(seed, e), at_book))
         if progress is not None:
             progress(i + 1, len(specs), e.eq)
     return _one_verdict_per_quantity(rows)

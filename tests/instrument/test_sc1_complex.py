@@ -48,7 +48,7 @@ def test_automatic_coordinatograph_lag_and_enlargement():
     assert lag == pytest.approx(2.0 * 0.05, abs=4 * 0.02 / np.sqrt(len(t)))
 
 
-# --- the options as switches of the instrument and of simulate (issue 11, deliverable 4) -----
+# --- the options as switches of the instrument and of simulate ---------------------------------
 
 from dataclasses import replace  # noqa: E402
 

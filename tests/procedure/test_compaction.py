@@ -1,4 +1,4 @@
-"""Remedies and loops at array speed (issue 26): a round run on the failing trials alone
+"""Remedies and loops at array speed: a round run on the failing trials alone
 (``procedure.compaction``) gives the masked round's values, and the chunks of a long run give
 the same columns in worker processes as here."""
 

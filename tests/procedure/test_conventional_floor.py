@@ -1,4 +1,4 @@
-"""The error-free floor of the conventional method (issue 9, deliverable 1).
+"""The error-free floor of the conventional method.
 
 Instrument errors zero and operator zero: every check passes on every shipped stereopair and
 instrument, by both ways of relative orientation. The instrument's self-test (``instrument

@@ -1,4 +1,4 @@
-"""The conventional method's remedies with the operator's practice (issue 9, deliverable 3).
+"""The conventional method's remedies with the operator's practice.
 
 CR1: where a control height misses H/3000 on the book's single reading, the operator slips the
 height scale and reads every control height again as the mean of ``REPEAT_POINTINGS`` fusings
@@ -13,7 +13,7 @@ near ½ is ≤ √(2·0.25/400) = 0.035, so a margin of 0.20 is ≥ 4 SE below t
 These figures are the free-σ operator's, judging each point in a single look (σ_p = σ_q =
 10 µm, ``OperatorModel(eye="sigma", remeasure=False)``), kept here because the remedies need
 failures to act on: with the eye-derived operator (σ_p = 6.06 µm) the book's single reading
-already passes 0.865 of 400 trials (seed 3, issue 25).
+already passes 0.865 of 400 trials (seed 3).
 """
 
 from __future__ import annotations

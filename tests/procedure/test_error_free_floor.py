@@ -1,4 +1,4 @@
-"""The error-free floor of the setup-data method (issue 9, deliverable 1).
+"""The error-free floor of the setup-data method.
 
 With the instrument's injected errors zero and the operator zero (``--errors zero --operator
 zero``), every shipped stereopair on every instrument either passes every check or is refused
@@ -32,7 +32,7 @@ UM = 1e-3  # mm
 
 
 def _mechanism(instrument):
-    """The instrument's own correction mechanism (issue 11): the floor is its level."""
+    """The instrument's own correction mechanism: the floor is its level."""
     return mechanism_for(load_instrument(instrument))
 
 
@@ -160,8 +160,8 @@ def test_mountain60_is_refused_with_the_mechanism_level(instrument):
     assert "\n" not in message
     assert message.startswith(f"{source}: photos[0].exterior.omega_deg: expected a tilt ")
     assert "found -2.9°" in message
-    # the canonical unit leaves 31.9 µm and 2.05 m (issue 9); each instrument's own mechanism
-    # adds its second-order term (issue 11, measured: SC-1 35.3, SPR-3 34.0, SD-3 32.8 µm)
+    # the canonical unit leaves 31.9 µm and 2.05 m; each instrument's own mechanism adds its
+    # second-order term (SC-1 35.3, SPR-3 34.0, SD-3 32.8 µm)
     found = re.search(r"leaves ([0-9.]+) µm and ([0-9.]+) m", message)
     assert found is not None
     q_um, h_m = float(found.group(1)), float(found.group(2))

@@ -1,4 +1,4 @@
-"""The operator's eye (``procedure.eye``, issue 25): judgement figures derived from stereo acuity
+"""The operator's eye (``procedure.eye``): judgement figures derived from stereo acuity
 and the observation system, and the six-point check as a detection with a remeasure.
 
 References: the textbook's stereo acuity of the first kind ≈ 30″ and of the second kind 10″

@@ -49,7 +49,7 @@ def test_common_tilt_along_the_base_is_the_rigid_turn_of_the_base(name):
 def test_r3_brings_the_control_heights_inside_h3000(pair60):
     """pair60/SC-1, default errors, the free-σ single-look operator (σ_p = σ_q = 10 µm, the
     operator of these figures; the eye-derived σ_p = 6.06 µm passes 0.41 of 300 trials without
-    a remedy, issue 25): the heights check passes in ≈ 20 % without a remedy (book practice)
+    a remedy): the heights check passes in ≈ 20 % without a remedy (book practice)
     and in ≥ 97 % with R3 (measured 0.994 over 10 000 trials)."""
     sc, spec = pair60
     rates = {}

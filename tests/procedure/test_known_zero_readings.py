@@ -7,7 +7,7 @@ decentrations on the decentration scales taking their places of zero into accoun
 So the default instrument draws only a calibration error for those (``known_zero_error_mm``,
 assumed one least count), not the 0.2 mm scatter of a place of zero still to be found.
 
-The run that showed why it matters (issue 24's finding, e12): with a 0.2 mm decentration zero
+Why it matters: with a 0.2 mm decentration zero
 error the photo sits 0.2 mm off the projection axis for the whole procedure, an interior
 orientation error the five relative elements cannot take out where the relief is high —
 mountain60, error-free operator: point 6 kept +33 µm of y-parallax after C2 converged (points

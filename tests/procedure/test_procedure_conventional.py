@@ -1,5 +1,5 @@
 """The conventional method: relative orientation by the six standard points, absolute
-orientation by control points (issue 5; procedure.md, "The conventional method")."""
+orientation by control points (procedure.md, "The conventional method")."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Simulated operator and the setup-data method (issue 5; procedure.md)."""
+"""Simulated operator and the setup-data method (procedure.md)."""
 
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ def _canonical(spec):
 @pytest.fixture(scope="module")
 def ideal(pair):
     sc, spec = pair
-    spec = _canonical(spec)  # the approximation level of kinematics.md §6 (issue 11 adds h)
+    spec = _canonical(spec)  # the approximation level of kinematics.md §6 (without h)
     return simulate(
         sc, spec, errors="zero", operator=OperatorModel().zero(), ideal_mechanics=True, seed=1
     )

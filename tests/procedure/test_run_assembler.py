@@ -1,4 +1,4 @@
-"""One run assembler (issue 23): every caller builds its instrument, operator and Run through
+"""One run assembler: every caller builds its instrument, operator and Run through
 ``stereoplotter.procedure.run``, so what one caller passes (the SC complex's options, the
 back-end, the mechanics) cannot drift from what another passes."""
 

@@ -1,4 +1,4 @@
-"""check-sheet (issue 13, deliverable 5): five planted mistakes, each of another kind, are found
+"""check-sheet: five planted mistakes, each of another kind, are found
 and named; the program's own sheet passes; a missing value is reported in one line.
 
 The planted values are computed independently of the checker: the sign of (6.4) by the

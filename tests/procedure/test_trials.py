@@ -1,4 +1,4 @@
-"""Long runs in chunks: chunk-size invariance, summary statistics, the per-trial file (issue 16)."""
+"""Long runs in chunks: chunk-size invariance, summary statistics, the per-trial file."""
 
 from __future__ import annotations
 

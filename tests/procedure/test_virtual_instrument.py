@@ -55,7 +55,7 @@ def test_sheet_readings_put_the_marks_on_the_fiducials(sheet):
     # The sheet's (6.12)/(6.13) targets, computed with the book's single-axis (6.1)/(6.2), are
     # where the instrument shows the fiducials: exactly for the canonical unit (kinematics.md
     # §3.3: the unit reproduces (6.1)/(6.2) on the axes), and scaled by the SC-1 gimbal's
-    # second-order lift for the SC-1's own mechanism (gimbal offset 20 mm, assumed; issue 11).
+    # second-order lift for the SC-1's own mechanism (gimbal offset 20 mm, assumed).
     # Independent paths: setup_data vs kinematics.
     spec = load_instrument("sc1")
     h_mm = spec.parameters["correction.gimbal_offset_mm"].value

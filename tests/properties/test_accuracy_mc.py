@@ -105,7 +105,7 @@ def test_plots_draw_against_the_rigorous_reference(rows):
     plt.close("all")
 
 
-# --- procedure MC, --geometry, histograms (issue 6 items 1-3) ---------------------------------
+# --- procedure MC, --geometry, histograms ---------------------------------------------------
 
 
 def test_procedure_columns_filled_and_disabled():

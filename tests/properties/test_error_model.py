@@ -15,8 +15,8 @@ def model():
     return error_model_from_spec(load_instrument("sc1"))
 
 
-def test_every_issue_term_is_there(model):
-    # issue 4: zero readings, gear/scale ratio errors, backlash per axis, setting errors of f_пр,
+def test_every_error_term_is_there(model):
+    # zero readings, gear/scale ratio errors, backlash per axis, setting errors of f_пр,
     # b, κ, decentrations and corrections, coordinatograph non-orthogonality, pen play, sheet
     # placement
     groups = {n.split(".")[0] for n in model.names}

@@ -1,6 +1,6 @@
 """Property and behaviour tests of the pure geometry (rotation, collinearity, (3.17), (6.1)/(6.2),
 intersection, similarity (6.8), f′). Independent computations serve as references; the book's own
-worked examples are in tests/test_reference_resection.py."""
+worked examples are in tests/reference/test_reference_resection.py."""
 
 from __future__ import annotations
 
@@ -143,7 +143,7 @@ def test_principal_point_transformed_position():
 
 @given(tilt, tilt, swing, photo_coordinate, photo_coordinate, st.floats(-300.0, 300.0))
 def test_collinearity_round_trip_photo_ground_photo(alpha, omega, kappa, x, y, Z):
-    # ground -> photo -> ground: round trip <= 1e-9 mm at photo scale (issue 2 acceptance)
+    # ground -> photo -> ground: round trip <= 1e-9 mm at photo scale
     centre = np.array([1200.0, -300.0, 1500.0])
     m = rotation_matrix(alpha, omega, kappa)
     ground = photo_to_object([x, y], Z, centre, m, 70.0, (0.01, -0.02))

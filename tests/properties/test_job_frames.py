@@ -1,4 +1,4 @@
-"""The passage from SK-42 to the photogrammetric frame of a job (issue 12, acceptance 3).
+"""The passage from SK-42 to the photogrammetric frame of a job.
 
 A job whose orientation is given in SK-42 Gauss–Krüger (centres x, ȳ, H; angles to the grid axes
 at the nadir), converted by the program, gives the same sheet as a hand-made job of the same pair

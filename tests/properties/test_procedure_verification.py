@@ -107,7 +107,7 @@ def test_setup_parallax_decomposition_is_first_order_in_the_trials_own_errors(se
 
 def test_independent_linkage_acts_in_the_setup_method():
     """B2 (linkage "independent"): the computed decentrations are set before the k_ω, k_α fits
-    in the setup method itself (before issue 25 only the self-test read the order). The
+    in the setup method itself. The
     error-free run then builds the model to
     well within the book's residual y-parallax check, ¼ of the mark (SC-1 sheet tolerance):
     its RMS δp is below that tolerance, as the dragging linkage's is."""

@@ -1,4 +1,4 @@
-"""The columnar sheet block (issue 27, deliverable 7) against an independent per-pair computation.
+"""The columnar sheet block against an independent per-pair computation.
 
 The pairs of ``jobs/strip8`` with their points thinned differently (2 to all 10 points, so the
 pairs' point counts and plan-control counts are unequal, one pair with a single point and no

@@ -1,4 +1,4 @@
-"""Verdicts of the verification table decided from the numbers (issue 10, deliverable 6).
+"""Verdicts of the verification table decided from the numbers.
 
 The book's arithmetic from its printed intermediates is redone here by hand (the printed numbers
 of ch. 6: (6.51) 0.24, (6.54) 0.95, (6.49) 0.12, m_xy = √2 m_p) and compared with the

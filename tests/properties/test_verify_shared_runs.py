@@ -41,7 +41,7 @@ def test_linear_mc_quadratic_form_is_the_drawn_field():
     removed): the per-trial mean squares of :func:`mc_rms` equal the field drawn and squared
     point by point, trial by trial, to rounding (1e-12 of the mean: a trial whose plane removal
     cancels its field keeps the absolute rounding of the mean square)."""
-    specs = v._row_specs(dict(v.BOOK))
+    specs = v.row_entries(dict(v.BOOK))
     kinds = set()
     for e in specs:
         m = e.model
@@ -73,7 +73,7 @@ def test_shared_conventional_run_is_each_configuration_on_its_trials(book80):
     first = 0
     for source, n in blocks.items():
         o = pm.ProcedureOptions(passes=3, sources=source)
-        plain, ctl, _, units = pm._run(
+        plain, ctl, _, units = pm.run_configuration(
             sc, spec, "conventional", first + n, 5, o, g, spec.decentration_linkage
         )
         r = merged[source]
@@ -83,7 +83,7 @@ def test_shared_conventional_run_is_each_configuration_on_its_trials(book80):
         value = math.sqrt(np.mean(ctl["plane"][first:])) / units["plane"]
         assert r["coefficient"] == pytest.approx(value, rel=1e-4)
         for k in ("slip", "book"):
-            cf, _ = pm._rms_ci(ctl[k][first:], units[k])
+            cf, _ = pm.rms_ci(ctl[k][first:], units[k])
             assert r["by_datum"][k][0] == pytest.approx(cf, rel=1e-4)
         first += n
 

@@ -24,12 +24,12 @@ from scipy.optimize import least_squares
 
 from stereoplotter.procedure.selftest import (
     SyntheticPair,
-    _apply_touch_up,
-    _true_units,
+    apply_touch_up,
     format_selftest,
     run_kinematic_selftest,
     sign_combinations,
     touch_up,
+    true_units,
     y_parallax,
 )
 
@@ -228,7 +228,7 @@ def test_instrument_spec_supplies_d_max():
     spec = load_instrument("sc1")
     r = run_kinematic_selftest(tilts=[1.0 * deg], variants=("L",), instrument=spec)
     assert r["data"]["projection_distance_max_mm"] == spec.projection_distance_max_mm
-    # one row per unit: the canonical, the strict per-axis and the SC-1's own mechanism (issue 11)
+    # one row per unit: the canonical, the strict per-axis and the SC-1's own mechanism
     rows = [(row["unit"], row["tilt_deg"]) for row in r["residuals"]]
     assert rows == [
         ("canonical", 1.0),
@@ -247,7 +247,7 @@ def test_touch_up_agrees_with_scipy():
     setting = pair.setting()
     tilts = sign_combinations()[[0, 5, 10]] * (3.0 * deg)
     pl, pr = pair.photos(tilts)
-    left, right = _true_units(pair, tilts, strict=False)
+    left, right = true_units(pair, tilts, strict=False)
     q, _, _ = touch_up(pl, pr, setting, left, right, "L")
     for b in range(3):
 
@@ -263,7 +263,7 @@ def test_touch_up_agrees_with_scipy():
         lu, ru = one(left), one(right)
 
         def fun(x, b=b, lu=lu, ru=ru):
-            s, l2, r2 = _apply_touch_up(x[None, :], setting, lu, ru, "L")
+            s, l2, r2 = apply_touch_up(x[None, :], setting, lu, ru, "L")
             return y_parallax(pl[b : b + 1], pr[b : b + 1], s, l2, r2).y_parallax_mm.ravel()
 
         ref = least_squares(fun, np.zeros(5), x_scale=[1e-3, 1e-3, 1e-3, 0.1, 0.1])
@@ -279,7 +279,7 @@ def test_strict_touch_up_has_the_documented_minimum():
     setting = pair.setting()
     tilts = sign_combinations() * (0.5 * deg)
     pl, pr = pair.photos(tilts)
-    left, right = _true_units(pair, tilts, strict=True)
+    left, right = true_units(pair, tilts, strict=True)
     q_near, _, _ = touch_up(pl, pr, setting, left, right, "L")
     shifted = (replace(left, kappa=left.kappa - 0.4), replace(right, kappa=right.kappa - 0.4))
     q_far, _, _ = touch_up(pl, pr, setting, *shifted, "L")

@@ -1,56 +1,17 @@
-"""Speed work on the simulated operator must not change its results (issues 5 and 16).
+"""Work on the simulated operator's speed must not change its results.
 
-The numbers below were recorded from a seeded vectorised run (T = 50, seed 3, pair60 on the SC-1,
-default injected errors and operator, closed-form back-end) on 2026-11-24 at the commit that made
-every random draw keyed by the trial index (chunked runs, issue 16; parent 010ed8a), with
-numpy 2.4.6 and scipy 1.17.1. They are compared within a relative tolerance of 1e-9: bit
-identity across numpy versions and processors is not promised (the SIMD paths of the elementary
-functions may differ in the last bit), only the same seed twice in one environment
-(``test_same_seed_gives_byte_identical_files``).
+The values below are those of a seeded vectorised run (T = 50, seed 3, pair60 on the SC-1,
+closed-form back-end), recorded with numpy 2.4.6 and scipy 1.17.1, for the setup-data method and
+the conventional method with the operator's practice and with the book's (``practice="book"``).
+They are compared within a relative tolerance of 1e-9: bit identity across numpy versions and
+processors is not promised (the SIMD paths of the elementary functions may differ in the last
+bit), only the same seed twice in one environment (``test_same_seed_gives_byte_identical_files``).
 
-The setup-method values were re-recorded (same environment) at the commit of issue 9's
-error-free floor: the stage-1 L-check corrections in their ratio form (decision D9) and κ cleared
-before the stage-3 heights are read (decision D10) legitimately change every setup-method run;
-the conventional method's values are unchanged.
-
-The setup-method values were re-recorded again (same environment) at the commit of issue 9's
-remedies (deliverable 3): the default practice is now the operator's ("operator": R1 repeats a
-failed stage-1 L-check with averaged pointings, R2 refines the relative orientation where q
-exceeds ¼ mark after stages 2 and 3), which legitimately changes every setup-method run;
-``practice="book"`` gives the previous values.
-
-The setup-method values were re-recorded again (same environment) at the commit of remedy R3
-(issue 9, deliverable 3: where a stage-3 control height misses H/3000 the operator refines the
-scale by b_x and levels the model by a q-neutral common tilt), which legitimately changes every
-setup-method run whose heights failed (trial 29: 0.803 m → 0.122 m); stages 1–2 are unchanged.
-
-The conventional values were re-recorded (same environment) at the commit of issue 9's C2
-stopping rule (go on while the RMS of the six looks falls by ½ a pass), the common tilt that
-frees a knob at its stop, the loops' bound 2 × max_iterations and C3's final levelling without a
-relative orientation after it: every conventional run legitimately changes.
-
-The conventional values of the default run were re-recorded (same environment) at commit
-3d03e90 that gives the conventional method the operator's-practice remedies (issue 9:
-CR1 re-reads failed control heights as the mean of 4 fusings, CR2 refines the relative
-orientation where q fails after C3 and levels again): the default practice is "operator", so
-the default run legitimately changes from C3's final checks on (trial 29's control heights
-0.393 → 0.622 m: CR2's refinement re-tilts it). ``practice="book"`` gives the previous values
-unchanged ("conventional/book", pinned to the old figures).
-
-Issue 11 gave each instrument its own correction mechanism; the SC-1's (a carrier tilted about
-gimbal axes h = 20 mm below the emulsion, assumed) scales each photo by a second-order factor.
-The runs below set h = 0, which makes the SC-1's mechanism the canonical unit of the recorded
-runs: the recorded values are then reproduced unchanged (checked at the merge of issue 11).
-
-Issue 25 derived the default operator's σ_p, σ_q from the eye (6.06 and 2.02 µm) and made the
-six-point check a detection with a remeasure: the default run legitimately changes. The runs
-below name the operator of the recorded values, ``OperatorModel(eye="sigma", remeasure=False)``
-(σ_p = σ_q = 10 µm, one look; ``simulate --operator sigma``), and reproduce them unchanged.
-
-The places of zero of b_x and of the decentration scales became known constants of the
-instrument (§26 uses them without finding them): their default error is now the calibration
-error ``known_zero_error_mm`` (0.01 mm) instead of the 0.2 mm scatter. The runs below override
-those five terms back to 0.2 mm (:data:`RECORDED_ZERO_SCATTER`) and reproduce the values unchanged.
+The runs fix what the defaults would otherwise move: the SC-1's gimbal offset h = 0 (the
+canonical correction unit), the free-σ operator ``OperatorModel(eye="sigma", remeasure=False)``
+(σ_p = σ_q = 10 µm, one look; ``simulate --operator sigma``) and a 0.2 mm zero-reading scatter of
+b_x and the decentration scales (:data:`RECORDED_ZERO_SCATTER`; the default is the calibration
+error ``known_zero_error_mm``).
 """
 
 from __future__ import annotations
@@ -80,7 +41,7 @@ def runs():
     key = "correction.gimbal_offset_mm"  # h = 0: the canonical unit of the recorded runs
     params[key] = dataclasses.replace(params[key], value=0.0)
     spec = dataclasses.replace(spec, parameters=MappingProxyType(params))
-    op = OperatorModel(eye="sigma", remeasure=False)  # the recorded runs' operator (issue 25)
+    op = OperatorModel(eye="sigma", remeasure=False)  # the recorded runs' operator
     errors = error_model_from_spec(spec).with_overrides(RECORDED_ZERO_SCATTER)
     out = {
         m: simulate(

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.mechanics.base import (
     N_PER_UM,
     AxisParams,
@@ -58,8 +59,6 @@ class CoordinatographParams:
     y: AxisParams = PEN_CARRIAGE
 
     def __post_init__(self) -> None:
-        from stereoplotter.errors import StereoplotterError
-
         if (self.x.dt_s, self.x.iterations) != (self.y.dt_s, self.y.iterations):
             raise StereoplotterError(
                 "coordinatograph: X and Y share one space, so dt_s and iterations must agree, "

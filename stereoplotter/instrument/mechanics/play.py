@@ -127,6 +127,17 @@ class PlayAxis:
         """Carriage positions, shape (T,). [mm]"""
         return self._car.copy()
 
+    @property
+    def nut_view(self) -> np.ndarray:
+        """:attr:`nut` without the copy, to compute with and not to keep or write into (a move
+        replaces the array, it never writes into it). [mm]"""
+        return self._nut
+
+    @property
+    def position_view(self) -> np.ndarray:
+        """:attr:`position` without the copy, on the terms of :attr:`nut_view`. [mm]"""
+        return self._car
+
     def place(self, nut_mm: ArrayLike, side: Side = None) -> None:
         """Put every trial at rest as a long monotone move from ``side`` leaves it.
 

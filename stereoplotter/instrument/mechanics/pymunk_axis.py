@@ -382,16 +382,6 @@ class PymunkAxis:
         """Carriage position. [mm]"""
         return self._u(self.car_body)
 
-    @property
-    def push_force(self) -> float:
-        """Force the backlash coupling transmitted in the last step (impulse / dt). [mN]"""
-        return self.coupling.impulse / self.params.dt_s
-
-    @property
-    def friction_in_use(self) -> float:
-        """Friction force the rail exerted in the last step (impulse / dt), ≤ μ·m·g. [mN]"""
-        return self.friction_joint.impulse / self.params.dt_s
-
     def place(self, nut_mm: float, side: Side = None) -> None:
         """Put the axis at rest as a long monotone move from ``side`` would leave it.
 

@@ -42,8 +42,6 @@ __all__ = [
     "error_terms_for",
     "mark_phrase",
     "mechanism_for",
-    "mechanism_for_principle",
-    "principle_of",
     "sequence_for",
     "setting_values",
 ]
@@ -52,19 +50,6 @@ __all__ = [
 PRINCIPLES: dict[str, Principle] = {
     p.name: p for p in (plates.PLATES, lens_shift.LENS_SHIFT, gimbal.GIMBAL)
 }
-
-
-def principle_of(name: str) -> Principle | None:
-    """The principle named ``name`` (None: not one of the registered ones — the canonical
-    unit, s = 1, with no settings of its own)."""
-    return PRINCIPLES.get(name)
-
-
-def mechanism_for_principle(principle: str) -> CorrectionMechanism | None:
-    """The mechanism of an instrument's ``principle`` with its default dimension (None: the
-    canonical unit, s = 1)."""
-    p = PRINCIPLES.get(principle)
-    return p.mechanism_with() if p is not None else None
 
 
 def mechanism_for(spec: InstrumentSpec) -> CorrectionMechanism | None:

@@ -184,12 +184,14 @@ _INCL = "tan θ = k·tan {t}"
 _DEC = "f′·tan {t}"
 
 
-def _incl(key: str, name: str, symbol: str, tilt: str) -> Setting:
+def inclination_setting(key: str, name: str, symbol: str, tilt: str) -> Setting:
     t = "α" if tilt == "alpha" else "ω"
     return Setting(key, name, symbol, "deg", _INCL.format(t=t), "primary", tilt)
 
 
-def _dec(key: str, name: str, symbol: str, tilt: str, formula: str | None = None) -> Setting:
+def decentration_setting(
+    key: str, name: str, symbol: str, tilt: str, formula: str | None = None
+) -> Setting:
     t = "α" if tilt == "alpha" else "ω"
     return Setting(key, name, symbol, "mm", formula or _DEC.format(t=t), "derived", tilt)
 

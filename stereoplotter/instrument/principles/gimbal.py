@@ -18,8 +18,8 @@ from stereoplotter.instrument.principles.base import (
     Principle,
     SchemaField,
     SettingSequence,
-    _dec,
-    _incl,
+    decentration_setting,
+    inclination_setting,
 )
 
 __all__ = ["GIMBAL", "MechanicalProjection"]
@@ -71,10 +71,14 @@ GIMBAL = Principle(
     SettingSequence(
         "mechanical_projection_transformed_bundle",
         (
-            _incl("carrier_alpha", "photo-carrier tilt α (gimbal, k_α scale)", "θ_α", "alpha"),
-            _incl("carrier_omega", "photo-carrier tilt ω (gimbal, k_ω scale)", "θ_ω", "omega"),
-            _dec("photo_dx", "photo-carrier decentration x", "d_x", "alpha"),
-            _dec("photo_dy", "photo-carrier decentration y", "d_y", "omega"),
+            inclination_setting(
+                "carrier_alpha", "photo-carrier tilt α (gimbal, k_α scale)", "θ_α", "alpha"
+            ),
+            inclination_setting(
+                "carrier_omega", "photo-carrier tilt ω (gimbal, k_ω scale)", "θ_ω", "omega"
+            ),
+            decentration_setting("photo_dx", "photo-carrier decentration x", "d_x", "alpha"),
+            decentration_setting("photo_dy", "photo-carrier decentration y", "d_y", "omega"),
         ),
         8,
         "2 tilts on the k_α, k_ω scales and 2 decentrations per photo",

@@ -17,8 +17,8 @@ from stereoplotter.instrument.principles.base import (
     Principle,
     SchemaField,
     SettingSequence,
-    _dec,
-    _incl,
+    decentration_setting,
+    inclination_setting,
 )
 
 __all__ = ["LENS_SHIFT", "LensShift"]
@@ -77,14 +77,22 @@ LENS_SHIFT = Principle(
     SettingSequence(
         "transformed_bundle_lens_shift_correction",
         (
-            _incl("lens_alpha", "lens-shift mechanism kα", "θ_α", "alpha"),
-            _incl("lens_omega", "lens-shift mechanism kω", "θ_ω", "omega"),
-            _dec("photo_dx", "photo-carriage decentration x", "e_x", "alpha"),
-            _dec("photo_dy", "photo-carriage decentration y", "e_y", "omega"),
-            _dec("mechanism_dx", "correction-mechanism decentration x", "c_x", "alpha"),
-            _dec("mechanism_dy", "correction-mechanism decentration y", "c_y", "omega"),
-            _dec("follower_dx", "follower decentration x (correction plate)", "u_x", "alpha"),
-            _dec("follower_dy", "follower decentration y (correction plate)", "u_y", "omega"),
+            inclination_setting("lens_alpha", "lens-shift mechanism kα", "θ_α", "alpha"),
+            inclination_setting("lens_omega", "lens-shift mechanism kω", "θ_ω", "omega"),
+            decentration_setting("photo_dx", "photo-carriage decentration x", "e_x", "alpha"),
+            decentration_setting("photo_dy", "photo-carriage decentration y", "e_y", "omega"),
+            decentration_setting(
+                "mechanism_dx", "correction-mechanism decentration x", "c_x", "alpha"
+            ),
+            decentration_setting(
+                "mechanism_dy", "correction-mechanism decentration y", "c_y", "omega"
+            ),
+            decentration_setting(
+                "follower_dx", "follower decentration x (correction plate)", "u_x", "alpha"
+            ),
+            decentration_setting(
+                "follower_dy", "follower decentration y (correction plate)", "u_y", "omega"
+            ),
         ),
         12,
         "the 3 kinds of decentration (photo, correction mechanism, follower) × x, y × 2 photos, "

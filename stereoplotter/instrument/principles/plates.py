@@ -17,8 +17,8 @@ from stereoplotter.instrument.principles.base import (
     Principle,
     SchemaField,
     SettingSequence,
-    _dec,
-    _incl,
+    decentration_setting,
+    inclination_setting,
 )
 
 __all__ = ["PLATES", "PlaneFollower"]
@@ -77,16 +77,16 @@ PLATES = Principle(
     SettingSequence(
         "transformed_bundle_correction_planes",
         (
-            _incl("plate_alpha", "correction-plate inclination (α)", "θ_α", "alpha"),
-            _incl("plate_omega", "correction-plate inclination (ω)", "θ_ω", "omega"),
-            _dec(
+            inclination_setting("plate_alpha", "correction-plate inclination (α)", "θ_α", "alpha"),
+            inclination_setting("plate_omega", "correction-plate inclination (ω)", "θ_ω", "omega"),
+            decentration_setting(
                 "photo_dx",
                 "photo decentration x (from the plate)",
                 "d_x",
                 "alpha",
                 "(f′/k)·tan θ_α = f′·tan α",
             ),
-            _dec(
+            decentration_setting(
                 "photo_dy",
                 "photo decentration y (from the plate)",
                 "d_y",

@@ -1,0 +1,95 @@
+"""Every draw is keyed by its identity, not by its place: a step or a verification row inserted
+among the others leaves every other result unchanged, bit for bit."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from stereoplotter.io.instrument_file import load_instrument
+from stereoplotter.io.scenario_file import load_scenario
+from stereoplotter.procedure import conventional, setup_method, simulate
+from stereoplotter.verification import table
+
+TRIALS = 4
+
+
+def _dummy_step(run) -> None:
+    """A step of its own identity: it judges (a draw of its own stream) and reads every counter
+    it can read without moving a carriage."""
+    run.op.noise.normal("dummy/judgment", 1.0)
+    for control in ("X", "Y", "Z", "bx", "by", "bz"):
+        run.op.read(control, f"dummy/{control}")
+
+
+def _results(r) -> dict[str, bytes]:
+    """Every number of a run, as bytes."""
+    out = {
+        "q_standard": r.q_standard_mm.tobytes(),
+        "q_grid": r.q_grid_mm.tobytes(),
+        "Z": np.asarray(r.instrument.state()["carriages_mm"]["Z"]).tobytes(),
+    }
+    for name, check in r.checks.items():
+        out[f"check {name}"] = np.asarray(check.residual).tobytes()
+    for name, stage in r.stages.items():
+        out[f"iterations {name}"] = np.asarray(stage.iterations).tobytes()
+    for name, value in r.zero_readings.items():
+        out[f"zero {name}"] = np.asarray(value).tobytes()
+    return out
+
+
+def _run(method: str) -> dict[str, bytes]:
+    sc, spec = load_scenario("scenarios/pair60.yaml"), load_instrument("sc1")
+    r = simulate(sc, spec, method=method, seed=11, trials=TRIALS, evaluate=False)
+    return _results(r)
+
+
+@pytest.mark.parametrize(
+    ("method", "module", "before"),
+    [("setup", setup_method, "stage3_scale_model"), ("conventional", conventional, "c4_sheet")],
+)
+def test_an_inserted_step_changes_no_other_result(monkeypatch, method, module, before):
+    plain = _run(method)
+    step = getattr(module, before)
+
+    def with_dummy(*args, **kwargs):
+        _dummy_step(args[0])
+        return step(*args, **kwargs)
+
+    monkeypatch.setattr(module, before, with_dummy)
+    inserted = _run(method)
+    assert inserted.keys() == plain.keys()
+    changed = [k for k in plain if plain[k] != inserted[k]]
+    assert changed == []
+
+
+def _linear_rows(monkeypatch, insert: bool) -> list[dict]:
+    specs = table.row_entries
+
+    def with_dummy(g):
+        rows = specs(g)
+        dummy = dataclasses.replace(rows[5], eq="(dummy)", quantity="an inserted row")
+        return [rows[0], dummy, *rows[1:]]
+
+    if insert:
+        monkeypatch.setattr(table, "row_entries", with_dummy)
+    return table.run_verification(trials=300, seed=5, procedure_trials=0)
+
+
+def test_an_inserted_verification_row_changes_no_other_row(monkeypatch):
+    plain = _linear_rows(monkeypatch, insert=False)
+    inserted = _linear_rows(monkeypatch, insert=True)
+    assert [r["eq"] for r in inserted] == [plain[0]["eq"], "(dummy)"] + [r["eq"] for r in plain[1:]]
+    others = [r for r in inserted if r["eq"] != "(dummy)"]
+    for a, b in zip(plain, others, strict=True):
+        assert (a["mc_linear"], a["mc_linear_ci"]) == (b["mc_linear"], b["mc_linear_ci"]), a["eq"]
+        assert a == b
+
+
+def test_two_rows_of_one_identity_are_refused(monkeypatch):
+    specs = table.row_entries
+    monkeypatch.setattr(table, "row_entries", lambda g: [*specs(g), specs(g)[3]])
+    with pytest.raises(ValueError, match="share the identity"):
+        table.run_verification(trials=10, seed=5, procedure_trials=0)
