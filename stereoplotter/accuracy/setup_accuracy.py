@@ -26,10 +26,13 @@ import numpy as np
 
 from stereoplotter.accuracy.chapter5 import (
     _check_mode,
-    _mean_shifted_square,
     geodetic_orientation_parallax_rms,
+    mean_shifted_square,
     relative_orientation_parallax_rms,
 )
+
+#: The name tests/properties/test_procedure_verification.py imports from here.
+_mean_shifted_square = mean_shifted_square
 
 #: The setup-element error sources of (6.21)/(6.22), in the order of every error vector here.
 SETUP_SOURCES = (
@@ -550,7 +553,7 @@ def setup_relative_residual_rms(
         f, mark_distance_mm, n, sigma_counter_mm, "printed" if mode == "book" else "rigorous"
     )
     shift = c / 2.0 if mode == "book" else (c - a) / 2.0
-    mean_w = c**2 / 3.0 * _mean_shifted_square(shift, c)
+    mean_w = c**2 / 3.0 * mean_shifted_square(shift, c)
     mean_a = c**2 * (10 * a**2 + 5 * a * c + c**2) / 30.0
     var = (mean_w * m_w**2 + mean_a * m_a**2) / f**2
     if mode == "rigorous":
