@@ -244,6 +244,7 @@ def _job_files(
     photo number the job cannot take stops everything."""
     if production is None:
         return {}
+    # imported here: the CLI starts fast (pyproj and pydantic load only when a command runs)
     from stereoplotter.io.triangulated_job import job_files
 
     description = (
@@ -265,6 +266,7 @@ def _result_files(
     block: Any, solution: Any, residuals: Any, snooping: Any, args: argparse.Namespace
 ) -> dict[str, str | bytes]:
     """Orientations, residuals, points, figures, the snooping tables and the report."""
+    # imported here: the CLI starts fast (matplotlib loads only when a command runs)
     from stereoplotter.plotting.triangulation import (
         photo_residual_figure_png,
         precision_figure_png,
