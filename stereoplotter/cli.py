@@ -42,7 +42,7 @@ from stereoplotter.errors import StereoplotterError
 from stereoplotter.io.paths import resolve_data_file, set_user_folders
 from stereoplotter.progress import configure_logging
 
-__all__ = ["COMMANDS", "main"]
+__all__ = ["COMMANDS", "build_parser", "main"]
 
 #: The command modules, in the order ``--help`` lists them. A new command is a module of
 #: :mod:`stereoplotter.commands` with ``add_arguments(sub)`` and ``run(args)``, added here.
@@ -91,7 +91,8 @@ def _add_verbosity(parser: argparse.ArgumentParser, default: Any) -> None:
     )
 
 
-def _parser() -> argparse.ArgumentParser:
+def build_parser() -> argparse.ArgumentParser:
+    """The command line: every command's subparser, -v/--quiet before the command only."""
     parser = _Parser(
         prog="stereoplotter",
         description="Virtual SC-1, SPR-3 and SD-3 stereoplotters and their setup data "
@@ -124,7 +125,7 @@ def _all_subparsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentPa
 
 def _full_parser() -> argparse.ArgumentParser:
     """The parser with -v/--quiet accepted before or after the command."""
-    parser = _parser()
+    parser = build_parser()
     for child in _all_subparsers(parser):
         _add_verbosity(child, argparse.SUPPRESS)
     return parser

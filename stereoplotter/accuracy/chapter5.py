@@ -38,6 +38,7 @@ __all__ = [
     "geodetic_orientation_parallax_rms",
     "geodetic_orientation_parallax_sigma",
     "levelling_design",
+    "mean_shifted_square",
     "relative_orientation_cofactors",
     "relative_orientation_design",
     "relative_orientation_parallax_rms",
@@ -281,7 +282,7 @@ def relative_orientation_residual_sigma(
     return np.sqrt(var) * sigma_y_parallax_mm
 
 
-def _mean_shifted_square(shift, c_mm):
+def mean_shifted_square(shift, c_mm):
     """Mean of (x + shift)² over x ∈ [−c, 0]."""
     return (shift**3 - (shift - c_mm) ** 3) / (3.0 * c_mm)
 
@@ -318,7 +319,7 @@ def relative_orientation_parallax_rms(a_mm, c_mm, x_parallax_mm, sigma_y_paralla
     a, c, p = a_mm, c_mm, x_parallax_mm
     alpha_term = (6 * c**2 + 10 * a * c - 5 * p * (2 * a + c)) / (30.0 * (a + c) ** 2)
     if mode == "rigorous":
-        omega_term = _mean_shifted_square((c - a) / 2.0, c) / (4.0 * c**2)
+        omega_term = mean_shifted_square((c - a) / 2.0, c) / (4.0 * c**2)
     else:
         omega_term = 1.0 / 48.0
     return np.sqrt(omega_term + alpha_term) * sigma_y_parallax_mm

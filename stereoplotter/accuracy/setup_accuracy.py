@@ -25,9 +25,9 @@ from __future__ import annotations
 import numpy as np
 
 from stereoplotter.accuracy.chapter5 import (
-    _mean_shifted_square,
     check_mode,
     geodetic_orientation_parallax_rms,
+    mean_shifted_square,
     relative_orientation_parallax_rms,
 )
 
@@ -550,7 +550,7 @@ def setup_relative_residual_rms(
         f, mark_distance_mm, n, sigma_counter_mm, "printed" if mode == "book" else "rigorous"
     )
     shift = c / 2.0 if mode == "book" else (c - a) / 2.0
-    mean_w = c**2 / 3.0 * _mean_shifted_square(shift, c)
+    mean_w = c**2 / 3.0 * mean_shifted_square(shift, c)
     mean_a = c**2 * (10 * a**2 + 5 * a * c + c**2) / 30.0
     var = (mean_w * m_w**2 + mean_a * m_a**2) / f**2
     if mode == "rigorous":

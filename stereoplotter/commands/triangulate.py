@@ -25,8 +25,19 @@ __all__ = ["add_arguments", "run", "run_synth"]
 METHODS = ("bundle", "strip", "polygon")
 
 
+#: Largest plausible antenna offset from the camera in any axis [m] (assumed: an antenna on the
+#: fuselage above the camera hatch of a survey aircraft sits a few metres from it at most).
+MAX_LEVER_ARM_M = 5.0
+
+
 def add_arguments(sub: Any) -> None:
     """Add ``triangulate`` and ``block`` (action ``synth``) to the CLI's subparsers."""
+    _add_triangulate(sub)
+    _add_block_synth(sub)
+
+
+def _add_triangulate(sub: Any) -> None:
+    """``triangulate BLOCK -o DIR`` with its method and the bundle's options."""
     p = sub.add_parser(
         "triangulate",
         help="analytic phototriangulation of a block: orientations, residuals, report, job file",
@@ -83,6 +94,10 @@ def add_arguments(sub: Any) -> None:
         "f,x0,y0,k1,k2,p1,p2 or 'all' (default none: the certificate holds)",
     )
     p.set_defaults(func=run)
+
+
+def _add_block_synth(sub: Any) -> None:
+    """``block synth -o DIR``: the synthetic block's size, control, errors and production."""
     b = sub.add_parser("block", help="blocks of comparator measurements (docs/triangulation.md)")
     acts = b.add_subparsers(dest="block_command", required=True, metavar="ACTION")
     s = acts.add_parser("synth", help="a synthetic block from an invented ground truth")
@@ -125,11 +140,12 @@ def add_arguments(sub: Any) -> None:
     )
     s.add_argument(
         "--lever-arm",
-        type=float,
+        type=bounded_float(-MAX_LEVER_ARM_M, MAX_LEVER_ARM_M),
         nargs=3,
         default=(0.0, 0.0, 0.0),
         metavar=("X", "Y", "Z"),
-        help="the antenna in the camera system [m] (with --centres; default 0 0 0)",
+        help="the antenna in the camera system [m] (with --centres; default 0 0 0; each within "
+        f"±{MAX_LEVER_ARM_M:g} m, assumed: an antenna a few metres from the camera at most)",
     )
     s.add_argument("--name", default="synthetic", help="name of the block")
     s.add_argument("--instrument", default="sc1", help="instrument of the production job")
@@ -205,7 +221,52 @@ def run(args: argparse.Namespace) -> int:
     # imported here: the CLI starts fast (no pyproj, matplotlib or pydantic until a command runs)
     from stereoplotter.io.atomic_write import write_files
     from stereoplotter.io.block_measurements_file import load_block_measurements
+    from stereoplotter.triangulation.solution import catalogue_residuals
+
+    block, production = load_block_measurements(args.block)
+    solution, snooping = _solve(block, args)
+    residuals = catalogue_residuals(block, solution)
+    files = _job_files(block, production, solution, snooping, args)
+    files.update(_result_files(block, solution, residuals, snooping, args))
+    out = Path(args.output)
+    encoded = {n: c if isinstance(c, bytes) else c.encode("utf-8") for n, c in files.items()}
+    write_files(out, encoded)  # every file whole or not at all
+    print(_summary_line(block, solution, residuals, snooping, args, production is not None))
+    if production is None:
+        print("no production section in the block file: no job file written", file=sys.stderr)
+    return 0
+
+
+def _job_files(
+    block: Any, production: Any, solution: Any, snooping: Any, args: argparse.Namespace
+) -> dict[str, str | bytes]:
+    """The production job's files (none without a ``production`` section); made first, so a
+    photo number the job cannot take stops everything."""
+    if production is None:
+        return {}
+    # imported here: the CLI starts fast (pyproj and pydantic load only when a command runs)
     from stereoplotter.io.triangulated_job import job_files
+
+    description = (
+        f"Exterior orientation of block {block.name} by stereoplotter triangulate "
+        f"--method {args.method} from {Path(args.block).name}."
+    )
+    return dict(
+        job_files(
+            _calibrated(block, snooping, args),
+            production,
+            solution.orientations,
+            source=args.block,
+            description=description,
+        )
+    )
+
+
+def _result_files(
+    block: Any, solution: Any, residuals: Any, snooping: Any, args: argparse.Namespace
+) -> dict[str, str | bytes]:
+    """Orientations, residuals, points, figures, the snooping tables and the report."""
+    # imported here: the CLI starts fast (matplotlib loads only when a command runs)
     from stereoplotter.plotting.triangulation import (
         photo_residual_figure_png,
         precision_figure_png,
@@ -220,27 +281,8 @@ def run(args: argparse.Namespace) -> int:
         report_markdown,
         residual_csv,
     )
-    from stereoplotter.triangulation.solution import catalogue_residuals
 
-    block, production = load_block_measurements(args.block)
-    solution, snooping = _solve(block, args)
-    residuals = catalogue_residuals(block, solution)
     files: dict[str, str | bytes] = {}
-    job_block = _calibrated(block, snooping, args)
-    if production is not None:  # first: a photo number the job cannot take stops everything
-        description = (
-            f"Exterior orientation of block {block.name} by stereoplotter triangulate "
-            f"--method {args.method} from {Path(args.block).name}."
-        )
-        files.update(
-            job_files(
-                job_block,
-                production,
-                solution.orientations,
-                source=args.block,
-                description=description,
-            )
-        )
     files["orientations.csv"] = orientation_csv(block, solution)
     files["residuals.csv"] = residual_csv(block, residuals)
     files["points.csv"] = points_csv(block, solution)
@@ -258,11 +300,21 @@ def run(args: argparse.Namespace) -> int:
     files["report.md"] = report_markdown(
         block, solution, residuals, args.block, snooping, args.reject or args.robust is not None
     )
+    return files
+
+
+def _summary_line(
+    block: Any,
+    solution: Any,
+    residuals: Any,
+    snooping: Any,
+    args: argparse.Namespace,
+    has_job: bool,
+) -> str:
+    """The one line printed on success: method, iterations, σ₀, RMS at check points, flags."""
     out = Path(args.output)
-    encoded = {n: c if isinstance(c, bytes) else c.encode("utf-8") for n, c in files.items()}
-    write_files(out, encoded)  # every file whole or not at all
     rms = residuals.rms(block, "check")
-    job = f"; job file {out / 'job.yaml'}" if production is not None else ""
+    job = f"; job file {out / 'job.yaml'}" if has_job else ""
     flagged = ""
     if snooping is not None:
         what = (
@@ -273,15 +325,12 @@ def run(args: argparse.Namespace) -> int:
             else "kept; --reject removes them"
         )
         flagged = f"; {len(snooping.flags)} observations flagged ({what})"
-    print(
+    return (
         f"block {block.name}: {len(block.photos)} photos by {args.method} in "
         f"{solution.iterations} iterations, σ₀ = {solution.sigma0:.3f}; RMS at check points "
         f"X {rms[0]:.3f}, Y {rms[1]:.3f}, Z {rms[2]:.3f} m{flagged}; report "
         f"{out / 'report.md'}{job}"
     )
-    if production is None:
-        print("no production section in the block file: no job file written", file=sys.stderr)
-    return 0
 
 
 def _production(block: Any, orientations: Any, instrument: str, date: str) -> dict[str, Any]:

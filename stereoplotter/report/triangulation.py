@@ -214,10 +214,21 @@ def _photo_rms(block: Block, v: NDArray) -> tuple[NDArray, NDArray]:
 
 
 def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]:
-    rel, g = (
-        (sn.reliability, sn.global_test) if reject else (sn.reliability_first, sn.global_test_first)
-    )
+    """The section "Tests after Baarda": global test, data snooping, flags and reliability."""
+    rel = sn.reliability if reject else sn.reliability_first
     prob = sn.problem_last if reject else sn.problem_first
+    return [
+        *_test_lines(sn, reject),
+        *_flag_lines(sn, reject),
+        *_reliability_table_lines(rel),
+        *_reliability_note_lines(block, prob, rel),
+    ]
+
+
+def _test_lines(sn: SnoopingResult, reject: bool) -> list[str]:
+    """The global test of σ₀ and how data snooping (or robust re-weighting) went."""
+    rel = sn.reliability if reject else sn.reliability_first
+    g = sn.global_test if reject else sn.global_test_first
     verdict = (
         "accepted"
         if g.passed
@@ -225,7 +236,7 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
         "or an error the model lacks — e.g. the fiducial marks' error, which moves all points "
         "of a photo together)"
     )
-    lines = [
+    return [
         "## Tests after Baarda",
         "",
         f"Global test of σ₀ (χ², two-sided, α = 5 %): σ₀ = {g.sigma0:.3f} on a redundancy of "
@@ -250,65 +261,86 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
         ),
         "",
     ]
+
+
+def _flag_lines(sn: SnoopingResult, reject: bool) -> list[str]:
+    """The flagged observations' table (or "No observation flagged.")."""
     if not sn.flags:
-        lines += ["No observation flagged.", ""]
-    else:
-        lines += [
-            "| round | photo | point | observation | w | MDB | cannot be told from |",
-            "|---:|---|---|---|---:|---:|---|",
-        ]
-        for f in sn.flags:
-            photo_mm = f.observation.endswith("_mm")
-            unit = "µm" if photo_mm else "m"
-            mdb = f.mdb * 1000 if photo_mm else f.mdb
-            lines.append(
-                f"| {f.round} | {f.photo or '(catalogue)'} | {f.point or '(centre)'} | "
-                f"{f.observation} | {f.w:.1f} | {mdb:.3g} {unit} | "
-                f"{', '.join(f.inseparable) or '—'} |"
-            )
-        lines += [
-            "",
-            "Flagged observations one per line: `flagged.csv`. "
-            + (
-                "They were removed and the block readjusted (`--reject`): the results below "
-                "are without them."
-                if reject
-                else "The results below still hold them: `--reject` removes them and readjusts."
-            ),
-            "",
-        ]
-
-    def stats_row(name: str, r: NDArray, mdb: NDArray, effect: NDArray, unit: str, k: float):
-        ok = np.isfinite(r)
-        controlled = ok & (r >= 0.01)
-        r, mdb, effect = r[ok], mdb[ok], effect[controlled]
-        if not r.size:
-            return f"| {name} | 0 | — | — | — | — | — |"
-        weak = int(np.count_nonzero(r < 0.01))
-        return (
-            f"| {name} | {r.size} | {r.min():.3f} | {r.mean():.3f} | {weak} | "
-            f"{np.median(mdb) * k:.3g} {unit} | "
-            + (f"{np.max(effect):.3f} m |" if effect.size else "— |")
+        return ["No observation flagged.", ""]
+    lines = [
+        "| round | photo | point | observation | w | MDB | cannot be told from |",
+        "|---:|---|---|---|---:|---:|---|",
+    ]
+    for f in sn.flags:
+        photo_mm = f.observation.endswith("_mm")
+        unit = "µm" if photo_mm else "m"
+        mdb = f.mdb * 1000 if photo_mm else f.mdb
+        lines.append(
+            f"| {f.round} | {f.photo or '(catalogue)'} | {f.point or '(centre)'} | "
+            f"{f.observation} | {f.w:.1f} | {mdb:.3g} {unit} | "
+            f"{', '.join(f.inseparable) or '—'} |"
         )
+    return [
+        *lines,
+        "",
+        "Flagged observations one per line: `flagged.csv`. "
+        + (
+            "They were removed and the block readjusted (`--reject`): the results below "
+            "are without them."
+            if reject
+            else "The results below still hold them: `--reject` removes them and readjusts."
+        ),
+        "",
+    ]
 
-    lines += [
+
+def _reliability_row(
+    name: str, r: NDArray, mdb: NDArray, effect: NDArray, unit: str, k: float
+) -> str:
+    """One row of the reliability table: n, r min and mean, uncontrolled, median MDB (× k into
+    the unit), largest effect of a controlled observation."""
+    ok = np.isfinite(r)
+    controlled = ok & (r >= 0.01)
+    r, mdb, effect = r[ok], mdb[ok], effect[controlled]
+    if not r.size:
+        return f"| {name} | 0 | — | — | — | — | — |"
+    weak = int(np.count_nonzero(r < 0.01))
+    return (
+        f"| {name} | {r.size} | {r.min():.3f} | {r.mean():.3f} | {weak} | "
+        f"{np.median(mdb) * k:.3g} {unit} | "
+        + (f"{np.max(effect):.3f} m |" if effect.size else "— |")
+    )
+
+
+def _reliability_table_lines(rel: ObservationReliability) -> list[str]:
+    """The reliability table: photo coordinates, control, projection centres (if measured)."""
+    lines = [
         "Reliability (of the adjustment the report gives; every measurement in "
         "`observations.csv`):",
         "",
         "| observations | n | r min | r mean | r < 0.01 | median MDB | largest effect (r ≥ 0.01) |",
         "|---|---:|---:|---:|---:|---:|---:|",
-        stats_row("photo x, y", rel.photo_r, rel.photo_mdb, rel.photo_effect, "µm", 1000.0),
-        stats_row(
+        _reliability_row("photo x, y", rel.photo_r, rel.photo_mdb, rel.photo_effect, "µm", 1000.0),
+        _reliability_row(
             "control X, Y, height", rel.control_r, rel.control_mdb, rel.control_effect, "m", 1.0
         ),
     ]
     if rel.centre_r.size:
         none = np.full_like(rel.centre_r, np.nan)
-        lines.append(stats_row("projection centres", rel.centre_r, rel.centre_mdb, none, "m", 1.0))
+        lines.append(
+            _reliability_row("projection centres", rel.centre_r, rel.centre_mdb, none, "m", 1.0)
+        )
     lines.append("")
+    return lines
+
+
+def _reliability_note_lines(
+    block: Block, prob: BundleProblem, rel: ObservationReliability
+) -> list[str]:
+    """What r, MDB and effect mean, and where the largest effect is."""
     worst = int(np.argmax(rel.photo_effect.max(axis=1))) if rel.photo_r.size else 0
     pr = rel.photo_r
-    lines += [
+    return [
         "r: redundancy number (share of an error the residual shows); MDB = δ₀·σ/√r the "
         "smallest blunder found with probability β₀; its effect: how far such a blunder, "
         "undetected, moves the point. An observation with r < 0.01 is not controlled (x on a "
@@ -321,7 +353,6 @@ def _snooping_lines(block: Block, sn: SnoopingResult, reject: bool) -> list[str]
         ),
         "",
     ]
-    return lines
 
 
 def _camera_lines(c: CameraCalibration) -> list[str]:
@@ -352,7 +383,6 @@ def _camera_lines(c: CameraCalibration) -> list[str]:
     return [*lines, ""]
 
 
-# long: the report's sections one after the other (block, tests, residuals, precision, photos)
 def report_markdown(
     block: Block,
     solution: BlockSolution,
@@ -366,10 +396,25 @@ def report_markdown(
     the points and orientations, the residuals photo by photo and the figure ``residuals.png``.
     No NaN: a value that does not exist is a dash."""
     v = photo_residuals(block, solution)
-    ok = np.all(np.isfinite(v), axis=1)
-    photo_rms = float(np.sqrt(np.mean(v[ok] ** 2))) if ok.any() else float("nan")
-    se = solution.standard_errors
-    lines = [
+    lines = _header_lines(block, solution, source)
+    if snooping is not None:
+        lines += _snooping_lines(block, snooping, reject)
+        prob = snooping.problem_last if reject else snooping.problem_first
+        if prob.camera_free:
+            adj = snooping.last if reject else snooping.first
+            lines += _camera_lines(camera_calibration(prob, adj))
+    lines += _catalogue_residual_lines(block, residuals, v)
+    lines += _point_precision_lines(block, solution)
+    lines += _orientation_precision_lines(solution)
+    lines += _largest_residual_lines(block, residuals)
+    lines += _photo_residual_lines(block, v)
+    lines += _file_lines(snooping is not None)
+    return "\n".join(lines)
+
+
+def _header_lines(block: Block, solution: BlockSolution, source: str) -> list[str]:
+    """Title, the block file, the method, iterations, σ₀ and the solution's notes."""
+    return [
         f"# Phototriangulation of block {block.name}",
         "",
         f"Block file `{Path(source).name}`: {len(block.strips)} strips, {len(block.photos)} "
@@ -382,13 +427,13 @@ def report_markdown(
         *[f"- {n}" for n in solution.notes],
         "",
     ]
-    if snooping is not None:
-        lines += _snooping_lines(block, snooping, reject)
-        prob = snooping.problem_last if reject else snooping.problem_first
-        if prob.camera_free:
-            adj = snooping.last if reject else snooping.first
-            lines += _camera_lines(camera_calibration(prob, adj))
-    lines += [
+
+
+def _catalogue_residual_lines(block: Block, residuals: CatalogueResiduals, v: NDArray) -> list[str]:
+    """RMS at control and check points, the vector figure, the RMS photo residual [µm]."""
+    ok = np.all(np.isfinite(v), axis=1)
+    photo_rms = float(np.sqrt(np.mean(v[ok] ** 2))) if ok.any() else float("nan")
+    return [
         "## Residuals at control and check points (triangulated − catalogue) [m]",
         "",
         "| role | points | RMS X | RMS Y | RMS Z |",
@@ -405,48 +450,63 @@ def report_markdown(
         + (f" ({ok.size - int(ok.sum())} of points not intersected)." if not ok.all() else "."),
         "",
     ]
+
+
+def _point_precision_lines(block: Block, solution: BlockSolution) -> list[str]:
+    """RMS of the points' σ by role and how the σ were found (none without point σ)."""
     pse = solution.point_standard_errors
-    if pse is not None:
-        roles = np.array([r for r, _ in _point_roles(block)])
-        lines += [
-            "## Precision of the points (RMS of the σ; every point in `points.csv`) [m]",
-            "",
-            "| points | n | σX | σY | σZ |",
-            "|---|---:|---:|---:|---:|",
-        ]
-        for role in ("tie", "control", "check"):
-            m = (roles == role) & np.all(np.isfinite(pse), axis=1)
-            if m.any():
-                rms = np.sqrt(np.mean(pse[m] ** 2, axis=0))
-                lines.append(f"| {role} | {int(m.sum())} | " + " | ".join(f"{x:.3f}" for x in rms)
-                             + " |")  # fmt: skip
-        how = (
-            "σ = σ₀·√(diagonal of N⁻¹), from the selected inverse of the normal equations (no "
-            "dense inverse)."
-            if solution.method == "bundle"
-            else "σ propagated through the polynomial adjustment with its a posteriori σ₀ "
-            "(model coordinates independent)."
-            if solution.method == "strip"
-            else "σ by an empirical rule: the RMS residual at the control points, per axis."
+    if pse is None:
+        return []
+    roles = np.array([r for r, _ in _point_roles(block)])
+    lines = [
+        "## Precision of the points (RMS of the σ; every point in `points.csv`) [m]",
+        "",
+        "| points | n | σX | σY | σZ |",
+        "|---|---:|---:|---:|---:|",
+    ]
+    for role in ("tie", "control", "check"):
+        m = (roles == role) & np.all(np.isfinite(pse), axis=1)
+        if m.any():
+            rms = np.sqrt(np.mean(pse[m] ** 2, axis=0))
+            lines.append(f"| {role} | {int(m.sum())} | " + " | ".join(f"{x:.3f}" for x in rms)
+                         + " |")  # fmt: skip
+    how = (
+        "σ = σ₀·√(diagonal of N⁻¹), from the selected inverse of the normal equations (no "
+        "dense inverse)."
+        if solution.method == "bundle"
+        else "σ propagated through the polynomial adjustment with its a posteriori σ₀ "
+        "(model coordinates independent)."
+        if solution.method == "strip"
+        else "σ by an empirical rule: the RMS residual at the control points, per axis."
+    )
+    return [*lines, "", f"{how} Plan σ ellipses and σ_Z over the block:", "",
+            "![precision of the points](precision.png)", ""]  # fmt: skip
+
+
+def _orientation_precision_lines(solution: BlockSolution) -> list[str]:
+    """RMS over the photos of the orientations' σ (none without them)."""
+    se = solution.standard_errors
+    if se is None:
+        return []
+    mean = np.sqrt(np.mean(se**2, axis=0))
+    return [
+        "## Precision of the orientations (RMS of the σ over the photos)",
+        "",
+        "| σα ″ | σω ″ | σκ ″ | σX_S m | σY_S m | σZ_S m |",
+        "|---:|---:|---:|---:|---:|---:|",
+        "| "
+        + " | ".join(
+            [f"{x * ARCSEC_PER_RAD:.1f}" for x in mean[:3]] + [f"{x:.3f}" for x in mean[3:]]
         )
-        lines += ["", f"{how} Plan σ ellipses and σ_Z over the block:", "",
-                  "![precision of the points](precision.png)", ""]  # fmt: skip
-    if se is not None:
-        mean = np.sqrt(np.mean(se**2, axis=0))
-        lines += [
-            "## Precision of the orientations (RMS of the σ over the photos)",
-            "",
-            "| σα ″ | σω ″ | σκ ″ | σX_S m | σY_S m | σZ_S m |",
-            "|---:|---:|---:|---:|---:|---:|",
-            "| "
-            + " | ".join(
-                [f"{x * ARCSEC_PER_RAD:.1f}" for x in mean[:3]] + [f"{x:.3f}" for x in mean[3:]]
-            )
-            + " |",
-            "",
-        ]
+        + " |",
+        "",
+    ]
+
+
+def _largest_residual_lines(block: Block, residuals: CatalogueResiduals) -> list[str]:
+    """The ten catalogue points with the largest residual vectors."""
     worst = np.argsort(-np.linalg.norm(np.nan_to_num(residuals.residuals_m), axis=1))[:10]
-    lines += [
+    lines = [
         "## The ten largest residuals [m]",
         "",
         "| point | role | kind | rays | vX | vY | vZ |",
@@ -461,8 +521,13 @@ def report_markdown(
             else "not intersected | | "
         )
         lines.append(f"| {c.id} | {c.role} | {c.kind} | {residuals.rays[k]} | {cells} |")
+    return lines
+
+
+def _photo_residual_lines(block: Block, v: NDArray) -> list[str]:
+    """RMS photo residuals photo by photo [µm] with the figure ``photo_residuals.png``."""
     n, rms = _photo_rms(block, v)
-    lines += [
+    lines = [
         "",
         "## Photo residuals photo by photo (RMS, measured − computed) [µm]",
         "",
@@ -477,7 +542,12 @@ def report_markdown(
             f"| {photo} | {int(strip[j]) + 1} | {int(n[j])} | {_num(rms[j, 0] * 1000, '.2f')} | "
             f"{_num(rms[j, 1] * 1000, '.2f')} |"
         )
-    lines += [
+    return lines
+
+
+def _file_lines(snooped: bool) -> list[str]:
+    """Where the tables are: the CSV files written beside the report."""
+    return [
         "",
         "Orientations with their σ: `orientations.csv`; points with their σ: `points.csv`; "
         "residuals at catalogue points: `residuals.csv`"
@@ -485,9 +555,8 @@ def report_markdown(
             "; every observation's residual, w, r and MDB: `observations.csv` (photo "
             "coordinates) and `catalogue_observations.csv` (control and centres); flagged "
             "observations: `flagged.csv`."
-            if snooping is not None
+            if snooped
             else "."
         ),
         "",
     ]
-    return "\n".join(lines)

@@ -10,7 +10,7 @@ import numpy as np
 
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.scenario.model import Scenario
-from stereoplotter.scenario.synthetic import _imaged, footprint_m, working_area_grid_m
+from stereoplotter.scenario.synthetic import footprint_m, points_in_format, working_area_grid_m
 
 __all__ = ["flying_height_and_relief", "mean_flying_height_m", "summarize_scenario"]
 
@@ -114,7 +114,7 @@ def _photo_summary(scenario: Scenario, photo, pts, z_mean: float) -> dict[str, A
     """One photo's entry of ``photos`` (see :func:`summarize_scenario`)."""
     ext = photo.exterior
     height = ext.projection_centre_m[2] - z_mean
-    imaged = _imaged(scenario, photo, pts)
+    imaged = points_in_format(scenario, photo, pts)
     return {
         "name": photo.name,
         "projection_centre_m": [_r(v) for v in ext.projection_centre_m],

@@ -26,6 +26,7 @@ __all__ = [
     "PhotoMeasurements",
     "film_deformed",
     "footprint_m",
+    "points_in_format",
     "synthesize_measurements",
     "working_area_grid_m",
 ]
@@ -136,7 +137,7 @@ def working_area_grid_m(
     grid = np.column_stack([X.ravel(), Y.ravel(), scenario.terrain.height_m(X, Y).ravel()])
     keep = np.ones(len(grid), bool)
     for photo in scenario.photos:
-        keep &= _imaged(scenario, photo, grid)
+        keep &= points_in_format(scenario, photo, grid)
     return grid[keep]
 
 
@@ -151,7 +152,8 @@ def _project(scenario: Scenario, photo: Photo, points_m: NDArray) -> NDArray[np.
     )
 
 
-def _imaged(scenario: Scenario, photo: Photo, points_m: NDArray) -> NDArray[np.bool_]:
+def points_in_format(scenario: Scenario, photo: Photo, points_m: NDArray) -> NDArray[np.bool_]:
+    """Which ground points [m] the photo images inside its format (|x|, |y| ≤ format/2)."""
     xy = _project(scenario, photo, points_m)
     with np.errstate(invalid="ignore"):
         return np.all(np.abs(xy) <= scenario.camera.format_mm / 2.0, axis=-1)

@@ -301,19 +301,7 @@ def grade(
     t0 = time.perf_counter()
     acuity = trainee_acuity(session.records)
     pop_prep = with_acuity(session.prep, acuity) if acuity else session.prep
-    pop = (
-        population_measures(
-            pop_prep,
-            session.seed,
-            ex.stages,
-            population,
-            session.inst.injected,
-            progress=progress,
-            unusable=ex.unusable_points,
-        )
-        if population
-        else {}
-    )
+    pop = _population(session, pop_prep, population, progress)
     pop_seconds = time.perf_counter() - t0
     stages_out, ratios, par_ratios, pop_ratio = _outcome(session, par, pop)
     score = max(ratios) if ratios else float("inf")
@@ -325,12 +313,7 @@ def grade(
     hints = hint_cost(ex.stages, session.log)
     overall = _overall(score, stages_out, par_ratios, hints["total"])
     if pop_ratio is not None:
-        pct = percentile(score, pop_ratio)
-        overall["percentile"] = pct
-        # binomial standard error of a share estimated from N operators [%]
-        overall["percentile_se"] = 100.0 * float(
-            np.sqrt(pct / 100.0 * (1.0 - pct / 100.0) / len(pop_ratio))
-        )
+        overall.update(_percentile(score, pop_ratio))
     return json_finite(
         {
             "format": GRADE_FORMAT,
@@ -362,6 +345,36 @@ def grade(
             },
         }
     )
+
+
+def _population(
+    session: Session,
+    pop_prep: Any,
+    population: int,
+    progress: Callable[[int], None] | None,
+) -> dict[str, Any]:
+    """The measures of ``population`` simulated operators on the session's instrument (with
+    the trainee's acuity in ``pop_prep``); empty when ``population`` is 0."""
+    if not population:
+        return {}
+    ex = session.exercise
+    return population_measures(
+        pop_prep,
+        session.seed,
+        ex.stages,
+        population,
+        session.inst.injected,
+        progress=progress,
+        unusable=ex.unusable_points,
+    )
+
+
+def _percentile(score: float, pop_ratio: Any) -> dict[str, float]:
+    """The score's percentile among the operators [%] with its binomial standard error (of a
+    share estimated from N operators) [%]."""
+    pct = percentile(score, pop_ratio)
+    se = 100.0 * float(np.sqrt(pct / 100.0 * (1.0 - pct / 100.0) / len(pop_ratio)))
+    return {"percentile": pct, "percentile_se": se}
 
 
 #: A substitute for a standard point may lie this fraction of c from it (assumed: the relative

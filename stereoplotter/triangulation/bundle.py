@@ -352,7 +352,6 @@ class Normals:
     rg: NDArray[np.float64] | None = None
 
 
-# long: normal blocks, point elimination and the reduced matrix in one pass over the measurements
 def normals(
     p: BundleProblem,
     orient: NDArray,
@@ -370,6 +369,33 @@ def normals(
     v, jc, jg = _linearise(p, orient, points, camera)
     w = p.photo_weights()  # (n_obs, 2) [1/mm²]
     jp = -jc[:, :, 3:]
+    ncc, bc, npp, bp, vv = _normal_blocks(p, orient, points, v, jc, jp, w)
+    unused = np.bincount(p.obs_point, minlength=p.n_points) == 0
+    npp[unused] = np.eye(3)
+    _check_points_fixed(p, npp)
+    pinv = np.linalg.inv(npp)
+    ncp = np.einsum("nki,nk,nkj->nij", jc, w, jp)  # per measurement, 6 × 3
+    s = _reduced_matrix(p, ncc, ncp, pinv, pairs)
+    reduced_p = np.einsum("nij,nj->ni", pinv, bp)
+    rhs = bc.copy()
+    np.add.at(rhs, p.obs_photo, -np.einsum("nij,nj->ni", ncp, reduced_p[p.obs_point]))
+    if not p.camera_free:
+        return Normals(v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused)
+    ngp, sgc, sgg, rg = _camera_border(p, v, jc, jp, jg, w, ncp, pinv, pairs, reduced_p)
+    return Normals(v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused, jg, ngp, sgc, sgg, rg)
+
+
+def _normal_blocks(
+    p: BundleProblem,
+    orient: NDArray,
+    points: NDArray,
+    v: NDArray,
+    jc: NDArray,
+    jp: NDArray,
+    w: NDArray,
+) -> tuple[NDArray, NDArray, NDArray, NDArray, float]:
+    """The diagonal blocks of the normals and their right-hand sides: per photo (6 × 6, with
+    the measured projection centres) and per point (3 × 3, with the control), and [vv]."""
     ncc = np.zeros((p.n_photos, 6, 6))
     np.add.at(ncc, p.obs_photo, np.einsum("nki,nk,nkj->nij", jc, w, jc))
     bc = np.zeros((p.n_photos, 6))
@@ -383,13 +409,16 @@ def normals(
     bp[p.control_point] += p.control_weight * dc
     vv = float(np.sum(w * v**2) + np.sum(p.control_weight * dc**2))
     if p.centre_photo.size:
-        vg, jg = centre_residuals(p, orient)
+        vg, jcentre = centre_residuals(p, orient)
         wg = p.centre_weight
-        np.add.at(ncc, p.centre_photo, np.einsum("nki,nk,nkj->nij", jg, wg, jg))
-        np.add.at(bc, p.centre_photo, np.einsum("nki,nk,nk->ni", jg, wg, vg))
+        np.add.at(ncc, p.centre_photo, np.einsum("nki,nk,nkj->nij", jcentre, wg, jcentre))
+        np.add.at(bc, p.centre_photo, np.einsum("nki,nk,nk->ni", jcentre, wg, vg))
         vv += float(np.sum(wg * vg**2))
-    unused = np.bincount(p.obs_point, minlength=p.n_points) == 0
-    npp[unused] = np.eye(3)
+    return ncc, bc, npp, bp, vv
+
+
+def _check_points_fixed(p: BundleProblem, npp: NDArray) -> None:
+    """Raise :class:`GeometryError` for the first point whose 3 × 3 normal block is singular."""
     det = np.linalg.det(npp)
     scale3 = np.einsum("nii->n", npp) ** 3
     weak = np.flatnonzero(~(np.abs(det) > 1e-12 * scale3))
@@ -402,8 +431,13 @@ def normals(
             "fix it (they lie along one line): expected rays from two photos at an angle; check "
             "the point identification"
         )
-    pinv = np.linalg.inv(npp)
-    ncp = np.einsum("nki,nk,nkj->nij", jc, w, jp)  # per measurement, 6 × 3
+
+
+def _reduced_matrix(
+    p: BundleProblem, ncc: NDArray, ncp: NDArray, pinv: NDArray, pairs: MeasurementPairs
+) -> sp.csc_matrix:
+    """The orientations' reduced normal matrix (6·photos square, sparse): the photo blocks
+    less, for each pair of measurements of one point, N_cp·N_pp⁻¹·N_pc."""
     pt = p.obs_point[pairs.first]
     blocks = np.einsum("nij,njk,nlk->nil", ncp[pairs.first], pinv[pt], ncp[pairs.second])
     jf, js = p.obs_photo[pairs.first], p.obs_photo[pairs.second]
@@ -414,7 +448,7 @@ def normals(
         (1, 1, 6), int
     )
     diag_c = np.swapaxes(diag_r, 1, 2)
-    s = sp.coo_matrix(
+    return sp.coo_matrix(
         (
             np.concatenate([ncc.ravel(), -blocks.ravel()]),
             (
@@ -424,11 +458,24 @@ def normals(
         ),
         shape=(n6, n6),
     ).tocsc()
-    reduced_p = np.einsum("nij,nj->ni", pinv, bp)
-    rhs = bc.copy()
-    np.add.at(rhs, p.obs_photo, -np.einsum("nij,nj->ni", ncp, reduced_p[p.obs_point]))
-    if not p.camera_free:
-        return Normals(v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused)
+
+
+def _camera_border(
+    p: BundleProblem,
+    v: NDArray,
+    jc: NDArray,
+    jp: NDArray,
+    jg: NDArray,
+    w: NDArray,
+    ncp: NDArray,
+    pinv: NDArray,
+    pairs: MeasurementPairs,
+    reduced_p: NDArray,
+) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """The free camera parameters' border of the reduced normals, points eliminated: N_gp per
+    measurement, the camera × orientations block, the camera block and its right-hand side."""
+    pt = p.obs_point[pairs.first]
+    js = p.obs_photo[pairs.second]
     ng = jg.shape[2]
     ngp = np.einsum("nki,nk,nkj->nij", jg, w, jp)
     ngc = np.einsum("nki,nk,nkj->nij", jg, w, jc)
@@ -439,9 +486,7 @@ def normals(
     sgg = np.einsum("nki,nk,nkj->ij", jg, w, jg)
     sgg -= np.einsum("nij,njk,nlk->il", ngp[pairs.first], pinv[pt], ngp[pairs.second])
     rg = np.einsum("nki,nk,nk->i", jg, w, v) - np.einsum("nij,nj->i", ngp, reduced_p[p.obs_point])
-    return Normals(
-        v, jc, jp, ncp, pinv, s, rhs, bp, vv, unused, jg, ngp, sgc.reshape(ng, -1), sgg, rg
-    )
+    return ngp, sgc.reshape(ng, -1), sgg, rg
 
 
 def _step(p, orient, points, pairs, camera=None):

@@ -93,7 +93,6 @@ class StripPolynomials:
         return out
 
 
-# long: two sparse linear systems (plan and height) assembled from their observation rows
 def adjust_strip_polynomials(
     obs_strip: NDArray[np.int64],
     obs_point: NDArray[np.int64],
@@ -120,69 +119,120 @@ def adjust_strip_polynomials(
     """
     if degree not in (1, 2, 3):
         raise GeometryError(f"strip polynomials: expected degree 1, 2 or 3, found {degree}")
-    ns, n_obs = len(axes), obs_strip.size
-    u = np.empty(n_obs)
-    v = np.empty(n_obs)
-    for s, ax in enumerate(axes):
-        m = obs_strip == s
-        u[m], v[m] = ax.uv(strip_xyz[m, :2])
-    wm = 1.0 / sigma_model_m
-    results = []
-    for terms, dims in (
-        (plan_terms(u, v, degree), (0, 1)),
-        (height_terms(u, v, degree)[:, None], (2,)),
-    ):
-        nt = terms.shape[2]
-        nd = len(dims)
-        rows, cols, vals, rhs = [], [], [], []
-        for k, dim in enumerate(dims):
-            r = np.arange(n_obs) + k * n_obs
-            rows += [np.repeat(r, nt), r]
-            cols += [
-                (obs_strip[:, None] * nt + np.arange(nt)).ravel(),
-                ns * nt + nd * obs_point + k,
-            ]
-            vals += [wm * terms[:, k, :].ravel(), np.full(n_obs, -wm)]
-            rhs.append(-wm * strip_xyz[:, dim])
-        base = nd * n_obs
-        for k, dim in enumerate(dims):
-            wc = np.sqrt(control_weight[:, dim])
-            use = wc > 0
-            r = base + np.arange(int(use.sum()))
-            base += r.size
-            rows.append(r)
-            cols.append(ns * nt + nd * control_point[use] + k)
-            vals.append(wc[use])
-            rhs.append(wc[use] * control_m[use, dim])
-        rows_a, cols_a = np.concatenate(rows), np.concatenate(cols)
-        a = sp.csr_matrix(
-            (np.concatenate(vals), (rows_a, cols_a)), shape=(base, ns * nt + nd * n_points)
+    u, v = _strip_uv(obs_strip, strip_xyz, axes)
+    control = (control_point, control_m, control_weight)
+    results = [
+        _adjust_dimensions(
+            terms, dims, obs_strip, obs_point, strip_xyz, len(axes), n_points, control,
+            sigma_model_m, degree,
         )
-        used = np.zeros(a.shape[1], bool)
-        used[cols_a] = True
-        x = np.full(a.shape[1], np.nan)
-        try:
-            au, bu = a[:, used], np.concatenate(rhs)
-            x[used] = sparse_least_squares(au, bu)
-            sig = np.full(a.shape[1], np.nan)
-            sig[used] = point_sigmas(au, bu, x[used], int(np.count_nonzero(used[: ns * nt])))
-        except RuntimeError:
-            raise GeometryError(
-                f"strip polynomials of degree {degree}: the control does not fix them (a "
-                "singular system): give more control or a lower degree"
-            ) from None
-        results.append(
-            (
-                x[: ns * nt].reshape(ns, nt),
-                x[ns * nt :].reshape(n_points, nd),
-                sig[ns * nt :].reshape(n_points, nd),
-            )
+        for terms, dims in (
+            (plan_terms(u, v, degree), (0, 1)),
+            (height_terms(u, v, degree)[:, None], (2,)),
         )
+    ]  # fmt: skip
     (plan, plan_pts, plan_sig), (height, height_pts, height_sig) = results
     points = np.column_stack([plan_pts, height_pts])
     return StripPolynomials(
         degree, axes, plan, height, points, np.column_stack([plan_sig, height_sig])
     )
+
+
+def _strip_uv(
+    obs_strip: NDArray[np.int64], strip_xyz: NDArray[np.float64], axes: tuple[StripAxes, ...]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Each observation's coordinates along and across its strip's axis (:meth:`StripAxes.uv`)."""
+    u = np.empty(obs_strip.size)
+    v = np.empty(obs_strip.size)
+    for s, ax in enumerate(axes):
+        m = obs_strip == s
+        u[m], v[m] = ax.uv(strip_xyz[m, :2])
+    return u, v
+
+
+def _adjust_dimensions(
+    terms: NDArray[np.float64],
+    dims: tuple[int, ...],
+    obs_strip: NDArray[np.int64],
+    obs_point: NDArray[np.int64],
+    strip_xyz: NDArray[np.float64],
+    ns: int,
+    n_points: int,
+    control: tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]],
+    sigma_model_m: float,
+    degree: int,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """One of the two systems (plan: ``dims`` (0, 1); height: (2,)) solved: the strips'
+    coefficients (strips × terms), the points' coordinates and their σ (points × dims) [m]."""
+    nt = terms.shape[2]
+    nd = len(dims)
+    a, b, cols = _observation_rows(
+        terms, dims, obs_strip, obs_point, strip_xyz, ns, n_points, control, sigma_model_m
+    )
+    used = np.zeros(a.shape[1], bool)
+    used[cols] = True
+    x = np.full(a.shape[1], np.nan)
+    try:
+        au = a[:, used]
+        x[used] = sparse_least_squares(au, b)
+        sig = np.full(a.shape[1], np.nan)
+        sig[used] = point_sigmas(au, b, x[used], int(np.count_nonzero(used[: ns * nt])))
+    except RuntimeError:
+        raise GeometryError(
+            f"strip polynomials of degree {degree}: the control does not fix them (a "
+            "singular system): give more control or a lower degree"
+        ) from None
+    return (
+        x[: ns * nt].reshape(ns, nt),
+        x[ns * nt :].reshape(n_points, nd),
+        sig[ns * nt :].reshape(n_points, nd),
+    )
+
+
+def _observation_rows(
+    terms: NDArray[np.float64],
+    dims: tuple[int, ...],
+    obs_strip: NDArray[np.int64],
+    obs_point: NDArray[np.int64],
+    strip_xyz: NDArray[np.float64],
+    ns: int,
+    n_points: int,
+    control: tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]],
+    sigma_model_m: float,
+) -> tuple[sp.csr_matrix, NDArray[np.float64], NDArray[np.int64]]:
+    """The weighted design matrix, right-hand side and the columns used: a row per strip
+    coordinate (polynomial of the strip − point = −coordinate, weight 1/σ of the model) and per
+    given control coordinate (point = control, weight 1/σ)."""
+    control_point, control_m, control_weight = control
+    n_obs = obs_strip.size
+    nt = terms.shape[2]
+    nd = len(dims)
+    wm = 1.0 / sigma_model_m
+    rows, cols, vals, rhs = [], [], [], []
+    for k, dim in enumerate(dims):
+        r = np.arange(n_obs) + k * n_obs
+        rows += [np.repeat(r, nt), r]
+        cols += [
+            (obs_strip[:, None] * nt + np.arange(nt)).ravel(),
+            ns * nt + nd * obs_point + k,
+        ]
+        vals += [wm * terms[:, k, :].ravel(), np.full(n_obs, -wm)]
+        rhs.append(-wm * strip_xyz[:, dim])
+    base = nd * n_obs
+    for k, dim in enumerate(dims):
+        wc = np.sqrt(control_weight[:, dim])
+        use = wc > 0
+        r = base + np.arange(int(use.sum()))
+        base += r.size
+        rows.append(r)
+        cols.append(ns * nt + nd * control_point[use] + k)
+        vals.append(wc[use])
+        rhs.append(wc[use] * control_m[use, dim])
+    rows_a, cols_a = np.concatenate(rows), np.concatenate(cols)
+    a = sp.csr_matrix(
+        (np.concatenate(vals), (rows_a, cols_a)), shape=(base, ns * nt + nd * n_points)
+    )
+    return a, np.concatenate(rhs), cols_a
 
 
 def point_sigmas(a: sp.spmatrix, b: NDArray, x: NDArray, n_coefficients: int) -> NDArray:

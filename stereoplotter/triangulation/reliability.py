@@ -323,7 +323,6 @@ def _remove_measurement(p: BundleProblem, keep: NDArray[np.bool_]) -> BundleProb
     )
 
 
-# long: the loop of data snooping: test, remove the largest, readjust, until none is above k
 def snoop(
     p: BundleProblem,
     *,
@@ -340,71 +339,11 @@ def snoop(
     a0 = rel.alpha0
     adj, q, flags = adj0, p, []
     for rnd in range(1, max_rounds + 1):
-        pw = np.abs(rel.photo_w)
-        cw = np.nan_to_num(np.abs(rel.control_w), nan=0.0)
-        best_p = np.unravel_index(int(np.argmax(pw)), pw.shape) if pw.size else None
-        best_c = np.unravel_index(int(np.argmax(cw)), cw.shape) if cw.size else None
-        gw = np.nan_to_num(np.abs(rel.centre_w), nan=0.0)
-        best_g = np.unravel_index(int(np.argmax(gw)), gw.shape) if gw.size else None
-        wp = pw[best_p] if best_p is not None else 0.0
-        wc = cw[best_c] if best_c is not None else 0.0
-        wg = gw[best_g] if best_g is not None else 0.0
-        if max(wp, wc, wg) <= rel.k:
+        removed = _remove_largest(q, adj, rel, rnd)
+        if removed is None:
             break
-        if wg > max(wp, wc):
-            g, c = best_g
-            flags.append(
-                Flag(
-                    q.photo_ids[q.centre_photo[g]],
-                    "",
-                    CENTRE_NAMES[c],
-                    float(rel.centre_w[g, c]),
-                    float(rel.centre_mdb[g, c]),
-                    rnd,
-                )
-            )
-            weight = q.centre_weight.copy()
-            weight[g, c] = 0.0
-            q = dataclasses.replace(q, centre_weight=weight)
-        elif wp >= wc:
-            o, c = best_p
-            rho, rows = _w_correlations(q, adj, o, c)
-            alike = np.abs(rho) >= INSEPARABLE
-            alike[rows == o, c] = False
-            others = tuple(
-                f"{q.photo_ids[q.obs_photo[rows[b]]]} {PHOTO_NAMES[d]}"
-                for b, d in zip(*np.nonzero(alike), strict=True)
-            )
-            flags.append(
-                Flag(
-                    q.photo_ids[q.obs_photo[o]],
-                    q.point_ids[q.obs_point[o]],
-                    PHOTO_NAMES[c],
-                    float(rel.photo_w[o, c]),
-                    float(rel.photo_mdb[o, c]),
-                    rnd,
-                    others,
-                )
-            )
-            keep = np.ones(q.obs_photo.size, bool)
-            keep[o] = False
-            keep[rows[np.any(alike, axis=1)]] = False
-            q = _remove_measurement(q, keep)
-        else:
-            k, c = best_c
-            flags.append(
-                Flag(
-                    "",
-                    q.point_ids[q.control_point[k]],
-                    CONTROL_NAMES[c],
-                    float(rel.control_w[k, c]),
-                    float(rel.control_mdb[k, c]),
-                    rnd,
-                )
-            )
-            weight = q.control_weight.copy()
-            weight[k, c] = 0.0
-            q = dataclasses.replace(q, control_weight=weight)
+        q, flag = removed
+        flags.append(flag)
         s = adj.solution
         start = (s.orientations, np.where(np.isfinite(s.points_m), s.points_m, 0.0))
         adj = bundle_adjusted(q, start)
@@ -413,6 +352,105 @@ def snoop(
     g = global_test(adj.solution.sigma0, adj.redundancy, alpha)
     g0 = global_test(adj0.solution.sigma0, adj0.redundancy, alpha)
     return SnoopingResult(adj0, adj, p, q, tuple(flags), rel, g, kept, rel0, g0)
+
+
+def _largest(
+    w: NDArray[np.float64], nan_as_zero: bool = True
+) -> tuple[tuple[int, ...] | None, float]:
+    """Index and value of the largest |w| (NaN as 0 when ``nan_as_zero``); (None, 0) when
+    there is none."""
+    aw = np.nan_to_num(np.abs(w), nan=0.0) if nan_as_zero else np.abs(w)
+    if not aw.size:
+        return None, 0.0
+    best = np.unravel_index(int(np.argmax(aw)), aw.shape)
+    return best, aw[best]
+
+
+def _remove_largest(
+    q: BundleProblem, adj: Adjusted, rel: ObservationReliability, rnd: int
+) -> tuple[BundleProblem, Flag] | None:
+    """One round of data snooping: the observation with the largest |w| flagged and removed
+    (the problem without it and its flag), or None when no |w| is above k. A centre coordinate
+    goes only when its |w| is strictly the largest; on a tie a photo coordinate goes before a
+    control coordinate."""
+    best_p, wp = _largest(rel.photo_w, nan_as_zero=False)
+    best_c, wc = _largest(rel.control_w)
+    best_g, wg = _largest(rel.centre_w)
+    if max(wp, wc, wg) <= rel.k:
+        return None
+    if wg > max(wp, wc):
+        return _remove_centre(q, rel, best_g, rnd)
+    if wp >= wc:
+        return _remove_photo_measurement(q, adj, rel, best_p, rnd)
+    return _remove_control(q, rel, best_c, rnd)
+
+
+def _remove_centre(
+    q: BundleProblem, rel: ObservationReliability, best: tuple[int, ...], rnd: int
+) -> tuple[BundleProblem, Flag]:
+    """A measured projection centre's coordinate flagged and given weight 0."""
+    g, c = best
+    flag = Flag(
+        q.photo_ids[q.centre_photo[g]],
+        "",
+        CENTRE_NAMES[c],
+        float(rel.centre_w[g, c]),
+        float(rel.centre_mdb[g, c]),
+        rnd,
+    )
+    weight = q.centre_weight.copy()
+    weight[g, c] = 0.0
+    return dataclasses.replace(q, centre_weight=weight), flag
+
+
+def _remove_photo_measurement(
+    q: BundleProblem,
+    adj: Adjusted,
+    rel: ObservationReliability,
+    best: tuple[int, ...],
+    rnd: int,
+) -> tuple[BundleProblem, Flag]:
+    """A photo measurement flagged and removed, with the measurements whose w it cannot be
+    told from (|ρ| ≥ :data:`INSEPARABLE`)."""
+    o, c = best
+    rho, rows = _w_correlations(q, adj, o, c)
+    alike = np.abs(rho) >= INSEPARABLE
+    alike[rows == o, c] = False
+    others = tuple(
+        f"{q.photo_ids[q.obs_photo[rows[b]]]} {PHOTO_NAMES[d]}"
+        for b, d in zip(*np.nonzero(alike), strict=True)
+    )
+    flag = Flag(
+        q.photo_ids[q.obs_photo[o]],
+        q.point_ids[q.obs_point[o]],
+        PHOTO_NAMES[c],
+        float(rel.photo_w[o, c]),
+        float(rel.photo_mdb[o, c]),
+        rnd,
+        others,
+    )
+    keep = np.ones(q.obs_photo.size, bool)
+    keep[o] = False
+    keep[rows[np.any(alike, axis=1)]] = False
+    return _remove_measurement(q, keep), flag
+
+
+def _remove_control(
+    q: BundleProblem, rel: ObservationReliability, best: tuple[int, ...], rnd: int
+) -> tuple[BundleProblem, Flag]:
+    """A control coordinate flagged and given weight 0."""
+    k, c = best
+    flag = Flag(
+        "",
+        q.point_ids[q.control_point[k]],
+        CONTROL_NAMES[c],
+        float(rel.control_w[k, c]),
+        float(rel.control_mdb[k, c]),
+        rnd,
+    )
+    weight = q.control_weight.copy()
+    weight[k, c] = 0.0
+    return dataclasses.replace(q, control_weight=weight), flag
 
 
 def snooped_block(

@@ -194,7 +194,6 @@ def _camera(spec: SynthSpec) -> Camera:
     return Camera(spec.focal_length_mm, (0.0, 0.0), spec.format_mm, marks, "distances")
 
 
-# long: the measuring of a block in its steps (images, comparator placement, fiducials, catalogue)
 def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, Truth]:
     """Make a block and its truth from ``spec`` with the random numbers of ``rng``.
 
@@ -214,6 +213,39 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
     )
     ids = tuple(f"P{int(rr) + 1}.{int(cc) + 1}" for rr, cc in zip(r, c, strict=True))
     rot = rotation_matrix(stations[:, 0], stations[:, 1], stations[:, 2])
+    photo, seen = _true_images(spec, cam, points, stations, rot)
+    obs_photo, obs_point = np.nonzero(seen)
+    measured, fiducials = _comparator_readings(spec, cam, rng, photo, obs_photo, obs_point)
+    block0 = Block(
+        spec.name,
+        cam,
+        strips,
+        fiducials,
+        obs_photo,
+        obs_point,
+        measured,
+        ids,
+        (),
+        spec.origin_sk42_m,
+    )
+    block_frame(block0)  # the origin is checked before any point is converted
+    catalogue = _catalogue(spec, rng, block0, points, c, r)
+    sigmas, centres = _measured_centres(spec, rng, block0, stations, rot)
+    block = dataclasses.replace(
+        block0,
+        catalogue=catalogue,
+        sigmas=sigmas,
+        centres=centres,
+        lever_arm_m=tuple(map(float, spec.lever_arm_m)),
+    )
+    return block, Truth(stations, points, terrain)
+
+
+def _true_images(
+    spec: SynthSpec, cam: Camera, points: NDArray, stations: NDArray, rot: NDArray
+) -> tuple[NDArray, NDArray]:
+    """Every point's image on every photo [mm] by Eq. (2.53) with the camera's true errors
+    (photos × points × 2), and where it lies in the usable field."""
     true = np.array(spec.camera_error, float)
     true[0] += cam.focal_length_mm
     photo = object_to_photo(points[None], stations[:, None, 3:], rot[:, None], true[0])
@@ -224,9 +256,21 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
         ok = np.all(np.isfinite(flat), axis=1)
         flat[ok] = camera_image(flat[ok], true)[0]
         photo = flat.reshape(photo.shape)
-    obs_photo, obs_point = np.nonzero(seen)
-    n_photos, n_obs = stations.shape[0], obs_photo.size
-    # the diapositive on the comparator: film deformation, a turn and a shift per photo
+    return photo, seen
+
+
+def _comparator_readings(
+    spec: SynthSpec,
+    cam: Camera,
+    rng: np.random.Generator,
+    photo: NDArray,
+    obs_photo: NDArray,
+    obs_point: NDArray,
+) -> tuple[NDArray, NDArray]:
+    """The measured points and fiducial marks in comparator coordinates [mm]: the diapositive
+    on the comparator with film deformation, a turn and a shift per photo, and the σ of a
+    reading."""
+    n_photos, n_obs = photo.shape[0], obs_photo.size
     film = 1.0 + rng.uniform(-spec.film_deformation_ppm, 0.0, (n_photos, 2)) * 1e-6
     turn = rotation_z(np.radians(rng.uniform(-2.0, 2.0, n_photos)))[:, :2, :2]
     shift = 100.0 + rng.uniform(-5.0, 5.0, (n_photos, 2))
@@ -241,43 +285,47 @@ def synthesize_block(spec: SynthSpec, rng: np.random.Generator) -> tuple[Block, 
     fiducials = comparator(jj, np.tile(marks, (n_photos, 1))).reshape(n_photos, 4, 2)
     sf = spec.sigma_photo_mm if spec.sigma_fiducial_mm is None else spec.sigma_fiducial_mm
     fiducials += rng.normal(0.0, sf, fiducials.shape)
+    return measured, fiducials
+
+
+def _catalogue(
+    spec: SynthSpec,
+    rng: np.random.Generator,
+    block0: Block,
+    points: NDArray,
+    c: NDArray,
+    r: NDArray,
+) -> tuple[CataloguePoint, ...]:
+    """The catalogue: every measured point with its role and kind, in SK-42 with the σ of
+    control."""
     role, kind = _roles(spec, c, r)
-    in_catalogue = np.flatnonzero(np.isin(np.arange(len(ids)), obs_point))
-    block0 = Block(
-        spec.name,
-        cam,
-        strips,
-        fiducials,
-        obs_photo,
-        obs_point,
-        measured,
-        ids,
-        (),
-        spec.origin_sk42_m,
-    )
-    block_frame(block0)  # the origin is checked before any point is converted
+    ids = block0.point_ids
+    in_catalogue = np.flatnonzero(np.isin(np.arange(len(ids)), block0.obs_point))
     noisy = points[in_catalogue] + rng.normal(0.0, spec.sigma_control_m, (in_catalogue.size, 3))
     sk42 = sk42_from_block_local(block0, noisy)
-    catalogue = tuple(
+    return tuple(
         CataloguePoint(ids[i], str(role[i]), str(kind[i]), tuple(map(float, s)))  # type: ignore[arg-type]
         for i, s in zip(in_catalogue, sk42, strict=True)
     )
+
+
+def _measured_centres(
+    spec: SynthSpec,
+    rng: np.random.Generator,
+    block0: Block,
+    stations: NDArray,
+    rot: NDArray,
+) -> tuple[Sigmas, tuple]:
+    """The block's σ and, with ``spec.centre_sigma_m``, every photo's antenna position (the
+    projection centre plus the lever arm turned by the photo) measured with that σ, in SK-42."""
     sigmas = Sigmas(spec.sigma_photo_mm, spec.sigma_control_m, spec.sigma_control_m)
-    centres: tuple = ()
-    if spec.centre_sigma_m is not None:
-        sigmas = dataclasses.replace(
-            sigmas, centre_plan_m=spec.centre_sigma_m, centre_height_m=spec.centre_sigma_m
-        )
-        antenna = stations[:, 3:] + rot @ np.asarray(spec.lever_arm_m)
-        antenna += rng.normal(0.0, spec.centre_sigma_m, antenna.shape)
-        geo = sk42_from_block_local(block0, antenna)
-        photos = [p for strip in strips for p in strip]
-        centres = tuple((p, tuple(map(float, g))) for p, g in zip(photos, geo, strict=True))
-    block = dataclasses.replace(
-        block0,
-        catalogue=catalogue,
-        sigmas=sigmas,
-        centres=centres,
-        lever_arm_m=tuple(map(float, spec.lever_arm_m)),
+    if spec.centre_sigma_m is None:
+        return sigmas, ()
+    sigmas = dataclasses.replace(
+        sigmas, centre_plan_m=spec.centre_sigma_m, centre_height_m=spec.centre_sigma_m
     )
-    return block, Truth(stations, points, terrain)
+    antenna = stations[:, 3:] + rot @ np.asarray(spec.lever_arm_m)
+    antenna += rng.normal(0.0, spec.centre_sigma_m, antenna.shape)
+    geo = sk42_from_block_local(block0, antenna)
+    photos = [p for strip in block0.strips for p in strip]
+    return sigmas, tuple((p, tuple(map(float, g))) for p, g in zip(photos, geo, strict=True))

@@ -1,10 +1,10 @@
-"""Issue 24, item 2: a robot trainee completes every shipped exercise through the instrument
-page's controls alone, and the page's grade is the core's grade of the same log.
+"""A robot trainee completes every shipped exercise through the instrument page's controls
+alone, and the page's grade is the core's grade of the same log.
 
 The robot's actions are the core's :func:`~stereoplotter.trainer.robot.robot_script` for the
 exercise (the simulated operator's settings that pass it), each made as a gesture
 (:mod:`tests.browser.robot`): a typed value and Enter, a click. The test never opens a
-WebSocket; it reads the log over HTTP with the session's own key (issue 22) and grades it with
+WebSocket; it reads the log over HTTP with the session's own key and grades it with
 the core, independently of the server. Parametrized over the shipped exercise files: a new file
 is covered with no new code.
 """

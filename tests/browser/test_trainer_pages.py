@@ -1,4 +1,4 @@
-"""Issue 14 acceptance in a real browser (headless Debian chromium through Playwright).
+"""The trainer's pages in a real browser (headless Debian chromium through Playwright).
 
 Two independent paths to one state: the page drives the server by clicks, keys and wheel
 events; the core :class:`Session`, fed the action log the server recorded, must reach the same
@@ -85,7 +85,7 @@ def test_browser_trainee_completes_stage1_like_the_core_session(page, server, ar
     }
 
     secret = page.evaluate(f"localStorage.getItem('stereoplotter-key-{sid}')")
-    key = {"Authorization": f"Bearer {secret}"}  # the session's own key (issue 22)
+    key = {"Authorization": f"Bearer {secret}"}  # the session's own key
     log = [json.loads(line) for line in page.request.get(
         f"{server}/api/sessions/{sid}/log.jsonl", headers=key).text().splitlines()]
     assert len(log) == n + 1  # header + every click, key and wheel notch as one action
@@ -234,7 +234,7 @@ def test_exercise_picker_lists_the_shipped_exercises(page, server, artefacts):
 
 
 def test_an_exam_shows_no_parallax_numbers(page, server):
-    """Issue 24, item 4: with the q/p read-out off the page shows no parallax number; the
+    """With the q/p read-out off the page shows no parallax number; the
     eyepieces are what the trainee judges from. Practice with the read-out shows one."""
     for exercise, readout in ((EXAM, False), ("e03-setup-stage2", True)):
         _start(page, server, exercise, trainee=f"readout-{readout}")

@@ -1,6 +1,6 @@
-"""Issue 22 in a real browser: a trainee name with markup stays text on the instructor's page
-(its script never runs, the token is not read), the Content-Security-Policy blocks inline
-script, and a dropped socket is reopened and the session resumes."""
+"""User text is text, in a real browser: a trainee name with markup stays text on the
+instructor's page (its script never runs, the token is not read), the Content-Security-Policy
+blocks inline script, and a dropped socket is reopened and the session resumes."""
 
 from __future__ import annotations
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from stereoplotter.cli import _parser, main
+from stereoplotter.cli import build_parser, main
 from stereoplotter.commands.arguments import (
     MAX_SEED,
     bounded_float,
@@ -141,7 +141,7 @@ def _numeric_actions(parser: argparse.ArgumentParser, prefix: str = "") -> list:
 
 
 def test_every_numeric_option_is_range_checked():
-    actions = _numeric_actions(_parser())
+    actions = _numeric_actions(build_parser())
     assert len(actions) >= 11  # 4 seeds, 3 trial counts, 2 scales, b_z sense, tilts, …
     for name, action in actions:
         # a bare int/float accepts -1, 0 and nan; choices are a range of their own

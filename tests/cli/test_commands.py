@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 from matplotlib.figure import Figure
 
-from stereoplotter.cli import COMMANDS, _parser
+from stereoplotter.cli import COMMANDS, build_parser
 from stereoplotter.commands.arguments import LibraryDefault
 from stereoplotter.plotting.encode import figure_bytes
 from stereoplotter.procedure.trials import DEFAULT_MEMORY_BUDGET_MB
@@ -23,7 +23,7 @@ HEAVY = ("scipy", "matplotlib", "starlette", "pydantic", "yaml", "pyproj", "fpdf
 
 def test_importing_the_cli_loads_no_heavy_library():
     code = (
-        "import sys, stereoplotter.cli as c; c._parser(); "
+        "import sys, stereoplotter.cli as c; c.build_parser(); "
         f"print(','.join(m for m in {HEAVY!r} if m in sys.modules))"
     )
     done = subprocess.run(
@@ -44,7 +44,7 @@ def _leaves(parser: argparse.ArgumentParser, prefix: str = "") -> list[tuple[str
 def test_every_command_has_a_run_and_every_leaf_calls_one():
     for module in COMMANDS:
         assert callable(module.add_arguments) and callable(module.run), module.__name__
-    leaves = _leaves(_parser())
+    leaves = _leaves(build_parser())
     before = {"info", "scenario check", "instrument show", "instrument test", "render", "setup",
               "check-sheet", "job to-scenario", "simulate", "verify", "budget", "demo",
               "exercise list", "exercise show", "session run", "grade", "trainer"}  # fmt: skip
@@ -54,12 +54,12 @@ def test_every_command_has_a_run_and_every_leaf_calls_one():
 
 
 def test_a_library_default_is_shown_and_used_as_the_library_has_it(capsys):
-    args = _parser().parse_args(["simulate", "pair60", "--instrument", "sc1"])
+    args = build_parser().parse_args(["simulate", "pair60", "--instrument", "sc1"])
     assert LibraryDefault.of(args.memory_mb) == DEFAULT_MEMORY_BUDGET_MB
-    args = _parser().parse_args(["budget", "pair60", "--instrument", "sc1"])
+    args = build_parser().parse_args(["budget", "pair60", "--instrument", "sc1"])
     assert LibraryDefault.of(args.trials) == DEFAULT_BUDGET_TRIALS
     with pytest.raises(SystemExit):
-        _parser().parse_args(["simulate", "--help"])
+        build_parser().parse_args(["simulate", "--help"])
     help_text = " ".join(capsys.readouterr().out.split())
     assert f"(default: {DEFAULT_MEMORY_BUDGET_MB} MB)" in help_text
 

@@ -11,7 +11,7 @@ import time
 import urllib.request
 
 from stereoplotter.cli import main
-from stereoplotter.io.exercise_file import shipped_exercises
+from stereoplotter.io.exercise_file import load_exercise, shipped_exercises
 
 
 def test_exercise_list_names_every_shipped_exercise(capsys):
@@ -61,7 +61,7 @@ def test_a_refused_action_stops_the_run_but_the_log_is_written(tmp_path, capsys)
 
 def test_trainer_serves_on_the_printed_free_port(tmp_path):
     # `stereoplotter trainer` with the default port 0: the system picks a free port and the
-    # printed address is the one that answers (issue 14, deliverable 1)
+    # printed address is the one that answers
     with subprocess.Popen(
         [sys.executable, "-m", "stereoplotter", "trainer", "--token", "t0",
          "--data-dir", str(tmp_path)],  # never the user's own data folder
@@ -101,8 +101,6 @@ def test_trainer_on_a_busy_port_is_one_error_line(capsys, tmp_path):
 
 
 def test_exercise_new_writes_a_file_that_loads_back(tmp_path, capsys):
-    from stereoplotter.io.exercise_file import load_exercise
-
     path = tmp_path / "mine.yaml"
     argv = ["exercise", "new", "mine", "--stages", "2", "--unusable-points", "5", "--seed", "4"]
     assert main([*argv, "--errors", "announced", "-o", str(path)]) == 0

@@ -178,7 +178,7 @@ def test_levelled_setup_rows_are_the_formula_at_the_procedures_own_tilt_errors(s
     is shown by the linkage switch (docs/accuracy.md, ``verify --linkage independent``)."""
     from dataclasses import replace
 
-    from stereoplotter.accuracy.setup_accuracy import _mean_shifted_square
+    from stereoplotter.accuracy.chapter5 import mean_shifted_square
     from stereoplotter.procedure.operator import OperatorModel
     from stereoplotter.procedure.simulate import simulate
 
@@ -203,7 +203,7 @@ def test_levelled_setup_rows_are_the_formula_at_the_procedures_own_tilt_errors(s
     wl, wr = errors("tan_omega")
     g = setup80
     a, c = g["a"], g["c"]
-    mean_w = c**2 / 3.0 * _mean_shifted_square((c - a) / 2.0, c)
+    mean_w = c**2 / 3.0 * mean_shifted_square((c - a) / 2.0, c)
     mean_a = c**2 * (10 * a**2 + 5 * a * c + c**2) / 30.0
     var = (mean_w * np.var(wl - wr) + mean_a * np.var(al - ar)) / f**2
     at_measured = math.sqrt(var) / (n * sigma)  # per m_xy = n_л·σ

@@ -1,5 +1,5 @@
-"""Replaying a session log needs no registration done by importing io (issue 23): the reader of
-the header's exercise is passed explicitly; without one the replay is refused in one line."""
+"""Replaying a session log needs no registration done by importing io: the reader of the
+header's exercise is passed explicitly; without one the replay is refused in one line."""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
-"""The shipped exercises: ≥ 10, graded easy → hard, each loads and its session starts; bad
-exercise files are refused in one line naming the file and the field."""
+"""The shipped exercises: at least 24, levels from 1 to at least 10, every stage of both
+methods on each instrument, each loads and its session starts; bad exercise files are refused in
+one line naming the file and the field."""
 
 from __future__ import annotations
 

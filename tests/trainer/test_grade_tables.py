@@ -1,4 +1,4 @@
-"""A grade that teaches (issue 24): per-point tables, the hint cost, the process per stage."""
+"""A grade that teaches: per-point tables, the hint cost, the process per stage."""
 
 from __future__ import annotations
 

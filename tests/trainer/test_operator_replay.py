@@ -1,5 +1,5 @@
-"""Acceptance (issue 13): a scripted trainee that replays the simulated operator's actions
-through :class:`Session` reaches the same instrument state and the same grade as the operator.
+"""A scripted trainee that replays the simulated operator's actions through :class:`Session`
+reaches the same instrument state and the same grade as the operator.
 
 The operator's own instrument (``session.par.instrument``, driven by the procedure code) is
 compared with the trainee's (driven only by logged session actions): two independent paths to

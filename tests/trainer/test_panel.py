@@ -1,4 +1,4 @@
-"""What the page shows beside the eyepieces (issue 24): the action catalogue, the overview, the
+"""What the page shows beside the eyepieces: the action catalogue, the overview, the
 checklist, coupled motions explained, readable hints, no numeric read-out in an exam."""
 
 from __future__ import annotations

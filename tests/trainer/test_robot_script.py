@@ -1,6 +1,6 @@
-"""Acceptance (issue 24, item 2, core side): the robot trainee's script — one page control use
-per action — passes every shipped exercise when replayed through :class:`Session`, graded on
-the true values against the book's tolerances. A new exercise file is covered without code."""
+"""The robot trainee's script in the core (one page control use per action) passes every
+shipped exercise when replayed through :class:`Session`, graded on the true values
+against the book's tolerances. A new exercise file is covered without code."""
 
 from __future__ import annotations
 

@@ -112,3 +112,19 @@ def test_a_camera_as_certified_is_not_significant():
     assert not c.group_significant and c.f_statistic < c.f_critical
     assert not np.any(c.significant)
     assert c.f_critical == pytest.approx(2.03, abs=0.01)  # F_0.95(7, r ≈ 400)
+
+
+def test_planted_camera_errors_are_recovered_with_measured_centres():
+    # the projection centres measured (σ 5 cm) as well: their normals enter the photo blocks,
+    # the camera's border comes from the photo measurements alone
+    block, _ = synthesize_block(
+        SynthSpec(camera_error=PLANTED, centre_sigma_m=0.05), np.random.default_rng([0, 5])
+    )
+    p = problem(block, CAMERA_PARAMETERS)
+    c = camera_calibration(p, bundle_adjusted(p))
+    truth = np.array([70.0 + PLANTED[0], *PLANTED[1:]])
+    z = (c.values - truth) / c.sigma
+    named = {n: float(v) for n, v in zip(c.names, z, strict=True)}
+    # 3σ: the chance that any of the four normal z exceeds it is about 1 %
+    assert all(abs(named[n]) < 3.0 for n in ("f", "x0", "y0", "k1")), named
+    assert c.group_significant

@@ -1,5 +1,5 @@
-// DOM built from elements and text nodes only: no string of data is ever parsed as HTML
-// (issue 22). el("td", {class: "num"}, "text", child) → <td class="num">text…</td>.
+// DOM built from elements and text nodes only: no string of data is ever parsed as HTML.
+// el("td", {class: "num"}, "text", child) → <td class="num">text…</td>.
 export function el(tag, attrs = {}, ...children) {
   const e = document.createElement(tag);
   for (const [k, v] of Object.entries(attrs)) {

@@ -1,6 +1,6 @@
 // The grade page's teaching parts: per-point tables, the y-parallax map (a canvas drawn from the
 // grade's JSON grid), process measures per stage, the checks skipped by name, hint costs.
-// Built from elements and text nodes only (issue 22).
+// Built from elements and text nodes only.
 import { el } from "./dom.js";
 
 export const fmt = (v) => (typeof v !== "number" ? String(v ?? "—")

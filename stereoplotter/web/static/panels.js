@@ -1,6 +1,6 @@
 // The instrument page's panels built from the core's data: the action controls (one per action
 // kind of the core's catalogue), readable results, the stage checklist, announced errors,
-// coupled motions and the setup sheet. DOM from elements and text nodes only (issue 22).
+// coupled motions and the setup sheet. DOM from elements and text nodes only.
 import { el } from "./dom.js";
 import { LABELS } from "./wheels.js";
 import { withTerms, termEl, names, sheetValue } from "./words.js";
