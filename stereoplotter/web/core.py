@@ -1,4 +1,4 @@
-"""The web layer's only door to the trainer core (issue 13): exercises, sessions, grades, logs.
+"""The web layer's only door to the trainer core: exercises, sessions, grades, logs.
 
 Every call the server makes into :mod:`stereoplotter.trainer`, :mod:`stereoplotter.io` and
 :mod:`stereoplotter.report` goes through here, so a change of the core's contract

@@ -1,4 +1,4 @@
-"""What the classroom server checks before it believes a client (issue 22).
+"""What the classroom server checks before it believes a client.
 
 Nothing a client sends is trusted: every HTTP request passes :class:`Guard` (the Host must be
 this server's, a state-changing request must come from this server's pages, and every response

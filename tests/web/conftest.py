@@ -1,4 +1,4 @@
-"""The classroom server under attack (issue 22): Starlette's TestClient, no browser.
+"""The classroom server under attack: Starlette's TestClient, no browser.
 
 Every test plays a client the server must not trust; the server runs in-process with its
 store in a temporary folder, grading and photos in worker threads.

@@ -1,4 +1,4 @@
-"""One test per attack of issue 22, each asserting the refusal (and that the honest path still
+"""One test per attack a classroom server meets, each asserting the refusal (and that the honest path still
 works). The server: ``stereoplotter.web.app.create_app`` with a temporary store."""
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ from importlib import resources
 import pytest
 from starlette.websockets import WebSocketDisconnect
 
+from stereoplotter.trainer.exercise import trainee_seed
 from stereoplotter.web.app import create_app
 from stereoplotter.web.guard import BURST, CSP, MAX_MESSAGE, RATE
 from tests.web.conftest import (
@@ -133,8 +134,6 @@ def test_exam_refuses_a_client_seed_a_demonstration_and_a_second_attempt(client)
         assert r.status_code == 403, extra
     sid, _ = start(client, EXAM, trainee="dan")
     head = client.get(f"/api/sessions/{sid}/log.jsonl", params={"token": TOKEN}).text
-    from stereoplotter.trainer.exercise import trainee_seed
-
     assert json.loads(head.splitlines()[0])["seed"] != trainee_seed(EXAM, "dan")  # the server's
     for name in ("dan", "DAN", " dan "):  # the same trainee, however typed
         r = client.post("/api/sessions", json={"exercise": EXAM, "trainee": name})
