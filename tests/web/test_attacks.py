@@ -1,5 +1,5 @@
-"""One test per attack a classroom server meets, each asserting the refusal (and that the honest path still
-works). The server: ``stereoplotter.web.app.create_app`` with a temporary store."""
+"""One test per attack a classroom server meets, each asserting the refusal (and that the honest
+path still works). The server: ``stereoplotter.web.app.create_app`` with a temporary store."""
 
 from __future__ import annotations
 
