@@ -15,7 +15,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import BinaryIO
 
-__all__ = ["atomic_stream", "atomic_write_bytes", "atomic_write_text", "write_files"]
+__all__ = [
+    "atomic_stream",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "fsync_folder",
+    "write_files",
+]
 
 log = logging.getLogger(__name__)
 
@@ -50,7 +56,7 @@ def atomic_stream(path: str | os.PathLike[str]) -> Iterator[BinaryIO]:
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
-    _fsync_folder(target.parent)
+    fsync_folder(target.parent)
 
 
 def _create_temporary(target: Path) -> tuple[Path, int]:
@@ -65,8 +71,8 @@ def _create_temporary(target: Path) -> tuple[Path, int]:
     raise FileExistsError(f"{target.parent}: no free temporary file name for {target.name}")
 
 
-def _fsync_folder(folder: Path) -> None:
-    """Make a rename in ``folder`` durable where the platform allows it (best effort)."""
+def fsync_folder(folder: Path) -> None:
+    """Make a rename or a swap in ``folder`` durable where the platform allows it (best effort)."""
     try:
         fd = os.open(folder, os.O_RDONLY)
     except OSError:

@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from stereoplotter.errors import StereoplotterError
-from stereoplotter.io.atomic_write import write_files
+from stereoplotter.io.atomic_write import fsync_folder, write_files
 
 __all__ = ["MANIFEST", "OutputReport", "manifest_bytes", "write_outputs"]
 
@@ -208,7 +208,7 @@ def _swap(staging: Path, out: Path) -> None:
         os.rename(out, aside)
         os.rename(staging, out)
         os.rename(aside, staging)
-    _fsync_folder(out.parent)
+    fsync_folder(out.parent)
 
 
 @contextmanager
@@ -254,16 +254,3 @@ def _exchange(a: Path, b: Path) -> bool:
         raise OSError(errno, os.strerror(errno), str(b))
     return True
 
-
-def _fsync_folder(folder: Path) -> None:
-    """Make the swap in ``folder`` durable where the platform allows it (best effort)."""
-    try:
-        fd = os.open(folder, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)

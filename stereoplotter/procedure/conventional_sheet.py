@@ -18,6 +18,8 @@ from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.virtual import NOMINAL_ZERO
 from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.sheet_stages import (
+    check_plan_control,
+    needle_against_plotted,
     sheet_needle,
     sheet_table,
     stage4_orient_sheet,
@@ -182,22 +184,8 @@ def plan_control_check(run) -> None:
     errs = []
     for pid in sheet.similarity_point_ids:
         fuse_and_read(run, control_point_m(run, pid), f"5/plan/{pid}", None, ())
-        needle = sheet_needle(run, f"5/plan/{pid}")
-        plotted = pose.table_of(sheet_table(run, _plotted_mm(run, pid)))
-        err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
-        errs.append(err)
-        op.log.add(
-            "5",
-            f"plan control point {pid}: fuse, needle against the plotted point",
-            "",
-            residual=err,
-            equation="stage 5",
-        )
-    run.check(
-        "stage 5: plan control points (needle − plotted)",
-        np.max(np.stack(errs, axis=-1), axis=-1),
-        sheet.tolerances["corner_mm"],
-    )
+        errs.append(needle_against_plotted(run, pose, pid, _plotted_mm(run, pid)))
+    check_plan_control(run, errs)
     run.record_stage("5", op.v(1).astype(int))
 
 

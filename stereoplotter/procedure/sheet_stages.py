@@ -16,7 +16,12 @@ from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.run import Run
 from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
-__all__ = ["stage4_orient_sheet", "stage5_check"]
+__all__ = [
+    "check_plan_control",
+    "needle_against_plotted",
+    "stage4_orient_sheet",
+    "stage5_check",
+]
 
 
 def sheet_table(run: Run, xy_mm) -> NDArray[np.float64]:
@@ -139,22 +144,33 @@ def stage5_check(run: Run) -> None:
         )
         img = run.scene.images(np.asarray(p.local_m, float)[None, :])
         op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
-        needle = sheet_needle(run, f"5/plan/{pid}")
-        plotted = pose.table_of(sheet_table(run, np.asarray(xy, float).reshape(2)))
-        err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
-        errs.append(err)
-        op.log.add(
-            "5",
-            f"plan control point {pid}: fuse, needle against the plotted point",
-            "",
-            residual=err,
-            equation="stage 5",
-        )
+        errs.append(needle_against_plotted(run, pose, pid, np.asarray(xy, float).reshape(2)))
+    check_plan_control(run, errs)
+
+
+def needle_against_plotted(run: Run, pose, pid: str, plotted_mm) -> NDArray[np.float64]:
+    """Stage 5 at a plan control point the operator has fused on: the needle against the point
+    plotted at ``plotted_mm`` (its instrument coordinates (6.7)), the distance logged. [mm]"""
+    needle = sheet_needle(run, f"5/plan/{pid}")
+    plotted = pose.table_of(sheet_table(run, plotted_mm))
+    err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
+    run.op.log.add(
+        "5",
+        f"plan control point {pid}: fuse, needle against the plotted point",
+        "",
+        residual=err,
+        equation="stage 5",
+    )
+    return err
+
+
+def check_plan_control(run: Run, errs: list[NDArray[np.float64]]) -> None:
+    """Stage 5's check of the plan control points: the largest needle − plotted distance."""
     # Tolerance (assumed): the book gives no figure for this final check; it is the same
     # comparison as corner 4 (needle against a point plotted on the sheet), so the corner-4
     # figure 0.3 mm (documented, stage 5) is used — 3.75 σ of the assumed plotting σ 0.08 mm.
     run.check(
         "stage 5: plan control points (needle − plotted)",
         np.max(np.stack(errs, axis=-1), axis=-1),
-        sheet.tolerances["corner_mm"],
+        run.sheet.tolerances["corner_mm"],
     )
