@@ -53,6 +53,7 @@ __all__ = [
     "cell_operator",
     "cell_run",
     "combine_chunks",
+    "prepared_run",
     "run_task",
 ]
 
@@ -199,8 +200,10 @@ def chunk_measures(
 VALUE_MEASURES = ("y_parallax_rms_um", "height_rms_permille", "plan_rms_map_mm")
 
 
-def _chunk(design: StudyDesign, run: CellRun, task: Task, checks: tuple[str, ...]) -> Moments:
-    prep = prepare_run(
+def prepared_run(design: StudyDesign, run: CellRun):
+    """A cell's procedure prepared once (the sheet, the instrument, the keyed streams of the
+    study's seed), for any number of its chunks."""
+    return prepare_run(
         run.scenario,
         run.spec,
         run.method,
@@ -209,6 +212,10 @@ def _chunk(design: StudyDesign, run: CellRun, task: Task, checks: tuple[str, ...
         operator=run.operator,
         practice=run.practice,
     )
+
+
+def _chunk(design: StudyDesign, run: CellRun, task: Task, checks: tuple[str, ...]) -> Moments:
+    prep = prepared_run(design, run)
     result = run_trials_chunk(prep, task.first, task.trials, evaluate=True, transcript=False)
     assert result.evaluation is not None
     cols = trial_columns(result)

@@ -36,7 +36,14 @@ from stereoplotter.procedure.trials import (
     chunk_trials_for,
     trial_columns,
 )
-from stereoplotter.study.cells import CellRun, Moments, cell_run, chunk_measures, run_task
+from stereoplotter.study.cells import (
+    CellRun,
+    Moments,
+    cell_run,
+    chunk_measures,
+    prepared_run,
+    run_task,
+)
 from stereoplotter.study.design import StudyDesign, Task
 from stereoplotter.study.results import cell_values
 from stereoplotter.verification.budget import budget_terms
@@ -184,15 +191,7 @@ _PREPARED: dict[tuple[str, int], tuple[CellRun, PreparedRun]] = {}
 def _prepared(design: StudyDesign, config: dict[str, Any], cell: int, key: str):
     if (key, cell) not in _PREPARED:
         run = cell_run(design, cell, config)
-        prep = prepare_run(
-            run.scenario,
-            run.spec,
-            run.method,
-            run.errors,
-            design.seed,
-            operator=run.operator,
-            practice=run.practice,
-        )
+        prep = prepared_run(design, run)
         _PREPARED.clear()  # one cell at a time: cells are submitted in order
         _PREPARED[(key, cell)] = (run, prep)
     return _PREPARED[(key, cell)]
