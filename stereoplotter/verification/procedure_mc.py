@@ -638,7 +638,8 @@ class ProcedureOptions:
     grid : tuple of int
         Midpoint grid of the statistic (nx, ny).
     quantity : {"heights", "parallax"}
-        Conventional only (``docs/accuracy.md``, "Why the total M_p was +54 % / +123 %"): the
+        Conventional only (``docs/accuracy.md``, "The conventional method: levelling, height
+        datum and error-free floor"): the
         height read on the slipped height scale in parallax units (what M_p measures) or δp at
         the ideal model position (counts the b_x scale error and the model's datum).
     standard_points : {"book", "nadirs"}

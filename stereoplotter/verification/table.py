@@ -619,8 +619,8 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
     return rows
 
 
-#: Mechanisms of decomposition steps, each shown by a switch run that removes it
-#: (``docs/accuracy.md``, "Decomposition of the procedure rows"), on the book's scenarios with
+#: Mechanisms of decomposition steps, each shown by a switch run that removes it (``verify -o
+#: DIR``'s verification.md, "Decomposition of the procedure rows"), on the book's scenarios with
 #: the SC-1 and the dragging linkage only: step → text. Attached only to runs of that setting.
 FIRST_ORDER_MECHANISMS = {
     "element_errors": "the knob–decentration linkage: switched to independent "
