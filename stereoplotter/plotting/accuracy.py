@@ -55,7 +55,7 @@ def plot_error_maps(
             levelled=levelled,
             grid=grid,
         )
-        Ge = mc._effective_G(m)
+        Ge = mc.effective_G(m)
         sd = np.sqrt(np.einsum("kp,kl,lp->p", Ge, m.M @ m.M.T, Ge)).reshape(grid)
         im = ax.imshow(sd.T * 1000, origin="lower", aspect="auto")
         ax.set_title(f"{name} [µm]")

@@ -35,6 +35,7 @@ __all__ = [
     "CI_Z",
     "LinearModel",
     "covariance_rms",
+    "effective_G",
     "grid_chapter5",
     "grid_setup_unadjusted",
     "least_squares_model",
@@ -258,7 +259,9 @@ def combine(*models):
     return LinearModel(G, M, Gc, P_fit, sc, sw)
 
 
-def _effective_G(model):
+def effective_G(model):
+    """The model's sensitivity rows with the control-point fit removed (``G − (P_fit·Gc)ᵀ``
+    where the row levels on control points; ``G`` itself otherwise)."""
     G = model.G
     if model.Gc is not None:
         G = G - (model.P_fit @ model.Gc.T).T
@@ -273,7 +276,7 @@ def covariance_rms(model: LinearModel) -> float:
     >>> round(covariance_rms(least_squares_model(np.eye(2), 2.0, 1)), 6)
     2.0
     """
-    Ge = _effective_G(model)
+    Ge = effective_G(model)
     S = model.M @ model.M.T
     var = np.einsum("kp,kl,lp->p", Ge, S, Ge)
     if model.Gc is not None and model.sigma_control:
