@@ -283,6 +283,12 @@ function handle(msg) {
   if (state) render();
   const [action, before] = msg.seq !== undefined && sent.has(msg.seq) ? sent.get(msg.seq) : [msg.demo && msg.demo.action, null];
   if (msg.seq !== undefined) sent.delete(msg.seq);
+  if (msg.error && action && !msg.demo && /^too many messages/.test(msg.error)) {
+    // refused for the server's rate before it counted (messages bunch up on a busy line):
+    // the action goes out again shortly, as the queue above promises a fast hand
+    setTimeout(() => send(action), 250);
+    return;
+  }
   if (msg.error) message(msg.error, "error");
   else if (msg.demo) message(`operator: ${describe(msg.demo.action)}`);
   else if (!msg.hello) message("");
