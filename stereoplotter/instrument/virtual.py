@@ -50,6 +50,7 @@ from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.spec.range_checks import check_in_range
 
 __all__ = [
+    "ACTION_KINDS",
     "BACKENDS",
     "CASSETTES",
     "CONTROLS",
@@ -59,6 +60,9 @@ __all__ = [
     "KNOBS",
     "NOMINAL_ZERO",
     "SCREWS",
+    "Action",
+    "ActionKind",
+    "ActionListener",
     "CassetteName",
     "Control",
     "ControlInfo",
@@ -112,6 +116,46 @@ CONTROLS = SCREWS + _SET
 ControlKind = Literal[
     "screw", "principal_distance", "cassette", "decentration", "knob", "height_scale"
 ]
+
+
+#: The operator's calls an :class:`Instrument` tells its listener about (:class:`Action`).
+ActionKind = Literal["set", "knob", "direction", "read", "gear", "slip", "connect", "needle"]
+ACTION_KINDS: Final[tuple[ActionKind, ...]] = get_args(ActionKind)
+
+
+@dataclass(frozen=True, slots=True)
+class Action:
+    """One call of an operator's method on an :class:`Instrument`, as it was made: what the
+    instrument's listener (:attr:`Instrument.on_action`) is told once the call has succeeded.
+
+    Attributes
+    ----------
+    kind : ActionKind
+        The method: "set" (:meth:`Instrument.set`), "knob" (:meth:`~Instrument.turn_knob`),
+        "direction" (:meth:`~Instrument.switch_counter`), "read", "gear"
+        (:meth:`~Instrument.gear_height_counter`), "slip" (:meth:`~Instrument.slip_height_scale`),
+        "connect" (:meth:`~Instrument.connect_coordinatograph`) or "needle".
+    control : str or None
+        The control set, knob turned, counter switched or read (None for the others).
+    value : array_like or None
+        The value passed: a reading (set, slip; the control's unit), a tilt tangent (knob), the
+        counter's sense (direction), M_в (gear), the gear ratio (connect); None (read, needle).
+    side : str or None
+        The side a setting or the needle finishes from ("below", "above"; None: direct).
+    origin_mm : (float, float) or None
+        The coordinatograph's origin on the table as passed (connect; None: the default, the
+        table centre). [mm]
+    """
+
+    kind: ActionKind
+    control: str | None = None
+    value: Any = None
+    side: str | None = None
+    origin_mm: ArrayLike | None = None
+
+
+#: A listener of an instrument's actions (:attr:`Instrument.on_action`).
+ActionListener = Callable[[Action], None]
 
 
 @dataclass(frozen=True, slots=True)
@@ -296,6 +340,16 @@ class Instrument:
         ``options`` are fitted to ``spec`` already (:meth:`SC1Options.fitted_to`, done once per
         run by ``procedure.simulate.prepare_run``): not checked again.
 
+    Attributes
+    ----------
+    on_action : callable or None
+        The listener of the operator's actions: called with an :class:`Action` after each
+        successful call of :meth:`set`, :meth:`turn_knob`, :meth:`switch_counter`, :meth:`read`,
+        :meth:`gear_height_counter`, :meth:`slip_height_scale`,
+        :meth:`connect_coordinatograph` and :meth:`needle` (one action per call: the height
+        scale's setting of Z is not told again). With a listener, :meth:`drive_screw` declines,
+        so that its caller's reads and settings are told too. None (default): nobody listens.
+
     Notes
     -----
     Ranges are stops: a setting outside the instrument's range raises
@@ -379,6 +433,7 @@ class Instrument:
         #: The last :attr:`setting` and the arrays it was built from (f_пр, the base carriages).
         self._setting_cache: tuple[tuple[Any, ...], InstrumentSetting] | None = None
         self._travel: dict[str, tuple[float, float]] = {}
+        self.on_action: ActionListener | None = None
 
     # --- construction --------------------------------------------------------------------
 
@@ -454,6 +509,13 @@ class Instrument:
         exact : bool
             Return the exact reading instead of the one rounded to the least count.
         """
+        out = self._read(control, exact)
+        if self.on_action is not None:
+            self.on_action(Action("read", str(control)))
+        return out
+
+    def _read(self, control: ScaleName, exact: bool) -> NDArray[np.float64] | float:
+        """:meth:`read` without telling the listener."""
         if control == HEIGHT_SCALE:
             reading = self._height_reading()
             out = reading if exact else self._round_height(reading)
@@ -489,10 +551,21 @@ class Instrument:
         RangeRefusal, TravelRefusal
             A setting beyond the instrument's range: refused like the real stop.
         """
+        self._set(control, reading, side)
+        if self.on_action is not None:
+            self.on_action(Action("set", str(control), reading, side))
+
+    def _set(
+        self,
+        control: ScrewName | SetControl | HeightScaleName,
+        reading: ArrayLike,
+        side: str | None,
+    ) -> None:
+        """:meth:`set` without telling the listener (the height scale sets Z through it)."""
         if control == HEIGHT_SCALE:
             gear = self._gear()
             depth_reading = (self._height_slip - np.asarray(reading, float)) * 1000.0 / gear
-            self.set("Z", depth_reading, side)
+            self._set("Z", depth_reading, side)
             return
         if control in self._axes:
             nut = self._scales[control].position(reading)
@@ -565,6 +638,8 @@ class Instrument:
         self._units[side] = turn_correction_knob(
             self._units[side], axis, t, linkage=self.variant.linkage
         )
+        if self.on_action is not None:
+            self.on_action(Action("knob", str(knob), tan_tilt))
 
     def switch_counter(self, control: ScrewName | DecentrationName, sense: int) -> None:
         """Switch a counter's direction (+1: readings grow with the position, the book's
@@ -584,6 +659,8 @@ class Instrument:
         now = scale.reading(position)
         zero = now - sense * (1.0 + scale.ratio_error) * np.asarray(position, float)
         self._scales[control] = replace(scale, zero=zero, sense=sense)
+        if self.on_action is not None:
+            self.on_action(Action("direction", str(control), sense))
 
     def counter_sense(self, control: ScrewName | DecentrationName) -> int:
         """The direction of a counter (+1 or −1)."""
@@ -603,9 +680,10 @@ class Instrument:
         reading through ``limit`` (the caller's stop rule) and sets it from ``side`` — the
         arithmetic of :meth:`read` (exact) and :meth:`set`, on the axis's own (T,) arrays
         without the copies and checks of each call. False (nothing done) for a pymunk axis or a
-        single instrument, which the caller drives by :meth:`read` and :meth:`set`. [mm]"""
+        single instrument or an instrument with a listener (:attr:`on_action`), which the caller
+        drives by :meth:`read` and :meth:`set`. [mm]"""
         axis = self._axes[control]
-        if not self.trials or not isinstance(axis, PlayAxis):
+        if not self.trials or not isinstance(axis, PlayAxis) or self.on_action is not None:
             return False
         scale = self._scales[control]
         zero, gain = scale.zero, scale.gain
@@ -665,12 +743,16 @@ class Instrument:
             self.spec, "vertical_scale_denominators", float(vertical_scale_denominator), "M_в"
         )
         self._height_gear = float(vertical_scale_denominator)
+        if self.on_action is not None:
+            self.on_action(Action("gear", value=vertical_scale_denominator))
 
     def slip_height_scale(self, reading_m: ArrayLike) -> None:
         """Slip the metre height scale (friction coupling) so that it shows ``reading_m`` now."""
         self._height_slip = self._height_slip + (
             np.asarray(reading_m, float) - self._height_reading()
         )
+        if self.on_action is not None:
+            self.on_action(Action("slip", value=reading_m))
 
     def _gear(self) -> float:
         if self._height_gear is None:
@@ -799,6 +881,7 @@ class Instrument:
         if self.ideal_mechanics:
             ideal = {"backlash_mm": 0.0, "friction": 0.0, "stiffness_kg_s2": math.inf}
             params = CoordinatographParams(replace(params.x, **ideal), replace(params.y, **ideal))
+        origin_given = origin_table_mm
         if origin_table_mm is None:
             origin_table_mm = (0.5 * sum(params.x.range_mm), 0.5 * sum(params.y.range_mm))
         self._cg_ratio = float(ratio)
@@ -815,6 +898,8 @@ class Instrument:
             )
             for axis, start in zip(self._cg_axes, self._cg_origin, strict=True):
                 axis.place(start)
+        if self.on_action is not None:
+            self.on_action(Action("connect", value=ratio, origin_mm=origin_given))
 
     def table_position_mm(self, model_xy_mm: ArrayLike) -> NDArray[np.float64]:
         """Ideal table position of a model position (X, Y): origin + r·(X, Y), the gears
@@ -866,11 +951,14 @@ class Instrument:
             y = np.asarray(y_axis.approach(self._arg(target_y), side), float)
             play = self.injected["coordinatograph.pen_play"]
         x = x + (y - self._cg_origin[1]) * np.sin(eps) + play
-        return (
+        out = (
             self._out(np.stack([x, y], axis=-1))
             if self.trials
             else np.array([float(np.squeeze(x)), float(np.squeeze(y))])
         )
+        if self.on_action is not None:
+            self.on_action(Action("needle", side=side))
+        return out
 
     # --- state for tests and reports (not an operator's view) ---------------------------------
 

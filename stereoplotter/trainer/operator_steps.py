@@ -2,9 +2,10 @@
 
 The procedure (:mod:`stereoplotter.procedure.setup_method`, ``conventional``) drives the
 instrument through :meth:`Instrument.set`, :meth:`~Instrument.turn_knob`, the height counter,
-the coordinatograph and reads its counters. :class:`RecordingInstrument` is an instrument that
-notes each of these calls as a session action (``set``, ``read``, ``gear``, ``slip``,
-``connect``, ``needle``) with the stage in which it happened; :func:`operator_run` runs the
+the coordinatograph and reads its counters. An :class:`ActionRecorder`, the instrument's
+listener (:attr:`Instrument.on_action`), notes each of these calls as a session action
+(``set``, ``read``, ``gear``, ``slip``, ``connect``, ``needle``) with the stage in which it
+happened; :func:`operator_run` runs the
 method once (trial 0 of ``simulate(..., seed=seed)``, the same instrument, errors and judgments)
 and returns those actions. They are what a hint of level 3 replays ("show me") and what presets
 the stages before an exercise's first stage; replayed through a
@@ -19,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.instrument.virtual import Instrument
+from stereoplotter.instrument.virtual import Action, Instrument
 from stereoplotter.procedure.conventional import (
     c1_interior,
     c2_relative_by_elements,
@@ -39,10 +40,11 @@ from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_che
 from stereoplotter.procedure.transcript import Transcript
 
 __all__ = [
+    "ActionRecorder",
     "OperatorRun",
-    "RecordingInstrument",
     "new_instrument",
     "operator_run",
+    "session_action",
     "stage_functions",
 ]
 
@@ -55,74 +57,67 @@ def _num(value: Any) -> Any:
     return [float(v) for v in a.reshape(-1)]
 
 
-class RecordingInstrument(Instrument):
-    """An instrument that notes every operator call as a session action (``self.actions``)."""
+class ActionRecorder:
+    """Notes each operator action on an instrument as a session action: the instrument's
+    listener (``inst.on_action = recorder``, :attr:`Instrument.on_action`).
 
-    def __init__(self, *args: Any, **kwargs: Any):
-        super().__init__(*args, **kwargs)
+    Attributes
+    ----------
+    actions : list of dict
+        The session actions (``set``, ``read``, ``gear``, ``slip``, ``connect``, ``needle``,
+        ``direction``; a correction knob's turn is a ``set``), each with its ``stage``.
+    stage : str
+        The stage the next actions belong to.
+    recording : bool
+        False: actions are not noted.
+    transcript : Transcript or None
+        The operator's transcript: each action notes how many records it held
+        (:attr:`record_index`), so that the action's step is the next record's.
+    """
+
+    def __init__(self, transcript: Transcript | None = None):
         self.actions: list[dict[str, Any]] = []
         self.stage = ""
         self.recording = True
-        self._depth = 0
-        #: The operator's transcript (set by :func:`operator_run`): each action notes how many
-        #: records it held, so that the action's step is the next record's.
-        self.transcript: Transcript | None = None
+        self.transcript = transcript
         self.record_index: list[int] = []
 
-    def _note(self, action: dict[str, Any]) -> None:
-        if self.recording and self._depth == 0:
-            self.actions.append({**action, "stage": self.stage})
+    def __call__(self, action: Action) -> None:
+        """Note ``action`` (see :func:`session_action`) unless not :attr:`recording`."""
+        if self.recording:
+            self.actions.append({**session_action(action), "stage": self.stage})
             self.record_index.append(len(self.transcript.records) if self.transcript else 0)
 
-    def set(self, control, reading, side=None) -> None:  # type: ignore[override]
-        self._depth += 1  # the height scale sets Z: only the outer call is the operator's
-        try:
-            super().set(control, reading, side)
-        finally:
-            self._depth -= 1
-        action = {"kind": "set", "control": str(control), "value": _num(reading)}
-        if side is not None:
-            action["side"] = side
-        self._note(action)
 
-    def turn_knob(self, knob, tan_tilt) -> None:  # type: ignore[override]
-        super().turn_knob(knob, tan_tilt)
-        self._note({"kind": "set", "control": str(knob), "value": _num(tan_tilt)})
-
-    def gear_height_counter(self, vertical_scale_denominator: int) -> None:
-        super().gear_height_counter(vertical_scale_denominator)
-        self._note({"kind": "gear", "value": int(vertical_scale_denominator)})
-
-    def slip_height_scale(self, reading_m) -> None:  # type: ignore[override]
-        super().slip_height_scale(reading_m)
-        self._note({"kind": "slip", "value": _num(reading_m)})
-
-    def connect_coordinatograph(self, ratio, origin_table_mm=None, enlargement=None) -> None:  # type: ignore[override]
-        super().connect_coordinatograph(ratio, origin_table_mm, enlargement)
-        action: dict[str, Any] = {"kind": "connect", "value": float(ratio)}
-        if origin_table_mm is not None:
-            action["origin_mm"] = [float(v) for v in origin_table_mm]
-        self._note(action)
-
-    def needle(self, side=None, servo_noise_mm=None):  # type: ignore[override]
-        out = super().needle(side, servo_noise_mm)
-        action: dict[str, Any] = {"kind": "needle"}
-        if side is not None:
-            action["side"] = side
-        self._note(action)
-        return out
-
-    def read(self, control, exact: bool = False):  # type: ignore[override]
-        out = super().read(control, exact)
-        self._note({"kind": "read", "counter": str(control)})
-        return out
+def session_action(action: Action) -> dict[str, Any]:
+    """The session action (:mod:`stereoplotter.trainer.actions`) an instrument's action is."""
+    out: dict[str, Any]
+    if action.kind in ("set", "knob"):
+        out = {"kind": "set", "control": str(action.control), "value": _num(action.value)}
+        if action.side is not None:
+            out["side"] = action.side
+    elif action.kind == "read":
+        out = {"kind": "read", "counter": str(action.control)}
+    elif action.kind == "direction":
+        out = {"kind": "direction", "counter": str(action.control), "sign": int(action.value)}
+    elif action.kind == "gear":
+        out = {"kind": "gear", "value": int(action.value)}
+    elif action.kind == "slip":
+        out = {"kind": "slip", "value": _num(action.value)}
+    elif action.kind == "connect":
+        out = {"kind": "connect", "value": float(action.value)}
+        if action.origin_mm is not None:
+            out["origin_mm"] = [float(v) for v in np.asarray(action.origin_mm, float)]
+    else:  # needle
+        out = {"kind": "needle"}
+        if action.side is not None:
+            out["side"] = action.side
+    return out
 
 
-def new_instrument(prep: PreparedRun, seed: int, cls: type[Instrument] = Instrument) -> Instrument:
+def new_instrument(prep: PreparedRun, seed: int) -> Instrument:
     """The instrument of trial 0 of a run seeded ``seed`` (errors drawn as ``simulate`` does)."""
-    return build_instrument(
-        prep, injected=prep.model.draw_keyed(seed, 0, None), instrument_cls=cls
-    )
+    return build_instrument(prep, injected=prep.model.draw_keyed(seed, 0, None))
 
 
 @dataclass
@@ -134,12 +129,13 @@ class OperatorRun:
     actions : list of dict
         Session actions with their ``stage``, in order.
     run : Run
-    instrument : RecordingInstrument
+    instrument : Instrument
+        The instrument the run left (its listener removed).
     """
 
     actions: list[dict[str, Any]]
     run: Run
-    instrument: RecordingInstrument
+    instrument: Instrument
     stage_ends: dict[str, int] = field(default_factory=dict)
     #: Per action, the step of the transcript it belongs to (the first record written after it).
     steps: list[str] = field(default_factory=list)
@@ -199,31 +195,31 @@ def operator_run(
     prep: PreparedRun,
     seed: int,
     upto: str | None = None,
-    after_stage: Callable[[str, RecordingInstrument], None] | None = None,
+    after_stage: Callable[[str, Instrument, list[dict[str, Any]]], None] | None = None,
 ) -> OperatorRun:
     """Run the simulated operator (trial 0 of seed ``seed``) stage by stage, noting its actions;
-    it stops after stage ``upto`` (default: the method's last). ``after_stage(stage, inst)``
-    runs at the end of each stage, its calls on the instrument noted as the stage's actions
-    (the robot trainee's finishing, :mod:`stereoplotter.trainer.robot`)."""
+    it stops after stage ``upto`` (default: the method's last). ``after_stage(stage, inst,
+    actions)`` runs at the end of each stage (``actions``: those noted so far), its calls on the
+    instrument noted as the stage's actions (the robot trainee's finishing,
+    :mod:`stereoplotter.trainer.robot`)."""
     run = build_run(
-        prep,
-        injected=prep.model.draw_keyed(seed, 0, None),
-        noise=Noise(seed, None, None, 0),
-        instrument_cls=RecordingInstrument,
+        prep, injected=prep.model.draw_keyed(seed, 0, None), noise=Noise(seed, None, None, 0)
     )
     op, inst = run.op, run.op.inst
-    assert isinstance(inst, RecordingInstrument)
-    inst.transcript = op.log
+    recorder = ActionRecorder(op.log)
+    inst.on_action = recorder
     ends = {}
     for name, fn in stage_functions(run, prep.method).items():
-        inst.stage = name
+        recorder.stage = name
         fn()
         if after_stage is not None:
-            after_stage(name, inst)
-        ends[name] = len(inst.actions)
+            after_stage(name, inst, recorder.actions)
+        ends[name] = len(recorder.actions)
         if name == upto:
             break
-    inst.recording = False
+    inst.on_action = None
     records = op.log.records
-    steps = [records[min(i, len(records) - 1)].step if records else "" for i in inst.record_index]
-    return OperatorRun(inst.actions, run, inst, ends, steps)
+    steps = [
+        records[min(i, len(records) - 1)].step if records else "" for i in recorder.record_index
+    ]
+    return OperatorRun(recorder.actions, run, inst, ends, steps)

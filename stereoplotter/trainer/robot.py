@@ -49,7 +49,7 @@ from stereoplotter.instrument.virtual import CASSETTES, DECENTRATIONS, KNOBS, SC
 from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.trainer.actions import apply, control_value
 from stereoplotter.trainer.exercise import Exercise
-from stereoplotter.trainer.operator_steps import OperatorRun, RecordingInstrument, operator_run
+from stereoplotter.trainer.operator_steps import OperatorRun, operator_run
 from stereoplotter.trainer.outcome import PARALLAX_STAGES, model_evaluation, standard_q
 
 __all__ = [
@@ -85,18 +85,18 @@ def _exact_q(inst: Instrument, prep: PreparedRun) -> np.ndarray:
 
 
 def _copy(inst: Instrument) -> Instrument:
-    """A plain copy of an instrument's physical state (a recording instrument's notes and
-    transcript left out: the twin only looks)."""
+    """A plain copy of an instrument's physical state, without its listener (the twin only
+    looks: its actions are nobody's)."""
     memo: dict[int, Any] = {id(inst.spec): inst.spec, id(inst.errors): inst.errors}
-    if isinstance(inst, RecordingInstrument):
-        memo.update({id(inst.actions): [], id(inst.record_index): [], id(inst.transcript): None})
+    if inst.on_action is not None:
+        memo[id(inst.on_action)] = None
     return copy.deepcopy(inst, memo)
 
 
-def _commanded(inst: RecordingInstrument) -> dict[str, float]:
-    """The last value set on each scale-set control (f_пр, κ, knobs) from the noted actions."""
+def _commanded(actions: list[dict[str, Any]]) -> dict[str, float]:
+    """The last value set on each scale-set control (f_пр, κ, knobs) in ``actions``."""
     out: dict[str, float] = {}
-    for a in inst.actions:
+    for a in actions:
         if a["kind"] == "set" and a["control"] not in SCREWS and a["control"] not in DECENTRATIONS:
             out[a["control"]] = a["value"]
     return out
@@ -118,8 +118,6 @@ def _clear_parallax(
         jac = np.empty((int(use.sum()), len(RELATIVE_ELEMENTS)))
         for j, control in enumerate(RELATIVE_ELEMENTS):
             twin, cmd = _copy(inst), dict(commanded)
-            if isinstance(twin, RecordingInstrument):
-                twin.recording = False
             value = control_value(twin, control, cmd) + _H
             apply(twin, {"kind": "set", "control": control, "value": value}, cmd)
             jac[:, j] = (_exact_q(twin, prep)[use] - q0) / _H
@@ -156,8 +154,6 @@ def _level(
         jac = np.empty((r0.size, len(LEVEL_ELEMENTS)))
         for j, control in enumerate(LEVEL_ELEMENTS):
             twin, cmd = _copy(inst), dict(commanded)
-            if isinstance(twin, RecordingInstrument):
-                twin.recording = False
             h = _LEVEL_H.get(control, _H)
             value = control_value(twin, control, cmd) + h
             apply(twin, {"kind": "set", "control": control, "value": value}, cmd)
@@ -281,8 +277,8 @@ def _robot_run(session: Any) -> OperatorRun:
     ex: Exercise = session.exercise
     prep = dataclasses.replace(session.prep, operator=session.prep.operator.zero())
 
-    def finish(stage: str, inst: RecordingInstrument) -> None:
-        _finish(stage, inst, session.prep, _commanded(inst), ex.unusable_points)
+    def finish(stage: str, inst: Instrument, actions: list[dict[str, Any]]) -> None:
+        _finish(stage, inst, session.prep, _commanded(actions), ex.unusable_points)
 
     return operator_run(prep, session.seed, ex.stages[-1], after_stage=finish)
 
