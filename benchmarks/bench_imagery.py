@@ -1,4 +1,4 @@
-"""Benchmark: synthetic photographs and eyepiece views (issue 13, deliverable 3).
+"""Benchmark: synthetic photographs and eyepiece views.
 
 Run ``python benchmarks/bench_imagery.py`` (optionally ``--scenario mountain60 --views 200``).
 Times:

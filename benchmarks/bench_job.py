@@ -1,4 +1,4 @@
-"""Benchmark: a production job (issue 12), the per-pair sheets and the vectorised Table 24 part.
+"""Benchmark: a production job, the per-pair sheets and the vectorised Table 24 part.
 
 Run ``python benchmarks/bench_job.py`` (``--copies 1250``: 10 000 pairs in the vectorised part).
 
@@ -16,7 +16,7 @@ read or written, no PDF):
   one ``setup.table24.compute_table24`` call on the stacked measured inputs, each pair with its
   own f′ and measured marks (the per-pair f′ of the job's films).
 
-Goal (issue 12): ≥ 10⁴ pairs/s for the numeric part of a block. Speed is measured here, never
+Goal: ≥ 10⁴ pairs/s for the numeric part of a block. Speed is measured here, never
 asserted in the tests.
 """
 

@@ -1,4 +1,4 @@
-"""Benchmark: whole sheets of a job's pairs, and their PDF forms (issue 27, deliverable 7).
+"""Benchmark: whole sheets of a job's pairs, and their PDF forms.
 
 Run ``python benchmarks/bench_job_sheets.py`` (``--pairs 10000 --forms 100``).
 
@@ -20,7 +20,7 @@ and the files of ``--forms`` pairs (``report.job.job_files``: every ``sheet.yaml
 the PDF form of each pair and ``forms.pdf``), rendered in memory and then written through
 ``commands.setup_job.write_job`` into a new folder.
 
-Goals (issue 27): ≥ 10⁴ pairs/s for the sheets without PDFs, ≥ 20 pairs/s with the PDF forms.
+Goals: ≥ 10⁴ pairs/s for the sheets without PDFs, ≥ 20 pairs/s with the PDF forms.
 Each figure is printed by the wall clock and by the process's CPU time (the machine is shared by
 other jobs: compare the CPU rates between runs). Speed is measured here, never asserted in the
 tests.

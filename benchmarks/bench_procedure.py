@@ -1,4 +1,4 @@
-"""Benchmark: full five-stage setup-data procedures per second (issue 5).
+"""Benchmark: full five-stage setup-data procedures per second.
 
 python benchmarks/bench_procedure.py                 # T = 10 000 vectorised, 20 in the loop
 python benchmarks/bench_procedure.py --trials 1000 --loop 10 --no-pymunk

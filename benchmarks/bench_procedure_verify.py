@@ -1,7 +1,7 @@
-"""The procedure Monte Carlo of `stereoplotter verify` (issue 10, deliverable 3; issue 26,
-deliverable 3): every run of `verification.table.run_procedure_mc` at its default trials, its
-time, the relative 99.9 % CI of each outcome row (controlled and plain), and the wall time with
-two workers. The conventional configurations of a slot are one shared run (issue 26).
+"""The procedure Monte Carlo of `stereoplotter verify`: every run of
+`verification.table.run_procedure_mc` at its default trials, its time, the relative 99.9 % CI of
+each outcome row (controlled and plain), and the wall time with two workers. The conventional
+configurations of a slot are one shared run.
 
 python benchmarks/bench_procedure_verify.py            # the defaults (PROCEDURE_TRIALS, ...)
 python benchmarks/bench_procedure_verify.py --trials 3000

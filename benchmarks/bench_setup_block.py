@@ -3,9 +3,8 @@
 Run ``python benchmarks/bench_setup_block.py`` (optionally ``--pairs 10000 --loop-pairs 300``).
 Times the numeric part only — :func:`stereoplotter.setup.block.compute_block` on N pairs (best of
 5) and the per-pair scalar oracle ``per_pair_loop`` of ``tests/oracles/setup_pair_oracle.py`` on a
-subset — and prints pairs per second,
-their ratio and the machine. Goal (issue "block mode"): ≥ 10⁴ pairs/s vectorised on a 2-core
-machine. Speed is measured here, never asserted in the test suite.
+subset — and prints pairs per second, their ratio and the machine. Goal: ≥ 10⁴ pairs/s
+vectorised on a 2-core machine. Speed is measured here, never asserted in the test suite.
 """
 
 from __future__ import annotations

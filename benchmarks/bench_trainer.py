@@ -1,4 +1,4 @@
-"""Benchmark: the trainer's session round trip and the grading population (issue 13).
+"""Benchmark: the trainer's session round trip and the grading population.
 
 python benchmarks/bench_trainer.py                      # e08 (setup) and e09 (conventional)
 python benchmarks/bench_trainer.py --population 2000 --exercise e03-setup-stage2

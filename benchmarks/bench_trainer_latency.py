@@ -3,7 +3,7 @@
 A turn of a handwheel is sent by the page (WebSocket), the server answers with the new state
 (counters, marks), and the page redraws both eyepieces from the photo patches it holds; the time
 is from the send to the next animation frame after the redraw (``window.trainer.actAndFrame``).
-Target (issue 14): median ≤ 50 ms.
+Target: median ≤ 50 ms.
 
     python -m benchmarks.bench_trainer_latency [--turns 200]   (from the checkout)
 """

@@ -1,4 +1,4 @@
-"""A class on the trainer server (issue 22): 20 trainees on WebSockets and an instructor, while
+"""A class on the trainer server: 20 trainees on WebSockets and an instructor, while
 sessions are graded and replayed.
 
 The server is ``stereoplotter trainer`` in its own process (worker processes for grading,

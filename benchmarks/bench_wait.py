@@ -1,6 +1,6 @@
-"""Benchmark: speed where the user waits (issue 26) — whole commands and where their time goes.
+"""Benchmark: speed where the user waits — whole commands and where their time goes.
 
-python benchmarks/bench_wait.py times                       # the issue's rows, this checkout
+python benchmarks/bench_wait.py times                       # the rows of ROWS, this checkout
 python benchmarks/bench_wait.py times --before /path/main   # … and another checkout, in turn
 python benchmarks/bench_wait.py profile simulate --label after   # cProfile → benchmarks/profiles/
 
@@ -35,7 +35,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 
-#: The issue's rows: label, arguments of ``python -m stereoplotter``, trials (None: no rate).
+#: The timed rows: label, arguments of ``python -m stereoplotter``, trials (None: no rate).
 ROWS = (
     ("--version", ["--version"], None),
     ("info", ["info"], None),
@@ -147,7 +147,7 @@ def profile(args: argparse.Namespace) -> None:
         def part() -> None:
             import stereoplotter.cli as cli
 
-            cli._full_parser()
+            cli.full_parser()
 
     prof = cProfile.Profile()
     t = time.perf_counter()

@@ -42,7 +42,7 @@ from stereoplotter.errors import StereoplotterError
 from stereoplotter.io.paths import resolve_data_file, set_user_folders
 from stereoplotter.progress import configure_logging
 
-__all__ = ["COMMANDS", "build_parser", "main"]
+__all__ = ["COMMANDS", "build_parser", "full_parser", "main"]
 
 #: The command modules, in the order ``--help`` lists them. A new command is a module of
 #: :mod:`stereoplotter.commands` with ``add_arguments(sub)`` and ``run(args)``, added here.
@@ -123,7 +123,7 @@ def _all_subparsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentPa
     return found
 
 
-def _full_parser() -> argparse.ArgumentParser:
+def full_parser() -> argparse.ArgumentParser:
     """The parser with -v/--quiet accepted before or after the command."""
     parser = build_parser()
     for child in _all_subparsers(parser):
@@ -143,7 +143,7 @@ def _resolve_data_arguments(args: argparse.Namespace) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``stereoplotter`` command. Returns the exit code."""
     try:
-        args = _full_parser().parse_args(argv)
+        args = full_parser().parse_args(argv)
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130

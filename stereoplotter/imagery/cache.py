@@ -75,6 +75,12 @@ class ViewCache:
         self.__dict__.update(state)
         self._lock = threading.Lock()
 
+    def forget_views(self) -> None:
+        """Forget the kept eyepiece views (the tiles stay): the next :meth:`view` of each spot
+        is sampled from the tiles again."""
+        with self._lock:
+            self._views.clear()
+
     def prefetch(self, side: str, x_mm: float, y_mm: float, radius_mm: float = 3.0) -> int:
         """Render the finest level's tiles within ``radius_mm`` of photo point x, y [mm] ahead of
         use (a view whose tiles are rendered only samples them; the times of both:

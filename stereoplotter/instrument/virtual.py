@@ -754,6 +754,11 @@ class Instrument:
         if self.on_action is not None:
             self.on_action(Action("slip", value=reading_m))
 
+    @property
+    def height_gear(self) -> float | None:
+        """M_в the height counter is geared for (:meth:`gear_height_counter`); None: not geared."""
+        return self._height_gear
+
     def _gear(self) -> float:
         if self._height_gear is None:
             raise StereoplotterError(
@@ -915,6 +920,11 @@ class Instrument:
                 "the coordinatograph is not connected (connect_coordinatograph(ratio) first)"
             )
         return self._cg_origin + self._cg_ratio * np.asarray(model_xy_mm, float)
+
+    @property
+    def coordinatograph_connected(self) -> bool:
+        """The coordinatograph is coupled to the carriages (:meth:`connect_coordinatograph`)."""
+        return hasattr(self, "_cg_axes")
 
     @property
     def servo_sigma_mm(self) -> float:

@@ -67,7 +67,6 @@ __all__ = [
     "origin_data",
     "production_data",
     "write_block_measurements",
-    "yaml_number",
 ]
 
 FORMAT = "stereoplotter-block-measurements/1"
@@ -326,13 +325,6 @@ def load_block_measurements(path: str | os.PathLike[str]) -> tuple[Block, Produc
     prod = doc.production
     production = Production(prod.instrument, prod.date, tuple(prod.map_sheets)) if prod else None
     return block, production
-
-
-def yaml_number(value: float) -> str:
-    """A float as YAML 1.1 reads it back as a float (PyYAML takes ``1e-09`` for text)."""
-    text = repr(float(value))
-    mantissa, _, exponent = text.partition("e")
-    return f"{mantissa}.0e{exponent}" if exponent and "." not in mantissa else text
 
 
 def camera_data(cam: Camera) -> dict[str, Any]:

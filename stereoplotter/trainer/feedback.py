@@ -61,7 +61,7 @@ def _settings(session: Any, stage: str, inst: Any) -> list[dict[str, Any]]:
     out = []
     for control, target in targets.items():
         if control == "gear":
-            value = None if inst._height_gear is None else float(inst._height_gear)
+            value = None if inst.height_gear is None else float(inst.height_gear)
             lc, unit = 1.0, ""
         else:
             value = control_value(inst, control, session.commanded)

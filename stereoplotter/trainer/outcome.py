@@ -136,7 +136,7 @@ def model_evaluation(inst: Instrument, prep: PreparedRun):
     height counter is geared."""
     units = inst.state()["units"]
     zero = None
-    if inst._height_gear is not None:
+    if inst.height_gear is not None:
         zero = (
             np.asarray(inst.read("H", exact=True))
             + np.asarray(inst.state()["carriages_mm"]["Z"])
@@ -194,7 +194,7 @@ def stage_measures(
     if stage == "C1" and not f_unset:
         out.append(Measure("f_пр as set − sheet f_пр", _f_scale_error(inst, prep), lc, "mm"))
     if stage == "1":
-        geared = inst._height_gear == float(prep.sheet.vertical_scale_denominator)
+        geared = inst.height_gear == float(prep.sheet.vertical_scale_denominator)
         value = np.zeros(inst.trials) if inst.trials else 0.0
         out.append(Measure("height counter not geared for M_в", value + (not geared), 0.5, "—"))
     if stage in ("1", "C1"):
@@ -234,7 +234,7 @@ def stage_measures(
                 "mm",
             )
         )
-        connected = hasattr(inst, "_cg_axes")
+        connected = inst.coordinatograph_connected
         value = np.zeros(inst.trials) if inst.trials else 0.0
         out.append(Measure("coordinatograph not connected", value + (not connected), 0.5, "—"))
     return out

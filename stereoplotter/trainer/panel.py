@@ -85,6 +85,8 @@ __all__ = [
     "overview",
     "sheet_parts",
     "show_me_actions",
+    "span_fails",
+    "standard_q_now",
     "step_rules",
     "step_targets",
 ]
@@ -353,7 +355,7 @@ def _target_met(
         if control in corrected:
             continue
         if control == "gear":
-            if inst._height_gear is None or float(inst._height_gear) != target:
+            if inst.height_gear is None or float(inst.height_gear) != target:
                 return False
             continue
         value = control_value(inst, control, session.commanded)
@@ -382,11 +384,11 @@ def _settings_key(session: Any, *more: str) -> tuple:
     return (
         tuple(sorted(session.commanded.items())),
         tuple(control_value(inst, c, session.commanded) for c in (*_SPAN_SCALES, *more)),
-        inst._height_gear,
+        inst.height_gear,
     )
 
 
-def _standard_q(session: Any) -> np.ndarray:
+def standard_q_now(session: Any) -> np.ndarray:
     """|q| at the six standard points on the instrument as it stands (cached while only X, Y,
     Z move). [mm]"""
     key = _settings_key(session)
@@ -398,7 +400,7 @@ def _standard_q(session: Any) -> np.ndarray:
     return q
 
 
-def _span_fails(session: Any) -> bool:
+def span_fails(session: Any) -> bool:
     """The L-check's condition: |L − L′| (true) outside its tolerance on the instrument as it
     stands (False before f_пр is set: nothing to check yet)."""
     if "f_instrument" not in session.commanded:
@@ -423,9 +425,9 @@ def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
     rules = session.step_rules(stage)
     q = None
     if any(e["rule"] == "parallax" for e in rules) and "f_instrument" in session.commanded:
-        q = _standard_q(session)
+        q = standard_q_now(session)
     tol_q = float(session.prep.sheet.tolerances["residual_y_parallax_mm"])
-    fails = _span_fails(session) if any(e["conditional"] for e in rules) else False
+    fails = span_fails(session) if any(e["conditional"] for e in rules) else False
     done, shown = [], []
     for entry in rules:
         if entry["rule"] == "target":

@@ -186,7 +186,7 @@ def _finish(
     out: list[dict[str, Any]] = []
     if stage in PARALLAX_STAGES:
         out += _clear_parallax(inst, prep, commanded, unusable)
-    if stage in ("3", "C3") and inst._height_gear is not None:
+    if stage in ("3", "C3") and inst.height_gear is not None:
         out += _level(inst, prep, commanded, unusable)
     return out
 

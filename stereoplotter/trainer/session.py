@@ -232,7 +232,7 @@ class Session:
                 "least_count": spec.z_least_count_mm if name == "Z" else spec.xy_least_count_mm,
                 "direction": self.inst.counter_sense(name),
             }
-        if self.inst._height_gear is not None:
+        if self.inst.height_gear is not None:
             out[HEIGHT_SCALE] = {
                 "value": _f(self.inst.read(HEIGHT_SCALE)),
                 "unit": "m",

@@ -52,7 +52,7 @@ from stereoplotter.web.routes import START_LIMIT, Web
 from stereoplotter.web.sockets import ADDRESS_LIMIT, instructor_socket, trainee_socket
 from stereoplotter.web.workers import watch_parent
 
-__all__ = ["create_app"]
+__all__ = ["create_app", "worker_pool"]
 
 log = logging.getLogger(__name__)
 
@@ -68,7 +68,9 @@ def _page(name: str):
     return endpoint
 
 
-def _executor(processes: bool) -> Executor:
+def worker_pool(processes: bool) -> Executor:
+    """The server's pool of one worker for slow work off the event loop: a process of its own
+    (spawned, watching this process: it ends when the server dies) or, for tests, a thread."""
     if processes:  # spawn: the server's threads are never forked
         return ProcessPoolExecutor(
             max_workers=1,
@@ -153,8 +155,8 @@ def create_app(
         token,
         store,
         catalogue,
-        _executor(processes),
-        _executor(processes),
+        worker_pool(processes),
+        worker_pool(processes),
         message_limit,
         address_limit,
     )

@@ -12,7 +12,7 @@ import shutil
 import subprocess
 import sys
 
-__all__ = ["CHROMIUM", "chromium_path", "main"]
+__all__ = ["CHROMIUM", "chromium_path", "main", "run_quietly"]
 
 #: Where Debian's chromium package puts the browser.
 CHROMIUM = "/usr/bin/chromium"
@@ -27,17 +27,20 @@ def chromium_path() -> str | None:
     return None
 
 
-def _run(cmd: list[str]) -> None:
+def run_quietly(cmd: list[str]) -> None:
+    """Run ``cmd``, its output discarded; raises ``CalledProcessError`` (with its stderr) when
+    it fails."""
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
 
 def main() -> int:
+    """Install chromium with apt-get unless it is there; 0, or 1 with one line on stderr."""
     if chromium_path():
         return 0
     apt = ["apt-get"] if os.geteuid() == 0 else ["sudo", "-n", "apt-get"]
     try:
-        _run([*apt, "update", "-q"])
-        _run([*apt, "install", "-y", "-q", "chromium"])
+        run_quietly([*apt, "update", "-q"])
+        run_quietly([*apt, "install", "-y", "-q", "chromium"])
     except (OSError, subprocess.CalledProcessError) as exc:
         detail = getattr(exc, "stderr", "") or str(exc)
         last = detail.strip().splitlines()[-1] if detail.strip() else str(exc)

@@ -41,12 +41,10 @@ __all__ = [
     "build_view_cache",
     "checklist_of",
     "format_mm",
-    "grade_of",
     "grade_records",
     "grade_text",
     "log_bytes",
     "log_of",
-    "log_text",
     "operator_script",
     "overview_of",
     "photo_key",
@@ -199,19 +197,9 @@ def log_of(session: Session) -> list[dict[str, Any]]:
     return [session.header(), *session.log]
 
 
-def log_text(session: Session) -> bytes:
-    """The session log as JSON lines (the format ``io.session_log`` writes)."""
-    return log_bytes(log_of(session))
-
-
 def replay(records: list[dict[str, Any]]) -> Session:
     """A session run again from its log."""
     return Session.replay(records, read_exercise=exercise_from_mapping)
-
-
-def grade_of(session_or_log: Session | list[dict[str, Any]]) -> dict[str, Any]:
-    """The grade (``stereoplotter-grade/1`` dict) of a session or its log."""
-    return grade(session_or_log, population=GRADE_POPULATION, read_exercise=exercise_from_mapping)
 
 
 def grade_text(grade_dict: dict[str, Any]) -> str:

@@ -26,6 +26,7 @@ from urllib.parse import urlsplit
 from starlette.datastructures import Headers
 from starlette.responses import JSONResponse
 
+import stereoplotter
 from stereoplotter.trainer.actions import ACTION_FIELDS
 
 __all__ = [
@@ -93,8 +94,6 @@ def server_roots(*folders: Any) -> None:
 
 
 def _default_roots() -> None:
-    import stereoplotter
-
     here = os.path.dirname(os.path.dirname(os.path.abspath(stereoplotter.__file__)))
     server_roots(here, sys.prefix, sys.base_prefix, os.path.expanduser("~"), os.getcwd(),
                  tempfile.gettempdir())

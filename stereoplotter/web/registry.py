@@ -363,6 +363,11 @@ class Registry:
 
     # --- grades, replays, photos --------------------------------------------------------------
 
+    def grading(self, sid: str) -> Future | None:
+        """The grading of a session started in this server's life when it finished (None: not
+        started here: not finished, or its grade kept from before a restart)."""
+        return self._grading.get(sid)
+
     def _grade_later(self, sid: str) -> Future:
         fut = self._grading.get(sid)
         if fut is None:

@@ -70,7 +70,7 @@ def _loaded(code: str) -> list[str]:
 
 
 def test_importing_the_cli_and_building_its_parser_loads_none_of_it():
-    code = "import stereoplotter.cli as c\nc._full_parser()"
+    code = "import stereoplotter.cli as c\nc.full_parser()"
     assert _loaded(code) == []
 
 

@@ -122,7 +122,7 @@ def test_nothing_is_ticked_for_a_control_never_set(e01):
 
 def test_the_cached_checks_follow_z_and_the_orientation():
     from stereoplotter.trainer.outcome import stage_measures, standard_q
-    from stereoplotter.trainer.panel import _span_fails, _standard_q
+    from stereoplotter.trainer.panel import span_fails, standard_q_now
 
     s = Session.start(load_exercise("e01-setup-stage1"), trainee="ann")
     s.act({"kind": "set", "control": "f_instrument", "value": 109.3748})
@@ -130,11 +130,11 @@ def test_the_cached_checks_follow_z_and_the_orientation():
     for z in (185.0, 184.0, 185.0):  # Z is the projection distance: the span follows it
         s.act({"kind": "set", "control": "Z", "value": z})
         span = float(stage_measures(s.inst, s.prep, "1")[0].value)
-        assert _span_fails(s) == (span > tol)
+        assert span_fails(s) == (span > tol)
     c2 = Session.start(load_exercise("e05-conventional-c2"), trainee="ann")
     for action in (
         {"kind": "set", "control": "X", "value": 250.0},  # a pointing: q stays
         {"kind": "set", "control": "kappa_right", "value": 0.002},  # an element: q changes
     ):
         c2.act(action)
-        np.testing.assert_array_equal(_standard_q(c2), np.abs(standard_q(c2.inst, c2.prep)))
+        np.testing.assert_array_equal(standard_q_now(c2), np.abs(standard_q(c2.inst, c2.prep)))

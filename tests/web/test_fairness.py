@@ -100,7 +100,7 @@ def test_patches_render_in_parallel_and_are_limited_per_session(tmp_path, monkey
         assert not hasattr(reg, "photo_locks")
         spots = [("left", x, 1.0, 6.0) for x in np.linspace(-5, 5, 12)]
         serial = [cache.view(side, x, y, 0.0, mag, 128).tobytes() for side, x, y, mag in spots]
-        cache._views.clear()
+        cache.forget_views()
         got: dict[int, bytes] = {}
 
         def render(k: int) -> None:

@@ -179,8 +179,8 @@ def test_worker_processes_die_with_a_killed_server(tmp_path):
     SIGKILL: the worker finds its parent gone and ends within seconds."""
     code = (
         "import os, sys, time\n"
-        "from stereoplotter.web.app import _executor\n"
-        "pool = _executor(True)\n"
+        "from stereoplotter.web.app import worker_pool\n"
+        "pool = worker_pool(True)\n"
         "print(pool.submit(os.getpid).result(), flush=True)\n"
         "time.sleep(600)\n"
     )

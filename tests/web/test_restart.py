@@ -12,7 +12,7 @@ def test_a_restart_keeps_grades_and_resumes_sessions(tmp_path):
     with make_client(tmp_path) as c1:
         done_sid, done_secret = start(c1, trainee="finished")
         claim_all(c1, done_sid, done_secret)
-        grade1 = c1.app.state.registry._grading[done_sid].result(timeout=60)
+        grade1 = c1.app.state.registry.grading(done_sid).result(timeout=60)
         open_sid, open_secret = start(c1, trainee="unfinished")
         ws, conn, hello = open_socket(c1, open_sid, open_secret)
         f = hello["state"]["controls"]["f_instrument"]
@@ -33,7 +33,7 @@ def test_a_restart_keeps_grades_and_resumes_sessions(tmp_path):
     with make_client(tmp_path) as c2:  # the restarted server
         r = c2.get(f"/api/sessions/{done_sid}/grade", params={"key": done_secret})
         assert r.status_code == 200 and r.json()["grade"] == grade1
-        assert done_sid not in c2.app.state.registry._grading  # kept, not regraded
+        assert c2.app.state.registry.grading(done_sid) is None  # kept, not regraded
         rows = {
             r["id"]: r for r in c2.get("/api/instructor/sessions", params={"token": TOKEN}).json()
         }

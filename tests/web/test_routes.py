@@ -115,7 +115,7 @@ def test_instructor_table_is_pushed_without_regrading(client):
         assert len(rows) == len(first) + 1 and rows[-1]["trainee"] == "pushed"
         claim_all(client, sid, secret)
         reg = client.app.state.registry
-        reg._grading[sid].result(timeout=60)  # graded once, in the worker, when finished
+        reg.grading(sid).result(timeout=60)  # graded once, in the worker, when finished
         for _ in range(10):
             rows = json.loads(ins.receive_text())["sessions"]
             mine = next(r for r in rows if r["id"] == sid)
@@ -128,7 +128,7 @@ def test_instructor_table_is_pushed_without_regrading(client):
 def test_csv_export_and_class_archive(client):
     sid, secret = start(client, trainee="archived")
     claim_all(client, sid, secret)
-    client.app.state.registry._grading[sid].result(timeout=60)
+    client.app.state.registry.grading(sid).result(timeout=60)
     csv = client.get("/api/instructor/results.csv", headers={"Authorization": f"Bearer {TOKEN}"})
     assert csv.status_code == 200 and csv.text.splitlines()[0].startswith("id,trainee,exercise")
     assert any(line.startswith(f"{sid},archived,{PRACTICE}") for line in csv.text.splitlines())
