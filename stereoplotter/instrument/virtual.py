@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.instrument.action_listener import Action, ActionListener
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -50,7 +51,6 @@ from stereoplotter.spec.instrument_spec import InstrumentSpec
 from stereoplotter.spec.range_checks import check_in_range
 
 __all__ = [
-    "ACTION_KINDS",
     "BACKENDS",
     "CASSETTES",
     "CONTROLS",
@@ -60,9 +60,6 @@ __all__ = [
     "KNOBS",
     "NOMINAL_ZERO",
     "SCREWS",
-    "Action",
-    "ActionKind",
-    "ActionListener",
     "CassetteName",
     "Control",
     "ControlInfo",
@@ -116,46 +113,6 @@ CONTROLS = SCREWS + _SET
 ControlKind = Literal[
     "screw", "principal_distance", "cassette", "decentration", "knob", "height_scale"
 ]
-
-
-#: The operator's calls an :class:`Instrument` tells its listener about (:class:`Action`).
-ActionKind = Literal["set", "knob", "direction", "read", "gear", "slip", "connect", "needle"]
-ACTION_KINDS: Final[tuple[ActionKind, ...]] = get_args(ActionKind)
-
-
-@dataclass(frozen=True, slots=True)
-class Action:
-    """One call of an operator's method on an :class:`Instrument`, as it was made: what the
-    instrument's listener (:attr:`Instrument.on_action`) is told once the call has succeeded.
-
-    Attributes
-    ----------
-    kind : ActionKind
-        The method: "set" (:meth:`Instrument.set`), "knob" (:meth:`~Instrument.turn_knob`),
-        "direction" (:meth:`~Instrument.switch_counter`), "read", "gear"
-        (:meth:`~Instrument.gear_height_counter`), "slip" (:meth:`~Instrument.slip_height_scale`),
-        "connect" (:meth:`~Instrument.connect_coordinatograph`) or "needle".
-    control : str or None
-        The control set, knob turned, counter switched or read (None for the others).
-    value : array_like or None
-        The value passed: a reading (set, slip; the control's unit), a tilt tangent (knob), the
-        counter's sense (direction), M_в (gear), the gear ratio (connect); None (read, needle).
-    side : str or None
-        The side a setting or the needle finishes from ("below", "above"; None: direct).
-    origin_mm : (float, float) or None
-        The coordinatograph's origin on the table as passed (connect; None: the default, the
-        table centre). [mm]
-    """
-
-    kind: ActionKind
-    control: str | None = None
-    value: Any = None
-    side: str | None = None
-    origin_mm: ArrayLike | None = None
-
-
-#: A listener of an instrument's actions (:attr:`Instrument.on_action`).
-ActionListener = Callable[[Action], None]
 
 
 @dataclass(frozen=True, slots=True)
@@ -343,12 +300,13 @@ class Instrument:
     Attributes
     ----------
     on_action : callable or None
-        The listener of the operator's actions: called with an :class:`Action` after each
-        successful call of :meth:`set`, :meth:`turn_knob`, :meth:`switch_counter`, :meth:`read`,
-        :meth:`gear_height_counter`, :meth:`slip_height_scale`,
-        :meth:`connect_coordinatograph` and :meth:`needle` (one action per call: the height
-        scale's setting of Z is not told again). With a listener, :meth:`drive_screw` declines,
-        so that its caller's reads and settings are told too. None (default): nobody listens.
+        The listener of the operator's actions (:mod:`~stereoplotter.instrument.action_listener`):
+        told an ``Action`` after each successful call of :meth:`set`, :meth:`turn_knob`,
+        :meth:`switch_counter`, :meth:`read`, :meth:`gear_height_counter`,
+        :meth:`slip_height_scale`, :meth:`connect_coordinatograph` and :meth:`needle` (one per
+        call: the height scale's setting of Z is not told again). With a listener,
+        :meth:`drive_screw` declines, so that its caller's reads and settings are told too.
+        None (default): nobody listens.
 
     Notes
     -----

@@ -20,7 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.instrument.virtual import Action, Instrument
+from stereoplotter.instrument.action_listener import Action
+from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import (
     c1_interior,
     c2_relative_by_elements,

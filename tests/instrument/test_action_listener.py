@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stereoplotter.instrument.virtual import Action, Instrument
+from stereoplotter.instrument.action_listener import Action
+from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.spec.range_checks import RangeRefusal
 
