@@ -97,7 +97,6 @@ if TYPE_CHECKING:
 
 __all__ = [
     "LINKAGE_VARIANTS",
-    "PROCEDURE_ROWS",
     "SOURCES",
     "ProcedureOptions",
     "conventional_sources_mc",
@@ -107,20 +106,6 @@ __all__ = [
     "procedure_mc",
     "scenario_geometry",
 ]
-
-#: Row → (book scenario, method); the scenarios are the book's §27 setting (shipped ``pair60``,
-#: ``pair80``), loaded by the caller (:func:`stereoplotter.report.verification.book_scenarios`).
-PROCEDURE_ROWS = {
-    "(6.43)": ("pair60.yaml", "setup"),
-    "(6.44)": ("pair80.yaml", "setup"),
-    "(6.39)": ("pair60.yaml", "setup"),
-    "(6.40)": ("pair80.yaml", "setup"),
-    "(6.45)": ("pair60.yaml", "conventional"),
-    "(6.46)": ("pair80.yaml", "conventional"),
-    "(6.60)": ("pair60.yaml", "conventional"),
-    "(6.61)": ("pair80.yaml", "conventional"),
-}
-
 
 def scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict:
     """f, l, n_л, f_пр, photo base p = B·f/H̄, overlap and the book's c of a scenario.

@@ -3,13 +3,13 @@
 :func:`run_verification` builds one row per numbered result, each with the printed value, the
 book-mode and rigorous values, the linear Monte Carlo RMS with its CI half-width, the exact
 covariance propagation on the same grid, a verdict and a note. The rows are data: each is an
-:class:`~stereoplotter.verification.entry.Entry` built by a small named function of a topic module
-(``rows_chapter5``: Tables 19, 20 and chapter 5; ``rows_setup_elements``: (6.28)–(6.38);
-``rows_outcomes``: (6.39)–(6.46); ``rows_levelled``: (6.47)–(6.61)); :func:`row_entries` lists
-them in order. :func:`closing_comparison` is the book's closing claim (setup data vs the
-conventional method at 60 % and 80 %). Rendered by
-:mod:`stereoplotter.report.verification`, written by
-:mod:`stereoplotter.commands.verification`.
+:class:`~stereoplotter.verification.entry.Entry` (its formulas, verdict rule and procedure
+measure) returned by one declared function of a topic module (``rows_chapter5``: Tables 19, 20
+and chapter 5; ``rows_setup_elements``: (6.28)–(6.38); ``rows_outcomes``: (6.39)–(6.46);
+``rows_levelled``: (6.47)–(6.61)); :func:`row_entries` concatenates the modules' declared rows
+(:data:`ROW_MODULES`) in order. :func:`closing_comparison` is the book's closing claim (setup
+data vs the conventional method at 60 % and 80 %). Rendered by
+:mod:`stereoplotter.report.verification`, written by :mod:`stereoplotter.commands.verification`.
 
 Book geometry (§27): f = 70 mm, l = 85 mm, n = 1.42 (SC-1), c = 70 mm; 60 %: p = 70, a = 0;
 80 %: p = 35, a = 35. Values are coefficients: m_x = m_y = m_xy = 1 for (6.31)-(6.50),
@@ -21,9 +21,10 @@ from __future__ import annotations
 import math
 import multiprocessing
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
+from functools import cache
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -32,38 +33,43 @@ from stereoplotter.procedure.fidelity import MECHANISMS, Fidelity
 from stereoplotter.random_streams import key_code
 from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification import linear_mc as mc
+from stereoplotter.verification import (
+    rows_chapter5,
+    rows_levelled,
+    rows_outcomes,
+    rows_setup_elements,
+)
 from stereoplotter.verification.as_formula import (
     as_formula_block,
     procedure_value,
     switch_chain,
     switch_decomposition,
 )
-from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
+from stereoplotter.verification.entry import (
+    BOOK,
+    RULE,
+    DeclaredRows,
+    Entry,
+    ProcedureMeasure,
+    Setting,
+)
 from stereoplotter.verification.procedure_mc import (
     conventional_sources_mc,
     idealised_geometry,
     procedure_mc,
-)
-from stereoplotter.verification.rows_chapter5 import chapter5_entries
-from stereoplotter.verification.rows_levelled import (
-    closing_entries,
-    conventional_term_entries,
-    setup_residual_entries,
-)
-from stereoplotter.verification.rows_outcomes import conventional_entries, setup_outcome_entries
-from stereoplotter.verification.rows_setup_elements import (
-    setup_element_entries,
-    unadjusted_generic_entries,
 )
 from stereoplotter.verification.verdicts import VERDICTS, decide
 
 __all__ = [
     "BOOK",
     "ROW_KEYS",
+    "ROW_MODULES",
     "VERDICTS",
     "attach_procedure_mc",
     "check_geometry",
     "closing_comparison",
+    "procedure_rows",
+    "row_entries",
     "run_procedure_mc",
     "run_verification",
     "start_procedure_mc",
@@ -130,20 +136,36 @@ STEP_TRIALS = 2000
 INSTRUMENT_TRIALS = {"setup": 4000, "conventional": 600, "y_parallax": 600, "stereo": 300}
 
 
-def row_entries(g) -> list[Entry]:
+#: The rows each topic module declares (:class:`~stereoplotter.verification.entry.DeclaredRows`),
+#: in the table's order. A new row is declared in its topic module only; a new topic module is
+#: added here.
+ROW_MODULES: tuple[DeclaredRows, ...] = (
+    rows_chapter5.ROWS,
+    rows_setup_elements.ROWS,
+    rows_outcomes.ROWS,
+    rows_levelled.ROWS,
+)
+
+
+def row_entries(g: Mapping[str, float]) -> list[Entry]:
     """Every row of the table as an :class:`~stereoplotter.verification.entry.Entry`, in the
     table's order (a row's random stream is keyed by its identity, not by its place)."""
     s = Setting.from_mapping(g)
-    return [
-        *chapter5_entries(s),
-        *unadjusted_generic_entries(s),
-        *setup_element_entries(s),
-        *setup_outcome_entries(s),
-        *conventional_entries(s),
-        *setup_residual_entries(s),
-        *conventional_term_entries(s),
-        *closing_entries(s),
-    ]
+    return [entry for rows in ROW_MODULES for entry in rows.entries(s)]
+
+
+@cache
+def procedure_rows() -> dict[str, ProcedureMeasure]:
+    """Rows with a procedure MC: eq → the :class:`~.entry.ProcedureMeasure` its row declares
+    (every outcome row of §27, (6.39)–(6.61)). The measures do not depend on the geometry: they
+    are read from the rows at the book's."""
+    out: dict[str, ProcedureMeasure] = {}
+    for entry in row_entries(BOOK):
+        if entry.procedure is None:
+            continue
+        if out.setdefault(entry.eq, entry.procedure) != entry.procedure:
+            raise ValueError(f"two procedure rows of the table share the equation {entry.eq!r}")
+    return out
 
 
 #: Accepted values of a flat ``--geometry`` mapping (keys of :data:`BOOK`), in mm or [—]: wide
@@ -207,24 +229,6 @@ def _normalise_geometry(geometry) -> dict:
             if f"p{ov}" in geometry and f"a{ov}" not in geometry:
                 g[f"a{ov}"] = g["c"] - g[f"p{ov}"]
     return g
-
-
-#: Rows with a procedure MC: eq → (overlap slot, configuration, field of the setup run or
-#: None, scaled by f/p). Every outcome row of §27, (6.39)–(6.61).
-PROCEDURE_ROWS = {
-    **{eq: ("60", "setup", "parallax", False) for eq in ("(6.39)", "(6.41)", "(6.43)")},
-    **{eq: ("80", "setup", "parallax", False) for eq in ("(6.40)", "(6.42)", "(6.44)")},
-    **{eq: ("60", "setup", "levelled", False) for eq in ("(6.47)", "(6.49)")},
-    **{eq: ("80", "setup", "levelled", False) for eq in ("(6.48)", "(6.50)")},
-    "(6.58)": ("60", "setup", "observed", False),
-    "(6.59)": ("80", "setup", "observed", False),
-    **{eq: ("60", "conventional", None, False) for eq in ("(6.45)", "(6.60)")},
-    **{eq: ("80", "conventional", None, False) for eq in ("(6.46)", "(6.53)", "(6.61)")},
-    **{eq: ("60", "y_parallax", None, False) for eq in ("(6.51)", "(6.56)")},
-    **{eq: ("80", "y_parallax", None, False) for eq in ("(6.52)", "(6.57)")},
-    "(6.54)": ("60", "stereo", None, False),
-    "(6.55)": ("80", "stereo", None, True),  # the row's unit: k = (M_p,го/m_p)·f/p
-}
 
 
 #: The jobs of the current :func:`run_procedure_mc`, read by forked workers by index (the loaded
@@ -592,7 +596,7 @@ def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
     formula at the simulated geometry), ``mc_procedure_instrument`` (and its CI) and the note
     from :func:`run_procedure_mc`."""
     for r in rows:
-        spec = PROCEDURE_ROWS.get(r["eq"])
+        spec = procedure_rows().get(r["eq"])
         if spec is None:
             continue
         slot, config, field, scaled = spec
