@@ -50,9 +50,9 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -72,8 +72,8 @@ from stereoplotter.procedure import conventional as cv
 from stereoplotter.procedure import evaluation as ev
 from stereoplotter.procedure.evaluation import instrument_frame_m
 from stereoplotter.procedure.fidelity import LINKAGE_VARIANTS, Fidelity
-from stereoplotter.procedure.operator import OperatorModel
-from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
+from stereoplotter.procedure.operator import Noise, OperatorModel
+from stereoplotter.procedure.simulate import SimulationResult, prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import (
     DEFAULT_MEMORY_BUDGET_MB,
     chunk_trials_for,
@@ -92,8 +92,13 @@ from stereoplotter.verification.linear_mc import (
 )
 
 if TYPE_CHECKING:
+    from stereoplotter.procedure.run import PreparedRun
     from stereoplotter.scenario.model import Scenario
+    from stereoplotter.setup.records import SetupSheet
     from stereoplotter.spec.instrument_spec import InstrumentSpec
+
+#: An array of floats (photo mm, m or their squares, as each name says).
+FloatArray = NDArray[np.float64]
 
 __all__ = [
     "LINKAGE_VARIANTS",
@@ -106,6 +111,7 @@ __all__ = [
     "procedure_mc",
     "scenario_geometry",
 ]
+
 
 def scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict:
     """f, l, n_л, f_пр, photo base p = B·f/H̄, overlap and the book's c of a scenario.
@@ -213,8 +219,36 @@ SOURCES = ("both", "y_parallax", "stereo")
 METHODS = ("setup", "setup_control", "conventional")
 
 
-def _configuration(method, sigma_mm, c, p, n, sources="both"):
-    """Operator errors, domain x_л-range, unit and run options of ``method`` (module docstring).
+@dataclass(frozen=True)
+class MethodOperator:
+    """The operator and the statistic's domain of a method's runs (the module docstring).
+
+    Attributes
+    ----------
+    error_free : OperatorModel
+        Every operator error zero: the run whose δp is the deterministic residue (``bias``).
+    noisy : OperatorModel
+        The formula's operator errors on (monocular σ; or σ_q, σ_p of the conventional method).
+    x_left_range_mm : tuple of float
+        The statistic's domain in x_л [mm]: (6.27)'s [0, c], or chapter 5's x_п ∈ [−c, 0].
+    unit_mm : float
+        The statistic's unit [photo mm]: m_xy = n_л·σ (setup) or σ (conventional).
+    relative : {"elements", "equations"}
+        The relative orientation of the run (``prepare_run``): by the elements (setup data) or
+        by the six measured q and (5.11) (conventional, least squares as (5.54) assumes).
+    """
+
+    error_free: OperatorModel
+    noisy: OperatorModel
+    x_left_range_mm: tuple[float, float]
+    unit_mm: float
+    relative: str
+
+
+def _configuration(
+    method: str, sigma_mm: float, c: float, p: float, n: float, sources: str = "both"
+) -> MethodOperator:
+    """The operator, domain and unit of ``method`` (module docstring).
 
     ``sources`` (conventional only): "both" (σ_q = σ_p = σ, the formula's m_q = m_p), or only
     the y-parallax σ_q ("y_parallax", the relative-orientation part (5.54)) or only the stereo σ_p
@@ -223,18 +257,21 @@ def _configuration(method, sigma_mm, c, p, n, sources="both"):
     zero = OperatorModel().zero()
     if method in ("setup", "setup_control"):
         op = replace(zero, monocular_sigma_mm=sigma_mm)
-        return zero, op, (0.0, c), n * sigma_mm, {}  # domain of (6.27)
+        return MethodOperator(zero, op, (0.0, c), n * sigma_mm, "elements")  # domain of (6.27)
     if method == "conventional":
         sq = 0.0 if sources == "stereo" else sigma_mm
         sp = 0.0 if sources == "y_parallax" else sigma_mm
         op = replace(zero, stereo_sigma_mm=sp, y_parallax_sigma_mm=sq)
-        return zero, op, (p - c, p), sigma_mm, {"relative": "equations"}  # x_п ∈ [−c, 0]
+        return MethodOperator(zero, op, (p - c, p), sigma_mm, "equations")  # x_п ∈ [−c, 0]
     raise ValueError(f"method: expected one of {METHODS}, found {method!r}")
 
 
-def _height_errors_parallax(sc, sheet, inst, frame_pts):
+def _height_errors_parallax(
+    scenario: Scenario, sheet: SetupSheet, inst: Any, frame_pts: FloatArray
+) -> FloatArray:
     """The error of the height read on the slipped height scale at ``frame_pts`` (the mark
-    fused exactly on each point), converted to x-parallax (photo mm) by dp/dH = B·f/(Z_S − Z)².
+    fused exactly on each point) [m], to be converted to x-parallax (photo mm) by
+    dp/dH = B·f/(Z_S − Z)².
 
     This is what M_p measures ((5.42), (5.56)): the datum is carried by the height scale (its
     slip), not by the model's position; a model scale error of b_x moves every δp at the ideal
@@ -244,8 +281,8 @@ def _height_errors_parallax(sc, sheet, inst, frame_pts):
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
     local = ev.instrument_frame_m(frame_pts, origin, theta, inverse=True)
-    gl = ev.film_points_mm(sc, "left", local)
-    gr = ev.film_points_mm(sc, "right", local)
+    gl = ev.film_points_mm(scenario, "left", local)
+    gr = ev.film_points_mm(scenario, "right", local)
     units = inst.state()["units"]
     setting, left, right = inst.setting, units["left"], units["right"]
     gear = float(sheet.vertical_scale_denominator)
@@ -258,17 +295,22 @@ def _height_errors_parallax(sc, sheet, inst, frame_pts):
         left, right = ev.with_point_axis(left), ev.with_point_axis(right)
         slip = slip[:, None]
     depth = counters_from_homologous_points(gl, gr, setting, left, right).depth_mm
-    dh = slip - depth * gear / 1000.0 - local[:, 2]
+    dh: FloatArray = slip - depth * gear / 1000.0 - local[:, 2]
     return dh
 
 
-def _levelling_frame_points(prep):
+@dataclass(frozen=True)
+class _SceneOf:
+    """What ``conventional.levelling_points`` reads of a run: its scene and sheet."""
+
+    scene: Any
+    sheet: SetupSheet
+
+
+def _levelling_frame_points(prep: PreparedRun) -> tuple[list[str], FloatArray]:
     """The procedure's four levelling points (``conventional.levelling_points``) in the frame."""
 
-    class _R:  # levelling_points reads only run.scene and run.sheet
-        scene, sheet = prep.scene, prep.sheet
-
-    ids = cv.levelling_points(_R)
+    ids = list(cv.levelling_points(_SceneOf(prep.scene, prep.sheet)))
     local = np.array(
         [next(p for p in prep.scenario.points if p.id == i).local_m for i in ids], float
     )
@@ -276,10 +318,13 @@ def _levelling_frame_points(prep):
     return ids, instrument_frame_m(local, origin, float(prep.sheet.frame_rotation))
 
 
+#: The key of a per-trial mean square: a field's name, or (reading, level) of a decomposition
+#: (:mod:`.decomposition`) and ("element", element) of the setup elements' errors.
+FieldKey = str | tuple[str, str]
 #: A run's fields: (result, noise) → field name → per-trial values over the domain, (T, n).
-Fields = Callable[[Any, Any], dict[str, NDArray[np.float64]]]
+Fields = Callable[[SimulationResult, Noise], dict[str, FloatArray]]
 #: The decomposition's mean squares: (result, the run's fields) → (reading, level) → (T,).
-Decompose = Callable[[Any, dict[str, NDArray[np.float64]]], dict[tuple[str, str], Any]]
+Decompose = Callable[[SimulationResult, dict[str, FloatArray]], dict[FieldKey, FloatArray]]
 
 
 @dataclass(frozen=True)
@@ -291,16 +336,117 @@ class FieldMaker:
     decompose: Decompose | None = None
 
 
-def _setup_fields(sc, zero_run, g, xr, grid, sigma_control: float = 0.0):
+@dataclass(frozen=True)
+class ProcedureRun:
+    """One configuration's run of the procedure MC: what :func:`mean_squares` runs.
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The simulated pair (loaded by the caller).
+    spec : InstrumentSpec
+        The instrument, its standard points at the geometry's c (``standard_points_c_mm``).
+    method : {"setup", "setup_control", "conventional"}
+        :data:`METHODS`.
+    seed : int
+        The seed of every keyed draw of the run.
+    trials : int
+        Trials 0 … trials − 1.
+    operator : MethodOperator
+        The error-free and the noisy operator, the domain and the unit (:func:`_configuration`).
+    geometry : dict
+        :func:`scenario_geometry` of the scenario.
+    grid : tuple of int
+        Midpoint grid of the statistic (nx, ny).
+    variant : str
+        The instrument's decentration variant (:data:`LINKAGE_VARIANTS` of the linkage).
+    fidelity : Fidelity
+        The mechanism switches, resolved (:meth:`ProcedureOptions.switches`).
+    instrument_errors : bool
+        Every injected instrument error term at its configured σ, with the real mechanics.
+    control_variate : bool
+        Also the estimate with the linear control variate
+        (:mod:`~stereoplotter.verification.control_variate`).
+    standard_points_at_a : bool
+        The standard points moved to Fig. 39 at a = c − p (:func:`standard_points_at_a`; the
+        conventional method's "book" layout).
+    sigma_control_mm : float
+        Setup methods: σ of each observed control parallax (the "observed" reading).
+    sources_off : mapping or None
+        Key prefix → (trials,) mask of the trials whose acts of that prefix draw 0
+        (:func:`conventional_sources_mc`); None: every act drawn on every trial.
+    """
+
+    scenario: Scenario
+    spec: InstrumentSpec
+    method: str
+    seed: int
+    trials: int
+    operator: MethodOperator
+    geometry: dict[str, float]
+    grid: tuple[int, int]
+    variant: str
+    fidelity: Fidelity
+    instrument_errors: bool = False
+    control_variate: bool = True
+    standard_points_at_a: bool = False
+    sigma_control_mm: float = 0.0
+    sources_off: Mapping[str, NDArray[np.bool_]] | None = None
+
+    @property
+    def procedure(self) -> str:
+        """The procedure that runs: the conventional method or the setup-data method."""
+        return "conventional" if self.method == "conventional" else "setup"
+
+    def prepared(self, operator: OperatorModel, errors: str | None) -> PreparedRun:
+        """The prepared run with ``operator``; ``errors`` "zero" (none injected, ideal
+        mechanics) or None (the instrument's error model, real mechanics if
+        :attr:`instrument_errors`). The formulas of §27 describe the book's procedure, task 1:
+        each element set once, no remedies (``practice="book"``) — for both methods (the
+        operator's remedies would lower the setup-data value)."""
+        real_mechanics = self.instrument_errors and errors != "zero"
+        prep = prepare_run(
+            self.scenario,
+            self.spec,
+            self.procedure,
+            errors,
+            self.seed,
+            operator=operator,
+            ideal_mechanics=not real_mechanics,
+            variant=self.variant,
+            relative=self.operator.relative,
+            practice="book",
+            fidelity=self.fidelity,
+        )
+        if self.standard_points_at_a:
+            tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
+            prep = standard_points_at_a(prep, self.geometry)
+            prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
+        return prep
+
+
+@dataclass(frozen=True)
+class MeanSquares:
+    """Per-trial mean squares of each field of a run, (trials,) each: ``plain`` (and the
+    decomposition's, :data:`FieldKey`), ``controlled`` (with the linear control variate; empty
+    without it), and ``error_free_dp`` (δp of the error-free run on the statistic's domain)."""
+
+    plain: dict[FieldKey, FloatArray]
+    controlled: dict[FieldKey, FloatArray]
+    error_free_dp: FloatArray
+
+
+def _setup_fields(run: ProcedureRun, zero_run: SimulationResult) -> tuple[FieldMaker, FloatArray]:
     """Field makers of the setup-data method: δp on the (6.27) domain ("parallax", task 1), and
     on the chapter-5 domain after levelling on Fig. 39's four control points (task 2,
     :data:`METHODS` "setup_control"): "levelled" with exact control heights, "observed" with
-    each control height's parallax observed with σ_c = ``sigma_control`` (keyed draws
-    ``mc/control/i``)."""
+    each control height's parallax observed with σ_c = ``run.sigma_control_mm`` (keyed draws
+    ``mc/control/i``). With the error-free run's δp on the (6.27) domain."""
 
+    sc, g, grid = run.scenario, run.geometry, run.grid
     f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
     sheet = zero_run.sheet
-    pts = domain_points(sc, sheet, xr, c, p, f, h, grid)
+    pts = domain_points(sc, sheet, run.operator.x_left_range_mm, c, p, f, h, grid)
     lev = domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
     book, _, _ = control_frame_points(sc, sheet, g)
     n, nl = len(pts), len(lev)
@@ -312,12 +458,13 @@ def _setup_fields(sc, zero_run, g, xr, grid, sigma_control: float = 0.0):
     refit = levelling_design(lev[:, 0], lev[:, 1]) @ np.linalg.pinv(
         levelling_design(book[:, 0], book[:, 1])
     )
+    sigma_control = run.sigma_control_mm
 
-    def readings(d):
+    def readings(d: FloatArray) -> dict[str, FloatArray]:
         dom, ctl = d[:, first_lev : first_lev + nl], d[:, first_ctl:]
         return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
 
-    def fields(result, noise):
+    def fields(result: SimulationResult, noise: Noise) -> dict[str, FloatArray]:
         d = dp_at(sc, result.sheet, result.instrument, allp) - zero
         out = readings(d)
         obs = np.stack(
@@ -329,7 +476,9 @@ def _setup_fields(sc, zero_run, g, xr, grid, sigma_control: float = 0.0):
     state0 = (zero_run.instrument.setting, {s: units0[s] for s in ("left", "right")})
     jac = dc.state_jacobian(*state0, _dp_of(sc, sheet, allp))
 
-    def decompose(result, main):
+    def decompose(
+        result: SimulationResult, main: dict[str, FloatArray]
+    ) -> dict[FieldKey, FloatArray]:
         """Per-trial mean squares of the first-order fields of the decomposition
         (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²]."""
         units = result.instrument.state()["units"]
@@ -339,7 +488,9 @@ def _setup_fields(sc, zero_run, g, xr, grid, sigma_control: float = 0.0):
         )
         noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
         # each (6.22) element's error (instrument units: mm, tangent, rad), squared per trial
-        out = {("element", f"{o}.{f}"): deltas[i] ** 2 for i, (o, f) in enumerate(dc.ELEMENTS)}
+        out: dict[FieldKey, FloatArray] = {
+            ("element", f"{o}.{f}"): deltas[i] ** 2 for i, (o, f) in enumerate(dc.ELEMENTS)
+        }
         for step, d in dc.linear_fields(jac, deltas):
             r = readings(d)
             r["observed"] = r["levelled"] + noise
@@ -349,17 +500,22 @@ def _setup_fields(sc, zero_run, g, xr, grid, sigma_control: float = 0.0):
     return FieldMaker(fields, decompose), zero[:n]
 
 
-def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
+def _conventional_fields(
+    run: ProcedureRun, zero_prep: PreparedRun, zero_run: SimulationResult
+) -> tuple[FieldMaker, FloatArray]:
     """Field makers of the conventional method (``procedure_mc`` options): δp at the ideal model
     position ("parallax") and the heights read on the slipped height scale in parallax units
     (dp/dH = B·f/(Z_S − Z)², frame origin S_л) with three datums: the procedure's slip ("slip"),
     the levelling plane's offset from the four levelling heights each observed with σ_p ("plane",
     the formula's), and the built model re-levelled by the least-squares plane through its
-    height errors at x_п ∈ {−c, a}, y = ±c, each observed with σ_p ("book")."""
+    height errors at x_п ∈ {−c, a}, y = ±c, each observed with σ_p ("book"). With the
+    error-free run's δp on the statistic's domain."""
 
+    sc, g, grid = run.scenario, run.geometry, run.grid
+    sigma_p = run.operator.noisy.stereo_sigma_mm
     f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
     sheet = zero_run.sheet
-    pts = domain_points(sc, sheet, xr, c, p, f, h, grid)
+    pts = domain_points(sc, sheet, run.operator.x_left_range_mm, c, p, f, h, grid)
     d_zero = dp_at(sc, sheet, zero_run.instrument, pts)
     _, lev = _levelling_frame_points(zero_prep)
     book, _, _ = control_frame_points(sc, sheet, g)
@@ -371,7 +527,7 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
         levelling_design(book[:, 0], book[:, 1])
     )
 
-    def fields(result, noise):
+    def fields(result: SimulationResult, noise: Noise) -> dict[str, FloatArray]:
         d = dp_at(sc, result.sheet, result.instrument, pts) - d_zero
         e = (_height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
         obs = e[:, n : n + nl] + np.stack(
@@ -390,92 +546,90 @@ def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
     return FieldMaker(fields), d_zero
 
 
-def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
-    """The prepared run of the procedure MC: real mechanics only with instrument errors; the
-    standard points at a = c − p (``standard_points`` "book"); ``kw["fidelity"]`` the mechanism
-    switches (its ``passes``: no check ever passes, so every loop runs that many times)."""
-    instrument = bool(options.get("instrument")) and errors != "zero"
-    prep = prepare_run(
-        sc, spec, base, errors, seed, operator=operator, ideal_mechanics=not instrument, **kw
-    )
-    if options.get("standard_points") == "book":
-        tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
-        prep = standard_points_at_a(prep, g)
-        prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
-    return prep
-
-
-def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, options=None):
-    """Per-trial mean squares of each field (:func:`_setup_fields`,
+def mean_squares(run: ProcedureRun) -> MeanSquares:
+    """Per-trial mean squares of each field of ``run`` (:func:`_setup_fields`,
     :func:`_conventional_fields`), plain and with the linear control variate
     (:mod:`~stereoplotter.verification.control_variate`), and the error-free run's δp.
 
     The error-free run once; the linearisation once; the noisy trials in chunks under the memory
     budget (the random draws are keyed by trial, so the chunk size changes no result).
-    ``options``: ``standard_points`` "book" (conventional: standard points at a = c − p),
-    ``instrument`` (every injected instrument error at its configured σ, real mechanics),
-    ``sigma_control`` (setup: σ of the observed control parallaxes), ``control_variate``,
-    ``passes`` (:func:`_prepared_run`).
     """
 
-    options = options or {}
-    instrument = bool(options.get("instrument"))
-    base = "conventional" if method == "conventional" else "setup"
-    # The formulas of §27 describe the book's procedure, task 1: each element set once, no
-    # remedies — for both methods (the operator's remedies would lower the setup-data value).
-    kw = {"practice": "book", **kw}
-
-    def prepared(operator, errors="zero"):
-        return _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw)
-
-    zero_prep = prepared(zero)
+    zero_prep = run.prepared(run.operator.error_free, "zero")
     zero_run = run_trials_chunk(zero_prep, 0, None, evaluate=False, transcript=False)
-    if base == "setup":
-        sigma_control = float(options.get("sigma_control", 0.0))
-        maker, d_zero = _setup_fields(sc, zero_run, g, xr, grid, sigma_control)
+    if run.procedure == "setup":
+        maker, d_zero = _setup_fields(run, zero_run)
     else:
-        maker, d_zero = _conventional_fields(
-            sc, zero_prep, zero_run, g, xr, grid, op.stereo_sigma_mm
-        )
-    prep = prepared(op, None if instrument else "zero")
-    model = prep.model
+        maker, d_zero = _conventional_fields(run, zero_prep, zero_run)
+    prep = run.prepared(run.operator.noisy, None if run.instrument_errors else "zero")
+    lin = _linearisation(prep, maker) if run.control_variate else None
+    chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, run.procedure)
+    plain: dict[FieldKey, FloatArray] = {}
+    controlled: dict[FieldKey, FloatArray] = {}
+    for first in range(0, run.trials, chunk):
+        m = min(chunk, run.trials - first)
+        part_plain, part_controlled = _chunk_mean_squares(run, prep, maker, lin, first, m)
+        for name, v in part_plain.items():
+            plain.setdefault(name, np.empty(run.trials))[first : first + m] = v
+            if name in part_controlled:
+                controlled.setdefault(name, np.empty(run.trials))[first : first + m] = (
+                    part_controlled[name]
+                )
+    return MeanSquares(plain, controlled, d_zero)
 
-    def run(injected, noise, n):
+
+def _linearisation(prep: PreparedRun, maker: FieldMaker) -> cvar.LinearControl:
+    """The linear control variate of ``maker``'s fields about the run with every random input 0
+    (:func:`~stereoplotter.verification.control_variate.linear_control`)."""
+
+    def fields_of(injected: dict[str, Any], noise: Noise, trials: int) -> dict[str, FloatArray]:
         result = run_trials_chunk(
-            prep, 0, n, evaluate=False, transcript=False, injected=injected, noise=noise
+            prep, 0, trials, evaluate=False, transcript=False, injected=injected, noise=noise
         )
         return maker.fields(result, noise)
 
-    lin = cvar.linear_control(run, model) if options.get("control_variate", True) else None
-    chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, base)
-    plain: dict[str, np.ndarray] = {}
-    controlled: dict[str, np.ndarray] = {}
-    off = options.get("off")
-    for first in range(0, int(trials), chunk):
-        m = min(chunk, int(trials) - first)
-        injected = model.draw_keyed(prep.seed, first, first + m)
-        if off:
-            part = {k: v[first : first + m] for k, v in off.items()}
-            noise = cvar.SourceNoise(prep.seed, m, first, part)
-        else:
-            noise = cvar.RecordingNoise(prep.seed, m, first)
-        result = run_trials_chunk(
-            prep, first, m, evaluate=False, transcript=False, injected=injected, noise=noise
-        )
-        fs = maker.fields(result, noise)
-        on = _inputs_on(lin, part, m) if lin and off else None
-        cv = cvar.per_trial_controlled(fs, lin, noise, injected, model, on) if lin else {}
-        ms = {name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()}
-        if maker.decompose is not None:  # already mean squares
-            ms.update(maker.decompose(result, fs))
-        for name, v in ms.items():
-            plain.setdefault(name, np.empty(int(trials)))[first : first + m] = v
-            if lin and name in cv:
-                controlled.setdefault(name, np.empty(int(trials)))[first : first + m] = cv[name]
-    return plain, controlled, d_zero
+    return cvar.linear_control(fields_of, prep.model)
 
 
-def _inputs_on(lin, off, trials):
+def _chunk_mean_squares(
+    run: ProcedureRun,
+    prep: PreparedRun,
+    maker: FieldMaker,
+    lin: cvar.LinearControl | None,
+    first: int,
+    trials: int,
+) -> tuple[dict[FieldKey, FloatArray], dict[str, FloatArray]]:
+    """Per-trial mean squares of trials ``first … first + trials − 1``: plain (with the
+    decomposition's) and controlled (empty without ``lin``)."""
+    model = prep.model
+    injected = model.draw_keyed(prep.seed, first, first + trials)
+    off = run.sources_off
+    noise: cvar.RecordingNoise
+    part: dict[str, NDArray[np.bool_]] = {}
+    if off:
+        part = {k: v[first : first + trials] for k, v in off.items()}
+        noise = cvar.SourceNoise(prep.seed, trials, first, part)
+    else:
+        noise = cvar.RecordingNoise(prep.seed, trials, first)
+    result = run_trials_chunk(
+        prep, first, trials, evaluate=False, transcript=False, injected=injected, noise=noise
+    )
+    fs = maker.fields(result, noise)
+    controlled: dict[str, FloatArray] = {}
+    if lin:
+        on = _inputs_on(lin, part, trials) if off else None
+        controlled = cvar.per_trial_controlled(fs, lin, noise, dict(injected), model, on)
+    plain: dict[FieldKey, FloatArray] = {
+        name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()
+    }
+    if maker.decompose is not None:  # already mean squares
+        plain.update(maker.decompose(result, fs))
+    return plain, controlled
+
+
+def _inputs_on(
+    lin: cvar.LinearControl, off: Mapping[str, NDArray[np.bool_]], trials: int
+) -> FloatArray:
     """(K, T): 1 where input k of ``lin`` is drawn on a trial, 0 where its source is off."""
     on = np.ones((len(lin.inputs), trials))
     for j, name in enumerate(lin.inputs):
@@ -824,28 +978,61 @@ def conventional_sources_mc(
     return {k: {**v, "seconds": seconds} for k, v in out.items()}
 
 
-def run_configuration(scenario, spec, method, trials, seed, o, g, linkage, off=None):
-    """The runs of :func:`procedure_mc`: per-trial mean squares (plain, controlled), the
-    error-free δp and the unit of each field [photo mm]. ``off``: key prefix → (trials,) mask of
-    the trials whose acts of that prefix draw 0 (:func:`conventional_sources_mc`; the run then
-    has every source on)."""
-    sources = "both" if off else o.sources
-    zero, op, xr, unit, kw = _configuration(method, o.sigma_mm, g["c"], g["p"], g["n"], sources)
-    fidelity = o.switches(spec)
-    kw = {**kw, "variant": LINKAGE_VARIANTS[linkage], "fidelity": fidelity}
-    options = {"instrument": o.instrument, "control_variate": o.control_variate}
+class ConfigurationRun(NamedTuple):
+    """The runs of one configuration (:func:`run_configuration`): per-trial mean squares
+    (``plain``, ``controlled``; :class:`MeanSquares`), the error-free δp and the unit of each
+    field [photo mm]."""
+
+    plain: dict[FieldKey, FloatArray]
+    controlled: dict[FieldKey, FloatArray]
+    error_free_dp: FloatArray
+    units: dict[str, float]
+
+
+def run_configuration(
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    method: str,
+    trials: int,
+    seed: int,
+    options: ProcedureOptions,
+    geometry: dict[str, float],
+    linkage: str,
+    sources_off: Mapping[str, NDArray[np.bool_]] | None = None,
+) -> ConfigurationRun:
+    """The runs of :func:`procedure_mc` with ``options`` at ``geometry``
+    (:func:`scenario_geometry`) and ``linkage`` (resolved: "drag" or "independent").
+    ``sources_off``: key prefix → (trials,) mask of the trials whose acts of that prefix draw 0
+    (:func:`conventional_sources_mc`; the run then has every source on)."""
+    sources = "both" if sources_off else options.sources
+    c, p, n = geometry["c"], geometry["p"], geometry["n"]
+    operator = _configuration(method, options.sigma_mm, c, p, n, sources)
+    unit = operator.unit_mm
     if method == "conventional":
-        options["standard_points"] = o.standard_points
         units = dict.fromkeys(("parallax", "slip", "plane", "book"), unit)
+        sigma_control = 0.0
     else:  # m_p = m_xy/√2 of the observed control parallaxes
         units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
-        options["sigma_control"] = units["observed"]
-    spec_c = replace(spec, standard_points_c_mm=g["c"])
-    options["off"] = off
-    plain, controlled, d_zero = _mean_squares(
-        scenario, spec_c, method, seed, trials, zero, op, xr, g, o.grid, kw, options
+        sigma_control = units["observed"]
+    run = ProcedureRun(
+        scenario=scenario,
+        spec=replace(spec, standard_points_c_mm=c),
+        method=method,
+        seed=seed,
+        trials=int(trials),
+        operator=operator,
+        geometry=geometry,
+        grid=options.grid,
+        variant=LINKAGE_VARIANTS[linkage],
+        fidelity=options.switches(spec),
+        instrument_errors=bool(options.instrument),
+        control_variate=options.control_variate,
+        standard_points_at_a=method == "conventional" and options.standard_points == "book",
+        sigma_control_mm=sigma_control,
+        sources_off=sources_off,
     )
-    return plain, controlled, d_zero, units
+    ms = mean_squares(run)
+    return ConfigurationRun(ms.plain, ms.controlled, ms.error_free_dp, units)
 
 
 def _keyed(ms: dict, kind: str):
