@@ -152,7 +152,7 @@ class Setting:
     a80: float
 
     @classmethod
-    def from_mapping(cls, g: dict) -> Setting:
+    def from_mapping(cls, g: Mapping[str, float]) -> Setting:
         return cls(**{k: g[k] for k in BOOK})
 
     @property
@@ -175,15 +175,20 @@ class Setting:
         """(a, p) of the "60" or "80" % slot."""
         return (self.a60, self.p60) if overlap == "60" else (self.a80, self.p80)
 
-    def setup_sigmas(self, m_xy: float = 1.0) -> dict:
+    def setup_sigmas(self, m_xy: float = 1.0) -> dict[str, float]:
         """Book-mode σ's of the setup elements (6.31)–(6.38) per m_xy."""
-        return sa.setup_element_sigmas(self.f, self.l, self.n, m_xy, mode="book")
+        sigmas: dict[str, float] = sa.setup_element_sigmas(
+            self.f, self.l, self.n, m_xy, mode="book"
+        )
+        return sigmas
 
-    def unadjusted(self, a: float, p: float, sigmas: dict) -> mc.LinearModel:
+    def unadjusted(self, a: float, p: float, sigmas: Mapping[str, float]) -> mc.LinearModel:
         """Setup data without levelling, both photos' element errors (problem 1)."""
         return mc.setup_model(self.f, p, a, self.c, both_photos(sigmas), levelled=False)
 
-    def levelled(self, a: float, p: float, sigmas: dict, control: float = 0.0) -> mc.LinearModel:
+    def levelled(
+        self, a: float, p: float, sigmas: Mapping[str, float], control: float = 0.0
+    ) -> mc.LinearModel:
         """Setup data after levelling on control with σ ``control`` [mm] (problem 2)."""
         return mc.setup_model(
             self.f,
@@ -195,7 +200,7 @@ class Setting:
             sigma_control_mm=control,
         )
 
-    def conventional(self, a: float, p: float, sq: float = 1.0, sc: float = 1.0):
+    def conventional(self, a: float, p: float, sq: float = 1.0, sc: float = 1.0) -> mc.LinearModel:
         """Conventional method: relative orientation (σ_q = ``sq``) and levelling (σ = ``sc``)."""
         return mc.relative_orientation_model(a, self.c, p, self.f, sq, sigma_control_mm=sc)
 
@@ -214,7 +219,7 @@ class Setting:
 
     def geodetic(self, a: float, p: float, mode: str) -> float:
         """(5.55) m_p,г/m_p over the pair in ``mode``."""
-        return c5.geodetic_orientation_parallax_rms(a, self.c, p, self.f, 1.0, mode)
+        return float(c5.geodetic_orientation_parallax_rms(a, self.c, p, self.f, 1.0, mode))
 
 
 #: A row's declaration: the function that computes its :class:`Entry` at a :class:`Setting`.

@@ -85,6 +85,7 @@ from stereoplotter.verification import control_variate as cvar
 from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification.linear_mc import (
     CI_Z,
+    FloatArray,
     LinearModel,
     covariance_rms,
     grid_chapter5,
@@ -96,9 +97,6 @@ if TYPE_CHECKING:
     from stereoplotter.scenario.model import Scenario
     from stereoplotter.setup.records import SetupSheet
     from stereoplotter.spec.instrument_spec import InstrumentSpec
-
-#: An array of floats (photo mm, m or their squares, as each name says).
-FloatArray = NDArray[np.float64]
 
 __all__ = [
     "LINKAGE_VARIANTS",

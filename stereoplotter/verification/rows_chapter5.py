@@ -10,6 +10,7 @@ import numpy as np
 from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.verification import linear_mc as mc
 from stereoplotter.verification.entry import RULE, DeclaredRows, Entry, Setting
+from stereoplotter.verification.linear_mc import FloatArray
 
 __all__ = ["ROWS"]
 
@@ -17,9 +18,10 @@ __all__ = ["ROWS"]
 ROWS = DeclaredRows()
 
 
-def _relative_design(s: Setting):
+def _relative_design(s: Setting) -> FloatArray:
     _, xs, ys = c5.standard_points(s.a60, s.p60, s.c)
-    return c5.relative_orientation_design(xs, ys, s.p60, s.f)
+    design: FloatArray = c5.relative_orientation_design(xs, ys, s.p60, s.f)
+    return design
 
 
 @ROWS.row
@@ -54,8 +56,9 @@ def table19_omega(s: Setting) -> Entry:
     )
 
 
-def _levelling_design(s: Setting):
-    return c5.levelling_design(*c5.control_points(s.a80, s.c))
+def _levelling_design(s: Setting) -> FloatArray:
+    design: FloatArray = c5.levelling_design(*c5.control_points(s.a80, s.c))
+    return design
 
 
 @ROWS.row
@@ -88,19 +91,26 @@ def table20_xi(s: Setting) -> Entry:
     )
 
 
-def _book_point(s: Setting):
+def _book_point(s: Setting) -> tuple[FloatArray, FloatArray]:
     """The point of (5.19)/(5.20): book (−35, 35) at c = 70."""
     return (np.array([-s.c / 2]), np.array([s.c / 2]))
 
 
-def _at_point(model, a, c, p, f, pt):
+def _at_point(
+    model: mc.LinearModel,
+    a: float,
+    c: float,
+    p: float,
+    f: float,
+    pt: tuple[FloatArray, FloatArray],
+) -> mc.LinearModel:
     G = mc.relative_field_basis(pt[0], pt[1], p, f)
     Hg = c5.levelling_design(*pt)
     Ac = c5.levelling_design(*c5.control_points(a, c))
     return mc.LinearModel(G, model.M, model.Gc, Hg @ np.linalg.pinv(Ac))
 
 
-def _levelling_point_model(a, c, pt):
+def _levelling_point_model(a: float, c: float, pt: tuple[FloatArray, FloatArray]) -> mc.LinearModel:
     G = np.zeros((1, 1))
     Hg = c5.levelling_design(*pt)
     Ac = c5.levelling_design(*c5.control_points(a, c))

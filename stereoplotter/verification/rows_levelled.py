@@ -18,12 +18,12 @@ ROWS = DeclaredRows()
 
 def _residual(s: Setting, overlap: str, mode: str, m_xy: float = 1.0) -> float:
     a, _ = s.slot(overlap)
-    return sa.setup_relative_residual_rms(a, s.c, s.f, s.l, s.n, m_xy, mode)
+    return float(sa.setup_relative_residual_rms(a, s.c, s.f, s.l, s.n, m_xy, mode))
 
 
 def _residual_printed(s: Setting, overlap: str) -> float:
     a, _ = s.slot(overlap)
-    return sa.setup_relative_residual_rms_printed(a, s.c, s.l, s.n, 1.0)
+    return float(sa.setup_relative_residual_rms_printed(a, s.c, s.l, s.n, 1.0))
 
 
 def _residual_entry(
@@ -123,7 +123,7 @@ def eq_6_50(s: Setting) -> Entry:
 
 def _relative(s: Setting, overlap: str, mode: str) -> float:
     a, p = s.slot(overlap)
-    return c5.relative_orientation_parallax_rms(a, s.c, p, 1.0, mode)
+    return float(c5.relative_orientation_parallax_rms(a, s.c, p, 1.0, mode))
 
 
 def _relative_entry(

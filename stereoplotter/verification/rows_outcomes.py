@@ -16,7 +16,7 @@ ROWS = DeclaredRows()
 
 def _from_pointing(s: Setting, overlap: str, mode: str = "book") -> float:
     _, p = s.slot(overlap)
-    return sa.setup_parallax_rms_from_pointing(s.f, p, s.c, s.l, s.n, 1.0, mode=mode)
+    return float(sa.setup_parallax_rms_from_pointing(s.f, p, s.c, s.l, s.n, 1.0, mode=mode))
 
 
 def _outcome(

@@ -16,6 +16,7 @@ from stereoplotter.verification.entry import (
     Setting,
     both_photos,
 )
+from stereoplotter.verification.linear_mc import FloatArray
 
 __all__ = ["ROWS"]
 
@@ -58,12 +59,12 @@ def eq_6_30(s: Setting) -> Entry:
     return _unadjusted_generic(s, "(6.30)", s.a80, s.p80, "80 %")
 
 
-def _design_31(s: Setting):
+def _design_31(s: Setting) -> FloatArray:
     """(6.31)/(6.32): x readings at the centre mark and a mark at x = l."""
     return np.array([[1.0, 0.0], [1.0, s.l**2 / s.f]])
 
 
-def _design_33(s: Setting):
+def _design_33(s: Setting) -> FloatArray:
     """(6.33)–(6.35): y readings at the centre mark and two marks at ±l."""
     return np.array([[1.0, 0.0], [1.0, s.l**2 / s.f], [1.0, s.l**2 / s.f]])
 
