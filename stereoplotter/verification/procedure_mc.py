@@ -55,7 +55,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.accuracy.chapter5 import (
@@ -83,6 +83,7 @@ from stereoplotter.scenario.synthetic import working_area_grid_m
 from stereoplotter.setup.sheet import compute_setup_sheet
 from stereoplotter.verification import control_variate as cvar
 from stereoplotter.verification import decomposition as dc
+from stereoplotter.verification.as_formula import RunResult
 from stereoplotter.verification.linear_mc import (
     CI_Z,
     FloatArray,
@@ -93,6 +94,8 @@ from stereoplotter.verification.linear_mc import (
 )
 
 if TYPE_CHECKING:
+    from stereoplotter.instrument.kinematics import CorrectionUnit, InstrumentSetting
+    from stereoplotter.instrument.virtual import Instrument
     from stereoplotter.procedure.run import PreparedRun
     from stereoplotter.scenario.model import Scenario
     from stereoplotter.setup.records import SetupSheet
@@ -111,7 +114,7 @@ __all__ = [
 ]
 
 
-def scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict:
+def scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict[str, float]:
     """f, l, n_л, f_пр, photo base p = B·f/H̄, overlap and the book's c of a scenario.
 
     c follows the book's §27 convention: c = p below 70 % overlap (60 %: a = 0), c = 2p above
@@ -131,7 +134,7 @@ def scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict:
     return _scenario_geometry(scenario, spec)
 
 
-def _scenario_geometry(scenario, spec):
+def _scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict[str, float]:
 
     sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
     f = float(scenario.camera.focal_length_mm)
@@ -163,7 +166,16 @@ def _scenario_geometry(scenario, spec):
     }
 
 
-def domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
+def domain_points(
+    scenario: Scenario,
+    sheet: SetupSheet,
+    x_left_range: tuple[float, float],
+    c: float,
+    p: float,
+    f: float,
+    height: float,
+    grid: tuple[int, int] = (16, 32),
+) -> FloatArray:
     """Ground points (instrument frame) under a midpoint grid of left-photo (x_л, y) [mm]."""
 
     nx, ny = grid
@@ -182,13 +194,15 @@ def domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32))
     return instrument_frame_m(local, origin, theta)
 
 
-def dp_at(scenario, sheet, inst, frame_pts):
+def dp_at(
+    scenario: Scenario, sheet: SetupSheet, inst: Instrument, frame_pts: FloatArray
+) -> FloatArray:
     """δp [photo mm] of the built instrument ``inst`` at ``frame_pts`` (ideal model position)."""
     units = inst.state()["units"]
     return _dp_of(scenario, sheet, frame_pts)(inst.setting, units["left"], units["right"])
 
 
-def _dp_of(scenario, sheet, frame_pts):
+def _dp_of(scenario: Scenario, sheet: SetupSheet, frame_pts: FloatArray) -> dc.DpOf:
     """δp at ``frame_pts`` as a function of an instrument state (setting, left, right units)."""
     origin = np.asarray(sheet.frame_origin_m, float)
     theta = float(sheet.frame_rotation)
@@ -198,10 +212,21 @@ def _dp_of(scenario, sheet, frame_pts):
     model = ev.ideal_model_mm(
         frame_pts, sheet.horizontal_scale_denominator, sheet.vertical_scale_denominator
     )
-    return lambda setting, left, right: _dp_state(model, gl, gr, setting, left, right)
+
+    def dp(setting: InstrumentSetting, left: CorrectionUnit, right: CorrectionUnit) -> FloatArray:
+        return _dp_state(model, gl, gr, setting, left, right)
+
+    return dp
 
 
-def _dp_state(model, gl, gr, setting, left, right):
+def _dp_state(
+    model: FloatArray,
+    gl: FloatArray,
+    gr: FloatArray,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+) -> FloatArray:
     if ev.trial_count(setting, (left, right)) is not None:
         setting = ev.with_point_axis(setting)
         left, right = ev.with_point_axis(left), ev.with_point_axis(right)
@@ -234,6 +259,9 @@ class MethodOperator:
     relative : {"elements", "equations"}
         The relative orientation of the run (``prepare_run``): by the elements (setup data) or
         by the six measured q and (5.11) (conventional, least squares as (5.54) assumes).
+    stereo_sigma_mm : float
+        σ_p of the noisy operator's stereo judgments (conventional; 0 for the setup methods),
+        also the σ of each observed levelling height.
     """
 
     error_free: OperatorModel
@@ -241,6 +269,7 @@ class MethodOperator:
     x_left_range_mm: tuple[float, float]
     unit_mm: float
     relative: str
+    stereo_sigma_mm: float = 0.0
 
 
 def _configuration(
@@ -260,7 +289,7 @@ def _configuration(
         sq = 0.0 if sources == "stereo" else sigma_mm
         sp = 0.0 if sources == "y_parallax" else sigma_mm
         op = replace(zero, stereo_sigma_mm=sp, y_parallax_sigma_mm=sq)
-        return MethodOperator(zero, op, (p - c, p), sigma_mm, "equations")  # x_п ∈ [−c, 0]
+        return MethodOperator(zero, op, (p - c, p), sigma_mm, "equations", sp)  # x_п ∈ [−c, 0]
     raise ValueError(f"method: expected one of {METHODS}, found {method!r}")
 
 
@@ -510,7 +539,7 @@ def _conventional_fields(
     error-free run's δp on the statistic's domain."""
 
     sc, g, grid = run.scenario, run.geometry, run.grid
-    sigma_p = run.operator.noisy.stereo_sigma_mm
+    sigma_p = run.operator.stereo_sigma_mm
     f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
     sheet = zero_run.sheet
     pts = domain_points(sc, sheet, run.operator.x_left_range_mm, c, p, f, h, grid)
@@ -638,7 +667,12 @@ def _inputs_on(
     return on
 
 
-def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
+def levelling_formula(
+    g: Mapping[str, float],
+    x_right_mm: ArrayLike,
+    y_mm: ArrayLike,
+    grid: tuple[int, int] = (16, 32),
+) -> dict[str, float]:
     """The rigorous M_p of the conventional method, (5.54) ⊕ (5.55), with the levelling plane
     fitted at the given control points instead of Fig. 39's x_п ∈ {−c, a}, y = ±c.
 
@@ -664,7 +698,7 @@ def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
     xg, yg = grid_chapter5(c, *grid)
     xc, yc = np.asarray(x_right_mm, float), np.asarray(y_mm, float)
     fit = levelling_design(xg, yg) @ np.linalg.pinv(levelling_design(xc, yc))
-    out = {}
+    out: dict[str, float] = {}
     for name, sq, sp in (("y_parallax", 1.0, 0.0), ("stereo", 0.0, 1.0), ("both", 1.0, 1.0)):
         model = LinearModel(
             relative_field_basis(xg, yg, p, f),
@@ -678,7 +712,9 @@ def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
     return out
 
 
-def levelling_points_photo(scenario: Scenario, spec: InstrumentSpec, g: dict):
+def levelling_points_photo(
+    scenario: Scenario, spec: InstrumentSpec, g: Mapping[str, float]
+) -> tuple[FloatArray, FloatArray]:
     """(x_п, y) [mm] of the procedure's four levelling points (the scenario's control points
     nearest standard points 3–6, ``conventional.levelling_points``) at the mean photo scale."""
 
@@ -689,7 +725,7 @@ def levelling_points_photo(scenario: Scenario, spec: InstrumentSpec, g: dict):
     return lev[:, 0] * s - g["p"], lev[:, 1] * s
 
 
-def rms_ci(ms, unit):
+def rms_ci(ms: FloatArray, unit: float) -> tuple[float, float]:
     """(RMS, CI half-width) per ``unit`` from per-trial mean squares (``CI_Z`` s.e.)."""
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(max(mean_ms, 0.0))
@@ -699,7 +735,7 @@ def rms_ci(ms, unit):
     return rms / unit, half / unit
 
 
-def _check_options(method, **options):
+def _check_options(method: str, **options: str) -> None:
     if method not in METHODS:
         raise ValueError(f"method: expected one of {METHODS}, found {method!r}")
     allowed = {
@@ -715,7 +751,7 @@ def _check_options(method, **options):
             raise ValueError(f"{name}: expected one of {allowed[name]}, found {value!r}")
 
 
-def _field_name(method, quantity, levelling, datum, control):
+def _field_name(method: str, quantity: str, levelling: str, datum: str, control: str) -> str:
     """The field whose mean square is the procedure's statistic."""
     if method == "setup":
         return "parallax"
@@ -726,7 +762,15 @@ def _field_name(method, quantity, levelling, datum, control):
     return "book" if levelling == "book" else datum
 
 
-def _formulas(method, scenario, spec, g, sources, control, levelled=None):
+def _formulas(
+    method: str,
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    g: Mapping[str, float],
+    sources: str,
+    control: str,
+    levelled: tuple[Mapping[str, float], Mapping[str, float]] | None = None,
+) -> dict[str, float]:
     """The rigorous formula at the simulated geometry for the statistic (per its unit).
     ``levelled``: the two :func:`levelling_formula` results (procedure's points, Fig. 39's) if
     already computed."""
@@ -812,7 +856,7 @@ class ProcedureOptions:
     """
 
     sigma_mm: float = 0.01
-    grid: tuple = (16, 32)
+    grid: tuple[int, int] = (16, 32)
     quantity: str = "heights"
     standard_points: str = "book"
     datum: str = "plane"
@@ -825,13 +869,19 @@ class ProcedureOptions:
     linkage: str | None = None
     fidelity: Fidelity | None = None
 
-    def switches(self, spec) -> Fidelity:
+    def switches(self, spec: InstrumentSpec) -> Fidelity:
         """The run's :class:`Fidelity`, ``passes`` and ``linkage`` applied, the linkage
-        resolved (None: the instrument's)."""
+        resolved (:meth:`linkage_of`)."""
         f = self.fidelity or Fidelity()
         passes = f.passes if self.passes is None else self.passes
-        linkage = self.linkage or f.linkage or spec.decentration_linkage
-        return replace(f, passes=passes, linkage=linkage)
+        return replace(f, passes=passes, linkage=self.linkage_of(spec))
+
+    def linkage_of(self, spec: InstrumentSpec) -> str:
+        """The run's knob–decentration linkage: ``linkage``, else the fidelity's, else the
+        instrument's ``correction.decentration_linkage``."""
+        f = self.fidelity or Fidelity()
+        linkage: str = self.linkage or f.linkage or spec.decentration_linkage
+        return linkage
 
 
 def procedure_mc(
@@ -841,8 +891,8 @@ def procedure_mc(
     spec: InstrumentSpec,
     trials: int = 600,
     seed: int = 20240601,
-    **options,
-) -> dict:
+    **options: Any,
+) -> RunResult:
     """Run the procedure MC for one scenario and method (see the module docstring).
 
     ``method`` (:data:`METHODS`): "setup" (§27 task 1: stages 1–5 with the operator's monocular
@@ -881,15 +931,22 @@ def procedure_mc(
         **{k: getattr(o, k) for k in ("sources", "control")},
     )
     g = scenario_geometry(scenario, spec)
-    linkage = o.switches(spec).linkage
-    plain, controlled, d_zero, units = run_configuration(
-        scenario, spec, method, trials, seed, o, g, linkage
-    )
-    out = _result(scenario, spec, method, o, g, linkage, (plain, controlled, d_zero, units))
+    linkage = o.linkage_of(spec)
+    runs = run_configuration(scenario, spec, method, trials, seed, o, g, linkage)
+    out = _result(scenario, spec, method, o, g, linkage, runs)
     return {**out, "trials": int(trials), "seed": int(seed), "seconds": time.perf_counter() - t0}
 
 
-def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
+def _result(
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    method: str,
+    o: ProcedureOptions,
+    g: dict[str, float],
+    linkage: str,
+    runs: ConfigurationRun,
+    formulas: dict[str, float] | None = None,
+) -> RunResult:
     """The result of :func:`procedure_mc` from the per-trial mean squares of its run(s)."""
     plain, controlled, d_zero, units = runs
     name = _field_name(method, o.quantity, o.levelling, o.datum, o.control)
@@ -931,8 +988,8 @@ def conventional_sources_mc(
     spec: InstrumentSpec,
     trials: dict[str, int],
     seed: int = 20240601,
-    **options,
-) -> dict[str, dict]:
+    **options: Any,
+) -> dict[str, RunResult]:
     """:func:`procedure_mc` of the conventional method for several ``sources`` at once, as one
     run: ``trials`` maps a source (:data:`SOURCES`) to its trials, laid out in blocks of one run
     with σ_q = σ_p = σ whose acts of the sources a block leaves out draw 0 on its trials
@@ -951,7 +1008,7 @@ def conventional_sources_mc(
     o = ProcedureOptions(**options)
     _check_options("conventional", **{k: getattr(o, k) for k in ("quantity", "standard_points")})
     g = scenario_geometry(scenario, spec)
-    linkage = o.switches(spec).linkage
+    linkage = o.linkage_of(spec)
     names = list(trials)
     bounds = np.cumsum([0] + [int(trials[k]) for k in names])
     off_of = {
@@ -964,12 +1021,14 @@ def conventional_sources_mc(
     )
     lev = levelling_formula(g, *levelling_points_photo(scenario, spec, g))
     book = levelling_formula(g, *control_points(g["a"], g["c"]))
-    out = {}
+    out: dict[str, RunResult] = {}
     for k, first, last in zip(names, bounds[:-1], bounds[1:], strict=True):
         ok = replace(o, sources=k)
-        cut = [{n: v[first:last] for n, v in d.items()} for d in (plain, controlled)]
+        plain_k, controlled_k = (
+            {n: v[first:last] for n, v in d.items()} for d in (plain, controlled)
+        )
         formulas = _formulas("conventional", scenario, spec, g, k, o.control, (lev, book))
-        runs = (*cut, d_zero, units)
+        runs = ConfigurationRun(plain_k, controlled_k, d_zero, units)
         res = _result(scenario, spec, "conventional", ok, g, linkage, runs, formulas)
         out[k] = {**res, "trials": int(last - first), "seed": int(seed), "first_trial": int(first)}
     seconds = time.perf_counter() - t0
@@ -1033,12 +1092,21 @@ def run_configuration(
     return ConfigurationRun(ms.plain, ms.controlled, ms.error_free_dp, units)
 
 
-def _keyed(ms: dict, kind: str):
-    """The items of ``ms`` whose key is a tuple (``kind``, name)."""
-    return [(k, v) for k, v in ms.items() if isinstance(k, tuple) and k[0] == kind]
+def _keyed(ms: Mapping[FieldKey, FloatArray], kind: str) -> list[tuple[str, FloatArray]]:
+    """(name, values) of the items of ``ms`` whose key is a tuple (``kind``, name)."""
+    return [(k[1], v) for k, v in ms.items() if isinstance(k, tuple) and k[0] == kind]
 
 
-def _extras(scenario, spec, method, o, g, plain, best, units):
+def _extras(
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    method: str,
+    o: ProcedureOptions,
+    g: dict[str, float],
+    plain: Mapping[FieldKey, FloatArray],
+    best: Mapping[FieldKey, FloatArray],
+    units: Mapping[str, float],
+) -> dict[str, Any]:
     """The method's own parts of the result: the three readings of a setup run with their
     decompositions, or the conventional run's readings by datum and its options."""
     if method == "conventional":
@@ -1048,7 +1116,7 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
             **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
             "sources": o.sources,
         }
-    fields = {}
+    fields: dict[str, dict[str, Any]] = {}
     for key, m, c in (
         ("parallax", "setup", "exact"),
         ("levelled", "setup_control", "exact"),
@@ -1066,9 +1134,9 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
             "mean_squares": plain[key],  # per trial, photo mm² (paired switch steps)
             "unit": units[key],
         }
-    extra = {"fields": fields}
+    extra: dict[str, Any] = {"fields": fields}
     extra["element_rms"] = {
-        name: float(np.sqrt(np.mean(v))) for (kind, name), v in _keyed(plain, "element")
+        name: float(np.sqrt(np.mean(v))) for name, v in _keyed(plain, "element")
     }
     if method == "setup_control":
         extra["control"] = o.control
@@ -1102,7 +1170,7 @@ def idealised_geometry(scenario: Scenario) -> Scenario:
     return replace(scenario, terrain=Terrain(scenario.terrain.base_height_m), photos=photos)
 
 
-def standard_points_at_a(prep, g):
+def standard_points_at_a(prep: PreparedRun, g: Mapping[str, float]) -> PreparedRun:
     """The prepared run with standard points 1, 3, 5 moved by −a and 2, 4, 6 by +a along the
     base (Fig. 39, x_л ∈ {−a, p + a}, a = c − p) and the C2 tolerance 0, so every trial makes
     the same number of passes (no 'stop when satisfied' selection, which (5.54) does not model)."""
@@ -1123,7 +1191,9 @@ def standard_points_at_a(prep, g):
     )
 
 
-def control_frame_points(scenario, sheet, g):
+def control_frame_points(
+    scenario: Scenario, sheet: SetupSheet, g: Mapping[str, float]
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """The four levelling control points of (5.54), x_п ∈ {−c, a}, y = ±c, on the ground; with
     their (x_п, y) [mm]."""
 
