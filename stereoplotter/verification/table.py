@@ -22,9 +22,10 @@ import math
 import multiprocessing
 import warnings
 from collections.abc import Callable, Mapping
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import replace
+from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, replace
 from functools import cache
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -40,6 +41,8 @@ from stereoplotter.verification import (
     rows_setup_elements,
 )
 from stereoplotter.verification.as_formula import (
+    ProcedureResults,
+    RunResult,
     as_formula_block,
     procedure_value,
     switch_chain,
@@ -59,6 +62,27 @@ from stereoplotter.verification.procedure_mc import (
     procedure_mc,
 )
 from stereoplotter.verification.verdicts import VERDICTS, decide
+
+if TYPE_CHECKING:
+    from stereoplotter.scenario.model import Scenario
+    from stereoplotter.spec.instrument_spec import InstrumentSpec
+
+#: ``progress(done, total, label)`` after each step.
+Progress = Callable[[int, int, str], None]
+#: A configuration of the procedure MC: :func:`procedure_mc` keyword arguments (``method``,
+#: ``grid``, ``passes``, ``sources``, ``fidelity``) and ``idealised`` (run on vertical photos
+#: over flat terrain).
+ConfigOptions = dict[str, Any]
+#: A row of the table: the values of :data:`ROW_KEYS`.
+Row = dict[str, Any]
+
+
+class FieldErrors(Protocol):
+    """Where :func:`check_geometry` reports a bad field: ``error(field, expected, found)``
+    returns the exception to raise."""
+
+    def error(self, field: str, expected: str, found: str) -> Exception: ...
+
 
 __all__ = [
     "BOOK",
@@ -107,7 +131,7 @@ PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this
 #: setup run's statistic is the mean over a midpoint grid of 8 × 16 (not 16 × 32): half the
 #: time, values within 0.3 % of the finer grid on the same 4 000 trials (pair60 levelled
 #: 0.1298 / 0.1302, observed 0.6696 / 0.6707; parallax within 0.02 %).
-PROCEDURE_CONFIGS = {
+PROCEDURE_CONFIGS: dict[str, ConfigOptions] = {
     "setup": {"method": "setup", "grid": (8, 16)},
     "conventional": {"method": "conventional", "passes": 3},
     "y_parallax": {"method": "conventional", "sources": "y_parallax", "passes": 3},
@@ -170,7 +194,7 @@ def procedure_rows() -> dict[str, ProcedureMeasure]:
 
 #: Accepted values of a flat ``--geometry`` mapping (keys of :data:`BOOK`), in mm or [—]: wide
 #: round bounds around the book's setting that keep every formula finite.
-def check_geometry(fields, geometry: dict) -> None:
+def check_geometry(fields: FieldErrors, geometry: Mapping[str, float]) -> None:
     """Refuse a geometry outside the domain of the table's formulas, naming the field.
 
     The standard and control points sit at x_п = −c, a and −(p + a): they must be distinct
@@ -207,8 +231,7 @@ def check_geometry(fields, geometry: dict) -> None:
             f"{type(exc).__name__}: {exc}",
         ) from None
     for entry in specs:
-        values = [entry.printed, entry.book, entry.rigorous]
-        values = [v for v in values if isinstance(v, int | float)]
+        values = [v for v in (entry.printed, entry.book, entry.rigorous) if v is not None]
         if not all(math.isfinite(v) for v in values):
             raise fields.error(
                 "(geometry)",
@@ -217,7 +240,7 @@ def check_geometry(fields, geometry: dict) -> None:
             )
 
 
-def _normalise_geometry(geometry) -> dict:
+def _normalise_geometry(geometry: Mapping[str, float] | None) -> dict[str, float]:
     g = dict(BOOK)
     if geometry:
         unknown = set(geometry) - set(BOOK)
@@ -233,7 +256,7 @@ def _normalise_geometry(geometry) -> dict:
 
 #: The jobs of the current :func:`run_procedure_mc`, read by forked workers by index (the loaded
 #: scenarios and instrument hold mappings that do not pickle).
-_JOBS: list = []
+_JOBS: list[ProcedureJob] = []
 
 #: The configurations that run the same procedure (the conventional method, its judgment
 #: sources on or off): one job, one run with a block of trials per configuration
@@ -245,16 +268,46 @@ SHARED_RUNS = {"conventional": ("conventional", "y_parallax", "stereo")}
 TRIAL_COST = {"setup": 1.0, "conventional": 4.0}
 
 
-def _job_at(i):
+def _job_at(i: int) -> dict[str, RunResult]:
     # one BLAS thread a worker: the workers are the parallelism (two processes × two OpenBLAS
     # threads on two cores made `verify` 1.2 × the CPU and 1.5 × the wall, benchmarks/README.md)
     with threadpool_limits(limits=1, user_api="blas"):
         return _job(_JOBS[i])
 
 
-def _job(args):
+@dataclass(frozen=True)
+class ProcedureJob:
+    """The runs one worker makes: the configurations ``configs`` (one, or the configurations of
+    a :data:`SHARED_RUNS` run) on ``scenario`` with ``spec``, each with its ``trials`` and its
+    :func:`procedure_configs` keyword arguments (``options``), at ``seed``; with every
+    instrument error term at its σ (``instrument_errors``) or on the ideal instrument; the
+    ``linkage`` (None: the run's fidelity's or the instrument's)."""
+
+    scenario: Scenario
+    spec: InstrumentSpec
+    configs: tuple[str, ...]
+    trials: dict[str, int]
+    seed: int
+    instrument_errors: bool
+    linkage: str | None
+    options: dict[str, ConfigOptions]
+
+    def cost(self) -> float:
+        """Estimated cost of the job in setup trials (:data:`TRIAL_COST`)."""
+        method = self.options[self.configs[0]]["method"]
+        return TRIAL_COST.get(method, 1.0) * sum(self.trials.values())
+
+
+def _job(job: ProcedureJob) -> dict[str, RunResult]:
     """A job's results, configuration → :func:`procedure_mc` result."""
-    scenario, spec, configs, trials, seed, instrument, linkage, options = args
+    scenario, spec, configs, trials, seed = (
+        job.scenario,
+        job.spec,
+        job.configs,
+        job.trials,
+        job.seed,
+    )
+    instrument, linkage, options = job.instrument_errors, job.linkage, job.options
     if len(configs) == 1:
         (config,) = configs
         kw = dict(options[config])
@@ -285,7 +338,7 @@ def _job(args):
     return {by_source[k]: r for k, r in out.items()}
 
 
-def _trials_of(trials, config, instrument):
+def _trials_of(trials: int | None, config: str, instrument: bool) -> int:
     if config.startswith(("setup_formula", "setup_step")):
         cap = FORMULA_TRIALS if config.startswith("setup_formula") else STEP_TRIALS
         main = _trials_of(trials, "setup", instrument)
@@ -295,14 +348,14 @@ def _trials_of(trials, config, instrument):
     return (INSTRUMENT_TRIALS if instrument else PROCEDURE_TRIALS)[config]
 
 
-def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, dict]:
+def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ConfigOptions]:
     """The configurations of a ``verify`` run: :data:`PROCEDURE_CONFIGS` with the setup method
     at ``fidelity``, "setup_formula" (every switch at the formula's assumption) and
     "setup_step_i" (the formula's setting with the first i switches of :func:`switch_chain`
     at ``fidelity``'s, i = 1 … k − 1; the k-th is "setup" itself)."""
     f = fidelity or Fidelity()
     base = PROCEDURE_CONFIGS["setup"]
-    out = {**PROCEDURE_CONFIGS, "setup": {**base, "fidelity": f}}
+    out: dict[str, ConfigOptions] = {**PROCEDURE_CONFIGS, "setup": {**base, "fidelity": f}}
     formula = Fidelity.as_formula()
     out["setup_formula"] = {**base, "fidelity": formula}
     out["setup_formula_flat"] = {**base, "fidelity": formula, "idealised": True}
@@ -310,7 +363,8 @@ def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, dict]:
     step = formula
     for i, name in enumerate(chain[:-1], 1):
         value = getattr(f, name)
-        step = replace(step, **{name: value})
+        change: dict[str, Any] = {name: value}
+        step = replace(step, **change)
         if name == "linkage" and value is None:
             step = replace(step, linkage=None)
         out[f"setup_step_{i}"] = {**base, "fidelity": step}
@@ -324,17 +378,17 @@ def _stream(config: str) -> str:
 
 
 def run_procedure_mc(
-    trials=None,
-    seed=20240601,
-    scenarios=None,
-    progress=None,
+    trials: int | None = None,
+    seed: int = 20240601,
+    scenarios: Mapping[str, Scenario | None] | None = None,
+    progress: Progress | None = None,
     *,
-    instrument=None,
-    with_instrument=True,
-    workers=2,
-    linkage=None,
-    fidelity=None,
-):
+    instrument: InstrumentSpec | None = None,
+    with_instrument: bool = True,
+    workers: int = 2,
+    linkage: str | None = None,
+    fidelity: Fidelity | None = None,
+) -> dict[tuple[str, ...], RunResult]:
     """:func:`start_procedure_mc` and wait for its result (arguments as there)."""
     return start_procedure_mc(
         trials,
@@ -349,15 +403,15 @@ def run_procedure_mc(
 
 
 def start_procedure_mc(
-    trials=None,
-    seed=20240601,
-    scenarios=None,
+    trials: int | None = None,
+    seed: int = 20240601,
+    scenarios: Mapping[str, Scenario | None] | None = None,
     *,
-    instrument=None,
-    with_instrument=True,
-    workers=2,
-    linkage=None,
-    fidelity=None,
+    instrument: InstrumentSpec | None = None,
+    with_instrument: bool = True,
+    workers: int = 2,
+    linkage: str | None = None,
+    fidelity: Fidelity | None = None,
 ) -> PendingProcedureMC:
     """The procedure MC of :mod:`stereoplotter.verification.procedure_mc` for every
     configuration of :data:`PROCEDURE_CONFIGS` at each overlap slot, on the ideal instrument and
@@ -401,37 +455,39 @@ def start_procedure_mc(
         for c in configs
         if not (inst and c not in PROCEDURE_CONFIGS)  # the switch runs: ideal instrument only
     ]
-    if todo and instrument is None:
+    if not todo:
+        return PendingProcedureMC([], [], workers)
+    if instrument is None:
         raise ValueError("instrument: expected the InstrumentSpec of the procedure MC, found None")
     shared = {c: lead for lead, cs in SHARED_RUNS.items() for c in cs}
-    groups: dict = {}
+    groups: dict[tuple[str, str, bool], list[str]] = {}
     for s, c, inst in todo:  # the configurations of one procedure go into one job
         groups.setdefault((s, shared.get(c, c), inst), []).append(c)
     jobs = [
-        (
-            scenarios[s],
-            instrument,
-            tuple(cs),
-            {c: _trials_of(trials, c, inst) for c in cs},
-            seed + 7 * (2 * CONFIG_STREAM[_stream(lead)] + (s == "80")) + 1,
-            inst,
-            None if "fidelity" in configs[lead] else linkage,  # else the fidelity's
-            {c: configs[c] for c in cs},
+        ProcedureJob(
+            scenario=_loaded(scenarios[s]),
+            spec=instrument,
+            configs=tuple(cs),
+            trials={c: _trials_of(trials, c, inst) for c in cs},
+            seed=seed + 7 * (2 * CONFIG_STREAM[_stream(lead)] + (s == "80")) + 1,
+            instrument_errors=inst,
+            linkage=None if "fidelity" in configs[lead] else linkage,  # else the fidelity's
+            options={c: configs[c] for c in cs},
         )
         for (s, lead, inst), cs in groups.items()
     ]
-    keys = [
+    keys: list[list[tuple[str, ...]]] = [
         [(s, c, "instrument") if inst else (s, c) for c in cs]
         for (s, _, inst), cs in groups.items()
     ]
     return PendingProcedureMC(jobs, keys, workers)
 
 
-def _cost(job) -> float:
-    """Estimated cost of a job in setup trials (:data:`TRIAL_COST`)."""
-    configs, trials = job[2], job[3]
-    method = job[7][configs[0]]["method"]
-    return TRIAL_COST.get(method, 1.0) * sum(trials.values())
+def _loaded(scenario: Scenario | None) -> Scenario:
+    """A slot's scenario (a slot without one is never run)."""
+    if scenario is None:
+        raise ValueError("scenario: expected a loaded Scenario for a slot that runs, found None")
+    return scenario
 
 
 class PendingProcedureMC:
@@ -441,11 +497,13 @@ class PendingProcedureMC:
     (the linear rows): ``verify`` overlaps the two. ``keys[i]``: the result keys of job i, one
     per configuration it runs."""
 
-    def __init__(self, jobs: list, keys: list, workers: int = 2):
+    def __init__(
+        self, jobs: list[ProcedureJob], keys: list[list[tuple[str, ...]]], workers: int = 2
+    ):
         self.jobs, self.keys = jobs, keys
-        self.order = sorted(range(len(jobs)), key=lambda i: -_cost(jobs[i]))
-        self.pool = None
-        self.futures = {}
+        self.order = sorted(range(len(jobs)), key=lambda i: -jobs[i].cost())
+        self.pool: ProcessPoolExecutor | None = None
+        self.futures: dict[Future[dict[str, RunResult]], int] = {}
         if workers > 1 and len(jobs) > 1 and "fork" in multiprocessing.get_all_start_methods():
             _JOBS[:] = jobs  # inherited by the forked workers
             context = multiprocessing.get_context("fork")
@@ -454,9 +512,9 @@ class PendingProcedureMC:
             # and one here while they run (the caller's linear rows): no process oversubscribes
             self.limits = threadpool_limits(limits=1, user_api="blas")
 
-    def result(self, progress=None) -> dict:
+    def result(self, progress: Progress | None = None) -> dict[tuple[str, ...], RunResult]:
         """(slot, configuration[, "instrument"]) → result; ``progress(done, total, label)``."""
-        out = {}
+        out: dict[tuple[str, ...], RunResult] = {}
         n = len(self.jobs)
         if self.pool is None:
             for done, i in enumerate(self.order, 1):
@@ -476,12 +534,13 @@ class PendingProcedureMC:
             _JOBS.clear()
         return {k: out[k] for ks in self.keys for k in ks}
 
-    def _keyed(self, i, results):
+    def _keyed(self, i: int, results: Mapping[str, RunResult]) -> dict[tuple[str, ...], RunResult]:
         """Job i's results (configuration → result) under their keys."""
         return {key: results[key[1]] for key in self.keys[i]}
 
 
-_FIELD_TEXT = {
+#: What a setup run's reading measures: field → text (a conventional row has no field, None).
+_FIELD_TEXT: dict[str | None, str] = {
     "parallax": "δp of the built model on the (6.27) domain per m_xy = n_л·σ (task 1)",
     "levelled": "δp on the chapter-5 domain after levelling on Fig. 39's four control points "
     "(least-squares plane, exact control heights) per m_xy = n_л·σ (task 2)",
@@ -490,14 +549,14 @@ _FIELD_TEXT = {
 }
 
 
-def _switches_text(fidelity) -> str:
+def _switches_text(fidelity: Fidelity | None) -> str:
     """``name=value`` of each mechanism switch of a run's :class:`Fidelity`."""
     if fidelity is None:
         return "the defaults"
     return ", ".join(f"{m.name}={getattr(fidelity, m.name)}" for m in MECHANISMS)
 
 
-def _procedure_note(eq, res, field, scaled):
+def _procedure_note(eq: str, res: RunResult, field: str | None, scaled: bool) -> str:
     """The note of a procedure-MC row: the run, the formula at the simulated geometry, their
     ratio and the mismatches of assumptions."""
     f, p, c, a, n, ll = res["f"], res["p"], res["c"], res["a"], res["n"], res["l"]
@@ -537,13 +596,13 @@ def _procedure_note(eq, res, field, scaled):
 def run_verification(
     trials: int = 60000,
     seed: int = 20240601,
-    geometry=None,
-    progress: Callable[[int, int, str], None] | None = None,
+    geometry: Mapping[str, float] | None = None,
+    progress: Progress | None = None,
     procedure_trials: int | None = None,
-    procedure_scenarios=None,
-    instrument=None,
-    linkage=None,
-) -> list[dict]:
+    procedure_scenarios: Mapping[str, Scenario | None] | None = None,
+    instrument: InstrumentSpec | None = None,
+    linkage: str | None = None,
+) -> list[Row]:
     """Compute the verification table.
 
     Parameters
@@ -591,7 +650,7 @@ def run_verification(
     return rows
 
 
-def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
+def attach_procedure_mc(rows: list[Row], proc: ProcedureResults) -> list[Row]:
     """Fill ``mc_procedure``, ``mc_procedure_ci``, ``mc_procedure_formula`` (the rigorous
     formula at the simulated geometry), ``mc_procedure_instrument`` (and its CI) and the note
     from :func:`run_procedure_mc`."""
@@ -640,7 +699,7 @@ FIRST_ORDER_MECHANISMS = {
 MECHANISM_SETTING = ({"pair60", "pair80"}, "sc1", "drag")
 
 
-def _mechanism(res: dict, step: str, field: str | None) -> str | None:
+def _mechanism(res: RunResult, step: str, field: str | None) -> str | None:
     names, key, linkage = MECHANISM_SETTING
     shown = res.get("scenario") in names and res.get("instrument_key") == key
     if not shown or res.get("linkage") != linkage or res.get("instrument"):
@@ -650,7 +709,9 @@ def _mechanism(res: dict, step: str, field: str | None) -> str | None:
     return FIRST_ORDER_MECHANISMS.get(step)
 
 
-def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -> dict:
+def row_decomposition(
+    book: float, res: RunResult, field: str | None, scaled: bool
+) -> dict[str, Any]:
     """The ``decomposition`` block of a procedure row (:mod:`.decomposition`): the formula at
     the book geometry (``book``, the row's rigorous column) → at the simulated geometry → the
     first order of each trial's own errors → the procedure, each step with its CI; ``sum``
@@ -715,7 +776,7 @@ def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -
 SAME_QUANTITY = {"(6.60)": "(6.45)", "(6.61)": "(6.46)"}
 
 
-def _one_verdict_per_quantity(rows: list[dict]) -> list[dict]:
+def _one_verdict_per_quantity(rows: list[Row]) -> list[Row]:
     """The later print of a quantity (:data:`SAME_QUANTITY`) takes the first print's verdict
     and value from printed inputs; its note keeps what its own print gave."""
     by = {r["eq"]: r for r in rows}
@@ -734,7 +795,7 @@ def _one_verdict_per_quantity(rows: list[dict]) -> list[dict]:
     return rows
 
 
-def _fmt_printed(v) -> str:
+def _fmt_printed(v: float | None) -> str:
     return "—" if v is None else f"{v:g}"
 
 
@@ -745,7 +806,13 @@ def row_stream(seed: int, entry: Entry) -> np.random.Generator:
     return np.random.default_rng([seed, key_code(entry.identity)])
 
 
-def _rows(specs: list[Entry], trials, seed, progress, at_book: bool = True):
+def _rows(
+    specs: list[Entry],
+    trials: int,
+    seed: int,
+    progress: Progress | None,
+    at_book: bool = True,
+) -> list[Row]:
     seen: dict[str, int] = {}
     for i, e in enumerate(specs):
         if seen.setdefault(e.identity, i) != i:
@@ -778,7 +845,7 @@ def _verdict(e: Entry, at_book: bool) -> tuple[float | None, float | None, str, 
     return printed, fpi, verdict, f"{head}; {check}" + (f". {e.note}" if keep else "")
 
 
-def _row(e: Entry, trials, rng, at_book: bool = True) -> dict:
+def _row(e: Entry, trials: int, rng: np.random.Generator, at_book: bool = True) -> Row:
     """The row of ``e``: its linear MC (``trials``, ``rng``) and covariance RMS."""
     # a squared statistic doubles the relative CI: four times the trials keep it ≤ 1 %
     r, h, _ = mc.mc_rms(e.model, 4 * trials if e.squared else trials, rng)
@@ -808,7 +875,7 @@ def _row(e: Entry, trials, rng, at_book: bool = True) -> dict:
     }
 
 
-def closing_comparison(rows: list[dict]) -> list[dict]:
+def closing_comparison(rows: list[Row]) -> list[dict[str, Any]]:
     """The book's closing claim (OCR L4022-4026) against the recomputed chain.
 
     Examples
@@ -823,7 +890,7 @@ def closing_comparison(rows: list[dict]) -> list[dict]:
         ("60 %", "(6.58)", "(6.60)", "equal accuracy"),
         ("80 %", "(6.59)", "(6.61)", "setup data 20 % better"),
     ):
-        row = {"overlap": ov, "book_claim": claim}
+        row: dict[str, Any] = {"overlap": ov, "book_claim": claim}
         for key in ("printed", "book", "rigorous", "mc_linear", "mc_procedure"):
             a, b = by[s][key], by[cv][key]
             row[f"setup_{key}"], row[f"conventional_{key}"] = a, b
