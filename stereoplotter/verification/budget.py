@@ -97,7 +97,7 @@ STEP_AGREEMENT = 1e-2
 #: negligible (numerical noise of the procedure's solves): no validation asked. [—]
 NEGLIGIBLE = 1e-6
 #: Agreement of the linear and the simulated one-at-a-time Δ: |Δ_sim − Δ_lin| ≤ Z·SE(Δ_sim);
-#: of Σ one-at-a-time Δ and Δ(all on − all off): |gap| ≤ Z·SE(gap) (the issue's 2 SE). [—]
+#: of Σ one-at-a-time Δ and Δ(all on − all off): |gap| ≤ Z·SE(gap) (2 SE). [—]
 Z_AGREE = 2.0
 
 #: The three measures: key → (unit, what).

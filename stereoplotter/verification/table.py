@@ -300,39 +300,32 @@ class ProcedureJob:
 
 def _job(job: ProcedureJob) -> dict[str, RunResult]:
     """A job's results, configuration → :func:`procedure_mc` result."""
-    scenario, spec, configs, trials, seed = (
-        job.scenario,
-        job.spec,
-        job.configs,
-        job.trials,
-        job.seed,
-    )
-    instrument, linkage, options = job.instrument_errors, job.linkage, job.options
-    if len(configs) == 1:
-        (config,) = configs
-        kw = dict(options[config])
+    if len(job.configs) == 1:
+        (config,) = job.configs
+        kw = dict(job.options[config])
+        scenario = job.scenario
         if kw.pop("idealised", False):  # vertical photos over flat terrain
             scenario = idealised_geometry(scenario)
         res = procedure_mc(
             scenario,
-            spec=spec,
-            trials=trials[config],
-            seed=seed,
-            instrument=instrument,
-            linkage=linkage,
+            spec=job.spec,
+            trials=job.trials[config],
+            seed=job.seed,
+            instrument=job.instrument_errors,
+            linkage=job.linkage,
             **kw,
         )
         return {config: res}
-    passes = {options[c]["passes"] for c in configs}
+    passes = {job.options[c]["passes"] for c in job.configs}
     (passes,) = passes  # the shared run makes one number of passes
-    by_source = {options[c].get("sources", "both"): c for c in configs}
+    by_source = {job.options[c].get("sources", "both"): c for c in job.configs}
     out = conventional_sources_mc(
-        scenario,
-        spec=spec,
-        trials={k: trials[c] for k, c in by_source.items()},
-        seed=seed,
-        instrument=instrument,
-        linkage=linkage,
+        job.scenario,
+        spec=job.spec,
+        trials={k: job.trials[c] for k, c in by_source.items()},
+        seed=job.seed,
+        instrument=job.instrument_errors,
+        linkage=job.linkage,
         passes=passes,
     )
     return {by_source[k]: r for k, r in out.items()}
