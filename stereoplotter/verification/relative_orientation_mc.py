@@ -1,7 +1,7 @@
 """Procedure Monte Carlo of the conventional relative orientation alone against (5.54): the
 simulated operator's C1 and C2 by (5.11) on an ideal instrument with only the y-parallax
 judgment error (``docs/accuracy.md``, "The conventional relative orientation alone against
-(5.54)"). The geometry helpers are the procedure Monte Carlo's (``procedure_mc``)."""
+(5.54)"). The geometry helpers are the procedure Monte Carlo's (``procedure_geometry``)."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.run import build_run
 from stereoplotter.procedure.simulate import prepare_run
 from stereoplotter.verification.linear_mc import CI_Z, FloatArray
-from stereoplotter.verification.procedure_mc import (
+from stereoplotter.verification.procedure_geometry import (
     control_frame_points,
     domain_points,
     dp_at,
