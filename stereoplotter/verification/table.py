@@ -69,10 +69,6 @@ if TYPE_CHECKING:
 
 #: ``progress(done, total, label)`` after each step.
 Progress = Callable[[int, int, str], None]
-#: A configuration of the procedure MC: :func:`procedure_mc` keyword arguments (``method``,
-#: ``grid``, ``passes``, ``sources``, ``fidelity``) and ``idealised`` (run on vertical photos
-#: over flat terrain).
-ConfigOptions = dict[str, Any]
 #: A row of the table: the values of :data:`ROW_KEYS`.
 Row = dict[str, Any]
 
@@ -122,7 +118,34 @@ ROW_KEYS = (
 #: The columns of the CSV (the nested ``as_formula``, ``decomposition`` blocks: JSON only).
 CSV_KEYS = tuple(k for k in ROW_KEYS if k not in ("as_formula", "decomposition"))
 PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this quantity)"
-#: Procedure-MC configurations: name → :func:`procedure_mc` keyword arguments. "setup" is one
+
+
+@dataclass(frozen=True)
+class ProcedureConfig:
+    """A configuration of the procedure MC: its ``method`` and the options of its runs (the
+    fields of :class:`~stereoplotter.verification.procedure_mc.ProcedureOptions` it sets:
+    ``grid``, ``passes``, ``sources``, ``fidelity``); ``idealised``: run on the scenario with
+    vertical photos over flat terrain (:func:`idealised_geometry`)."""
+
+    method: str
+    grid: tuple[int, int] = (16, 32)
+    passes: int | None = None
+    sources: str = "both"
+    fidelity: Fidelity | None = None
+    idealised: bool = False
+
+    def options(self) -> dict[str, Any]:
+        """The :func:`procedure_mc` keyword arguments of a run of this configuration."""
+        return {
+            "method": self.method,
+            "grid": self.grid,
+            "passes": self.passes,
+            "sources": self.sources,
+            "fidelity": self.fidelity,
+        }
+
+
+#: Procedure-MC configurations: name → :class:`ProcedureConfig`. "setup" is one
 #: run of the setup-data method with three readings (§27 task 1, and task 2: levelled on
 #: control exactly and with observed control parallaxes); the conventional method with both
 #: judgment errors, the y-parallax σ_q only and the stereo σ_p only. Conventional runs make a
@@ -131,11 +154,11 @@ PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this
 #: setup run's statistic is the mean over a midpoint grid of 8 × 16 (not 16 × 32): half the
 #: time, values within 0.3 % of the finer grid on the same 4 000 trials (pair60 levelled
 #: 0.1298 / 0.1302, observed 0.6696 / 0.6707; parallax within 0.02 %).
-PROCEDURE_CONFIGS: dict[str, ConfigOptions] = {
-    "setup": {"method": "setup", "grid": (8, 16)},
-    "conventional": {"method": "conventional", "passes": 3},
-    "y_parallax": {"method": "conventional", "sources": "y_parallax", "passes": 3},
-    "stereo": {"method": "conventional", "sources": "stereo", "passes": 3},
+PROCEDURE_CONFIGS = {
+    "setup": ProcedureConfig("setup", grid=(8, 16)),
+    "conventional": ProcedureConfig("conventional", passes=3),
+    "y_parallax": ProcedureConfig("conventional", passes=3, sources="y_parallax"),
+    "stereo": ProcedureConfig("conventional", passes=3, sources="stereo"),
 }
 #: The seed stream of each configuration's runs, declared (not its place in
 #: :data:`PROCEDURE_CONFIGS`): a run of configuration c at overlap slot s takes the seed
@@ -290,11 +313,11 @@ class ProcedureJob:
     seed: int
     instrument_errors: bool
     linkage: str | None
-    options: dict[str, ConfigOptions]
+    options: dict[str, ProcedureConfig]
 
     def cost(self) -> float:
         """Estimated cost of the job in setup trials (:data:`TRIAL_COST`)."""
-        method = self.options[self.configs[0]]["method"]
+        method = self.options[self.configs[0]].method
         return TRIAL_COST.get(method, 1.0) * sum(self.trials.values())
 
 
@@ -302,9 +325,9 @@ def _job(job: ProcedureJob) -> dict[str, RunResult]:
     """A job's results, configuration → :func:`procedure_mc` result."""
     if len(job.configs) == 1:
         (config,) = job.configs
-        kw = dict(job.options[config])
+        run = job.options[config]
         scenario = job.scenario
-        if kw.pop("idealised", False):  # vertical photos over flat terrain
+        if run.idealised:  # vertical photos over flat terrain
             scenario = idealised_geometry(scenario)
         res = procedure_mc(
             scenario,
@@ -313,12 +336,11 @@ def _job(job: ProcedureJob) -> dict[str, RunResult]:
             seed=job.seed,
             instrument=job.instrument_errors,
             linkage=job.linkage,
-            **kw,
+            **run.options(),
         )
         return {config: res}
-    passes = {job.options[c]["passes"] for c in job.configs}
-    (passes,) = passes  # the shared run makes one number of passes
-    by_source = {job.options[c].get("sources", "both"): c for c in job.configs}
+    (passes,) = {job.options[c].passes for c in job.configs}  # the shared run: one number
+    by_source = {job.options[c].sources: c for c in job.configs}
     out = conventional_sources_mc(
         job.scenario,
         spec=job.spec,
@@ -341,17 +363,17 @@ def _trials_of(trials: int | None, config: str, instrument: bool) -> int:
     return (INSTRUMENT_TRIALS if instrument else PROCEDURE_TRIALS)[config]
 
 
-def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ConfigOptions]:
+def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ProcedureConfig]:
     """The configurations of a ``verify`` run: :data:`PROCEDURE_CONFIGS` with the setup method
     at ``fidelity``, "setup_formula" (every switch at the formula's assumption) and
     "setup_step_i" (the formula's setting with the first i switches of :func:`switch_chain`
     at ``fidelity``'s, i = 1 … k − 1; the k-th is "setup" itself)."""
     f = fidelity or Fidelity()
     base = PROCEDURE_CONFIGS["setup"]
-    out: dict[str, ConfigOptions] = {**PROCEDURE_CONFIGS, "setup": {**base, "fidelity": f}}
+    out = {**PROCEDURE_CONFIGS, "setup": replace(base, fidelity=f)}
     formula = Fidelity.as_formula()
-    out["setup_formula"] = {**base, "fidelity": formula}
-    out["setup_formula_flat"] = {**base, "fidelity": formula, "idealised": True}
+    out["setup_formula"] = replace(base, fidelity=formula)
+    out["setup_formula_flat"] = replace(base, fidelity=formula, idealised=True)
     chain = switch_chain(f)
     step = formula
     for i, name in enumerate(chain[:-1], 1):
@@ -360,7 +382,7 @@ def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ConfigOptio
         step = replace(step, **change)
         if name == "linkage" and value is None:
             step = replace(step, linkage=None)
-        out[f"setup_step_{i}"] = {**base, "fidelity": step}
+        out[f"setup_step_{i}"] = replace(base, fidelity=step)
     return out
 
 
@@ -464,7 +486,7 @@ def start_procedure_mc(
             trials={c: _trials_of(trials, c, inst) for c in cs},
             seed=seed + 7 * (2 * CONFIG_STREAM[_stream(lead)] + (s == "80")) + 1,
             instrument_errors=inst,
-            linkage=None if "fidelity" in configs[lead] else linkage,  # else the fidelity's
+            linkage=None if configs[lead].fidelity is not None else linkage,  # else its fidelity's
             options={c: configs[c] for c in cs},
         )
         for (s, lead, inst), cs in groups.items()
