@@ -37,7 +37,7 @@ def main():
     print(
         f"{'row':<8}{'value':>8}{'CI %':>7}{'plain CI %':>11}{'formula':>9}{'instr.':>8}{'CI %':>7}"
     )
-    for eq, (slot, config, field, scaled) in v.PROCEDURE_ROWS.items():
+    for eq, (slot, config, field, scaled) in v.procedure_rows().items():
         r, ri = proc[(slot, config)], proc[(slot, config, "instrument")]
         val, ci, ref = v.procedure_value(r, field, scaled)
         vi, cii, _ = v.procedure_value(ri, field, scaled)

@@ -9,6 +9,8 @@ inside, the rows' units outside); pure numpy.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -18,6 +20,8 @@ from stereoplotter.verification import decomposition as dc
 
 __all__ = [
     "CONVENTIONAL_REST",
+    "ProcedureResults",
+    "RunResult",
     "as_formula_block",
     "element_ratios",
     "procedure_value",
@@ -26,8 +30,16 @@ __all__ = [
     "vertical_flat_block",
 ]
 
+#: The result of one procedure-MC run (:func:`~.procedure_mc.procedure_mc`): named values of
+#: several kinds (numbers, arrays, the geometry, nested blocks), as documented there.
+RunResult = dict[str, Any]
+#: The runs of a ``verify``: (slot, configuration) or (slot, configuration, "instrument") → run.
+ProcedureResults = Mapping[tuple[str, ...], RunResult]
 
-def procedure_value(res: dict, field: str | None, scaled: bool) -> tuple[float, float, float]:
+
+def procedure_value(
+    res: Mapping[str, Any], field: str | None, scaled: bool
+) -> tuple[float, float, float]:
     """(value, CI half-width, rigorous formula at the simulated geometry) of a row from its
     procedure-MC run: the ``field`` of a setup run, or the run's coefficient (the formula then
     with the levelling plane at the procedure's control points,
@@ -69,7 +81,14 @@ CONVENTIONAL_REST = {
 }
 
 
-def as_formula_block(eq, proc, slot, config, field, scaled) -> dict | None:
+def as_formula_block(
+    eq: str,
+    proc: ProcedureResults,
+    slot: str,
+    config: str,
+    field: str | None,
+    scaled: bool,
+) -> dict[str, Any] | None:
     """The ``as_formula`` block of a procedure row: ``value``, ``ci``, ``ci_rel``, ``formula``
     (the rigorous formula at the simulated geometry), ``ratio``, ``agrees`` (|value − formula|
     ≤ CI), ``fidelity`` (the switches), ``trials``; where it does not agree, ``mechanism`` (what
@@ -83,11 +102,11 @@ def as_formula_block(eq, proc, slot, config, field, scaled) -> dict | None:
         res = proc.get((slot, "setup_formula"))
         if res is None:
             return None
-        fidelity = {m.name: m.as_formula for m in MECHANISMS}
+        fidelity: dict[str, Any] | None = {m.name: m.as_formula for m in MECHANISMS}
     else:
         res, fidelity = proc[(slot, config)], None
     v, h, ref = procedure_value(res, field, scaled)
-    out = {
+    out: dict[str, Any] = {
         "value": v,
         "ci": h,
         "ci_rel": h / v,
@@ -110,7 +129,7 @@ def as_formula_block(eq, proc, slot, config, field, scaled) -> dict | None:
     return out
 
 
-def element_ratios(res: dict) -> dict:
+def element_ratios(res: Mapping[str, Any]) -> dict[str, dict[str, float]]:
     """Each (6.22) element's RMS error in a setup run against (6.32)–(6.38) with the least-squares
     m_ω and the unit-consistent m_bz (``setup_element_sigmas(mode="rigorous")``), at m_x = m_y
     = n_л·σ, photo scale: element → (``procedure``, ``formula``, ``ratio``). b_y has no term
@@ -131,7 +150,7 @@ def element_ratios(res: dict) -> dict:
     return out
 
 
-def vertical_flat_block(res: dict, field: str, scaled: bool) -> dict:
+def vertical_flat_block(res: Mapping[str, Any], field: str, scaled: bool) -> dict[str, Any]:
     """The as-formula run on the scenario with vertical photos over flat terrain
     (:func:`~stereoplotter.verification.procedure_mc.idealised_geometry`), against the formula
     there; for the unlevelled reading ("parallax", (6.39)–(6.44)) also against the formula with
@@ -151,7 +170,7 @@ def vertical_flat_block(res: dict, field: str, scaled: bool) -> dict:
     return out
 
 
-def _formula_rest(block: dict) -> str:
+def _formula_rest(block: Mapping[str, Any]) -> str:
     """What still differs in the as-formula run, from the runs themselves: the elements whose
     RMS error departs from (6.32)–(6.38) by more than 5 %, and the run on vertical photos over
     flat terrain."""
@@ -179,7 +198,13 @@ def _formula_rest(block: dict) -> str:
     return text
 
 
-def switch_decomposition(proc, slot, field, scaled, as_formula) -> dict:
+def switch_decomposition(
+    proc: ProcedureResults,
+    slot: str,
+    field: str | None,
+    scaled: bool,
+    as_formula: Mapping[str, Any] | None,
+) -> dict[str, Any]:
     """The ``decomposition`` block: from the ``as_formula`` run to the row's run, one switch a
     step (:func:`switch_chain`), each step a paired difference of RMS values on the first
     :data:`STEP_TRIALS` trials of the setup run's seed, with its CI; ``sum`` = the as-formula
@@ -233,7 +258,7 @@ def switch_decomposition(proc, slot, field, scaled, as_formula) -> dict:
     }
 
 
-def _step_names(proc, slot) -> list[str]:
+def _step_names(proc: ProcedureResults, slot: str) -> list[str]:
     """The step configurations run at ``slot``, in order."""
     names = [k[1] for k in proc if len(k) == 2 and k[0] == slot and k[1].startswith("setup_step")]
     return sorted(names, key=lambda c: int(c.rsplit("_", 1)[1]))

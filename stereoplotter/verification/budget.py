@@ -48,7 +48,7 @@ Pure: no file, no plot (``report.budget`` and ``plotting.budget`` render the res
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -97,7 +97,7 @@ STEP_AGREEMENT = 1e-2
 #: negligible (numerical noise of the procedure's solves): no validation asked. [—]
 NEGLIGIBLE = 1e-6
 #: Agreement of the linear and the simulated one-at-a-time Δ: |Δ_sim − Δ_lin| ≤ Z·SE(Δ_sim);
-#: of Σ one-at-a-time Δ and Δ(all on − all off): |gap| ≤ Z·SE(gap) (the issue's 2 SE). [—]
+#: of Σ one-at-a-time Δ and Δ(all on − all off): |gap| ≤ Z·SE(gap) (2 SE). [—]
 Z_AGREE = 2.0
 
 #: The three measures: key → (unit, what).
@@ -212,9 +212,16 @@ class _BudgetNoise(Noise):
     """Operator judgments of stacked configurations: block k of n_base trials repeats base trials
     0 … n_base−1; ``factors[family]`` (T,) switches a family on (1) or off (0) per trial."""
 
-    def __init__(self, seed: int, n_base: int, factors: dict[str, NDArray], cache: dict):
+    def __init__(
+        self,
+        seed: int,
+        n_base: int,
+        factors: dict[str, NDArray[np.float64]],
+        cache: dict[str, NDArray[np.float64]],
+    ):
         trials = len(next(iter(factors.values())))
         super().__init__(seed, trials)
+        self.stacked_trials = trials
         self.n_base = n_base
         self.factors = factors
         self.cache = cache
@@ -222,20 +229,24 @@ class _BudgetNoise(Noise):
     def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
         f = _family_factor(self.factors, key)
         if sigma == 0.0 or not f.any():
-            return np.zeros(self.trials)
+            return np.zeros(self.stacked_trials)
         z = self.cache.get(key)
         if z is None:
             z = keyed_draws(self.seed, key, 0, self.n_base, _standard_normal)
             self.cache[key] = z
-        return np.tile(z, self.trials // self.n_base) * f * sigma
+        out: NDArray[np.float64] = np.tile(z, self.stacked_trials // self.n_base) * f * sigma
+        return out
 
 
 class _LinearisationNoise(Noise):
     """Designed operator judgments: ``steps[key]`` (T,) in units of the act's σ; every other act
     exact. ``record`` collects the act keys in order of first use (the discovery run)."""
 
-    def __init__(self, trials: int, steps: dict[str, NDArray], record: list[str] | None = None):
+    def __init__(
+        self, trials: int, steps: dict[str, NDArray[np.float64]], record: list[str] | None = None
+    ):
         super().__init__(0, trials)
+        self.design_trials = trials
         self.steps = steps
         self.record = record
 
@@ -244,7 +255,7 @@ class _LinearisationNoise(Noise):
         if self.record is not None and key not in self.record:
             self.record.append(key)
         step = self.steps.get(key)
-        return np.zeros(self.trials) if step is None else step * sigma
+        return np.zeros(self.design_trials) if step is None else step * sigma
 
 
 _FAMILIES = {family: name for name, (family, *_rest) in OPERATOR_TERMS.items()}
@@ -259,7 +270,7 @@ def _family_of(key: str) -> str:
     return family
 
 
-def _family_factor(factors: dict[str, NDArray], key: str) -> NDArray:
+def _family_factor(factors: dict[str, NDArray[np.float64]], key: str) -> NDArray[np.float64]:
     return factors[_family_of(key)]
 
 
@@ -289,7 +300,9 @@ def _run_key(config: _Config, terms: Sequence[BudgetTerm]) -> frozenset[str]:
     return frozenset(t.name for t in terms if not t.per_trial and t.name in config.on)
 
 
-def _measures(result: Any, first: int, stop: int, n_base: int) -> list[dict[str, NDArray]]:
+def _measures(
+    result: Any, first: int, stop: int, n_base: int
+) -> list[dict[str, NDArray[np.float64]]]:
     """Per configuration block of a stacked result: per-trial mean squares of each measure."""
     ev = result.evaluation
     q = np.asarray(result.q_grid_mm, float)[first:stop] * UM_PER_MM
@@ -330,12 +343,12 @@ def _decisions(result: Any, trials: int) -> NDArray[np.float64]:
 def _stacked_inputs(
     configs: Sequence[_Config],
     terms: Sequence[BudgetTerm],
-    base: dict[str, NDArray],
+    base: Mapping[str, NDArray[np.float64] | float],
     n_base: int,
-) -> tuple[dict[str, Any], dict[str, NDArray]]:
+) -> tuple[dict[str, Any], dict[str, NDArray[np.float64]]]:
     """Injected instrument errors and operator family switches of configurations stacked."""
     injected: dict[str, Any] = {}
-    factors = {family: [] for family in _FAMILIES}
+    factors: dict[str, list[NDArray[np.float64]]] = {family: [] for family in _FAMILIES}
     for t in terms:
         if t.kind != "instrument":
             continue
@@ -355,12 +368,12 @@ def _run_group(
     prep: PreparedRun,
     configs: Sequence[_Config],
     terms: Sequence[BudgetTerm],
-    base: dict[str, NDArray],
+    base: Mapping[str, NDArray[np.float64] | float],
     n_base: int,
     chunk_trials: int,
-    cache: dict,
+    cache: dict[str, NDArray[np.float64]],
     progress: Callable[[int], None] | None,
-) -> dict[str, dict[str, NDArray]]:
+) -> dict[str, dict[str, NDArray[np.float64]]]:
     """Run configurations sharing their per-run terms; label → per-trial mean squares."""
     rounding = ROUNDING in configs[0].on and prep.operator.quantise
     prep = replace(prep, operator=replace(prep.operator, quantise=rounding))
@@ -409,7 +422,7 @@ def _linear_predictions(
     for t in terms:
         if t.kind == "instrument":
             injected[t.name] = np.zeros(trials) if t.per_trial else 0.0
-    steps: dict[str, NDArray] = {key: np.zeros(trials) for key in acts}
+    steps: dict[str, NDArray[np.float64]] = {key: np.zeros(trials) for key in acts}
     for b, eps in enumerate(steps_sigma):
         first = 1 + _POINTS * pairs * b
         for j, t in enumerate(instrument):
@@ -444,7 +457,7 @@ def _linear_predictions(
     return out[0], out[1]
 
 
-def _difference_fields(result: Any, trials: int) -> dict[str, list[NDArray]]:
+def _difference_fields(result: Any, trials: int) -> dict[str, list[NDArray[np.float64]]]:
     """The measures' fields of a linearisation run, (trials, points) each, in their units."""
     ev = result.evaluation
     m = MM_PER_M / ev.map_scale_denominator if ev.map_scale_denominator else math.nan
@@ -468,17 +481,17 @@ _POINTS = len(_OFFSETS)
 
 
 def _difference_squares(
-    fields: dict[str, list[NDArray]], first: int, terms: int, eps: float
-) -> dict[str, NDArray]:
+    fields: dict[str, list[NDArray[np.float64]]], first: int, terms: int, eps: float
+) -> dict[str, NDArray[np.float64]]:
     """mean_p (g² + y₀·h) per term from trial ``first`` on, in the measures' units² per σ²:
     g = (y₁ − y₋₁)/(2ε) and h = (y₂ + y₋₂ − y₁ − y₋₁)/(3ε²) the first and second derivatives
     (yₖ at k·ε, :data:`_OFFSETS`), y₀ the error-free result (trial 0). For a zero-mean error e of
     variance σ², E[(y₀ + g·e + ½h·e²)²] − y₀² = σ²(g² + y₀·h) + O(σ⁴): the σ² order of Δ of the
     mean square, which has the floor's curvature term y₀·h beside the linear g² (the floor y₀
     is not zero)."""
-    out = {}
+    out: dict[str, NDArray[np.float64]] = {}
     for key, arrays in fields.items():
-        total = 0.0
+        total: NDArray[np.float64] | float = 0.0
         for a in arrays:
             y0 = a[0]
             block = a[first : first + _POINTS * terms]
@@ -486,11 +499,11 @@ def _difference_squares(
             g = (p1 - m1) / (2.0 * eps)
             h = (p2 + m2 - p1 - m1) / (3.0 * eps**2)
             total = total + np.mean(g**2 + y0 * h, axis=1)
-        out[key] = total
+        out[key] = np.asarray(total)
     return out
 
 
-def _rms(ms: NDArray) -> dict[str, float]:
+def _rms(ms: NDArray[np.float64]) -> dict[str, float]:
     """RMS = √mean(ms) with its standard error (delta method)."""
     n = ms.size
     mean = float(np.mean(ms))
@@ -499,7 +512,7 @@ def _rms(ms: NDArray) -> dict[str, float]:
     return {"rms": rms, "se": se / (2.0 * rms) if rms > 0 else 0.0, "ms": mean, "ms_se": se}
 
 
-def _contribution(on: NDArray, off: NDArray) -> dict[str, float]:
+def _contribution(on: NDArray[np.float64], off: NDArray[np.float64]) -> dict[str, float]:
     """Δ = mean(on − off) (paired) with its SE, and the signed RMS sign(Δ)·√|Δ| with its SE."""
     d = on - off
     delta = float(np.mean(d))
@@ -609,8 +622,8 @@ def run_budget(
             f"trials: expected at most {chunk} for the {method} method (one configuration's "
             f"trials run in one chunk of {memory_budget_mb:g} MB), found {trials}"
         )
-    cache: dict[str, NDArray] = {}
-    ms: dict[str, dict[str, NDArray]] = {}
+    cache: dict[str, NDArray[np.float64]] = {}
+    ms: dict[str, dict[str, NDArray[np.float64]]] = {}
     for group in groups.values():
         ms.update(_run_group(prep, group, terms, base, trials, chunk, cache, progress))
     linear, linear_check = _linear_predictions(prep, terms)
@@ -642,7 +655,7 @@ def run_budget(
 def _totals(
     m: str,
     terms: Sequence[BudgetTerm],
-    ms: dict[str, dict[str, NDArray]],
+    ms: dict[str, dict[str, NDArray[np.float64]]],
     linear: dict[str, dict[str, float | None]],
 ) -> dict[str, Any]:
     """All on, all off (the error-free floor), and the additivity of the one-at-a-time Δᵢ.
@@ -665,7 +678,7 @@ def _totals(
         d, se = float(np.mean(i_t)), float(np.std(i_t, ddof=1) / math.sqrt(n))
         if abs(d) > Z_AGREE * se and d != 0.0:
             interactions.append({"term": t.name, "delta_ms": d, "delta_ms_se": se})
-    lin = [v[m] for v in linear.values() if v.get(m) is not None]
+    lin = [x for v in linear.values() if (x := v.get(m)) is not None]
     return {
         "all_on": _rms(on),
         "all_off": _rms(off),
@@ -691,7 +704,7 @@ def budget_work(model: ErrorModel, trials: int) -> int:
 
 def _term_row(
     t: BudgetTerm,
-    ms: dict[str, dict[str, NDArray]],
+    ms: dict[str, dict[str, NDArray[np.float64]]],
     linear: dict[str, dict[str, float]],
     linear_check: dict[str, dict[str, float]],
     changed: float,
@@ -703,7 +716,8 @@ def _term_row(
     else:
         how = "numerical linearisation"
     one = {m: _contribution(ms[f"only {t.name}"][m], ms["all off"][m]) for m in MEASURES}
-    lin = linear.get(t.name)
+    lin: dict[str, float] | None = linear.get(t.name)
+    linear_check_t: dict[str, float] | None
     if how.startswith("zero"):
         lin = linear_check_t = {m: 0.0 for m in MEASURES}
     else:

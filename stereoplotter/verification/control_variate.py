@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.instrument.error_model import ErrorModel
+from stereoplotter.instrument.error_model import ErrorModel, ErrorTerm
 from stereoplotter.procedure.operator import Noise
 
 __all__ = [
@@ -96,6 +96,7 @@ class DesignNoise(Noise):
         self, trials: int, steps: dict[str, NDArray[np.float64]], record: list[str] | None = None
     ):
         super().__init__(0, trials)
+        self.design_trials = trials
         self.steps = steps
         self.record = record
 
@@ -103,7 +104,7 @@ class DesignNoise(Noise):
         if self.record is not None and sigma != 0.0 and key not in self.record:
             self.record.append(key)
         step = self.steps.get(key)
-        return np.zeros(self.trials) if step is None else step * sigma
+        return np.zeros(self.design_trials) if step is None else step * sigma
 
 
 @dataclass(frozen=True)
@@ -120,10 +121,17 @@ class LinearControl:
     gradient_ms: dict[str, NDArray[np.float64]] | None = None
 
 
-def _random_terms(model: ErrorModel | None) -> list:
+def _random_terms(model: ErrorModel | None) -> list[ErrorTerm]:
     if model is None:
         return []
     return [t for t in model.terms if t.distribution in _VARIANCE and t.scale]
+
+
+def _scale(model: ErrorModel | None, name: str) -> float:
+    """The σ (scale) of the instrument error term ``name`` of ``model``."""
+    if model is None:
+        raise ValueError(f"{name}: an instrument input without an instrument error model")
+    return model.term(name).scale
 
 
 def design_inputs(model: ErrorModel | None, trials: int) -> dict[str, object]:
@@ -141,7 +149,7 @@ def design_inputs(model: ErrorModel | None, trials: int) -> dict[str, object]:
 
 
 def linear_control(
-    run: Callable[[dict, Noise, int], dict[str, NDArray[np.float64]]],
+    run: Callable[[dict[str, object], Noise, int], dict[str, NDArray[np.float64]]],
     model: ErrorModel | None,
 ) -> LinearControl:
     """Linearise the fields of ``run(injected, noise, trials) -> {name: (T, P)}`` about the run
@@ -162,7 +170,7 @@ def linear_control(
         if kind == "noise":
             steps[key] = s
         else:
-            injected[key] = s * model.term(key).scale
+            injected[key] = s * _scale(model, key)
     fields = run(injected, DesignNoise(trials, steps), trials)
     variance = np.array([1.0] * len(keys) + [_VARIANCE[t.distribution] for t in terms], float)
     center, gradient, expectation, gms = {}, {}, {}, {}
@@ -196,16 +204,19 @@ def per_trial_controlled(
             if z is not None:
                 u[j] = z
         else:
-            u[j] = np.asarray(injected[key], float) / model.term(key).scale
+            u[j] = np.asarray(injected[key], float) / _scale(model, key)
     out = {}
     for name, v in fields.items():
         v = np.asarray(v, float).reshape(trials, -1)
         lin_v = u.T @ lin.gradient[name]
         lin_v += lin.center[name][None, :]
         lin_ms = np.einsum("tp,tp->t", lin_v, lin_v) / lin_v.shape[1]
+        expect: float | NDArray[np.float64]
         if on is None:
             expect = lin.expectation[name]
         else:
+            if lin.variance is None or lin.gradient_ms is None:
+                raise ValueError("on: the linearisation holds no input variances")
             b2 = float(np.mean(lin.center[name] ** 2))
             expect = b2 + (lin.variance * lin.gradient_ms[name]) @ on
         out[name] = np.einsum("tp,tp->t", v, v) / v.shape[1] - lin_ms + expect

@@ -30,11 +30,14 @@ Units: photo mm inside; the summaries per the row's unit (m_xy or m_p). Pure num
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
-from stereoplotter.verification.linear_mc import CI_Z
+from stereoplotter.instrument.kinematics import CorrectionUnit, InstrumentSetting
+from stereoplotter.verification.linear_mc import CI_Z, FloatArray
 
 __all__ = [
     "ELEMENTS",
@@ -51,6 +54,8 @@ __all__ = [
     "state_jacobian",
 ]
 
+#: A variable of the instrument state: (object, field), the object "setting" or a unit side.
+StateKey = tuple[str, str]
 #: The elements of (6.22): (object, field) of the instrument state; "setting" or a unit side.
 ELEMENTS = (
     ("setting", "base_x_mm"),
@@ -88,26 +93,37 @@ _STEP = {"tan_alpha": 1e-6, "tan_omega": 1e-6, "kappa": 1e-6}
 _STEP_MM = 1e-4
 
 
-def _resolved(unit):
+def _resolved(unit: CorrectionUnit) -> CorrectionUnit:
     """The unit with its plane decentration written out (c = e under decision D2)."""
     cx, cy = unit.plane_decentration_mm
     return replace(unit, plane_decentration_x_mm=cx, plane_decentration_y_mm=cy)
 
 
-def _get(setting, units, key):
+def _get(
+    setting: InstrumentSetting, units: Mapping[str, CorrectionUnit], key: StateKey
+) -> FloatArray:
     obj, name = key
     src = setting if obj == "setting" else units[obj]
     return np.asarray(getattr(src, name), float)
 
 
-def _set(setting, units, key, value):
+def _set(
+    setting: InstrumentSetting, units: Mapping[str, CorrectionUnit], key: StateKey, value: float
+) -> tuple[InstrumentSetting, dict[str, CorrectionUnit]]:
     obj, name = key
+    change: dict[str, Any] = {name: value}
     if obj == "setting":
-        return replace(setting, **{name: value}), units
-    return setting, {**units, obj: replace(units[obj], **{name: value})}
+        return replace(setting, **change), dict(units)
+    return setting, {**units, obj: replace(units[obj], **change)}
 
 
-def state_jacobian(setting, units, dp_of) -> np.ndarray:
+#: δp at fixed points [photo mm] as a function of an instrument state (setting, left, right).
+DpOf = Callable[[InstrumentSetting, CorrectionUnit, CorrectionUnit], FloatArray]
+
+
+def state_jacobian(
+    setting: InstrumentSetting, units: Mapping[str, CorrectionUnit], dp_of: DpOf
+) -> FloatArray:
     """∂δp/∂s for every state variable s of :data:`STATE` at the (error-free, scalar) state.
 
     ``dp_of(setting, left, right)`` → δp at the points (P,) [photo mm]. Returns (len(STATE), P).
@@ -125,7 +141,13 @@ def state_jacobian(setting, units, dp_of) -> np.ndarray:
     return np.array(rows)
 
 
-def state_deltas(setting, units, zero_setting, zero_units, trials: int) -> np.ndarray:
+def state_deltas(
+    setting: InstrumentSetting,
+    units: Mapping[str, CorrectionUnit],
+    zero_setting: InstrumentSetting,
+    zero_units: Mapping[str, CorrectionUnit],
+    trials: int,
+) -> FloatArray:
     """Each trial's state minus the error-free state, (len(STATE), T)."""
     units = {k: _resolved(u) for k, u in units.items()}
     zero_units = {k: _resolved(u) for k, u in zero_units.items()}
@@ -137,15 +159,16 @@ def state_deltas(setting, units, zero_setting, zero_units, trials: int) -> np.nd
     return out
 
 
-def linear_fields(jacobian: np.ndarray, deltas: np.ndarray):
+def linear_fields(jacobian: FloatArray, deltas: FloatArray) -> Iterator[tuple[str, FloatArray]]:
     """The cumulative first-order fields (T, P) of :data:`LEVELS`, one at a time: (name, field)
     for ``elements`` (the (6.22) elements only), ``principal_distance`` (+ f_пр) and
     ``first_order`` (every state variable)."""
-    field, done = 0.0, 0
+    field: FloatArray | float = 0.0
+    done = 0
     for name, upto in LEVELS:
         field = field + deltas[done:upto].T @ jacobian[done:upto]
         done = upto
-        yield name, field
+        yield name, np.asarray(field)
 
 
 def _rms_ci(ms: np.ndarray) -> tuple[float, float]:
@@ -193,7 +216,7 @@ _PAIRS = (
 )
 
 
-def rms_steps(simulated: float, ms: dict[str, np.ndarray], unit: float) -> dict:
+def rms_steps(simulated: float, ms: Mapping[str, FloatArray], unit: float) -> dict[str, Any]:
     """The decomposition block of one reading, without the book-geometry step (:func:`at_book`).
 
     ``simulated``: the formula per unit at the simulated geometry; ``ms``: per-trial mean
@@ -205,7 +228,7 @@ def rms_steps(simulated: float, ms: dict[str, np.ndarray], unit: float) -> dict:
     for name in (*(n for n, _ in LEVELS), "procedure"):
         r, h = _rms_ci(ms[name])
         levels[name] = (r / unit, h / unit)
-    steps = []
+    steps: list[dict[str, Any]] = []
     for (name, text), (a, b) in zip(STEPS[1:], _PAIRS, strict=True):
         if a in ms:
             c, h = _diff_ci(ms[b], ms[a])
@@ -218,7 +241,7 @@ def rms_steps(simulated: float, ms: dict[str, np.ndarray], unit: float) -> dict:
     return {"values": {k: {"value": v, "ci": h} for k, (v, h) in levels.items()}, "steps": steps}
 
 
-def at_book(block: dict, book: float, scale: float = 1.0) -> dict:
+def at_book(block: Mapping[str, Any], book: float, scale: float = 1.0) -> dict[str, Any]:
     """``block`` of :func:`rms_steps` × ``scale`` with the geometry step from the formula at the
     book geometry ``book`` prepended, and ``sum`` = book + Σ contributions (= the plain
     procedure value)."""

@@ -1,5 +1,10 @@
-"""One row of the verification table as data (:class:`Entry`) and the geometry the rows are
-computed at (:class:`Setting`), shared by the row modules ``rows_*``.
+"""One row of the verification table as data (:class:`Entry`), its procedure measure
+(:class:`ProcedureMeasure`), the geometry the rows are computed at (:class:`Setting`) and the
+declaration of rows (:class:`DeclaredRows`), shared by the row modules ``rows_*``.
+
+A row is declared once: a function of :class:`Setting` that returns its :class:`Entry` (equation,
+printed value, book and rigorous formulas, linear model, verdict rule, procedure measure),
+decorated by its module's :class:`DeclaredRows`; the table concatenates the modules' lists.
 
 Book geometry (§27): f = 70 mm, l = 85 mm, n = 1.42 (SC-1), c = 70 mm; 60 %: p = 70, a = 0;
 80 %: p = 35, a = 35.
@@ -9,13 +14,25 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.verification import linear_mc as mc
 
-__all__ = ["BOOK", "CONVENTION_NOTE", "GENERIC_SIGMAS", "RULE", "Entry", "Setting", "both_photos"]
+__all__ = [
+    "BOOK",
+    "CONVENTION_NOTE",
+    "GENERIC_SIGMAS",
+    "RULE",
+    "DeclaredRows",
+    "Entry",
+    "ProcedureMeasure",
+    "Setting",
+    "both_photos",
+]
 
 BOOK = {
     "f": 70.0,
@@ -46,7 +63,20 @@ GENERIC_SIGMAS = {
 }
 
 
-@dataclass(frozen=True)
+class ProcedureMeasure(NamedTuple):
+    """What the procedure Monte Carlo measures for a row: the run of configuration ``config``
+    (``verification.table.PROCEDURE_CONFIGS``) at the overlap ``slot`` ("60" or "80"), its
+    reading ``field`` (a field of the setup run, "parallax", "levelled" or "observed"; None: the
+    conventional run's statistic) and ``scaled`` (the value × f/p, the row's unit k of
+    (k·p/f)·m_p)."""
+
+    slot: str
+    config: str
+    field: str | None = None
+    scaled: bool = False
+
+
+@dataclass(frozen=True, kw_only=True)
 class Entry:
     """A row of the table before its Monte Carlo: the formula values and the linear model.
 
@@ -62,6 +92,8 @@ class Entry:
     number exists at the book's geometry only). ``upstream``: the equation whose error the row
     inherits when it disagrees with the rigorous value. ``book_only``: ``printed`` is a formula
     with coefficients evaluated for the book's geometry ((6.41), (6.42)), void elsewhere.
+    ``procedure``: what the procedure Monte Carlo measures for the row (None: it measures
+    nothing the row states).
     """
 
     eq: str
@@ -78,8 +110,9 @@ class Entry:
     digits: int | None = None
     upstream: str | None = None
     book_only: bool = False
+    procedure: ProcedureMeasure | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "book", float(self.book))
         object.__setattr__(self, "rigorous", float(self.rigorous))
 
@@ -91,7 +124,7 @@ class Entry:
         return f"{self.eq} | {self.quantity}"
 
 
-def both_photos(s: dict) -> dict:
+def both_photos(s: Mapping[str, float]) -> dict[str, float]:
     """Setup-element σ's of one photo (keys of :data:`GENERIC_SIGMAS`) for both photos."""
     return {
         "base_x": s["base_x"],
@@ -119,7 +152,7 @@ class Setting:
     a80: float
 
     @classmethod
-    def from_mapping(cls, g: dict) -> Setting:
+    def from_mapping(cls, g: Mapping[str, float]) -> Setting:
         return cls(**{k: g[k] for k in BOOK})
 
     @property
@@ -142,15 +175,20 @@ class Setting:
         """(a, p) of the "60" or "80" % slot."""
         return (self.a60, self.p60) if overlap == "60" else (self.a80, self.p80)
 
-    def setup_sigmas(self, m_xy: float = 1.0) -> dict:
+    def setup_sigmas(self, m_xy: float = 1.0) -> dict[str, float]:
         """Book-mode σ's of the setup elements (6.31)–(6.38) per m_xy."""
-        return sa.setup_element_sigmas(self.f, self.l, self.n, m_xy, mode="book")
+        sigmas: dict[str, float] = sa.setup_element_sigmas(
+            self.f, self.l, self.n, m_xy, mode="book"
+        )
+        return sigmas
 
-    def unadjusted(self, a: float, p: float, sigmas: dict) -> mc.LinearModel:
+    def unadjusted(self, a: float, p: float, sigmas: Mapping[str, float]) -> mc.LinearModel:
         """Setup data without levelling, both photos' element errors (problem 1)."""
         return mc.setup_model(self.f, p, a, self.c, both_photos(sigmas), levelled=False)
 
-    def levelled(self, a: float, p: float, sigmas: dict, control: float = 0.0) -> mc.LinearModel:
+    def levelled(
+        self, a: float, p: float, sigmas: Mapping[str, float], control: float = 0.0
+    ) -> mc.LinearModel:
         """Setup data after levelling on control with σ ``control`` [mm] (problem 2)."""
         return mc.setup_model(
             self.f,
@@ -162,7 +200,7 @@ class Setting:
             sigma_control_mm=control,
         )
 
-    def conventional(self, a: float, p: float, sq: float = 1.0, sc: float = 1.0):
+    def conventional(self, a: float, p: float, sq: float = 1.0, sc: float = 1.0) -> mc.LinearModel:
         """Conventional method: relative orientation (σ_q = ``sq``) and levelling (σ = ``sc``)."""
         return mc.relative_orientation_model(a, self.c, p, self.f, sq, sigma_control_mm=sc)
 
@@ -181,4 +219,62 @@ class Setting:
 
     def geodetic(self, a: float, p: float, mode: str) -> float:
         """(5.55) m_p,г/m_p over the pair in ``mode``."""
-        return c5.geodetic_orientation_parallax_rms(a, self.c, p, self.f, 1.0, mode)
+        return float(c5.geodetic_orientation_parallax_rms(a, self.c, p, self.f, 1.0, mode))
+
+
+#: A row's declaration: the function that computes its :class:`Entry` at a :class:`Setting`.
+RowBuilder = Callable[[Setting], Entry]
+
+
+class DeclaredRows:
+    """The rows of one topic module, in the order they are declared (the table's order).
+
+    A row is declared once, by decorating the function that returns its :class:`Entry`::
+
+        ROWS = DeclaredRows()
+
+        @ROWS.row
+        def eq_6_38(s: Setting) -> Entry:
+            return Entry(eq="(6.38)", ...)
+
+    :meth:`each_overlap` declares one row per overlap slot ("60", then "80") from a function of
+    the setting and the slot. The table (``verification.table.ROW_MODULES``) concatenates the
+    modules' lists; a row's random stream is keyed by its identity, not by its place.
+    """
+
+    def __init__(self) -> None:
+        self._builders: list[RowBuilder] = []
+
+    def row(self, build: RowBuilder) -> RowBuilder:
+        """Declare the row ``build`` computes (a decorator; ``build`` is returned as it was)."""
+        self._builders.append(build)
+        return build
+
+    def each_overlap(
+        self, build: Callable[[Setting, str], Entry]
+    ) -> Callable[[Setting, str], Entry]:
+        """Declare two rows, ``build(s, "60")`` and ``build(s, "80")`` (a decorator)."""
+        for overlap in ("60", "80"):
+            self._builders.append(_AtOverlap(build, overlap))
+        return build
+
+    def __iter__(self) -> Iterator[RowBuilder]:
+        return iter(self._builders)
+
+    def __len__(self) -> int:
+        return len(self._builders)
+
+    def entries(self, s: Setting) -> list[Entry]:
+        """Every declared row's :class:`Entry` at ``s``, in the declared order."""
+        return [build(s) for build in self._builders]
+
+
+@dataclass(frozen=True)
+class _AtOverlap:
+    """A row of :meth:`DeclaredRows.each_overlap`: ``build`` at one overlap slot."""
+
+    build: Callable[[Setting, str], Entry]
+    overlap: str
+
+    def __call__(self, s: Setting) -> Entry:
+        return self.build(s, self.overlap)

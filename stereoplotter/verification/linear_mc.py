@@ -19,9 +19,11 @@ se(mean s) = sd(s_t)/√T and the half-width of the RMS is z·se/(2·rms) (delta
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.accuracy.chapter5 import (
     control_points,
@@ -33,6 +35,7 @@ from stereoplotter.accuracy.setup_accuracy import SETUP_SOURCES
 
 __all__ = [
     "CI_Z",
+    "FloatArray",
     "LinearModel",
     "covariance_rms",
     "effective_G",
@@ -46,6 +49,8 @@ __all__ = [
 ]
 
 CI_Z = 3.29  # two-sided 99.9 % normal quantile
+#: An array of floats (mm, mm², rad or a coefficient, as each name says).
+FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -68,20 +73,20 @@ class LinearModel:
         Independent pointwise noise (measurement error) [mm].
     """
 
-    G: np.ndarray
-    M: np.ndarray
-    Gc: np.ndarray | None = None
-    P_fit: np.ndarray | None = None
+    G: FloatArray
+    M: FloatArray
+    Gc: FloatArray | None = None
+    P_fit: FloatArray | None = None
     sigma_control: float = 0.0
     sigma_white: float = 0.0
 
 
-def _midpoints(lo, hi, n):
+def _midpoints(lo: float, hi: float, n: int) -> FloatArray:
     h = (hi - lo) / n
-    return lo + h * (np.arange(n) + 0.5)
+    return np.asarray(lo + h * (np.arange(n) + 0.5), dtype=np.float64)
 
 
-def grid_setup_unadjusted(c_mm, nx=16, ny=32):
+def grid_setup_unadjusted(c_mm: float, nx: int = 16, ny: int = 32) -> tuple[FloatArray, FloatArray]:
     """Midpoint grid of the (6.27) domain x_л ∈ [0, c], y ∈ [−c, c]; returns (x_л, y) flat.
 
     Examples
@@ -94,7 +99,7 @@ def grid_setup_unadjusted(c_mm, nx=16, ny=32):
     return x.ravel(), y.ravel()
 
 
-def grid_chapter5(c_mm, nx=16, ny=32):
+def grid_chapter5(c_mm: float, nx: int = 16, ny: int = 32) -> tuple[FloatArray, FloatArray]:
     """Midpoint grid of the chapter-5 domain x_п ∈ [−c, 0], y ∈ [−c, c]; returns (x_п, y) flat.
 
     Examples
@@ -107,7 +112,9 @@ def grid_chapter5(c_mm, nx=16, ny=32):
     return x.ravel(), y.ravel()
 
 
-def setup_field_basis(x_right_mm, y_mm, x_parallax_mm, focal_length_mm):
+def setup_field_basis(
+    x_right_mm: ArrayLike, y_mm: ArrayLike, x_parallax_mm: float, focal_length_mm: float
+) -> FloatArray:
     """Field of each setup source (unit error) at points, (6.22) with (3.22) signs; (8, P).
 
     Order: :data:`SETUP_SOURCES`.
@@ -126,23 +133,26 @@ def setup_field_basis(x_right_mm, y_mm, x_parallax_mm, focal_length_mm):
     )
 
 
-def _plane_fit_operator(x_grid, y_grid, a_mm, c_mm):
+def _plane_fit_operator(
+    x_grid: FloatArray, y_grid: FloatArray, a_mm: float, c_mm: float
+) -> FloatArray:
     Ac = levelling_design(*control_points(a_mm, c_mm))
     Hg = levelling_design(x_grid, y_grid)
-    return Hg @ np.linalg.pinv(Ac)
+    out: FloatArray = Hg @ np.linalg.pinv(Ac)
+    return out
 
 
 def setup_model(
-    focal_length_mm,
-    x_parallax_mm,
-    a_mm,
-    c_mm,
-    sigmas,
+    focal_length_mm: float,
+    x_parallax_mm: float,
+    a_mm: float,
+    c_mm: float,
+    sigmas: Mapping[str, float],
     *,
-    levelled,
-    sigma_control_mm=0.0,
-    grid=(16, 32),
-):
+    levelled: bool,
+    sigma_control_mm: float = 0.0,
+    grid: tuple[int, int] = (16, 32),
+) -> LinearModel:
     """Linear model of setup-element errors; unlevelled on the (6.27) domain or levelled on the
     chapter-5 domain.
 
@@ -171,22 +181,22 @@ def setup_model(
     return LinearModel(G, M, Gc, _plane_fit_operator(xr, y, a_mm, c_mm), sigma_control_mm)
 
 
-def relative_field_basis(xr, y, p, f):
+def relative_field_basis(xr: FloatArray, y: FloatArray, p: float, f: float) -> FloatArray:
     # (5.13), first order, right-photo elements τ, ν, Δα, Δω, Δκ (sign of (3.22)).
     return np.stack([-p * np.ones_like(xr), -p * xr / f, -(xr**2) / f, -xr * y / f, y])
 
 
 def relative_orientation_model(
-    a_mm,
-    c_mm,
-    x_parallax_mm,
-    focal_length_mm,
-    sigma_y_parallax_mm,
+    a_mm: float,
+    c_mm: float,
+    x_parallax_mm: float,
+    focal_length_mm: float,
+    sigma_y_parallax_mm: float,
     *,
-    sigma_control_mm=0.0,
-    sigma_white_mm=0.0,
-    grid=(16, 32),
-):
+    sigma_control_mm: float = 0.0,
+    sigma_white_mm: float = 0.0,
+    grid: tuple[int, int] = (16, 32),
+) -> LinearModel:
     """Relative orientation by six standard points (least squares, (5.10)) then levelling on four
     control points, on the chapter-5 domain.
 
@@ -211,7 +221,7 @@ def relative_orientation_model(
     )
 
 
-def least_squares_model(design, sigma_obs, select):
+def least_squares_model(design: ArrayLike, sigma_obs: float, select: int) -> LinearModel:
     """Model of one least-squares estimate (a single 'grid point'): element ``select`` of
     pinv(design) @ noise.
 
@@ -227,7 +237,7 @@ def least_squares_model(design, sigma_obs, select):
     return LinearModel(G, L)
 
 
-def combine(*models):
+def combine(*models: LinearModel) -> LinearModel:
     """Sum of independent models on the same grid (block-diagonal mixing).
 
     Examples
@@ -247,25 +257,32 @@ def combine(*models):
         i += k
         j += jj
     fits = [m for m in models if m.Gc is not None]
+    Gc: FloatArray | None = None
+    P_fit: FloatArray | None = None
     if fits:
         Gc = np.concatenate(
             [m.Gc if m.Gc is not None else np.zeros((m.G.shape[0], 4)) for m in models]
         )
         P_fit = fits[0].P_fit
-    else:
-        Gc = P_fit = None
     sc = float(np.sqrt(sum(m.sigma_control**2 for m in models)))
     sw = float(np.sqrt(sum(m.sigma_white**2 for m in models)))
     return LinearModel(G, M, Gc, P_fit, sc, sw)
 
 
-def effective_G(model):
+def effective_G(model: LinearModel) -> FloatArray:
     """The model's sensitivity rows with the control-point fit removed (``G − (P_fit·Gc)ᵀ``
     where the row levels on control points; ``G`` itself otherwise)."""
     G = model.G
     if model.Gc is not None:
-        G = G - (model.P_fit @ model.Gc.T).T
+        G = G - (_fit(model) @ model.Gc.T).T
     return G
+
+
+def _fit(model: LinearModel) -> FloatArray:
+    """``P_fit`` of a model that levels on control points (``Gc`` set)."""
+    if model.P_fit is None:
+        raise ValueError("a model with control-point fields (Gc) needs its plane fit (P_fit)")
+    return model.P_fit
 
 
 def covariance_rms(model: LinearModel) -> float:
@@ -280,12 +297,14 @@ def covariance_rms(model: LinearModel) -> float:
     S = model.M @ model.M.T
     var = np.einsum("kp,kl,lp->p", Ge, S, Ge)
     if model.Gc is not None and model.sigma_control:
-        var = var + model.sigma_control**2 * np.sum(model.P_fit**2, axis=1)
+        var = var + model.sigma_control**2 * np.sum(_fit(model) ** 2, axis=1)
     var = var + model.sigma_white**2
     return float(np.sqrt(var.mean()))
 
 
-def mc_rms(model: LinearModel, trials: int, rng: np.random.Generator, chunk: int = 4000):
+def mc_rms(
+    model: LinearModel, trials: int, rng: np.random.Generator, chunk: int = 4000
+) -> tuple[float, float, FloatArray]:
     """Monte Carlo RMS over trials and grid points, with its CI half-width.
 
     Returns
@@ -315,10 +334,10 @@ def mc_rms(model: LinearModel, trials: int, rng: np.random.Generator, chunk: int
     B = model.M.T @ model.G  # (J, P)
     nc = 0
     if model.Gc is not None:
-        B = B - (model.M.T @ model.Gc) @ model.P_fit.T
+        B = B - (model.M.T @ model.Gc) @ _fit(model).T
         if model.sigma_control:
             nc = model.Gc.shape[1]
-            B = np.vstack([B, -model.sigma_control * model.P_fit.T])
+            B = np.vstack([B, -model.sigma_control * _fit(model).T])
     Q = B @ B.T / P
     out = np.empty(trials)
     for start in range(0, trials, chunk):

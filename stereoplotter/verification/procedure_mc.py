@@ -42,20 +42,22 @@ Every run can carry the instrument's error terms at their σ (``instrument=True`
 mechanics), and is estimated with the linear control variate of
 :mod:`~stereoplotter.verification.control_variate` (unbiased; ``plain`` keeps the plain mean).
 
-:func:`relative_orientation_mc` runs the conventional relative orientation alone (σ_q only, fixed
-passes) against (5.54).
+One configuration's run is made of the typed parts of :mod:`.procedure_run`; the points and δp
+of a scenario and a built instrument are :mod:`.procedure_geometry`'s.
+:mod:`.relative_orientation_mc` runs the conventional relative orientation alone (σ_q only,
+fixed passes) against (5.54).
 """
 
 from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.accuracy import setup_accuracy as sa
 from stereoplotter.accuracy.chapter5 import (
@@ -66,29 +68,30 @@ from stereoplotter.accuracy.chapter5 import (
     relative_orientation_parallax_rms,
     standard_points,
 )
-from stereoplotter.instrument.kinematics import counters_from_homologous_points
-from stereoplotter.instrument.virtual import HEIGHT_SCALE
-from stereoplotter.procedure import conventional as cv
-from stereoplotter.procedure import evaluation as ev
-from stereoplotter.procedure.evaluation import instrument_frame_m
 from stereoplotter.procedure.fidelity import LINKAGE_VARIANTS, Fidelity
 from stereoplotter.procedure.operator import OperatorModel
-from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
-from stereoplotter.procedure.trials import (
-    DEFAULT_MEMORY_BUDGET_MB,
-    chunk_trials_for,
-)
-from stereoplotter.scenario.model import Terrain
-from stereoplotter.scenario.synthetic import working_area_grid_m
-from stereoplotter.setup.sheet import compute_setup_sheet
-from stereoplotter.verification import control_variate as cvar
+from stereoplotter.procedure.simulate import prepare_run
 from stereoplotter.verification import decomposition as dc
+from stereoplotter.verification.as_formula import RunResult
 from stereoplotter.verification.linear_mc import (
     CI_Z,
+    FloatArray,
     LinearModel,
     covariance_rms,
     grid_chapter5,
     relative_field_basis,
+)
+from stereoplotter.verification.procedure_geometry import (
+    idealised_geometry,
+    levelling_frame_points,
+    scenario_geometry,
+)
+from stereoplotter.verification.procedure_run import (
+    METHODS,
+    FieldKey,
+    ProcedureRun,
+    mean_squares,
+    method_operator,
 )
 
 if TYPE_CHECKING:
@@ -97,411 +100,31 @@ if TYPE_CHECKING:
 
 __all__ = [
     "LINKAGE_VARIANTS",
-    "PROCEDURE_ROWS",
+    "METHODS",
     "SOURCES",
+    "ConfigurationRun",
     "ProcedureOptions",
     "conventional_sources_mc",
     "idealised_geometry",
     "levelling_formula",
     "levelling_points_photo",
     "procedure_mc",
+    "rms_ci",
+    "run_configuration",
     "scenario_geometry",
 ]
-
-#: Row → (book scenario, method); the scenarios are the book's §27 setting (shipped ``pair60``,
-#: ``pair80``), loaded by the caller (:func:`stereoplotter.report.verification.book_scenarios`).
-PROCEDURE_ROWS = {
-    "(6.43)": ("pair60.yaml", "setup"),
-    "(6.44)": ("pair80.yaml", "setup"),
-    "(6.39)": ("pair60.yaml", "setup"),
-    "(6.40)": ("pair80.yaml", "setup"),
-    "(6.45)": ("pair60.yaml", "conventional"),
-    "(6.46)": ("pair80.yaml", "conventional"),
-    "(6.60)": ("pair60.yaml", "conventional"),
-    "(6.61)": ("pair80.yaml", "conventional"),
-}
-
-
-def scenario_geometry(scenario: Scenario, spec: InstrumentSpec) -> dict:
-    """f, l, n_л, f_пр, photo base p = B·f/H̄, overlap and the book's c of a scenario.
-
-    c follows the book's §27 convention: c = p below 70 % overlap (60 %: a = 0), c = 2p above
-    (80 %: a = p). ``spec`` is the instrument whose setup sheet gives n_л and f_пр (the book's
-    SC-1).
-
-    Examples
-    --------
-    >>> from stereoplotter.io.paths import data_dir
-    >>> from stereoplotter.io.scenario_file import load_scenario
-    >>> from stereoplotter.io.instrument_file import load_instrument
-    >>> sc = load_scenario(data_dir("scenarios") / "pair60.yaml")
-    >>> g = scenario_geometry(sc, load_instrument("sc1"))
-    >>> round(g["f"]), round(g["l"]), g["overlap"] < 0.7
-    (70, 85, True)
-    """
-    return _scenario_geometry(scenario, spec)
-
-
-def _scenario_geometry(scenario, spec):
-
-    sheet = compute_setup_sheet(scenario, spec, rng=np.random.default_rng(scenario.seed))
-    f = float(scenario.camera.focal_length_mm)
-    pts = np.asarray(scenario.camera.fiducial_array_mm(), float)
-    ll = float(np.mean(np.hypot(pts[:, 0], pts[:, 1])))  # mark distance l from the centre
-    origin = np.asarray(sheet.frame_origin_m, float)
-    theta = float(sheet.frame_rotation)
-    grid = instrument_frame_m(working_area_grid_m(scenario, (9, 9)), origin, theta)
-    height = float(-np.mean(grid[:, 2]))
-    right = instrument_frame_m(
-        np.asarray(scenario.photo("right").exterior.centre, float)[None], origin, theta
-    )[0]
-    p = float(right[0]) * f / height
-    fmt = float(scenario.camera.format_mm)
-    overlap = 1.0 - p / fmt
-    c = p if overlap < 0.7 else 2.0 * p
-    return {
-        "f": f,
-        "l": ll,
-        "n": float(sheet.n_left),
-        "f_instrument": float(sheet.f_instrument_mm),
-        "p": p,
-        "c": c,
-        "a": c - p,
-        "overlap": overlap,
-        "flying_height_m": height,
-        # the terrain's depth in the model, H̄/M_в, against the carriage's D = n_л·f_пр
-        "terrain_depth_mm": height * 1000.0 / float(sheet.vertical_scale_denominator),
-    }
-
-
-def domain_points(scenario, sheet, x_left_range, c, p, f, height, grid=(16, 32)):
-    """Ground points (instrument frame) under a midpoint grid of left-photo (x_л, y) [mm]."""
-
-    nx, ny = grid
-    x0, x1 = x_left_range
-    xs = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
-    ys = -c + (np.arange(ny) + 0.5) * 2 * c / ny
-    X, Y = np.meshgrid(xs, ys, indexing="ij")
-    scale = height / f  # ground m per photo mm
-    plan = np.column_stack([X.ravel() * scale, Y.ravel() * scale])
-    origin = np.asarray(sheet.frame_origin_m, float)
-    theta = float(sheet.frame_rotation)
-    local = instrument_frame_m(
-        np.column_stack([plan, np.zeros(len(plan))]), origin, theta, inverse=True
-    )
-    local[:, 2] = scenario.terrain.height_m(local[:, 0], local[:, 1])
-    return instrument_frame_m(local, origin, theta)
-
-
-def dp_at(scenario, sheet, inst, frame_pts):
-    """δp [photo mm] of the built instrument ``inst`` at ``frame_pts`` (ideal model position)."""
-    units = inst.state()["units"]
-    return _dp_of(scenario, sheet, frame_pts)(inst.setting, units["left"], units["right"])
-
-
-def _dp_of(scenario, sheet, frame_pts):
-    """δp at ``frame_pts`` as a function of an instrument state (setting, left, right units)."""
-    origin = np.asarray(sheet.frame_origin_m, float)
-    theta = float(sheet.frame_rotation)
-    local = ev.instrument_frame_m(frame_pts, origin, theta, inverse=True)
-    gl = ev.film_points_mm(scenario, "left", local)
-    gr = ev.film_points_mm(scenario, "right", local)
-    model = ev.ideal_model_mm(
-        frame_pts, sheet.horizontal_scale_denominator, sheet.vertical_scale_denominator
-    )
-    return lambda setting, left, right: _dp_state(model, gl, gr, setting, left, right)
-
-
-def _dp_state(model, gl, gr, setting, left, right):
-    if ev.trial_count(setting, (left, right)) is not None:
-        setting = ev.with_point_axis(setting)
-        left, right = ev.with_point_axis(left), ev.with_point_axis(right)
-    dp, _ = ev.parallax_errors_at_ideal(model, gl, gr, setting, left, right)
-    return np.asarray(dp, float)
 
 
 #: ``procedure_mc(sources=…)`` of the conventional method: which judgment errors are on.
 SOURCES = ("both", "y_parallax", "stereo")
 
-#: The procedure methods: §27 task 1 with unadjusted setup data ("setup"), task 2 with setup data
-#: refined on control ("setup_control"), and the conventional method.
-METHODS = ("setup", "setup_control", "conventional")
 
-
-def _configuration(method, sigma_mm, c, p, n, sources="both"):
-    """Operator errors, domain x_л-range, unit and run options of ``method`` (module docstring).
-
-    ``sources`` (conventional only): "both" (σ_q = σ_p = σ, the formula's m_q = m_p), or only
-    the y-parallax σ_q ("y_parallax", the relative-orientation part (5.54)) or only the stereo σ_p
-    ("stereo", the levelling part (5.55))."""
-
-    zero = OperatorModel().zero()
-    if method in ("setup", "setup_control"):
-        op = replace(zero, monocular_sigma_mm=sigma_mm)
-        return zero, op, (0.0, c), n * sigma_mm, {}  # domain of (6.27)
-    if method == "conventional":
-        sq = 0.0 if sources == "stereo" else sigma_mm
-        sp = 0.0 if sources == "y_parallax" else sigma_mm
-        op = replace(zero, stereo_sigma_mm=sp, y_parallax_sigma_mm=sq)
-        return zero, op, (p - c, p), sigma_mm, {"relative": "equations"}  # x_п ∈ [−c, 0]
-    raise ValueError(f"method: expected one of {METHODS}, found {method!r}")
-
-
-def _height_errors_parallax(sc, sheet, inst, frame_pts):
-    """The error of the height read on the slipped height scale at ``frame_pts`` (the mark
-    fused exactly on each point), converted to x-parallax (photo mm) by dp/dH = B·f/(Z_S − Z)².
-
-    This is what M_p measures ((5.42), (5.56)): the datum is carried by the height scale (its
-    slip), not by the model's position; a model scale error of b_x moves every δp at the ideal
-    model position by p·ε but a slipped height by only ε·ΔH.
-    """
-
-    origin = np.asarray(sheet.frame_origin_m, float)
-    theta = float(sheet.frame_rotation)
-    local = ev.instrument_frame_m(frame_pts, origin, theta, inverse=True)
-    gl = ev.film_points_mm(sc, "left", local)
-    gr = ev.film_points_mm(sc, "right", local)
-    units = inst.state()["units"]
-    setting, left, right = inst.setting, units["left"], units["right"]
-    gear = float(sheet.vertical_scale_denominator)
-    slip = (
-        np.asarray(inst.read(HEIGHT_SCALE, exact=True), float)
-        + np.asarray(inst.read("Z", exact=True), float) * gear / 1000.0
-    )
-    if ev.trial_count(setting, (left, right)) is not None:
-        setting = ev.with_point_axis(setting)
-        left, right = ev.with_point_axis(left), ev.with_point_axis(right)
-        slip = slip[:, None]
-    depth = counters_from_homologous_points(gl, gr, setting, left, right).depth_mm
-    dh = slip - depth * gear / 1000.0 - local[:, 2]
-    return dh
-
-
-def _levelling_frame_points(prep):
-    """The procedure's four levelling points (``conventional.levelling_points``) in the frame."""
-
-    class _R:  # levelling_points reads only run.scene and run.sheet
-        scene, sheet = prep.scene, prep.sheet
-
-    ids = cv.levelling_points(_R)
-    local = np.array(
-        [next(p for p in prep.scenario.points if p.id == i).local_m for i in ids], float
-    )
-    origin = np.asarray(prep.sheet.frame_origin_m, float)
-    return ids, instrument_frame_m(local, origin, float(prep.sheet.frame_rotation))
-
-
-#: A run's fields: (result, noise) → field name → per-trial values over the domain, (T, n).
-Fields = Callable[[Any, Any], dict[str, NDArray[np.float64]]]
-#: The decomposition's mean squares: (result, the run's fields) → (reading, level) → (T,).
-Decompose = Callable[[Any, dict[str, NDArray[np.float64]]], dict[tuple[str, str], Any]]
-
-
-@dataclass(frozen=True)
-class FieldMaker:
-    """What a method's procedure MC measures on a run: its ``fields`` and, for the setup-data
-    method, the per-trial mean squares of their first-order ``decompose`` (None: none)."""
-
-    fields: Fields
-    decompose: Decompose | None = None
-
-
-def _setup_fields(sc, zero_run, g, xr, grid, sigma_control: float = 0.0):
-    """Field makers of the setup-data method: δp on the (6.27) domain ("parallax", task 1), and
-    on the chapter-5 domain after levelling on Fig. 39's four control points (task 2,
-    :data:`METHODS` "setup_control"): "levelled" with exact control heights, "observed" with
-    each control height's parallax observed with σ_c = ``sigma_control`` (keyed draws
-    ``mc/control/i``)."""
-
-    f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
-    sheet = zero_run.sheet
-    pts = domain_points(sc, sheet, xr, c, p, f, h, grid)
-    lev = domain_points(sc, sheet, (p - c, p), c, p, f, h, grid)
-    book, _, _ = control_frame_points(sc, sheet, g)
-    n, nl = len(pts), len(lev)
-    # below 70 % overlap c = p: the two domains are one (60 %: x_л ∈ [0, p]), δp computed once
-    same = pts.shape == lev.shape and np.array_equal(pts, lev)
-    allp = np.vstack([pts, book] if same else [pts, lev, book])
-    first_lev, first_ctl = (0, n) if same else (n, n + nl)
-    zero = dp_at(sc, sheet, zero_run.instrument, allp)
-    refit = levelling_design(lev[:, 0], lev[:, 1]) @ np.linalg.pinv(
-        levelling_design(book[:, 0], book[:, 1])
-    )
-
-    def readings(d):
-        dom, ctl = d[:, first_lev : first_lev + nl], d[:, first_ctl:]
-        return {"parallax": d[:, :n], "levelled": dom - ctl @ refit.T}
-
-    def fields(result, noise):
-        d = dp_at(sc, result.sheet, result.instrument, allp) - zero
-        out = readings(d)
-        obs = np.stack(
-            [noise.normal(f"mc/control/{i}", sigma_control) for i in range(len(book))], -1
-        )
-        return {**out, "observed": out["levelled"] - obs @ refit.T}
-
-    units0 = zero_run.instrument.state()["units"]
-    state0 = (zero_run.instrument.setting, {s: units0[s] for s in ("left", "right")})
-    jac = dc.state_jacobian(*state0, _dp_of(sc, sheet, allp))
-
-    def decompose(result, main):
-        """Per-trial mean squares of the first-order fields of the decomposition
-        (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²]."""
-        units = result.instrument.state()["units"]
-        trials = len(next(iter(main.values())))
-        deltas = dc.state_deltas(
-            result.instrument.setting, {s: units[s] for s in ("left", "right")}, *state0, trials
-        )
-        noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
-        # each (6.22) element's error (instrument units: mm, tangent, rad), squared per trial
-        out = {("element", f"{o}.{f}"): deltas[i] ** 2 for i, (o, f) in enumerate(dc.ELEMENTS)}
-        for step, d in dc.linear_fields(jac, deltas):
-            r = readings(d)
-            r["observed"] = r["levelled"] + noise
-            out.update({(key, step): np.mean(v**2, axis=-1) for key, v in r.items()})
-        return out
-
-    return FieldMaker(fields, decompose), zero[:n]
-
-
-def _conventional_fields(sc, zero_prep, zero_run, g, xr, grid, sigma_p):
-    """Field makers of the conventional method (``procedure_mc`` options): δp at the ideal model
-    position ("parallax") and the heights read on the slipped height scale in parallax units
-    (dp/dH = B·f/(Z_S − Z)², frame origin S_л) with three datums: the procedure's slip ("slip"),
-    the levelling plane's offset from the four levelling heights each observed with σ_p ("plane",
-    the formula's), and the built model re-levelled by the least-squares plane through its
-    height errors at x_п ∈ {−c, a}, y = ±c, each observed with σ_p ("book")."""
-
-    f, p, c, h = g["f"], g["p"], g["c"], g["flying_height_m"]
-    sheet = zero_run.sheet
-    pts = domain_points(sc, sheet, xr, c, p, f, h, grid)
-    d_zero = dp_at(sc, sheet, zero_run.instrument, pts)
-    _, lev = _levelling_frame_points(zero_prep)
-    book, _, _ = control_frame_points(sc, sheet, g)
-    allp = np.vstack([pts, lev, book])
-    k = (p * h / f) * f / allp[:, 2] ** 2  # photo mm of x-parallax per m of height
-    h_zero = _height_errors_parallax(sc, sheet, zero_run.instrument, allp)
-    n, nl = len(pts), len(lev)
-    refit = levelling_design(pts[:, 0], pts[:, 1]) @ np.linalg.pinv(
-        levelling_design(book[:, 0], book[:, 1])
-    )
-
-    def fields(result, noise):
-        d = dp_at(sc, result.sheet, result.instrument, pts) - d_zero
-        e = (_height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
-        obs = e[:, n : n + nl] + np.stack(
-            [noise.normal(f"mc/datum/{i}", sigma_p) for i in range(nl)], -1
-        )
-        ctl = e[:, n + nl :] + np.stack(
-            [noise.normal(f"mc/book/{i}", sigma_p) for i in range(len(book))], -1
-        )
-        return {
-            "parallax": d,
-            "slip": e[:, :n],
-            "plane": e[:, :n] - np.mean(obs, axis=-1, keepdims=True),
-            "book": e[:, :n] - ctl @ refit.T,
-        }
-
-    return FieldMaker(fields), d_zero
-
-
-def _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw):
-    """The prepared run of the procedure MC: real mechanics only with instrument errors; the
-    standard points at a = c − p (``standard_points`` "book"); ``kw["fidelity"]`` the mechanism
-    switches (its ``passes``: no check ever passes, so every loop runs that many times)."""
-    instrument = bool(options.get("instrument")) and errors != "zero"
-    prep = prepare_run(
-        sc, spec, base, errors, seed, operator=operator, ideal_mechanics=not instrument, **kw
-    )
-    if options.get("standard_points") == "book":
-        tol = prep.sheet.tolerances  # keep the operator's tolerances (stopping rule as built)
-        prep = standard_points_at_a(prep, g)
-        prep = replace(prep, sheet=replace(prep.sheet, tolerances=tol))
-    return prep
-
-
-def _mean_squares(sc, spec, method, seed, trials, zero, op, xr, g, grid, kw, options=None):
-    """Per-trial mean squares of each field (:func:`_setup_fields`,
-    :func:`_conventional_fields`), plain and with the linear control variate
-    (:mod:`~stereoplotter.verification.control_variate`), and the error-free run's δp.
-
-    The error-free run once; the linearisation once; the noisy trials in chunks under the memory
-    budget (the random draws are keyed by trial, so the chunk size changes no result).
-    ``options``: ``standard_points`` "book" (conventional: standard points at a = c − p),
-    ``instrument`` (every injected instrument error at its configured σ, real mechanics),
-    ``sigma_control`` (setup: σ of the observed control parallaxes), ``control_variate``,
-    ``passes`` (:func:`_prepared_run`).
-    """
-
-    options = options or {}
-    instrument = bool(options.get("instrument"))
-    base = "conventional" if method == "conventional" else "setup"
-    # The formulas of §27 describe the book's procedure, task 1: each element set once, no
-    # remedies — for both methods (the operator's remedies would lower the setup-data value).
-    kw = {"practice": "book", **kw}
-
-    def prepared(operator, errors="zero"):
-        return _prepared_run(sc, spec, base, seed, operator, errors, g, options, kw)
-
-    zero_prep = prepared(zero)
-    zero_run = run_trials_chunk(zero_prep, 0, None, evaluate=False, transcript=False)
-    if base == "setup":
-        sigma_control = float(options.get("sigma_control", 0.0))
-        maker, d_zero = _setup_fields(sc, zero_run, g, xr, grid, sigma_control)
-    else:
-        maker, d_zero = _conventional_fields(
-            sc, zero_prep, zero_run, g, xr, grid, op.stereo_sigma_mm
-        )
-    prep = prepared(op, None if instrument else "zero")
-    model = prep.model
-
-    def run(injected, noise, n):
-        result = run_trials_chunk(
-            prep, 0, n, evaluate=False, transcript=False, injected=injected, noise=noise
-        )
-        return maker.fields(result, noise)
-
-    lin = cvar.linear_control(run, model) if options.get("control_variate", True) else None
-    chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, base)
-    plain: dict[str, np.ndarray] = {}
-    controlled: dict[str, np.ndarray] = {}
-    off = options.get("off")
-    for first in range(0, int(trials), chunk):
-        m = min(chunk, int(trials) - first)
-        injected = model.draw_keyed(prep.seed, first, first + m)
-        if off:
-            part = {k: v[first : first + m] for k, v in off.items()}
-            noise = cvar.SourceNoise(prep.seed, m, first, part)
-        else:
-            noise = cvar.RecordingNoise(prep.seed, m, first)
-        result = run_trials_chunk(
-            prep, first, m, evaluate=False, transcript=False, injected=injected, noise=noise
-        )
-        fs = maker.fields(result, noise)
-        on = _inputs_on(lin, part, m) if lin and off else None
-        cv = cvar.per_trial_controlled(fs, lin, noise, injected, model, on) if lin else {}
-        ms = {name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()}
-        if maker.decompose is not None:  # already mean squares
-            ms.update(maker.decompose(result, fs))
-        for name, v in ms.items():
-            plain.setdefault(name, np.empty(int(trials)))[first : first + m] = v
-            if lin and name in cv:
-                controlled.setdefault(name, np.empty(int(trials)))[first : first + m] = cv[name]
-    return plain, controlled, d_zero
-
-
-def _inputs_on(lin, off, trials):
-    """(K, T): 1 where input k of ``lin`` is drawn on a trial, 0 where its source is off."""
-    on = np.ones((len(lin.inputs), trials))
-    for j, name in enumerate(lin.inputs):
-        kind, _, key = name.partition(":")
-        mask = next((m for p, m in off.items() if key.startswith(p)), None)
-        if kind == "noise" and mask is not None:
-            on[j] = ~mask
-    return on
-
-
-def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
+def levelling_formula(
+    g: Mapping[str, float],
+    x_right_mm: ArrayLike,
+    y_mm: ArrayLike,
+    grid: tuple[int, int] = (16, 32),
+) -> dict[str, float]:
     """The rigorous M_p of the conventional method, (5.54) ⊕ (5.55), with the levelling plane
     fitted at the given control points instead of Fig. 39's x_п ∈ {−c, a}, y = ±c.
 
@@ -527,7 +150,7 @@ def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
     xg, yg = grid_chapter5(c, *grid)
     xc, yc = np.asarray(x_right_mm, float), np.asarray(y_mm, float)
     fit = levelling_design(xg, yg) @ np.linalg.pinv(levelling_design(xc, yc))
-    out = {}
+    out: dict[str, float] = {}
     for name, sq, sp in (("y_parallax", 1.0, 0.0), ("stereo", 0.0, 1.0), ("both", 1.0, 1.0)):
         model = LinearModel(
             relative_field_basis(xg, yg, p, f),
@@ -541,18 +164,20 @@ def levelling_formula(g: dict, x_right_mm, y_mm, grid=(16, 32)) -> dict:
     return out
 
 
-def levelling_points_photo(scenario: Scenario, spec: InstrumentSpec, g: dict):
+def levelling_points_photo(
+    scenario: Scenario, spec: InstrumentSpec, g: Mapping[str, float]
+) -> tuple[FloatArray, FloatArray]:
     """(x_п, y) [mm] of the procedure's four levelling points (the scenario's control points
     nearest standard points 3–6, ``conventional.levelling_points``) at the mean photo scale."""
 
     spec = replace(spec, standard_points_c_mm=g["c"])
     prep = prepare_run(scenario, spec, "conventional", "zero", 0, operator=OperatorModel().zero())
-    _, lev = _levelling_frame_points(prep)
+    _, lev = levelling_frame_points(prep)
     s = g["f"] / g["flying_height_m"]
     return lev[:, 0] * s - g["p"], lev[:, 1] * s
 
 
-def rms_ci(ms, unit):
+def rms_ci(ms: FloatArray, unit: float) -> tuple[float, float]:
     """(RMS, CI half-width) per ``unit`` from per-trial mean squares (``CI_Z`` s.e.)."""
     mean_ms = float(np.mean(ms))
     rms = math.sqrt(max(mean_ms, 0.0))
@@ -562,7 +187,7 @@ def rms_ci(ms, unit):
     return rms / unit, half / unit
 
 
-def _check_options(method, **options):
+def _check_options(method: str, **options: str) -> None:
     if method not in METHODS:
         raise ValueError(f"method: expected one of {METHODS}, found {method!r}")
     allowed = {
@@ -578,7 +203,7 @@ def _check_options(method, **options):
             raise ValueError(f"{name}: expected one of {allowed[name]}, found {value!r}")
 
 
-def _field_name(method, quantity, levelling, datum, control):
+def _field_name(method: str, quantity: str, levelling: str, datum: str, control: str) -> str:
     """The field whose mean square is the procedure's statistic."""
     if method == "setup":
         return "parallax"
@@ -589,7 +214,15 @@ def _field_name(method, quantity, levelling, datum, control):
     return "book" if levelling == "book" else datum
 
 
-def _formulas(method, scenario, spec, g, sources, control, levelled=None):
+def _formulas(
+    method: str,
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    g: Mapping[str, float],
+    sources: str,
+    control: str,
+    levelled: tuple[Mapping[str, float], Mapping[str, float]] | None = None,
+) -> dict[str, float]:
     """The rigorous formula at the simulated geometry for the statistic (per its unit).
     ``levelled``: the two :func:`levelling_formula` results (procedure's points, Fig. 39's) if
     already computed."""
@@ -675,7 +308,7 @@ class ProcedureOptions:
     """
 
     sigma_mm: float = 0.01
-    grid: tuple = (16, 32)
+    grid: tuple[int, int] = (16, 32)
     quantity: str = "heights"
     standard_points: str = "book"
     datum: str = "plane"
@@ -688,13 +321,19 @@ class ProcedureOptions:
     linkage: str | None = None
     fidelity: Fidelity | None = None
 
-    def switches(self, spec) -> Fidelity:
+    def switches(self, spec: InstrumentSpec) -> Fidelity:
         """The run's :class:`Fidelity`, ``passes`` and ``linkage`` applied, the linkage
-        resolved (None: the instrument's)."""
+        resolved (:meth:`linkage_of`)."""
         f = self.fidelity or Fidelity()
         passes = f.passes if self.passes is None else self.passes
-        linkage = self.linkage or f.linkage or spec.decentration_linkage
-        return replace(f, passes=passes, linkage=linkage)
+        return replace(f, passes=passes, linkage=self.linkage_of(spec))
+
+    def linkage_of(self, spec: InstrumentSpec) -> str:
+        """The run's knob–decentration linkage: ``linkage``, else the fidelity's, else the
+        instrument's ``correction.decentration_linkage``."""
+        f = self.fidelity or Fidelity()
+        linkage: str = self.linkage or f.linkage or spec.decentration_linkage
+        return linkage
 
 
 def procedure_mc(
@@ -704,8 +343,8 @@ def procedure_mc(
     spec: InstrumentSpec,
     trials: int = 600,
     seed: int = 20240601,
-    **options,
-) -> dict:
+    **options: Any,
+) -> RunResult:
     """Run the procedure MC for one scenario and method (see the module docstring).
 
     ``method`` (:data:`METHODS`): "setup" (§27 task 1: stages 1–5 with the operator's monocular
@@ -744,15 +383,22 @@ def procedure_mc(
         **{k: getattr(o, k) for k in ("sources", "control")},
     )
     g = scenario_geometry(scenario, spec)
-    linkage = o.switches(spec).linkage
-    plain, controlled, d_zero, units = run_configuration(
-        scenario, spec, method, trials, seed, o, g, linkage
-    )
-    out = _result(scenario, spec, method, o, g, linkage, (plain, controlled, d_zero, units))
+    linkage = o.linkage_of(spec)
+    runs = run_configuration(scenario, spec, method, trials, seed, o, g, linkage)
+    out = _result(scenario, spec, method, o, g, linkage, runs)
     return {**out, "trials": int(trials), "seed": int(seed), "seconds": time.perf_counter() - t0}
 
 
-def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
+def _result(
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    method: str,
+    o: ProcedureOptions,
+    g: dict[str, float],
+    linkage: str,
+    runs: ConfigurationRun,
+    formulas: dict[str, float] | None = None,
+) -> RunResult:
     """The result of :func:`procedure_mc` from the per-trial mean squares of its run(s)."""
     plain, controlled, d_zero, units = runs
     name = _field_name(method, o.quantity, o.levelling, o.datum, o.control)
@@ -784,7 +430,7 @@ def _result(scenario, spec, method, o, g, linkage, runs, formulas=None):
 
 #: Key prefixes of the acts of each judgment source of the conventional method (σ_q: the
 #: y-parallax judgments ``q/…``; σ_p: the stereo judgments ``stereo/…`` and the observed
-#: levelling heights ``mc/datum/…``, ``mc/book/…`` of :func:`_conventional_fields`).
+#: levelling heights ``mc/datum/…``, ``mc/book/…`` of the conventional run, :mod:`.procedure_run`).
 SOURCE_PREFIXES = {"y_parallax": ("q/",), "stereo": ("stereo/", "mc/datum/", "mc/book/")}
 
 
@@ -794,8 +440,8 @@ def conventional_sources_mc(
     spec: InstrumentSpec,
     trials: dict[str, int],
     seed: int = 20240601,
-    **options,
-) -> dict[str, dict]:
+    **options: Any,
+) -> dict[str, RunResult]:
     """:func:`procedure_mc` of the conventional method for several ``sources`` at once, as one
     run: ``trials`` maps a source (:data:`SOURCES`) to its trials, laid out in blocks of one run
     with σ_q = σ_p = σ whose acts of the sources a block leaves out draw 0 on its trials
@@ -814,7 +460,7 @@ def conventional_sources_mc(
     o = ProcedureOptions(**options)
     _check_options("conventional", **{k: getattr(o, k) for k in ("quantity", "standard_points")})
     g = scenario_geometry(scenario, spec)
-    linkage = o.switches(spec).linkage
+    linkage = o.linkage_of(spec)
     names = list(trials)
     bounds = np.cumsum([0] + [int(trials[k]) for k in names])
     off_of = {
@@ -827,48 +473,92 @@ def conventional_sources_mc(
     )
     lev = levelling_formula(g, *levelling_points_photo(scenario, spec, g))
     book = levelling_formula(g, *control_points(g["a"], g["c"]))
-    out = {}
+    out: dict[str, RunResult] = {}
     for k, first, last in zip(names, bounds[:-1], bounds[1:], strict=True):
         ok = replace(o, sources=k)
-        cut = [{n: v[first:last] for n, v in d.items()} for d in (plain, controlled)]
+        plain_k, controlled_k = (
+            {n: v[first:last] for n, v in d.items()} for d in (plain, controlled)
+        )
         formulas = _formulas("conventional", scenario, spec, g, k, o.control, (lev, book))
-        runs = (*cut, d_zero, units)
+        runs = ConfigurationRun(plain_k, controlled_k, d_zero, units)
         res = _result(scenario, spec, "conventional", ok, g, linkage, runs, formulas)
         out[k] = {**res, "trials": int(last - first), "seed": int(seed), "first_trial": int(first)}
     seconds = time.perf_counter() - t0
     return {k: {**v, "seconds": seconds} for k, v in out.items()}
 
 
-def run_configuration(scenario, spec, method, trials, seed, o, g, linkage, off=None):
-    """The runs of :func:`procedure_mc`: per-trial mean squares (plain, controlled), the
-    error-free δp and the unit of each field [photo mm]. ``off``: key prefix → (trials,) mask of
-    the trials whose acts of that prefix draw 0 (:func:`conventional_sources_mc`; the run then
-    has every source on)."""
-    sources = "both" if off else o.sources
-    zero, op, xr, unit, kw = _configuration(method, o.sigma_mm, g["c"], g["p"], g["n"], sources)
-    fidelity = o.switches(spec)
-    kw = {**kw, "variant": LINKAGE_VARIANTS[linkage], "fidelity": fidelity}
-    options = {"instrument": o.instrument, "control_variate": o.control_variate}
+class ConfigurationRun(NamedTuple):
+    """The runs of one configuration (:func:`run_configuration`): per-trial mean squares
+    (``plain``, ``controlled``; :class:`MeanSquares`), the error-free δp and the unit of each
+    field [photo mm]."""
+
+    plain: dict[FieldKey, FloatArray]
+    controlled: dict[FieldKey, FloatArray]
+    error_free_dp: FloatArray
+    units: dict[str, float]
+
+
+def run_configuration(
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    method: str,
+    trials: int,
+    seed: int,
+    options: ProcedureOptions,
+    geometry: dict[str, float],
+    linkage: str,
+    sources_off: Mapping[str, NDArray[np.bool_]] | None = None,
+) -> ConfigurationRun:
+    """The runs of :func:`procedure_mc` with ``options`` at ``geometry``
+    (:func:`scenario_geometry`) and ``linkage`` (resolved: "drag" or "independent").
+    ``sources_off``: key prefix → (trials,) mask of the trials whose acts of that prefix draw 0
+    (:func:`conventional_sources_mc`; the run then has every source on)."""
+    sources = "both" if sources_off else options.sources
+    c, p, n = geometry["c"], geometry["p"], geometry["n"]
+    operator = method_operator(method, options.sigma_mm, c, p, n, sources)
+    unit = operator.unit_mm
     if method == "conventional":
-        options["standard_points"] = o.standard_points
         units = dict.fromkeys(("parallax", "slip", "plane", "book"), unit)
+        sigma_control = 0.0
     else:  # m_p = m_xy/√2 of the observed control parallaxes
         units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
-        options["sigma_control"] = units["observed"]
-    spec_c = replace(spec, standard_points_c_mm=g["c"])
-    options["off"] = off
-    plain, controlled, d_zero = _mean_squares(
-        scenario, spec_c, method, seed, trials, zero, op, xr, g, o.grid, kw, options
+        sigma_control = units["observed"]
+    run = ProcedureRun(
+        scenario=scenario,
+        spec=replace(spec, standard_points_c_mm=c),
+        method=method,
+        seed=seed,
+        trials=int(trials),
+        operator=operator,
+        geometry=geometry,
+        grid=options.grid,
+        variant=LINKAGE_VARIANTS[linkage],
+        fidelity=options.switches(spec),
+        instrument_errors=bool(options.instrument),
+        control_variate=options.control_variate,
+        standard_points_at_a=method == "conventional" and options.standard_points == "book",
+        sigma_control_mm=sigma_control,
+        sources_off=sources_off,
     )
-    return plain, controlled, d_zero, units
+    ms = mean_squares(run)
+    return ConfigurationRun(ms.plain, ms.controlled, ms.error_free_dp, units)
 
 
-def _keyed(ms: dict, kind: str):
-    """The items of ``ms`` whose key is a tuple (``kind``, name)."""
-    return [(k, v) for k, v in ms.items() if isinstance(k, tuple) and k[0] == kind]
+def _keyed(ms: Mapping[FieldKey, FloatArray], kind: str) -> list[tuple[str, FloatArray]]:
+    """(name, values) of the items of ``ms`` whose key is a tuple (``kind``, name)."""
+    return [(k[1], v) for k, v in ms.items() if isinstance(k, tuple) and k[0] == kind]
 
 
-def _extras(scenario, spec, method, o, g, plain, best, units):
+def _extras(
+    scenario: Scenario,
+    spec: InstrumentSpec,
+    method: str,
+    o: ProcedureOptions,
+    g: dict[str, float],
+    plain: Mapping[FieldKey, FloatArray],
+    best: Mapping[FieldKey, FloatArray],
+    units: Mapping[str, float],
+) -> dict[str, Any]:
     """The method's own parts of the result: the three readings of a setup run with their
     decompositions, or the conventional run's readings by datum and its options."""
     if method == "conventional":
@@ -878,7 +568,7 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
             **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
             "sources": o.sources,
         }
-    fields = {}
+    fields: dict[str, dict[str, Any]] = {}
     for key, m, c in (
         ("parallax", "setup", "exact"),
         ("levelled", "setup_control", "exact"),
@@ -896,75 +586,10 @@ def _extras(scenario, spec, method, o, g, plain, best, units):
             "mean_squares": plain[key],  # per trial, photo mm² (paired switch steps)
             "unit": units[key],
         }
-    extra = {"fields": fields}
+    extra: dict[str, Any] = {"fields": fields}
     extra["element_rms"] = {
-        name: float(np.sqrt(np.mean(v))) for (kind, name), v in _keyed(plain, "element")
+        name: float(np.sqrt(np.mean(v))) for name, v in _keyed(plain, "element")
     }
     if method == "setup_control":
         extra["control"] = o.control
     return extra
-
-
-# --------------------------------------------------------------------------------------------
-# The conventional relative orientation alone against (5.54)
-# --------------------------------------------------------------------------------------------
-
-
-def idealised_geometry(scenario: Scenario) -> Scenario:
-    """``scenario`` with vertical photos at the left photo's height, flat terrain at the base
-    height and no film deformation: the geometry (5.54) assumes (points exactly at Fig. 39)."""
-
-    z = float(scenario.photo("left").exterior.centre[2])
-    photos = tuple(
-        replace(
-            ph,
-            exterior=replace(
-                ph.exterior,
-                alpha=0.0,
-                omega=0.0,
-                kappa=0.0,
-                projection_centre_m=(*ph.exterior.projection_centre_m[:2], z),
-            ),
-            film_deformation_ppm=(0.0, 0.0),
-        )
-        for ph in scenario.photos
-    )
-    return replace(scenario, terrain=Terrain(scenario.terrain.base_height_m), photos=photos)
-
-
-def standard_points_at_a(prep, g):
-    """The prepared run with standard points 1, 3, 5 moved by −a and 2, 4, 6 by +a along the
-    base (Fig. 39, x_л ∈ {−a, p + a}, a = c − p) and the C2 tolerance 0, so every trial makes
-    the same number of passes (no 'stop when satisfied' selection, which (5.54) does not model)."""
-
-    sc, sheet, scene = prep.scenario, prep.sheet, prep.scene
-    origin = np.asarray(sheet.frame_origin_m, float)
-    theta = float(sheet.frame_rotation)
-    frame = instrument_frame_m(scene.standard_points_m, origin, theta)
-    a_m = g["a"] * g["flying_height_m"] / g["f"]
-    frame[:, 0] += np.array([-a_m, a_m] * 3)
-    local = instrument_frame_m(frame, origin, theta, inverse=True)
-    local[:, 2] = sc.terrain.height_m(local[:, 0], local[:, 1])
-    tol = {**sheet.tolerances, "residual_y_parallax_mm": 0.0}
-    return replace(
-        prep,
-        scene=replace(scene, standard_points_m=local),
-        sheet=replace(sheet, tolerances=tol),
-    )
-
-
-def control_frame_points(scenario, sheet, g):
-    """The four levelling control points of (5.54), x_п ∈ {−c, a}, y = ±c, on the ground; with
-    their (x_п, y) [mm]."""
-
-    c, p, a = g["c"], g["p"], g["a"]
-    xr = np.array([-c, a, -c, a])
-    y = np.array([c, c, -c, -c])
-    scale = g["flying_height_m"] / g["f"]
-    origin = np.asarray(sheet.frame_origin_m, float)
-    theta = float(sheet.frame_rotation)
-    local = instrument_frame_m(
-        np.column_stack([(xr + p) * scale, y * scale, np.zeros(4)]), origin, theta, inverse=True
-    )
-    local[:, 2] = scenario.terrain.height_m(local[:, 0], local[:, 1])
-    return instrument_frame_m(local, origin, theta), xr, y

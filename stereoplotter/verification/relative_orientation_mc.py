@@ -1,14 +1,14 @@
 """Procedure Monte Carlo of the conventional relative orientation alone against (5.54): the
 simulated operator's C1 and C2 by (5.11) on an ideal instrument with only the y-parallax
 judgment error (``docs/accuracy.md``, "The conventional relative orientation alone against
-(5.54)"). The geometry helpers are the procedure Monte Carlo's (``procedure_mc``)."""
+(5.54)"). The geometry helpers are the procedure Monte Carlo's (``procedure_geometry``)."""
 
 from __future__ import annotations
 
 import math
 import time
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,8 +17,8 @@ from stereoplotter.procedure import conventional as cv
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.run import build_run
 from stereoplotter.procedure.simulate import prepare_run
-from stereoplotter.verification.linear_mc import CI_Z
-from stereoplotter.verification.procedure_mc import (
+from stereoplotter.verification.linear_mc import CI_Z, FloatArray
+from stereoplotter.verification.procedure_geometry import (
     control_frame_points,
     domain_points,
     dp_at,
@@ -28,13 +28,14 @@ from stereoplotter.verification.procedure_mc import (
 )
 
 if TYPE_CHECKING:
+    from stereoplotter.procedure.run import PreparedRun, Run
     from stereoplotter.scenario.model import Scenario
     from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["relative_orientation_mc"]
 
 
-def _relative_only(prep, first, trials):
+def _relative_only(prep: PreparedRun, first: int, trials: int | None) -> Run:
     """C1, the calibration and C2 by (5.11) on trials ``first … first + trials − 1`` (None: one
     error-free trial); returns the run."""
 
@@ -47,12 +48,13 @@ def _relative_only(prep, first, trials):
     return run
 
 
-def _midpoint_grid(c: float, grid: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+def _midpoint_grid(c: float, grid: tuple[int, int]) -> tuple[FloatArray, FloatArray]:
     """The midpoints of an nx × ny grid over x_п ∈ [−c, 0], y ∈ [−c, c], flattened. [mm]"""
     nx, ny = grid
     xs = -c + (np.arange(nx) + 0.5) * c / nx
     ys = -c + (np.arange(ny) + 0.5) * 2 * c / ny
-    return tuple(v.ravel() for v in np.meshgrid(xs, ys, indexing="ij"))
+    x, y = np.meshgrid(xs, ys, indexing="ij")
+    return x.ravel(), y.ravel()
 
 
 def relative_orientation_mc(
@@ -64,8 +66,8 @@ def relative_orientation_mc(
     sigma_mm: float = 0.01,
     ideal_geometry: bool = False,
     chunk: int = 2000,
-    grid=(16, 32),
-) -> dict:
+    grid: tuple[int, int] = (16, 32),
+) -> dict[str, Any]:
     """Procedure MC of the conventional relative orientation alone, the quantity of (5.54).
 
     The simulated operator runs C1 and C2 by the six measured q and (5.11) on an ideal instrument

@@ -9,96 +9,115 @@ import numpy as np
 
 from stereoplotter.accuracy import chapter5 as c5
 from stereoplotter.verification import linear_mc as mc
-from stereoplotter.verification.entry import RULE, Entry, Setting
+from stereoplotter.verification.entry import RULE, DeclaredRows, Entry, Setting
+from stereoplotter.verification.linear_mc import FloatArray
 
-__all__ = ["chapter5_entries", "table19_entries", "table20_entries"]
+__all__ = ["ROWS"]
+
+#: The rows of chapter 5, in the table's order.
+ROWS = DeclaredRows()
 
 
-def _relative_design(s: Setting):
+def _relative_design(s: Setting) -> FloatArray:
     _, xs, ys = c5.standard_points(s.a60, s.p60, s.c)
-    return c5.relative_orientation_design(xs, ys, s.p60, s.f)
+    design: FloatArray = c5.relative_orientation_design(xs, ys, s.p60, s.f)
+    return design
 
 
+@ROWS.row
 def table19_alpha(s: Setting) -> Entry:
     q_aa = math.sqrt(c5.cofactor_alpha_relative(s.f, s.a60, s.c))
     return Entry(
-        "Table 19",
-        "√Q_αα, m_Δα per m_q [rad/mm], 60 %",
-        None,
-        q_aa,
-        q_aa,
-        mc.least_squares_model(_relative_design(s), 1.0, 2),
-        RULE,
-        "f/(c(a+c)); least squares on the six standard points of Fig. 39, (5.10) left system",
+        eq="Table 19",
+        quantity="√Q_αα, m_Δα per m_q [rad/mm], 60 %",
+        printed=None,
+        book=q_aa,
+        rigorous=q_aa,
+        model=mc.least_squares_model(_relative_design(s), 1.0, 2),
+        verdict=RULE,
+        note="f/(c(a+c)); least squares on the six standard points of Fig. 39, (5.10) left system",
     )
 
 
+@ROWS.row
 def table19_omega(s: Setting) -> Entry:
     f, c = s.f, s.c
     q_ww = math.sqrt(c5.cofactor_omega_relative(f, c))
     return Entry(
-        "Table 19",
-        "√Q_ωω, m_Δω per m_q [rad/mm]",
-        math.sqrt(3 * f**2 / (4 * c**2)),
-        q_ww,
-        q_ww,
-        mc.least_squares_model(_relative_design(s), 1.0, 3),
-        RULE,
-        "printed 3f²/(4c²) is not dimensionless; 3f²/(4c⁴) as the text's m_ω₂′ = f√3 m_q/(2c²)",
+        eq="Table 19",
+        quantity="√Q_ωω, m_Δω per m_q [rad/mm]",
+        printed=math.sqrt(3 * f**2 / (4 * c**2)),
+        book=q_ww,
+        rigorous=q_ww,
+        model=mc.least_squares_model(_relative_design(s), 1.0, 3),
+        verdict=RULE,
+        note="printed 3f²/(4c²) is not dimensionless; 3f²/(4c⁴) as the text's "
+        "m_ω₂′ = f√3 m_q/(2c²)",
     )
 
 
-def _levelling_design(s: Setting):
-    return c5.levelling_design(*c5.control_points(s.a80, s.c))
+def _levelling_design(s: Setting) -> FloatArray:
+    design: FloatArray = c5.levelling_design(*c5.control_points(s.a80, s.c))
+    return design
 
 
+@ROWS.row
 def table20_eta(s: Setting) -> Entry:
     q_ee = math.sqrt(c5.cofactors_levelling(s.a80, s.c)[1, 1])
     return Entry(
-        "Table 20",
-        "√Q_ηη, slope per unit control error [1/mm], 80 %",
-        1 / (s.a80 + s.c),
-        q_ee,
-        q_ee,
-        mc.least_squares_model(_levelling_design(s), 1.0, 1),
-        RULE,
-        "1/(a + c)",
+        eq="Table 20",
+        quantity="√Q_ηη, slope per unit control error [1/mm], 80 %",
+        printed=1 / (s.a80 + s.c),
+        book=q_ee,
+        rigorous=q_ee,
+        model=mc.least_squares_model(_levelling_design(s), 1.0, 1),
+        verdict=RULE,
+        note="1/(a + c)",
     )
 
 
+@ROWS.row
 def table20_xi(s: Setting) -> Entry:
     q_xx = math.sqrt(c5.cofactors_levelling(s.a80, s.c)[2, 2])
     return Entry(
-        "Table 20",
-        "√Q_ξξ [1/mm], 80 %",
-        math.sqrt(s.f / (4 * s.c**2)),
-        q_xx,
-        q_xx,
-        mc.least_squares_model(_levelling_design(s), 1.0, 2),
-        RULE,
-        "printed f/(4c²) (not dimensionless); least squares gives 1/(4c²)",
+        eq="Table 20",
+        quantity="√Q_ξξ [1/mm], 80 %",
+        printed=math.sqrt(s.f / (4 * s.c**2)),
+        book=q_xx,
+        rigorous=q_xx,
+        model=mc.least_squares_model(_levelling_design(s), 1.0, 2),
+        verdict=RULE,
+        note="printed f/(4c²) (not dimensionless); least squares gives 1/(4c²)",
     )
 
 
-def _book_point(s: Setting):
+def _book_point(s: Setting) -> tuple[FloatArray, FloatArray]:
     """The point of (5.19)/(5.20): book (−35, 35) at c = 70."""
     return (np.array([-s.c / 2]), np.array([s.c / 2]))
 
 
-def _at_point(model, a, c, p, f, pt):
+def _at_point(
+    model: mc.LinearModel,
+    a: float,
+    c: float,
+    p: float,
+    f: float,
+    pt: tuple[FloatArray, FloatArray],
+) -> mc.LinearModel:
     G = mc.relative_field_basis(pt[0], pt[1], p, f)
     Hg = c5.levelling_design(*pt)
     Ac = c5.levelling_design(*c5.control_points(a, c))
     return mc.LinearModel(G, model.M, model.Gc, Hg @ np.linalg.pinv(Ac))
 
 
-def _levelling_point_model(a, c, pt):
+def _levelling_point_model(a: float, c: float, pt: tuple[FloatArray, FloatArray]) -> mc.LinearModel:
     G = np.zeros((1, 1))
     Hg = c5.levelling_design(*pt)
     Ac = c5.levelling_design(*c5.control_points(a, c))
     return mc.LinearModel(G, np.zeros((1, 1)), np.zeros((1, 4)), Hg @ np.linalg.pinv(Ac), 1.0)
 
 
+@ROWS.row
 def eq_5_19(s: Setting) -> Entry:
     a8, c, p8, f = s.a80, s.c, s.p80, s.f
     pt = _book_point(s)
@@ -106,34 +125,36 @@ def eq_5_19(s: Setting) -> Entry:
     r519 = c5.relative_orientation_residual_sigma(*pt, a8, c, f, 1.0, "rigorous")[0]
     m519 = mc.relative_orientation_model(a8, c, p8, f, 1.0, grid=(1, 1))
     return Entry(
-        "(5.19)",
-        f"m_p,в/m_q at x_п = {-c / 2:g}, y = {c / 2:g} mm, 80 %",
-        None,
-        b519,
-        r519,
-        _at_point(m519, a8, c, p8, f, pt),
-        RULE,
-        "(5.15) ω residual y(x_п + c/2) is the least-squares plane residual only for a = 0; "
+        eq="(5.19)",
+        quantity=f"m_p,в/m_q at x_п = {-c / 2:g}, y = {c / 2:g} mm, 80 %",
+        printed=None,
+        book=b519,
+        rigorous=r519,
+        model=_at_point(m519, a8, c, p8, f, pt),
+        verdict=RULE,
+        note="(5.15) ω residual y(x_п + c/2) is the least-squares plane residual only for a = 0; "
         "exact: y(x_п + (c − a)/2)",
     )
 
 
+@ROWS.row
 def eq_5_20(s: Setting) -> Entry:
     c = s.c
     pt = _book_point(s)
     lv_pt = c5.geodetic_orientation_parallax_sigma(*pt, s.a80, c, 1.0)[0]
     return Entry(
-        "(5.20)",
-        f"levelling σ/m at x_п = {-c / 2:g}, y = {c / 2:g} mm, 80 %",
-        lv_pt,
-        lv_pt,
-        lv_pt,
-        _levelling_point_model(s.a80, c, pt),
-        RULE,
-        "variance of the plane fitted at 4 control points (Table 20)",
+        eq="(5.20)",
+        quantity=f"levelling σ/m at x_п = {-c / 2:g}, y = {c / 2:g} mm, 80 %",
+        printed=lv_pt,
+        book=lv_pt,
+        rigorous=lv_pt,
+        model=_levelling_point_model(s.a80, c, pt),
+        verdict=RULE,
+        note="variance of the plane fitted at 4 control points (Table 20)",
     )
 
 
+@ROWS.each_overlap
 def eq_5_54(s: Setting, overlap: str) -> Entry:
     a, p = s.slot(overlap)
     bk = c5.relative_orientation_parallax_rms(a, s.c, p, 1.0, "book")
@@ -142,14 +163,14 @@ def eq_5_54(s: Setting, overlap: str) -> Entry:
     if overlap == "80":
         note += f"; rigorous {rg:.4f} from the exact plane residual (5.19)"
     return Entry(
-        "(5.54)",
-        f"m_p,в/m_q over the pair, {overlap} %",
-        bk,
-        bk,
-        rg,
-        mc.relative_orientation_model(a, s.c, p, s.f, 1.0),
-        RULE,
-        note,
+        eq="(5.54)",
+        quantity=f"m_p,в/m_q over the pair, {overlap} %",
+        printed=bk,
+        book=bk,
+        rigorous=rg,
+        model=mc.relative_orientation_model(a, s.c, p, s.f, 1.0),
+        verdict=RULE,
+        note=note,
         upstream="(5.19)",
     )
 
@@ -170,21 +191,23 @@ _NOTE_5_55 = {
 }
 
 
+@ROWS.each_overlap
 def eq_5_55(s: Setting, overlap: str) -> Entry:
     a, p = s.slot(overlap)
     verdict, note = _NOTE_5_55[overlap]
     return Entry(
-        "(5.55)",
-        f"m_p,г/m_p over the pair, {overlap} %, f = {s.f:g}",
-        s.geodetic(a, p, "printed"),
-        s.geodetic(a, p, "book"),
-        s.geodetic(a, p, "rigorous"),
-        mc.relative_orientation_model(a, s.c, p, s.f, 0.0, sigma_control_mm=1.0),
-        verdict,
-        note,
+        eq="(5.55)",
+        quantity=f"m_p,г/m_p over the pair, {overlap} %, f = {s.f:g}",
+        printed=s.geodetic(a, p, "printed"),
+        book=s.geodetic(a, p, "book"),
+        rigorous=s.geodetic(a, p, "rigorous"),
+        model=mc.relative_orientation_model(a, s.c, p, s.f, 0.0, sigma_control_mm=1.0),
+        verdict=verdict,
+        note=note,
     )
 
 
+@ROWS.each_overlap
 def eq_5_57_58(s: Setting, overlap: str) -> Entry:
     """(5.57) at 60 %, (5.58) at 80 %: height error of a single model."""
     a, p = s.slot(overlap)
@@ -193,51 +216,27 @@ def eq_5_57_58(s: Setting, overlap: str) -> Entry:
     if overlap == "60":
         note += "; and inherits the printed (5.55)"
     return Entry(
-        "(5.57)" if overlap == "60" else "(5.58)",
-        f"m_h·p/(H·m_p), {overlap} %, f = {f:g}, p = {p:g}",
-        c5.single_model_height_rms(a, c, p, f, 1.0, "printed"),
-        c5.single_model_height_rms(a, c, p, f, 1.0, "book"),
-        c5.single_model_height_rms(a, c, p, f, 1.0, "rigorous"),
-        s.single_model(a, p),
-        "not reproducible" if overlap == "60" else RULE,
-        note,
+        eq="(5.57)" if overlap == "60" else "(5.58)",
+        quantity=f"m_h·p/(H·m_p), {overlap} %, f = {f:g}, p = {p:g}",
+        printed=c5.single_model_height_rms(a, c, p, f, 1.0, "printed"),
+        book=c5.single_model_height_rms(a, c, p, f, 1.0, "book"),
+        rigorous=c5.single_model_height_rms(a, c, p, f, 1.0, "rigorous"),
+        model=s.single_model(a, p),
+        verdict="not reproducible" if overlap == "60" else RULE,
+        note=note,
     )
 
 
+@ROWS.row
 def eq_5_43(s: Setting) -> Entry:
     rg43 = c5.single_model_height_rms(s.a60, s.c, s.p60, s.f, 1.0, "rigorous")
     return Entry(
-        "(5.43)",
-        "quadrature sum of independent errors, 60 % (as (5.57))",
-        None,
-        rg43,
-        rg43,
-        s.single_model(s.a60, s.p60),
-        RULE,
-        "MC of the summed fields confirms independence (no cross terms)",
+        eq="(5.43)",
+        quantity="quadrature sum of independent errors, 60 % (as (5.57))",
+        printed=None,
+        book=rg43,
+        rigorous=rg43,
+        model=s.single_model(s.a60, s.p60),
+        verdict=RULE,
+        note="MC of the summed fields confirms independence (no cross terms)",
     )
-
-
-def table19_entries(s: Setting) -> list[Entry]:
-    return [table19_alpha(s), table19_omega(s)]
-
-
-def table20_entries(s: Setting) -> list[Entry]:
-    return [table20_eta(s), table20_xi(s)]
-
-
-def chapter5_entries(s: Setting) -> list[Entry]:
-    """Tables 19, 20 and (5.19)–(5.58), in the table's order."""
-    return [
-        *table19_entries(s),
-        *table20_entries(s),
-        eq_5_19(s),
-        eq_5_20(s),
-        eq_5_54(s, "60"),
-        eq_5_54(s, "80"),
-        eq_5_55(s, "60"),
-        eq_5_55(s, "80"),
-        eq_5_57_58(s, "60"),
-        eq_5_57_58(s, "80"),
-        eq_5_43(s),
-    ]

@@ -6,18 +6,31 @@ from __future__ import annotations
 import math
 
 from stereoplotter.accuracy import setup_accuracy as sa
-from stereoplotter.verification.entry import RULE, Entry, Setting
+from stereoplotter.verification.entry import RULE, DeclaredRows, Entry, ProcedureMeasure, Setting
 
-__all__ = ["conventional_entries", "setup_outcome_entries"]
+__all__ = ["ROWS"]
+
+#: The rows of (6.39)–(6.46), in the table's order.
+ROWS = DeclaredRows()
 
 
 def _from_pointing(s: Setting, overlap: str, mode: str = "book") -> float:
     _, p = s.slot(overlap)
-    return sa.setup_parallax_rms_from_pointing(s.f, p, s.c, s.l, s.n, 1.0, mode=mode)
+    return float(sa.setup_parallax_rms_from_pointing(s.f, p, s.c, s.l, s.n, 1.0, mode=mode))
 
 
 def _outcome(
-    s: Setting, eq: str, overlap: str, quantity: str, printed, verdict, note, **printed_inputs
+    s: Setting,
+    eq: str,
+    overlap: str,
+    quantity: str,
+    printed: float,
+    verdict: str,
+    note: str,
+    *,
+    from_printed_inputs: float | None = None,
+    digits: int | None = None,
+    book_only: bool = False,
 ) -> Entry:
     """A row of m_p⁰/m_xy of unadjusted setup data at ``overlap``: book σ's of (6.31)–(6.38)
     (m_bz = f m_y/l) and rigorous σ's (m_bz = f m_y/(n l) at photo scale, ``docs/errata.md``);
@@ -25,19 +38,24 @@ def _outcome(
     a, p = s.slot(overlap)
     rigorous_sigmas = sa.setup_element_sigmas(s.f, s.l, s.n, 1.0, mode="rigorous")
     return Entry(
-        eq,
-        quantity,
-        printed,
-        _from_pointing(s, overlap),
-        _from_pointing(s, overlap, "rigorous"),
-        s.unadjusted(a, p, rigorous_sigmas),
-        verdict,
-        note + "; rigorous: m_bz of (6.37) at photo scale, f m_y/(n l) (15p²/l² for 15p²n²/l²)",
+        eq=eq,
+        quantity=quantity,
+        printed=printed,
+        book=_from_pointing(s, overlap),
+        rigorous=_from_pointing(s, overlap, "rigorous"),
+        model=s.unadjusted(a, p, rigorous_sigmas),
+        verdict=verdict,
+        note=note
+        + "; rigorous: m_bz of (6.37) at photo scale, f m_y/(n l) (15p²/l² for 15p²n²/l²)",
         upstream="(6.37)",
-        **printed_inputs,
+        from_printed_inputs=from_printed_inputs,
+        digits=digits,
+        book_only=book_only,
+        procedure=ProcedureMeasure(overlap, "setup", "parallax"),
     )
 
 
+@ROWS.row
 def eq_6_39(s: Setting) -> Entry:
     return _outcome(
         s,
@@ -50,6 +68,7 @@ def eq_6_39(s: Setting) -> Entry:
     )
 
 
+@ROWS.row
 def eq_6_40(s: Setting) -> Entry:
     return _outcome(
         s,
@@ -62,6 +81,7 @@ def eq_6_40(s: Setting) -> Entry:
     )
 
 
+@ROWS.row
 def eq_6_41(s: Setting) -> Entry:
     return _outcome(
         s,
@@ -75,6 +95,7 @@ def eq_6_41(s: Setting) -> Entry:
     )
 
 
+@ROWS.row
 def eq_6_42(s: Setting) -> Entry:
     return _outcome(
         s,
@@ -88,6 +109,7 @@ def eq_6_42(s: Setting) -> Entry:
     )
 
 
+@ROWS.row
 def eq_6_43(s: Setting) -> Entry:
     return _outcome(
         s,
@@ -102,6 +124,7 @@ def eq_6_43(s: Setting) -> Entry:
     )
 
 
+@ROWS.row
 def eq_6_44(s: Setting) -> Entry:
     return _outcome(
         s,
@@ -117,23 +140,19 @@ def eq_6_44(s: Setting) -> Entry:
     )
 
 
-def setup_outcome_entries(s: Setting) -> list[Entry]:
-    """(6.39)–(6.44), in the table's order."""
-    return [eq_6_39(s), eq_6_40(s), eq_6_41(s), eq_6_42(s), eq_6_43(s), eq_6_44(s)]
-
-
+@ROWS.row
 def eq_6_45(s: Setting) -> Entry:
     pr, bk, rg = s.conventional_values(s.a60, s.p60)
     return s.convention_off_book(
         Entry(
-            "(6.45)",
-            f"m_p⁰/m_p conventional, 60 %, p = {s.p60:g}, m_q = m_p",
-            0.98,
-            bk,
-            rg,
-            s.conventional(s.a60, s.p60),
-            RULE,
-            "from printed inputs: the intermediates printed before (6.45), the printed (5.54) "
+            eq="(6.45)",
+            quantity=f"m_p⁰/m_p conventional, 60 %, p = {s.p60:g}, m_q = m_p",
+            printed=0.98,
+            book=bk,
+            rigorous=rg,
+            model=s.conventional(s.a60, s.p60),
+            verdict=RULE,
+            note="from printed inputs: the intermediates printed before (6.45), the printed (5.54) "
             f"and (5.55) of chapter 5, unrounded: {pr:.4f}; the 0.24 and 0.95 the book prints "
             "after it ((6.51), (6.54)) give "
             f"√(0.24² + (0.95 p/f)²) = {math.hypot(0.24, 0.95 * s.p60 / s.f):.4f}; the "
@@ -141,32 +160,30 @@ def eq_6_45(s: Setting) -> Entry:
             from_printed_inputs=pr,
             digits=2,
             upstream="(5.55)",
+            procedure=ProcedureMeasure("60", "conventional"),
         )
     )
 
 
+@ROWS.row
 def eq_6_46(s: Setting) -> Entry:
     pr, bk, rg = s.conventional_values(s.a80, s.p80)
     return s.convention_off_book(
         Entry(
-            "(6.46)",
-            f"m_p⁰/m_p conventional, 80 %, p = {s.p80:g}, m_q = m_p",
-            0.67,
-            bk,
-            rg,
-            s.conventional(s.a80, s.p80),
-            "not reproducible",
-            "tried: from the intermediates printed before (6.46), the printed (5.54)/(5.55) "
+            eq="(6.46)",
+            quantity=f"m_p⁰/m_p conventional, 80 %, p = {s.p80:g}, m_q = m_p",
+            printed=0.67,
+            book=bk,
+            rigorous=rg,
+            model=s.conventional(s.a80, s.p80),
+            verdict="not reproducible",
+            note="tried: from the intermediates printed before (6.46), the printed (5.54)/(5.55) "
             f"unrounded, {pr:.4f}; with the 0.33 and 0.63 printed after it ((6.52), (6.55)) "
             f"√(0.33² + (0.63 p/f)²) = {math.hypot(0.33, 0.63 * s.p80 / s.f):.4f}; "
             "√(0.63² + 0.23²) = 0.671 (p/f dropped and the 60 % m_p,в used) is the only reading "
             "found that gives 0.67",
             from_printed_inputs=pr,
             digits=2,
+            procedure=ProcedureMeasure("80", "conventional"),
         )
     )
-
-
-def conventional_entries(s: Setting) -> list[Entry]:
-    """(6.45), (6.46)."""
-    return [eq_6_45(s), eq_6_46(s)]

@@ -3,13 +3,13 @@
 :func:`run_verification` builds one row per numbered result, each with the printed value, the
 book-mode and rigorous values, the linear Monte Carlo RMS with its CI half-width, the exact
 covariance propagation on the same grid, a verdict and a note. The rows are data: each is an
-:class:`~stereoplotter.verification.entry.Entry` built by a small named function of a topic module
-(``rows_chapter5``: Tables 19, 20 and chapter 5; ``rows_setup_elements``: (6.28)–(6.38);
-``rows_outcomes``: (6.39)–(6.46); ``rows_levelled``: (6.47)–(6.61)); :func:`row_entries` lists
-them in order. :func:`closing_comparison` is the book's closing claim (setup data vs the
-conventional method at 60 % and 80 %). Rendered by
-:mod:`stereoplotter.report.verification`, written by
-:mod:`stereoplotter.commands.verification`.
+:class:`~stereoplotter.verification.entry.Entry` (its formulas, verdict rule and procedure
+measure) returned by one declared function of a topic module (``rows_chapter5``: Tables 19, 20
+and chapter 5; ``rows_setup_elements``: (6.28)–(6.38); ``rows_outcomes``: (6.39)–(6.46);
+``rows_levelled``: (6.47)–(6.61)); :func:`row_entries` concatenates the modules' declared rows
+(:data:`ROW_MODULES`) in order. :func:`closing_comparison` is the book's closing claim (setup
+data vs the conventional method at 60 % and 80 %). Rendered by
+:mod:`stereoplotter.report.verification`, written by :mod:`stereoplotter.commands.verification`.
 
 Book geometry (§27): f = 70 mm, l = 85 mm, n = 1.42 (SC-1), c = 70 mm; 60 %: p = 70, a = 0;
 80 %: p = 35, a = 35. Values are coefficients: m_x = m_y = m_xy = 1 for (6.31)-(6.50),
@@ -21,9 +21,11 @@ from __future__ import annotations
 import math
 import multiprocessing
 import warnings
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import replace
+from collections.abc import Callable, Mapping
+from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, replace
+from functools import cache
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -32,38 +34,62 @@ from stereoplotter.procedure.fidelity import MECHANISMS, Fidelity
 from stereoplotter.random_streams import key_code
 from stereoplotter.verification import decomposition as dc
 from stereoplotter.verification import linear_mc as mc
+from stereoplotter.verification import (
+    rows_chapter5,
+    rows_levelled,
+    rows_outcomes,
+    rows_setup_elements,
+)
 from stereoplotter.verification.as_formula import (
+    ProcedureResults,
+    RunResult,
     as_formula_block,
     procedure_value,
     switch_chain,
     switch_decomposition,
 )
-from stereoplotter.verification.entry import BOOK, RULE, Entry, Setting
+from stereoplotter.verification.entry import (
+    BOOK,
+    RULE,
+    DeclaredRows,
+    Entry,
+    ProcedureMeasure,
+    Setting,
+)
 from stereoplotter.verification.procedure_mc import (
     conventional_sources_mc,
     idealised_geometry,
     procedure_mc,
 )
-from stereoplotter.verification.rows_chapter5 import chapter5_entries
-from stereoplotter.verification.rows_levelled import (
-    closing_entries,
-    conventional_term_entries,
-    setup_residual_entries,
-)
-from stereoplotter.verification.rows_outcomes import conventional_entries, setup_outcome_entries
-from stereoplotter.verification.rows_setup_elements import (
-    setup_element_entries,
-    unadjusted_generic_entries,
-)
 from stereoplotter.verification.verdicts import VERDICTS, decide
+
+if TYPE_CHECKING:
+    from stereoplotter.scenario.model import Scenario
+    from stereoplotter.spec.instrument_spec import InstrumentSpec
+
+#: ``progress(done, total, label)`` after each step.
+Progress = Callable[[int, int, str], None]
+#: A row of the table: the values of :data:`ROW_KEYS`.
+Row = dict[str, Any]
+
+
+class FieldErrors(Protocol):
+    """Where :func:`check_geometry` reports a bad field: ``error(field, expected, found)``
+    returns the exception to raise."""
+
+    def error(self, field: str, expected: str, found: str) -> Exception: ...
+
 
 __all__ = [
     "BOOK",
     "ROW_KEYS",
+    "ROW_MODULES",
     "VERDICTS",
     "attach_procedure_mc",
     "check_geometry",
     "closing_comparison",
+    "procedure_rows",
+    "row_entries",
     "run_procedure_mc",
     "run_verification",
     "start_procedure_mc",
@@ -92,7 +118,34 @@ ROW_KEYS = (
 #: The columns of the CSV (the nested ``as_formula``, ``decomposition`` blocks: JSON only).
 CSV_KEYS = tuple(k for k in ROW_KEYS if k not in ("as_formula", "decomposition"))
 PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this quantity)"
-#: Procedure-MC configurations: name → :func:`procedure_mc` keyword arguments. "setup" is one
+
+
+@dataclass(frozen=True)
+class ProcedureConfig:
+    """A configuration of the procedure MC: its ``method`` and the options of its runs (the
+    fields of :class:`~stereoplotter.verification.procedure_mc.ProcedureOptions` it sets:
+    ``grid``, ``passes``, ``sources``, ``fidelity``); ``idealised``: run on the scenario with
+    vertical photos over flat terrain (:func:`idealised_geometry`)."""
+
+    method: str
+    grid: tuple[int, int] = (16, 32)
+    passes: int | None = None
+    sources: str = "both"
+    fidelity: Fidelity | None = None
+    idealised: bool = False
+
+    def options(self) -> dict[str, Any]:
+        """The :func:`procedure_mc` keyword arguments of a run of this configuration."""
+        return {
+            "method": self.method,
+            "grid": self.grid,
+            "passes": self.passes,
+            "sources": self.sources,
+            "fidelity": self.fidelity,
+        }
+
+
+#: Procedure-MC configurations: name → :class:`ProcedureConfig`. "setup" is one
 #: run of the setup-data method with three readings (§27 task 1, and task 2: levelled on
 #: control exactly and with observed control parallaxes); the conventional method with both
 #: judgment errors, the y-parallax σ_q only and the stereo σ_p only. Conventional runs make a
@@ -102,10 +155,10 @@ PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this
 #: time, values within 0.3 % of the finer grid on the same 4 000 trials (pair60 levelled
 #: 0.1298 / 0.1302, observed 0.6696 / 0.6707; parallax within 0.02 %).
 PROCEDURE_CONFIGS = {
-    "setup": {"method": "setup", "grid": (8, 16)},
-    "conventional": {"method": "conventional", "passes": 3},
-    "y_parallax": {"method": "conventional", "sources": "y_parallax", "passes": 3},
-    "stereo": {"method": "conventional", "sources": "stereo", "passes": 3},
+    "setup": ProcedureConfig("setup", grid=(8, 16)),
+    "conventional": ProcedureConfig("conventional", passes=3),
+    "y_parallax": ProcedureConfig("conventional", passes=3, sources="y_parallax"),
+    "stereo": ProcedureConfig("conventional", passes=3, sources="stereo"),
 }
 #: The seed stream of each configuration's runs, declared (not its place in
 #: :data:`PROCEDURE_CONFIGS`): a run of configuration c at overlap slot s takes the seed
@@ -130,25 +183,41 @@ STEP_TRIALS = 2000
 INSTRUMENT_TRIALS = {"setup": 4000, "conventional": 600, "y_parallax": 600, "stereo": 300}
 
 
-def row_entries(g) -> list[Entry]:
+#: The rows each topic module declares (:class:`~stereoplotter.verification.entry.DeclaredRows`),
+#: in the table's order. A new row is declared in its topic module only; a new topic module is
+#: added here.
+ROW_MODULES: tuple[DeclaredRows, ...] = (
+    rows_chapter5.ROWS,
+    rows_setup_elements.ROWS,
+    rows_outcomes.ROWS,
+    rows_levelled.ROWS,
+)
+
+
+def row_entries(g: Mapping[str, float]) -> list[Entry]:
     """Every row of the table as an :class:`~stereoplotter.verification.entry.Entry`, in the
     table's order (a row's random stream is keyed by its identity, not by its place)."""
     s = Setting.from_mapping(g)
-    return [
-        *chapter5_entries(s),
-        *unadjusted_generic_entries(s),
-        *setup_element_entries(s),
-        *setup_outcome_entries(s),
-        *conventional_entries(s),
-        *setup_residual_entries(s),
-        *conventional_term_entries(s),
-        *closing_entries(s),
-    ]
+    return [entry for rows in ROW_MODULES for entry in rows.entries(s)]
+
+
+@cache
+def procedure_rows() -> dict[str, ProcedureMeasure]:
+    """Rows with a procedure MC: eq → the :class:`~.entry.ProcedureMeasure` its row declares
+    (every outcome row of §27, (6.39)–(6.61)). The measures do not depend on the geometry: they
+    are read from the rows at the book's."""
+    out: dict[str, ProcedureMeasure] = {}
+    for entry in row_entries(BOOK):
+        if entry.procedure is None:
+            continue
+        if out.setdefault(entry.eq, entry.procedure) != entry.procedure:
+            raise ValueError(f"two procedure rows of the table share the equation {entry.eq!r}")
+    return out
 
 
 #: Accepted values of a flat ``--geometry`` mapping (keys of :data:`BOOK`), in mm or [—]: wide
 #: round bounds around the book's setting that keep every formula finite.
-def check_geometry(fields, geometry: dict) -> None:
+def check_geometry(fields: FieldErrors, geometry: Mapping[str, float]) -> None:
     """Refuse a geometry outside the domain of the table's formulas, naming the field.
 
     The standard and control points sit at x_п = −c, a and −(p + a): they must be distinct
@@ -185,8 +254,7 @@ def check_geometry(fields, geometry: dict) -> None:
             f"{type(exc).__name__}: {exc}",
         ) from None
     for entry in specs:
-        values = [entry.printed, entry.book, entry.rigorous]
-        values = [v for v in values if isinstance(v, int | float)]
+        values = [v for v in (entry.printed, entry.book, entry.rigorous) if v is not None]
         if not all(math.isfinite(v) for v in values):
             raise fields.error(
                 "(geometry)",
@@ -195,7 +263,7 @@ def check_geometry(fields, geometry: dict) -> None:
             )
 
 
-def _normalise_geometry(geometry) -> dict:
+def _normalise_geometry(geometry: Mapping[str, float] | None) -> dict[str, float]:
     g = dict(BOOK)
     if geometry:
         unknown = set(geometry) - set(BOOK)
@@ -209,27 +277,9 @@ def _normalise_geometry(geometry) -> dict:
     return g
 
 
-#: Rows with a procedure MC: eq → (overlap slot, configuration, field of the setup run or
-#: None, scaled by f/p). Every outcome row of §27, (6.39)–(6.61).
-PROCEDURE_ROWS = {
-    **{eq: ("60", "setup", "parallax", False) for eq in ("(6.39)", "(6.41)", "(6.43)")},
-    **{eq: ("80", "setup", "parallax", False) for eq in ("(6.40)", "(6.42)", "(6.44)")},
-    **{eq: ("60", "setup", "levelled", False) for eq in ("(6.47)", "(6.49)")},
-    **{eq: ("80", "setup", "levelled", False) for eq in ("(6.48)", "(6.50)")},
-    "(6.58)": ("60", "setup", "observed", False),
-    "(6.59)": ("80", "setup", "observed", False),
-    **{eq: ("60", "conventional", None, False) for eq in ("(6.45)", "(6.60)")},
-    **{eq: ("80", "conventional", None, False) for eq in ("(6.46)", "(6.53)", "(6.61)")},
-    **{eq: ("60", "y_parallax", None, False) for eq in ("(6.51)", "(6.56)")},
-    **{eq: ("80", "y_parallax", None, False) for eq in ("(6.52)", "(6.57)")},
-    "(6.54)": ("60", "stereo", None, False),
-    "(6.55)": ("80", "stereo", None, True),  # the row's unit: k = (M_p,го/m_p)·f/p
-}
-
-
 #: The jobs of the current :func:`run_procedure_mc`, read by forked workers by index (the loaded
 #: scenarios and instrument hold mappings that do not pickle).
-_JOBS: list = []
+_JOBS: list[ProcedureJob] = []
 
 #: The configurations that run the same procedure (the conventional method, its judgment
 #: sources on or off): one job, one run with a block of trials per configuration
@@ -241,47 +291,69 @@ SHARED_RUNS = {"conventional": ("conventional", "y_parallax", "stereo")}
 TRIAL_COST = {"setup": 1.0, "conventional": 4.0}
 
 
-def _job_at(i):
+def _job_at(i: int) -> dict[str, RunResult]:
     # one BLAS thread a worker: the workers are the parallelism (two processes × two OpenBLAS
     # threads on two cores made `verify` 1.2 × the CPU and 1.5 × the wall, benchmarks/README.md)
     with threadpool_limits(limits=1, user_api="blas"):
         return _job(_JOBS[i])
 
 
-def _job(args):
+@dataclass(frozen=True)
+class ProcedureJob:
+    """The runs one worker makes: the configurations ``configs`` (one, or the configurations of
+    a :data:`SHARED_RUNS` run) on ``scenario`` with ``spec``, each with its ``trials`` and its
+    :func:`procedure_configs` keyword arguments (``options``), at ``seed``; with every
+    instrument error term at its σ (``instrument_errors``) or on the ideal instrument; the
+    ``linkage`` (None: the run's fidelity's or the instrument's)."""
+
+    scenario: Scenario
+    spec: InstrumentSpec
+    configs: tuple[str, ...]
+    trials: dict[str, int]
+    seed: int
+    instrument_errors: bool
+    linkage: str | None
+    options: dict[str, ProcedureConfig]
+
+    def cost(self) -> float:
+        """Estimated cost of the job in setup trials (:data:`TRIAL_COST`)."""
+        method = self.options[self.configs[0]].method
+        return TRIAL_COST.get(method, 1.0) * sum(self.trials.values())
+
+
+def _job(job: ProcedureJob) -> dict[str, RunResult]:
     """A job's results, configuration → :func:`procedure_mc` result."""
-    scenario, spec, configs, trials, seed, instrument, linkage, options = args
-    if len(configs) == 1:
-        (config,) = configs
-        kw = dict(options[config])
-        if kw.pop("idealised", False):  # vertical photos over flat terrain
+    if len(job.configs) == 1:
+        (config,) = job.configs
+        run = job.options[config]
+        scenario = job.scenario
+        if run.idealised:  # vertical photos over flat terrain
             scenario = idealised_geometry(scenario)
         res = procedure_mc(
             scenario,
-            spec=spec,
-            trials=trials[config],
-            seed=seed,
-            instrument=instrument,
-            linkage=linkage,
-            **kw,
+            spec=job.spec,
+            trials=job.trials[config],
+            seed=job.seed,
+            instrument=job.instrument_errors,
+            linkage=job.linkage,
+            **run.options(),
         )
         return {config: res}
-    passes = {options[c]["passes"] for c in configs}
-    (passes,) = passes  # the shared run makes one number of passes
-    by_source = {options[c].get("sources", "both"): c for c in configs}
+    (passes,) = {job.options[c].passes for c in job.configs}  # the shared run: one number
+    by_source = {job.options[c].sources: c for c in job.configs}
     out = conventional_sources_mc(
-        scenario,
-        spec=spec,
-        trials={k: trials[c] for k, c in by_source.items()},
-        seed=seed,
-        instrument=instrument,
-        linkage=linkage,
+        job.scenario,
+        spec=job.spec,
+        trials={k: job.trials[c] for k, c in by_source.items()},
+        seed=job.seed,
+        instrument=job.instrument_errors,
+        linkage=job.linkage,
         passes=passes,
     )
     return {by_source[k]: r for k, r in out.items()}
 
 
-def _trials_of(trials, config, instrument):
+def _trials_of(trials: int | None, config: str, instrument: bool) -> int:
     if config.startswith(("setup_formula", "setup_step")):
         cap = FORMULA_TRIALS if config.startswith("setup_formula") else STEP_TRIALS
         main = _trials_of(trials, "setup", instrument)
@@ -291,25 +363,26 @@ def _trials_of(trials, config, instrument):
     return (INSTRUMENT_TRIALS if instrument else PROCEDURE_TRIALS)[config]
 
 
-def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, dict]:
+def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ProcedureConfig]:
     """The configurations of a ``verify`` run: :data:`PROCEDURE_CONFIGS` with the setup method
     at ``fidelity``, "setup_formula" (every switch at the formula's assumption) and
     "setup_step_i" (the formula's setting with the first i switches of :func:`switch_chain`
     at ``fidelity``'s, i = 1 … k − 1; the k-th is "setup" itself)."""
     f = fidelity or Fidelity()
     base = PROCEDURE_CONFIGS["setup"]
-    out = {**PROCEDURE_CONFIGS, "setup": {**base, "fidelity": f}}
+    out = {**PROCEDURE_CONFIGS, "setup": replace(base, fidelity=f)}
     formula = Fidelity.as_formula()
-    out["setup_formula"] = {**base, "fidelity": formula}
-    out["setup_formula_flat"] = {**base, "fidelity": formula, "idealised": True}
+    out["setup_formula"] = replace(base, fidelity=formula)
+    out["setup_formula_flat"] = replace(base, fidelity=formula, idealised=True)
     chain = switch_chain(f)
     step = formula
     for i, name in enumerate(chain[:-1], 1):
         value = getattr(f, name)
-        step = replace(step, **{name: value})
+        change: dict[str, Any] = {name: value}
+        step = replace(step, **change)
         if name == "linkage" and value is None:
             step = replace(step, linkage=None)
-        out[f"setup_step_{i}"] = {**base, "fidelity": step}
+        out[f"setup_step_{i}"] = replace(base, fidelity=step)
     return out
 
 
@@ -320,17 +393,17 @@ def _stream(config: str) -> str:
 
 
 def run_procedure_mc(
-    trials=None,
-    seed=20240601,
-    scenarios=None,
-    progress=None,
+    trials: int | None = None,
+    seed: int = 20240601,
+    scenarios: Mapping[str, Scenario | None] | None = None,
+    progress: Progress | None = None,
     *,
-    instrument=None,
-    with_instrument=True,
-    workers=2,
-    linkage=None,
-    fidelity=None,
-):
+    instrument: InstrumentSpec | None = None,
+    with_instrument: bool = True,
+    workers: int = 2,
+    linkage: str | None = None,
+    fidelity: Fidelity | None = None,
+) -> dict[tuple[str, ...], RunResult]:
     """:func:`start_procedure_mc` and wait for its result (arguments as there)."""
     return start_procedure_mc(
         trials,
@@ -345,15 +418,15 @@ def run_procedure_mc(
 
 
 def start_procedure_mc(
-    trials=None,
-    seed=20240601,
-    scenarios=None,
+    trials: int | None = None,
+    seed: int = 20240601,
+    scenarios: Mapping[str, Scenario | None] | None = None,
     *,
-    instrument=None,
-    with_instrument=True,
-    workers=2,
-    linkage=None,
-    fidelity=None,
+    instrument: InstrumentSpec | None = None,
+    with_instrument: bool = True,
+    workers: int = 2,
+    linkage: str | None = None,
+    fidelity: Fidelity | None = None,
 ) -> PendingProcedureMC:
     """The procedure MC of :mod:`stereoplotter.verification.procedure_mc` for every
     configuration of :data:`PROCEDURE_CONFIGS` at each overlap slot, on the ideal instrument and
@@ -397,37 +470,39 @@ def start_procedure_mc(
         for c in configs
         if not (inst and c not in PROCEDURE_CONFIGS)  # the switch runs: ideal instrument only
     ]
-    if todo and instrument is None:
+    if not todo:
+        return PendingProcedureMC([], [], workers)
+    if instrument is None:
         raise ValueError("instrument: expected the InstrumentSpec of the procedure MC, found None")
     shared = {c: lead for lead, cs in SHARED_RUNS.items() for c in cs}
-    groups: dict = {}
+    groups: dict[tuple[str, str, bool], list[str]] = {}
     for s, c, inst in todo:  # the configurations of one procedure go into one job
         groups.setdefault((s, shared.get(c, c), inst), []).append(c)
     jobs = [
-        (
-            scenarios[s],
-            instrument,
-            tuple(cs),
-            {c: _trials_of(trials, c, inst) for c in cs},
-            seed + 7 * (2 * CONFIG_STREAM[_stream(lead)] + (s == "80")) + 1,
-            inst,
-            None if "fidelity" in configs[lead] else linkage,  # else the fidelity's
-            {c: configs[c] for c in cs},
+        ProcedureJob(
+            scenario=_loaded(scenarios[s]),
+            spec=instrument,
+            configs=tuple(cs),
+            trials={c: _trials_of(trials, c, inst) for c in cs},
+            seed=seed + 7 * (2 * CONFIG_STREAM[_stream(lead)] + (s == "80")) + 1,
+            instrument_errors=inst,
+            linkage=None if configs[lead].fidelity is not None else linkage,  # else its fidelity's
+            options={c: configs[c] for c in cs},
         )
         for (s, lead, inst), cs in groups.items()
     ]
-    keys = [
+    keys: list[list[tuple[str, ...]]] = [
         [(s, c, "instrument") if inst else (s, c) for c in cs]
         for (s, _, inst), cs in groups.items()
     ]
     return PendingProcedureMC(jobs, keys, workers)
 
 
-def _cost(job) -> float:
-    """Estimated cost of a job in setup trials (:data:`TRIAL_COST`)."""
-    configs, trials = job[2], job[3]
-    method = job[7][configs[0]]["method"]
-    return TRIAL_COST.get(method, 1.0) * sum(trials.values())
+def _loaded(scenario: Scenario | None) -> Scenario:
+    """A slot's scenario (a slot without one is never run)."""
+    if scenario is None:
+        raise ValueError("scenario: expected a loaded Scenario for a slot that runs, found None")
+    return scenario
 
 
 class PendingProcedureMC:
@@ -437,11 +512,13 @@ class PendingProcedureMC:
     (the linear rows): ``verify`` overlaps the two. ``keys[i]``: the result keys of job i, one
     per configuration it runs."""
 
-    def __init__(self, jobs: list, keys: list, workers: int = 2):
+    def __init__(
+        self, jobs: list[ProcedureJob], keys: list[list[tuple[str, ...]]], workers: int = 2
+    ):
         self.jobs, self.keys = jobs, keys
-        self.order = sorted(range(len(jobs)), key=lambda i: -_cost(jobs[i]))
-        self.pool = None
-        self.futures = {}
+        self.order = sorted(range(len(jobs)), key=lambda i: -jobs[i].cost())
+        self.pool: ProcessPoolExecutor | None = None
+        self.futures: dict[Future[dict[str, RunResult]], int] = {}
         if workers > 1 and len(jobs) > 1 and "fork" in multiprocessing.get_all_start_methods():
             _JOBS[:] = jobs  # inherited by the forked workers
             context = multiprocessing.get_context("fork")
@@ -450,9 +527,9 @@ class PendingProcedureMC:
             # and one here while they run (the caller's linear rows): no process oversubscribes
             self.limits = threadpool_limits(limits=1, user_api="blas")
 
-    def result(self, progress=None) -> dict:
+    def result(self, progress: Progress | None = None) -> dict[tuple[str, ...], RunResult]:
         """(slot, configuration[, "instrument"]) → result; ``progress(done, total, label)``."""
-        out = {}
+        out: dict[tuple[str, ...], RunResult] = {}
         n = len(self.jobs)
         if self.pool is None:
             for done, i in enumerate(self.order, 1):
@@ -472,12 +549,13 @@ class PendingProcedureMC:
             _JOBS.clear()
         return {k: out[k] for ks in self.keys for k in ks}
 
-    def _keyed(self, i, results):
+    def _keyed(self, i: int, results: Mapping[str, RunResult]) -> dict[tuple[str, ...], RunResult]:
         """Job i's results (configuration → result) under their keys."""
         return {key: results[key[1]] for key in self.keys[i]}
 
 
-_FIELD_TEXT = {
+#: What a setup run's reading measures: field → text (a conventional row has no field, None).
+_FIELD_TEXT: dict[str | None, str] = {
     "parallax": "δp of the built model on the (6.27) domain per m_xy = n_л·σ (task 1)",
     "levelled": "δp on the chapter-5 domain after levelling on Fig. 39's four control points "
     "(least-squares plane, exact control heights) per m_xy = n_л·σ (task 2)",
@@ -486,14 +564,14 @@ _FIELD_TEXT = {
 }
 
 
-def _switches_text(fidelity) -> str:
+def _switches_text(fidelity: Fidelity | None) -> str:
     """``name=value`` of each mechanism switch of a run's :class:`Fidelity`."""
     if fidelity is None:
         return "the defaults"
     return ", ".join(f"{m.name}={getattr(fidelity, m.name)}" for m in MECHANISMS)
 
 
-def _procedure_note(eq, res, field, scaled):
+def _procedure_note(eq: str, res: RunResult, field: str | None, scaled: bool) -> str:
     """The note of a procedure-MC row: the run, the formula at the simulated geometry, their
     ratio and the mismatches of assumptions."""
     f, p, c, a, n, ll = res["f"], res["p"], res["c"], res["a"], res["n"], res["l"]
@@ -533,13 +611,13 @@ def _procedure_note(eq, res, field, scaled):
 def run_verification(
     trials: int = 60000,
     seed: int = 20240601,
-    geometry=None,
-    progress: Callable[[int, int, str], None] | None = None,
+    geometry: Mapping[str, float] | None = None,
+    progress: Progress | None = None,
     procedure_trials: int | None = None,
-    procedure_scenarios=None,
-    instrument=None,
-    linkage=None,
-) -> list[dict]:
+    procedure_scenarios: Mapping[str, Scenario | None] | None = None,
+    instrument: InstrumentSpec | None = None,
+    linkage: str | None = None,
+) -> list[Row]:
     """Compute the verification table.
 
     Parameters
@@ -587,12 +665,12 @@ def run_verification(
     return rows
 
 
-def attach_procedure_mc(rows: list[dict], proc: dict) -> list[dict]:
+def attach_procedure_mc(rows: list[Row], proc: ProcedureResults) -> list[Row]:
     """Fill ``mc_procedure``, ``mc_procedure_ci``, ``mc_procedure_formula`` (the rigorous
     formula at the simulated geometry), ``mc_procedure_instrument`` (and its CI) and the note
     from :func:`run_procedure_mc`."""
     for r in rows:
-        spec = PROCEDURE_ROWS.get(r["eq"])
+        spec = procedure_rows().get(r["eq"])
         if spec is None:
             continue
         slot, config, field, scaled = spec
@@ -636,7 +714,7 @@ FIRST_ORDER_MECHANISMS = {
 MECHANISM_SETTING = ({"pair60", "pair80"}, "sc1", "drag")
 
 
-def _mechanism(res: dict, step: str, field: str | None) -> str | None:
+def _mechanism(res: RunResult, step: str, field: str | None) -> str | None:
     names, key, linkage = MECHANISM_SETTING
     shown = res.get("scenario") in names and res.get("instrument_key") == key
     if not shown or res.get("linkage") != linkage or res.get("instrument"):
@@ -646,7 +724,9 @@ def _mechanism(res: dict, step: str, field: str | None) -> str | None:
     return FIRST_ORDER_MECHANISMS.get(step)
 
 
-def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -> dict:
+def row_decomposition(
+    book: float, res: RunResult, field: str | None, scaled: bool
+) -> dict[str, Any]:
     """The ``decomposition`` block of a procedure row (:mod:`.decomposition`): the formula at
     the book geometry (``book``, the row's rigorous column) → at the simulated geometry → the
     first order of each trial's own errors → the procedure, each step with its CI; ``sum``
@@ -711,7 +791,7 @@ def row_decomposition(book: float, res: dict, field: str | None, scaled: bool) -
 SAME_QUANTITY = {"(6.60)": "(6.45)", "(6.61)": "(6.46)"}
 
 
-def _one_verdict_per_quantity(rows: list[dict]) -> list[dict]:
+def _one_verdict_per_quantity(rows: list[Row]) -> list[Row]:
     """The later print of a quantity (:data:`SAME_QUANTITY`) takes the first print's verdict
     and value from printed inputs; its note keeps what its own print gave."""
     by = {r["eq"]: r for r in rows}
@@ -730,7 +810,7 @@ def _one_verdict_per_quantity(rows: list[dict]) -> list[dict]:
     return rows
 
 
-def _fmt_printed(v) -> str:
+def _fmt_printed(v: float | None) -> str:
     return "—" if v is None else f"{v:g}"
 
 
@@ -741,7 +821,13 @@ def row_stream(seed: int, entry: Entry) -> np.random.Generator:
     return np.random.default_rng([seed, key_code(entry.identity)])
 
 
-def _rows(specs: list[Entry], trials, seed, progress, at_book: bool = True):
+def _rows(
+    specs: list[Entry],
+    trials: int,
+    seed: int,
+    progress: Progress | None,
+    at_book: bool = True,
+) -> list[Row]:
     seen: dict[str, int] = {}
     for i, e in enumerate(specs):
         if seen.setdefault(e.identity, i) != i:
@@ -774,7 +860,7 @@ def _verdict(e: Entry, at_book: bool) -> tuple[float | None, float | None, str, 
     return printed, fpi, verdict, f"{head}; {check}" + (f". {e.note}" if keep else "")
 
 
-def _row(e: Entry, trials, rng, at_book: bool = True) -> dict:
+def _row(e: Entry, trials: int, rng: np.random.Generator, at_book: bool = True) -> Row:
     """The row of ``e``: its linear MC (``trials``, ``rng``) and covariance RMS."""
     # a squared statistic doubles the relative CI: four times the trials keep it ≤ 1 %
     r, h, _ = mc.mc_rms(e.model, 4 * trials if e.squared else trials, rng)
@@ -804,7 +890,7 @@ def _row(e: Entry, trials, rng, at_book: bool = True) -> dict:
     }
 
 
-def closing_comparison(rows: list[dict]) -> list[dict]:
+def closing_comparison(rows: list[Row]) -> list[dict[str, Any]]:
     """The book's closing claim (OCR L4022-4026) against the recomputed chain.
 
     Examples
@@ -819,7 +905,7 @@ def closing_comparison(rows: list[dict]) -> list[dict]:
         ("60 %", "(6.58)", "(6.60)", "equal accuracy"),
         ("80 %", "(6.59)", "(6.61)", "setup data 20 % better"),
     ):
-        row = {"overlap": ov, "book_claim": claim}
+        row: dict[str, Any] = {"overlap": ov, "book_claim": claim}
         for key in ("printed", "book", "rigorous", "mc_linear", "mc_procedure"):
             a, b = by[s][key], by[cv][key]
             row[f"setup_{key}"], row[f"conventional_{key}"] = a, b

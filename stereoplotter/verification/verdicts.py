@@ -65,7 +65,7 @@ def printed_agreement(printed: float, value: float, digits: int) -> tuple[str | 
     return None, text
 
 
-def _matches(printed, value, digits):
+def _matches(printed: float, value: float, digits: int | None) -> tuple[bool, str]:
     if digits is None:
         return agree(printed, value), f"{value:.5g}"
     how, text = printed_agreement(printed, value, digits)

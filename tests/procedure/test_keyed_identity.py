@@ -11,7 +11,8 @@ import pytest
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import conventional, setup_method, simulate
-from stereoplotter.verification import table
+from stereoplotter.verification import rows_chapter5, table
+from stereoplotter.verification.entry import DeclaredRows
 
 TRIALS = 4
 
@@ -66,22 +67,24 @@ def test_an_inserted_step_changes_no_other_result(monkeypatch, method, module, b
 
 
 def _linear_rows(monkeypatch, insert: bool) -> list[dict]:
-    specs = table.row_entries
-
-    def with_dummy(g):
-        rows = specs(g)
-        dummy = dataclasses.replace(rows[5], eq="(dummy)", quantity="an inserted row")
-        return [rows[0], dummy, *rows[1:]]
-
+    """The linear rows; with ``insert``, a row declared in a topic module of its own placed
+    first in the table (it takes the model of (5.19) under a new identity)."""
     if insert:
-        monkeypatch.setattr(table, "row_entries", with_dummy)
+        dummy_rows = DeclaredRows()
+
+        @dummy_rows.row
+        def dummy(s):
+            row = rows_chapter5.eq_5_19(s)
+            return dataclasses.replace(row, eq="(dummy)", quantity="an inserted row")
+
+        monkeypatch.setattr(table, "ROW_MODULES", (dummy_rows, *table.ROW_MODULES))
     return table.run_verification(trials=300, seed=5, procedure_trials=0)
 
 
 def test_an_inserted_verification_row_changes_no_other_row(monkeypatch):
     plain = _linear_rows(monkeypatch, insert=False)
     inserted = _linear_rows(monkeypatch, insert=True)
-    assert [r["eq"] for r in inserted] == [plain[0]["eq"], "(dummy)"] + [r["eq"] for r in plain[1:]]
+    assert [r["eq"] for r in inserted] == ["(dummy)"] + [r["eq"] for r in plain]
     others = [r for r in inserted if r["eq"] != "(dummy)"]
     for a, b in zip(plain, others, strict=True):
         assert (a["mc_linear"], a["mc_linear_ci"]) == (b["mc_linear"], b["mc_linear_ci"]), a["eq"]

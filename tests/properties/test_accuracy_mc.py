@@ -114,18 +114,18 @@ def test_procedure_columns_filled_and_disabled():
     errors; the other slot's rows and every other row stay empty."""
     from stereoplotter.io.book_setting import book_instrument, book_scenarios
     from stereoplotter.verification.table import (
-        PROCEDURE_ROWS,
         attach_procedure_mc,
+        procedure_rows,
         run_procedure_mc,
     )
 
     proc = run_procedure_mc(100, 2, {"60": book_scenarios()["60"]}, instrument=book_instrument())
     rows = attach_procedure_mc(run_verification(trials=200, seed=2, procedure_trials=0), proc)
     outcome = {f"(6.{i})" for i in range(39, 62)}
-    assert set(PROCEDURE_ROWS) == outcome
+    assert set(procedure_rows()) == outcome
     keys = ("mc_procedure", "mc_procedure_ci", "mc_procedure_formula", "mc_procedure_instrument")
     for r in rows:
-        filled = r["eq"] in outcome and PROCEDURE_ROWS[r["eq"]][0] == "60"
+        filled = r["eq"] in outcome and procedure_rows()[r["eq"]].slot == "60"
         assert all((r[k] is not None) == filled for k in keys), r["eq"]
         assert ("procedure MC (pair60" in r["note"]) == filled
     off = run_verification(trials=200, seed=2, procedure_trials=0)
