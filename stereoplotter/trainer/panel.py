@@ -125,9 +125,10 @@ def overview(session: Any) -> dict[str, Any]:
     scene = session.prep.scene
     points = scene.points
     images = scene.images(np.array([p.local_m for p in points], float)) if points else None
-    marks = None
-    if "f_instrument" in session.commanded:
-        marks = [np.asarray(m, float).reshape(-1) for m in session.inst.marks()]
+    shown = session.shown_marks()  # as the state gives them (where the read-out is hidden:
+    marks = None  # to the counters' least count)
+    if shown is not None:
+        marks = [np.array([shown[s]["x_mm"], shown[s]["y_mm"]], float) for s in ("left", "right")]
     diameter = float(ex.spec.mark_diameter_mm)
     photos = {}
     for i, side in enumerate(("left", "right")):
@@ -416,18 +417,33 @@ def _span_fails(session: Any) -> bool:
     return fails
 
 
-def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
+def _ticks(session: Any, stage: str, blind: bool = False) -> tuple[list[bool], list[bool]]:
     """(done, shown) per step of the stage: done when its target is met (see the module
-    docstring); shown unless it is conditional and its condition does not hold."""
+    docstring); shown unless it is conditional and its condition does not hold. ``blind``
+    (the read-out hidden): no tick depends on a hidden quantity — a target or parallax step
+    is done when its controls were used, every conditional step is shown (whether |L − L′|
+    holds is the trainee's to find), as a ``"controls"`` step is."""
     used, read, near = session.progress_of(stage)
     rules = session.step_rules(stage)
     q = None
-    if any(e["rule"] == "parallax" for e in rules) and "f_instrument" in session.commanded:
+    if (
+        not blind
+        and any(e["rule"] == "parallax" for e in rules)
+        and "f_instrument" in session.commanded
+    ):
         q = _standard_q(session)
     tol_q = float(session.prep.sheet.tolerances["residual_y_parallax_mm"])
-    fails = _span_fails(session) if any(e["conditional"] for e in rules) else False
+    fails = (
+        _span_fails(session) if not blind and any(e["conditional"] for e in rules) else False
+    )
     done, shown = [], []
     for entry in rules:
+        if blind and entry["rule"] in ("target", "parallax"):
+            needs = [*entry["targets"], *entry["needs"]]
+            ok = SHOWN in used or all(c in used for c in needs)
+            done.append(bool(ok))
+            shown.append(True)
+            continue
         if entry["rule"] == "target":
             ok = _target_met(session, entry["targets"])
             touched = all(c in used for c in entry["corrected"]) or SHOWN in used
@@ -444,31 +460,32 @@ def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
             ok = entry["point"] in near
         else:
             ok = any(c in read for c in entry["reads"]) if entry["reads"] else bool(read)
-        see = not entry["conditional"] or fails
+        see = not entry["conditional"] or fails or blind
         done.append(bool(ok) and see)
         shown.append(see)
     return done, shown
 
 
-def checklist_ticks(session: Any) -> dict[str, Any] | None:
+def checklist_ticks(session: Any, blind: bool = False) -> dict[str, Any] | None:
     """The stage in hand's done and shown flags, in the order of :func:`checklist`'s steps
     (what the session state carries on every action: ``{"stage", "done": [bool, …], "shown":
-    [bool, …]}``); None when every stage is claimed."""
+    [bool, …]}``); None when every stage is claimed. ``blind``: see :func:`_ticks`."""
     stage = session.stage
     if stage is None:
         return None
-    done, shown = _ticks(session, stage)
+    done, shown = _ticks(session, stage, blind)
     return {"stage": stage, "done": done, "shown": shown}
 
 
-def checklist(session: Any) -> dict[str, Any] | None:
+def checklist(session: Any, blind: bool = False) -> dict[str, Any] | None:
     """The stage in hand's steps with done flags (see the module docstring); None when every
-    stage is claimed."""
+    stage is claimed. ``blind`` (the read-out hidden): ticks as :func:`_ticks` gives them
+    blind, and no step carries its targets (the operator's values on this instrument)."""
     stage = session.stage
     if stage is None:
         return None
     steps = []
-    ticks, shown = _ticks(session, stage)
+    ticks, shown = _ticks(session, stage, blind)
     rules = session.step_rules(stage)
     given = sheet_parts(session.exercise)["given"]
     for n, (entry, done, see) in enumerate(zip(rules, ticks, shown, strict=True), 1):
@@ -481,7 +498,7 @@ def checklist(session: Any) -> dict[str, Any] | None:
                 "rule": entry["rule"],
                 "shown": bool(see),
                 "conditional": entry["conditional"],
-                "targets": dict(entry["targets"]),
+                "targets": {} if blind else dict(entry["targets"]),
                 **step_words(session, entry, given),
             }
         )
