@@ -417,14 +417,18 @@ def _span_fails(session: Any) -> bool:
     return fails
 
 
-def _ticks(session: Any, stage: str, blind: bool = False) -> tuple[list[bool], list[bool]]:
+def _ticks(
+    session: Any, stage: str, blind: bool = False, rules: list[dict[str, Any]] | None = None
+) -> tuple[list[bool], list[bool]]:
     """(done, shown) per step of the stage: done when its target is met (see the module
     docstring); shown unless it is conditional and its condition does not hold. ``blind``
     (the read-out hidden): no tick depends on a hidden quantity — a target or parallax step
     is done when its controls were used, every conditional step is shown (whether |L − L′|
-    holds is the trainee's to find), as a ``"controls"`` step is."""
+    holds is the trainee's to find), as a ``"controls"`` step is. ``rules``: the steps to
+    tick (default the session's own, :meth:`~stereoplotter.trainer.session.Session.step_rules`)."""
     used, read, near = session.progress_of(stage)
-    rules = session.step_rules(stage)
+    if rules is None:
+        rules = session.step_rules(stage)
     q = None
     if (
         not blind
@@ -466,27 +470,32 @@ def _ticks(session: Any, stage: str, blind: bool = False) -> tuple[list[bool], l
     return done, shown
 
 
-def checklist_ticks(session: Any, blind: bool = False) -> dict[str, Any] | None:
+def checklist_ticks(
+    session: Any, blind: bool = False, rules: list[dict[str, Any]] | None = None
+) -> dict[str, Any] | None:
     """The stage in hand's done and shown flags, in the order of :func:`checklist`'s steps
     (what the session state carries on every action: ``{"stage", "done": [bool, …], "shown":
-    [bool, …]}``); None when every stage is claimed. ``blind``: see :func:`_ticks`."""
+    [bool, …]}``); None when every stage is claimed. ``blind``, ``rules``: see :func:`_ticks`."""
     stage = session.stage
     if stage is None:
         return None
-    done, shown = _ticks(session, stage, blind)
+    done, shown = _ticks(session, stage, blind, rules)
     return {"stage": stage, "done": done, "shown": shown}
 
 
-def checklist(session: Any, blind: bool = False) -> dict[str, Any] | None:
+def checklist(session: Any, blind: bool = False, reference: bool = False) -> dict[str, Any] | None:
     """The stage in hand's steps with done flags (see the module docstring); None when every
     stage is claimed. ``blind`` (the read-out hidden): ticks as :func:`_ticks` gives them
-    blind, and no step carries its targets (the operator's values on this instrument)."""
+    blind, and no step carries its targets (the operator's values on this instrument).
+    ``reference``: the steps of the operator's run on the exercise's error-free instrument
+    (:meth:`~stereoplotter.trainer.session.Session.reference_rules`), not on this one (whose
+    steps follow from its hidden errors: a clearing the check made necessary, a pass more)."""
     stage = session.stage
     if stage is None:
         return None
     steps = []
-    ticks, shown = _ticks(session, stage, blind)
-    rules = session.step_rules(stage)
+    rules = session.reference_rules(stage) if reference else session.step_rules(stage)
+    ticks, shown = _ticks(session, stage, blind, rules)
     given = sheet_parts(session.exercise)["given"]
     for n, (entry, done, see) in enumerate(zip(rules, ticks, shown, strict=True), 1):
         steps.append(

@@ -423,6 +423,17 @@ class Session:
             self._rules[stage] = step_rules(self.par, stage)
         return self._rules[stage]
 
+    def reference_rules(self, stage: str) -> list[dict[str, Any]]:
+        """The steps of a stage with their tick rules as the simulated operator takes them on
+        the exercise's instrument without errors (the same for every trainee: what an exam's
+        checklist lists, :func:`~.panel.checklist` ``reference``)."""
+        return _reference_rules(self.exercise, stage)
+
+    def shows_reference_steps(self) -> bool:
+        """Whether the trainee's checklist lists :meth:`reference_rules` (an exercise without
+        hints: the steps of the operator's run on this instrument follow from its errors)."""
+        return not self.exercise.allows("hints")
+
     def _targets(self, stage: str) -> dict[Any, Any]:
         """The points a stage's steps read at (cached; :func:`~.panel.step_targets`)."""
         if stage not in self._target_points:
@@ -456,11 +467,13 @@ class Session:
 
     def trainee_view(self, full: dict[str, Any]) -> dict[str, Any]:
         """``full`` (:meth:`full_state` of the session as it stands) as the trainee sees it."""
-        if not self.hides_readout():
+        hides, reference = self.hides_readout(), self.shows_reference_steps()
+        if not hides and not reference:
             return full
+        rules = self.reference_rules(self.stage) if reference and self.stage else None
         return full | {
             "marks": self.shown_marks(),
-            "checklist_ticks": checklist_ticks(self, blind=True),
+            "checklist_ticks": checklist_ticks(self, blind=hides, rules=rules),
         }
 
     def full_state(self) -> dict[str, Any]:
@@ -693,6 +706,20 @@ def secret_seed(key: bytes, exercise: str, trainee: str, attempt: int) -> int:
     message = "\x00".join((exercise, trainee, str(int(attempt)))).encode("utf-8")
     digest = hmac.new(key, message, hashlib.sha256).digest()
     return int.from_bytes(digest[:8], "big") >> 1
+
+
+#: Exercise (its file content) → stage → the reference run's step rules (one run per exercise
+#: and process, about a second; every trainee of the exercise shares it).
+_REFERENCE: dict[str, dict[str, list[dict[str, Any]]]] = {}
+
+
+def _reference_rules(exercise: Exercise, stage: str) -> list[dict[str, Any]]:
+    key = json.dumps(exercise.source, sort_keys=True, default=str)
+    if key not in _REFERENCE:
+        prep = prepare_run(exercise.scenario, exercise.spec, exercise.method, "zero", 0)
+        par = operator_run(prep, 0, exercise.stages[-1])
+        _REFERENCE[key] = {s: step_rules(par, s) for s in exercise.stages}
+    return _REFERENCE[key][stage]
 
 
 def _on_step(value: float, step: float) -> float:

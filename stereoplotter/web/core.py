@@ -328,12 +328,14 @@ def _on_grid(value: float | None) -> float | None:
 #: control, removed where the exercise gives no hints: a number with a decimal point (a common
 #: tilt, a pass's RMS, an over-correction: the operator's answers), the control a step turns.
 _FOUND_NUMBER = re.compile(r"[+\-−]?\d+\.\d+")
+_CONTROL_ID = r"(?:(?:kappa|k_alpha|k_omega|dx|dy)_(?:left|right)|b[xyz]|f_instrument)"
 _NAMED_CONTROL = (
-    re.compile(r"\s*\(by turning [^)]*\)"),
-    re.compile(r" by turning \S+"),
-    re.compile(r"(?<=y-parallax) with \S+( \([^)]*\))?"),
-    re.compile(r"[;:] turn \w+$"),
-    re.compile(r"\s*\((?:k_alpha|k_omega|dx|dy|kappa)_(?:left|right)\)"),
+    (re.compile(r"\s*\(by turning [^)]*\)"), ""),
+    (re.compile(r" by turning \S+"), ""),
+    (re.compile(r"(?<=y-parallax) with \S+( \([^)]*\))?"), ""),
+    (re.compile(rf"[;:,] turn {_CONTROL_ID}$"), ""),
+    (re.compile(rf"\bturn {_CONTROL_ID} by\b"), "turn an element by"),
+    (re.compile(rf"\s*\({_CONTROL_ID}\)"), ""),
 )
 
 
@@ -342,8 +344,8 @@ def bare_words(text: str | None) -> str | None:
     checklist: naming the controls is hint 2; the numbers are this instrument's answers)."""
     if text is None:
         return None
-    for pattern in _NAMED_CONTROL:
-        text = pattern.sub("", text)
+    for pattern, instead in _NAMED_CONTROL:
+        text = pattern.sub(instead, text)
     return _FOUND_NUMBER.sub("…", text)
 
 
@@ -351,9 +353,11 @@ def checklist_of(session: Session) -> dict[str, Any] | None:
     """The stage in hand's steps with their done flags (``trainer.panel.checklist``; the state
     carries only the flags on every action; run on the actor thread). Where the read-out is
     hidden, no tick depends on a hidden quantity and no step carries its targets (blind);
-    where the exercise gives no hints, the steps name no controls (that is hint 2) and carry
-    none of the operator's numbers (:func:`bare_words`)."""
-    body = _jsonable(checklist(session, blind=session.hides_readout()))
+    where the exercise gives no hints, the steps are those of the operator's run on the
+    error-free instrument (the same for every trainee), name no controls (that is hint 2)
+    and carry none of the operator's numbers (:func:`bare_words`)."""
+    body = _jsonable(checklist(session, blind=session.hides_readout(),
+                               reference=session.shows_reference_steps()))
     if body is not None and not session.exercise.allows("hints"):
         for step in body["steps"]:
             for key in ("controls", "control_names", "sheet_rows"):

@@ -59,6 +59,8 @@ def _words(session) -> dict[str, Any]:
     share = FULL_POINTS / max(len(session.stages), 1)
     stage = session.stage
     n = len(session.par.stage_actions(stage)) if stage is not None else 0
+    if not session.exercise.allows("hints"):  # no show-me: its length is the operator's run
+        n = None
     return {
         "stage": stage,
         "hint_points": {str(k): round(share * v, 2) for k, v in HINT_COST.items()},
