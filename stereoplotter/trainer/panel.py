@@ -422,32 +422,18 @@ def _ticks(
 ) -> tuple[list[bool], list[bool]]:
     """(done, shown) per step of the stage: done when its target is met (see the module
     docstring); shown unless it is conditional and its condition does not hold. ``blind``
-    (the read-out hidden): no tick depends on a hidden quantity — a target or parallax step
-    is done when its controls were used, every conditional step is shown (whether |L − L′|
-    holds is the trainee's to find), as a ``"controls"`` step is. ``rules``: the steps to
-    tick (default the session's own, :meth:`~stereoplotter.trainer.session.Session.step_rules`)."""
+    or ``rules`` given: :func:`_blind_ticks`."""
+    if blind or rules is not None:
+        return _blind_ticks(session, stage, rules)
     used, read, near = session.progress_of(stage)
-    if rules is None:
-        rules = session.step_rules(stage)
+    rules = session.step_rules(stage)
     q = None
-    if (
-        not blind
-        and any(e["rule"] == "parallax" for e in rules)
-        and "f_instrument" in session.commanded
-    ):
+    if any(e["rule"] == "parallax" for e in rules) and "f_instrument" in session.commanded:
         q = _standard_q(session)
     tol_q = float(session.prep.sheet.tolerances["residual_y_parallax_mm"])
-    fails = (
-        _span_fails(session) if not blind and any(e["conditional"] for e in rules) else False
-    )
+    fails = _span_fails(session) if any(e["conditional"] for e in rules) else False
     done, shown = [], []
     for entry in rules:
-        if blind and entry["rule"] in ("target", "parallax"):
-            needs = [*entry["targets"], *entry["needs"]]
-            ok = SHOWN in used or all(c in used for c in needs)
-            done.append(bool(ok))
-            shown.append(True)
-            continue
         if entry["rule"] == "target":
             ok = _target_met(session, entry["targets"])
             touched = all(c in used for c in entry["corrected"]) or SHOWN in used
@@ -464,10 +450,33 @@ def _ticks(
             ok = entry["point"] in near
         else:
             ok = any(c in read for c in entry["reads"]) if entry["reads"] else bool(read)
-        see = not entry["conditional"] or fails or blind
+        see = not entry["conditional"] or fails
         done.append(bool(ok) and see)
         shown.append(see)
     return done, shown
+
+
+def _blind_ticks(
+    session: Any, stage: str, rules: list[dict[str, Any]] | None
+) -> tuple[list[bool], list[bool]]:
+    """(done, shown) of ``rules`` (default the session's own steps) with no tick on a hidden
+    quantity (the read-out hidden, or steps not of this instrument): a target, parallax or
+    controls step is done once its controls were used, a pointed or reading step as
+    :func:`_ticks` ticks it, every step after hint 3; every step is shown (whether a
+    conditional step's condition holds is the trainee's to judge)."""
+    used, read, near = session.progress_of(stage)
+    done = []
+    for entry in session.step_rules(stage) if rules is None else rules:
+        if SHOWN in used:
+            ok = True
+        elif entry["rule"] in ("target", "parallax", "controls"):
+            ok = all(c in used for c in [*entry["targets"], *entry["needs"]])
+        elif entry["rule"] == "pointed":
+            ok = entry["point"] in near
+        else:
+            ok = any(c in read for c in entry["reads"]) if entry["reads"] else bool(read)
+        done.append(bool(ok))
+    return done, [True] * len(done)
 
 
 def checklist_ticks(
@@ -495,7 +504,7 @@ def checklist(session: Any, blind: bool = False, reference: bool = False) -> dic
         return None
     steps = []
     rules = session.reference_rules(stage) if reference else session.step_rules(stage)
-    ticks, shown = _ticks(session, stage, blind, rules)
+    ticks, shown = _ticks(session, stage, blind, rules if reference else None)
     given = sheet_parts(session.exercise)["given"]
     for n, (entry, done, see) in enumerate(zip(rules, ticks, shown, strict=True), 1):
         steps.append(

@@ -467,13 +467,13 @@ class Session:
 
     def trainee_view(self, full: dict[str, Any]) -> dict[str, Any]:
         """``full`` (:meth:`full_state` of the session as it stands) as the trainee sees it."""
-        hides, reference = self.hides_readout(), self.shows_reference_steps()
-        if not hides and not reference:
+        reference = self.shows_reference_steps()
+        if not self.hides_readout() and not reference:
             return full
         rules = self.reference_rules(self.stage) if reference and self.stage else None
         return full | {
             "marks": self.shown_marks(),
-            "checklist_ticks": checklist_ticks(self, blind=hides, rules=rules),
+            "checklist_ticks": checklist_ticks(self, blind=True, rules=rules),
         }
 
     def full_state(self) -> dict[str, Any]:

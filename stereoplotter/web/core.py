@@ -356,8 +356,9 @@ def checklist_of(session: Session) -> dict[str, Any] | None:
     where the exercise gives no hints, the steps are those of the operator's run on the
     error-free instrument (the same for every trainee), name no controls (that is hint 2)
     and carry none of the operator's numbers (:func:`bare_words`)."""
-    body = _jsonable(checklist(session, blind=session.hides_readout(),
-                               reference=session.shows_reference_steps()))
+    reference = session.shows_reference_steps()
+    blind = session.hides_readout() or reference
+    body = _jsonable(checklist(session, blind=blind, reference=reference))
     if body is not None and not session.exercise.allows("hints"):
         for step in body["steps"]:
             for key in ("controls", "control_names", "sheet_rows"):
