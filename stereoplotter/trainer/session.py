@@ -471,10 +471,13 @@ class Session:
         if not self.hides_readout() and not reference:
             return full
         rules = self.reference_rules(self.stage) if reference and self.stage else None
-        return full | {
+        view = full | {
             "marks": self.shown_marks(),
             "checklist_ticks": checklist_ticks(self, blind=True, rules=rules),
         }
+        if self.hides_readout():
+            view["controls"] = _scales_as_shown(full["controls"])
+        return view
 
     def full_state(self) -> dict[str, Any]:
         """The session's whole state, the exact marks included: what the log's digests and
@@ -720,6 +723,22 @@ def _reference_rules(exercise: Exercise, stage: str) -> list[dict[str, Any]]:
         par = operator_run(prep, 0, exercise.stages[-1])
         _REFERENCE[key] = {s: step_rules(par, s) for s in exercise.stages}
     return _REFERENCE[key][stage]
+
+
+def _scales_as_shown(controls: dict[str, Any]) -> dict[str, Any]:
+    """The controls with the scales the instrument reads (the screws' and decentrations'
+    values and stops) to their least count, the control's ``step``: read exactly, the stops
+    give a counter's hidden zero and scale errors, and a decentration's follow of a knob turn
+    the true f′ (what the counters show to the least count anyway)."""
+    out = dict(controls)
+    for name in (*SCREWS, *DECENTRATIONS):
+        if name in out:
+            c = dict(out[name])
+            for key in ("value", "min", "max"):
+                if c.get(key) is not None:
+                    c[key] = _on_step(float(c[key]), float(c["step"]))
+            out[name] = c
+    return out
 
 
 def _on_step(value: float, step: float) -> float:

@@ -153,17 +153,24 @@ def test_the_read_out_is_not_recomputed_from_marks_go_to_and_overview(exam):
     assert rms_x >= SIGMA_Q_UM and rms_y >= SIGMA_Q_UM, (rms_x, rms_y, errors)
 
 
-def test_the_cassettes_true_kappa_is_not_in_the_state(exam):
+def test_the_cassettes_kappa_and_the_counters_errors_are_not_in_the_state(exam):
     """The field's turn the state gives less the κ the trainee set tells less than half of the
-    cassette's hidden setting error."""
+    cassette's hidden setting error; the screws' stops as their scales read give the counters'
+    hidden errors no finer than the least count (the exact stop readings would give them to
+    the last digit)."""
     c, sessions, _ = exam
     s = sessions["hider"]
     state = ask(s["conn"], {"action": {"kind": "read", "counter": "X"}})["state"]
-    injected = _oracle(c, s).inst.injected
+    session = _oracle(c, s)
     for side in ("left", "right"):
-        truth = float(injected[f"setting.kappa_{side}"])
+        truth = float(session.inst.injected[f"setting.kappa_{side}"])
         guess = state["marks"][side]["kappa_rad"] - state["controls"][f"kappa_{side}"]["value"]
         assert abs(truth) > 1e-6 and abs(guess - truth) >= 0.5 * abs(truth), (side, guess, truth)
+    exact = session.full_state()["controls"]
+    for screw in ("X", "Y", "Z"):
+        for stop in ("min", "max"):
+            miss = abs(state["controls"][screw][stop] - exact[screw][stop])
+            assert miss > 1e-6, (screw, stop, miss)
 
 
 def test_the_checklist_does_not_tick_on_the_hidden_parallax(exam):
