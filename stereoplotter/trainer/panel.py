@@ -127,9 +127,10 @@ def overview(session: Any) -> dict[str, Any]:
     scene = session.prep.scene
     points = scene.points
     images = scene.images(np.array([p.local_m for p in points], float)) if points else None
-    marks = None
-    if "f_instrument" in session.commanded:
-        marks = [np.asarray(m, float).reshape(-1) for m in session.inst.marks()]
+    shown = session.shown_marks()  # as the state gives them (where the read-out is hidden:
+    marks = None  # to the counters' least count)
+    if shown is not None:
+        marks = [np.array([shown[s]["x_mm"], shown[s]["y_mm"]], float) for s in ("left", "right")]
     diameter = float(ex.spec.mark_diameter_mm)
     photos = {}
     for i, side in enumerate(("left", "right")):
@@ -418,9 +419,14 @@ def span_fails(session: Any) -> bool:
     return fails
 
 
-def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
+def _ticks(
+    session: Any, stage: str, blind: bool = False, rules: list[dict[str, Any]] | None = None
+) -> tuple[list[bool], list[bool]]:
     """(done, shown) per step of the stage: done when its target is met (see the module
-    docstring); shown unless it is conditional and its condition does not hold."""
+    docstring); shown unless it is conditional and its condition does not hold. ``blind``
+    or ``rules`` given: :func:`_blind_ticks`."""
+    if blind or rules is not None:
+        return _blind_ticks(session, stage, rules)
     used, read, near = session.progress_of(stage)
     rules = session.step_rules(stage)
     q = None
@@ -452,26 +458,55 @@ def _ticks(session: Any, stage: str) -> tuple[list[bool], list[bool]]:
     return done, shown
 
 
-def checklist_ticks(session: Any) -> dict[str, Any] | None:
+def _blind_ticks(
+    session: Any, stage: str, rules: list[dict[str, Any]] | None
+) -> tuple[list[bool], list[bool]]:
+    """(done, shown) of ``rules`` (default the session's own steps) with no tick on a hidden
+    quantity (the read-out hidden, or steps not of this instrument): a target, parallax or
+    controls step is done once its controls were used, a pointed or reading step as
+    :func:`_ticks` ticks it, every step after hint 3; every step is shown (whether a
+    conditional step's condition holds is the trainee's to judge)."""
+    used, read, near = session.progress_of(stage)
+    done = []
+    for entry in session.step_rules(stage) if rules is None else rules:
+        if SHOWN in used:
+            ok = True
+        elif entry["rule"] in ("target", "parallax", "controls"):
+            ok = all(c in used for c in [*entry["targets"], *entry["needs"]])
+        elif entry["rule"] == "pointed":
+            ok = entry["point"] in near
+        else:
+            ok = any(c in read for c in entry["reads"]) if entry["reads"] else bool(read)
+        done.append(bool(ok))
+    return done, [True] * len(done)
+
+
+def checklist_ticks(
+    session: Any, blind: bool = False, rules: list[dict[str, Any]] | None = None
+) -> dict[str, Any] | None:
     """The stage in hand's done and shown flags, in the order of :func:`checklist`'s steps
     (what the session state carries on every action: ``{"stage", "done": [bool, …], "shown":
-    [bool, …]}``); None when every stage is claimed."""
+    [bool, …]}``); None when every stage is claimed. ``blind``, ``rules``: see :func:`_ticks`."""
     stage = session.stage
     if stage is None:
         return None
-    done, shown = _ticks(session, stage)
+    done, shown = _ticks(session, stage, blind, rules)
     return {"stage": stage, "done": done, "shown": shown}
 
 
-def checklist(session: Any) -> dict[str, Any] | None:
+def checklist(session: Any, blind: bool = False, reference: bool = False) -> dict[str, Any] | None:
     """The stage in hand's steps with done flags (see the module docstring); None when every
-    stage is claimed."""
+    stage is claimed. ``blind`` (the read-out hidden): ticks as :func:`_ticks` gives them
+    blind, and no step carries its targets (the operator's values on this instrument).
+    ``reference``: the steps of the operator's run on the exercise's error-free instrument
+    (:meth:`~stereoplotter.trainer.session.Session.reference_rules`), not on this one (whose
+    steps follow from its hidden errors: a clearing the check made necessary, a pass more)."""
     stage = session.stage
     if stage is None:
         return None
     steps = []
-    ticks, shown = _ticks(session, stage)
-    rules = session.step_rules(stage)
+    rules = session.reference_rules(stage) if reference else session.step_rules(stage)
+    ticks, shown = _ticks(session, stage, blind, rules if reference else None)
     given = sheet_parts(session.exercise)["given"]
     for n, (entry, done, see) in enumerate(zip(rules, ticks, shown, strict=True), 1):
         steps.append(
@@ -483,7 +518,7 @@ def checklist(session: Any) -> dict[str, Any] | None:
                 "rule": entry["rule"],
                 "shown": bool(see),
                 "conditional": entry["conditional"],
-                "targets": dict(entry["targets"]),
+                "targets": {} if blind else dict(entry["targets"]),
                 **step_words(session, entry, given),
             }
         )

@@ -297,6 +297,39 @@ class Session:
             return None
         return float(got["min"]), float(got["max"])
 
+    def hides_readout(self) -> bool:
+        """Whether the exercise hides the parallax read-out (an exam, or practice with the
+        read-out off): then the trainee's state gives the marks only as the eyepieces show
+        them (:meth:`shown_marks`) and the checklist ticks nothing on a hidden quantity."""
+        return not self.exercise.allows("parallax_readout")
+
+    def mark_quantum_mm(self) -> float:
+        """The step in which the trainee's state gives a mark's photo position where the
+        read-out is hidden: the least count of the X, Y counters (0.01 mm on all three
+        instruments), the finest position the instrument shows in numbers. A parallax taken
+        from two marks so given is uncertain by ±1 step (σ = step/√6 = 4.1 µm), twice the
+        eye's σ_q = 10″·d/V = 2.0 µm at the binocular's 6× (``procedure.eye``): the numbers
+        tell no more than one look. [mm]"""
+        return float(self.exercise.spec.xy_least_count_mm)
+
+    def shown_marks(self) -> dict[str, Any] | None:
+        """The marks as the trainee's state gives them: exact where the read-out is shown;
+        where it is hidden, each position rounded to :meth:`mark_quantum_mm` and the field
+        turned by the cassette's scale (the κ set, without its hidden setting error: at most
+        10⁻⁴ rad, a hundredth of a screen pixel at the eyepiece's edge)."""
+        marks = self._marks()
+        if marks is None or not self.hides_readout():
+            return marks
+        step = self.mark_quantum_mm()
+        out = {}
+        for side, mark in marks.items():
+            out[side] = {
+                "x_mm": _on_step(mark["x_mm"], step),
+                "y_mm": _on_step(mark["y_mm"], step),
+                "kappa_rad": float(self.commanded.get(f"kappa_{side}", 0.0)),
+            }
+        return out
+
     def _marks(self) -> dict[str, Any] | None:
         """Where each mark stands on its photo; None before f_пр is set (no projection yet)."""
         if "f_instrument" not in self.commanded:
@@ -390,6 +423,17 @@ class Session:
             self._rules[stage] = step_rules(self.par, stage)
         return self._rules[stage]
 
+    def reference_rules(self, stage: str) -> list[dict[str, Any]]:
+        """The steps of a stage with their tick rules as the simulated operator takes them on
+        the exercise's instrument without errors (the same for every trainee: what an exam's
+        checklist lists, :func:`~.panel.checklist` ``reference``)."""
+        return _reference_rules(self.exercise, stage)
+
+    def shows_reference_steps(self) -> bool:
+        """Whether the trainee's checklist lists :meth:`reference_rules` (an exercise without
+        hints: the steps of the operator's run on this instrument follow from its errors)."""
+        return not self.exercise.allows("hints")
+
     def _targets(self, stage: str) -> dict[Any, Any]:
         """The points a stage's steps read at (cached; :func:`~.panel.step_targets`)."""
         if stage not in self._target_points:
@@ -416,7 +460,28 @@ class Session:
 
     def state(self) -> dict[str, Any]:
         """What the trainee sees (JSON-serialisable; the contract's keys; a value that is not
-        finite, e.g. a range without a stop, is null)."""
+        finite, e.g. a range without a stop, is null): :meth:`full_state` with, where the
+        read-out is hidden, the marks as the eyepieces show them (:meth:`shown_marks`) and
+        the checklist's ticks blind to hidden quantities."""
+        return self.trainee_view(self.full_state())
+
+    def trainee_view(self, full: dict[str, Any]) -> dict[str, Any]:
+        """``full`` (:meth:`full_state` of the session as it stands) as the trainee sees it."""
+        reference = self.shows_reference_steps()
+        if not self.hides_readout() and not reference:
+            return full
+        rules = self.reference_rules(self.stage) if reference and self.stage else None
+        view = full | {
+            "marks": self.shown_marks(),
+            "checklist_ticks": checklist_ticks(self, blind=True, rules=rules),
+        }
+        if self.hides_readout():
+            view["controls"] = _scales_as_shown(full["controls"])
+        return view
+
+    def full_state(self) -> dict[str, Any]:
+        """The session's whole state, the exact marks included: what the log's digests and
+        its claim records hold (the log is given once every stage is claimed)."""
         return json_finite(
             {
                 "instrument": self.exercise.spec.key,
@@ -487,7 +552,7 @@ class Session:
         """
         t = self._now(action) if isinstance(action, dict) else 0.0
         last = self._last_state
-        before = last[1] if last is not None and last[0] == len(self.log) else self.state()
+        before = last[1] if last is not None and last[0] == len(self.log) else self.full_state()
         clean = {k: v for k, v in action.items() if k != "t"} if isinstance(action, dict) else {}
         record: dict[str, Any] = {
             "n": len(self.log) + 1,
@@ -508,18 +573,18 @@ class Session:
             self.events = coupled_motion(clean, before["counters"], self._counters())
         except TrainerError as exc:
             record["refused"] = str(exc)
-            after = self.state()
+            after = self.full_state()
             record["state_after"] = state_digest(after)
             self.log.append(record)
             self._last_state = (len(self.log), dict(after))
             raise
-        after = self.state()
+        after = self.full_state()
         record["state_after"] = state_digest(after)
         if clean["kind"] == "claim":
             record["state"] = after
         self.log.append(record)
         self._last_state = (len(self.log), dict(after))
-        return after
+        return self.trainee_view(after)
 
     def _do(self, action: dict[str, Any], before: dict[str, Any]) -> Any:
         kind = action["kind"]
@@ -644,6 +709,41 @@ def secret_seed(key: bytes, exercise: str, trainee: str, attempt: int) -> int:
     message = "\x00".join((exercise, trainee, str(int(attempt)))).encode("utf-8")
     digest = hmac.new(key, message, hashlib.sha256).digest()
     return int.from_bytes(digest[:8], "big") >> 1
+
+
+#: Exercise (its file content) → stage → the reference run's step rules (one run per exercise
+#: and process, about a second; every trainee of the exercise shares it).
+_REFERENCE: dict[str, dict[str, list[dict[str, Any]]]] = {}
+
+
+def _reference_rules(exercise: Exercise, stage: str) -> list[dict[str, Any]]:
+    key = json.dumps(exercise.source, sort_keys=True, default=str)
+    if key not in _REFERENCE:
+        prep = prepare_run(exercise.scenario, exercise.spec, exercise.method, "zero", 0)
+        par = operator_run(prep, 0, exercise.stages[-1])
+        _REFERENCE[key] = {s: step_rules(par, s) for s in exercise.stages}
+    return _REFERENCE[key][stage]
+
+
+def _scales_as_shown(controls: dict[str, Any]) -> dict[str, Any]:
+    """The controls with the scales the instrument reads (the screws' and decentrations'
+    values and stops) to their least count, the control's ``step``: read exactly, the stops
+    give a counter's hidden zero and scale errors, and a decentration's follow of a knob turn
+    the true f′ (what the counters show to the least count anyway)."""
+    out = dict(controls)
+    for name in (*SCREWS, *DECENTRATIONS):
+        if name in out:
+            c = dict(out[name])
+            for key in ("value", "min", "max"):
+                if c.get(key) is not None:
+                    c[key] = _on_step(float(c[key]), float(c["step"]))
+            out[name] = c
+    return out
+
+
+def _on_step(value: float, step: float) -> float:
+    """``value`` rounded to a multiple of ``step`` (to 9 decimals: no binary residue)."""
+    return round(round(value / step) * step, 9)
 
 
 def _is_point(value: Any) -> bool:

@@ -312,14 +312,47 @@ def _on_grid(value: float | None) -> float | None:
     return round(round(value / HIDDEN_GRID_MM) * HIDDEN_GRID_MM, 3)
 
 
+#: What a step's words say that the operator found on this instrument or that names its
+#: control, removed where the exercise gives no hints: a number with a decimal point (a common
+#: tilt, a pass's RMS, an over-correction: the operator's answers), the control a step turns.
+_FOUND_NUMBER = re.compile(r"[+\-−]?\d+\.\d+")
+_CONTROL_ID = r"(?:(?:kappa|k_alpha|k_omega|dx|dy)_(?:left|right)|b[xyz]|f_instrument)"
+_NAMED_CONTROL = (
+    (re.compile(r"\s*\(by turning [^)]*\)"), ""),
+    (re.compile(r" by turning \S+"), ""),
+    (re.compile(r"(?<=y-parallax) with \S+( \([^)]*\))?"), ""),
+    (re.compile(rf"[;:,] turn {_CONTROL_ID}$"), ""),
+    (re.compile(rf"\bturn {_CONTROL_ID} by\b"), "turn an element by"),
+    (re.compile(rf"\s*\({_CONTROL_ID}\)"), ""),
+)
+
+
+def bare_words(text: str | None) -> str | None:
+    """A step's words without the controls they name or the operator's numbers (an exam's
+    checklist: naming the controls is hint 2; the numbers are this instrument's answers)."""
+    if text is None:
+        return None
+    for pattern, instead in _NAMED_CONTROL:
+        text = pattern.sub(instead, text)
+    return _FOUND_NUMBER.sub("…", text)
+
+
 def checklist_of(session: Session) -> dict[str, Any] | None:
     """The stage in hand's steps with their done flags (``trainer.panel.checklist``; the state
-    carries only the flags on every action; run on the actor thread). Where the exercise gives
-    no hints, the steps do not name their controls (that is hint 2)."""
-    body = _jsonable(checklist(session))
+    carries only the flags on every action; run on the actor thread). Where the read-out is
+    hidden, no tick depends on a hidden quantity and no step carries its targets (blind);
+    where the exercise gives no hints, the steps are those of the operator's run on the
+    error-free instrument (the same for every trainee), name no controls (that is hint 2)
+    and carry none of the operator's numbers (:func:`bare_words`)."""
+    reference = session.shows_reference_steps()
+    blind = session.hides_readout() or reference
+    body = _jsonable(checklist(session, blind=blind, reference=reference))
     if body is not None and not session.exercise.allows("hints"):
         for step in body["steps"]:
-            step.pop("controls", None)
+            for key in ("controls", "control_names", "sheet_rows"):
+                step.pop(key, None)
+            step["text"] = bare_words(step["text"])
+            step["note"] = bare_words(step.get("note"))
     return body
 
 

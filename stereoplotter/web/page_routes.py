@@ -24,6 +24,7 @@ from stereoplotter.trainer.acuity import ACUITY_RECORDS
 from stereoplotter.trainer.feedback import stage_feedback
 from stereoplotter.trainer.grade_tables import FULL_POINTS, HINT_COST
 from stereoplotter.trainer.navigation import goto_actions
+from stereoplotter.trainer.panel import least_count
 from stereoplotter.trainer.step_words import CONTROL_NAMES, SHEET_NAMES, glossary
 from stereoplotter.trainer.tour import tour_of
 from stereoplotter.web.guard import Refused
@@ -58,6 +59,8 @@ def _words(session) -> dict[str, Any]:
     share = FULL_POINTS / max(len(session.stages), 1)
     stage = session.stage
     n = len(session.par.stage_actions(stage)) if stage is not None else 0
+    if not session.exercise.allows("hints"):  # no show-me: its length is the operator's run
+        n = None
     return {
         "stage": stage,
         "hint_points": {str(k): round(share * v, 2) for k, v in HINT_COST.items()},
@@ -76,7 +79,14 @@ async def words(request: Request) -> Response:
 
 
 def _goto(session, point: str | None, xy: list[float] | None) -> list[dict[str, Any]]:
-    return goto_actions(session, point=point, left_xy=xy)
+    """Where the read-out is hidden, each setting to its counter's least count (a setting to
+    the µm would give where the left mark truly projects, the instrument's hidden errors)."""
+    actions = goto_actions(session, point=point, left_xy=xy)
+    if session.hides_readout():
+        for action in actions:
+            step = least_count(session.exercise.spec, action["control"])
+            action["value"] = round(round(action["value"] / step) * step, 9)
+    return actions
 
 
 async def goto(request: Request) -> Response:
@@ -128,6 +138,9 @@ async def feedback(request: Request) -> Response:
     reg, live, row = await _live(request)
     if row["mode"] == "exam":
         raise Refused(403, "feedback: an exam's outcome is given by its grade")
+    if which == "now" and live.session.hides_readout():  # the stage's checks are a read-out
+        raise Refused(403, "feedback: the read-out is off in this exercise: feedback comes "
+                      "with the claim")
     try:
         body = await _on_actor(request, reg, live, _feedback, live.session, which)
     except TrainerError as exc:
