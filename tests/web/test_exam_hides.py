@@ -19,17 +19,20 @@ of the counters' least count, not of this test.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 
 import numpy as np
 import pytest
 
 from stereoplotter.io.exercise_file import load_exercise
+from stereoplotter.io.session_store import SessionStore
 from stereoplotter.procedure.eye import Eye, ObservationSystem
 from stereoplotter.procedure.operator import Noise, Operator
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.trainer.session import Session
 from stereoplotter.web.app import create_app
+from stereoplotter.web.registry import SEED_KEY
 from tests.web.conftest import EXAM, TOKEN, ask, make_test_client, open_socket, start
 
 #: One look's y-parallax judgement at the instruments' 6× binocular, 250 mm. [µm]
@@ -65,11 +68,12 @@ def _run(conn, actions):
 @pytest.fixture(scope="module")
 def exam(tmp_path_factory):
     """Two trainees' exams after the same actions (stage 2 in hand), and the scene offline."""
-    app = create_app(TOKEN, tmp_path_factory.mktemp("hide-data"), hosts=("testserver",),
-                     message_limit=(1e4, 10**4))
+    data = tmp_path_factory.mktemp("hide-data")
+    # the server's key kept in the data folder, fixed: the same instruments every run
+    SessionStore(data).put_value(SEED_KEY, hashlib.sha256(b"a fixed server key").hexdigest())
+    app = create_app(TOKEN, data, hosts=("testserver",), message_limit=(1e4, 10**4))
     offline = Session(load_exercise(EXAM), "anyone", 0).prep.scene.standard
     with make_test_client(app) as c, contextlib.ExitStack() as stack:
-        c.app.state.registry._seed_key = b"a fixed server key: the same instruments every run"
         sessions, script = {}, None
         for trainee in ("hider", "twin"):
             sid, secret = start(c, EXAM, trainee=trainee)
