@@ -6,7 +6,9 @@ queued under its owner (a client address, then a session of that address), and a
 takes the next job of the next address in turn, and within the address of the next session in
 turn. A session never has two jobs running at once (its actions keep their order). So a
 trainee's request waits for at most one job of each other address with work queued, however
-many that address has sent.
+many that address has sent. With ``per_address``, an address never has more jobs running at
+once than that, so with more workers than that one client cannot occupy them all: a newcomer's
+job starts on the worker left free.
 """
 
 from __future__ import annotations
@@ -21,10 +23,13 @@ __all__ = ["FairPool"]
 
 
 class FairPool:
-    """``workers`` threads serving jobs round-robin by address, then by session."""
+    """``workers`` threads serving jobs round-robin by address, then by session; at most
+    ``per_address`` jobs of one address running at once (None: no cap)."""
 
-    def __init__(self, workers: int = 2, name: str = "fair"):
+    def __init__(self, workers: int = 2, name: str = "fair", per_address: int | None = None):
         self._cv = threading.Condition()
+        self._per_address = per_address
+        self._busy: dict[str, int] = {}  # jobs running per address
         self._jobs: dict[tuple[str, str], deque] = {}
         self._addresses: deque[str] = deque()
         self._sessions: dict[str, deque[str]] = {}
@@ -65,6 +70,8 @@ class FairPool:
         for _ in range(len(self._addresses)):
             address = self._addresses[0]
             self._addresses.rotate(-1)
+            if self._per_address is not None and self._busy.get(address, 0) >= self._per_address:
+                continue
             ring = self._sessions[address]
             for _ in range(len(ring)):
                 session = ring[0]
@@ -98,6 +105,7 @@ class FairPool:
                     got = self._next()
                 key, (fut, fn, args) = got
                 self._running.add(key)
+                self._busy[key[0]] = self._busy.get(key[0], 0) + 1
             try:
                 if fut.set_running_or_notify_cancel():
                     try:
@@ -107,6 +115,9 @@ class FairPool:
             finally:
                 with self._cv:
                     self._running.discard(key)
+                    left = self._busy.pop(key[0]) - 1
+                    if left:
+                        self._busy[key[0]] = left
                     self._forget(key)
                     self._cv.notify_all()
 

@@ -8,10 +8,11 @@ attempt per trainee and exercise unless the instructor grants another. Every act
 written to the store as it happens; after a restart an unfinished session is replayed from its
 log the first time its page reconnects.
 
-Slow work never runs on the event loop: session start, actions and photo patches run in worker
-threads; grading, replays for the instructor and building the photos' tile pyramids run in
-worker processes (``Executor`` objects given to the registry). A finished session's grade is
-computed once, when its last stage is claimed, and kept in the store.
+Slow work never runs on the event loop: session start and actions run in worker threads;
+photo patches are queued on worker threads and rendered in worker processes; grading, replays
+for the instructor and building the photos' tile pyramids run in worker processes
+(``Executor`` objects given to the registry). A finished session's grade is computed once,
+when its last stage is claimed, and kept in the store.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from stereoplotter.web.guard import (
     text_ok,
     trainee_key,
 )
+from stereoplotter.web.render import Renderers
 
 __all__ = ["MAX_ACTIONS", "RANGE_SLACK", "Live", "Registry", "token_hash"]
 
@@ -57,10 +59,14 @@ RANGE_SLACK = 0.01
 #: address together (a class of 40 behind one address). [1/s], [patches]
 PATCH_LIMIT = (10.0, 30)
 PATCH_ADDRESS_LIMIT = (200.0, 400)
-#: Worker threads of the fair pools (actions; photo patches). One patch thread: a render holds
-#: the interpreter's lock for most of its 0.1–0.3 s, and two renders at once only share it (an
-#: honest trainee's patch would wait for one render and then run beside another). [threads]
-ACTORS, PATCHERS = 2, 1
+#: Worker threads of the fair pools (actions; photo patches). Each patch thread hands its
+#: renders to a worker process of its own (``render.Renderers``: a render holds the
+#: interpreter's lock for most of its 0.1–0.3 s, which in the server would stall the event loop
+#: and the actors). [threads]
+ACTORS, PATCHERS = 2, 2
+#: Photo patches of one client address rendered at once: with PATCHERS above it, a client
+#: asking for patches without pause leaves a worker free for the others. [patches]
+PATCHES_AT_ONCE = 1
 #: Sockets a session may open (a page reconnects after a dropped network or a reload): a rate
 #: and a burst; beyond, a socket is closed (4429) before any work is done for it. [1/s], [—]
 CONNECT_LIMIT = (1.0, 5)
@@ -112,6 +118,7 @@ class Registry:
         imager: Executor,
         message_limit: tuple[float, int] = (RATE, BURST),
         address_limit: tuple[float, int] = (1_200.0, 2_400),
+        renderers: Renderers | None = None,
     ):
         self.store = store
         #: A token made now (printed once by the server), or None when the stored one is kept.
@@ -136,9 +143,11 @@ class Registry:
         self.connect_limits: dict[str, RateLimit] = {}
         #: The threads that carry out the sessions' actions (round-robin by client address and
         #: session: a flood from one client does not queue the others behind it), and render
-        #: photo patches.
+        #: photo patches (at most PATCHES_AT_ONCE of one address at once; rendered in worker
+        #: processes when ``renderers`` has them).
         self.actor = FairPool(ACTORS, "trainer-actor")
-        self.patcher = FairPool(PATCHERS, "trainer-patch")
+        self.patcher = FairPool(PATCHERS, "trainer-patch", per_address=PATCHES_AT_ONCE)
+        self.renderers = renderers if renderers is not None else Renderers(PATCHERS, False)
         self._seed_key = store.server_key(SEED_KEY)
         self.rows: dict[str, dict[str, Any]] = {r["id"]: r for r in store.sessions()}
         self.grades: dict[str, dict[str, Any]] = store.grades()
@@ -394,6 +403,13 @@ class Registry:
         return self.grader.submit(core.replay_json, self.store.records(sid), row["trainee"],
                                   row["exercise"])
 
+    def patch(self, exercise, cache, side: str, x_mm: float, y_mm: float, mag: float,
+              size_px: int) -> bytes:
+        """PNG of a photo patch of ``exercise`` (its photos ``cache``), rendered by the patch
+        thread's worker process (run on :attr:`patcher`)."""
+        return self.renderers.render(core.photo_key(exercise), cache, side, x_mm, y_mm, mag,
+                                     size_px)
+
     def photos(self, exercise) -> Future:
         """The view cache of an exercise's photos (built once, in a worker)."""
         key = core.photo_key(exercise)
@@ -401,6 +417,12 @@ class Registry:
         if fut is None:
             fut = self.imager.submit(core.build_view_cache, exercise.source)
             self._photos[key] = fut
+
+            def offer(f: Future) -> None:  # the patch workers have them before a first patch
+                if not f.cancelled() and f.exception() is None:
+                    self.renderers.offer(key, f.result())
+
+            fut.add_done_callback(offer)
         return fut
 
     def prepare_photos(self) -> None:

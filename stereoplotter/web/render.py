@@ -1,0 +1,108 @@
+"""Photo patches rendered in worker processes, one process for each patch thread.
+
+Rendering a patch (sampling the tile pyramid, rendering the tiles it needs, encoding the PNG)
+holds the interpreter's lock for most of its time: in the server's process it would slow the
+event loop and the session actors of every trainee while one client asks for patches. Here
+each thread of the registry's fair patch pool owns one worker process and hands it the render;
+the thread only waits. A worker is given an exercise's photos (the tile pyramid built once by
+the registry) the first time it renders a patch of them, and keeps them.
+
+Without processes (the tests' in-memory server) a render runs in the calling thread.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import threading
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from multiprocessing import get_context
+from typing import Any
+
+from stereoplotter.web import core
+from stereoplotter.web.workers import watch_parent
+
+__all__ = ["Renderers"]
+
+# --- in the worker process --------------------------------------------------------------------
+
+_CACHES: dict[Any, Any] = {}
+
+
+def _keep(key: Any, cache: Any) -> None:
+    _CACHES[key] = cache
+
+
+def _render(key: Any, side: str, x_mm: float, y_mm: float, mag: float, size_px: int) -> bytes:
+    return core.photo_patch(_CACHES[key], side, x_mm, y_mm, mag, size_px)
+
+
+def _worker() -> ProcessPoolExecutor:
+    # spawn: the server's threads are never forked; the worker ends with the server
+    return ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"),
+                               initializer=watch_parent, initargs=(os.getpid(),))
+
+
+# --- in the server ---------------------------------------------------------------------------
+
+
+class Renderers:
+    """``slots`` worker processes (``processes``; else in the calling thread): a calling thread
+    is given a process of its own the first time it renders, so the pool's threads never
+    share one."""
+
+    def __init__(self, slots: int, processes: bool):
+        self._processes = processes
+        self._executors: list[ProcessPoolExecutor] = []
+        self._kept: list[set] = []
+        if processes:
+            for _ in range(slots):
+                self._executors.append(_worker())
+                self._kept.append(set())
+        self._next = itertools.count()
+        self._closed = False
+        self._mine = threading.local()
+
+    def offer(self, key: Any, cache: Any) -> None:
+        """Hand the photos ``cache`` (known as ``key``) to every worker ahead of their first
+        patch (queued before any render of them: each worker takes its jobs in order)."""
+        if self._closed:
+            return
+        for slot, executor in enumerate(self._executors):
+            if key not in self._kept[slot]:
+                executor.submit(_keep, key, cache)
+                self._kept[slot].add(key)
+
+    def render(self, key: Any, cache: Any, side: str, x_mm: float, y_mm: float, mag: float,
+               size_px: int) -> bytes:
+        """PNG of a patch of the photos ``cache`` (known as ``key``): ``core.photo_patch``."""
+        if not self._processes:
+            return core.photo_patch(cache, side, x_mm, y_mm, mag, size_px)
+        slot = getattr(self._mine, "slot", None)
+        if slot is None:
+            slot = self._mine.slot = next(self._next) % len(self._executors)
+        try:
+            return self._in(slot, key, cache, side, x_mm, y_mm, mag, size_px)
+        except BrokenProcessPool:  # the worker died (killed, out of memory): a new one
+            if self._closed:
+                raise
+            self._executors[slot] = _worker()
+            self._kept[slot] = set()
+            return self._in(slot, key, cache, side, x_mm, y_mm, mag, size_px)
+
+    def _in(self, slot: int, key: Any, cache: Any, *args: Any) -> bytes:
+        executor = self._executors[slot]
+        if key not in self._kept[slot]:
+            executor.submit(_keep, key, cache).result()
+            self._kept[slot].add(key)
+        return executor.submit(_render, key, *args).result()
+
+    def shutdown(self) -> None:
+        """Stop the worker processes at once (a render in progress is abandoned)."""
+        self._closed = True
+        for executor in self._executors:
+            workers = list((getattr(executor, "_processes", None) or {}).values())
+            executor.shutdown(wait=False, cancel_futures=True)
+            for proc in workers:
+                proc.terminate()

@@ -1,0 +1,78 @@
+"""Photo patches under abuse: one client address never renders more than one patch at once
+(another client's patch starts on the worker left free), and patches are rendered in worker
+processes, not in the server's own (where a render would hold the interpreter's lock)."""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+
+from stereoplotter.imagery.cache import ViewCache
+from stereoplotter.io.exercise_file import load_exercise
+from stereoplotter.web import core
+from stereoplotter.web.fair import FairPool
+from stereoplotter.web.render import Renderers
+from tests.web.conftest import PRACTICE
+
+
+def test_one_address_never_occupies_every_worker():
+    """Two workers, at most one job of an address at once: an abuser queues 20 patch jobs over
+    5 sessions; while its first is running, a trainee's job starts on the other worker."""
+    pool = FairPool(2, "test", per_address=1)
+    running: list[str] = []
+    most = {"abuser": 0}
+    gate = threading.Event()
+    honest_started = threading.Event()
+    lock = threading.Lock()
+
+    def job(who: str) -> str:
+        with lock:
+            running.append(who)
+            most["abuser"] = max(most["abuser"], running.count("abuser"))
+        if who == "honest":
+            honest_started.set()
+        else:
+            gate.wait(5)
+        with lock:
+            running.remove(who)
+        return who
+
+    try:
+        flood = [pool.submit("10.0.0.66", f"s{k % 5}", job, "abuser") for k in range(20)]
+        time.sleep(0.05)
+        honest = pool.submit("10.0.0.7", "mine", job, "honest")
+        # started while the abuser's first job still holds its worker
+        assert honest_started.wait(5)
+        assert not gate.is_set()
+        gate.set()
+        assert honest.result(5) == "honest"
+        assert [f.result(5) for f in flood] == ["abuser"] * 20
+    finally:
+        gate.set()
+        pool.shutdown()
+    assert most["abuser"] == 1
+
+
+def test_patches_are_rendered_in_worker_processes():
+    ex = load_exercise(PRACTICE)
+    cache = ViewCache(ex.scenario, ex.seed, pixel_mm=0.32)  # coarse photos: quick to build
+    here = core.photo_patch(cache, "left", 1.5, -2.0, 0.625, 64)
+    renderers = Renderers(2, processes=True)
+    got: dict[str, tuple[bytes, int]] = {}
+
+    def render(name: str) -> None:  # each thread of the pool gets a process of its own
+        png = renderers.render(core.photo_key(ex), cache, "left", 1.5, -2.0, 0.625, 64)
+        got[name] = (png, renderers._executors[renderers._mine.slot].submit(os.getpid).result())
+
+    try:
+        threads = [threading.Thread(target=render, args=(n,)) for n in ("a", "b")]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(120)
+    finally:
+        renderers.shutdown()
+    pids = {pid for _, pid in got.values()}
+    assert [png for png, _ in got.values()] == [here, here]  # the same bytes as in-process
+    assert len(pids) == 2 and os.getpid() not in pids
