@@ -9,6 +9,9 @@ trainee's request waits for at most one job of each other address with work queu
 many that address has sent. With ``per_address``, an address never has more jobs running at
 once than that, so with more workers than that one client cannot occupy them all: a newcomer's
 job starts on the worker left free.
+
+:class:`Holds` counts refusals held back before they are sent (a client that retries at once
+waits for its refusal), with a bound per client and in all.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
-__all__ = ["FairPool"]
+__all__ = ["FairPool", "Holds"]
 
 
 class FairPool:
@@ -133,3 +136,28 @@ class FairPool:
         if wait:
             for t in self._threads:
                 t.join(timeout=10)
+
+
+class Holds:
+    """Refused sockets held back before their refusal is sent: at most ``per_address`` of one
+    client address and ``total`` of all at once (each holds a connection open)."""
+
+    def __init__(self, per_address: int, total: int):
+        self.per_address, self.total = per_address, total
+        self.held: dict[str, int] = {}
+        self.count = 0
+
+    def take(self, address: str) -> bool:
+        """Whether one more refusal of ``address`` may be held now (then counted)."""
+        if self.count >= self.total or self.held.get(address, 0) >= self.per_address:
+            return False
+        self.held[address] = self.held.get(address, 0) + 1
+        self.count += 1
+        return True
+
+    def give(self, address: str) -> None:
+        """A held refusal of ``address`` was sent."""
+        self.count -= 1
+        left = self.held.pop(address) - 1
+        if left:
+            self.held[address] = left

@@ -30,7 +30,7 @@ from typing import Any
 from stereoplotter.io.session_store import SessionStore, storable
 from stereoplotter.trainer.session import secret_seed
 from stereoplotter.web import core
-from stereoplotter.web.fair import FairPool
+from stereoplotter.web.fair import FairPool, Holds
 from stereoplotter.web.guard import (
     BURST,
     RATE,
@@ -73,6 +73,9 @@ CONNECT_LIMIT = (1.0, 5)
 #: Sockets one client address may open, checked before the socket is accepted (a class of 40
 #: behind one address reconnecting after a restart has room). [1/s], [—]
 ADDRESS_CONNECT_LIMIT = (20.0, 80)
+#: Refusals held back at once: of one client address, and of all (each holds a connection
+#: open; beyond, a refusal is answered at once). [connections]
+HELD_REFUSALS = (256, 2_048)
 
 
 def token_hash(token: str) -> str:
@@ -141,6 +144,8 @@ class Registry:
         self.address_limits: dict[str, Any] = {}
         self.patch_limits: dict[tuple[str, str], RateLimit] = {}
         self.connect_limits: dict[str, RateLimit] = {}
+        #: Refused sockets waiting for their refusal (``sockets.REFUSAL_DELAY_S``).
+        self.refusal_holds = Holds(*HELD_REFUSALS)
         #: The threads that carry out the sessions' actions (round-robin by client address and
         #: session: a flood from one client does not queue the others behind it), and render
         #: photo patches (at most PATCHES_AT_ONCE of one address at once; rendered in worker

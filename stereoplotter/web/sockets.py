@@ -10,7 +10,10 @@ frame also carries ``"hello"``. A malformed, oversized or too frequent message g
 network, a restarted server) sends its secret again and resumes where the log ends.
 
 One live socket per session: a newer one (the page reloaded, or opened twice) replaces the
-older, which is closed with code 4409. Messages are limited per session (however many sockets
+older, which is closed with code 4409. Sockets are limited per client address (checked before
+the socket is accepted) and per session; a socket refused for either is answered after
+:data:`REFUSAL_DELAY_S`, so a client reconnecting in a loop is paced by the server. Messages
+are limited per session (however many sockets
 it opens one after the other) and per client address (:data:`ADDRESS_LIMIT`: a class behind
 one address has room), and carried out on the registry's fair pool.
 
@@ -40,7 +43,7 @@ from stereoplotter.web.guard import (
 )
 from stereoplotter.web.registry import CONNECT_LIMIT, Registry
 
-__all__ = ["AUTH_TIMEOUT_S", "PUSH_S", "instructor_socket", "trainee_socket"]
+__all__ = ["AUTH_TIMEOUT_S", "PUSH_S", "REFUSAL_DELAY_S", "instructor_socket", "trainee_socket"]
 
 log = logging.getLogger(__name__)
 
@@ -55,6 +58,11 @@ PATCH_PX = 768
 ADDRESS_LIMIT = (1_200.0, 2_400)
 #: Addresses whose limits are remembered (beyond: forgotten, rather than grow without bound).
 MAX_ADDRESSES = 10_000
+#: A socket refused for the rate at which its address or session opens sockets is answered
+#: after this delay: a client that reconnects the moment it is refused (a flood) then costs
+#: the server one handshake per delay for each connection it holds, not one per round trip.
+#: A page's own reconnects stay within the limits and are never delayed. [s]
+REFUSAL_DELAY_S = 2.0
 
 
 def address_of(conn) -> str:
@@ -90,9 +98,22 @@ async def _refuse(websocket: WebSocket, text: str, code: int = 4403) -> None:
         pass
 
 
+async def _held(reg: Registry, address: str) -> None:
+    """Wait :data:`REFUSAL_DELAY_S` before a refusal is sent, while the registry's holds allow
+    (``registry.HELD_REFUSALS``):
+    a client that reconnects the moment it is refused is then paced by the server."""
+    if not reg.refusal_holds.take(address):
+        return
+    try:
+        await asyncio.sleep(REFUSAL_DELAY_S)
+    finally:
+        reg.refusal_holds.give(address)
+
+
 async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     sid = websocket.path_params["sid"]
     if not reg.connect_allowed(address_of(websocket)):  # refused before any work (HTTP 403)
+        await _held(reg, address_of(websocket))
         await websocket.close(4429)
         return
     await websocket.accept()
@@ -109,6 +130,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     if live.connects is None:
         live.connects = RateLimit(*CONNECT_LIMIT)
     if not live.connects.allow():
+        await _held(reg, address_of(websocket))
         return await _refuse(websocket, "too many connections of this session: wait a moment",
                              4429)
     ex = live.session.exercise
