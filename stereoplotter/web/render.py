@@ -4,7 +4,8 @@ Rendering a patch (sampling the tile pyramid, rendering the tiles it needs, enco
 holds the interpreter's lock for most of its time: in the server's process it would slow the
 event loop and the session actors of every trainee while one client asks for patches. Here
 each thread of the registry's fair patch pool owns one worker process and hands it the render;
-the thread only waits. A worker is given an exercise's photos (the tile pyramid built once by
+the thread only waits. The workers run at a lower priority than the server
+(:data:`RENDER_NICENESS`). A worker is given an exercise's photos (the tile pyramid built once by
 the registry) the first time it renders a patch of them, and keeps them.
 
 Without processes (the tests' in-memory server) a render runs in the calling thread.
@@ -23,7 +24,12 @@ from typing import Any
 from stereoplotter.web import core
 from stereoplotter.web.workers import watch_parent
 
-__all__ = ["Renderers"]
+__all__ = ["RENDER_NICENESS", "Renderers"]
+
+#: Niceness a render worker adds to its own (Unix ``nice``): renders take the processor only
+#: when the server's event loop and session actors leave it, so a client asking for patches
+#: without pause cannot slow the other trainees' actions, only share the render workers. [—]
+RENDER_NICENESS = 10
 
 # --- in the worker process --------------------------------------------------------------------
 
@@ -38,10 +44,16 @@ def _render(key: Any, side: str, x_mm: float, y_mm: float, mag: float, size_px: 
     return core.photo_patch(_CACHES[key], side, x_mm, y_mm, mag, size_px)
 
 
+def _start(parent: int) -> None:
+    """A render worker's start: it ends with the server, and yields the CPU to it."""
+    watch_parent(parent)
+    os.nice(RENDER_NICENESS)
+
+
 def _worker() -> ProcessPoolExecutor:
-    # spawn: the server's threads are never forked; the worker ends with the server
+    # spawn: the server's threads are never forked
     return ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"),
-                               initializer=watch_parent, initargs=(os.getpid(),))
+                               initializer=_start, initargs=(os.getpid(),))
 
 
 # --- in the server ---------------------------------------------------------------------------

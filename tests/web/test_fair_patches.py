@@ -1,6 +1,7 @@
 """Photo patches under abuse: one client address never renders more than one patch at once
 (another client's patch starts on the worker left free), and patches are rendered in worker
-processes, not in the server's own (where a render would hold the interpreter's lock)."""
+processes at a lower priority, not in the server's own (where a render would hold the
+interpreter's lock)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from stereoplotter.imagery.cache import ViewCache
 from stereoplotter.io.exercise_file import load_exercise
 from stereoplotter.web import core
 from stereoplotter.web.fair import FairPool
-from stereoplotter.web.render import Renderers
+from stereoplotter.web.render import RENDER_NICENESS, Renderers
 from tests.web.conftest import PRACTICE
 
 
@@ -59,11 +60,12 @@ def test_patches_are_rendered_in_worker_processes():
     cache = ViewCache(ex.scenario, ex.seed, pixel_mm=0.32)  # coarse photos: quick to build
     here = core.photo_patch(cache, "left", 1.5, -2.0, 0.625, 64)
     renderers = Renderers(2, processes=True)
-    got: dict[str, tuple[bytes, int]] = {}
+    got: dict[str, tuple[bytes, int, int]] = {}
 
     def render(name: str) -> None:  # each thread of the pool gets a process of its own
         png = renderers.render(core.photo_key(ex), cache, "left", 1.5, -2.0, 0.625, 64)
-        got[name] = (png, renderers._executors[renderers._mine.slot].submit(os.getpid).result())
+        worker = renderers._executors[renderers._mine.slot]
+        got[name] = (png, worker.submit(os.getpid).result(), worker.submit(os.nice, 0).result())
 
     try:
         threads = [threading.Thread(target=render, args=(n,)) for n in ("a", "b")]
@@ -73,6 +75,8 @@ def test_patches_are_rendered_in_worker_processes():
             t.join(120)
     finally:
         renderers.shutdown()
-    pids = {pid for _, pid in got.values()}
-    assert [png for png, _ in got.values()] == [here, here]  # the same bytes as in-process
+    pids = {pid for _, pid, _ in got.values()}
+    assert [png for png, _, _ in got.values()] == [here, here]  # the same bytes as in-process
     assert len(pids) == 2 and os.getpid() not in pids
+    # and at a lower priority than the server (its niceness plus RENDER_NICENESS, at most 19)
+    assert {nice for _, _, nice in got.values()} == {min(19, os.nice(0) + RENDER_NICENESS)}
