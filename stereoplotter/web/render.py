@@ -29,7 +29,7 @@ __all__ = ["RENDER_NICENESS", "Renderers"]
 #: Niceness a render worker adds to its own (Unix ``nice``): renders take the processor only
 #: when the server's event loop and session actors leave it, so a client asking for patches
 #: without pause cannot slow the other trainees' actions, only share the render workers. [—]
-RENDER_NICENESS = 10
+RENDER_NICENESS = 5
 
 # --- in the worker process --------------------------------------------------------------------
 
