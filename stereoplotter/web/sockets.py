@@ -12,8 +12,9 @@ network, a restarted server) sends its secret again and resumes where the log en
 One live socket per session: a newer one (the page reloaded, or opened twice) replaces the
 older, which is closed with code 4409. Sockets are limited per client address (checked before
 the socket is accepted) and per session; a socket refused for either is answered after
-:data:`REFUSAL_DELAY_S`, so a client reconnecting in a loop is paced by the server. Messages
-are limited per session (however many sockets
+:data:`REFUSAL_DELAY_S`, so a client reconnecting in a loop is paced by the server; a socket
+that sends on after :data:`FLOOD_REFUSALS` refusals for the rate in a row is closed (4429).
+Messages are limited per session (however many sockets
 it opens one after the other) and per client address (:data:`ADDRESS_LIMIT`: a class behind
 one address has room), and carried out on the registry's fair pool.
 
@@ -58,6 +59,11 @@ PATCH_PX = 768
 ADDRESS_LIMIT = (1_200.0, 2_400)
 #: Addresses whose limits are remembered (beyond: forgotten, rather than grow without bound).
 MAX_ADDRESSES = 10_000
+#: Messages refused for the rate in a row after which the socket is closed (4429): a page
+#: paces itself by the rate its hello gives, and a page's retries of a refused action come
+#: after a pause; a client that sends on regardless costs the server a reply each. [messages]
+FLOOD_REFUSALS = 200
+_TOO_MANY = "too many messages"
 #: A socket refused for the rate at which its address or session opens sockets is answered
 #: after this delay: a client that reconnects the moment it is refused (a flood) then costs
 #: the server one handshake per delay for each connection it holds, not one per round trip.
@@ -162,6 +168,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     if live.limit is None:
         live.limit = RateLimit(*reg.message_limit)
     limits = (live.limit, address_limit(reg, address, reg.address_limits))
+    flooding = 0  # messages refused for the rate in a row
     try:
         await websocket.send_text(
             _dump({"hello": hello, "state": state, "error": None, "n": len(live.session.log)})
@@ -171,6 +178,10 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
             if message["type"] == "websocket.disconnect" or live.socket is not websocket:
                 return
             reply = await _answer(reg, live, message, limits)
+            flooding = flooding + 1 if (reply.get("error") or "").startswith(_TOO_MANY) else 0
+            if flooding > FLOOD_REFUSALS:  # sent on regardless of the refusals: closed
+                await _refuse(websocket, "too many messages: this socket is closed", 4429)
+                return
             if reply.get("error"):  # an instrument's refusal may name a file: never shown
                 reply["error"] = one_line(reply["error"])
             reply["n"] = len(live.session.log)
@@ -192,10 +203,10 @@ async def _answer(reg: Registry, live, message: dict[str, Any], limits) -> dict:
         session_limit, address_limit_ = limits
         if not session_limit.allow():
             raise Refused(
-                429, f"too many messages: at most {session_limit.rate:g} a second a session"
+                429, f"{_TOO_MANY}: at most {session_limit.rate:g} a second a session"
             )
         if not address_limit_.allow():
-            raise Refused(429, "too many messages from this address: wait a moment")
+            raise Refused(429, f"{_TOO_MANY} from this address: wait a moment")
         msg = parse_message(message.get("text"))
         seq = msg.get("seq")
         if msg.get("demo") == "step" and live.demonstration:

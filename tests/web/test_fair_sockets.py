@@ -61,3 +61,25 @@ def test_refusals_held_back_are_bounded():
     for address in ("10.0.0.66", "10.0.0.7", "10.0.0.8"):
         holds.give(address)
     assert holds.count == 0 and holds.held == {}
+
+
+def test_a_socket_sending_on_regardless_of_its_refusals_is_closed(tmp_path, monkeypatch):
+    monkeypatch.setattr(sockets, "FLOOD_REFUSALS", 5)
+    app = create_app(TOKEN, tmp_path, hosts=("testserver",), message_limit=(0.01, 3))
+    read = json.dumps({"action": {"kind": "read", "counter": "X"}})
+    with make_test_client(app) as c:
+        sid, secret = start(c, PRACTICE, trainee="flooding")
+        ws, conn, _ = open_socket(c, sid, secret)
+        try:
+            answers = []
+            for _ in range(3 + 6):
+                conn.send_text(read)
+                answers.append(json.loads(conn.receive_text())["error"])
+            with pytest.raises(WebSocketDisconnect) as closed:
+                conn.receive_text()
+        finally:
+            ws.__exit__(None, None, None)
+    assert answers[:3] == [None] * 3
+    assert all(a.startswith("too many messages: at most") for a in answers[3:8]), answers
+    assert answers[8] == "too many messages: this socket is closed"
+    assert closed.value.code == 4429
