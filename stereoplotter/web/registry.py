@@ -161,6 +161,7 @@ class Registry:
         self.version = 0
         self._grading: dict[str, Future] = {}
         self._photos: dict[tuple, Future] = {}
+        self._offered: set[tuple] = set()
         self._resume_lock = threading.Lock()
         for sid, row in self.rows.items():  # finished before a restart, not yet graded
             if row["done"] and sid not in self.grades:
@@ -273,7 +274,7 @@ class Registry:
             )
         self.rows[live.id] = row
         self.live[live.id] = live
-        self.photos(ex)
+        self._offer_photos(ex)
         self.version += 1
         return live, secret
 
@@ -422,13 +423,21 @@ class Registry:
         if fut is None:
             fut = self.imager.submit(core.build_view_cache, exercise.source)
             self._photos[key] = fut
-
-            def offer(f: Future) -> None:  # the patch workers have them before a first patch
-                if not f.cancelled() and f.exception() is None:
-                    self.renderers.offer(key, f.result())
-
-            fut.add_done_callback(offer)
         return fut
+
+    def _offer_photos(self, exercise) -> None:
+        """Build the photos of an exercise a session has started on, and hand them to the
+        patch workers before its first patch (once: each worker keeps them)."""
+        key = core.photo_key(exercise)
+        if key in self._offered:
+            return
+        self._offered.add(key)
+
+        def offer(f: Future) -> None:
+            if not f.cancelled() and f.exception() is None:
+                self.renderers.offer(key, f.result())
+
+        self.photos(exercise).add_done_callback(offer)
 
     def prepare_photos(self) -> None:
         """Start building the photos of every known exercise (at start-up, in the background)."""
