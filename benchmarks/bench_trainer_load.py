@@ -23,7 +23,10 @@ a second. Phase 1 (idle) times them alone; phase 2 the same while one abuser (it
 one address, 127.0.0.250) opens ``--abuse-sockets`` sockets over ``--abuse-sessions`` sessions,
 each sending turns as fast as its answers come (reconnecting when a newer socket replaces it),
 and ``--abuse-patchers`` clients fetch patches as fast as they are answered. Prints each
-phase's round trip (median, p95) and patch median, and what the abuser got served.
+phase's round trip (median, p95) and patch median, what the abuser got served, and how its
+socket attempts ended: refused at the handshake (its address's connection rate), refused after
+the key (its session's), or accepted (and then replaced by a newer socket of the session, or
+closed otherwise).
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20]
 """
