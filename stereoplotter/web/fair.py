@@ -10,19 +10,20 @@ many that address has sent. With ``per_address``, an address never has more jobs
 once than that, so with more workers than that one client cannot occupy them all: a newcomer's
 job starts on the worker left free.
 
-:class:`Holds` counts refusals held back before they are sent (a client that retries at once
-waits for its refusal), with a bound per client and in all.
+:class:`FairCache` keeps values per owner within one budget, evicting from the owner that
+holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
+retries at once waits for its refusal), with a bound per client and in all.
 """
 
 from __future__ import annotations
 
 import threading
-from collections import deque
+from collections import OrderedDict, deque
 from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
-__all__ = ["FairPool", "Holds"]
+__all__ = ["FairCache", "FairPool", "Holds"]
 
 
 class FairPool:
@@ -161,3 +162,45 @@ class Holds:
         left = self.held.pop(address) - 1
         if left:
             self.held[address] = left
+
+
+class FairCache:
+    """Values kept per owner within one budget of bytes: when the budget is exceeded, the
+    owner holding the most bytes loses its oldest value. So a client filling the cache evicts
+    its own values, never another's while it holds more than they do."""
+
+    def __init__(self, budget_bytes: int):
+        self.budget = budget_bytes
+        self._owners: dict[str, OrderedDict[Any, bytes]] = {}
+        self._bytes: dict[str, int] = {}
+        self.total = 0
+        self._lock = threading.Lock()
+
+    def get(self, owner: str, key: Any) -> bytes | None:
+        with self._lock:
+            mine = self._owners.get(owner)
+            if mine is None or key not in mine:
+                return None
+            mine.move_to_end(key)
+            return mine[key]
+
+    def put(self, owner: str, key: Any, value: bytes) -> None:
+        with self._lock:
+            mine = self._owners.setdefault(owner, OrderedDict())
+            if key in mine:
+                return
+            mine[key] = value
+            self._bytes[owner] = self._bytes.get(owner, 0) + len(value)
+            self.total += len(value)
+            while self.total > self.budget:
+                richest = max(self._bytes, key=self._bytes.__getitem__)
+                _, dropped = self._owners[richest].popitem(last=False)
+                self._bytes[richest] -= len(dropped)
+                self.total -= len(dropped)
+                if not self._owners[richest]:
+                    del self._owners[richest], self._bytes[richest]
+
+    def owned(self, owner: str) -> list[Any]:
+        """The keys ``owner`` has kept, oldest first."""
+        with self._lock:
+            return list(self._owners.get(owner, ()))

@@ -409,12 +409,13 @@ class Registry:
         return self.grader.submit(core.replay_json, self.store.records(sid), row["trainee"],
                                   row["exercise"])
 
-    def patch(self, exercise, cache, side: str, x_mm: float, y_mm: float, mag: float,
-              size_px: int) -> bytes:
-        """PNG of a photo patch of ``exercise`` (its photos ``cache``), rendered by the patch
-        thread's worker process (run on :attr:`patcher`)."""
-        return self.renderers.render(core.photo_key(exercise), cache, side, x_mm, y_mm, mag,
-                                     size_px)
+    def patch(self, address: str, exercise, cache, side: str, x_mm: float, y_mm: float,
+              mag: float, size_px: int) -> bytes:
+        """PNG of a photo patch of ``exercise`` (its photos ``cache``) for a client ``address``,
+        rendered by the patch thread's worker process (run on :attr:`patcher`), or kept from
+        before for that address."""
+        return self.renderers.render(address, core.photo_key(exercise), cache, side, x_mm, y_mm,
+                                     mag, size_px)
 
     def photos(self, exercise) -> Future:
         """The view cache of an exercise's photos (built once, in a worker)."""

@@ -22,9 +22,10 @@ from multiprocessing import get_context
 from typing import Any
 
 from stereoplotter.web import core
+from stereoplotter.web.fair import FairCache
 from stereoplotter.web.workers import watch_parent
 
-__all__ = ["RENDER_NICENESS", "Renderers"]
+__all__ = ["PATCHES_KEPT_BYTES", "RENDER_NICENESS", "Renderers"]
 
 #: Niceness a render worker adds to its own (Unix ``nice``): renders take the processor only
 #: when the server's event loop and session actors leave it, so a client asking for patches
@@ -40,8 +41,24 @@ def _keep(key: Any, cache: Any) -> None:
     _CACHES[key] = cache
 
 
-def _render(key: Any, side: str, x_mm: float, y_mm: float, mag: float, size_px: int) -> bytes:
-    return core.photo_patch(_CACHES[key], side, x_mm, y_mm, mag, size_px)
+#: Patches a worker keeps, per client address, within one budget (``fair.FairCache``: a
+#: client asking for many evicts its own before another's). [bytes]
+PATCHES_KEPT_BYTES = 32 * 2**20
+_KEPT = FairCache(PATCHES_KEPT_BYTES)
+
+
+def _render(key: Any, owner: str, *args: Any) -> bytes:
+    return _kept_or_made(_KEPT, owner, key, _CACHES[key], args)
+
+
+def _kept_or_made(kept: FairCache, owner: str, key: Any, cache: Any, args: tuple) -> bytes:
+    """The patch ``args`` of the photos ``cache``: the one ``owner`` was given before, or made
+    now (``core.photo_patch``) and kept for it."""
+    png = kept.get(owner, (key, *args))
+    if png is None:
+        png = core.photo_patch(cache, *args)
+        kept.put(owner, (key, *args), png)
+    return png
 
 
 def _start(parent: int) -> None:
@@ -74,6 +91,7 @@ class Renderers:
                 self._kept.append(set())
         self._next = itertools.count()
         self._closed = False
+        self._kept_here = FairCache(PATCHES_KEPT_BYTES)  # without processes
         self._mine = threading.local()
 
     def offer(self, key: Any, cache: Any) -> None:
@@ -86,29 +104,31 @@ class Renderers:
                 executor.submit(_keep, key, cache)
                 self._kept[slot].add(key)
 
-    def render(self, key: Any, cache: Any, side: str, x_mm: float, y_mm: float, mag: float,
-               size_px: int) -> bytes:
-        """PNG of a patch of the photos ``cache`` (known as ``key``): ``core.photo_patch``."""
+    def render(self, owner: str, key: Any, cache: Any, side: str, x_mm: float, y_mm: float,
+               mag: float, size_px: int) -> bytes:
+        """PNG of a patch of the photos ``cache`` (known as ``key``) for the client ``owner``
+        (its address): ``core.photo_patch``, or the same patch kept from before."""
+        args = (side, x_mm, y_mm, mag, size_px)
         if not self._processes:
-            return core.photo_patch(cache, side, x_mm, y_mm, mag, size_px)
+            return _kept_or_made(self._kept_here, owner, key, cache, args)
         slot = getattr(self._mine, "slot", None)
         if slot is None:
             slot = self._mine.slot = next(self._next) % len(self._executors)
         try:
-            return self._in(slot, key, cache, side, x_mm, y_mm, mag, size_px)
+            return self._in(slot, owner, key, cache, args)
         except BrokenProcessPool:  # the worker died (killed, out of memory): a new one
             if self._closed:
                 raise
             self._executors[slot] = _worker()
             self._kept[slot] = set()
-            return self._in(slot, key, cache, side, x_mm, y_mm, mag, size_px)
+            return self._in(slot, owner, key, cache, args)
 
-    def _in(self, slot: int, key: Any, cache: Any, *args: Any) -> bytes:
+    def _in(self, slot: int, owner: str, key: Any, cache: Any, args: tuple) -> bytes:
         executor = self._executors[slot]
         if key not in self._kept[slot]:
             executor.submit(_keep, key, cache).result()
             self._kept[slot].add(key)
-        return executor.submit(_render, key, *args).result()
+        return executor.submit(_render, key, owner, *args).result()
 
     def shutdown(self) -> None:
         """Stop the worker processes at once (a render in progress is abandoned)."""

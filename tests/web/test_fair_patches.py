@@ -1,7 +1,8 @@
 """Photo patches under abuse: one client address never renders more than one patch at once
 (another client's patch starts on the worker left free), and patches are rendered in worker
 processes at a lower priority, not in the server's own (where a render would hold the
-interpreter's lock)."""
+interpreter's lock); the patches kept for reuse are kept per client address, and a client
+filling the cache evicts its own."""
 
 from __future__ import annotations
 
@@ -11,8 +12,8 @@ import time
 
 from stereoplotter.imagery.cache import ViewCache
 from stereoplotter.io.exercise_file import load_exercise
-from stereoplotter.web import core
-from stereoplotter.web.fair import FairPool
+from stereoplotter.web import core, render
+from stereoplotter.web.fair import FairCache, FairPool
 from stereoplotter.web.render import RENDER_NICENESS, Renderers
 from tests.web.conftest import PRACTICE
 
@@ -62,13 +63,13 @@ def test_patches_are_rendered_in_worker_processes():
     renderers = Renderers(2, processes=True)
     got: dict[str, tuple[bytes, int, int]] = {}
 
-    def render(name: str) -> None:  # each thread of the pool gets a process of its own
-        png = renderers.render(core.photo_key(ex), cache, "left", 1.5, -2.0, 0.625, 64)
+    def one(name: str) -> None:  # each thread of the pool gets a process of its own
+        png = renderers.render(name, core.photo_key(ex), cache, "left", 1.5, -2.0, 0.625, 64)
         worker = renderers._executors[renderers._mine.slot]
         got[name] = (png, worker.submit(os.getpid).result(), worker.submit(os.nice, 0).result())
 
     try:
-        threads = [threading.Thread(target=render, args=(n,)) for n in ("a", "b")]
+        threads = [threading.Thread(target=one, args=(n,)) for n in ("a", "b")]
         for t in threads:
             t.start()
         for t in threads:
@@ -80,3 +81,32 @@ def test_patches_are_rendered_in_worker_processes():
     assert len(pids) == 2 and os.getpid() not in pids
     # and at a lower priority than the server (its niceness plus RENDER_NICENESS, at most 19)
     assert {nice for _, _, nice in got.values()} == {min(19, os.nice(0) + RENDER_NICENESS)}
+
+
+def test_a_client_filling_the_patch_cache_evicts_its_own(monkeypatch):
+    made: list[tuple] = []
+
+    def photo_patch(cache, side, x, y, mag, size):  # a patch of 100 bytes, counted
+        made.append((side, x))
+        return bytes(100)
+
+    monkeypatch.setattr(core, "photo_patch", photo_patch)
+    monkeypatch.setattr(render, "PATCHES_KEPT_BYTES", 1_000)
+    renderers = Renderers(2, processes=False)
+    renderers.render("10.0.0.7", "photos", None, "left", 1.0, 0.0, 6.0, 768)  # the trainee's
+    for k in range(50):  # the abuser's, each new
+        renderers.render("10.0.0.66", "photos", None, "right", float(k), 0.0, 6.0, 768)
+    assert len(made) == 51
+    renderers.render("10.0.0.7", "photos", None, "left", 1.0, 0.0, 6.0, 768)  # kept for it
+    renderers.render("10.0.0.66", "photos", None, "right", 0.0, 0.0, 6.0, 768)  # evicted
+    assert len(made) == 52 and made[-1] == ("right", 0.0)
+
+
+def test_the_fair_cache_evicts_from_the_richest_owner():
+    kept = FairCache(budget_bytes=500)
+    kept.put("a", 1, bytes(200))
+    kept.put("a", 2, bytes(200))
+    kept.put("b", 1, bytes(100))
+    kept.put("b", 2, bytes(100))  # 600 > 500: a holds the most and loses its oldest
+    assert kept.owned("a") == [2] and kept.owned("b") == [1, 2] and kept.total == 400
+    assert kept.get("b", 1) == bytes(100) and kept.get("a", 1) is None
