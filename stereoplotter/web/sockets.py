@@ -120,7 +120,10 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     sid = websocket.path_params["sid"]
     if not reg.connect_allowed(address_of(websocket)):  # refused before any work (HTTP 403)
         await _held(reg, address_of(websocket))
-        await websocket.close(4429)
+        try:
+            await websocket.close(4429)
+        except (RuntimeError, OSError, WebSocketDisconnect):  # the client left meanwhile
+            pass
         return
     await websocket.accept()
     secret = await _auth(websocket)
