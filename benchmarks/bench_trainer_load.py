@@ -23,7 +23,10 @@ a second. Phase 1 (idle) times them alone; phase 2 the same while one abuser (it
 one address, 127.0.0.250) opens ``--abuse-sockets`` sockets over ``--abuse-sessions`` sessions,
 each sending turns as fast as its answers come (reconnecting when a newer socket replaces it),
 and ``--abuse-patchers`` clients fetch patches as fast as they are answered. Prints each
-phase's round trip (median, p95) and patch median, and what the abuser got served.
+phase's round trip (median, p95) and patch median, what the abuser got served, and how its
+socket attempts ended: refused at the handshake (its address's connection rate), refused after
+the key (its session's), or accepted (and then replaced by a newer socket of the session, or
+closed otherwise).
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20]
 """
@@ -43,6 +46,7 @@ import time
 
 import httpx
 from websockets.asyncio.client import connect
+from websockets.exceptions import ConnectionClosed, InvalidStatus
 
 TOKEN = "bench-token"
 
@@ -254,7 +258,9 @@ async def honest(host, n: int, stop: float, rtt: list, patches: list | None, pau
 
 async def _abuse(host: str, stop: float, sockets: int, sessions: int, patchers: int) -> dict:
     address = _local(250)
-    got = {"served": 0, "refused": 0, "replaced": 0, "patches": 0, "patches_refused": 0}
+    got = {"served": 0, "refused": 0, "handshakes_refused": 0, "refused_after_key": 0,
+           "accepted": 0, "replaced": 0, "closed_other": 0, "failed_open": 0, "patches": 0,
+           "patches_refused": 0}
     transport = httpx.AsyncHTTPTransport(local_address=address, limits=httpx.Limits(
         max_connections=patchers + 4))
     async with httpx.AsyncClient(base_url=f"http://{host}", transport=transport,
@@ -272,15 +278,32 @@ async def _abuse(host: str, stop: float, sockets: int, sessions: int, patchers: 
             sid, secret = owned[j % len(owned)]
             while time.monotonic() < stop:
                 try:
-                    ws, _ = await _open_from(host, sid, secret, address)
+                    ws, hello = await _open_from(host, sid, secret, address)
+                except InvalidStatus:  # refused before the handshake (the address's limit)
+                    got["handshakes_refused"] += 1
+                    await asyncio.sleep(0.01)
+                    continue
+                except (ConnectionClosed, OSError):
+                    got["failed_open"] += 1
+                    await asyncio.sleep(0.01)
+                    continue
+                if "hello" not in hello:  # refused after the key (the session's own limit)
+                    got["refused_after_key"] += 1
+                    await ws.close()
+                    await asyncio.sleep(0.01)
+                    continue
+                got["accepted"] += 1
+                try:
                     while time.monotonic() < stop:
                         await ws.send(json.dumps({"action": {"kind": "turn", "control": "X",
                                                              "delta": 0.01}}))
                         reply = json.loads(await ws.recv())
                         got["served" if reply.get("error") is None else "refused"] += 1
-                except Exception:  # replaced by a newer socket of the same session
-                    got["replaced"] += 1
+                except ConnectionClosed as exc:  # replaced by a newer socket of the session
+                    code = exc.rcvd.code if exc.rcvd is not None else None
+                    got["replaced" if code == 4409 else "closed_other"] += 1
                     await asyncio.sleep(0.01)
+                await ws.close()
 
         async def patch_flood(j: int):
             sid, secret = owned[j % len(owned)]
@@ -356,7 +379,11 @@ async def abuse_async(args) -> None:
     abuse_patch = statistics.median(results["abuse"][1] or [math.nan])
     print(f"abuser ({args.abuse_sockets} sockets on {args.abuse_sessions} sessions, "
           f"{args.abuse_patchers} patch clients): turns served {a['served']}, refused "
-          f"{a['refused']}, sockets replaced {a['replaced']}, patches {a['patches']} served, "
+          f"{a['refused']}; socket attempts: refused at the handshake "
+          f"{a['handshakes_refused']}, refused after the key {a['refused_after_key']}, "
+          f"accepted {a['accepted']} (of which replaced by a newer socket {a['replaced']}, "
+          f"closed otherwise {a['closed_other']}), failed to open {a['failed_open']}; "
+          f"patches {a['patches']} served, "
           f"{a['patches_refused']} refused")
     print(f"patch median under abuse / idle: {abuse_patch / idle_patch:.2f} "
           f"(os.cpu_count() = {os.cpu_count()}, 1-minute load average at the end "

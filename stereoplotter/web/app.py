@@ -47,7 +47,8 @@ from stereoplotter.web.guard import (
     public_origin,
     server_roots,
 )
-from stereoplotter.web.registry import Registry
+from stereoplotter.web.registry import PATCHERS, Registry
+from stereoplotter.web.render import Renderers
 from stereoplotter.web.routes import START_LIMIT, Web
 from stereoplotter.web.sockets import ADDRESS_LIMIT, instructor_socket, trainee_socket
 from stereoplotter.web.workers import watch_parent
@@ -134,8 +135,8 @@ def create_app(
     """The application.
 
     ``token`` guards the instructor's pages (random when None); ``data_dir`` holds the SQLite
-    file (None: in memory, nothing kept); ``processes`` grades, replays and builds photos in
-    worker processes (else in one worker thread each: tests); ``prepare_photos`` starts
+    file (None: in memory, nothing kept); ``processes`` grades, replays, builds photos and
+    renders photo patches in worker processes (else in threads: tests); ``prepare_photos`` starts
     building every exercise's photos at start-up; ``hosts`` are names besides localhost, this
     machine's name and IP addresses that pages may use to reach the server; ``start_limit``
     the sessions a client address may start (a rate [1/s] and a burst); ``message_limit`` the
@@ -159,6 +160,7 @@ def create_app(
         worker_pool(processes),
         message_limit,
         address_limit,
+        Renderers(PATCHERS, processes),
     )
     if prepare_photos:
         reg.prepare_photos()
@@ -174,6 +176,7 @@ def create_app(
                 proc.terminate()
         reg.actor.shutdown(wait=True)
         reg.patcher.shutdown(wait=True)
+        reg.renderers.shutdown()
         store.close()
 
     app = Starlette(

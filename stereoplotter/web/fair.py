@@ -6,25 +6,34 @@ queued under its owner (a client address, then a session of that address), and a
 takes the next job of the next address in turn, and within the address of the next session in
 turn. A session never has two jobs running at once (its actions keep their order). So a
 trainee's request waits for at most one job of each other address with work queued, however
-many that address has sent.
+many that address has sent. With ``per_address``, an address never has more jobs running at
+once than that, so with more workers than that one client cannot occupy them all: a newcomer's
+job starts on the worker left free.
+
+:class:`FairCache` keeps values per owner within one budget, evicting from the owner that
+holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
+retries at once waits for its refusal), with a bound per client and in all.
 """
 
 from __future__ import annotations
 
 import threading
-from collections import deque
+from collections import OrderedDict, deque
 from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
-__all__ = ["FairPool"]
+__all__ = ["FairCache", "FairPool", "Holds"]
 
 
 class FairPool:
-    """``workers`` threads serving jobs round-robin by address, then by session."""
+    """``workers`` threads serving jobs round-robin by address, then by session; at most
+    ``per_address`` jobs of one address running at once (None: no cap)."""
 
-    def __init__(self, workers: int = 2, name: str = "fair"):
+    def __init__(self, workers: int = 2, name: str = "fair", per_address: int | None = None):
         self._cv = threading.Condition()
+        self._per_address = per_address
+        self._busy: dict[str, int] = {}  # jobs running per address
         self._jobs: dict[tuple[str, str], deque] = {}
         self._addresses: deque[str] = deque()
         self._sessions: dict[str, deque[str]] = {}
@@ -65,6 +74,8 @@ class FairPool:
         for _ in range(len(self._addresses)):
             address = self._addresses[0]
             self._addresses.rotate(-1)
+            if self._per_address is not None and self._busy.get(address, 0) >= self._per_address:
+                continue
             ring = self._sessions[address]
             for _ in range(len(ring)):
                 session = ring[0]
@@ -98,6 +109,7 @@ class FairPool:
                     got = self._next()
                 key, (fut, fn, args) = got
                 self._running.add(key)
+                self._busy[key[0]] = self._busy.get(key[0], 0) + 1
             try:
                 if fut.set_running_or_notify_cancel():
                     try:
@@ -107,6 +119,9 @@ class FairPool:
             finally:
                 with self._cv:
                     self._running.discard(key)
+                    left = self._busy.pop(key[0]) - 1
+                    if left:
+                        self._busy[key[0]] = left
                     self._forget(key)
                     self._cv.notify_all()
 
@@ -122,3 +137,70 @@ class FairPool:
         if wait:
             for t in self._threads:
                 t.join(timeout=10)
+
+
+class Holds:
+    """Refused sockets held back before their refusal is sent: at most ``per_address`` of one
+    client address and ``total`` of all at once (each holds a connection open)."""
+
+    def __init__(self, per_address: int, total: int):
+        self.per_address, self.total = per_address, total
+        self.held: dict[str, int] = {}
+        self.count = 0
+
+    def take(self, address: str) -> bool:
+        """Whether one more refusal of ``address`` may be held now (then counted)."""
+        if self.count >= self.total or self.held.get(address, 0) >= self.per_address:
+            return False
+        self.held[address] = self.held.get(address, 0) + 1
+        self.count += 1
+        return True
+
+    def give(self, address: str) -> None:
+        """A held refusal of ``address`` was sent."""
+        self.count -= 1
+        left = self.held.pop(address) - 1
+        if left:
+            self.held[address] = left
+
+
+class FairCache:
+    """Values kept per owner within one budget of bytes: when the budget is exceeded, the
+    owner holding the most bytes loses its oldest value. So a client filling the cache evicts
+    its own values, never another's while it holds more than they do."""
+
+    def __init__(self, budget_bytes: int):
+        self.budget = budget_bytes
+        self._owners: dict[str, OrderedDict[Any, bytes]] = {}
+        self._bytes: dict[str, int] = {}
+        self.total = 0
+        self._lock = threading.Lock()
+
+    def get(self, owner: str, key: Any) -> bytes | None:
+        with self._lock:
+            mine = self._owners.get(owner)
+            if mine is None or key not in mine:
+                return None
+            mine.move_to_end(key)
+            return mine[key]
+
+    def put(self, owner: str, key: Any, value: bytes) -> None:
+        with self._lock:
+            mine = self._owners.setdefault(owner, OrderedDict())
+            if key in mine:
+                return
+            mine[key] = value
+            self._bytes[owner] = self._bytes.get(owner, 0) + len(value)
+            self.total += len(value)
+            while self.total > self.budget:
+                richest = max(self._bytes, key=self._bytes.__getitem__)
+                _, dropped = self._owners[richest].popitem(last=False)
+                self._bytes[richest] -= len(dropped)
+                self.total -= len(dropped)
+                if not self._owners[richest]:
+                    del self._owners[richest], self._bytes[richest]
+
+    def owned(self, owner: str) -> list[Any]:
+        """The keys ``owner`` has kept, oldest first."""
+        with self._lock:
+            return list(self._owners.get(owner, ()))

@@ -10,6 +10,7 @@ traceback nor a server path.
 
 from __future__ import annotations
 
+import functools
 import ipaddress
 import json
 import math
@@ -103,8 +104,14 @@ _default_roots()
 
 
 def _path_pattern() -> re.Pattern:
-    roots = sorted(_SERVER_ROOTS, key=len, reverse=True)
-    alts = "|".join(re.escape(r) for r in roots)
+    return _pattern_of(frozenset(_SERVER_ROOTS))
+
+
+@functools.lru_cache(maxsize=4)
+def _pattern_of(roots: frozenset[str]) -> re.Pattern:
+    """The pattern of paths into ``roots`` (made once for a set of roots: a hello scrubs many
+    texts, and a client may have many refused)."""
+    alts = "|".join(re.escape(r) for r in sorted(roots, key=len, reverse=True))
     return re.compile(rf"(?:{alts})(?:[\\/][^\s'\"]*)?")
 
 

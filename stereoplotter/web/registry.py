@@ -8,10 +8,11 @@ attempt per trainee and exercise unless the instructor grants another. Every act
 written to the store as it happens; after a restart an unfinished session is replayed from its
 log the first time its page reconnects.
 
-Slow work never runs on the event loop: session start, actions and photo patches run in worker
-threads; grading, replays for the instructor and building the photos' tile pyramids run in
-worker processes (``Executor`` objects given to the registry). A finished session's grade is
-computed once, when its last stage is claimed, and kept in the store.
+Slow work never runs on the event loop: session start and actions run in worker threads;
+photo patches are queued on worker threads and rendered in worker processes; grading, replays
+for the instructor and building the photos' tile pyramids run in worker processes
+(``Executor`` objects given to the registry). A finished session's grade is computed once,
+when its last stage is claimed, and kept in the store.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from typing import Any
 from stereoplotter.io.session_store import SessionStore, storable
 from stereoplotter.trainer.session import secret_seed
 from stereoplotter.web import core
-from stereoplotter.web.fair import FairPool
+from stereoplotter.web.fair import FairPool, Holds
 from stereoplotter.web.guard import (
     BURST,
     RATE,
@@ -39,6 +40,7 @@ from stereoplotter.web.guard import (
     text_ok,
     trainee_key,
 )
+from stereoplotter.web.render import Renderers
 
 __all__ = ["MAX_ACTIONS", "RANGE_SLACK", "Live", "Registry", "token_hash"]
 
@@ -57,16 +59,23 @@ RANGE_SLACK = 0.01
 #: address together (a class of 40 behind one address). [1/s], [patches]
 PATCH_LIMIT = (10.0, 30)
 PATCH_ADDRESS_LIMIT = (200.0, 400)
-#: Worker threads of the fair pools (actions; photo patches). One patch thread: a render holds
-#: the interpreter's lock for most of its 0.1–0.3 s, and two renders at once only share it (an
-#: honest trainee's patch would wait for one render and then run beside another). [threads]
-ACTORS, PATCHERS = 2, 1
+#: Worker threads of the fair pools (actions; photo patches). Each patch thread hands its
+#: renders to a worker process of its own (``render.Renderers``: a render holds the
+#: interpreter's lock for most of its 0.1–0.3 s, which in the server would stall the event loop
+#: and the actors). [threads]
+ACTORS, PATCHERS = 2, 2
+#: Photo patches of one client address rendered at once: with PATCHERS above it, a client
+#: asking for patches without pause leaves a worker free for the others. [patches]
+PATCHES_AT_ONCE = 1
 #: Sockets a session may open (a page reconnects after a dropped network or a reload): a rate
 #: and a burst; beyond, a socket is closed (4429) before any work is done for it. [1/s], [—]
 CONNECT_LIMIT = (1.0, 5)
 #: Sockets one client address may open, checked before the socket is accepted (a class of 40
 #: behind one address reconnecting after a restart has room). [1/s], [—]
 ADDRESS_CONNECT_LIMIT = (20.0, 80)
+#: Refusals held back at once: of one client address, and of all (each holds a connection
+#: open; beyond, a refusal is answered at once). [connections]
+HELD_REFUSALS = (256, 2_048)
 
 
 def token_hash(token: str) -> str:
@@ -112,6 +121,7 @@ class Registry:
         imager: Executor,
         message_limit: tuple[float, int] = (RATE, BURST),
         address_limit: tuple[float, int] = (1_200.0, 2_400),
+        renderers: Renderers | None = None,
     ):
         self.store = store
         #: A token made now (printed once by the server), or None when the stored one is kept.
@@ -134,11 +144,15 @@ class Registry:
         self.address_limits: dict[str, Any] = {}
         self.patch_limits: dict[tuple[str, str], RateLimit] = {}
         self.connect_limits: dict[str, RateLimit] = {}
+        #: Refused sockets waiting for their refusal (``sockets.REFUSAL_DELAY_S``).
+        self.refusal_holds = Holds(*HELD_REFUSALS)
         #: The threads that carry out the sessions' actions (round-robin by client address and
         #: session: a flood from one client does not queue the others behind it), and render
-        #: photo patches.
+        #: photo patches (at most PATCHES_AT_ONCE of one address at once; rendered in worker
+        #: processes when ``renderers`` has them).
         self.actor = FairPool(ACTORS, "trainer-actor")
-        self.patcher = FairPool(PATCHERS, "trainer-patch")
+        self.patcher = FairPool(PATCHERS, "trainer-patch", per_address=PATCHES_AT_ONCE)
+        self.renderers = renderers if renderers is not None else Renderers(PATCHERS, False)
         self._seed_key = store.server_key(SEED_KEY)
         self.rows: dict[str, dict[str, Any]] = {r["id"]: r for r in store.sessions()}
         self.grades: dict[str, dict[str, Any]] = store.grades()
@@ -147,6 +161,7 @@ class Registry:
         self.version = 0
         self._grading: dict[str, Future] = {}
         self._photos: dict[tuple, Future] = {}
+        self._offered: set[tuple] = set()
         self._resume_lock = threading.Lock()
         for sid, row in self.rows.items():  # finished before a restart, not yet graded
             if row["done"] and sid not in self.grades:
@@ -259,7 +274,7 @@ class Registry:
             )
         self.rows[live.id] = row
         self.live[live.id] = live
-        self.photos(ex)
+        self._offer_photos(ex)
         self.version += 1
         return live, secret
 
@@ -399,6 +414,14 @@ class Registry:
         return self.grader.submit(core.replay_json, self.store.records(sid), row["trainee"],
                                   row["exercise"])
 
+    def patch(self, address: str, exercise, cache, side: str, x_mm: float, y_mm: float,
+              mag: float, size_px: int) -> bytes:
+        """PNG of a photo patch of ``exercise`` (its photos ``cache``) for a client ``address``,
+        rendered by the patch thread's worker process (run on :attr:`patcher`), or kept from
+        before for that address."""
+        return self.renderers.render(address, core.photo_key(exercise), cache, side, x_mm, y_mm,
+                                     mag, size_px)
+
     def photos(self, exercise) -> Future:
         """The view cache of an exercise's photos (built once, in a worker)."""
         key = core.photo_key(exercise)
@@ -407,6 +430,20 @@ class Registry:
             fut = self.imager.submit(core.build_view_cache, exercise.source)
             self._photos[key] = fut
         return fut
+
+    def _offer_photos(self, exercise) -> None:
+        """Build the photos of an exercise a session has started on, and hand them to the
+        patch workers before its first patch (once: each worker keeps them)."""
+        key = core.photo_key(exercise)
+        if key in self._offered:
+            return
+        self._offered.add(key)
+
+        def offer(f: Future) -> None:
+            if not f.cancelled() and f.exception() is None:
+                self.renderers.offer(key, f.result())
+
+        self.photos(exercise).add_done_callback(offer)
 
     def prepare_photos(self) -> None:
         """Start building the photos of every known exercise (at start-up, in the background)."""

@@ -273,8 +273,8 @@ async def patch_png(request: Request) -> Response:
         raise Refused(429, "too many photo patches: wait a moment")
     cache = await asyncio.wrap_future(web.reg.photos(ex))
     png = await asyncio.wrap_future(
-        web.reg.run(web.reg.patcher, address_of(request), row["id"], core.photo_patch,
-                    cache, side, x, y, mag, size)
+        web.reg.run(web.reg.patcher, address_of(request), row["id"], web.reg.patch,
+                    address_of(request), ex, cache, side, x, y, mag, size)
     )
     return Response(png, media_type="image/png", headers={"Cache-Control": "private, max-age=3600"})
 

@@ -95,6 +95,9 @@ def uvicorn_config(app, public_url: str | None = None,
         app,
         log_level="warning",
         ws_max_size=WS_MAX_SIZE,
+        # no per-message compression: negotiating it for each handshake and deflating each
+        # frame is the event loop's work, for states of a few kB on a classroom's network
+        ws_per_message_deflate=False,
         proxy_headers=public_url is not None,
         forwarded_allow_ips=trusted_proxies,
     )

@@ -10,7 +10,11 @@ frame also carries ``"hello"``. A malformed, oversized or too frequent message g
 network, a restarted server) sends its secret again and resumes where the log ends.
 
 One live socket per session: a newer one (the page reloaded, or opened twice) replaces the
-older, which is closed with code 4409. Messages are limited per session (however many sockets
+older, which is closed with code 4409. Sockets are limited per client address (checked before
+the socket is accepted) and per session; a socket refused for either is answered after
+:data:`REFUSAL_DELAY_S`, so a client reconnecting in a loop is paced by the server; a socket
+that sends on after :data:`FLOOD_REFUSALS` refusals for the rate in a row is closed (4429).
+Messages are limited per session (however many sockets
 it opens one after the other) and per client address (:data:`ADDRESS_LIMIT`: a class behind
 one address has room), and carried out on the registry's fair pool.
 
@@ -40,7 +44,7 @@ from stereoplotter.web.guard import (
 )
 from stereoplotter.web.registry import CONNECT_LIMIT, Registry
 
-__all__ = ["AUTH_TIMEOUT_S", "PUSH_S", "instructor_socket", "trainee_socket"]
+__all__ = ["AUTH_TIMEOUT_S", "PUSH_S", "REFUSAL_DELAY_S", "instructor_socket", "trainee_socket"]
 
 log = logging.getLogger(__name__)
 
@@ -55,6 +59,16 @@ PATCH_PX = 768
 ADDRESS_LIMIT = (1_200.0, 2_400)
 #: Addresses whose limits are remembered (beyond: forgotten, rather than grow without bound).
 MAX_ADDRESSES = 10_000
+#: Messages refused for the rate in a row after which the socket is closed (4429): a page
+#: paces itself by the rate its hello gives, and a page's retries of a refused action come
+#: after a pause; a client that sends on regardless costs the server a reply each. [messages]
+FLOOD_REFUSALS = 200
+_TOO_MANY = "too many messages"
+#: A socket refused for the rate at which its address or session opens sockets is answered
+#: after this delay: a client that reconnects the moment it is refused (a flood) then costs
+#: the server one handshake per delay for each connection it holds, not one per round trip.
+#: A page's own reconnects stay within the limits and are never delayed. [s]
+REFUSAL_DELAY_S = 2.0
 
 
 def address_of(conn) -> str:
@@ -90,10 +104,26 @@ async def _refuse(websocket: WebSocket, text: str, code: int = 4403) -> None:
         pass
 
 
+async def _held(reg: Registry, address: str) -> None:
+    """Wait :data:`REFUSAL_DELAY_S` before a refusal is sent, while the registry's holds allow
+    (``registry.HELD_REFUSALS``):
+    a client that reconnects the moment it is refused is then paced by the server."""
+    if not reg.refusal_holds.take(address):
+        return
+    try:
+        await asyncio.sleep(REFUSAL_DELAY_S)
+    finally:
+        reg.refusal_holds.give(address)
+
+
 async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     sid = websocket.path_params["sid"]
     if not reg.connect_allowed(address_of(websocket)):  # refused before any work (HTTP 403)
-        await websocket.close(4429)
+        await _held(reg, address_of(websocket))
+        try:
+            await websocket.close(4429)
+        except (RuntimeError, OSError, WebSocketDisconnect):  # the client left meanwhile
+            pass
         return
     await websocket.accept()
     secret = await _auth(websocket)
@@ -109,6 +139,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     if live.connects is None:
         live.connects = RateLimit(*CONNECT_LIMIT)
     if not live.connects.allow():
+        await _held(reg, address_of(websocket))
         return await _refuse(websocket, "too many connections of this session: wait a moment",
                              4429)
     ex = live.session.exercise
@@ -140,6 +171,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     if live.limit is None:
         live.limit = RateLimit(*reg.message_limit)
     limits = (live.limit, address_limit(reg, address, reg.address_limits))
+    flooding = 0  # messages refused for the rate in a row
     try:
         await websocket.send_text(
             _dump({"hello": hello, "state": state, "error": None, "n": len(live.session.log)})
@@ -149,6 +181,10 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
             if message["type"] == "websocket.disconnect" or live.socket is not websocket:
                 return
             reply = await _answer(reg, live, message, limits)
+            flooding = flooding + 1 if (reply.get("error") or "").startswith(_TOO_MANY) else 0
+            if flooding > FLOOD_REFUSALS:  # sent on regardless of the refusals: closed
+                await _refuse(websocket, "too many messages: this socket is closed", 4429)
+                return
             if reply.get("error"):  # an instrument's refusal may name a file: never shown
                 reply["error"] = one_line(reply["error"])
             reply["n"] = len(live.session.log)
@@ -170,10 +206,10 @@ async def _answer(reg: Registry, live, message: dict[str, Any], limits) -> dict:
         session_limit, address_limit_ = limits
         if not session_limit.allow():
             raise Refused(
-                429, f"too many messages: at most {session_limit.rate:g} a second a session"
+                429, f"{_TOO_MANY}: at most {session_limit.rate:g} a second a session"
             )
         if not address_limit_.allow():
-            raise Refused(429, "too many messages from this address: wait a moment")
+            raise Refused(429, f"{_TOO_MANY} from this address: wait a moment")
         msg = parse_message(message.get("text"))
         seq = msg.get("seq")
         if msg.get("demo") == "step" and live.demonstration:

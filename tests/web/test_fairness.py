@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from starlette.websockets import WebSocketDisconnect
 
-from stereoplotter.web import registry
+from stereoplotter.web import registry, sockets
 from stereoplotter.web.app import create_app
 from stereoplotter.web.fair import FairPool
 from tests.web.conftest import PRACTICE, TOKEN, ask, make_test_client, open_socket, start
@@ -123,9 +123,10 @@ def test_patches_render_in_parallel_and_are_limited_per_session(tmp_path, monkey
         assert r.status_code == 200
 
 
-def test_a_session_opens_only_so_many_sockets(tmp_path):
+def test_a_session_opens_only_so_many_sockets(tmp_path, monkeypatch):
     """Sockets replacing one another in a loop would cost the server a hello each: beyond a
     burst of 5 (then one a second) a session's new socket is closed before any work."""
+    monkeypatch.setattr(sockets, "REFUSAL_DELAY_S", 0.01)
     with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
         sid, secret = start(c, PRACTICE, trainee="reconnecting")
         hellos = []
@@ -139,6 +140,7 @@ def test_a_session_opens_only_so_many_sockets(tmp_path):
 
 def test_an_address_opens_only_so_many_sockets(tmp_path, monkeypatch):
     monkeypatch.setattr(registry, "ADDRESS_CONNECT_LIMIT", (0.01, 3))
+    monkeypatch.setattr(sockets, "REFUSAL_DELAY_S", 0.01)
     with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
         sid, secret = start(c, PRACTICE, trainee="churn")
         for _ in range(3):
