@@ -82,7 +82,7 @@ class Renderers:
     share one."""
 
     def __init__(self, slots: int, processes: bool):
-        self._processes = processes
+        self._in_processes = processes
         self._executors: list[ProcessPoolExecutor] = []
         self._kept: list[set] = []
         if processes:
@@ -109,7 +109,7 @@ class Renderers:
         """PNG of a patch of the photos ``cache`` (known as ``key``) for the client ``owner``
         (its address): ``core.photo_patch``, or the same patch kept from before."""
         args = (side, x_mm, y_mm, mag, size_px)
-        if not self._processes:
+        if not self._in_processes:
             return _kept_or_made(self._kept_here, owner, key, cache, args)
         slot = getattr(self._mine, "slot", None)
         if slot is None:
@@ -129,6 +129,12 @@ class Renderers:
             executor.submit(_keep, key, cache).result()
             self._kept[slot].add(key)
         return executor.submit(_render, key, owner, *args).result()
+
+    def this_threads_worker(self) -> ProcessPoolExecutor | None:
+        """The worker process that renders for the calling thread (None before its first
+        render, or without processes)."""
+        slot = getattr(self._mine, "slot", None)
+        return None if slot is None else self._executors[slot]
 
     def shutdown(self) -> None:
         """Stop the worker processes at once (a render in progress is abandoned)."""

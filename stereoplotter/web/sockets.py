@@ -116,6 +116,26 @@ async def _held(reg: Registry, address: str) -> None:
         reg.refusal_holds.give(address)
 
 
+def _hello(reg: Registry, live) -> dict[str, Any]:
+    """What the page is told once when its socket opens: the exercise, the screen and the
+    controls (the state follows in the same message)."""
+    ex = live.session.exercise
+    return {
+        "exercise": live.exercise,
+        "trainee": live.trainee,
+        "demonstration": live.demonstration,
+        "id": live.id,
+        "screen_pixel_mm": core.SCREEN_PIXEL_MM,
+        "patch_px": PATCH_PX,
+        "format_mm": core.format_mm(ex),
+        "description": ex.description,
+        "coarse_mag": core.COARSE_MAG,
+        "actions": core.action_catalogue(),
+        "rate": list(reg.message_limit),
+        "mode": ex.mode,
+    }
+
+
 async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     sid = websocket.path_params["sid"]
     if not reg.connect_allowed(address_of(websocket)):  # refused before any work (HTTP 403)
@@ -142,21 +162,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         await _held(reg, address_of(websocket))
         return await _refuse(websocket, "too many connections of this session: wait a moment",
                              4429)
-    ex = live.session.exercise
-    hello = {
-        "exercise": live.exercise,
-        "trainee": live.trainee,
-        "demonstration": live.demonstration,
-        "id": live.id,
-        "screen_pixel_mm": core.SCREEN_PIXEL_MM,
-        "patch_px": PATCH_PX,
-        "format_mm": core.format_mm(ex),
-        "description": ex.description,
-        "coarse_mag": core.COARSE_MAG,
-        "actions": core.action_catalogue(),
-        "rate": list(reg.message_limit),
-        "mode": ex.mode,
-    }
+    hello = _hello(reg, live)
     address = address_of(websocket)
     live.address = address
     # not while an action changes it

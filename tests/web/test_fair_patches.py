@@ -65,7 +65,8 @@ def test_patches_are_rendered_in_worker_processes():
 
     def one(name: str) -> None:  # each thread of the pool gets a process of its own
         png = renderers.render(name, core.photo_key(ex), cache, "left", 1.5, -2.0, 0.625, 64)
-        worker = renderers._executors[renderers._mine.slot]
+        worker = renderers.this_threads_worker()
+        assert worker is not None
         got[name] = (png, worker.submit(os.getpid).result(), worker.submit(os.nice, 0).result())
 
     try:
