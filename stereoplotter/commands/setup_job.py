@@ -22,7 +22,7 @@ from pathlib import Path
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import Job, MeasuredPair, load_job, measured_pair
+from stereoplotter.io.job_file import Job, MeasuredPair, load_job, measured_pairs
 from stereoplotter.io.output_folder import OutputReport, write_outputs
 from stereoplotter.report.job import JobResult, PairResult, job_files, manifest_about, pair_dict
 from stereoplotter.report.plain_data import json_text
@@ -67,12 +67,7 @@ def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
         vertical_scale_denominator=job.vertical_scale,
         bz_scale_sense=job.bz_scale_sense,
     )
-    measured: list[MeasuredPair | SetupRefusal] = []
-    for pair in job.pairs:
-        try:
-            measured.append(measured_pair(job, pair))
-        except SetupRefusal as exc:
-            measured.append(exc)
+    measured = measured_pairs(job)
     ready = [m for m in measured if isinstance(m, MeasuredPair)]
     sheets = iter(compute_sheets_from_measurements(
         [m.sheet_arguments() for m in ready], spec=spec, options=options, source=job.source,

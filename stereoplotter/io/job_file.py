@@ -41,8 +41,12 @@ from numpy.typing import NDArray
 from pydantic import BeforeValidator, ConfigDict, Field, field_validator
 
 from stereoplotter.errors import ConfigError, StereoplotterError, describe_value
-from stereoplotter.geodesy import split_conventional_ordinate
-from stereoplotter.geodesy.photogrammetric import local_from_gauss_kruger
+from stereoplotter.geodesy import (
+    geocentric_from_geodetic,
+    geographic_from_gauss_kruger,
+    split_conventional_ordinate,
+)
+from stereoplotter.geodesy.photogrammetric import LocalFrame, local_from_gauss_kruger
 from stereoplotter.geometry.collinearity import object_to_photo, photo_to_object
 from stereoplotter.geometry.film import corrected_focal_length, fiducial_spans_mm
 from stereoplotter.geometry.rotation import rotation_matrix
@@ -83,6 +87,7 @@ __all__ = [
     "is_job_file",
     "load_job",
     "measured_pair",
+    "measured_pairs",
 ]
 
 #: The value of the ``format`` key that marks a job file.
@@ -771,13 +776,28 @@ def grid_to_local_rotation(
     rotation, by SVD: removes the grid scale factor). M_local = R·M_grid. [—]
     """
     lf = frame_tie.local_frame(frame)
+    stepped = _stepped_points(lf, north_m, east_m, height_m, step_m)
+    return _rotation_of_steps(local_from_gauss_kruger(lf, *stepped))
+
+
+def _stepped_points(
+    lf: LocalFrame, north_m: float, east_m: float, height_m: float, step_m: float = 10.0
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The six points of :func:`grid_to_local_rotation` around a station (east, north, up; −
+    then +) as Gauss–Krüger x, plain y and H of the frame's zone; a station in another zone is
+    refused."""
     zone, y = split_conventional_ordinate(east_m)
     if int(zone) != lf.zone:
         raise StereoplotterError(f"a station in zone {int(zone)}, the frame in zone {lf.zone}")
     d, zero = np.array([-step_m, step_m]), np.zeros(2)
-    # the six stepped points (east, north, up; − then +) in one geodesy call
     dn, de, dh = (np.concatenate(v) for v in ((zero, d, zero), (d, zero, zero), (zero, zero, d)))
-    X, Y, Z = local_from_gauss_kruger(lf, north_m + dn, float(y) + de, height_m + dh)
+    return north_m + dn, float(y) + de, height_m + dh
+
+
+def _rotation_of_steps(local: tuple[NDArray, NDArray, NDArray]) -> NDArray[np.float64]:
+    """The rotation of :func:`grid_to_local_rotation` from its six stepped points in the local
+    frame."""
+    X, Y, Z = local
     cols = np.array([X[1::2] - X[0::2], Y[1::2] - Y[0::2], Z[1::2] - Z[0::2]])
     u, _, vt = np.linalg.svd(cols)
     return u @ vt
@@ -793,12 +813,9 @@ def _pair_frame(job: Job, left: JobPhoto, right: JobPhoto) -> Frame | None:
     return Frame("sk42", (float(north), float(east), 0.0))
 
 
-def _local_points(job: Job, frame: Frame | None) -> tuple[Point, ...]:
-    """The job's points in the pair's frame (SK-42 jobs: all points in one geodesy call)."""
-    if job.frame_kind == "local" or not job.points:
-        return job.points
-    assert frame is not None
-    lf = frame_tie.local_frame(frame)
+def _points_in_zone(job: Job, lf: LocalFrame) -> tuple[NDArray, NDArray, NDArray]:
+    """The job's SK-42 points as Gauss–Krüger x, plain y and H, all in the zone of the pair's
+    frame (a point in another zone is bad input)."""
     sk42 = np.array([p.sk42_m for p in job.points], float)
     zone, y = split_conventional_ordinate(sk42[:, 1])
     far = np.flatnonzero(np.asarray(zone) != lf.zone)
@@ -810,20 +827,52 @@ def _local_points(job: Job, frame: Frame | None) -> tuple[Point, ...]:
             "the zone of the pair's frame)",
             f"point {job.points[i].id} in zone {int(np.asarray(zone)[i])}",
         )
-    X, Y, Z = local_from_gauss_kruger(lf, sk42[:, 0], np.asarray(y, float), sk42[:, 2])
-    return tuple(
-        Point(p.id, p.role, p.kind, (float(X[i]), float(Y[i]), float(Z[i])), p.sk42_m)
-        for i, p in enumerate(job.points)
-    )
+    return sk42[:, 0], np.asarray(y, float), sk42[:, 2]
 
 
-def _station(job: Job, frame: Frame | None, photo: JobPhoto) -> tuple[NDArray, NDArray]:
-    m = rotation_matrix(*photo.angles)
+def _station_centre(job: Job, frame: Frame | None, photo: JobPhoto) -> NDArray[np.float64]:
     if job.frame_kind == "local":
-        return np.array(photo.centre, float), m
+        return np.array(photo.centre, float)
     assert frame is not None
-    centre = np.array(frame_tie.local_from_sk42(frame, photo.centre), float)
-    return centre, grid_to_local_rotation(frame, *photo.centre) @ m
+    return np.array(frame_tie.local_from_sk42(frame, photo.centre), float)
+
+
+def _stations_and_points(
+    job: Job, frame: Frame | None, photos: tuple[JobPhoto, JobPhoto]
+) -> tuple[list[NDArray], list[NDArray], NDArray[np.float64]]:
+    """The two stations' centres and rotations (M_local = R·M_grid, :func:`
+    grid_to_local_rotation`) and the job's points, all in the pair's frame.
+
+    The stepped points of both rotations and the points go through one geodesy call (each
+    value the one its own call gives: the calls are element-wise but the frame's final turn, a
+    matrix product that gives the same bits for any number of rows above one)."""
+    centres = [_station_centre(job, frame, photo) for photo in photos]
+    grid_angles = [rotation_matrix(*photo.angles) for photo in photos]
+    if job.frame_kind == "local":
+        xyz = np.array([p.local_m for p in job.points], float).reshape(-1, 3)
+        return centres, grid_angles, xyz
+    assert frame is not None
+    lf = frame_tie.local_frame(frame)
+    parts = [_stepped_points(lf, *photo.centre) for photo in photos]
+    if job.points:
+        parts.append(_points_in_zone(job, lf))
+    X, Y, Z = local_from_gauss_kruger(lf, *(np.concatenate(v) for v in zip(*parts, strict=True)))
+    rotations = [
+        _rotation_of_steps((X[k : k + 6], Y[k : k + 6], Z[k : k + 6])) @ m
+        for k, m in zip((0, 6), grid_angles, strict=True)
+    ]
+    return centres, rotations, np.column_stack([X[12:], Y[12:], Z[12:]])
+
+
+def _local_points(job: Job, xyz: NDArray[np.float64], keep: NDArray[np.bool_]) -> tuple[Point, ...]:
+    """The job's points kept by ``keep``, at their places ``xyz`` in the pair's frame."""
+    if job.frame_kind == "local":
+        return tuple(p for p, k in zip(job.points, keep, strict=True) if k)
+    return tuple(
+        Point(p.id, p.role, p.kind, (float(X), float(Y), float(Z)), p.sk42_m)
+        for p, k, (X, Y, Z) in zip(job.points, keep, xyz.tolist(), strict=True)
+        if k
+    )
 
 
 def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
@@ -837,19 +886,19 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
     mean point height, shrunk by 5 % a side, at the lowest and highest ground (``working_area``
     of the pair, else the points' heights).
     """
-    cam = job.camera
     left, right = job.photos[pair.left], job.photos[pair.right]
     frame = _pair_frame(job, left, right)
-    cal_marks = cam.fiducial_array_mm()
-    cal_spans = fiducial_spans_mm(cam.fiducials_mm)
-    ratios = [np.array(p.fiducial_distances_mm) / cal_spans for p in (left, right)]
-    f = cam.focal_length_mm
-    f_pair = float(corrected_focal_length(f, np.concatenate(ratios), np.ones(4)))
-    per_photo = (float(f * np.mean(ratios[0])), float(f * np.mean(ratios[1])))
-    marks = np.array([cal_marks * r for r in ratios]) - np.asarray(cam.principal_point_mm, float)
+    return _measured(job, pair, frame, _pair_geodesy(job, pair, frame))
+
+
+def _pair_geodesy(
+    job: Job, pair: JobPair, frame: Frame | None
+) -> tuple[list[NDArray], list[NDArray], NDArray[np.float64]]:
+    """:func:`_stations_and_points` of one pair, a station or point beyond the zone of its
+    frame as the one-line error of the pair."""
+    left, right = job.photos[pair.left], job.photos[pair.right]
     try:  # the geodesy of the pair's frame: a station or point beyond its zone is bad input
-        (c_l, m_l), (c_r, m_r) = _station(job, frame, left), _station(job, frame, right)
-        points = _local_points(job, frame)
+        return _stations_and_points(job, frame, (left, right))
     except StereoplotterError as exc:
         if isinstance(exc, ConfigError) or str(exc).startswith(f"{job.source}: "):
             raise
@@ -859,15 +908,133 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
             f"{job.source}: pairs: pair {pair.name}: expected stations and points the pair's "
             f"frame{origin} can take (one Gauss–Krüger zone), found: {exc}"
         ) from None
-    xyz = np.array([p.local_m for p in points], float).reshape(-1, 3)
+
+
+def measured_pairs(job: Job) -> list[MeasuredPair | SetupRefusal]:
+    """:func:`measured_pair` of every pair of the job, in order (a pair that cannot be set up
+    as its :class:`SetupRefusal`).
+
+    The geodesy of an SK-42 job's pairs (stations, the grid-to-local rotations and the points in
+    each pair's frame) is one call for all pairs (:func:`_geodesy_of_pairs`): every value the
+    bits of the pair computed alone. When a pair's stations or points are beyond its frame's
+    zone, the pairs are computed one at a time, for the error of the first such pair.
+    """
+    photos = [(job.photos[p.left], job.photos[p.right]) for p in job.pairs]
+    frames = [_pair_frame(job, left, right) for left, right in photos]
+    geodesy = _geodesy_of_pairs(job, frames, photos)
+    out: list[MeasuredPair | SetupRefusal] = []
+    for i, (pair, frame) in enumerate(zip(job.pairs, frames, strict=True)):
+        found = geodesy[i] if geodesy is not None else _pair_geodesy(job, pair, frame)
+        try:
+            out.append(_measured(job, pair, frame, found))
+        except SetupRefusal as exc:
+            out.append(exc)
+    return out
+
+
+def _geodesy_of_pairs(
+    job: Job, frames: list[Frame | None], photos: list[tuple[JobPhoto, JobPhoto]]
+) -> list[tuple[list[NDArray], list[NDArray], NDArray[np.float64]]] | None:
+    """:func:`_stations_and_points` of every pair of an SK-42 job, in one geodesy call (None for
+    a local job, or when a station or point is beyond its pair's frame: the caller then takes the
+    pairs one at a time, for their errors).
+
+    Each step is element-wise (PROJ per point; (2.7) by numpy's element-wise functions) but the
+    frame's turn, a matrix product per pair, stacked: numpy gives each product the bits of its own
+    call, the stations' with one row as the one-point call.
+    """
+    if job.frame_kind == "local" or not photos:
+        return None
+    try:
+        lfs = [frame_tie.local_frame(frame) for frame in frames]  # type: ignore[arg-type]
+        zones = {lf.zone for lf in lfs}
+        if len(zones) != 1:
+            return None
+        (zone,) = zones
+        centres = np.array([[p.centre for p in pair] for pair in photos], float)  # (P, 2, 3)
+        station_zone, station_y = split_conventional_ordinate(centres[..., 1])
+        if np.any(np.asarray(station_zone) != zone) or np.any(
+            np.abs(np.asarray(station_y, float)) > frame_tie.MAX_PLAIN_ORDINATE_M
+        ):
+            return None
+        if job.points:
+            pn, py, ph = _points_in_zone(job, lfs[0])
+        else:
+            pn = py = ph = np.zeros(0)
+    except StereoplotterError:
+        return None
+    n_pairs, n_points = len(photos), len(pn)
+    step = np.array([-10.0, 10.0])
+    zero = np.zeros(2)
+    dn, de, dh = (
+        np.concatenate(v) for v in ((zero, step, zero), (step, zero, zero), (zero, zero, step))
+    )
+    y = np.asarray(station_y, float)
+    # rows of each pair: the six stepped points of each station, then the job's points
+    stepped_n = (centres[..., 0, None] + dn).reshape(n_pairs, 12)
+    stepped_e = (y[..., None] + de).reshape(n_pairs, 12)
+    stepped_h = (centres[..., 2, None] + dh).reshape(n_pairs, 12)
+    rows_n = np.concatenate([stepped_n, np.broadcast_to(pn, (n_pairs, n_points))], axis=1)
+    rows_e = np.concatenate([stepped_e, np.broadcast_to(py, (n_pairs, n_points))], axis=1)
+    rows_h = np.concatenate([stepped_h, np.broadcast_to(ph, (n_pairs, n_points))], axis=1)
+    every_n = np.concatenate([centres[..., 0].ravel(), rows_n.ravel()])
+    every_e = np.concatenate([y.ravel(), rows_e.ravel()])
+    every_h = np.concatenate([centres[..., 2].ravel(), rows_h.ravel()])
+    try:
+        b, lon = geographic_from_gauss_kruger(every_n, every_e, zone)  # (2.10), pyproj
+    except StereoplotterError:
+        return None
+    g = np.stack(geocentric_from_geodetic(b, lon, every_h), axis=-1)  # (2.7)
+    origins = np.array([lf.origin_geocentric_m for lf in lfs])  # (P, 3)
+    turns = np.array([lf.rotation for lf in lfs])  # (P, 3, 3)
+    # (2.8), (2.11), (2.14) per pair: the stations one row each, the other rows together
+    stations = (g[: 2 * n_pairs].reshape(n_pairs, 2, 1, 3) - origins[:, None, None, :]) @ (
+        np.swapaxes(turns, 1, 2)[:, None]
+    )
+    rows = (g[2 * n_pairs :].reshape(n_pairs, 12 + n_points, 3) - origins[:, None, :]) @ (
+        np.swapaxes(turns, 1, 2)
+    )
+    X, Y, Z = rows[..., 0], rows[..., 1], rows[..., 2]
+    cols = np.stack([X[:, 1:12:2] - X[:, 0:12:2], Y[:, 1:12:2] - Y[:, 0:12:2],
+                     Z[:, 1:12:2] - Z[:, 0:12:2]], axis=1)  # fmt: skip
+    cols = cols.reshape(n_pairs, 3, 2, 3).transpose(0, 2, 1, 3)  # (P, station, axis, step)
+    u, _, vt = np.linalg.svd(cols)
+    angles = np.array([[rotation_matrix(*p.angles) for p in pair] for pair in photos])
+    rotations = (u @ vt) @ angles  # (P, 2, 3, 3)
+    out = []
+    for i in range(n_pairs):
+        out.append((
+            [stations[i, 0, 0], stations[i, 1, 0]],
+            [rotations[i, 0], rotations[i, 1]],
+            rows[i, 12:],
+        ))  # fmt: skip
+    return out
+
+
+def _measured(
+    job: Job,
+    pair: JobPair,
+    frame: Frame | None,
+    geodesy: tuple[list[NDArray], list[NDArray], NDArray[np.float64]],
+) -> MeasuredPair:
+    """:func:`measured_pair` from the pair's stations, rotations and points in its frame."""
+    cam = job.camera
+    left, right = job.photos[pair.left], job.photos[pair.right]
+    (c_l, c_r), (m_l, m_r), xyz = geodesy
+    cal_marks = cam.fiducial_array_mm()
+    cal_spans = fiducial_spans_mm(cam.fiducials_mm)
+    ratios = [np.array(p.fiducial_distances_mm) / cal_spans for p in (left, right)]
+    f = cam.focal_length_mm
+    f_pair = float(corrected_focal_length(f, np.concatenate(ratios), np.ones(4)))
+    per_photo = (float(f * np.mean(ratios[0])), float(f * np.mean(ratios[1])))
+    marks = np.array([cal_marks * r for r in ratios]) - np.asarray(cam.principal_point_mm, float)
     half = cam.format_mm / 2.0
-    inside = np.ones(len(points), bool)
+    inside = np.ones(len(xyz), bool)
     for c, m in ((c_l, m_l), (c_r, m_r)):
         xy = object_to_photo(xyz, c, m, f, cam.principal_point_mm)
         with np.errstate(invalid="ignore"):
             inside &= np.all(np.abs(xy) <= half, axis=-1)
-    every_point = points
-    points = tuple(p for p, ok in zip(points, inside, strict=True) if ok)
+    points = _local_points(job, xyz, inside)
     heights = [p.local_m[2] for p in points if p.kind != "plan"] or [p.local_m[2] for p in points]
     if pair.working_area_m is not None:
         lowest, highest = _local_heights(frame, c_l, c_r, pair.working_area_m)
@@ -877,7 +1044,8 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
         raise SetupRefusal(
             "no control point imaged on both photos and no working_area (lowest_m, highest_m) "
             "of the pair: nothing fixes the heights of its model"
-            + _suspects(job, pair, every_point, ((c_l, m_l), (c_r, m_r)))
+            + _suspects(job, pair, _local_points(job, xyz, np.ones(len(xyz), bool)),
+                        ((c_l, m_l), (c_r, m_r)))
         )
     z0 = (lowest + highest) / 2.0
     corners = np.array([[half, half], [-half, half], [-half, -half], [half, -half]])
