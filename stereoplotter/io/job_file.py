@@ -888,7 +888,10 @@ def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
     """
     left, right = job.photos[pair.left], job.photos[pair.right]
     frame = _pair_frame(job, left, right)
-    return _measured(job, pair, frame, _pair_geodesy(job, pair, frame))
+    (found,) = _measured(job, [pair], [frame], [_pair_geodesy(job, pair, frame)])
+    if isinstance(found, SetupRefusal):
+        raise found
+    return found
 
 
 def _pair_geodesy(
@@ -922,14 +925,11 @@ def measured_pairs(job: Job) -> list[MeasuredPair | SetupRefusal]:
     photos = [(job.photos[p.left], job.photos[p.right]) for p in job.pairs]
     frames = [_pair_frame(job, left, right) for left, right in photos]
     geodesy = _geodesy_of_pairs(job, frames, photos)
-    out: list[MeasuredPair | SetupRefusal] = []
-    for i, (pair, frame) in enumerate(zip(job.pairs, frames, strict=True)):
-        found = geodesy[i] if geodesy is not None else _pair_geodesy(job, pair, frame)
-        try:
-            out.append(_measured(job, pair, frame, found))
-        except SetupRefusal as exc:
-            out.append(exc)
-    return out
+    if geodesy is None:
+        geodesy = [
+            _pair_geodesy(job, pair, frame) for pair, frame in zip(job.pairs, frames, strict=True)
+        ]
+    return _measured(job, list(job.pairs), frames, geodesy)
 
 
 def _geodesy_of_pairs(
@@ -1013,62 +1013,91 @@ def _geodesy_of_pairs(
 
 def _measured(
     job: Job,
-    pair: JobPair,
-    frame: Frame | None,
-    geodesy: tuple[list[NDArray], list[NDArray], NDArray[np.float64]],
-) -> MeasuredPair:
-    """:func:`measured_pair` from the pair's stations, rotations and points in its frame."""
+    pairs: list[JobPair],
+    frames: list[Frame | None],
+    geodesy: list[tuple[list[NDArray], list[NDArray], NDArray[np.float64]]],
+) -> list[MeasuredPair | SetupRefusal]:
+    """:func:`measured_pair` of each pair from its stations, rotations and points in its frame
+    (:func:`_stations_and_points`): f′ and the marks, the points imaged on both photos and the
+    working area of all pairs as arrays (element-wise arithmetic, minima and maxima: the bits of
+    each pair computed alone); the points' records and the refusals pair by pair."""
     cam = job.camera
-    left, right = job.photos[pair.left], job.photos[pair.right]
-    (c_l, c_r), (m_l, m_r), xyz = geodesy
-    cal_marks = cam.fiducial_array_mm()
-    cal_spans = fiducial_spans_mm(cam.fiducials_mm)
-    ratios = [np.array(p.fiducial_distances_mm) / cal_spans for p in (left, right)]
+    n = len(pairs)
     f = cam.focal_length_mm
-    f_pair = float(corrected_focal_length(f, np.concatenate(ratios), np.ones(4)))
-    per_photo = (float(f * np.mean(ratios[0])), float(f * np.mean(ratios[1])))
-    marks = np.array([cal_marks * r for r in ratios]) - np.asarray(cam.principal_point_mm, float)
+    pp = np.asarray(cam.principal_point_mm, float)
     half = cam.format_mm / 2.0
-    inside = np.ones(len(xyz), bool)
-    for c, m in ((c_l, m_l), (c_r, m_r)):
-        xy = object_to_photo(xyz, c, m, f, cam.principal_point_mm)
-        with np.errstate(invalid="ignore"):
-            inside &= np.all(np.abs(xy) <= half, axis=-1)
-    points = _local_points(job, xyz, inside)
-    heights = [p.local_m[2] for p in points if p.kind != "plan"] or [p.local_m[2] for p in points]
-    if pair.working_area_m is not None:
-        lowest, highest = _local_heights(frame, c_l, c_r, pair.working_area_m)
-    elif heights:
-        lowest, highest = min(heights), max(heights)
-    else:  # this pair alone cannot be set up: the job's other pairs still can
-        raise SetupRefusal(
-            "no control point imaged on both photos and no working_area (lowest_m, highest_m) "
-            "of the pair: nothing fixes the heights of its model"
-            + _suspects(job, pair, _local_points(job, xyz, np.ones(len(xyz), bool)),
-                        ((c_l, m_l), (c_r, m_r)))
+    spans = np.array(
+        [[job.photos[p.left].fiducial_distances_mm, job.photos[p.right].fiducial_distances_mm]
+         for p in pairs], float,
+    ).reshape(n, 2, 2)  # fmt: skip
+    ratios = spans / fiducial_spans_mm(cam.fiducials_mm)  # (pair, photo, span)
+    f_pairs = corrected_focal_length(f, ratios.reshape(n, 4), np.ones(4))
+    per_photo = f * np.mean(ratios, axis=-1)
+    marks = cam.fiducial_array_mm() * ratios[:, :, None, :] - pp
+    centres = np.array([g[0] for g in geodesy], float).reshape(n, 2, 3)
+    rotations = np.array([g[1] for g in geodesy], float).reshape(n, 2, 3, 3)
+    every = [g[2] for g in geodesy]
+    if len({len(xyz) for xyz in every}) == 1:  # the job's points in each pair's frame
+        xy = object_to_photo(
+            np.array(every).reshape(n, 1, -1, 3), centres[:, :, None], rotations[:, :, None], f, pp
         )
-    z0 = (lowest + highest) / 2.0
+        with np.errstate(invalid="ignore"):
+            inside = list(np.all(np.abs(xy) <= half, axis=-1).all(axis=1))
+    else:
+        inside = []
+        for xyz, c, m in zip(every, centres, rotations, strict=True):
+            xy = object_to_photo(xyz, c[:, None], m[:, None], f, pp)
+            with np.errstate(invalid="ignore"):
+                inside.append(np.all(np.abs(xy) <= half, axis=-1).all(axis=0))
+    out: list[MeasuredPair | SetupRefusal | None] = []
+    kept, heights = [], np.full((n, 2), np.nan)
+    for i, pair in enumerate(pairs):
+        points = _local_points(job, every[i], inside[i])
+        kept.append(points)
+        z = [p.local_m[2] for p in points if p.kind != "plan"] or [p.local_m[2] for p in points]
+        if pair.working_area_m is not None:
+            heights[i] = _local_heights(frames[i], *centres[i], pair.working_area_m)
+        elif z:
+            heights[i] = min(z), max(z)
+        else:  # this pair alone cannot be set up: the job's other pairs still can
+            out.append(SetupRefusal(
+                "no control point imaged on both photos and no working_area (lowest_m, "
+                "highest_m) of the pair: nothing fixes the heights of its model"
+                + _suspects(job, pair, _local_points(job, every[i], np.ones(len(every[i]), bool)),
+                            tuple(zip(centres[i], rotations[i], strict=True)))
+            ))  # fmt: skip
+            continue
+        out.append(None)
+    z0 = (heights[:, 0] + heights[:, 1]) / 2.0
     corners = np.array([[half, half], [-half, half], [-half, -half], [half, -half]])
-    boxes = [photo_to_object(corners, z0, c, m, f, cam.principal_point_mm)
-             for c, m in ((c_l, m_l), (c_r, m_r))]  # fmt: skip
-    lo = np.max([b[:, :2].min(axis=0) for b in boxes], axis=0)
-    hi = np.min([b[:, :2].max(axis=0) for b in boxes], axis=0)
-    pad = WORKING_AREA_MARGIN * (hi - lo)
-    lo, hi = lo + pad, hi - pad
-    plan = ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1]))
-    area = np.array([[x, y, z] for z in (lowest, highest) for x, y in plan])
-    return MeasuredPair(
-        name=pair.name,
-        origin_sk42_m=frame.origin_sk42_m if frame is not None else None,
-        focal_length_corrected_mm=f_pair,
-        focal_length_corrected_per_photo_mm=per_photo,
-        marks_mm=marks,
-        centres_m=np.array([c_l, c_r]),
-        rotations=np.array([m_l, m_r]),
-        points=points,
-        working_area_m=area,
-        map_sheet=pair.map_sheet,
-    )
+    with np.errstate(invalid="ignore"):  # the refused pairs' NaN
+        boxes = photo_to_object(
+            corners, z0[:, None, None], centres[:, :, None], rotations[:, :, None], f, pp
+        )[..., :2]  # (pair, photo, corner, X Y)
+        lo = np.max(np.min(boxes, axis=2), axis=1)
+        hi = np.min(np.max(boxes, axis=2), axis=1)
+        pad = WORKING_AREA_MARGIN * (hi - lo)
+        lo, hi = lo + pad, hi - pad
+    for i, pair in enumerate(pairs):
+        if out[i] is not None:
+            continue
+        (x0, y0), (x1, y1) = lo[i].tolist(), hi[i].tolist()
+        plan = ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+        area = np.array([[x, y, z] for z in heights[i].tolist() for x, y in plan])
+        frame = frames[i]
+        out[i] = MeasuredPair(
+            name=pair.name,
+            origin_sk42_m=frame.origin_sk42_m if frame is not None else None,
+            focal_length_corrected_mm=float(f_pairs[i]),
+            focal_length_corrected_per_photo_mm=(float(per_photo[i, 0]), float(per_photo[i, 1])),
+            marks_mm=marks[i],
+            centres_m=centres[i],
+            rotations=rotations[i],
+            points=kept[i],
+            working_area_m=area,
+            map_sheet=pair.map_sheet,
+        )
+    return out  # type: ignore[return-value]
 
 
 def _suspects(
