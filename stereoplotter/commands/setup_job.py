@@ -27,7 +27,7 @@ from stereoplotter.io.output_folder import OutputReport, write_outputs
 from stereoplotter.report.job import JobResult, PairResult, job_files, manifest_about, pair_dict
 from stereoplotter.report.plain_data import json_text
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
-from stereoplotter.setup.sheet import compute_sheets_from_measurements
+from stereoplotter.setup.sheet import deferred_sheets
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["compute_job", "raise_keyboard_interrupt", "run", "write_job"]
@@ -56,9 +56,11 @@ def _instrument(job: Job) -> InstrumentSpec:
 def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
     """Every pair's sheet from its measured inputs; a refused pair keeps its reason.
 
-    The pairs' Table 24 is one vectorised call (per-pair f′ and marks,
-    :func:`~stereoplotter.setup.sheet.compute_sheets_from_measurements`); each sheet is the one
-    the pair alone would give, to the bit.
+    The measured inputs of all pairs in one pass (:func:`~stereoplotter.io.job_file.
+    measured_pairs`), the pairs' sheets as one block of columns with Table 24 in one vectorised
+    call (per-pair f′ and marks, :func:`~stereoplotter.setup.sheet.deferred_sheets`); each
+    pair's record is built from the columns when first read (``PairResult.sheet``), the one the
+    pair alone would give, to the bit.
     """
     spec = spec or _instrument(job)
     options = SetupOptions(
@@ -69,7 +71,7 @@ def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
     )
     measured = measured_pairs(job)
     ready = [m for m in measured if isinstance(m, MeasuredPair)]
-    sheets = iter(compute_sheets_from_measurements(
+    sheets = iter(deferred_sheets(
         [m.sheet_arguments() for m in ready], spec=spec, options=options, source=job.source,
         name=job.name,
     ))  # fmt: skip
