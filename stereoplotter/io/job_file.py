@@ -999,8 +999,9 @@ def _geodesy_of_pairs(
                      Z[:, 1:12:2] - Z[:, 0:12:2]], axis=1)  # fmt: skip
     cols = cols.reshape(n_pairs, 3, 2, 3).transpose(0, 2, 1, 3)  # (P, station, axis, step)
     u, _, vt = np.linalg.svd(cols)
-    angles = np.array([[rotation_matrix(*p.angles) for p in pair] for pair in photos])
-    rotations = (u @ vt) @ angles  # (P, 2, 3, 3)
+    angles = np.array([[p.angles for p in pair] for pair in photos], float)  # (P, 2, 3)
+    alpha, omega, kappa = np.moveaxis(angles, -1, 0)
+    rotations = (u @ vt) @ rotation_matrix(alpha, omega, kappa)  # (P, 2, 3, 3)
     out = []
     for i in range(n_pairs):
         out.append((

@@ -65,7 +65,7 @@ __all__ = [
     "SetupRefusal",
     "SetupSheet",
     "assumed_parameters",
-    "block_refusal",
+    "block_refusals",
     "compute_setup_sheet",
     "compute_sheet_from_measurements",
     "compute_sheets_from_measurements",
@@ -327,21 +327,27 @@ def _checked_table(block: SheetBlock, i: int) -> BlockResult:
     return table
 
 
-def block_refusal(block: SheetBlock, i: int) -> SetupRefusal | None:
-    """The refusal :func:`sheet_of_block` raises for pair ``i``, or None, read from the block's
-    columns without building the pair's record."""
-    if block.refusals[i] is not None:
-        return block.refusals[i]
-    group, row = (int(v) for v in block.table_of[i])
-    columns = block.tables[group]
-    tilt = float(np.abs(columns.angles[row, :, :2]).max())
-    if int(columns.reason_code[row]) == 0 and tilt <= block.spec.tilt_max:
-        return None
-    try:
-        _checked_table(block, i)
-    except SetupRefusal as exc:
-        return exc
-    return None
+def block_refusals(block: SheetBlock) -> list[SetupRefusal | None]:
+    """The refusal :func:`sheet_of_block` raises for each pair, or None, read from the block's
+    columns without building the records (the checks run again only for a pair Table 24's
+    reason code or a tilt refuses, for the words of its refusal)."""
+    tilt_max = block.spec.tilt_max
+    flagged = [
+        (table.reason_code != 0) | (np.abs(table.angles[:, :, :2]).max(axis=(1, 2)) > tilt_max)
+        for table in block.tables
+    ]
+    out: list[SetupRefusal | None] = []
+    for i in range(len(block)):
+        refusal = block.refusals[i]
+        if refusal is None:
+            group, row = (int(v) for v in block.table_of[i])
+            if flagged[group][row]:
+                try:
+                    _checked_table(block, i)
+                except SetupRefusal as exc:
+                    refusal = exc
+        out.append(refusal)
+    return out
 
 
 def deferred_sheets(
@@ -360,11 +366,10 @@ def deferred_sheets(
     and points as mappings) are what only its printed files read."""
     block = compute_sheet_block(pairs, spec=spec, options=options, source=source, name=name)
     assumed = assumed_parameters(spec)
-    out: list[SetupRefusal | Callable[[], SetupSheet]] = []
-    for i in range(len(block)):
-        refusal = block_refusal(block, i)
-        out.append(refusal if refusal is not None else partial(sheet_of_block, block, i, assumed))
-    return out
+    return [
+        refusal if refusal is not None else partial(sheet_of_block, block, i, assumed)
+        for i, refusal in enumerate(block_refusals(block))
+    ]
 
 
 def sheet_of_block(
