@@ -766,8 +766,12 @@ class MeasuredPair:
         }
 
 
+#: The step of the central differences of :func:`grid_to_local_rotation`. [m]
+GRID_STEP_M = 10.0
+
+
 def grid_to_local_rotation(
-    frame: Frame, north_m: float, east_m: float, height_m: float, step_m: float = 10.0
+    frame: Frame, north_m: float, east_m: float, height_m: float, step_m: float = GRID_STEP_M
 ) -> NDArray[np.float64]:
     """R: the directions of grid east, grid north and up at a point, in the local frame.
 
@@ -781,7 +785,7 @@ def grid_to_local_rotation(
 
 
 def _stepped_points(
-    lf: LocalFrame, north_m: float, east_m: float, height_m: float, step_m: float = 10.0
+    lf: LocalFrame, north_m: float, east_m: float, height_m: float, step_m: float = GRID_STEP_M
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The six points of :func:`grid_to_local_rotation` around a station (east, north, up; −
     then +) as Gauss–Krüger x, plain y and H of the frame's zone; a station in another zone is
@@ -789,9 +793,16 @@ def _stepped_points(
     zone, y = split_conventional_ordinate(east_m)
     if int(zone) != lf.zone:
         raise StereoplotterError(f"a station in zone {int(zone)}, the frame in zone {lf.zone}")
+    dn, de, dh = _steps(step_m)
+    return north_m + dn, float(y) + de, height_m + dh
+
+
+def _steps(step_m: float) -> tuple[NDArray, NDArray, NDArray]:
+    """The steps in x, y, H of the six points of :func:`grid_to_local_rotation` (east, north,
+    up; − then +). [m]"""
     d, zero = np.array([-step_m, step_m]), np.zeros(2)
     dn, de, dh = (np.concatenate(v) for v in ((zero, d, zero), (d, zero, zero), (zero, zero, d)))
-    return north_m + dn, float(y) + de, height_m + dh
+    return dn, de, dh
 
 
 def _rotation_of_steps(local: tuple[NDArray, NDArray, NDArray]) -> NDArray[np.float64]:
@@ -964,11 +975,7 @@ def _geodesy_of_pairs(
     except StereoplotterError:
         return None
     n_pairs, n_points = len(photos), len(pn)
-    step = np.array([-10.0, 10.0])
-    zero = np.zeros(2)
-    dn, de, dh = (
-        np.concatenate(v) for v in ((zero, step, zero), (step, zero, zero), (zero, zero, step))
-    )
+    dn, de, dh = _steps(GRID_STEP_M)
     y = np.asarray(station_y, float)
     # rows of each pair: the six stepped points of each station, then the job's points
     stepped_n = (centres[..., 0, None] + dn).reshape(n_pairs, 12)
@@ -982,7 +989,7 @@ def _geodesy_of_pairs(
     every_h = np.concatenate([centres[..., 2].ravel(), rows_h.ravel()])
     try:
         b, lon = geographic_from_gauss_kruger(every_n, every_e, zone)  # (2.10), pyproj
-    except StereoplotterError:
+    except Exception:  # the pairs one at a time raise it as each pair's own
         return None
     g = np.stack(geocentric_from_geodetic(b, lon, every_h), axis=-1)  # (2.7)
     origins = np.array([lf.origin_geocentric_m for lf in lfs])  # (P, 3)
