@@ -5,7 +5,7 @@ Run ``python benchmarks/bench_job_sheets.py`` (``--pairs 10000 --forms 100``).
 The 8 pairs of ``jobs/strip8`` are repeated up to ``--pairs`` pairs and timed end to end, as
 ``stereoplotter setup JOB`` computes them (``commands.setup_job.compute_job``), split into:
 
-* **measured inputs** — ``io.job_file.measured_pairs`` (what ``compute_job`` runs: SK-42 → each
+* **measured inputs** — ``io.job_measured.measured_pairs`` (what ``compute_job`` runs: SK-42 → each
   pair's local frame for all pairs in one geodesy call, f′, the pair's points, the working area);
 * **sheet block** — ``setup.sheet_block.compute_sheet_block``: the columns of all pairs' sheets
   (frame, ground in it, (6.8) over pairs of unequal point counts, sheet corners, Table 24 with
@@ -43,7 +43,8 @@ import numpy as np
 
 from stereoplotter.commands.setup_job import compute_job, write_job
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import load_job, measured_pairs
+from stereoplotter.io.job_file import load_job
+from stereoplotter.io.job_measured import measured_pairs
 from stereoplotter.report.job import job_files
 from stereoplotter.setup.records import SetupOptions
 from stereoplotter.setup.sheet import compute_sheets_from_measurements

@@ -22,7 +22,8 @@ from pathlib import Path
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import Job, MeasuredPair, load_job, measured_pairs
+from stereoplotter.io.job_file import Job, load_job
+from stereoplotter.io.job_measured import MeasuredPair, measured_pairs
 from stereoplotter.io.output_folder import OutputReport, write_outputs
 from stereoplotter.report.job import JobResult, PairResult, job_files, manifest_about, pair_dict
 from stereoplotter.report.plain_data import json_text
@@ -56,7 +57,7 @@ def _instrument(job: Job) -> InstrumentSpec:
 def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
     """Every pair's sheet from its measured inputs; a refused pair keeps its reason.
 
-    The measured inputs of all pairs in one pass (:func:`~stereoplotter.io.job_file.
+    The measured inputs of all pairs in one pass (:func:`~stereoplotter.io.job_measured.
     measured_pairs`), the pairs' sheets as one block of columns with Table 24 in one vectorised
     call (per-pair f′ and marks, :func:`~stereoplotter.setup.sheet.deferred_sheets`); each
     pair's record is built from the columns when first read (``PairResult.sheet``), the one the

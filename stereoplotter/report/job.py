@@ -24,7 +24,8 @@ import numpy as np
 
 from stereoplotter import __version__
 from stereoplotter.glossary import TERMS, check_language, term
-from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
+from stereoplotter.io.job_file import Job, JobPair
+from stereoplotter.io.job_measured import MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
 from stereoplotter.report.form_fields import rigorous_sides
 from stereoplotter.report.form_layout import literal, localized_text, plain

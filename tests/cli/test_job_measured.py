@@ -12,7 +12,8 @@ import pytest
 import yaml
 
 from stereoplotter.commands.setup_job import compute_job
-from stereoplotter.io.job_file import load_job, measured_pair, measured_pairs
+from stereoplotter.io.job_file import load_job
+from stereoplotter.io.job_measured import measured_pair, measured_pairs
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import compute_sheets_from_measurements
 
