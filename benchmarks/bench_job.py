@@ -5,7 +5,7 @@ Run ``python benchmarks/bench_job.py`` (``--copies 1250``: 10 000 pairs in the v
 The job ``jobs/strip8`` is repeated (its 8 pairs each time) and timed, numeric part only (no file
 read or written, no PDF):
 
-* **measured inputs** — ``io.job_file.measured_pair`` per pair (SK-42 → the pair's local frame,
+* **measured inputs** — ``io.job_measured.measured_pair`` per pair (SK-42 → the pair's local frame,
   f′, the pair's points, the working area);
 * **sheets, one at a time** — ``setup.sheet.compute_sheet_from_measurements`` per pair (Table 24
   as a block of one, corners (6.7)/(6.8), readings);
@@ -31,7 +31,8 @@ from pathlib import Path
 import numpy as np
 
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import load_job, measured_pair
+from stereoplotter.io.job_file import load_job
+from stereoplotter.io.job_measured import measured_pair
 from stereoplotter.setup.records import SetupOptions
 from stereoplotter.setup.scale_choice import candidate_scales
 from stereoplotter.setup.sheet import (

@@ -71,10 +71,12 @@ def _data_entry(found: Any) -> dict[str, Any]:
 
 def info() -> dict[str, Any]:
     """Versions, data folders (in look-up order), instruments and scenarios with their counts."""
-    # imported here: the file readers load pydantic, which `--help` does not need
+    # imported here: `--help` reads no file. A scenario is listed from its outline (name,
+    # photos, points), not validated whole: that loads numpy, pydantic and pyproj
+    # (`stereoplotter scenario check NAME` validates it)
     from stereoplotter.errors import StereoplotterError
     from stereoplotter.io.paths import data_files, shipped_root, user_folders
-    from stereoplotter.io.scenario_file import load_scenario
+    from stereoplotter.io.scenario_outline import scenario_outline
     from stereoplotter.io.yaml_input import load_yaml_mapping
 
     instruments = []
@@ -92,8 +94,8 @@ def info() -> dict[str, Any]:
     for found in data_files("scenarios"):
         entry = _data_entry(found)
         try:
-            s = load_scenario(found.path)
-            entry.update(name=s.name, photos=len(s.photos), points=len(s.points))
+            s = scenario_outline(found.path)
+            entry.update(name=s.name, photos=s.photos, points=s.points)
         except StereoplotterError as exc:
             entry["error"] = str(exc)
         scenarios.append(entry)

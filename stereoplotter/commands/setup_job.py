@@ -22,12 +22,13 @@ from pathlib import Path
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import Job, MeasuredPair, load_job, measured_pair
+from stereoplotter.io.job_file import Job, load_job
+from stereoplotter.io.job_measured import MeasuredPair, measured_pairs
 from stereoplotter.io.output_folder import OutputReport, write_outputs
 from stereoplotter.report.job import JobResult, PairResult, job_files, manifest_about, pair_dict
 from stereoplotter.report.plain_data import json_text
 from stereoplotter.setup.records import SetupOptions, SetupRefusal
-from stereoplotter.setup.sheet import compute_sheets_from_measurements
+from stereoplotter.setup.sheet import deferred_sheets
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["compute_job", "raise_keyboard_interrupt", "run", "write_job"]
@@ -56,9 +57,11 @@ def _instrument(job: Job) -> InstrumentSpec:
 def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
     """Every pair's sheet from its measured inputs; a refused pair keeps its reason.
 
-    The pairs' Table 24 is one vectorised call (per-pair f′ and marks,
-    :func:`~stereoplotter.setup.sheet.compute_sheets_from_measurements`); each sheet is the one
-    the pair alone would give, to the bit.
+    The measured inputs of all pairs in one pass (:func:`~stereoplotter.io.job_measured.
+    measured_pairs`), the pairs' sheets as one block of columns with Table 24 in one vectorised
+    call (per-pair f′ and marks, :func:`~stereoplotter.setup.sheet.deferred_sheets`); each
+    pair's record is built from the columns when first read (``PairResult.sheet``), the one the
+    pair alone would give, to the bit.
     """
     spec = spec or _instrument(job)
     options = SetupOptions(
@@ -67,14 +70,9 @@ def compute_job(job: Job, spec: InstrumentSpec | None = None) -> JobResult:
         vertical_scale_denominator=job.vertical_scale,
         bz_scale_sense=job.bz_scale_sense,
     )
-    measured: list[MeasuredPair | SetupRefusal] = []
-    for pair in job.pairs:
-        try:
-            measured.append(measured_pair(job, pair))
-        except SetupRefusal as exc:
-            measured.append(exc)
+    measured = measured_pairs(job)
     ready = [m for m in measured if isinstance(m, MeasuredPair)]
-    sheets = iter(compute_sheets_from_measurements(
+    sheets = iter(deferred_sheets(
         [m.sheet_arguments() for m in ready], spec=spec, options=options, source=job.source,
         name=job.name,
     ))  # fmt: skip

@@ -5,8 +5,8 @@ camera's calibration certificate, the exterior orientation of every photo by num
 aerotriangulation, the fiducial distances measured on each diapositive, the control and check
 points of the catalogue, the map sheets, the stereopairs as pairs of photo numbers and the
 instrument. :func:`load_job` validates it (pydantic models on :mod:`stereoplotter.io.validation`;
-JSON Schema ``docs/schemas/job.schema.json``) into a frozen :class:`Job`; :func:`measured_pair`
-turns one pair into the measured inputs of
+JSON Schema ``docs/schemas/job.schema.json``) into a frozen :class:`Job`;
+:mod:`stereoplotter.io.job_measured` turns its pairs into the measured inputs of
 :func:`stereoplotter.setup.sheet.compute_sheet_from_measurements`. Nothing here draws a random
 number: the same job gives the same sheets.
 
@@ -19,7 +19,7 @@ The passage to the photogrammetric frame (``frame.kind``)
   of Eq. (2.50) are given relative to the grid axes at the photo's nadir (X grid east, Y grid
   north, Z along the normal, up); they are carried into the local system by the rotation R whose
   columns are the local directions of grid east, grid north and up at the nadir
-  (:func:`grid_to_local_rotation`): M_local = R·M_grid.
+  (:func:`stereoplotter.io.job_measured.grid_to_local_rotation`): M_local = R·M_grid.
 * ``local``: centres, angles and points are already in one photogrammetric system; with
   ``frame.origin`` that system is the §10 system at that SK-42 origin (then map sheets and the
   similarity (6.8) are available), without it there is no geodetic tie (no sheet corners).
@@ -41,11 +41,7 @@ from numpy.typing import NDArray
 from pydantic import BeforeValidator, ConfigDict, Field, field_validator
 
 from stereoplotter.errors import ConfigError, StereoplotterError, describe_value
-from stereoplotter.geodesy import split_conventional_ordinate
-from stereoplotter.geodesy.photogrammetric import local_from_gauss_kruger
-from stereoplotter.geometry.collinearity import object_to_photo, photo_to_object
-from stereoplotter.geometry.film import corrected_focal_length, fiducial_spans_mm
-from stereoplotter.geometry.rotation import rotation_matrix
+from stereoplotter.geometry.film import fiducial_spans_mm
 from stereoplotter.io.scenario_file import (
     MAX_FILM_DEFORMATION_PPM,
     Corner,
@@ -70,7 +66,6 @@ from stereoplotter.io.validation import (
 from stereoplotter.io.yaml_input import load_yaml_mapping, read_text_file
 from stereoplotter.scenario import frame as frame_tie
 from stereoplotter.scenario.model import Camera, Frame, MapSheet, Point
-from stereoplotter.setup.records import SetupRefusal
 
 __all__ = [
     "FORMAT",
@@ -78,11 +73,8 @@ __all__ = [
     "JobFile",
     "JobPair",
     "JobPhoto",
-    "MeasuredPair",
-    "grid_to_local_rotation",
     "is_job_file",
     "load_job",
-    "measured_pair",
 ]
 
 #: The value of the ``format`` key that marks a job file.
@@ -90,8 +82,6 @@ FORMAT = "stereoplotter-job/1"
 MAX_TILT_DEG = 15.0
 _TILT_BASIS = f"near-vertical aerial photos only: |tilt| ≤ {MAX_TILT_DEG:g}°"
 _EAST = "m (conventional ordinate: zone × 10⁶ + 500 000 + y)"
-#: Margin of the working area inside the overlap of the two footprints (as for a scenario).
-WORKING_AREA_MARGIN = 0.05
 
 
 # --- the models -------------------------------------------------------------------------------
@@ -723,248 +713,3 @@ def _pairs(
                                   list(area))
         pairs.append(JobPair(p.left, p.right, sheet, area))
     return tuple(pairs)
-
-
-# --- from a pair to the measured inputs of the sheet ----------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class MeasuredPair:
-    """The measured inputs of one pair's sheet (the keyword arguments of
-    :func:`stereoplotter.setup.sheet.compute_sheet_from_measurements`) and the frame they are
-    in (``origin_sk42_m`` is None for a local job without a tie)."""
-
-    name: str
-    origin_sk42_m: tuple[float, float, float] | None
-    focal_length_corrected_mm: float
-    focal_length_corrected_per_photo_mm: tuple[float, float]
-    marks_mm: NDArray[np.float64]
-    centres_m: NDArray[np.float64]
-    rotations: NDArray[np.float64]
-    points: tuple[Point, ...]
-    working_area_m: NDArray[np.float64]
-    map_sheet: MapSheet | None
-
-    def sheet_arguments(self) -> dict[str, Any]:
-        """The keyword arguments of ``compute_sheet_from_measurements`` but spec and options."""
-        return {
-            "name": self.name,
-            "focal_length_corrected_mm": self.focal_length_corrected_mm,
-            "focal_length_corrected_per_photo_mm": self.focal_length_corrected_per_photo_mm,
-            "marks_mm": self.marks_mm,
-            "centres_m": self.centres_m,
-            "rotations": self.rotations,
-            "points": self.points,
-            "working_area_m": self.working_area_m,
-            "map_sheet": self.map_sheet,
-            "exterior_sources": ("aerotriangulation", "aerotriangulation"),
-        }
-
-
-def grid_to_local_rotation(
-    frame: Frame, north_m: float, east_m: float, height_m: float, step_m: float = 10.0
-) -> NDArray[np.float64]:
-    """R: the directions of grid east, grid north and up at a point, in the local frame.
-
-    Columns: the central differences of :func:`~stereoplotter.geodesy.photogrammetric.
-    local_from_gauss_kruger` along ȳ, x and H at the point, made orthonormal (the nearest
-    rotation, by SVD: removes the grid scale factor). M_local = R·M_grid. [—]
-    """
-    lf = frame_tie.local_frame(frame)
-    zone, y = split_conventional_ordinate(east_m)
-    if int(zone) != lf.zone:
-        raise StereoplotterError(f"a station in zone {int(zone)}, the frame in zone {lf.zone}")
-    d, zero = np.array([-step_m, step_m]), np.zeros(2)
-    # the six stepped points (east, north, up; − then +) in one geodesy call
-    dn, de, dh = (np.concatenate(v) for v in ((zero, d, zero), (d, zero, zero), (zero, zero, d)))
-    X, Y, Z = local_from_gauss_kruger(lf, north_m + dn, float(y) + de, height_m + dh)
-    cols = np.array([X[1::2] - X[0::2], Y[1::2] - Y[0::2], Z[1::2] - Z[0::2]])
-    u, _, vt = np.linalg.svd(cols)
-    return u @ vt
-
-
-def _pair_frame(job: Job, left: JobPhoto, right: JobPhoto) -> Frame | None:
-    if job.origin_sk42_m is not None:
-        return Frame("sk42", job.origin_sk42_m)
-    if job.frame_kind == "local":
-        return None
-    north = round((left.centre[0] + right.centre[0]) / 2.0)
-    east = round((left.centre[1] + right.centre[1]) / 2.0)
-    return Frame("sk42", (float(north), float(east), 0.0))
-
-
-def _local_points(job: Job, frame: Frame | None) -> tuple[Point, ...]:
-    """The job's points in the pair's frame (SK-42 jobs: all points in one geodesy call)."""
-    if job.frame_kind == "local" or not job.points:
-        return job.points
-    assert frame is not None
-    lf = frame_tie.local_frame(frame)
-    sk42 = np.array([p.sk42_m for p in job.points], float)
-    zone, y = split_conventional_ordinate(sk42[:, 1])
-    far = np.flatnonzero(np.asarray(zone) != lf.zone)
-    if far.size:
-        i = int(far[0])
-        src, fld = job.point_places[i] if job.point_places else (job.source, "points")
-        raise ConfigError(
-            src, fld, f"a point in zone {lf.zone} (the points of a job in one Gauss–Krüger zone, "
-            "the zone of the pair's frame)",
-            f"point {job.points[i].id} in zone {int(np.asarray(zone)[i])}",
-        )
-    X, Y, Z = local_from_gauss_kruger(lf, sk42[:, 0], np.asarray(y, float), sk42[:, 2])
-    return tuple(
-        Point(p.id, p.role, p.kind, (float(X[i]), float(Y[i]), float(Z[i])), p.sk42_m)
-        for i, p in enumerate(job.points)
-    )
-
-
-def _station(job: Job, frame: Frame | None, photo: JobPhoto) -> tuple[NDArray, NDArray]:
-    m = rotation_matrix(*photo.angles)
-    if job.frame_kind == "local":
-        return np.array(photo.centre, float), m
-    assert frame is not None
-    centre = np.array(frame_tie.local_from_sk42(frame, photo.centre), float)
-    return centre, grid_to_local_rotation(frame, *photo.centre) @ m
-
-
-def measured_pair(job: Job, pair: JobPair) -> MeasuredPair:
-    """One pair of the job as the measured inputs of its sheet.
-
-    f′ by :mod:`stereoplotter.geometry.film` from the measured 1–2, 3–4 against the certificate
-    (one f′ per pair from all four spans; per photo for the record); the measured marks are the
-    certificate's scaled per axis by the same ratios (the uniform film deformation of
-    ``docs/conventions.md`` §7), relative to the principal point; the points of the pair are
-    those imaged on both photos; the working area is the overlap of the two footprints at the
-    mean point height, shrunk by 5 % a side, at the lowest and highest ground (``working_area``
-    of the pair, else the points' heights).
-    """
-    cam = job.camera
-    left, right = job.photos[pair.left], job.photos[pair.right]
-    frame = _pair_frame(job, left, right)
-    cal_marks = cam.fiducial_array_mm()
-    cal_spans = fiducial_spans_mm(cam.fiducials_mm)
-    ratios = [np.array(p.fiducial_distances_mm) / cal_spans for p in (left, right)]
-    f = cam.focal_length_mm
-    f_pair = float(corrected_focal_length(f, np.concatenate(ratios), np.ones(4)))
-    per_photo = (float(f * np.mean(ratios[0])), float(f * np.mean(ratios[1])))
-    marks = np.array([cal_marks * r for r in ratios]) - np.asarray(cam.principal_point_mm, float)
-    try:  # the geodesy of the pair's frame: a station or point beyond its zone is bad input
-        (c_l, m_l), (c_r, m_r) = _station(job, frame, left), _station(job, frame, right)
-        points = _local_points(job, frame)
-    except StereoplotterError as exc:
-        if isinstance(exc, ConfigError) or str(exc).startswith(f"{job.source}: "):
-            raise
-        origin = "" if frame is None or frame.origin_sk42_m is None else (
-            " at x = {:.0f} m, ȳ = {:.0f} m".format(*frame.origin_sk42_m[:2]))  # fmt: skip
-        raise StereoplotterError(
-            f"{job.source}: pairs: pair {pair.name}: expected stations and points the pair's "
-            f"frame{origin} can take (one Gauss–Krüger zone), found: {exc}"
-        ) from None
-    xyz = np.array([p.local_m for p in points], float).reshape(-1, 3)
-    half = cam.format_mm / 2.0
-    inside = np.ones(len(points), bool)
-    for c, m in ((c_l, m_l), (c_r, m_r)):
-        xy = object_to_photo(xyz, c, m, f, cam.principal_point_mm)
-        with np.errstate(invalid="ignore"):
-            inside &= np.all(np.abs(xy) <= half, axis=-1)
-    every_point = points
-    points = tuple(p for p, ok in zip(points, inside, strict=True) if ok)
-    heights = [p.local_m[2] for p in points if p.kind != "plan"] or [p.local_m[2] for p in points]
-    if pair.working_area_m is not None:
-        lowest, highest = _local_heights(frame, c_l, c_r, pair.working_area_m)
-    elif heights:
-        lowest, highest = min(heights), max(heights)
-    else:  # this pair alone cannot be set up: the job's other pairs still can
-        raise SetupRefusal(
-            "no control point imaged on both photos and no working_area (lowest_m, highest_m) "
-            "of the pair: nothing fixes the heights of its model"
-            + _suspects(job, pair, every_point, ((c_l, m_l), (c_r, m_r)))
-        )
-    z0 = (lowest + highest) / 2.0
-    corners = np.array([[half, half], [-half, half], [-half, -half], [half, -half]])
-    boxes = [photo_to_object(corners, z0, c, m, f, cam.principal_point_mm)
-             for c, m in ((c_l, m_l), (c_r, m_r))]  # fmt: skip
-    lo = np.max([b[:, :2].min(axis=0) for b in boxes], axis=0)
-    hi = np.min([b[:, :2].max(axis=0) for b in boxes], axis=0)
-    pad = WORKING_AREA_MARGIN * (hi - lo)
-    lo, hi = lo + pad, hi - pad
-    plan = ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1]))
-    area = np.array([[x, y, z] for z in (lowest, highest) for x, y in plan])
-    return MeasuredPair(
-        name=pair.name,
-        origin_sk42_m=frame.origin_sk42_m if frame is not None else None,
-        focal_length_corrected_mm=f_pair,
-        focal_length_corrected_per_photo_mm=per_photo,
-        marks_mm=marks,
-        centres_m=np.array([c_l, c_r]),
-        rotations=np.array([m_l, m_r]),
-        points=points,
-        working_area_m=area,
-        map_sheet=pair.map_sheet,
-    )
-
-
-def _suspects(
-    job: Job,
-    pair: JobPair,
-    points: tuple[Point, ...],
-    stations: tuple[tuple[NDArray, NDArray], ...],
-) -> str:
-    """Which input of a pair without imaged control looks wrong, and why, as "; suspicious: …"
-    (empty when nothing does): a photo at or below the control's median height; two photos
-    whose footprints cannot overlap (the base longer than a footprint); the control point
-    nearest to being imaged, with how far its projection falls outside the format on each
-    photo (or that it lies above the camera)."""
-    cam, f = job.camera, job.camera.focal_length_mm
-    half = cam.format_mm / 2.0
-    names = (pair.left, pair.right)
-    out = []
-    xyz = np.array([p.local_m for p in points], float).reshape(-1, 3)
-    ground = float(np.median(xyz[:, 2])) if len(points) else 0.0
-    heights = [float(c[2]) - ground for c, _ in stations]
-    for name, h in zip(names, heights, strict=True):
-        if h <= 0:
-            z = round(h + ground, 1) + 0.0  # no "-0.0"
-            out.append(f"photo {name} at {z:.1f} m is not above the control's median height "
-                       f"{ground:.1f} m (check its height)")  # fmt: skip
-    if min(heights) > 0:
-        base = float(np.hypot(*(stations[0][0][:2] - stations[1][0][:2])))
-        footprint = cam.format_mm / f * float(np.mean(heights))
-        if base > footprint:
-            far = ""
-            if len(points):
-                near = [float(np.min(np.hypot(*(xyz[:, :2] - c[:2]).T))) for c, _ in stations]
-                lost = [n for n, d in zip(names, near, strict=True) if d > footprint]
-                if len(lost) == 1:
-                    far = (f"; photo {lost[0]} is {max(near) / 1000:.1f} km from the nearest "
-                           f"control point, the other {min(near) / 1000:.1f} km")  # fmt: skip
-            out.append(f"photos {names[0]} and {names[1]} are {base:.0f} m apart, more than a "
-                       f"footprint ({footprint:.0f} m at {np.mean(heights):.0f} m above the "
-                       f"control): they cannot overlap (check their coordinates){far}")  # fmt: skip
-    if len(points) and min(heights) > 0:
-        outside = []
-        for c, m in stations:
-            xy = object_to_photo(xyz, c, m, f, cam.principal_point_mm)
-            beyond = np.max(np.abs(xy), axis=-1) - half
-            beyond[xyz[:, 2] >= c[2]] = np.inf  # above the camera: never imaged
-            outside.append(np.where(np.isfinite(beyond), np.maximum(beyond, 0.0), np.inf))
-        worst = np.max(outside, axis=0)
-        i = int(np.argmin(worst))
-        where = [("above the camera" if not np.isfinite(o[i]) else
-                  "inside the format" if o[i] == 0 else f"{o[i]:.1f} mm outside the format")
-                 + f" on photo {n}" for o, n in zip(outside, names, strict=True)]  # fmt: skip
-        out.append(f"the control point nearest to being imaged, {points[i].id}, falls "
-                   f"{' and '.join(where)} ({cam.format_mm:g} mm; check its coordinates or the "
-                   "photos' orientation)")  # fmt: skip
-    return "; suspicious: " + "; ".join(out) if out else ""
-
-
-def _local_heights(
-    frame: Frame | None, c_l: NDArray, c_r: NDArray, heights: tuple[float, float]
-) -> tuple[float, float]:
-    """The working area's lowest and highest ground as local Z under the pair's centre."""
-    if frame is None:
-        return heights
-    centre = (c_l + c_r) / 2.0
-    north, east, _ = frame_tie.sk42_from_local(frame, (centre[0], centre[1], 0.0))
-    z = [frame_tie.local_from_sk42(frame, (north, east, h))[2] for h in heights]
-    return (float(z[0]), float(z[1]))

@@ -5,7 +5,7 @@ A job has no ground truth; a scenario is one. :func:`job_pair_scenario` writes t
 
 * the camera of the certificate (its marks as the certificate gives them);
 * the two photos' exterior orientation in the pair's own frame, as the job computes it
-  (:func:`stereoplotter.io.job_file.measured_pair`: the §10 local system of the pair, angles
+  (:func:`stereoplotter.io.job_measured.measured_pair`: the §10 local system of the pair, angles
   turned by M_local = R·M_grid), the angles recovered from M by the inverse of (2.50);
 * the film deformation of each photo from its measured fiducial distances (l′/l − 1 per axis,
   the uniform deformation the job assumes), so the scenario's f′ is the job's;
@@ -35,7 +35,8 @@ from stereoplotter.errors import ConfigError
 from stereoplotter.geometry.film import fiducial_spans_mm
 from stereoplotter.geometry.rotation import angles_from_matrix
 from stereoplotter.io.atomic_write import atomic_write_bytes
-from stereoplotter.io.job_file import Job, JobPair, MeasuredPair, measured_pair
+from stereoplotter.io.job_file import Job, JobPair
+from stereoplotter.io.job_measured import MeasuredPair, measured_pair
 from stereoplotter.scenario.model import Point
 
 __all__ = ["TerrainFit", "fit_terrain", "job_pair_scenario", "write_job_scenario"]

@@ -17,6 +17,7 @@ from pydantic import BeforeValidator, ConfigDict, Field, field_validator, model_
 from stereoplotter.errors import ConfigError, StereoplotterError, describe_value
 from stereoplotter.geometry.collinearity import object_to_photo
 from stereoplotter.io.paths import resolve_data_file
+from stereoplotter.io.scenario_outline import refuse_block_file
 from stereoplotter.io.validation import (
     FileModel,
     check_number,
@@ -60,9 +61,6 @@ MAX_FILM_DEFORMATION_PPM = 5000.0  # 0.5 %: beyond any usable film base
 MIN_RESECTION_POINTS = 3
 MIN_SIMILARITY_POINTS = 2
 
-#: Top-level fields that only a block file has (``stereoplotter.setup.block``).
-_BLOCK_FIELDS = ("models", "models_csv")
-
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:
@@ -101,16 +99,7 @@ def scenario_from_mapping(data: dict[str, Any], source: str = "<scenario>") -> S
     source : str
         Name of the file, for messages.
     """
-    block_fields = [k for k in _BLOCK_FIELDS if isinstance(data, dict) and k in data]
-    if block_fields:
-        raise ConfigError(
-            source,
-            block_fields[0],
-            "a scenario (one photo or one stereopair: fields photos, points)",
-            "a block file (it has " + ", ".join(block_fields) + ")",
-            "a block file is set up model by model with: stereoplotter setup FILE --instrument "
-            "NAME",
-        )
+    refuse_block_file(data, source)
     doc = validate(ScenarioFile, _drop_nulls(data, _NULLABLE_TOP), source)
     camera = camera_from_model(source, doc.camera)
     frame = _frame(source, doc.frame)

@@ -209,14 +209,16 @@ class Form(FPDF):
         """Draw ``text`` (a form text: :func:`rich_runs`) with its baseline at (x, y) in the
         current font, each subscript smaller and lowered; returns the width drawn (mm)."""
         size, style = self.font_size_pt, self.font_style
+        # only the size changes within a text (the forms' one family, this style; no underline
+        # or strike-through): fpdf2's set_font_size, what its set_font does then
         for run, sub in rich_runs(text):
             run_size = size * _SUB if sub else size
             if run_size != self.font_size_pt:
-                self.set_font(FONT, style, run_size)
+                self.set_font_size(run_size)
             self.text(x, y + (_SUB_DROP * size * _PT if sub else 0.0), run)
             x += _plain_width(self, run, style, run_size)
         if self.font_size_pt != size:
-            self.set_font(FONT, style, size)
+            self.set_font_size(size)
         return x
 
     def append_pages(self, source: Form) -> None:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,7 +24,8 @@ import numpy as np
 
 from stereoplotter import __version__
 from stereoplotter.glossary import TERMS, check_language, term
-from stereoplotter.io.job_file import Job, JobPair, MeasuredPair
+from stereoplotter.io.job_file import Job, JobPair
+from stereoplotter.io.job_measured import MeasuredPair
 from stereoplotter.io.yaml_output import yaml_text
 from stereoplotter.report.form_fields import rigorous_sides
 from stereoplotter.report.form_layout import literal, localized_text, plain
@@ -47,16 +49,29 @@ __all__ = [
 
 @dataclass(frozen=True, slots=True)
 class PairResult:
-    """One pair of a job: its measured inputs, and the sheet or the refusal."""
+    """One pair of a job: its measured inputs, and the sheet or the refusal.
+
+    The sheet may be given as a function that builds it (:func:`stereoplotter.setup.sheet.
+    deferred_sheets`): it is then built when first read, once."""
 
     pair: JobPair
     measured: MeasuredPair | None
-    sheet: SetupSheet | None
+    sheet_or_builder: SetupSheet | Callable[[], SetupSheet] | None
     reason: str
 
     @property
+    def sheet(self) -> SetupSheet | None:
+        """The pair's sheet (None for a refused pair)."""
+        found = self.sheet_or_builder
+        if found is None or isinstance(found, SetupSheet):
+            return found
+        built = found()
+        object.__setattr__(self, "sheet_or_builder", built)  # built once, kept
+        return built
+
+    @property
     def accepted(self) -> bool:
-        return self.sheet is not None
+        return self.sheet_or_builder is not None
 
 
 @dataclass(frozen=True, slots=True)

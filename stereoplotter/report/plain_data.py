@@ -3,14 +3,21 @@
 from __future__ import annotations
 
 import json
+import sys
 from typing import Any
-
-import numpy as np
 
 __all__ = ["json_ready", "json_text"]
 
 
+def _numpy() -> Any:
+    """numpy if it is loaded (a numpy value cannot exist before): ``info`` never loads it."""
+    return sys.modules.get("numpy")
+
+
 def _json_default(value: Any) -> Any:
+    np = _numpy()
+    if np is None:
+        raise TypeError(f"not JSON serialisable: {type(value).__name__}")
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, np.ndarray):
@@ -25,6 +32,9 @@ def json_text(data: Any) -> str:
 
 
 def _plain(v: Any) -> Any:
+    np = _numpy()
+    if np is None:
+        return str(v)
     if isinstance(v, np.ndarray):
         return v.tolist()
     if isinstance(v, np.generic):

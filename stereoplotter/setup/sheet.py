@@ -15,8 +15,9 @@ scenario's seed, so a sheet is reproducible.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -64,9 +65,11 @@ __all__ = [
     "SetupRefusal",
     "SetupSheet",
     "assumed_parameters",
+    "block_refusals",
     "compute_setup_sheet",
     "compute_sheet_from_measurements",
     "compute_sheets_from_measurements",
+    "deferred_sheets",
     "instrument_frame_m",
     "sheet_of_block",
 ]
@@ -307,6 +310,68 @@ def compute_setup_sheet(
     return sheet
 
 
+def _checked_table(block: SheetBlock, i: int) -> BlockResult:
+    """Table 24 of pair ``i`` of a block as a block of one, or the pair's refusal (raised): the
+    range checks run again only for a pair Table 24's reason code (or a tilt) refuses, for the
+    words of its refusal."""
+    refusal = block.refusals[i]
+    if refusal is not None:
+        raise refusal
+    group, row = (int(v) for v in block.table_of[i])
+    table = block.tables[group].take(row)
+    code = int(table.reason_code[0])
+    if code & SCALE_FLAGS:
+        _refuse_scales(table, block.extent_m[i][None])
+    if code or float(np.abs(table.angles[0, :, :2]).max()) > block.spec.tilt_max:
+        _check_settings(table)  # the words of the refusal (_check_tilt has no slack)
+    return table
+
+
+def block_refusals(block: SheetBlock) -> list[SetupRefusal | None]:
+    """The refusal :func:`sheet_of_block` raises for each pair, or None, read from the block's
+    columns without building the records (the checks run again only for a pair Table 24's
+    reason code or a tilt refuses, for the words of its refusal)."""
+    tilt_max = block.spec.tilt_max
+    flagged = [
+        (table.reason_code != 0) | (np.abs(table.angles[:, :, :2]).max(axis=(1, 2)) > tilt_max)
+        for table in block.tables
+    ]
+    out: list[SetupRefusal | None] = []
+    for i in range(len(block)):
+        refusal = block.refusals[i]
+        if refusal is None:
+            group, row = (int(v) for v in block.table_of[i])
+            if flagged[group][row]:
+                try:
+                    _checked_table(block, i)
+                except SetupRefusal as exc:
+                    refusal = exc
+        out.append(refusal)
+    return out
+
+
+def deferred_sheets(
+    pairs: Sequence[Mapping[str, Any]],
+    *,
+    spec: InstrumentSpec,
+    options: SetupOptions,
+    source: str,
+    name: str = "job",
+) -> list[SetupRefusal | Callable[[], SetupSheet]]:
+    """:func:`compute_sheets_from_measurements` with each pair's record built when it is first
+    asked for: the block's columns and every refusal now, for a pair set up a function that
+    returns its sheet (the same sheet, built from the same columns by :func:`sheet_of_block`).
+
+    A job's records (the stage readings as rows of text, the settings per photo, the corners
+    and points as mappings) are what only its printed files read."""
+    block = compute_sheet_block(pairs, spec=spec, options=options, source=source, name=name)
+    assumed = assumed_parameters(spec)
+    return [
+        refusal if refusal is not None else partial(sheet_of_block, block, i, assumed)
+        for i, refusal in enumerate(block_refusals(block))
+    ]
+
+
 def sheet_of_block(
     block: SheetBlock, i: int, assumed: dict[str, tuple[str, ...]] | None = None
 ) -> SetupSheet:
@@ -315,18 +380,8 @@ def sheet_of_block(
 
     The range checks are Table 24's reason code, computed once for all pairs: only a refused
     pair goes through the checks again, for the words of its refusal."""
-    refusal = block.refusals[i]
-    if refusal is not None:
-        raise refusal
-    group, row = (int(v) for v in block.table_of[i])
-    table = block.tables[group].take(row)
-    extent = block.extent_m[i]
-    code = int(table.reason_code[0])
-    if code & SCALE_FLAGS:
-        _refuse_scales(table, extent[None])
+    table = _checked_table(block, i)
     spec, options, inputs = block.spec, block.options, block.inputs[i]
-    if code or float(np.abs(table.angles[0, :, :2]).max()) > spec.tilt_max:
-        _check_settings(table)  # the words of the refusal (_check_tilt has no slack)
     points, points_m = tuple(inputs["points"]), block.points_of(i)
     mg, mv = int(table.horizontal_scale_denominator[0]), int(table.vertical_scale_denominator[0])
     n_left = float(table.n_left[0])

@@ -8,8 +8,9 @@ roughly in order and a killed study loses at most the cells in flight. A cell's 
 chunks run as one batch (:func:`chunk_batches`: one pass of the procedure over their trials,
 up to the memory budget's chunk, its fixed cost paid once), each chunk still reduced to its own
 moments; a process keeps the prepared run of the cell it last ran (:func:`run_chunks`), not one
-per task. :func:`start_local_client` starts an embedded cluster on a thread, so that it comes
-up while the study is being prepared. A cell is handed to
+per task. :func:`start_local_client` starts an embedded cluster whose workers are forked from
+this process with the library loaded (on Linux; elsewhere spawned on a thread, so that they come
+up while the study is being prepared). A cell is handed to
 ``sink(cell, values)`` as soon as its last task returns; ``done`` cells (already in the store)
 are skipped — that is how a study resumes.
 
@@ -20,6 +21,7 @@ combined in trial order (:func:`~stereoplotter.study.cells.combine_chunks`).
 
 from __future__ import annotations
 
+import sys
 import threading
 import uuid
 from collections.abc import Callable, Iterable
@@ -57,6 +59,7 @@ __all__ = [
     "started_client",
     "study_checks",
     "study_terms",
+    "worker_start_method",
 ]
 
 Sink = Callable[[int, dict[str, Any]], None]
@@ -99,15 +102,28 @@ def study_terms(design: StudyDesign) -> tuple[str, ...]:
     return tuple(names)
 
 
+def worker_start_method() -> str:
+    """How the embedded cluster starts its worker processes: forked from this process on Linux
+    (each worker has the library loaded at once: a spawned worker imports numpy, Dask and the
+    library again, ≈ 2 s of CPU each), spawned elsewhere (macOS's system libraries are not safe
+    to fork; Windows cannot)."""
+    return "fork" if sys.platform.startswith("linux") else "spawn"
+
+
 def local_client(workers: int | None = None, dashboard: bool = True):
     """An embedded ``LocalCluster``: ``workers`` processes (default one per core), one thread
-    each, and its client. The workers' statistical profiler is off (it samples the task's
-    thread every 10 ms and competes with it for the interpreter)."""
+    each, started by :func:`worker_start_method`, and its client. The workers' statistical
+    profiler is off (it samples the task's thread every 10 ms and competes with it for the
+    interpreter)."""
     # Imported here: dask.distributed is the optional extra `study` and takes a second to load.
     import dask
     from distributed import Client, LocalCluster
 
-    with dask.config.set({"distributed.worker.profile.enabled": False}):
+    settings = {
+        "distributed.worker.profile.enabled": False,
+        "distributed.worker.multiprocessing-method": worker_start_method(),
+    }
+    with dask.config.set(settings):
         cluster = LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
@@ -123,9 +139,21 @@ def _load_library() -> None:
 
 
 def start_local_client(workers: int | None = None, dashboard: bool = True) -> Future:
-    """:func:`local_client` started on a thread, each worker loading the library: a Future of
-    the client, to be taken once the study is prepared (the two overlap)."""
+    """:func:`local_client` as a Future of the client, to be taken once the study is prepared.
+
+    Forked workers (:func:`worker_start_method`) are started here, before the study is prepared:
+    a process is forked while no other thread of this one is working (a thread's lock held at
+    the fork, an import half done, would stay so in the worker), and the workers need no start
+    of their own. Spawned workers start on a thread, each loading the library, while the study
+    is prepared (the two overlap)."""
     started: Future = Future()
+    if worker_start_method() == "fork":
+        try:
+            _load_library()  # the workers inherit it
+            started.set_result(local_client(workers, dashboard))
+        except Exception as exc:  # handed to whoever takes the client
+            started.set_exception(exc)
+        return started
 
     def start() -> None:
         try:

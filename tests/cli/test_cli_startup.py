@@ -42,6 +42,8 @@ NOT_AT_START = (
 
 #: What ``info`` (versions, data files) has no use for.
 NOT_IN_INFO = (
+    "numpy",
+    "pydantic",
     "scipy",
     "matplotlib",
     "starlette",

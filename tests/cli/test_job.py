@@ -19,7 +19,8 @@ from stereoplotter import __version__
 from stereoplotter.cli import main
 from stereoplotter.commands.setup_job import compute_job
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import load_job, measured_pair
+from stereoplotter.io.job_file import load_job
+from stereoplotter.io.job_measured import measured_pair
 from stereoplotter.io.job_scenario import fit_terrain
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.report.form_fields import rigorous_sides, value_to_set

@@ -15,7 +15,8 @@ import yaml
 
 from stereoplotter.cli import main
 from stereoplotter.commands.setup_job import compute_job, write_job
-from stereoplotter.io.job_file import load_job, measured_pair
+from stereoplotter.io.job_file import load_job
+from stereoplotter.io.job_measured import measured_pair
 
 ROOT = Path(__file__).resolve().parents[2]
 STRIP8 = ROOT / "jobs" / "strip8"

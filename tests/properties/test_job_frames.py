@@ -24,7 +24,8 @@ from stereoplotter.geodesy import split_conventional_ordinate
 from stereoplotter.geodesy.photogrammetric import LocalFrame
 from stereoplotter.geometry.rotation import angles_from_matrix
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import grid_to_local_rotation, load_job
+from stereoplotter.io.job_file import load_job
+from stereoplotter.io.job_measured import grid_to_local_rotation
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.report.sheet import sheet_to_dict
 from stereoplotter.scenario.frame import local_frame, sk42_from_local

@@ -22,7 +22,8 @@ import pytest
 
 from stereoplotter.geometry.grouped import group_sums
 from stereoplotter.io.instrument_file import load_instrument
-from stereoplotter.io.job_file import load_job, measured_pair
+from stereoplotter.io.job_file import load_job
+from stereoplotter.io.job_measured import measured_pair
 from stereoplotter.setup.records import SetupOptions, SetupSheet
 from stereoplotter.setup.sheet import compute_sheet_from_measurements, sheet_of_block
 from stereoplotter.setup.sheet_block import CORNER_ORDER, compute_sheet_block

@@ -1,6 +1,6 @@
 """`study run` on a reduced grid of the shipped formula-validity study: the Dataset of 2 Dask
-workers (one of them killed mid-run) is identical to the serial run, bit for bit, and so is a
-run resumed after its process was killed."""
+workers (one of them killed mid-run; or forked by the embedded cluster) is identical to the
+serial run, bit for bit, and so is a run resumed after its process was killed."""
 
 from __future__ import annotations
 
@@ -134,3 +134,26 @@ def test_a_store_of_another_study_is_refused(serial, tmp_path):
     run_into_store(first, "a", str(out))
     with pytest.raises(StereoplotterError, match="another study"):
         run_into_store({**first, "trials": 3}, "b", str(out))
+
+
+def _has_pytest() -> bool:
+    return "_pytest" in sys.modules
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers are forked on Linux")
+def test_embedded_cluster_forks_its_workers_and_gives_the_serial_dataset(serial, tmp_path):
+    from stereoplotter.study.runner import start_local_client, started_client
+
+    started = start_local_client(2, dashboard=False)
+    client = started_client(started)
+    assert client is not None
+    try:
+        # forked from this process: a worker holds what only this process imported
+        assert list(client.run(_has_pytest).values()) == [True, True]
+        out = tmp_path / "forked.zarr"
+        run_into_store(reduced_study(), "reduced", str(out), started)
+    finally:
+        cluster = client.cluster
+        client.close()
+        cluster.close()
+    assert_same_bits(open_results(out), serial)
