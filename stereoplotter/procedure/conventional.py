@@ -55,12 +55,14 @@ from stereoplotter.procedure.conventional_sheet import (
     plotted_control,
     scale_on_plotted_control,
 )
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.operator import solve_1d
 from stereoplotter.procedure.relative_equations import (
     overcorrection_factor,
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
+from stereoplotter.procedure.step_values import KNOB_AT_STOP, Line, turn_common_tilt
 from stereoplotter.procedure.steps import (
     REPEAT_POINTINGS,
     control_point_m,
@@ -117,6 +119,25 @@ _CONTROLS = (
 
 #: Unit of a control's line in the transcript of a common tilt (the cassettes' turns: none).
 _TRANSFER_UNIT = {"screw": "mm", "knob": "tan"}
+
+
+def _transfer_unit(control: str) -> str:
+    """The unit a common tilt's record of ``control`` shows (:data:`_TRANSFER_UNIT`)."""
+    return _TRANSFER_UNIT.get(control_kind(control), "—")
+
+
+#: C2's common tilt at a knob's stop, per control turned.
+_TRANSFER_LINE = Line(
+    "C2",
+    "a knob of axis {axis} at its stop: common tilt Δ{axis} = {phi_mrad:+.4f} mrad centres "
+    "the pair; turn {control}",
+    "common tilt (q-neutral)",
+    condition=KNOB_AT_STOP,
+)
+#: C3's levelling turn of a control by its rate × the common tilt φ.
+_LEVEL_LINE = Line(
+    "C3", "common tilt Δ{axis} = {phi_mrad:+.4f} mrad: turn {control}", "levelling (assumption)"
+)
 
 
 def _perturb(
@@ -299,6 +320,8 @@ def calibrate(run, level_ids: tuple[str, ...]) -> Calibration:
 # --------------------------------------------------------------------------------------------
 
 _SIDE = {"left": "л", "right": "п"}
+#: The identities of the conventional stages' draws (each act's own below its stage).
+C1, C3 = NoiseKey("C1"), NoiseKey("C3")
 _BOOK = {"alpha1": "α′₁", "alpha2": "α′₂", "omega2": "ω′₂", "kappa1": "κ′₁", "kappa2": "κ′₂"}
 
 
@@ -395,28 +418,14 @@ def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
         if not np.any(near):
             continue
         moved = moved | near
+        key = NoiseKey(stage).at(it, f"transfer{name}")
         phi = np.where(near, -(now[0] + now[1]) / (combo[pair[0]] + combo[pair[1]]), 0.0)
-        for control, rate in combo.items():
-            if control in ("by", "bz"):
-                before = op.read(control, f"{stage}/{it}/transfer{name}/{control}")
-                after = before + rate * phi
-                op.set(control, after, f"{stage}/{it}/transfer{name}/set{control}", near)
-            else:
-                before = op.physical(control)
-                _turn(op, control, before + rate * phi, near)
-                after = op.physical(control)
-            op.log.add(
-                stage,
-                f"a knob of axis {name} at its stop: common tilt "
-                f"Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad centres the pair; "
-                f"turn {control}",
-                control,
-                before=before,
-                after=after,
-                unit=_TRANSFER_UNIT.get(control_kind(control), "—"),
-                iteration=it,
-                equation="common tilt (q-neutral)",
-            )
+        fields = {"axis": name, "phi_mrad": float(np.ravel(phi)[0]) * 1e3}
+        turn_common_tilt(
+            run, combo, phi, key, near, _TRANSFER_LINE, fields=fields,
+            turn=lambda c, target, on: _turn(op, c, target, on), unit_of=_transfer_unit,
+            iteration=it,
+        )  # fmt: skip
     return moved
 
 
@@ -434,7 +443,7 @@ def c1_interior(run) -> None:
     log = op.log
     interior_orientation(run, "C1")
     bx, by, _ = sheet.base_mm
-    op.set("bx", NOMINAL_ZERO["bx"] + bx, "C1/bx")
+    op.set("bx", NOMINAL_ZERO["bx"] + bx, C1.at("bx"))
     log.add(
         "C1",
         "base carriage: b_x of the sheet",
@@ -442,7 +451,7 @@ def c1_interior(run) -> None:
         reading=NOMINAL_ZERO["bx"] + bx,
         equation="stage 1",
     )
-    op.set("bz", NOMINAL_ZERO["bz"], "C1/bz")
+    op.set("bz", NOMINAL_ZERO["bz"], C1.at("bz"))
     log.add(
         "C1",
         "b_z′ = 0 (found by the levelling, C3)",
@@ -451,7 +460,7 @@ def c1_interior(run) -> None:
         equation="assumption",
     )
     depth = sheet.n_left * sheet.f_instrument_mm
-    op.set("Z", NOMINAL_ZERO["Z"] + depth, "C1/Z")
+    op.set("Z", NOMINAL_ZERO["Z"] + depth, C1.at("Z"))
     log.add(
         "C1",
         "lower the carriage to D = n_л·f_пр",
@@ -460,11 +469,11 @@ def c1_interior(run) -> None:
         equation="(6.3)",
     )
     mo_by = zero_base_y(run, "C1")
-    op.set("by", mo_by + by, "C1/by")
+    op.set("by", mo_by + by, C1.at("by"))
     log.add("C1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="stage 1")
-    e = op.mark_on("left", np.zeros(2), "C1/MO")
-    run.zero["MO_X"] = op.read("X", "C1/MO/X")
-    run.zero["MO_Y"] = op.read("Y", "C1/MO/Y")
+    e = op.mark_on("left", np.zeros(2), C1.at("MO"))
+    run.zero["MO_X"] = op.read("X", C1.at("MO", "X"))
+    run.zero["MO_Y"] = op.read("Y", C1.at("MO", "Y"))
     log.add(
         "C1",
         "left mark on the left cassette centre → MO_X",
@@ -511,7 +520,7 @@ _SEQUENCE = (
 
 
 def c2_relative_by_elements(
-    run, cal: Calibration | None = None, stage: str = "C2", key0: str = "C2"
+    run, cal: Calibration | None = None, stage: str = "C2", key0: KeyLike = "C2"
 ):
     """C2 (a): element by element — point 1 → κ_п, 2 → κ_л, 4 → α_л, 3 → α_п, 5 → ω_п with the
     over-correction ½(f′²/c² − 1); repeat while the residual y-parallax of the six looks still
@@ -532,7 +541,7 @@ def c2_relative_by_elements(
         with compacted(run, active) as cut:  # the trials still orienting only
             on = cut.active
             ahead = None if prev_rms is None else cut.take(prev_rms)
-            seen, rms, done = _c2_pass(cut.run, stage, key0, it, on, ahead, over)
+            seen, rms, done = _c2_pass(cut.run, stage, as_key(key0), it, on, ahead, over)
             going = on & ~done
             moved = np.zeros(np.shape(on), bool)
             if cal is not None and np.any(going):
@@ -546,7 +555,7 @@ def c2_relative_by_elements(
     return its, worst
 
 
-def _c2_pass(run, stage: str, key0: str, it: int, active, prev_rms, over: float):
+def _c2_pass(run, stage: str, key0: NoiseKey, it: int, active, prev_rms, over: float):
     """Pass ``it`` of C2 (a) on ``active``: the five points cleared element by element, then the
     six looks and the stopping rule. Returns the six q seen, their RMS and the trials that stop
     (:func:`_c2_stop`)."""
@@ -555,10 +564,10 @@ def _c2_pass(run, stage: str, key0: str, it: int, active, prev_rms, over: float)
     pts = run.scene.standard_points_m
     imgs = run.scene.standard  # the standard points' true images, computed once
     for idx, control, element in _SEQUENCE:
-        key = f"{key0}/a/{it}/{idx + 1}"
+        key = key0.at("a", it, idx + 1)
         img = (imgs[0][idx], imgs[1][idx])
         q_seen, q_true = op.fuse(pts[idx], img, key, active)
-        target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+        target = op.noise.draw(key.at("clear").by("q"), op.model.y_parallax_sigma_mm)
         before = op.physical(control)
         clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
         extra = ""
@@ -583,14 +592,14 @@ def _c2_pass(run, stage: str, key0: str, it: int, active, prev_rms, over: float)
             equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
         )
     seen = judge_standard_points(
-        run, stage, f"{key0}/a/{it}/check", active, iteration=it, text=_SIX_Q
+        run, stage, key0.at("a", it, "check"), active, iteration=it, text=_SIX_Q
     )
     rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
     return seen, rms, done
 
 
 def c2_relative_by_equations(
-    run, cal: Calibration, stage: str = "C2", key0: str = "C2", passes: int | None = None
+    run, cal: Calibration, stage: str = "C2", key0: KeyLike = "C2", passes: int | None = None
 ):
     """C2 (b): measure the six q, solve (5.11), turn the five controls by the result through the
     numerical mapping; repeat while the residual still decreases (:func:`_c2_stop`, bounded); a
@@ -613,7 +622,7 @@ def c2_relative_by_equations(
     for it in range(1, bound + 1):
         its = np.where(active, it, its)
         seen = judge_standard_points(
-            run, stage, f"{key0}/b/{it}", active, iteration=it, text=_SIX_Q
+            run, stage, as_key(key0).at("b", it), active, iteration=it, text=_SIX_Q
         )
         worst = np.where(active, _worst(seen), worst)
         if passes is None:
@@ -676,7 +685,9 @@ CR1 = "CR1 C3: read the control heights as the mean of several fusings"
 CR2 = "CR2 C3: refine the relative orientation only where q fails, then check the heights again"
 
 
-def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int, remedy: str = ""):
+def _slip_and_read_heights(
+    run, rows, heights, key: NoiseKey, active, pointings: int, remedy: str = ""
+):
     """Fuse on the first levelling point, slip the height scale there (on the mean of
     ``pointings`` readings where ``pointings`` > 1), then read every other control height (the
     mean of ``pointings``) and log it against H/3000. Trials not ``active`` keep their scale.
@@ -687,10 +698,10 @@ def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int,
     tol = run.sheet.tolerances["control_height_m"]
     pid0, p0 = rows[0]
     if pointings == 1:
-        fuse_and_read(run, p0, f"{key}/slip/{pid0}", active, ())
+        fuse_and_read(run, p0, key.at("slip", pid0), active, ())
         op.inst.slip_height_scale(p0[2])
     else:
-        slip_height_scale_on_mean(run, p0, f"{key}/slip/{pid0}", active, pointings)
+        slip_height_scale_on_mean(run, p0, key.at("slip", pid0), active, pointings)
     times = f" ({pointings} times, mean)" if pointings > 1 else ""
     op.log.add(
         "C3",
@@ -706,7 +717,7 @@ def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int,
     for pid, p in heights:
         if pid == pid0:
             continue
-        read = height_mean(run, p, f"{key}/h/{pid}", active, pointings)
+        read = height_mean(run, p, key.at("h", pid), active, pointings)
         errs.append(read - p[2])
         op.log.add(
             "C3",
@@ -725,7 +736,7 @@ def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int,
 
 
 def _level(
-    run, cal: Calibration, rows, key: str, active, pointings: int, it: int, remedy: str = ""
+    run, cal: Calibration, rows, key: NoiseKey, active, pointings: int, it: int, remedy: str = ""
 ):
     """Read the levelling points' heights (each the mean of ``pointings`` fusings), log them
     against the first, fit offset + common tilts φ_α, φ_ω (``cal.level_weights``) and turn the
@@ -733,7 +744,7 @@ def _level(
     op = run.op
     tol = run.sheet.tolerances["control_height_m"]
     when = active if remedy else None  # the book's loop logs every iteration as before
-    errs = [height_mean(run, p, f"{key}/level/{pid}", active, pointings) - p[2] for pid, p in rows]
+    errs = [height_mean(run, p, key.at("level", pid), active, pointings) - p[2] for pid, p in rows]
     resid = [e - errs[0] for e in errs]
     for (pid, _), r, e in zip(rows, resid, errs, strict=True):
         op.log.add(
@@ -754,27 +765,12 @@ def _level(
     phi_a = -fixed_order_sum(w[1, i] * e for i, e in enumerate(errs))
     phi_o = -fixed_order_sum(w[2, i] * e for i, e in enumerate(errs))
     for name, phi, combo in (("α", phi_a, cal.common_alpha), ("ω", phi_o, cal.common_omega)):
-        for control, rate in combo.items():
-            if control in ("by", "bz"):
-                before = op.read(control, f"{key}/{name}/{control}")
-                op.set(control, before + rate * phi, f"{key}/{name}/set{control}", active)
-                after = before + rate * phi
-            else:
-                before = op.physical(control)
-                _turn(op, control, before + rate * phi, active)
-                after = op.physical(control)
-            op.log.add(
-                "C3",
-                f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: turn {control}",
-                control,
-                before=before,
-                after=after,
-                unit=_TRANSFER_UNIT.get(control_kind(control), "—"),
-                iteration=it,
-                equation="levelling (assumption)",
-                remedy=remedy,
-                when=when,
-            )
+        fields = {"axis": name, "phi_mrad": float(np.ravel(phi)[0]) * 1e3}
+        turn_common_tilt(
+            run, combo, phi, key.at(name), active, _LEVEL_LINE, fields=fields,
+            turn=lambda c, target, on: _turn(op, c, target, on), unit_of=_transfer_unit,
+            iteration=it, remedy=remedy, when=when,
+        )  # fmt: skip
     return resid
 
 
@@ -783,7 +779,7 @@ def _level(
 def _scale_on_two_points(run, a, b, d_true: float, active, it: int) -> None:
     """C3's scale with ``sheet_on="corners"``: the two plan control points farthest apart,
     their counter distance against the ground distance/M_г, b_x in proportion. [mm]"""
-    bx, new, d_model = scale_by_two_points(run, a, b, d_true, f"C3/{it}", active)
+    bx, new, d_model = scale_by_two_points(run, a, b, d_true, C3.at(it), active)
     run.op.log.add(
         "C3",
         f"scale: fuse on {a[0]} and {b[0]}, model distance against {d_true:.3f} mm; "
@@ -840,10 +836,10 @@ def c3_absolute(
     for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
         if plotted is not None:
-            scale_on_plotted_control(run, plotted, f"C3/{it}", active, it)
+            scale_on_plotted_control(run, plotted, C3.at(it), active, it)
         else:
             _scale_on_two_points(run, (a_id, pa), (b_id, pb), d_true, active, it)
-        resid = _level(run, cal, rows, f"C3/{it}", active, 1, it)
+        resid = _level(run, cal, rows, C3.at(it), active, 1, it)
         worst = np.where(active, _worst(resid), worst)
         # every trial still iterating levels on these heights (the least-squares plane of the
         # four points, as (5.54)/(5.55) assume); those inside H/3000 (or at the bound) stop after
@@ -853,16 +849,16 @@ def c3_absolute(
         if not np.any(active):
             break
         if relative_fn is not None:
-            r_its, _ = _masked(run, active, relative_fn, cal, f"C3/{it}/ro")
+            r_its, _ = _masked(run, active, relative_fn, cal, C3.at(it, "ro"))
             ro_its = ro_its + np.where(active, r_its, 0)
     run.record_stage("C3", its)
     run.record_stage("C3/relative", ro_its)
     run.check("C3: levelling points (against the first)", worst, tol, unit="m", iterations=its)
     heights = _height_points(run, [h["id"] for h in sheet.control_heights])
     if not run.remedial:  # the book: single readings, nothing after a failed check
-        errs = _slip_and_read_heights(run, rows, heights, "C3", None, 1)
+        errs = _slip_and_read_heights(run, rows, heights, C3, None, 1)
         run.check("C3: control heights", _worst(errs) if errs else op.v(0.0), tol, unit="m")
-        seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
+        seen = judge_standard_points(run, "C3", C3.at("std"), text=_SIX_Q)
         run.check("C3: residual y-parallax (6 points)", _worst(seen), tol_q)
         return
     _c3_operator_checks(run, cal, rows, heights, relative_fn, _pointings(run))
@@ -879,26 +875,26 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
     tol = run.sheet.tolerances["control_height_m"]
     tol_q = run.sheet.tolerances["residual_y_parallax_mm"]
     name_h, name_q = "C3: control heights", "C3: residual y-parallax (6 points)"
-    errs = _slip_and_read_heights(run, rows, heights, "C3", None, 1)
+    errs = _slip_and_read_heights(run, rows, heights, C3, None, 1)
     h_worst = _worst(errs) if errs else op.v(0.0)
     h_failed = h_worst > tol
     if errs and np.any(h_failed):
         with compacted(run, h_failed) as cut:  # CR1 on the trials that failed only
             again = _slip_and_read_heights(
-                cut.run, rows, heights, "C3/CR1", cut.active, pointings, CR1
+                cut.run, rows, heights, C3.at("CR1"), cut.active, pointings, CR1
             )
         h_worst = cut.put(h_worst, _worst(again))
-    seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
+    seen = judge_standard_points(run, "C3", C3.at("std"), text=_SIX_Q)
     q_worst = _worst(seen)
     q_failed = q_worst > tol_q
     rounds = np.zeros(np.shape(q_failed), int)
     if relative_fn is not None and np.any(q_failed):
         with compacted(run, q_failed) as cut:  # CR2 on the trials that failed only
             sub, on = cut.run, cut.active
-            r_its, _ = _masked(sub, on, relative_fn, cal, "C3/CR2/ro")
-            seen = judge_standard_points(sub, "C3", "C3/CR2/std", on, text=_SIX_Q)
-            _level(sub, cal, rows, "C3/CR2", on, pointings, 1, CR2)
-            errs = _slip_and_read_heights(sub, rows, heights, "C3/CR2", on, pointings, CR2)
+            r_its, _ = _masked(sub, on, relative_fn, cal, C3.at("CR2", "ro"))
+            seen = judge_standard_points(sub, "C3", C3.at("CR2", "std"), on, text=_SIX_Q)
+            _level(sub, cal, rows, C3.at("CR2"), on, pointings, 1, CR2)
+            errs = _slip_and_read_heights(sub, rows, heights, C3.at("CR2"), on, pointings, CR2)
         rounds = cut.put(rounds, r_its)
         q_worst = cut.put(q_worst, _worst(seen))
         if errs:

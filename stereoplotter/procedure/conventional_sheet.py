@@ -16,8 +16,10 @@ from numpy.typing import NDArray
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.virtual import NOMINAL_ZERO
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.sheet_stages import (
+    PLAN_CHECK,
     check_plan_control,
     needle_against_plotted,
     sheet_needle,
@@ -44,6 +46,9 @@ __all__ = [
 #: setup sheet's corners (stage 4 of the setup-data method).
 SHEET_OPTIONS = ("control", "corners")
 
+#: The identity of C4's laying of the sheet on the plan control (the needles, the placement).
+_PLACE = NoiseKey("4").at("place")
+
 
 def plotted_control(run) -> dict[str, NDArray[np.float64]] | None:
     """The plan control points as plotted on the sheet, id → instrument coordinates (6.7)
@@ -56,26 +61,27 @@ def plotted_control(run) -> dict[str, NDArray[np.float64]] | None:
     return {pid: _plotted_mm(run, pid) for pid in ids}
 
 
-def scale_on_plotted_control(run, plotted, key: str, active, it: int) -> None:
+def scale_on_plotted_control(run, plotted, key: KeyLike, active, it: int) -> None:
     """C3's scale on the plotted plan control (``sheet_on="control"``): fuse on every plan
     control point, read X, Y, compare the spread of the counters about their centroid (RMS
     distance) with the spread of the plotted points (6.7) — the scale of the least-squares
     similarity between them — and turn b_x in proportion, O′_bx = MO_bx + b_x·ratio. [mm]"""
     op = run.op
+    key = as_key(key)
     pts = np.stack(list(plotted.values()))
     spread_plot = float(np.sqrt(((pts - pts.mean(axis=0)) ** 2).sum(axis=-1).mean()))
     xy = []
     for pid in plotted:
-        r = fuse_and_read(run, control_point_m(run, pid), f"{key}/scale/{pid}", active, ("X", "Y"))
+        r = fuse_and_read(run, control_point_m(run, pid), key.at("scale", pid), active, ("X", "Y"))
         xy.append(np.stack([r["X"], r["Y"]], axis=-1))
     xy = np.stack(xy, axis=-2)
     d = xy - xy.mean(axis=-2, keepdims=True)
     spread = np.sqrt((d**2).sum(axis=-1).mean(axis=-1))
     with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
         ratio = np.where(active, spread_plot / spread, 1.0)
-    bx = op.read("bx", f"{key}/bx")
+    bx = op.read("bx", key.at("bx"))
     new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio
-    op.set("bx", new, f"{key}/setbx", active)
+    op.set("bx", new, key.at("setbx"), active)
     op.log.add(
         "C3",
         f"scale: fuse on the {len(plotted)} plan control points, counters' spread against the "
@@ -114,12 +120,12 @@ def connect_coordinatograph(run) -> None:
     op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
 
 
-def _needles_on(run, ids, key: str) -> NDArray[np.float64]:
+def _needles_on(run, ids, key: NoiseKey) -> NDArray[np.float64]:
     """Fuse on each plan control point and put the needle down: table positions (T, n, 2)."""
     out = []
     for pid in ids:
-        fuse_and_read(run, control_point_m(run, pid), f"{key}/{pid}", None, ())
-        out.append(sheet_needle(run, f"{key}/{pid}"))
+        fuse_and_read(run, control_point_m(run, pid), key.at(pid), None, ())
+        out.append(sheet_needle(run, key.at(pid)))
     return np.stack(out, axis=-2)
 
 
@@ -141,7 +147,7 @@ def sheet_on_control(run) -> None:
     plotted = np.stack([sheet_table(run, _plotted_mm(run, pid)) for pid in ids])  # (n, 2)
     centre = plotted.mean(axis=0)
     d_plot = plotted - centre
-    needles = _needles_on(run, ids, "4/place")
+    needles = _needles_on(run, ids, _PLACE)
     n_centre = needles.mean(axis=-2)
     d_needle = needles - n_centre[..., None, :]
     cross = (d_plot[..., 0] * d_needle[..., 1] - d_plot[..., 1] * d_needle[..., 0]).sum(-1)
@@ -155,9 +161,9 @@ def sheet_on_control(run) -> None:
         axis=-1,
     )
     sigma = op.model.monocular_sigma_mm
-    e = np.stack([op.noise.normal(f"mono/4/place/{a}", sigma) for a in "xy"], axis=-1)
+    e = np.stack([op.noise.draw(_PLACE.at(a).by("mono"), sigma) for a in "xy"], axis=-1)
     spread_plot = float(np.sqrt((d_plot**2).sum(axis=-1).mean()))
-    e_turn = op.noise.normal("mono/4/place/turn", sigma) / spread_plot
+    e_turn = op.noise.draw(_PLACE.at("turn").by("mono"), sigma) / spread_plot
     angle = np.arctan2(cross, dot) + e_turn
     run.sheet_pose = SheetPose(angle, centre + place + e, n_centre)
     op.log.add(
@@ -183,7 +189,7 @@ def plan_control_check(run) -> None:
         return
     errs = []
     for pid in sheet.similarity_point_ids:
-        fuse_and_read(run, control_point_m(run, pid), f"5/plan/{pid}", None, ())
+        fuse_and_read(run, control_point_m(run, pid), PLAN_CHECK.at(pid), None, ())
         errs.append(needle_against_plotted(run, pose, pid, _plotted_mm(run, pid)))
     check_plan_control(run, errs)
     run.record_stage("5", op.v(1).astype(int))

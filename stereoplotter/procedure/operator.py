@@ -53,6 +53,7 @@ from stereoplotter.procedure.evaluation import (
     standard_points_m,
 )
 from stereoplotter.procedure.eye import EYE_MODES, LEGACY_SIGMA_MM, Eye, ObservationSystem
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.random_streams import keyed_standard_normal
 from stereoplotter.scenario.model import Camera, Photo, Point, Scenario
@@ -242,8 +243,13 @@ class Noise:
         self.trial = trial
         self.first_trial = int(first_trial)
 
+    def draw(self, key: NoiseKey, sigma: float) -> NDArray[np.float64]:
+        """σ·z for the draw of the declared identity ``key``: :meth:`normal` of its stream key
+        (:meth:`NoiseKey.stream`, the one encoding)."""
+        return self.normal(key.stream(), sigma)
+
     def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
-        """σ·z for the act ``key``: shape (T,), or () for a single run or a per-trial oracle."""
+        """σ·z for the stream ``key``: shape (T,), or () for a single run or a per-trial oracle."""
         if self.trial is not None:
             start = self.first_trial + self.trial
             stop = start + 1
@@ -479,11 +485,11 @@ class Operator:
 
     # --- reading and setting ------------------------------------------------------------------
 
-    def read(self, control: ScaleName, key: str) -> NDArray[np.float64]:
+    def read(self, control: ScaleName, key: KeyLike) -> NDArray[np.float64]:
         """Read a counter or scale: exact value + σ_read, rounded to the least count."""
         lc = self.least_count(control)
         exact = self.v(self.inst.read(control, exact=True))
-        seen = exact + self.noise.normal(f"read/{key}", self.model.reading_sigma_lc * lc)
+        seen = exact + self.noise.draw(as_key(key).by("read"), self.model.reading_sigma_lc * lc)
         if self.model.quantise:
             seen = np.round(seen / lc) * lc
         return seen
@@ -492,7 +498,7 @@ class Operator:
         self,
         control: SetControlName,
         value: ArrayLike,
-        key: str,
+        key: KeyLike,
         active: NDArray[np.bool_] | None = None,
     ) -> NDArray[np.float64]:
         """Set a computed value on a scale (σ_set); backlash and scale errors stay in."""
@@ -502,14 +508,14 @@ class Operator:
         value = self.v(value)
         if control in SCREWS or control == HEIGHT_SCALE:
             lc = self.least_count(control)
-            cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
+            cmd = value + self.noise.draw(as_key(key).by("set"), self.model.setting_sigma_lc * lc)
             prev = self.v(self.inst.read(control, exact=True))
             cmd = self._at_stop(control, cmd)
             self.inst.set(control, np.where(active, cmd, prev), side=self.model.finish_side)
         else:
             on_xy_scale = control_kind(control) in ("decentration", "principal_distance")
             lc = self.inst.spec.xy_least_count_mm if on_xy_scale else 0.0
-            cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
+            cmd = value + self.noise.draw(as_key(key).by("set"), self.model.setting_sigma_lc * lc)
             prev = self.commanded.get(control, cmd)
             cmd = np.where(active, cmd, prev)
             self.inst.set(control, cmd)
@@ -617,7 +623,7 @@ class Operator:
         self,
         side: Side,
         photo_point_mm: ArrayLike,
-        key: str,
+        key: KeyLike,
         active: NDArray[np.bool_] | None = None,
         free: str = "XY",
     ) -> NDArray[np.float64]:
@@ -628,8 +634,8 @@ class Operator:
         """
         e = np.stack(
             [
-                self.noise.normal(f"mono/{key}/x", self.model.monocular_sigma_mm),
-                self.noise.normal(f"mono/{key}/y", self.model.monocular_sigma_mm),
+                self.noise.draw(as_key(key).by("mono").at("x"), self.model.monocular_sigma_mm),
+                self.noise.draw(as_key(key).by("mono").at("y"), self.model.monocular_sigma_mm),
             ],
             axis=-1,
         )
@@ -668,17 +674,17 @@ class Operator:
         self,
         points_m: ArrayLike,
         images: tuple[NDArray, NDArray],
-        key: str,
+        key: KeyLike,
         active: NDArray[np.bool_] | None = None,
         move: bool = True,
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Stereo pointing on a ground point: clear the x-parallax (σ_p) with the floating mark
         on the point (σ_mono); return the y-parallax seen there (σ_q) and the true one. [mm]"""
         pl, pr = images
-        ex = self.noise.normal(f"mono/{key}/x", self.model.monocular_sigma_mm)
-        ey = self.noise.normal(f"mono/{key}/y", self.model.monocular_sigma_mm)
-        ep = self.noise.normal(f"stereo/{key}", self.model.stereo_sigma_mm)
-        eq = self.noise.normal(f"q/{key}", self.model.y_parallax_sigma_mm)
+        ex = self.noise.draw(as_key(key).by("mono").at("x"), self.model.monocular_sigma_mm)
+        ey = self.noise.draw(as_key(key).by("mono").at("y"), self.model.monocular_sigma_mm)
+        ep = self.noise.draw(as_key(key).by("stereo"), self.model.stereo_sigma_mm)
+        eq = self.noise.draw(as_key(key).by("q"), self.model.y_parallax_sigma_mm)
         pl, pr = np.asarray(pl, float), np.asarray(pr, float)
         # the marks at the photo points shifted by (ex, ey) on both photos and by ep in x on the
         # left: by component (the y of the left mark + 0·ep is that y, to the bit)

@@ -32,6 +32,7 @@ from stereoplotter.instrument.virtual import (
 from stereoplotter.procedure import steps
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.levelling import LevelDesign
+from stereoplotter.procedure.noise_key import NoiseKey
 from stereoplotter.procedure.operator import Operator, solve_1d
 from stereoplotter.procedure.records import (
     ControlHeight,
@@ -39,6 +40,7 @@ from stereoplotter.procedure.records import (
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.span_check import fiducial_mm, span_loop
+from stereoplotter.procedure.step_values import Line, turn_common_tilt
 from stereoplotter.setup.equations import (
     sheet_corner_instrument_coordinates,
 )
@@ -72,6 +74,9 @@ _TILT = {"alpha": "α", "omega": "ω"}
 #: tilt).
 Q_ELEMENTS = ("kappa_left", "kappa_right", "k_omega_right", "k_alpha_left", "k_alpha_right")
 
+#: The identities of the stages' draws (each act's own below its stage by its path).
+STAGE1, STAGE2, STAGE3 = NoiseKey("1"), NoiseKey("2"), NoiseKey("3")
+
 
 # --- stage 1 ---------------------------------------------------------------------------------
 
@@ -83,7 +88,7 @@ def stage1_scale_coefficient(run: Run) -> None:
     steps.interior_orientation(run, "1")
     run.zero["MO_bx"] = _bx_zero(run)
     o_bx = run.target("O_bx", run.zero["MO_bx"])
-    op.set("bx", o_bx, "1/bx")
+    op.set("bx", o_bx, STAGE1.at("bx"))
     log.add(
         "1",
         "base carriage: O_bx = MO_bx + b_x",
@@ -91,9 +96,9 @@ def stage1_scale_coefficient(run: Run) -> None:
         reading=o_bx,
         equation="item 1",
     )
-    op.set("bz", NOMINAL_ZERO["bz"], "1/bz0")
+    op.set("bz", NOMINAL_ZERO["bz"], STAGE1.at("bz0"))
     depth = run.target("O_Z")  # absolute height counter: D = n_л·f_пр
-    op.set("Z", depth, "1/Z")
+    op.set("Z", depth, STAGE1.at("Z"))
     log.add(
         "1",
         "lower the carriage to O_Z = n_л·f_пр (absolute height counter)",
@@ -103,16 +108,16 @@ def stage1_scale_coefficient(run: Run) -> None:
     )
     steps.zero_base_y(run, "1")
     o_by = run.target("O_by")
-    op.set("by", o_by, "1/by")
+    op.set("by", o_by, STAGE1.at("by"))
     log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=o_by, equation="item 1")
-    its, ok, res = span_loop(run, "1", "1/L", units_at_zero=True)
+    its, ok, res = span_loop(run, "1", STAGE1.at("L"), units_at_zero=True)
     name = "stage 1: |L − L′|"
     if run.remedial:  # R1: "otherwise the setting is repeated", with averaged pointings
         remedy = "R1 repeat the setting"
         failed = ~ok
         with compacted(run, failed) as cut:  # on the trials that failed only
             r_its, _, r_res = span_loop(
-                cut.run, "1", "1/L/R1", True, cut.active, steps.REPEAT_POINTINGS, remedy
+                cut.run, "1", STAGE1.at("L", "R1"), True, cut.active, steps.REPEAT_POINTINGS, remedy
             )
         r_its = cut.put(np.zeros_like(its), r_its)
         res = cut.put(res, r_res)
@@ -134,7 +139,7 @@ def _bx_zero(run: Run):
     if run.fidelity.bx_zero == "exact":
         return op.v(NOMINAL_ZERO["bx"])
     sigma = op.model.monocular_sigma_mm
-    e = [op.noise.normal(f"mono/1/MObx/{side}", sigma) for side in ("left", "right")]
+    e = [op.noise.draw(STAGE1.at("MObx", side).by("mono"), sigma) for side in ("left", "right")]
     zero = NOMINAL_ZERO["bx"] + run.sheet.n_left * (e[1] - e[0])
     op.log.add(
         "1",
@@ -150,9 +155,9 @@ def _bx_zero(run: Run):
 
 def _record_stage1_zeros(run: Run) -> None:
     op = run.op
-    run.zero["MO_Z"] = op.read(HEIGHT_SCALE, "1/MOZ")
-    run.zero["D_MO_Z"] = op.read("Z", "1/MOZ/D")
-    bzr = op.read("bz", "1/MObz")
+    run.zero["MO_Z"] = op.read(HEIGHT_SCALE, STAGE1.at("MOZ"))
+    run.zero["D_MO_Z"] = op.read("Z", STAGE1.at("MOZ", "D"))
+    bzr = op.read("bz", STAGE1.at("MObz"))
     run.zero["MO_bz"] = run.target("MO_bz", bzr)  # (b_z reading) ∓ b_z′ (D7)
     op.log.add(
         "1",
@@ -174,12 +179,12 @@ def _record_stage1_zeros(run: Run) -> None:
 # --- stage 2 ---------------------------------------------------------------------------------
 
 
-def _zero_readings(run: Run, key: str) -> None:
+def _zero_readings(run: Run, key: NoiseKey) -> None:
     op = run.op
     for side, names in (("left", ("MO_X", "MO_Y")), ("right", ("MO_X,п", "MO_Y,п"))):
-        e = op.mark_on(side, np.zeros(2), f"{key}/{side}")
-        run.zero[names[0]] = op.read("X", f"{key}/{side}/X")
-        run.zero[names[1]] = op.read("Y", f"{key}/{side}/Y")
+        e = op.mark_on(side, np.zeros(2), key.at(side))
+        run.zero[names[0]] = op.read("X", key.at(side, "X"))
+        run.zero[names[1]] = op.read("Y", key.at(side, "Y"))
         op.log.add(
             "2",
             f"{side} mark on the {side} cassette centre → {names[0]}",
@@ -198,7 +203,7 @@ def _zero_readings(run: Run, key: str) -> None:
         )
 
 
-def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active):
+def _fit_knob(run: Run, side: str, axis: str, mark: str, key: NoiseKey, active):
     """Set the counter to MO + n·(x⁰ or y⁰), the other handwheel onto the fiducial line, turn
     the knob until the fiducial is under the mark ((6.12) or (6.13)); the knob's tangent
     after the turn. [—]"""
@@ -212,9 +217,9 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active):
         counter, free, comp = "X", "Y", 0
         eq = "(6.13)"
     value = _fit_target(run, side, f"O_{counter}{mark},{_SIDE[side]}")
-    op.set(counter, value, f"{key}/set", active)
-    op.mark_on(side, fid, f"{key}/line", active, free=free)
-    e = op.noise.normal(f"mono/{key}/knob", op.model.monocular_sigma_mm)
+    op.set(counter, value, key.at("set"), active)
+    op.mark_on(side, fid, key.at("line"), active, free=free)
+    e = op.noise.draw(key.at("knob").by("mono"), op.model.monocular_sigma_mm)
     left_u, right_u = op.units()
     unit = left_u if side == "left" else right_u
     rod = rod_from_counters(
@@ -255,14 +260,14 @@ def _fit_target(run: Run, side: str, name: str):
     return value + reading.value * (n_true / n_sheet - 1.0)
 
 
-def _fit_omega(run: Run, side: str, key: str, active) -> None:
+def _fit_omega(run: Run, side: str, key: NoiseKey, active) -> None:
     """k_ω of ``side`` (switch ``tilts``): fitted at mark 3 ("knob_fit"), or at marks 3 and 4
     and set to the mean of the two fits ("least_squares", (6.33))."""
     t3 = _fit_knob(run, side, "omega", "3", key, active)
     if run.fidelity.tilts != "least_squares":
         return
     op = run.op
-    t4 = _fit_knob(run, side, "omega", "4", f"{key}/4", active)
+    t4 = _fit_knob(run, side, "omega", "4", key.at("4"), active)
     knob = f"k_omega_{side}"
     before = op.physical(knob)
     op.drive(knob, 0.5 * (t3 + t4), active)
@@ -277,15 +282,15 @@ def _fit_omega(run: Run, side: str, key: str, active) -> None:
     )
 
 
-def _mark4(run: Run, side: str, key: str, active) -> NDArray[np.float64]:
+def _mark4(run: Run, side: str, key: NoiseKey, active) -> NDArray[np.float64]:
     """Check mark 4 at MO_Y + n·y⁰₄ (6.12): the offset of the mark from fiducial 4 seen."""
     op = run.op
     fid = fiducial_mm(run, side, "4")
     value = run.target(f"O_Y4,{_SIDE[side]}")
-    op.set("Y", value, f"{key}/set", active)
-    op.mark_on(side, fid, f"{key}/line", active, free="X")
+    op.set("Y", value, key.at("set"), active)
+    op.mark_on(side, fid, key.at("line"), active, free="X")
     off = op.inst.mark_offsets(**{f"{side}_point_mm": fid})[side]
-    e = op.noise.normal(f"mono/{key}/seen", op.model.monocular_sigma_mm)
+    e = op.noise.draw(key.at("seen").by("mono"), op.model.monocular_sigma_mm)
     return np.abs(np.asarray(off)[..., 1]) + e
 
 
@@ -311,11 +316,11 @@ def stage2_transform(run: Run) -> None:
     run.record_stage("2", its)
     run.check("stage 2: mark 4", worst, tol4, iterations=its)
     for side, mark in (("left", "2"), ("right", "1")):
-        _fit_knob(run, side, "alpha", mark, f"2/{side}/alpha", op.all())
+        _fit_knob(run, side, "alpha", mark, STAGE2.at(side, "alpha"), op.all())
     if not op.inst.variant.decentrations_first:  # B2 set them before the k_ω fit
         _set_computed_decentrations(run)
     bz = run.target("O_bz")
-    op.set("bz", bz, "2/bz")
+    op.set("bz", bz, STAGE2.at("bz"))
     op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
     if run.fidelity.kappa == "fiducials":
         kappa_from_fiducials(run, "2")
@@ -331,9 +336,10 @@ def kappa_from_fiducials(run: Run, stage: str) -> None:
     m_κ = m_x/(√2·l·n) at counter scale. No y-parallax is judged. [rad]"""
     op = run.op
     sigma = op.model.monocular_sigma_mm
+    key = NoiseKey(stage).at("kappa")
     for side, photo in zip(("left", "right"), run.sheet.photos, strict=True):
         span = fiducial_mm(run, side, "3")[1] - fiducial_mm(run, side, "4")[1]
-        e3, e4 = (op.noise.normal(f"mono/{stage}/kappa/{side}/{m}", sigma) for m in "34")
+        e3, e4 = (op.noise.draw(key.at(side, m).by("mono"), sigma) for m in "34")
         control = f"kappa_{side}"
         before = op.physical(control)
         op.drive(control, photo.kappa + (e3 - e4) / span)
@@ -358,7 +364,7 @@ def _set_computed_decentrations(run: Run) -> None:
             control = f"{d}_{side}"
             # MO_dx, MO_dy: the decentration scale's place of zero
             value = run.target(f"d_{d[1]},{_SIDE[side]}", NOMINAL_ZERO[control])
-            op.set(control, value, f"2/{control}")
+            op.set(control, value, STAGE2.at(control))
             tilt = "α" if d == "dx" else "ω"
             op.log.add(
                 "2",
@@ -380,15 +386,15 @@ def _stage2_round(run: Run, it: int, active, tol4: float):
     op = run.op
     l_its = None
     if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
-        l_its, _, _ = span_loop(run, "2", f"2/L{it}", active=active)
+        l_its, _, _ = span_loop(run, "2", STAGE2.at(f"L{it}"), active=active)
     else:  # with the correction units still at zero the cassette centre is on the plumb
-        _zero_readings(run, "2/MO")
+        _zero_readings(run, STAGE2.at("MO"))
         if op.inst.variant.decentrations_first:  # B2: the decentrations before the fits
             _set_computed_decentrations(run)
     seen = []
     for side in ("left", "right"):
-        _fit_omega(run, side, f"2/{it}/{side}/omega", active)
-        m4 = _mark4(run, side, f"2/{it}/{side}/m4", active)
+        _fit_omega(run, side, STAGE2.at(it, side, "omega"), active)
+        m4 = _mark4(run, side, STAGE2.at(it, side, "m4"), active)
         seen.append(m4)
         op.log.add(
             "2",
@@ -445,12 +451,12 @@ def _kappa_round(run: Run, stage: str, it: int, active, pts, imgs, tol: float):
     op = run.op
     qs = []
     for idx, side in ((0, "right"), (1, "left")):
-        key = f"{stage}/kappa/{it}/{idx + 1}"
+        key = NoiseKey(stage).at("kappa", it, idx + 1)
         img = (imgs[0][idx], imgs[1][idx])
         q_seen, q_true = op.fuse(pts[idx], img, key, active)
         qs.append(q_seen)
         control = f"kappa_{side}"
-        target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+        target = op.noise.draw(key.at("clear").by("q"), op.model.y_parallax_sigma_mm)
         q_of = op.q_turning(control, img)  # q with κ turned, the rest as it is now
         ok_here = np.abs(q_seen) <= tol
         move = active & ~ok_here if it > 1 else active
@@ -484,7 +490,7 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     """The residual y-parallax at the six standard points, judged by the operator; with the
     operator's practice, remedy R2 where it exceeds ¼ mark."""
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    seen = np.stack(steps.judge_standard_points(run, stage, f"{stage}/std"), axis=-1)
+    seen = np.stack(steps.judge_standard_points(run, stage, NoiseKey(stage).at("std")), axis=-1)
     worst = np.max(np.abs(seen), axis=-1)
     name = f"stage {stage}: residual y-parallax (6 points)"
     if run.remedial:
@@ -636,7 +642,7 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
         )
     return np.stack(
         steps.judge_standard_points(
-            run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
+            run, stage, NoiseKey(stage).at("R2", it), active, remedy=remedy, iteration=it
         ),
         axis=-1,
     )
@@ -668,7 +674,7 @@ def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
         (a_id, steps.control_point_m(run, a_id)),
         (b_id, steps.control_point_m(run, b_id)),
         d_sheet,
-        f"3/R3/{it}",
+        STAGE3.at("R3", it),
         active,
     )
     op.log.add(
@@ -687,6 +693,14 @@ def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
     )
 
 
+#: R3's turn of a control by its rate × the common tilt φ.
+_LEVEL_LINE = Line(
+    "3",
+    "level: common tilt Δφ_{axis} = {phi_mrad:+.4f} mrad, turn {control}",
+    "levelling on control (assumption, q-neutral common tilt)",
+)
+
+
 def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) -> None:
     """R3 (2): fit offset + common tilts φ_α, φ_ω to the control-height errors and turn the
     q-neutral common tilts (:class:`LevelDesign`) by −φ."""
@@ -697,28 +711,12 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
         phi = np.where(
             active, -steps.fixed_order_sum(w[row, i] * e for i, e in enumerate(errs)), 0.0
         )
-        for control, rate in design.combos[name].items():
-            if control == "bz":
-                before = op.read("bz", f"3/R3/{it}/{name}/bz")
-                after = before + sense * rate * phi
-                op.set("bz", after, f"3/R3/{it}/{name}/setbz", active)
-            else:
-                before = op.physical(control)
-                op.drive(control, before + rate * phi, active)
-                after = op.physical(control)
-            op.log.add(
-                "3",
-                f"level: common tilt Δφ_{name[0]} = {_shown(op, phi) * 1e3:+.4f} mrad, "
-                f"turn {control}",
-                control,
-                before=before,
-                after=after,
-                unit=CONTROL_INFO[control].unit,
-                iteration=it,
-                equation="levelling on control (assumption, q-neutral common tilt)",
-                remedy=remedy,
-                when=active,
-            )
+        fields = {"axis": name[0], "phi_mrad": _shown(op, phi) * 1e3}
+        key = STAGE3.at("R3", it, name)
+        turn_common_tilt(
+            run, design.combos[name], phi, key, active, _LEVEL_LINE, fields=fields,
+            scale_sense=sense, iteration=it, remedy=remedy, when=active,
+        )  # fmt: skip
 
 
 def _shown(op: Operator, value) -> float:
@@ -730,7 +728,7 @@ def _shown(op: Operator, value) -> float:
 def _read_control_heights(
     run: Run,
     rows: Sequence[ControlHeight],
-    key: str,
+    key: NoiseKey,
     active,
     remedy: str,
     it: int,
@@ -741,7 +739,7 @@ def _read_control_heights(
     the errors (read − truth) of points 1 … n−1. [m]"""
     op, tol = run.op, run.sheet.tolerances["control_height_m"]
     p0 = rows[0].ground_m
-    steps.slip_height_scale_on_mean(run, p0, f"{key}/slip", active, pointings)
+    steps.slip_height_scale_on_mean(run, p0, key.at("slip"), active, pointings)
     op.log.add(
         "3",
         f"fuse on {rows[0].id} ({pointings} times), slip the height scale to H = {p0[2]:.2f} m",
@@ -758,7 +756,7 @@ def _read_control_heights(
             op,
             "3",
             f"control point {h.id}: fuse, read the height ({pointings} times, mean)",
-            steps.height_mean(run, h.ground_m, f"{key}/{h.id}", active, pointings),
+            steps.height_mean(run, h.ground_m, key.at(h.id), active, pointings),
             h.ground_m[2],
             tol,
             iteration=it,
@@ -812,9 +810,9 @@ def refine_scale_and_level(
         with compacted(run, active) as cut:  # the round on the trials still failing only
             sub, on = cut.run, cut.active
             _refine_scale(sub, it, on, remedy)
-            level = _read_control_heights(sub, rows, f"3/R3/{it}/level", on, remedy, it)
+            level = _read_control_heights(sub, rows, STAGE3.at("R3", it, "level"), on, remedy, it)
             _level(sub, design, [sub.op.v(0.0) * 0.0, *level], it, on, remedy)
-            errs = _read_control_heights(sub, rows, f"3/R3/{it}/check", on, remedy, it)
+            errs = _read_control_heights(sub, rows, STAGE3.at("R3", it, "check"), on, remedy, it)
             new = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
         worst = cut.put(worst, new)
         active = active & (worst > tol)
@@ -825,14 +823,14 @@ def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
     """Stage 3's scaling (switch ``stage3``): the mark fused on the height control point ``pid``
     by turning b_x, then ("fuse") κ cleared again (D10)."""
     op = run.op
-    op.mark_on("left", left_img, "3/left")
-    e = op.noise.normal("stereo/3/bx", op.model.stereo_sigma_mm)
+    op.mark_on("left", left_img, STAGE3.at("left"))
+    e = op.noise.draw(STAGE3.at("bx").by("stereo"), op.model.stereo_sigma_mm)
     right_map = op.unit_map("right")
     xi_r = right_map.rod_from_photo(right_img + np.stack([e, 0.0 * e], axis=-1))[..., 0]
     n_r = (op.physical("Z") + op.physical("bz")) / op.inst.setting.f_instrument_mm
-    before = op.read("bx", "3/bx/before")
+    before = op.read("bx", STAGE3.at("bx", "before"))
     op.drive("bx", op.physical("X") - n_r * xi_r)
-    after = op.read("bx", "3/bx/after")
+    after = op.read("bx", STAGE3.at("bx", "after"))
     op.log.add(
         "3",
         f"fuse the mark on point {pid} by turning b_x",
@@ -861,7 +859,7 @@ def stage3_scale_model(run: Run) -> None:
     h0 = rows[0]
     p0 = h0.ground_m
     o_z = run.target(f"O_Z{h0.id}")  # MO_Z + (6.15)
-    op.set(HEIGHT_SCALE, o_z, "3/OZ")
+    op.set(HEIGHT_SCALE, o_z, STAGE3.at("OZ"))
     op.log.add(
         "3",
         f"height scale to O_Z{h0.id} for control point {h0.id}",
@@ -873,7 +871,7 @@ def stage3_scale_model(run: Run) -> None:
     pl, pr = run.scene.images(p0[None, :])
     if run.fidelity.stage3 != "none":
         _fuse_bx(run, h0.id, pl[0], pr[0])
-    op.fuse(p0, (pl[0], pr[0]), "3/refuse")
+    op.fuse(p0, (pl[0], pr[0]), STAGE3.at("refuse"))
     op.inst.slip_height_scale(p0[2])
     op.log.add(
         "3",
@@ -887,8 +885,8 @@ def stage3_scale_model(run: Run) -> None:
     for h in rows[1:]:
         p = h.ground_m
         img = run.scene.images(p[None, :])
-        op.fuse(p, (img[0][0], img[1][0]), f"3/h/{h.id}")
-        read = op.read(HEIGHT_SCALE, f"3/h/{h.id}")
+        op.fuse(p, (img[0][0], img[1][0]), STAGE3.at("h", h.id))
+        read = op.read(HEIGHT_SCALE, STAGE3.at("h", h.id))
         text = f"control point {h.id}: fuse, read the height"
         errs.append(log_control_height(op, "3", text, read, p[2], tol))
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1) if errs else op.v(0.0)

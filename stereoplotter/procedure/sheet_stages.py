@@ -12,16 +12,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.run import Run
 from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
 __all__ = [
+    "PLAN_CHECK",
     "check_plan_control",
     "needle_against_plotted",
     "stage4_orient_sheet",
     "stage5_check",
 ]
+
+#: The identity of stage 5's check at the plotted plan control points (a point's draws below
+#: it by its id), the same in both methods.
+PLAN_CHECK = NoiseKey("5").at("plan")
 
 
 def sheet_table(run: Run, xy_mm) -> NDArray[np.float64]:
@@ -29,22 +35,23 @@ def sheet_table(run: Run, xy_mm) -> NDArray[np.float64]:
     return run.op.inst.table_position_mm(xy_mm)
 
 
-def _needle_at(run: Run, corner: str, key: str) -> NDArray[np.float64]:
+def _needle_at(run: Run, corner: str, key: NoiseKey) -> NDArray[np.float64]:
     """Counters to the sheet's readings of ``corner`` (MO_X, MO_Y + x′, y′): the needle."""
     op = run.op
-    op.set("X", run.target(f"corner {corner}: O_X"), f"{key}/X")
-    op.set("Y", run.target(f"corner {corner}: O_Y"), f"{key}/Y")
+    op.set("X", run.target(f"corner {corner}: O_X"), key.at("X"))
+    op.set("Y", run.target(f"corner {corner}: O_Y"), key.at("Y"))
     return sheet_needle(run, key)
 
 
-def sheet_needle(run: Run, key: str) -> NDArray[np.float64]:
+def sheet_needle(run: Run, key: KeyLike) -> NDArray[np.float64]:
     """The needle on the table; with the SC complex's automatic coordinatograph, its settled
     servo noise drawn from the run's keyed streams (σ_s per axis)."""
     op = run.op
     sigma = op.inst.servo_sigma_mm
     noise = None
     if sigma:
-        noise = np.stack([op.noise.normal(f"servo/{key}/{a}", sigma) for a in "xy"], axis=-1)
+        servo = as_key(key).by("servo")
+        noise = np.stack([op.noise.draw(servo.at(a), sigma) for a in "xy"], axis=-1)
     return np.asarray(op.inst.needle(op.model.finish_side, noise), float)
 
 
@@ -77,10 +84,14 @@ def stage4_orient_sheet(run: Run) -> None:
         axis=-1,
     )
     angle = op.v(0.0)
+    stage = NoiseKey("4")
     for it in (1, 2):
-        n1 = _needle_at(run, "1", f"4/{it}/c1")
+        n1 = _needle_at(run, "1", stage.at(it, "c1"))
         e = np.stack(
-            [op.noise.normal(f"mono/4/{it}/pin/{a}", op.model.monocular_sigma_mm) for a in "xy"],
+            [
+                op.noise.draw(stage.at(it, "pin", a).by("mono"), op.model.monocular_sigma_mm)
+                for a in "xy"
+            ],
             axis=-1,
         )
         pin_sheet = ideal["1"] + (place if it == 1 else 0.0) + e
@@ -92,8 +103,8 @@ def stage4_orient_sheet(run: Run) -> None:
             iteration=it,
             equation="(6.16)",
         )
-        n3 = _needle_at(run, "3", f"4/{it}/c3")
-        e3 = op.noise.normal(f"mono/4/{it}/c3", op.model.monocular_sigma_mm)
+        n3 = _needle_at(run, "3", stage.at(it, "c3"))
+        e3 = op.noise.draw(stage.at(it, "c3").by("mono"), op.model.monocular_sigma_mm)
         a_needle = np.arctan2(n3[..., 1] - n1[..., 1], n3[..., 0] - n1[..., 0])
         d = ideal["3"] - pin_sheet
         a_mark = np.arctan2(d[..., 1], d[..., 0])
@@ -118,7 +129,7 @@ def stage5_check(run: Run) -> None:
     if pose is None:
         return
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
-    n4 = _needle_at(run, "4", "5/c4")
+    n4 = _needle_at(run, "4", NoiseKey("5").at("c4"))
     mark4 = pose.table_of(sheet_table(run, corners["4"]))
     mis = np.hypot(*np.moveaxis(mark4 - n4, -1, 0))
     tol = sheet.tolerances["corner_mm"]
@@ -143,7 +154,7 @@ def stage5_check(run: Run) -> None:
             sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
         )
         img = run.scene.images(np.asarray(p.local_m, float)[None, :])
-        op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
+        op.fuse(p.local_m, (img[0][0], img[1][0]), PLAN_CHECK.at(pid))
         errs.append(needle_against_plotted(run, pose, pid, np.asarray(xy, float).reshape(2)))
     check_plan_control(run, errs)
 
@@ -151,7 +162,7 @@ def stage5_check(run: Run) -> None:
 def needle_against_plotted(run: Run, pose, pid: str, plotted_mm) -> NDArray[np.float64]:
     """Stage 5 at a plan control point the operator has fused on: the needle against the point
     plotted at ``plotted_mm`` (its instrument coordinates (6.7)), the distance logged. [mm]"""
-    needle = sheet_needle(run, f"5/plan/{pid}")
+    needle = sheet_needle(run, PLAN_CHECK.at(pid))
     plotted = pose.table_of(sheet_table(run, plotted_mm))
     err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
     run.op.log.add(

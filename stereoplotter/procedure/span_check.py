@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 
 from stereoplotter.instrument.virtual import NOMINAL_ZERO, Side
 from stereoplotter.procedure.compaction import compacted
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key, pointing
 from stereoplotter.procedure.run import Run
 from stereoplotter.setup.equations import base_z_correction, height_correction
 
@@ -25,7 +26,9 @@ def fiducial_mm(run: Run, side: str, mark: str) -> NDArray[np.float64]:
     return run.scene.fiducials_mm[side][int(mark) - 1]
 
 
-def _measure_span(run: Run, side: str, key: str, active, pointings: int = 1) -> NDArray[np.float64]:
+def _measure_span(
+    run: Run, side: str, key: NoiseKey, active, pointings: int = 1
+) -> NDArray[np.float64]:
     """L′: the mark on fiducial 3 then 4 of ``side``, Y read at each (the mean of
     ``pointings`` pointings and readings per mark, remedy R1)."""
     op = run.op
@@ -33,7 +36,7 @@ def _measure_span(run: Run, side: str, key: str, active, pointings: int = 1) -> 
     for mark in ("3", "4"):
         y = 0.0
         for j in range(pointings):
-            k = f"{key}/{side}/{mark}" + (f"/p{j}" if j else "")
+            k = key.at(side, mark, *pointing(j))
             op.mark_on(side, fiducial_mm(run, side, mark), k, active)
             y = y + op.read("Y", k)
         ys.append(y / pointings)
@@ -50,7 +53,7 @@ def _spans(run: Run, units_at_zero: bool) -> tuple[float, float]:
 def span_loop(
     run: Run,
     stage: str,
-    key: str,
+    key: KeyLike,
     units_at_zero: bool = False,
     active=None,
     pointings: int = 1,
@@ -67,7 +70,7 @@ def span_loop(
         its = np.where(active, it, its)
         with compacted(run, active) as cut:  # the trials still outside the tolerance only
             dl_s, dr_s = _span_round(
-                cut.run, stage, f"{key}/{it}", it, cut.active, (span_l, span_r),
+                cut.run, stage, as_key(key).at(it), it, cut.active, (span_l, span_r),
                 (cut.take(dl), cut.take(dr)), units_at_zero, pointings, remedy,
             )  # fmt: skip
         dl, dr = cut.put(dl, dl_s), cut.put(dr, dr_s)
@@ -80,7 +83,7 @@ def span_loop(
 
 
 def _span_round(
-    run: Run, stage: str, k: str, it: int, active, spans, diffs, units_at_zero: bool,
+    run: Run, stage: str, k: NoiseKey, it: int, active, spans, diffs, units_at_zero: bool,
     pointings: int, remedy: str,
 ) -> tuple[NDArray, NDArray]:  # fmt: skip
     """One pass of the L-check on ``active``: measure L′ of both photos, log, and correct the
@@ -131,7 +134,9 @@ def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy:
     )
 
 
-def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_mm, remedy: str):
+def _past_bottom_stop(
+    run: Run, stage: str, k: NoiseKey, it: int, active, depth, dz_mm, remedy: str
+):
     """The carriage at its bottom stop D_max (switch ``bottom_stop``,
     :mod:`~stereoplotter.procedure.fidelity`).
 
@@ -171,7 +176,7 @@ def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_m
         beyond = beyond | back
     if np.any(beyond):
         f_ratio = np.where(beyond, f_new / f_set, 1.0)
-        op.set("f_instrument", f_new, f"{k}/setf", beyond)
+        op.set("f_instrument", f_new, k.at("setf"), beyond)
         op.log.add(
             stage,
             "n = D/f_пр at the carriage's bottom stop (D_max): f′_пр = f_пр·D/(D + ΔD), "
@@ -190,7 +195,7 @@ def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_m
 
 
 def _correct_span(
-    run: Run, stage: str, k: str, it: int, active, diffs, spans, remedy: str = ""
+    run: Run, stage: str, k: NoiseKey, it: int, active, diffs, spans, remedy: str = ""
 ) -> None:
     """One correction of the L-check: ΔZ (6.9) from the left photo (or f_пр at the bottom
     stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11).
@@ -209,11 +214,11 @@ def _correct_span(
     span_l, span_r = spans
     meas_l, meas_r = span_l - dl, span_r - dr  # L′ as measured
     sense = sheet.options.bz_scale_sense
-    depth = op.read("Z", f"{k}/Z")
+    depth = op.read("Z", k.at("Z"))
     dz_m = height_correction(depth, dl, meas_l, sheet.vertical_scale_denominator)
     dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
     _, f_ratio, dz_mm = _past_bottom_stop(run, stage, k, it, active, depth, dz_mm, remedy)
-    op.set("Z", depth + dz_mm, f"{k}/setZ", active & (dz_mm != 0.0))
+    op.set("Z", depth + dz_mm, k.at("setZ"), active & (dz_mm != 0.0))
     shown = op.log.shown if np.ndim(dz_mm) else 0
     # logged where the ΔZ set is one the counter shows (not the carriage's last least count
     # down to the stop)
@@ -229,7 +234,7 @@ def _correct_span(
             remedy,
             active,
         )
-    bz = op.read("bz", f"{k}/bz")
+    bz = op.read("bz", k.at("bz"))
     # D_п as the operator knows it: D + b_z from the b_z scale's nominal place of zero; scaled
     # by f_пр/f′_пр where f_пр was changed, less the ΔZ just set (both move the right photo)
     depth_r = (depth + sense * (bz - NOMINAL_ZERO["bz"])) * f_ratio
@@ -239,7 +244,7 @@ def _correct_span(
         - (depth + dz_mm)
         - (sense * (bz - NOMINAL_ZERO["bz"]))
     )
-    op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
+    op.set("bz", bz + sense * dbz, k.at("setbz"), active)
     op.log.add(
         stage,
         "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): "

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key, pointing
 from stereoplotter.procedure.run import Run
 
 __all__ = [
@@ -47,9 +48,10 @@ def interior_orientation(run: Run, stage: str) -> None:
     decentrations at their zero places (OCR L3755–3759)."""
     op, sheet = run.op, run.sheet
     log = op.log
+    key = NoiseKey(stage)
     op.inst.gear_height_counter(sheet.vertical_scale_denominator)
     f_instrument = run.target("f_пр")
-    op.set("f_instrument", f_instrument, f"{stage}/f")
+    op.set("f_instrument", f_instrument, key.at("f"))
     log.add(
         stage,
         "set the instrument principal distance f_пр",
@@ -70,7 +72,7 @@ def interior_orientation(run: Run, stage: str) -> None:
         for axis in ("alpha", "omega"):
             op.drive(f"k_{axis}_{side}", 0.0)
         for d in ("dx", "dy"):
-            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], f"{stage}/{d}_{side}")
+            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], key.at(f"{d}_{side}"))
     log.add(
         stage,
         "correction mechanisms and decentrations to their zero places",
@@ -84,11 +86,11 @@ def zero_base_y(run: Run, stage: str) -> NDArray[np.float64]:
     the right mark is on the right cassette centre's line (σ_mono across it); recorded in
     ``run.zero``. Returns MO_by. [mm]"""
     op = run.op
-    key = f"{stage}/MOby"
-    op.mark_on("left", np.zeros(2), f"{key}/left")
+    key = NoiseKey(stage).at("MOby")
+    op.mark_on("left", np.zeros(2), key.at("left"))
     right_map = op.unit_map("right")  # kinematics.rod_from_photo with the unit's cos κ kept
     car = {c: op.physical(c) for c in ("X", "Y", "Z")}
-    e = op.noise.normal(f"mono/{key}/right", op.model.monocular_sigma_mm)
+    e = op.noise.draw(key.by("mono").at("right"), op.model.monocular_sigma_mm)
     eta = right_map.rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
     n_r = (car["Z"] + op.physical("bz")) / op.inst.setting.f_instrument_mm
     op.drive("by", car["Y"] - n_r * eta)
@@ -128,26 +130,27 @@ def scale_pair(run: Run, ties: str = "first") -> tuple[str, str]:
     return max(pairs, key=lambda ab: float(np.hypot(*(pts[ab[0]][:2] - pts[ab[1]][:2]))))
 
 
-def fuse_and_read(run: Run, p, key: str, active, read: tuple[str, ...]) -> dict[str, NDArray]:
+def fuse_and_read(run: Run, p, key: KeyLike, active, read: tuple[str, ...]) -> dict[str, NDArray]:
     """Fuse the floating mark on the ground point ``p`` [m] and read the counters ``read``."""
     op = run.op
+    key = as_key(key)
     img = run.scene.images(np.asarray(p, float)[None, :])
     op.fuse(p, (img[0][0], img[1][0]), key, active)
-    return {c: op.read(c, f"{key}/{c}") for c in read}
+    return {c: op.read(c, key.at(c)) for c in read}
 
 
-def height_mean(run: Run, p, key: str, active, pointings: int) -> NDArray[np.float64]:
+def height_mean(run: Run, p, key: KeyLike, active, pointings: int) -> NDArray[np.float64]:
     """The height scale read after ``pointings`` fusings on ``p``, averaged (the first fusing
     has the single reading's noise key, so ``pointings=1`` is the book's single reading). [m]"""
     total = None
     for j in range(pointings):
-        k = key + (f"/p{j}" if j else "")
+        k = as_key(key).at(*pointing(j))
         read = fuse_and_read(run, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
         total = read if total is None else total + read
     return total / pointings
 
 
-def slip_height_scale_on_mean(run: Run, p0, key: str, active, pointings: int) -> None:
+def slip_height_scale_on_mean(run: Run, p0, key: KeyLike, active, pointings: int) -> None:
     """Fuse on the control point ``p0`` [m] ``pointings`` times and slip the height scale so
     that the mean reading shows its known height; trials not ``active`` keep their scale."""
     op = run.op
@@ -158,28 +161,29 @@ def slip_height_scale_on_mean(run: Run, p0, key: str, active, pointings: int) ->
 
 
 def scale_by_two_points(
-    run: Run, a, b, distance_mm: float, key: str, active
+    run: Run, a, b, distance_mm: float, key: KeyLike, active
 ) -> tuple[NDArray, NDArray, NDArray]:
     """Scaling: fuse on the ground points ``a``, ``b`` [m], compare the X, Y counters' distance
     with ``distance_mm`` (the model distance the scale asks for) and turn b_x in proportion,
     O′_bx = MO_bx + b_x·ratio. Returns (b_x read before, b_x set, the counters' distance). [mm]
     """
     op = run.op
-    ra = fuse_and_read(run, a[1], f"{key}/scale/{a[0]}", active, ("X", "Y"))
-    rb = fuse_and_read(run, b[1], f"{key}/scale/{b[0]}", active, ("X", "Y"))
+    key = as_key(key)
+    ra = fuse_and_read(run, a[1], key.at("scale", a[0]), active, ("X", "Y"))
+    rb = fuse_and_read(run, b[1], key.at("scale", b[0]), active, ("X", "Y"))
     d_model = np.hypot(ra["X"] - rb["X"], ra["Y"] - rb["Y"])
     with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
         ratio = np.where(active, distance_mm / d_model, 1.0)
-    bx = op.read("bx", f"{key}/bx")
+    bx = op.read("bx", key.at("bx"))
     new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio  # MO_bx + b_x·ratio
-    op.set("bx", new, f"{key}/setbx", active)
+    op.set("bx", new, key.at("setbx"), active)
     return bx, new, d_model
 
 
 def judge_standard_points(
     run: Run,
     stage: str,
-    key: str,
+    key: KeyLike,
     active=None,
     *,
     text: str = "residual y-parallax at standard point {i}",
@@ -194,6 +198,7 @@ def judge_standard_points(
     (key ``…/again``, a new pointing and judgement) and the second look is what counts: a
     point fails only when both looks see it over."""
     op = run.op
+    key = as_key(key)
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     pts = run.scene.standard_points_m
     imgs = run.scene.standard  # the standard points' true images, computed once
@@ -201,10 +206,10 @@ def judge_standard_points(
     seen = []
     for i in range(6):
         img = (imgs[0][i], imgs[1][i])
-        q, q_true = op.fuse(pts[i], img, f"{key}/{i + 1}", active)
+        q, q_true = op.fuse(pts[i], img, key.at(i + 1), active)
         again = act & (np.abs(q) > tol) if op.model.remeasure else None
         if again is not None and np.any(again):
-            q2, _ = op.fuse(pts[i], img, f"{key}/{i + 1}/again", again)
+            q2, _ = op.fuse(pts[i], img, key.at(i + 1, "again"), again)
             q = np.where(again, q2, q)
         seen.append(q)
         op.log.add(
