@@ -40,13 +40,22 @@ from stereoplotter.procedure.records import (
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.span_check import fiducial_mm, span_loop
-from stereoplotter.procedure.step_values import Line, turn_common_tilt
+from stereoplotter.procedure.step_values import (
+    Act,
+    Line,
+    ReadStep,
+    SetStep,
+    Step,
+    perform_all,
+    turn_common_tilt,
+)
 from stereoplotter.setup.equations import (
     sheet_corner_instrument_coordinates,
 )
 
 __all__ = [
     "Q_ELEMENTS",
+    "STAGE1_STEPS",
     "check_standard_points",
     "clear_kappa",
     "kappa_from_fiducials",
@@ -81,55 +90,80 @@ STAGE1, STAGE2, STAGE3 = NoiseKey("1"), NoiseKey("2"), NoiseKey("3")
 # --- stage 1 ---------------------------------------------------------------------------------
 
 
-def stage1_scale_coefficient(run: Run) -> None:
-    """Stage 1: interior settings, base, D = n_л f_пр, the L-check loop, MO_Z and MO_bz (D7)."""
-    op, sheet = run.op, run.sheet
-    log = op.log
-    steps.interior_orientation(run, "1")
-    run.zero["MO_bx"] = _bx_zero(run)
-    o_bx = run.target("O_bx", run.zero["MO_bx"])
-    op.set("bx", o_bx, STAGE1.at("bx"))
-    log.add(
-        "1",
-        "base carriage: O_bx = MO_bx + b_x",
-        "bx",
-        reading=o_bx,
-        equation="item 1",
-    )
-    op.set("bz", NOMINAL_ZERO["bz"], STAGE1.at("bz0"))
-    depth = run.target("O_Z")  # absolute height counter: D = n_л·f_пр
-    op.set("Z", depth, STAGE1.at("Z"))
-    log.add(
-        "1",
-        "lower the carriage to O_Z = n_л·f_пр (absolute height counter)",
-        "Z",
-        reading=depth,
-        equation="(6.3)",
-    )
-    steps.zero_base_y(run, "1")
-    o_by = run.target("O_by")
-    op.set("by", o_by, STAGE1.at("by"))
-    log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=o_by, equation="item 1")
-    its, ok, res = span_loop(run, "1", STAGE1.at("L"), units_at_zero=True)
+def _stage1_l_check(run: Run, key: NoiseKey) -> None:
+    """The stage-1 L-check loop (units at zero, D5), with R1 where it ends failed (the
+    operator's practice): "otherwise the setting is repeated", with averaged pointings."""
+    its, ok, res = span_loop(run, "1", key, units_at_zero=True)
     name = "stage 1: |L − L′|"
     if run.remedial:  # R1: "otherwise the setting is repeated", with averaged pointings
         remedy = "R1 repeat the setting"
         failed = ~ok
         with compacted(run, failed) as cut:  # on the trials that failed only
             r_its, _, r_res = span_loop(
-                cut.run, "1", STAGE1.at("L", "R1"), True, cut.active, steps.REPEAT_POINTINGS, remedy
+                cut.run, "1", key.at("R1"), True, cut.active, steps.REPEAT_POINTINGS, remedy
             )
         r_its = cut.put(np.zeros_like(its), r_its)
         res = cut.put(res, r_res)
         its = its + np.where(failed, r_its, 0)
     run.record_stage("1", its)
-    run.check(name, res, sheet.tolerances["mark_span_mm"], iterations=its)
+    run.check(name, res, run.sheet.tolerances["mark_span_mm"], iterations=its)
     if run.remedial:
         run.record_remedy("R1 stage 1: repeat the setting", name, failed, r_its * failed)
-    _record_stage1_zeros(run)
 
 
-def _bx_zero(run: Run):
+def _record_bx_zero(run: Run, key: NoiseKey) -> None:
+    run.zero["MO_bx"] = _bx_zero(run, key)
+
+
+#: Stage 1 (§26, OCR L3753–3763): interior settings, base, D = n_л f_пр, the L-check loop,
+#: MO_Z and MO_bz (D7).
+STAGE1_STEPS: tuple[Step, ...] = (
+    *steps.interior_steps("1"),
+    Act("MO_bx, b_x's place of zero", STAGE1.at("MObx"), _record_bx_zero),
+    SetStep(
+        "bx",
+        lambda run: run.target("O_bx", run.zero["MO_bx"]),
+        STAGE1.at("bx"),
+        Line("1", "base carriage: O_bx = MO_bx + b_x", "item 1"),
+    ),
+    SetStep("bz", lambda run: NOMINAL_ZERO["bz"], STAGE1.at("bz0")),
+    SetStep(
+        "Z",
+        lambda run: run.target("O_Z"),  # absolute height counter: D = n_л·f_пр
+        STAGE1.at("Z"),
+        Line("1", "lower the carriage to O_Z = n_л·f_пр (absolute height counter)", "(6.3)"),
+    ),
+    Act("MO_by", STAGE1.at("MOby"), lambda run, key: steps.zero_base_y(run, "1", key)),
+    SetStep(
+        "by",
+        lambda run: run.target("O_by"),
+        STAGE1.at("by"),
+        Line("1", "base carriage: O_by = MO_by + b_y", "item 1"),
+    ),
+    Act("the L-check (6.9)–(6.11)", STAGE1.at("L"), _stage1_l_check),
+    ReadStep(
+        HEIGHT_SCALE,
+        STAGE1.at("MOZ"),
+        "MO_Z",
+        Line("1", "record MO_Z on the height scale", "stage 1"),
+    ),
+    ReadStep("Z", STAGE1.at("MOZ", "D"), "D_MO_Z"),
+    ReadStep(
+        "bz",
+        STAGE1.at("MObz"),
+        "MO_bz",
+        Line("1", "record MO_bz = (b_z reading) − b_z′", "decision D7"),
+        recorded=lambda run, reading: run.target("MO_bz", reading),  # (b_z reading) ∓ b_z′
+    ),
+)
+
+
+def stage1_scale_coefficient(run: Run) -> None:
+    """Stage 1: :data:`STAGE1_STEPS`."""
+    perform_all(run, STAGE1_STEPS)
+
+
+def _bx_zero(run: Run, key: NoiseKey):
     """MO_bx, b_x's place of zero (switch ``bx_zero``, :mod:`~stereoplotter.procedure.fidelity`):
     "two_pointings" ((6.38), m_bx = √2·m_x/n): found as MO_by is, the left mark monocularly on
     the left cassette centre, the right mark on the right one, each pointing with σ_mono along
@@ -139,41 +173,18 @@ def _bx_zero(run: Run):
     if run.fidelity.bx_zero == "exact":
         return op.v(NOMINAL_ZERO["bx"])
     sigma = op.model.monocular_sigma_mm
-    e = [op.noise.draw(STAGE1.at("MObx", side).by("mono"), sigma) for side in ("left", "right")]
+    e = [op.noise.draw(key.at(side).by("mono"), sigma) for side in ("left", "right")]
     zero = NOMINAL_ZERO["bx"] + run.sheet.n_left * (e[1] - e[0])
-    op.log.add(
-        "1",
-        "MO_bx: the left mark on the left cassette centre, the right mark on the right one "
-        "(two monocular pointings along x)",
-        "bx",
-        reading=zero,
-        judgment_error=e[1] - e[0],
-        equation="(6.38)",
-    )
+    _BX_ZERO_LINE.log(op, "bx", reading=zero, judgment_error=e[1] - e[0])
     return zero
 
 
-def _record_stage1_zeros(run: Run) -> None:
-    op = run.op
-    run.zero["MO_Z"] = op.read(HEIGHT_SCALE, STAGE1.at("MOZ"))
-    run.zero["D_MO_Z"] = op.read("Z", STAGE1.at("MOZ", "D"))
-    bzr = op.read("bz", STAGE1.at("MObz"))
-    run.zero["MO_bz"] = run.target("MO_bz", bzr)  # (b_z reading) ∓ b_z′ (D7)
-    op.log.add(
-        "1",
-        "record MO_Z on the height scale",
-        HEIGHT_SCALE,
-        reading=run.zero["MO_Z"],
-        unit="m",
-        equation="stage 1",
-    )
-    op.log.add(
-        "1",
-        "record MO_bz = (b_z reading) − b_z′",
-        "bz",
-        reading=run.zero["MO_bz"],
-        equation="decision D7",
-    )
+_BX_ZERO_LINE = Line(
+    "1",
+    "MO_bx: the left mark on the left cassette centre, the right mark on the right one "
+    "(two monocular pointings along x)",
+    "(6.38)",
+)
 
 
 # --- stage 2 ---------------------------------------------------------------------------------

@@ -3,14 +3,15 @@ noise identity and its condition, declared once; :func:`perform` is the one inte
 does the mechanics (through the operator) and writes the transcript from the declaration.
 
 A method is a sequence of steps (:data:`Step`): :class:`SetStep` sets a computed value on a
-control's scale, :class:`ReadStep` reads a scale into a zero reading of the run, :class:`Act`
-hands a step whose mechanics are a loop or a look (the L-check, a fit) to its function. Every
-step declares its :class:`~stereoplotter.procedure.noise_key.NoiseKey`, so a step inserted,
-removed or moved leaves the draws of every other step as they were. :class:`Line` is a step's
-line in the transcript (its wording a template whose fields the interpreter fills);
-:class:`Condition` marks a step taken only where its condition holds (the L-check's
-corrections, the carriage at its bottom stop, a knob at its stop), recorded with each of its
-transcript records (:attr:`~stereoplotter.procedure.transcript.Record.condition`).
+control's scale, :class:`DriveStep` turns a control while looking, :class:`ReadStep` reads a
+scale into a zero reading of the run, :class:`Note` is the line of steps done together, and
+:class:`Act` hands a step whose mechanics are a loop or a look (the L-check, a fit) to its
+function. Every step declares its :class:`~stereoplotter.procedure.noise_key.NoiseKey`, so a
+step inserted, removed or moved leaves the draws of every other step as they were.
+:class:`Line` is a step's line in the transcript (its wording a template whose fields the
+interpreter fills); :class:`Condition` marks a step taken only where its condition holds (the
+L-check's corrections, the carriage at its bottom stop, a knob at its stop), recorded with
+each of its transcript records (:attr:`~stereoplotter.procedure.transcript.Record.condition`).
 :func:`turn_common_tilt` is the one "turn each control of a combination by rate·φ and log it"
 of both methods (the setup method's levelling, the conventional method's levelling and its
 common tilt at a knob's stop).
@@ -42,7 +43,9 @@ __all__ = [
     "L_CHECK_FAILED",
     "Act",
     "Condition",
+    "DriveStep",
     "Line",
+    "Note",
     "ReadStep",
     "SetStep",
     "Step",
@@ -159,6 +162,31 @@ class SetStep:
 
 
 @dataclass(frozen=True, slots=True)
+class DriveStep:
+    """Turn a control while looking until it is physically at a value (no scale read: no
+    draw) and log the value as the reading.
+
+    Attributes
+    ----------
+    control : str
+    value : callable
+        ``value(run)``: where the control is turned to.
+    line : Line or None
+    """
+
+    control: str
+    value: Callable[[Run], ArrayLike]
+    line: Line | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Note:
+    """A line for steps done together just before it (each declared silent)."""
+
+    line: Line
+
+
+@dataclass(frozen=True, slots=True)
 class ReadStep:
     """Read a control's scale (σ_read, rounded to the least count) into the run's zero reading
     ``zero`` and log what is recorded.
@@ -206,7 +234,7 @@ class Act:
 
 
 #: A step of a method.
-Step: TypeAlias = SetStep | ReadStep | Act
+Step: TypeAlias = SetStep | DriveStep | ReadStep | Note | Act
 
 
 def perform(run: Run, step: Step) -> None:
@@ -217,6 +245,13 @@ def perform(run: Run, step: Step) -> None:
         op.set(step.control, value, step.key)  # type: ignore[arg-type]
         if step.line is not None:
             step.line.log(op, step.control, reading=value)
+    elif isinstance(step, DriveStep):
+        value = step.value(run)
+        op.drive(step.control, value)  # type: ignore[arg-type]
+        if step.line is not None:
+            step.line.log(op, step.control, reading=value)
+    elif isinstance(step, Note):
+        step.line.log(op)
     elif isinstance(step, ReadStep):
         reading = op.read(step.control, step.key)  # type: ignore[arg-type]
         value = reading if step.recorded is None else step.recorded(run, reading)

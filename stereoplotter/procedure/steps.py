@@ -14,7 +14,7 @@ Units: mm on the instrument, m on the ground (the height scale reads m).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,6 +22,15 @@ from numpy.typing import NDArray
 from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key, pointing
 from stereoplotter.procedure.run import Run
+from stereoplotter.procedure.step_values import (
+    Act,
+    DriveStep,
+    Line,
+    Note,
+    SetStep,
+    Step,
+    perform_all,
+)
 
 __all__ = [
     "REPEAT_POINTINGS",
@@ -30,6 +39,7 @@ __all__ = [
     "fuse_and_read",
     "height_mean",
     "interior_orientation",
+    "interior_steps",
     "judge_standard_points",
     "scale_by_two_points",
     "scale_pair",
@@ -42,51 +52,59 @@ __all__ = [
 REPEAT_POINTINGS = 4
 
 
-def interior_orientation(run: Run, stage: str) -> None:
-    """Interior settings common to stage 1 and the conventional method's C1: the height-counter
-    gear M_в, f_пр, the cassettes parallel to the axes, the correction mechanisms and the
-    decentrations at their zero places (OCR L3755–3759)."""
-    op, sheet = run.op, run.sheet
-    log = op.log
+def interior_steps(stage: str) -> tuple[Step, ...]:
+    """The interior settings common to stage 1 and the conventional method's C1, as steps of
+    ``stage``: the height-counter gear M_в, f_пр, the cassettes parallel to the axes, the
+    correction mechanisms and the decentrations at their zero places (OCR L3755–3759)."""
     key = NoiseKey(stage)
-    op.inst.gear_height_counter(sheet.vertical_scale_denominator)
-    f_instrument = run.target("f_пр")
-    op.set("f_instrument", f_instrument, key.at("f"))
-    log.add(
-        stage,
-        "set the instrument principal distance f_пр",
-        "f_instrument",
-        reading=f_instrument,
-        equation="item 1",
-    )
+    out: list[Step] = [
+        Act("gear the height counter to 1:M_в", key, _gear_height_counter),
+        SetStep(
+            "f_instrument",
+            lambda run: run.target("f_пр"),
+            key.at("f"),
+            Line(stage, "set the instrument principal distance f_пр", "item 1"),
+        ),
+    ]
     for side in ("left", "right"):
-        op.drive(f"kappa_{side}", 0.0)
-        log.add(
-            stage,
-            f"turn the {side} cassette: fiducial lines parallel to the axes",
-            f"kappa_{side}",
-            reading=0.0,
-            unit="rad",
-            equation="stage 1",
+        cassette = Line(
+            stage, f"turn the {side} cassette: fiducial lines parallel to the axes", "stage 1"
         )
-        for axis in ("alpha", "omega"):
-            op.drive(f"k_{axis}_{side}", 0.0)
+        out.append(DriveStep(f"kappa_{side}", _at_zero, cassette))
+        out += [DriveStep(f"k_{axis}_{side}", _at_zero) for axis in ("alpha", "omega")]
         for d in ("dx", "dy"):
-            op.set(f"{d}_{side}", NOMINAL_ZERO[f"{d}_{side}"], key.at(f"{d}_{side}"))
-    log.add(
-        stage,
-        "correction mechanisms and decentrations to their zero places",
-        "",
-        equation="stage 1",
+            control = f"{d}_{side}"
+            out.append(SetStep(control, _nominal_zero(control), key.at(control)))
+    out.append(
+        Note(Line(stage, "correction mechanisms and decentrations to their zero places", "stage 1"))
     )
+    return tuple(out)
 
 
-def zero_base_y(run: Run, stage: str) -> NDArray[np.float64]:
+def _gear_height_counter(run: Run, key: NoiseKey) -> None:
+    run.op.inst.gear_height_counter(run.sheet.vertical_scale_denominator)
+
+
+def _at_zero(run: Run) -> float:
+    return 0.0
+
+
+def _nominal_zero(control: str) -> Callable[[Run], float]:
+    """The scale reading of ``control``'s place of zero."""
+    return lambda run: NOMINAL_ZERO[control]
+
+
+def interior_orientation(run: Run, stage: str) -> None:
+    """The interior settings of :func:`interior_steps`, done."""
+    perform_all(run, interior_steps(stage))
+
+
+def zero_base_y(run: Run, stage: str, key: NoiseKey | None = None) -> NDArray[np.float64]:
     """MO_by (stage 1 and C1): the left mark on the left cassette centre, then b_y turned until
     the right mark is on the right cassette centre's line (σ_mono across it); recorded in
     ``run.zero``. Returns MO_by. [mm]"""
     op = run.op
-    key = NoiseKey(stage).at("MOby")
+    key = NoiseKey(stage).at("MOby") if key is None else key
     op.mark_on("left", np.zeros(2), key.at("left"))
     right_map = op.unit_map("right")  # kinematics.rod_from_photo with the unit's cos κ kept
     car = {c: op.physical(c) for c in ("X", "Y", "Z")}
