@@ -56,6 +56,8 @@ from stereoplotter.setup.equations import (
 __all__ = [
     "Q_ELEMENTS",
     "STAGE1_STEPS",
+    "STAGE2_STEPS",
+    "STAGE3_STEPS",
     "check_standard_points",
     "clear_kappa",
     "kappa_from_fiducials",
@@ -305,9 +307,9 @@ def _mark4(run: Run, side: str, key: NoiseKey, active) -> NDArray[np.float64]:
     return np.abs(np.asarray(off)[..., 1]) + e
 
 
-def stage2_transform(run: Run) -> None:
-    """Stage 2: zero readings, k_ω with the mark-4 check (iterated with the stage-1 L-check,
-    decision D5), k_α, computed decentrations, O_bz (6.14), κ (D8), residual y-parallax."""
+def _stage2_k_omega(run: Run, key: NoiseKey) -> None:
+    """k_ω of both photos with the mark-4 check, iterated with the stage-1 L-check (decision
+    D5) until mark 4 is within its tolerance (bounded)."""
     op, sheet = run.op, run.sheet
     tol4 = sheet.tolerances["mark_fit_mm"]
     active = op.all()
@@ -316,7 +318,7 @@ def stage2_transform(run: Run) -> None:
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
         with compacted(run, active) as cut:  # the trials whose mark 4 is still off only
-            l_its, new = _stage2_round(cut.run, it, cut.active, tol4)
+            l_its, new = _stage2_round(cut.run, key, it, cut.active, tol4)
         if it > 1:  # D5: the L-check repeated with the units set
             l_its = cut.put(np.zeros(np.shape(active), int), l_its)
             run.record_stage("1", run.stage_iterations("1") + np.where(active, l_its, 0))
@@ -326,18 +328,49 @@ def stage2_transform(run: Run) -> None:
             break
     run.record_stage("2", its)
     run.check("stage 2: mark 4", worst, tol4, iterations=its)
+
+
+def _stage2_k_alpha(run: Run, key: NoiseKey) -> None:
+    """k_α of the left photo at mark 2, of the right at mark 1 ((6.13))."""
     for side, mark in (("left", "2"), ("right", "1")):
-        _fit_knob(run, side, "alpha", mark, STAGE2.at(side, "alpha"), op.all())
-    if not op.inst.variant.decentrations_first:  # B2 set them before the k_ω fit
-        _set_computed_decentrations(run)
-    bz = run.target("O_bz")
-    op.set("bz", bz, STAGE2.at("bz"))
-    op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
+        _fit_knob(run, side, "alpha", mark, key.at(side, "alpha"), run.op.all())
+
+
+def _stage2_decentrations(run: Run, key: NoiseKey) -> None:
+    """The computed decentrations after the fits (variant B2 set them before, ``_stage2_round``)."""
+    if not run.op.inst.variant.decentrations_first:
+        _set_computed_decentrations(run, key)
+
+
+def _stage2_kappa(run: Run, key: NoiseKey) -> None:
+    """κ (switch ``kappa``): from the fiducials (6.36), or cleared at standard points 1, 2 (D8)."""
     if run.fidelity.kappa == "fiducials":
         kappa_from_fiducials(run, "2")
     else:
         clear_kappa(run, "2")
-    check_standard_points(run, "2")
+
+
+#: Stage 2 (§26, OCR L3764–3790): zero readings, k_ω with the mark-4 check (iterated with the
+#: stage-1 L-check, decision D5), k_α, computed decentrations, O_bz (6.14), κ (D8), the residual
+#: y-parallax.
+STAGE2_STEPS: tuple[Step, ...] = (
+    Act("k_ω with the mark-4 check", STAGE2, _stage2_k_omega),
+    Act("k_α", STAGE2, _stage2_k_alpha),
+    Act("computed decentrations", STAGE2, _stage2_decentrations),
+    SetStep(
+        "bz",
+        lambda run: run.target("O_bz"),
+        STAGE2.at("bz"),
+        Line("2", "O_bz = MO_bz + b_z′", "(6.14)"),
+    ),
+    Act("κ", STAGE2.at("kappa"), _stage2_kappa),
+    Act("residual y-parallax", STAGE2.at("std"), lambda run, key: check_standard_points(run, "2")),
+)
+
+
+def stage2_transform(run: Run) -> None:
+    """Stage 2: :data:`STAGE2_STEPS`."""
+    perform_all(run, STAGE2_STEPS)
 
 
 def kappa_from_fiducials(run: Run, stage: str) -> None:
@@ -366,7 +399,7 @@ def kappa_from_fiducials(run: Run, stage: str) -> None:
         )
 
 
-def _set_computed_decentrations(run: Run) -> None:
+def _set_computed_decentrations(run: Run, key: NoiseKey) -> None:
     """The computed decentrations d = MO_d + f′·tan(tilt) on the scales (stage 2): after the
     k_α, k_ω fits in the book's order, before them under variant B2 (``decentrations_first``)."""
     op = run.op
@@ -375,7 +408,7 @@ def _set_computed_decentrations(run: Run) -> None:
             control = f"{d}_{side}"
             # MO_dx, MO_dy: the decentration scale's place of zero
             value = run.target(f"d_{d[1]},{_SIDE[side]}", NOMINAL_ZERO[control])
-            op.set(control, value, STAGE2.at(control))
+            op.set(control, value, key.at(control))
             tilt = "α" if d == "dx" else "ω"
             op.log.add(
                 "2",
@@ -389,7 +422,7 @@ def _set_computed_decentrations(run: Run) -> None:
             )
 
 
-def _stage2_round(run: Run, it: int, active, tol4: float):
+def _stage2_round(run: Run, key: NoiseKey, it: int, active, tol4: float):
     """One pass of stage 2's k_ω loop on ``active``: (from the second on) the L-check again
     with the units set (D5), or the zero readings; k_ω fitted and mark 4 checked on both
     photos. Returns the L-check's iterations (None on the first pass) and the worst mark-4
@@ -397,15 +430,15 @@ def _stage2_round(run: Run, it: int, active, tol4: float):
     op = run.op
     l_its = None
     if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
-        l_its, _, _ = span_loop(run, "2", STAGE2.at(f"L{it}"), active=active)
+        l_its, _, _ = span_loop(run, "2", key.at(f"L{it}"), active=active)
     else:  # with the correction units still at zero the cassette centre is on the plumb
-        _zero_readings(run, STAGE2.at("MO"))
+        _zero_readings(run, key.at("MO"))
         if op.inst.variant.decentrations_first:  # B2: the decentrations before the fits
-            _set_computed_decentrations(run)
+            _set_computed_decentrations(run, key)
     seen = []
     for side in ("left", "right"):
-        _fit_omega(run, side, STAGE2.at(it, side, "omega"), active)
-        m4 = _mark4(run, side, STAGE2.at(it, side, "m4"), active)
+        _fit_omega(run, side, key.at(it, side, "omega"), active)
+        m4 = _mark4(run, side, key.at(it, side, "m4"), active)
         seen.append(m4)
         op.log.add(
             "2",
@@ -861,43 +894,35 @@ def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
         clear_kappa(run, "3")
 
 
-def stage3_scale_model(run: Run) -> None:
-    """Stage 3: (6.15) at a height control point, b_x until the mark fuses, slip the height
-    scale, check the other control heights (H/3000), re-check κ and the residual y-parallax."""
-    op, sheet = run.op, run.sheet
-    rows = run.heights.rows  # the sheet's height control points, prepared once per run
-    tol = sheet.tolerances["control_height_m"]
-    h0 = rows[0]
+def _stage3_fuse(run: Run, key: NoiseKey) -> None:
+    """b_x until the mark fuses on the first height control point (switch ``stage3``), the
+    mark fused there again and the height scale slipped to its height."""
+    op = run.op
+    h0 = run.heights.rows[0]
     p0 = h0.ground_m
-    o_z = run.target(f"O_Z{h0.id}")  # MO_Z + (6.15)
-    op.set(HEIGHT_SCALE, o_z, STAGE3.at("OZ"))
-    op.log.add(
-        "3",
-        f"height scale to O_Z{h0.id} for control point {h0.id}",
-        HEIGHT_SCALE,
-        reading=o_z,
-        unit="m",
-        equation="(6.15)",
-    )
     pl, pr = run.scene.images(p0[None, :])
     if run.fidelity.stage3 != "none":
         _fuse_bx(run, h0.id, pl[0], pr[0])
-    op.fuse(p0, (pl[0], pr[0]), STAGE3.at("refuse"))
+    op.fuse(p0, (pl[0], pr[0]), key.at("refuse"))
     op.inst.slip_height_scale(p0[2])
-    op.log.add(
-        "3",
-        f"slip the height scale to H = {p0[2]:.2f} m",
-        HEIGHT_SCALE,
-        reading=p0[2],
-        unit="m",
-        equation="stage 3",
-    )
+    _SLIP_LINE.log(op, HEIGHT_SCALE, {"height": p0[2]}, reading=p0[2])
+
+
+_SLIP_LINE = Line("3", "slip the height scale to H = {height:.2f} m", "stage 3")
+
+
+def _stage3_heights(run: Run, key: NoiseKey) -> None:
+    """The other control heights read against H/3000; R3 where one misses it (the operator's
+    practice)."""
+    op, sheet = run.op, run.sheet
+    rows = run.heights.rows  # the sheet's height control points, prepared once per run
+    tol = sheet.tolerances["control_height_m"]
     errs = []
     for h in rows[1:]:
         p = h.ground_m
         img = run.scene.images(p[None, :])
-        op.fuse(p, (img[0][0], img[1][0]), STAGE3.at("h", h.id))
-        read = op.read(HEIGHT_SCALE, STAGE3.at("h", h.id))
+        op.fuse(p, (img[0][0], img[1][0]), key.at(h.id))
+        read = op.read(HEIGHT_SCALE, key.at(h.id))
         text = f"control point {h.id}: fuse, read the height"
         errs.append(log_control_height(op, "3", text, read, p[2], tol))
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1) if errs else op.v(0.0)
@@ -910,7 +935,28 @@ def stage3_scale_model(run: Run) -> None:
     if remedial:
         remedy = "R3 stage 3: refine scaling and levelling on control"
         run.record_remedy(remedy, name, failed, rounds)
-    check_standard_points(run, "3")
+
+
+#: Stage 3 (§26, OCR L3791–3805): (6.15) at a height control point, b_x until the mark fuses,
+#: slip the height scale, check the other control heights (H/3000), re-check κ and the residual
+#: y-parallax.
+STAGE3_STEPS: tuple[Step, ...] = (
+    SetStep(
+        HEIGHT_SCALE,
+        lambda run: run.target(f"O_Z{run.heights.rows[0].id}"),  # MO_Z + (6.15)
+        STAGE3.at("OZ"),
+        Line("3", "height scale to O_Z{id} for control point {id}", "(6.15)"),
+        fields=lambda run: {"id": run.heights.rows[0].id},
+    ),
+    Act("fuse on the control point, slip the height scale", STAGE3, _stage3_fuse),
+    Act("control heights", STAGE3.at("h"), _stage3_heights),
+    Act("residual y-parallax", STAGE3.at("std"), lambda run, key: check_standard_points(run, "3")),
+)
+
+
+def stage3_scale_model(run: Run) -> None:
+    """Stage 3: :data:`STAGE3_STEPS`."""
+    perform_all(run, STAGE3_STEPS)
 
 
 def run_setup_method(run: Run) -> Run:

@@ -153,12 +153,15 @@ class SetStep:
         The identity of the setting's draw.
     line : Line or None
         Its line (None: set together with a step that has one).
+    fields : callable or None
+        ``fields(run)``: the values of the line's template fields.
     """
 
     control: str
     value: Callable[[Run], ArrayLike]
     key: NoiseKey
     line: Line | None = None
+    fields: Callable[[Run], Mapping[str, Any]] | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -244,7 +247,8 @@ def perform(run: Run, step: Step) -> None:
         value = step.value(run)
         op.set(step.control, value, step.key)  # type: ignore[arg-type]
         if step.line is not None:
-            step.line.log(op, step.control, reading=value)
+            fields = step.fields(run) if step.fields is not None else None
+            step.line.log(op, step.control, fields, reading=value)
     elif isinstance(step, DriveStep):
         value = step.value(run)
         op.drive(step.control, value)  # type: ignore[arg-type]
