@@ -14,11 +14,47 @@ from stereoplotter.instrument.virtual import NOMINAL_ZERO, Side
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key, pointing
 from stereoplotter.procedure.run import Run
+from stereoplotter.procedure.step_values import BOTTOM_STOP, L_CHECK_FAILED, Line
 from stereoplotter.setup.equations import base_z_correction, height_correction
 
 __all__ = ["fiducial_mm", "span_loop"]
 
 _SIDE: dict[Side, str] = {"left": "л", "right": "п"}
+
+#: The lines of the L-check, declared for stage "1" (a loop of stage 2 writes them as its own).
+#: The measurement of L′ of a photo against the sheet's L.
+MEASURE_SPAN = Line(
+    "1", "measure L′_{side} (marks 3, 4), compare with L_{side} = {span:.3f} mm", "(6.5)"
+)
+#: The correction ΔZ (6.9), where the check failed.
+DELTA_Z = Line(
+    "1",
+    "ΔZ = {dz:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
+    "(6.9), (6.11)",
+    condition=L_CHECK_FAILED,
+)
+#: The correction Δb_z (6.10), where the check failed.
+DELTA_BZ = Line(
+    "1",
+    "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): O′_bz = O_bz {sign} Δb_z",
+    "(6.10), (6.11)",
+    condition=L_CHECK_FAILED,
+)
+#: f_пр changed where the ΔZ meets the carriage's bottom stop.
+AT_BOTTOM_STOP = Line(
+    "1",
+    "n = D/f_пр at the carriage's bottom stop (D_max): f′_пр = f_пр·D/(D + ΔD), "
+    "shortened for a deeper carriage, lengthened back (to the sheet's f_пр at most) "
+    "for a shallower one",
+    "(6.3), (6.9), (6.11)",
+    condition=BOTTOM_STOP,
+)
+#: The L-check's conditional steps.
+CONDITIONAL_LINES = (DELTA_Z, DELTA_BZ, AT_BOTTOM_STOP)
+
+
+def _measure_line(stage: str, units_at_zero: bool) -> Line:
+    return MEASURE_SPAN.in_stage(stage, "(6.5), decision D5" if units_at_zero else None)
 
 
 def fiducial_mm(run: Run, side: str, mark: str) -> NDArray[np.float64]:
@@ -96,20 +132,13 @@ def _span_round(
     dl = np.where(active, span_l - meas_l, diffs[0])
     dr = np.where(active, span_r - meas_r, diffs[1])
     ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
+    line = _measure_line(stage, units_at_zero)
     for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
-        op.log.add(
-            stage,
-            f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} = {span:.3f} mm",
-            "Y",
-            reading=meas,
-            residual=d,
-            tolerance=tol,
-            passed=np.abs(d) <= tol,
-            iteration=it,
-            equation="(6.5)" if not units_at_zero else "(6.5), decision D5",
-            remedy=remedy,
-            when=active if remedy else None,
-        )
+        line.log(
+            op, "Y", {"side": _SIDE[side], "span": span},
+            reading=meas, residual=d, tolerance=tol, passed=np.abs(d) <= tol, iteration=it,
+            remedy=remedy, when=active if remedy else None,
+        )  # fmt: skip
     going = active & ~ok
     if np.any(going):
         _correct_span(run, stage, k, it, going, (dl, dr), spans, remedy)
@@ -120,18 +149,11 @@ def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy:
     """Log the ΔZ (6.9) setting; the word follows the sign: the Z counter counts the projection
     distance D, so ΔZ > 0 (a larger D) lowers the carriage and ΔZ < 0 raises it. [m, mm]"""
     direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
-    op.log.add(
-        stage,
-        f"ΔZ = {dz_shown:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
-        "Z",
-        before=depth,
-        after=depth + dz_mm,
-        reading=depth + dz_mm,
-        iteration=it,
-        equation="(6.9), (6.11)",
-        remedy=remedy,
-        when=active if remedy else None,
-    )
+    DELTA_Z.in_stage(stage).log(
+        op, "Z", {"dz": dz_shown, "direction": direction},
+        before=depth, after=depth + dz_mm, reading=depth + dz_mm, iteration=it,
+        remedy=remedy, when=active if remedy else None,
+    )  # fmt: skip
 
 
 def _past_bottom_stop(
@@ -177,20 +199,10 @@ def _past_bottom_stop(
     if np.any(beyond):
         f_ratio = np.where(beyond, f_new / f_set, 1.0)
         op.set("f_instrument", f_new, k.at("setf"), beyond)
-        op.log.add(
-            stage,
-            "n = D/f_пр at the carriage's bottom stop (D_max): f′_пр = f_пр·D/(D + ΔD), "
-            "shortened for a deeper carriage, lengthened back (to the sheet's f_пр at most) "
-            "for a shallower one",
-            "f_instrument",
-            before=f_set,
-            after=f_new,
-            reading=f_new,
-            iteration=it,
-            equation="(6.3), (6.9), (6.11)",
-            remedy=remedy,
-            when=beyond if remedy else None,
-        )
+        AT_BOTTOM_STOP.in_stage(stage).log(
+            op, "f_instrument", before=f_set, after=f_new, reading=f_new, iteration=it,
+            remedy=remedy, when=beyond if remedy else None,
+        )  # fmt: skip
     return beyond, f_ratio, rest
 
 
@@ -245,16 +257,8 @@ def _correct_span(
         - (sense * (bz - NOMINAL_ZERO["bz"]))
     )
     op.set("bz", bz + sense * dbz, k.at("setbz"), active)
-    op.log.add(
-        stage,
-        "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): "
-        "O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
-        "bz",
-        before=bz,
-        after=bz + sense * dbz,
-        reading=bz + sense * dbz,
-        iteration=it,
-        equation="(6.10), (6.11)",
-        remedy=remedy,
-        when=active if remedy else None,
-    )
+    DELTA_BZ.in_stage(stage).log(
+        op, "bz", {"sign": "+" if sense > 0 else "−"},
+        before=bz, after=bz + sense * dbz, reading=bz + sense * dbz, iteration=it,
+        remedy=remedy, when=active if remedy else None,
+    )  # fmt: skip

@@ -23,7 +23,7 @@ Units: mm on the instrument, m on the height scale, rad for the cassettes, tan f
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
@@ -115,6 +115,11 @@ class Line:
     equation: str = ""
     unit: str | None = None
     condition: Condition | None = None
+
+    def in_stage(self, stage: str, equation: str | None = None) -> Line:
+        """This line written in ``stage`` (a step both stages or methods take), ``equation``
+        where that stage's basis differs."""
+        return replace(self, stage=stage, equation=self.equation if equation is None else equation)
 
     def log(
         self,
