@@ -62,14 +62,22 @@ from stereoplotter.procedure.relative_equations import (
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
-from stereoplotter.procedure.step_values import KNOB_AT_STOP, Line, turn_common_tilt
+from stereoplotter.procedure.step_values import (
+    KNOB_AT_STOP,
+    Act,
+    Line,
+    SetStep,
+    Step,
+    perform_all,
+    turn_common_tilt,
+)
 from stereoplotter.procedure.steps import (
     REPEAT_POINTINGS,
     control_point_m,
     fixed_order_sum,
     fuse_and_read,
     height_mean,
-    interior_orientation,
+    interior_steps,
     judge_standard_points,
     scale_by_two_points,
     scale_pair,
@@ -78,6 +86,7 @@ from stereoplotter.procedure.steps import (
 )
 
 __all__ = [
+    "C1_STEPS",
     "ELEMENTS",
     "RELATIVE_OPTIONS",
     "SHEET_OPTIONS",
@@ -429,67 +438,66 @@ def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
     return moved
 
 
-def c1_interior(run) -> None:
-    """C1: interior orientation as in stage 1, without computed setup data.
+def _c1_left_zero(run, key: NoiseKey) -> None:
+    """MO_X, MO_Y: the left mark on the left cassette centre (units at zero), read."""
+    op = run.op
+    e = op.mark_on("left", np.zeros(2), key)
+    run.zero["MO_X"] = op.read("X", key.at("X"))
+    run.zero["MO_Y"] = op.read("Y", key.at("Y"))
+    _C1_MO_X.log(op, "X", reading=run.zero["MO_X"], judgment_error=e[..., 0])
+    _C1_MO_Y.log(op, "Y", reading=run.zero["MO_Y"], judgment_error=e[..., 1])
 
-    f_пр, M_в (height-counter gear) and b_x, b_y are those of the setup sheet (one instrument and
-    scenario for the comparison); cassettes parallel (κ = 0), correction knobs and decentrations
-    at their zero places, b_z′ = 0 (decision: the conventional operator does not know the
-    exterior orientation; the levelling in C3 finds b_z′), D = n_л·f_пр, MO_b_y by the right mark
-    on the right cassette centre as in stage 1, MO_X, MO_Y with the left mark on the left cassette
-    centre (units at zero).
-    """
-    op, sheet = run.op, run.sheet
-    log = op.log
-    interior_orientation(run, "C1")
-    bx, by, _ = sheet.base_mm
-    op.set("bx", NOMINAL_ZERO["bx"] + bx, C1.at("bx"))
-    log.add(
-        "C1",
-        "base carriage: b_x of the sheet",
+
+_C1_MO_X = Line("C1", "left mark on the left cassette centre → MO_X", "decision D6")
+_C1_MO_Y = Line("C1", "… and MO_Y", "decision D6")
+
+
+def _c1_base_y(run, key: NoiseKey) -> None:
+    """MO_by found as in stage 1, then b_y of the sheet set from it."""
+    op = run.op
+    mo_by = zero_base_y(run, "C1", key.at("MOby"))
+    by = mo_by + run.sheet.base_mm[1]
+    op.set("by", by, key.at("by"))
+    _C1_BY.log(op, "by", reading=by)
+
+
+_C1_BY = Line("C1", "base carriage: O_by = MO_by + b_y", "stage 1")
+
+#: C1: interior orientation as in stage 1, without computed setup data. f_пр, M_в (the
+#: height-counter gear) and b_x, b_y are those of the setup sheet (one instrument and scenario
+#: for the comparison); cassettes parallel (κ = 0), correction knobs and decentrations at their
+#: zero places, b_z′ = 0 (decision: the conventional operator does not know the exterior
+#: orientation; the levelling in C3 finds b_z′), D = n_л·f_пр, MO_b_y by the right mark on the
+#: right cassette centre as in stage 1, MO_X, MO_Y with the left mark on the left cassette
+#: centre (units at zero).
+C1_STEPS: tuple[Step, ...] = (
+    *interior_steps("C1"),
+    SetStep(
         "bx",
-        reading=NOMINAL_ZERO["bx"] + bx,
-        equation="stage 1",
-    )
-    op.set("bz", NOMINAL_ZERO["bz"], C1.at("bz"))
-    log.add(
-        "C1",
-        "b_z′ = 0 (found by the levelling, C3)",
+        lambda run: NOMINAL_ZERO["bx"] + run.sheet.base_mm[0],
+        C1.at("bx"),
+        Line("C1", "base carriage: b_x of the sheet", "stage 1"),
+    ),
+    SetStep(
         "bz",
-        reading=NOMINAL_ZERO["bz"],
-        equation="assumption",
-    )
-    depth = sheet.n_left * sheet.f_instrument_mm
-    op.set("Z", NOMINAL_ZERO["Z"] + depth, C1.at("Z"))
-    log.add(
-        "C1",
-        "lower the carriage to D = n_л·f_пр",
+        lambda run: NOMINAL_ZERO["bz"],
+        C1.at("bz"),
+        Line("C1", "b_z′ = 0 (found by the levelling, C3)", "assumption"),
+    ),
+    SetStep(
         "Z",
-        reading=NOMINAL_ZERO["Z"] + depth,
-        equation="(6.3)",
-    )
-    mo_by = zero_base_y(run, "C1")
-    op.set("by", mo_by + by, C1.at("by"))
-    log.add("C1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="stage 1")
-    e = op.mark_on("left", np.zeros(2), C1.at("MO"))
-    run.zero["MO_X"] = op.read("X", C1.at("MO", "X"))
-    run.zero["MO_Y"] = op.read("Y", C1.at("MO", "Y"))
-    log.add(
-        "C1",
-        "left mark on the left cassette centre → MO_X",
-        "X",
-        reading=run.zero["MO_X"],
-        judgment_error=e[..., 0],
-        equation="decision D6",
-    )
-    log.add(
-        "C1",
-        "… and MO_Y",
-        "Y",
-        reading=run.zero["MO_Y"],
-        judgment_error=e[..., 1],
-        equation="decision D6",
-    )
+        lambda run: NOMINAL_ZERO["Z"] + run.sheet.n_left * run.sheet.f_instrument_mm,
+        C1.at("Z"),
+        Line("C1", "lower the carriage to D = n_л·f_пр", "(6.3)"),
+    ),
+    Act("MO_by, then b_y", C1, _c1_base_y),
+    Act("MO_X, MO_Y", C1.at("MO"), _c1_left_zero),
+)
+
+
+def c1_interior(run) -> None:
+    """C1: :data:`C1_STEPS`."""
+    perform_all(run, C1_STEPS)
 
 
 def _turn(op, control: str, target, active) -> None:
