@@ -23,7 +23,6 @@ from numpy.typing import NDArray
 from stereoplotter.instrument.kinematics import rod_from_counters
 from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
 from stereoplotter.instrument.virtual import (
-    CONTROL_INFO,
     HEIGHT_SCALE,
     NOMINAL_ZERO,
     Side,
@@ -198,22 +197,14 @@ def _zero_readings(run: Run, key: NoiseKey) -> None:
         e = op.mark_on(side, np.zeros(2), key.at(side))
         run.zero[names[0]] = op.read("X", key.at(side, "X"))
         run.zero[names[1]] = op.read("Y", key.at(side, "Y"))
-        op.log.add(
-            "2",
-            f"{side} mark on the {side} cassette centre → {names[0]}",
-            "X",
-            reading=run.zero[names[0]],
-            judgment_error=e[..., 0],
-            equation="decision D6",
-        )
-        op.log.add(
-            "2",
-            f"… and {names[1]}",
-            "Y",
-            reading=run.zero[names[1]],
-            judgment_error=e[..., 1],
-            equation="decision D6",
-        )
+        fields = {"side": side, "x": names[0], "y": names[1]}
+        _ZERO_X.log(op, "X", fields, reading=run.zero[names[0]], judgment_error=e[..., 0])
+        _ZERO_Y.log(op, "Y", fields, reading=run.zero[names[1]], judgment_error=e[..., 1])
+
+
+#: Stage 2's zero readings MO_X, MO_Y (MO_X,п, MO_Y,п) of a photo.
+_ZERO_X = Line("2", "{side} mark on the {side} cassette centre → {x}", "decision D6")
+_ZERO_Y = Line("2", "… and {y}", "decision D6")
 
 
 def _fit_knob(run: Run, side: str, axis: str, mark: str, key: NoiseKey, active):
@@ -225,10 +216,8 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: NoiseKey, active):
     fid = fiducial_mm(run, side, mark)
     if axis == "omega":
         counter, free, comp = "Y", "X", 1
-        eq = "(6.12)"
     else:
         counter, free, comp = "X", "Y", 0
-        eq = "(6.13)"
     value = _fit_target(run, side, f"O_{counter}{mark},{_SIDE[side]}")
     op.set(counter, value, key.at("set"), active)
     op.mark_on(side, fid, key.at("line"), active, free=free)
@@ -243,19 +232,26 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: NoiseKey, active):
     before = op.physical(knob)
     op.drive(knob, t, active)
     coordinate = f"{counter.lower()}⁰{_SUB[mark]}"  # y⁰₃ for k_ω, x⁰₂ / x⁰₁ for k_α
-    op.log.add(
-        "2",
-        f"{side} photo: counter {counter} at {'MO_' + counter + sfx} + n·{coordinate} "
-        f"= {np.ravel(value)[0]:.2f} mm, turn {control_name(op.inst.spec.principle, knob)} "
-        f"(tan {_TILT[axis]}) until {mark_phrase(op.inst.spec.principle, mark)}",
-        knob,
-        before=before,
-        after=op.physical(knob),
-        unit="tan",
-        judgment_error=e,
-        equation=eq,
-    )
+    fields = {
+        "side": side,
+        "counter": counter,
+        "zero": "MO_" + counter + sfx,
+        "coordinate": coordinate,
+        "value": np.ravel(value)[0],
+        "knob": control_name(op.inst.spec.principle, knob),
+        "tilt": _TILT[axis],
+        "mark": mark_phrase(op.inst.spec.principle, mark),
+    }
+    _FIT_KNOB[axis].log(op, knob, fields, before=before, after=op.physical(knob), judgment_error=e)
     return op.physical(knob)
+
+
+_FIT_TEXT = (
+    "{side} photo: counter {counter} at {zero} + n·{coordinate} = {value:.2f} mm, turn {knob} "
+    "(tan {tilt}) until {mark}"
+)
+#: Stage 2's fit of a correction knob: k_ω (6.12), k_α (6.13).
+_FIT_KNOB = {"omega": Line("2", _FIT_TEXT, "(6.12)"), "alpha": Line("2", _FIT_TEXT, "(6.13)")}
 
 
 def _fit_target(run: Run, side: str, name: str):
@@ -284,15 +280,12 @@ def _fit_omega(run: Run, side: str, key: NoiseKey, active) -> None:
     knob = f"k_omega_{side}"
     before = op.physical(knob)
     op.drive(knob, 0.5 * (t3 + t4), active)
-    op.log.add(
-        "2",
-        f"{side} photo: k_ω to the mean of its fits at marks 3 and 4 (least squares)",
-        knob,
-        before=before,
-        after=op.physical(knob),
-        unit="tan",
-        equation="(6.33)",
-    )
+    _OMEGA_MEAN.log(op, knob, {"side": side}, before=before, after=op.physical(knob))
+
+
+_OMEGA_MEAN = Line(
+    "2", "{side} photo: k_ω to the mean of its fits at marks 3 and 4 (least squares)", "(6.33)"
+)
 
 
 def _mark4(run: Run, side: str, key: NoiseKey, active) -> NDArray[np.float64]:
@@ -387,16 +380,15 @@ def kappa_from_fiducials(run: Run, stage: str) -> None:
         control = f"kappa_{side}"
         before = op.physical(control)
         op.drive(control, photo.kappa + (e3 - e4) / span)
-        op.log.add(
-            stage,
-            f"κ_{_SIDE[side]} from the fiducials: marks 3 and 4 at equal x-readings",
-            control,
-            before=before,
-            after=op.physical(control),
-            unit="rad",
-            judgment_error=e3 - e4,
-            equation="(6.36)",
-        )
+        _KAPPA_FIDUCIALS.in_stage(stage).log(
+            op, control, {"side": _SIDE[side]},
+            before=before, after=op.physical(control), judgment_error=e3 - e4,
+        )  # fmt: skip
+
+
+_KAPPA_FIDUCIALS = Line(
+    "2", "κ_{side} from the fiducials: marks 3 and 4 at equal x-readings", "(6.36)"
+)
 
 
 def _set_computed_decentrations(run: Run, key: NoiseKey) -> None:
@@ -409,17 +401,26 @@ def _set_computed_decentrations(run: Run, key: NoiseKey) -> None:
             # MO_dx, MO_dy: the decentration scale's place of zero
             value = run.target(f"d_{d[1]},{_SIDE[side]}", NOMINAL_ZERO[control])
             op.set(control, value, key.at(control))
-            tilt = "α" if d == "dx" else "ω"
-            op.log.add(
-                "2",
-                f"decentration {control_name(op.inst.spec.principle, control)} "
-                f"= MO_{d} + f′·tan {tilt}_{_SIDE[side]} "
-                f"(place of zero MO_{d} = {NOMINAL_ZERO[control]:g} mm)"
-                + _table_settings(op.inst.spec.principle, d),
-                control,
-                reading=value,
-                equation=f"f′·tan {tilt} (§2.4)",
-            )
+            fields = {
+                "name": control_name(op.inst.spec.principle, control),
+                "d": d,
+                "side": _SIDE[side],
+                "zero": NOMINAL_ZERO[control],
+                "tables": _table_settings(op.inst.spec.principle, d),
+            }
+            _DECENTRATION[d].log(op, control, fields, reading=value)
+
+
+def _decentration_line(d: str, tilt: str) -> Line:
+    text = (
+        "decentration {name} = MO_{d} + f′·tan " + tilt + "_{side} "
+        "(place of zero MO_{d} = {zero:g} mm){tables}"
+    )
+    return Line("2", text, f"f′·tan {tilt} (§2.4)")
+
+
+#: Stage 2's computed decentration d_x (from α) or d_y (from ω) of a photo.
+_DECENTRATION = {"dx": _decentration_line("dx", "α"), "dy": _decentration_line("dy", "ω")}
 
 
 def _stage2_round(run: Run, key: NoiseKey, it: int, active, tol4: float):
@@ -440,17 +441,35 @@ def _stage2_round(run: Run, key: NoiseKey, it: int, active, tol4: float):
         _fit_omega(run, side, key.at(it, side, "omega"), active)
         m4 = _mark4(run, side, key.at(it, side, "m4"), active)
         seen.append(m4)
-        op.log.add(
-            "2",
-            f"{side} photo: check mark 4 at MO_Y{',п' if side == 'right' else ''} + n·y⁰₄",
-            "Y",
-            residual=m4,
-            tolerance=tol4,
-            passed=np.abs(m4) <= tol4,
-            iteration=it,
-            equation="(6.12)",
-        )
+        _MARK4.log(
+            op, "Y", {"sfx": ",п" if side == "right" else "", "side": side},
+            residual=m4, tolerance=tol4, passed=np.abs(m4) <= tol4, iteration=it,
+        )  # fmt: skip
     return l_its, np.maximum(np.abs(seen[0]), np.abs(seen[1]))
+
+
+#: Stage 2's check of mark 4 of a photo.
+_MARK4 = Line("2", "{side} photo: check mark 4 at MO_Y{sfx} + n·y⁰₄", "(6.12)")
+#: D8: the y-parallax at standard point 1 or 2 cleared with a cassette's κ.
+_CLEAR_KAPPA = Line(
+    "2", "standard point {point}: clear the y-parallax with κ_{side}", "decision D8"
+)
+#: R2: a turn of an element by the least-squares clearing of the six q.
+_R2_TURN = Line(
+    "2",
+    "turn {control} by the least-squares clearing of the six q seen",
+    "§26 stages 2, 3: κ along the initial direction; refine k_ω",
+)
+#: R3: the height scale slipped on the first control point, on the mean of several fusings.
+_R3_SLIP = Line(
+    "3",
+    "fuse on {id} ({pointings} times), slip the height scale to H = {height:.2f} m",
+    "stage 3",
+)
+#: A control height read against its known height (H/3000).
+_CONTROL_HEIGHT = Line("3", "{text}, against the point's known height {truth:.2f} m", "H/3000")
+#: Stage 3: b_x turned until the mark fuses on the height control point.
+_FUSE_BX = Line("3", "fuse the mark on point {id} by turning b_x", "stage 3")
 
 
 def _table_settings(principle: str, control: str) -> str:
@@ -507,21 +526,11 @@ def _kappa_round(run: Run, stage: str, it: int, active, pts, imgs, tol: float):
         kappa = op.physical(control)
         new = _solve_kappa(q_of, kappa, target)
         op.drive(control, new, move)
-        op.log.add(
-            stage,
-            f"standard point {idx + 1}: clear the y-parallax with κ_{_SIDE[side]}",
-            control,
-            before=kappa,
-            after=op.physical(control),
-            unit="rad",
-            residual=q_seen,
-            true=q_true,
-            judgment_error=q_seen - q_true,
-            tolerance=tol,
-            passed=ok_here,
-            iteration=it,
-            equation="decision D8",
-        )
+        _CLEAR_KAPPA.in_stage(stage).log(
+            op, control, {"point": idx + 1, "side": _SIDE[side]},
+            before=kappa, after=op.physical(control), residual=q_seen, true=q_true,
+            judgment_error=q_seen - q_true, tolerance=tol, passed=ok_here, iteration=it,
+        )  # fmt: skip
     return (np.abs(qs[0]) <= tol) & (np.abs(qs[1]) <= tol)
 
 
@@ -672,18 +681,10 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
     for j, control in enumerate(Q_ELEMENTS):
         before = op.physical(control)
         op.drive(control, before + delta[..., j], active)
-        op.log.add(
-            stage,
-            f"turn {control} by the least-squares clearing of the six q seen",
-            control,
-            before=before,
-            after=op.physical(control),
-            unit=CONTROL_INFO[control].unit,
-            iteration=it,
-            equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
-            remedy=remedy,
-            when=active,
-        )
+        _R2_TURN.in_stage(stage).log(
+            op, control, {"control": control},
+            before=before, after=op.physical(control), iteration=it, remedy=remedy, when=active,
+        )  # fmt: skip
     return np.stack(
         steps.judge_standard_points(
             run, stage, NoiseKey(stage).at("R2", it), active, remedy=remedy, iteration=it
@@ -721,20 +722,19 @@ def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
         STAGE3.at("R3", it),
         active,
     )
-    op.log.add(
-        "3",
-        f"scale: fuse on {a_id} and {b_id}, counter distance against the sheet's "
-        f"{d_sheet:.3f} mm (6.7); turn b_x in proportion",
-        "bx",
-        before=bx,
-        after=new,
-        reading=new,
-        residual=d_model - d_sheet,
-        iteration=it,
-        equation="§26 stage 3: scaling refined (b_x)",
-        remedy=remedy,
-        when=active,
-    )
+    _R3_SCALE.log(
+        op, "bx", {"a": a_id, "b": b_id, "d": d_sheet},
+        before=bx, after=new, reading=new, residual=d_model - d_sheet, iteration=it,
+        remedy=remedy, when=active,
+    )  # fmt: skip
+
+
+_R3_SCALE = Line(
+    "3",
+    "scale: fuse on {a} and {b}, counter distance against the sheet's {d:.3f} mm (6.7); "
+    "turn b_x in proportion",
+    "§26 stage 3: scaling refined (b_x)",
+)
 
 
 #: R3's turn of a control by its rate × the common tilt φ.
@@ -784,17 +784,10 @@ def _read_control_heights(
     op, tol = run.op, run.sheet.tolerances["control_height_m"]
     p0 = rows[0].ground_m
     steps.slip_height_scale_on_mean(run, p0, key.at("slip"), active, pointings)
-    op.log.add(
-        "3",
-        f"fuse on {rows[0].id} ({pointings} times), slip the height scale to H = {p0[2]:.2f} m",
-        HEIGHT_SCALE,
-        reading=p0[2],
-        unit="m",
-        iteration=it,
-        equation="stage 3",
-        remedy=remedy,
-        when=active,
-    )
+    _R3_SLIP.log(
+        op, HEIGHT_SCALE, {"id": rows[0].id, "pointings": pointings, "height": p0[2]},
+        reading=p0[2], iteration=it, remedy=remedy, when=active,
+    )  # fmt: skip
     return [
         log_control_height(
             op,
@@ -814,18 +807,11 @@ def _read_control_heights(
 def log_control_height(op, stage: str, text: str, read, truth_m: float, tol, **extra):
     """Log one control-point height read on the height scale against its truth and H/3000;
     return the error read − truth. [m]"""
-    op.log.add(
-        stage,
-        f"{text}, against the point's known height {truth_m:.2f} m",
-        HEIGHT_SCALE,
-        reading=read,
-        unit="m",
-        residual=read - truth_m,
-        tolerance=tol,
-        passed=np.abs(read - truth_m) <= tol,
-        equation="H/3000",
-        **extra,
-    )
+    _CONTROL_HEIGHT.in_stage(stage).log(
+        op, HEIGHT_SCALE, {"text": text, "truth": truth_m},
+        reading=read, residual=read - truth_m, tolerance=tol,
+        passed=np.abs(read - truth_m) <= tol, **extra,
+    )  # fmt: skip
     return read - truth_m
 
 
@@ -875,16 +861,7 @@ def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
     before = op.read("bx", STAGE3.at("bx", "before"))
     op.drive("bx", op.physical("X") - n_r * xi_r)
     after = op.read("bx", STAGE3.at("bx", "after"))
-    op.log.add(
-        "3",
-        f"fuse the mark on point {pid} by turning b_x",
-        "bx",
-        before=before,
-        after=after,
-        reading=after,
-        judgment_error=e,
-        equation="stage 3",
-    )
+    _FUSE_BX.log(op, "bx", {"id": pid}, before=before, after=after, reading=after, judgment_error=e)
     # Decision D10 (docs/procedure.md): the b_x change moves the rods' meeting depth and with it
     # q where η_л ≠ η_п, so κ is cleared again (D8) *before* the heights are read: they are then
     # read on the model that is kept. Read before it (pair80: b_x 57.6 mm, κ absorbing f·ω/b),
