@@ -41,7 +41,6 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.virtual import (
-    CONTROL_INFO,
     HEIGHT_SCALE,
     NOMINAL_ZERO,
     control_axis,
@@ -142,6 +141,37 @@ _TRANSFER_LINE = Line(
     "the pair; turn {control}",
     "common tilt (q-neutral)",
     condition=KNOB_AT_STOP,
+)
+#: C2's stopping rule after a pass's six looks.
+_C2_STOP = Line("C2", "pass {pass}: RMS of the six looks {rms_um:.1f} µm — {what}", "stopping rule")
+#: C2 (a): a standard point's y-parallax cleared with the control of its element.
+_CLEAR_ELEMENT = Line(
+    "C2", "standard point {point}: clear the y-parallax with {control} ({element})", "(5.10)"
+)
+#: … with ω′₂, over-corrected by ½(f′²/c² − 1).
+_CLEAR_OVERCORRECTED = Line(
+    "C2",
+    "standard point {point}: clear the y-parallax with {control} ({element}) and over-correct "
+    "by {over:+.4f} of the turn",
+    "(5.10), ½(f²/c² − 1)",
+)
+#: C2 (b): a control turned by the element (5.11) gives.
+_TURN_BY_511 = Line(
+    "C2", "{element} = {mrad:+.4f} mrad (5.11): turn {control} by −m·{element}", "(5.11)"
+)
+#: C3: the height scale slipped on the first levelling point.
+_C3_SLIP = Line("C3", "fuse on {id}{times}, slip the height scale to H = {height:.2f} m", "stage 3")
+#: C3: a control height read against its known height.
+_C3_HEIGHT = Line("C3", "control point {id}: fuse, read the height{times}", "H/3000")
+#: C3: a levelling point's height error against the first.
+_C3_LEVEL_POINT = Line(
+    "C3", "level: control point {id}, height error against point {first}", "H/3000"
+)
+#: C3 (``sheet_on="corners"``): the scale on two points' ground distance.
+_C3_SCALE = Line(
+    "C3",
+    "scale: fuse on {a} and {b}, model distance against {d:.3f} mm; turn b_x in proportion",
+    "scale by b_x",
 )
 #: C3's levelling turn of a control by its rate × the common tilt φ.
 _LEVEL_LINE = Line(
@@ -392,13 +422,8 @@ def _c2_stop(run, stage: str, it: int, seen, prev_rms, active):
         what = f"ratio {r0:.2f} ≤ {DECREASE_RATIO}: still decreasing"
     if bound and not bool(np.ravel(done)[0]):
         what += f"; bound of {it} passes reached, stop"
-    op.log.add(
-        stage,
-        f"pass {it}: RMS of the six looks {q0:.1f} µm — {what}",
-        "",
-        residual=rms,
-        iteration=it,
-        equation="stopping rule",
+    _C2_STOP.in_stage(stage).log(
+        op, "", {"pass": it, "rms_um": q0, "what": what}, residual=rms, iteration=it
     )
     return rms, done & active
 
@@ -578,27 +603,17 @@ def _c2_pass(run, stage: str, key0: NoiseKey, it: int, active, prev_rms, over: f
         target = op.noise.draw(key.at("clear").by("q"), op.model.y_parallax_sigma_mm)
         before = op.physical(control)
         clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
-        extra = ""
+        line = _CLEAR_ELEMENT
         if element == "omega2":
             clear = before + (1.0 + over) * (clear - before)
-            extra = f" and over-correct by {over:+.4f} of the turn"
+            line = _CLEAR_OVERCORRECTED
         _turn(op, control, clear, active)
-        op.log.add(
-            stage,
-            f"standard point {idx + 1}: clear the y-parallax with {control} "
-            f"({_BOOK[element]}){extra}",
-            control,
-            before=before,
-            after=op.physical(control),
-            unit=CONTROL_INFO[control].unit,
-            judgment_error=target,
-            residual=q_seen,
-            true=q_true,
-            tolerance=tol,
-            passed=np.abs(q_seen) <= tol,
-            iteration=it,
-            equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
-        )
+        line.in_stage(stage).log(
+            op, control,
+            {"point": idx + 1, "control": control, "element": _BOOK[element], "over": over},
+            before=before, after=op.physical(control), judgment_error=target, residual=q_seen,
+            true=q_true, tolerance=tol, passed=np.abs(q_seen) <= tol, iteration=it,
+        )  # fmt: skip
     seen = judge_standard_points(
         run, stage, key0.at("a", it, "check"), active, iteration=it, text=_SIX_Q
     )
@@ -651,16 +666,13 @@ def c2_relative_by_equations(
         for element, control in ELEMENTS.items():
             before = op.physical(control)
             _turn(op, control, before - cal.mapping[element] * el[element], active)
-            op.log.add(
-                stage,
-                f"{_BOOK[element]} = {float(np.ravel(el[element])[0]) * 1e3:+.4f} mrad (5.11): "
-                f"turn {control} by −m·{_BOOK[element]}",
-                control,
-                before=before,
-                after=op.physical(control),
-                unit=CONTROL_INFO[control].unit,
-                iteration=it,
-                equation="(5.11)",
+            fields = {
+                "element": _BOOK[element],
+                "mrad": float(np.ravel(el[element])[0]) * 1e3,
+                "control": control,
+            }
+            _TURN_BY_511.in_stage(stage).log(
+                op, control, fields, before=before, after=op.physical(control), iteration=it
             )
         moved = _transfer_common_tilt(run, cal, active, stage, it)
         prev_rms = np.where(moved, np.nan, prev_rms)
@@ -711,35 +723,21 @@ def _slip_and_read_heights(
     else:
         slip_height_scale_on_mean(run, p0, key.at("slip", pid0), active, pointings)
     times = f" ({pointings} times, mean)" if pointings > 1 else ""
-    op.log.add(
-        "C3",
-        f"fuse on {pid0}{times}, slip the height scale to H = {p0[2]:.2f} m",
-        HEIGHT_SCALE,
-        reading=p0[2],
-        unit="m",
-        equation="stage 3",
-        remedy=remedy,
-        when=active,
-    )
+    _C3_SLIP.log(
+        op, HEIGHT_SCALE, {"id": pid0, "times": times, "height": p0[2]},
+        reading=p0[2], remedy=remedy, when=active,
+    )  # fmt: skip
     errs = []
     for pid, p in heights:
         if pid == pid0:
             continue
         read = height_mean(run, p, key.at("h", pid), active, pointings)
         errs.append(read - p[2])
-        op.log.add(
-            "C3",
-            f"control point {pid}: fuse, read the height{times}",
-            HEIGHT_SCALE,
-            reading=read,
-            unit="m",
-            residual=read - p[2],
-            tolerance=tol,
-            passed=np.abs(read - p[2]) <= tol,
-            equation="H/3000",
-            remedy=remedy,
-            when=active,
-        )
+        _C3_HEIGHT.log(
+            op, HEIGHT_SCALE, {"id": pid, "times": times},
+            reading=read, residual=read - p[2], tolerance=tol, passed=np.abs(read - p[2]) <= tol,
+            remedy=remedy, when=active,
+        )  # fmt: skip
     return errs
 
 
@@ -755,20 +753,11 @@ def _level(
     errs = [height_mean(run, p, key.at("level", pid), active, pointings) - p[2] for pid, p in rows]
     resid = [e - errs[0] for e in errs]
     for (pid, _), r, e in zip(rows, resid, errs, strict=True):
-        op.log.add(
-            "C3",
-            f"level: control point {pid}, height error against point {rows[0][0]}",
-            HEIGHT_SCALE,
-            reading=e,
-            unit="m",
-            residual=r,
-            tolerance=tol,
-            passed=np.abs(r) <= tol,
-            iteration=it,
-            equation="H/3000",
-            remedy=remedy,
-            when=when,
-        )
+        _C3_LEVEL_POINT.log(
+            op, HEIGHT_SCALE, {"id": pid, "first": rows[0][0]},
+            reading=e, residual=r, tolerance=tol, passed=np.abs(r) <= tol, iteration=it,
+            remedy=remedy, when=when,
+        )  # fmt: skip
     w = cal.level_weights
     phi_a = -fixed_order_sum(w[1, i] * e for i, e in enumerate(errs))
     phi_o = -fixed_order_sum(w[2, i] * e for i, e in enumerate(errs))
@@ -788,18 +777,10 @@ def _scale_on_two_points(run, a, b, d_true: float, active, it: int) -> None:
     """C3's scale with ``sheet_on="corners"``: the two plan control points farthest apart,
     their counter distance against the ground distance/M_г, b_x in proportion. [mm]"""
     bx, new, d_model = scale_by_two_points(run, a, b, d_true, C3.at(it), active)
-    run.op.log.add(
-        "C3",
-        f"scale: fuse on {a[0]} and {b[0]}, model distance against {d_true:.3f} mm; "
-        "turn b_x in proportion",
-        "bx",
-        before=bx,
-        after=new,
-        reading=new,
-        residual=d_model - d_true,
-        iteration=it,
-        equation="scale by b_x",
-    )
+    _C3_SCALE.log(
+        run.op, "bx", {"a": a[0], "b": b[0], "d": d_true},
+        before=bx, after=new, reading=new, residual=d_model - d_true, iteration=it,
+    )  # fmt: skip
 
 
 def c3_absolute(

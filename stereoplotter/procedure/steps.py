@@ -99,6 +99,10 @@ def interior_orientation(run: Run, stage: str) -> None:
     perform_all(run, interior_steps(stage))
 
 
+#: MO_by found by turning b_y (stage 1, C1).
+_MO_BY = Line("1", "MO_by: right mark on the right cassette centre (by turning b_y)", "stage 1")
+
+
 def zero_base_y(run: Run, stage: str, key: NoiseKey | None = None) -> NDArray[np.float64]:
     """MO_by (stage 1 and C1): the left mark on the left cassette centre, then b_y turned until
     the right mark is on the right cassette centre's line (σ_mono across it); recorded in
@@ -114,14 +118,7 @@ def zero_base_y(run: Run, stage: str, key: NoiseKey | None = None) -> NDArray[np
     op.drive("by", car["Y"] - n_r * eta)
     mo_by = op.read("by", key)
     run.zero["MO_by"] = mo_by
-    op.log.add(
-        stage,
-        "MO_by: right mark on the right cassette centre (by turning b_y)",
-        "by",
-        reading=mo_by,
-        judgment_error=e,
-        equation="stage 1",
-    )
+    _MO_BY.in_stage(stage).log(op, "by", reading=mo_by, judgment_error=e)
     return mo_by
 
 
@@ -221,6 +218,7 @@ def judge_standard_points(
     pts = run.scene.standard_points_m
     imgs = run.scene.standard  # the standard points' true images, computed once
     act = op.all() if active is None else op.v(active).astype(bool)
+    line = Line(stage, text, "≤ ¼ mark")
     seen = []
     for i in range(6):
         img = (imgs[0][i], imgs[1][i])
@@ -230,20 +228,12 @@ def judge_standard_points(
             q2, _ = op.fuse(pts[i], img, key.at(i + 1, "again"), again)
             q = np.where(again, q2, q)
         seen.append(q)
-        op.log.add(
-            stage,
-            text.format(i=i + 1),
-            "",
-            residual=q,
-            true=q_true,
-            judgment_error=q - q_true,
-            tolerance=tol,
-            passed=np.abs(q) <= tol,
-            iteration=iteration,
-            equation="≤ ¼ mark",
-            remedy=remedy,
+        line.log(
+            op, "", {"i": i + 1},
+            residual=q, true=q_true, judgment_error=q - q_true, tolerance=tol,
+            passed=np.abs(q) <= tol, iteration=iteration, remedy=remedy,
             when=active if remedy else None,
-        )
+        )  # fmt: skip
     return seen
 
 
