@@ -27,6 +27,7 @@ from stereoplotter.procedure.sheet_stages import (
     stage4_orient_sheet,
     stage5_check,
 )
+from stereoplotter.procedure.step_values import Line
 from stereoplotter.procedure.steps import control_point_m, fuse_and_read
 from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
@@ -48,6 +49,22 @@ SHEET_OPTIONS = ("control", "corners")
 
 #: The identity of C4's laying of the sheet on the plan control (the needles, the placement).
 _PLACE = NoiseKey("4").at("place")
+
+
+#: C3: the model scaled on the plotted plan control.
+_SCALE_ON_PLOTTED = Line(
+    "C3",
+    "scale: fuse on the {n} plan control points, counters' spread against the plotted points' "
+    "{spread:.3f} mm; turn b_x in proportion",
+    "conventional method: the model to the scale of the plotted control",
+)
+#: C4: the sheet laid on the plan control's needle positions.
+_LAY_SHEET = Line(
+    "4",
+    "lay the sheet on the needle positions of the plan control points (least squares: "
+    "centroid on centroid, turned onto them)",
+    "conventional method: the sheet on the plotted control",
+)
 
 
 def plotted_control(run) -> dict[str, NDArray[np.float64]] | None:
@@ -82,18 +99,10 @@ def scale_on_plotted_control(run, plotted, key: KeyLike, active, it: int) -> Non
     bx = op.read("bx", key.at("bx"))
     new = NOMINAL_ZERO["bx"] + (bx - NOMINAL_ZERO["bx"]) * ratio
     op.set("bx", new, key.at("setbx"), active)
-    op.log.add(
-        "C3",
-        f"scale: fuse on the {len(plotted)} plan control points, counters' spread against the "
-        f"plotted points' {spread_plot:.3f} mm; turn b_x in proportion",
-        "bx",
-        before=bx,
-        after=new,
-        reading=new,
-        residual=spread - spread_plot,
-        iteration=it,
-        equation="conventional method: the model to the scale of the plotted control",
-    )
+    _SCALE_ON_PLOTTED.log(
+        op, "bx", {"n": len(plotted), "spread": spread_plot},
+        before=bx, after=new, reading=new, residual=spread - spread_plot, iteration=it,
+    )  # fmt: skip
 
 
 def _plotted_mm(run, pid: str) -> NDArray[np.float64]:
@@ -166,14 +175,7 @@ def sheet_on_control(run) -> None:
     e_turn = op.noise.draw(_PLACE.at("turn").by("mono"), sigma) / spread_plot
     angle = np.arctan2(cross, dot) + e_turn
     run.sheet_pose = SheetPose(angle, centre + place + e, n_centre)
-    op.log.add(
-        "4",
-        "lay the sheet on the needle positions of the plan control points (least squares: "
-        "centroid on centroid, turned onto them)",
-        "",
-        reading=None,
-        equation="conventional method: the sheet on the plotted control",
-    )
+    _LAY_SHEET.log(op)
     run.record_stage("4", op.v(2).astype(int))
 
 

@@ -15,6 +15,7 @@ from stereoplotter.constants import MM_PER_M
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.run import Run
+from stereoplotter.procedure.step_values import Line
 from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
 __all__ = [
@@ -28,6 +29,24 @@ __all__ = [
 #: The identity of stage 5's check at the plotted plan control points (a point's draws below
 #: it by its id), the same in both methods.
 PLAN_CHECK = NoiseKey("5").at("plan")
+
+
+#: Stage 4: corner 1 under the needle (6.16).
+_PIN_CORNER1 = Line(
+    "4", "counters to corner 1, pin the sheet's corner 1 under the needle", "(6.16)"
+)
+#: Stage 4: the sheet turned about corner 1 until the needle meets corner 3 (6.17).
+_TURN_TO_CORNER3 = Line(
+    "4",
+    "counters to corner 3, rotate the sheet about corner 1 until the needle meets corner 3",
+    "(6.17)",
+)
+#: Stage 5: corner 4's misclosure (6.18).
+_CORNER4 = Line("5", "counters to corner 4: misclosure of needle and corner 4", "(6.18)")
+#: Stage 5: a plan control point, the needle against the plotted point.
+_PLAN_POINT = Line(
+    "5", "plan control point {id}: fuse, needle against the plotted point", "stage 5"
+)
 
 
 def sheet_table(run: Run, xy_mm) -> NDArray[np.float64]:
@@ -95,29 +114,14 @@ def stage4_orient_sheet(run: Run) -> None:
             axis=-1,
         )
         pin_sheet = ideal["1"] + (place if it == 1 else 0.0) + e
-        op.log.add(
-            "4",
-            "counters to corner 1, pin the sheet's corner 1 under the needle",
-            "X",
-            reading=run.target("corner 1: O_X"),
-            iteration=it,
-            equation="(6.16)",
-        )
+        _PIN_CORNER1.log(op, "X", reading=run.target("corner 1: O_X"), iteration=it)
         n3 = _needle_at(run, "3", stage.at(it, "c3"))
         e3 = op.noise.draw(stage.at(it, "c3").by("mono"), op.model.monocular_sigma_mm)
         a_needle = np.arctan2(n3[..., 1] - n1[..., 1], n3[..., 0] - n1[..., 0])
         d = ideal["3"] - pin_sheet
         a_mark = np.arctan2(d[..., 1], d[..., 0])
         angle = a_needle - a_mark + e3 / np.hypot(d[..., 0], d[..., 1])
-        op.log.add(
-            "4",
-            "counters to corner 3, rotate the sheet about corner 1 until the needle meets corner 3",
-            "",
-            reading=None,
-            judgment_error=e3,
-            iteration=it,
-            equation="(6.17)",
-        )
+        _TURN_TO_CORNER3.log(op, judgment_error=e3, iteration=it)
     run.sheet_pose = SheetPose(angle, pin_sheet, n1)
     run.record_stage("4", op.v(2).astype(int))
 
@@ -133,15 +137,7 @@ def stage5_check(run: Run) -> None:
     mark4 = pose.table_of(sheet_table(run, corners["4"]))
     mis = np.hypot(*np.moveaxis(mark4 - n4, -1, 0))
     tol = sheet.tolerances["corner_mm"]
-    op.log.add(
-        "5",
-        "counters to corner 4: misclosure of needle and corner 4",
-        "",
-        residual=mis,
-        tolerance=tol,
-        passed=mis <= tol,
-        equation="(6.18)",
-    )
+    _CORNER4.log(op, residual=mis, tolerance=tol, passed=mis <= tol)
     run.check("stage 5: corner 4", mis, tol)
     run.record_stage("5", op.v(1).astype(int))
     # plotted plan control points: fuse on the point, compare the needle with the plotted point
@@ -165,13 +161,7 @@ def needle_against_plotted(run: Run, pose, pid: str, plotted_mm) -> NDArray[np.f
     needle = sheet_needle(run, PLAN_CHECK.at(pid))
     plotted = pose.table_of(sheet_table(run, plotted_mm))
     err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
-    run.op.log.add(
-        "5",
-        f"plan control point {pid}: fuse, needle against the plotted point",
-        "",
-        residual=err,
-        equation="stage 5",
-    )
+    _PLAN_POINT.log(run.op, "", {"id": pid}, residual=err)
     return err
 
 
