@@ -9,6 +9,7 @@ their SK-42 coordinates by the sheet's similarity. Units: mm (model, table, shee
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,12 +17,15 @@ from numpy.typing import NDArray
 from stereoplotter.constants import MM_PER_M
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.virtual import NOMINAL_ZERO
+from stereoplotter.procedure.arrays import Mask
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.records import SheetPose
+from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.sheet_stages import (
     PLAN_CHECK,
     check_plan_control,
     needle_against_plotted,
+    plotted_mm,
     sheet_needle,
     sheet_table,
     stage4_orient_sheet,
@@ -29,7 +33,6 @@ from stereoplotter.procedure.sheet_stages import (
 )
 from stereoplotter.procedure.step_values import Line
 from stereoplotter.procedure.steps import control_point_m, fuse_and_read
-from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
 __all__ = [
     "SHEET_OPTIONS",
@@ -67,7 +70,7 @@ _LAY_SHEET = Line(
 )
 
 
-def plotted_control(run) -> dict[str, NDArray[np.float64]] | None:
+def plotted_control(run: Run) -> dict[str, NDArray[np.float64]] | None:
     """The plan control points as plotted on the sheet, id → instrument coordinates (6.7)
     [mm]; None where the sheet has fewer than two (then C3 scales on two points' ground
     distance)."""
@@ -75,10 +78,12 @@ def plotted_control(run) -> dict[str, NDArray[np.float64]] | None:
     ids = tuple(sheet.similarity_point_ids)
     if sheet.similarity is None or len(ids) < 2:
         return None
-    return {pid: _plotted_mm(run, pid) for pid in ids}
+    return {pid: plotted_mm(run, pid) for pid in ids}
 
 
-def scale_on_plotted_control(run, plotted, key: KeyLike, active, it: int) -> None:
+def scale_on_plotted_control(
+    run: Run, plotted: dict[str, NDArray[np.float64]], key: KeyLike, active: Mask, it: int
+) -> None:
     """C3's scale on the plotted plan control (``sheet_on="control"``): fuse on every plan
     control point, read X, Y, compare the spread of the counters about their centroid (RMS
     distance) with the spread of the plotted points (6.7) — the scale of the least-squares
@@ -87,11 +92,11 @@ def scale_on_plotted_control(run, plotted, key: KeyLike, active, it: int) -> Non
     key = as_key(key)
     pts = np.stack(list(plotted.values()))
     spread_plot = float(np.sqrt(((pts - pts.mean(axis=0)) ** 2).sum(axis=-1).mean()))
-    xy = []
+    points = []
     for pid in plotted:
         r = fuse_and_read(run, control_point_m(run, pid), key.at("scale", pid), active, ("X", "Y"))
-        xy.append(np.stack([r["X"], r["Y"]], axis=-1))
-    xy = np.stack(xy, axis=-2)
+        points.append(np.stack([r["X"], r["Y"]], axis=-1))
+    xy = np.stack(points, axis=-2)
     d = xy - xy.mean(axis=-2, keepdims=True)
     spread = np.sqrt((d**2).sum(axis=-1).mean(axis=-1))
     with np.errstate(divide="ignore", invalid="ignore"):  # trials at rest may read d = 0
@@ -105,31 +110,21 @@ def scale_on_plotted_control(run, plotted, key: KeyLike, active, it: int) -> Non
     )  # fmt: skip
 
 
-def _plotted_mm(run, pid: str) -> NDArray[np.float64]:
-    """A plan control point as plotted on the sheet: its instrument coordinates (6.7) from its
-    SK-42 coordinates by the sheet's similarity. [mm]"""
-    sheet = run.sheet
-    p = run.scene.point(pid)
-    xy = sheet_corner_instrument_coordinates(
-        sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
-    )
-    return np.asarray(xy, float).reshape(2)
-
-
-def connect_coordinatograph(run) -> None:
+def connect_coordinatograph(run: Run) -> None:
     """The coordinatograph connected at the sheet's ratio M_г/M_map (and, with the SC
     complex's automatic coordinatograph, its photo → map enlargement), as stage 4 does."""
     op, sheet = run.op, run.sheet
-    ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
+    map_scale = cast(int, sheet.map_scale_denominator)  # a sheet on plan control has its scale
+    ratio = sheet.horizontal_scale_denominator / map_scale
     enlargement = None
     if op.inst.options.automatic_coordinatograph:
         scene = run.scene
         photo_scale = MM_PER_M * scene.flying_height_m / float(scene.camera.focal_length_mm)
-        enlargement = photo_scale / sheet.map_scale_denominator
+        enlargement = photo_scale / map_scale
     op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
 
 
-def _needles_on(run, ids, key: NoiseKey) -> NDArray[np.float64]:
+def _needles_on(run: Run, ids: tuple[str, ...], key: NoiseKey) -> NDArray[np.float64]:
     """Fuse on each plan control point and put the needle down: table positions (T, n, 2)."""
     out = []
     for pid in ids:
@@ -138,7 +133,7 @@ def _needles_on(run, ids, key: NoiseKey) -> NDArray[np.float64]:
     return np.stack(out, axis=-2)
 
 
-def sheet_on_control(run) -> None:
+def sheet_on_control(run: Run) -> None:
     """C4 (``sheet_on="control"``): the map sheet laid on its plotted plan control points, as
     the conventional method does (the model was brought to the scale of the plotted control in
     C3, :func:`scale_on_plotted_control`): fuse on each plan control point, put the needle down,
@@ -153,7 +148,7 @@ def sheet_on_control(run) -> None:
         stage4_orient_sheet(run)
         return
     connect_coordinatograph(run)
-    plotted = np.stack([sheet_table(run, _plotted_mm(run, pid)) for pid in ids])  # (n, 2)
+    plotted = np.stack([sheet_table(run, plotted_mm(run, pid)) for pid in ids])  # (n, 2)
     centre = plotted.mean(axis=0)
     d_plot = plotted - centre
     needles = _needles_on(run, ids, _PLACE)
@@ -179,7 +174,7 @@ def sheet_on_control(run) -> None:
     run.record_stage("4", op.v(2).astype(int))
 
 
-def plan_control_check(run) -> None:
+def plan_control_check(run: Run) -> None:
     """The check of a sheet laid on its plan control: fuse on each plan control point, the
     needle against the plotted point; the largest distance against the corner tolerance (the
     same comparison as stage 5's, its tolerance 0.3 mm). Corner 4 is not checked: its counter
@@ -192,12 +187,12 @@ def plan_control_check(run) -> None:
     errs = []
     for pid in sheet.similarity_point_ids:
         fuse_and_read(run, control_point_m(run, pid), PLAN_CHECK.at(pid), None, ())
-        errs.append(needle_against_plotted(run, pose, pid, _plotted_mm(run, pid)))
+        errs.append(needle_against_plotted(run, pose, pid, plotted_mm(run, pid)))
     check_plan_control(run, errs)
     run.record_stage("5", op.v(1).astype(int))
 
 
-def c4_sheet(run, sheet_on: str = "control") -> None:
+def c4_sheet(run: Run, sheet_on: str = "control") -> None:
     """C4: the sheet on the coordinatograph — on its plotted plan control points
     (:func:`sheet_on_control`, default) or on the setup sheet's corners (stage 4 of the
     setup-data method) — then corner 4 and the plotted plan control (stage 5)."""

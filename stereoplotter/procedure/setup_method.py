@@ -37,7 +37,7 @@ from stereoplotter.procedure.records import (
     ControlHeight,
 )
 from stereoplotter.procedure.run import Run
-from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.sheet_stages import plotted_mm, stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.span_check import fiducial_mm, span_loop
 from stereoplotter.procedure.step_values import (
     Act,
@@ -47,9 +47,6 @@ from stereoplotter.procedure.step_values import (
     Step,
     perform_all,
     turn_common_tilt,
-)
-from stereoplotter.setup.equations import (
-    sheet_corner_instrument_coordinates,
 )
 
 __all__ = [
@@ -696,16 +693,6 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
 # --- stage 3 ---------------------------------------------------------------------------------
 
 
-def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
-    """The instrument coordinates (6.7) of a plan control point (the sheet's similarity)."""
-    sheet = run.sheet
-    p = run.scene.point(pid)
-    xy = sheet_corner_instrument_coordinates(
-        sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
-    )
-    return np.asarray(xy, float).reshape(2)
-
-
 def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
     """R3 (1): fuse on the two plan control points farthest apart, compare the distance of the
     X, Y counters with that of their sheet coordinates (6.7), turn b_x in proportion."""
@@ -713,7 +700,7 @@ def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
     if sheet.similarity is None:
         return
     a_id, b_id = steps.scale_pair(run)
-    d_sheet = float(np.hypot(*(_sheet_xy(run, a_id) - _sheet_xy(run, b_id))))
+    d_sheet = float(np.hypot(*(plotted_mm(run, a_id) - plotted_mm(run, b_id))))
     bx, new, d_model = steps.scale_by_two_points(
         run,
         (a_id, steps.control_point_m(run, a_id)),

@@ -8,20 +8,27 @@ mm on the table and the sheet.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, cast
+
 import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M
+from stereoplotter.procedure.arrays import Value
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.step_values import Line
 from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
+if TYPE_CHECKING:  # typing only
+    from stereoplotter.geometry.similarity import SimilarityFit
+
 __all__ = [
     "PLAN_CHECK",
     "check_plan_control",
     "needle_against_plotted",
+    "plotted_mm",
     "stage4_orient_sheet",
     "stage5_check",
 ]
@@ -49,9 +56,24 @@ _PLAN_POINT = Line(
 )
 
 
-def sheet_table(run: Run, xy_mm) -> NDArray[np.float64]:
+def plotted_mm(run: Run, pid: str) -> NDArray[np.float64]:
+    """A plan control point as plotted on the sheet: its instrument coordinates (6.7) from its
+    SK-42 coordinates by the sheet's similarity. [mm]"""
+    sheet = run.sheet
+    sk42 = cast(tuple[float, float, float], run.scene.point(pid).sk42_m)  # plan control has them
+    xy = sheet_corner_instrument_coordinates(
+        cast("SimilarityFit", sheet.similarity),  # a sheet with plan control has its similarity
+        sk42[0],
+        sk42[1],
+        sheet.horizontal_scale_denominator,
+    )
+    return np.asarray(xy, float).reshape(2)
+
+
+def sheet_table(run: Run, xy_mm: Value) -> NDArray[np.float64]:
     """Ideal table position of a model position (x′, y′) for the coordinatograph's origin."""
-    return run.op.inst.table_position_mm(xy_mm)
+    position: NDArray[np.float64] = run.op.inst.table_position_mm(xy_mm)
+    return position
 
 
 def _needle_at(run: Run, corner: str, key: NoiseKey) -> NDArray[np.float64]:
@@ -85,12 +107,13 @@ def stage4_orient_sheet(run: Run) -> None:
     if not sheet.corners:
         run.sheet_pose = None
         return
-    ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
+    map_scale = cast(int, sheet.map_scale_denominator)  # a sheet with corners has its scale
+    ratio = sheet.horizontal_scale_denominator / map_scale
     enlargement = None
     if op.inst.options.automatic_coordinatograph:  # photo → map, checked against its 10 ×
         scene = run.scene
         photo_scale = MM_PER_M * scene.flying_height_m / float(scene.camera.focal_length_mm)
-        enlargement = photo_scale / sheet.map_scale_denominator
+        enlargement = photo_scale / map_scale
     op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
     ideal = {k: sheet_table(run, v) for k, v in corners.items()}
@@ -146,21 +169,20 @@ def stage5_check(run: Run) -> None:
     errs = []
     for pid in sheet.similarity_point_ids:
         p = run.scene.point(pid)
-        xy = sheet_corner_instrument_coordinates(
-            sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
-        )
         img = run.scene.images(np.asarray(p.local_m, float)[None, :])
         op.fuse(p.local_m, (img[0][0], img[1][0]), PLAN_CHECK.at(pid))
-        errs.append(needle_against_plotted(run, pose, pid, np.asarray(xy, float).reshape(2)))
+        errs.append(needle_against_plotted(run, pose, pid, plotted_mm(run, pid)))
     check_plan_control(run, errs)
 
 
-def needle_against_plotted(run: Run, pose, pid: str, plotted_mm) -> NDArray[np.float64]:
+def needle_against_plotted(
+    run: Run, pose: SheetPose, pid: str, plotted_mm: Value
+) -> NDArray[np.float64]:
     """Stage 5 at a plan control point the operator has fused on: the needle against the point
     plotted at ``plotted_mm`` (its instrument coordinates (6.7)), the distance logged. [mm]"""
     needle = sheet_needle(run, PLAN_CHECK.at(pid))
     plotted = pose.table_of(sheet_table(run, plotted_mm))
-    err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
+    err: NDArray[np.float64] = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
     _PLAN_POINT.log(run.op, "", {"id": pid}, residual=err)
     return err
 

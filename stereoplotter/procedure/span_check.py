@@ -11,8 +11,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.instrument.virtual import NOMINAL_ZERO, Side
+from stereoplotter.procedure.arrays import Active, Floats, Mask, Value
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key, pointing
+from stereoplotter.procedure.operator import Operator
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.step_values import BOTTOM_STOP, L_CHECK_FAILED, Line
 from stereoplotter.setup.equations import base_z_correction, height_correction
@@ -59,18 +61,17 @@ def _measure_line(stage: str, units_at_zero: bool) -> Line:
 
 def fiducial_mm(run: Run, side: str, mark: str) -> NDArray[np.float64]:
     """The true position of fiducial ``mark`` on the ``side`` photo. [mm]"""
-    return run.scene.fiducials_mm[side][int(mark) - 1]
+    position: NDArray[np.float64] = run.scene.fiducials_mm[side][int(mark) - 1]
+    return position
 
 
-def _measure_span(
-    run: Run, side: str, key: NoiseKey, active, pointings: int = 1
-) -> NDArray[np.float64]:
+def _measure_span(run: Run, side: Side, key: NoiseKey, active: Active, pointings: int = 1) -> Value:
     """L′: the mark on fiducial 3 then 4 of ``side``, Y read at each (the mean of
     ``pointings`` pointings and readings per mark, remedy R1)."""
     op = run.op
     ys = []
     for mark in ("3", "4"):
-        y = 0.0
+        y: Value = 0.0
         for j in range(pointings):
             k = key.at(side, mark, *pointing(j))
             op.mark_on(side, fiducial_mm(run, side, mark), k, active)
@@ -91,10 +92,10 @@ def span_loop(
     stage: str,
     key: KeyLike,
     units_at_zero: bool = False,
-    active=None,
+    active: Active = None,
     pointings: int = 1,
     remedy: str = "",
-) -> tuple[NDArray, NDArray, NDArray]:
+) -> tuple[NDArray[np.int_], Mask, Floats]:
     """The L-check loop (6.9)–(6.11) until |L − L′| ≤ 0.03/n_л for both photos."""
     op, sheet = run.op, run.sheet
     tol = sheet.tolerances["mark_span_mm"]
@@ -119,9 +120,9 @@ def span_loop(
 
 
 def _span_round(
-    run: Run, stage: str, k: NoiseKey, it: int, active, spans, diffs, units_at_zero: bool,
-    pointings: int, remedy: str,
-) -> tuple[NDArray, NDArray]:  # fmt: skip
+    run: Run, stage: str, k: NoiseKey, it: int, active: Mask, spans: tuple[float, float],
+    diffs: tuple[Floats, Floats], units_at_zero: bool, pointings: int, remedy: str,
+) -> tuple[Floats, Floats]:  # fmt: skip
     """One pass of the L-check on ``active``: measure L′ of both photos, log, and correct the
     trials outside the tolerance; the differences L − L′ (kept where not ``active``). [mm]"""
     op = run.op
@@ -133,7 +134,11 @@ def _span_round(
     dr = np.where(active, span_r - meas_r, diffs[1])
     ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
     line = _measure_line(stage, units_at_zero)
-    for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
+    sides: tuple[tuple[Side, Floats, Value, float], ...] = (
+        ("left", dl, meas_l, span_l),
+        ("right", dr, meas_r, span_r),
+    )
+    for side, d, meas, span in sides:
         line.log(
             op, "Y", {"side": _SIDE[side], "span": span},
             reading=meas, residual=d, tolerance=tol, passed=np.abs(d) <= tol, iteration=it,
@@ -145,7 +150,16 @@ def _span_round(
     return dl, dr
 
 
-def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy: str, active):
+def _log_delta_z(
+    op: Operator,
+    stage: str,
+    dz_shown: float,
+    depth: Value,
+    dz_mm: Value,
+    it: int,
+    remedy: str,
+    active: Mask,
+) -> None:
     """Log the ΔZ (6.9) setting; the word follows the sign: the Z counter counts the projection
     distance D, so ΔZ > 0 (a larger D) lowers the carriage and ΔZ < 0 raises it. [m, mm]"""
     direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
@@ -157,8 +171,15 @@ def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy:
 
 
 def _past_bottom_stop(
-    run: Run, stage: str, k: NoiseKey, it: int, active, depth, dz_mm, remedy: str
-):
+    run: Run,
+    stage: str,
+    k: NoiseKey,
+    it: int,
+    active: Mask,
+    depth: Value,
+    dz_mm: Value,
+    remedy: str,
+) -> tuple[Mask, Value, Value]:
     """The carriage at its bottom stop D_max (switch ``bottom_stop``,
     :mod:`~stereoplotter.procedure.fidelity`).
 
@@ -207,7 +228,14 @@ def _past_bottom_stop(
 
 
 def _correct_span(
-    run: Run, stage: str, k: NoiseKey, it: int, active, diffs, spans, remedy: str = ""
+    run: Run,
+    stage: str,
+    k: NoiseKey,
+    it: int,
+    active: Mask,
+    diffs: tuple[Floats, Floats],
+    spans: tuple[float, float],
+    remedy: str = "",
 ) -> None:
     """One correction of the L-check: ΔZ (6.9) from the left photo (or f_пр at the bottom
     stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11).

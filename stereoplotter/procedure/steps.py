@@ -19,7 +19,8 @@ from collections.abc import Callable, Iterable
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO
+from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, ScaleName
+from stereoplotter.procedure.arrays import Active, Floats, Mask, Value
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key, pointing
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.step_values import (
@@ -114,7 +115,8 @@ def zero_base_y(run: Run, stage: str, key: NoiseKey | None = None) -> NDArray[np
     car = {c: op.physical(c) for c in ("X", "Y", "Z")}
     e = op.noise.draw(key.by("mono").at("right"), op.model.monocular_sigma_mm)
     eta = right_map.rod_from_photo(np.stack([0.0 * e, e], axis=-1))[..., 1]
-    n_r = (car["Z"] + op.physical("bz")) / op.inst.setting.f_instrument_mm
+    f_instrument: Value = op.inst.setting.f_instrument_mm
+    n_r = (car["Z"] + op.physical("bz")) / f_instrument
     op.drive("by", car["Y"] - n_r * eta)
     mo_by = op.read("by", key)
     run.zero["MO_by"] = mo_by
@@ -145,7 +147,9 @@ def scale_pair(run: Run, ties: str = "first") -> tuple[str, str]:
     return max(pairs, key=lambda ab: float(np.hypot(*(pts[ab[0]][:2] - pts[ab[1]][:2]))))
 
 
-def fuse_and_read(run: Run, p, key: KeyLike, active, read: tuple[str, ...]) -> dict[str, NDArray]:
+def fuse_and_read(
+    run: Run, p: Value, key: KeyLike, active: Active, read: tuple[ScaleName, ...]
+) -> dict[str, Floats]:
     """Fuse the floating mark on the ground point ``p`` [m] and read the counters ``read``."""
     op = run.op
     key = as_key(key)
@@ -154,18 +158,20 @@ def fuse_and_read(run: Run, p, key: KeyLike, active, read: tuple[str, ...]) -> d
     return {c: op.read(c, key.at(c)) for c in read}
 
 
-def height_mean(run: Run, p, key: KeyLike, active, pointings: int) -> NDArray[np.float64]:
+def height_mean(run: Run, p: Value, key: KeyLike, active: Active, pointings: int) -> Floats:
     """The height scale read after ``pointings`` fusings on ``p``, averaged (the first fusing
     has the single reading's noise key, so ``pointings=1`` is the book's single reading). [m]"""
-    total = None
+    total: Value = None
     for j in range(pointings):
         k = as_key(key).at(*pointing(j))
         read = fuse_and_read(run, p, k, active, (HEIGHT_SCALE,))[HEIGHT_SCALE]
         total = read if total is None else total + read
-    return total / pointings
+    return total / pointings  # type: ignore[no-any-return]
 
 
-def slip_height_scale_on_mean(run: Run, p0, key: KeyLike, active, pointings: int) -> None:
+def slip_height_scale_on_mean(
+    run: Run, p0: Value, key: KeyLike, active: Active, pointings: int
+) -> None:
     """Fuse on the control point ``p0`` [m] ``pointings`` times and slip the height scale so
     that the mean reading shows its known height; trials not ``active`` keep their scale."""
     op = run.op
@@ -176,8 +182,13 @@ def slip_height_scale_on_mean(run: Run, p0, key: KeyLike, active, pointings: int
 
 
 def scale_by_two_points(
-    run: Run, a, b, distance_mm: float, key: KeyLike, active
-) -> tuple[NDArray, NDArray, NDArray]:
+    run: Run,
+    a: tuple[str, Floats],
+    b: tuple[str, Floats],
+    distance_mm: float,
+    key: KeyLike,
+    active: Mask,
+) -> tuple[Floats, Floats, Floats]:
     """Scaling: fuse on the ground points ``a``, ``b`` [m], compare the X, Y counters' distance
     with ``distance_mm`` (the model distance the scale asks for) and turn b_x in proportion,
     O′_bx = MO_bx + b_x·ratio. Returns (b_x read before, b_x set, the counters' distance). [mm]
@@ -199,7 +210,7 @@ def judge_standard_points(
     run: Run,
     stage: str,
     key: KeyLike,
-    active=None,
+    active: Active = None,
     *,
     text: str = "residual y-parallax at standard point {i}",
     remedy: str = "",
@@ -237,9 +248,9 @@ def judge_standard_points(
     return seen
 
 
-def fixed_order_sum(values: Iterable) -> NDArray[np.float64]:
+def fixed_order_sum(values: Iterable[Value]) -> Floats:
     """A sum over points in a fixed order (a vectorised run and a per-trial loop agree)."""
-    total = None
+    total: Value = None
     for v in values:
         total = v if total is None else total + v
-    return total
+    return total  # type: ignore[no-any-return]
