@@ -243,10 +243,11 @@ class Noise:
         self.trial = trial
         self.first_trial = int(first_trial)
 
-    def draw(self, key: NoiseKey, sigma: float) -> NDArray[np.float64]:
+    def draw(self, key: NoiseKey, sigma: float | None) -> NDArray[np.float64]:
         """σ·z for the draw of the declared identity ``key``: :meth:`normal` of its stream key
-        (:meth:`NoiseKey.stream`, the one encoding)."""
-        return self.normal(key.stream(), sigma)
+        (:meth:`NoiseKey.stream`, the one encoding). ``sigma`` is an :class:`OperatorModel`'s,
+        resolved for the instrument before a run (never None then)."""
+        return self.normal(key.stream(), cast(float, sigma))
 
     def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
         """σ·z for the stream ``key``: shape (T,), or () for a single run or a per-trial oracle."""
@@ -609,7 +610,8 @@ class Operator:
 
     # --- looking ------------------------------------------------------------------------------
 
-    def units(self):
+    def units(self) -> tuple[CorrectionUnit, CorrectionUnit]:
+        """The correction units of the left and right photo as they are."""
         return self.inst.unit("left"), self.inst.unit("right")
 
     def unit_map(self, side: Side, unit: CorrectionUnit | None = None) -> UnitMap:

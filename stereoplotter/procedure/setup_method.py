@@ -16,6 +16,7 @@ Reference
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,17 +26,21 @@ from stereoplotter.instrument.principles import control_name, mark_phrase, seque
 from stereoplotter.instrument.virtual import (
     HEIGHT_SCALE,
     NOMINAL_ZERO,
+    CassetteName,
+    KnobName,
+    ScrewName,
     Side,
     control_kind,
 )
 from stereoplotter.procedure import steps
+from stereoplotter.procedure.arrays import Floats, Mask, Value
 from stereoplotter.procedure.compaction import compacted
+from stereoplotter.procedure.control_names import CASSETTE, DECENTRATION, KNOB, Tilt
+from stereoplotter.procedure.floor import ControlHeights
 from stereoplotter.procedure.levelling import LevelDesign
 from stereoplotter.procedure.noise_key import NoiseKey
-from stereoplotter.procedure.operator import Operator, solve_1d
-from stereoplotter.procedure.records import (
-    ControlHeight,
-)
+from stereoplotter.procedure.operator import Look, Operator, solve_1d
+from stereoplotter.procedure.records import ControlHeight
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.sheet_stages import plotted_mm, stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.span_check import fiducial_mm, span_loop
@@ -48,6 +53,7 @@ from stereoplotter.procedure.step_values import (
     perform_all,
     turn_common_tilt,
 )
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "Q_ELEMENTS",
@@ -79,7 +85,13 @@ _TILT = {"alpha": "α", "omega": "ω"}
 #: whole stereopair", stage 3). Not b_y (a constant q, dependent on κ_л, κ_п at six points),
 #: not b_z (it carries n_п, set by the stage-1 L-check, and moves the model's longitudinal
 #: tilt).
-Q_ELEMENTS = ("kappa_left", "kappa_right", "k_omega_right", "k_alpha_left", "k_alpha_right")
+Q_ELEMENTS: tuple[CassetteName | KnobName, ...] = (
+    "kappa_left",
+    "kappa_right",
+    "k_omega_right",
+    "k_alpha_left",
+    "k_alpha_right",
+)
 
 #: The identities of the stages' draws (each act's own below its stage by its path).
 STAGE1, STAGE2, STAGE3 = NoiseKey("1"), NoiseKey("2"), NoiseKey("3")
@@ -161,7 +173,7 @@ def stage1_scale_coefficient(run: Run) -> None:
     perform_all(run, STAGE1_STEPS)
 
 
-def _bx_zero(run: Run, key: NoiseKey):
+def _bx_zero(run: Run, key: NoiseKey) -> Floats:
     """MO_bx, b_x's place of zero (switch ``bx_zero``, :mod:`~stereoplotter.procedure.fidelity`):
     "two_pointings" ((6.38), m_bx = √2·m_x/n): found as MO_by is, the left mark monocularly on
     the left cassette centre, the right mark on the right one, each pointing with σ_mono along
@@ -190,7 +202,11 @@ _BX_ZERO_LINE = Line(
 
 def _zero_readings(run: Run, key: NoiseKey) -> None:
     op = run.op
-    for side, names in (("left", ("MO_X", "MO_Y")), ("right", ("MO_X,п", "MO_Y,п"))):
+    zeros: tuple[tuple[Side, tuple[str, str]], ...] = (
+        ("left", ("MO_X", "MO_Y")),
+        ("right", ("MO_X,п", "MO_Y,п")),
+    )
+    for side, names in zeros:
         e = op.mark_on(side, np.zeros(2), key.at(side))
         run.zero[names[0]] = op.read("X", key.at(side, "X"))
         run.zero[names[1]] = op.read("Y", key.at(side, "Y"))
@@ -204,13 +220,14 @@ _ZERO_X = Line("2", "{side} mark on the {side} cassette centre → {x}", "decisi
 _ZERO_Y = Line("2", "… and {y}", "decision D6")
 
 
-def _fit_knob(run: Run, side: str, axis: str, mark: str, key: NoiseKey, active):
+def _fit_knob(run: Run, side: Side, axis: Tilt, mark: str, key: NoiseKey, active: Mask) -> Floats:
     """Set the counter to MO + n·(x⁰ or y⁰), the other handwheel onto the fiducial line, turn
     the knob until the fiducial is under the mark ((6.12) or (6.13)); the knob's tangent
     after the turn. [—]"""
     op = run.op
     sfx = "" if side == "left" else ",п"
     fid = fiducial_mm(run, side, mark)
+    counter: ScrewName
     if axis == "omega":
         counter, free, comp = "Y", "X", 1
     else:
@@ -224,7 +241,7 @@ def _fit_knob(run: Run, side: str, axis: str, mark: str, key: NoiseKey, active):
     rod = rod_from_counters(
         op.physical("X"), op.physical("Y"), op.physical("Z"), op.inst.setting, side
     )
-    knob = f"k_{axis}_{side}"
+    knob = KNOB[axis, side]
     t = op.knob_for(knob, unit, fid, rod, comp, fid[comp] + e)
     before = op.physical(knob)
     op.drive(knob, t, active)
@@ -251,7 +268,7 @@ _FIT_TEXT = (
 _FIT_KNOB = {"omega": Line("2", _FIT_TEXT, "(6.12)"), "alpha": Line("2", _FIT_TEXT, "(6.13)")}
 
 
-def _fit_target(run: Run, side: str, name: str):
+def _fit_target(run: Run, side: Side, name: str) -> Value:
     """The counter target MO (+ ,п) + n·x⁰ or n·y⁰ of a fit (switch ``fit_scale``): the sheet's
     reading ("as_set"), or its value scaled by n_true/n of the sheet, n_true = D/f_пр of the
     instrument as it is (D + b_z on the right; "exact"). [mm]"""
@@ -260,13 +277,14 @@ def _fit_target(run: Run, side: str, name: str):
         return value
     op, sheet = run.op, run.sheet
     depth = op.physical("Z") + (op.physical("bz") if side == "right" else 0.0)
-    n_true = depth / op.inst.setting.f_instrument_mm
+    f_instrument: Value = op.inst.setting.f_instrument_mm
+    n_true = depth / f_instrument
     n_sheet = sheet.n_left if side == "left" else sheet.n_right
     reading = run.readings[name]
     return value + reading.value * (n_true / n_sheet - 1.0)
 
 
-def _fit_omega(run: Run, side: str, key: NoiseKey, active) -> None:
+def _fit_omega(run: Run, side: Side, key: NoiseKey, active: Mask) -> None:
     """k_ω of ``side`` (switch ``tilts``): fitted at mark 3 ("knob_fit"), or at marks 3 and 4
     and set to the mean of the two fits ("least_squares", (6.33))."""
     t3 = _fit_knob(run, side, "omega", "3", key, active)
@@ -274,7 +292,7 @@ def _fit_omega(run: Run, side: str, key: NoiseKey, active) -> None:
         return
     op = run.op
     t4 = _fit_knob(run, side, "omega", "4", key.at("4"), active)
-    knob = f"k_omega_{side}"
+    knob = KNOB["omega", side]
     before = op.physical(knob)
     op.drive(knob, 0.5 * (t3 + t4), active)
     _OMEGA_MEAN.log(op, knob, {"side": side}, before=before, after=op.physical(knob))
@@ -285,7 +303,7 @@ _OMEGA_MEAN = Line(
 )
 
 
-def _mark4(run: Run, side: str, key: NoiseKey, active) -> NDArray[np.float64]:
+def _mark4(run: Run, side: Side, key: NoiseKey, active: Mask) -> Floats:
     """Check mark 4 at MO_Y + n·y⁰₄ (6.12): the offset of the mark from fiducial 4 seen."""
     op = run.op
     fid = fiducial_mm(run, side, "4")
@@ -294,7 +312,8 @@ def _mark4(run: Run, side: str, key: NoiseKey, active) -> NDArray[np.float64]:
     op.mark_on(side, fid, key.at("line"), active, free="X")
     off = op.inst.mark_offsets(**{f"{side}_point_mm": fid})[side]
     e = op.noise.draw(key.at("seen").by("mono"), op.model.monocular_sigma_mm)
-    return np.abs(np.asarray(off)[..., 1]) + e
+    seen: Floats = np.abs(np.asarray(off)[..., 1]) + e
+    return seen
 
 
 def _stage2_k_omega(run: Run, key: NoiseKey) -> None:
@@ -322,7 +341,8 @@ def _stage2_k_omega(run: Run, key: NoiseKey) -> None:
 
 def _stage2_k_alpha(run: Run, key: NoiseKey) -> None:
     """k_α of the left photo at mark 2, of the right at mark 1 ((6.13))."""
-    for side, mark in (("left", "2"), ("right", "1")):
+    marks: tuple[tuple[Side, str], ...] = (("left", "2"), ("right", "1"))
+    for side, mark in marks:
         _fit_knob(run, side, "alpha", mark, key.at(side, "alpha"), run.op.all())
 
 
@@ -371,10 +391,11 @@ def kappa_from_fiducials(run: Run, stage: str) -> None:
     op = run.op
     sigma = op.model.monocular_sigma_mm
     key = NoiseKey(stage).at("kappa")
-    for side, photo in zip(("left", "right"), run.sheet.photos, strict=True):
+    sides: tuple[Side, Side] = ("left", "right")
+    for side, photo in zip(sides, run.sheet.photos, strict=True):
         span = fiducial_mm(run, side, "3")[1] - fiducial_mm(run, side, "4")[1]
         e3, e4 = (op.noise.draw(key.at(side, m).by("mono"), sigma) for m in "34")
-        control = f"kappa_{side}"
+        control = CASSETTE[side]
         before = op.physical(control)
         op.drive(control, photo.kappa + (e3 - e4) / span)
         _KAPPA_FIDUCIALS.in_stage(stage).log(
@@ -392,9 +413,10 @@ def _set_computed_decentrations(run: Run, key: NoiseKey) -> None:
     """The computed decentrations d = MO_d + f′·tan(tilt) on the scales (stage 2): after the
     k_α, k_ω fits in the book's order, before them under variant B2 (``decentrations_first``)."""
     op = run.op
-    for side in ("left", "right"):
+    sides: tuple[Side, Side] = ("left", "right")
+    for side in sides:
         for d in ("dx", "dy"):
-            control = f"{d}_{side}"
+            control = DECENTRATION[d, side]
             # MO_dx, MO_dy: the decentration scale's place of zero
             value = run.target(f"d_{d[1]},{_SIDE[side]}", NOMINAL_ZERO[control])
             op.set(control, value, key.at(control))
@@ -420,7 +442,9 @@ def _decentration_line(d: str, tilt: str) -> Line:
 _DECENTRATION = {"dx": _decentration_line("dx", "α"), "dy": _decentration_line("dy", "ω")}
 
 
-def _stage2_round(run: Run, key: NoiseKey, it: int, active, tol4: float):
+def _stage2_round(
+    run: Run, key: NoiseKey, it: int, active: Mask, tol4: float
+) -> tuple[NDArray[np.int_] | None, Floats]:
     """One pass of stage 2's k_ω loop on ``active``: (from the second on) the L-check again
     with the units set (D5), or the zero readings; k_ω fitted and mark 4 checked on both
     photos. Returns the L-check's iterations (None on the first pass) and the worst mark-4
@@ -505,17 +529,26 @@ def clear_kappa(run: Run, stage: str) -> None:
     run.record_stage(f"{stage}/kappa", its)
 
 
-def _kappa_round(run: Run, stage: str, it: int, active, pts, imgs, tol: float):
+def _kappa_round(
+    run: Run,
+    stage: str,
+    it: int,
+    active: Mask,
+    pts: Floats,
+    imgs: tuple[Floats, Floats],
+    tol: float,
+) -> Mask:
     """One pass of D8 on ``active``: q at standard point 1 cleared with κ_п, at point 2 with
     κ_л; whether both were within ¼ mark as seen before the turns."""
     op = run.op
     qs = []
-    for idx, side in ((0, "right"), (1, "left")):
+    points: tuple[tuple[int, Side], ...] = ((0, "right"), (1, "left"))
+    for idx, side in points:
         key = NoiseKey(stage).at("kappa", it, idx + 1)
         img = (imgs[0][idx], imgs[1][idx])
         q_seen, q_true = op.fuse(pts[idx], img, key, active)
         qs.append(q_seen)
-        control = f"kappa_{side}"
+        control = CASSETTE[side]
         target = op.noise.draw(key.at("clear").by("q"), op.model.y_parallax_sigma_mm)
         q_of = op.q_turning(control, img)  # q with κ turned, the rest as it is now
         ok_here = np.abs(q_seen) <= tol
@@ -531,9 +564,9 @@ def _kappa_round(run: Run, stage: str, it: int, active, pts, imgs, tol: float):
     return (np.abs(qs[0]) <= tol) & (np.abs(qs[1]) <= tol)
 
 
-def _solve_kappa(q_of, kappa0, target):
-
-    return solve_1d(q_of, kappa0, target, iterations=4, h=1e-6)
+def _solve_kappa(q_of: Look, kappa0: Floats, target: Floats) -> Floats:
+    kappa: Floats = solve_1d(q_of, kappa0, target, iterations=4, h=1e-6)
+    return kappa
 
 
 def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
@@ -550,10 +583,10 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     if run.remedial:
         remedy = f"R2 stage {stage}: refine the relative orientation"
         run.record_remedy(remedy, name, failed, rounds)
-    return worst
+    return cast(Floats, worst)
 
 
-def _q_jacobian(run: Run, imgs) -> NDArray[np.float64]:
+def _q_jacobian(run: Run, imgs: tuple[Floats, Floats]) -> NDArray[np.float64]:
     """∂q/∂element at the six standard points for :data:`Q_ELEMENTS`, the rest of the
     instrument as it is (the operator's knowledge of how each element moves q): (..., 6, 5).
 
@@ -611,7 +644,7 @@ R2_DAMPING = (0.0, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0)
 R2_RANGE_FRACTION = 0.98
 
 
-def r2_element_bounds(spec) -> dict[str, tuple[float, float]]:
+def r2_element_bounds(spec: InstrumentSpec) -> dict[str, tuple[float, float]]:
     """Where R2 may drive each of :data:`Q_ELEMENTS`: the instrument's κ range [rad] and its
     correction range ±tilt_max as tan of the tilt [—], each shrunk to
     :data:`R2_RANGE_FRACTION` (the stops are the instrument file's
@@ -625,7 +658,9 @@ def r2_element_bounds(spec) -> dict[str, tuple[float, float]]:
     }
 
 
-def r2_turns(jac, seen, before, bounds) -> NDArray[np.float64]:
+def r2_turns(
+    jac: Floats, seen: Floats, before: Floats, bounds: Sequence[tuple[float, float]]
+) -> NDArray[np.float64]:
     """R2's turns δ of :data:`Q_ELEMENTS` from the six q seen (..., 6) and the Jacobian
     (..., 6, 5): the least squares −(JᵀJ)⁻¹Jᵀq where it keeps every element inside ``bounds``,
     else damped (Levenberg–Marquardt, the first λ of :data:`R2_DAMPING` that keeps them
@@ -645,8 +680,8 @@ def r2_turns(jac, seen, before, bounds) -> NDArray[np.float64]:
     lo = np.array([b[0] for b in bounds])
     hi = np.array([b[1] for b in bounds])
     diag = np.einsum("...ii->...i", a)
-    out = None
-    done = None
+    out: Value = None
+    done: Value = None
     for lam in R2_DAMPING:
         m = a + lam * (diag[..., :, None] * np.eye(a.shape[-1]))
         with np.errstate(all="ignore"):
@@ -662,12 +697,15 @@ def r2_turns(jac, seen, before, bounds) -> NDArray[np.float64]:
             out = np.where(done[..., None], out, delta)
             done = done | inside
         if np.all(done):
-            return out
+            return cast(Floats, out)
     # the most damped step, clipped where still outside: the element stops at its range
-    return np.where(done[..., None], out, np.clip(before + out, lo, hi) - before)
+    clipped: Floats = np.where(done[..., None], out, np.clip(before + out, lo, hi) - before)
+    return clipped
 
 
-def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArray[np.float64]:
+def _r2_round(
+    run: Run, stage: str, it: int, seen: Floats, active: Mask, remedy: str
+) -> NDArray[np.float64]:
     """One round of R2 on ``active``: the bounded least-squares turns (:func:`r2_turns`) from
     the six q seen, then the six points judged again; the q seen, (..., 6). [mm]"""
     op = run.op
@@ -693,7 +731,7 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
 # --- stage 3 ---------------------------------------------------------------------------------
 
 
-def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
+def _refine_scale(run: Run, it: int, active: Mask, remedy: str) -> None:
     """R3 (1): fuse on the two plan control points farthest apart, compare the distance of the
     X, Y counters with that of their sheet coordinates (6.7), turn b_x in proportion."""
     op, sheet = run.op, run.sheet
@@ -732,7 +770,9 @@ _LEVEL_LINE = Line(
 )
 
 
-def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) -> None:
+def _level(
+    run: Run, design: LevelDesign, errs: Sequence[Value], it: int, active: Mask, remedy: str
+) -> None:
     """R3 (2): fit offset + common tilts φ_α, φ_ω to the control-height errors and turn the
     q-neutral common tilts (:class:`LevelDesign`) by −φ."""
     op = run.op
@@ -750,7 +790,7 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
         )  # fmt: skip
 
 
-def _shown(op: Operator, value) -> float:
+def _shown(op: Operator, value: Value) -> float:
     """The value of the trial the transcript shows."""
     flat = np.ravel(value)
     return float(flat[op.log.shown if flat.size > 1 else 0])
@@ -760,7 +800,7 @@ def _read_control_heights(
     run: Run,
     rows: Sequence[ControlHeight],
     key: NoiseKey,
-    active,
+    active: Mask,
     remedy: str,
     it: int,
     pointings: int = steps.REPEAT_POINTINGS,
@@ -791,7 +831,9 @@ def _read_control_heights(
     ]
 
 
-def log_control_height(op, stage: str, text: str, read, truth_m: float, tol, **extra):
+def log_control_height(
+    op: Operator, stage: str, text: str, read: Value, truth_m: float, tol: float, **extra: Any
+) -> Value:
     """Log one control-point height read on the height scale against its truth and H/3000;
     return the error read − truth. [m]"""
     _CONTROL_HEIGHT.in_stage(stage).log(
@@ -803,7 +845,7 @@ def log_control_height(op, stage: str, text: str, read, truth_m: float, tol, **e
 
 
 def refine_scale_and_level(
-    run: Run, rows: Sequence[ControlHeight], errs, failed: NDArray[np.bool_]
+    run: Run, rows: Sequence[ControlHeight], errs: Sequence[Value], failed: NDArray[np.bool_]
 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Remedy R3: a control height misses H/3000 after stage 3. Each round: (1) the scale by
     b_x on the two plan control points farthest apart; (2) the levelling: read the control
@@ -816,7 +858,7 @@ def refine_scale_and_level(
     op = run.op
     tol = run.sheet.tolerances["control_height_m"]
     remedy = "R3 refine scaling and levelling on control"
-    design = run.level
+    design = cast(LevelDesign, run.level)  # prepared with the run
     active = op.v(failed).astype(bool)
     rounds = np.zeros(np.shape(active), int)
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
@@ -836,7 +878,7 @@ def refine_scale_and_level(
     return rounds, worst
 
 
-def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
+def _fuse_bx(run: Run, pid: str, left_img: Floats, right_img: Floats) -> None:
     """Stage 3's scaling (switch ``stage3``): the mark fused on the height control point ``pid``
     by turning b_x, then ("fuse") κ cleared again (D10)."""
     op = run.op
@@ -844,7 +886,8 @@ def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
     e = op.noise.draw(STAGE3.at("bx").by("stereo"), op.model.stereo_sigma_mm)
     right_map = op.unit_map("right")
     xi_r = right_map.rod_from_photo(right_img + np.stack([e, 0.0 * e], axis=-1))[..., 0]
-    n_r = (op.physical("Z") + op.physical("bz")) / op.inst.setting.f_instrument_mm
+    f_instrument: Value = op.inst.setting.f_instrument_mm
+    n_r = (op.physical("Z") + op.physical("bz")) / f_instrument
     before = op.read("bx", STAGE3.at("bx", "before"))
     op.drive("bx", op.physical("X") - n_r * xi_r)
     after = op.read("bx", STAGE3.at("bx", "after"))
@@ -858,11 +901,16 @@ def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
         clear_kappa(run, "3")
 
 
+def _heights(run: Run) -> ControlHeights:
+    """The run's height control points (prepared with the run)."""
+    return cast(ControlHeights, run.heights)
+
+
 def _stage3_fuse(run: Run, key: NoiseKey) -> None:
     """b_x until the mark fuses on the first height control point (switch ``stage3``), the
     mark fused there again and the height scale slipped to its height."""
     op = run.op
-    h0 = run.heights.rows[0]
+    h0 = _heights(run).rows[0]
     p0 = h0.ground_m
     pl, pr = run.scene.images(p0[None, :])
     if run.fidelity.stage3 != "none":
@@ -879,7 +927,7 @@ def _stage3_heights(run: Run, key: NoiseKey) -> None:
     """The other control heights read against H/3000; R3 where one misses it (the operator's
     practice)."""
     op, sheet = run.op, run.sheet
-    rows = run.heights.rows  # the sheet's height control points, prepared once per run
+    rows = _heights(run).rows  # the sheet's height control points, prepared once per run
     tol = sheet.tolerances["control_height_m"]
     errs = []
     for h in rows[1:]:
@@ -907,10 +955,10 @@ def _stage3_heights(run: Run, key: NoiseKey) -> None:
 STAGE3_STEPS: tuple[Step, ...] = (
     SetStep(
         HEIGHT_SCALE,
-        lambda run: run.target(f"O_Z{run.heights.rows[0].id}"),  # MO_Z + (6.15)
+        lambda run: run.target(f"O_Z{_heights(run).rows[0].id}"),  # MO_Z + (6.15)
         STAGE3.at("OZ"),
         Line("3", "height scale to O_Z{id} for control point {id}", "(6.15)"),
-        fields=lambda run: {"id": run.heights.rows[0].id},
+        fields=lambda run: {"id": _heights(run).rows[0].id},
     ),
     Act("fuse on the control point, slip the height scale", STAGE3, _stage3_fuse),
     Act("control heights", STAGE3.at("h"), _stage3_heights),
