@@ -27,8 +27,9 @@ Reference
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -43,10 +44,13 @@ from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.virtual import (
     HEIGHT_SCALE,
     NOMINAL_ZERO,
+    CassetteName,
+    KnobName,
     control_axis,
     control_kind,
     control_side,
 )
+from stereoplotter.procedure.arrays import Active, Floats, Mask, Value
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.conventional_sheet import (
     SHEET_OPTIONS,
@@ -55,12 +59,13 @@ from stereoplotter.procedure.conventional_sheet import (
     scale_on_plotted_control,
 )
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
-from stereoplotter.procedure.operator import solve_1d
+from stereoplotter.procedure.operator import DrivenControl, Operator, solve_1d
 from stereoplotter.procedure.relative_equations import (
     overcorrection_factor,
     relative_orientation_from_standard_points,
     y_parallax_first_order,
 )
+from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.step_values import (
     KNOB_AT_STOP,
     Act,
@@ -96,11 +101,15 @@ __all__ = [
     "run_conventional_method",
 ]
 
+#: A way of relative orientation (:func:`c2_relative_by_elements`,
+#: :func:`c2_relative_by_equations`): its iterations and the worst |q| seen last, per trial.
+Relative = Callable[..., tuple[NDArray[np.int_], Floats]]
+
 #: The two ways of relative orientation offered (``procedure.md``, the conventional method).
 RELATIVE_OPTIONS = ("elements", "equations")
 
 #: Book element (basis system, (5.10)) → the instrument control that realises it.
-ELEMENTS = {
+ELEMENTS: dict[str, CassetteName | KnobName] = {
     "alpha1": "k_alpha_left",
     "alpha2": "k_alpha_right",
     "omega2": "k_omega_right",
@@ -131,7 +140,7 @@ _TRANSFER_UNIT = {"screw": "mm", "knob": "tan"}
 
 def _transfer_unit(control: str) -> str:
     """The unit a common tilt's record of ``control`` shows (:data:`_TRANSFER_UNIT`)."""
-    return _TRANSFER_UNIT.get(control_kind(control), "—")
+    return _TRANSFER_UNIT.get(control_kind(control) or "", "—")
 
 
 #: C2's common tilt at a knob's stop, per control turned.
@@ -291,11 +300,13 @@ class Calibration:
     level_weights: NDArray[np.float64]
 
 
-def _dot(a, b) -> float:
+def _dot(a: ArrayLike, b: ArrayLike) -> float:
     return float(np.dot(np.asarray(a, float), np.asarray(b, float)))
 
 
-def _null_q(j, fixed: dict[str, float], free: tuple[str, ...]) -> dict[str, float]:
+def _null_q(
+    j: dict[str, Floats], fixed: dict[str, float], free: tuple[str, ...]
+) -> dict[str, float]:
     """Turns of the ``free`` controls that cancel the q of the ``fixed`` turns (least squares)."""
     rhs = -sum(j[k] * v for k, v in fixed.items())
     a = np.column_stack([j[k] for k in free])
@@ -303,7 +314,7 @@ def _null_q(j, fixed: dict[str, float], free: tuple[str, ...]) -> dict[str, floa
     return {**fixed, **{k: float(v) for k, v in zip(free, sol, strict=True)}}
 
 
-def calibrate(run, level_ids: tuple[str, ...]) -> Calibration:
+def calibrate(run: Run, level_ids: tuple[str, ...]) -> Calibration:
     """The numerical sensitivities of the nominal instrument (sheet f_пр, b_x, b_y; b_z′ = 0;
     units at zero) at the six standard points and at the levelling points.
 
@@ -351,7 +362,8 @@ def calibrate(run, level_ids: tuple[str, ...]) -> Calibration:
         _, dd = control_sensitivity(limgs, setting, unit, unit, combo, linkage=linkage)
         cols.append(-dd * mv / 1000.0)
     design = np.column_stack(cols)
-    return Calibration(mapping, fit, common_alpha, common_omega, design, np.linalg.pinv(design))
+    weights = cast(Floats, np.linalg.pinv(design))
+    return Calibration(mapping, fit, common_alpha, common_omega, design, weights)
 
 
 # --------------------------------------------------------------------------------------------
@@ -368,12 +380,14 @@ _BOOK = {"alpha1": "α′₁", "alpha2": "α′₂", "omega2": "ω′₂", "kapp
 _SIX_Q = "standard point {i}: fuse, judge the y-parallax"
 
 
-def _worst(values) -> NDArray[np.float64]:
-    return np.max(np.abs(np.stack(values, axis=-1)), axis=-1)
+def _worst(values: Sequence[Value]) -> NDArray[np.float64]:
+    worst: Floats = np.max(np.abs(np.stack(values, axis=-1)), axis=-1)
+    return worst
 
 
-def _rms(values) -> NDArray[np.float64]:
-    return np.sqrt(np.mean(np.square(np.stack(values, axis=-1)), axis=-1))
+def _rms(values: Sequence[Value]) -> NDArray[np.float64]:
+    rms: Floats = np.sqrt(np.mean(np.square(np.stack(values, axis=-1)), axis=-1))
+    return rms
 
 
 #: C2 stopping rule: a pass whose RMS of the six looks is above this fraction of the previous
@@ -390,12 +404,14 @@ DECREASE_RATIO = 0.5
 BOUND_FACTOR = 2
 
 
-def _bound(op) -> int:
+def _bound(op: Operator) -> int:
     """The bound of a conventional loop (:data:`BOUND_FACTOR` × ``max_iterations``)."""
     return BOUND_FACTOR * op.model.max_iterations
 
 
-def _c2_stop(run, stage: str, it: int, seen, prev_rms, active):
+def _c2_stop(
+    run: Run, stage: str, it: int, seen: Sequence[Value], prev_rms: Value, active: Mask
+) -> tuple[Floats, Mask]:
     """The operator's judgment after the six looks of pass ``it``: go on while the residual
     y-parallax still decreases (RMS of the six looks ≤ :data:`DECREASE_RATIO` × the previous
     pass's), stop when it no longer does — further passes would chase the judgment error or the
@@ -428,7 +444,7 @@ def _c2_stop(run, stage: str, it: int, seen, prev_rms, active):
     return rms, done & active
 
 
-def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
+def _transfer_common_tilt(run: Run, cal: Calibration, active: Mask, stage: str, it: int) -> Mask:
     """A correction knob at its stop: move the model by a common tilt
     (:class:`Calibration` ``common_alpha`` / ``common_omega``, q-neutral to first order) that
     centres the pair of knobs of that axis, so the relative orientation has room again.
@@ -443,10 +459,11 @@ def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
     moved = np.zeros(np.shape(active), bool)
     if stage != "C2":  # in C3 the knobs hold the levelling: a common tilt would undo it
         return moved
-    for name, combo, pair in (
+    axes: tuple[tuple[str, dict[str, float], tuple[KnobName, KnobName]], ...] = (
         ("α", cal.common_alpha, ("k_alpha_left", "k_alpha_right")),
         ("ω", cal.common_omega, ("k_omega_left", "k_omega_right")),
-    ):
+    )
+    for name, combo, pair in axes:
         now = [op.physical(c) for c in pair]
         near = active & ((np.abs(now[0]) >= 0.999 * hi) | (np.abs(now[1]) >= 0.999 * hi))
         if not np.any(near):
@@ -457,13 +474,13 @@ def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
         fields = {"axis": name, "phi_mrad": float(np.ravel(phi)[0]) * 1e3}
         turn_common_tilt(
             run, combo, phi, key, near, _TRANSFER_LINE, fields=fields,
-            turn=lambda c, target, on: _turn(op, c, target, on), unit_of=_transfer_unit,
+            turn=_turner(op), unit_of=_transfer_unit,
             iteration=it,
         )  # fmt: skip
     return moved
 
 
-def _c1_left_zero(run, key: NoiseKey) -> None:
+def _c1_left_zero(run: Run, key: NoiseKey) -> None:
     """MO_X, MO_Y: the left mark on the left cassette centre (units at zero), read."""
     op = run.op
     e = op.mark_on("left", np.zeros(2), key)
@@ -477,7 +494,7 @@ _C1_MO_X = Line("C1", "left mark on the left cassette centre → MO_X", "decisio
 _C1_MO_Y = Line("C1", "… and MO_Y", "decision D6")
 
 
-def _c1_base_y(run, key: NoiseKey) -> None:
+def _c1_base_y(run: Run, key: NoiseKey) -> None:
     """MO_by found as in stage 1, then b_y of the sheet set from it."""
     op = run.op
     mo_by = zero_base_y(run, "C1", key.at("MOby"))
@@ -520,12 +537,12 @@ C1_STEPS: tuple[Step, ...] = (
 )
 
 
-def c1_interior(run) -> None:
+def c1_interior(run: Run) -> None:
     """C1: :data:`C1_STEPS`."""
     perform_all(run, C1_STEPS)
 
 
-def _turn(op, control: str, target, active) -> None:
+def _turn(op: Operator, control: DrivenControl, target: Value, active: Mask) -> None:
     """Turn a knob or cassette while looking, no further than its stop (2 % short of the
     tilt limit, 1 % of the κ range): a trial that needed more is flagged in ``op.stopped``."""
     spec = op.inst.spec
@@ -542,8 +559,14 @@ def _turn(op, control: str, target, active) -> None:
     op.drive(control, np.clip(target, lo, hi), active)
 
 
+def _turner(op: Operator) -> Callable[[str, Floats, Mask], None]:
+    """:func:`_turn` on ``op``: a common tilt's turn of a knob or cassette, no further than
+    its stop."""
+    return lambda control, target, on: _turn(op, cast(DrivenControl, control), target, on)
+
+
 #: The classic sequence (``instruments.md`` §6.1): point index, control, book element.
-_SEQUENCE = (
+_SEQUENCE: tuple[tuple[int, CassetteName | KnobName, str], ...] = (
     (0, "kappa_right", "kappa2"),
     (1, "kappa_left", "kappa1"),
     (3, "k_alpha_left", "alpha1"),
@@ -553,8 +576,8 @@ _SEQUENCE = (
 
 
 def c2_relative_by_elements(
-    run, cal: Calibration | None = None, stage: str = "C2", key0: KeyLike = "C2"
-):
+    run: Run, cal: Calibration | None = None, stage: str = "C2", key0: KeyLike = "C2"
+) -> tuple[NDArray[np.int_], Floats]:
     """C2 (a): element by element — point 1 → κ_п, 2 → κ_л, 4 → α_л, 3 → α_п, 5 → ω_п with the
     over-correction ½(f′²/c² − 1); repeat while the residual y-parallax of the six looks still
     decreases (:func:`_c2_stop`, bounded); a knob at its stop hands its tilt to a common tilt
@@ -588,7 +611,9 @@ def c2_relative_by_elements(
     return its, worst
 
 
-def _c2_pass(run, stage: str, key0: NoiseKey, it: int, active, prev_rms, over: float):
+def _c2_pass(
+    run: Run, stage: str, key0: NoiseKey, it: int, active: Mask, prev_rms: Value, over: float
+) -> tuple[list[Floats], Floats, Mask]:
     """Pass ``it`` of C2 (a) on ``active``: the five points cleared element by element, then the
     six looks and the stopping rule. Returns the six q seen, their RMS and the trials that stop
     (:func:`_c2_stop`)."""
@@ -622,8 +647,12 @@ def _c2_pass(run, stage: str, key0: NoiseKey, it: int, active, prev_rms, over: f
 
 
 def c2_relative_by_equations(
-    run, cal: Calibration, stage: str = "C2", key0: KeyLike = "C2", passes: int | None = None
-):
+    run: Run,
+    cal: Calibration,
+    stage: str = "C2",
+    key0: KeyLike = "C2",
+    passes: int | None = None,
+) -> tuple[NDArray[np.int_], Floats]:
     """C2 (b): measure the six q, solve (5.11), turn the five controls by the result through the
     numerical mapping; repeat while the residual still decreases (:func:`_c2_stop`, bounded); a
     knob at its stop hands its tilt to a common tilt (:func:`_transfer_common_tilt`).
@@ -641,7 +670,7 @@ def c2_relative_by_equations(
     active = op.all()
     its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
-    prev_rms = None
+    prev_rms: Value = None
     for it in range(1, bound + 1):
         its = np.where(active, it, its)
         seen = judge_standard_points(
@@ -679,11 +708,11 @@ def c2_relative_by_equations(
     return its, worst
 
 
-def _height_points(run, ids) -> list[tuple[str, NDArray[np.float64]]]:
+def _height_points(run: Run, ids: Sequence[str]) -> list[tuple[str, NDArray[np.float64]]]:
     return [(i, control_point_m(run, i)) for i in ids]
 
 
-def levelling_points(run) -> tuple[str, ...]:
+def levelling_points(run: Run) -> tuple[str, ...]:
     """The height control points nearest (in plan) to standard points 3, 4, 5, 6, distinct."""
     rows = _height_points(run, [h["id"] for h in run.sheet.control_heights])
     out: list[str] = []
@@ -694,7 +723,7 @@ def levelling_points(run) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _pointings(run) -> int:
+def _pointings(run: Run) -> int:
     """Fusings per height reading in C3: the setup method's ``REPEAT_POINTINGS`` with the
     operator's practice (remedy CR1), one with the book's."""
     return REPEAT_POINTINGS if getattr(run, "remedial", False) else 1
@@ -706,8 +735,14 @@ CR2 = "CR2 C3: refine the relative orientation only where q fails, then check th
 
 
 def _slip_and_read_heights(
-    run, rows, heights, key: NoiseKey, active, pointings: int, remedy: str = ""
-):
+    run: Run,
+    rows: Sequence[tuple[str, Floats]],
+    heights: Sequence[tuple[str, Floats]],
+    key: NoiseKey,
+    active: Active,
+    pointings: int,
+    remedy: str = "",
+) -> list[Value]:
     """Fuse on the first levelling point, slip the height scale there (on the mean of
     ``pointings`` readings where ``pointings`` > 1), then read every other control height (the
     mean of ``pointings``) and log it against H/3000. Trials not ``active`` keep their scale.
@@ -742,8 +777,15 @@ def _slip_and_read_heights(
 
 
 def _level(
-    run, cal: Calibration, rows, key: NoiseKey, active, pointings: int, it: int, remedy: str = ""
-):
+    run: Run,
+    cal: Calibration,
+    rows: Sequence[tuple[str, Floats]],
+    key: NoiseKey,
+    active: Mask,
+    pointings: int,
+    it: int,
+    remedy: str = "",
+) -> list[Value]:
     """Read the levelling points' heights (each the mean of ``pointings`` fusings), log them
     against the first, fit offset + common tilts φ_α, φ_ω (``cal.level_weights``) and turn the
     common tilts by −φ for the ``active`` trials. Returns the heights against the first. [m]"""
@@ -765,7 +807,7 @@ def _level(
         fields = {"axis": name, "phi_mrad": float(np.ravel(phi)[0]) * 1e3}
         turn_common_tilt(
             run, combo, phi, key.at(name), active, _LEVEL_LINE, fields=fields,
-            turn=lambda c, target, on: _turn(op, c, target, on), unit_of=_transfer_unit,
+            turn=_turner(op), unit_of=_transfer_unit,
             iteration=it, remedy=remedy, when=when,
         )  # fmt: skip
     return resid
@@ -773,7 +815,9 @@ def _level(
 
 # long: the book's items of absolute orientation (scale, levelling, repeated relative orientation,
 # final levelling) in their order, one bounded loop; split, the loop state would pass through each.
-def _scale_on_two_points(run, a, b, d_true: float, active, it: int) -> None:
+def _scale_on_two_points(
+    run: Run, a: tuple[str, Floats], b: tuple[str, Floats], d_true: float, active: Mask, it: int
+) -> None:
     """C3's scale with ``sheet_on="corners"``: the two plan control points farthest apart,
     their counter distance against the ground distance/M_г, b_x in proportion. [mm]"""
     bx, new, d_model = scale_by_two_points(run, a, b, d_true, C3.at(it), active)
@@ -784,10 +828,10 @@ def _scale_on_two_points(run, a, b, d_true: float, active, it: int) -> None:
 
 
 def c3_absolute(
-    run,
+    run: Run,
     cal: Calibration,
     level_ids: tuple[str, ...],
-    relative_fn=None,
+    relative_fn: Relative | None = None,
     sheet_on: str = "control",
 ) -> None:
     """C3: absolute orientation by control points, iterated until the levelling points agree in
@@ -853,7 +897,14 @@ def c3_absolute(
     _c3_operator_checks(run, cal, rows, heights, relative_fn, _pointings(run))
 
 
-def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) -> None:
+def _c3_operator_checks(
+    run: Run,
+    cal: Calibration,
+    rows: Sequence[tuple[str, Floats]],
+    heights: Sequence[tuple[str, Floats]],
+    relative_fn: Relative | None,
+    pointings: int,
+) -> None:
     """The end of C3 with the operator's practice. The control heights are first read once, as
     the book does; where one misses H/3000 the operator slips and reads them all again, each the
     mean of ``pointings`` fusings (CR1: one reading has σ_p·H/b = 0.19 m at pair60, 0.39 m at
@@ -894,7 +945,9 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
     run.record_remedy(CR2, name_q, q_failed, rounds)
 
 
-def _masked(run, active, relative_fn, cal, key0):
+def _masked(
+    run: Run, active: Mask, relative_fn: Relative, cal: Calibration, key0: NoiseKey
+) -> tuple[NDArray[np.int_], Floats]:
     """The relative orientation for the trials still ``active`` only (the others stay): run on
     those trials alone (:func:`~stereoplotter.procedure.compaction.compacted`), masked within.
     Returns its iterations and worst |q| (0 and NaN where not ``active``)."""
@@ -902,15 +955,15 @@ def _masked(run, active, relative_fn, cal, key0):
         op = cut.run.op
         saved = op.all
         on = cut.active
-        op.all = lambda: on.copy()
+        op.all = lambda: on.copy()  # type: ignore[method-assign]  # the masked trials are "all"
         try:
             its, worst = relative_fn(cut.run, cal, stage="C3", key0=key0)
         finally:
-            op.all = saved
+            op.all = saved  # type: ignore[method-assign]
     return cut.put(np.zeros(np.shape(active), int), its), cut.put(run.op.v(np.nan), worst)
 
 
-def run_conventional_method(run, relative: str = "elements", sheet_on: str = "control"):
+def run_conventional_method(run: Run, relative: str = "elements", sheet_on: str = "control") -> Run:
     """The conventional method on a virtual instrument: C1–C4 in order.
 
     Parameters

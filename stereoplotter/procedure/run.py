@@ -100,6 +100,10 @@ class Run:
         once per run).
     fidelity : Fidelity
         The mechanism switches (:mod:`~stereoplotter.procedure.fidelity`).
+    calibration : Calibration or None
+        The conventional method's calibration of the instrument's response
+        (:class:`~stereoplotter.procedure.conventional.Calibration`, found after C1; None
+        otherwise).
     """
 
     op: Operator
@@ -114,6 +118,7 @@ class Run:
     heights: ControlHeights | None = None
     level: LevelDesign | None = None
     fidelity: Fidelity = field(default_factory=Fidelity)
+    calibration: Any = None
     readings: SheetReadings = field(init=False)
 
     def __post_init__(self) -> None:
