@@ -280,7 +280,13 @@ class Look:
         return self.fn(value)
 
 
-def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: float = 1e-6):
+def solve_1d(
+    fun: Callable[[Any], Any],
+    x0: ArrayLike,
+    target: ArrayLike,
+    iterations: int = 6,
+    h: float = 1e-6,
+) -> NDArray[np.float64]:
     """x with fun(x) = target by a fixed number of Newton steps (central differences).
 
     A fixed count (no early exit) keeps a vectorised run and a per-trial loop bit-identical.
@@ -422,12 +428,13 @@ class Scene:
         key = pts.tobytes() + repr(pts.shape).encode()
         known = self._images.get(key)
         if known is None:  # the few control points a procedure fuses on, again and again
-            known = tuple(
-                photo_points_mm(self.camera, self.photo(n), pts) for n in ("left", "right")
+            known = (
+                photo_points_mm(self.camera, self.photo("left"), pts),
+                photo_points_mm(self.camera, self.photo("right"), pts),
             )
             if pts.size <= 30:
                 self._images[key] = known
-        out = tuple(a.copy() for a in known)
+        out = (known[0].copy(), known[1].copy())
         for a in out if read_only else ():
             a.setflags(write=False)
         return out
@@ -536,7 +543,7 @@ class Operator:
             self._flag_stopped(control, (reading < low) | (reading > high))
         return out
 
-    def _stop_readings(self, control: ScrewName) -> tuple[NDArray, NDArray]:
+    def _stop_readings(self, control: ScrewName) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The readings of the two stops of a lead screw (low, high), cached."""
         stops = self._stops.get(control)
         if stops is None:
@@ -558,7 +565,7 @@ class Operator:
     def physical(self, control: DrivenControl) -> NDArray[np.float64]:
         """Where a control physically is (what the eye judges in the eyepiece)."""
         if control in SCREWS:
-            now = self.inst.position(control)  # a copy of the carriages
+            now: Any = self.inst.position(control)  # a copy of the carriages
             return now if self.trials and np.shape(now) == (self.trials,) else self.v(now)
         if control_kind(control) == "cassette":
             return self.v(self.inst.unit(control_side(control)).kappa)
@@ -583,7 +590,7 @@ class Operator:
         if not np.any(active):
             return
         if self.trials and control in SCREWS:  # a lead screw over T trials: the fast path
-            screw = cast(ScrewName, control)
+            screw = control
             target = np.asarray(target, float)  # only read: no copy of a (T,) target
             if target.shape != (self.trials,):
                 target = self.v(target)
@@ -605,7 +612,7 @@ class Operator:
                 self.commanded[control] = cmd
             else:
                 cmd = self.commanded.get(control, now) + err
-                self.inst.set(control, cmd)
+                self.inst.set(cast(CassetteName, control), cmd)
                 self.commanded[control] = cmd
 
     # --- looking ------------------------------------------------------------------------------
@@ -659,23 +666,23 @@ class Operator:
             if axis == "X":
                 eta = (np.asarray(car["Y"], float) - sy) / n
 
-                def seen(value, eta=eta, comp=comp):
-                    return umap.photo_xy((np.asarray(value, float) - sx) / n, eta)[comp]
+                def seen(value: Any, other: Any = eta, comp: int = comp) -> Any:
+                    return umap.photo_xy((np.asarray(value, float) - sx) / n, other)[comp]
             else:
                 xi = (np.asarray(car["X"], float) - sx) / n
 
-                def seen(value, xi=xi, comp=comp):
-                    return umap.photo_xy(xi, (np.asarray(value, float) - sy) / n)[comp]
+                def seen(value: Any, other: Any = xi, comp: int = comp) -> Any:
+                    return umap.photo_xy(other, (np.asarray(value, float) - sy) / n)[comp]
 
             car[axis] = solve_1d(seen, car[axis], target[..., comp], iterations=4, h=1e-3)
         for axis in free:
-            self.drive(axis, car[axis], active)
+            self.drive(cast(ScrewName, axis), car[axis], active)
         return e
 
     def fuse(
         self,
         points_m: ArrayLike,
-        images: tuple[NDArray, NDArray],
+        images: tuple[NDArray[np.float64], NDArray[np.float64]],
         key: KeyLike,
         active: NDArray[np.bool_] | None = None,
         move: bool = True,
@@ -696,7 +703,12 @@ class Operator:
             self.inst.setting,
         )
         if move:
-            for axis, value in (("X", r.x_mm), ("Y", r.y_mm), ("Z", r.depth_mm)):
+            moves: tuple[tuple[ScrewName, Any], ...] = (
+                ("X", r.x_mm),
+                ("Y", r.y_mm),
+                ("Z", r.depth_mm),
+            )
+            for axis, value in moves:
                 self.drive(axis, value, active)
         return r.y_parallax_mm + eq, r.y_parallax_mm
 
@@ -712,7 +724,7 @@ class Operator:
         are computed once.
         """
         side = control_side(control)
-        other = "right" if side == "left" else "left"
+        other: Side = "right" if side == "left" else "left"
         pts = {"left": np.asarray(images[0], float), "right": np.asarray(images[1], float)}
         setting = self.inst.setting
         fixed = self.unit_map(other).rod_xy(pts[other][..., 0], pts[other][..., 1])
@@ -721,16 +733,16 @@ class Operator:
         cassette = control_kind(control) == "cassette"
         if cassette:
 
-            def turned(value):
+            def turned(value: Any) -> UnitMap:
                 return base.with_kappa(value)
         else:
             axis = control_axis(control)
             linkage = self.inst.variant.linkage
 
-            def turned(value):
+            def turned(value: Any) -> UnitMap:
                 return base.with_knob(axis, value, linkage)
 
-        def q(value):
+        def q(value: Any) -> Any:
             moving = turned(value).rod_xy(x, y)
             if side == "left":
                 return rods_y_parallax(moving, fixed, setting)
@@ -741,7 +753,9 @@ class Operator:
         # x, x ± h at once
         return Look(q, stacked=not cassette and np.ndim(x) == 0 and np.ndim(y) == 0)
 
-    def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):
+    def y_parallax(
+        self, points_m: ArrayLike, images: tuple[NDArray[np.float64], NDArray[np.float64]]
+    ) -> Any:
         """The true y-parallax of the present model at ground points (no judgment). [mm]"""
         left, right = self.units()
         setting = self.inst.setting
@@ -754,7 +768,15 @@ class Operator:
             setting,
         )
 
-    def knob_for(self, knob: KnobName, unit, photo_point, rod, comp: int, target) -> NDArray:
+    def knob_for(
+        self,
+        knob: KnobName,
+        unit: CorrectionUnit,
+        photo_point: ArrayLike,
+        rod: ArrayLike,
+        comp: int,
+        target: ArrayLike,
+    ) -> NDArray[np.float64]:
         """T of ``knob`` that puts ``photo_point`` under the rod coordinate ``rod`` (axis comp).
 
         A 1-D Newton solve on the unit model with the instrument's own linkage (D1).
@@ -765,7 +787,7 @@ class Operator:
         rod = np.asarray(rod, float)
         xi, eta = rod[..., 0], rod[..., 1]
 
-        def seen(t):
+        def seen(t: Any) -> Any:
             u = turn_correction_knob(unit, axis, t, linkage=linkage)
             return UnitMap(u, trig).photo_xy(xi, eta)[comp]
 
@@ -778,7 +800,7 @@ def _given(value: float | None, derived: float) -> float:
     return derived if value is None else value
 
 
-def _column(obj):
+def _column(obj: Any) -> Any:
     """A frozen unit/setting with every per-trial field (T,) turned into a column (T, 1)."""
     changes = {}
     for f in fields(obj):
