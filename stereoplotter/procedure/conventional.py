@@ -98,6 +98,7 @@ __all__ = [
     "c4_sheet",
     "calibrate",
     "control_sensitivity",
+    "conventional_steps",
     "run_conventional_method",
 ]
 
@@ -986,15 +987,47 @@ def run_conventional_method(run: Run, relative: str = "elements", sheet_on: str 
         raise StereoplotterError(
             f"relative: expected one of {', '.join(RELATIVE_OPTIONS)}, found {relative!r}"
         )
-    c1_interior(run)
-    level_ids = levelling_points(run)
-    cal = calibrate(run, level_ids)
-    run.calibration = cal
-    relative_fn = c2_relative_by_elements if relative == "elements" else c2_relative_by_equations
-    its, worst = relative_fn(run, cal)
+    perform_all(run, conventional_steps(relative, sheet_on))
+    return run
+
+
+def _calibration(run: Run) -> Calibration:
+    """The run's calibration (:func:`conventional_steps` finds it after C1)."""
+    cal: Calibration = run.calibration
+    return cal
+
+
+def _calibrate(run: Run, key: NoiseKey) -> None:
+    """What the operator knows of the instrument's response (no draws): :func:`calibrate` at
+    the levelling points."""
+    run.calibration = calibrate(run, levelling_points(run))
+
+
+def _relative_orientation(run: Run, key: NoiseKey, relative_fn: Relative) -> None:
+    """C2: the relative orientation (``relative_fn``) and its ¼-mark check."""
+    its, worst = relative_fn(run, _calibration(run), key0=key)
     run.record_stage("C2", its)
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     run.check("C2: residual y-parallax (6 points)", worst, tol, iterations=its)
-    c3_absolute(run, cal, level_ids, relative_fn, sheet_on)
-    c4_sheet(run, sheet_on)
-    return run
+
+
+def conventional_steps(relative: str = "elements", sheet_on: str = "control") -> tuple[Step, ...]:
+    """The conventional method as declared steps: C1 (:data:`C1_STEPS`), the calibration, C2
+    by ``relative`` (:data:`RELATIVE_OPTIONS`), C3 and C4 with the sheet ``sheet_on``
+    (:data:`SHEET_OPTIONS`)."""
+    relative_fn = c2_relative_by_elements if relative == "elements" else c2_relative_by_equations
+
+    def absolute(run: Run, key: NoiseKey) -> None:
+        c3_absolute(run, _calibration(run), levelling_points(run), relative_fn, sheet_on)
+
+    return (
+        *C1_STEPS,
+        Act("calibrate the instrument's response (no draws)", C1.at("calibration"), _calibrate),
+        Act(
+            "C2: relative orientation",
+            NoiseKey("C2"),
+            lambda run, key: _relative_orientation(run, key, relative_fn),
+        ),
+        Act("C3: absolute orientation", C3, absolute),
+        Act("C4: the sheet", NoiseKey("4"), lambda run, key: c4_sheet(run, sheet_on)),
+    )

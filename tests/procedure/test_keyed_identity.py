@@ -115,6 +115,27 @@ def test_a_declared_step_inserted_changes_no_other_result(
     assert inserted_lines == lines
 
 
+@pytest.mark.parametrize("after", ["C1_STEPS", "C2: relative orientation"])
+def test_a_step_inserted_into_the_conventional_method_changes_no_other_result(monkeypatch, after):
+    """The conventional method's declared sequence (C1, calibration, C2, C3, C4) with a dummy
+    step after C1 or after C2: every other number and transcript line as before, bit for bit."""
+    plain, lines, _ = _run_with_transcript("conventional")
+    declared = conventional.conventional_steps
+    step = Act("a dummy step", NoiseKey("dummy"), _declared_dummy)
+
+    def with_dummy(*args, **kwargs):
+        steps = declared(*args, **kwargs)
+        names = [getattr(s, "name", "") for s in steps]
+        at = len(conventional.C1_STEPS) if after == "C1_STEPS" else names.index(after) + 1
+        return (*steps[:at], step, *steps[at:])
+
+    monkeypatch.setattr(conventional, "conventional_steps", with_dummy)
+    inserted, inserted_lines, dummies = _run_with_transcript("conventional")
+    assert dummies == 1
+    assert [k for k in plain if plain[k] != inserted[k]] == []
+    assert inserted_lines == lines
+
+
 def _linear_rows(monkeypatch, insert: bool) -> list[dict]:
     specs = table.row_entries
 
