@@ -14,18 +14,30 @@ A single run (no trial axis) is trial 0 of the same streams.
 from __future__ import annotations
 
 import zlib
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["BLOCK", "key_code", "keyed_draws", "keyed_standard_normal"]
+__all__ = ["BLOCK", "key_code", "keyed_draws", "keyed_standard_normal", "stream_key"]
 
 #: Trials per keyed block (a convention: large enough that a block's generator costs little per
 #: trial, small enough that a per-trial oracle draws few unused numbers).
 BLOCK = 4096
 
 Draw = Callable[[np.random.Generator, int], NDArray[np.float64]]
+
+
+def stream_key(parts: Iterable[str | int]) -> str:
+    """The key of the stream of a declared identity: its parts, in their declared order, joined
+    by "/" (the one encoding; an identity's parts must not contain "/").
+
+    Examples
+    --------
+    >>> stream_key(("mono", "2", 1, "left", "omega", "knob"))
+    'mono/2/1/left/omega/knob'
+    """
+    return "/".join(str(part) for part in parts)
 
 
 def key_code(key: str) -> int:

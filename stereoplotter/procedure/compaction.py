@@ -28,12 +28,12 @@ import copy
 import dataclasses
 from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.procedure.operator import Noise
+from stereoplotter.procedure.operator import DrivenControl, Noise
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.transcript import Transcript
 
@@ -115,7 +115,7 @@ def _take(value: Any, index: NDArray[np.intp], trials: int, memo: Memo | None = 
     if isinstance(value, np.ndarray):
         if not (value.ndim and value.shape[0] == trials):
             return value
-        out = value[index]
+        out: Any = value[index]
     elif isinstance(value, dict):
         out = {k: _take(v, index, trials, memo) for k, v in value.items()}
     elif isinstance(value, list | tuple) and not hasattr(value, "_fields"):
@@ -193,7 +193,7 @@ def scatter(
 
 
 def _sub_run(run: Run, index: NDArray[np.intp], memo: Memo) -> Run:
-    op, trials = run.op, run.op.trials
+    op, trials = run.op, cast(int, run.op.trials)  # a run of trials (compacted() checks)
     inst = copy.copy(op.inst)
     for name, value in vars(op.inst).items():
         if name not in _FIXED and name not in _CACHES:
@@ -224,7 +224,7 @@ def _sub_run(run: Run, index: NDArray[np.intp], memo: Memo) -> Run:
 
 
 def _merge(run: Run, sub: Run, index: NDArray[np.intp], memo: Memo) -> None:
-    op, trials = run.op, run.op.trials
+    op, trials = run.op, cast(int, run.op.trials)  # a run of trials (compacted() checks)
     for name, value in vars(sub.op.inst).items():
         if name in _FIXED or name in _CACHES or name == "trials":
             continue
@@ -233,11 +233,11 @@ def _merge(run: Run, sub: Run, index: NDArray[np.intp], memo: Memo) -> None:
     for control, value in sub.op.commanded.items():
         old = op.commanded.get(control)
         if old is None:  # first turned in the sub-run (a knob, a cassette): the others are
-            old = op.physical(control)  # where they physically are, as ``drive`` takes them
+            old = op.physical(cast(DrivenControl, control))  # where they physically are
         op.commanded[control] = scatter(old, value, index, trials, memo)
     for control, value in sub.op.stopped.items():
-        old = op.stopped.get(control, np.zeros(trials, bool))
-        op.stopped[control] = scatter(old, value, index, trials, memo)
+        was = op.stopped.get(control, np.zeros(trials, np.bool_))
+        op.stopped[control] = scatter(was, value, index, trials, memo)
     # the stops' readings: a cache of the scales, the parent's own where it has them
     op._stops = {
         k: scatter(v, sub.op._stops[k], index, trials, memo) if k in sub.op._stops else v
@@ -253,8 +253,12 @@ class Cut:
     """A compacted round: ``run`` (the sub-run), ``active`` (its mask), ``take`` and ``put``."""
 
     def __init__(
-        self, run: Run, active: NDArray[np.bool_], index: NDArray[np.intp] | None, trials: int
-    ):
+        self,
+        run: Run,
+        active: NDArray[np.bool_],
+        index: NDArray[np.intp] | None,
+        trials: int | None,
+    ) -> None:
         self.run = run
         self.active = active
         self.index = index
@@ -264,24 +268,30 @@ class Cut:
         """A per-trial array of the whole run cut to the sub-run's trials."""
         if self.index is None:
             return value
-        return _take(value, self.index, self._trials)
+        return _take(value, self.index, cast(int, self._trials))
 
     def put(self, whole: Any, part: Any) -> NDArray[Any]:
         """``whole`` (over the run's trials) with the sub-run's *active* trials replaced by
         ``part`` (``np.where(active, part, whole)`` of the masked round)."""
         mask = np.asarray(self.active, bool)
-        part, whole = np.asarray(part), np.asarray(whole)
+        part_a: NDArray[Any] = np.asarray(part)
+        whole_a: NDArray[Any] = np.asarray(whole)
         if self.index is None:
-            ndim = max(part.ndim, whole.ndim)
-            return np.where(mask.reshape(mask.shape + (1,) * (ndim - mask.ndim)), part, whole)
-        return scatter(whole, part[mask], self.index[mask], self._trials)
+            ndim = max(part_a.ndim, whole_a.ndim)
+            shape = mask.shape + (1,) * (ndim - mask.ndim)
+            return np.where(mask.reshape(shape), part_a, whole_a)
+        trials = cast(int, self._trials)
+        out: NDArray[Any] = scatter(whole_a, part_a[mask], self.index[mask], trials)
+        return out
 
     def put_all(self, whole: Any, part: Any) -> NDArray[Any]:
         """``whole`` with every trial of the sub-run replaced by ``part`` (active or not: a
         value the masked round computed for all its trials), ``part`` itself uncut."""
         if self.index is None:
             return np.asarray(part)
-        return scatter(np.asarray(whole), np.asarray(part), self.index, self._trials)
+        trials = cast(int, self._trials)
+        out: NDArray[Any] = scatter(np.asarray(whole), np.asarray(part), self.index, trials)
+        return out
 
 
 @contextmanager

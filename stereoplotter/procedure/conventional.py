@@ -27,8 +27,9 @@ Reference
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -41,13 +42,15 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.virtual import (
-    CONTROL_INFO,
     HEIGHT_SCALE,
     NOMINAL_ZERO,
+    CassetteName,
+    KnobName,
     control_axis,
     control_kind,
     control_side,
 )
+from stereoplotter.procedure.arrays import Active, Floats, Mask, Value
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.conventional_sheet import (
     SHEET_OPTIONS,
@@ -55,11 +58,22 @@ from stereoplotter.procedure.conventional_sheet import (
     plotted_control,
     scale_on_plotted_control,
 )
-from stereoplotter.procedure.operator import solve_1d
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
+from stereoplotter.procedure.operator import DrivenControl, Operator, solve_1d
 from stereoplotter.procedure.relative_equations import (
     overcorrection_factor,
     relative_orientation_from_standard_points,
     y_parallax_first_order,
+)
+from stereoplotter.procedure.run import Run
+from stereoplotter.procedure.step_values import (
+    KNOB_AT_STOP,
+    Act,
+    Line,
+    SetStep,
+    Step,
+    perform_all,
+    turn_common_tilt,
 )
 from stereoplotter.procedure.steps import (
     REPEAT_POINTINGS,
@@ -67,7 +81,7 @@ from stereoplotter.procedure.steps import (
     fixed_order_sum,
     fuse_and_read,
     height_mean,
-    interior_orientation,
+    interior_steps,
     judge_standard_points,
     scale_by_two_points,
     scale_pair,
@@ -76,6 +90,7 @@ from stereoplotter.procedure.steps import (
 )
 
 __all__ = [
+    "C1_STEPS",
     "ELEMENTS",
     "RELATIVE_OPTIONS",
     "SHEET_OPTIONS",
@@ -83,14 +98,19 @@ __all__ = [
     "c4_sheet",
     "calibrate",
     "control_sensitivity",
+    "conventional_steps",
     "run_conventional_method",
 ]
+
+#: A way of relative orientation (:func:`c2_relative_by_elements`,
+#: :func:`c2_relative_by_equations`): its iterations and the worst |q| seen last, per trial.
+Relative = Callable[..., tuple[NDArray[np.int_], Floats]]
 
 #: The two ways of relative orientation offered (``procedure.md``, the conventional method).
 RELATIVE_OPTIONS = ("elements", "equations")
 
 #: Book element (basis system, (5.10)) → the instrument control that realises it.
-ELEMENTS = {
+ELEMENTS: dict[str, CassetteName | KnobName] = {
     "alpha1": "k_alpha_left",
     "alpha2": "k_alpha_right",
     "omega2": "k_omega_right",
@@ -117,6 +137,56 @@ _CONTROLS = (
 
 #: Unit of a control's line in the transcript of a common tilt (the cassettes' turns: none).
 _TRANSFER_UNIT = {"screw": "mm", "knob": "tan"}
+
+
+def _transfer_unit(control: str) -> str:
+    """The unit a common tilt's record of ``control`` shows (:data:`_TRANSFER_UNIT`)."""
+    return _TRANSFER_UNIT.get(control_kind(control) or "", "—")
+
+
+#: C2's common tilt at a knob's stop, per control turned.
+_TRANSFER_LINE = Line(
+    "C2",
+    "a knob of axis {axis} at its stop: common tilt Δ{axis} = {phi_mrad:+.4f} mrad centres "
+    "the pair; turn {control}",
+    "common tilt (q-neutral)",
+    condition=KNOB_AT_STOP,
+)
+#: C2's stopping rule after a pass's six looks.
+_C2_STOP = Line("C2", "pass {pass}: RMS of the six looks {rms_um:.1f} µm — {what}", "stopping rule")
+#: C2 (a): a standard point's y-parallax cleared with the control of its element.
+_CLEAR_ELEMENT = Line(
+    "C2", "standard point {point}: clear the y-parallax with {control} ({element})", "(5.10)"
+)
+#: … with ω′₂, over-corrected by ½(f′²/c² − 1).
+_CLEAR_OVERCORRECTED = Line(
+    "C2",
+    "standard point {point}: clear the y-parallax with {control} ({element}) and over-correct "
+    "by {over:+.4f} of the turn",
+    "(5.10), ½(f²/c² − 1)",
+)
+#: C2 (b): a control turned by the element (5.11) gives.
+_TURN_BY_511 = Line(
+    "C2", "{element} = {mrad:+.4f} mrad (5.11): turn {control} by −m·{element}", "(5.11)"
+)
+#: C3: the height scale slipped on the first levelling point.
+_C3_SLIP = Line("C3", "fuse on {id}{times}, slip the height scale to H = {height:.2f} m", "stage 3")
+#: C3: a control height read against its known height.
+_C3_HEIGHT = Line("C3", "control point {id}: fuse, read the height{times}", "H/3000")
+#: C3: a levelling point's height error against the first.
+_C3_LEVEL_POINT = Line(
+    "C3", "level: control point {id}, height error against point {first}", "H/3000"
+)
+#: C3 (``sheet_on="corners"``): the scale on two points' ground distance.
+_C3_SCALE = Line(
+    "C3",
+    "scale: fuse on {a} and {b}, model distance against {d:.3f} mm; turn b_x in proportion",
+    "scale by b_x",
+)
+#: C3's levelling turn of a control by its rate × the common tilt φ.
+_LEVEL_LINE = Line(
+    "C3", "common tilt Δ{axis} = {phi_mrad:+.4f} mrad: turn {control}", "levelling (assumption)"
+)
 
 
 def _perturb(
@@ -231,11 +301,13 @@ class Calibration:
     level_weights: NDArray[np.float64]
 
 
-def _dot(a, b) -> float:
+def _dot(a: ArrayLike, b: ArrayLike) -> float:
     return float(np.dot(np.asarray(a, float), np.asarray(b, float)))
 
 
-def _null_q(j, fixed: dict[str, float], free: tuple[str, ...]) -> dict[str, float]:
+def _null_q(
+    j: dict[str, Floats], fixed: dict[str, float], free: tuple[str, ...]
+) -> dict[str, float]:
     """Turns of the ``free`` controls that cancel the q of the ``fixed`` turns (least squares)."""
     rhs = -sum(j[k] * v for k, v in fixed.items())
     a = np.column_stack([j[k] for k in free])
@@ -243,7 +315,7 @@ def _null_q(j, fixed: dict[str, float], free: tuple[str, ...]) -> dict[str, floa
     return {**fixed, **{k: float(v) for k, v in zip(free, sol, strict=True)}}
 
 
-def calibrate(run, level_ids: tuple[str, ...]) -> Calibration:
+def calibrate(run: Run, level_ids: tuple[str, ...]) -> Calibration:
     """The numerical sensitivities of the nominal instrument (sheet f_пр, b_x, b_y; b_z′ = 0;
     units at zero) at the six standard points and at the levelling points.
 
@@ -291,7 +363,8 @@ def calibrate(run, level_ids: tuple[str, ...]) -> Calibration:
         _, dd = control_sensitivity(limgs, setting, unit, unit, combo, linkage=linkage)
         cols.append(-dd * mv / 1000.0)
     design = np.column_stack(cols)
-    return Calibration(mapping, fit, common_alpha, common_omega, design, np.linalg.pinv(design))
+    weights = cast(Floats, np.linalg.pinv(design))
+    return Calibration(mapping, fit, common_alpha, common_omega, design, weights)
 
 
 # --------------------------------------------------------------------------------------------
@@ -299,6 +372,8 @@ def calibrate(run, level_ids: tuple[str, ...]) -> Calibration:
 # --------------------------------------------------------------------------------------------
 
 _SIDE = {"left": "л", "right": "п"}
+#: The identities of the conventional stages' draws (each act's own below its stage).
+C1, C3 = NoiseKey("C1"), NoiseKey("C3")
 _BOOK = {"alpha1": "α′₁", "alpha2": "α′₂", "omega2": "ω′₂", "kappa1": "κ′₁", "kappa2": "κ′₂"}
 
 
@@ -306,12 +381,14 @@ _BOOK = {"alpha1": "α′₁", "alpha2": "α′₂", "omega2": "ω′₂", "kapp
 _SIX_Q = "standard point {i}: fuse, judge the y-parallax"
 
 
-def _worst(values) -> NDArray[np.float64]:
-    return np.max(np.abs(np.stack(values, axis=-1)), axis=-1)
+def _worst(values: Sequence[Value]) -> NDArray[np.float64]:
+    worst: Floats = np.max(np.abs(np.stack(values, axis=-1)), axis=-1)
+    return worst
 
 
-def _rms(values) -> NDArray[np.float64]:
-    return np.sqrt(np.mean(np.square(np.stack(values, axis=-1)), axis=-1))
+def _rms(values: Sequence[Value]) -> NDArray[np.float64]:
+    rms: Floats = np.sqrt(np.mean(np.square(np.stack(values, axis=-1)), axis=-1))
+    return rms
 
 
 #: C2 stopping rule: a pass whose RMS of the six looks is above this fraction of the previous
@@ -328,12 +405,14 @@ DECREASE_RATIO = 0.5
 BOUND_FACTOR = 2
 
 
-def _bound(op) -> int:
+def _bound(op: Operator) -> int:
     """The bound of a conventional loop (:data:`BOUND_FACTOR` × ``max_iterations``)."""
     return BOUND_FACTOR * op.model.max_iterations
 
 
-def _c2_stop(run, stage: str, it: int, seen, prev_rms, active):
+def _c2_stop(
+    run: Run, stage: str, it: int, seen: Sequence[Value], prev_rms: Value, active: Mask
+) -> tuple[Floats, Mask]:
     """The operator's judgment after the six looks of pass ``it``: go on while the residual
     y-parallax still decreases (RMS of the six looks ≤ :data:`DECREASE_RATIO` × the previous
     pass's), stop when it no longer does — further passes would chase the judgment error or the
@@ -360,18 +439,13 @@ def _c2_stop(run, stage: str, it: int, seen, prev_rms, active):
         what = f"ratio {r0:.2f} ≤ {DECREASE_RATIO}: still decreasing"
     if bound and not bool(np.ravel(done)[0]):
         what += f"; bound of {it} passes reached, stop"
-    op.log.add(
-        stage,
-        f"pass {it}: RMS of the six looks {q0:.1f} µm — {what}",
-        "",
-        residual=rms,
-        iteration=it,
-        equation="stopping rule",
+    _C2_STOP.in_stage(stage).log(
+        op, "", {"pass": it, "rms_um": q0, "what": what}, residual=rms, iteration=it
     )
     return rms, done & active
 
 
-def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
+def _transfer_common_tilt(run: Run, cal: Calibration, active: Mask, stage: str, it: int) -> Mask:
     """A correction knob at its stop: move the model by a common tilt
     (:class:`Calibration` ``common_alpha`` / ``common_omega``, q-neutral to first order) that
     centres the pair of knobs of that axis, so the relative orientation has room again.
@@ -386,104 +460,90 @@ def _transfer_common_tilt(run, cal: Calibration, active, stage: str, it: int):
     moved = np.zeros(np.shape(active), bool)
     if stage != "C2":  # in C3 the knobs hold the levelling: a common tilt would undo it
         return moved
-    for name, combo, pair in (
+    axes: tuple[tuple[str, dict[str, float], tuple[KnobName, KnobName]], ...] = (
         ("α", cal.common_alpha, ("k_alpha_left", "k_alpha_right")),
         ("ω", cal.common_omega, ("k_omega_left", "k_omega_right")),
-    ):
+    )
+    for name, combo, pair in axes:
         now = [op.physical(c) for c in pair]
         near = active & ((np.abs(now[0]) >= 0.999 * hi) | (np.abs(now[1]) >= 0.999 * hi))
         if not np.any(near):
             continue
         moved = moved | near
+        key = NoiseKey(stage).at(it, f"transfer{name}")
         phi = np.where(near, -(now[0] + now[1]) / (combo[pair[0]] + combo[pair[1]]), 0.0)
-        for control, rate in combo.items():
-            if control in ("by", "bz"):
-                before = op.read(control, f"{stage}/{it}/transfer{name}/{control}")
-                after = before + rate * phi
-                op.set(control, after, f"{stage}/{it}/transfer{name}/set{control}", near)
-            else:
-                before = op.physical(control)
-                _turn(op, control, before + rate * phi, near)
-                after = op.physical(control)
-            op.log.add(
-                stage,
-                f"a knob of axis {name} at its stop: common tilt "
-                f"Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad centres the pair; "
-                f"turn {control}",
-                control,
-                before=before,
-                after=after,
-                unit=_TRANSFER_UNIT.get(control_kind(control), "—"),
-                iteration=it,
-                equation="common tilt (q-neutral)",
-            )
+        fields = {"axis": name, "phi_mrad": float(np.ravel(phi)[0]) * 1e3}
+        turn_common_tilt(
+            run, combo, phi, key, near, _TRANSFER_LINE, fields=fields,
+            turn=_turner(op), unit_of=_transfer_unit,
+            iteration=it,
+        )  # fmt: skip
     return moved
 
 
-def c1_interior(run) -> None:
-    """C1: interior orientation as in stage 1, without computed setup data.
+def _c1_left_zero(run: Run, key: NoiseKey) -> None:
+    """MO_X, MO_Y: the left mark on the left cassette centre (units at zero), read."""
+    op = run.op
+    e = op.mark_on("left", np.zeros(2), key)
+    run.zero["MO_X"] = op.read("X", key.at("X"))
+    run.zero["MO_Y"] = op.read("Y", key.at("Y"))
+    _C1_MO_X.log(op, "X", reading=run.zero["MO_X"], judgment_error=e[..., 0])
+    _C1_MO_Y.log(op, "Y", reading=run.zero["MO_Y"], judgment_error=e[..., 1])
 
-    f_пр, M_в (height-counter gear) and b_x, b_y are those of the setup sheet (one instrument and
-    scenario for the comparison); cassettes parallel (κ = 0), correction knobs and decentrations
-    at their zero places, b_z′ = 0 (decision: the conventional operator does not know the
-    exterior orientation; the levelling in C3 finds b_z′), D = n_л·f_пр, MO_b_y by the right mark
-    on the right cassette centre as in stage 1, MO_X, MO_Y with the left mark on the left cassette
-    centre (units at zero).
-    """
-    op, sheet = run.op, run.sheet
-    log = op.log
-    interior_orientation(run, "C1")
-    bx, by, _ = sheet.base_mm
-    op.set("bx", NOMINAL_ZERO["bx"] + bx, "C1/bx")
-    log.add(
-        "C1",
-        "base carriage: b_x of the sheet",
+
+_C1_MO_X = Line("C1", "left mark on the left cassette centre → MO_X", "decision D6")
+_C1_MO_Y = Line("C1", "… and MO_Y", "decision D6")
+
+
+def _c1_base_y(run: Run, key: NoiseKey) -> None:
+    """MO_by found as in stage 1, then b_y of the sheet set from it."""
+    op = run.op
+    mo_by = zero_base_y(run, "C1", key.at("MOby"))
+    by = mo_by + run.sheet.base_mm[1]
+    op.set("by", by, key.at("by"))
+    _C1_BY.log(op, "by", reading=by)
+
+
+_C1_BY = Line("C1", "base carriage: O_by = MO_by + b_y", "stage 1")
+
+#: C1: interior orientation as in stage 1, without computed setup data. f_пр, M_в (the
+#: height-counter gear) and b_x, b_y are those of the setup sheet (one instrument and scenario
+#: for the comparison); cassettes parallel (κ = 0), correction knobs and decentrations at their
+#: zero places, b_z′ = 0 (decision: the conventional operator does not know the exterior
+#: orientation; the levelling in C3 finds b_z′), D = n_л·f_пр, MO_b_y by the right mark on the
+#: right cassette centre as in stage 1, MO_X, MO_Y with the left mark on the left cassette
+#: centre (units at zero).
+C1_STEPS: tuple[Step, ...] = (
+    *interior_steps("C1"),
+    SetStep(
         "bx",
-        reading=NOMINAL_ZERO["bx"] + bx,
-        equation="stage 1",
-    )
-    op.set("bz", NOMINAL_ZERO["bz"], "C1/bz")
-    log.add(
-        "C1",
-        "b_z′ = 0 (found by the levelling, C3)",
+        lambda run: NOMINAL_ZERO["bx"] + run.sheet.base_mm[0],
+        C1.at("bx"),
+        Line("C1", "base carriage: b_x of the sheet", "stage 1"),
+    ),
+    SetStep(
         "bz",
-        reading=NOMINAL_ZERO["bz"],
-        equation="assumption",
-    )
-    depth = sheet.n_left * sheet.f_instrument_mm
-    op.set("Z", NOMINAL_ZERO["Z"] + depth, "C1/Z")
-    log.add(
-        "C1",
-        "lower the carriage to D = n_л·f_пр",
+        lambda run: NOMINAL_ZERO["bz"],
+        C1.at("bz"),
+        Line("C1", "b_z′ = 0 (found by the levelling, C3)", "assumption"),
+    ),
+    SetStep(
         "Z",
-        reading=NOMINAL_ZERO["Z"] + depth,
-        equation="(6.3)",
-    )
-    mo_by = zero_base_y(run, "C1")
-    op.set("by", mo_by + by, "C1/by")
-    log.add("C1", "base carriage: O_by = MO_by + b_y", "by", reading=mo_by + by, equation="stage 1")
-    e = op.mark_on("left", np.zeros(2), "C1/MO")
-    run.zero["MO_X"] = op.read("X", "C1/MO/X")
-    run.zero["MO_Y"] = op.read("Y", "C1/MO/Y")
-    log.add(
-        "C1",
-        "left mark on the left cassette centre → MO_X",
-        "X",
-        reading=run.zero["MO_X"],
-        judgment_error=e[..., 0],
-        equation="decision D6",
-    )
-    log.add(
-        "C1",
-        "… and MO_Y",
-        "Y",
-        reading=run.zero["MO_Y"],
-        judgment_error=e[..., 1],
-        equation="decision D6",
-    )
+        lambda run: NOMINAL_ZERO["Z"] + run.sheet.n_left * run.sheet.f_instrument_mm,
+        C1.at("Z"),
+        Line("C1", "lower the carriage to D = n_л·f_пр", "(6.3)"),
+    ),
+    Act("MO_by, then b_y", C1, _c1_base_y),
+    Act("MO_X, MO_Y", C1.at("MO"), _c1_left_zero),
+)
 
 
-def _turn(op, control: str, target, active) -> None:
+def c1_interior(run: Run) -> None:
+    """C1: :data:`C1_STEPS`."""
+    perform_all(run, C1_STEPS)
+
+
+def _turn(op: Operator, control: DrivenControl, target: Value, active: Mask) -> None:
     """Turn a knob or cassette while looking, no further than its stop (2 % short of the
     tilt limit, 1 % of the κ range): a trial that needed more is flagged in ``op.stopped``."""
     spec = op.inst.spec
@@ -500,8 +560,14 @@ def _turn(op, control: str, target, active) -> None:
     op.drive(control, np.clip(target, lo, hi), active)
 
 
+def _turner(op: Operator) -> Callable[[str, Floats, Mask], None]:
+    """:func:`_turn` on ``op``: a common tilt's turn of a knob or cassette, no further than
+    its stop."""
+    return lambda control, target, on: _turn(op, cast(DrivenControl, control), target, on)
+
+
 #: The classic sequence (``instruments.md`` §6.1): point index, control, book element.
-_SEQUENCE = (
+_SEQUENCE: tuple[tuple[int, CassetteName | KnobName, str], ...] = (
     (0, "kappa_right", "kappa2"),
     (1, "kappa_left", "kappa1"),
     (3, "k_alpha_left", "alpha1"),
@@ -511,8 +577,8 @@ _SEQUENCE = (
 
 
 def c2_relative_by_elements(
-    run, cal: Calibration | None = None, stage: str = "C2", key0: str = "C2"
-):
+    run: Run, cal: Calibration | None = None, stage: str = "C2", key0: KeyLike = "C2"
+) -> tuple[NDArray[np.int_], Floats]:
     """C2 (a): element by element — point 1 → κ_п, 2 → κ_л, 4 → α_л, 3 → α_п, 5 → ω_п with the
     over-correction ½(f′²/c² − 1); repeat while the residual y-parallax of the six looks still
     decreases (:func:`_c2_stop`, bounded); a knob at its stop hands its tilt to a common tilt
@@ -532,7 +598,7 @@ def c2_relative_by_elements(
         with compacted(run, active) as cut:  # the trials still orienting only
             on = cut.active
             ahead = None if prev_rms is None else cut.take(prev_rms)
-            seen, rms, done = _c2_pass(cut.run, stage, key0, it, on, ahead, over)
+            seen, rms, done = _c2_pass(cut.run, stage, as_key(key0), it, on, ahead, over)
             going = on & ~done
             moved = np.zeros(np.shape(on), bool)
             if cal is not None and np.any(going):
@@ -546,7 +612,9 @@ def c2_relative_by_elements(
     return its, worst
 
 
-def _c2_pass(run, stage: str, key0: str, it: int, active, prev_rms, over: float):
+def _c2_pass(
+    run: Run, stage: str, key0: NoiseKey, it: int, active: Mask, prev_rms: Value, over: float
+) -> tuple[list[Floats], Floats, Mask]:
     """Pass ``it`` of C2 (a) on ``active``: the five points cleared element by element, then the
     six looks and the stopping rule. Returns the six q seen, their RMS and the trials that stop
     (:func:`_c2_stop`)."""
@@ -555,43 +623,37 @@ def _c2_pass(run, stage: str, key0: str, it: int, active, prev_rms, over: float)
     pts = run.scene.standard_points_m
     imgs = run.scene.standard  # the standard points' true images, computed once
     for idx, control, element in _SEQUENCE:
-        key = f"{key0}/a/{it}/{idx + 1}"
+        key = key0.at("a", it, idx + 1)
         img = (imgs[0][idx], imgs[1][idx])
         q_seen, q_true = op.fuse(pts[idx], img, key, active)
-        target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+        target = op.noise.draw(key.at("clear").by("q"), op.model.y_parallax_sigma_mm)
         before = op.physical(control)
         clear = solve_1d(op.q_turning(control, img), before, target, 4, 1e-6)
-        extra = ""
+        line = _CLEAR_ELEMENT
         if element == "omega2":
             clear = before + (1.0 + over) * (clear - before)
-            extra = f" and over-correct by {over:+.4f} of the turn"
+            line = _CLEAR_OVERCORRECTED
         _turn(op, control, clear, active)
-        op.log.add(
-            stage,
-            f"standard point {idx + 1}: clear the y-parallax with {control} "
-            f"({_BOOK[element]}){extra}",
-            control,
-            before=before,
-            after=op.physical(control),
-            unit=CONTROL_INFO[control].unit,
-            judgment_error=target,
-            residual=q_seen,
-            true=q_true,
-            tolerance=tol,
-            passed=np.abs(q_seen) <= tol,
-            iteration=it,
-            equation="(5.10), ½(f²/c² − 1)" if element == "omega2" else "(5.10)",
-        )
+        line.in_stage(stage).log(
+            op, control,
+            {"point": idx + 1, "control": control, "element": _BOOK[element], "over": over},
+            before=before, after=op.physical(control), judgment_error=target, residual=q_seen,
+            true=q_true, tolerance=tol, passed=np.abs(q_seen) <= tol, iteration=it,
+        )  # fmt: skip
     seen = judge_standard_points(
-        run, stage, f"{key0}/a/{it}/check", active, iteration=it, text=_SIX_Q
+        run, stage, key0.at("a", it, "check"), active, iteration=it, text=_SIX_Q
     )
     rms, done = _c2_stop(run, stage, it, seen, prev_rms, active)
     return seen, rms, done
 
 
 def c2_relative_by_equations(
-    run, cal: Calibration, stage: str = "C2", key0: str = "C2", passes: int | None = None
-):
+    run: Run,
+    cal: Calibration,
+    stage: str = "C2",
+    key0: KeyLike = "C2",
+    passes: int | None = None,
+) -> tuple[NDArray[np.int_], Floats]:
     """C2 (b): measure the six q, solve (5.11), turn the five controls by the result through the
     numerical mapping; repeat while the residual still decreases (:func:`_c2_stop`, bounded); a
     knob at its stop hands its tilt to a common tilt (:func:`_transfer_common_tilt`).
@@ -609,11 +671,11 @@ def c2_relative_by_equations(
     active = op.all()
     its = np.zeros(np.shape(active), int)
     worst = op.v(np.nan)
-    prev_rms = None
+    prev_rms: Value = None
     for it in range(1, bound + 1):
         its = np.where(active, it, its)
         seen = judge_standard_points(
-            run, stage, f"{key0}/b/{it}", active, iteration=it, text=_SIX_Q
+            run, stage, as_key(key0).at("b", it), active, iteration=it, text=_SIX_Q
         )
         worst = np.where(active, _worst(seen), worst)
         if passes is None:
@@ -634,27 +696,24 @@ def c2_relative_by_equations(
         for element, control in ELEMENTS.items():
             before = op.physical(control)
             _turn(op, control, before - cal.mapping[element] * el[element], active)
-            op.log.add(
-                stage,
-                f"{_BOOK[element]} = {float(np.ravel(el[element])[0]) * 1e3:+.4f} mrad (5.11): "
-                f"turn {control} by −m·{_BOOK[element]}",
-                control,
-                before=before,
-                after=op.physical(control),
-                unit=CONTROL_INFO[control].unit,
-                iteration=it,
-                equation="(5.11)",
+            fields = {
+                "element": _BOOK[element],
+                "mrad": float(np.ravel(el[element])[0]) * 1e3,
+                "control": control,
+            }
+            _TURN_BY_511.in_stage(stage).log(
+                op, control, fields, before=before, after=op.physical(control), iteration=it
             )
         moved = _transfer_common_tilt(run, cal, active, stage, it)
         prev_rms = np.where(moved, np.nan, prev_rms)
     return its, worst
 
 
-def _height_points(run, ids) -> list[tuple[str, NDArray[np.float64]]]:
+def _height_points(run: Run, ids: Sequence[str]) -> list[tuple[str, NDArray[np.float64]]]:
     return [(i, control_point_m(run, i)) for i in ids]
 
 
-def levelling_points(run) -> tuple[str, ...]:
+def levelling_points(run: Run) -> tuple[str, ...]:
     """The height control points nearest (in plan) to standard points 3, 4, 5, 6, distinct."""
     rows = _height_points(run, [h["id"] for h in run.sheet.control_heights])
     out: list[str] = []
@@ -665,7 +724,7 @@ def levelling_points(run) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _pointings(run) -> int:
+def _pointings(run: Run) -> int:
     """Fusings per height reading in C3: the setup method's ``REPEAT_POINTINGS`` with the
     operator's practice (remedy CR1), one with the book's."""
     return REPEAT_POINTINGS if getattr(run, "remedial", False) else 1
@@ -676,7 +735,15 @@ CR1 = "CR1 C3: read the control heights as the mean of several fusings"
 CR2 = "CR2 C3: refine the relative orientation only where q fails, then check the heights again"
 
 
-def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int, remedy: str = ""):
+def _slip_and_read_heights(
+    run: Run,
+    rows: Sequence[tuple[str, Floats]],
+    heights: Sequence[tuple[str, Floats]],
+    key: NoiseKey,
+    active: Active,
+    pointings: int,
+    remedy: str = "",
+) -> list[Value]:
     """Fuse on the first levelling point, slip the height scale there (on the mean of
     ``pointings`` readings where ``pointings`` > 1), then read every other control height (the
     mean of ``pointings``) and log it against H/3000. Trials not ``active`` keep their scale.
@@ -687,122 +754,85 @@ def _slip_and_read_heights(run, rows, heights, key: str, active, pointings: int,
     tol = run.sheet.tolerances["control_height_m"]
     pid0, p0 = rows[0]
     if pointings == 1:
-        fuse_and_read(run, p0, f"{key}/slip/{pid0}", active, ())
+        fuse_and_read(run, p0, key.at("slip", pid0), active, ())
         op.inst.slip_height_scale(p0[2])
     else:
-        slip_height_scale_on_mean(run, p0, f"{key}/slip/{pid0}", active, pointings)
+        slip_height_scale_on_mean(run, p0, key.at("slip", pid0), active, pointings)
     times = f" ({pointings} times, mean)" if pointings > 1 else ""
-    op.log.add(
-        "C3",
-        f"fuse on {pid0}{times}, slip the height scale to H = {p0[2]:.2f} m",
-        HEIGHT_SCALE,
-        reading=p0[2],
-        unit="m",
-        equation="stage 3",
-        remedy=remedy,
-        when=active,
-    )
+    _C3_SLIP.log(
+        op, HEIGHT_SCALE, {"id": pid0, "times": times, "height": p0[2]},
+        reading=p0[2], remedy=remedy, when=active,
+    )  # fmt: skip
     errs = []
     for pid, p in heights:
         if pid == pid0:
             continue
-        read = height_mean(run, p, f"{key}/h/{pid}", active, pointings)
+        read = height_mean(run, p, key.at("h", pid), active, pointings)
         errs.append(read - p[2])
-        op.log.add(
-            "C3",
-            f"control point {pid}: fuse, read the height{times}",
-            HEIGHT_SCALE,
-            reading=read,
-            unit="m",
-            residual=read - p[2],
-            tolerance=tol,
-            passed=np.abs(read - p[2]) <= tol,
-            equation="H/3000",
-            remedy=remedy,
-            when=active,
-        )
+        _C3_HEIGHT.log(
+            op, HEIGHT_SCALE, {"id": pid, "times": times},
+            reading=read, residual=read - p[2], tolerance=tol, passed=np.abs(read - p[2]) <= tol,
+            remedy=remedy, when=active,
+        )  # fmt: skip
     return errs
 
 
 def _level(
-    run, cal: Calibration, rows, key: str, active, pointings: int, it: int, remedy: str = ""
-):
+    run: Run,
+    cal: Calibration,
+    rows: Sequence[tuple[str, Floats]],
+    key: NoiseKey,
+    active: Mask,
+    pointings: int,
+    it: int,
+    remedy: str = "",
+) -> list[Value]:
     """Read the levelling points' heights (each the mean of ``pointings`` fusings), log them
     against the first, fit offset + common tilts φ_α, φ_ω (``cal.level_weights``) and turn the
     common tilts by −φ for the ``active`` trials. Returns the heights against the first. [m]"""
     op = run.op
     tol = run.sheet.tolerances["control_height_m"]
     when = active if remedy else None  # the book's loop logs every iteration as before
-    errs = [height_mean(run, p, f"{key}/level/{pid}", active, pointings) - p[2] for pid, p in rows]
+    errs = [height_mean(run, p, key.at("level", pid), active, pointings) - p[2] for pid, p in rows]
     resid = [e - errs[0] for e in errs]
     for (pid, _), r, e in zip(rows, resid, errs, strict=True):
-        op.log.add(
-            "C3",
-            f"level: control point {pid}, height error against point {rows[0][0]}",
-            HEIGHT_SCALE,
-            reading=e,
-            unit="m",
-            residual=r,
-            tolerance=tol,
-            passed=np.abs(r) <= tol,
-            iteration=it,
-            equation="H/3000",
-            remedy=remedy,
-            when=when,
-        )
+        _C3_LEVEL_POINT.log(
+            op, HEIGHT_SCALE, {"id": pid, "first": rows[0][0]},
+            reading=e, residual=r, tolerance=tol, passed=np.abs(r) <= tol, iteration=it,
+            remedy=remedy, when=when,
+        )  # fmt: skip
     w = cal.level_weights
     phi_a = -fixed_order_sum(w[1, i] * e for i, e in enumerate(errs))
     phi_o = -fixed_order_sum(w[2, i] * e for i, e in enumerate(errs))
     for name, phi, combo in (("α", phi_a, cal.common_alpha), ("ω", phi_o, cal.common_omega)):
-        for control, rate in combo.items():
-            if control in ("by", "bz"):
-                before = op.read(control, f"{key}/{name}/{control}")
-                op.set(control, before + rate * phi, f"{key}/{name}/set{control}", active)
-                after = before + rate * phi
-            else:
-                before = op.physical(control)
-                _turn(op, control, before + rate * phi, active)
-                after = op.physical(control)
-            op.log.add(
-                "C3",
-                f"common tilt Δ{name} = {float(np.ravel(phi)[0]) * 1e3:+.4f} mrad: turn {control}",
-                control,
-                before=before,
-                after=after,
-                unit=_TRANSFER_UNIT.get(control_kind(control), "—"),
-                iteration=it,
-                equation="levelling (assumption)",
-                remedy=remedy,
-                when=when,
-            )
+        fields = {"axis": name, "phi_mrad": float(np.ravel(phi)[0]) * 1e3}
+        turn_common_tilt(
+            run, combo, phi, key.at(name), active, _LEVEL_LINE, fields=fields,
+            turn=_turner(op), unit_of=_transfer_unit,
+            iteration=it, remedy=remedy, when=when,
+        )  # fmt: skip
     return resid
 
 
 # long: the book's items of absolute orientation (scale, levelling, repeated relative orientation,
 # final levelling) in their order, one bounded loop; split, the loop state would pass through each.
-def _scale_on_two_points(run, a, b, d_true: float, active, it: int) -> None:
+def _scale_on_two_points(
+    run: Run, a: tuple[str, Floats], b: tuple[str, Floats], d_true: float, active: Mask, it: int
+) -> None:
     """C3's scale with ``sheet_on="corners"``: the two plan control points farthest apart,
     their counter distance against the ground distance/M_г, b_x in proportion. [mm]"""
-    bx, new, d_model = scale_by_two_points(run, a, b, d_true, f"C3/{it}", active)
-    run.op.log.add(
-        "C3",
-        f"scale: fuse on {a[0]} and {b[0]}, model distance against {d_true:.3f} mm; "
-        "turn b_x in proportion",
-        "bx",
-        before=bx,
-        after=new,
-        reading=new,
-        residual=d_model - d_true,
-        iteration=it,
-        equation="scale by b_x",
-    )
+    bx, new, d_model = scale_by_two_points(run, a, b, d_true, C3.at(it), active)
+    _C3_SCALE.log(
+        run.op, "bx", {"a": a[0], "b": b[0], "d": d_true},
+        before=bx, after=new, reading=new, residual=d_model - d_true, iteration=it,
+    )  # fmt: skip
 
 
 def c3_absolute(
-    run,
+    run: Run,
     cal: Calibration,
     level_ids: tuple[str, ...],
-    relative_fn=None,
+    relative_fn: Relative | None = None,
     sheet_on: str = "control",
 ) -> None:
     """C3: absolute orientation by control points, iterated until the levelling points agree in
@@ -840,10 +870,10 @@ def c3_absolute(
     for it in range(1, _bound(op) + 1):
         its = np.where(active, it, its)
         if plotted is not None:
-            scale_on_plotted_control(run, plotted, f"C3/{it}", active, it)
+            scale_on_plotted_control(run, plotted, C3.at(it), active, it)
         else:
             _scale_on_two_points(run, (a_id, pa), (b_id, pb), d_true, active, it)
-        resid = _level(run, cal, rows, f"C3/{it}", active, 1, it)
+        resid = _level(run, cal, rows, C3.at(it), active, 1, it)
         worst = np.where(active, _worst(resid), worst)
         # every trial still iterating levels on these heights (the least-squares plane of the
         # four points, as (5.54)/(5.55) assume); those inside H/3000 (or at the bound) stop after
@@ -853,22 +883,29 @@ def c3_absolute(
         if not np.any(active):
             break
         if relative_fn is not None:
-            r_its, _ = _masked(run, active, relative_fn, cal, f"C3/{it}/ro")
+            r_its, _ = _masked(run, active, relative_fn, cal, C3.at(it, "ro"))
             ro_its = ro_its + np.where(active, r_its, 0)
     run.record_stage("C3", its)
     run.record_stage("C3/relative", ro_its)
     run.check("C3: levelling points (against the first)", worst, tol, unit="m", iterations=its)
     heights = _height_points(run, [h["id"] for h in sheet.control_heights])
     if not run.remedial:  # the book: single readings, nothing after a failed check
-        errs = _slip_and_read_heights(run, rows, heights, "C3", None, 1)
+        errs = _slip_and_read_heights(run, rows, heights, C3, None, 1)
         run.check("C3: control heights", _worst(errs) if errs else op.v(0.0), tol, unit="m")
-        seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
+        seen = judge_standard_points(run, "C3", C3.at("std"), text=_SIX_Q)
         run.check("C3: residual y-parallax (6 points)", _worst(seen), tol_q)
         return
     _c3_operator_checks(run, cal, rows, heights, relative_fn, _pointings(run))
 
 
-def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) -> None:
+def _c3_operator_checks(
+    run: Run,
+    cal: Calibration,
+    rows: Sequence[tuple[str, Floats]],
+    heights: Sequence[tuple[str, Floats]],
+    relative_fn: Relative | None,
+    pointings: int,
+) -> None:
     """The end of C3 with the operator's practice. The control heights are first read once, as
     the book does; where one misses H/3000 the operator slips and reads them all again, each the
     mean of ``pointings`` fusings (CR1: one reading has σ_p·H/b = 0.19 m at pair60, 0.39 m at
@@ -879,26 +916,26 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
     tol = run.sheet.tolerances["control_height_m"]
     tol_q = run.sheet.tolerances["residual_y_parallax_mm"]
     name_h, name_q = "C3: control heights", "C3: residual y-parallax (6 points)"
-    errs = _slip_and_read_heights(run, rows, heights, "C3", None, 1)
+    errs = _slip_and_read_heights(run, rows, heights, C3, None, 1)
     h_worst = _worst(errs) if errs else op.v(0.0)
     h_failed = h_worst > tol
     if errs and np.any(h_failed):
         with compacted(run, h_failed) as cut:  # CR1 on the trials that failed only
             again = _slip_and_read_heights(
-                cut.run, rows, heights, "C3/CR1", cut.active, pointings, CR1
+                cut.run, rows, heights, C3.at("CR1"), cut.active, pointings, CR1
             )
         h_worst = cut.put(h_worst, _worst(again))
-    seen = judge_standard_points(run, "C3", "C3/std", text=_SIX_Q)
+    seen = judge_standard_points(run, "C3", C3.at("std"), text=_SIX_Q)
     q_worst = _worst(seen)
     q_failed = q_worst > tol_q
     rounds = np.zeros(np.shape(q_failed), int)
     if relative_fn is not None and np.any(q_failed):
         with compacted(run, q_failed) as cut:  # CR2 on the trials that failed only
             sub, on = cut.run, cut.active
-            r_its, _ = _masked(sub, on, relative_fn, cal, "C3/CR2/ro")
-            seen = judge_standard_points(sub, "C3", "C3/CR2/std", on, text=_SIX_Q)
-            _level(sub, cal, rows, "C3/CR2", on, pointings, 1, CR2)
-            errs = _slip_and_read_heights(sub, rows, heights, "C3/CR2", on, pointings, CR2)
+            r_its, _ = _masked(sub, on, relative_fn, cal, C3.at("CR2", "ro"))
+            seen = judge_standard_points(sub, "C3", C3.at("CR2", "std"), on, text=_SIX_Q)
+            _level(sub, cal, rows, C3.at("CR2"), on, pointings, 1, CR2)
+            errs = _slip_and_read_heights(sub, rows, heights, C3.at("CR2"), on, pointings, CR2)
         rounds = cut.put(rounds, r_its)
         q_worst = cut.put(q_worst, _worst(seen))
         if errs:
@@ -909,7 +946,9 @@ def _c3_operator_checks(run, cal, rows, heights, relative_fn, pointings: int) ->
     run.record_remedy(CR2, name_q, q_failed, rounds)
 
 
-def _masked(run, active, relative_fn, cal, key0):
+def _masked(
+    run: Run, active: Mask, relative_fn: Relative, cal: Calibration, key0: NoiseKey
+) -> tuple[NDArray[np.int_], Floats]:
     """The relative orientation for the trials still ``active`` only (the others stay): run on
     those trials alone (:func:`~stereoplotter.procedure.compaction.compacted`), masked within.
     Returns its iterations and worst |q| (0 and NaN where not ``active``)."""
@@ -917,15 +956,15 @@ def _masked(run, active, relative_fn, cal, key0):
         op = cut.run.op
         saved = op.all
         on = cut.active
-        op.all = lambda: on.copy()
+        op.all = lambda: on.copy()  # type: ignore[method-assign]  # the masked trials are "all"
         try:
             its, worst = relative_fn(cut.run, cal, stage="C3", key0=key0)
         finally:
-            op.all = saved
+            op.all = saved  # type: ignore[method-assign]
     return cut.put(np.zeros(np.shape(active), int), its), cut.put(run.op.v(np.nan), worst)
 
 
-def run_conventional_method(run, relative: str = "elements", sheet_on: str = "control"):
+def run_conventional_method(run: Run, relative: str = "elements", sheet_on: str = "control") -> Run:
     """The conventional method on a virtual instrument: C1–C4 in order.
 
     Parameters
@@ -948,15 +987,47 @@ def run_conventional_method(run, relative: str = "elements", sheet_on: str = "co
         raise StereoplotterError(
             f"relative: expected one of {', '.join(RELATIVE_OPTIONS)}, found {relative!r}"
         )
-    c1_interior(run)
-    level_ids = levelling_points(run)
-    cal = calibrate(run, level_ids)
-    run.calibration = cal
-    relative_fn = c2_relative_by_elements if relative == "elements" else c2_relative_by_equations
-    its, worst = relative_fn(run, cal)
+    perform_all(run, conventional_steps(relative, sheet_on))
+    return run
+
+
+def _calibration(run: Run) -> Calibration:
+    """The run's calibration (:func:`conventional_steps` finds it after C1)."""
+    cal: Calibration = run.calibration
+    return cal
+
+
+def _calibrate(run: Run, key: NoiseKey) -> None:
+    """What the operator knows of the instrument's response (no draws): :func:`calibrate` at
+    the levelling points."""
+    run.calibration = calibrate(run, levelling_points(run))
+
+
+def _relative_orientation(run: Run, key: NoiseKey, relative_fn: Relative) -> None:
+    """C2: the relative orientation (``relative_fn``) and its ¼-mark check."""
+    its, worst = relative_fn(run, _calibration(run), key0=key)
     run.record_stage("C2", its)
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     run.check("C2: residual y-parallax (6 points)", worst, tol, iterations=its)
-    c3_absolute(run, cal, level_ids, relative_fn, sheet_on)
-    c4_sheet(run, sheet_on)
-    return run
+
+
+def conventional_steps(relative: str = "elements", sheet_on: str = "control") -> tuple[Step, ...]:
+    """The conventional method as declared steps: C1 (:data:`C1_STEPS`), the calibration, C2
+    by ``relative`` (:data:`RELATIVE_OPTIONS`), C3 and C4 with the sheet ``sheet_on``
+    (:data:`SHEET_OPTIONS`)."""
+    relative_fn = c2_relative_by_elements if relative == "elements" else c2_relative_by_equations
+
+    def absolute(run: Run, key: NoiseKey) -> None:
+        c3_absolute(run, _calibration(run), levelling_points(run), relative_fn, sheet_on)
+
+    return (
+        *C1_STEPS,
+        Act("calibrate the instrument's response (no draws)", C1.at("calibration"), _calibrate),
+        Act(
+            "C2: relative orientation",
+            NoiseKey("C2"),
+            lambda run, key: _relative_orientation(run, key, relative_fn),
+        ),
+        Act("C3: absolute orientation", C3, absolute),
+        Act("C4: the sheet", NoiseKey("4"), lambda run, key: c4_sheet(run, sheet_on)),
+    )

@@ -346,7 +346,8 @@ def plane_residuals(
     # to T single calls
     c0, c1, c2 = (np.sum(v * row, axis=-1)[..., None] for row in pinv)
     e = np.asarray(xy, float)
-    return np.asarray(values, float) - (c0 + c1 * e[:, 0] + c2 * e[:, 1])
+    residual: NDArray[np.float64] = np.asarray(values, float) - (c0 + c1 * e[:, 0] + c2 * e[:, 1])
+    return residual
 
 
 # --------------------------------------------------------------------------------------------
@@ -357,7 +358,8 @@ def plane_residuals(
 def trial_count(setting: InstrumentSetting, units: Sequence[CorrectionUnit]) -> int | None:
     """T when any field carries a trial dimension (shape (T,)), else None."""
     trials: set[int] = set()
-    for obj in (setting, *units):
+    objs: tuple[Any, ...] = (setting, *units)
+    for obj in objs:
         for f in fields(obj):
             v = getattr(obj, f.name)
             if v is None or isinstance(v, bool | str):
@@ -553,7 +555,7 @@ def model_truth(
             tuple(f"g{i}" for i in range(len(grid_frame))),
             grid_frame,
             grid_local[:, 2],
-            tuple(np.asarray(g, float) for g in grid_images_mm),
+            (np.asarray(grid_images_mm[0], float), np.asarray(grid_images_mm[1], float)),
         ),
         standard_points=PointSetTruth(
             tuple(str(i) for i in range(1, 7)),
@@ -762,7 +764,7 @@ def evaluate_against(
             ("check", truth.check),
         )
     }
-    c4 = corner4_misclosure_mm
+    c4: Any = corner4_misclosure_mm
     if c4 is not None:
         c4 = float(c4) if np.ndim(c4) == 0 else np.asarray(c4, float)
     return ModelEvaluation(
@@ -780,7 +782,9 @@ def evaluate_against(
     )
 
 
-def evaluate_instrument(scenario: Scenario, sheet: Any, instrument: Any, **kwargs: Any):
+def evaluate_instrument(
+    scenario: Scenario, sheet: Any, instrument: Any, **kwargs: Any
+) -> ModelEvaluation:
     r""":func:`evaluate_model` on the physical state of a virtual instrument.
 
     Parameters

@@ -21,11 +21,13 @@ _F = NDArray[np.float64]
 
 
 def _rms(v: _F) -> _F:
-    return np.sqrt(np.mean(np.square(v), axis=-1))
+    rms: _F = np.sqrt(np.mean(np.square(v), axis=-1))
+    return rms
 
 
 def _max_abs(v: _F) -> _F:
-    return np.max(np.abs(v), axis=-1)
+    worst: _F = np.max(np.abs(v), axis=-1)
+    return worst
 
 
 def _plain(v: Any) -> Any:
@@ -230,4 +232,5 @@ class ModelEvaluation:
                 for name, s in self.sets().items()
             },
         }
-        return _plain(out)
+        plain: dict[str, Any] = _plain(out)
+        return plain

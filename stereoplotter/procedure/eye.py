@@ -85,7 +85,7 @@ LOOKS = 2
 _ARCSEC = math.pi / (180.0 * 3600.0)
 
 
-def angle_to_photo_mm(angle_arcsec: float, magnification: float, viewing_distance_mm: float):
+def angle_to_photo_mm(angle_arcsec: float, magnification: float, viewing_distance_mm: float) -> Any:
     """(eye 1): the photo length [mm] that subtends ``angle_arcsec`` at the eye.
 
     Examples
@@ -168,15 +168,21 @@ class Eye:
     def stereo_sigma_mm(self) -> float:
         """σ_p of the fused mark (x-parallax judged zero), first kind, photo scale. [mm]"""
         s = self.system
-        return angle_to_photo_mm(self.acuity_first_arcsec, s.magnification, s.viewing_distance_mm)
+        sigma: float = angle_to_photo_mm(
+            self.acuity_first_arcsec, s.magnification, s.viewing_distance_mm
+        )
+        return sigma
 
     @property
     def y_parallax_sigma_mm(self) -> float:
         """σ_q of a y-parallax judgement, second kind, photo scale. [mm]"""
         s = self.system
-        return angle_to_photo_mm(self.acuity_second_arcsec, s.magnification, s.viewing_distance_mm)
+        sigma: float = angle_to_photo_mm(
+            self.acuity_second_arcsec, s.magnification, s.viewing_distance_mm
+        )
+        return sigma
 
-    def check_pass_probability(self, q_mm: Any, tolerance_mm: float, looks: int = LOOKS):
+    def check_pass_probability(self, q_mm: Any, tolerance_mm: float, looks: int = LOOKS) -> Any:
         """Probability that the six-point check passes at true y-parallaxes ``q_mm`` (one per
         point, independent looks; a point fails when all ``looks`` see it). [—]
 

@@ -15,6 +15,7 @@ pair60 and pair80, both methods, the scenarios' own seeds).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +23,8 @@ import numpy as np
 from stereoplotter.procedure.operator import OperatorModel
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
 from stereoplotter.procedure.trials import trial_columns
+from stereoplotter.scenario.model import Scenario
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = ["SETTINGS", "PassRates", "pass_rate_table", "pass_rates", "table_markdown"]
 
@@ -48,7 +51,9 @@ class PassRates:
     weakest_rate: float
 
 
-def pass_rates(scenario, spec, method: str, operator: OperatorModel, trials: int) -> PassRates:
+def pass_rates(
+    scenario: Scenario, spec: InstrumentSpec, method: str, operator: OperatorModel, trials: int
+) -> PassRates:
     """Run ``trials`` trials (the scenario's seed, default errors) and summarise the checks."""
     prep = prepare_run(scenario, spec, method, None, scenario.seed, operator=operator)
     result = run_trials_chunk(prep, 0, trials, evaluate=False, transcript=False)
@@ -70,7 +75,12 @@ def pass_rates(scenario, spec, method: str, operator: OperatorModel, trials: int
     )
 
 
-def pass_rate_table(scenarios, spec, trials: int, methods=("setup", "conventional")):
+def pass_rate_table(
+    scenarios: Sequence[Scenario],
+    spec: InstrumentSpec,
+    trials: int,
+    methods: tuple[str, ...] = ("setup", "conventional"),
+) -> dict[tuple[str, str, str], PassRates]:
     """{(setting label, scenario name, method): PassRates} over :data:`SETTINGS`."""
     out = {}
     for label, sq, sp in SETTINGS:
@@ -81,7 +91,11 @@ def pass_rate_table(scenarios, spec, trials: int, methods=("setup", "conventiona
     return out
 
 
-def table_markdown(rows, scenarios, methods=("setup", "conventional")) -> str:
+def table_markdown(
+    rows: Mapping[tuple[str, str, str], PassRates],
+    scenarios: Sequence[Scenario],
+    methods: tuple[str, ...] = ("setup", "conventional"),
+) -> str:
     """The table: one row per setting of ``rows`` (in their order), per (scenario, method)
     'all checks ± SE (weakest check, its rate)'."""
     heads = [f"{s.name} {m}" for s in scenarios for m in methods]

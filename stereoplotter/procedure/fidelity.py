@@ -16,6 +16,7 @@ its own configuration in the procedure Monte Carlo.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
+from typing import Any
 
 __all__ = ["LINKAGE_VARIANTS", "MECHANISMS", "Fidelity", "Mechanism", "mechanism"]
 
@@ -35,13 +36,13 @@ class Mechanism:
 
     name: str
     flag: str
-    choices: tuple
+    choices: tuple[Any, ...]
     default: object
     basis: str
     as_formula: object
     formula: str
 
-    def option(self, value) -> str:
+    def option(self, value: object) -> str:
         """The command line that sets ``value``: ``--flag value``."""
         return f"{self.flag} {value}"
 
@@ -208,7 +209,8 @@ class Fidelity:
     @classmethod
     def as_formula(cls) -> Fidelity:
         """Every switch at the formula's assumption."""
-        return cls(**{m.name: m.as_formula for m in MECHANISMS})
+        settings: dict[str, Any] = {m.name: m.as_formula for m in MECHANISMS}
+        return cls(**settings)
 
     def departures(self) -> tuple[str, ...]:
         """The switches not at the formula's assumption, in :data:`MECHANISMS` order."""
@@ -216,7 +218,8 @@ class Fidelity:
 
     def with_formula(self, name: str) -> Fidelity:
         """This with switch ``name`` at the formula's assumption."""
-        return replace(self, **{name: mechanism(name).as_formula})
+        setting: dict[str, Any] = {name: mechanism(name).as_formula}
+        return replace(self, **setting)
 
     def variant(self, default: str) -> str:
         """The instrument's decentration variant for this linkage (``default``: the caller's

@@ -6,6 +6,7 @@ it before any trial is run.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,7 +33,7 @@ __all__ = [
 
 
 def sheet_settings(
-    sheet: SetupSheet, strict_per_axis: bool = False, mechanism=None
+    sheet: SetupSheet, strict_per_axis: bool = False, mechanism: Any = None
 ) -> tuple[InstrumentSetting, dict[str, CorrectionUnit]]:
     """The instrument at the sheet's own settings, without any error: f_пр and
     b = (b_x, b_y, b_z′) of the sheet, and the correction units "left", "right" at the sheet's
@@ -76,7 +77,7 @@ def mechanism_level(
     scene: Scene,
     heights: ControlHeights,
     strict_per_axis: bool = False,
-    mechanism=None,
+    mechanism: Any = None,
 ) -> tuple[float, float]:
     """What the correction mechanism itself leaves at the sheet's own settings (the floor).
 
@@ -92,7 +93,7 @@ def mechanism_level(
     setting, exact = sheet_settings(sheet, strict_per_axis, mechanism)
     units = [UnitMap(exact[side]) for side in ("left", "right")]
 
-    def reading(images):
+    def reading(images: tuple[NDArray[np.float64], NDArray[np.float64]]) -> Any:
         pl, pr = images
         return rods_intersection(units[0].rod_from_photo(pl), units[1].rod_from_photo(pr), setting)
 
@@ -111,8 +112,8 @@ def refuse_beyond_mechanism(
     scene: Scene,
     heights: ControlHeights,
     strict_per_axis: bool = False,
-    mechanism=None,
-):
+    mechanism: Any = None,
+) -> None:
     """Raise :class:`SetupRefusal` when the mechanism's own level (:func:`mechanism_level`)
     already exceeds the residual y-parallax (¼ mark) or the control-height (H/3000) tolerance:
     no operator can then build the model by the setup-data method on this instrument.

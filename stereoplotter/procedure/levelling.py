@@ -8,10 +8,12 @@ for every trial: :func:`~stereoplotter.procedure.run.prepare_pair` computes it o
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -68,7 +70,10 @@ class LevelDesign:
 
 
 def _turned(
-    setting: InstrumentSetting, units: dict[str, CorrectionUnit], changes, linkage: str
+    setting: InstrumentSetting,
+    units: dict[str, CorrectionUnit],
+    changes: Mapping[str, float],
+    linkage: str,
 ) -> tuple[InstrumentSetting, dict[str, CorrectionUnit]]:
     units = dict(units)
     for control, d in changes.items():
@@ -86,7 +91,14 @@ def _turned(
     return setting, units
 
 
-def _response(images, setting, units, changes, linkage: str, step: float = 1e-5):
+def _response(
+    images: tuple[ArrayLike, ArrayLike],
+    setting: InstrumentSetting,
+    units: dict[str, CorrectionUnit],
+    changes: Mapping[str, float],
+    linkage: str,
+    step: float = 1e-5,
+) -> tuple[Any, Any]:
     """∂q [mm, photo] and ∂D [mm, model] per unit of a combined turn (central differences)."""
     out = []
     for sign in (1.0, -1.0):

@@ -53,6 +53,7 @@ from stereoplotter.procedure.evaluation import (
     standard_points_m,
 )
 from stereoplotter.procedure.eye import EYE_MODES, LEGACY_SIGMA_MM, Eye, ObservationSystem
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.transcript import Transcript
 from stereoplotter.random_streams import keyed_standard_normal
 from stereoplotter.scenario.model import Camera, Photo, Point, Scenario
@@ -242,8 +243,14 @@ class Noise:
         self.trial = trial
         self.first_trial = int(first_trial)
 
+    def draw(self, key: NoiseKey, sigma: float | None) -> NDArray[np.float64]:
+        """σ·z for the draw of the declared identity ``key``: :meth:`normal` of its stream key
+        (:meth:`NoiseKey.stream`, the one encoding). ``sigma`` is an :class:`OperatorModel`'s,
+        resolved for the instrument before a run (never None then)."""
+        return self.normal(key.stream(), cast(float, sigma))
+
     def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
-        """σ·z for the act ``key``: shape (T,), or () for a single run or a per-trial oracle."""
+        """σ·z for the stream ``key``: shape (T,), or () for a single run or a per-trial oracle."""
         if self.trial is not None:
             start = self.first_trial + self.trial
             stop = start + 1
@@ -273,7 +280,13 @@ class Look:
         return self.fn(value)
 
 
-def solve_1d(fun, x0: ArrayLike, target: ArrayLike, iterations: int = 6, h: float = 1e-6):
+def solve_1d(
+    fun: Callable[[Any], Any],
+    x0: ArrayLike,
+    target: ArrayLike,
+    iterations: int = 6,
+    h: float = 1e-6,
+) -> NDArray[np.float64]:
     """x with fun(x) = target by a fixed number of Newton steps (central differences).
 
     A fixed count (no early exit) keeps a vectorised run and a per-trial loop bit-identical.
@@ -415,12 +428,13 @@ class Scene:
         key = pts.tobytes() + repr(pts.shape).encode()
         known = self._images.get(key)
         if known is None:  # the few control points a procedure fuses on, again and again
-            known = tuple(
-                photo_points_mm(self.camera, self.photo(n), pts) for n in ("left", "right")
+            known = (
+                photo_points_mm(self.camera, self.photo("left"), pts),
+                photo_points_mm(self.camera, self.photo("right"), pts),
             )
             if pts.size <= 30:
                 self._images[key] = known
-        out = tuple(a.copy() for a in known)
+        out = (known[0].copy(), known[1].copy())
         for a in out if read_only else ():
             a.setflags(write=False)
         return out
@@ -479,11 +493,11 @@ class Operator:
 
     # --- reading and setting ------------------------------------------------------------------
 
-    def read(self, control: ScaleName, key: str) -> NDArray[np.float64]:
+    def read(self, control: ScaleName, key: KeyLike) -> NDArray[np.float64]:
         """Read a counter or scale: exact value + σ_read, rounded to the least count."""
         lc = self.least_count(control)
         exact = self.v(self.inst.read(control, exact=True))
-        seen = exact + self.noise.normal(f"read/{key}", self.model.reading_sigma_lc * lc)
+        seen = exact + self.noise.draw(as_key(key).by("read"), self.model.reading_sigma_lc * lc)
         if self.model.quantise:
             seen = np.round(seen / lc) * lc
         return seen
@@ -492,7 +506,7 @@ class Operator:
         self,
         control: SetControlName,
         value: ArrayLike,
-        key: str,
+        key: KeyLike,
         active: NDArray[np.bool_] | None = None,
     ) -> NDArray[np.float64]:
         """Set a computed value on a scale (σ_set); backlash and scale errors stay in."""
@@ -502,14 +516,14 @@ class Operator:
         value = self.v(value)
         if control in SCREWS or control == HEIGHT_SCALE:
             lc = self.least_count(control)
-            cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
+            cmd = value + self.noise.draw(as_key(key).by("set"), self.model.setting_sigma_lc * lc)
             prev = self.v(self.inst.read(control, exact=True))
             cmd = self._at_stop(control, cmd)
             self.inst.set(control, np.where(active, cmd, prev), side=self.model.finish_side)
         else:
             on_xy_scale = control_kind(control) in ("decentration", "principal_distance")
             lc = self.inst.spec.xy_least_count_mm if on_xy_scale else 0.0
-            cmd = value + self.noise.normal(f"set/{key}", self.model.setting_sigma_lc * lc)
+            cmd = value + self.noise.draw(as_key(key).by("set"), self.model.setting_sigma_lc * lc)
             prev = self.commanded.get(control, cmd)
             cmd = np.where(active, cmd, prev)
             self.inst.set(control, cmd)
@@ -529,7 +543,7 @@ class Operator:
             self._flag_stopped(control, (reading < low) | (reading > high))
         return out
 
-    def _stop_readings(self, control: ScrewName) -> tuple[NDArray, NDArray]:
+    def _stop_readings(self, control: ScrewName) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The readings of the two stops of a lead screw (low, high), cached."""
         stops = self._stops.get(control)
         if stops is None:
@@ -551,7 +565,7 @@ class Operator:
     def physical(self, control: DrivenControl) -> NDArray[np.float64]:
         """Where a control physically is (what the eye judges in the eyepiece)."""
         if control in SCREWS:
-            now = self.inst.position(control)  # a copy of the carriages
+            now: Any = self.inst.position(control)  # a copy of the carriages
             return now if self.trials and np.shape(now) == (self.trials,) else self.v(now)
         if control_kind(control) == "cassette":
             return self.v(self.inst.unit(control_side(control)).kappa)
@@ -576,7 +590,7 @@ class Operator:
         if not np.any(active):
             return
         if self.trials and control in SCREWS:  # a lead screw over T trials: the fast path
-            screw = cast(ScrewName, control)
+            screw = control
             target = np.asarray(target, float)  # only read: no copy of a (T,) target
             if target.shape != (self.trials,):
                 target = self.v(target)
@@ -598,12 +612,13 @@ class Operator:
                 self.commanded[control] = cmd
             else:
                 cmd = self.commanded.get(control, now) + err
-                self.inst.set(control, cmd)
+                self.inst.set(cast(CassetteName, control), cmd)
                 self.commanded[control] = cmd
 
     # --- looking ------------------------------------------------------------------------------
 
-    def units(self):
+    def units(self) -> tuple[CorrectionUnit, CorrectionUnit]:
+        """The correction units of the left and right photo as they are."""
         return self.inst.unit("left"), self.inst.unit("right")
 
     def unit_map(self, side: Side, unit: CorrectionUnit | None = None) -> UnitMap:
@@ -617,7 +632,7 @@ class Operator:
         self,
         side: Side,
         photo_point_mm: ArrayLike,
-        key: str,
+        key: KeyLike,
         active: NDArray[np.bool_] | None = None,
         free: str = "XY",
     ) -> NDArray[np.float64]:
@@ -628,8 +643,8 @@ class Operator:
         """
         e = np.stack(
             [
-                self.noise.normal(f"mono/{key}/x", self.model.monocular_sigma_mm),
-                self.noise.normal(f"mono/{key}/y", self.model.monocular_sigma_mm),
+                self.noise.draw(as_key(key).by("mono").at("x"), self.model.monocular_sigma_mm),
+                self.noise.draw(as_key(key).by("mono").at("y"), self.model.monocular_sigma_mm),
             ],
             axis=-1,
         )
@@ -651,34 +666,34 @@ class Operator:
             if axis == "X":
                 eta = (np.asarray(car["Y"], float) - sy) / n
 
-                def seen(value, eta=eta, comp=comp):
-                    return umap.photo_xy((np.asarray(value, float) - sx) / n, eta)[comp]
+                def seen(value: Any, other: Any = eta, comp: int = comp) -> Any:
+                    return umap.photo_xy((np.asarray(value, float) - sx) / n, other)[comp]
             else:
                 xi = (np.asarray(car["X"], float) - sx) / n
 
-                def seen(value, xi=xi, comp=comp):
-                    return umap.photo_xy(xi, (np.asarray(value, float) - sy) / n)[comp]
+                def seen(value: Any, other: Any = xi, comp: int = comp) -> Any:
+                    return umap.photo_xy(other, (np.asarray(value, float) - sy) / n)[comp]
 
             car[axis] = solve_1d(seen, car[axis], target[..., comp], iterations=4, h=1e-3)
         for axis in free:
-            self.drive(axis, car[axis], active)
+            self.drive(cast(ScrewName, axis), car[axis], active)
         return e
 
     def fuse(
         self,
         points_m: ArrayLike,
-        images: tuple[NDArray, NDArray],
-        key: str,
+        images: tuple[NDArray[np.float64], NDArray[np.float64]],
+        key: KeyLike,
         active: NDArray[np.bool_] | None = None,
         move: bool = True,
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Stereo pointing on a ground point: clear the x-parallax (σ_p) with the floating mark
         on the point (σ_mono); return the y-parallax seen there (σ_q) and the true one. [mm]"""
         pl, pr = images
-        ex = self.noise.normal(f"mono/{key}/x", self.model.monocular_sigma_mm)
-        ey = self.noise.normal(f"mono/{key}/y", self.model.monocular_sigma_mm)
-        ep = self.noise.normal(f"stereo/{key}", self.model.stereo_sigma_mm)
-        eq = self.noise.normal(f"q/{key}", self.model.y_parallax_sigma_mm)
+        ex = self.noise.draw(as_key(key).by("mono").at("x"), self.model.monocular_sigma_mm)
+        ey = self.noise.draw(as_key(key).by("mono").at("y"), self.model.monocular_sigma_mm)
+        ep = self.noise.draw(as_key(key).by("stereo"), self.model.stereo_sigma_mm)
+        eq = self.noise.draw(as_key(key).by("q"), self.model.y_parallax_sigma_mm)
         pl, pr = np.asarray(pl, float), np.asarray(pr, float)
         # the marks at the photo points shifted by (ex, ey) on both photos and by ep in x on the
         # left: by component (the y of the left mark + 0·ep is that y, to the bit)
@@ -688,7 +703,12 @@ class Operator:
             self.inst.setting,
         )
         if move:
-            for axis, value in (("X", r.x_mm), ("Y", r.y_mm), ("Z", r.depth_mm)):
+            moves: tuple[tuple[ScrewName, Any], ...] = (
+                ("X", r.x_mm),
+                ("Y", r.y_mm),
+                ("Z", r.depth_mm),
+            )
+            for axis, value in moves:
                 self.drive(axis, value, active)
         return r.y_parallax_mm + eq, r.y_parallax_mm
 
@@ -704,7 +724,7 @@ class Operator:
         are computed once.
         """
         side = control_side(control)
-        other = "right" if side == "left" else "left"
+        other: Side = "right" if side == "left" else "left"
         pts = {"left": np.asarray(images[0], float), "right": np.asarray(images[1], float)}
         setting = self.inst.setting
         fixed = self.unit_map(other).rod_xy(pts[other][..., 0], pts[other][..., 1])
@@ -713,16 +733,16 @@ class Operator:
         cassette = control_kind(control) == "cassette"
         if cassette:
 
-            def turned(value):
+            def turned(value: Any) -> UnitMap:
                 return base.with_kappa(value)
         else:
             axis = control_axis(control)
             linkage = self.inst.variant.linkage
 
-            def turned(value):
+            def turned(value: Any) -> UnitMap:
                 return base.with_knob(axis, value, linkage)
 
-        def q(value):
+        def q(value: Any) -> Any:
             moving = turned(value).rod_xy(x, y)
             if side == "left":
                 return rods_y_parallax(moving, fixed, setting)
@@ -733,7 +753,9 @@ class Operator:
         # x, x ± h at once
         return Look(q, stacked=not cassette and np.ndim(x) == 0 and np.ndim(y) == 0)
 
-    def y_parallax(self, points_m: ArrayLike, images: tuple[NDArray, NDArray]):
+    def y_parallax(
+        self, points_m: ArrayLike, images: tuple[NDArray[np.float64], NDArray[np.float64]]
+    ) -> Any:
         """The true y-parallax of the present model at ground points (no judgment). [mm]"""
         left, right = self.units()
         setting = self.inst.setting
@@ -746,7 +768,15 @@ class Operator:
             setting,
         )
 
-    def knob_for(self, knob: KnobName, unit, photo_point, rod, comp: int, target) -> NDArray:
+    def knob_for(
+        self,
+        knob: KnobName,
+        unit: CorrectionUnit,
+        photo_point: ArrayLike,
+        rod: ArrayLike,
+        comp: int,
+        target: ArrayLike,
+    ) -> NDArray[np.float64]:
         """T of ``knob`` that puts ``photo_point`` under the rod coordinate ``rod`` (axis comp).
 
         A 1-D Newton solve on the unit model with the instrument's own linkage (D1).
@@ -757,7 +787,7 @@ class Operator:
         rod = np.asarray(rod, float)
         xi, eta = rod[..., 0], rod[..., 1]
 
-        def seen(t):
+        def seen(t: Any) -> Any:
             u = turn_correction_knob(unit, axis, t, linkage=linkage)
             return UnitMap(u, trig).photo_xy(xi, eta)[comp]
 
@@ -770,7 +800,7 @@ def _given(value: float | None, derived: float) -> float:
     return derived if value is None else value
 
 
-def _column(obj):
+def _column(obj: Any) -> Any:
     """A frozen unit/setting with every per-trial field (T,) turned into a column (T, 1)."""
     changes = {}
     for f in fields(obj):

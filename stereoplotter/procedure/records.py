@@ -10,9 +10,9 @@ every target reading from it, zero reading (MO) + the printed signed value, and 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -187,7 +187,8 @@ class SheetReading:
             return self.value
         if zero is None:
             raise StereoplotterError(f"{self.name} needs its zero reading {self.zero_reading}")
-        return zero + self.value
+        reading: NDArray[np.float64] | float = cast(Any, zero) + self.value
+        return reading
 
 
 class SheetReadings(Mapping[str, SheetReading]):
@@ -229,7 +230,7 @@ class SheetReadings(Mapping[str, SheetReading]):
                 f"setup sheet: no reading {name!r}; readings: {', '.join(self._rows)}"
             ) from None
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[str]:
         return iter(self._rows)
 
     def __len__(self) -> int:

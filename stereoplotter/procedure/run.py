@@ -18,7 +18,7 @@ it found.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -100,6 +100,10 @@ class Run:
         once per run).
     fidelity : Fidelity
         The mechanism switches (:mod:`~stereoplotter.procedure.fidelity`).
+    calibration : Calibration or None
+        The conventional method's calibration of the instrument's response
+        (:class:`~stereoplotter.procedure.conventional.Calibration`, found after C1; None
+        otherwise).
     """
 
     op: Operator
@@ -114,13 +118,19 @@ class Run:
     heights: ControlHeights | None = None
     level: LevelDesign | None = None
     fidelity: Fidelity = field(default_factory=Fidelity)
+    calibration: Any = None
     readings: SheetReadings = field(init=False)
 
     def __post_init__(self) -> None:
         self.readings = SheetReadings.of(self.sheet)
 
     def check(
-        self, name: str, residual, tolerance, unit: str = "mm", iterations=None
+        self,
+        name: str,
+        residual: ArrayLike,
+        tolerance: ArrayLike | None,
+        unit: str = "mm",
+        iterations: ArrayLike | None = None,
     ) -> NDArray[np.bool_]:
         """Record a tolerance check (|residual| ≤ tolerance) and return pass/fail per trial."""
         residual = self.op.v(residual)
@@ -128,19 +138,23 @@ class Run:
         passed = np.abs(residual) <= tol if tol is not None else None
         its = None if iterations is None else self.op.v(iterations).astype(int)
         self.results[name] = Check(name, residual, tol, passed, its, unit)
-        return passed
+        return cast(NDArray[np.bool_], passed)  # None only for a check without a tolerance
 
     @property
     def remedial(self) -> bool:
         """The operator's practice: remedies after a failed check."""
         return self.practice == "operator"
 
-    def record_remedy(self, name: str, check: str, applied, rounds) -> None:
+    def record_remedy(self, name: str, check: str, applied: ArrayLike, rounds: ArrayLike) -> None:
         """Record a remedy against the final state of ``check``."""
         applied = self.op.v(applied).astype(bool)
         passed = self.results[check].passed
         self.remedies[name] = Remedy(
-            name, check, applied, self.op.v(rounds).astype(int), self.op.v(passed).astype(bool)
+            name,
+            check,
+            applied,
+            self.op.v(rounds).astype(int),
+            self.op.v(cast(ArrayLike, passed)).astype(bool),
         )
 
     def record_stage(self, stage: str, iterations: ArrayLike) -> None:
@@ -151,7 +165,7 @@ class Run:
         """The iterations recorded for ``stage``."""
         return self.stages[stage].iterations
 
-    def target(self, reading: str, zero: ArrayLike | None = None):
+    def target(self, reading: str, zero: ArrayLike | None = None) -> Any:
         """The sheet's reading ``reading`` as set: its zero reading + the printed value.
 
         ``zero`` defaults to the zero reading the operator has determined (``self.zero``, by
@@ -388,8 +402,10 @@ def prepare_pair(
     truth = model_truth(
         scenario,
         sheet,
-        scene.grid_m,
+        cast(NDArray[np.float64], scene.grid_m),
         standard_points_c_mm=c_mm,
         grid_images_mm=scene.grid_images_mm,
     )
-    return PreparedPair(sheet, scene, scene.grid_m, scene.grid_images_mm, truth, heights, level)
+    grid_m = cast(NDArray[np.float64], scene.grid_m)  # built with the grid above
+    images = cast(tuple[NDArray[np.float64], NDArray[np.float64]], scene.grid_images_mm)
+    return PreparedPair(sheet, scene, grid_m, images, truth, heights, level)

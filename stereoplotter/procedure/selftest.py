@@ -30,8 +30,9 @@ exact affine image. Range checks are off: the terrain spans D ≈ 167–203 mm.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -157,7 +158,8 @@ class SyntheticPair:
     @property
     def station_right_m(self) -> NDArray[np.float64]:
         """S_п = S_л + B. [m]"""
-        return self.station_left_m + np.asarray(self.base_m, float)
+        station: NDArray[np.float64] = self.station_left_m + np.asarray(self.base_m, float)
+        return station
 
     def ground_points_m(self) -> NDArray[np.float64]:
         """The 49 ground points, shape (grid_size², 3), exactly as §5 builds them. [m]"""
@@ -178,7 +180,7 @@ class SyntheticPair:
             self.f_instrument_mm, base_x_mm=b[0], base_y_mm=b[1], base_z_mm=b[2]
         )
 
-    def photos(self, tilts: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
+    def photos(self, tilts: NDArray[np.float64]) -> tuple[NDArray[Any], NDArray[Any]]:
         """Rigorous photo coordinates of the ground points, Eq. (2.53) via ``object_to_photo``.
 
         Parameters
@@ -226,12 +228,12 @@ def sign_combinations() -> NDArray[np.float64]:
 
 
 def y_parallax(
-    photo_left: NDArray,
-    photo_right: NDArray,
+    photo_left: NDArray[Any],
+    photo_right: NDArray[Any],
     setting: InstrumentSetting,
     left: CorrectionUnit,
     right: CorrectionUnit,
-):
+) -> Any:
     """Counters and q at the model points of homologous photo points (``kinematics.md`` §3.4).
 
     Thin alias of :func:`~stereoplotter.instrument.kinematics.rods_intersection` after
@@ -247,7 +249,9 @@ def y_parallax(
 _TOUCH_UP_STEPS = np.array([1e-6, 1e-6, 1e-6, 1e-4, 1e-4])
 
 
-def apply_touch_up(p, setting, left, right, linkage):
+def apply_touch_up(
+    p: Any, setting: InstrumentSetting, left: CorrectionUnit, right: CorrectionUnit, linkage: str
+) -> tuple[InstrumentSetting, CorrectionUnit, CorrectionUnit]:
     left = replace(left, kappa=left.kappa + p[..., 1:2])
     right = replace(right, kappa=right.kappa + p[..., 0:1])
     right = turn_correction_knob(right, "omega", right.tan_omega + p[..., 2:3], linkage)
@@ -259,7 +263,9 @@ def apply_touch_up(p, setting, left, right, linkage):
     return setting, left, right
 
 
-def _central_jacobian(q_of, p: NDArray, shape: tuple[int, ...]) -> NDArray:
+def _central_jacobian(
+    q_of: Callable[[Any], Any], p: NDArray[Any], shape: tuple[int, ...]
+) -> NDArray[Any]:
     """∂q/∂p by central differences with the steps ``_TOUCH_UP_STEPS``, shape (*shape, 5)."""
     jac = np.empty((*shape, 5))
     for i, h in enumerate(_TOUCH_UP_STEPS):
@@ -270,14 +276,14 @@ def _central_jacobian(q_of, p: NDArray, shape: tuple[int, ...]) -> NDArray:
 
 
 def touch_up(
-    photo_left: NDArray,
-    photo_right: NDArray,
+    photo_left: NDArray[Any],
+    photo_right: NDArray[Any],
     setting: InstrumentSetting,
     left: CorrectionUnit,
     right: CorrectionUnit,
     linkage: str = "L",
     max_iterations: int = 100,
-):
+) -> Any:
     r"""Least-squares relative-orientation touch-up over κ_п, κ_л, θ_ω,п, b_y, b_z′.
 
     Parameters
@@ -313,7 +319,7 @@ def touch_up(
     nb = photo_left.shape[0]
     p = np.zeros((nb, 5))
 
-    def q_of(params):
+    def q_of(params: Any) -> Any:
         s, lu, ru = apply_touch_up(params, setting, left, right, linkage)
         return y_parallax(photo_left, photo_right, s, lu, ru).y_parallax_mm
 
@@ -349,7 +355,7 @@ def touch_up(
 
 
 def height_deformation_permille(
-    depth_mm: NDArray, pair: SyntheticPair, axis: int = -1
+    depth_mm: NDArray[Any], pair: SyntheticPair, axis: int = -1
 ) -> NDArray[np.float64]:
     r"""Height deformation after levelling and scaling, max |·| in ‰ of H.
 
@@ -379,7 +385,10 @@ def height_deformation_permille(
     err_m = (pair.true_depth_mm() - depth_mm) * pair.vertical_scale_denominator / MM_PER_M
     design = np.column_stack([np.ones(len(g)), g[:, 0], g[:, 1], g[:, 2]])
     fitted = err_m @ np.linalg.pinv(design).T @ design.T
-    return np.max(np.abs(err_m - fitted), axis=-1) / pair.flying_height_m * 1000.0
+    worst: NDArray[np.float64] = (
+        np.max(np.abs(err_m - fitted), axis=-1) / pair.flying_height_m * 1000.0
+    )
+    return worst
 
 
 # --------------------------------------------------------------------------------------------
@@ -387,7 +396,7 @@ def height_deformation_permille(
 # --------------------------------------------------------------------------------------------
 
 
-def true_units(pair: SyntheticPair, tilts: NDArray, strict: bool):
+def true_units(pair: SyntheticPair, tilts: NDArray[Any], strict: bool) -> Any:
     t = tilts[..., None]  # broadcast against the points
     f = pair.focal_length_mm
     left = unit_for_orientation(
@@ -399,12 +408,14 @@ def true_units(pair: SyntheticPair, tilts: NDArray, strict: bool):
     return left, right
 
 
-def _q_stats(q_mm: NDArray) -> tuple[NDArray, NDArray]:
+def _q_stats(q_mm: NDArray[Any]) -> tuple[NDArray[Any], NDArray[Any]]:
     return np.max(np.abs(q_mm), axis=-1), np.sqrt(np.mean(q_mm**2, axis=-1))
 
 
 def residual_table(
-    pair: SyntheticPair | None = None, tilts_deg=(0.5, 1.0, 3.0), mechanism=None
+    pair: SyntheticPair | None = None,
+    tilts_deg: Sequence[float] = (0.5, 1.0, 3.0),
+    mechanism: Any = None,
 ) -> list[dict[str, Any]]:
     r"""``kinematics.md`` §6: residual y-parallax of the per-axis approximation.
 
@@ -470,7 +481,14 @@ def residual_table(
 # --------------------------------------------------------------------------------------------
 
 
-def _fit_knob(unit, axis, fiducial_mm, target_rod_mm, linkage, iterations=30):
+def _fit_knob(
+    unit: CorrectionUnit,
+    axis: str,
+    fiducial_mm: Any,
+    target_rod_mm: Any,
+    linkage: str,
+    iterations: int = 30,
+) -> CorrectionUnit:
     """Turn one knob until the fiducial is under the mark at the target rod coordinate.
 
     Vectorised Newton iteration on T with a central-difference derivative; the coordinate that is
@@ -478,7 +496,7 @@ def _fit_knob(unit, axis, fiducial_mm, target_rod_mm, linkage, iterations=30):
     """
     comp = 0 if axis == "alpha" else 1
 
-    def g(t):
+    def g(t: Any) -> Any:
         u = turn_correction_knob(unit, axis, t, linkage)
         return rod_from_photo(fiducial_mm, u)[..., comp] - target_rod_mm
 
@@ -515,9 +533,9 @@ class Stage2Result(NamedTuple):
 
 
 def stage2_setting(
-    alpha: NDArray,
-    omega: NDArray,
-    side_sign: NDArray,
+    alpha: NDArray[Any],
+    omega: NDArray[Any],
+    side_sign: NDArray[Any],
     variant: str,
     pair: SyntheticPair | None = None,
 ) -> Stage2Result:
@@ -593,14 +611,15 @@ def stage2_setting(
 STAGE2_SIGNS = (1.0, -1.0, -1.0, 1.0)
 
 
-def _photo_unit(unit: CorrectionUnit, i: int, kappa) -> CorrectionUnit:
+def _photo_unit(unit: CorrectionUnit, i: int, kappa: Any) -> CorrectionUnit:
     """Photo ``i`` (0 left, 1 right) of a stage-2 unit fitted for both photos, shape (T, 1)."""
+    fitted: Any = unit  # its fields (2, T), one row per photo
     return replace(
         unit,
-        tan_alpha=unit.tan_alpha[i][:, None],
-        tan_omega=unit.tan_omega[i][:, None],
-        decentration_x_mm=unit.decentration_x_mm[i][:, None],
-        decentration_y_mm=unit.decentration_y_mm[i][:, None],
+        tan_alpha=fitted.tan_alpha[i][:, None],
+        tan_omega=fitted.tan_omega[i][:, None],
+        decentration_x_mm=fitted.decentration_x_mm[i][:, None],
+        decentration_y_mm=fitted.decentration_y_mm[i][:, None],
         plane_decentration_x_mm=None,
         plane_decentration_y_mm=None,
         kappa=kappa,
@@ -609,8 +628,8 @@ def _photo_unit(unit: CorrectionUnit, i: int, kappa) -> CorrectionUnit:
 
 def stage2_table(
     pair: SyntheticPair | None = None,
-    tilts_deg=(0.5, 1.0, 3.0),
-    variants=("L", "A", "B", "B2", "S"),
+    tilts_deg: Sequence[float] = (0.5, 1.0, 3.0),
+    variants: Sequence[str] = ("L", "A", "B", "B2", "S"),
 ) -> list[dict[str, Any]]:
     r"""``kinematics.md`` §5 [1]: stage 2 in each decentration variant.
 
@@ -636,7 +655,9 @@ def stage2_table(
     pair = pair or SyntheticPair()
     setting = pair.setting()
     n_l = pair.n_left
-    n_r = (pair.projection_distance_max_mm + float(setting.base_z_mm)) / pair.f_instrument_mm
+    n_r = (pair.projection_distance_max_mm + float(cast(Any, setting.base_z_mm))) / (
+        pair.f_instrument_mm
+    )
     t = np.asarray(tilts_deg, float) * _DEG
     s = np.asarray(STAGE2_SIGNS)
     tilts = t[:, None] * s  # (T, 4)
@@ -656,8 +677,9 @@ def stage2_table(
         max_q, rms_q = _q_stats(reading.y_parallax_mm)
         q_after, _, _ = touch_up(pl, pr, setting, left, right, v.linkage)
         max_after, _ = _q_stats(q_after)
-        a_fit = np.arctan(unit.tan_alpha[0])
-        w_fit = np.arctan(unit.tan_omega[0])
+        fitted: Any = unit
+        a_fit = np.arctan(fitted.tan_alpha[0])
+        w_fit = np.arctan(fitted.tan_omega[0])
         for i, t_deg in enumerate(tilts_deg):
             rows.append(
                 {
@@ -729,9 +751,9 @@ def sanity_checks(pair: SyntheticPair | None = None, tilt_deg: float = 1.0) -> d
 
 
 def run_kinematic_selftest(
-    tilts=(0.5 * _DEG, 1.0 * _DEG, 3.0 * _DEG),
-    variants=("L", "A", "B", "B2", "S"),
-    instrument=None,
+    tilts: Sequence[float] = (0.5 * _DEG, 1.0 * _DEG, 3.0 * _DEG),
+    variants: Sequence[str] = ("L", "A", "B", "B2", "S"),
+    instrument: Any = None,
 ) -> dict[str, Any]:
     r"""The kinematic acceptance of ``kinematics.md`` §5 and §6, as JSON-ready data.
 

@@ -16,6 +16,7 @@ Reference
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,28 +24,42 @@ from numpy.typing import NDArray
 from stereoplotter.instrument.kinematics import rod_from_counters
 from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
 from stereoplotter.instrument.virtual import (
-    CONTROL_INFO,
     HEIGHT_SCALE,
     NOMINAL_ZERO,
+    CassetteName,
+    KnobName,
+    ScrewName,
     Side,
     control_kind,
 )
 from stereoplotter.procedure import steps
+from stereoplotter.procedure.arrays import Floats, Mask, Value
 from stereoplotter.procedure.compaction import compacted
+from stereoplotter.procedure.control_names import CASSETTE, DECENTRATION, KNOB, Tilt
+from stereoplotter.procedure.floor import ControlHeights
 from stereoplotter.procedure.levelling import LevelDesign
-from stereoplotter.procedure.operator import Operator, solve_1d
-from stereoplotter.procedure.records import (
-    ControlHeight,
-)
+from stereoplotter.procedure.noise_key import NoiseKey
+from stereoplotter.procedure.operator import Look, Operator, solve_1d
+from stereoplotter.procedure.records import ControlHeight
 from stereoplotter.procedure.run import Run
-from stereoplotter.procedure.sheet_stages import stage4_orient_sheet, stage5_check
+from stereoplotter.procedure.sheet_stages import plotted_mm, stage4_orient_sheet, stage5_check
 from stereoplotter.procedure.span_check import fiducial_mm, span_loop
-from stereoplotter.setup.equations import (
-    sheet_corner_instrument_coordinates,
+from stereoplotter.procedure.step_values import (
+    Act,
+    Line,
+    ReadStep,
+    SetStep,
+    Step,
+    perform_all,
+    turn_common_tilt,
 )
+from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
     "Q_ELEMENTS",
+    "STAGE1_STEPS",
+    "STAGE2_STEPS",
+    "STAGE3_STEPS",
     "check_standard_points",
     "clear_kappa",
     "kappa_from_fiducials",
@@ -70,61 +85,95 @@ _TILT = {"alpha": "α", "omega": "ω"}
 #: whole stereopair", stage 3). Not b_y (a constant q, dependent on κ_л, κ_п at six points),
 #: not b_z (it carries n_п, set by the stage-1 L-check, and moves the model's longitudinal
 #: tilt).
-Q_ELEMENTS = ("kappa_left", "kappa_right", "k_omega_right", "k_alpha_left", "k_alpha_right")
+Q_ELEMENTS: tuple[CassetteName | KnobName, ...] = (
+    "kappa_left",
+    "kappa_right",
+    "k_omega_right",
+    "k_alpha_left",
+    "k_alpha_right",
+)
+
+#: The identities of the stages' draws (each act's own below its stage by its path).
+STAGE1, STAGE2, STAGE3 = NoiseKey("1"), NoiseKey("2"), NoiseKey("3")
 
 
 # --- stage 1 ---------------------------------------------------------------------------------
 
 
-def stage1_scale_coefficient(run: Run) -> None:
-    """Stage 1: interior settings, base, D = n_л f_пр, the L-check loop, MO_Z and MO_bz (D7)."""
-    op, sheet = run.op, run.sheet
-    log = op.log
-    steps.interior_orientation(run, "1")
-    run.zero["MO_bx"] = _bx_zero(run)
-    o_bx = run.target("O_bx", run.zero["MO_bx"])
-    op.set("bx", o_bx, "1/bx")
-    log.add(
-        "1",
-        "base carriage: O_bx = MO_bx + b_x",
-        "bx",
-        reading=o_bx,
-        equation="item 1",
-    )
-    op.set("bz", NOMINAL_ZERO["bz"], "1/bz0")
-    depth = run.target("O_Z")  # absolute height counter: D = n_л·f_пр
-    op.set("Z", depth, "1/Z")
-    log.add(
-        "1",
-        "lower the carriage to O_Z = n_л·f_пр (absolute height counter)",
-        "Z",
-        reading=depth,
-        equation="(6.3)",
-    )
-    steps.zero_base_y(run, "1")
-    o_by = run.target("O_by")
-    op.set("by", o_by, "1/by")
-    log.add("1", "base carriage: O_by = MO_by + b_y", "by", reading=o_by, equation="item 1")
-    its, ok, res = span_loop(run, "1", "1/L", units_at_zero=True)
+def _stage1_l_check(run: Run, key: NoiseKey) -> None:
+    """The stage-1 L-check loop (units at zero, D5), with R1 where it ends failed (the
+    operator's practice): "otherwise the setting is repeated", with averaged pointings."""
+    its, ok, res = span_loop(run, "1", key, units_at_zero=True)
     name = "stage 1: |L − L′|"
     if run.remedial:  # R1: "otherwise the setting is repeated", with averaged pointings
         remedy = "R1 repeat the setting"
         failed = ~ok
         with compacted(run, failed) as cut:  # on the trials that failed only
             r_its, _, r_res = span_loop(
-                cut.run, "1", "1/L/R1", True, cut.active, steps.REPEAT_POINTINGS, remedy
+                cut.run, "1", key.at("R1"), True, cut.active, steps.REPEAT_POINTINGS, remedy
             )
         r_its = cut.put(np.zeros_like(its), r_its)
         res = cut.put(res, r_res)
         its = its + np.where(failed, r_its, 0)
     run.record_stage("1", its)
-    run.check(name, res, sheet.tolerances["mark_span_mm"], iterations=its)
+    run.check(name, res, run.sheet.tolerances["mark_span_mm"], iterations=its)
     if run.remedial:
         run.record_remedy("R1 stage 1: repeat the setting", name, failed, r_its * failed)
-    _record_stage1_zeros(run)
 
 
-def _bx_zero(run: Run):
+def _record_bx_zero(run: Run, key: NoiseKey) -> None:
+    run.zero["MO_bx"] = _bx_zero(run, key)
+
+
+#: Stage 1 (§26, OCR L3753–3763): interior settings, base, D = n_л f_пр, the L-check loop,
+#: MO_Z and MO_bz (D7).
+STAGE1_STEPS: tuple[Step, ...] = (
+    *steps.interior_steps("1"),
+    Act("MO_bx, b_x's place of zero", STAGE1.at("MObx"), _record_bx_zero),
+    SetStep(
+        "bx",
+        lambda run: run.target("O_bx", run.zero["MO_bx"]),
+        STAGE1.at("bx"),
+        Line("1", "base carriage: O_bx = MO_bx + b_x", "item 1"),
+    ),
+    SetStep("bz", lambda run: NOMINAL_ZERO["bz"], STAGE1.at("bz0")),
+    SetStep(
+        "Z",
+        lambda run: run.target("O_Z"),  # absolute height counter: D = n_л·f_пр
+        STAGE1.at("Z"),
+        Line("1", "lower the carriage to O_Z = n_л·f_пр (absolute height counter)", "(6.3)"),
+    ),
+    Act("MO_by", STAGE1.at("MOby"), lambda run, key: steps.zero_base_y(run, "1", key)),
+    SetStep(
+        "by",
+        lambda run: run.target("O_by"),
+        STAGE1.at("by"),
+        Line("1", "base carriage: O_by = MO_by + b_y", "item 1"),
+    ),
+    Act("the L-check (6.9)–(6.11)", STAGE1.at("L"), _stage1_l_check),
+    ReadStep(
+        HEIGHT_SCALE,
+        STAGE1.at("MOZ"),
+        "MO_Z",
+        Line("1", "record MO_Z on the height scale", "stage 1"),
+    ),
+    ReadStep("Z", STAGE1.at("MOZ", "D"), "D_MO_Z"),
+    ReadStep(
+        "bz",
+        STAGE1.at("MObz"),
+        "MO_bz",
+        Line("1", "record MO_bz = (b_z reading) − b_z′", "decision D7"),
+        recorded=lambda run, reading: run.target("MO_bz", reading),  # (b_z reading) ∓ b_z′
+    ),
+)
+
+
+def stage1_scale_coefficient(run: Run) -> None:
+    """Stage 1: :data:`STAGE1_STEPS`."""
+    perform_all(run, STAGE1_STEPS)
+
+
+def _bx_zero(run: Run, key: NoiseKey) -> Floats:
     """MO_bx, b_x's place of zero (switch ``bx_zero``, :mod:`~stereoplotter.procedure.fidelity`):
     "two_pointings" ((6.38), m_bx = √2·m_x/n): found as MO_by is, the left mark monocularly on
     the left cassette centre, the right mark on the right one, each pointing with σ_mono along
@@ -134,113 +183,92 @@ def _bx_zero(run: Run):
     if run.fidelity.bx_zero == "exact":
         return op.v(NOMINAL_ZERO["bx"])
     sigma = op.model.monocular_sigma_mm
-    e = [op.noise.normal(f"mono/1/MObx/{side}", sigma) for side in ("left", "right")]
+    e = [op.noise.draw(key.at(side).by("mono"), sigma) for side in ("left", "right")]
     zero = NOMINAL_ZERO["bx"] + run.sheet.n_left * (e[1] - e[0])
-    op.log.add(
-        "1",
-        "MO_bx: the left mark on the left cassette centre, the right mark on the right one "
-        "(two monocular pointings along x)",
-        "bx",
-        reading=zero,
-        judgment_error=e[1] - e[0],
-        equation="(6.38)",
-    )
+    _BX_ZERO_LINE.log(op, "bx", reading=zero, judgment_error=e[1] - e[0])
     return zero
 
 
-def _record_stage1_zeros(run: Run) -> None:
-    op = run.op
-    run.zero["MO_Z"] = op.read(HEIGHT_SCALE, "1/MOZ")
-    run.zero["D_MO_Z"] = op.read("Z", "1/MOZ/D")
-    bzr = op.read("bz", "1/MObz")
-    run.zero["MO_bz"] = run.target("MO_bz", bzr)  # (b_z reading) ∓ b_z′ (D7)
-    op.log.add(
-        "1",
-        "record MO_Z on the height scale",
-        HEIGHT_SCALE,
-        reading=run.zero["MO_Z"],
-        unit="m",
-        equation="stage 1",
-    )
-    op.log.add(
-        "1",
-        "record MO_bz = (b_z reading) − b_z′",
-        "bz",
-        reading=run.zero["MO_bz"],
-        equation="decision D7",
-    )
+_BX_ZERO_LINE = Line(
+    "1",
+    "MO_bx: the left mark on the left cassette centre, the right mark on the right one "
+    "(two monocular pointings along x)",
+    "(6.38)",
+)
 
 
 # --- stage 2 ---------------------------------------------------------------------------------
 
 
-def _zero_readings(run: Run, key: str) -> None:
+def _zero_readings(run: Run, key: NoiseKey) -> None:
     op = run.op
-    for side, names in (("left", ("MO_X", "MO_Y")), ("right", ("MO_X,п", "MO_Y,п"))):
-        e = op.mark_on(side, np.zeros(2), f"{key}/{side}")
-        run.zero[names[0]] = op.read("X", f"{key}/{side}/X")
-        run.zero[names[1]] = op.read("Y", f"{key}/{side}/Y")
-        op.log.add(
-            "2",
-            f"{side} mark on the {side} cassette centre → {names[0]}",
-            "X",
-            reading=run.zero[names[0]],
-            judgment_error=e[..., 0],
-            equation="decision D6",
-        )
-        op.log.add(
-            "2",
-            f"… and {names[1]}",
-            "Y",
-            reading=run.zero[names[1]],
-            judgment_error=e[..., 1],
-            equation="decision D6",
-        )
+    zeros: tuple[tuple[Side, tuple[str, str]], ...] = (
+        ("left", ("MO_X", "MO_Y")),
+        ("right", ("MO_X,п", "MO_Y,п")),
+    )
+    for side, names in zeros:
+        e = op.mark_on(side, np.zeros(2), key.at(side))
+        run.zero[names[0]] = op.read("X", key.at(side, "X"))
+        run.zero[names[1]] = op.read("Y", key.at(side, "Y"))
+        fields = {"side": side, "x": names[0], "y": names[1]}
+        _ZERO_X.log(op, "X", fields, reading=run.zero[names[0]], judgment_error=e[..., 0])
+        _ZERO_Y.log(op, "Y", fields, reading=run.zero[names[1]], judgment_error=e[..., 1])
 
 
-def _fit_knob(run: Run, side: str, axis: str, mark: str, key: str, active):
+#: Stage 2's zero readings MO_X, MO_Y (MO_X,п, MO_Y,п) of a photo.
+_ZERO_X = Line("2", "{side} mark on the {side} cassette centre → {x}", "decision D6")
+_ZERO_Y = Line("2", "… and {y}", "decision D6")
+
+
+def _fit_knob(run: Run, side: Side, axis: Tilt, mark: str, key: NoiseKey, active: Mask) -> Floats:
     """Set the counter to MO + n·(x⁰ or y⁰), the other handwheel onto the fiducial line, turn
     the knob until the fiducial is under the mark ((6.12) or (6.13)); the knob's tangent
     after the turn. [—]"""
     op = run.op
     sfx = "" if side == "left" else ",п"
     fid = fiducial_mm(run, side, mark)
+    counter: ScrewName
     if axis == "omega":
         counter, free, comp = "Y", "X", 1
-        eq = "(6.12)"
     else:
         counter, free, comp = "X", "Y", 0
-        eq = "(6.13)"
     value = _fit_target(run, side, f"O_{counter}{mark},{_SIDE[side]}")
-    op.set(counter, value, f"{key}/set", active)
-    op.mark_on(side, fid, f"{key}/line", active, free=free)
-    e = op.noise.normal(f"mono/{key}/knob", op.model.monocular_sigma_mm)
+    op.set(counter, value, key.at("set"), active)
+    op.mark_on(side, fid, key.at("line"), active, free=free)
+    e = op.noise.draw(key.at("knob").by("mono"), op.model.monocular_sigma_mm)
     left_u, right_u = op.units()
     unit = left_u if side == "left" else right_u
     rod = rod_from_counters(
         op.physical("X"), op.physical("Y"), op.physical("Z"), op.inst.setting, side
     )
-    knob = f"k_{axis}_{side}"
+    knob = KNOB[axis, side]
     t = op.knob_for(knob, unit, fid, rod, comp, fid[comp] + e)
     before = op.physical(knob)
     op.drive(knob, t, active)
     coordinate = f"{counter.lower()}⁰{_SUB[mark]}"  # y⁰₃ for k_ω, x⁰₂ / x⁰₁ for k_α
-    op.log.add(
-        "2",
-        f"{side} photo: counter {counter} at {'MO_' + counter + sfx} + n·{coordinate} "
-        f"= {np.ravel(value)[0]:.2f} mm, turn {control_name(op.inst.spec.principle, knob)} "
-        f"(tan {_TILT[axis]}) until {mark_phrase(op.inst.spec.principle, mark)}",
-        knob,
-        before=before,
-        after=op.physical(knob),
-        unit="tan",
-        judgment_error=e,
-        equation=eq,
-    )
+    fields = {
+        "side": side,
+        "counter": counter,
+        "zero": "MO_" + counter + sfx,
+        "coordinate": coordinate,
+        "value": np.ravel(value)[0],
+        "knob": control_name(op.inst.spec.principle, knob),
+        "tilt": _TILT[axis],
+        "mark": mark_phrase(op.inst.spec.principle, mark),
+    }
+    _FIT_KNOB[axis].log(op, knob, fields, before=before, after=op.physical(knob), judgment_error=e)
     return op.physical(knob)
 
 
-def _fit_target(run: Run, side: str, name: str):
+_FIT_TEXT = (
+    "{side} photo: counter {counter} at {zero} + n·{coordinate} = {value:.2f} mm, turn {knob} "
+    "(tan {tilt}) until {mark}"
+)
+#: Stage 2's fit of a correction knob: k_ω (6.12), k_α (6.13).
+_FIT_KNOB = {"omega": Line("2", _FIT_TEXT, "(6.12)"), "alpha": Line("2", _FIT_TEXT, "(6.13)")}
+
+
+def _fit_target(run: Run, side: Side, name: str) -> Value:
     """The counter target MO (+ ,п) + n·x⁰ or n·y⁰ of a fit (switch ``fit_scale``): the sheet's
     reading ("as_set"), or its value scaled by n_true/n of the sheet, n_true = D/f_пр of the
     instrument as it is (D + b_z on the right; "exact"). [mm]"""
@@ -249,49 +277,48 @@ def _fit_target(run: Run, side: str, name: str):
         return value
     op, sheet = run.op, run.sheet
     depth = op.physical("Z") + (op.physical("bz") if side == "right" else 0.0)
-    n_true = depth / op.inst.setting.f_instrument_mm
+    f_instrument: Value = op.inst.setting.f_instrument_mm
+    n_true = depth / f_instrument
     n_sheet = sheet.n_left if side == "left" else sheet.n_right
     reading = run.readings[name]
     return value + reading.value * (n_true / n_sheet - 1.0)
 
 
-def _fit_omega(run: Run, side: str, key: str, active) -> None:
+def _fit_omega(run: Run, side: Side, key: NoiseKey, active: Mask) -> None:
     """k_ω of ``side`` (switch ``tilts``): fitted at mark 3 ("knob_fit"), or at marks 3 and 4
     and set to the mean of the two fits ("least_squares", (6.33))."""
     t3 = _fit_knob(run, side, "omega", "3", key, active)
     if run.fidelity.tilts != "least_squares":
         return
     op = run.op
-    t4 = _fit_knob(run, side, "omega", "4", f"{key}/4", active)
-    knob = f"k_omega_{side}"
+    t4 = _fit_knob(run, side, "omega", "4", key.at("4"), active)
+    knob = KNOB["omega", side]
     before = op.physical(knob)
     op.drive(knob, 0.5 * (t3 + t4), active)
-    op.log.add(
-        "2",
-        f"{side} photo: k_ω to the mean of its fits at marks 3 and 4 (least squares)",
-        knob,
-        before=before,
-        after=op.physical(knob),
-        unit="tan",
-        equation="(6.33)",
-    )
+    _OMEGA_MEAN.log(op, knob, {"side": side}, before=before, after=op.physical(knob))
 
 
-def _mark4(run: Run, side: str, key: str, active) -> NDArray[np.float64]:
+_OMEGA_MEAN = Line(
+    "2", "{side} photo: k_ω to the mean of its fits at marks 3 and 4 (least squares)", "(6.33)"
+)
+
+
+def _mark4(run: Run, side: Side, key: NoiseKey, active: Mask) -> Floats:
     """Check mark 4 at MO_Y + n·y⁰₄ (6.12): the offset of the mark from fiducial 4 seen."""
     op = run.op
     fid = fiducial_mm(run, side, "4")
     value = run.target(f"O_Y4,{_SIDE[side]}")
-    op.set("Y", value, f"{key}/set", active)
-    op.mark_on(side, fid, f"{key}/line", active, free="X")
+    op.set("Y", value, key.at("set"), active)
+    op.mark_on(side, fid, key.at("line"), active, free="X")
     off = op.inst.mark_offsets(**{f"{side}_point_mm": fid})[side]
-    e = op.noise.normal(f"mono/{key}/seen", op.model.monocular_sigma_mm)
-    return np.abs(np.asarray(off)[..., 1]) + e
+    e = op.noise.draw(key.at("seen").by("mono"), op.model.monocular_sigma_mm)
+    seen: Floats = np.abs(np.asarray(off)[..., 1]) + e
+    return seen
 
 
-def stage2_transform(run: Run) -> None:
-    """Stage 2: zero readings, k_ω with the mark-4 check (iterated with the stage-1 L-check,
-    decision D5), k_α, computed decentrations, O_bz (6.14), κ (D8), residual y-parallax."""
+def _stage2_k_omega(run: Run, key: NoiseKey) -> None:
+    """k_ω of both photos with the mark-4 check, iterated with the stage-1 L-check (decision
+    D5) until mark 4 is within its tolerance (bounded)."""
     op, sheet = run.op, run.sheet
     tol4 = sheet.tolerances["mark_fit_mm"]
     active = op.all()
@@ -300,7 +327,7 @@ def stage2_transform(run: Run) -> None:
     for it in range(1, op.model.max_iterations + 1):
         its = np.where(active, it, its)
         with compacted(run, active) as cut:  # the trials whose mark 4 is still off only
-            l_its, new = _stage2_round(cut.run, it, cut.active, tol4)
+            l_its, new = _stage2_round(cut.run, key, it, cut.active, tol4)
         if it > 1:  # D5: the L-check repeated with the units set
             l_its = cut.put(np.zeros(np.shape(active), int), l_its)
             run.record_stage("1", run.stage_iterations("1") + np.where(active, l_its, 0))
@@ -310,18 +337,50 @@ def stage2_transform(run: Run) -> None:
             break
     run.record_stage("2", its)
     run.check("stage 2: mark 4", worst, tol4, iterations=its)
-    for side, mark in (("left", "2"), ("right", "1")):
-        _fit_knob(run, side, "alpha", mark, f"2/{side}/alpha", op.all())
-    if not op.inst.variant.decentrations_first:  # B2 set them before the k_ω fit
-        _set_computed_decentrations(run)
-    bz = run.target("O_bz")
-    op.set("bz", bz, "2/bz")
-    op.log.add("2", "O_bz = MO_bz + b_z′", "bz", reading=bz, equation="(6.14)")
+
+
+def _stage2_k_alpha(run: Run, key: NoiseKey) -> None:
+    """k_α of the left photo at mark 2, of the right at mark 1 ((6.13))."""
+    marks: tuple[tuple[Side, str], ...] = (("left", "2"), ("right", "1"))
+    for side, mark in marks:
+        _fit_knob(run, side, "alpha", mark, key.at(side, "alpha"), run.op.all())
+
+
+def _stage2_decentrations(run: Run, key: NoiseKey) -> None:
+    """The computed decentrations after the fits (variant B2 set them before, ``_stage2_round``)."""
+    if not run.op.inst.variant.decentrations_first:
+        _set_computed_decentrations(run, key)
+
+
+def _stage2_kappa(run: Run, key: NoiseKey) -> None:
+    """κ (switch ``kappa``): from the fiducials (6.36), or cleared at standard points 1, 2 (D8)."""
     if run.fidelity.kappa == "fiducials":
         kappa_from_fiducials(run, "2")
     else:
         clear_kappa(run, "2")
-    check_standard_points(run, "2")
+
+
+#: Stage 2 (§26, OCR L3764–3790): zero readings, k_ω with the mark-4 check (iterated with the
+#: stage-1 L-check, decision D5), k_α, computed decentrations, O_bz (6.14), κ (D8), the residual
+#: y-parallax.
+STAGE2_STEPS: tuple[Step, ...] = (
+    Act("k_ω with the mark-4 check", STAGE2, _stage2_k_omega),
+    Act("k_α", STAGE2, _stage2_k_alpha),
+    Act("computed decentrations", STAGE2, _stage2_decentrations),
+    SetStep(
+        "bz",
+        lambda run: run.target("O_bz"),
+        STAGE2.at("bz"),
+        Line("2", "O_bz = MO_bz + b_z′", "(6.14)"),
+    ),
+    Act("κ", STAGE2.at("kappa"), _stage2_kappa),
+    Act("residual y-parallax", STAGE2.at("std"), lambda run, key: check_standard_points(run, "2")),
+)
+
+
+def stage2_transform(run: Run) -> None:
+    """Stage 2: :data:`STAGE2_STEPS`."""
+    perform_all(run, STAGE2_STEPS)
 
 
 def kappa_from_fiducials(run: Run, stage: str) -> None:
@@ -331,48 +390,61 @@ def kappa_from_fiducials(run: Run, stage: str) -> None:
     m_κ = m_x/(√2·l·n) at counter scale. No y-parallax is judged. [rad]"""
     op = run.op
     sigma = op.model.monocular_sigma_mm
-    for side, photo in zip(("left", "right"), run.sheet.photos, strict=True):
+    key = NoiseKey(stage).at("kappa")
+    sides: tuple[Side, Side] = ("left", "right")
+    for side, photo in zip(sides, run.sheet.photos, strict=True):
         span = fiducial_mm(run, side, "3")[1] - fiducial_mm(run, side, "4")[1]
-        e3, e4 = (op.noise.normal(f"mono/{stage}/kappa/{side}/{m}", sigma) for m in "34")
-        control = f"kappa_{side}"
+        e3, e4 = (op.noise.draw(key.at(side, m).by("mono"), sigma) for m in "34")
+        control = CASSETTE[side]
         before = op.physical(control)
         op.drive(control, photo.kappa + (e3 - e4) / span)
-        op.log.add(
-            stage,
-            f"κ_{_SIDE[side]} from the fiducials: marks 3 and 4 at equal x-readings",
-            control,
-            before=before,
-            after=op.physical(control),
-            unit="rad",
-            judgment_error=e3 - e4,
-            equation="(6.36)",
-        )
+        _KAPPA_FIDUCIALS.in_stage(stage).log(
+            op, control, {"side": _SIDE[side]},
+            before=before, after=op.physical(control), judgment_error=e3 - e4,
+        )  # fmt: skip
 
 
-def _set_computed_decentrations(run: Run) -> None:
+_KAPPA_FIDUCIALS = Line(
+    "2", "κ_{side} from the fiducials: marks 3 and 4 at equal x-readings", "(6.36)"
+)
+
+
+def _set_computed_decentrations(run: Run, key: NoiseKey) -> None:
     """The computed decentrations d = MO_d + f′·tan(tilt) on the scales (stage 2): after the
     k_α, k_ω fits in the book's order, before them under variant B2 (``decentrations_first``)."""
     op = run.op
-    for side in ("left", "right"):
+    sides: tuple[Side, Side] = ("left", "right")
+    for side in sides:
         for d in ("dx", "dy"):
-            control = f"{d}_{side}"
+            control = DECENTRATION[d, side]
             # MO_dx, MO_dy: the decentration scale's place of zero
             value = run.target(f"d_{d[1]},{_SIDE[side]}", NOMINAL_ZERO[control])
-            op.set(control, value, f"2/{control}")
-            tilt = "α" if d == "dx" else "ω"
-            op.log.add(
-                "2",
-                f"decentration {control_name(op.inst.spec.principle, control)} "
-                f"= MO_{d} + f′·tan {tilt}_{_SIDE[side]} "
-                f"(place of zero MO_{d} = {NOMINAL_ZERO[control]:g} mm)"
-                + _table_settings(op.inst.spec.principle, d),
-                control,
-                reading=value,
-                equation=f"f′·tan {tilt} (§2.4)",
-            )
+            op.set(control, value, key.at(control))
+            fields = {
+                "name": control_name(op.inst.spec.principle, control),
+                "d": d,
+                "side": _SIDE[side],
+                "zero": NOMINAL_ZERO[control],
+                "tables": _table_settings(op.inst.spec.principle, d),
+            }
+            _DECENTRATION[d].log(op, control, fields, reading=value)
 
 
-def _stage2_round(run: Run, it: int, active, tol4: float):
+def _decentration_line(d: str, tilt: str) -> Line:
+    text = (
+        "decentration {name} = MO_{d} + f′·tan " + tilt + "_{side} "
+        "(place of zero MO_{d} = {zero:g} mm){tables}"
+    )
+    return Line("2", text, f"f′·tan {tilt} (§2.4)")
+
+
+#: Stage 2's computed decentration d_x (from α) or d_y (from ω) of a photo.
+_DECENTRATION = {"dx": _decentration_line("dx", "α"), "dy": _decentration_line("dy", "ω")}
+
+
+def _stage2_round(
+    run: Run, key: NoiseKey, it: int, active: Mask, tol4: float
+) -> tuple[NDArray[np.int_] | None, Floats]:
     """One pass of stage 2's k_ω loop on ``active``: (from the second on) the L-check again
     with the units set (D5), or the zero readings; k_ω fitted and mark 4 checked on both
     photos. Returns the L-check's iterations (None on the first pass) and the worst mark-4
@@ -380,27 +452,45 @@ def _stage2_round(run: Run, it: int, active, tol4: float):
     op = run.op
     l_its = None
     if it > 1:  # D5: repeat the L-check with the units set, then refit k_ω
-        l_its, _, _ = span_loop(run, "2", f"2/L{it}", active=active)
+        l_its, _, _ = span_loop(run, "2", key.at(f"L{it}"), active=active)
     else:  # with the correction units still at zero the cassette centre is on the plumb
-        _zero_readings(run, "2/MO")
+        _zero_readings(run, key.at("MO"))
         if op.inst.variant.decentrations_first:  # B2: the decentrations before the fits
-            _set_computed_decentrations(run)
+            _set_computed_decentrations(run, key)
     seen = []
     for side in ("left", "right"):
-        _fit_omega(run, side, f"2/{it}/{side}/omega", active)
-        m4 = _mark4(run, side, f"2/{it}/{side}/m4", active)
+        _fit_omega(run, side, key.at(it, side, "omega"), active)
+        m4 = _mark4(run, side, key.at(it, side, "m4"), active)
         seen.append(m4)
-        op.log.add(
-            "2",
-            f"{side} photo: check mark 4 at MO_Y{',п' if side == 'right' else ''} + n·y⁰₄",
-            "Y",
-            residual=m4,
-            tolerance=tol4,
-            passed=np.abs(m4) <= tol4,
-            iteration=it,
-            equation="(6.12)",
-        )
+        _MARK4.log(
+            op, "Y", {"sfx": ",п" if side == "right" else "", "side": side},
+            residual=m4, tolerance=tol4, passed=np.abs(m4) <= tol4, iteration=it,
+        )  # fmt: skip
     return l_its, np.maximum(np.abs(seen[0]), np.abs(seen[1]))
+
+
+#: Stage 2's check of mark 4 of a photo.
+_MARK4 = Line("2", "{side} photo: check mark 4 at MO_Y{sfx} + n·y⁰₄", "(6.12)")
+#: D8: the y-parallax at standard point 1 or 2 cleared with a cassette's κ.
+_CLEAR_KAPPA = Line(
+    "2", "standard point {point}: clear the y-parallax with κ_{side}", "decision D8"
+)
+#: R2: a turn of an element by the least-squares clearing of the six q.
+_R2_TURN = Line(
+    "2",
+    "turn {control} by the least-squares clearing of the six q seen",
+    "§26 stages 2, 3: κ along the initial direction; refine k_ω",
+)
+#: R3: the height scale slipped on the first control point, on the mean of several fusings.
+_R3_SLIP = Line(
+    "3",
+    "fuse on {id} ({pointings} times), slip the height scale to H = {height:.2f} m",
+    "stage 3",
+)
+#: A control height read against its known height (H/3000).
+_CONTROL_HEIGHT = Line("3", "{text}, against the point's known height {truth:.2f} m", "H/3000")
+#: Stage 3: b_x turned until the mark fuses on the height control point.
+_FUSE_BX = Line("3", "fuse the mark on point {id} by turning b_x", "stage 3")
 
 
 def _table_settings(principle: str, control: str) -> str:
@@ -439,52 +529,51 @@ def clear_kappa(run: Run, stage: str) -> None:
     run.record_stage(f"{stage}/kappa", its)
 
 
-def _kappa_round(run: Run, stage: str, it: int, active, pts, imgs, tol: float):
+def _kappa_round(
+    run: Run,
+    stage: str,
+    it: int,
+    active: Mask,
+    pts: Floats,
+    imgs: tuple[Floats, Floats],
+    tol: float,
+) -> Mask:
     """One pass of D8 on ``active``: q at standard point 1 cleared with κ_п, at point 2 with
     κ_л; whether both were within ¼ mark as seen before the turns."""
     op = run.op
     qs = []
-    for idx, side in ((0, "right"), (1, "left")):
-        key = f"{stage}/kappa/{it}/{idx + 1}"
+    points: tuple[tuple[int, Side], ...] = ((0, "right"), (1, "left"))
+    for idx, side in points:
+        key = NoiseKey(stage).at("kappa", it, idx + 1)
         img = (imgs[0][idx], imgs[1][idx])
         q_seen, q_true = op.fuse(pts[idx], img, key, active)
         qs.append(q_seen)
-        control = f"kappa_{side}"
-        target = op.noise.normal(f"q/{key}/clear", op.model.y_parallax_sigma_mm)
+        control = CASSETTE[side]
+        target = op.noise.draw(key.at("clear").by("q"), op.model.y_parallax_sigma_mm)
         q_of = op.q_turning(control, img)  # q with κ turned, the rest as it is now
         ok_here = np.abs(q_seen) <= tol
         move = active & ~ok_here if it > 1 else active
         kappa = op.physical(control)
         new = _solve_kappa(q_of, kappa, target)
         op.drive(control, new, move)
-        op.log.add(
-            stage,
-            f"standard point {idx + 1}: clear the y-parallax with κ_{_SIDE[side]}",
-            control,
-            before=kappa,
-            after=op.physical(control),
-            unit="rad",
-            residual=q_seen,
-            true=q_true,
-            judgment_error=q_seen - q_true,
-            tolerance=tol,
-            passed=ok_here,
-            iteration=it,
-            equation="decision D8",
-        )
+        _CLEAR_KAPPA.in_stage(stage).log(
+            op, control, {"point": idx + 1, "side": _SIDE[side]},
+            before=kappa, after=op.physical(control), residual=q_seen, true=q_true,
+            judgment_error=q_seen - q_true, tolerance=tol, passed=ok_here, iteration=it,
+        )  # fmt: skip
     return (np.abs(qs[0]) <= tol) & (np.abs(qs[1]) <= tol)
 
 
-def _solve_kappa(q_of, kappa0, target):
-
-    return solve_1d(q_of, kappa0, target, iterations=4, h=1e-6)
+def _solve_kappa(q_of: Look, kappa0: Floats, target: Floats) -> Floats:
+    kappa: Floats = solve_1d(q_of, kappa0, target, iterations=4, h=1e-6)
+    return kappa
 
 
 def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     """The residual y-parallax at the six standard points, judged by the operator; with the
     operator's practice, remedy R2 where it exceeds ¼ mark."""
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
-    seen = np.stack(steps.judge_standard_points(run, stage, f"{stage}/std"), axis=-1)
+    seen = np.stack(steps.judge_standard_points(run, stage, NoiseKey(stage).at("std")), axis=-1)
     worst = np.max(np.abs(seen), axis=-1)
     name = f"stage {stage}: residual y-parallax (6 points)"
     if run.remedial:
@@ -494,10 +583,10 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     if run.remedial:
         remedy = f"R2 stage {stage}: refine the relative orientation"
         run.record_remedy(remedy, name, failed, rounds)
-    return worst
+    return cast(Floats, worst)
 
 
-def _q_jacobian(run: Run, imgs) -> NDArray[np.float64]:
+def _q_jacobian(run: Run, imgs: tuple[Floats, Floats]) -> NDArray[np.float64]:
     """∂q/∂element at the six standard points for :data:`Q_ELEMENTS`, the rest of the
     instrument as it is (the operator's knowledge of how each element moves q): (..., 6, 5).
 
@@ -555,7 +644,7 @@ R2_DAMPING = (0.0, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0)
 R2_RANGE_FRACTION = 0.98
 
 
-def r2_element_bounds(spec) -> dict[str, tuple[float, float]]:
+def r2_element_bounds(spec: InstrumentSpec) -> dict[str, tuple[float, float]]:
     """Where R2 may drive each of :data:`Q_ELEMENTS`: the instrument's κ range [rad] and its
     correction range ±tilt_max as tan of the tilt [—], each shrunk to
     :data:`R2_RANGE_FRACTION` (the stops are the instrument file's
@@ -569,7 +658,9 @@ def r2_element_bounds(spec) -> dict[str, tuple[float, float]]:
     }
 
 
-def r2_turns(jac, seen, before, bounds) -> NDArray[np.float64]:
+def r2_turns(
+    jac: Floats, seen: Floats, before: Floats, bounds: Sequence[tuple[float, float]]
+) -> NDArray[np.float64]:
     """R2's turns δ of :data:`Q_ELEMENTS` from the six q seen (..., 6) and the Jacobian
     (..., 6, 5): the least squares −(JᵀJ)⁻¹Jᵀq where it keeps every element inside ``bounds``,
     else damped (Levenberg–Marquardt, the first λ of :data:`R2_DAMPING` that keeps them
@@ -589,8 +680,8 @@ def r2_turns(jac, seen, before, bounds) -> NDArray[np.float64]:
     lo = np.array([b[0] for b in bounds])
     hi = np.array([b[1] for b in bounds])
     diag = np.einsum("...ii->...i", a)
-    out = None
-    done = None
+    out: Value = None
+    done: Value = None
     for lam in R2_DAMPING:
         m = a + lam * (diag[..., :, None] * np.eye(a.shape[-1]))
         with np.errstate(all="ignore"):
@@ -606,12 +697,15 @@ def r2_turns(jac, seen, before, bounds) -> NDArray[np.float64]:
             out = np.where(done[..., None], out, delta)
             done = done | inside
         if np.all(done):
-            return out
+            return cast(Floats, out)
     # the most damped step, clipped where still outside: the element stops at its range
-    return np.where(done[..., None], out, np.clip(before + out, lo, hi) - before)
+    clipped: Floats = np.where(done[..., None], out, np.clip(before + out, lo, hi) - before)
+    return clipped
 
 
-def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArray[np.float64]:
+def _r2_round(
+    run: Run, stage: str, it: int, seen: Floats, active: Mask, remedy: str
+) -> NDArray[np.float64]:
     """One round of R2 on ``active``: the bounded least-squares turns (:func:`r2_turns`) from
     the six q seen, then the six points judged again; the q seen, (..., 6). [mm]"""
     op = run.op
@@ -622,21 +716,13 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
     for j, control in enumerate(Q_ELEMENTS):
         before = op.physical(control)
         op.drive(control, before + delta[..., j], active)
-        op.log.add(
-            stage,
-            f"turn {control} by the least-squares clearing of the six q seen",
-            control,
-            before=before,
-            after=op.physical(control),
-            unit=CONTROL_INFO[control].unit,
-            iteration=it,
-            equation="§26 stages 2, 3: κ along the initial direction; refine k_ω",
-            remedy=remedy,
-            when=active,
-        )
+        _R2_TURN.in_stage(stage).log(
+            op, control, {"control": control},
+            before=before, after=op.physical(control), iteration=it, remedy=remedy, when=active,
+        )  # fmt: skip
     return np.stack(
         steps.judge_standard_points(
-            run, stage, f"{stage}/R2/{it}", active, remedy=remedy, iteration=it
+            run, stage, NoiseKey(stage).at("R2", it), active, remedy=remedy, iteration=it
         ),
         axis=-1,
     )
@@ -645,49 +731,48 @@ def _r2_round(run: Run, stage: str, it: int, seen, active, remedy: str) -> NDArr
 # --- stage 3 ---------------------------------------------------------------------------------
 
 
-def _sheet_xy(run: Run, pid: str) -> NDArray[np.float64]:
-    """The instrument coordinates (6.7) of a plan control point (the sheet's similarity)."""
-    sheet = run.sheet
-    p = run.scene.point(pid)
-    xy = sheet_corner_instrument_coordinates(
-        sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
-    )
-    return np.asarray(xy, float).reshape(2)
-
-
-def _refine_scale(run: Run, it: int, active, remedy: str) -> None:
+def _refine_scale(run: Run, it: int, active: Mask, remedy: str) -> None:
     """R3 (1): fuse on the two plan control points farthest apart, compare the distance of the
     X, Y counters with that of their sheet coordinates (6.7), turn b_x in proportion."""
     op, sheet = run.op, run.sheet
     if sheet.similarity is None:
         return
     a_id, b_id = steps.scale_pair(run)
-    d_sheet = float(np.hypot(*(_sheet_xy(run, a_id) - _sheet_xy(run, b_id))))
+    d_sheet = float(np.hypot(*(plotted_mm(run, a_id) - plotted_mm(run, b_id))))
     bx, new, d_model = steps.scale_by_two_points(
         run,
         (a_id, steps.control_point_m(run, a_id)),
         (b_id, steps.control_point_m(run, b_id)),
         d_sheet,
-        f"3/R3/{it}",
+        STAGE3.at("R3", it),
         active,
     )
-    op.log.add(
-        "3",
-        f"scale: fuse on {a_id} and {b_id}, counter distance against the sheet's "
-        f"{d_sheet:.3f} mm (6.7); turn b_x in proportion",
-        "bx",
-        before=bx,
-        after=new,
-        reading=new,
-        residual=d_model - d_sheet,
-        iteration=it,
-        equation="§26 stage 3: scaling refined (b_x)",
-        remedy=remedy,
-        when=active,
-    )
+    _R3_SCALE.log(
+        op, "bx", {"a": a_id, "b": b_id, "d": d_sheet},
+        before=bx, after=new, reading=new, residual=d_model - d_sheet, iteration=it,
+        remedy=remedy, when=active,
+    )  # fmt: skip
 
 
-def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) -> None:
+_R3_SCALE = Line(
+    "3",
+    "scale: fuse on {a} and {b}, counter distance against the sheet's {d:.3f} mm (6.7); "
+    "turn b_x in proportion",
+    "§26 stage 3: scaling refined (b_x)",
+)
+
+
+#: R3's turn of a control by its rate × the common tilt φ.
+_LEVEL_LINE = Line(
+    "3",
+    "level: common tilt Δφ_{axis} = {phi_mrad:+.4f} mrad, turn {control}",
+    "levelling on control (assumption, q-neutral common tilt)",
+)
+
+
+def _level(
+    run: Run, design: LevelDesign, errs: Sequence[Value], it: int, active: Mask, remedy: str
+) -> None:
     """R3 (2): fit offset + common tilts φ_α, φ_ω to the control-height errors and turn the
     q-neutral common tilts (:class:`LevelDesign`) by −φ."""
     op = run.op
@@ -697,31 +782,15 @@ def _level(run: Run, design: LevelDesign, errs, it: int, active, remedy: str) ->
         phi = np.where(
             active, -steps.fixed_order_sum(w[row, i] * e for i, e in enumerate(errs)), 0.0
         )
-        for control, rate in design.combos[name].items():
-            if control == "bz":
-                before = op.read("bz", f"3/R3/{it}/{name}/bz")
-                after = before + sense * rate * phi
-                op.set("bz", after, f"3/R3/{it}/{name}/setbz", active)
-            else:
-                before = op.physical(control)
-                op.drive(control, before + rate * phi, active)
-                after = op.physical(control)
-            op.log.add(
-                "3",
-                f"level: common tilt Δφ_{name[0]} = {_shown(op, phi) * 1e3:+.4f} mrad, "
-                f"turn {control}",
-                control,
-                before=before,
-                after=after,
-                unit=CONTROL_INFO[control].unit,
-                iteration=it,
-                equation="levelling on control (assumption, q-neutral common tilt)",
-                remedy=remedy,
-                when=active,
-            )
+        fields = {"axis": name[0], "phi_mrad": _shown(op, phi) * 1e3}
+        key = STAGE3.at("R3", it, name)
+        turn_common_tilt(
+            run, design.combos[name], phi, key, active, _LEVEL_LINE, fields=fields,
+            scale_sense=sense, iteration=it, remedy=remedy, when=active,
+        )  # fmt: skip
 
 
-def _shown(op: Operator, value) -> float:
+def _shown(op: Operator, value: Value) -> float:
     """The value of the trial the transcript shows."""
     flat = np.ravel(value)
     return float(flat[op.log.shown if flat.size > 1 else 0])
@@ -730,8 +799,8 @@ def _shown(op: Operator, value) -> float:
 def _read_control_heights(
     run: Run,
     rows: Sequence[ControlHeight],
-    key: str,
-    active,
+    key: NoiseKey,
+    active: Mask,
     remedy: str,
     it: int,
     pointings: int = steps.REPEAT_POINTINGS,
@@ -741,24 +810,17 @@ def _read_control_heights(
     the errors (read − truth) of points 1 … n−1. [m]"""
     op, tol = run.op, run.sheet.tolerances["control_height_m"]
     p0 = rows[0].ground_m
-    steps.slip_height_scale_on_mean(run, p0, f"{key}/slip", active, pointings)
-    op.log.add(
-        "3",
-        f"fuse on {rows[0].id} ({pointings} times), slip the height scale to H = {p0[2]:.2f} m",
-        HEIGHT_SCALE,
-        reading=p0[2],
-        unit="m",
-        iteration=it,
-        equation="stage 3",
-        remedy=remedy,
-        when=active,
-    )
+    steps.slip_height_scale_on_mean(run, p0, key.at("slip"), active, pointings)
+    _R3_SLIP.log(
+        op, HEIGHT_SCALE, {"id": rows[0].id, "pointings": pointings, "height": p0[2]},
+        reading=p0[2], iteration=it, remedy=remedy, when=active,
+    )  # fmt: skip
     return [
         log_control_height(
             op,
             "3",
             f"control point {h.id}: fuse, read the height ({pointings} times, mean)",
-            steps.height_mean(run, h.ground_m, f"{key}/{h.id}", active, pointings),
+            steps.height_mean(run, h.ground_m, key.at(h.id), active, pointings),
             h.ground_m[2],
             tol,
             iteration=it,
@@ -769,26 +831,21 @@ def _read_control_heights(
     ]
 
 
-def log_control_height(op, stage: str, text: str, read, truth_m: float, tol, **extra):
+def log_control_height(
+    op: Operator, stage: str, text: str, read: Value, truth_m: float, tol: float, **extra: Any
+) -> Value:
     """Log one control-point height read on the height scale against its truth and H/3000;
     return the error read − truth. [m]"""
-    op.log.add(
-        stage,
-        f"{text}, against the point's known height {truth_m:.2f} m",
-        HEIGHT_SCALE,
-        reading=read,
-        unit="m",
-        residual=read - truth_m,
-        tolerance=tol,
-        passed=np.abs(read - truth_m) <= tol,
-        equation="H/3000",
-        **extra,
-    )
+    _CONTROL_HEIGHT.in_stage(stage).log(
+        op, HEIGHT_SCALE, {"text": text, "truth": truth_m},
+        reading=read, residual=read - truth_m, tolerance=tol,
+        passed=np.abs(read - truth_m) <= tol, **extra,
+    )  # fmt: skip
     return read - truth_m
 
 
 def refine_scale_and_level(
-    run: Run, rows: Sequence[ControlHeight], errs, failed: NDArray[np.bool_]
+    run: Run, rows: Sequence[ControlHeight], errs: Sequence[Value], failed: NDArray[np.bool_]
 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Remedy R3: a control height misses H/3000 after stage 3. Each round: (1) the scale by
     b_x on the two plan control points farthest apart; (2) the levelling: read the control
@@ -801,7 +858,7 @@ def refine_scale_and_level(
     op = run.op
     tol = run.sheet.tolerances["control_height_m"]
     remedy = "R3 refine scaling and levelling on control"
-    design = run.level
+    design = cast(LevelDesign, run.level)  # prepared with the run
     active = op.v(failed).astype(bool)
     rounds = np.zeros(np.shape(active), int)
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
@@ -812,37 +869,29 @@ def refine_scale_and_level(
         with compacted(run, active) as cut:  # the round on the trials still failing only
             sub, on = cut.run, cut.active
             _refine_scale(sub, it, on, remedy)
-            level = _read_control_heights(sub, rows, f"3/R3/{it}/level", on, remedy, it)
+            level = _read_control_heights(sub, rows, STAGE3.at("R3", it, "level"), on, remedy, it)
             _level(sub, design, [sub.op.v(0.0) * 0.0, *level], it, on, remedy)
-            errs = _read_control_heights(sub, rows, f"3/R3/{it}/check", on, remedy, it)
+            errs = _read_control_heights(sub, rows, STAGE3.at("R3", it, "check"), on, remedy, it)
             new = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1)
         worst = cut.put(worst, new)
         active = active & (worst > tol)
     return rounds, worst
 
 
-def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
+def _fuse_bx(run: Run, pid: str, left_img: Floats, right_img: Floats) -> None:
     """Stage 3's scaling (switch ``stage3``): the mark fused on the height control point ``pid``
     by turning b_x, then ("fuse") κ cleared again (D10)."""
     op = run.op
-    op.mark_on("left", left_img, "3/left")
-    e = op.noise.normal("stereo/3/bx", op.model.stereo_sigma_mm)
+    op.mark_on("left", left_img, STAGE3.at("left"))
+    e = op.noise.draw(STAGE3.at("bx").by("stereo"), op.model.stereo_sigma_mm)
     right_map = op.unit_map("right")
     xi_r = right_map.rod_from_photo(right_img + np.stack([e, 0.0 * e], axis=-1))[..., 0]
-    n_r = (op.physical("Z") + op.physical("bz")) / op.inst.setting.f_instrument_mm
-    before = op.read("bx", "3/bx/before")
+    f_instrument: Value = op.inst.setting.f_instrument_mm
+    n_r = (op.physical("Z") + op.physical("bz")) / f_instrument
+    before = op.read("bx", STAGE3.at("bx", "before"))
     op.drive("bx", op.physical("X") - n_r * xi_r)
-    after = op.read("bx", "3/bx/after")
-    op.log.add(
-        "3",
-        f"fuse the mark on point {pid} by turning b_x",
-        "bx",
-        before=before,
-        after=after,
-        reading=after,
-        judgment_error=e,
-        equation="stage 3",
-    )
+    after = op.read("bx", STAGE3.at("bx", "after"))
+    _FUSE_BX.log(op, "bx", {"id": pid}, before=before, after=after, reading=after, judgment_error=e)
     # Decision D10 (docs/procedure.md): the b_x change moves the rods' meeting depth and with it
     # q where η_л ≠ η_п, so κ is cleared again (D8) *before* the heights are read: they are then
     # read on the model that is kept. Read before it (pair80: b_x 57.6 mm, κ absorbing f·ω/b),
@@ -852,43 +901,40 @@ def _fuse_bx(run: Run, pid: str, left_img, right_img) -> None:
         clear_kappa(run, "3")
 
 
-def stage3_scale_model(run: Run) -> None:
-    """Stage 3: (6.15) at a height control point, b_x until the mark fuses, slip the height
-    scale, check the other control heights (H/3000), re-check κ and the residual y-parallax."""
-    op, sheet = run.op, run.sheet
-    rows = run.heights.rows  # the sheet's height control points, prepared once per run
-    tol = sheet.tolerances["control_height_m"]
-    h0 = rows[0]
+def _heights(run: Run) -> ControlHeights:
+    """The run's height control points (prepared with the run)."""
+    return cast(ControlHeights, run.heights)
+
+
+def _stage3_fuse(run: Run, key: NoiseKey) -> None:
+    """b_x until the mark fuses on the first height control point (switch ``stage3``), the
+    mark fused there again and the height scale slipped to its height."""
+    op = run.op
+    h0 = _heights(run).rows[0]
     p0 = h0.ground_m
-    o_z = run.target(f"O_Z{h0.id}")  # MO_Z + (6.15)
-    op.set(HEIGHT_SCALE, o_z, "3/OZ")
-    op.log.add(
-        "3",
-        f"height scale to O_Z{h0.id} for control point {h0.id}",
-        HEIGHT_SCALE,
-        reading=o_z,
-        unit="m",
-        equation="(6.15)",
-    )
     pl, pr = run.scene.images(p0[None, :])
     if run.fidelity.stage3 != "none":
         _fuse_bx(run, h0.id, pl[0], pr[0])
-    op.fuse(p0, (pl[0], pr[0]), "3/refuse")
+    op.fuse(p0, (pl[0], pr[0]), key.at("refuse"))
     op.inst.slip_height_scale(p0[2])
-    op.log.add(
-        "3",
-        f"slip the height scale to H = {p0[2]:.2f} m",
-        HEIGHT_SCALE,
-        reading=p0[2],
-        unit="m",
-        equation="stage 3",
-    )
+    _SLIP_LINE.log(op, HEIGHT_SCALE, {"height": p0[2]}, reading=p0[2])
+
+
+_SLIP_LINE = Line("3", "slip the height scale to H = {height:.2f} m", "stage 3")
+
+
+def _stage3_heights(run: Run, key: NoiseKey) -> None:
+    """The other control heights read against H/3000; R3 where one misses it (the operator's
+    practice)."""
+    op, sheet = run.op, run.sheet
+    rows = _heights(run).rows  # the sheet's height control points, prepared once per run
+    tol = sheet.tolerances["control_height_m"]
     errs = []
     for h in rows[1:]:
         p = h.ground_m
         img = run.scene.images(p[None, :])
-        op.fuse(p, (img[0][0], img[1][0]), f"3/h/{h.id}")
-        read = op.read(HEIGHT_SCALE, f"3/h/{h.id}")
+        op.fuse(p, (img[0][0], img[1][0]), key.at(h.id))
+        read = op.read(HEIGHT_SCALE, key.at(h.id))
         text = f"control point {h.id}: fuse, read the height"
         errs.append(log_control_height(op, "3", text, read, p[2], tol))
     worst = np.max(np.abs(np.stack(errs, axis=-1)), axis=-1) if errs else op.v(0.0)
@@ -901,7 +947,28 @@ def stage3_scale_model(run: Run) -> None:
     if remedial:
         remedy = "R3 stage 3: refine scaling and levelling on control"
         run.record_remedy(remedy, name, failed, rounds)
-    check_standard_points(run, "3")
+
+
+#: Stage 3 (§26, OCR L3791–3805): (6.15) at a height control point, b_x until the mark fuses,
+#: slip the height scale, check the other control heights (H/3000), re-check κ and the residual
+#: y-parallax.
+STAGE3_STEPS: tuple[Step, ...] = (
+    SetStep(
+        HEIGHT_SCALE,
+        lambda run: run.target(f"O_Z{_heights(run).rows[0].id}"),  # MO_Z + (6.15)
+        STAGE3.at("OZ"),
+        Line("3", "height scale to O_Z{id} for control point {id}", "(6.15)"),
+        fields=lambda run: {"id": _heights(run).rows[0].id},
+    ),
+    Act("fuse on the control point, slip the height scale", STAGE3, _stage3_fuse),
+    Act("control heights", STAGE3.at("h"), _stage3_heights),
+    Act("residual y-parallax", STAGE3.at("std"), lambda run, key: check_standard_points(run, "3")),
+)
+
+
+def stage3_scale_model(run: Run) -> None:
+    """Stage 3: :data:`STAGE3_STEPS`."""
+    perform_all(run, STAGE3_STEPS)
 
 
 def run_setup_method(run: Run) -> Run:

@@ -8,43 +8,91 @@ mm on the table and the sheet.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, cast
+
 import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M
+from stereoplotter.procedure.arrays import Value
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
 from stereoplotter.procedure.records import SheetPose
 from stereoplotter.procedure.run import Run
+from stereoplotter.procedure.step_values import Line
 from stereoplotter.setup.equations import sheet_corner_instrument_coordinates
 
+if TYPE_CHECKING:  # typing only
+    from stereoplotter.geometry.similarity import SimilarityFit
+
 __all__ = [
+    "PLAN_CHECK",
     "check_plan_control",
     "needle_against_plotted",
+    "plotted_mm",
     "stage4_orient_sheet",
     "stage5_check",
 ]
 
+#: The identity of stage 5's check at the plotted plan control points (a point's draws below
+#: it by its id), the same in both methods.
+PLAN_CHECK = NoiseKey("5").at("plan")
 
-def sheet_table(run: Run, xy_mm) -> NDArray[np.float64]:
+
+#: Stage 4: corner 1 under the needle (6.16).
+_PIN_CORNER1 = Line(
+    "4", "counters to corner 1, pin the sheet's corner 1 under the needle", "(6.16)"
+)
+#: Stage 4: the sheet turned about corner 1 until the needle meets corner 3 (6.17).
+_TURN_TO_CORNER3 = Line(
+    "4",
+    "counters to corner 3, rotate the sheet about corner 1 until the needle meets corner 3",
+    "(6.17)",
+)
+#: Stage 5: corner 4's misclosure (6.18).
+_CORNER4 = Line("5", "counters to corner 4: misclosure of needle and corner 4", "(6.18)")
+#: Stage 5: a plan control point, the needle against the plotted point.
+_PLAN_POINT = Line(
+    "5", "plan control point {id}: fuse, needle against the plotted point", "stage 5"
+)
+
+
+def plotted_mm(run: Run, pid: str) -> NDArray[np.float64]:
+    """A plan control point as plotted on the sheet: its instrument coordinates (6.7) from its
+    SK-42 coordinates by the sheet's similarity. [mm]"""
+    sheet = run.sheet
+    sk42 = cast(tuple[float, float, float], run.scene.point(pid).sk42_m)  # plan control has them
+    xy = sheet_corner_instrument_coordinates(
+        cast("SimilarityFit", sheet.similarity),  # a sheet with plan control has its similarity
+        sk42[0],
+        sk42[1],
+        sheet.horizontal_scale_denominator,
+    )
+    return np.asarray(xy, float).reshape(2)
+
+
+def sheet_table(run: Run, xy_mm: Value) -> NDArray[np.float64]:
     """Ideal table position of a model position (x′, y′) for the coordinatograph's origin."""
-    return run.op.inst.table_position_mm(xy_mm)
+    position: NDArray[np.float64] = run.op.inst.table_position_mm(xy_mm)
+    return position
 
 
-def _needle_at(run: Run, corner: str, key: str) -> NDArray[np.float64]:
+def _needle_at(run: Run, corner: str, key: NoiseKey) -> NDArray[np.float64]:
     """Counters to the sheet's readings of ``corner`` (MO_X, MO_Y + x′, y′): the needle."""
     op = run.op
-    op.set("X", run.target(f"corner {corner}: O_X"), f"{key}/X")
-    op.set("Y", run.target(f"corner {corner}: O_Y"), f"{key}/Y")
+    op.set("X", run.target(f"corner {corner}: O_X"), key.at("X"))
+    op.set("Y", run.target(f"corner {corner}: O_Y"), key.at("Y"))
     return sheet_needle(run, key)
 
 
-def sheet_needle(run: Run, key: str) -> NDArray[np.float64]:
+def sheet_needle(run: Run, key: KeyLike) -> NDArray[np.float64]:
     """The needle on the table; with the SC complex's automatic coordinatograph, its settled
     servo noise drawn from the run's keyed streams (σ_s per axis)."""
     op = run.op
     sigma = op.inst.servo_sigma_mm
     noise = None
     if sigma:
-        noise = np.stack([op.noise.normal(f"servo/{key}/{a}", sigma) for a in "xy"], axis=-1)
+        servo = as_key(key).by("servo")
+        noise = np.stack([op.noise.draw(servo.at(a), sigma) for a in "xy"], axis=-1)
     return np.asarray(op.inst.needle(op.model.finish_side, noise), float)
 
 
@@ -59,12 +107,13 @@ def stage4_orient_sheet(run: Run) -> None:
     if not sheet.corners:
         run.sheet_pose = None
         return
-    ratio = sheet.horizontal_scale_denominator / sheet.map_scale_denominator
+    map_scale = cast(int, sheet.map_scale_denominator)  # a sheet with corners has its scale
+    ratio = sheet.horizontal_scale_denominator / map_scale
     enlargement = None
     if op.inst.options.automatic_coordinatograph:  # photo → map, checked against its 10 ×
         scene = run.scene
         photo_scale = MM_PER_M * scene.flying_height_m / float(scene.camera.focal_length_mm)
-        enlargement = photo_scale / sheet.map_scale_denominator
+        enlargement = photo_scale / map_scale
     op.inst.connect_coordinatograph(ratio, enlargement=enlargement)
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
     ideal = {k: sheet_table(run, v) for k, v in corners.items()}
@@ -77,36 +126,25 @@ def stage4_orient_sheet(run: Run) -> None:
         axis=-1,
     )
     angle = op.v(0.0)
+    stage = NoiseKey("4")
     for it in (1, 2):
-        n1 = _needle_at(run, "1", f"4/{it}/c1")
+        n1 = _needle_at(run, "1", stage.at(it, "c1"))
         e = np.stack(
-            [op.noise.normal(f"mono/4/{it}/pin/{a}", op.model.monocular_sigma_mm) for a in "xy"],
+            [
+                op.noise.draw(stage.at(it, "pin", a).by("mono"), op.model.monocular_sigma_mm)
+                for a in "xy"
+            ],
             axis=-1,
         )
         pin_sheet = ideal["1"] + (place if it == 1 else 0.0) + e
-        op.log.add(
-            "4",
-            "counters to corner 1, pin the sheet's corner 1 under the needle",
-            "X",
-            reading=run.target("corner 1: O_X"),
-            iteration=it,
-            equation="(6.16)",
-        )
-        n3 = _needle_at(run, "3", f"4/{it}/c3")
-        e3 = op.noise.normal(f"mono/4/{it}/c3", op.model.monocular_sigma_mm)
+        _PIN_CORNER1.log(op, "X", reading=run.target("corner 1: O_X"), iteration=it)
+        n3 = _needle_at(run, "3", stage.at(it, "c3"))
+        e3 = op.noise.draw(stage.at(it, "c3").by("mono"), op.model.monocular_sigma_mm)
         a_needle = np.arctan2(n3[..., 1] - n1[..., 1], n3[..., 0] - n1[..., 0])
         d = ideal["3"] - pin_sheet
         a_mark = np.arctan2(d[..., 1], d[..., 0])
         angle = a_needle - a_mark + e3 / np.hypot(d[..., 0], d[..., 1])
-        op.log.add(
-            "4",
-            "counters to corner 3, rotate the sheet about corner 1 until the needle meets corner 3",
-            "",
-            reading=None,
-            judgment_error=e3,
-            iteration=it,
-            equation="(6.17)",
-        )
+        _TURN_TO_CORNER3.log(op, judgment_error=e3, iteration=it)
     run.sheet_pose = SheetPose(angle, pin_sheet, n1)
     run.record_stage("4", op.v(2).astype(int))
 
@@ -118,19 +156,11 @@ def stage5_check(run: Run) -> None:
     if pose is None:
         return
     corners = {c["corner"]: np.array([c["x_mm"], c["y_mm"]]) for c in sheet.corners}
-    n4 = _needle_at(run, "4", "5/c4")
+    n4 = _needle_at(run, "4", NoiseKey("5").at("c4"))
     mark4 = pose.table_of(sheet_table(run, corners["4"]))
     mis = np.hypot(*np.moveaxis(mark4 - n4, -1, 0))
     tol = sheet.tolerances["corner_mm"]
-    op.log.add(
-        "5",
-        "counters to corner 4: misclosure of needle and corner 4",
-        "",
-        residual=mis,
-        tolerance=tol,
-        passed=mis <= tol,
-        equation="(6.18)",
-    )
+    _CORNER4.log(op, residual=mis, tolerance=tol, passed=mis <= tol)
     run.check("stage 5: corner 4", mis, tol)
     run.record_stage("5", op.v(1).astype(int))
     # plotted plan control points: fuse on the point, compare the needle with the plotted point
@@ -139,28 +169,21 @@ def stage5_check(run: Run) -> None:
     errs = []
     for pid in sheet.similarity_point_ids:
         p = run.scene.point(pid)
-        xy = sheet_corner_instrument_coordinates(
-            sheet.similarity, p.sk42_m[0], p.sk42_m[1], sheet.horizontal_scale_denominator
-        )
         img = run.scene.images(np.asarray(p.local_m, float)[None, :])
-        op.fuse(p.local_m, (img[0][0], img[1][0]), f"5/plan/{pid}")
-        errs.append(needle_against_plotted(run, pose, pid, np.asarray(xy, float).reshape(2)))
+        op.fuse(p.local_m, (img[0][0], img[1][0]), PLAN_CHECK.at(pid))
+        errs.append(needle_against_plotted(run, pose, pid, plotted_mm(run, pid)))
     check_plan_control(run, errs)
 
 
-def needle_against_plotted(run: Run, pose, pid: str, plotted_mm) -> NDArray[np.float64]:
+def needle_against_plotted(
+    run: Run, pose: SheetPose, pid: str, plotted_mm: Value
+) -> NDArray[np.float64]:
     """Stage 5 at a plan control point the operator has fused on: the needle against the point
     plotted at ``plotted_mm`` (its instrument coordinates (6.7)), the distance logged. [mm]"""
-    needle = sheet_needle(run, f"5/plan/{pid}")
+    needle = sheet_needle(run, PLAN_CHECK.at(pid))
     plotted = pose.table_of(sheet_table(run, plotted_mm))
-    err = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
-    run.op.log.add(
-        "5",
-        f"plan control point {pid}: fuse, needle against the plotted point",
-        "",
-        residual=err,
-        equation="stage 5",
-    )
+    err: NDArray[np.float64] = np.hypot(*np.moveaxis(needle - plotted, -1, 0))
+    _PLAN_POINT.log(run.op, "", {"id": pid}, residual=err)
     return err
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -24,7 +24,7 @@ from stereoplotter.instrument.sc1_complex import (
 )
 from stereoplotter.instrument.virtual import Instrument
 from stereoplotter.procedure.conventional import run_conventional_method
-from stereoplotter.procedure.evaluation import ModelEvaluation, evaluate_against
+from stereoplotter.procedure.evaluation import ModelEvaluation, ModelTruth, evaluate_against
 from stereoplotter.procedure.fidelity import Fidelity
 from stereoplotter.procedure.operator import Noise, OperatorModel, Scene
 from stereoplotter.procedure.records import Check, Remedy, SheetPose, StageRecord
@@ -170,8 +170,8 @@ def apply_correction_unit(
     photos = tuple(replace(p, film_deformation_ppm=(0.0, 0.0)) for p in scenario.photos)
     sc_mm = unit.residual_sigma_um / 1000.0
 
-    def plus(sigma_mm: float, k: float) -> float:
-        return float(np.hypot(sigma_mm, np.sqrt(k) * sc_mm))
+    def plus(sigma_mm: float | None, k: float) -> float:  # σ resolved for the instrument
+        return float(np.hypot(cast(float, sigma_mm), np.sqrt(k) * sc_mm))
 
     model = replace(
         operator,
@@ -254,7 +254,9 @@ def prepare_run(
 FREE_STOP_MM = 20.0
 
 
-def _with_passes(sheet: SetupSheet, operator: OperatorModel, passes: int | None):
+def _with_passes(
+    sheet: SetupSheet, operator: OperatorModel, passes: int | None
+) -> tuple[SetupSheet, OperatorModel]:
     """Switch ``passes`` (:mod:`~stereoplotter.procedure.fidelity`): every tolerance loop makes
     ``passes`` passes — no check ever passes (its tolerance −∞, so the checks report failed)
     and ``max_iterations`` = ``passes``; None: the sheet and operator as they are."""
@@ -271,7 +273,7 @@ def _run_one(
     noise: Noise | None,
     transcript: bool = True,
     first: int = 0,
-):
+) -> tuple[Run, Any, Any]:
     """Trials ``first … first + trials − 1`` of ``prep`` (the keyed draws where ``injected``,
     ``noise`` are None: :func:`~stereoplotter.procedure.run.build_run`), with the true residual
     y-parallax at the standard points and over the grid."""
@@ -282,8 +284,8 @@ def _run_one(
     else:
         run_conventional_method(run, prep.relative)
     scene = prep.scene
-    q_std = op.y_parallax(scene.standard_points_m, scene.standard)
-    q_grid = op.y_parallax(prep.grid_m, prep.grid_images_mm)
+    q_std = op.y_parallax(scene.standard_points_m, cast(Any, scene.standard))
+    q_grid = op.y_parallax(cast(Any, prep.grid_m), cast(Any, prep.grid_images_mm))
     return run, q_std, q_grid
 
 
@@ -456,7 +458,7 @@ def simulate_per_trial(
     first = rows[0][0]
     for name, c in first.results.items():
 
-        def stacked(attr: str, name: str = name, c: Check = c):
+        def stacked(attr: str, name: str = name, c: Check = c) -> Any:
             if getattr(c, attr) is None:
                 return None
             return np.array([getattr(r[0].results[name], attr) for r in rows])
@@ -491,7 +493,7 @@ def _evaluate(prep: PreparedRun, run: Run) -> ModelEvaluation:
     )
     corner = run.results.get("stage 5: corner 4")
     return evaluate_against(
-        prep.truth,
+        cast(ModelTruth, prep.truth),  # prepared for an evaluated run
         inst.setting,
         units["left"],
         units["right"],

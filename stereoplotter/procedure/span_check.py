@@ -11,29 +11,69 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.instrument.virtual import NOMINAL_ZERO, Side
+from stereoplotter.procedure.arrays import Active, Floats, Mask, Value
 from stereoplotter.procedure.compaction import compacted
+from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key, pointing
+from stereoplotter.procedure.operator import Operator
 from stereoplotter.procedure.run import Run
+from stereoplotter.procedure.step_values import BOTTOM_STOP, L_CHECK_FAILED, Line
 from stereoplotter.setup.equations import base_z_correction, height_correction
 
 __all__ = ["fiducial_mm", "span_loop"]
 
 _SIDE: dict[Side, str] = {"left": "л", "right": "п"}
 
+#: The lines of the L-check, declared for stage "1" (a loop of stage 2 writes them as its own).
+#: The measurement of L′ of a photo against the sheet's L.
+MEASURE_SPAN = Line(
+    "1", "measure L′_{side} (marks 3, 4), compare with L_{side} = {span:.3f} mm", "(6.5)"
+)
+#: The correction ΔZ (6.9), where the check failed.
+DELTA_Z = Line(
+    "1",
+    "ΔZ = {dz:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
+    "(6.9), (6.11)",
+    condition=L_CHECK_FAILED,
+)
+#: The correction Δb_z (6.10), where the check failed.
+DELTA_BZ = Line(
+    "1",
+    "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): O′_bz = O_bz {sign} Δb_z",
+    "(6.10), (6.11)",
+    condition=L_CHECK_FAILED,
+)
+#: f_пр changed where the ΔZ meets the carriage's bottom stop.
+AT_BOTTOM_STOP = Line(
+    "1",
+    "n = D/f_пр at the carriage's bottom stop (D_max): f′_пр = f_пр·D/(D + ΔD), "
+    "shortened for a deeper carriage, lengthened back (to the sheet's f_пр at most) "
+    "for a shallower one",
+    "(6.3), (6.9), (6.11)",
+    condition=BOTTOM_STOP,
+)
+#: The L-check's conditional steps.
+CONDITIONAL_LINES = (DELTA_Z, DELTA_BZ, AT_BOTTOM_STOP)
+
+
+def _measure_line(stage: str, units_at_zero: bool) -> Line:
+    return MEASURE_SPAN.in_stage(stage, "(6.5), decision D5" if units_at_zero else None)
+
 
 def fiducial_mm(run: Run, side: str, mark: str) -> NDArray[np.float64]:
     """The true position of fiducial ``mark`` on the ``side`` photo. [mm]"""
-    return run.scene.fiducials_mm[side][int(mark) - 1]
+    position: NDArray[np.float64] = run.scene.fiducials_mm[side][int(mark) - 1]
+    return position
 
 
-def _measure_span(run: Run, side: str, key: str, active, pointings: int = 1) -> NDArray[np.float64]:
+def _measure_span(run: Run, side: Side, key: NoiseKey, active: Active, pointings: int = 1) -> Value:
     """L′: the mark on fiducial 3 then 4 of ``side``, Y read at each (the mean of
     ``pointings`` pointings and readings per mark, remedy R1)."""
     op = run.op
     ys = []
     for mark in ("3", "4"):
-        y = 0.0
+        y: Value = 0.0
         for j in range(pointings):
-            k = f"{key}/{side}/{mark}" + (f"/p{j}" if j else "")
+            k = key.at(side, mark, *pointing(j))
             op.mark_on(side, fiducial_mm(run, side, mark), k, active)
             y = y + op.read("Y", k)
         ys.append(y / pointings)
@@ -50,12 +90,12 @@ def _spans(run: Run, units_at_zero: bool) -> tuple[float, float]:
 def span_loop(
     run: Run,
     stage: str,
-    key: str,
+    key: KeyLike,
     units_at_zero: bool = False,
-    active=None,
+    active: Active = None,
     pointings: int = 1,
     remedy: str = "",
-) -> tuple[NDArray, NDArray, NDArray]:
+) -> tuple[NDArray[np.int_], Mask, Floats]:
     """The L-check loop (6.9)–(6.11) until |L − L′| ≤ 0.03/n_л for both photos."""
     op, sheet = run.op, run.sheet
     tol = sheet.tolerances["mark_span_mm"]
@@ -67,7 +107,7 @@ def span_loop(
         its = np.where(active, it, its)
         with compacted(run, active) as cut:  # the trials still outside the tolerance only
             dl_s, dr_s = _span_round(
-                cut.run, stage, f"{key}/{it}", it, cut.active, (span_l, span_r),
+                cut.run, stage, as_key(key).at(it), it, cut.active, (span_l, span_r),
                 (cut.take(dl), cut.take(dr)), units_at_zero, pointings, remedy,
             )  # fmt: skip
         dl, dr = cut.put(dl, dl_s), cut.put(dr, dr_s)
@@ -80,9 +120,9 @@ def span_loop(
 
 
 def _span_round(
-    run: Run, stage: str, k: str, it: int, active, spans, diffs, units_at_zero: bool,
-    pointings: int, remedy: str,
-) -> tuple[NDArray, NDArray]:  # fmt: skip
+    run: Run, stage: str, k: NoiseKey, it: int, active: Mask, spans: tuple[float, float],
+    diffs: tuple[Floats, Floats], units_at_zero: bool, pointings: int, remedy: str,
+) -> tuple[Floats, Floats]:  # fmt: skip
     """One pass of the L-check on ``active``: measure L′ of both photos, log, and correct the
     trials outside the tolerance; the differences L − L′ (kept where not ``active``). [mm]"""
     op = run.op
@@ -93,45 +133,53 @@ def _span_round(
     dl = np.where(active, span_l - meas_l, diffs[0])
     dr = np.where(active, span_r - meas_r, diffs[1])
     ok = (np.abs(dl) <= tol) & (np.abs(dr) <= tol)
-    for side, d, meas, span in (("left", dl, meas_l, span_l), ("right", dr, meas_r, span_r)):
-        op.log.add(
-            stage,
-            f"measure L′_{_SIDE[side]} (marks 3, 4), compare with L_{_SIDE[side]} = {span:.3f} mm",
-            "Y",
-            reading=meas,
-            residual=d,
-            tolerance=tol,
-            passed=np.abs(d) <= tol,
-            iteration=it,
-            equation="(6.5)" if not units_at_zero else "(6.5), decision D5",
-            remedy=remedy,
-            when=active if remedy else None,
-        )
+    line = _measure_line(stage, units_at_zero)
+    sides: tuple[tuple[Side, Floats, Value, float], ...] = (
+        ("left", dl, meas_l, span_l),
+        ("right", dr, meas_r, span_r),
+    )
+    for side, d, meas, span in sides:
+        line.log(
+            op, "Y", {"side": _SIDE[side], "span": span},
+            reading=meas, residual=d, tolerance=tol, passed=np.abs(d) <= tol, iteration=it,
+            remedy=remedy, when=active if remedy else None,
+        )  # fmt: skip
     going = active & ~ok
     if np.any(going):
         _correct_span(run, stage, k, it, going, (dl, dr), spans, remedy)
     return dl, dr
 
 
-def _log_delta_z(op, stage: str, dz_shown: float, depth, dz_mm, it: int, remedy: str, active):
+def _log_delta_z(
+    op: Operator,
+    stage: str,
+    dz_shown: float,
+    depth: Value,
+    dz_mm: Value,
+    it: int,
+    remedy: str,
+    active: Mask,
+) -> None:
     """Log the ΔZ (6.9) setting; the word follows the sign: the Z counter counts the projection
     distance D, so ΔZ > 0 (a larger D) lowers the carriage and ΔZ < 0 raises it. [m, mm]"""
     direction = "lower" if dz_shown > 0 else "raise" if dz_shown < 0 else "leave"
-    op.log.add(
-        stage,
-        f"ΔZ = {dz_shown:+.3f} m (6.9): {direction} the carriage, O′_Z = O_Z + ΔZ",
-        "Z",
-        before=depth,
-        after=depth + dz_mm,
-        reading=depth + dz_mm,
-        iteration=it,
-        equation="(6.9), (6.11)",
-        remedy=remedy,
-        when=active if remedy else None,
-    )
+    DELTA_Z.in_stage(stage).log(
+        op, "Z", {"dz": dz_shown, "direction": direction},
+        before=depth, after=depth + dz_mm, reading=depth + dz_mm, iteration=it,
+        remedy=remedy, when=active if remedy else None,
+    )  # fmt: skip
 
 
-def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_mm, remedy: str):
+def _past_bottom_stop(
+    run: Run,
+    stage: str,
+    k: NoiseKey,
+    it: int,
+    active: Mask,
+    depth: Value,
+    dz_mm: Value,
+    remedy: str,
+) -> tuple[Mask, Value, Value]:
     """The carriage at its bottom stop D_max (switch ``bottom_stop``,
     :mod:`~stereoplotter.procedure.fidelity`).
 
@@ -171,26 +219,23 @@ def _past_bottom_stop(run: Run, stage: str, k: str, it: int, active, depth, dz_m
         beyond = beyond | back
     if np.any(beyond):
         f_ratio = np.where(beyond, f_new / f_set, 1.0)
-        op.set("f_instrument", f_new, f"{k}/setf", beyond)
-        op.log.add(
-            stage,
-            "n = D/f_пр at the carriage's bottom stop (D_max): f′_пр = f_пр·D/(D + ΔD), "
-            "shortened for a deeper carriage, lengthened back (to the sheet's f_пр at most) "
-            "for a shallower one",
-            "f_instrument",
-            before=f_set,
-            after=f_new,
-            reading=f_new,
-            iteration=it,
-            equation="(6.3), (6.9), (6.11)",
-            remedy=remedy,
-            when=beyond if remedy else None,
-        )
+        op.set("f_instrument", f_new, k.at("setf"), beyond)
+        AT_BOTTOM_STOP.in_stage(stage).log(
+            op, "f_instrument", before=f_set, after=f_new, reading=f_new, iteration=it,
+            remedy=remedy, when=beyond if remedy else None,
+        )  # fmt: skip
     return beyond, f_ratio, rest
 
 
 def _correct_span(
-    run: Run, stage: str, k: str, it: int, active, diffs, spans, remedy: str = ""
+    run: Run,
+    stage: str,
+    k: NoiseKey,
+    it: int,
+    active: Mask,
+    diffs: tuple[Floats, Floats],
+    spans: tuple[float, float],
+    remedy: str = "",
 ) -> None:
     """One correction of the L-check: ΔZ (6.9) from the left photo (or f_пр at the bottom
     stop), Δb_z (6.10) from the right, set as O′ = O + Δ (6.11).
@@ -209,11 +254,11 @@ def _correct_span(
     span_l, span_r = spans
     meas_l, meas_r = span_l - dl, span_r - dr  # L′ as measured
     sense = sheet.options.bz_scale_sense
-    depth = op.read("Z", f"{k}/Z")
+    depth = op.read("Z", k.at("Z"))
     dz_m = height_correction(depth, dl, meas_l, sheet.vertical_scale_denominator)
     dz_mm = dz_m * 1000.0 / sheet.vertical_scale_denominator
     _, f_ratio, dz_mm = _past_bottom_stop(run, stage, k, it, active, depth, dz_mm, remedy)
-    op.set("Z", depth + dz_mm, f"{k}/setZ", active & (dz_mm != 0.0))
+    op.set("Z", depth + dz_mm, k.at("setZ"), active & (dz_mm != 0.0))
     shown = op.log.shown if np.ndim(dz_mm) else 0
     # logged where the ΔZ set is one the counter shows (not the carriage's last least count
     # down to the stop)
@@ -229,7 +274,7 @@ def _correct_span(
             remedy,
             active,
         )
-    bz = op.read("bz", f"{k}/bz")
+    bz = op.read("bz", k.at("bz"))
     # D_п as the operator knows it: D + b_z from the b_z scale's nominal place of zero; scaled
     # by f_пр/f′_пр where f_пр was changed, less the ΔZ just set (both move the right photo)
     depth_r = (depth + sense * (bz - NOMINAL_ZERO["bz"])) * f_ratio
@@ -239,17 +284,9 @@ def _correct_span(
         - (depth + dz_mm)
         - (sense * (bz - NOMINAL_ZERO["bz"]))
     )
-    op.set("bz", bz + sense * dbz, f"{k}/setbz", active)
-    op.log.add(
-        stage,
-        "Δb_z (6.10), ratio form with D_п = D + b_z and L′_п (decision D9): "
-        "O′_bz = O_bz " + ("+" if sense > 0 else "−") + " Δb_z",
-        "bz",
-        before=bz,
-        after=bz + sense * dbz,
-        reading=bz + sense * dbz,
-        iteration=it,
-        equation="(6.10), (6.11)",
-        remedy=remedy,
-        when=active if remedy else None,
-    )
+    op.set("bz", bz + sense * dbz, k.at("setbz"), active)
+    DELTA_BZ.in_stage(stage).log(
+        op, "bz", {"sign": "+" if sense > 0 else "−"},
+        before=bz, after=bz + sense * dbz, reading=bz + sense * dbz, iteration=it,
+        remedy=remedy, when=active if remedy else None,
+    )  # fmt: skip

@@ -67,6 +67,10 @@ class Record:
         knob turns in tan). "" = ``unit``.
     residual_unit : str
         The unit of ``residual``, ``tolerance``, ``judgment_error`` and ``true``: "mm" or "m".
+    condition : str
+        The name of the condition of a conditional step (a step taken only where it holds:
+        :data:`stereoplotter.procedure.step_values.CONDITIONS`), "" for a step every run takes.
+        Not written by :meth:`Transcript.to_jsonl` (a reader of the records has it).
     """
 
     number: int
@@ -87,6 +91,7 @@ class Record:
     true: float | None = None
     reading_unit: str = ""
     residual_unit: str = "mm"
+    condition: str = ""
 
 
 class Transcript:
@@ -118,6 +123,7 @@ class Transcript:
         true: Any = None,
         reading_unit: str = "",
         residual_unit: str = "",
+        condition: str = "",
     ) -> None:
         """Append a record (array arguments are taken at trial ``shown``); ``when`` (a mask
         over the trials) skips the record where trial ``shown`` did not do the act."""
@@ -152,13 +158,15 @@ class Transcript:
                 _f(true, t),
                 reading_unit,
                 residual_unit or ("m" if unit == "m" else "mm"),
+                condition,
             )
         )
 
     def to_jsonl(self) -> str:
         """JSON lines, one record per line (keys as in :class:`Record`)."""
         return "".join(
-            json.dumps(asdict(r), ensure_ascii=False, sort_keys=False) + "\n" for r in self.records
+            json.dumps(_written(r), ensure_ascii=False, sort_keys=False) + "\n"
+            for r in self.records
         )
 
     def to_text(self) -> str:
@@ -197,6 +205,13 @@ class Transcript:
                 text += f"  ({r.equation})"
             lines.append(text)
         return "\n".join(lines) + "\n"
+
+
+def _written(record: Record) -> dict[str, Any]:
+    """The fields of a record the JSON lines carry (all but ``condition``)."""
+    out = asdict(record)
+    del out["condition"]
+    return out
 
 
 def _small(value: float, unit: str, sign: str = "+") -> str:

@@ -23,7 +23,7 @@ import os
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -190,13 +190,15 @@ def iter_chunk_columns(
         processes = min(workers, count - 1)
         pool = ProcessPoolExecutor(max_workers=processes, mp_context=context)
         depth = QUEUED_PER_WORKER * processes
-    given: dict[int, Future] = {}  # each chunk after the first: its worker's columns
+    given: dict[int, Future[Any]] = {}  # each chunk after the first: its worker's columns
     given_next = 1  # the first chunk not yet given to a process
 
     def give_workers(yielding: int) -> None:
         nonlocal given_next
         while given_next < count and given_next - yielding < depth:
-            given[given_next] = pool.submit(_chunk_columns, starts[given_next], sizes[given_next])
+            given[given_next] = cast(ProcessPoolExecutor, pool).submit(
+                _chunk_columns, starts[given_next], sizes[given_next]
+            )
             given_next += 1
 
     try:
@@ -223,7 +225,7 @@ def iter_chunk_columns(
             _PREPARED.clear()
 
 
-def _columns_here(prep: PreparedRun, first: int, n: int, evaluate: bool) -> dict[str, NDArray]:
+def _columns_here(prep: PreparedRun, first: int, n: int, evaluate: bool) -> dict[str, NDArray[Any]]:
     return trial_columns(run_trials_chunk(prep, first, n, evaluate=evaluate, transcript=False))
 
 
@@ -401,7 +403,7 @@ def _column_figures(
             yield name, _column_figure(name, values)
         return
     with ThreadPoolExecutor(max_workers=2) as pool:
-        pending: collections.deque = collections.deque()
+        pending: collections.deque[Any] = collections.deque()
         for name, values in itertools.chain([first], items):
             pending.append((name, pool.submit(_column_figure, name, values)))
             if len(pending) > ahead:
@@ -420,7 +422,7 @@ def summarise_result(result: SimulationResult) -> dict[str, Any]:
     return summarise_columns(run_info(result, result.trials), trial_columns(result).items())
 
 
-def _value(v) -> Any:
+def _value(v: Any) -> Any:
     a = np.asarray(v, float)
     x = float(a.reshape(-1)[0])
     return None if math.isnan(x) else x

@@ -11,6 +11,8 @@ import pytest
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import conventional, setup_method, simulate
+from stereoplotter.procedure.noise_key import NoiseKey
+from stereoplotter.procedure.step_values import Act, Line
 from stereoplotter.verification import rows_chapter5, table
 from stereoplotter.verification.entry import DeclaredRows
 
@@ -64,6 +66,75 @@ def test_an_inserted_step_changes_no_other_result(monkeypatch, method, module, b
     assert inserted.keys() == plain.keys()
     changed = [k for k in plain if plain[k] != inserted[k]]
     assert changed == []
+
+
+_DUMMY_LINE = Line("dummy", "a dummy step: judge, read the counters")
+
+
+def _declared_dummy(run, key: NoiseKey) -> None:
+    """A declared step of its own identity: a judgment, every counter read, a line."""
+    op = run.op
+    e = op.noise.draw(key.at("judgment").by("q"), op.model.y_parallax_sigma_mm)
+    for control in ("X", "Y", "Z", "bx", "by", "bz"):
+        op.read(control, key.at(control))
+    _DUMMY_LINE.log(op, judgment_error=e)
+
+
+def _run_with_transcript(method: str) -> tuple[dict[str, bytes], list, int]:
+    sc, spec = load_scenario("scenarios/pair60.yaml"), load_instrument("sc1")
+    r = simulate(sc, spec, method=method, seed=11, trials=TRIALS, evaluate=False)
+    records = r.transcript.records
+    others = [dataclasses.replace(x, number=0) for x in records if x.stage != "dummy"]
+    return _results(r), others, len(records) - len(others)
+
+
+@pytest.mark.parametrize(
+    ("method", "module", "sequence", "at"),
+    [
+        ("setup", setup_method, "STAGE1_STEPS", 0),
+        ("setup", setup_method, "STAGE1_STEPS", 12),
+        ("setup", setup_method, "STAGE2_STEPS", 3),
+        ("setup", setup_method, "STAGE3_STEPS", 1),
+        ("conventional", conventional, "C1_STEPS", 13),
+    ],
+)
+def test_a_declared_step_inserted_changes_no_other_result(
+    monkeypatch, method, module, sequence, at
+):
+    """A step inserted into a method's declared sequence draws from its own identity only:
+    every number of the run and every other line of the transcript stays as it was, bit for
+    bit (a step keyed by its place would shift the draws of every step after it)."""
+    plain, lines, dummies = _run_with_transcript(method)
+    assert dummies == 0
+    declared = getattr(module, sequence)
+    step = Act("a dummy step", NoiseKey("dummy"), _declared_dummy)
+    monkeypatch.setattr(module, sequence, (*declared[:at], step, *declared[at:]))
+    inserted, inserted_lines, dummies = _run_with_transcript(method)
+    assert dummies == 1
+    assert inserted.keys() == plain.keys()
+    assert [k for k in plain if plain[k] != inserted[k]] == []
+    assert inserted_lines == lines
+
+
+@pytest.mark.parametrize("after", ["C1_STEPS", "C2: relative orientation"])
+def test_a_step_inserted_into_the_conventional_method_changes_no_other_result(monkeypatch, after):
+    """The conventional method's declared sequence (C1, calibration, C2, C3, C4) with a dummy
+    step after C1 or after C2: every other number and transcript line as before, bit for bit."""
+    plain, lines, _ = _run_with_transcript("conventional")
+    declared = conventional.conventional_steps
+    step = Act("a dummy step", NoiseKey("dummy"), _declared_dummy)
+
+    def with_dummy(*args, **kwargs):
+        steps = declared(*args, **kwargs)
+        names = [getattr(s, "name", "") for s in steps]
+        at = len(conventional.C1_STEPS) if after == "C1_STEPS" else names.index(after) + 1
+        return (*steps[:at], step, *steps[at:])
+
+    monkeypatch.setattr(conventional, "conventional_steps", with_dummy)
+    inserted, inserted_lines, dummies = _run_with_transcript("conventional")
+    assert dummies == 1
+    assert [k for k in plain if plain[k] != inserted[k]] == []
+    assert inserted_lines == lines
 
 
 def _linear_rows(monkeypatch, insert: bool) -> list[dict]:

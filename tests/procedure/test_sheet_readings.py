@@ -19,6 +19,7 @@ from stereoplotter.instrument.virtual import NOMINAL_ZERO
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import simulate
+from stereoplotter.procedure.noise_key import as_key
 from stereoplotter.procedure.operator import Operator
 
 SIDE = {"left": "л", "right": "п"}
@@ -72,7 +73,7 @@ def recorded():
     def recording(self, control, value, key, active=None):
         cmd = original(self, control, value, key, active)
         stopped = np.array(self.stopped.get(control, False))  # trials turned against a stop
-        calls.append((control, key, self.v(value), np.array(cmd, float), stopped))
+        calls.append((control, as_key(key).stream(), self.v(value), np.array(cmd, float), stopped))
         return cmd
 
     mp = pytest.MonkeyPatch()
