@@ -59,7 +59,7 @@ from stereoplotter.procedure.conventional_sheet import (
     scale_on_plotted_control,
 )
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key
-from stereoplotter.procedure.operator import DrivenControl, Operator, solve_1d
+from stereoplotter.procedure.operator import DrivenControl, Operator, Scene, solve_1d
 from stereoplotter.procedure.relative_equations import (
     overcorrection_factor,
     relative_orientation_from_standard_points,
@@ -88,6 +88,7 @@ from stereoplotter.procedure.steps import (
     slip_height_scale_on_mean,
     zero_base_y,
 )
+from stereoplotter.setup.sheet import SetupSheet
 
 __all__ = [
     "C1_STEPS",
@@ -713,11 +714,13 @@ def _height_points(run: Run, ids: Sequence[str]) -> list[tuple[str, NDArray[np.f
     return [(i, control_point_m(run, i)) for i in ids]
 
 
-def levelling_points(run: Run) -> tuple[str, ...]:
-    """The height control points nearest (in plan) to standard points 3, 4, 5, 6, distinct."""
-    rows = _height_points(run, [h["id"] for h in run.sheet.control_heights])
+def levelling_points(scene: Scene, sheet: SetupSheet) -> tuple[str, ...]:
+    """The height control points of the ``sheet`` nearest (in plan) to the ``scene``'s standard
+    points 3, 4, 5, 6, distinct."""
+    rows = [(h["id"], np.asarray(scene.point(h["id"]).local_m, float))
+            for h in sheet.control_heights]
     out: list[str] = []
-    for std in run.scene.standard_points_m[2:6]:
+    for std in scene.standard_points_m[2:6]:
         free = [(float(np.hypot(*(p[:2] - std[:2]))), i) for i, p in rows if i not in out]
         if free:
             out.append(min(free)[1])
@@ -1000,7 +1003,7 @@ def _calibration(run: Run) -> Calibration:
 def _calibrate(run: Run, key: NoiseKey) -> None:
     """What the operator knows of the instrument's response (no draws): :func:`calibrate` at
     the levelling points."""
-    run.calibration = calibrate(run, levelling_points(run))
+    run.calibration = calibrate(run, levelling_points(run.scene, run.sheet))
 
 
 def _relative_orientation(run: Run, key: NoiseKey, relative_fn: Relative) -> None:
@@ -1018,7 +1021,8 @@ def conventional_steps(relative: str = "elements", sheet_on: str = "control") ->
     relative_fn = c2_relative_by_elements if relative == "elements" else c2_relative_by_equations
 
     def absolute(run: Run, key: NoiseKey) -> None:
-        c3_absolute(run, _calibration(run), levelling_points(run), relative_fn, sheet_on)
+        levels = levelling_points(run.scene, run.sheet)
+        c3_absolute(run, _calibration(run), levels, relative_fn, sheet_on)
 
     return (
         *C1_STEPS,

@@ -161,7 +161,7 @@ def _conventional_stages(run: Run):
         c1_interior(run)
 
     def c2() -> None:
-        state["levels"] = levelling_points(run)
+        state["levels"] = levelling_points(run.scene, run.sheet)
         state["cal"] = calibrate(run, state["levels"])
         run.calibration = state["cal"]
         its, worst = c2_relative_by_elements(run, state["cal"])

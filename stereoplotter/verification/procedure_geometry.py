@@ -8,7 +8,7 @@ and moved standard points of the formulas' own setting.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -198,18 +198,10 @@ def height_errors_parallax(
     return dh
 
 
-@dataclass(frozen=True)
-class _SceneOf:
-    """What ``conventional.levelling_points`` reads of a run: its scene and sheet."""
-
-    scene: Any
-    sheet: SetupSheet
-
-
 def levelling_frame_points(prep: PreparedRun) -> tuple[list[str], FloatArray]:
     """The procedure's four levelling points (``conventional.levelling_points``) in the frame."""
 
-    ids = list(cv.levelling_points(_SceneOf(prep.scene, prep.sheet)))
+    ids = list(cv.levelling_points(prep.scene, prep.sheet))
     local = np.array(
         [next(p for p in prep.scenario.points if p.id == i).local_m for i in ids], float
     )

@@ -43,7 +43,7 @@ def _relative_only(prep: PreparedRun, first: int, trials: int | None) -> Run:
     # "book": no remedy between C1 and C2 (the run is not the simulated procedure)
     run = build_run(prep, first, trials, transcript=False, ideal_mechanics=True, practice="book")
     cv.c1_interior(run)
-    cal = cv.calibrate(run, cv.levelling_points(run))
+    cal = cv.calibrate(run, cv.levelling_points(run.scene, run.sheet))
     cv.c2_relative_by_equations(run, cal, passes=prep.operator.max_iterations)
     return run
 
