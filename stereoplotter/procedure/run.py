@@ -269,7 +269,6 @@ def build_instrument(
     injected: dict[str, Any] | None = None,
     backend: str | None = None,
     ideal_mechanics: bool | None = None,
-    instrument_cls: type[Instrument] = Instrument,
 ) -> Instrument:
     """The instrument of trials ``first … first + trials − 1`` of ``prep`` (one trial for None).
 
@@ -287,13 +286,11 @@ def build_instrument(
         Overrides ``prep.backend`` (a vectorised population needs ``"closed-form"``).
     ideal_mechanics : bool, optional
         Overrides ``prep.ideal_mechanics``.
-    instrument_cls : type
-        :class:`Instrument` or a subclass (the trainer's recording instrument).
     """
     if injected is None:
         stop = None if trials is None else first + trials
         injected = prep.model.draw_keyed(prep.seed, first, stop)
-    return instrument_cls(
+    return Instrument(
         prep.spec,
         prep.sheet.focal_length_corrected_mm,
         errors=prep.model,
@@ -319,7 +316,6 @@ def build_run(
     backend: str | None = None,
     ideal_mechanics: bool | None = None,
     practice: str | None = None,
-    instrument_cls: type[Instrument] = Instrument,
 ) -> Run:
     """Assemble a run: the instrument, the operator at it, and the :class:`Run` on the sheet.
 
@@ -341,8 +337,6 @@ def build_run(
         Override ``prep``'s (:func:`build_instrument`).
     practice : {"operator", "book"}, optional
         Overrides ``prep.practice``.
-    instrument_cls : type
-        :class:`Instrument` or a subclass.
 
     Returns
     -------
@@ -357,7 +351,6 @@ def build_run(
         injected=injected,
         backend=backend,
         ideal_mechanics=ideal_mechanics,
-        instrument_cls=instrument_cls,
     )
     if noise is None:
         noise = Noise(prep.seed, trials, None, first)

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from stereoplotter.instrument.virtual import CONTROL_INFO
 from stereoplotter.setup.sheet_check import check_sheet
 from stereoplotter.trainer.actions import control_value
 from stereoplotter.trainer.outcome import stage_measures, standard_q
@@ -66,8 +67,7 @@ def _settings(session: Any, stage: str, inst: Any) -> list[dict[str, Any]]:
         else:
             value = control_value(inst, control, session.commanded)
             lc = least_count(inst.spec, control)
-            kind = "rad" if control.startswith("kappa") else "tan"
-            unit = kind if control.startswith(("kappa", "k_")) else "mm"
+            unit = CONTROL_INFO[control].unit if control in CONTROL_INFO else "mm"
         if value is None or not np.isfinite(value) or control == "gear":
             counts = 0.0 if value == target else float("inf")
         else:

@@ -66,7 +66,8 @@ from typing import Any
 
 import numpy as np
 
-from stereoplotter.instrument.virtual import DECENTRATIONS, HEIGHT_SCALE, KNOBS
+from stereoplotter.instrument.virtual import CONTROL_INFO, DECENTRATIONS, HEIGHT_SCALE, KNOBS
+from stereoplotter.procedure.step_values import BOTTOM_STOP, L_CHECK_FAILED
 from stereoplotter.trainer.actions import control_value
 from stereoplotter.trainer.exercise import Exercise
 from stereoplotter.trainer.outcome import stage_measures, standard_q
@@ -165,9 +166,6 @@ def overview(session: Any) -> dict[str, Any]:
 _JUDGED = re.compile(r"clear(ing)? (of )?the (y-parallax|six q)|common tilt|level|fuse|turn \w+ by")
 #: A standard point whose y-parallax a step clears.
 _CLEARS_AT = re.compile(r"standard point (\d): clear the y-parallax")
-#: Steps the operator took only because a check failed (the L-check's corrections): shown when
-#: their condition holds on the trainee's instrument.
-_CONDITIONAL = re.compile(r"^(ΔZ|Δb_z)\b|would take the carriage|at the carriage's bottom stop")
 #: Controls that follow from the sheet in a step that names another control: the zero places
 #: of the correction mechanisms and decentrations (set together in the step that names them).
 _ZERO_PLACE_FAMILY = tuple(KNOBS) + tuple(DECENTRATIONS)
@@ -192,6 +190,21 @@ def _step_of(action: dict[str, Any], step: str, texts: list[str]) -> str:
         if home is not None:
             return home
     return step
+
+
+#: The declared conditions the page judges by the trainee's L-check (its corrections, and the
+#: carriage's bottom stop they may reach): steps under them are shown when the L-check fails.
+#: A knob at its stop in C2 is the operator's own instrument's: shown as the operator took it.
+_SHOWN_WHEN_THE_L_CHECK_FAILS = frozenset({L_CHECK_FAILED.name, BOTTOM_STOP.name})
+
+
+def _conditional_steps(par: Any) -> set[str]:
+    """The steps the operator took only where the L-check's conditions held (each transcript
+    record carries its step's declared condition, ``procedure.step_values.CONDITIONS``)."""
+    log = getattr(getattr(getattr(par, "run", None), "op", None), "log", None)
+    if log is None:
+        return set()
+    return {r.step for r in log.records if r.condition in _SHOWN_WHEN_THE_L_CHECK_FAILS}
 
 
 def _add_silent_records(par: Any, stage: str, steps: dict[str, dict[str, Any]]) -> None:
@@ -222,9 +235,10 @@ def least_count(spec: Any, control: str) -> float:
         return float(spec.z_least_count_mm)
     if control == HEIGHT_SCALE:
         return float(spec.height_scale_least_count_m)
-    if control in KNOBS:
+    kind = CONTROL_INFO[control].kind if control in CONTROL_INFO else "screw"
+    if kind == "knob":
         return 1e-5
-    if control.startswith("kappa"):
+    if kind == "cassette":
         return 1e-4
     return float(spec.xy_least_count_mm)
 
@@ -257,6 +271,7 @@ def step_rules(par: Any, stage: str) -> list[dict[str, Any]]:
         elif kind == "set" and isinstance(action.get("value"), (int, float)):
             entry["targets"][name] = float(action["value"])
     _add_silent_records(par, stage, steps)
+    conditional = _conditional_steps(par)
     out = []
     looked: set[str] = set()  # controls set by looking: later values are relative to them
     for entry in steps.values():
@@ -271,7 +286,7 @@ def step_rules(par: Any, stage: str) -> list[dict[str, Any]]:
             if not judged and not measuring and c not in ("X", "Y") and c not in looked
         }
         clears = _CLEARS_AT.search(entry["text"])
-        entry["conditional"] = bool(_CONDITIONAL.search(entry["text"]))
+        entry["conditional"] = entry["text"] in conditional
         entry["clears_point"] = int(clears.group(1)) if clears else None
         if entry["clears_point"] is not None:
             entry["rule"], entry["point"] = "parallax", None
@@ -549,8 +564,11 @@ def sheet_parts(exercise: Exercise) -> dict[str, Any]:
 
 def _why(control: str, counter: str) -> str:
     """Why ``counter`` moves when ``control`` turns."""
-    if control in KNOBS and counter in DECENTRATIONS and control.split("_")[-1] == counter[3:]:
-        axis = "α" if "alpha" in control else "ω"
+    knob, dec = CONTROL_INFO.get(control), CONTROL_INFO.get(counter)
+    if knob and dec and knob.kind == "knob" and dec.kind == "decentration" and (
+        knob.side == dec.side
+    ):
+        axis = "α" if knob.axis == "alpha" else "ω"
         return (
             f"{counter} moved with {control}: the photo carrier's decentration is linked to the "
             f"correction knob of {axis} (the dependent decentration, decision D1 in "

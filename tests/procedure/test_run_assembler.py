@@ -23,7 +23,7 @@ ASSEMBLER = PACKAGE / "procedure" / "run.py"
 
 #: The names whose call builds a run's parts: outside the assembler, only the instrument's own
 #: package may call them (a subclass calling its parent, a copy of an instrument).
-BUILDERS = {"Run", "Instrument", "instrument_cls"}
+BUILDERS = {"Run", "Instrument"}
 
 #: The callers the issue names, and the assembler's function each must call.
 CALLERS = {
