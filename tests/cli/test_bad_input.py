@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import re
-import time
 from pathlib import Path
 
 import pytest
@@ -300,10 +299,8 @@ def test_setup_refusals_name_the_scenario_file(tmp_path, capsys):
 )
 def test_yaml_problems_are_config_errors(tmp_path, text, message):
     path = _write(tmp_path, text, "doc.yaml")
-    t0 = time.perf_counter()
     with pytest.raises(ConfigError, match=r"doc\.yaml: " + message):
         load_yaml_mapping(path)
-    assert time.perf_counter() - t0 < 1.0
 
 
 def test_non_utf8_empty_and_directory_inputs(tmp_path, capsys):

@@ -767,11 +767,11 @@ def test_mutated_inputs_never_crash(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("raw", [_bomb_flow(), _bomb_flow(12, 6), _CLASSIC_BOMB])
-def test_alias_bombs_are_refused_quickly(tmp_path, raw):
+def test_alias_bombs_are_refused_by_their_node_count(tmp_path, raw):
+    """Refused by counting the nodes the aliases would expand to, before any expansion (the
+    time it takes is the benchmarks', not asserted here)."""
     path = tmp_path / "bomb.yaml"
     path.write_text(raw if raw.startswith("a0:") else f"name: x\nvalue: {raw}\n", encoding="utf-8")
-    t0 = time.perf_counter()
     with pytest.raises(ConfigError, match=r"bomb\.yaml: .*: expected at most 1,000,000 YAML nodes"):
         load_yaml_mapping(path)
-    assert time.perf_counter() - t0 < 1.0
     assert MAX_YAML_NODES == 1_000_000
