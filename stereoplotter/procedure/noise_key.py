@@ -18,7 +18,7 @@ Examples
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 from stereoplotter.random_streams import stream_key
@@ -52,11 +52,11 @@ class NoiseKey:
 
     def at(self, *parts: Part) -> NoiseKey:
         """The identity ``parts`` below this one."""
-        return replace(self, path=(*self.path, *parts))
+        return NoiseKey(self.step, (*self.path, *parts), self.act)  # replace(), without its checks
 
     def by(self, act: Act) -> NoiseKey:
         """The draw of ``act`` at this identity."""
-        return replace(self, act=act)
+        return NoiseKey(self.step, self.path, act)
 
     def parts(self) -> tuple[Part, ...]:
         """The parts in the order of the encoding: act (where one draws), step, path."""

@@ -23,7 +23,7 @@ from stereoplotter.procedure.trials import (
     summarise_result,
     trial_columns,
 )
-from stereoplotter.random_streams import BLOCK, keyed_draws
+from stereoplotter.random_streams import BLOCK, keyed_draws, keyed_standard_normal
 from stereoplotter.statistics import scale_summary, summarise_flags, summarise_values
 
 
@@ -44,6 +44,18 @@ def test_keyed_streams_do_not_depend_on_the_cut():
     # block 0 is the stream a run of ≤ BLOCK trials drew before chunking existed
     before = np.random.default_rng([9, zlib.crc32(b"k")]).standard_normal(50)
     assert np.array_equal(whole[:50], before)
+
+
+def test_keyed_normals_go_on_from_where_a_range_stopped():
+    """Consecutive ranges (the chunks of a run, which go on with a block's generator where the
+    previous range left it), the same range twice and ranges out of order give the numbers of
+    the block drawn whole, by ``Generator.standard_normal`` of a generator of their own."""
+    whole = keyed_draws(11, "k/n", 0, 3 * BLOCK, _normal)
+    cuts = [0, 1, 2, BLOCK + 7, 2 * BLOCK - 1, 2 * BLOCK + 100, 3 * BLOCK]
+    ranges = list(itertools.pairwise(cuts))
+    for order in (ranges, ranges[::-1], [*ranges, *ranges]):
+        for a, b in order:
+            assert np.array_equal(keyed_standard_normal(11, "k/n", a, b), whole[a:b]), (a, b)
 
 
 @pytest.mark.parametrize("method", ["setup", "conventional"])
