@@ -22,13 +22,36 @@ import math
 import operator
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any, Final, Literal, get_args
+from typing import Any, Final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import ConfigError, StereoplotterError
 from stereoplotter.instrument.action_listener import Action, ActionListener
+from stereoplotter.instrument.controls import (
+    CASSETTES,
+    CONTROL_INFO,
+    CONTROLS,
+    DECENTRATIONS,
+    KNOBS,
+    SCREWS,
+    CassetteName,
+    Control,
+    ControlInfo,
+    ControlKind,
+    ControlPart,
+    DecentrationName,
+    HeightScaleName,
+    KnobName,
+    ScaleName,
+    ScrewName,
+    SetControl,
+    Side,
+    control_axis,
+    control_kind,
+    control_side,
+)
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
@@ -64,6 +87,7 @@ __all__ = [
     "Control",
     "ControlInfo",
     "ControlKind",
+    "ControlPart",
     "DecentrationName",
     "HeightScaleName",
     "Instrument",
@@ -80,108 +104,6 @@ __all__ = [
 
 #: Mechanics back-ends of the lead-screw axes.
 BACKENDS = ("closed-form", "pymunk")
-
-#: The two photos / projectors.
-Side = Literal["left", "right"]
-#: Lead-screw axes with a counter or scale: the carriages and the base carriage.
-ScrewName = Literal["X", "Y", "Z", "bx", "by", "bz"]
-#: Cassette rotations κ, set on their scales [rad].
-CassetteName = Literal["kappa_left", "kappa_right"]
-#: Decentration scales of the correction units [mm].
-DecentrationName = Literal["dx_left", "dy_left", "dx_right", "dy_right"]
-#: Correction knobs k_α, k_ω, turned to the tilt tangent they represent (:meth:`turn_knob`).
-KnobName = Literal["k_alpha_left", "k_omega_left", "k_alpha_right", "k_omega_right"]
-#: The metre height scale geared to the Z screw.
-HeightScaleName = Literal["H"]
-#: Controls set on a scale: f_пр, the cassette rotations and the decentrations.
-SetControl = Literal["f_instrument", CassetteName, DecentrationName]
-#: Every counter or scale that can be read (:meth:`Instrument.read`).
-ScaleName = Literal[ScrewName, DecentrationName, HeightScaleName]
-#: Every control of the instrument (what an operator turns or sets).
-Control = Literal[ScrewName, SetControl, KnobName, HeightScaleName]
-
-SCREWS: Final[tuple[ScrewName, ...]] = get_args(ScrewName)
-CASSETTES: Final[tuple[CassetteName, ...]] = get_args(CassetteName)
-DECENTRATIONS: Final[tuple[DecentrationName, ...]] = get_args(DecentrationName)
-KNOBS: Final[tuple[KnobName, ...]] = get_args(KnobName)
-_SET: tuple[SetControl, ...] = get_args(SetControl)
-#: Every control an operator can turn to a reading.
-CONTROLS = SCREWS + _SET
-
-#: What a control is: a lead screw with its counter, the principal-distance scale, a cassette
-#: rotation, a decentration scale, a correction knob or the height scale.
-ControlKind = Literal[
-    "screw", "principal_distance", "cassette", "decentration", "knob", "height_scale"
-]
-
-
-@dataclass(frozen=True, slots=True)
-class ControlInfo:
-    """One control of the instrument, declared once (:data:`CONTROL_INFO`).
-
-    Attributes
-    ----------
-    name : str
-        The control's name (:data:`Control`).
-    kind : ControlKind
-    unit : str
-        Unit of its setting: "mm" (screws, f_пр, decentrations), "rad" (cassettes), "tan" (a
-        knob: the tangent of the tilt it represents), "m" (the height scale).
-    side : {"left", "right"} or None
-        The photo it acts on (None: both, the carriages and the base).
-    axis : str or None
-        A decentration's "x" or "y", a knob's "alpha" or "omega" (None: none).
-    """
-
-    name: str
-    kind: ControlKind
-    unit: str
-    side: Side | None = None
-    axis: str | None = None
-
-
-def _control_table() -> dict[str, ControlInfo]:
-    out = {name: ControlInfo(name, "screw", "mm") for name in SCREWS}
-    out["f_instrument"] = ControlInfo("f_instrument", "principal_distance", "mm")
-    out["H"] = ControlInfo("H", "height_scale", "m")
-    sides: tuple[Side, ...] = ("left", "right")
-    for side in sides:
-        out[f"kappa_{side}"] = ControlInfo(f"kappa_{side}", "cassette", "rad", side)
-        for axis in ("x", "y"):
-            name = f"d{axis}_{side}"
-            out[name] = ControlInfo(name, "decentration", "mm", side, axis)
-        for axis in ("alpha", "omega"):
-            name = f"k_{axis}_{side}"
-            out[name] = ControlInfo(name, "knob", "tan", side, axis)
-    return out
-
-
-#: Every control → its :class:`ControlInfo`: the instrument and the operator dispatch on its
-#: ``kind`` and take its ``side`` and ``axis`` from here, never from the name's spelling.
-CONTROL_INFO: Final[dict[str, ControlInfo]] = _control_table()
-
-
-def control_kind(control: str) -> ControlKind | None:
-    """The kind of ``control`` (None: not a control of the instrument)."""
-    info = CONTROL_INFO.get(control)
-    return None if info is None else info.kind
-
-
-def control_side(control: str) -> Side:
-    """The photo a cassette, decentration or knob acts on."""
-    side = CONTROL_INFO[control].side
-    if side is None:
-        raise StereoplotterError(f"{control!r} acts on no single photo")
-    return side
-
-
-def control_axis(control: str) -> str:
-    """A decentration's "x" or "y", a knob's "alpha" or "omega"."""
-    axis = CONTROL_INFO[control].axis
-    if axis is None:
-        raise StereoplotterError(f"{control!r} has no axis")
-    return axis
-
 
 #: The metre height scale geared to the Z screw: reading = slip − D·M_в/1000 [m].
 HEIGHT_SCALE: Final[HeightScaleName] = "H"
@@ -250,14 +172,13 @@ def _scales(
     spec: InstrumentSpec, injected: dict[str, Any], full: Callable[[Any], NDArray[np.float64]]
 ) -> dict[str, Scale]:
     """The counters' scales with their injected zero-reading and ratio errors (least counts of
-    the spec: X, Y and the base scales at the xy least count, Z at its own)."""
-    least = {"X": spec.xy_least_count_mm, "Y": spec.xy_least_count_mm, "Z": spec.z_least_count_mm}
+    the spec, each control's own: :meth:`ControlInfo.least_count`)."""
     return {
         name: Scale(
             name,
             full(nominal + injected[f"zero_reading.{name}"]),
             full(injected.get(f"counter_scale.{name}", 0.0)),
-            least.get(name, spec.xy_least_count_mm),
+            CONTROL_INFO[name].resolution(spec),
         )
         for name, nominal in _NOMINAL_ZERO.items()
     }
@@ -408,15 +329,10 @@ class Instrument:
 
     def _axis_params(self, name: str) -> AxisParams:
         spec = self.spec
-        ranges = {
-            "X": "model_x_offset_range_mm",
-            "Y": "model_y_offset_range_mm",
-            "Z": "projection_distance_range_mm",
-            "bx": "base_x_range_mm",
-            "by": "base_y_range_mm",
-            "bz": "base_z_range_mm",
-        }
-        key = spec.key_of(ranges[name])
+        info = CONTROL_INFO[name]
+        travel = info.range(spec)
+        assert info.range_attribute is not None and travel is not None  # every screw has stops
+        key = spec.key_of(info.range_attribute)
         parameter = spec.parameters[key]
         ideal = self.ideal_mechanics
         backlash = 0.0 if ideal else float(np.mean(self.injected[f"backlash.{name}"]))
@@ -427,7 +343,7 @@ class Instrument:
                 friction=0.0 if ideal else spec.friction_coefficient,
                 mass_kg=spec.z_carriage_mass_kg if name == "Z" else spec.carriage_mass_kg,
                 stiffness_kg_s2=math.inf if ideal else spec.screw_stiffness_N_per_um * N_PER_UM,
-                range_mm=tuple(float(v) for v in getattr(spec, ranges[name])),
+                range_mm=travel,
                 range_source=f"{parameter.file}: {key} ({parameter.status})",
                 vertical=name == "Z",
             )
@@ -534,26 +450,29 @@ class Instrument:
                 axis.approach(self._arg(nut), side)
             return
         value = np.asarray(reading, float)
-        if control == "f_instrument":
-            check_in_range(self.spec, "f_instrument_range_mm", float(np.max(value)), "f_пр")
-            check_in_range(self.spec, "f_instrument_range_mm", float(np.min(value)), "f_пр")
+        info = CONTROL_INFO.get(control)
+        kind = None if info is None else info.kind
+        stops = None if info is None else info.range_attribute
+        if kind == "principal_distance" and stops is not None:
+            check_in_range(self.spec, stops, float(np.max(value)), "f_пр")
+            check_in_range(self.spec, stops, float(np.min(value)), "f_пр")
             self._f_instrument = value + self.injected["setting.f_instrument"]
-        elif control_kind(control) == "cassette":
+        elif kind == "cassette" and stops is not None:
             side_name = control_side(control)
             for v in (np.min(value), np.max(value)):
-                check_in_range(self.spec, "kappa_range", float(v), f"κ_{side_name}")
-            self._kappa[side_name] = value + self.injected[f"setting.kappa_{side_name}"]
+                check_in_range(self.spec, stops, float(v), f"κ_{side_name}")
+            self._kappa[side_name] = value + self.injected[f"setting.{control}"]
             self._units[side_name] = _replace(self._units[side_name], kappa=self._kappa[side_name])
-        elif control_kind(control) == "decentration":
-            axis, side_name = f"d{control_axis(control)}", control_side(control)
+        elif kind == "decentration" and stops is not None:
+            axis, side_name = control_axis(control), control_side(control)
             d = self._scales[control].position(value) + self.injected[f"setting.{control}"]
             for v in (np.min(d), np.max(d)):
                 check_in_range(
-                    self.spec, "decentration_range_mm", float(v), f"decentration {axis},{side_name}"
+                    self.spec, stops, float(v), f"decentration {info.family},{side_name}"
                 )
             unit = self._units[side_name]
             cx, cy = unit.plane_decentration_mm
-            if axis == "dx":
+            if axis == "x":
                 unit = _replace(
                     unit, decentration_x_mm=d, plane_decentration_x_mm=d, plane_decentration_y_mm=cy
                 )
@@ -578,21 +497,15 @@ class Instrument:
         RangeRefusal
             |tilt| beyond the correction range.
         """
-        try:
-            axis, side = {
-                "k_alpha_left": ("alpha", "left"),
-                "k_omega_left": ("omega", "left"),
-                "k_alpha_right": ("alpha", "right"),
-                "k_omega_right": ("omega", "right"),
-            }[knob]
-        except KeyError:
-            raise StereoplotterError(
-                f"no correction knob {knob!r}; knobs: k_alpha_left, k_omega_left, "
-                "k_alpha_right, k_omega_right"
-            ) from None
+        info = CONTROL_INFO.get(knob)
+        if info is None or info.kind != "knob" or info.range_attribute is None:
+            raise StereoplotterError(f"no correction knob {knob!r}; knobs: {', '.join(KNOBS)}")
+        axis, side = control_axis(knob), control_side(knob)
         t = np.asarray(tan_tilt, float) + np.tan(self.injected[f"setting.correction_{axis}_{side}"])
         for v in (np.min(t), np.max(t)):
-            check_in_range(self.spec, "tilt_max", math.atan(float(v)), f"k_{axis},{side}")
+            check_in_range(
+                self.spec, info.range_attribute, math.atan(float(v)), f"{info.family},{side}"
+            )
         self._units[side] = turn_correction_knob(
             self._units[side], axis, t, linkage=self.variant.linkage
         )
@@ -729,7 +642,7 @@ class Instrument:
         return self._height_slip - depth * self._gear() / 1000.0
 
     def _round_height(self, reading: NDArray) -> NDArray[np.float64]:
-        lc = self.spec.height_scale_least_count_m
+        lc = CONTROL_INFO[HEIGHT_SCALE].resolution(self.spec)
         return np.round(np.asarray(reading, float) / lc) * lc
 
     # --- looking through the eyepieces ---------------------------------------------------------

@@ -32,6 +32,7 @@ from stereoplotter.instrument.kinematics import (
 )
 from stereoplotter.instrument.knobs import turn_correction_knob
 from stereoplotter.instrument.virtual import (
+    CONTROL_INFO,
     HEIGHT_SCALE,
     KNOBS,
     SCREWS,
@@ -483,13 +484,11 @@ class Operator:
 
     # --- least counts -------------------------------------------------------------------------
 
-    def least_count(self, control: ScaleName) -> float:
-        spec = self.inst.spec
-        if control == HEIGHT_SCALE:
-            return spec.height_scale_least_count_m
-        if control == "Z":
-            return spec.z_least_count_mm
-        return spec.xy_least_count_mm
+    def least_count(self, control: ScaleName | SetControlName) -> float:
+        """The least count of a control's scale (:meth:`ControlInfo.least_count`); 0 for κ and
+        the knobs, whose scales the instrument file gives none (no setting error in least
+        counts). [its unit]"""
+        return CONTROL_INFO[control].least_count(self.inst.spec) or 0.0
 
     # --- reading and setting ------------------------------------------------------------------
 
@@ -521,8 +520,7 @@ class Operator:
             cmd = self._at_stop(control, cmd)
             self.inst.set(control, np.where(active, cmd, prev), side=self.model.finish_side)
         else:
-            on_xy_scale = control_kind(control) in ("decentration", "principal_distance")
-            lc = self.inst.spec.xy_least_count_mm if on_xy_scale else 0.0
+            lc = self.least_count(control)
             cmd = value + self.noise.draw(as_key(key).by("set"), self.model.setting_sigma_lc * lc)
             prev = self.commanded.get(control, cmd)
             cmd = np.where(active, cmd, prev)

@@ -22,8 +22,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.instrument.kinematics import rod_from_counters
-from stereoplotter.instrument.principles import control_name, mark_phrase, sequence_for
+from stereoplotter.instrument.principles import mark_phrase, sequence_for
 from stereoplotter.instrument.virtual import (
+    CONTROL_INFO,
     HEIGHT_SCALE,
     NOMINAL_ZERO,
     CassetteName,
@@ -252,7 +253,7 @@ def _fit_knob(run: Run, side: Side, axis: Tilt, mark: str, key: NoiseKey, active
         "zero": "MO_" + counter + sfx,
         "coordinate": coordinate,
         "value": np.ravel(value)[0],
-        "knob": control_name(op.inst.spec.principle, knob),
+        "knob": CONTROL_INFO[knob].own_name(op.inst.spec.principle),
         "tilt": _TILT[axis],
         "mark": mark_phrase(op.inst.spec.principle, mark),
     }
@@ -421,7 +422,7 @@ def _set_computed_decentrations(run: Run, key: NoiseKey) -> None:
             value = run.target(f"d_{d[1]},{_SIDE[side]}", NOMINAL_ZERO[control])
             op.set(control, value, key.at(control))
             fields = {
-                "name": control_name(op.inst.spec.principle, control),
+                "name": CONTROL_INFO[control].own_name(op.inst.spec.principle),
                 "d": d,
                 "side": _SIDE[side],
                 "zero": NOMINAL_ZERO[control],

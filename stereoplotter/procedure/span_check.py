@@ -262,7 +262,7 @@ def _correct_span(
     shown = op.log.shown if np.ndim(dz_mm) else 0
     # logged where the ΔZ set is one the counter shows (not the carriage's last least count
     # down to the stop)
-    if abs(np.ravel(dz_mm)[shown if np.size(dz_mm) > 1 else 0]) >= op.inst.spec.z_least_count_mm:
+    if abs(np.ravel(dz_mm)[shown if np.size(dz_mm) > 1 else 0]) >= op.least_count("Z"):
         set_m = dz_mm * sheet.vertical_scale_denominator / 1000.0  # ΔZ set on Z [m]
         _log_delta_z(
             op,

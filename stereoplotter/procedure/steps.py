@@ -19,8 +19,9 @@ from collections.abc import Callable, Iterable
 import numpy as np
 from numpy.typing import NDArray
 
-from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, ScaleName
+from stereoplotter.instrument.virtual import HEIGHT_SCALE, NOMINAL_ZERO, ScaleName, Side
 from stereoplotter.procedure.arrays import Active, Floats, Mask, Value
+from stereoplotter.procedure.control_names import CASSETTE, DECENTRATION, KNOB, Tilt
 from stereoplotter.procedure.noise_key import KeyLike, NoiseKey, as_key, pointing
 from stereoplotter.procedure.run import Run
 from stereoplotter.procedure.step_values import (
@@ -67,14 +68,16 @@ def interior_steps(stage: str) -> tuple[Step, ...]:
             Line(stage, "set the instrument principal distance f_пр", "item 1"),
         ),
     ]
-    for side in ("left", "right"):
+    sides: tuple[Side, ...] = ("left", "right")
+    tilts: tuple[Tilt, ...] = ("alpha", "omega")
+    for side in sides:
         cassette = Line(
             stage, f"turn the {side} cassette: fiducial lines parallel to the axes", "stage 1"
         )
-        out.append(DriveStep(f"kappa_{side}", _at_zero, cassette))
-        out += [DriveStep(f"k_{axis}_{side}", _at_zero) for axis in ("alpha", "omega")]
+        out.append(DriveStep(CASSETTE[side], _at_zero, cassette))
+        out += [DriveStep(KNOB[tilt, side], _at_zero) for tilt in tilts]
         for d in ("dx", "dy"):
-            control = f"{d}_{side}"
+            control = DECENTRATION[d, side]
             out.append(SetStep(control, _nominal_zero(control), key.at(control)))
     out.append(
         Note(Line(stage, "correction mechanisms and decentrations to their zero places", "stage 1"))

@@ -21,8 +21,8 @@ from stereoplotter.glossary import (
     term,
     translate,
 )
+from stereoplotter.instrument.controls import CONTROL_INFO
 from stereoplotter.instrument.principles import (
-    control_name,
     mark_phrase,
     sequence_for,
     setting_values,
@@ -336,8 +336,12 @@ def _controls_rows(sheet: SetupSheet, lang: str = "en") -> list[str]:
     principle = sheet.instrument_principle
     rows = []
     for p in sheet.photos:
-        names = [control_name(principle, f"{c}_{p.name}") for c in ("k_alpha", "k_omega", "dx",
-                                                                     "dy")]  # fmt: skip
+        names = [
+            info.own_name(principle)
+            for kind in ("knob", "decentration")  # k_α, k_ω, then dx, dy
+            for info in CONTROL_INFO.values()
+            if info.kind == kind and info.side == p.name
+        ]
         how = mark_phrase(principle, "N")
         if lang == "en":
             rows.append(f"| controls, {p.name} | — | {', '.join(names)} | — | stage 2: {how} |")

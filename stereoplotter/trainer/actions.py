@@ -22,6 +22,7 @@ import numpy as np
 from stereoplotter.errors import StereoplotterError, TrainerError
 from stereoplotter.instrument.virtual import (
     CASSETTES,
+    CONTROL_INFO,
     DECENTRATIONS,
     HEIGHT_SCALE,
     KNOBS,
@@ -71,19 +72,23 @@ def _field(name: str, type_: str, unit: str | None = None, **more: Any) -> dict[
 
 
 _SIDE = _field("side", "choice", None, choices=["below", "above"], optional=True)
+#: Each control → its unit (:data:`~stereoplotter.instrument.virtual.CONTROL_INFO`), for a field
+#: in the control's own unit.
+_UNITS = {name: CONTROL_INFO[name].unit for name in TURNABLE}
 #: Every action the core accepts, with its fields, for a page to make one control per kind
 #: (JSON). Field ``type``: ``choice`` (one of ``choices``), ``number``, ``integer``, ``text``,
 #: ``point`` ([x_mm, y_mm] on the left photo) or ``number-or-point``; ``unit`` in the control's
 #: own unit where the field is a number (``"control"``: mm of a counter, m of the height scale,
-#: rad of κ, tangent of a correction knob, mm of f_пр). ``acts_on``: ``instrument`` or
-#: ``session``; ``assist``: the exercise assist that must allow it (exam: never undo nor hints).
+#: rad of κ, tangent of a correction knob, mm of f_пр; each control's in ``units``).
+#: ``acts_on``: ``instrument`` or ``session``; ``assist``: the exercise assist that must allow
+#: it (exam: never undo nor hints).
 ACTION_CATALOGUE: list[dict[str, Any]] = [
     {
         "kind": "turn",
         "label": "turn a handwheel, knob or scale by a step",
         "fields": [
             _field("control", "choice", None, choices=list(TURNABLE)),
-            _field("delta", "number", "control"),
+            _field("delta", "number", "control", units=_UNITS),
             _SIDE,
         ],
         "acts_on": "instrument",
@@ -94,7 +99,7 @@ ACTION_CATALOGUE: list[dict[str, Any]] = [
         "label": "turn a control until its scale shows a value",
         "fields": [
             _field("control", "choice", None, choices=list(TURNABLE)),
-            _field("value", "number", "control"),
+            _field("value", "number", "control", units=_UNITS),
             _SIDE,
         ],
         "acts_on": "instrument",

@@ -230,17 +230,10 @@ def _add_silent_records(par: Any, stage: str, steps: dict[str, dict[str, Any]]) 
 
 
 def least_count(spec: Any, control: str) -> float:
-    """The least count of a control's scale, as the session's controls give it. [its unit]"""
-    if control == "Z":
-        return float(spec.z_least_count_mm)
-    if control == HEIGHT_SCALE:
-        return float(spec.height_scale_least_count_m)
-    kind = CONTROL_INFO[control].kind if control in CONTROL_INFO else "screw"
-    if kind == "knob":
-        return 1e-5
-    if kind == "cassette":
-        return 1e-4
-    return float(spec.xy_least_count_mm)
+    """The least count of a control's scale, as the session's controls give it
+    (:meth:`ControlInfo.resolution`; a name that is no control: the X, Y counters'). [its unit]"""
+    info = CONTROL_INFO.get(control)
+    return info.resolution(spec) if info is not None else float(spec.xy_least_count_mm)
 
 
 def step_rules(par: Any, stage: str) -> list[dict[str, Any]]:

@@ -30,12 +30,15 @@ import numpy as np
 from stereoplotter.errors import TrainerError
 from stereoplotter.instrument.virtual import (
     CASSETTES,
+    CONTROL_INFO,
     DECENTRATIONS,
     HEIGHT_SCALE,
     KNOBS,
     SCREWS,
+    ControlInfo,
     Instrument,
 )
+from stereoplotter.procedure.control_names import CASSETTE
 from stereoplotter.procedure.operator import Noise, Operator
 from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.simulate import prepare_run
@@ -225,69 +228,49 @@ class Session:
     def _counters(self) -> dict[str, Any]:
         spec = self.inst.spec
         out: dict[str, Any] = {}
-        for name in (*SCREWS, *DECENTRATIONS):
+        geared = self.inst.height_gear is not None  # the metre scale shows once geared
+        shown = (*SCREWS, *DECENTRATIONS, *([HEIGHT_SCALE] if geared else []))
+        for name in shown:
+            info = CONTROL_INFO[name]
             out[name] = {
                 "value": _f(self.inst.read(name)),
-                "unit": "mm",
-                "least_count": spec.z_least_count_mm if name == "Z" else spec.xy_least_count_mm,
-                "direction": self.inst.counter_sense(name),
-            }
-        if self.inst.height_gear is not None:
-            out[HEIGHT_SCALE] = {
-                "value": _f(self.inst.read(HEIGHT_SCALE)),
-                "unit": "m",
-                "least_count": spec.height_scale_least_count_m,
-                "direction": 1,
+                "unit": info.unit,
+                "least_count": info.resolution(spec),
+                "direction": 1 if name == HEIGHT_SCALE else self.inst.counter_sense(name),
             }
         return out
 
     def _controls(self) -> dict[str, Any]:
-        spec = self.inst.spec
         out: dict[str, Any] = {}
-        for name in SCREWS:
-            lo, hi = (_f(self.inst.reading_of(name, v)) for v in self.inst.travel_mm(name))
+        for name in (*SCREWS, "f_instrument", *CASSETTES, *DECENTRATIONS, *KNOBS):
+            info = CONTROL_INFO[name]
+            if info.kind in ("screw", "decentration"):
+                value = control_value(self.inst, name, self.commanded)
+            else:  # f_пр unset until the operator sets it; κ and the knobs start at zero
+                value = self.commanded.get(name, None if info.kind == "principal_distance" else 0.0)
+            low, high = self._stops(info)
             out[name] = {
-                "value": control_value(self.inst, name, self.commanded),
-                "unit": "mm",
-                "min": min(lo, hi),
-                "max": max(lo, hi),
-                "step": spec.z_least_count_mm if name == "Z" else spec.xy_least_count_mm,
-            }
-        f_lo, f_hi = spec.f_instrument_range_mm
-        out["f_instrument"] = {
-            "value": self.commanded.get("f_instrument"),
-            "unit": "mm",
-            "min": float(f_lo),
-            "max": float(f_hi),
-            "step": spec.xy_least_count_mm,
-        }
-        k_lo, k_hi = spec.kappa_range
-        for name in CASSETTES:
-            out[name] = {
-                "value": self.commanded.get(name, 0.0),
-                "unit": "rad",
-                "min": float(k_lo),
-                "max": float(k_hi),
-                "step": 1e-4,
-            }
-        for name in DECENTRATIONS:
-            out[name] = {
-                "value": control_value(self.inst, name, self.commanded),
-                "unit": "mm",
-                "min": None,
-                "max": None,
-                "step": spec.xy_least_count_mm,
-            }
-        t_max = float(np.tan(spec.tilt_max))
-        for name in KNOBS:
-            out[name] = {
-                "value": self.commanded.get(name, 0.0),
-                "unit": "tan",
-                "min": -t_max,
-                "max": t_max,
-                "step": 1e-5,
+                "value": value,
+                "unit": info.unit,
+                "min": low,
+                "max": high,
+                "step": info.resolution(self.inst.spec),
             }
         return out
+
+    def _stops(self, info: ControlInfo) -> tuple[float | None, float | None]:
+        """A control's stops as its scale reads them (:meth:`ControlInfo.range`): a lead
+        screw's counter readings at the ends of its travel; none shown for a decentration,
+        whose stop limits the physical decentration its scale reads with its zero-reading
+        error. [the control's unit]"""
+        if info.kind == "screw":
+            ends = (_f(self.inst.reading_of(info.name, v)) for v in self.inst.travel_mm(info.name))
+            lo, hi = ends
+            return min(lo, hi), max(lo, hi)
+        stops = info.range(self.inst.spec)
+        if stops is None or info.kind == "decentration":
+            return None, None
+        return stops
 
     def control_range(self, name: str) -> tuple[float, float] | None:
         """The values a control can be set to (its stops, as its scale reads), or None for a
@@ -326,7 +309,7 @@ class Session:
             out[side] = {
                 "x_mm": _on_step(mark["x_mm"], step),
                 "y_mm": _on_step(mark["y_mm"], step),
-                "kappa_rad": float(self.commanded.get(f"kappa_{side}", 0.0)),
+                "kappa_rad": float(self.commanded.get(CASSETTE[side], 0.0)),
             }
         return out
 
@@ -393,7 +376,7 @@ class Session:
                 out.append(
                     {
                         "name": "C1: f_пр on its scale against the sheet",
-                        "tolerance": float(self.exercise.spec.xy_least_count_mm),
+                        "tolerance": CONTROL_INFO["f_instrument"].resolution(self.exercise.spec),
                         "unit": "mm",
                         "graded": True,
                     }

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from stereoplotter.instrument.virtual import CONTROL_INFO
 from stereoplotter.trainer.step_words import CONTROL_NAMES
 
 __all__ = ["ERROR_TERMS", "announced_row", "claim_text", "hint_lines", "measure_line"]
@@ -110,6 +111,6 @@ def _control_name(control: str) -> str:
         return f"{name} (its wheel appears once the height counter is geared)"
     if control in ("gear", "slip", "connect", "needle", "record"):
         return f"{control} (a form under 'Instrument and sheet actions')"
-    if control in ("X", "Y", "Z", "bx", "by", "bz") or control.startswith(("k", "d", "f_")):
+    if control in CONTROL_INFO:  # every control but the height scale has its wheel
         return f"{name} (wheel)"
     return name

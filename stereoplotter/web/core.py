@@ -14,6 +14,7 @@ from typing import Any
 from stereoplotter.errors import StereoplotterError, TrainerError
 from stereoplotter.imagery.cache import EAGER_PIXEL_MM, ViewCache
 from stereoplotter.imagery.eyepiece import SCREEN_PIXEL_MM
+from stereoplotter.instrument.virtual import CONTROL_INFO
 from stereoplotter.io.exercise_file import (
     exercise_from_mapping,
     load_exercise,
@@ -316,7 +317,15 @@ def _on_grid(value: float | None) -> float | None:
 #: control, removed where the exercise gives no hints: a number with a decimal point (a common
 #: tilt, a pass's RMS, an over-correction: the operator's answers), the control a step turns.
 _FOUND_NUMBER = re.compile(r"[+\-−]?\d+\.\d+")
-_CONTROL_ID = r"(?:(?:kappa|k_alpha|k_omega|dx|dy)_(?:left|right)|b[xyz]|f_instrument)"
+#: The controls a step's words name, by their identifiers: every one but the carriages' X, Y,
+#: Z and the height scale H (single letters the words use for their coordinates too).
+_CONTROL_ID = "(?:{})".format(
+    "|".join(
+        re.escape(name)
+        for name, info in CONTROL_INFO.items()
+        if info.part not in ("carriage", "height counter")
+    )
+)
 _NAMED_CONTROL = (
     (re.compile(r"\s*\(by turning [^)]*\)"), ""),
     (re.compile(r" by turning \S+"), ""),

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Literal, Protocol, runtime_checkable
 import numpy as np
 
 from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.controls import CONTROL_INFO
 from stereoplotter.instrument.mechanics.dead_band import G_MM_S2, half_play_mm, play_offset_mm
 
 if TYPE_CHECKING:
@@ -253,11 +254,9 @@ class AxisParams:
         """
         if axis not in ("X", "Y", "Z"):
             raise StereoplotterError(f"axis must be 'X', 'Y' or 'Z', found {axis!r}")
-        attribute = {
-            "X": "model_x_offset_range_mm",
-            "Y": "model_y_offset_range_mm",
-            "Z": "projection_distance_range_mm",
-        }[axis]
+        attribute = CONTROL_INFO[axis].range_attribute  # the stops of the axis's screw
+        if attribute is None:
+            raise StereoplotterError(f"axis {axis!r} has no stops in the instrument file")
         backlash = "backlash_z_mm" if axis == "Z" else "backlash_xy_mm"
         key = spec.key_of(attribute)
         parameter = spec.parameters[key]

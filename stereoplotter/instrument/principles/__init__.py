@@ -38,7 +38,6 @@ __all__ = [
     "SchemaField",
     "Setting",
     "SettingSequence",
-    "control_name",
     "error_terms_for",
     "mark_phrase",
     "mechanism_for",
@@ -65,15 +64,6 @@ def sequence_for(principle: str) -> SettingSequence | None:
     """The settings of an instrument ``principle`` (None: not one of the registered ones)."""
     p = PRINCIPLES.get(principle)
     return p.settings if p is not None else None
-
-
-def control_name(principle: str, control: str) -> str:
-    """``control`` (``k_alpha_left``, ``dx_right`` …) with the instrument's own name added."""
-    p = PRINCIPLES.get(principle)
-    if p is None:
-        return control
-    own = p.controls.get(control.rsplit("_", 1)[0])
-    return control if own is None else f"{own} ({control})"
 
 
 def mark_phrase(principle: str, mark: str) -> str:
