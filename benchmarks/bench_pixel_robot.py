@@ -7,8 +7,10 @@ claim the grade's true residual y-parallax at the six points is read, for the re
 
     PYTHONPATH=$PWD python -m benchmarks.bench_pixel_robot [--seeds 10]   (from the checkout)
 
-Prints per seed: passed, the true |q| at the six points [µm], the robot's last measured q,
-actions, looks, seconds; then the pass rate.
+Prints per seed: passed, the true q at the six points [µm] (the grade's sign), the robot's last
+reading of q at each point with its magnification (the page's sign: "a detail lower on the right"
+is +, the opposite of the grade's), actions, looks, seconds; then the pass rate. The exam seed
+of a trainee is drawn by the server from its own key, so each run meets other instruments.
 """
 
 from __future__ import annotations
@@ -61,9 +63,11 @@ def main() -> None:
             rows = g["tables"]["y_parallax"]["rows"]
             ok = bool(g["overall"]["passed"])
             passed += ok
-            true = [round(r["value"], 2) for r in rows]
-            seen = {n: round(q, 2) for n, q in rec.q_um.items()}
-            print(f"seed 'pixel {k}': passed {ok}; true |q| {true} µm; measured q {seen}; "
+            true = [round(r["value"], 1) for r in rows]
+            seen = {n: f"{q:.1f} (×{rec.mag[n]})" for n, q in sorted(rec.q_um.items())}
+            worst = max(abs(v) for v in true)
+            print(f"seed 'pixel {k}': passed {ok}; true q {true} µm (worst {worst}); "
+                  f"last read q {seen} µm; "
                   f"{eyes.sent} actions, {eyes.looks} looks, {rec.passes} passes, "
                   f"{seconds:.0f} s", flush=True)
         ctx.close()

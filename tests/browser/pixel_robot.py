@@ -6,24 +6,27 @@ page draws, the measuring mark at their centre) and return parallaxes and turns.
 the images and carries the turns out.
 
 **Measuring the parallax at a point.** The left eyepiece's centre (around the mark, the mark itself
-masked out) is searched for in the right eyepiece by normalised cross-correlation, masked
-(Padfield's form, every sum an FFT correlation), sub-pixel by a parabola through the peak on
-each axis. The offset of the match from the right eyepiece's centre is the parallax as the eye
-sees it: horizontal = x-parallax, vertical = y-parallax, in screen pixels, i.e.
-``SCREEN_PIXEL_MM / magnification`` mm of photo each. Coarse to fine: ×2 finds the detail in a
-12.8 mm field (one pixel 50 µm), the finest of ×20 and ×6 whose field holds the found offset
-measures it (5 µm, 16.7 µm a pixel), searched only near the coarse offset. A match is rejected
+masked out) is searched for in the right eyepiece — turned back first by the difference of the
+carriers' κ the wheels show (:func:`view`) — by normalised cross-correlation, masked (Padfield's
+form, every sum an FFT correlation), of the grey level less its blur (:data:`HIGH_PASS_PX`),
+sub-pixel by a parabola through the peak on each axis. The offset of the match from the right
+eyepiece's centre is the parallax as the eye sees it: horizontal = x-parallax, vertical =
+y-parallax, in screen pixels of ``SCREEN_PIXEL_MM / magnification`` mm of photo. Coarse to fine
+(:func:`refine`): ×2 finds the detail in a 12.8 mm field (one pixel 50 µm), ×6 and then ×20
+measure it (16.7 µm, 5 µm a pixel), each searched near the coarser offset. A match is rejected
 where its peak is weak (:data:`MIN_PEAK`), where a second peak away from it is nearly as high
-(:data:`MIN_MARGIN`: the striped low-contrast fields), or where the fine offset lies far from the
-coarse one (:data:`AGREE_PX` coarse pixels).
+(:data:`MIN_MARGIN`: the striped low-contrast fields), at the search's edge, or where the finer
+offset lies far from the coarser one (:data:`AGREE_PX`). Where a point's own field is striped or
+plain, the marks are moved to the most detailed place next to it (:func:`textured_spot`).
 
-**Relative orientation by least squares.** At each standard point the robot measures the
-y-parallax, then turns each of the five elements (κ_л, κ_п, k_α,л, k_α,п, k_ω,п) by a probe step
-and back, the change per unit its row of the Jacobian; the turns that null the six y-parallaxes
-in least squares are made at once; the points are measured again (at ×20 near the predicted
-parallax), and so on until the largest measured |q| is under :data:`DONE_SHARE` of the
-tolerance. A point not found yet (its detail beyond the coarse field) is left out of the first
-solution and probed when it is found.
+**Relative orientation** (:class:`Robot`). Z is set to clear the x-parallax (its effect learnt
+by one probe); cycles of the conventional method's element-by-element clearing (:data:`CLASSIC`,
+each element's effect learnt by a probe turn) bring every detail near the mark; then at each
+standard point the robot turns each of the five elements (κ_л, κ_п, k_α,л, k_α,п, k_ω,п) by a
+probe step and back, the change per unit its row of the Jacobian; the turns that null the six
+y-parallaxes in weighted least squares (:data:`WEIGHT` by magnification) are made at once; the
+points are measured again (at ×20 near the predicted parallax), and so on until the ×20 readings
+are under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done.
 """
 
 from __future__ import annotations
