@@ -1,0 +1,78 @@
+"""The pixel robot (``tests/browser/pixel_robot.py``) on N seeds of the C2 exam, in Chromium.
+
+The robot reads only the two eyepiece canvases the page draws and turns the page's controls
+(the go-to buttons, the keyboard box, the magnification); the exam shows no parallax read-out.
+Each seed is a trainee name (the exam's seed is per trainee, drawn by the server). After the
+claim the grade's true residual y-parallax at the six points is read, for the report only.
+
+    PYTHONPATH=$PWD python -m benchmarks.bench_pixel_robot [--seeds 10]   (from the checkout)
+
+Prints per seed: passed, the true q at the six points [µm] (the grade's sign), the robot's last
+reading of q at each point with its magnification (the page's sign: "a detail lower on the right"
+is +, the opposite of the grade's), actions, looks, seconds; then the pass rate. The exam seed
+of a trainee is drawn by the server from its own key, so each run meets other instruments.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import threading
+import time
+
+import uvicorn
+from playwright.sync_api import sync_playwright
+
+from stereoplotter.web.app import create_app
+from stereoplotter.web.browser_setup import chromium_path
+from tests.browser import pixel_page
+from tests.browser.conftest import FLAGS, _free_port
+from tests.browser.pixel_robot import relative_orientation
+
+TOKEN = "bench-token"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first", type=int, default=1, help="first trainee number")
+    args = ap.parse_args()
+    port = _free_port()
+    app = create_app(TOKEN, message_limit=(2000.0, 4000))
+    srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    threading.Thread(target=srv.run, daemon=True).start()
+    while not srv.started:
+        time.sleep(0.02)
+    base = f"http://127.0.0.1:{port}"
+    passed = 0
+    with sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
+        ctx = pw.chromium.launch_persistent_context(
+            profile, executable_path=chromium_path(), headless=True, args=FLAGS,
+            viewport={"width": 1440, "height": 900})
+        page = ctx.new_page()
+        page.goto(base + "/")
+        pixel_page.upload_exam(page, base, TOKEN)
+        for k in range(args.first, args.first + args.seeds):
+            t0 = time.perf_counter()
+            sid = pixel_page.start(page, base, f"pixel {k}")
+            eyes = pixel_page.PageEyes(page)
+            rec = relative_orientation(eyes, pixel_page.tolerance_um(page))
+            eyes.claim()
+            seconds = time.perf_counter() - t0
+            g = pixel_page.grade_after_claim(page, base, sid)
+            rows = g["tables"]["y_parallax"]["rows"]
+            ok = bool(g["overall"]["passed"])
+            passed += ok
+            true = [round(r["value"], 1) for r in rows]
+            seen = {n: f"{q:.1f} (×{rec.mag[n]})" for n, q in sorted(rec.q_um.items())}
+            worst = max(abs(v) for v in true)
+            print(f"seed 'pixel {k}': passed {ok}; true q {true} µm (worst {worst}); "
+                  f"last read q {seen} µm; "
+                  f"{eyes.sent} actions, {eyes.looks} looks, {rec.passes} passes, "
+                  f"{seconds:.0f} s", flush=True)
+        ctx.close()
+    print(f"passed {passed} of {args.seeds}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,149 @@
+"""The pixel robot's hands and eyes on the instrument page (``tests/browser/pixel_robot.py``
+decides): the go-to buttons, turns typed into the keyboard box, the magnification box, and the
+two eyepiece canvases as the page draws them (read back as PNG). Nothing else of the page is
+read: no parallax read-out (an exam has none), no state, no core.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import time
+
+import numpy as np
+from PIL import Image
+
+_CANVASES = "() => ['left', 'right'].map((s) => document.getElementById('eye-' + s).toDataURL())"
+
+
+class PageEyes:
+    """:class:`tests.browser.pixel_robot.Eyes` on an open instrument page; counts the actions
+    it causes (:attr:`sent`), the looks and the seconds spent waiting for the photos."""
+
+    def __init__(self, page):
+        self.page = page
+        self.sent = 0
+        self.looks = 0
+        self.mag: int | None = None
+        self.wait_s = 0.0
+
+    def settle(self) -> None:
+        """Every action sent answered (a refused one too: a turn past a stop is refused and not
+        counted, so the count is the server's)."""
+        self.page.wait_for_function("() => window.trainer.idle()", timeout=60_000)
+        self.sent = self.page.evaluate("() => window.__n")
+
+    def _type(self, text: str) -> None:
+        self.page.fill("#command", text)
+        self.page.press("#command", "Enter")
+        self.settle()
+
+    def go_to(self, point: int) -> None:
+        before = self.sent
+        self.page.click(f"#goto button[data-point='{point}']")
+        # the page fetches the settings, then sends X and Y
+        self.page.wait_for_function(f"() => window.__n >= {before + 2}", timeout=60_000)
+        self.settle()
+
+    def turn(self, control: str, delta: float) -> None:
+        self._type(f"turn {control} {float(delta)!r}")
+
+    def set(self, control: str, value: float) -> None:
+        self._type(f"{control} {float(value)!r}")
+
+    def wheel(self, control: str) -> float:
+        text = self.page.inner_text(f".wheel[data-control='{control}'] .value")
+        return float(text.split()[0].replace("−", "-"))
+
+    def claim(self) -> None:
+        before = self.sent
+        self.page.click("#claim")
+        self.page.wait_for_function(f"() => window.__n >= {before + 1}", timeout=60_000)
+        self.settle()
+
+    def look(self, magnification: int) -> tuple[np.ndarray, np.ndarray]:
+        if self.mag != magnification:
+            self.page.fill("#mag", str(magnification))
+            self.page.dispatch_event("#mag", "change")
+            self.mag = magnification
+        t0 = time.monotonic()
+        # the page asks a patch once the mark has rested 120 ms: wait past it, then for the
+        # sharp patches of this magnification under both marks
+        self.page.wait_for_timeout(150)
+        self.page.wait_for_function(
+            "(m) => window.trainer.photosReady()"
+            " && window.trainer.patchMags().every((v) => v === m)",
+            arg=magnification, timeout=60_000,
+        )
+        self.page.evaluate("() => new Promise((r) => requestAnimationFrame(() => setTimeout(r)))")
+        self.wait_s += time.monotonic() - t0
+        urls = self.page.evaluate(_CANVASES)
+        self.looks += 1
+        out = []
+        for url in urls:
+            png = base64.b64decode(url.split(",", 1)[1])
+            out.append(np.asarray(Image.open(io.BytesIO(png)).convert("RGB")))
+        return out[0], out[1]
+
+
+#: The conventional exam of relative orientation the robot sits: C2 of the shipped e05 (SC-1,
+#: hilly pair, injected errors) as an exam — per-trainee seed, errors hidden, no read-out, no
+#: undo, no hints — uploaded by the instructor.
+EXAM_NAME = "c2-exam-pixel"
+EXAM = f"""format: stereoplotter-exercise/1
+name: {EXAM_NAME}
+title: "Exam: relative orientation by eye (C2, conventional method)"
+level: 9
+description: >-
+  C1 preset. Clear the y-parallax at the six standard points by eye; no read-out.
+instrument: sc1
+scenario: pair60
+method: conventional
+stages: "C2"
+terrain: hilly
+model: complete
+errors: "hidden"
+tilt: small
+assists: {{parallax_readout: false, undo: false, hints: false}}
+mode: exam
+seed: per-trainee
+"""
+
+
+def upload_exam(page, server: str, token: str) -> None:
+    """Upload :data:`EXAM` as the instructor (a second upload of the same name is refused 409:
+    already there)."""
+    r = page.request.post(f"{server}/api/instructor/exercises?token={token}", data=EXAM)
+    assert r.status in (200, 409), r.text()
+
+
+def start(page, server: str, trainee: str) -> str:
+    """Open the exam for ``trainee`` from the exercises page; the session id."""
+    page.goto(server + "/")
+    page.fill("#trainee", trainee)
+    page.click(f"button[data-exercise='{EXAM_NAME}']")
+    page.wait_for_url("**/s/*")
+    page.wait_for_selector("body[data-ready='1']")
+    page.wait_for_selector("body[data-overview='1']")
+    return page.url.rsplit("/", 1)[1]
+
+
+def grade_after_claim(page, server: str, sid: str) -> dict:
+    """The grade, read with the session's own key once the stage is claimed (the robot never
+    reads it before)."""
+    secret = page.evaluate(f"localStorage.getItem('stereoplotter-key-{sid}')")
+    r = page.request.get(f"{server}/api/sessions/{sid}/grade",
+                         headers={"Authorization": f"Bearer {secret}"}, timeout=300_000)
+    assert r.ok, r.text()
+    body = r.json()
+    return body.get("grade", body)
+
+
+def tolerance_um(page) -> float:
+    """The y-parallax tolerance the page's checks name (``0.0125 mm``). [µm]"""
+    import re
+
+    text = page.inner_text("#checks")
+    m = re.search(r"y-parallax[^:]*:[^\d]*([\d.]+) mm", text)
+    assert m, text
+    return float(m.group(1)) * 1000.0

@@ -1,0 +1,568 @@
+"""The pixel robot's judgement: what a trainee sees in the two eyepieces, and what it turns.
+
+No page, no core here: the decisions take the two eyepiece images (RGB arrays of the canvases the
+page draws, the measuring mark at their centre) and return parallaxes and turns. A driver
+(:class:`Eyes`: ``tests/browser/pixel_page.py`` drives the instrument page in Chromium) shows
+the images and carries the turns out.
+
+**Measuring the parallax at a point.** The left eyepiece's centre (around the mark, the mark itself
+masked out) is searched for in the right eyepiece — turned back first by the difference of the
+carriers' κ the wheels show (:func:`view`) — by normalised cross-correlation, masked (Padfield's
+form, every sum an FFT correlation), of the grey level less its blur (:data:`HIGH_PASS_PX`),
+sub-pixel by a parabola through the peak on each axis. The offset of the match from the right
+eyepiece's centre is the parallax as the eye sees it: horizontal = x-parallax, vertical =
+y-parallax, in screen pixels of ``SCREEN_PIXEL_MM / magnification`` mm of photo. Coarse to fine
+(:func:`refine`): ×2 finds the detail in a 12.8 mm field (one pixel 50 µm), ×6 and then ×20
+measure it (16.7 µm, 5 µm a pixel), each searched near the coarser offset. A match is rejected
+where its peak is weak (:data:`MIN_PEAK`), where a second peak away from it is nearly as high
+(:data:`MIN_MARGIN`: the striped low-contrast fields), at the search's edge, or where the finer
+offset lies far from the coarser one (:data:`AGREE_PX`). Where a point's own field is striped or
+plain, the marks are moved to the most detailed place next to it (:func:`textured_spot`).
+
+**Relative orientation** (:class:`Robot`). Z is set to clear the x-parallax (its effect learnt
+by one probe); cycles of the conventional method's element-by-element clearing (:data:`CLASSIC`,
+each element's effect learnt by a probe turn) bring every detail near the mark; then at each
+standard point the robot turns each of the five elements (κ_л, κ_п, k_α,л, k_α,п, k_ω,п) by a
+probe step and back, the change per unit its row of the Jacobian; the turns that null the six
+y-parallaxes in weighted least squares (:data:`WEIGHT` by magnification) are made at once; the
+points are measured again (at ×20 near the predicted parallax), and so on until the ×20 readings
+are under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+from scipy.ndimage import binary_dilation, gaussian_filter, rotate
+from scipy.signal import fftconvolve
+
+#: The page's screen pixel at ×1 (the server's ``SCREEN_PIXEL_MM``, sent in its first message). [mm]
+SCREEN_PIXEL_MM = 0.1
+#: The relative elements the robot turns (the page's control names), and their probe steps
+#: (κ in rad, the correction knobs in tan: ≈ 0.2–0.7 mm of y-parallax, 4–14 px at ×2). [—]
+ELEMENTS = ("kappa_left", "kappa_right", "k_alpha_left", "k_alpha_right", "k_omega_right")
+PROBE = {"kappa_left": 3e-3, "kappa_right": 3e-3, "k_alpha_left": 3e-3, "k_alpha_right": 3e-3,
+         "k_omega_right": 3e-3}
+#: Magnifications: the finding one and the measuring ones, finest first.
+FIND_MAG, FINE_MAGS = 2, (20, 6)
+#: Side of the template cut from the left eyepiece's centre, by magnification. [px]
+TEMPLATE_PX = {2: 96, 6: 96, 20: 96}
+#: The window of the detail search at ×2 (≈ the ×20 template) [px]; how much more fine
+#: detail a spot needs than the point's own place to be preferred [—]; its reach [px].
+SPOT_PX, SPOT_GAIN, SPOT_REACH_PX = 10, 2.0, 50
+#: The reach of the detail search at ×20. [px]
+FINE_REACH_PX = 100
+#: The probe turn of X and Y. [mm]
+XY_PROBE = 1.0
+#: The high-pass filter's Gaussian (the grey level less its blur). [px]
+HIGH_PASS_PX = 6.0
+#: Largest offset searched (the template then overlaps the right view by half or more). [px]
+SEARCH_PX = 100
+#: The measuring mark's disc masked out of both images (the page draws a ring of 9 px). [px]
+MARK_RADIUS_PX = 13
+#: Smallest correlation peak accepted; least lead of the peak over any other peak further than
+#: :data:`PEAK_EXCLUSION_PX` away (assumed: the striped fields correlate 0.63–0.74 with their
+#: own match, so the lead, not the peak alone, rejects a false match). [—], [px]
+MIN_PEAK, MIN_MARGIN, PEAK_EXCLUSION_PX = 0.3, 0.05, 6
+#: A finer match must lie within this many pixels (of the coarser look) of the coarser one:
+#: the ×2 look is off by up to ≈ 150 µm = 3 of its pixels where the field is far from
+#: oriented (measured: one seed near its solution, ×2 against the grade's true q). [px]
+AGREE_PX = 4.0
+#: Margin kept between the searched offset and the eyepiece's edge. [px]
+EDGE_PX = 8
+#: The robot claims when the largest measured |q| is under this share of the tolerance. [—]
+DONE_SHARE = 0.35
+#: Weights of a y-parallax in the least squares by the magnification it was read at: a ×6
+#: reading was off by 5–40 µm where ×20 agreed with the grade's true q within ≈ 3 µm (one
+#: run, two seeds, read against the true q only while developing). [—]
+WEIGHT = {20: 1.0, 6: 0.2, 2: 0.05}
+#: Least-squares passes at most.
+PASSES = 8
+
+
+class Eyes(Protocol):
+    """What the robot does on the page: go to a standard point, turn an element, look."""
+
+    def go_to(self, point: int) -> None: ...
+
+    def set(self, control: str, value: float) -> None: ...
+
+    def wheel(self, control: str) -> float:
+        """The value a control's wheel shows."""
+        ...
+
+    def turn(self, control: str, delta: float) -> None: ...
+
+    def look(self, magnification: int) -> tuple[np.ndarray, np.ndarray]:
+        """The left and right eyepiece canvases as drawn (H×W×3 uint8)."""
+        ...
+
+
+@dataclass(frozen=True)
+class Match:
+    """Where the left eyepiece's centre lies in the right one: offset from the right centre in
+    screen pixels (x right, y down), the correlation peak and its lead over the next peak."""
+
+    dx_px: float
+    dy_px: float
+    peak: float
+    margin: float
+    magnification: int
+
+    @property
+    def um_per_px(self) -> float:
+        return SCREEN_PIXEL_MM / self.magnification * 1000.0
+
+    @property
+    def q_um(self) -> float:
+        """The y-parallax seen (photo y up: a detail lower on the right is +). [µm]"""
+        return -self.dy_px * self.um_per_px
+
+    @property
+    def p_um(self) -> float:
+        """The x-parallax seen. [µm]"""
+        return self.dx_px * self.um_per_px
+
+
+def grey_and_mask(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The photo's grey level (green channel) and the mask of pixels that show the photo: the
+    mark's disc and any coloured pixel (the red mark, the page's yellow notes) left out."""
+    rgb = np.asarray(rgb, float)
+    grey = rgb[..., 1] - gaussian_filter(rgb[..., 1], HIGH_PASS_PX)  # the fields' edges, texture
+    h, w = grey.shape
+    yy, xx = np.mgrid[0:h, 0:w]
+    r2 = (xx - (w - 1) / 2) ** 2 + (yy - (h - 1) / 2) ** 2
+    coloured = (np.abs(rgb[..., 0] - rgb[..., 1]) > 2) | (np.abs(rgb[..., 2] - rgb[..., 1]) > 2)
+    coloured = binary_dilation(coloured, iterations=int(2 * HIGH_PASS_PX))
+    return grey, (r2 > (MARK_RADIUS_PX + 2 * HIGH_PASS_PX) ** 2) & ~coloured
+
+
+def view(eyes: Eyes, magnification: int) -> tuple[np.ndarray, np.ndarray]:
+    """The two eyepieces, the right one turned back by the difference of the carriers' κ as
+    their wheels show it (the page turns each field by its carrier's κ; a relative turn of a
+    few hundredths of a radian biases a correlation by up to 5 px where the detail lies on one
+    side of the field — measured: 4.9 px at ×2, point 4 of one seed, Δκ = −0.033 rad)."""
+    left, right = eyes.look(magnification)
+    turn = eyes.wheel("kappa_right") - eyes.wheel("kappa_left")
+    if abs(turn) > 1e-4:
+        right = rotate(np.asarray(right, float), np.degrees(turn), reshape=False, order=1,
+                       mode="nearest")
+    return left, right
+
+
+def textured_spot(rgb: np.ndarray, reach_px: float) -> tuple[float, float]:
+    """Where near the centre (within ``reach_px``) the left eyepiece shows the most fine detail
+    (the energy of the high-passed grey level over a :data:`SPOT_PX` window, the mark's disc
+    left out): the offset from the centre in screen pixels (x right, y down). A point's
+    y-parallax is measured on such a detail next to it where its own field is a low-contrast
+    stripe (the y-parallax changes by well under a micrometre over a millimetre of photo once
+    the model is near its orientation)."""
+    grey = np.asarray(rgb, float)[..., 1]
+    fine = grey - gaussian_filter(grey, 1.5)
+    _, ok = grey_and_mask(rgb)
+    energy = gaussian_filter(fine**2 * ok, SPOT_PX / 2) / np.maximum(
+        gaussian_filter(ok.astype(float), SPOT_PX / 2), 1e-3)
+    h, w = grey.shape
+    yy, xx = np.mgrid[0:h, 0:w]
+    dx, dy = xx - (w - 1) / 2, yy - (h - 1) / 2
+    energy = np.where(np.hypot(dx, dy) <= reach_px, energy, -1)
+    centre = float(np.max(np.where(np.hypot(dx, dy) <= SPOT_PX, energy, -1)))
+    i, j = np.unravel_index(int(np.argmax(energy)), energy.shape)
+    if energy[i, j] < SPOT_GAIN * centre:
+        return 0.0, 0.0
+    return float(dx[i, j]), float(dy[i, j])
+
+
+def masked_ncc(t: np.ndarray, a: np.ndarray, g: np.ndarray, b: np.ndarray,
+               min_overlap: float = 0.5) -> np.ndarray:
+    """Normalised cross-correlation of template ``t`` (mask ``a``) at every position overlapping
+    image ``g`` (mask ``b``), only pixels valid in both counted (Padfield 2012, every sum one
+    FFT): ``out[i, j]`` for the template's top-left corner at row i − (th − 1), column
+    j − (tw − 1); −1 where fewer than ``min_overlap`` of the template's pixels overlap."""
+    a = a.astype(float)
+    b = b.astype(float)
+    t = t * a
+    gb = g * b
+
+    def corr(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return fftconvolve(y, x[::-1, ::-1], mode="full")
+
+    n = corr(a, b)
+    st, sg = corr(t, b), corr(a, gb)
+    stt, sgg = corr(t * t, b), corr(a, gb * g)
+    stg = corr(t, gb)
+    n_safe = np.maximum(n, 1.0)
+    num = stg - st * sg / n_safe
+    den = (stt - st**2 / n_safe) * (sgg - sg**2 / n_safe)
+    ok = (den > 1e-6) & (n > min_overlap * a.sum())
+    return np.where(ok, num / np.sqrt(np.maximum(den, 1e-12)), -1.0)
+
+
+def _vertex(c_m: float, c_0: float, c_p: float) -> float:
+    d = c_m - 2 * c_0 + c_p
+    return 0.0 if d >= -1e-9 else float(np.clip(0.5 * (c_m - c_p) / d, -1.0, 1.0))
+
+
+def match(
+    left: np.ndarray, right: np.ndarray, magnification: int,
+    predict_px: tuple[float, float] | None = None, radius_px: float | None = None,
+    strict: bool = True,
+) -> Match | None:
+    """The left eyepiece's centre found in the right eyepiece (see the module docstring), or
+    None where the match is weak or ambiguous. ``predict_px``, ``radius_px``: search only
+    offsets within ``radius_px`` of ``predict_px`` (the peak's lead is still taken over the
+    whole eyepiece)."""
+    gl, ml = grey_and_mask(left)
+    gr, mr = grey_and_mask(right)
+    h, w = gl.shape
+    size = TEMPLATE_PX.get(magnification, 96)
+    c0 = (h - size) // 2, (w - size) // 2
+    t = gl[c0[0]:c0[0] + size, c0[1]:c0[1] + size]
+    a = ml[c0[0]:c0[0] + size, c0[1]:c0[1] + size]
+    ncc = masked_ncc(t, a, gr, mr)
+    oy, ox = np.mgrid[0:ncc.shape[0], 0:ncc.shape[1]]
+    # offsets of the template from its place in the left view
+    oy, ox = oy - (size - 1) - c0[0], ox - (size - 1) - c0[1]
+    allowed = (np.abs(oy) <= SEARCH_PX) & (np.abs(ox) <= SEARCH_PX)
+    if predict_px is not None and radius_px is not None:
+        allowed &= np.hypot(ox - predict_px[0], oy - predict_px[1]) <= radius_px
+    if not allowed.any():
+        return None
+    masked = np.where(allowed, ncc, -np.inf)
+    i, j = np.unravel_index(int(np.argmax(masked)), ncc.shape)
+    peak = float(ncc[i, j])
+    far = np.hypot(oy - oy[i, j], ox - ox[i, j]) > PEAK_EXCLUSION_PX
+    inside = (np.abs(oy) <= SEARCH_PX) & (np.abs(ox) <= SEARCH_PX)
+    second = float(np.max(np.where(far & inside, ncc, -1)))
+    margin = peak - second
+    if strict and (peak < MIN_PEAK or margin < MIN_MARGIN):
+        return None
+    if max(abs(oy[i, j]), abs(ox[i, j])) >= SEARCH_PX:  # at the search's edge: beyond it
+        return None
+    di = _vertex(ncc[i - 1, j], ncc[i, j], ncc[i + 1, j])
+    dj = _vertex(ncc[i, j - 1], ncc[i, j], ncc[i, j + 1])
+    return Match(float(ox[i, j] + dj), float(oy[i, j] + di), peak, margin, magnification)
+
+
+def fits(offset_px: tuple[float, float], from_mag: int, to_mag: int) -> bool:
+    """Whether an offset seen at ``from_mag`` stays inside the search area of ``to_mag``."""
+    k = to_mag / from_mag
+    return max(abs(offset_px[0]), abs(offset_px[1])) * k <= 0.6 * SEARCH_PX
+
+
+def refine(eyes: Eyes, m: Match) -> Match:
+    """A match carried to finer magnifications (×6, then ×20) while the offset stays in the
+    finer field: each finer look searched within :data:`AGREE_PX` pixels of the coarser one."""
+    for mag in sorted(FINE_MAGS):
+        if mag <= m.magnification or not fits((m.dx_px, m.dy_px), m.magnification, mag):
+            continue
+        k = mag / m.magnification
+        images = view(eyes, mag)
+        fine = match(*images, mag, (m.dx_px * k, m.dy_px * k), AGREE_PX * k)
+        if fine is None:
+            break
+        m = fine
+    return m
+
+
+def measure(eyes: Eyes, predict_um: tuple[float, float] | None = None,
+            radius_um: float = 40.0) -> Match | None:
+    """The parallax at the place the marks are on, coarse to fine (module docstring).
+    ``predict_um`` (x-, y-parallax as :class:`Match` gives them) skips the finding look where
+    the prediction holds at ×20."""
+    if predict_um is not None:
+        um = SCREEN_PIXEL_MM / FINE_MAGS[0] * 1000.0
+        guess = (predict_um[0] / um, -predict_um[1] / um)
+        if fits(guess, FINE_MAGS[0], FINE_MAGS[0]):
+            m = match(*view(eyes, FINE_MAGS[0]), FINE_MAGS[0], guess, radius_um / um)
+            if m is not None:
+                return m
+    coarse = match(*view(eyes, FIND_MAG), FIND_MAG)
+    return None if coarse is None else refine(eyes, coarse)
+
+
+@dataclass
+class Orientation:
+    """The robot's record of a relative orientation: what it measured and turned."""
+
+    tolerance_um: float
+    points: tuple[int, ...] = (1, 2, 3, 4, 5, 6)
+    jacobian: dict[int, np.ndarray] = field(default_factory=dict)  # µm of q per unit
+    q_um: dict[int, float] = field(default_factory=dict)
+    mag: dict[int, int] = field(default_factory=dict)  # the magnification each q was read at
+    p_um: dict[int, float] = field(default_factory=dict)
+    passes: int = 0
+    looks: int = 0
+    history: list[dict[int, float]] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    x_per_z: float | None = None  # µm of x-parallax per mm of Z
+    measured: list[tuple] = field(default_factory=list)  # (point, q, magnification, actions)
+
+
+def probe(eyes: Eyes) -> np.ndarray | None:
+    """The y-parallax's change per unit of each element at the point the marks are on, by a
+    probe turn of each and back, measured at the finding magnification (the probes move the
+    detail 4–14 of its pixels). [µm]"""
+    base = match(*view(eyes, FIND_MAG), FIND_MAG)
+    if base is None:
+        return None
+    row = np.empty(len(ELEMENTS))
+    for k, control in enumerate(ELEMENTS):
+        h = PROBE[control]
+        eyes.turn(control, h)
+        m = match(*view(eyes, FIND_MAG), FIND_MAG, (base.dx_px, base.dy_px), 20.0)
+        eyes.turn(control, -h)
+        if m is None:
+            return None
+        row[k] = (m.q_um - base.q_um) / h
+    return row
+
+
+def solve(rec: Orientation) -> dict[str, float]:
+    """The turns of :data:`ELEMENTS` that null the measured y-parallaxes in least squares
+    (minimum norm where fewer than five points are known). [rad, tan]"""
+    pts = [n for n in rec.points if n in rec.q_um and n in rec.jacobian]
+    if not pts:
+        return {}
+    w = np.array([WEIGHT.get(rec.mag.get(n, FIND_MAG), 0.05) for n in pts])
+    jac = np.array([rec.jacobian[n] for n in pts]) * w[:, None]
+    q = np.array([rec.q_um[n] for n in pts]) * w
+    step, *_ = np.linalg.lstsq(jac, -q, rcond=1e-6)
+    return dict(zip(ELEMENTS, (float(s) for s in step), strict=True))
+
+
+#: Turns of κ_п that search for point 1's detail where it is not in the field. [rad]
+COMMON_SEARCH = (0.04, -0.04, 0.08, -0.08)
+#: The conventional method's order: the point and the element that clears it (κ_п at 1, κ_л at
+#: 2, α_л at 4, α_п at 3, ω_п at 5); cycles of it at most; |q| under which a point is left;
+#: the largest single turn (rad, tan). [—], [µm], [—]
+CLASSIC = ((1, "kappa_right"), (2, "kappa_left"), (4, "k_alpha_left"), (3, "k_alpha_right"),
+           (5, "k_omega_right"))
+CLASSIC_CYCLES, CLASSIC_DONE_UM, CLASSIC_MAX_TURN = 3, 150.0, 0.05
+#: Z's probe step (downwards: the carriage may start at its upper stop) [mm]; the x-parallax
+#: one step of the search by Z moves the detail (under the finding field's half) [µm]; the
+#: x-parallax left uncleared (the ×20 search holds ±300 µm) [µm].
+Z_PROBE, Z_SEARCH_UM, X_CLEAR_UM = -2.0, 3500.0, 60.0
+#: Steps of the search by Z, in :data:`Z_SEARCH_UM`. [—]
+Z_STEPS = (1, -1, 2, -2)
+
+
+class Robot:
+    """The relative orientation from the eyepieces (module docstring). Z, the foot wheel, is
+    set to a value (read once from its wheel, then the robot's own settings), and each point's
+    fused Z is kept and set again when the robot comes back to it."""
+
+    def __init__(self, eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6)):
+        self.eyes = eyes
+        self.rec = Orientation(tolerance_um, tuple(points))
+        self.z: float | None = None
+        self.z_at: dict[int, float] = {}
+        self.px_per_xy: np.ndarray | None = None  # ×2 screen px of the left view per mm of X, Y
+        self.spot_at: dict[int, tuple[float, float]] = {}  # the X, Y turns to each point's spot
+
+    def learn_xy(self) -> None:
+        """How a turn of X and of Y moves the left view (a probe turn of each, once)."""
+        eyes = self.eyes
+        before = view(eyes, FIND_MAG)[0]
+        cols = []
+        for axis in ("X", "Y"):
+            eyes.turn(axis, XY_PROBE)
+            after = view(eyes, FIND_MAG)[0]
+            eyes.turn(axis, -XY_PROBE)
+            m = match(before, after, FIND_MAG)
+            if m is None:
+                return
+            cols.append([-m.dx_px / XY_PROBE, -m.dy_px / XY_PROBE])
+        self.px_per_xy = np.array(cols).T
+        self.rec.notes.append(f"px per X, Y: {self.px_per_xy.tolist()}")
+
+    def go_to(self, n: int) -> None:
+        """Go to point ``n`` and on to its detail (:func:`textured_spot`), chosen the first
+        time from the ×2 view."""
+        self.eyes.go_to(n)
+        if self.px_per_xy is None:
+            return
+        if n not in self.spot_at:
+            off = textured_spot(view(self.eyes, FIND_MAG)[0], SPOT_REACH_PX)
+            turns = np.linalg.solve(self.px_per_xy, np.array(off)) if any(off) else np.zeros(2)
+            self.spot_at[n] = (round(float(turns[0]), 3), round(float(turns[1]), 3))
+            self.rec.notes.append(f"spot {n}: {off} px, turns {self.spot_at[n]}")
+        for axis, d in zip(("X", "Y"), self.spot_at[n], strict=True):
+            if d:
+                self.eyes.turn(axis, d)
+
+    def set_z(self, value: float) -> None:
+        self.eyes.set("Z", round(value, 3))
+        self.z = self.eyes.wheel("Z")  # at a stop the carriage stays there
+
+    def fine_spot(self, n: int, m: Match) -> Match:
+        """Where ×20 finds nothing sure at point ``n``'s detail (a striped field, a plain one),
+        the marks are moved onto the most detailed place within :data:`FINE_REACH_PX` of the
+        ×20 view and looked at there (kept as the point's spot); else the coarser match."""
+        if self.px_per_xy is None:
+            return m
+        mag = FINE_MAGS[0]
+        off = textured_spot(view(self.eyes, mag)[0], FINE_REACH_PX)
+        if not any(off):
+            return m
+        turns = np.linalg.solve(self.px_per_xy * (mag / FIND_MAG), np.array(off))
+        for axis, d in zip(("X", "Y"), turns, strict=True):
+            self.eyes.turn(axis, round(float(d), 4))
+        k = mag / m.magnification
+        fine = match(*view(self.eyes, mag), mag, (m.dx_px * k, m.dy_px * k), AGREE_PX * k)
+        self.rec.notes.append(f"fine spot {n}: {off} px: {fine}")
+        if fine is None:
+            for axis, d in zip(("X", "Y"), turns, strict=True):
+                self.eyes.turn(axis, -round(float(d), 4))
+            return m
+        x, y = self.spot_at.get(n, (0.0, 0.0))
+        self.spot_at[n] = (x + round(float(turns[0]), 4), y + round(float(turns[1]), 4))
+        return fine
+
+    def look(self, predict=None, radius=None) -> Match | None:
+        return match(*view(self.eyes, FIND_MAG), FIND_MAG, predict, radius)
+
+    def clear_x(self, m: Match) -> Match:
+        """Z set to clear the x-parallax of a found detail (up to three settings, the detail
+        looked for again after each); the last match."""
+        for _ in range(3):
+            if self.rec.x_per_z is None or abs(m.p_um) <= X_CLEAR_UM:
+                return m
+            self.set_z(self.z - m.p_um / self.rec.x_per_z)
+            again = self.look((0.0, m.dy_px), 40.0) or self.look()
+            if again is None:
+                return m
+            m = again
+        return m
+
+    def coarse(self, n: int) -> Match | None:
+        """The detail at point ``n`` found at ×2 (a search by Z where not), its x-parallax
+        cleared by Z."""
+        rec = self.rec
+        if n in self.z_at and self.z != self.z_at[n]:
+            self.set_z(self.z_at[n])
+        m = self.look()
+        if m is None and rec.x_per_z is not None:
+            start = self.z
+            for k in Z_STEPS:
+                self.set_z(start + k * Z_SEARCH_UM / abs(rec.x_per_z))
+                m = self.look()
+                if m is not None:
+                    break
+            else:
+                self.set_z(start)
+        if m is None:
+            rec.notes.append(f"coarse {n}: not found")
+            return None
+        m = self.clear_x(m)
+        self.z_at[n] = self.z
+        rec.notes.append(f"coarse {n}: {m}")
+        return m
+
+    def clear_with(self, n: int, control: str) -> bool:
+        """At point ``n``: the detail found, ``control`` turned by a probe step to learn its
+        effect on the y-parallax, then turned to clear it (a step of the conventional method,
+        by the eye)."""
+        self.eyes.go_to(n)
+        m = self.coarse(n)
+        if m is None:
+            return False
+        if abs(m.q_um) < CLASSIC_DONE_UM:
+            return True
+        self.eyes.turn(control, PROBE[control])
+        moved = self.look((m.dx_px, m.dy_px), 40.0)
+        if moved is None or abs(moved.q_um - m.q_um) < 20.0:
+            self.eyes.turn(control, -PROBE[control])
+            return False
+        per = (moved.q_um - m.q_um) / PROBE[control]
+        d = float(np.clip(-moved.q_um / per, -CLASSIC_MAX_TURN, CLASSIC_MAX_TURN))
+        self.eyes.turn(control, d)
+        self.rec.notes.append(f"classic {n} {control}: q {moved.q_um:.0f} µm, turned {d:.5f}")
+        return True
+
+    def start(self) -> None:
+        """Point 1 found (a search by turns of κ_п where not), Z's effect on the x-parallax
+        learnt there; then cycles of the conventional method's element-by-element clearing (by
+        the eye, each element's effect learnt by a probe turn) until every detail is found near
+        the mark."""
+        n = self.rec.points[0]
+        self.eyes.go_to(n)
+        self.z = self.eyes.wheel("Z")
+        m = self.look()
+        for d in COMMON_SEARCH:
+            if m is not None:
+                break
+            self.eyes.turn("kappa_right", d)
+            m = self.look()
+            if m is None:
+                self.eyes.turn("kappa_right", -d)
+        if m is None:
+            return
+        z0 = self.z
+        self.set_z(z0 + Z_PROBE)
+        moved = self.look((m.dx_px, m.dy_px), 40.0)
+        if moved is not None and abs(moved.p_um - m.p_um) > 50.0 and self.z != z0:
+            self.rec.x_per_z = (moved.p_um - m.p_um) / (self.z - z0)
+        self.rec.notes.append(f"x per Z: {self.rec.x_per_z} µm/mm")
+        for _ in range(CLASSIC_CYCLES):
+            ok = [self.clear_with(p, c) for p, c in CLASSIC if p in self.rec.points]
+            if all(ok):
+                break
+        self.eyes.go_to(n)
+        self.learn_xy()
+
+    def run(self) -> Orientation:
+        rec, eyes = self.rec, self.eyes
+        self.start()
+        predicted: dict[int, tuple[float, float]] = {}
+        for _ in range(PASSES):
+            rec.passes += 1
+            rec.q_um.clear()
+            for n in rec.points:
+                self.go_to(n)
+                m = None
+                if n in predicted and n in self.z_at:
+                    if self.z != self.z_at[n]:
+                        self.set_z(self.z_at[n])
+                    m = measure(eyes, predicted[n])
+                    if m is not None and m.magnification == FIND_MAG:
+                        m = None
+                if m is None:
+                    c = self.coarse(n)
+                    if c is None:
+                        continue
+                    if n not in rec.jacobian:
+                        row = probe(eyes)
+                        rec.notes.append(f"probe {n}: {row}")
+                        if row is not None:
+                            rec.jacobian[n] = row
+                    m = refine(eyes, c)
+                    if m.magnification != FINE_MAGS[0]:
+                        m = self.fine_spot(n, m)
+                rec.notes.append(f"measure {n}: {m}")
+                rec.q_um[n], rec.p_um[n], rec.mag[n] = m.q_um, m.p_um, m.magnification
+                rec.measured.append((n, m.q_um, m.magnification, getattr(eyes, "sent", None)))
+            rec.history.append(dict(rec.q_um))
+            sure = [n for n in rec.q_um if rec.mag[n] == FINE_MAGS[0]]
+            done = len(sure) >= len(ELEMENTS) and all(
+                abs(rec.q_um[n]) < DONE_SHARE * rec.tolerance_um for n in sure)
+            if done:
+                break
+            step = solve(rec)
+            for control, d in step.items():
+                if abs(d) > 1e-7:
+                    eyes.turn(control, d)
+            predicted = {}
+            for n in rec.q_um:
+                if n in rec.jacobian:
+                    dq = float(rec.jacobian[n] @ np.array([step[c] for c in ELEMENTS]))
+                    predicted[n] = (rec.p_um[n], rec.q_um[n] + dq)
+        return rec
+
+
+def relative_orientation(eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6)) -> Orientation:
+    """Clear the y-parallax at the standard ``points`` by least squares on the measured
+    parallaxes (module docstring); returns the record (the last measured q at each point)."""
+    return Robot(eyes, tolerance_um, points).run()
