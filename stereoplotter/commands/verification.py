@@ -164,7 +164,8 @@ def reuse_freed_memory() -> bool:
     memory (``benchmarks/README.md``); values are unchanged (only where memory comes from).
     Returns whether the C library took the settings (False off glibc)."""
     try:
-        os.confstr("CS_GNU_LIBC_VERSION")  # glibc only
+        if not os.confstr("CS_GNU_LIBC_VERSION"):  # glibc only
+            return False
         mallopt = ctypes.CDLL(None).mallopt
     except (ValueError, OSError, AttributeError):
         return False
