@@ -90,6 +90,7 @@ __all__ = [
     "closing_comparison",
     "procedure_rows",
     "row_entries",
+    "run_procedure_job",
     "run_procedure_mc",
     "run_verification",
     "start_procedure_mc",
@@ -295,7 +296,7 @@ def _job_at(i: int) -> dict[str, RunResult]:
     # one BLAS thread a worker: the workers are the parallelism (two processes × two OpenBLAS
     # threads on two cores made `verify` 1.2 × the CPU and 1.5 × the wall, benchmarks/README.md)
     with threadpool_limits(limits=1, user_api="blas"):
-        return _job(_JOBS[i])
+        return run_procedure_job(_JOBS[i])
 
 
 @dataclass(frozen=True)
@@ -321,7 +322,7 @@ class ProcedureJob:
         return TRIAL_COST.get(method, 1.0) * sum(self.trials.values())
 
 
-def _job(job: ProcedureJob) -> dict[str, RunResult]:
+def run_procedure_job(job: ProcedureJob) -> dict[str, RunResult]:
     """A job's results, configuration → :func:`procedure_mc` result."""
     if len(job.configs) == 1:
         (config,) = job.configs
@@ -533,7 +534,7 @@ class PendingProcedureMC:
         n = len(self.jobs)
         if self.pool is None:
             for done, i in enumerate(self.order, 1):
-                out.update(self._keyed(i, _job(self.jobs[i])))
+                out.update(self._keyed(i, run_procedure_job(self.jobs[i])))
                 if progress is not None:
                     progress(done, n, "proc " + " ".join(self.keys[i][0]))
             return {k: out[k] for ks in self.keys for k in ks}
