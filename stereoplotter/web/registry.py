@@ -67,6 +67,13 @@ ACTORS, PATCHERS = 2, 2
 #: Photo patches of one client address rendered at once: with PATCHERS above it, a client
 #: asking for patches without pause leaves a worker free for the others. [patches]
 PATCHES_AT_ONCE = 1
+#: Actions of one client address run at once: one address's sessions cannot hold both actor
+#: threads, so another address's action starts at once. An action is mostly Python (it holds
+#: the interpreter's lock), so a second thread adds little for one address: a class behind one
+#: address loses little. On the idle machine (``bench_trainer_load.py --abuser --seconds 20``)
+#: the honest trainees' p95 under abuse was 149 ms without this cap and 112 ms, 90 ms with it
+#: (single runs). [actions]
+ACTIONS_AT_ONCE = 1
 #: Sockets a session may open (a page reconnects after a dropped network or a reload): a rate
 #: and a burst; beyond, a socket is closed (4429) before any work is done for it. [1/s], [—]
 CONNECT_LIMIT = (1.0, 5)
@@ -150,7 +157,7 @@ class Registry:
         #: session: a flood from one client does not queue the others behind it), and render
         #: photo patches (at most PATCHES_AT_ONCE of one address at once; rendered in worker
         #: processes when ``renderers`` has them).
-        self.actor = FairPool(ACTORS, "trainer-actor")
+        self.actor = FairPool(ACTORS, "trainer-actor", per_address=ACTIONS_AT_ONCE)
         self.patcher = FairPool(PATCHERS, "trainer-patch", per_address=PATCHES_AT_ONCE)
         self.renderers = renderers if renderers is not None else Renderers(PATCHERS, False)
         self._seed_key = store.server_key(SEED_KEY)

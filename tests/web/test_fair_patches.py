@@ -10,18 +10,33 @@ import os
 import threading
 import time
 
+import pytest
+
 from stereoplotter.imagery.cache import ViewCache
 from stereoplotter.io.exercise_file import load_exercise
 from stereoplotter.web import core, render
+from stereoplotter.web.app import create_app
 from stereoplotter.web.fair import FairCache, FairPool
 from stereoplotter.web.render import RENDER_NICENESS, Renderers
-from tests.web.conftest import PRACTICE
+from tests.web.conftest import PRACTICE, TOKEN, make_test_client
 
 
-def test_one_address_never_occupies_every_worker():
-    """Two workers, at most one job of an address at once: an abuser queues 20 patch jobs over
-    5 sessions; while its first is running, a trainee's job starts on the other worker."""
-    pool = FairPool(2, "test", per_address=1)
+@pytest.fixture(scope="module")
+def server_pools(tmp_path_factory):
+    """The server's own pools: its actors (actions, state reads) and its patch threads."""
+    app = create_app(TOKEN, tmp_path_factory.mktemp("pools"), hosts=("testserver",))
+    with make_test_client(app) as c:
+        reg = c.app.state.registry
+        yield {"actor": reg.actor, "patcher": reg.patcher}
+
+
+@pytest.mark.parametrize("which", ["actor", "patcher", "a pool of its own"])
+def test_one_address_never_occupies_every_worker(server_pools, which):
+    """Two workers, at most one job of an address at once: an abuser queues 20 jobs over
+    5 sessions; while its first is running, a trainee's job starts on the other worker (the
+    server's actor pool, its patch pool, and a pool made with the cap)."""
+    own = which not in server_pools
+    pool = FairPool(2, "test", per_address=1) if own else server_pools[which]
     running: list[str] = []
     most = {"abuser": 0}
     gate = threading.Event()
@@ -52,7 +67,8 @@ def test_one_address_never_occupies_every_worker():
         assert [f.result(5) for f in flood] == ["abuser"] * 20
     finally:
         gate.set()
-        pool.shutdown()
+        if own:
+            pool.shutdown()
     assert most["abuser"] == 1
 
 
