@@ -198,10 +198,16 @@ def _step_of(action: dict[str, Any], step: str, texts: list[str]) -> str:
 _SHOWN_WHEN_THE_L_CHECK_FAILS = frozenset({L_CHECK_FAILED.name, BOTTOM_STOP.name})
 
 
+def _operator_log(par: Any) -> Any:
+    """The simulated operator's transcript of ``par``
+    (:class:`~stereoplotter.trainer.operator_steps.OperatorRun`), or None."""
+    return getattr(getattr(getattr(par, "run", None), "op", None), "log", None)
+
+
 def _conditional_steps(par: Any) -> set[str]:
     """The steps the operator took only where the L-check's conditions held (each transcript
     record carries its step's declared condition, ``procedure.step_values.CONDITIONS``)."""
-    log = getattr(getattr(getattr(par, "run", None), "op", None), "log", None)
+    log = _operator_log(par)
     if log is None:
         return set()
     return {r.step for r in log.records if r.condition in _SHOWN_WHEN_THE_L_CHECK_FAILS}
@@ -211,7 +217,7 @@ def _add_silent_records(par: Any, stage: str, steps: dict[str, dict[str, Any]]) 
     """Steps of the operator's transcript that no action of its own precedes (the right photo's
     L′, measured together with the left one before either is written down), placed after the
     step written before them; a measurement of L′ reads Y."""
-    records = getattr(getattr(getattr(par, "run", None), "op", None), "log", None)
+    records = _operator_log(par)
     if records is None:
         return
     order = list(dict.fromkeys(r.step for r in records.records if r.stage == stage and r.step))
