@@ -458,6 +458,11 @@ class Operator:
         self.inst = instrument
         self.model = model.for_instrument(instrument.spec)
         self.noise = noise
+        #: Every act draws, its value used or not (:meth:`fuse_mark`): where the noise is not a
+        #: plain keyed stream (one that records or designs its acts, whose list of acts is part
+        #: of its result). A plain stream leaves an unused act undrawn: a key's draws are its
+        #: own, so every other act draws the same numbers.
+        self.draws_unused = type(noise) is not Noise
         self.log = transcript
         self.trials = instrument.trials
         self.commanded: dict[str, NDArray[np.float64]] = {}
@@ -536,10 +541,12 @@ class Operator:
         if control == HEIGHT_SCALE:
             return reading
         low, high = self._stop_readings(control)
-        out = np.minimum(np.maximum(reading, low), high)  # np.clip's values, less overhead
-        if (out != reading).any():  # beyond a stop (or NaN)
-            self._flag_stopped(control, (reading < low) | (reading > high))
-        return out
+        beyond = reading < low
+        beyond |= reading > high
+        if not beyond.any():  # within the stops (or NaN, which stays NaN): the reading as it is
+            return reading
+        self._flag_stopped(control, beyond)
+        return np.minimum(np.maximum(reading, low), high)  # np.clip's values, less overhead
 
     def _stop_readings(self, control: ScrewName) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The readings of the two stops of a lead screw (low, high), cached."""
@@ -687,12 +694,41 @@ class Operator:
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Stereo pointing on a ground point: clear the x-parallax (σ_p) with the floating mark
         on the point (σ_mono); return the y-parallax seen there (σ_q) and the true one. [mm]"""
-        pl, pr = images
-        ex = self.noise.draw(as_key(key).by("mono").at("x"), self.model.monocular_sigma_mm)
-        ey = self.noise.draw(as_key(key).by("mono").at("y"), self.model.monocular_sigma_mm)
-        ep = self.noise.draw(as_key(key).by("stereo"), self.model.stereo_sigma_mm)
-        eq = self.noise.draw(as_key(key).by("q"), self.model.y_parallax_sigma_mm)
-        pl, pr = np.asarray(pl, float), np.asarray(pr, float)
+        key = as_key(key)
+        q_true = self._fused(images, key, active, move)
+        eq = self.noise.draw(key.by("q"), self.model.y_parallax_sigma_mm)
+        return q_true + eq, q_true
+
+    def fuse_mark(
+        self,
+        points_m: ArrayLike,
+        images: tuple[NDArray[np.float64], NDArray[np.float64]],
+        key: KeyLike,
+        active: NDArray[np.bool_] | None = None,
+    ) -> NDArray[np.float64]:
+        """:meth:`fuse` where no y-parallax is judged (the mark fused on a point to read a
+        counter or the height scale): the same pointing, without the act σ_q, whose keyed draw
+        is then not made (unless :attr:`draws_unused`). Returns the true y-parallax. [mm]"""
+        key = as_key(key)
+        q_true = self._fused(images, key, active, True)
+        if self.draws_unused:
+            self.noise.draw(key.by("q"), self.model.y_parallax_sigma_mm)
+        return q_true
+
+    def _fused(
+        self,
+        images: tuple[NDArray[np.float64], NDArray[np.float64]],
+        key: NoiseKey,
+        active: NDArray[np.bool_] | None,
+        move: bool,
+    ) -> NDArray[np.float64]:
+        """The pointing of :meth:`fuse` (σ_mono, σ_p), the carriages moved there when ``move``;
+        the true y-parallax at the mark. [mm]"""
+        mono = key.by("mono")
+        ex = self.noise.draw(mono.at("x"), self.model.monocular_sigma_mm)
+        ey = self.noise.draw(mono.at("y"), self.model.monocular_sigma_mm)
+        ep = self.noise.draw(key.by("stereo"), self.model.stereo_sigma_mm)
+        pl, pr = (np.asarray(p, float) for p in images)
         # the marks at the photo points shifted by (ex, ey) on both photos and by ep in x on the
         # left: by component (the y of the left mark + 0·ep is that y, to the bit)
         r = rods_intersection_xy(
@@ -701,14 +737,10 @@ class Operator:
             self.inst.setting,
         )
         if move:
-            moves: tuple[tuple[ScrewName, Any], ...] = (
-                ("X", r.x_mm),
-                ("Y", r.y_mm),
-                ("Z", r.depth_mm),
-            )
-            for axis, value in moves:
-                self.drive(axis, value, active)
-        return r.y_parallax_mm + eq, r.y_parallax_mm
+            self.drive("X", r.x_mm, active)
+            self.drive("Y", r.y_mm, active)
+            self.drive("Z", r.depth_mm, active)
+        return r.y_parallax_mm
 
     def q_turning(
         self, control: CassetteName | KnobName, images: tuple[ArrayLike, ArrayLike]

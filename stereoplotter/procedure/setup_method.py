@@ -916,7 +916,7 @@ def _stage3_fuse(run: Run, key: NoiseKey) -> None:
     pl, pr = run.scene.images(p0[None, :])
     if run.fidelity.stage3 != "none":
         _fuse_bx(run, h0.id, pl[0], pr[0])
-    op.fuse(p0, (pl[0], pr[0]), key.at("refuse"))
+    op.fuse_mark(p0, (pl[0], pr[0]), key.at("refuse"))
     op.inst.slip_height_scale(p0[2])
     _SLIP_LINE.log(op, HEIGHT_SCALE, {"height": p0[2]}, reading=p0[2])
 
@@ -934,7 +934,7 @@ def _stage3_heights(run: Run, key: NoiseKey) -> None:
     for h in rows[1:]:
         p = h.ground_m
         img = run.scene.images(p[None, :])
-        op.fuse(p, (img[0][0], img[1][0]), key.at(h.id))
+        op.fuse_mark(p, (img[0][0], img[1][0]), key.at(h.id))
         read = op.read(HEIGHT_SCALE, key.at(h.id))
         text = f"control point {h.id}: fuse, read the height"
         errs.append(log_control_height(op, "3", text, read, p[2], tol))

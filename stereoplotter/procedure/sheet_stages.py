@@ -170,7 +170,7 @@ def stage5_check(run: Run) -> None:
     for pid in sheet.similarity_point_ids:
         p = run.scene.point(pid)
         img = run.scene.images(np.asarray(p.local_m, float)[None, :])
-        op.fuse(p.local_m, (img[0][0], img[1][0]), PLAN_CHECK.at(pid))
+        op.fuse_mark(p.local_m, (img[0][0], img[1][0]), PLAN_CHECK.at(pid))
         errs.append(needle_against_plotted(run, pose, pid, plotted_mm(run, pid)))
     check_plan_control(run, errs)
 

@@ -157,7 +157,7 @@ def fuse_and_read(
     op = run.op
     key = as_key(key)
     img = run.scene.images(np.asarray(p, float)[None, :])
-    op.fuse(p, (img[0][0], img[1][0]), key, active)
+    op.fuse_mark(p, (img[0][0], img[1][0]), key, active)
     return {c: op.read(c, key.at(c)) for c in read}
 
 
