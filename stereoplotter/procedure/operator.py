@@ -644,15 +644,21 @@ class Operator:
         """Monocular pointing: move X and/or Y until the mark of ``side`` is on a photo point.
 
         ``free`` names the handwheels turned ("XY", "X": onto the fiducial line x = const with
-        Y as set, "Y": onto y = const). Returns the judgment error drawn, shape (..., 2). [mm]
+        Y as set, "Y": onto y = const). Returns the judgment error, shape (..., 2); on one line
+        only its component across the line is judged, the other is 0 (its act not drawn unless
+        :attr:`draws_unused`). [mm]
         """
-        e = np.stack(
-            [
-                self.noise.draw(as_key(key).by("mono").at("x"), self.model.monocular_sigma_mm),
-                self.noise.draw(as_key(key).by("mono").at("y"), self.model.monocular_sigma_mm),
-            ],
-            axis=-1,
-        )
+        mono = as_key(key).by("mono")
+        sigma = self.model.monocular_sigma_mm
+        parts = []
+        for axis, comp in (("X", "x"), ("Y", "y")):
+            if axis in free:
+                parts.append(self.noise.draw(mono.at(comp), sigma))
+            else:
+                if self.draws_unused:
+                    self.noise.draw(mono.at(comp), sigma)
+                parts.append(self.v(0.0))
+        e = np.stack(parts, axis=-1)
         target = np.asarray(photo_point_mm, float) + e
         umap = self.unit_map(side)
         setting = self.inst.setting
