@@ -651,12 +651,12 @@ class Operator:
         mono = as_key(key).by("mono")
         sigma = self.model.monocular_sigma_mm
         parts = []
-        for axis, comp in (("X", "x"), ("Y", "y")):
-            if axis in free:
-                parts.append(self.noise.draw(mono.at(comp), sigma))
+        for handwheel, name in (("X", "x"), ("Y", "y")):
+            if handwheel in free:
+                parts.append(self.noise.draw(mono.at(name), sigma))
             else:
                 if self.draws_unused:
-                    self.noise.draw(mono.at(comp), sigma)
+                    self.noise.draw(mono.at(name), sigma)
                 parts.append(self.v(0.0))
         e = np.stack(parts, axis=-1)
         target = np.asarray(photo_point_mm, float) + e
