@@ -12,8 +12,11 @@ from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure import conventional, setup_method, simulate
 from stereoplotter.procedure.noise_key import NoiseKey
+from stereoplotter.procedure.operator import Noise
+from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
 from stereoplotter.procedure.step_values import Act, Line
 from stereoplotter.verification import rows_chapter5, table
+from stereoplotter.verification.control_variate import RecordingNoise
 from stereoplotter.verification.entry import DeclaredRows
 
 TRIALS = 4
@@ -167,3 +170,38 @@ def test_two_rows_of_one_identity_are_refused(monkeypatch):
     monkeypatch.setattr(table, "row_entries", lambda g: [*specs(g), specs(g)[3]])
     with pytest.raises(ValueError, match="share the identity"):
         table.run_verification(trials=10, seed=5, procedure_trials=0)
+
+
+def _run_with_noise(method: str, recording: bool) -> tuple[dict[str, bytes], set[str]]:
+    """A run of ``method`` and the keys it drew: on the plain keyed stream, or on a recording
+    one (every act draws, used or not)."""
+    sc, spec = load_scenario("scenarios/pair60.yaml"), load_instrument("sc1")
+    drawn: set[str] = set()
+    plain_normal = Noise.normal
+
+    def recorded(self, key, sigma):
+        drawn.add(key)
+        return plain_normal(self, key, sigma)
+
+    mp = pytest.MonkeyPatch()
+    mp.setattr(Noise, "normal", recorded)
+    try:
+        noise = RecordingNoise(11, TRIALS) if recording else Noise(11, TRIALS)
+        prep = prepare_run(sc, spec, method, seed=11)
+        r = run_trials_chunk(prep, 0, TRIALS, evaluate=False, noise=noise)
+    finally:
+        mp.undo()
+    return _results(r), drawn
+
+
+@pytest.mark.parametrize("method", ["setup", "conventional"])
+def test_an_act_whose_value_nothing_uses_is_left_undrawn_and_changes_no_result(method):
+    """A fusing that only reads (no y-parallax judged) and a pointing onto one line (the
+    component along it not judged) do not draw those acts on the plain keyed stream; a noise
+    that records its acts still gets them. Every result is the same, bit for bit."""
+    plain, plain_keys = _run_with_noise(method, recording=False)
+    every, every_keys = _run_with_noise(method, recording=True)
+    assert plain == every
+    undrawn = every_keys - plain_keys
+    assert plain_keys <= every_keys
+    assert undrawn and all(k.startswith(("q/", "mono/")) for k in undrawn)
