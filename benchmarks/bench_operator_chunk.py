@@ -8,8 +8,8 @@ turn, and prints the median process CPU of a chunk, its ratio to today's code an
 chunk's residual y-parallaxes (standard points and grid) are today's to the bit. Variants (each
 a change of the operator's arithmetic, measured here and not in the package):
 
-* ``stacked-kappa``: the cassette's κ look of C2 evaluated on x, x ± h at once (as the knobs'
-  are), cos and sin over three stacked rows;
+* ``kappa-one-at-a-time``: the cassette's κ look evaluated on x, x + h, x − h one after
+  another (as before it was stacked like the knobs' looks);
 * ``one-pass``: one look-and-correct pass of a drive instead of two (``Operator.passes``);
 * ``one-pass+newton2``: and two Newton steps instead of four in C2's clearing of a point.
 
@@ -36,7 +36,7 @@ from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
 
 VARIANTS = {
     "today": {},
-    "stacked-kappa": {"stack": True},
+    "kappa-one-at-a-time": {"unstack": True},
     "one-pass": {"passes": 1},
     "one-pass+newton2": {"passes": 1, "newton": 2},
 }
@@ -56,8 +56,8 @@ def _patch() -> None:
 
     def patched_q(self: Any, control: Any, images: Any) -> Any:
         look = q_turning(self, control, images)
-        scalar = np.ndim(np.asarray(images[0], float)[..., 0]) == 0
-        return operator.Look(look.fn, stacked=True) if _NOW.get("stack") and scalar else look
+        cassette = str(control).startswith("kappa_")
+        return operator.Look(look.fn) if _NOW.get("unstack") and cassette else look
 
     operator.Operator.__init__ = patched_init  # type: ignore[method-assign]
     conventional.solve_1d = patched_solve  # C2's clearing of a point

@@ -293,7 +293,7 @@ def solve_1d(
     A fixed count (no early exit) keeps a vectorised run and a per-trial loop bit-identical.
     A :class:`Look` with ``stacked`` set is evaluated once per step on x, x + h, x − h stacked
     on a new leading axis (it must give each the bits it gives alone: element-wise IEEE
-    arithmetic and square roots only).
+    arithmetic, square roots and element-wise ufuncs such as cos, sin only).
 
     Examples
     --------
@@ -784,10 +784,11 @@ class Operator:
                 return rods_y_parallax(moving, fixed, setting)
             return rods_y_parallax(fixed, moving, setting)
 
-        # a knob's turn at one point is element-wise arithmetic and square roots (the mechanisms'
-        # scales too), no cos, sin, whose vectorised loops may round differently by position:
+        # a turn at one point is element-wise arithmetic and square roots (the mechanisms' scales
+        # too) and, for a cassette, cos κ and sin κ, element-wise ufuncs whose every element a
+        # vectorised run already needs to be the one of the trial alone (the per-trial oracle):
         # x, x ± h at once
-        return Look(q, stacked=not cassette and np.ndim(x) == 0 and np.ndim(y) == 0)
+        return Look(q, stacked=np.ndim(x) == 0 and np.ndim(y) == 0)
 
     def y_parallax(
         self, points_m: ArrayLike, images: tuple[NDArray[np.float64], NDArray[np.float64]]
