@@ -9,7 +9,7 @@ chunk's residual y-parallaxes (standard points and grid) are today's to the bit.
 a change of the operator's arithmetic, measured here and not in the package):
 
 * ``kappa-one-at-a-time``: the cassette's κ look evaluated on x, x + h, x − h one after
-  another (as before it was stacked like the knobs' looks);
+  another instead of stacked (the knobs' looks stay stacked); the same bits;
 * ``one-pass``: one look-and-correct pass of a drive instead of two (``Operator.passes``);
 * ``one-pass+newton2``: and two Newton steps instead of four in C2's clearing of a point.
 
