@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import platform
 import sys
 from importlib.metadata import version
 from typing import Any
@@ -40,7 +39,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _versions() -> dict[str, str]:
-    found = {"stereoplotter": __version__, "python": platform.python_version()}
+    # the interpreter's version as platform.python_version() reads it (the first word of
+    # sys.version), without importing platform
+    found = {"stereoplotter": __version__, "python": sys.version.split()[0]}
     found.update({key: version(dist) for key, dist in _LIBRARIES.items()})
     found["proj"] = _proj_version()
     return found
