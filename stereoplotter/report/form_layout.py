@@ -25,6 +25,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import fpdf.output
+from fontTools import subset as ftsubset
 from fontTools import ttLib
 from fpdf import FPDF
 from fpdf.enums import TextMode
@@ -133,6 +135,8 @@ class _SavedFont(ttLib.TTFont):
     the same glyphs (:meth:`Form.output`), so its bytes do not change after the first save."""
 
     saved: bytes | None = None
+    #: The glyph names it is subset to (set once it is, :meth:`Form.output`).
+    subset_to: frozenset[str] | None = None
 
     def save(self, file: Any, reorderTables: bool | None = True) -> None:
         if self.saved is None:
@@ -140,6 +144,34 @@ class _SavedFont(ttLib.TTFont):
             super().save(buffer, reorderTables)
             self.saved = buffer.getvalue()
         file.write(self.saved)
+
+
+class _Subsetter(ftsubset.Subsetter):  # type: ignore[misc]
+    """fontTools' subsetter as fpdf2 runs it on every font of a document it outputs, except on
+    a font file object already subset to the glyphs asked for (:data:`_SUBSETS`,
+    ``subset_to``): subsetting it again to them gives the same font, byte for byte, and was
+    a twelfth of a form's time."""
+
+    def subset(self, font: Any) -> None:
+        done = getattr(font, "subset_to", None)
+        asked = self.glyph_names_requested
+        if done is not None and done == asked and not (
+            self.unicodes_requested or self.glyph_ids_requested
+        ):
+            return
+        super().subset(font)
+
+
+class _SubsetModule:
+    """:mod:`fontTools.subset` as fpdf2's output module sees it: its :class:`_Subsetter`."""
+
+    Subsetter = _Subsetter
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(ftsubset, name)
+
+
+fpdf.output.ftsubset = _SubsetModule()  # type: ignore[attr-defined]
 
 
 #: The font file objects as subset by an output, by (font file, glyph names): the next document
@@ -175,6 +207,12 @@ class Form(FPDF):
         self._codes: dict[int, dict[str, str]] = {}
         #: Per font index, each text as its "(…) Tj" operand in this document.
         self._encoded: dict[int, dict[str, str]] = {}
+        #: (font index, an operand's bytes between its parentheses) → the text it encodes
+        #: (:meth:`text`), for a document that takes this one's pages (:meth:`append_pages`).
+        self.operand_texts: dict[tuple[int, bytes], str] = {}
+        #: (font index, text) → its "(…) Tj" operand in this document, as re-encoded from the
+        #: pages of any form it took (:meth:`_reencoded`).
+        self._taken_texts: dict[tuple[int, str], bytes] = {}
 
     def text(self, x: float, y: float, text: str = "") -> None:
         """fpdf2's ``text`` for what the forms draw (filled text, no underline, a TrueType
@@ -200,6 +238,7 @@ class Form(FPDF):
                     code = codes[char] = "" if picked is None else chr(picked)
                 mapped.append(code)
             encoded = self._encoded[font.i][text] = _operand("".join(mapped))
+            self.operand_texts[(font.i, encoded[1:-4].encode("latin-1"))] = text
         line = f"BT {x * self.k:.2f} {(self.h - y) * self.k:.2f} Td {encoded} ET"
         if self.fill_color != self.text_color:
             line = f"q {self.text_color.serialize().lower()} {line} Q"
@@ -265,15 +304,22 @@ class Form(FPDF):
             if done is not None:
                 return done
             table = codes.get(index)
-            if table is None:
+            if table is None:  # at the font's first text of the source, as each page comes
                 target = own[index].subset
                 table = codes[index] = {
                     code: target.pick_glyph(glyph)
                     for glyph, code in theirs[index].subset.items()
                     if glyph is not None
                 }
-            text = _UNESCAPE.sub(_unescape, match.group(2)).decode("utf-16-be")
-            done = _operand("".join(chr(table[ord(c)]) for c in text)).encode("latin-1")
+            # a text an earlier form drew too has its operand here already: a glyph's code in
+            # this document does not change once given
+            text = source.operand_texts.get((index, match.group(2)))
+            done = None if text is None else self._taken_texts.get((index, text))
+            if done is None:
+                codes_text = _UNESCAPE.sub(_unescape, match.group(2)).decode("utf-16-be")
+                done = _operand("".join(chr(table[ord(c)]) for c in codes_text)).encode("latin-1")
+                if text is not None:
+                    self._taken_texts[(index, text)] = done
             operands[(index, match.group(2))] = done
             return done
 
@@ -313,6 +359,7 @@ class Form(FPDF):
                 for ttfont in _SUBSETS.values():
                     ttfont.close()
                 _SUBSETS.clear()
+            font.ttfont.subset_to = key[1]
             earlier = _SUBSETS.get(key)  # another thread's document of the same glyphs
             if earlier is not None and earlier is not font.ttfont:
                 earlier.close()
