@@ -294,12 +294,14 @@ class Form(FPDF):
         own = {f.i: f for f in self.fonts.values()}
         theirs = {f.i: f for f in source.fonts.values()}
         current = [0]
+        opening = [0]  # the "(" inside the operands (each one's own, escaped ones in it)
 
         def swap(match: re.Match[bytes]) -> bytes:
             if match.group(1) is not None:
                 current[0] = int(match.group(1))
                 return match.group(0)
             index = current[0]
+            opening[0] += 1 + match.group(2).count(b"(")
             done = operands.get((index, match.group(2)))
             if done is not None:
                 return done
@@ -323,9 +325,12 @@ class Form(FPDF):
             operands[(index, match.group(2))] = done
             return done
 
-        if b"(" in _TOKENS.sub(b"", body):  # pragma: no cover - text not written by the forms
+        out = _TOKENS.sub(swap, body)
+        # every "(" of the page inside an operand: no text other than "(…) Tj" (counted, not
+        # found by a second pass of the expression over the page)
+        if body.count(b"(") != opening[0]:  # pragma: no cover - text not written by the forms
             raise RuntimeError("a page holds text other than (…) Tj operands: not copied")
-        return _TOKENS.sub(swap, body)
+        return out
 
     def _state(self) -> dict[str, Any]:
         state = {name: getattr(self, name) for name in _STATE}
