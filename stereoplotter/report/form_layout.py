@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import copy
 import datetime as _dt
+import functools
 import importlib.util
 import io
 import re
@@ -250,7 +251,7 @@ class Form(FPDF):
         size, style = self.font_size_pt, self.font_style
         # only the size changes within a text (the forms' one family, this style; no underline
         # or strike-through): fpdf2's set_font_size, what its set_font does then
-        for run, sub in rich_runs(text):
+        for run, sub in _runs(text):
             run_size = size * _SUB if sub else size
             if run_size != self.font_size_pt:
                 self.set_font_size(run_size)
@@ -435,6 +436,13 @@ def literal(text: object) -> str:
 def rich_runs(text: str) -> list[tuple[str, bool]]:
     """``text`` as (run, is a subscript) in order: the book's symbols typeset (``f_пр`` → f with
     the subscript пр), user text (:func:`literal`) as written."""
+    return list(_runs(text))
+
+
+@functools.lru_cache(maxsize=65536)
+def _runs(text: str) -> tuple[tuple[str, bool], ...]:
+    """:func:`rich_runs` of ``text``, remembered: the forms of a job draw the same labels and
+    many of the same numbers, each measured and drawn more than once."""
     out: list[tuple[str, bool]] = []
     pos = 0
     for m in _LITERAL.finditer(text):
@@ -443,7 +451,7 @@ def rich_runs(text: str) -> list[tuple[str, bool]]:
             out.append((m.group(1), False))
         pos = m.end()
     out += _sub_runs(text[pos:].replace(_CLOSE, "").replace(_OPEN, ""))
-    return [r for r in out if r[0]]
+    return tuple(r for r in out if r[0])
 
 
 def _sub_runs(text: str) -> list[tuple[str, bool]]:
@@ -611,7 +619,7 @@ def _plain_width(pdf: Form, text: str, style: str, size: float) -> float:
 def text_width(pdf: Form, text: str, style: str, size: float) -> float:
     """The advance width of a form text as drawn (:func:`rich_runs`), in mm."""
     return sum(_plain_width(pdf, run, style, size * _SUB if sub else size)
-               for run, sub in rich_runs(text))  # fmt: skip
+               for run, sub in _runs(text))  # fmt: skip
 
 
 def wrap_lines(pdf: Form, text: str, width: float, style: str, size: float) -> tuple[str, ...]:
