@@ -305,9 +305,6 @@ class LeafBase(FileModel):
     model_config = ConfigDict(
         extra="forbid",
         frozen=True,
-        # a leaf model is only ever validated inside its section's model, whose validator holds
-        # the leaf's: building each leaf's own validator too took a fifth of this module's import
-        defer_build=True,
         json_schema_extra={
             "if": {"properties": {"status": {"const": "documented"}}},
             "then": {"required": ["src"], "not": {"required": ["basis"]}},
@@ -375,10 +372,7 @@ _LEAF_MODELS = {leaf.key: _leaf_model(leaf) for leaf in _SCHEMA}
 
 
 class _SectionBase(FileModel):
-    # validated only inside the file's model (see LeafBase)
-    model_config = ConfigDict(
-        extra="forbid", frozen=True, protected_namespaces=(), defer_build=True
-    )
+    model_config = ConfigDict(extra="forbid", frozen=True, protected_namespaces=())
 
 
 def _section_model(section: str) -> type[FileModel]:
