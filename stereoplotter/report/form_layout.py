@@ -602,12 +602,13 @@ _LINES: dict[tuple[str, float, float, str], tuple[str, ...]] = {}
 
 def forget_layout() -> None:
     """Forget what the process remembers of the fonts and texts (the parsed fonts, their
-    compiled subsets, the text widths, the lines of each cell), as a fresh process starts: the
-    next form is laid out from nothing, to the same bytes."""
+    compiled subsets, the text widths, the lines of each cell, the runs of each text), as a
+    fresh process starts: the next form is laid out from nothing, to the same bytes."""
     for font in [*_PARSED.values(), *_SUBSETS.values()]:
         font.close()
     for memory in (_PARSED, _SUBSETS, _WIDTHS, _LINES):
         memory.clear()
+    _runs.cache_clear()
 
 
 def _plain_width(pdf: Form, text: str, style: str, size: float) -> float:
