@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import difflib
 import re
 from collections.abc import Iterable
 from typing import Any
@@ -74,6 +73,9 @@ def did_you_mean(word: str, choices: Iterable[str]) -> str:
     >>> did_you_mean("w_mm", ["x_mm", "y_mm", "z_mm"])
     ''
     """
+    # imported here: only a mistyped name reaches it, and every command imports this module
+    import difflib
+
     choices = [str(c) for c in choices]
     lowered = {c.lower(): c for c in choices}
     matches = difflib.get_close_matches(str(word).lower(), list(lowered), n=2, cutoff=0.6)

@@ -11,8 +11,10 @@ import logging
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
-from tqdm import tqdm
+if TYPE_CHECKING:
+    from tqdm import tqdm
 
 __all__ = ["bars_enabled", "configure_logging", "progress_bar", "step_progress"]
 
@@ -65,6 +67,9 @@ def progress_bar(
     if not bars_enabled():
         yield lambda n: None
         return
+    # imported here: a command that draws no bar (`info`, `--quiet`, a pipe) does not load tqdm
+    from tqdm import tqdm
+
     with tqdm(total=total, desc=description, unit=unit, file=sys.stderr, leave=False) as bar:
         yield bar.update
 
@@ -78,6 +83,9 @@ def step_progress(description: str) -> Iterator[Callable[[int, int, str], None]]
         if not bars_enabled():
             return
         if not bar:
+            # imported here: a command that draws no bar does not load tqdm
+            from tqdm import tqdm
+
             bar.append(
                 tqdm(total=total, desc=description, unit="step", file=sys.stderr, leave=False)
             )

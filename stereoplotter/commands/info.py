@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import platform
 import sys
 from importlib.metadata import version
 from typing import Any
@@ -40,13 +39,43 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _versions() -> dict[str, str]:
-    # pyproj imported only for the PROJ library's own version (not in the package metadata)
+    # the interpreter's version as platform.python_version() reads it (the first word of
+    # sys.version), without importing platform
+    found = {"stereoplotter": __version__, "python": sys.version.split()[0]}
+    found.update({key: version(dist) for key, dist in _LIBRARIES.items()})
+    found["proj"] = _proj_version()
+    return found
+
+
+def _proj_version() -> str:
+    """The PROJ library's version (not in pyproj's package metadata).
+
+    Read from pyproj's own version module (``pyproj._version``, a small extension linked to
+    PROJ) loaded alone: ``import pyproj`` sets up its coordinate systems, transformers and
+    network code first, a third of ``info``'s time. Where pyproj is loaded already, or that
+    module moves, pyproj's own attribute is read.
+    """
+    # imported here: only `info` reads the PROJ version, and only this way
+    import importlib.machinery
+    import importlib.util
+
+    if "pyproj" not in sys.modules:
+        try:
+            package = importlib.util.find_spec("pyproj")
+            folders = package.submodule_search_locations if package else None
+            spec = importlib.machinery.PathFinder.find_spec("pyproj._version", folders)
+            if spec is not None and spec.loader is not None:
+                module = importlib.util.module_from_spec(spec)
+                spec.loader.exec_module(module)
+                # the extension registers itself; a later `import pyproj` loads it as its own
+                sys.modules.pop(spec.name, None)
+                return str(module.PROJ_VERSION_STR)
+        except (ImportError, AttributeError, OSError):
+            pass
+    # imported here: the fallback when pyproj's version module cannot be loaded alone
     import pyproj
 
-    found = {"stereoplotter": __version__, "python": platform.python_version()}
-    found.update({key: version(dist) for key, dist in _LIBRARIES.items()})
-    found["proj"] = pyproj.proj_version_str
-    return found
+    return str(pyproj.proj_version_str)
 
 
 def _count_status(node: Any, counts: dict[str, int]) -> None:

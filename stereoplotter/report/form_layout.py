@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import copy
 import datetime as _dt
+import functools
 import importlib.util
 import io
 import re
@@ -25,6 +26,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import fpdf.output
+from fontTools import subset as ftsubset
 from fontTools import ttLib
 from fpdf import FPDF
 from fpdf.enums import TextMode
@@ -133,6 +136,8 @@ class _SavedFont(ttLib.TTFont):
     the same glyphs (:meth:`Form.output`), so its bytes do not change after the first save."""
 
     saved: bytes | None = None
+    #: The glyph names it is subset to (set once it is, :meth:`Form.output`).
+    subset_to: frozenset[str] | None = None
 
     def save(self, file: Any, reorderTables: bool | None = True) -> None:
         if self.saved is None:
@@ -140,6 +145,34 @@ class _SavedFont(ttLib.TTFont):
             super().save(buffer, reorderTables)
             self.saved = buffer.getvalue()
         file.write(self.saved)
+
+
+class _Subsetter(ftsubset.Subsetter):  # type: ignore[misc]
+    """fontTools' subsetter as fpdf2 runs it on every font of a document it outputs, except on
+    a font file object already subset to the glyphs asked for (:data:`_SUBSETS`,
+    ``subset_to``): subsetting it again to them gives the same font, byte for byte, and was
+    a twelfth of a form's time."""
+
+    def subset(self, font: Any) -> None:
+        done = getattr(font, "subset_to", None)
+        asked = self.glyph_names_requested
+        if done is not None and done == asked and not (
+            self.unicodes_requested or self.glyph_ids_requested
+        ):
+            return
+        super().subset(font)
+
+
+class _SubsetModule:
+    """:mod:`fontTools.subset` as fpdf2's output module sees it: its :class:`_Subsetter`."""
+
+    Subsetter = _Subsetter
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(ftsubset, name)
+
+
+fpdf.output.ftsubset = _SubsetModule()  # type: ignore[attr-defined]
 
 
 #: The font file objects as subset by an output, by (font file, glyph names): the next document
@@ -175,6 +208,12 @@ class Form(FPDF):
         self._codes: dict[int, dict[str, str]] = {}
         #: Per font index, each text as its "(…) Tj" operand in this document.
         self._encoded: dict[int, dict[str, str]] = {}
+        #: (font index, an operand's bytes between its parentheses) → the text it encodes
+        #: (:meth:`text`), for a document that takes this one's pages (:meth:`append_pages`).
+        self.operand_texts: dict[tuple[int, bytes], str] = {}
+        #: (font index, text) → its "(…) Tj" operand in this document, as re-encoded from the
+        #: pages of any form it took (:meth:`_reencoded`).
+        self._taken_texts: dict[tuple[int, str], bytes] = {}
 
     def text(self, x: float, y: float, text: str = "") -> None:
         """fpdf2's ``text`` for what the forms draw (filled text, no underline, a TrueType
@@ -200,6 +239,7 @@ class Form(FPDF):
                     code = codes[char] = "" if picked is None else chr(picked)
                 mapped.append(code)
             encoded = self._encoded[font.i][text] = _operand("".join(mapped))
+            self.operand_texts[(font.i, encoded[1:-4].encode("latin-1"))] = text
         line = f"BT {x * self.k:.2f} {(self.h - y) * self.k:.2f} Td {encoded} ET"
         if self.fill_color != self.text_color:
             line = f"q {self.text_color.serialize().lower()} {line} Q"
@@ -211,7 +251,7 @@ class Form(FPDF):
         size, style = self.font_size_pt, self.font_style
         # only the size changes within a text (the forms' one family, this style; no underline
         # or strike-through): fpdf2's set_font_size, what its set_font does then
-        for run, sub in rich_runs(text):
+        for run, sub in _runs(text):
             run_size = size * _SUB if sub else size
             if run_size != self.font_size_pt:
                 self.set_font_size(run_size)
@@ -255,31 +295,43 @@ class Form(FPDF):
         own = {f.i: f for f in self.fonts.values()}
         theirs = {f.i: f for f in source.fonts.values()}
         current = [0]
+        opening = [0]  # the "(" inside the operands (each one's own, escaped ones in it)
 
         def swap(match: re.Match[bytes]) -> bytes:
             if match.group(1) is not None:
                 current[0] = int(match.group(1))
                 return match.group(0)
             index = current[0]
+            opening[0] += 1 + match.group(2).count(b"(")
             done = operands.get((index, match.group(2)))
             if done is not None:
                 return done
             table = codes.get(index)
-            if table is None:
+            if table is None:  # at the font's first text of the source, as each page comes
                 target = own[index].subset
                 table = codes[index] = {
                     code: target.pick_glyph(glyph)
                     for glyph, code in theirs[index].subset.items()
                     if glyph is not None
                 }
-            text = _UNESCAPE.sub(_unescape, match.group(2)).decode("utf-16-be")
-            done = _operand("".join(chr(table[ord(c)]) for c in text)).encode("latin-1")
+            # a text an earlier form drew too has its operand here already: a glyph's code in
+            # this document does not change once given
+            text = source.operand_texts.get((index, match.group(2)))
+            done = None if text is None else self._taken_texts.get((index, text))
+            if done is None:
+                codes_text = _UNESCAPE.sub(_unescape, match.group(2)).decode("utf-16-be")
+                done = _operand("".join(chr(table[ord(c)]) for c in codes_text)).encode("latin-1")
+                if text is not None:
+                    self._taken_texts[(index, text)] = done
             operands[(index, match.group(2))] = done
             return done
 
-        if b"(" in _TOKENS.sub(b"", body):  # pragma: no cover - text not written by the forms
+        out = _TOKENS.sub(swap, body)
+        # every "(" of the page inside an operand: no text other than "(…) Tj" (counted, not
+        # found by a second pass of the expression over the page)
+        if body.count(b"(") != opening[0]:  # pragma: no cover - text not written by the forms
             raise RuntimeError("a page holds text other than (…) Tj operands: not copied")
-        return _TOKENS.sub(swap, body)
+        return out
 
     def _state(self) -> dict[str, Any]:
         state = {name: getattr(self, name) for name in _STATE}
@@ -313,6 +365,7 @@ class Form(FPDF):
                 for ttfont in _SUBSETS.values():
                     ttfont.close()
                 _SUBSETS.clear()
+            font.ttfont.subset_to = key[1]
             earlier = _SUBSETS.get(key)  # another thread's document of the same glyphs
             if earlier is not None and earlier is not font.ttfont:
                 earlier.close()
@@ -383,6 +436,13 @@ def literal(text: object) -> str:
 def rich_runs(text: str) -> list[tuple[str, bool]]:
     """``text`` as (run, is a subscript) in order: the book's symbols typeset (``f_пр`` → f with
     the subscript пр), user text (:func:`literal`) as written."""
+    return list(_runs(text))
+
+
+@functools.lru_cache(maxsize=65536)
+def _runs(text: str) -> tuple[tuple[str, bool], ...]:
+    """:func:`rich_runs` of ``text``, remembered: the forms of a job draw the same labels and
+    many of the same numbers, each measured and drawn more than once."""
     out: list[tuple[str, bool]] = []
     pos = 0
     for m in _LITERAL.finditer(text):
@@ -391,7 +451,7 @@ def rich_runs(text: str) -> list[tuple[str, bool]]:
             out.append((m.group(1), False))
         pos = m.end()
     out += _sub_runs(text[pos:].replace(_CLOSE, "").replace(_OPEN, ""))
-    return [r for r in out if r[0]]
+    return tuple(r for r in out if r[0])
 
 
 def _sub_runs(text: str) -> list[tuple[str, bool]]:
@@ -542,12 +602,13 @@ _LINES: dict[tuple[str, float, float, str], tuple[str, ...]] = {}
 
 def forget_layout() -> None:
     """Forget what the process remembers of the fonts and texts (the parsed fonts, their
-    compiled subsets, the text widths, the lines of each cell), as a fresh process starts: the
-    next form is laid out from nothing, to the same bytes."""
+    compiled subsets, the text widths, the lines of each cell, the runs of each text), as a
+    fresh process starts: the next form is laid out from nothing, to the same bytes."""
     for font in [*_PARSED.values(), *_SUBSETS.values()]:
         font.close()
     for memory in (_PARSED, _SUBSETS, _WIDTHS, _LINES):
         memory.clear()
+    _runs.cache_clear()
 
 
 def _plain_width(pdf: Form, text: str, style: str, size: float) -> float:
@@ -559,7 +620,7 @@ def _plain_width(pdf: Form, text: str, style: str, size: float) -> float:
 def text_width(pdf: Form, text: str, style: str, size: float) -> float:
     """The advance width of a form text as drawn (:func:`rich_runs`), in mm."""
     return sum(_plain_width(pdf, run, style, size * _SUB if sub else size)
-               for run, sub in rich_runs(text))  # fmt: skip
+               for run, sub in _runs(text))  # fmt: skip
 
 
 def wrap_lines(pdf: Form, text: str, width: float, style: str, size: float) -> tuple[str, ...]:

@@ -340,13 +340,23 @@ def mc_rms(
             B = np.vstack([B, -model.sigma_control * _fit(model).T])
     Q = B @ B.T / P
     out = np.empty(trials)
+    if model.sigma_white:
+        # the chunk's field and white noise in two arrays reused by every chunk (filled in
+        # place: the same draws and the same arithmetic as fresh arrays, without allocating
+        # and touching t·P new values twice a chunk)
+        size = min(chunk, trials)
+        field_buffer, noise_buffer = np.empty((size, P)), np.empty((size, P))
     for start in range(0, trials, chunk):
         t = min(chunk, trials - start)
         x = rng.standard_normal((t, J))
         if nc:
             x = np.hstack([x, rng.standard_normal((t, nc))])
         if model.sigma_white:
-            field = x @ B + model.sigma_white * rng.standard_normal((t, P))
+            field, noise = field_buffer[:t], noise_buffer[:t]
+            np.matmul(x, B, out=field)
+            rng.standard_normal(out=noise)
+            np.multiply(noise, model.sigma_white, out=noise)
+            field += noise
             out[start : start + t] = np.einsum("tp,tp->t", field, field) / P
         else:
             out[start : start + t] = np.einsum("ti,ti->t", x @ Q, x)

@@ -40,10 +40,13 @@ NOT_AT_START = (
     *_TRAINER,
 )
 
-#: What ``info`` (versions, data files) has no use for.
+#: What ``info`` (versions, data files) has no use for: pyproj is asked for its PROJ version
+#: through its version module alone, and no progress bar is drawn.
 NOT_IN_INFO = (
     "numpy",
     "pydantic",
+    "pyproj",
+    "tqdm",
     "scipy",
     "matplotlib",
     "starlette",
@@ -92,3 +95,29 @@ def test_info_loads_only_the_file_readers():
         "with contextlib.redirect_stdout(io.StringIO()):\n    main(['info'])"
     )
     assert set(_loaded(code)).isdisjoint(NOT_IN_INFO)
+
+
+def test_info_prints_the_proj_version_pyproj_reports_and_leaves_pyproj_whole():
+    code = (
+        "import contextlib, io, json\nfrom stereoplotter.cli import main\n"
+        "out = io.StringIO()\n"
+        "with contextlib.redirect_stdout(out):\n    main(['info', '--json'])\n"
+        "import pyproj\nfrom pyproj import Transformer\n"
+        "t = Transformer.from_crs(4326, 28404, always_xy=True)\n"
+        "print(json.dumps([json.loads(out.getvalue())['versions']['proj'],"
+        " pyproj.proj_version_str, pyproj._version.PROJ_VERSION_STR,"
+        " [round(v, 3) for v in t.transform(37.0, 55.0)]]))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
+    )
+    printed, reported, module, moved = json.loads(done.stdout.strip().splitlines()[-1])
+    assert printed == reported == module
+    # pyproj loaded after info transforms as it does alone
+    alone = subprocess.run(
+        [sys.executable, "-c", "import json\nfrom pyproj import Transformer\n"
+         "t = Transformer.from_crs(4326, 28404, always_xy=True)\n"
+         "print(json.dumps([round(v, 3) for v in t.transform(37.0, 55.0)]))"],
+        capture_output=True, text=True, check=True, timeout=120,
+    )  # fmt: skip
+    assert moved == json.loads(alone.stdout.strip().splitlines()[-1])
