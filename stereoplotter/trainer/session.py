@@ -509,7 +509,7 @@ class Session:
             _copy_instrument(self.inst),
             dict(self.commanded),
             list(self.locked),
-            copy.deepcopy(self.records),
+            _state_copy(self.records, {}),
             self.stage_index,
             list(self.claimed),
             dict(self.at_claim),
@@ -751,8 +751,77 @@ def json_finite(value: Any) -> Any:
 
 def _copy_instrument(inst: Instrument) -> Instrument:
     """A copy of the instrument's physical state (the spec and error model shared: frozen)."""
-    memo = {id(inst.spec): inst.spec, id(inst.errors): inst.errors}
-    return copy.deepcopy(inst, memo)
+    memo: dict[int, Any] = {id(inst.spec): inst.spec, id(inst.errors): inst.errors}
+    return _state_copy(inst, memo)
+
+
+#: Values :func:`_state_copy` hands on as they are (immutable).
+_ATOMIC = frozenset(
+    {type(None), bool, int, float, complex, str, bytes, np.float64, np.int64, np.bool_}
+)
+#: Type → how :func:`_state_copy` copies its instances: "shared" (a frozen dataclass, a value:
+#: the instrument changes one by building a new one, :func:`dataclasses.replace`), "plain" (its
+#: state is its ``__dict__`` alone) or "other" (``copy.deepcopy``); only this package's own
+#: types are shared or copied as plain.
+_HOW: dict[type, str] = {}
+
+
+def _state_copy(obj: Any, memo: dict[int, Any]) -> Any:
+    """``copy.deepcopy(obj, memo)`` for the plain state a session holds (dicts, lists, tuples,
+    arrays, objects with a ``__dict__``), an order of magnitude faster: what ``deepcopy``
+    reaches there through its generic reconstruction is built directly, and a frozen
+    dataclass of this package is shared instead of copied (nothing changes it in place).
+    Anything else (another package's type, an object with ``__slots__`` or its own copy or
+    pickling hooks, an array of objects) goes to
+    ``copy.deepcopy`` with the same memo, so aliasing inside ``obj`` is kept as ``deepcopy``
+    keeps it."""
+    cls = type(obj)
+    if cls in _ATOMIC:
+        return obj
+    done = memo.get(id(obj))
+    if done is not None:
+        return done
+    if cls is np.ndarray and obj.dtype != object:
+        out: Any = obj.copy()
+    elif cls is dict:
+        out = memo[id(obj)] = {}
+        for k, v in obj.items():
+            out[k] = _state_copy(v, memo)
+        return out
+    elif cls is list:
+        out = memo[id(obj)] = []
+        out.extend(_state_copy(v, memo) for v in obj)
+        return out
+    elif cls is tuple:
+        items = [_state_copy(v, memo) for v in obj]
+        out = obj if all(a is b for a, b in zip(items, obj, strict=True)) else tuple(items)
+    elif (how := _HOW.get(cls) or _how(cls)) == "shared":
+        out = obj
+    elif how == "plain":
+        out = memo[id(obj)] = object.__new__(cls)
+        out.__dict__.update({k: _state_copy(v, memo) for k, v in obj.__dict__.items()})
+        return out
+    else:
+        return copy.deepcopy(obj, memo)
+    memo[id(obj)] = out
+    return out
+
+
+def _how(cls: type) -> str:
+    params = getattr(cls, "__dataclass_params__", None)
+    hooks = ("__deepcopy__", "__copy__", "__reduce_ex__", "__reduce__", "__getstate__",
+             "__setstate__")
+    ours = cls.__module__.split(".")[0] == "stereoplotter"  # others' types: deepcopy
+    if ours and params is not None and params.frozen:
+        how = "shared"
+    elif ours and "__slots__" not in cls.__dict__ and all(
+        getattr(cls, h, None) is getattr(object, h, None) for h in hooks
+    ) and "__dict__" in dir(cls):
+        how = "plain"
+    else:
+        how = "other"
+    _HOW[cls] = how
+    return how
 
 
 def check_stage(name: str) -> str | None:
