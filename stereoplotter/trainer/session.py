@@ -136,9 +136,10 @@ class Session:
         self.progress: dict[str, Any] = {}
         #: What the last action moved that it did not name (coupled motions), with a reason.
         self.events: list[dict[str, Any]] = []
-        #: The state after the last action, keyed by the log's length: the next action's "before"
-        #: (the state changes only by acting; building it twice per action was half the time).
-        self._last_state: tuple[int, dict[str, Any]] | None = None
+        #: The state after the last action and its digest, keyed by the log's length: the next
+        #: action's "before" (the state changes only by acting; building it twice per action
+        #: was half the time).
+        self._last_state: tuple[int, dict[str, Any], str] | None = None
         self._rules: dict[str, list[dict[str, Any]]] = {}  # stage → its steps' tick rules
         self._target_points: dict[str, dict[Any, Any]] = {}  # stage → the points its steps read
         for stage in exercise.preset_stages:
@@ -462,15 +463,16 @@ class Session:
             view["controls"] = _scales_as_shown(full["controls"])
         return view
 
-    def full_state(self) -> dict[str, Any]:
+    def full_state(self, counters: dict[str, Any] | None = None) -> dict[str, Any]:
         """The session's whole state, the exact marks included: what the log's digests and
-        its claim records hold (the log is given once every stage is claimed)."""
+        its claim records hold (the log is given once every stage is claimed). ``counters``:
+        :meth:`_counters` of the session as it stands, when the caller has it already."""
         return json_finite(
             {
                 "instrument": self.exercise.spec.key,
                 "stage": self.stage,
                 "step": self.stage,
-                "counters": self._counters(),
+                "counters": self._counters() if counters is None else counters,
                 "controls": self._controls(),
                 "marks": self._marks(),
                 "parallax": self._parallax(),
@@ -535,14 +537,18 @@ class Session:
         """
         t = self._now(action) if isinstance(action, dict) else 0.0
         last = self._last_state
-        before = last[1] if last is not None and last[0] == len(self.log) else self.full_state()
+        if last is not None and last[0] == len(self.log):
+            before, before_digest = last[1], last[2]
+        else:
+            before = self.full_state()
+            before_digest = state_digest(before)
         clean = {k: v for k, v in action.items() if k != "t"} if isinstance(action, dict) else {}
         record: dict[str, Any] = {
             "n": len(self.log) + 1,
             "t": t,
             "stage": self.stage,
             "action": clean,
-            "state_before": state_digest(before),
+            "state_before": before_digest,
         }
         self.events = []
         try:
@@ -553,20 +559,21 @@ class Session:
                 xy = None if marks is None else [marks["left"]["x_mm"], marks["left"]["y_mm"]]
                 targets = self._targets(record["stage"])
                 note_progress(self.progress, record["stage"], clean, xy, targets)
-            self.events = coupled_motion(clean, before["counters"], self._counters())
+            counters = self._counters()
+            self.events = coupled_motion(clean, before["counters"], counters)
         except TrainerError as exc:
             record["refused"] = str(exc)
             after = self.full_state()
             record["state_after"] = state_digest(after)
             self.log.append(record)
-            self._last_state = (len(self.log), dict(after))
+            self._last_state = (len(self.log), dict(after), record["state_after"])
             raise
-        after = self.full_state()
+        after = self.full_state(counters)
         record["state_after"] = state_digest(after)
         if clean["kind"] == "claim":
             record["state"] = after
         self.log.append(record)
-        self._last_state = (len(self.log), dict(after))
+        self._last_state = (len(self.log), dict(after), record["state_after"])
         return self.trainee_view(after)
 
     def _do(self, action: dict[str, Any], before: dict[str, Any]) -> Any:
