@@ -26,7 +26,9 @@ and ``--abuse-patchers`` clients fetch patches as fast as they are answered. Pri
 phase's round trip (median, p95) and patch median, what the abuser got served, and how its
 socket attempts ended: refused at the handshake (its address's connection rate), refused after
 the key (its session's), or accepted (and then replaced by a newer socket of the session, or
-closed otherwise).
+closed otherwise). It also prints the CPU time of the two client processes (the honest
+trainees' in each phase, the abuser's): on the server's own machine their work takes the
+server's processors, which a class's clients on their own machines would not.
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20]
 """
@@ -322,7 +324,9 @@ async def _abuse(host: str, stop: float, sockets: int, sessions: int, patchers: 
 
 def _abuser_process(host, stop_in, sockets, sessions, patchers, queue) -> None:
     stop = time.monotonic() + stop_in
-    queue.put(asyncio.run(_abuse(host, stop, sockets, sessions, patchers)))
+    got = asyncio.run(_abuse(host, stop, sockets, sessions, patchers))
+    got["cpu_s"] = time.process_time()  # the abuser client's own CPU, taken from the server's
+    queue.put(got)
 
 
 def _summary(name: str, rtt: list[float], patches: list[float]) -> str:
@@ -359,15 +363,18 @@ async def abuse_async(args) -> None:
                     abuser.start()
                     await asyncio.sleep(2.0)  # the abuser's sockets open first
                     stop = time.monotonic() + args.seconds
+                cpu = time.process_time()
                 await asyncio.gather(*(
                     honest(host, n + (100 if phase == "abuse" else 0), stop, rtt,
                            patches if n == 0 else None, 1 / args.rate)
                     for n in range(args.trainees)))
+                cpu = time.process_time() - cpu  # the honest clients' own CPU in the phase
                 if abuser is not None:
                     results["abuser"] = queue.get(timeout=60)
                     abuser.join(30)
                 results[phase] = (rtt, patches)
-                print(_summary(phase, rtt, patches), flush=True)
+                print(f"{_summary(phase, rtt, patches)}; the honest clients' CPU {cpu:.1f} s",
+                      flush=True)
         finally:
             proc.terminate()
             try:
@@ -384,7 +391,8 @@ async def abuse_async(args) -> None:
           f"accepted {a['accepted']} (of which replaced by a newer socket {a['replaced']}, "
           f"closed otherwise {a['closed_other']}), failed to open {a['failed_open']}; "
           f"patches {a['patches']} served, "
-          f"{a['patches_refused']} refused")
+          f"{a['patches_refused']} refused; the abuser client's CPU "
+          f"{a.get('cpu_s', math.nan):.1f} s")
     print(f"patch median under abuse / idle: {abuse_patch / idle_patch:.2f} "
           f"(os.cpu_count() = {os.cpu_count()}, 1-minute load average at the end "
           f"{os.getloadavg()[0]:.1f})")
