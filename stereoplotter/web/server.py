@@ -41,9 +41,8 @@ WS_MAX_SIZE = 4 * 1024 * 1024
 #: default: 5 ms). A trainee's action takes the lock three times after waiting for something
 #: (the event loop on the message, an actor thread on the job, the event loop on the answer),
 #: and each may wait this long behind a thread computing (another client's action): up to
-#: ~15 ms a round trip with the default. Measured (loaded machine,
-#: ``bench_trainer_load.py --abuser``, one run each) and in a two-thread model of the
-#: server: see ``benchmarks/README.md``. [s]
+#: ~15 ms a round trip with the default. Measured on a loaded machine only
+#: (``bench_trainer_load.py --abuser``, single runs): see ``benchmarks/README.md``. [s]
 SWITCH_INTERVAL_S = 0.001
 
 
