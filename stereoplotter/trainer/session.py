@@ -78,8 +78,9 @@ LOG_FORMAT = "stereoplotter-session/1"
 #: The stages that use the six standard points: an incomplete model's substitutes are recorded
 #: before they are claimed.
 SUBSTITUTE_STAGES = ("2", "C2")
-#: Undo steps kept (each about 16 kB: a copy of the instrument, measured on e08); older ones
-#: are dropped (assumed: a trainee undoes a few moves, not a stage's hundreds).
+#: Undo steps kept (each about 8 kB: a copy of the instrument's state, measured on e08 with
+#: tracemalloc; frozen values shared with the instrument); older ones are dropped (assumed: a
+#: trainee undoes a few moves, not a stage's hundreds).
 UNDO_DEPTH = 500
 
 
