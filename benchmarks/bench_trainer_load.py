@@ -26,9 +26,16 @@ and ``--abuse-patchers`` clients fetch patches as fast as they are answered. Pri
 phase's round trip (median, p95) and patch median, what the abuser got served, and how its
 socket attempts ended: refused at the handshake (its address's connection rate), refused after
 the key (its session's), or accepted (and then replaced by a newer socket of the session, or
-closed otherwise).
+closed otherwise). It also prints the CPU time of the two client processes (the honest
+trainees' in each phase, the abuser's): on the server's own machine their work takes the
+server's processors, which a class's clients on their own machines would not.
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20]
+
+``--action-cost``: no server; the CPU time of one honest turn (action and reply JSON) in this
+process, and the garbage collector's full pass over the server's start-up objects.
+
+    PYTHONPATH=. python benchmarks/bench_trainer_load.py --action-cost [--turns 3000]
 """
 
 from __future__ import annotations
@@ -322,7 +329,9 @@ async def _abuse(host: str, stop: float, sockets: int, sessions: int, patchers: 
 
 def _abuser_process(host, stop_in, sockets, sessions, patchers, queue) -> None:
     stop = time.monotonic() + stop_in
-    queue.put(asyncio.run(_abuse(host, stop, sockets, sessions, patchers)))
+    got = asyncio.run(_abuse(host, stop, sockets, sessions, patchers))
+    got["cpu_s"] = time.process_time()  # the abuser client's own CPU, taken from the server's
+    queue.put(got)
 
 
 def _summary(name: str, rtt: list[float], patches: list[float]) -> str:
@@ -359,15 +368,18 @@ async def abuse_async(args) -> None:
                     abuser.start()
                     await asyncio.sleep(2.0)  # the abuser's sockets open first
                     stop = time.monotonic() + args.seconds
+                cpu = time.process_time()
                 await asyncio.gather(*(
                     honest(host, n + (100 if phase == "abuse" else 0), stop, rtt,
                            patches if n == 0 else None, 1 / args.rate)
                     for n in range(args.trainees)))
+                cpu = time.process_time() - cpu  # the honest clients' own CPU in the phase
                 if abuser is not None:
                     results["abuser"] = queue.get(timeout=60)
                     abuser.join(30)
                 results[phase] = (rtt, patches)
-                print(_summary(phase, rtt, patches), flush=True)
+                print(f"{_summary(phase, rtt, patches)}; the honest clients' CPU {cpu:.1f} s",
+                      flush=True)
         finally:
             proc.terminate()
             try:
@@ -384,7 +396,8 @@ async def abuse_async(args) -> None:
           f"accepted {a['accepted']} (of which replaced by a newer socket {a['replaced']}, "
           f"closed otherwise {a['closed_other']}), failed to open {a['failed_open']}; "
           f"patches {a['patches']} served, "
-          f"{a['patches_refused']} refused")
+          f"{a['patches_refused']} refused; the abuser client's CPU "
+          f"{a.get('cpu_s', math.nan):.1f} s")
     print(f"patch median under abuse / idle: {abuse_patch / idle_patch:.2f} "
           f"(os.cpu_count() = {os.cpu_count()}, 1-minute load average at the end "
           f"{os.getloadavg()[0]:.1f})")
@@ -467,6 +480,47 @@ async def main_async(args) -> None:
     )
 
 
+def action_cost(turns: int) -> None:
+    """In this process, no server: the CPU time of an honest trainee's turn (the session's
+    action and the reply's JSON, what the server's threads compute for it), best of 5; and the
+    garbage collector's full pass over what the server's start-up builds, before and after
+    ``gc.freeze()`` (what ``stereoplotter trainer`` does before serving)."""
+    import gc
+
+    from stereoplotter.io.exercise_file import load_exercise
+    from stereoplotter.trainer.session import Session
+    from stereoplotter.web.app import create_app
+
+    session = Session.start(load_exercise("e01-setup-stage1"), trainee="cost", seed=1)
+    session.act({"kind": "set", "control": "f_instrument", "value": 120.0, "t": 0})
+    runs = []
+    for _ in range(5):
+        t0 = time.process_time()
+        for i in range(turns):
+            state = session.act({"kind": "turn", "control": "X",
+                                 "delta": 0.05 if i % 2 else -0.05, "t": i * 0.1})
+            json.dumps({"state": state, "error": None, "n": len(session.log)}, allow_nan=False)
+        runs.append((time.process_time() - t0) / turns * 1e3)
+    print(f"an honest turn: CPU {min(runs):.3f} ms (best of 5 × {turns}; all "
+          f"{', '.join(f'{r:.3f}' for r in runs)})")
+    del session
+    with tempfile.TemporaryDirectory() as data:
+        create_app("cost-token-0123456789", data, processes=False, prepare_photos=False)
+
+        def full_pass() -> float:
+            t0 = time.process_time()
+            gc.collect()
+            return (time.process_time() - t0) * 1e3
+
+        tracked = len(gc.get_objects())
+        before = min(full_pass() for _ in range(3))
+        gc.freeze()
+        after = min(full_pass() for _ in range(3))
+        gc.unfreeze()
+    print(f"after the server's start-up: {tracked} objects tracked by the garbage collector, a "
+          f"full pass {before:.1f} ms CPU; after gc.freeze() {after:.1f} ms")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--trainees", type=int, default=20)
@@ -493,7 +547,12 @@ def main() -> None:
         action="store_true",
         help="no first-view times (the photos are still prepared before the load)",
     )
+    ap.add_argument("--action-cost", action="store_true",
+                    help="no server: the CPU time of one honest turn, the collector's full pass")
+    ap.add_argument("--turns", type=int, default=3000, help="turns timed by --action-cost")
     args = ap.parse_args()
+    if args.action_cost:
+        return action_cost(args.turns)
     asyncio.run(abuse_async(args) if args.abuser else main_async(args))
 
 

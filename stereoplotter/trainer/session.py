@@ -78,8 +78,9 @@ LOG_FORMAT = "stereoplotter-session/1"
 #: The stages that use the six standard points: an incomplete model's substitutes are recorded
 #: before they are claimed.
 SUBSTITUTE_STAGES = ("2", "C2")
-#: Undo steps kept (each about 16 kB: a copy of the instrument, measured on e08); older ones
-#: are dropped (assumed: a trainee undoes a few moves, not a stage's hundreds).
+#: Undo steps kept (each about 8 kB: a copy of the instrument's state, measured on e08 with
+#: tracemalloc; frozen values shared with the instrument); older ones are dropped (assumed: a
+#: trainee undoes a few moves, not a stage's hundreds).
 UNDO_DEPTH = 500
 
 
@@ -136,9 +137,10 @@ class Session:
         self.progress: dict[str, Any] = {}
         #: What the last action moved that it did not name (coupled motions), with a reason.
         self.events: list[dict[str, Any]] = []
-        #: The state after the last action, keyed by the log's length: the next action's "before"
-        #: (the state changes only by acting; building it twice per action was half the time).
-        self._last_state: tuple[int, dict[str, Any]] | None = None
+        #: The state after the last action and its digest, keyed by the log's length: the next
+        #: action's "before" (the state changes only by acting; building it twice per action
+        #: was half the time).
+        self._last_state: tuple[int, dict[str, Any], str] | None = None
         self._rules: dict[str, list[dict[str, Any]]] = {}  # stage → its steps' tick rules
         self._target_points: dict[str, dict[Any, Any]] = {}  # stage → the points its steps read
         for stage in exercise.preset_stages:
@@ -462,15 +464,16 @@ class Session:
             view["controls"] = _scales_as_shown(full["controls"])
         return view
 
-    def full_state(self) -> dict[str, Any]:
+    def full_state(self, counters: dict[str, Any] | None = None) -> dict[str, Any]:
         """The session's whole state, the exact marks included: what the log's digests and
-        its claim records hold (the log is given once every stage is claimed)."""
+        its claim records hold (the log is given once every stage is claimed). ``counters``:
+        :meth:`_counters` of the session as it stands, when the caller has it already."""
         return json_finite(
             {
                 "instrument": self.exercise.spec.key,
                 "stage": self.stage,
                 "step": self.stage,
-                "counters": self._counters(),
+                "counters": self._counters() if counters is None else counters,
                 "controls": self._controls(),
                 "marks": self._marks(),
                 "parallax": self._parallax(),
@@ -509,7 +512,7 @@ class Session:
             _copy_instrument(self.inst),
             dict(self.commanded),
             list(self.locked),
-            copy.deepcopy(self.records),
+            _state_copy(self.records, {}),
             self.stage_index,
             list(self.claimed),
             dict(self.at_claim),
@@ -535,14 +538,18 @@ class Session:
         """
         t = self._now(action) if isinstance(action, dict) else 0.0
         last = self._last_state
-        before = last[1] if last is not None and last[0] == len(self.log) else self.full_state()
+        if last is not None and last[0] == len(self.log):
+            before, before_digest = last[1], last[2]
+        else:
+            before = self.full_state()
+            before_digest = state_digest(before)
         clean = {k: v for k, v in action.items() if k != "t"} if isinstance(action, dict) else {}
         record: dict[str, Any] = {
             "n": len(self.log) + 1,
             "t": t,
             "stage": self.stage,
             "action": clean,
-            "state_before": state_digest(before),
+            "state_before": before_digest,
         }
         self.events = []
         try:
@@ -553,20 +560,21 @@ class Session:
                 xy = None if marks is None else [marks["left"]["x_mm"], marks["left"]["y_mm"]]
                 targets = self._targets(record["stage"])
                 note_progress(self.progress, record["stage"], clean, xy, targets)
-            self.events = coupled_motion(clean, before["counters"], self._counters())
+            counters = self._counters()
+            self.events = coupled_motion(clean, before["counters"], counters)
         except TrainerError as exc:
             record["refused"] = str(exc)
             after = self.full_state()
             record["state_after"] = state_digest(after)
             self.log.append(record)
-            self._last_state = (len(self.log), dict(after))
+            self._last_state = (len(self.log), dict(after), record["state_after"])
             raise
-        after = self.full_state()
+        after = self.full_state(counters)
         record["state_after"] = state_digest(after)
         if clean["kind"] == "claim":
             record["state"] = after
         self.log.append(record)
-        self._last_state = (len(self.log), dict(after))
+        self._last_state = (len(self.log), dict(after), record["state_after"])
         return self.trainee_view(after)
 
     def _do(self, action: dict[str, Any], before: dict[str, Any]) -> Any:
@@ -751,8 +759,77 @@ def json_finite(value: Any) -> Any:
 
 def _copy_instrument(inst: Instrument) -> Instrument:
     """A copy of the instrument's physical state (the spec and error model shared: frozen)."""
-    memo = {id(inst.spec): inst.spec, id(inst.errors): inst.errors}
-    return copy.deepcopy(inst, memo)
+    memo: dict[int, Any] = {id(inst.spec): inst.spec, id(inst.errors): inst.errors}
+    return _state_copy(inst, memo)
+
+
+#: Values :func:`_state_copy` hands on as they are (immutable).
+_ATOMIC = frozenset(
+    {type(None), bool, int, float, complex, str, bytes, np.float64, np.int64, np.bool_}
+)
+#: Type → how :func:`_state_copy` copies its instances: "shared" (a frozen dataclass, a value:
+#: the instrument changes one by building a new one, :func:`dataclasses.replace`), "plain" (its
+#: state is its ``__dict__`` alone) or "other" (``copy.deepcopy``); only this package's own
+#: types are shared or copied as plain.
+_HOW: dict[type, str] = {}
+
+
+def _state_copy(obj: Any, memo: dict[int, Any]) -> Any:
+    """``copy.deepcopy(obj, memo)`` for the plain state a session holds (dicts, lists, tuples,
+    arrays, objects with a ``__dict__``), an order of magnitude faster: what ``deepcopy``
+    reaches there through its generic reconstruction is built directly, and a frozen
+    dataclass of this package is shared instead of copied (nothing changes it in place).
+    Anything else (another package's type, an object with ``__slots__`` or its own copy or
+    pickling hooks, an array of objects) goes to
+    ``copy.deepcopy`` with the same memo, so aliasing inside ``obj`` is kept as ``deepcopy``
+    keeps it."""
+    cls = type(obj)
+    if cls in _ATOMIC:
+        return obj
+    done = memo.get(id(obj))
+    if done is not None:
+        return done
+    if cls is np.ndarray and obj.dtype != object:
+        out: Any = obj.copy()
+    elif cls is dict:
+        out = memo[id(obj)] = {}
+        for k, v in obj.items():
+            out[k] = _state_copy(v, memo)
+        return out
+    elif cls is list:
+        out = memo[id(obj)] = []
+        out.extend(_state_copy(v, memo) for v in obj)
+        return out
+    elif cls is tuple:
+        items = [_state_copy(v, memo) for v in obj]
+        out = obj if all(a is b for a, b in zip(items, obj, strict=True)) else tuple(items)
+    elif (how := _HOW.get(cls) or _how(cls)) == "shared":
+        out = obj
+    elif how == "plain":
+        out = memo[id(obj)] = object.__new__(cls)
+        out.__dict__.update({k: _state_copy(v, memo) for k, v in obj.__dict__.items()})
+        return out
+    else:
+        return copy.deepcopy(obj, memo)
+    memo[id(obj)] = out
+    return out
+
+
+def _how(cls: type) -> str:
+    params = getattr(cls, "__dataclass_params__", None)
+    hooks = ("__deepcopy__", "__copy__", "__reduce_ex__", "__reduce__", "__getstate__",
+             "__setstate__")
+    ours = cls.__module__.split(".")[0] == "stereoplotter"  # others' types: deepcopy
+    if ours and params is not None and params.frozen:
+        how = "shared"
+    elif ours and "__slots__" not in cls.__dict__ and all(
+        getattr(cls, h, None) is getattr(object, h, None) for h in hooks
+    ) and "__dict__" in dir(cls):
+        how = "plain"
+    else:
+        how = "other"
+    _HOW[cls] = how
+    return how
 
 
 def check_stage(name: str) -> str | None:

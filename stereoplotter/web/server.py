@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import socket
 import sqlite3
 import sys
@@ -36,6 +37,13 @@ def listen(host: str = "127.0.0.1", port: int = 0) -> socket.socket:
 #: Largest WebSocket frame read at all (a larger one closes the socket with 1009); frames over
 #: the protocol's own limit (guard.MAX_MESSAGE) are read and answered with an error. [bytes]
 WS_MAX_SIZE = 4 * 1024 * 1024
+#: How long a thread computing holds the interpreter's lock while another waits for it (Python's
+#: default: 5 ms). A trainee's action takes the lock three times after waiting for something
+#: (the event loop on the message, an actor thread on the job, the event loop on the answer),
+#: and each may wait this long behind a thread computing (another client's action): up to
+#: ~15 ms a round trip with the default. Measured on a loaded machine only
+#: (``bench_trainer_load.py --abuser``, single runs): see ``benchmarks/README.md``. [s]
+SWITCH_INTERVAL_S = 0.001
 
 
 def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
@@ -83,6 +91,10 @@ def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
         print(f"instructor page: {base}/instructor?token=… (the token printed when it was made; "
               "a new one: --rotate-token)", flush=True)
     print(f"data folder:     {folder}", flush=True)
+    # what start-up built (modules, the exercise catalogue, the app) lives as long as the
+    # server: the cyclic garbage collector's full passes no longer walk it
+    gc.freeze()
+    sys.setswitchinterval(SWITCH_INTERVAL_S)
     uvicorn.Server(uvicorn_config(app, public_url, trusted_proxies)).run(sockets=[sock])
 
 

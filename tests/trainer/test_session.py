@@ -157,3 +157,43 @@ def test_a_hint_lists_the_operators_steps_of_the_stage(stage1):
     assert steps == list(dict.fromkeys(s for s in transcript if s in steps))
     assert set(steps) <= set(transcript)
     assert steps  # (the texts are the procedure's labels: not pinned here)
+
+
+def test_undo_and_redo_walk_back_and_forth_through_the_states_each_action_left():
+    """Every kind of state an action changes (screws with play, κ, decentrations, knobs, f_пр,
+    a lock, a record, a claim with its copy of the instrument) comes back exactly on undo, and
+    again on redo: each state compared with the one the session showed when it got there."""
+    s = Session.start(load_exercise("e08-setup-full"), trainee="ann")
+    s.act({"kind": "hint", "level": 3})  # the operator's stage 1 applied: not undoable itself
+    actions = [
+        {"kind": "set", "control": "f_instrument", "value": 120.0},
+        {"kind": "turn", "control": "X", "delta": 3.0},
+        {"kind": "turn", "control": "X", "delta": -1.0},  # reversal: the nut takes up its play
+        {"kind": "set", "control": "kappa_left", "value": 0.002},
+        {"kind": "turn", "control": "dx_right", "delta": 0.5},
+        {"kind": "set", "control": "k_omega_left", "value": 0.001},
+        {"kind": "turn", "control": "bz", "delta": -0.4},
+        {"kind": "record", "name": "note", "value": [1.0, 2.0]},
+        {"kind": "lock", "control": "by"},
+        {"kind": "claim", "step": "1"},
+        {"kind": "turn", "control": "Y", "delta": 2.0},
+    ]
+    seen = [s.full_state()]
+    for action in actions:
+        s.act(action)
+        seen.append(s.full_state())
+    checked = len(seen) - 1
+    for k in range(checked):
+        s.act({"kind": "undo"})
+        assert _undoable_part(s.full_state()) == _undoable_part(seen[-2 - k])
+    assert "undo" not in s.allowed()
+    for k in range(checked):
+        s.act({"kind": "redo"})
+        assert _undoable_part(s.full_state()) == _undoable_part(seen[1 + k])
+    assert s.at_claim["1"] is not s.inst
+
+
+def _undoable_part(state):
+    """A state without what undo leaves as it is (the checklist's ticks, the last action's
+    coupled motions) and what follows from the stacks (the actions allowed)."""
+    return {k: v for k, v in state.items() if k not in ("checklist_ticks", "events", "allowed")}
