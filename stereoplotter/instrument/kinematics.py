@@ -718,10 +718,22 @@ def marks_from_counters(
     out = []
     for side, unit in (("left", left), ("right", right)):
         # rod_from_counters, then photo_from_rod: the rod not stacked into pairs in between
-        sx, sy, n = rod_frame(setting, side, depth_mm)
-        xi, eta = (_a(x_mm) - sx) / n, (_a(y_mm) - sy) / n
-        out.append(_pair(*UnitMap(unit).photo_xy(xi, eta)))
+        sx, sy, sz = setting.pivot(side)
+        f = _a(setting.f_instrument_mm)
+        args = (_a(x_mm), _a(y_mm), _a(depth_mm), sx, sy, sz, f, *_map_fields(UnitMap(unit)))
+        out.append(_pair(*_rowwise(_photo_of_counters, args, 2)))
     return out[0], out[1]
+
+
+def _map_fields(m: UnitMap) -> tuple[Any, ...]:
+    """The fields of a map in the order of :func:`_photo_xy`'s arguments after ξ, η."""
+    return (m.f, m.ta, m.to, m.kx, m.ky, m.num, m.mech, m.ex, m.ey, m.c, m.s, m.ms)
+
+
+def _photo_of_counters(x, y, depth, sx, sy, sz, f_instrument, *fields):
+    """:func:`rod_frame`'s ξ, η of counters, then :func:`_photo_xy` (one side)."""
+    n = (depth + sz) / f_instrument
+    return _photo_xy((x - sx) / n, (y - sy) / n, *fields)
 
 
 def rods_intersection(
@@ -853,8 +865,27 @@ def counters_from_homologous_points(
     [45.0, 0.0, 130.0, 0.0]
     """
     pl, pr = _a(photo_left_mm), _a(photo_right_mm)
-    return rods_intersection_xy(  # rod_from_photo of each photo, not stacked into pairs
-        UnitMap(left).rod_xy(pl[..., 0], pl[..., 1]),
-        UnitMap(right).rod_xy(pr[..., 0], pr[..., 1]),
-        setting,
-    )
+    # rod_from_photo of each photo (not stacked into pairs), then rods_intersection_xy
+    sides = [(p[..., 0], p[..., 1], *_rod_fields(UnitMap(u))) for p, u in ((pl, left), (pr, right))]
+    f = _a(setting.f_instrument_mm)
+    bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
+    ox, oy = _a(setting.model_origin_x_mm), _a(setting.model_origin_y_mm)
+    args = (*sides[0], *sides[1], f, bx, by, bz, ox, oy)
+    return StereoReading(*np.broadcast_arrays(*_rowwise(_homologous, args, 4)))
+
+
+def _rod_fields(m: UnitMap) -> tuple[Any, ...]:
+    """The fields of a map in the order of :func:`_rod_xy`'s arguments after x, y."""
+    return (m.c, m.s, m.ex, m.ey, m.mech, m.f, m.ta, m.to, m.kx, m.ky, m.num)
+
+
+def _homologous(*args):
+    """X, Y, D and q of :func:`counters_from_homologous_points` from the photo points and the
+    two maps' fields (13 arguments a side, :func:`_rod_xy`'s) and f_пр, b_x, b_y, b_z, MO_X,
+    MO_Y: :func:`_rod_xy` of each side, then :func:`rods_intersection_xy`'s arithmetic."""
+    xi_l, eta_l = _rod_xy(*args[:13])
+    xi_r, eta_r = _rod_xy(*args[13:26])
+    f, bx, by, bz, ox, oy = args[26:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_l, y_l, y_r, q = _ray_arithmetic(xi_l, eta_l, xi_r, eta_r, f, bx, by, bz)
+    return ox + t_l * xi_l, oy + 0.5 * (y_l + y_r), t_l * f, q
