@@ -146,6 +146,10 @@ def _pair(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]
 ROWS_BLOCK_ELEMENTS = 1 << 14
 
 
+def _ndim(value: Any) -> int:
+    return getattr(value, "ndim", 0)
+
+
 def _rowwise(fn: Any, args: tuple[Any, ...], outputs: int) -> tuple[NDArray[np.float64], ...]:
     """``fn(*args)`` — ``outputs`` arrays, each element from the same elements of ``args`` by
     IEEE arithmetic (+, −, ×, ÷) alone — evaluated a block of leading rows at a time where the
@@ -520,7 +524,10 @@ class UnitMap:
     def photo_xy(self, xi: ArrayLike, eta: ArrayLike) -> tuple[NDArray, NDArray]:
         """:func:`photo_from_rod` on separate ξ, η arrays, returning (x, y) separately."""
         args = (xi, eta, self.f, self.ta, self.to, self.kx, self.ky, self.num, self.mech)
-        return _rowwise(_photo_xy, (*args, self.ex, self.ey, self.c, self.s, self.ms), 2)
+        args = (*args, self.ex, self.ey, self.c, self.s, self.ms)
+        if _ndim(xi) < 2 and _ndim(self.c) < 2:  # no (trials × points) grid: at once
+            return _photo_xy(*args)
+        return _rowwise(_photo_xy, args, 2)
 
     def photo_from_rod(self, rod_mm: ArrayLike) -> NDArray[np.float64]:
         """See :func:`photo_from_rod`."""
@@ -530,7 +537,10 @@ class UnitMap:
     def rod_xy(self, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """:func:`rod_from_photo` on separate x, y arrays, returning (ξ, η) separately."""
         args = (x, y, self.c, self.s, self.ex, self.ey, self.mech, self.f, self.ta, self.to)
-        return _rowwise(_rod_xy, (*args, self.kx, self.ky, self.num), 2)
+        args = (*args, self.kx, self.ky, self.num)
+        if _ndim(x) < 2 and _ndim(self.c) < 2:  # no (trials × points) grid: at once
+            return _rod_xy(*args)
+        return _rowwise(_rod_xy, args, 2)
 
     def rod_from_photo(self, photo_mm: ArrayLike) -> NDArray[np.float64]:
         """See :func:`rod_from_photo`."""
@@ -794,8 +804,11 @@ def _rays(xi_l, eta_l, xi_r, eta_r, setting: InstrumentSetting):
     """t_л, the two ray heights y_л, y_п and q of :func:`rods_intersection` (§3.4, "stereo")."""
     f = _a(setting.f_instrument_mm)
     bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
+    args = (xi_l, eta_l, xi_r, eta_r, f, bx, by, bz)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return _rowwise(_ray_arithmetic, (xi_l, eta_l, xi_r, eta_r, f, bx, by, bz), 4)
+        if _ndim(xi_l) < 2 and _ndim(xi_r) < 2:  # no (trials × points) grid: at once
+            return _ray_arithmetic(*args)
+        return _rowwise(_ray_arithmetic, args, 4)
 
 
 def _ray_arithmetic(xi_l, eta_l, xi_r, eta_r, f, bx, by, bz):
