@@ -141,6 +141,47 @@ def _pair(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]
     return out
 
 
+#: Elements of one block of rows when an element-wise map is evaluated on a large broadcast (a
+#: convention: the block's dozen temporaries, 8 bytes an element, stay in a core's cache). [—]
+ROWS_BLOCK_ELEMENTS = 1 << 14
+
+
+def _ndim(value: Any) -> int:
+    return getattr(value, "ndim", 0)
+
+
+def _rowwise(fn: Any, args: tuple[Any, ...], outputs: int) -> tuple[NDArray[np.float64], ...]:
+    """``fn(*args)`` — ``outputs`` arrays, each element from the same elements of ``args`` by
+    IEEE arithmetic (+, −, ×, ÷) alone — evaluated a block of leading rows at a time where the
+    arrays broadcast to more than two blocks of :data:`ROWS_BLOCK_ELEMENTS` over two or more
+    axes (the per-trial maps of a (T, points) grid): the same numbers, each rounded alike in any
+    block, with the temporaries in cache instead of main memory. ``None`` and scalars pass.
+
+    Examples
+    --------
+    >>> a = np.linspace(0.0, 1.0, 50_000).reshape(2500, 20)
+    >>> b = np.linspace(1.0, 3.0, 20)
+    >>> fn = lambda u, v: (u * v + 1.0, u / v)
+    >>> all(np.array_equal(p, q) for p, q in zip(_rowwise(fn, (a, b), 2), fn(a, b)))
+    True
+    """
+    if not any(getattr(a, "ndim", 0) >= 2 for a in args):
+        return tuple(fn(*args))
+    shape = np.broadcast_shapes(*(np.shape(a) for a in args if a is not None))
+    size = int(np.prod(shape))
+    if size <= 2 * ROWS_BLOCK_ELEMENTS:
+        return tuple(fn(*args))
+    rows = max(1, ROWS_BLOCK_ELEMENTS * shape[0] // size)
+    lead = len(shape)
+    cut = [isinstance(a, np.ndarray) and a.ndim == lead and a.shape[0] == shape[0] for a in args]
+    out = tuple(np.empty(shape) for _ in range(outputs))
+    for r in range(0, shape[0], rows):
+        part = fn(*(a[r : r + rows] if c else a for a, c in zip(args, cut, strict=True)))
+        for o, v in zip(out, part, strict=True):
+            o[r : r + rows] = v
+    return out
+
+
 @dataclass(frozen=True, slots=True)
 class CorrectionUnit:
     r"""State of the correction unit of one photo (``kinematics.md`` §3.2).
@@ -482,19 +523,11 @@ class UnitMap:
 
     def photo_xy(self, xi: ArrayLike, eta: ArrayLike) -> tuple[NDArray, NDArray]:
         """:func:`photo_from_rod` on separate ξ, η arrays, returning (x, y) separately."""
-        f, ta, to = self.f, self.ta, self.to
-        if self.strict:
-            u = xi * self.kx / (f + xi * ta)
-            v = eta * self.ky / (f + eta * to)
-        else:
-            tau = self.num / (f + xi * ta + eta * to)
-            u, v = tau * xi, tau * eta
-        if self.mech is not None:
-            u, v = self.mech * u, self.mech * v
-        u = u - self.ex
-        v = v - self.ey
-        c = self.c
-        return c * u + self.s * v, self.ms * u + c * v
+        args = (xi, eta, self.f, self.ta, self.to, self.kx, self.ky, self.num, self.mech)
+        args = (*args, self.ex, self.ey, self.c, self.s, self.ms)
+        if _ndim(xi) < 2 and _ndim(self.c) < 2:  # no (trials × points) grid: at once
+            return _photo_xy(*args)
+        return _rowwise(_photo_xy, args, 2)
 
     def photo_from_rod(self, rod_mm: ArrayLike) -> NDArray[np.float64]:
         """See :func:`photo_from_rod`."""
@@ -503,21 +536,43 @@ class UnitMap:
 
     def rod_xy(self, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """:func:`rod_from_photo` on separate x, y arrays, returning (ξ, η) separately."""
-        c, s = self.c, self.s
-        px = c * x - s * y + self.ex
-        py = s * x + c * y + self.ey
-        if self.mech is not None:
-            px, py = px / self.mech, py / self.mech
-        f, ta, to = self.f, self.ta, self.to
-        if self.strict:
-            return px * f / (self.kx - px * ta), py * f / (self.ky - py * to)
-        tau = (self.num - px * ta - py * to) / f
-        return px / tau, py / tau
+        args = (x, y, self.c, self.s, self.ex, self.ey, self.mech, self.f, self.ta, self.to)
+        args = (*args, self.kx, self.ky, self.num)
+        if _ndim(x) < 2 and _ndim(self.c) < 2:  # no (trials × points) grid: at once
+            return _rod_xy(*args)
+        return _rowwise(_rod_xy, args, 2)
 
     def rod_from_photo(self, photo_mm: ArrayLike) -> NDArray[np.float64]:
         """See :func:`rod_from_photo`."""
         p = _a(photo_mm)
         return _pair(*self.rod_xy(p[..., 0], p[..., 1]))
+
+
+def _photo_xy(xi, eta, f, ta, to, kx, ky, num, mech, ex, ey, c, s, ms):
+    """:meth:`UnitMap.photo_xy`'s arithmetic on its fields (``kx`` None: not strict per axis)."""
+    if kx is not None:
+        u = xi * kx / (f + xi * ta)
+        v = eta * ky / (f + eta * to)
+    else:
+        tau = num / (f + xi * ta + eta * to)
+        u, v = tau * xi, tau * eta
+    if mech is not None:
+        u, v = mech * u, mech * v
+    u = u - ex
+    v = v - ey
+    return c * u + s * v, ms * u + c * v
+
+
+def _rod_xy(x, y, c, s, ex, ey, mech, f, ta, to, kx, ky, num):
+    """:meth:`UnitMap.rod_xy`'s arithmetic on its fields (``kx`` None: not strict per axis)."""
+    px = c * x - s * y + ex
+    py = s * x + c * y + ey
+    if mech is not None:
+        px, py = px / mech, py / mech
+    if kx is not None:
+        return px * f / (kx - px * ta), py * f / (ky - py * to)
+    tau = (num - px * ta - py * to) / f
+    return px / tau, py / tau
 
 
 # --------------------------------------------------------------------------------------------
@@ -673,10 +728,22 @@ def marks_from_counters(
     out = []
     for side, unit in (("left", left), ("right", right)):
         # rod_from_counters, then photo_from_rod: the rod not stacked into pairs in between
-        sx, sy, n = rod_frame(setting, side, depth_mm)
-        xi, eta = (_a(x_mm) - sx) / n, (_a(y_mm) - sy) / n
-        out.append(_pair(*UnitMap(unit).photo_xy(xi, eta)))
+        sx, sy, sz = setting.pivot(side)
+        f = _a(setting.f_instrument_mm)
+        args = (_a(x_mm), _a(y_mm), _a(depth_mm), sx, sy, sz, f, *_map_fields(UnitMap(unit)))
+        out.append(_pair(*_rowwise(_photo_of_counters, args, 2)))
     return out[0], out[1]
+
+
+def _map_fields(m: UnitMap) -> tuple[Any, ...]:
+    """The fields of a map in the order of :func:`_photo_xy`'s arguments after ξ, η."""
+    return (m.f, m.ta, m.to, m.kx, m.ky, m.num, m.mech, m.ex, m.ey, m.c, m.s, m.ms)
+
+
+def _photo_of_counters(x, y, depth, sx, sy, sz, f_instrument, *fields):
+    """:func:`rod_frame`'s ξ, η of counters, then :func:`_photo_xy` (one side)."""
+    n = (depth + sz) / f_instrument
+    return _photo_xy((x - sx) / n, (y - sy) / n, *fields)
 
 
 def rods_intersection(
@@ -737,12 +804,19 @@ def _rays(xi_l, eta_l, xi_r, eta_r, setting: InstrumentSetting):
     """t_л, the two ray heights y_л, y_п and q of :func:`rods_intersection` (§3.4, "stereo")."""
     f = _a(setting.f_instrument_mm)
     bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
+    args = (xi_l, eta_l, xi_r, eta_r, f, bx, by, bz)
     with np.errstate(divide="ignore", invalid="ignore"):
-        t_l = (bx + xi_r * bz / f) / (xi_l - xi_r)
-        t_r = t_l + bz / f
-        y_l = t_l * eta_l
-        y_r = by + t_r * eta_r
-        q = (y_l - y_r) / t_l
+        if _ndim(xi_l) < 2 and _ndim(xi_r) < 2:  # no (trials × points) grid: at once
+            return _ray_arithmetic(*args)
+        return _rowwise(_ray_arithmetic, args, 4)
+
+
+def _ray_arithmetic(xi_l, eta_l, xi_r, eta_r, f, bx, by, bz):
+    t_l = (bx + xi_r * bz / f) / (xi_l - xi_r)
+    t_r = t_l + bz / f
+    y_l = t_l * eta_l
+    y_r = by + t_r * eta_r
+    q = (y_l - y_r) / t_l
     return t_l, y_l, y_r, q
 
 
@@ -804,8 +878,27 @@ def counters_from_homologous_points(
     [45.0, 0.0, 130.0, 0.0]
     """
     pl, pr = _a(photo_left_mm), _a(photo_right_mm)
-    return rods_intersection_xy(  # rod_from_photo of each photo, not stacked into pairs
-        UnitMap(left).rod_xy(pl[..., 0], pl[..., 1]),
-        UnitMap(right).rod_xy(pr[..., 0], pr[..., 1]),
-        setting,
-    )
+    # rod_from_photo of each photo (not stacked into pairs), then rods_intersection_xy
+    sides = [(p[..., 0], p[..., 1], *_rod_fields(UnitMap(u))) for p, u in ((pl, left), (pr, right))]
+    f = _a(setting.f_instrument_mm)
+    bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
+    ox, oy = _a(setting.model_origin_x_mm), _a(setting.model_origin_y_mm)
+    args = (*sides[0], *sides[1], f, bx, by, bz, ox, oy)
+    return StereoReading(*np.broadcast_arrays(*_rowwise(_homologous, args, 4)))
+
+
+def _rod_fields(m: UnitMap) -> tuple[Any, ...]:
+    """The fields of a map in the order of :func:`_rod_xy`'s arguments after x, y."""
+    return (m.c, m.s, m.ex, m.ey, m.mech, m.f, m.ta, m.to, m.kx, m.ky, m.num)
+
+
+def _homologous(*args):
+    """X, Y, D and q of :func:`counters_from_homologous_points` from the photo points and the
+    two maps' fields (13 arguments a side, :func:`_rod_xy`'s) and f_пр, b_x, b_y, b_z, MO_X,
+    MO_Y: :func:`_rod_xy` of each side, then :func:`rods_intersection_xy`'s arithmetic."""
+    xi_l, eta_l = _rod_xy(*args[:13])
+    xi_r, eta_r = _rod_xy(*args[13:26])
+    f, bx, by, bz, ox, oy = args[26:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_l, y_l, y_r, q = _ray_arithmetic(xi_l, eta_l, xi_r, eta_r, f, bx, by, bz)
+    return ox + t_l * xi_l, oy + 0.5 * (y_l + y_r), t_l * f, q

@@ -558,8 +558,11 @@ class Instrument:
             return False
         scale = self._scales[control]
         zero, gain = scale.zero, scale.gain
+        every = bool(np.all(active))  # then the error is the difference itself (no np.where)
         for _ in range(passes):
-            err = np.where(active, target - axis.position_view, 0.0)
+            err = target - axis.position_view
+            if not every:
+                err = np.where(active, err, 0.0)
             reading = np.asarray(zero + gain * axis.nut_view) + err  # the exact reading + error
             cmd = limit(reading)
             nut = (cmd - zero) / gain  # Scale.position

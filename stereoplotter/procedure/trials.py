@@ -49,6 +49,7 @@ __all__ = [
     "summarise_columns",
     "summarise_result",
     "trial_columns",
+    "worker_tasks",
 ]
 
 #: Peak working memory per trial of one chunk (simulation and evaluation), rounded up for
@@ -144,15 +145,46 @@ def split_chunk(trials: int, chunk_trials: int, workers: int) -> int:
 #: The prepared run of the forked chunk workers (set before the pool forks).
 _PREPARED: list[tuple[PreparedRun, bool]] = []
 
-#: Chunks a worker process has queued or done ahead of the one this process yields (a
+#: Tasks a worker process has queued or done ahead of the one this process yields (a
 #: convention: two keep a worker busy while this process hands a chunk's columns on; more only
-#: hold more finished columns here). [chunks]
+#: hold more finished columns here). [tasks]
 QUEUED_PER_WORKER = 2
 
+#: Most trials of one worker's task of consecutive chunks, where the chunks do not start on a
+#: keyed block (a convention: this process may hold the columns of the tasks queued ahead,
+#: ≈ 20 MB a task at ≈ 100 columns). [trials]
+TASK_TRIALS = 24_000
 
-def _chunk_columns(first: int, n: int) -> dict[str, NDArray[Any]]:
+
+def _chunk_columns(chunks: list[tuple[int, int]]) -> list[dict[str, NDArray[Any]]]:
     prep, evaluate = _PREPARED[0]
-    return _columns_here(prep, first, n, evaluate)
+    return [_columns_here(prep, first, n, evaluate) for first, n in chunks]
+
+
+def worker_tasks(count: int, chunk_trials: int, processes: int) -> list[list[int]]:
+    """The chunks after the first (1 … count − 1) as the workers' tasks, in order: one chunk a
+    task where chunks start on a keyed block (:data:`~stereoplotter.random_streams.BLOCK`), else
+    runs of consecutive chunks, up to :data:`TASK_TRIALS` trials and no more than an even share
+    of the processes. A chunk that starts inside a block goes on with the generator the chunk
+    before left (``random_streams.keyed_standard_normal``) only in the process that ran that
+    chunk: in another it draws the block's prefix again, on every stream (≈ 10 % of a chunk of
+    the setup method); within a task it never does.
+
+    Examples
+    --------
+    >>> worker_tasks(13, 8000, 2)  # the setup method's chunks at 10⁵ trials
+    [[1, 2, 3], [4, 5, 6], [7, 8, 9], [10, 11, 12]]
+    >>> worker_tasks(9, 12288, 2)  # whole blocks: a chunk a task
+    [[1], [2], [3], [4], [5], [6], [7], [8]]
+    >>> worker_tasks(4, 8000, 2)
+    [[1, 2], [3]]
+    """
+    chunks = list(range(1, count))
+    if chunk_trials % BLOCK == 0 or not chunks:
+        return [[k] for k in chunks]
+    share = -(-len(chunks) // max(1, processes))
+    size = max(1, min(share, TASK_TRIALS // chunk_trials))
+    return [chunks[i : i + size] for i in range(0, len(chunks), size)]
 
 
 def iter_chunk_columns(
@@ -169,10 +201,11 @@ def iter_chunk_columns(
     :func:`trial_columns`.
 
     With ``workers`` > 1 the chunks after the first run in that many forked processes, each
-    given the next chunk in trial order and at most :data:`QUEUED_PER_WORKER` ahead of the one
-    yielded, while this process runs the first and then only collects: it holds the columns of
-    a fixed number of chunks, never a share of the run, so its memory does not grow with the
-    trials (the forked processes keep the cores busy). ``progress`` counts each chunk when it
+    given the next task of :func:`worker_tasks` in trial order and at most
+    :data:`QUEUED_PER_WORKER` ahead of the one yielded, while this process runs the first and
+    then only collects: it holds the columns of a fixed number of tasks, never a share of the
+    run, so its memory does not grow with the trials (the forked processes keep the cores
+    busy). ``progress`` counts each chunk when it
     is yielded. Every draw is keyed by the trial, so the columns are the same whatever the
     workers and the chunks.
     """
@@ -184,26 +217,29 @@ def iter_chunk_columns(
     sizes = [min(chunk_trials, trials - f) for f in starts]
     count = len(starts)
     pool = None
+    tasks: list[list[int]] = []
     if workers > 1 and count > 1 and "fork" in multiprocessing.get_all_start_methods():
         _PREPARED[:] = [(prep, evaluate)]  # inherited by the forked workers
         context = multiprocessing.get_context("fork")
         processes = min(workers, count - 1)
         pool = ProcessPoolExecutor(max_workers=processes, mp_context=context)
         depth = QUEUED_PER_WORKER * processes
-    given: dict[int, Future[Any]] = {}  # each chunk after the first: its worker's columns
-    given_next = 1  # the first chunk not yet given to a process
+        tasks = worker_tasks(count, chunk_trials, processes)
+    task_of = {k: j for j, task in enumerate(tasks) for k in task}
+    given: dict[int, Future[Any]] = {}  # each task given to a process: its chunks' columns
+    done: dict[int, dict[str, NDArray[Any]]] = {}  # columns of a finished task, not yet yielded
+    given_next = 0  # the first task not yet given to a process
 
     def give_workers(yielding: int) -> None:
         nonlocal given_next
-        while given_next < count and given_next - yielding < depth:
-            given[given_next] = cast(ProcessPoolExecutor, pool).submit(
-                _chunk_columns, starts[given_next], sizes[given_next]
-            )
+        while given_next < len(tasks) and given_next - yielding < depth:
+            chunks = [(starts[k], sizes[k]) for k in tasks[given_next]]
+            given[given_next] = cast(ProcessPoolExecutor, pool).submit(_chunk_columns, chunks)
             given_next += 1
 
     try:
         if pool is not None:
-            give_workers(1)
+            give_workers(0)
         result = run_trials_chunk(prep, 0, sizes[0], evaluate=evaluate, transcript=True)
         yield result, trial_columns(result)
         del result  # the caller keeps what it needs of the first chunk
@@ -213,8 +249,11 @@ def iter_chunk_columns(
             if pool is None:
                 columns = _columns_here(prep, starts[k], sizes[k], evaluate)
             else:
-                give_workers(k)
-                columns = given.pop(k).result()
+                if k not in done:
+                    j = task_of[k]
+                    give_workers(j)
+                    done.update(zip(tasks[j], given.pop(j).result(), strict=True))
+                columns = done.pop(k)
             yield None, columns
             del columns
             if progress is not None:
