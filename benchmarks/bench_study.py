@@ -4,16 +4,19 @@ per worker, and a paper estimate of a 10⁸-procedure study on a cluster.
 python benchmarks/bench_study.py                      # 8 cells × 4000 trials, chunks of 1000
 python benchmarks/bench_study.py --trials 2000 --chunk 1000 --cells 4
 python benchmarks/bench_study.py --warm               # the cluster started before the clock
+python benchmarks/bench_study.py --timeline           # where the runs on Dask spend their wall
 
 The study: the shipped formula-validity file on f = 70, 140 mm × overlap 60, 80 % (× α 0, 1°
 for 8 cells), SC-1, setup data, the chunked measures only (checks, y-parallax, heights, plan):
 cells·T/C chunk tasks of C trials each. Each configuration (serial; 1 worker; 2 workers) writes
 a fresh Zarr store. By default the clock includes the embedded cluster's start, as ``study
 run --workers N`` pays it (started by ``study.runner.start_local_client`` while the study is
-prepared); with ``--warm`` the cluster is started and the library loaded on every worker
-before the clock starts. CPU seconds: this process's during the run and the workers' whole
-lives (their start included unless ``--warm``), which a loaded machine stretches far less than
-the wall seconds. The Datasets of the three runs are compared bit for bit.
+prepared); the one-time imports of this process (dask.distributed, xarray, zarr, what a
+procedure loads at its first run) are done before any clock, so that no run pays one the others
+do not (``study run`` pays them once); with ``--warm`` the cluster is started and the library
+loaded on every worker before the clock starts. CPU seconds: this process's during the run and
+the workers' whole lives (their start included unless ``--warm``), which a loaded machine
+stretches far less than the wall seconds. The Datasets of the three runs are compared bit for bit.
 
 Peak memory per worker: the worker's maximum resident set size after the run (ru_maxrss), to be
 read against the chunk's budget (C × BYTES_PER_TRIAL of procedure.trials, plus the interpreter
@@ -77,6 +80,16 @@ def _warm() -> None:
     import stereoplotter.study.cells  # noqa: F401 - the library loaded before the clock starts
 
 
+def _load_before_clocks(out: Path) -> None:
+    """The one-time loads of this process before any clock, so that the three runs are timed
+    alike: dask.distributed (else only the first run on Dask, the 1-worker one, pays its import)
+    and what a study's first procedure loads (else only the serial run, the first, pays it).
+    A 4-cell study of 10 trials, serial."""
+    import distributed  # noqa: F401
+
+    run_into_store(study(10, 10, 4), "warm", str(out), None)
+
+
 def _start(workers: int):
     try:
         from stereoplotter.study.runner import start_local_client
@@ -87,7 +100,25 @@ def _start(workers: int):
     return start_local_client(workers, dashboard=False)
 
 
-def timed(data: dict, out: Path, workers: int | None, warm: bool):
+def _timeline(label: str, t0: float, up: float, end: float, stream: list) -> None:
+    """Where a run's wall time goes: the cluster up, each worker's first task, its busy time
+    (the sum of its tasks), its last task's end, the run's end (the last cell written)."""
+    print(f"  {label} timeline (s from the clock's start): cluster up {up - t0:.2f}, "
+          f"study returned {end - t0:.2f}")  # fmt: skip
+    by_worker: dict[str, list[tuple[float, float]]] = {}
+    for task in stream:
+        for s in task["startstops"]:
+            if s["action"] == "compute":
+                by_worker.setdefault(task["worker"], []).append((s["start"], s["stop"]))
+    for i, spans in enumerate(sorted(by_worker.values())):
+        busy = sum(b - a for a, b in spans)
+        first, last = min(a for a, _ in spans), max(b for _, b in spans)
+        gaps = last - first - busy
+        print(f"    worker {i}: {len(spans)} tasks, first start {first - t0:.2f}, last end "
+              f"{last - t0:.2f}, busy {busy:.2f}, idle between {gaps:.2f}")  # fmt: skip
+
+
+def timed(data: dict, out: Path, workers: int | None, warm: bool, timeline: bool = False):
     from stereoplotter.study.runner import local_client
 
     client = None
@@ -97,9 +128,19 @@ def timed(data: dict, out: Path, workers: int | None, warm: bool):
     try:
         t0 = time.perf_counter()
         c0 = time.process_time()
+        t0_epoch = time.time()
         if workers and not warm:
             client = _start(workers)
-        run_into_store(data, "bench", str(out), client)
+        up = time.time()
+        if timeline and workers:
+            from distributed import get_task_stream
+
+            taken = client.result() if hasattr(client, "result") else client
+            with get_task_stream(taken) as stream:
+                run_into_store(data, "bench", str(out), client)
+            _timeline(f"{workers} worker(s)", t0_epoch, up, time.time(), stream.data)
+        else:
+            run_into_store(data, "bench", str(out), client)
         wall = time.perf_counter() - t0
         cpu = time.process_time() - c0
         if hasattr(client, "result"):  # a Future of the client
@@ -120,6 +161,8 @@ def main():
     ap.add_argument("--trials", type=int, default=4000, help="trials per cell")
     ap.add_argument("--cells", type=int, default=8, help="cells: 4 or 8")
     ap.add_argument("--warm", action="store_true", help="start the cluster before the clock")
+    ap.add_argument("--timeline", action="store_true",
+                    help="where the runs on Dask spend their wall time (Dask's task stream)")
     ap.add_argument("--chunk", type=int, default=1000, help="trials per task")
     ap.add_argument("--nodes", type=int, default=32)
     ap.add_argument("--cores-per-node", type=int, default=32)
@@ -133,9 +176,10 @@ def main():
     tmp = Path(tempfile.mkdtemp(prefix="bench_study_"))
     results, rates = {}, {}
     try:
+        _load_before_clocks(tmp / "warm.zarr")
         for label, workers in (("serial", None), ("1 worker", 1), ("2 workers", 2)):
             out = tmp / f"{label.replace(' ', '_')}.zarr"
-            wall, cpu, rss = timed(data, out, workers, a.warm)
+            wall, cpu, rss = timed(data, out, workers, a.warm, a.timeline)
             rates[label] = procedures / wall
             results[label] = open_results(out)
             print(f"{label:10s}: {wall:6.1f} s (CPU {cpu:5.1f} s), "
