@@ -47,7 +47,7 @@ SWITCH_INTERVAL_S = 0.001
 #: The cyclic garbage collector's thresholds (Python's: 700, 10, 10). A full pass walks every
 #: session's log and undo copies and stops every thread meanwhile; with Python's third
 #: threshold the server under the abuse benchmark made three full passes in its 20 s abuse
-#: phase, each 100–290 ms of wall time on a loaded machine (the slowest round trips there);
+#: phase, each 100–520 ms of wall time on a loaded machine (the slowest round trips there);
 #: with 100, none in the same span. Younger generations' passes are kept as they are (they
 #: walk only new objects). Measured on a loaded machine only (``bench_trainer_load.py
 #: --abuser``, the collector's passes timed by ``gc.callbacks``): see ``benchmarks/README.md``.
