@@ -18,22 +18,25 @@ turn-to-state round trip (median, p95, max) and the first-view times.
 
 ``--abuser``: fairness under abuse instead. Each honest trainee connects from its own loopback
 address (127.0.0.10, .11, …: a class of machines), turns a handwheel ``--rate`` times a second,
-and trainee 0 also fetches a sharp ×6 eyepiece patch (768 px, a new position each time) twice
-a second. Phase 1 (idle) times them alone; phase 2 the same while one abuser (its own process,
-one address, 127.0.0.250) opens ``--abuse-sockets`` sockets over ``--abuse-sessions`` sessions,
-each sending turns as fast as its answers come (reconnecting when a newer socket replaces it),
-and ``--abuse-patchers`` clients fetch patches as fast as they are answered. Prints each
-phase's round trip (median, p95) and patch median, what the abuser got served, and how its
-socket attempts ended: refused at the handshake (its address's connection rate), refused after
-the key (its session's), or accepted (and then replaced by a newer socket of the session, or
-closed otherwise). It also prints the CPU time of the two client processes (the honest
-trainees' in each phase, the abuser's): on the server's own machine their work takes the
-server's processors, which a class's clients on their own machines would not.
+and trainee 0 also fetches a sharp ×6 eyepiece patch (768 px, a new position each time) twice a
+second. Phase 1 (idle) times them alone; phase 2 the same while one abuser (its own process, one
+address, 127.0.0.250) opens ``--abuse-sockets`` sockets over ``--abuse-sessions`` sessions, each
+sending turns as fast as its answers come (reconnecting when a newer socket replaces it), and
+``--abuse-patchers`` clients fetch patches as fast as they are answered. Prints each phase's
+round trip (median, p95) and patch median, what the abuser got served, and how its socket
+attempts ended: refused at the handshake (its address's connection rate), refused after the key
+(its session's), or accepted (and then replaced by a newer socket of the session, or closed
+otherwise). The honest trainees take what changed in the state after the first whole state, as
+the page does (``--whole-states``: the whole state each time). It also prints the CPU time of
+the two client processes (the honest trainees' in each phase, the abuser's): on the server's own
+machine their work takes the server's processors, which a class's clients on their own machines
+would not.
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20]
 
-``--action-cost``: no server; the CPU time of one honest turn (action and reply JSON) in this
-process, and the garbage collector's full pass over the server's start-up objects.
+``--action-cost``: no server; the CPU time of one honest turn (action and reply JSON, with the
+whole state and with what changed in it) in this process, and the garbage collector's full pass
+over the server's start-up objects.
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py --action-cost [--turns 3000]
 """
@@ -54,6 +57,8 @@ import time
 import httpx
 from websockets.asyncio.client import connect
 from websockets.exceptions import ConnectionClosed, InvalidStatus
+
+from stereoplotter.web.statepatch import apply_patch, state_patch
 
 TOKEN = "bench-token"
 
@@ -216,24 +221,28 @@ def _local(n: int) -> str:
     return f"127.0.0.{n}"
 
 
-async def _open_from(host: str, sid: str, secret: str, address: str):
+async def _open_from(host: str, sid: str, secret: str, address: str, patches: bool = False):
     ws = await connect(f"ws://{host}/ws/{sid}", max_size=2**24, local_addr=(address, 0))
-    await ws.send(json.dumps({"auth": secret}))
+    await ws.send(json.dumps({"auth": secret, "patches": True} if patches else {"auth": secret}))
     hello = json.loads(await ws.recv())
     return ws, hello
 
 
-async def honest(host, n: int, stop: float, rtt: list, patches: list | None, pause: float):
+async def honest(host, n: int, stop: float, rtt: list, patches: list | None, pause: float,
+                 whole: bool = False):
+    """A trainee turning a wheel; like the page, it takes what changed in the state after the
+    first (``whole``: the whole state each time)."""
     address = _local(10 + n)
     transport = httpx.AsyncHTTPTransport(local_address=address)
     async with httpx.AsyncClient(base_url=f"http://{host}", transport=transport,
                                  timeout=120) as http:
         sid, secret = await _session(http, "e01-setup-stage1", f"honest-{n:02d}")
-        ws, hello = await _open_from(host, sid, secret, address)
+        ws, hello = await _open_from(host, sid, secret, address, patches=not whole)
         f = hello["state"]["controls"]["f_instrument"]
         state = (await _ask(ws, {"action": {"kind": "set", "control": "f_instrument",
                                             "value": round((f["min"] + f["max"]) / 2, 2)}}))
-        state = state["state"]
+        state = state["state"] if whole else apply_patch(hello["state"], state["patch"])
+        held = state
 
         async def patch_loop():
             k = 0
@@ -256,6 +265,8 @@ async def honest(host, n: int, stop: float, rtt: list, patches: list | None, pau
                                                "delta": 0.05 if i % 2 else -0.05}, "seq": i})
             if reply.get("error") is None:
                 rtt.append((time.perf_counter() - t0) * 1e3)
+            if "patch" in reply:  # what the page does with it
+                held = apply_patch(held, reply["patch"])
             i += 1
             await asyncio.sleep(pause)
         if task is not None:
@@ -371,7 +382,7 @@ async def abuse_async(args) -> None:
                 cpu = time.process_time()
                 await asyncio.gather(*(
                     honest(host, n + (100 if phase == "abuse" else 0), stop, rtt,
-                           patches if n == 0 else None, 1 / args.rate)
+                           patches if n == 0 else None, 1 / args.rate, args.whole_states)
                     for n in range(args.trainees)))
                 cpu = time.process_time() - cpu  # the honest clients' own CPU in the phase
                 if abuser is not None:
@@ -493,16 +504,26 @@ def action_cost(turns: int) -> None:
 
     session = Session.start(load_exercise("e01-setup-stage1"), trainee="cost", seed=1)
     session.act({"kind": "set", "control": "f_instrument", "value": 120.0, "t": 0})
-    runs = []
-    for _ in range(5):
-        t0 = time.process_time()
-        for i in range(turns):
-            state = session.act({"kind": "turn", "control": "X",
-                                 "delta": 0.05 if i % 2 else -0.05, "t": i * 0.1})
-            json.dumps({"state": state, "error": None, "n": len(session.log)}, allow_nan=False)
-        runs.append((time.process_time() - t0) / turns * 1e3)
-    print(f"an honest turn: CPU {min(runs):.3f} ms (best of 5 × {turns}; all "
-          f"{', '.join(f'{r:.3f}' for r in runs)})")
+    sent = session.state()
+    sizes = {}
+    for patched in (False, True):
+        runs = []
+        for _ in range(5):
+            t0 = time.process_time()
+            for i in range(turns):
+                state = session.act({"kind": "turn", "control": "X",
+                                     "delta": 0.05 if i % 2 else -0.05, "t": i * 0.1})
+                if patched:
+                    body = {"patch": state_patch(sent, state), "error": None}
+                    sent = state
+                else:
+                    body = {"state": state, "error": None}
+                body["n"] = len(session.log)
+                sizes[patched] = len(json.dumps(body, allow_nan=False))
+            runs.append((time.process_time() - t0) / turns * 1e3)
+        print(f"an honest turn, {'what changed' if patched else 'the whole state'} sent "
+              f"({sizes[patched]} characters): CPU {min(runs):.3f} ms (best of 5 × {turns}; "
+              f"all {', '.join(f'{r:.3f}' for r in runs)})")
     del session
     with tempfile.TemporaryDirectory() as data:
         create_app("cost-token-0123456789", data, processes=False, prepare_photos=False)
@@ -539,6 +560,8 @@ def main() -> None:
     )
     ap.add_argument("--abuser", action="store_true",
                     help="fairness: honest trainees alone, then beside one abuser")
+    ap.add_argument("--whole-states", action="store_true",
+                    help="--abuser: the honest trainees take the whole state each turn")
     ap.add_argument("--abuse-sockets", type=int, default=100)
     ap.add_argument("--abuse-sessions", type=int, default=10)
     ap.add_argument("--abuse-patchers", type=int, default=8)

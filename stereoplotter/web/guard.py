@@ -389,13 +389,14 @@ def seed_value(value: Any) -> int | None:
 
 # --- WebSocket messages ---------------------------------------------------------------------
 
-_MESSAGE_KEYS = {"action", "seq", "demo", "auth"}
+_MESSAGE_KEYS = {"action", "seq", "demo", "auth", "patches"}
 _OPTIONAL = ("side", "origin_mm")
 
 
 def parse_message(text: Any) -> dict[str, Any]:
     """A page's message: a JSON object of at most :data:`MAX_MESSAGE` characters with the
-    keys ``action``, ``seq``, ``demo`` or ``auth``; :class:`Refused` (one line) otherwise."""
+    keys ``action``, ``seq``, ``demo``, ``auth`` or ``patches``; :class:`Refused` (one line)
+    otherwise."""
     if not isinstance(text, str):
         raise Refused(400, "message: expected a JSON text frame")
     if len(text) > MAX_MESSAGE:

@@ -44,6 +44,14 @@ WS_MAX_SIZE = 4 * 1024 * 1024
 #: ~15 ms a round trip with the default. Measured on a loaded machine only
 #: (``bench_trainer_load.py --abuser``, single runs): see ``benchmarks/README.md``. [s]
 SWITCH_INTERVAL_S = 0.001
+#: The cyclic garbage collector's thresholds (Python's: 700, 10, 10). A full pass walks every
+#: session's log and undo copies and stops every thread meanwhile; with Python's third
+#: threshold the server under the abuse benchmark made three full passes in its 20 s abuse
+#: phase, each 100–520 ms of wall time on a loaded machine (the slowest round trips there);
+#: with 100, none in the same span. Younger generations' passes are kept as they are (they
+#: walk only new objects). Measured on a loaded machine only (``bench_trainer_load.py
+#: --abuser``, the collector's passes timed by ``gc.callbacks``): see ``benchmarks/README.md``.
+GC_THRESHOLDS = (700, 10, 100)
 
 
 def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
@@ -94,6 +102,7 @@ def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
     # what start-up built (modules, the exercise catalogue, the app) lives as long as the
     # server: the cyclic garbage collector's full passes no longer walk it
     gc.freeze()
+    gc.set_threshold(*GC_THRESHOLDS)
     sys.setswitchinterval(SWITCH_INTERVAL_S)
     uvicorn.Server(uvicorn_config(app, public_url, trusted_proxies)).run(sockets=[sock])
 

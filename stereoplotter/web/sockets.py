@@ -5,8 +5,11 @@ Trainee socket, page → server: first ``{"auth": SECRET}`` (the session's secre
 when it was started), then ``{"action": {...}, "seq": n}`` (an action of the trainer contract
 without ``t``: the server times it) or ``{"demo": "step", "seq": n}``. Server → page:
 ``{"state": {...}, "error": null | "one line", "n": actions so far, "seq": n}``; the first
-frame also carries ``"hello"``. A malformed, oversized or too frequent message gets
-``{"error": "one line"}`` and the socket stays open. A page that reconnects (a dropped
+frame also carries ``"hello"``. A page whose first message says ``"patches": true`` gets the
+whole state in its first frame only and, after it, ``"patch"`` in place of ``"state"``: what
+changed since the state this socket sent before (:mod:`stereoplotter.web.statepatch`). A
+malformed, oversized or too frequent message gets ``{"error": "one line"}`` and the socket
+stays open. A page that reconnects (a dropped
 network, a restarted server) sends its secret again and resumes where the log ends.
 
 One live socket per session: a newer one (the page reloaded, or opened twice) replaces the
@@ -43,6 +46,7 @@ from stereoplotter.web.guard import (
     scrub_paths,
 )
 from stereoplotter.web.registry import CONNECT_LIMIT, Registry
+from stereoplotter.web.statepatch import state_patch
 
 __all__ = ["AUTH_TIMEOUT_S", "PUSH_S", "REFUSAL_DELAY_S", "instructor_socket", "trainee_socket"]
 
@@ -87,13 +91,18 @@ def _dump(body: dict[str, Any]) -> str:
     return json.dumps(body, allow_nan=False)
 
 
-async def _auth(websocket: WebSocket) -> Any:
-    """The credential of the socket's first message (None: none within the time)."""
+async def _first(websocket: WebSocket) -> dict[str, Any]:
+    """The socket's first message (empty: none, or none valid, within the time)."""
     try:
         text = await asyncio.wait_for(websocket.receive_text(), AUTH_TIMEOUT_S)
-        return parse_message(text).get("auth")
+        return parse_message(text)
     except (TimeoutError, Refused, KeyError, RuntimeError, WebSocketDisconnect):
-        return None
+        return {}
+
+
+async def _auth(websocket: WebSocket) -> Any:
+    """The credential of the socket's first message (None: none within the time)."""
+    return (await _first(websocket)).get("auth")
 
 
 async def _refuse(websocket: WebSocket, text: str, code: int = 4403) -> None:
@@ -146,7 +155,8 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
             pass
         return
     await websocket.accept()
-    secret = await _auth(websocket)
+    first = await _first(websocket)
+    secret = first.get("auth")
     if sid not in reg.rows or not reg.check(sid, secret):
         return await _refuse(
             websocket, "this session's key is required (start a session from the exercises page)"
@@ -178,6 +188,8 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
         live.limit = RateLimit(*reg.message_limit)
     limits = (live.limit, address_limit(reg, address, reg.address_limits))
     flooding = 0  # messages refused for the rate in a row
+    # the state this socket sent last, when its page takes patches
+    sent = _Sent(state) if first.get("patches") is True else None
     try:
         await websocket.send_text(
             _dump({"hello": hello, "state": state, "error": None, "n": len(live.session.log)})
@@ -186,7 +198,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
             message = await websocket.receive()
             if message["type"] == "websocket.disconnect" or live.socket is not websocket:
                 return
-            reply = await _answer(reg, live, message, limits)
+            reply = await _answer(reg, live, message, limits, sent)
             flooding = flooding + 1 if (reply.get("error") or "").startswith(_TOO_MANY) else 0
             if flooding > FLOOD_REFUSALS:  # sent on regardless of the refusals: closed
                 await _refuse(websocket, "too many messages: this socket is closed", 4429)
@@ -205,8 +217,33 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
             live.socket = None
 
 
-async def _answer(reg: Registry, live, message: dict[str, Any], limits) -> dict:
-    """The reply to one message: the new state, or one line of refusal."""
+class _Sent:
+    """The state a socket sent last (its page holds it): the base of the next patch."""
+
+    __slots__ = ("state",)
+
+    def __init__(self, state: dict[str, Any]):
+        self.state = state
+
+
+def _patched(sent: _Sent | None, fn, *args) -> dict[str, Any]:
+    """``fn(*args)``'s reply, its state replaced by a patch against the state sent before
+    (on the actor thread: the event loop only sends it). The messages of one socket are
+    answered one after the other, so ``sent`` is never read and written at once."""
+    reply = fn(*args)
+    if sent is None:
+        return reply
+    state = reply.pop("state", None)
+    if state is not None:
+        reply["patch"] = state_patch(sent.state, state)
+        sent.state = state
+    return reply
+
+
+async def _answer(reg: Registry, live, message: dict[str, Any], limits,
+                  sent: _Sent | None = None) -> dict:
+    """The reply to one message: the new state (or what changed in it, ``sent``), or one line
+    of refusal."""
     seq = None
     try:
         session_limit, address_limit_ = limits
@@ -219,10 +256,10 @@ async def _answer(reg: Registry, live, message: dict[str, Any], limits) -> dict:
         msg = parse_message(message.get("text"))
         seq = msg.get("seq")
         if msg.get("demo") == "step" and live.demonstration:
-            reply = await _on_actor(reg, live, reg.demo_step, live)
+            reply = await _on_actor(reg, live, _patched, sent, reg.demo_step, live)
         elif "action" in msg and not live.demonstration:
             action = clean_action(msg["action"], live.session.records)
-            reply = await _on_actor(reg, live, reg.act, live, action)
+            reply = await _on_actor(reg, live, _patched, sent, reg.act, live, action)
         elif "action" in msg:
             raise Refused(400, "a demonstration takes demonstration steps, not actions")
         else:

@@ -27,7 +27,8 @@ function link(text, lost) {
 
 function connect() {
   ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws/${encodeURIComponent(sid)}`);
-  ws.onopen = () => ws.send(JSON.stringify({ auth: key || "" }));
+  // patches: after the first frame's whole state the server sends what changed (applyPatch)
+  ws.onopen = () => ws.send(JSON.stringify({ auth: key || "", patches: true }));
   ws.onmessage = onMessage;
   ws.onclose = (ev) => {
     if (ev.code === 4403) { link("", false); return; } // refused: the message says why
@@ -263,6 +264,19 @@ function render() { // at most once an animation frame, however many states arri
   });
 }
 
+// A new object: `old` with the server's patch applied ({set, del, sub}: keys replaced or
+// added, keys removed, objects patched in turn); `old` is left as it was (a sent action keeps
+// the state it was sent from). Keys are defined as own data properties, never assigned: a
+// record named "__proto__" stays a record.
+function applyPatch(old, patch) {
+  const out = { ...old };
+  const put = (k, v) => Object.defineProperty(out, k, { value: v, enumerable: true, writable: true, configurable: true });
+  for (const k of patch.del || []) delete out[k];
+  for (const [k, v] of Object.entries(patch.set || {})) put(k, v);
+  for (const [k, inner] of Object.entries(patch.sub || {})) put(k, applyPatch(out[k], inner));
+  return out;
+}
+
 function onMessage(ev) {
   const t0 = performance.now();
   try { handle(JSON.parse(ev.data)); } finally { window.__messageMs = (window.__messageMs || 0) + performance.now() - t0; }
@@ -280,6 +294,7 @@ function handle(msg) {
     buildActions($("actions"), hello.actions || [], Object.keys(msg.state.controls), send, message);
     loadOverview();
   }
+  if (msg.patch && state) msg.state = applyPatch(state, msg.patch);
   if (msg.state) state = msg.state;
   window.__n = msg.n;
   if (state) render();
