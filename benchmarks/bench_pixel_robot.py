@@ -20,6 +20,7 @@ import tempfile
 import threading
 import time
 
+import numpy as np
 import uvicorn
 from playwright.sync_api import sync_playwright
 
@@ -32,10 +33,34 @@ from tests.browser.pixel_robot import relative_orientation
 TOKEN = "bench-token"
 
 
+def _true_q_um(app, sid: str) -> list[float]:
+    """The true y-parallax at the six points now (the grade's sign). [µm]"""
+    from stereoplotter.trainer.outcome import standard_q
+
+    session = app.state.registry.live[sid].session
+    return [round(float(v) * 1000.0, 1)
+            for v in np.asarray(standard_q(session.inst, session.prep)).reshape(-1)]
+
+
+def _observer(app, sid: str, eyes):
+    """Diagnostics after each pass: the robot's readings against the true q, and Z."""
+
+    def show(rec) -> None:
+        true = _true_q_um(app, sid)
+        seen = {n: f"{-q:.1f}(×{rec.mag[n]})" for n, q in sorted(rec.q_um.items())}
+        print(f"  pass {rec.passes}: read (grade's sign) {seen}; true {true}; "
+              f"Z {eyes.wheel('Z')}; {eyes.sent} actions", flush=True)
+
+    return show
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--first", type=int, default=1, help="first trainee number")
+    ap.add_argument("--verbose", action="store_true",
+                    help="diagnostics: the robot's notes, and after each pass the true q and Z "
+                    "read from the server's session (never shown to the robot)")
     args = ap.parse_args()
     port = _free_port()
     app = create_app(TOKEN, message_limit=(2000.0, 4000))
@@ -56,7 +81,11 @@ def main() -> None:
             t0 = time.perf_counter()
             sid = pixel_page.start(page, base, f"pixel {k}")
             eyes = pixel_page.PageEyes(page)
-            rec = relative_orientation(eyes, pixel_page.tolerance_um(page))
+            observer = _observer(app, sid, eyes) if args.verbose else None
+            rec = relative_orientation(eyes, pixel_page.tolerance_um(page), observer=observer)
+            if args.verbose:
+                for note in rec.notes:
+                    print("   ", note)
             eyes.claim()
             seconds = time.perf_counter() - t0
             g = pixel_page.grade_after_claim(page, base, sid)

@@ -354,8 +354,12 @@ class Robot:
     set to a value (read once from its wheel, then the robot's own settings), and each point's
     fused Z is kept and set again when the robot comes back to it."""
 
-    def __init__(self, eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6)):
+    def __init__(self, eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6),
+                 observer=None):
         self.eyes = eyes
+        #: Called with the record after each pass (a benchmark's diagnostics; the robot never
+        #: reads what it does).
+        self.observer = observer
         self.rec = Orientation(tolerance_um, tuple(points))
         self.z: float | None = None
         self.z_at: dict[int, float] = {}
@@ -545,6 +549,8 @@ class Robot:
                 rec.q_um[n], rec.p_um[n], rec.mag[n] = m.q_um, m.p_um, m.magnification
                 rec.measured.append((n, m.q_um, m.magnification, getattr(eyes, "sent", None)))
             rec.history.append(dict(rec.q_um))
+            if self.observer is not None:
+                self.observer(rec)
             sure = [n for n in rec.q_um if rec.mag[n] == FINE_MAGS[0]]
             done = len(sure) >= len(ELEMENTS) and all(
                 abs(rec.q_um[n]) < DONE_SHARE * rec.tolerance_um for n in sure)
@@ -562,7 +568,9 @@ class Robot:
         return rec
 
 
-def relative_orientation(eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6)) -> Orientation:
+def relative_orientation(eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6),
+                         observer=None) -> Orientation:
     """Clear the y-parallax at the standard ``points`` by least squares on the measured
-    parallaxes (module docstring); returns the record (the last measured q at each point)."""
-    return Robot(eyes, tolerance_um, points).run()
+    parallaxes (module docstring); returns the record (the last measured q at each point).
+    ``observer`` (diagnostics only) is called with the record after each pass."""
+    return Robot(eyes, tolerance_um, points, observer).run()
