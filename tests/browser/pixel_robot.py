@@ -70,6 +70,9 @@ MIN_PEAK, MIN_MARGIN, PEAK_EXCLUSION_PX = 0.3, 0.05, 6
 #: the ×2 look is off by up to ≈ 150 µm = 3 of its pixels where the field is far from
 #: oriented (measured: one seed near its solution, ×2 against the grade's true q). [px]
 AGREE_PX = 4.0
+#: Where a search is near a prediction, the rivals that count lie within this many search radii
+#: of it (a peak far from where the coarser look put the detail cannot be taken for it). [—]
+LOCAL_RIVAL = 3.0
 #: Margin kept between the searched offset and the eyepiece's edge. [px]
 EDGE_PX = 8
 #: The robot claims when the largest measured |q| is under this share of the tolerance. [—]
@@ -212,8 +215,8 @@ def match(
 ) -> Match | None:
     """The left eyepiece's centre found in the right eyepiece (see the module docstring), or
     None where the match is weak or ambiguous. ``predict_px``, ``radius_px``: search only
-    offsets within ``radius_px`` of ``predict_px`` (the peak's lead is still taken over the
-    whole eyepiece)."""
+    offsets within ``radius_px`` of ``predict_px``; the peak's lead is then taken over the
+    peaks within :data:`LOCAL_RIVAL` radii of the prediction."""
     gl, ml = grey_and_mask(left)
     gr, mr = grey_and_mask(right)
     h, w = gl.shape
@@ -235,6 +238,9 @@ def match(
     peak = float(ncc[i, j])
     far = np.hypot(oy - oy[i, j], ox - ox[i, j]) > PEAK_EXCLUSION_PX
     inside = (np.abs(oy) <= SEARCH_PX) & (np.abs(ox) <= SEARCH_PX)
+    if predict_px is not None and radius_px is not None:
+        # near a prediction only a rival near it can mislead (a stripe's ridge still does)
+        inside &= np.hypot(ox - predict_px[0], oy - predict_px[1]) <= LOCAL_RIVAL * radius_px
     second = float(np.max(np.where(far & inside, ncc, -1)))
     margin = peak - second
     if strict and (peak < MIN_PEAK or margin < MIN_MARGIN):
@@ -345,6 +351,12 @@ CLASSIC_CYCLES, CLASSIC_DONE_UM, CLASSIC_MAX_TURN = 3, 150.0, 0.05
 #: one step of the search by Z moves the detail (under the finding field's half) [µm]; the
 #: x-parallax left uncleared (the ×20 search holds ±300 µm) [µm].
 Z_PROBE, Z_SEARCH_UM, X_CLEAR_UM = -2.0, 3500.0, 60.0
+#: The x-parallax left uncleared at the measuring magnifications. [px]
+FUSED_PX = 3.0
+#: The step of the marks' positions the page draws the photos at where the read-out is hidden
+#: (the X, Y counters' least count, 0.01 mm, as the counters show it) [mm]; looks averaged per
+#: ×20 reading; the search radius around the previous look [px].
+MARK_STEP_MM, DITHER, DITHER_RADIUS_PX = 0.01, 4, 4.0
 #: Steps of the search by Z, in :data:`Z_SEARCH_UM`. [—]
 Z_STEPS = (1, -1, 2, -2)
 
@@ -424,6 +436,63 @@ class Robot:
         x, y = self.spot_at.get(n, (0.0, 0.0))
         self.spot_at[n] = (x + round(float(turns[0]), 4), y + round(float(turns[1]), 4))
         return fine
+
+    def fine(self, n: int, m: Match) -> Match:
+        """A match carried to ×6, then ×20, as :func:`refine`, with the x-parallax cleared by Z
+        at each magnification before the finer look (a trainee fuses the detail with the foot
+        wheel: an x-parallax of a few hundred µm puts the detail outside the ×20 search, and
+        the relief inside a template biases a match that is far from fused)."""
+        for mag in (*sorted(FINE_MAGS), None):
+            m = self.fuse(m)
+            if mag is None:
+                break
+            if mag <= m.magnification or not fits((m.dx_px, m.dy_px), m.magnification, mag):
+                continue
+            k = mag / m.magnification
+            images = view(self.eyes, mag)
+            finer = match(*images, mag, (m.dx_px * k, m.dy_px * k), AGREE_PX * k)
+            if finer is None:
+                weak = match(*images, mag, (m.dx_px * k, m.dy_px * k), AGREE_PX * k, strict=False)
+                self.rec.notes.append(f"no sure ×{mag} at {n}: {weak}")
+                break
+            m = finer
+        self.z_at[n] = self.z
+        return m
+
+    def steady(self, m: Match) -> Match:
+        """A ×20 match with its y-parallax averaged over :data:`DITHER` looks, Y turned by a
+        :data:`DITHER`-th of :data:`MARK_STEP_MM` (on the photo) between them, and turned back.
+        Where the read-out is hidden the page draws each photo at its mark's position in steps
+        of the counters' least count, so one look's y-parallax is off by the two marks'
+        rounding, up to ±10 µm; over a step evenly sampled each rounding averages out to within
+        ``MARK_STEP_MM / (2·DITHER)``."""
+        mag = FINE_MAGS[0]
+        if self.px_per_xy is None or m.magnification != mag:
+            return m
+        photo_per_y = abs(self.px_per_xy[1, 1]) * SCREEN_PIXEL_MM / FIND_MAG  # mm per mm of Y
+        dy = round(MARK_STEP_MM / DITHER / photo_per_y, 4)
+        seen, last, turned = [m], m, 0
+        for _ in range(DITHER - 1):
+            self.eyes.turn("Y", dy)
+            turned += 1
+            again = match(*view(self.eyes, mag), mag, (last.dx_px, last.dy_px), DITHER_RADIUS_PX)
+            if again is not None:
+                seen.append(again)
+                last = again
+        self.eyes.turn("Y", -round(turned * dy, 4))
+        return Match(float(np.mean([s.dx_px for s in seen])),
+                     float(np.mean([s.dy_px for s in seen])),
+                     min(s.peak for s in seen), min(s.margin for s in seen), mag)
+
+    def fuse(self, m: Match) -> Match:
+        """Z set to clear the x-parallax of a match (to :data:`FUSED_PX` pixels of its
+        magnification), the detail looked at again at the same magnification; else ``m``."""
+        if self.rec.x_per_z is None or abs(m.dx_px) <= FUSED_PX:
+            return m
+        self.set_z(self.z - m.p_um / self.rec.x_per_z)
+        mag = m.magnification
+        again = match(*view(self.eyes, mag), mag, (0.0, m.dy_px), max(AGREE_PX, 0.3 * abs(m.dx_px)))
+        return m if again is None else again
 
     def look(self, predict=None, radius=None) -> Match | None:
         return match(*view(self.eyes, FIND_MAG), FIND_MAG, predict, radius)
@@ -533,6 +602,8 @@ class Robot:
                     m = measure(eyes, predicted[n])
                     if m is not None and m.magnification == FIND_MAG:
                         m = None
+                    if m is not None:
+                        m = self.fine(n, m)
                 if m is None:
                     c = self.coarse(n)
                     if c is None:
@@ -542,9 +613,10 @@ class Robot:
                         rec.notes.append(f"probe {n}: {row}")
                         if row is not None:
                             rec.jacobian[n] = row
-                    m = refine(eyes, c)
+                    m = self.fine(n, c)
                     if m.magnification != FINE_MAGS[0]:
                         m = self.fine_spot(n, m)
+                m = self.steady(m)
                 rec.notes.append(f"measure {n}: {m}")
                 rec.q_um[n], rec.p_um[n], rec.mag[n] = m.q_um, m.p_um, m.magnification
                 rec.measured.append((n, m.q_um, m.magnification, getattr(eyes, "sent", None)))
