@@ -48,7 +48,7 @@ PROBE = {"kappa_left": 3e-3, "kappa_right": 3e-3, "k_alpha_left": 3e-3, "k_alpha
 #: Magnifications: the finding one and the measuring ones, finest first.
 FIND_MAG, FINE_MAGS = 2, (20, 6)
 #: Side of the template cut from the left eyepiece's centre, by magnification. [px]
-TEMPLATE_PX = {2: 96, 6: 96, 20: 96}
+TEMPLATE_PX = {2: 96, 6: 96, 20: 160}
 #: The window of the detail search at ×2 (≈ the ×20 template) [px]; how much more fine
 #: detail a spot needs than the point's own place to be preferred [—]; its reach [px].
 SPOT_PX, SPOT_GAIN, SPOT_REACH_PX = 10, 2.0, 50
@@ -614,8 +614,8 @@ class Robot:
                         if row is not None:
                             rec.jacobian[n] = row
                     m = self.fine(n, c)
-                    if m.magnification != FINE_MAGS[0]:
-                        m = self.fine_spot(n, m)
+                if m.magnification != FINE_MAGS[0]:
+                    m = self.fine_spot(n, m)
                 m = self.steady(m)
                 rec.notes.append(f"measure {n}: {m}")
                 rec.q_um[n], rec.p_um[n], rec.mag[n] = m.q_um, m.p_um, m.magnification
@@ -624,7 +624,7 @@ class Robot:
             if self.observer is not None:
                 self.observer(rec)
             sure = [n for n in rec.q_um if rec.mag[n] == FINE_MAGS[0]]
-            done = len(sure) >= len(ELEMENTS) and all(
+            done = len(sure) == len(rec.points) and all(
                 abs(rec.q_um[n]) < DONE_SHARE * rec.tolerance_um for n in sure)
             if done:
                 break
