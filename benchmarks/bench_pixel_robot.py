@@ -70,6 +70,7 @@ def main() -> None:
         time.sleep(0.02)
     base = f"http://127.0.0.1:{port}"
     passed = 0
+    actions, secs = [], []
     with sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
         ctx = pw.chromium.launch_persistent_context(
             profile, executable_path=chromium_path(), headless=True, args=FLAGS,
@@ -95,12 +96,16 @@ def main() -> None:
             true = [round(r["value"], 1) for r in rows]
             seen = {n: f"{q:.1f} (×{rec.mag[n]})" for n, q in sorted(rec.q_um.items())}
             worst = max(abs(v) for v in true)
+            actions.append(eyes.sent)
+            secs.append(seconds)
             print(f"seed 'pixel {k}': passed {ok}; true q {true} µm (worst {worst}); "
                   f"last read q {seen} µm; "
                   f"{eyes.sent} actions, {eyes.looks} looks, {rec.passes} passes, "
                   f"{seconds:.0f} s", flush=True)
         ctx.close()
-    print(f"passed {passed} of {args.seeds}")
+    print(f"passed {passed} of {args.seeds}; actions {min(actions)}–{max(actions)} "
+          f"(median {np.median(actions):.0f}); {min(secs):.0f}–{max(secs):.0f} s "
+          f"(median {np.median(secs):.0f} s)")
 
 
 if __name__ == "__main__":

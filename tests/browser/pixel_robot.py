@@ -82,7 +82,7 @@ DONE_SHARE = 0.35
 #: run, two seeds, read against the true q only while developing). [—]
 WEIGHT = {20: 1.0, 6: 0.2, 2: 0.05}
 #: Least-squares passes at most.
-PASSES = 8
+PASSES = 10
 
 
 class Eyes(Protocol):
