@@ -12,12 +12,15 @@ form, every sum an FFT correlation), of the grey level less its blur (:data:`HIG
 sub-pixel by a parabola through the peak on each axis. The offset of the match from the right
 eyepiece's centre is the parallax as the eye sees it: horizontal = x-parallax, vertical =
 y-parallax, in screen pixels of ``SCREEN_PIXEL_MM / magnification`` mm of photo. Coarse to fine
-(:func:`refine`): ×2 finds the detail in a 12.8 mm field (one pixel 50 µm), ×6 and then ×20
-measure it (16.7 µm, 5 µm a pixel), each searched near the coarser offset. A match is rejected
-where its peak is weak (:data:`MIN_PEAK`), where a second peak away from it is nearly as high
-(:data:`MIN_MARGIN`: the striped low-contrast fields), at the search's edge, or where the finer
-offset lies far from the coarser one (:data:`AGREE_PX`). Where a point's own field is striped or
-plain, the marks are moved to the most detailed place next to it (:func:`textured_spot`).
+(:meth:`Robot.fine`): ×2 finds the detail in a 12.8 mm field (one pixel 50 µm), ×6 and then ×20
+measure it (16.7 µm, 5 µm a pixel), each searched near the coarser offset, Z set before each
+finer look to clear the x-parallax (:meth:`Robot.fuse`, as a trainee fuses the detail). A ×20
+reading is the mean of :data:`DITHER` looks with Y stepped through the step the page draws the
+marks at (:meth:`Robot.steady`). A match is rejected where its peak is weak (:data:`MIN_PEAK`),
+where a second peak away from it is nearly as high (:data:`MIN_MARGIN`: the striped
+low-contrast fields), at the search's edge, or where the finer offset lies far from the coarser
+one (:data:`AGREE_PX`). Where a point's own field is striped or plain, the marks are moved to
+the most detailed place next to it (:func:`textured_spot`).
 
 **Relative orientation** (:class:`Robot`). Z is set to clear the x-parallax (its effect learnt
 by one probe); cycles of the conventional method's element-by-element clearing (:data:`CLASSIC`,
@@ -25,8 +28,8 @@ each element's effect learnt by a probe turn) bring every detail near the mark; 
 standard point the robot turns each of the five elements (κ_л, κ_п, k_α,л, k_α,п, k_ω,п) by a
 probe step and back, the change per unit its row of the Jacobian; the turns that null the six
 y-parallaxes in weighted least squares (:data:`WEIGHT` by magnification) are made at once; the
-points are measured again (at ×20 near the predicted parallax), and so on until the ×20 readings
-are under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done.
+points are measured again (at ×20 near the predicted parallax), and so on until all the points
+read at ×20 under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done.
 """
 
 from __future__ import annotations
