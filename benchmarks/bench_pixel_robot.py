@@ -58,6 +58,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--first", type=int, default=1, help="first trainee number")
+    ap.add_argument("--practice-seed", type=int, default=None,
+                    help="run the fixed-seed practice exercise of "
+                    "tests/browser/test_pixel_robot.py with this seed, for its trainee")
     ap.add_argument("--verbose", action="store_true",
                     help="diagnostics: the robot's notes, and after each pass the true q and Z "
                     "read from the server's session (never shown to the robot)")
@@ -77,10 +80,17 @@ def main() -> None:
             viewport={"width": 1440, "height": 900})
         page = ctx.new_page()
         page.goto(base + "/")
-        pixel_page.upload_exam(page, base, TOKEN)
+        name = pixel_page.EXAM_NAME
+        if args.practice_seed is None:
+            pixel_page.upload_exam(page, base, TOKEN)
+        else:
+            name = f"c2-by-eye-{args.practice_seed}"
+            pixel_page.upload_exam(page, base, TOKEN,
+                                   pixel_page.exercise_text(name, "practice", args.practice_seed))
         for k in range(args.first, args.first + args.seeds):
             t0 = time.perf_counter()
-            sid = pixel_page.start(page, base, f"pixel {k}")
+            trainee = f"pixel {k}" if args.practice_seed is None else "pixel robot"
+            sid = pixel_page.start(page, base, trainee, name)
             eyes = pixel_page.PageEyes(page)
             observer = _observer(app, sid, eyes) if args.verbose else None
             rec = relative_orientation(eyes, pixel_page.tolerance_um(page), observer=observer)
