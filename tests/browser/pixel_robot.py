@@ -29,7 +29,9 @@ standard point the robot turns each of the five elements (κ_л, κ_п, k_α,л,
 probe step and back, the change per unit its row of the Jacobian; the turns that null the six
 y-parallaxes in weighted least squares (:data:`WEIGHT` by magnification) are made at once; the
 points are measured again (at ×20 near the predicted parallax), and so on until all the points
-read at ×20 under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done.
+read at ×20 under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done. Where a
+point is not found only :data:`PARTIAL_SHARE` of the step is taken; a step that loses a point or
+leaves the parallaxes worse is halved (half of it turned back) and the points measured again.
 """
 
 from __future__ import annotations
@@ -79,13 +81,21 @@ LOCAL_RIVAL = 3.0
 #: Margin kept between the searched offset and the eyepiece's edge. [px]
 EDGE_PX = 8
 #: The robot claims when the largest measured |q| is under this share of the tolerance. [—]
-DONE_SHARE = 0.35
+DONE_SHARE = 0.25
 #: Weights of a y-parallax in the least squares by the magnification it was read at: a ×6
 #: reading was off by 5–40 µm where ×20 agreed with the grade's true q within ≈ 3 µm (one
 #: run, two seeds, read against the true q only while developing). [—]
 WEIGHT = {20: 1.0, 6: 0.2, 2: 0.05}
 #: Least-squares passes at most.
 PASSES = 10
+#: A step is halved (half of it turned back, the points measured again) where it lost a point
+#: found before it or left the largest |q| of the points read both times above
+#: ``WORSE_FACTOR`` × its value before plus ``WORSE_UM`` (readings' scatter); at most
+#: ``HALVINGS`` times in a row. [—], [µm], [—]
+WORSE_FACTOR, WORSE_UM, HALVINGS = 1.5, 10.0, 3
+#: The share of a least-squares step taken where a point was not found (five points fix the
+#: five elements exactly, with nothing to check a wrong reading against). [—]
+PARTIAL_SHARE = 0.5
 
 
 class Eyes(Protocol):
@@ -589,10 +599,24 @@ class Robot:
         self.eyes.go_to(n)
         self.learn_xy()
 
+    def predict(self, q_um: dict[int, float], p_um: dict[int, float],
+                step: dict[str, float]) -> dict[int, tuple[float, float]]:
+        """The parallaxes (x, y) expected at the points after ``step`` from ``q_um``, ``p_um``."""
+        out = {}
+        for n in q_um:
+            if n in self.rec.jacobian and step:
+                dq = float(self.rec.jacobian[n] @ np.array([step[c] for c in ELEMENTS]))
+                out[n] = (p_um[n], q_um[n] + dq)
+        return out
+
     def run(self) -> Orientation:
         rec, eyes = self.rec, self.eyes
         self.start()
         predicted: dict[int, tuple[float, float]] = {}
+        last_step: dict[str, float] = {}
+        last_q: dict[int, float] = {}
+        last_p: dict[int, float] = {}
+        halvings = 0
         for _ in range(PASSES):
             rec.passes += 1
             rec.q_um.clear()
@@ -626,20 +650,38 @@ class Robot:
             rec.history.append(dict(rec.q_um))
             if self.observer is not None:
                 self.observer(rec)
+            found = set(rec.q_um)
+            lost = sorted(set(last_q) - found)
+            common = found & set(last_q)
+            worse = bool(common) and max(abs(rec.q_um[n]) for n in common) > (
+                WORSE_FACTOR * max(abs(last_q[n]) for n in common) + WORSE_UM)
+            if last_step and (lost or worse) and halvings < HALVINGS:
+                # the last step lost a point or made the parallaxes worse: half of it turned
+                # back (the wheels turned back by the amounts they were turned), measured again
+                halvings += 1
+                last_step = {c: d / 2 for c, d in last_step.items()}
+                for control, d in last_step.items():
+                    if abs(d) > 1e-7:
+                        eyes.turn(control, -d)
+                rec.notes.append(f"step halved (lost {lost}, worse {worse})")
+                predicted = self.predict(last_q, last_p, last_step)
+                continue
+            halvings = 0
             sure = [n for n in rec.q_um if rec.mag[n] == FINE_MAGS[0]]
             done = len(sure) == len(rec.points) and all(
                 abs(rec.q_um[n]) < DONE_SHARE * rec.tolerance_um for n in sure)
             if done:
                 break
             step = solve(rec)
+            if len(found) < len(rec.points):
+                # a point not found: five points fix the five elements with no check, so only
+                # a share of the step is taken
+                step = {c: PARTIAL_SHARE * d for c, d in step.items()}
             for control, d in step.items():
                 if abs(d) > 1e-7:
                     eyes.turn(control, d)
-            predicted = {}
-            for n in rec.q_um:
-                if n in rec.jacobian:
-                    dq = float(rec.jacobian[n] @ np.array([step[c] for c in ELEMENTS]))
-                    predicted[n] = (rec.p_um[n], rec.q_um[n] + dq)
+            last_step, last_q, last_p = step, dict(rec.q_um), dict(rec.p_um)
+            predicted = self.predict(last_q, last_p, step)
         return rec
 
 
