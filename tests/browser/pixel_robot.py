@@ -30,8 +30,10 @@ probe step and back, the change per unit its row of the Jacobian; the turns that
 y-parallaxes in weighted least squares (:data:`WEIGHT` by magnification) are made at once; the
 points are measured again (at ×20 near the predicted parallax), and so on until all the points
 read at ×20 under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done. Where a
-point is not found only :data:`PARTIAL_SHARE` of the step is taken; a step that loses a point or
-leaves the parallaxes worse is halved (half of it turned back) and the points measured again.
+point is not found only :data:`PARTIAL_SHARE` of the step is taken, and near the solution
+:data:`NEAR_SHARE` of it (averaging the readings' scatter over the passes); a step that loses
+a point or leaves the parallaxes worse is halved (half of it turned back) and the points
+measured again.
 """
 
 from __future__ import annotations
@@ -87,7 +89,7 @@ DONE_SHARE = 0.25
 #: run, two seeds, read against the true q only while developing). [—]
 WEIGHT = {20: 1.0, 6: 0.2, 2: 0.05}
 #: Least-squares passes at most.
-PASSES = 10
+PASSES = 12
 #: A step is halved (half of it turned back, the points measured again) where it lost a point
 #: found before it or left the largest |q| of the points read both times above
 #: ``WORSE_FACTOR`` × its value before plus ``WORSE_UM`` (readings' scatter); at most
@@ -96,6 +98,11 @@ WORSE_FACTOR, WORSE_UM, HALVINGS = 1.5, 10.0, 3
 #: The share of a least-squares step taken where a point was not found (five points fix the
 #: five elements exactly, with nothing to check a wrong reading against). [—]
 PARTIAL_SHARE = 0.5
+#: Where every point is found and reads under ``NEAR_UM``, ``NEAR_SHARE`` of each step is
+#: taken: a ×20 reading scatters by up to ≈ 10 µm about the true q (the verbose runs in
+#: docs/trainer.md); a full step carries that scatter whole into the next pass, half a step
+#: (the iteration q ← q/2 − e/2) leaves ≈ 1/√3 of it. [µm], [—]
+NEAR_UM, NEAR_SHARE = 25.0, 0.5
 
 
 class Eyes(Protocol):
@@ -677,6 +684,10 @@ class Robot:
                 # a point not found: five points fix the five elements with no check, so only
                 # a share of the step is taken
                 step = {c: PARTIAL_SHARE * d for c, d in step.items()}
+            elif max(abs(q) for q in rec.q_um.values()) < NEAR_UM:
+                # near the solution the readings' scatter is most of what is left: a share
+                # of each step averages it over the passes
+                step = {c: NEAR_SHARE * d for c, d in step.items()}
             for control, d in step.items():
                 if abs(d) > 1e-7:
                     eyes.turn(control, d)
