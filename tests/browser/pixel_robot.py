@@ -99,9 +99,9 @@ WORSE_FACTOR, WORSE_UM, HALVINGS = 1.5, 10.0, 3
 #: five elements exactly, with nothing to check a wrong reading against). [—]
 PARTIAL_SHARE = 0.5
 #: Where every point is found and reads under ``NEAR_UM``, ``NEAR_SHARE`` of each step is
-#: taken: a ×20 reading scatters by up to ≈ 10 µm about the true q (the verbose runs in
-#: docs/trainer.md); a full step carries that scatter whole into the next pass, half a step
-#: (the iteration q ← q/2 − e/2) leaves ≈ 1/√3 of it. [µm], [—]
+#: taken: a ×20 reading scatters by a few µm, at times up to 18 µm, about the true q (the
+#: verbose runs in docs/trainer.md); a full step carries that scatter whole into the next
+#: pass, half a step (the iteration q ← q/2 − e/2) leaves ≈ 1/√3 of it. [µm], [—]
 NEAR_UM, NEAR_SHARE = 25.0, 0.5
 
 
