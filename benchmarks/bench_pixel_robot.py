@@ -20,6 +20,7 @@ import tempfile
 import threading
 import time
 
+import numpy as np
 import uvicorn
 from playwright.sync_api import sync_playwright
 
@@ -32,10 +33,37 @@ from tests.browser.pixel_robot import relative_orientation
 TOKEN = "bench-token"
 
 
+def _true_q_um(app, sid: str) -> list[float]:
+    """The true y-parallax at the six points now (the grade's sign). [µm]"""
+    from stereoplotter.trainer.outcome import standard_q
+
+    session = app.state.registry.live[sid].session
+    return [round(float(v) * 1000.0, 1)
+            for v in np.asarray(standard_q(session.inst, session.prep)).reshape(-1)]
+
+
+def _observer(app, sid: str, eyes):
+    """Diagnostics after each pass: the robot's readings against the true q, and Z."""
+
+    def show(rec) -> None:
+        true = _true_q_um(app, sid)
+        seen = {n: f"{-q:.1f}(×{rec.mag[n]})" for n, q in sorted(rec.q_um.items())}
+        print(f"  pass {rec.passes}: read (grade's sign) {seen}; true {true}; "
+              f"Z {eyes.wheel('Z')}; {eyes.sent} actions", flush=True)
+
+    return show
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--first", type=int, default=1, help="first trainee number")
+    ap.add_argument("--practice-seed", type=int, default=None,
+                    help="run the fixed-seed practice exercise of "
+                    "tests/browser/test_pixel_robot.py with this seed, for its trainee")
+    ap.add_argument("--verbose", action="store_true",
+                    help="diagnostics: the robot's notes, and after each pass the true q and Z "
+                    "read from the server's session (never shown to the robot)")
     args = ap.parse_args()
     port = _free_port()
     app = create_app(TOKEN, message_limit=(2000.0, 4000))
@@ -45,18 +73,30 @@ def main() -> None:
         time.sleep(0.02)
     base = f"http://127.0.0.1:{port}"
     passed = 0
+    actions, secs = [], []
     with sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
         ctx = pw.chromium.launch_persistent_context(
             profile, executable_path=chromium_path(), headless=True, args=FLAGS,
             viewport={"width": 1440, "height": 900})
         page = ctx.new_page()
         page.goto(base + "/")
-        pixel_page.upload_exam(page, base, TOKEN)
+        name = pixel_page.EXAM_NAME
+        if args.practice_seed is None:
+            pixel_page.upload_exam(page, base, TOKEN)
+        else:
+            name = f"c2-by-eye-{args.practice_seed}"
+            pixel_page.upload_exam(page, base, TOKEN,
+                                   pixel_page.exercise_text(name, "practice", args.practice_seed))
         for k in range(args.first, args.first + args.seeds):
             t0 = time.perf_counter()
-            sid = pixel_page.start(page, base, f"pixel {k}")
+            trainee = f"pixel {k}" if args.practice_seed is None else "pixel robot"
+            sid = pixel_page.start(page, base, trainee, name)
             eyes = pixel_page.PageEyes(page)
-            rec = relative_orientation(eyes, pixel_page.tolerance_um(page))
+            observer = _observer(app, sid, eyes) if args.verbose else None
+            rec = relative_orientation(eyes, pixel_page.tolerance_um(page), observer=observer)
+            if args.verbose:
+                for note in rec.notes:
+                    print("   ", note)
             eyes.claim()
             seconds = time.perf_counter() - t0
             g = pixel_page.grade_after_claim(page, base, sid)
@@ -66,12 +106,16 @@ def main() -> None:
             true = [round(r["value"], 1) for r in rows]
             seen = {n: f"{q:.1f} (×{rec.mag[n]})" for n, q in sorted(rec.q_um.items())}
             worst = max(abs(v) for v in true)
+            actions.append(eyes.sent)
+            secs.append(seconds)
             print(f"seed 'pixel {k}': passed {ok}; true q {true} µm (worst {worst}); "
                   f"last read q {seen} µm; "
                   f"{eyes.sent} actions, {eyes.looks} looks, {rec.passes} passes, "
                   f"{seconds:.0f} s", flush=True)
         ctx.close()
-    print(f"passed {passed} of {args.seeds}")
+    print(f"passed {passed} of {args.seeds}; actions {min(actions)}–{max(actions)} "
+          f"(median {np.median(actions):.0f}); {min(secs):.0f}–{max(secs):.0f} s "
+          f"(median {np.median(secs):.0f} s)")
 
 
 if __name__ == "__main__":

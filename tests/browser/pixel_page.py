@@ -86,13 +86,14 @@ class PageEyes:
         return out[0], out[1]
 
 
-#: The conventional exam of relative orientation the robot sits: C2 of the shipped e05 (SC-1,
-#: hilly pair, injected errors) as an exam — per-trainee seed, errors hidden, no read-out, no
-#: undo, no hints — uploaded by the instructor.
-EXAM_NAME = "c2-exam-pixel"
-EXAM = f"""format: stereoplotter-exercise/1
-name: {EXAM_NAME}
-title: "Exam: relative orientation by eye (C2, conventional method)"
+def exercise_text(name: str, mode: str = "exam", seed: str = "per-trainee") -> str:
+    """C2 of the shipped e05 (SC-1, hilly pair, injected errors) by eye: C1 preset, errors
+    hidden, no read-out, no undo, no hints; as an exam (per-trainee seed drawn by the server)
+    or as practice with a fixed ``seed`` (the same instrument every run, the page as in the
+    exam: the read-out hidden, the marks drawn at the counters' least count)."""
+    return f"""format: stereoplotter-exercise/1
+name: {name}
+title: "Relative orientation by eye (C2, conventional method)"
 level: 9
 description: >-
   C1 preset. Clear the y-parallax at the six standard points by eye; no read-out.
@@ -105,23 +106,30 @@ model: complete
 errors: "hidden"
 tilt: small
 assists: {{parallax_readout: false, undo: false, hints: false}}
-mode: exam
-seed: per-trainee
+mode: {mode}
+seed: {seed}
 """
 
 
-def upload_exam(page, server: str, token: str) -> None:
-    """Upload :data:`EXAM` as the instructor (a second upload of the same name is refused 409:
-    already there)."""
-    r = page.request.post(f"{server}/api/instructor/exercises?token={token}", data=EXAM)
+#: The conventional exam of relative orientation the robot sits (:func:`exercise_text`),
+#: uploaded by the instructor.
+EXAM_NAME = "c2-exam-pixel"
+EXAM = exercise_text(EXAM_NAME)
+
+
+def upload_exam(page, server: str, token: str, text: str = EXAM) -> None:
+    """Upload :data:`EXAM` (or another exercise ``text``) as the instructor (a second upload of
+    the same name is refused 409: already there)."""
+    r = page.request.post(f"{server}/api/instructor/exercises?token={token}", data=text)
     assert r.status in (200, 409), r.text()
 
 
-def start(page, server: str, trainee: str) -> str:
-    """Open the exam for ``trainee`` from the exercises page; the session id."""
+def start(page, server: str, trainee: str, name: str = EXAM_NAME) -> str:
+    """Open the exam (or the exercise ``name``) for ``trainee`` from the exercises page; the
+    session id."""
     page.goto(server + "/")
     page.fill("#trainee", trainee)
-    page.click(f"button[data-exercise='{EXAM_NAME}']")
+    page.click(f"button[data-exercise='{name}']")
     page.wait_for_url("**/s/*")
     page.wait_for_selector("body[data-ready='1']")
     page.wait_for_selector("body[data-overview='1']")
