@@ -29,11 +29,13 @@ standard point the robot turns each of the five elements (κ_л, κ_п, k_α,л,
 probe step and back, the change per unit its row of the Jacobian; the turns that null the six
 y-parallaxes in weighted least squares (:data:`WEIGHT` by magnification) are made at once; the
 points are measured again (at ×20 near the predicted parallax), and so on until all the points
-read at ×20 under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done. Where a
-point is not found only :data:`PARTIAL_SHARE` of the step is taken, and near the solution
-:data:`NEAR_SHARE` of it (averaging the readings' scatter over the passes); a step that loses
-a point or leaves the parallaxes worse is halved (half of it turned back) and the points
-measured again.
+read at ×20 under :data:`DONE_SHARE` of the tolerance or :data:`PASSES` passes are done; the
+last pass only measures the step before it. Where a point is not found only
+:data:`PARTIAL_SHARE` of the step is taken, and near the solution :data:`NEAR_SHARE` of one
+solved from the ×20 readings alone (averaging the readings' scatter over the passes). A step
+that loses a point is turned back whole, the points measured again there, and a shorter one
+(:data:`LOST_SHARE`) taken; a step that leaves the parallaxes worse is halved (half of it
+turned back) and the points measured again, or turned back whole after the last pass.
 """
 
 from __future__ import annotations
@@ -98,11 +100,20 @@ WORSE_FACTOR, WORSE_UM, HALVINGS = 1.5, 10.0, 3
 #: The share of a least-squares step taken where a point was not found (five points fix the
 #: five elements exactly, with nothing to check a wrong reading against). [—]
 PARTIAL_SHARE = 0.5
-#: Where every point is found and reads under ``NEAR_UM``, ``NEAR_SHARE`` of each step is
-#: taken: a ×20 reading scatters by a few µm, at times up to 18 µm, about the true q (the
-#: verbose runs in docs/trainer.md); a full step carries that scatter whole into the next
-#: pass, half a step (the iteration q ← q/2 − e/2) leaves ≈ 1/√3 of it. [µm], [—]
-NEAR_UM, NEAR_SHARE = 25.0, 0.5
+#: Where every point is found, at least ``NEAR_FINE`` of them at ×20, and every ×20 reading
+#: is under ``NEAR_UM``, ``NEAR_SHARE`` of each step is taken: a ×20 reading scatters by a
+#: few µm, at times up to 18 µm, about the true q (the verbose runs in docs/trainer.md); a
+#: full step carries that scatter whole into the next pass, half a step (the iteration
+#: q ← q/2 − e/2) leaves ≈ 1/√3 of it. There the step is solved from the ×20 readings alone:
+#: a ×6 reading near the solution was 22–34 µm off where ×20 agreed within a few µm, and a
+#: step solved with it moved its point by most of it (docs/trainer.md, run "pixel 4").
+#: [µm], [—], [—]
+NEAR_UM, NEAR_SHARE, NEAR_FINE = 25.0, 0.5, 5
+#: A step that lost a point found before it is turned back whole (the wheels turned back by
+#: the amounts they were turned), the points measured again where all were found, the lost
+#: points' Jacobian rows probed again, and the next step taken at ``LOST_SHARE`` (to its
+#: power, after retreats in a row). [—]
+LOST_SHARE = 0.25
 
 
 class Eyes(Protocol):
@@ -346,10 +357,12 @@ def probe(eyes: Eyes) -> np.ndarray | None:
     return row
 
 
-def solve(rec: Orientation) -> dict[str, float]:
+def solve(rec: Orientation, only_mag: int | None = None) -> dict[str, float]:
     """The turns of :data:`ELEMENTS` that null the measured y-parallaxes in least squares
-    (minimum norm where fewer than five points are known). [rad, tan]"""
-    pts = [n for n in rec.points if n in rec.q_um and n in rec.jacobian]
+    (minimum norm where fewer than five points are known); ``only_mag``: only the readings
+    taken at that magnification. [rad, tan]"""
+    pts = [n for n in rec.points if n in rec.q_um and n in rec.jacobian
+           and (only_mag is None or rec.mag.get(n) == only_mag)]
     if not pts:
         return {}
     w = np.array([WEIGHT.get(rec.mag.get(n, FIND_MAG), 0.05) for n in pts])
@@ -506,26 +519,35 @@ class Robot:
 
     def fuse(self, m: Match) -> Match:
         """Z set to clear the x-parallax of a match (to :data:`FUSED_PX` pixels of its
-        magnification), the detail looked at again at the same magnification; else ``m``."""
+        magnification), the detail looked at again at the same magnification; else ``m``,
+        with Z set back to where ``m`` was seen."""
         if self.rec.x_per_z is None or abs(m.dx_px) <= FUSED_PX:
             return m
+        before = self.z
         self.set_z(self.z - m.p_um / self.rec.x_per_z)
         mag = m.magnification
         again = match(*view(self.eyes, mag), mag, (0.0, m.dy_px), max(AGREE_PX, 0.3 * abs(m.dx_px)))
-        return m if again is None else again
+        if again is None:
+            self.set_z(before)  # ``m`` was seen at the Z before: the foot wheel set back
+            return m
+        return again
 
     def look(self, predict=None, radius=None) -> Match | None:
         return match(*view(self.eyes, FIND_MAG), FIND_MAG, predict, radius)
 
     def clear_x(self, m: Match) -> Match:
         """Z set to clear the x-parallax of a found detail (up to three settings, the detail
-        looked for again after each); the last match."""
+        looked for again after each); the last match, and Z where it was seen."""
         for _ in range(3):
             if self.rec.x_per_z is None or abs(m.p_um) <= X_CLEAR_UM:
                 return m
+            before = self.z
             self.set_z(self.z - m.p_um / self.rec.x_per_z)
             again = self.look((0.0, m.dy_px), 40.0) or self.look()
             if again is None:
+                # ``m`` was seen at the Z before: the foot wheel set back there, so that the
+                # point's kept Z and its match agree (a later fusing starts from that Z)
+                self.set_z(before)
                 return m
             m = again
         return m
@@ -616,6 +638,45 @@ class Robot:
                 out[n] = (p_um[n], q_um[n] + dq)
         return out
 
+    def turn_all(self, step: dict[str, float], sign: float = 1.0) -> None:
+        """The elements turned by ``sign`` × ``step``."""
+        for control, d in step.items():
+            if abs(d) > 1e-7:
+                self.eyes.turn(control, sign * d)
+
+    def read(self, n: int, predicted: dict[int, tuple[float, float]]) -> Match | None:
+        """Point ``n`` measured (near its predicted parallaxes where there are some), its
+        Jacobian row probed where it has none."""
+        rec, eyes = self.rec, self.eyes
+        self.go_to(n)
+        m = None
+        if n in predicted and n in self.z_at:
+            if self.z != self.z_at[n]:
+                self.set_z(self.z_at[n])
+            m = measure(eyes, predicted[n])
+            if m is not None and m.magnification == FIND_MAG:
+                m = None
+            if m is not None:
+                if n not in rec.jacobian:
+                    self.probe_row(n)
+                m = self.fine(n, m)
+        if m is None:
+            m = self.coarse(n)
+            if m is None:
+                return None
+            if n not in rec.jacobian:
+                self.probe_row(n)
+            m = self.fine(n, m)
+        if m.magnification != FINE_MAGS[0]:
+            m = self.fine_spot(n, m)
+        return self.steady(m)
+
+    def probe_row(self, n: int) -> None:
+        row = probe(self.eyes)
+        self.rec.notes.append(f"probe {n}: {row}")
+        if row is not None:
+            self.rec.jacobian[n] = row
+
     def run(self) -> Orientation:
         rec, eyes = self.rec, self.eyes
         self.start()
@@ -623,34 +684,16 @@ class Robot:
         last_step: dict[str, float] = {}
         last_q: dict[int, float] = {}
         last_p: dict[int, float] = {}
-        halvings = 0
-        for _ in range(PASSES):
+        last_mag: dict[int, int] = {}
+        halvings = retreats = 0
+        while rec.passes < PASSES:
             rec.passes += 1
             rec.q_um.clear()
+            rec.mag.clear()
             for n in rec.points:
-                self.go_to(n)
-                m = None
-                if n in predicted and n in self.z_at:
-                    if self.z != self.z_at[n]:
-                        self.set_z(self.z_at[n])
-                    m = measure(eyes, predicted[n])
-                    if m is not None and m.magnification == FIND_MAG:
-                        m = None
-                    if m is not None:
-                        m = self.fine(n, m)
+                m = self.read(n, predicted)
                 if m is None:
-                    c = self.coarse(n)
-                    if c is None:
-                        continue
-                    if n not in rec.jacobian:
-                        row = probe(eyes)
-                        rec.notes.append(f"probe {n}: {row}")
-                        if row is not None:
-                            rec.jacobian[n] = row
-                    m = self.fine(n, c)
-                if m.magnification != FINE_MAGS[0]:
-                    m = self.fine_spot(n, m)
-                m = self.steady(m)
+                    continue
                 rec.notes.append(f"measure {n}: {m}")
                 rec.q_um[n], rec.p_um[n], rec.mag[n] = m.q_um, m.p_um, m.magnification
                 rec.measured.append((n, m.q_um, m.magnification, getattr(eyes, "sent", None)))
@@ -659,41 +702,80 @@ class Robot:
                 self.observer(rec)
             found = set(rec.q_um)
             lost = sorted(set(last_q) - found)
-            common = found & set(last_q)
-            worse = bool(common) and max(abs(rec.q_um[n]) for n in common) > (
-                WORSE_FACTOR * max(abs(last_q[n]) for n in common) + WORSE_UM)
-            if last_step and (lost or worse) and halvings < HALVINGS:
-                # the last step lost a point or made the parallaxes worse: half of it turned
-                # back (the wheels turned back by the amounts they were turned), measured again
+            worse = _worse(rec.q_um, rec.mag, last_q, last_mag)
+            last_pass = rec.passes >= PASSES
+            if last_step and lost and (retreats < HALVINGS or last_pass):
+                # the last step lost a point: turned back whole, to where every point was
+                # found; measured again there, the lost points' rows probed again
+                retreats += 1
+                self.turn_all(last_step, -1.0)
+                for n in lost:
+                    rec.jacobian.pop(n, None)
+                rec.notes.append(f"step turned back (lost {lost})")
+                rec.q_um, rec.p_um, rec.mag = dict(last_q), dict(last_p), dict(last_mag)
+                last_step = {}
+                predicted = {n: (last_p[n], last_q[n]) for n in last_q}
+                continue
+            if last_step and worse and last_pass:
+                # no pass is left to check a half: turned back whole, to the state measured
+                self.turn_all(last_step, -1.0)
+                rec.notes.append("last step turned back (worse)")
+                rec.q_um, rec.p_um, rec.mag = dict(last_q), dict(last_p), dict(last_mag)
+                break
+            if last_step and worse and halvings < HALVINGS:
+                # the last step made the parallaxes worse: half of it turned back (the wheels
+                # turned back by the amounts they were turned), measured again
                 halvings += 1
                 last_step = {c: d / 2 for c, d in last_step.items()}
-                for control, d in last_step.items():
-                    if abs(d) > 1e-7:
-                        eyes.turn(control, -d)
-                rec.notes.append(f"step halved (lost {lost}, worse {worse})")
+                self.turn_all(last_step, -1.0)
+                rec.notes.append(f"step halved (worse {worse})")
                 predicted = self.predict(last_q, last_p, last_step)
                 continue
             halvings = 0
             sure = [n for n in rec.q_um if rec.mag[n] == FINE_MAGS[0]]
             done = len(sure) == len(rec.points) and all(
                 abs(rec.q_um[n]) < DONE_SHARE * rec.tolerance_um for n in sure)
-            if done:
+            if done or last_pass:
+                # the last pass measures the step before it, and none is taken after it
                 break
-            step = solve(rec)
-            if len(found) < len(rec.points):
-                # a point not found: five points fix the five elements with no check, so only
-                # a share of the step is taken
-                step = {c: PARTIAL_SHARE * d for c, d in step.items()}
-            elif max(abs(q) for q in rec.q_um.values()) < NEAR_UM:
+            near = (len(found) == len(rec.points) and len(sure) >= NEAR_FINE
+                    and max(abs(rec.q_um[n]) for n in sure) < NEAR_UM)
+            if near:
                 # near the solution the readings' scatter is most of what is left: a share
-                # of each step averages it over the passes
-                step = {c: NEAR_SHARE * d for c, d in step.items()}
-            for control, d in step.items():
-                if abs(d) > 1e-7:
-                    eyes.turn(control, d)
-            last_step, last_q, last_p = step, dict(rec.q_um), dict(rec.p_um)
+                # of each step averages it over the passes; the step is solved from the ×20
+                # readings alone
+                step = {c: NEAR_SHARE * d for c, d in solve(rec, FINE_MAGS[0]).items()}
+            else:
+                step = solve(rec)
+                if len(found) < len(rec.points):
+                    # a point not found: five points fix the five elements with no check,
+                    # so only a share of the step is taken
+                    step = {c: PARTIAL_SHARE * d for c, d in step.items()}
+            if last_step:
+                retreats = 0  # the step before was measured and kept
+            if retreats:
+                # after a step that lost a point: a shorter one
+                step = {c: LOST_SHARE**retreats * d for c, d in step.items()}
+            self.turn_all(step)
+            last_step, last_q = step, dict(rec.q_um)
+            last_p, last_mag = dict(rec.p_um), dict(rec.mag)
             predicted = self.predict(last_q, last_p, step)
         return rec
+
+
+def _worse(q_um: dict[int, float], mag: dict[int, int], last_q: dict[int, float],
+           last_mag: dict[int, int]) -> bool:
+    """Whether the largest |q| of the points read both times (at ×20 both times where
+    :data:`NEAR_FINE` points were) rose above :data:`WORSE_FACTOR` × its value before plus
+    :data:`WORSE_UM`."""
+    common = set(q_um) & set(last_q)
+    fine = {n for n in common if mag.get(n) == last_mag.get(n) == FINE_MAGS[0]}
+    if len(fine) >= NEAR_FINE:
+        common = fine
+    if not common:
+        return False
+    return max(abs(q_um[n]) for n in common) > (
+        WORSE_FACTOR * max(abs(last_q[n]) for n in common) + WORSE_UM)
 
 
 def relative_orientation(eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6),
