@@ -165,7 +165,7 @@ def _rowwise(fn: Any, args: tuple[Any, ...], outputs: int) -> tuple[NDArray[np.f
     >>> all(np.array_equal(p, q) for p, q in zip(_rowwise(fn, (a, b), 2), fn(a, b)))
     True
     """
-    if not any(getattr(a, "ndim", 0) >= 2 for a in args):
+    if not any(_ndim(a) >= 2 for a in args):
         return tuple(fn(*args))
     shape = np.broadcast_shapes(*(np.shape(a) for a in args if a is not None))
     size = int(np.prod(shape))
