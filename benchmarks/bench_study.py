@@ -100,11 +100,12 @@ def _start(workers: int):
     return start_local_client(workers, dashboard=False)
 
 
-def _timeline(label: str, t0: float, up: float, end: float, stream: list) -> None:
-    """Where a run's wall time goes: the cluster up, each worker's first task, its busy time
-    (the sum of its tasks), its last task's end, the run's end (the last cell written)."""
-    print(f"  {label} timeline (s from the clock's start): cluster up {up - t0:.2f}, "
-          f"study returned {end - t0:.2f}")  # fmt: skip
+def _timeline(label: str, t0: float, returned: float, up: float, end: float, stream: list) -> None:
+    """Where a run's wall time goes: ``start_local_client`` returned (its workers forked), the
+    cluster up, each worker's first task, its busy time (the sum of its tasks), its last task's
+    end, the run's end (the last cell written)."""
+    print(f"  {label} timeline (s from the clock's start): start returned {returned - t0:.2f}, "
+          f"cluster up {up - t0:.2f}, study returned {end - t0:.2f}")  # fmt: skip
     by_worker: dict[str, list[tuple[float, float]]] = {}
     for task in stream:
         for s in task["startstops"]:
@@ -116,6 +117,20 @@ def _timeline(label: str, t0: float, up: float, end: float, stream: list) -> Non
         gaps = last - first - busy
         print(f"    worker {i}: {len(spans)} tasks, first start {first - t0:.2f}, last end "
               f"{last - t0:.2f}, busy {busy:.2f}, idle between {gaps:.2f}")  # fmt: skip
+
+
+def _when_up(client, ups: list) -> None:
+    """Note when the cluster is up and have its scheduler record the task stream from then on
+    (``client`` a client or a Future of one: the study is prepared meanwhile, not after)."""
+
+    def up(taken) -> None:
+        ups.append(time.time())
+        taken.get_task_stream(count=0)  # the scheduler's task-stream plugin, added now
+
+    if hasattr(client, "add_done_callback"):
+        client.add_done_callback(lambda f: f.exception() or up(f.result()))
+    else:
+        up(client)
 
 
 def timed(data: dict, out: Path, workers: int | None, warm: bool, timeline: bool = False):
@@ -131,20 +146,18 @@ def timed(data: dict, out: Path, workers: int | None, warm: bool, timeline: bool
         t0_epoch = time.time()
         if workers and not warm:
             client = _start(workers)
-        up = time.time()
+        returned, ups = time.time(), []
         if timeline and workers:
-            from distributed import get_task_stream
-
-            taken = client.result() if hasattr(client, "result") else client
-            with get_task_stream(taken) as stream:
-                run_into_store(data, "bench", str(out), client)
-            _timeline(f"{workers} worker(s)", t0_epoch, up, time.time(), stream.data)
-        else:
-            run_into_store(data, "bench", str(out), client)
+            _when_up(client, ups)
+        run_into_store(data, "bench", str(out), client)
+        end = time.time()
         wall = time.perf_counter() - t0
         cpu = time.process_time() - c0
         if hasattr(client, "result"):  # a Future of the client
             client = client.result()
+        if timeline and workers:
+            stream = client.get_task_stream(start=t0_epoch)
+            _timeline(f"{workers} worker(s)", t0_epoch, returned, ups[0], end, stream)
         rss = list(client.run(_peak_rss_mb).values()) if client else [_peak_rss_mb()]
         if client:  # the workers' CPU seconds (with their start when not --warm)
             cpu += sum(client.run(_cpu_seconds).values())

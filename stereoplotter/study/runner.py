@@ -21,12 +21,13 @@ combined in trial order (:func:`~stereoplotter.study.cells.combine_chunks`).
 
 from __future__ import annotations
 
+import os
 import sys
 import threading
 import uuid
 from collections.abc import Callable, Iterable
 from concurrent.futures import Future
-from typing import Any
+from typing import Any, ClassVar
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.instrument.error_model import error_model_from_spec
@@ -141,7 +142,7 @@ def local_client(workers: int | None = None, dashboard: bool = True):
     }
     with dask.config.set(settings):
         cluster = LocalCluster(
-            n_workers=workers,
+            n_workers=_worker_count(workers),
             threads_per_worker=1,
             processes=True,
             dashboard_address=":0" if dashboard else None,
@@ -149,38 +150,87 @@ def local_client(workers: int | None = None, dashboard: bool = True):
     return Client(cluster)
 
 
+def _worker_count(workers: int | None) -> int:
+    """The embedded cluster's workers: ``workers``, or one per core (as ``LocalCluster`` counts
+    them: the cores this process may use)."""
+    from dask.system import CPU_COUNT
+
+    return workers if workers else max(1, CPU_COUNT)
+
+
 def _load_library() -> None:
     # imported here: run on each worker as it starts, so that its first task does not pay it
     import stereoplotter.study.runner  # noqa: F401
 
 
+class _Forks:
+    """Counts the forks this process makes from threads other than the one that created it
+    (``os.register_at_fork``); ``done`` is set at ``expected`` of them, or by :meth:`stop`."""
+
+    _counting: ClassVar[list[_Forks]] = []
+    _registered = False
+
+    def __init__(self, expected: int):
+        self.expected = expected
+        self.waiter = threading.get_ident()
+        self.seen = 0
+        self.done = threading.Event()
+        self._lock = threading.Lock()
+        if not _Forks._registered and hasattr(os, "register_at_fork"):
+            os.register_at_fork(after_in_parent=_Forks._after_fork)
+            _Forks._registered = True
+        _Forks._counting.append(self)
+
+    @staticmethod
+    def _after_fork() -> None:
+        for forks in list(_Forks._counting):
+            if threading.get_ident() != forks.waiter:
+                with forks._lock:
+                    forks.seen += 1
+                    if forks.seen >= forks.expected:
+                        forks.stop()
+
+    def stop(self) -> None:
+        if self in _Forks._counting:
+            _Forks._counting.remove(self)
+        self.done.set()
+
+
 def start_local_client(workers: int | None = None, dashboard: bool = True) -> Future:
     """:func:`local_client` as a Future of the client, to be taken once the study is prepared.
 
-    Forked workers (:func:`worker_start_method`) are started here, before the study is prepared:
-    a process is forked while no other thread of this one is working (a thread's lock held at
-    the fork, an import half done, would stay so in the worker), and the workers need no start
-    of their own. Spawned workers start on a thread, each loading the library, while the study
-    is prepared (the two overlap)."""
+    The cluster is started on a thread and comes up while the study is prepared (its scheduler
+    starting, its workers connecting). Forked workers (:func:`worker_start_method`) inherit the
+    library, loaded here first; this returns once every worker process has been forked, so
+    that no fork happens while this thread prepares the study (a lock it held at the fork, an
+    import half done, would stay so in the worker). Spawned workers each load the library as
+    they start."""
     started: Future = Future()
-    if worker_start_method() == "fork":
+    fork = worker_start_method() == "fork"
+    if fork:
         try:
             _load_library()  # the workers inherit it
-            started.set_result(local_client(workers, dashboard))
-        except Exception as exc:  # handed to whoever takes the client
+        except BaseException as exc:  # handed to whoever takes the client
             started.set_exception(exc)
-        return started
+            return started
+        forks = _Forks(_worker_count(workers))
 
     def start() -> None:
         try:
             client = local_client(workers, dashboard)
-            client.run(_load_library)
+            if not fork:
+                client.run(_load_library)
         except BaseException as exc:  # handed to whoever takes the client
             started.set_exception(exc)
         else:
             started.set_result(client)
+        finally:
+            if fork:  # whatever happened, no fork of the start is left to wait for
+                forks.stop()
 
     threading.Thread(target=start, name="cluster-start", daemon=True).start()
+    if fork:
+        forks.done.wait()
     return started
 
 

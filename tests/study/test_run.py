@@ -157,3 +157,30 @@ def test_embedded_cluster_forks_its_workers_and_gives_the_serial_dataset(serial,
         client.close()
         cluster.close()
     assert_same_bits(open_results(out), serial)
+
+
+def _fork_and_reap() -> None:
+    pid = os.fork()
+    if pid == 0:
+        os._exit(0)
+    os.waitpid(pid, 0)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers are forked on Linux")
+def test_the_study_is_prepared_only_once_the_workers_are_forked():
+    # start_local_client waits for the cluster's forks (made by other threads), not its own
+    import threading
+
+    from stereoplotter.study.runner import _Forks
+
+    forks = _Forks(2)
+    _fork_and_reap()  # this thread's fork: not one of the cluster's
+    assert not forks.done.is_set()
+    for seen in (1, 2):
+        thread = threading.Thread(target=_fork_and_reap)
+        thread.start()
+        thread.join()
+        assert forks.seen == seen
+    assert forks.done.is_set()
+    _fork_and_reap()  # counted no more once done
+    assert forks.seen == 2
