@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import copy
 import functools
+import os
 import sys
 from contextlib import nullcontext
 from typing import Any
@@ -133,12 +134,12 @@ def run_into_store(
 ) -> tuple[int, int]:
     """Run the study document ``data`` into the store ``output`` (created or resumed), serially
     (``client`` None) or on a Dask client (or a Future of one, taken once the study is
-    prepared). ``bar(total)``: a context manager giving the
-    progress callback (``stereoplotter.progress.progress_bar``); ``progress(n)``: another
-    callback (tests). Returns (cells of the study, cells run now)."""
+    prepared; a new store is then created while the first tasks run). ``bar(total)``: a
+    context manager giving the progress callback (``stereoplotter.progress.progress_bar``);
+    ``progress(n)``: another callback (tests). Returns (cells of the study, cells run now)."""
     # Imported here: xarray and zarr (the extra `study`) load in seconds; `--help` must not.
     from stereoplotter.io.study_file import study_fingerprint, study_from_mapping
-    from stereoplotter.io.study_store import open_store
+    from stereoplotter.io.study_store import StudyStore, open_store
     from stereoplotter.study.results import empty_dataset
     from stereoplotter.study.runner import run_study, study_checks, study_terms
 
@@ -147,8 +148,20 @@ def run_into_store(
     checks = study_checks(design, cells) if "checks" in design.measures else ()
     terms = study_terms(design) if "budget" in design.measures else ()
     empty = empty_dataset(design, cells, checks, terms)
-    store = open_store(output, empty, study_fingerprint(data), data)
-    done = store.done()
+    stores: list[StudyStore] = []
+
+    def create() -> None:
+        if not stores:
+            stores.append(open_store(output, empty, study_fingerprint(data), data))
+
+    def write(cell: int, values: dict[str, Any]) -> None:
+        stores[0].write_cell(cell, values)
+
+    # a new store on Dask is written while the first tasks run (run_study's ``submitted``)
+    fresh = client is not None and not os.path.exists(output)
+    if not fresh:
+        create()
+    done = stores[0].done() if stores else set()
     tasks = sum(len(design.tasks(i)) for i in range(len(cells)) if i not in done)
     print(
         f"study {design.name}: {len(cells)} cells ({len(done)} done), {tasks} tasks to run, "
@@ -165,12 +178,13 @@ def run_into_store(
         ran = run_study(
             design,
             cells,
-            store.write_cell,
+            write,
             checks=checks,
             terms=terms,
             done=done,
             client=client,
             progress=both,
+            submitted=create,
         )
     return len(cells), ran
 

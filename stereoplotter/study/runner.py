@@ -342,10 +342,13 @@ def run_study(
     done: Iterable[int] = (),
     client: Any = None,
     progress: Callable[[int], None] | None = None,
+    submitted: Callable[[], None] | None = None,
 ) -> int:
     """Run every task of the cells not ``done``; call ``sink`` per finished cell. Returns the
     number of cells run. ``progress(n)``: n more tasks finished. ``client``: a Dask client, a
-    Future of one (:func:`start_local_client`), or None (serial, in this process)."""
+    Future of one (:func:`start_local_client`), or None (serial, in this process).
+    ``submitted()``: called before the first result is taken — on Dask once every task is
+    submitted, so that what it does (creating the store) overlaps the first tasks."""
     skip = set(done)
     pending = {i: design.tasks(i) for i in range(len(cells)) if i not in skip}
     parts: dict[int, list[tuple[Task, Any]]] = {}
@@ -362,6 +365,8 @@ def run_study(
     client = client.result() if isinstance(client, Future) else client
     if client is None:
         size = _batch_trials(design, len(pending), 1)
+        if submitted is not None:
+            submitted()
         try:
             for i, tasks in pending.items():
                 for batch in chunk_batches(tasks, size):
@@ -380,6 +385,8 @@ def run_study(
         client.submit(run_chunks, shared, cells[i], b, checks, token, key=_batch_key(token, b))
         for i, b in batches
     ]
+    if submitted is not None:
+        submitted()
     for future, results in as_completed(futures, with_results=True):
         for task, result in results:
             finish(task, result)
