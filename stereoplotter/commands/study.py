@@ -157,8 +157,15 @@ def run_into_store(
     def write(cell: int, values: dict[str, Any]) -> None:
         stores[0].write_cell(cell, values)
 
-    # a new store on Dask is written while the first tasks run (run_study's ``submitted``)
-    fresh = client is not None and not os.path.exists(output)
+    # A new store on Dask is written while the first tasks run (run_study's ``submitted``), in
+    # a folder that can take it; any other store first (its errors before any task).
+    parent = os.path.dirname(os.path.abspath(output))
+    fresh = (
+        client is not None
+        and not os.path.lexists(output)
+        and os.path.isdir(parent)
+        and os.access(parent, os.W_OK | os.X_OK)
+    )
     if not fresh:
         create()
     done = stores[0].done() if stores else set()

@@ -386,7 +386,11 @@ def run_study(
         for i, b in batches
     ]
     if submitted is not None:
-        submitted()
+        try:
+            submitted()
+        except BaseException:
+            client.cancel(futures)
+            raise
     for future, results in as_completed(futures, with_results=True):
         for task, result in results:
             finish(task, result)
