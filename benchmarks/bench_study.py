@@ -100,12 +100,18 @@ def _start(workers: int):
     return start_local_client(workers, dashboard=False)
 
 
-def _timeline(label: str, t0: float, returned: float, up: float, end: float, stream: list) -> None:
+def _timeline(label: str, t0: float, stamps: dict, end: float, stream: list) -> None:
     """Where a run's wall time goes: ``start_local_client`` returned (its workers forked), the
-    cluster up, each worker's first task, its busy time (the sum of its tasks), its last task's
-    end, the run's end (the last cell written)."""
-    print(f"  {label} timeline (s from the clock's start): start returned {returned - t0:.2f}, "
-          f"cluster up {up - t0:.2f}, study returned {end - t0:.2f}")  # fmt: skip
+    cluster up, the study's checks and store (start–end), the first task submitted, each
+    worker's first task, its busy time (the sum of its tasks), its last task's end, the run's
+    end (the last cell written)."""
+
+    def at(name: str) -> str:
+        return "–".join(f"{t - t0:.2f}" for t in stamps.get(name, [])) or "-"
+
+    print(f"  {label} timeline (s from the clock's start): start returned {at('returned')}, "
+          f"cluster up {at('up')}, checks {at('checks')}, store {at('store')}, first submit "
+          f"{at('submit')}, study returned {end - t0:.2f}")  # fmt: skip
     by_worker: dict[str, list[tuple[float, float]]] = {}
     for task in stream:
         for s in task["startstops"]:
@@ -119,13 +125,36 @@ def _timeline(label: str, t0: float, returned: float, up: float, end: float, str
               f"{last - t0:.2f}, busy {busy:.2f}, idle between {gaps:.2f}")  # fmt: skip
 
 
-def _when_up(client, ups: list) -> None:
-    """Note when the cluster is up and have its scheduler record the task stream from then on
-    (``client`` a client or a Future of one: the study is prepared meanwhile, not after)."""
+def _stamped(module, name: str, stamps: dict, key: str):
+    """Wrap ``module.name`` to stamp its start and end in ``stamps[key]``; returns the undo."""
+    original = getattr(module, name)
+
+    def wrapped(*args, **kwargs):
+        stamps.setdefault(key, []).append(time.time())
+        try:
+            return original(*args, **kwargs)
+        finally:
+            stamps[key].append(time.time())
+
+    setattr(module, name, wrapped)
+    return lambda: setattr(module, name, original)
+
+
+def _when_up(client, stamps: dict) -> None:
+    """Note when the cluster is up, have its scheduler record the task stream from then on and
+    stamp the first task submitted (``client`` a client or a Future of one: the study is
+    prepared meanwhile, not after)."""
 
     def up(taken) -> None:
-        ups.append(time.time())
+        stamps["up"] = [time.time()]
         taken.get_task_stream(count=0)  # the scheduler's task-stream plugin, added now
+        submit = taken.submit
+
+        def stamped(*args, **kwargs):
+            stamps.setdefault("submit", [time.time()])
+            return submit(*args, **kwargs)
+
+        taken.submit = stamped
 
     if hasattr(client, "add_done_callback"):
         client.add_done_callback(lambda f: f.exception() or up(f.result()))
@@ -146,10 +175,20 @@ def timed(data: dict, out: Path, workers: int | None, warm: bool, timeline: bool
         t0_epoch = time.time()
         if workers and not warm:
             client = _start(workers)
-        returned, ups = time.time(), []
+        stamps: dict[str, list[float]] = {"returned": [time.time()]}
+        undo = []
         if timeline and workers:
-            _when_up(client, ups)
-        run_into_store(data, "bench", str(out), client)
+            import stereoplotter.io.study_store as study_store
+            import stereoplotter.study.runner as runner
+
+            _when_up(client, stamps)
+            undo = [_stamped(runner, "study_checks", stamps, "checks"),
+                    _stamped(study_store, "open_store", stamps, "store")]  # fmt: skip
+        try:
+            run_into_store(data, "bench", str(out), client)
+        finally:
+            for restore in undo:
+                restore()
         end = time.time()
         wall = time.perf_counter() - t0
         cpu = time.process_time() - c0
@@ -157,7 +196,7 @@ def timed(data: dict, out: Path, workers: int | None, warm: bool, timeline: bool
             client = client.result()
         if timeline and workers:
             stream = client.get_task_stream(start=t0_epoch)
-            _timeline(f"{workers} worker(s)", t0_epoch, returned, ups[0], end, stream)
+            _timeline(f"{workers} worker(s)", t0_epoch, stamps, end, stream)
         rss = list(client.run(_peak_rss_mb).values()) if client else [_peak_rss_mb()]
         if client:  # the workers' CPU seconds (with their start when not --warm)
             cpu += sum(client.run(_cpu_seconds).values())
