@@ -8,9 +8,9 @@ roughly in order and a killed study loses at most the cells in flight. A cell's 
 chunks run as one batch (:func:`chunk_batches`: one pass of the procedure over their trials,
 up to the memory budget's chunk, its fixed cost paid once), each chunk still reduced to its own
 moments; a process keeps the prepared run of the cell it last ran (:func:`run_chunks`), not one
-per task. :func:`start_local_client` starts an embedded cluster whose workers are forked from
-this process with the library loaded (on Linux; elsewhere spawned on a thread, so that they come
-up while the study is being prepared). A cell is handed to
+per task. :func:`start_local_client` starts an embedded cluster on a thread, so that it comes
+up while the study is being prepared; its workers are forked from this process with the library
+loaded (on Linux; elsewhere spawned). A cell is handed to
 ``sink(cell, values)`` as soon as its last task returns; ``done`` cells (already in the store)
 are skipped — that is how a study resumes.
 
