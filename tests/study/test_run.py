@@ -184,3 +184,17 @@ def test_the_study_is_prepared_only_once_the_workers_are_forked():
     assert forks.done.is_set()
     _fork_and_reap()  # counted no more once done
     assert forks.seen == 2
+
+
+class _UnusedClient:
+    """A Dask client that fails the test if the study hands it any work."""
+
+    def __getattr__(self, name):
+        raise AssertionError(f"client.{name} used")
+
+
+def test_a_store_that_cannot_be_written_fails_before_any_task_is_submitted(tmp_path):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("", encoding="utf-8")
+    with pytest.raises(NotADirectoryError):
+        run_into_store(reduced_study(), "reduced", str(blocker / "out.zarr"), _UnusedClient())
