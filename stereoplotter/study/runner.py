@@ -155,7 +155,7 @@ def _worker_count(workers: int | None) -> int:
     them: the cores this process may use)."""
     from dask.system import CPU_COUNT
 
-    return workers if workers else max(1, CPU_COUNT)
+    return workers if workers is not None else max(1, CPU_COUNT)
 
 
 def _load_library() -> None:
@@ -180,6 +180,8 @@ class _Forks:
             os.register_at_fork(after_in_parent=_Forks._after_fork)
             _Forks._registered = True
         _Forks._counting.append(self)
+        if expected <= 0:
+            self.stop()
 
     @staticmethod
     def _after_fork() -> None:
