@@ -54,6 +54,7 @@ __all__ = [
     "counters_from_photo",
     "decentration_variant",
     "marks_from_counters",
+    "parallaxes_at_marks",
     "photo_from_rod",
     "rod_frame",
     "rod_from_counters",
@@ -733,6 +734,62 @@ def marks_from_counters(
         args = (_a(x_mm), _a(y_mm), _a(depth_mm), sx, sy, sz, f, *_map_fields(UnitMap(unit)))
         out.append(_pair(*_rowwise(_photo_of_counters, args, 2)))
     return out[0], out[1]
+
+
+def parallaxes_at_marks(
+    x_mm: ArrayLike,
+    y_mm: ArrayLike,
+    depth_mm: ArrayLike,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+    photo_left_mm: ArrayLike,
+    photo_right_mm: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    r"""x- and y-parallax of the photo points under the marks (:func:`marks_from_counters`)
+    against the photo points ``photo_left_mm``, ``photo_right_mm`` (shape (..., 2)):
+    (x_л − x⁰_л) − (x_п − x⁰_п) and (y_л − y⁰_л) − (y_п − y⁰_п). [mm]
+
+    The same arithmetic as :func:`marks_from_counters` followed by the two differences (the
+    same numbers), evaluated a block of rows at a time on a (trials × points) grid, without
+    the marks' (..., 2) pairs.
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(130.0, base_x_mm=90.0, base_y_mm=0.5)
+    >>> unit = CorrectionUnit(100.0, tan_alpha=0.01)
+    >>> pl, pr = marks_from_counters(40.0, 7.0, 125.0, setting, unit, unit)
+    >>> p0l, p0r = np.array([30.0, 5.0]), np.array([-40.0, 5.5])
+    >>> dp, q = parallaxes_at_marks(40.0, 7.0, 125.0, setting, unit, unit, p0l, p0r)
+    >>> bool(dp == (pl - p0l)[0] - (pr - p0r)[0] and q == (pl - p0l)[1] - (pr - p0r)[1])
+    True
+    """
+    sides = []
+    for side, unit in (("left", left), ("right", right)):
+        sx, sy, sz = setting.pivot(side)
+        sides.append((sx, sy, sz, *_map_fields(UnitMap(unit))))
+    pl, pr = _a(photo_left_mm), _a(photo_right_mm)
+    args = (
+        _a(x_mm),
+        _a(y_mm),
+        _a(depth_mm),
+        _a(setting.f_instrument_mm),
+        pl[..., 0],
+        pl[..., 1],
+        pr[..., 0],
+        pr[..., 1],
+        *sides[0],
+        *sides[1],
+    )
+    return _rowwise(_parallaxes_of_counters, args, 2)
+
+
+def _parallaxes_of_counters(x, y, depth, f_instrument, x0l, y0l, x0r, y0r, *fields):
+    """:func:`parallaxes_at_marks`' arithmetic: :func:`_photo_of_counters` of each side (its
+    pivot and 12 map fields, 15 arguments a side), then the differences."""
+    xl, yl = _photo_of_counters(x, y, depth, *fields[:3], f_instrument, *fields[3:15])
+    xr, yr = _photo_of_counters(x, y, depth, *fields[15:18], f_instrument, *fields[18:])
+    return (xl - x0l) - (xr - x0r), (yl - y0l) - (yr - y0r)
 
 
 def _map_fields(m: UnitMap) -> tuple[Any, ...]:

@@ -75,7 +75,7 @@ from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
     counters_from_homologous_points,
-    marks_from_counters,
+    parallaxes_at_marks,
 )
 from stereoplotter.procedure.evaluation_results import ModelEvaluation, PointSetEvaluation
 from stereoplotter.scenario.model import Camera, Photo, Scenario
@@ -300,10 +300,7 @@ def parallax_errors_at_ideal(
     m = np.asarray(model_mm, float)
     x = np.asarray(setting.model_origin_x_mm, float) + m[..., 0]
     y = np.asarray(setting.model_origin_y_mm, float) + m[..., 1]
-    pl, pr = marks_from_counters(x, y, m[..., 2], setting, left, right)
-    dl = pl - np.asarray(photo_left_mm, float)
-    dr = pr - np.asarray(photo_right_mm, float)
-    return dl[..., 0] - dr[..., 0], dl[..., 1] - dr[..., 1]
+    return parallaxes_at_marks(x, y, m[..., 2], setting, left, right, photo_left_mm, photo_right_mm)
 
 
 def plane_residuals(

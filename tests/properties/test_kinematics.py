@@ -28,6 +28,7 @@ from stereoplotter.instrument.kinematics import (
     counters_from_photo,
     decentration_variant,
     marks_from_counters,
+    parallaxes_at_marks,
     photo_from_rod,
     rod_from_counters,
     rod_from_photo,
@@ -323,3 +324,24 @@ def test_synthetic_photos_are_collinearity():
     pl, _ = pair.photos(t)
     m = rotation_matrix(t[0], t[1], pair.kappa_left)
     assert_allclose(pl, object_to_photo(pair.ground_points_m(), pair.station_left_m, m, 100.0))
+
+
+def test_parallaxes_at_marks_are_the_marks_minus_the_photo_points_on_a_trial_grid():
+    """On a (trials × points) grid large enough to be evaluated a block of rows at a time, the
+    parallaxes equal :func:`marks_from_counters`' marks minus the given photo points, to the
+    bit (the same arithmetic)."""
+    rng = np.random.default_rng(3)
+    trials, points = 700, 90
+    setting = InstrumentSetting(
+        130.0, base_x_mm=90.0 + rng.normal(0, 0.01, (trials, 1)), base_y_mm=0.5, base_z_mm=-1.0
+    )
+    left = CorrectionUnit(100.0, tan_alpha=rng.normal(0, 0.01, (trials, 1)), decentration_x_mm=0.2)
+    right = CorrectionUnit(100.0, tan_omega=rng.normal(0, 0.01, (trials, 1)))
+    x, y = rng.uniform(-50, 50, points), rng.uniform(-50, 50, points)
+    depth = rng.uniform(120, 140, points)
+    p0l, p0r = rng.uniform(-80, 80, (points, 2)), rng.uniform(-80, 80, (points, 2))
+    pl, pr = marks_from_counters(x, y, depth, setting, left, right)
+    dp, q = parallaxes_at_marks(x, y, depth, setting, left, right, p0l, p0r)
+    assert dp.shape == q.shape == (trials, points)
+    assert np.array_equal(dp, (pl - p0l)[..., 0] - (pr - p0r)[..., 0])
+    assert np.array_equal(q, (pl - p0l)[..., 1] - (pr - p0r)[..., 1])
