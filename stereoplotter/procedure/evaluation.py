@@ -658,9 +658,17 @@ def _raw(
     shape = np.broadcast_shapes(np.shape(dp), np.shape(dx), (len(t.frame_m),))
     out = {"ground_m": t.frame_m, "model_mm": model}
     for name, v in (("dp", dp), ("q", q), ("dx", dx), ("dy", dy), ("dh", dh)):
-        out[name] = np.broadcast_to(v, shape).copy()
-    out["q_seen"] = np.broadcast_to(built.y_parallax_mm, shape).copy()
+        out[name] = _own(v, shape)
+    out["q_seen"] = _own(built.y_parallax_mm, shape)
     return out
+
+
+def _own(v: Any, shape: tuple[int, ...]) -> _F:
+    """``v`` broadcast to ``shape`` as an array of its own: ``v`` itself where it is one
+    already (an array computed above, of that shape, owning its data), else a copy."""
+    if isinstance(v, np.ndarray) and v.shape == shape and v.base is None and v.flags.writeable:
+        return v
+    return np.broadcast_to(v, shape).copy()
 
 
 def _point_set(
