@@ -18,7 +18,6 @@ from collections.abc import Callable, Iterable, Iterator
 from functools import lru_cache
 
 import numpy as np
-from numpy.random.bit_generator import ISeedSequence
 from numpy.typing import NDArray
 
 __all__ = ["BLOCK", "key_code", "keyed_draws", "keyed_standard_normal", "stream_key"]
@@ -136,86 +135,15 @@ def _blocks(start: int, stop: int) -> Iterator[tuple[int, int, int, int]]:
 def _generator(seed: int, code: int, block: int) -> np.random.Generator:
     """The generator of block ``block`` of the stream (seed, key code): what
     ``numpy.random.default_rng([seed, code(, block)])`` returns, built without its argument
-    checks and its ``SeedSequence``, which cost more than the building (the times:
-    ``benchmarks/README.md``, keyed streams) and a chunk of the conventional method builds
-    thousands: the seed sequence's four state words (:func:`_pcg64_words`) are handed to
-    ``PCG64`` as they are.
+    checks, which cost about as much as the building (the times: ``benchmarks/README.md``,
+    keyed streams) and a chunk of the conventional method builds thousands.
+
     ``SeedSequence`` turns each integer of a list into its 32-bit words (one word for
-    0 ≤ n < 2³², 0 included), so the list's entropy *is* these numbers as words."""
-    if 0 <= seed < 2**32 and 0 <= block < 2**32:  # code < 2³² (CRC-32)
-        words = _pcg64_words(seed, code) if block == 0 else _pcg64_words(seed, code, block)
-        return np.random.Generator(np.random.PCG64(_StateWords(words)))
+    0 ≤ n < 2³², 0 included), so the list's entropy *is* the uint32 array of the same numbers,
+    which it takes without converting."""
     seeds = [seed, code] if block == 0 else [seed, code, block]
-    # a seed of more than one word (or a negative one, refused): numpy's own
-    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seeds)))
-
-
-#: numpy's ``SeedSequence`` (``numpy/random/bit_generator.pyx``, a pool of 4 words of 32 bits):
-#: the constants of its hash. Each hash step multiplies by the next power of its constant, the
-#: same whatever the data, so the multipliers are listed once here.
-_MASK32 = 0xFFFF_FFFF
-_INIT_A, _MULT_A, _INIT_B, _MULT_B = 0x43B0_D7E5, 0x931E_8875, 0x8B51_F9DD, 0x58F3_8DED
-_MIX_MULT_L, _MIX_MULT_R = 0xCA01_F9DD, 0x4973_F715
-
-
-def _powers(first: int, factor: int, n: int) -> tuple[int, ...]:
-    out = [first]
-    for _ in range(n - 1):
-        out.append(out[-1] * factor & _MASK32)
-    return tuple(out)
-
-
-#: The hash constants of the pool's 4 words and of its 12 mixing steps (source, destination).
-_HASH_A = _powers(_INIT_A, _MULT_A, 17)
-_MIX_STEPS = tuple(
-    (src, dst, _HASH_A[4 + j], _HASH_A[5 + j])
-    for j, (src, dst) in enumerate((s, d) for s in range(4) for d in range(4) if s != d)
-)
-#: The hash constants of the 8 words of 32 bits of ``generate_state(4, np.uint64)``.
-_HASH_B = _powers(_INIT_B, _MULT_B, 9)
-_STATE_STEPS = tuple((i % 4, _HASH_B[i], _HASH_B[i + 1]) for i in range(8))
-
-
-def _pcg64_words(*entropy: int) -> tuple[int, int, int, int]:
-    """``numpy.random.SeedSequence(entropy).generate_state(4, np.uint64)`` (what ``PCG64``
-    seeds from) for at most four words of 32 bits, in Python integers: the seed sequence's
-    pool mixed from the words, then the state words hashed from the pool, two words of 32 bits
-    (low first) a word of 64.
-
-    Examples
-    --------
-    >>> words = np.random.SeedSequence([7, 3, 1]).generate_state(4, np.uint64)
-    >>> _pcg64_words(7, 3, 1) == tuple(int(w) for w in words)
-    True
-    """
-    pool = []
-    for i in range(4):
-        v = ((entropy[i] if i < len(entropy) else 0) ^ _HASH_A[i]) * _HASH_A[i + 1] & _MASK32
-        pool.append(v ^ (v >> 16))
-    for src, dst, a, b in _MIX_STEPS:
-        v = (pool[src] ^ a) * b & _MASK32
-        r = (_MIX_MULT_L * pool[dst] - _MIX_MULT_R * (v ^ (v >> 16))) & _MASK32
-        pool[dst] = r ^ (r >> 16)
-    w = []
-    for src, a, b in _STATE_STEPS:
-        v = (pool[src] ^ a) * b & _MASK32
-        w.append(v ^ (v >> 16))
-    return (w[0] | w[1] << 32, w[2] | w[3] << 32, w[4] | w[5] << 32, w[6] | w[7] << 32)
-
-
-class _StateWords:
-    """A seed sequence (numpy's ``ISeedSequence``) that gives ``PCG64`` the state words of
-    :func:`_pcg64_words`, computed already."""
-
-    __slots__ = ("words",)
-
-    def __init__(self, words: tuple[int, int, int, int]):
-        self.words = words
-
-    def generate_state(self, n_words: int, dtype: type = np.uint32) -> NDArray[np.uint64]:
-        if n_words != 4 or np.dtype(dtype) != np.uint64:
-            raise ValueError(f"state: expected 4 words of uint64, found {n_words} of {dtype}")
-        return np.array(self.words, dtype=np.uint64)
-
-
-ISeedSequence.register(_StateWords)
+    if 0 <= seed < 2**32 and block < 2**32:  # code < 2³² (CRC-32)
+        entropy: object = np.array(seeds, dtype=np.uint32)
+    else:  # a seed of more than one word (or a negative one, refused): the list
+        entropy = seeds
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(entropy)))

@@ -11,7 +11,6 @@ import zlib
 import numpy as np
 import pytest
 
-from stereoplotter import random_streams
 from stereoplotter.cli import main
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
@@ -45,29 +44,6 @@ def test_keyed_streams_do_not_depend_on_the_cut():
     # block 0 is the stream a run of ≤ BLOCK trials drew before chunking existed
     before = np.random.default_rng([9, zlib.crc32(b"k")]).standard_normal(50)
     assert np.array_equal(whole[:50], before)
-
-
-@pytest.mark.parametrize(
-    ("seed", "block"), [(0, 0), (9, 1), (20240601, 7), (2**32 - 1, 2**32 - 1), (-1, 2), (2**40, 3)]
-)
-def test_a_blocks_generator_is_numpys_default_rng_of_its_words(seed, block):
-    """Every block's generator (its seed sequence hashed in Python where the words fit 32 bits)
-    is ``numpy.random.default_rng([seed, crc32(key)(, block)])``: the same state, the same
-    draws."""
-    code = zlib.crc32(b"mono/2/1/left/omega/knob")
-    words = [seed, code] if block == 0 else [seed, code, block]
-    if seed < 0:
-        for make in (
-            lambda: np.random.default_rng(words),
-            lambda: random_streams._generator(seed, code, block),
-        ):
-            with pytest.raises(ValueError):
-                make()
-        return
-    expected = np.random.default_rng(words)
-    got = random_streams._generator(seed, code, block)
-    assert got.bit_generator.state == expected.bit_generator.state
-    assert np.array_equal(got.standard_normal(20), expected.standard_normal(20))
 
 
 def test_keyed_normals_go_on_from_where_a_range_stopped():
@@ -164,7 +140,9 @@ def test_summary_of_a_run_holds_statistics_not_trial_arrays(pair):
 
 def test_trial_store_round_trip_and_npz(tmp_path):
     rng = np.random.default_rng(1)
-    chunks = [{"a/x": rng.normal(size=n), "b/passed": rng.random(n) < 0.5} for n in (4, 7, 1)]
+    chunks = [
+        {"a/x": rng.normal(size=n), "b/passed": rng.random(n) < 0.5} for n in (4, 7, 1)
+    ]
     with TrialStore() as store:
         for c in chunks:
             store.append(c)
