@@ -76,6 +76,7 @@ from stereoplotter.instrument.kinematics import (
     InstrumentSetting,
     counters_from_homologous_points,
     parallaxes_at_marks,
+    x_parallaxes_at_marks,
 )
 from stereoplotter.procedure.evaluation_results import ModelEvaluation, PointSetEvaluation
 from stereoplotter.scenario.model import Camera, Photo, Scenario
@@ -301,6 +302,31 @@ def parallax_errors_at_ideal(
     x = np.asarray(setting.model_origin_x_mm, float) + m[..., 0]
     y = np.asarray(setting.model_origin_y_mm, float) + m[..., 1]
     return parallaxes_at_marks(x, y, m[..., 2], setting, left, right, photo_left_mm, photo_right_mm)
+
+
+def x_parallax_errors_at_ideal(
+    model_mm: ArrayLike,
+    photo_left_mm: ArrayLike,
+    photo_right_mm: ArrayLike,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+) -> _F:
+    """δp of :func:`parallax_errors_at_ideal` alone (the same numbers; q not computed). [mm]
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(100.0, base_x_mm=80.0)
+    >>> unit = CorrectionUnit(100.0, tan_alpha=0.01)
+    >>> args = ([40.0, 10.0, 100.0], [40.0, 10.0], [-40.0, 10.0], setting, unit, unit)
+    >>> bool(x_parallax_errors_at_ideal(*args) == parallax_errors_at_ideal(*args)[0])
+    True
+    """
+    m = np.asarray(model_mm, float)
+    x = np.asarray(setting.model_origin_x_mm, float) + m[..., 0]
+    y = np.asarray(setting.model_origin_y_mm, float) + m[..., 1]
+    pl, pr = np.asarray(photo_left_mm, float), np.asarray(photo_right_mm, float)
+    return x_parallaxes_at_marks(x, y, m[..., 2], setting, left, right, pl[..., 0], pr[..., 0])
 
 
 def plane_residuals(
