@@ -3,11 +3,19 @@ parts.
 
 python benchmarks/bench_verify.py [--trials T] [--repeat R]
 python benchmarks/bench_verify.py --jobs     # CPU seconds of each procedure-MC job, serially
+python benchmarks/bench_verify.py --phases   # and each job's CPU split into its parts
 
 ``--jobs`` runs the default ``verify``'s procedure-MC jobs one after another in this process
 (one BLAS thread, as in a worker) and prints each job's CPU seconds (user + system), their sum
 and the linear rows' CPU: on two cores the wall of ``verify`` cannot go below about half their
 total plus the start-up (imports, loading the scenarios).
+
+``--phases`` runs the same jobs and splits each job's CPU (``time.process_time``) into what a
+job pays once — the run preparation (``ProcedureRun.prepared``, twice), the error-free run, the
+fields' set-up, the linearisation's discovery run (1 trial) and its designed run (1 + 2K
+trials) — and what grows with its trials: the noisy trials' procedure, the control variate
+(``control_variate.per_trial_controlled``) and the rest (the fields δp, the levelling and the
+decomposition), as a Markdown table.
 """
 
 import argparse
@@ -27,7 +35,11 @@ def main():
     ap.add_argument("--trials", type=int, default=60000)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--jobs", action="store_true", help="CPU seconds of each procedure-MC job")
+    ap.add_argument("--phases", action="store_true", help="each job's CPU split into its parts")
     a = ap.parse_args()
+    if a.phases:
+        jobs_phases()
+        return
     if a.jobs:
         jobs_cpu(a.trials)
         return
@@ -69,6 +81,75 @@ def jobs_cpu(trials):
     print(f"procedure MC jobs {total:.2f} s CPU, linear rows {rows:.2f} s CPU")
     half = (total + rows) / 2
     print(f"half of their sum (the wall floor on two cores, start-up aside): {half:.2f} s")
+
+
+#: The parts of a job in :func:`jobs_phases`, in the order of the table's columns.
+PHASES = (
+    "prepare",
+    "zero run",
+    "field set-up",
+    "discovery",
+    "design",
+    "trials",
+    "control variate",
+)
+
+
+def jobs_phases():
+    """Each procedure-MC job of the default ``verify`` with its CPU split into :data:`PHASES`
+    (each part wrapped with a CPU clock here) and the rest, seconds."""
+    from stereoplotter.verification import control_variate as cv
+    from stereoplotter.verification import procedure_run as pr
+
+    spent = dict.fromkeys(PHASES, 0.0)
+
+    def clocked(fn, part):
+        def run(*args, **kwargs):
+            t = time.process_time()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                spent[part(args, kwargs) if callable(part) else part] += time.process_time() - t
+
+        return run
+
+    def run_part(args, kwargs):
+        noise = type(kwargs.get("noise")).__name__
+        if args[2] is None:
+            return "zero run"
+        if noise == "DesignNoise":
+            return "discovery" if args[2] == 1 else "design"
+        return "trials"
+
+    pr.run_trials_chunk = clocked(pr.run_trials_chunk, run_part)
+    cv.per_trial_controlled = clocked(cv.per_trial_controlled, "control variate")
+    pr._setup_fields = clocked(pr._setup_fields, "field set-up")
+    pr._conventional_fields = clocked(pr._conventional_fields, "field set-up")
+    pr.ProcedureRun.prepared = clocked(pr.ProcedureRun.prepared, "prepare")
+    pending = v.start_procedure_mc(
+        None, 20240601, book_scenarios(), instrument=book_instrument(), workers=1
+    )
+    totals = dict.fromkeys((*PHASES, "rest", "CPU"), 0.0)
+    print("| job | trials | CPU | " + " | ".join(PHASES) + " | rest |")
+    print("|---|---:|---:|" + "---:|" * (len(PHASES) + 1))
+    with threadpool_limits(limits=1, user_api="blas"):
+        for i in pending.order:
+            job = pending.jobs[i]
+            for k in spent:
+                spent[k] = 0.0
+            t = time.process_time()
+            v.run_procedure_job(job)
+            cpu = time.process_time() - t
+            rest = cpu - sum(spent.values())
+            for k in PHASES:
+                totals[k] += spent[k]
+            totals["rest"] += rest
+            totals["CPU"] += cpu
+            parts = " | ".join(f"{spent[k]:.3f}" for k in PHASES)
+            name = " ".join(pending.keys[i][0])
+            print(f"| {name} | {sum(job.trials.values())} | {cpu:.3f} | {parts} | {rest:.3f} |")
+    parts = " | ".join(f"{totals[k]:.2f}" for k in (*PHASES, "rest"))
+    print(f"| **all** | | **{totals['CPU']:.2f}** | {parts} |")
 
 
 def _linear(entry, trials):

@@ -53,7 +53,9 @@ __all__ = [
     "counters_from_homologous_points",
     "counters_from_photo",
     "decentration_variant",
+    "depths_of_homologous_points",
     "marks_from_counters",
+    "parallaxes_at_marks",
     "photo_from_rod",
     "rod_frame",
     "rod_from_counters",
@@ -61,6 +63,7 @@ __all__ = [
     "rods_intersection",
     "rods_intersection_xy",
     "rods_y_parallax",
+    "x_parallaxes_at_marks",
 ]
 
 #: Allowed linkages between a correction knob and the decentrations (``kinematics.md`` §4.1):
@@ -550,6 +553,12 @@ class UnitMap:
 
 def _photo_xy(xi, eta, f, ta, to, kx, ky, num, mech, ex, ey, c, s, ms):
     """:meth:`UnitMap.photo_xy`'s arithmetic on its fields (``kx`` None: not strict per axis)."""
+    u, v = _photo_uv(xi, eta, f, ta, to, kx, ky, num, mech, ex, ey)
+    return c * u + s * v, ms * u + c * v
+
+
+def _photo_uv(xi, eta, f, ta, to, kx, ky, num, mech, ex, ey):
+    """:func:`_photo_xy` before the cassette's κ: the decentred photo point (u, v)."""
     if kx is not None:
         u = xi * kx / (f + xi * ta)
         v = eta * ky / (f + eta * to)
@@ -558,21 +567,33 @@ def _photo_xy(xi, eta, f, ta, to, kx, ky, num, mech, ex, ey, c, s, ms):
         u, v = tau * xi, tau * eta
     if mech is not None:
         u, v = mech * u, mech * v
-    u = u - ex
-    v = v - ey
-    return c * u + s * v, ms * u + c * v
+    return u - ex, v - ey
 
 
 def _rod_xy(x, y, c, s, ex, ey, mech, f, ta, to, kx, ky, num):
     """:meth:`UnitMap.rod_xy`'s arithmetic on its fields (``kx`` None: not strict per axis)."""
-    px = c * x - s * y + ex
-    py = s * x + c * y + ey
-    if mech is not None:
-        px, py = px / mech, py / mech
+    px, py = _rod_plane(x, y, c, s, ex, ey, mech)
     if kx is not None:
         return px * f / (kx - px * ta), py * f / (ky - py * to)
     tau = (num - px * ta - py * to) / f
     return px / tau, py / tau
+
+
+def _rod_plane(x, y, c, s, ex, ey, mech):
+    """:func:`_rod_xy`'s point on the correction plane, before the projection to the rod."""
+    px = c * x - s * y + ex
+    py = s * x + c * y + ey
+    if mech is not None:
+        px, py = px / mech, py / mech
+    return px, py
+
+
+def _rod_x(x, y, c, s, ex, ey, mech, f, ta, to, kx, ky, num):
+    """ξ of :func:`_rod_xy` alone (the same arithmetic)."""
+    px, py = _rod_plane(x, y, c, s, ex, ey, mech)
+    if kx is not None:
+        return px * f / (kx - px * ta)
+    return px / ((num - px * ta - py * to) / f)
 
 
 # --------------------------------------------------------------------------------------------
@@ -735,6 +756,114 @@ def marks_from_counters(
     return out[0], out[1]
 
 
+def parallaxes_at_marks(
+    x_mm: ArrayLike,
+    y_mm: ArrayLike,
+    depth_mm: ArrayLike,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+    photo_left_mm: ArrayLike,
+    photo_right_mm: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    r"""x- and y-parallax of the photo points under the marks (:func:`marks_from_counters`)
+    against the photo points ``photo_left_mm``, ``photo_right_mm`` (shape (..., 2)):
+    (x_л − x⁰_л) − (x_п − x⁰_п) and (y_л − y⁰_л) − (y_п − y⁰_п). [mm]
+
+    The same arithmetic as :func:`marks_from_counters` followed by the two differences (the
+    same numbers), evaluated a block of rows at a time on a (trials × points) grid, without
+    the marks' (..., 2) pairs.
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(130.0, base_x_mm=90.0, base_y_mm=0.5)
+    >>> unit = CorrectionUnit(100.0, tan_alpha=0.01)
+    >>> pl, pr = marks_from_counters(40.0, 7.0, 125.0, setting, unit, unit)
+    >>> p0l, p0r = np.array([30.0, 5.0]), np.array([-40.0, 5.5])
+    >>> dp, q = parallaxes_at_marks(40.0, 7.0, 125.0, setting, unit, unit, p0l, p0r)
+    >>> bool(dp == (pl - p0l)[0] - (pr - p0r)[0] and q == (pl - p0l)[1] - (pr - p0r)[1])
+    True
+    """
+    sides = []
+    for side, unit in (("left", left), ("right", right)):
+        sx, sy, sz = setting.pivot(side)
+        sides.append((sx, sy, sz, *_map_fields(UnitMap(unit))))
+    pl, pr = _a(photo_left_mm), _a(photo_right_mm)
+    args = (
+        _a(x_mm),
+        _a(y_mm),
+        _a(depth_mm),
+        _a(setting.f_instrument_mm),
+        pl[..., 0],
+        pl[..., 1],
+        pr[..., 0],
+        pr[..., 1],
+        *sides[0],
+        *sides[1],
+    )
+    return _rowwise(_parallaxes_of_counters, args, 2)
+
+
+def x_parallaxes_at_marks(
+    x_mm: ArrayLike,
+    y_mm: ArrayLike,
+    depth_mm: ArrayLike,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+    photo_left_x_mm: ArrayLike,
+    photo_right_x_mm: ArrayLike,
+) -> NDArray[np.float64]:
+    r"""The x-parallax of :func:`parallaxes_at_marks` alone, against the photo points' x
+    ``photo_left_x_mm``, ``photo_right_x_mm`` (the same numbers; the marks' y not computed). [mm]
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(130.0, base_x_mm=90.0, base_y_mm=0.5)
+    >>> unit = CorrectionUnit(100.0, tan_alpha=0.01)
+    >>> p0l, p0r = np.array([30.0, 5.0]), np.array([-40.0, 5.5])
+    >>> dp, _ = parallaxes_at_marks(40.0, 7.0, 125.0, setting, unit, unit, p0l, p0r)
+    >>> bool(x_parallaxes_at_marks(40.0, 7.0, 125.0, setting, unit, unit, 30.0, -40.0) == dp)
+    True
+    """
+    sides = []
+    for side, unit in (("left", left), ("right", right)):
+        sx, sy, sz = setting.pivot(side)
+        sides.append((sx, sy, sz, *_map_fields(UnitMap(unit))))
+    args = (
+        _a(x_mm),
+        _a(y_mm),
+        _a(depth_mm),
+        _a(setting.f_instrument_mm),
+        _a(photo_left_x_mm),
+        _a(photo_right_x_mm),
+        *sides[0],
+        *sides[1],
+    )
+    return _rowwise(_x_parallax_of_counters, args, 1)[0]
+
+
+def _x_parallax_of_counters(x, y, depth, f_instrument, x0l, x0r, *fields):
+    """:func:`x_parallaxes_at_marks`' arithmetic: per side (its pivot and 12 map fields) the
+    photo x of :func:`_photo_of_counters`, then the difference (one output, as a tuple)."""
+    xs = []
+    for side in (fields[:15], fields[15:]):
+        sx, sy, sz, *m = side
+        n = (depth + sz) / f_instrument
+        u, v = _photo_uv((x - sx) / n, (y - sy) / n, *m[:9])
+        c, s = m[9], m[10]
+        xs.append(c * u + s * v)
+    return ((xs[0] - x0l) - (xs[1] - x0r),)
+
+
+def _parallaxes_of_counters(x, y, depth, f_instrument, x0l, y0l, x0r, y0r, *fields):
+    """:func:`parallaxes_at_marks`' arithmetic: :func:`_photo_of_counters` of each side (its
+    pivot and 12 map fields, 15 arguments a side), then the differences."""
+    xl, yl = _photo_of_counters(x, y, depth, *fields[:3], f_instrument, *fields[3:15])
+    xr, yr = _photo_of_counters(x, y, depth, *fields[15:18], f_instrument, *fields[18:])
+    return (xl - x0l) - (xr - x0r), (yl - y0l) - (yr - y0r)
+
+
 def _map_fields(m: UnitMap) -> tuple[Any, ...]:
     """The fields of a map in the order of :func:`_photo_xy`'s arguments after ξ, η."""
     return (m.f, m.ta, m.to, m.kx, m.ky, m.num, m.mech, m.ex, m.ey, m.c, m.s, m.ms)
@@ -885,6 +1014,49 @@ def counters_from_homologous_points(
     ox, oy = _a(setting.model_origin_x_mm), _a(setting.model_origin_y_mm)
     args = (*sides[0], *sides[1], f, bx, by, bz, ox, oy)
     return StereoReading(*np.broadcast_arrays(*_rowwise(_homologous, args, 4)))
+
+
+def depths_of_homologous_points(
+    photo_left_mm: ArrayLike,
+    photo_right_mm: ArrayLike,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+) -> NDArray[np.float64]:
+    r"""The absolute height counter D of :func:`counters_from_homologous_points` alone (the
+    same numbers; X, Y, q and the rods' η not computed). [mm]
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(130.0, base_x_mm=90.0, base_y_mm=0.5)
+    >>> unit = CorrectionUnit(100.0, tan_alpha=0.01)
+    >>> r = counters_from_homologous_points([45.0, 1.0], [-44.0, 2.0], setting, unit, unit)
+    >>> bool(depths_of_homologous_points([45.0, 1.0], [-44.0, 2.0], setting, unit, unit)
+    ...      == r.depth_mm)
+    True
+    """
+    pl, pr = _a(photo_left_mm), _a(photo_right_mm)
+    sides = [(p[..., 0], p[..., 1], *_rod_fields(UnitMap(u))) for p, u in ((pl, left), (pr, right))]
+    f = _a(setting.f_instrument_mm)
+    bx, bz = _a(setting.base_x_mm), _a(setting.base_z_mm)
+    (depth,) = _rowwise(_homologous_depth, (*sides[0], *sides[1], f, bx, bz), 1)
+    # the shape of counters_from_homologous_points' four outputs, broadcast together
+    others = (setting.base_y_mm, setting.model_origin_x_mm, setting.model_origin_y_mm)
+    shape = np.broadcast_shapes(
+        *(np.shape(a) for a in (*sides[0], *sides[1], f, bx, bz, *others) if a is not None)
+    )
+    return np.broadcast_to(depth, shape)
+
+
+def _homologous_depth(*args):
+    """D of :func:`_homologous` alone: ξ of each side (:func:`_rod_x`), then t_л of
+    :func:`_ray_arithmetic` and D = t_л f_пр (one output, as a tuple)."""
+    xi_l = _rod_x(*args[:13])
+    xi_r = _rod_x(*args[13:26])
+    f, bx, bz = args[26:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_l = (bx + xi_r * bz / f) / (xi_l - xi_r)
+    return (t_l * f,)
 
 
 def _rod_fields(m: UnitMap) -> tuple[Any, ...]:

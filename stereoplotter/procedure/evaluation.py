@@ -75,7 +75,8 @@ from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
     counters_from_homologous_points,
-    marks_from_counters,
+    parallaxes_at_marks,
+    x_parallaxes_at_marks,
 )
 from stereoplotter.procedure.evaluation_results import ModelEvaluation, PointSetEvaluation
 from stereoplotter.scenario.model import Camera, Photo, Scenario
@@ -300,10 +301,32 @@ def parallax_errors_at_ideal(
     m = np.asarray(model_mm, float)
     x = np.asarray(setting.model_origin_x_mm, float) + m[..., 0]
     y = np.asarray(setting.model_origin_y_mm, float) + m[..., 1]
-    pl, pr = marks_from_counters(x, y, m[..., 2], setting, left, right)
-    dl = pl - np.asarray(photo_left_mm, float)
-    dr = pr - np.asarray(photo_right_mm, float)
-    return dl[..., 0] - dr[..., 0], dl[..., 1] - dr[..., 1]
+    return parallaxes_at_marks(x, y, m[..., 2], setting, left, right, photo_left_mm, photo_right_mm)
+
+
+def x_parallax_errors_at_ideal(
+    model_mm: ArrayLike,
+    photo_left_mm: ArrayLike,
+    photo_right_mm: ArrayLike,
+    setting: InstrumentSetting,
+    left: CorrectionUnit,
+    right: CorrectionUnit,
+) -> _F:
+    """δp of :func:`parallax_errors_at_ideal` alone (the same numbers; q not computed). [mm]
+
+    Examples
+    --------
+    >>> setting = InstrumentSetting(100.0, base_x_mm=80.0)
+    >>> unit = CorrectionUnit(100.0, tan_alpha=0.01)
+    >>> args = ([40.0, 10.0, 100.0], [40.0, 10.0], [-40.0, 10.0], setting, unit, unit)
+    >>> bool(x_parallax_errors_at_ideal(*args) == parallax_errors_at_ideal(*args)[0])
+    True
+    """
+    m = np.asarray(model_mm, float)
+    x = np.asarray(setting.model_origin_x_mm, float) + m[..., 0]
+    y = np.asarray(setting.model_origin_y_mm, float) + m[..., 1]
+    pl, pr = np.asarray(photo_left_mm, float), np.asarray(photo_right_mm, float)
+    return x_parallaxes_at_marks(x, y, m[..., 2], setting, left, right, pl[..., 0], pr[..., 0])
 
 
 def plane_residuals(
@@ -661,9 +684,17 @@ def _raw(
     shape = np.broadcast_shapes(np.shape(dp), np.shape(dx), (len(t.frame_m),))
     out = {"ground_m": t.frame_m, "model_mm": model}
     for name, v in (("dp", dp), ("q", q), ("dx", dx), ("dy", dy), ("dh", dh)):
-        out[name] = np.broadcast_to(v, shape).copy()
-    out["q_seen"] = np.broadcast_to(built.y_parallax_mm, shape).copy()
+        out[name] = _own(v, shape)
+    out["q_seen"] = _own(built.y_parallax_mm, shape)
     return out
+
+
+def _own(v: Any, shape: tuple[int, ...]) -> _F:
+    """``v`` broadcast to ``shape`` as an array of its own: ``v`` itself where it is one
+    already (an array computed above, of that shape, owning its data), else a copy."""
+    if isinstance(v, np.ndarray) and v.shape == shape and v.base is None and v.flags.writeable:
+        return v
+    return np.broadcast_to(v, shape).copy()
 
 
 def _point_set(

@@ -112,9 +112,10 @@ class PointSetEvaluation:
         put("x_parallax_error", self.x_parallax_error_mm, "mm")
         put("y_parallax", self.y_parallax_mm, "mm")
         put("x_parallax_error_after_plane", self.x_parallax_error_after_plane_mm, "mm")
-        put("plan_error", self.plan_error_m, "m")
+        plan = self.plan_error_m  # computed once for both units
+        put("plan_error", plan, "m")
         if map_scale_denominator:
-            put("plan_error", self.plan_error_m * MM_PER_M / map_scale_denominator, "map_mm")
+            put("plan_error", plan * MM_PER_M / map_scale_denominator, "map_mm")
         put("height_error", self.height_error_m, "m")
         put("height_error", self.height_error_m * per_h, "permille")
         if self.height_error_after_plane_m is not None:

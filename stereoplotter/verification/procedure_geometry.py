@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from stereoplotter.instrument.kinematics import counters_from_homologous_points
+from stereoplotter.instrument.kinematics import depths_of_homologous_points
 from stereoplotter.instrument.virtual import HEIGHT_SCALE
 from stereoplotter.procedure import conventional as cv
 from stereoplotter.procedure import evaluation as ev
@@ -161,8 +161,7 @@ def _dp_state(
     if ev.trial_count(setting, (left, right)) is not None:
         setting = ev.with_point_axis(setting)
         left, right = ev.with_point_axis(left), ev.with_point_axis(right)
-    dp, _ = ev.parallax_errors_at_ideal(model, gl, gr, setting, left, right)
-    return np.asarray(dp, float)
+    return np.asarray(ev.x_parallax_errors_at_ideal(model, gl, gr, setting, left, right), float)
 
 
 def height_errors_parallax(
@@ -193,7 +192,7 @@ def height_errors_parallax(
         setting = ev.with_point_axis(setting)
         left, right = ev.with_point_axis(left), ev.with_point_axis(right)
         slip = slip[:, None]
-    depth = counters_from_homologous_points(gl, gr, setting, left, right).depth_mm
+    depth = depths_of_homologous_points(gl, gr, setting, left, right)
     dh: FloatArray = slip - depth * gear / 1000.0 - local[:, 2]
     return dh
 

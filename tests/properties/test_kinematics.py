@@ -27,11 +27,14 @@ from stereoplotter.instrument.kinematics import (
     counters_from_homologous_points,
     counters_from_photo,
     decentration_variant,
+    depths_of_homologous_points,
     marks_from_counters,
+    parallaxes_at_marks,
     photo_from_rod,
     rod_from_counters,
     rod_from_photo,
     rods_intersection,
+    x_parallaxes_at_marks,
 )
 from stereoplotter.instrument.knobs import (
     correction_angle,
@@ -323,3 +326,56 @@ def test_synthetic_photos_are_collinearity():
     pl, _ = pair.photos(t)
     m = rotation_matrix(t[0], t[1], pair.kappa_left)
     assert_allclose(pl, object_to_photo(pair.ground_points_m(), pair.station_left_m, m, 100.0))
+
+
+def test_parallaxes_at_marks_are_the_marks_minus_the_photo_points_on_a_trial_grid():
+    """On a (trials × points) grid large enough to be evaluated a block of rows at a time, the
+    parallaxes equal :func:`marks_from_counters`' marks minus the given photo points, to the
+    bit (the same arithmetic)."""
+    rng = np.random.default_rng(3)
+    trials, points = 700, 90
+    setting = InstrumentSetting(
+        130.0, base_x_mm=90.0 + rng.normal(0, 0.01, (trials, 1)), base_y_mm=0.5, base_z_mm=-1.0
+    )
+    left = CorrectionUnit(100.0, tan_alpha=rng.normal(0, 0.01, (trials, 1)), decentration_x_mm=0.2)
+    right = CorrectionUnit(100.0, tan_omega=rng.normal(0, 0.01, (trials, 1)))
+    x, y = rng.uniform(-50, 50, points), rng.uniform(-50, 50, points)
+    depth = rng.uniform(120, 140, points)
+    p0l, p0r = rng.uniform(-80, 80, (points, 2)), rng.uniform(-80, 80, (points, 2))
+    pl, pr = marks_from_counters(x, y, depth, setting, left, right)
+    dp, q = parallaxes_at_marks(x, y, depth, setting, left, right, p0l, p0r)
+    assert dp.shape == q.shape == (trials, points)
+    assert np.array_equal(dp, (pl - p0l)[..., 0] - (pr - p0r)[..., 0])
+    assert np.array_equal(q, (pl - p0l)[..., 1] - (pr - p0r)[..., 1])
+
+
+def test_x_parallaxes_and_depths_alone_are_those_of_the_full_maps_on_a_trial_grid():
+    """δp alone (:func:`x_parallaxes_at_marks`) and D alone
+    (:func:`depths_of_homologous_points`) on a (trials × points) grid evaluated a block of rows
+    at a time equal, to the bit, the full maps' (the same arithmetic), strict per axis or not."""
+    rng = np.random.default_rng(5)
+    trials, points = 600, 80
+    setting = InstrumentSetting(
+        130.0, base_x_mm=90.0 + rng.normal(0, 0.01, (trials, 1)), base_y_mm=0.5, base_z_mm=-1.0
+    )
+    for strict in (False, True):
+        left = CorrectionUnit(
+            100.0,
+            tan_alpha=rng.normal(0, 0.01, (trials, 1)),
+            decentration_x_mm=0.2,
+            plane_decentration_x_mm=0.3,
+            plane_decentration_y_mm=-0.1,
+            strict_per_axis=strict,
+        )
+        right = CorrectionUnit(100.0, tan_omega=rng.normal(0, 0.01, (trials, 1)), kappa=0.01)
+        x, y = rng.uniform(-50, 50, points), rng.uniform(-50, 50, points)
+        depth = rng.uniform(120, 140, points)
+        p0l, p0r = rng.uniform(-80, 80, (points, 2)), rng.uniform(-80, 80, (points, 2))
+        dp, _ = parallaxes_at_marks(x, y, depth, setting, left, right, p0l, p0r)
+        alone = x_parallaxes_at_marks(x, y, depth, setting, left, right, p0l[:, 0], p0r[:, 0])
+        assert alone.shape == (trials, points)
+        assert np.array_equal(alone, dp)
+        full = counters_from_homologous_points(p0l, p0r, setting, left, right)
+        d = depths_of_homologous_points(p0l, p0r, setting, left, right)
+        assert d.shape == full.depth_mm.shape == (trials, points)
+        assert np.array_equal(d, full.depth_mm)
