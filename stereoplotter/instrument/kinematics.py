@@ -41,18 +41,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
+from stereoplotter.instrument.decentration_variants import LINKAGES
+from stereoplotter.instrument.row_blocks import ndim, rowwise
 
 __all__ = [
-    "DECENTRATION_VARIANTS",
-    "LINKAGES",
     "CorrectionUnit",
-    "DecentrationVariant",
     "InstrumentSetting",
     "StereoReading",
     "UnitMap",
     "counters_from_homologous_points",
     "counters_from_photo",
-    "decentration_variant",
     "depths_of_homologous_points",
     "marks_from_counters",
     "parallaxes_at_marks",
@@ -66,71 +64,6 @@ __all__ = [
     "x_parallaxes_at_marks",
 ]
 
-#: Allowed linkages between a correction knob and the decentrations (``kinematics.md`` §4.1):
-#: "L" both the photo decentration e and the plane decentration c follow the knob (D1),
-#: "A" only the photo decentration follows, "B" the decentrations are independent.
-LINKAGES = ("L", "A", "B")
-
-
-@dataclass(frozen=True, slots=True)
-class DecentrationVariant:
-    """A named decentration variant of the instrument model (``kinematics.md`` §4.1, §5).
-
-    Attributes
-    ----------
-    name : str
-        "L", "A", "B", "B2" or "S".
-    linkage : str
-        How turning a correction knob moves the decentrations, one of :data:`LINKAGES`.
-    decentrations_first : bool
-        The computed decentrations are set before the k_ω, k_α fits (B2) instead of after them.
-    strict_per_axis : bool
-        The correction unit is the strict per-axis mechanism (α only in x, ω only in y).
-    description : str
-        One line for tables.
-    """
-
-    name: str
-    linkage: str
-    decentrations_first: bool
-    strict_per_axis: bool
-    description: str
-
-
-#: The variants compared in ``kinematics.md`` §5 [1]; "L" is the canonical one (decision D1).
-DECENTRATION_VARIANTS: dict[str, DecentrationVariant] = {
-    v.name: v
-    for v in (
-        DecentrationVariant("L", "L", False, False, "canonical: dependent decentration (D1)"),
-        DecentrationVariant("A", "A", False, False, "only the photo decentration follows"),
-        DecentrationVariant("B", "B", False, False, "book order, independent decentrations"),
-        DecentrationVariant("B2", "B", True, False, "independent, decentrations set first"),
-        DecentrationVariant("S", "L", False, True, "strict per-axis unit, linkage as L"),
-    )
-}
-
-
-def decentration_variant(name: str) -> DecentrationVariant:
-    """The :class:`DecentrationVariant` called ``name``.
-
-    Raises
-    ------
-    StereoplotterError
-        ``name`` is not one of :data:`DECENTRATION_VARIANTS`.
-
-    Examples
-    --------
-    >>> decentration_variant("B2").decentrations_first
-    True
-    """
-    try:
-        return DECENTRATION_VARIANTS[name]
-    except KeyError:
-        raise StereoplotterError(
-            f"unknown decentration variant {name!r}; expected one of "
-            f"{', '.join(DECENTRATION_VARIANTS)}"
-        ) from None
-
 
 def _a(v: ArrayLike) -> NDArray[np.float64]:
     return np.asarray(v, dtype=float)
@@ -141,47 +74,6 @@ def _pair(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]
     out = np.empty((*np.broadcast_shapes(np.shape(a), np.shape(b)), 2))
     out[..., 0] = a
     out[..., 1] = b
-    return out
-
-
-#: Elements of one block of rows when an element-wise map is evaluated on a large broadcast (a
-#: convention: the block's dozen temporaries, 8 bytes an element, stay in a core's cache). [—]
-ROWS_BLOCK_ELEMENTS = 1 << 14
-
-
-def _ndim(value: Any) -> int:
-    return getattr(value, "ndim", 0)
-
-
-def _rowwise(fn: Any, args: tuple[Any, ...], outputs: int) -> tuple[NDArray[np.float64], ...]:
-    """``fn(*args)`` — ``outputs`` arrays, each element from the same elements of ``args`` by
-    IEEE arithmetic (+, −, ×, ÷) alone — evaluated a block of leading rows at a time where the
-    arrays broadcast to more than two blocks of :data:`ROWS_BLOCK_ELEMENTS` over two or more
-    axes (the per-trial maps of a (T, points) grid): the same numbers, each rounded alike in any
-    block, with the temporaries in cache instead of main memory. ``None`` and scalars pass.
-
-    Examples
-    --------
-    >>> a = np.linspace(0.0, 1.0, 50_000).reshape(2500, 20)
-    >>> b = np.linspace(1.0, 3.0, 20)
-    >>> fn = lambda u, v: (u * v + 1.0, u / v)
-    >>> all(np.array_equal(p, q) for p, q in zip(_rowwise(fn, (a, b), 2), fn(a, b)))
-    True
-    """
-    if not any(_ndim(a) >= 2 for a in args):
-        return tuple(fn(*args))
-    shape = np.broadcast_shapes(*(np.shape(a) for a in args if a is not None))
-    size = int(np.prod(shape))
-    if size <= 2 * ROWS_BLOCK_ELEMENTS:
-        return tuple(fn(*args))
-    rows = max(1, ROWS_BLOCK_ELEMENTS * shape[0] // size)
-    lead = len(shape)
-    cut = [isinstance(a, np.ndarray) and a.ndim == lead and a.shape[0] == shape[0] for a in args]
-    out = tuple(np.empty(shape) for _ in range(outputs))
-    for r in range(0, shape[0], rows):
-        part = fn(*(a[r : r + rows] if c else a for a, c in zip(args, cut, strict=True)))
-        for o, v in zip(out, part, strict=True):
-            o[r : r + rows] = v
     return out
 
 
@@ -528,9 +420,9 @@ class UnitMap:
         """:func:`photo_from_rod` on separate ξ, η arrays, returning (x, y) separately."""
         args = (xi, eta, self.f, self.ta, self.to, self.kx, self.ky, self.num, self.mech)
         args = (*args, self.ex, self.ey, self.c, self.s, self.ms)
-        if _ndim(xi) < 2 and _ndim(self.c) < 2:  # no (trials × points) grid: at once
+        if ndim(xi) < 2 and ndim(self.c) < 2:  # no (trials × points) grid: at once
             return _photo_xy(*args)
-        return _rowwise(_photo_xy, args, 2)
+        return rowwise(_photo_xy, args, 2)
 
     def photo_from_rod(self, rod_mm: ArrayLike) -> NDArray[np.float64]:
         """See :func:`photo_from_rod`."""
@@ -541,9 +433,9 @@ class UnitMap:
         """:func:`rod_from_photo` on separate x, y arrays, returning (ξ, η) separately."""
         args = (x, y, self.c, self.s, self.ex, self.ey, self.mech, self.f, self.ta, self.to)
         args = (*args, self.kx, self.ky, self.num)
-        if _ndim(x) < 2 and _ndim(self.c) < 2:  # no (trials × points) grid: at once
+        if ndim(x) < 2 and ndim(self.c) < 2:  # no (trials × points) grid: at once
             return _rod_xy(*args)
-        return _rowwise(_rod_xy, args, 2)
+        return rowwise(_rod_xy, args, 2)
 
     def rod_from_photo(self, photo_mm: ArrayLike) -> NDArray[np.float64]:
         """See :func:`rod_from_photo`."""
@@ -752,7 +644,7 @@ def marks_from_counters(
         sx, sy, sz = setting.pivot(side)
         f = _a(setting.f_instrument_mm)
         args = (_a(x_mm), _a(y_mm), _a(depth_mm), sx, sy, sz, f, *_map_fields(UnitMap(unit)))
-        out.append(_pair(*_rowwise(_photo_of_counters, args, 2)))
+        out.append(_pair(*rowwise(_photo_of_counters, args, 2)))
     return out[0], out[1]
 
 
@@ -801,7 +693,7 @@ def parallaxes_at_marks(
         *sides[0],
         *sides[1],
     )
-    return _rowwise(_parallaxes_of_counters, args, 2)
+    return rowwise(_parallaxes_of_counters, args, 2)
 
 
 def x_parallaxes_at_marks(
@@ -840,7 +732,7 @@ def x_parallaxes_at_marks(
         *sides[0],
         *sides[1],
     )
-    return _rowwise(_x_parallax_of_counters, args, 1)[0]
+    return rowwise(_x_parallax_of_counters, args, 1)[0]
 
 
 def _x_parallax_of_counters(x, y, depth, f_instrument, x0l, x0r, *fields):
@@ -935,9 +827,9 @@ def _rays(xi_l, eta_l, xi_r, eta_r, setting: InstrumentSetting):
     bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
     args = (xi_l, eta_l, xi_r, eta_r, f, bx, by, bz)
     with np.errstate(divide="ignore", invalid="ignore"):
-        if _ndim(xi_l) < 2 and _ndim(xi_r) < 2:  # no (trials × points) grid: at once
+        if ndim(xi_l) < 2 and ndim(xi_r) < 2:  # no (trials × points) grid: at once
             return _ray_arithmetic(*args)
-        return _rowwise(_ray_arithmetic, args, 4)
+        return rowwise(_ray_arithmetic, args, 4)
 
 
 def _ray_arithmetic(xi_l, eta_l, xi_r, eta_r, f, bx, by, bz):
@@ -1013,7 +905,7 @@ def counters_from_homologous_points(
     bx, by, bz = _a(setting.base_x_mm), _a(setting.base_y_mm), _a(setting.base_z_mm)
     ox, oy = _a(setting.model_origin_x_mm), _a(setting.model_origin_y_mm)
     args = (*sides[0], *sides[1], f, bx, by, bz, ox, oy)
-    return StereoReading(*np.broadcast_arrays(*_rowwise(_homologous, args, 4)))
+    return StereoReading(*np.broadcast_arrays(*rowwise(_homologous, args, 4)))
 
 
 def depths_of_homologous_points(
@@ -1039,7 +931,7 @@ def depths_of_homologous_points(
     sides = [(p[..., 0], p[..., 1], *_rod_fields(UnitMap(u))) for p, u in ((pl, left), (pr, right))]
     f = _a(setting.f_instrument_mm)
     bx, bz = _a(setting.base_x_mm), _a(setting.base_z_mm)
-    (depth,) = _rowwise(_homologous_depth, (*sides[0], *sides[1], f, bx, bz), 1)
+    (depth,) = rowwise(_homologous_depth, (*sides[0], *sides[1], f, bx, bz), 1)
     # the shape of counters_from_homologous_points' four outputs, broadcast together
     others = (setting.base_y_mm, setting.model_origin_x_mm, setting.model_origin_y_mm)
     shape = np.broadcast_shapes(

@@ -22,7 +22,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from stereoplotter.errors import StereoplotterError
 from stereoplotter.geometry.tilt_correction import correction_inclination, decentration
-from stereoplotter.instrument.kinematics import LINKAGES, CorrectionUnit
+from stereoplotter.instrument.decentration_variants import LINKAGES
+from stereoplotter.instrument.kinematics import CorrectionUnit
 
 __all__ = [
     "correction_angle",

@@ -52,12 +52,12 @@ from stereoplotter.instrument.controls import (
     control_kind,
     control_side,
 )
+from stereoplotter.instrument.decentration_variants import decentration_variant
 from stereoplotter.instrument.error_model import ErrorModel, error_model_from_spec
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
     UnitMap,
-    decentration_variant,
     marks_from_counters,
 )
 from stereoplotter.instrument.knobs import turn_correction_knob

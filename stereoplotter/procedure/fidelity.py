@@ -21,10 +21,10 @@ from typing import Any
 __all__ = ["LINKAGE_VARIANTS", "MECHANISMS", "Fidelity", "Mechanism", "mechanism"]
 
 #: The knob–decentration linkage → the instrument's decentration variant
-#: (:data:`~stereoplotter.instrument.kinematics.DECENTRATION_VARIANTS`): "drag", the knob drags
-#: the photo and plane decentrations (D1, "L"); "independent", the decentrations stay where
-#: they are set, and are set before the k_ω, k_α fits ("B2": set after them, as in the book's
-#: order, they would leave the fits made at zero decentration).
+#: (:data:`~stereoplotter.instrument.decentration_variants.DECENTRATION_VARIANTS`): "drag",
+#: the knob drags the photo and plane decentrations (D1, "L"); "independent", the
+#: decentrations stay where they are set, and are set before the k_ω, k_α fits ("B2": set
+#: after them, as in the book's order, they would leave the fits made at zero decentration).
 LINKAGE_VARIANTS = {"drag": "L", "independent": "B2"}
 
 

@@ -23,8 +23,8 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from stereoplotter.instrument.decentration_variants import decentration_variant
 from stereoplotter.instrument.error_model import ErrorModel
-from stereoplotter.instrument.kinematics import decentration_variant
 from stereoplotter.instrument.principles import mechanism_for
 from stereoplotter.instrument.sc1_complex import (
     AutomaticCoordinatograph,

@@ -45,10 +45,10 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
+from stereoplotter.instrument.decentration_variants import decentration_variant
 from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
-    decentration_variant,
     marks_from_counters,
     photo_from_rod,
     rod_from_photo,
@@ -548,7 +548,7 @@ def stage2_setting(
     side_sign : ndarray
         +1 for a left photo (k_α on mark 2 at +l), −1 for a right photo (mark 1 at −l).
     variant : {"L", "A", "B", "B2", "S"}
-        Decentration variant (``kinematics.DECENTRATION_VARIANTS``).
+        Decentration variant (``decentration_variants.DECENTRATION_VARIANTS``).
     pair : SyntheticPair, optional
         f′ and l; default the §5 data.
 
@@ -640,7 +640,7 @@ def stage2_table(
     tilts_deg : sequence of float
         Tilt magnitudes t; signs (α_л +, ω_л −, α_п −, ω_п +). [°]
     variants : sequence of str
-        Names from ``kinematics.DECENTRATION_VARIANTS``.
+        Names from ``decentration_variants.DECENTRATION_VARIANTS``.
 
     Returns
     -------

@@ -153,6 +153,7 @@ def local_client(workers: int | None = None, dashboard: bool = True):
 def _worker_count(workers: int | None) -> int:
     """The embedded cluster's workers: ``workers``, or one per core (as ``LocalCluster`` counts
     them: the cores this process may use)."""
+    # Imported here: dask is the optional extra `study`.
     from dask.system import CPU_COUNT
 
     return workers if workers is not None else max(1, CPU_COUNT)
@@ -163,11 +164,11 @@ def _load_library() -> None:
     import stereoplotter.study.runner  # noqa: F401
 
 
-class _Forks:
+class ForkCounter:
     """Counts the forks this process makes from threads other than the one that created it
     (``os.register_at_fork``); ``done`` is set at ``expected`` of them, or by :meth:`stop`."""
 
-    _counting: ClassVar[list[_Forks]] = []
+    _counting: ClassVar[list[ForkCounter]] = []
     _registered = False
 
     def __init__(self, expected: int):
@@ -176,16 +177,16 @@ class _Forks:
         self.seen = 0
         self.done = threading.Event()
         self._lock = threading.Lock()
-        if not _Forks._registered and hasattr(os, "register_at_fork"):
-            os.register_at_fork(after_in_parent=_Forks._after_fork)
-            _Forks._registered = True
-        _Forks._counting.append(self)
+        if not ForkCounter._registered and hasattr(os, "register_at_fork"):
+            os.register_at_fork(after_in_parent=ForkCounter._after_fork)
+            ForkCounter._registered = True
+        ForkCounter._counting.append(self)
         if expected <= 0:
             self.stop()
 
     @staticmethod
     def _after_fork() -> None:
-        for forks in list(_Forks._counting):
+        for forks in list(ForkCounter._counting):
             if threading.get_ident() != forks.waiter:
                 with forks._lock:
                     forks.seen += 1
@@ -193,8 +194,8 @@ class _Forks:
                         forks.stop()
 
     def stop(self) -> None:
-        if self in _Forks._counting:
-            _Forks._counting.remove(self)
+        if self in ForkCounter._counting:
+            ForkCounter._counting.remove(self)
         self.done.set()
 
 
@@ -215,7 +216,7 @@ def start_local_client(workers: int | None = None, dashboard: bool = True) -> Fu
         except BaseException as exc:  # handed to whoever takes the client
             started.set_exception(exc)
             return started
-        forks = _Forks(_worker_count(workers))
+        forks = ForkCounter(_worker_count(workers))
 
     def start() -> None:
         try:

@@ -20,13 +20,15 @@ from stereoplotter.geometry.transformed import (
     transformed_x_single_tilt,
     transformed_y_single_tilt,
 )
-from stereoplotter.instrument.kinematics import (
+from stereoplotter.instrument.decentration_variants import (
     DECENTRATION_VARIANTS,
+    decentration_variant,
+)
+from stereoplotter.instrument.kinematics import (
     CorrectionUnit,
     InstrumentSetting,
     counters_from_homologous_points,
     counters_from_photo,
-    decentration_variant,
     depths_of_homologous_points,
     marks_from_counters,
     parallaxes_at_marks,

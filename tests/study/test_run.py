@@ -171,9 +171,9 @@ def test_the_study_is_prepared_only_once_the_workers_are_forked():
     # start_local_client waits for the cluster's forks (made by other threads), not its own
     import threading
 
-    from stereoplotter.study.runner import _Forks
+    from stereoplotter.study.runner import ForkCounter
 
-    forks = _Forks(2)
+    forks = ForkCounter(2)
     _fork_and_reap()  # this thread's fork: not one of the cluster's
     assert not forks.done.is_set()
     for seen in (1, 2):
