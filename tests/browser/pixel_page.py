@@ -14,6 +14,10 @@ import numpy as np
 from PIL import Image
 
 _CANVASES = "() => ['left', 'right'].map((s) => document.getElementById('eye-' + s).toDataURL())"
+#: A wheel's shown value once the frames asked for so far are drawn (a frame asked for now runs
+#: after them).
+_WHEEL = ("(sel) => new Promise((r) => requestAnimationFrame(() => "
+          "r(document.querySelector(sel).textContent)))")
 
 
 class PageEyes:
@@ -52,7 +56,11 @@ class PageEyes:
         self._type(f"{control} {float(value)!r}")
 
     def wheel(self, control: str) -> float:
-        text = self.page.inner_text(f".wheel[data-control='{control}'] .value")
+        """The value the wheel shows, read after the page's next animation frame: the page
+        redraws its wheels in a frame after a state arrives, so a wheel read as soon as the
+        action is answered can still show the value before it (seen: Z set 2 mm down read as
+        its old value in 3 of 30 sessions)."""
+        text = self.page.evaluate(_WHEEL, f".wheel[data-control='{control}'] .value")
         return float(text.split()[0].replace("−", "-"))
 
     def claim(self) -> None:

@@ -380,10 +380,13 @@ COMMON_SEARCH = (0.04, -0.04, 0.08, -0.08)
 CLASSIC = ((1, "kappa_right"), (2, "kappa_left"), (4, "k_alpha_left"), (3, "k_alpha_right"),
            (5, "k_omega_right"))
 CLASSIC_CYCLES, CLASSIC_DONE_UM, CLASSIC_MAX_TURN = 3, 150.0, 0.05
-#: Z's probe step (downwards: the carriage may start at its upper stop) [mm]; the x-parallax
-#: one step of the search by Z moves the detail (under the finding field's half) [µm]; the
-#: x-parallax left uncleared (the ×20 search holds ±300 µm) [µm].
-Z_PROBE, Z_SEARCH_UM, X_CLEAR_UM = -2.0, 3500.0, 60.0
+#: Z's probe steps, tried in turn until one teaches its effect (downwards first: the carriage
+#: may start at its upper stop; then upwards, then a longer one down) [mm]; the least change
+#: of the x-parallax a probe must make (2 mm of Z changes it by ≈ 730 µm, 15 ×2 pixels, on
+#: the C2 exam's SC-1) [µm]; the x-parallax one step of the search by Z moves the detail
+#: (under the finding field's half) [µm]; the x-parallax left uncleared (the ×20 search holds
+#: ±300 µm) [µm].
+Z_PROBES, Z_PROBE_MIN_UM, Z_SEARCH_UM, X_CLEAR_UM = (-2.0, 2.0, -5.0), 50.0, 3500.0, 60.0
 #: The x-parallax left uncleared at the measuring magnifications. [px]
 FUSED_PX = 3.0
 #: The step of the marks' positions the page draws the photos at where the read-out is hidden
@@ -571,6 +574,8 @@ class Robot:
         if m is None:
             rec.notes.append(f"coarse {n}: not found")
             return None
+        if rec.x_per_z is None:
+            m = self.learn_z(m)  # not learnt at point 1: learnt here
         m = self.clear_x(m)
         self.z_at[n] = self.z
         rec.notes.append(f"coarse {n}: {m}")
@@ -597,6 +602,27 @@ class Robot:
         self.rec.notes.append(f"classic {n} {control}: q {moved.q_um:.0f} µm, turned {d:.5f}")
         return True
 
+    def learn_z(self, m: Match) -> Match:
+        """Z's effect on the x-parallax learnt from a found detail ``m``: Z set by each of
+        :data:`Z_PROBES` in turn from where it is (a setting past a stop leaves it there and is
+        skipped), the detail looked for near ``m``, then anywhere, until one changes the
+        x-parallax by more than :data:`Z_PROBE_MIN_UM`; Z stays at the setting that taught it
+        (the detail as seen there returned), else goes back (``m`` returned)."""
+        z0 = self.z
+        for dz in Z_PROBES:
+            self.set_z(z0 + dz)
+            if self.z == z0:
+                continue
+            moved = self.look((m.dx_px, m.dy_px), 40.0) or self.look()
+            if moved is not None and abs(moved.p_um - m.p_um) > Z_PROBE_MIN_UM:
+                self.rec.x_per_z = (moved.p_um - m.p_um) / (self.z - z0)
+                self.rec.notes.append(f"x per Z: {self.rec.x_per_z} µm/mm (probe {dz:+} mm)")
+                return moved
+            self.rec.notes.append(f"Z probe {dz:+} mm: {moved}")
+            self.set_z(z0)
+        self.rec.notes.append("x per Z: None")
+        return m
+
     def start(self) -> None:
         """Point 1 found (a search by turns of κ_п where not), Z's effect on the x-parallax
         learnt there; then cycles of the conventional method's element-by-element clearing (by
@@ -615,12 +641,7 @@ class Robot:
                 self.eyes.turn("kappa_right", -d)
         if m is None:
             return
-        z0 = self.z
-        self.set_z(z0 + Z_PROBE)
-        moved = self.look((m.dx_px, m.dy_px), 40.0)
-        if moved is not None and abs(moved.p_um - m.p_um) > 50.0 and self.z != z0:
-            self.rec.x_per_z = (moved.p_um - m.p_um) / (self.z - z0)
-        self.rec.notes.append(f"x per Z: {self.rec.x_per_z} µm/mm")
+        self.learn_z(m)
         for _ in range(CLASSIC_CYCLES):
             ok = [self.clear_with(p, c) for p, c in CLASSIC if p in self.rec.points]
             if all(ok):
