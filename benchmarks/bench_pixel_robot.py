@@ -9,7 +9,8 @@ claim the grade's true residual y-parallax at the six points is read, for the re
 
 Prints per seed: passed, the true q at the six points [µm] (the grade's sign), the robot's last
 reading of q at each point with its magnification (the page's sign: "a detail lower on the right"
-is +, the opposite of the grade's), actions, looks, seconds; then the pass rate. The exam seed
+is +, the opposite of the grade's), actions, looks, seconds (and how they split: acting, waiting
+for the photos, reading the canvases, the rest); then the pass rate. The exam seed
 of a trainee is drawn by the server from its own key (HMAC of exercise, trainee, attempt):
 ``--server-key TEXT`` gives the server the key SHA-256(TEXT) (a data folder in a temporary
 directory holds it), so that a run meets the same instruments as another run with the same
@@ -127,7 +128,10 @@ def main() -> None:
             print(f"seed 'pixel {k}': passed {ok}; true q {true} µm (worst {worst}); "
                   f"last read q {seen} µm; "
                   f"{eyes.sent} actions, {eyes.looks} looks, {rec.passes} passes, "
-                  f"{seconds:.0f} s", flush=True)
+                  f"{seconds:.0f} s (acting {eyes.act_s:.0f}, waiting for the photos "
+                  f"{eyes.wait_s:.0f}, reading them {eyes.read_s:.0f}, the rest — the "
+                  f"robot's judgement, the session's start and the claim — "
+                  f"{seconds - eyes.act_s - eyes.wait_s - eyes.read_s:.0f})", flush=True)
         ctx.close()
     print(f"passed {passed} of {args.seeds}; actions {min(actions)}–{max(actions)} "
           f"(median {np.median(actions):.0f}); {min(secs):.0f}–{max(secs):.0f} s "

@@ -22,7 +22,9 @@ _WHEEL = ("(sel) => new Promise((r) => requestAnimationFrame(() => "
 
 class PageEyes:
     """:class:`tests.browser.pixel_robot.Eyes` on an open instrument page; counts the actions
-    it causes (:attr:`sent`), the looks and the seconds spent waiting for the photos."""
+    it causes (:attr:`sent`), the looks, the seconds spent waiting for the photos
+    (:attr:`wait_s`), reading the canvases back (:attr:`read_s`) and acting (:attr:`act_s`:
+    the turns, settings and go-tos until answered)."""
 
     def __init__(self, page):
         self.page = page
@@ -30,6 +32,8 @@ class PageEyes:
         self.looks = 0
         self.mag: int | None = None
         self.wait_s = 0.0
+        self.read_s = 0.0
+        self.act_s = 0.0
 
     def settle(self) -> None:
         """Every action sent answered (a refused one too: a turn past a stop is refused and not
@@ -38,16 +42,20 @@ class PageEyes:
         self.sent = self.page.evaluate("() => window.__n")
 
     def _type(self, text: str) -> None:
+        t0 = time.monotonic()
         self.page.fill("#command", text)
         self.page.press("#command", "Enter")
         self.settle()
+        self.act_s += time.monotonic() - t0
 
     def go_to(self, point: int) -> None:
+        t0 = time.monotonic()
         before = self.sent
         self.page.click(f"#goto button[data-point='{point}']")
         # the page fetches the settings, then sends X and Y
         self.page.wait_for_function(f"() => window.__n >= {before + 2}", timeout=60_000)
         self.settle()
+        self.act_s += time.monotonic() - t0
 
     def turn(self, control: str, delta: float) -> None:
         self._type(f"turn {control} {float(delta)!r}")
@@ -84,13 +92,15 @@ class PageEyes:
             arg=magnification, timeout=60_000,
         )
         self.page.evaluate("() => new Promise((r) => requestAnimationFrame(() => setTimeout(r)))")
-        self.wait_s += time.monotonic() - t0
+        t1 = time.monotonic()
+        self.wait_s += t1 - t0
         urls = self.page.evaluate(_CANVASES)
         self.looks += 1
         out = []
         for url in urls:
             png = base64.b64decode(url.split(",", 1)[1])
             out.append(np.asarray(Image.open(io.BytesIO(png)).convert("RGB")))
+        self.read_s += time.monotonic() - t1
         return out[0], out[1]
 
 

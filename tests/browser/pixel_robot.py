@@ -23,7 +23,8 @@ one (:data:`AGREE_PX`). Where a point's own field is striped or plain, the marks
 the most detailed place next to it (:func:`textured_spot`).
 
 **Relative orientation** (:class:`Robot`). Z is set to clear the x-parallax (its effect learnt
-by one probe); cycles of the conventional method's element-by-element clearing (:data:`CLASSIC`,
+by a probe setting at point 1, :meth:`Robot.learn_z`; the wheel read after the page has
+redrawn it); cycles of the conventional method's element-by-element clearing (:data:`CLASSIC`,
 each element's effect learnt by a probe turn) bring every detail near the mark; then at each
 standard point the robot turns each of the five elements (κ_л, κ_п, k_α,л, k_α,п, k_ω,п) by a
 probe step and back, the change per unit its row of the Jacobian; the turns that null the six
@@ -44,8 +45,8 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
+from scipy import fft as sfft
 from scipy.ndimage import binary_dilation, gaussian_filter, rotate
-from scipy.signal import fftconvolve
 
 #: The page's screen pixel at ×1 (the server's ``SCREEN_PIXEL_MM``, sent in its first message). [mm]
 SCREEN_PIXEL_MM = 0.1
@@ -213,20 +214,30 @@ def masked_ncc(t: np.ndarray, a: np.ndarray, g: np.ndarray, b: np.ndarray,
                min_overlap: float = 0.5) -> np.ndarray:
     """Normalised cross-correlation of template ``t`` (mask ``a``) at every position overlapping
     image ``g`` (mask ``b``), only pixels valid in both counted (Padfield 2012, every sum one
-    FFT): ``out[i, j]`` for the template's top-left corner at row i − (th − 1), column
-    j − (tw − 1); −1 where fewer than ``min_overlap`` of the template's pixels overlap."""
+    FFT correlation; the three template and three image transforms made once): ``out[i, j]``
+    for the template's top-left corner at row i − (th − 1), column j − (tw − 1); −1 where fewer
+    than ``min_overlap`` of the template's pixels overlap."""
     a = a.astype(float)
     b = b.astype(float)
     t = t * a
     gb = g * b
+    shape = (g.shape[0] + t.shape[0] - 1, g.shape[1] + t.shape[1] - 1)
+    fast = tuple(sfft.next_fast_len(n, real=True) for n in shape)
 
-    def corr(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        return fftconvolve(y, x[::-1, ::-1], mode="full")
+    def spectrum(x: np.ndarray) -> np.ndarray:
+        return sfft.rfft2(x, fast)
 
-    n = corr(a, b)
-    st, sg = corr(t, b), corr(a, gb)
-    stt, sgg = corr(t * t, b), corr(a, gb * g)
-    stg = corr(t, gb)
+    flipped = [spectrum(x[::-1, ::-1]) for x in (a, t, t * t)]
+    fa, ft, ftt = flipped
+    fb, fgb, fgg = (spectrum(x) for x in (b, gb, gb * g))
+
+    def corr(fx: np.ndarray, fy: np.ndarray) -> np.ndarray:
+        return sfft.irfft2(fx * fy, fast)[:shape[0], :shape[1]]
+
+    n = corr(fa, fb)
+    st, sg = corr(ft, fb), corr(fa, fgb)
+    stt, sgg = corr(ftt, fb), corr(fa, fgg)
+    stg = corr(ft, fgb)
     n_safe = np.maximum(n, 1.0)
     num = stg - st * sg / n_safe
     den = (stt - st**2 / n_safe) * (sgg - sg**2 / n_safe)
