@@ -398,8 +398,10 @@ CLASSIC_CYCLES, CLASSIC_DONE_UM, CLASSIC_MAX_TURN = 3, 150.0, 0.05
 #: (under the finding field's half) [µm]; the x-parallax left uncleared (the ×20 search holds
 #: ±300 µm) [µm].
 Z_PROBES, Z_PROBE_MIN_UM, Z_SEARCH_UM, X_CLEAR_UM = (-2.0, 2.0, -5.0), 50.0, 3500.0, 60.0
-#: The x-parallax left uncleared at the measuring magnifications. [px]
-FUSED_PX = 3.0
+#: The x-parallax left uncleared at the measuring magnifications [px]; the largest a ×20
+#: reading is taken with (a fused detail read 0–3 px; the matches on something else than the
+#: detail that fusing could not clear, 25–52 px: runs of docs/trainer.md) [px].
+FUSED_PX, UNFUSED_PX = 3.0, 10.0
 #: The step of the marks' positions the page draws the photos at where the read-out is hidden
 #: (the X, Y counters' least count, 0.01 mm, as the counters show it) [mm]; looks averaged per
 #: ×20 reading; the search radius around the previous look [px].
@@ -489,10 +491,13 @@ class Robot:
         at each magnification before the finer look (a trainee fuses the detail with the foot
         wheel: an x-parallax of a few hundred µm puts the detail outside the ×20 search, and
         the relief inside a template biases a match that is far from fused)."""
+        coarser = m
         for mag in (*sorted(FINE_MAGS), None):
             m = self.fuse(m)
             if mag is None:
                 break
+            if m.magnification < FINE_MAGS[0]:
+                coarser = m
             if mag <= m.magnification or not fits((m.dx_px, m.dy_px), m.magnification, mag):
                 continue
             k = mag / m.magnification
@@ -503,8 +508,24 @@ class Robot:
                 self.rec.notes.append(f"no sure ×{mag} at {n}: {weak}")
                 break
             m = finer
+        if m.magnification == FINE_MAGS[0] and abs(m.dx_px) > UNFUSED_PX and (
+                coarser.magnification < FINE_MAGS[0]):
+            m = self.fused_or(n, m, coarser)
         self.z_at[n] = self.z
         return m
+
+    def fused_or(self, n: int, m: Match, coarser: Match) -> Match:
+        """A ×20 match ``m`` that fusing did not clear (its x-parallax over
+        :data:`UNFUSED_PX`) is not taken as a reading: the detail is looked for fused, near
+        ``m``'s y-parallax at no x-parallax (within :data:`UNFUSED_PX`), at the Z it was seen
+        at; found, that is the reading; else the coarser reading (``coarser``) is kept. In the
+        runs this rule came from, such a match sat 25–52 ×20 pixels off in x, its y-parallax
+        the same (within 0.5 px) over nine passes while the true q moved 20 µm: a match on
+        something else than the detail, its reading 13–21 µm off (docs/trainer.md)."""
+        mag = m.magnification
+        fused = match(*view(self.eyes, mag), mag, (0.0, m.dy_px), UNFUSED_PX)
+        self.rec.notes.append(f"unfused ×{mag} at {n}: {m}; fused look: {fused}")
+        return coarser if fused is None else fused
 
     def steady(self, m: Match) -> Match:
         """A ×20 match with its y-parallax averaged over :data:`DITHER` looks, Y turned by a
@@ -686,8 +707,9 @@ class Robot:
             if self.z != self.z_at[n]:
                 self.set_z(self.z_at[n])
             m = measure(eyes, predicted[n])
-            if m is not None and m.magnification == FIND_MAG:
-                m = None
+            if m is not None and (m.magnification == FIND_MAG or (
+                    m.magnification == FINE_MAGS[0] and abs(m.dx_px) > UNFUSED_PX)):
+                m = None  # found only at ×2, or at ×20 not fused: looked for from ×2 again
             if m is not None:
                 if n not in rec.jacobian:
                     self.probe_row(n)
