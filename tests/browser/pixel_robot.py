@@ -400,7 +400,7 @@ CLASSIC_CYCLES, CLASSIC_DONE_UM, CLASSIC_MAX_TURN = 3, 150.0, 0.05
 Z_PROBES, Z_PROBE_MIN_UM, Z_SEARCH_UM, X_CLEAR_UM = (-2.0, 2.0, -5.0), 50.0, 3500.0, 60.0
 #: The x-parallax left uncleared at the measuring magnifications [px]; the largest a ×20
 #: reading is taken with (a fused detail read 0–3 px; the matches on something else than the
-#: detail that fusing could not clear, 25–52 px: runs of docs/trainer.md) [px].
+#: detail that fusing could not clear, 23–53 px: runs of docs/trainer.md) [px].
 FUSED_PX, UNFUSED_PX = 3.0, 10.0
 #: The step of the marks' positions the page draws the photos at where the read-out is hidden
 #: (the X, Y counters' least count, 0.01 mm, as the counters show it) [mm]; looks averaged per
@@ -519,9 +519,10 @@ class Robot:
         :data:`UNFUSED_PX`) is not taken as a reading: the detail is looked for fused, near
         ``m``'s y-parallax at no x-parallax (within :data:`UNFUSED_PX`), at the Z it was seen
         at; found, that is the reading; else the coarser reading (``coarser``) is kept. In the
-        runs this rule came from, such a match sat 25–52 ×20 pixels off in x, its y-parallax
-        the same (within 0.5 px) over nine passes while the true q moved 20 µm: a match on
-        something else than the detail, its reading 13–21 µm off (docs/trainer.md)."""
+        runs this rule came from, such a match sat 23–53 ×20 pixels off in x, its y offset near
+        zero (mostly within 0.6 px) and the same pass after pass while the true q moved by up
+        to 8 µm: a match on something other than the detail, its reading 13–21 µm off
+        (docs/trainer.md)."""
         mag = m.magnification
         fused = match(*view(self.eyes, mag), mag, (0.0, m.dy_px), UNFUSED_PX)
         self.rec.notes.append(f"unfused ×{mag} at {n}: {m}; fused look: {fused}")
