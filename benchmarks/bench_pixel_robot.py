@@ -9,13 +9,18 @@ claim the grade's true residual y-parallax at the six points is read, for the re
 
 Prints per seed: passed, the true q at the six points [µm] (the grade's sign), the robot's last
 reading of q at each point with its magnification (the page's sign: "a detail lower on the right"
-is +, the opposite of the grade's), actions, looks, seconds; then the pass rate. The exam seed
-of a trainee is drawn by the server from its own key, so each run meets other instruments.
+is +, the opposite of the grade's), actions, looks, seconds (and how they split: acting, waiting
+for the photos, reading the canvases, the rest); then the pass rate. The exam seed
+of a trainee is drawn by the server from its own key (HMAC of exercise, trainee, attempt):
+``--server-key TEXT`` gives the server the key SHA-256(TEXT) (a data folder in a temporary
+directory holds it), so that a run meets the same instruments as another run with the same
+TEXT; ``--server-key random`` (the default) a fresh key, other instruments each run.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import tempfile
 import threading
 import time
@@ -24,8 +29,10 @@ import numpy as np
 import uvicorn
 from playwright.sync_api import sync_playwright
 
+from stereoplotter.io.session_store import SessionStore
 from stereoplotter.web.app import create_app
 from stereoplotter.web.browser_setup import chromium_path
+from stereoplotter.web.registry import SEED_KEY
 from tests.browser import pixel_page
 from tests.browser.conftest import FLAGS, _free_port
 from tests.browser.pixel_robot import relative_orientation
@@ -64,9 +71,19 @@ def main() -> None:
     ap.add_argument("--verbose", action="store_true",
                     help="diagnostics: the robot's notes, and after each pass the true q and Z "
                     "read from the server's session (never shown to the robot)")
+    ap.add_argument("--server-key", default="random",
+                    help="the server's exam-seed key is SHA-256 of this text (the same text, "
+                    "the same instruments); 'random': a fresh key")
     args = ap.parse_args()
     port = _free_port()
-    app = create_app(TOKEN, message_limit=(2000.0, 4000))
+    data = tempfile.TemporaryDirectory()
+    data_dir = None
+    if args.server_key != "random":
+        data_dir = data.name
+        store = SessionStore(data_dir)
+        store.put_value(SEED_KEY, hashlib.sha256(args.server_key.encode()).hexdigest())
+        store.close()
+    app = create_app(TOKEN, data_dir, message_limit=(2000.0, 4000))
     srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
     threading.Thread(target=srv.run, daemon=True).start()
     while not srv.started:
@@ -111,7 +128,10 @@ def main() -> None:
             print(f"seed 'pixel {k}': passed {ok}; true q {true} µm (worst {worst}); "
                   f"last read q {seen} µm; "
                   f"{eyes.sent} actions, {eyes.looks} looks, {rec.passes} passes, "
-                  f"{seconds:.0f} s", flush=True)
+                  f"{seconds:.0f} s (acting {eyes.act_s:.0f}, waiting for the photos "
+                  f"{eyes.wait_s:.0f}, reading them {eyes.read_s:.0f}, the rest — the "
+                  f"robot's judgement, the session's start and the claim — "
+                  f"{seconds - eyes.act_s - eyes.wait_s - eyes.read_s:.0f})", flush=True)
         ctx.close()
     print(f"passed {passed} of {args.seeds}; actions {min(actions)}–{max(actions)} "
           f"(median {np.median(actions):.0f}); {min(secs):.0f}–{max(secs):.0f} s "

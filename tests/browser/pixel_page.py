@@ -14,11 +14,17 @@ import numpy as np
 from PIL import Image
 
 _CANVASES = "() => ['left', 'right'].map((s) => document.getElementById('eye-' + s).toDataURL())"
+#: A wheel's shown value once the frames asked for so far are drawn (a frame asked for now runs
+#: after them).
+_WHEEL = ("(sel) => new Promise((r) => requestAnimationFrame(() => "
+          "r(document.querySelector(sel).textContent)))")
 
 
 class PageEyes:
     """:class:`tests.browser.pixel_robot.Eyes` on an open instrument page; counts the actions
-    it causes (:attr:`sent`), the looks and the seconds spent waiting for the photos."""
+    it causes (:attr:`sent`), the looks, the seconds spent waiting for the photos
+    (:attr:`wait_s`), reading the canvases back (:attr:`read_s`) and acting (:attr:`act_s`:
+    the turns, settings and go-tos until answered)."""
 
     def __init__(self, page):
         self.page = page
@@ -26,6 +32,8 @@ class PageEyes:
         self.looks = 0
         self.mag: int | None = None
         self.wait_s = 0.0
+        self.read_s = 0.0
+        self.act_s = 0.0
 
     def settle(self) -> None:
         """Every action sent answered (a refused one too: a turn past a stop is refused and not
@@ -34,16 +42,20 @@ class PageEyes:
         self.sent = self.page.evaluate("() => window.__n")
 
     def _type(self, text: str) -> None:
+        t0 = time.monotonic()
         self.page.fill("#command", text)
         self.page.press("#command", "Enter")
         self.settle()
+        self.act_s += time.monotonic() - t0
 
     def go_to(self, point: int) -> None:
+        t0 = time.monotonic()
         before = self.sent
         self.page.click(f"#goto button[data-point='{point}']")
         # the page fetches the settings, then sends X and Y
         self.page.wait_for_function(f"() => window.__n >= {before + 2}", timeout=60_000)
         self.settle()
+        self.act_s += time.monotonic() - t0
 
     def turn(self, control: str, delta: float) -> None:
         self._type(f"turn {control} {float(delta)!r}")
@@ -52,7 +64,11 @@ class PageEyes:
         self._type(f"{control} {float(value)!r}")
 
     def wheel(self, control: str) -> float:
-        text = self.page.inner_text(f".wheel[data-control='{control}'] .value")
+        """The value the wheel shows, read after the page's next animation frame: the page
+        redraws its wheels in a frame after a state arrives, so a wheel read as soon as the
+        action is answered can still show the value before it (seen: Z set 2 mm down read as
+        its old value in 3 of 30 sessions)."""
+        text = self.page.evaluate(_WHEEL, f".wheel[data-control='{control}'] .value")
         return float(text.split()[0].replace("−", "-"))
 
     def claim(self) -> None:
@@ -76,13 +92,15 @@ class PageEyes:
             arg=magnification, timeout=60_000,
         )
         self.page.evaluate("() => new Promise((r) => requestAnimationFrame(() => setTimeout(r)))")
-        self.wait_s += time.monotonic() - t0
+        t1 = time.monotonic()
+        self.wait_s += t1 - t0
         urls = self.page.evaluate(_CANVASES)
         self.looks += 1
         out = []
         for url in urls:
             png = base64.b64decode(url.split(",", 1)[1])
             out.append(np.asarray(Image.open(io.BytesIO(png)).convert("RGB")))
+        self.read_s += time.monotonic() - t1
         return out[0], out[1]
 
 
