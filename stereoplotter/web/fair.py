@@ -1,14 +1,23 @@
-"""A fair worker pool: jobs of many clients served round-robin, not first come, first served.
+"""A fair worker pool: the job of the session with the least recent work first, not first come,
+first served.
 
 The server's actions and photo patches run on worker threads. With one queue, a client that
 sends a hundred requests puts every other trainee's request behind them; here each job is
 queued under its owner (a client address, then a session of that address), and a free worker
-takes the next job of the next address in turn, and within the address of the next session in
-turn. A session never has two jobs running at once (its actions keep their order). So a
-trainee's request waits for at most one job of each other address with work queued, however
-many that address has sent. With ``per_address``, an address never has more jobs running at
-once than that, so with more workers than that one client cannot occupy them all: a newcomer's
-job starts on the worker left free.
+takes the queued job of the session that has had the least of the workers' time lately (the
+CPU time its jobs took on them, decayed with a half-life of :data:`HALF_LIFE_S`: CPU, not wall
+time, so a job slowed by others is not charged for them); between sessions with the
+same, the address served longest ago goes first, then the job queued first. A session never
+has two jobs running at once (its actions keep their order). So a trainee's request waits for
+no job of a session that has had more of the workers lately, however many that session or
+its address have sent; a class behind one address is served session by session like any
+other. With ``per_address``, an address never has more jobs running at once than that, so
+with more workers than that one client cannot occupy them all. With ``heavy_alone``, a job of
+a session that has had more of the workers lately than the average session does not start
+while another job is running: the server's actions hold the interpreter's lock, so a heavy
+session's action run beside a trainee's would halve the trainee's share of it; the heavy
+session is served when the workers are free (and once its time decays below the average, like
+any other).
 
 :class:`FairCache` keeps values per owner within one budget, evicting from the owner that
 holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
@@ -17,27 +26,48 @@ retries at once waits for its refusal), with a bound per client and in all.
 
 from __future__ import annotations
 
+import math
 import threading
+import time
 from collections import OrderedDict, deque
 from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
-__all__ = ["FairCache", "FairPool", "Holds"]
+__all__ = ["HALF_LIFE_S", "FairCache", "FairPool", "Holds"]
+
+
+#: Half-life of a session's recent time on the workers: the CPU time its jobs took is forgotten
+#: over a few seconds, so a trainee who drove hard a moment ago is soon served like the others
+#: (assumed: a page's burst of moves lasts a second or two). [s]
+HALF_LIFE_S = 1.0
+#: A session whose recent time has decayed below this is forgotten: it no longer counts in the
+#: average (an idle session would lower it) and its next job is served as a newcomer's. [s]
+FORGOTTEN_S = 1e-4
 
 
 class FairPool:
-    """``workers`` threads serving jobs round-robin by address, then by session; at most
-    ``per_address`` jobs of one address running at once (None: no cap)."""
+    """``workers`` threads serving the job of the session with the least recent time on them
+    first; at most ``per_address`` jobs of one address running at once (None: no cap); with
+    ``heavy_alone``, a job of a session above the average recent time only when no other job
+    runs."""
 
-    def __init__(self, workers: int = 2, name: str = "fair", per_address: int | None = None):
+    def __init__(self, workers: int = 2, name: str = "fair", per_address: int | None = None,
+                 heavy_alone: bool = False, clock: Callable[[], float] = time.monotonic):
         self._cv = threading.Condition()
         self._per_address = per_address
+        self._heavy_alone = heavy_alone
+        self._clock = clock
         self._busy: dict[str, int] = {}  # jobs running per address
-        self._jobs: dict[tuple[str, str], deque] = {}
-        self._addresses: deque[str] = deque()
-        self._sessions: dict[str, deque[str]] = {}
+        self._jobs: dict[tuple[str, str], deque] = {}  # queued: (future, fn, args, queued at)
         self._running: set[tuple[str, str]] = set()
+        #: each session's recent time on the workers [s] and when it was last brought up to date
+        self._used: dict[tuple[str, str], tuple[float, float]] = {}
+        self._served: dict[str, float] = {}  # when an address's job last started
+        self._pruned = clock()
+        #: the sum of every session's recent time [s] and when it was brought up to date (all
+        #: decay alike: the average is read without a pass over the sessions)
+        self._total, self._total_at = 0.0, clock()
         self._closed = False
         self._threads = [
             threading.Thread(target=self._work, name=f"{name}-{i}", daemon=True)
@@ -53,14 +83,8 @@ class FairPool:
             if self._closed:
                 fut.set_exception(RuntimeError("the server is stopping"))
                 return fut
-            key = (address, session)
-            if key not in self._jobs:
-                self._jobs[key] = deque()
-                if address not in self._sessions:  # a newcomer is next in turn
-                    self._sessions[address] = deque()
-                    self._addresses.appendleft(address)
-                self._sessions[address].appendleft(session)
-            self._jobs[key].append((fut, fn, args))
+            self._jobs.setdefault((address, session), deque()).append(
+                (fut, fn, args, self._clock()))
             self._cv.notify()
         return fut
 
@@ -69,34 +93,56 @@ class FairPool:
         with self._cv:
             return sum(len(q) for q in self._jobs.values())
 
+    def recent(self, address: str, session: str) -> float:
+        """A session's recent time on the workers [s] (decayed with :data:`HALF_LIFE_S`)."""
+        with self._cv:
+            return self._recent((address, session), self._clock())
+
+    def _recent(self, key: tuple[str, str], now: float) -> float:
+        used, then = self._used.get(key, (0.0, now))
+        return used * 0.5 ** ((now - then) / HALF_LIFE_S)
+
+    def _decayed_total(self, now: float) -> float:
+        return self._total * 0.5 ** ((now - self._total_at) / HALF_LIFE_S)
+
     def _next(self) -> tuple[tuple[str, str], Any] | None:
-        """The next job in turn (called with the lock held), or None."""
-        for _ in range(len(self._addresses)):
-            address = self._addresses[0]
-            self._addresses.rotate(-1)
+        """The next job (called with the lock held), or None."""
+        now = self._clock()
+        best = None
+        for key, queue in self._jobs.items():
+            if not queue or key in self._running:
+                continue
+            address = key[0]
             if self._per_address is not None and self._busy.get(address, 0) >= self._per_address:
                 continue
-            ring = self._sessions[address]
-            for _ in range(len(ring)):
-                session = ring[0]
-                ring.rotate(-1)
-                key = (address, session)
-                if key not in self._running and self._jobs[key]:
-                    return key, self._jobs[key].popleft()
-        return None
+            rank = (self._recent(key, now), self._served.get(address, -math.inf), queue[0][3])
+            if best is None or rank < best[0]:
+                best = (rank, key)
+        if best is None:
+            return None
+        (recent, _, _), key = best
+        if self._heavy_alone and self._running and self._used:
+            mean = self._decayed_total(now) / len(self._used)
+            if recent > mean:  # served when the workers are free
+                return None
+        self._served[key[0]] = now
+        return key, self._jobs[key].popleft()
 
-    def _forget(self, key: tuple[str, str]) -> None:
-        """Drop an owner with nothing queued nor running (lock held)."""
-        if self._jobs.get(key) or key in self._running:
-            return
-        address, session = key
-        self._jobs.pop(key, None)
-        ring = self._sessions.get(address)
-        if ring is not None and session in ring:
-            ring.remove(session)
-            if not ring:
-                del self._sessions[address]
-                self._addresses.remove(address)
+    def _forget(self, key: tuple[str, str], now: float) -> None:
+        """Drop an owner with nothing queued nor running (lock held), and the recent time of
+        sessions long idle."""
+        if not self._jobs.get(key) and key not in self._running:
+            self._jobs.pop(key, None)
+        if now - self._pruned > HALF_LIFE_S:
+            self._pruned = now
+            for k in [k for k in self._used if self._recent(k, now) < FORGOTTEN_S
+                      and k not in self._jobs and k not in self._running]:
+                self._total_at, self._total = now, max(
+                    0.0, self._decayed_total(now) - self._recent(k, now))
+                del self._used[k]
+            if len(self._served) > 4 * len(self._used) + 64:
+                live = {a for a, _ in self._used} | {a for a, _ in self._jobs}
+                self._served = {a: t for a, t in self._served.items() if a in live}
 
     def _work(self) -> None:
         while True:
@@ -107,9 +153,10 @@ class FairPool:
                         return
                     self._cv.wait()
                     got = self._next()
-                key, (fut, fn, args) = got
+                key, (fut, fn, args, _) = got
                 self._running.add(key)
                 self._busy[key[0]] = self._busy.get(key[0], 0) + 1
+            began = time.thread_time()
             try:
                 if fut.set_running_or_notify_cancel():
                     try:
@@ -118,11 +165,15 @@ class FairPool:
                         fut.set_exception(exc)
             finally:
                 with self._cv:
+                    now = self._clock()
+                    spent = time.thread_time() - began
+                    self._used[key] = (self._recent(key, now) + spent, now)
+                    self._total_at, self._total = now, self._decayed_total(now) + spent
                     self._running.discard(key)
                     left = self._busy.pop(key[0]) - 1
                     if left:
                         self._busy[key[0]] = left
-                    self._forget(key)
+                    self._forget(key, now)
                     self._cv.notify_all()
 
     def shutdown(self, wait: bool = True) -> None:
@@ -130,7 +181,7 @@ class FairPool:
         with self._cv:
             self._closed = True
             for q in self._jobs.values():
-                for fut, _, _ in q:
+                for fut, _, _, _ in q:
                     fut.cancel()
                 q.clear()
             self._cv.notify_all()
