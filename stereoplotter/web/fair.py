@@ -12,12 +12,13 @@ has two jobs running at once (its actions keep their order). So a trainee's requ
 no job of a session that has had more of the workers lately, however many that session or
 its address have sent; a class behind one address is served session by session like any
 other. With ``per_address``, an address never has more jobs running at once than that, so
-with more workers than that one client cannot occupy them all. With ``heavy_alone``, a job of
-a session that has had more of the workers lately than the average session does not start
-while another job is running: the server's actions hold the interpreter's lock, so a heavy
-session's action run beside a trainee's would halve the trainee's share of it; the heavy
-session is served when the workers are free (and once its time decays below the average, like
-any other).
+with more workers than that one client cannot occupy them all. With ``heavy_alone``, a job
+starts beside a running one only if its session has had no more of the workers lately than the
+running job's session: the server's actions hold the interpreter's lock, so a heavier
+session's action run beside a trainee's would take half of the trainee's share of it. A
+lighter session's job starts beside a heavier one's at once (it waits for no job of a heavier
+session); the heavier session's next job waits for the lighter one to end (a job's time,
+not a queue).
 
 :class:`FairCache` keeps values per owner within one budget, evicting from the owner that
 holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
@@ -41,16 +42,16 @@ __all__ = ["HALF_LIFE_S", "FairCache", "FairPool", "Holds"]
 #: over a few seconds, so a trainee who drove hard a moment ago is soon served like the others
 #: (assumed: a page's burst of moves lasts a second or two). [s]
 HALF_LIFE_S = 1.0
-#: A session whose recent time has decayed below this is forgotten: it no longer counts in the
-#: average (an idle session would lower it) and its next job is served as a newcomer's. [s]
+#: A session whose recent time has decayed below this is forgotten: its next job is served as a
+#: newcomer's. [s]
 FORGOTTEN_S = 1e-4
 
 
 class FairPool:
     """``workers`` threads serving the job of the session with the least recent time on them
     first; at most ``per_address`` jobs of one address running at once (None: no cap); with
-    ``heavy_alone``, a job of a session above the average recent time only when no other job
-    runs."""
+    ``heavy_alone``, a job beside a running one only if its session has had no more recent
+    time than the running job's."""
 
     def __init__(self, workers: int = 2, name: str = "fair", per_address: int | None = None,
                  heavy_alone: bool = False, clock: Callable[[], float] = time.monotonic):
@@ -65,9 +66,6 @@ class FairPool:
         self._used: dict[tuple[str, str], tuple[float, float]] = {}
         self._served: dict[str, float] = {}  # when an address's job last started
         self._pruned = clock()
-        #: the sum of every session's recent time [s] and when it was brought up to date (all
-        #: decay alike: the average is read without a pass over the sessions)
-        self._total, self._total_at = 0.0, clock()
         self._closed = False
         self._threads = [
             threading.Thread(target=self._work, name=f"{name}-{i}", daemon=True)
@@ -102,9 +100,6 @@ class FairPool:
         used, then = self._used.get(key, (0.0, now))
         return used * 0.5 ** ((now - then) / HALF_LIFE_S)
 
-    def _decayed_total(self, now: float) -> float:
-        return self._total * 0.5 ** ((now - self._total_at) / HALF_LIFE_S)
-
     def _next(self) -> tuple[tuple[str, str], Any] | None:
         """The next job (called with the lock held), or None."""
         now = self._clock()
@@ -121,10 +116,8 @@ class FairPool:
         if best is None:
             return None
         (recent, _, _), key = best
-        if self._heavy_alone and self._running and self._used:
-            mean = self._decayed_total(now) / len(self._used)
-            if recent > mean:  # served when the workers are free
-                return None
+        if self._heavy_alone and any(recent > self._recent(k, now) for k in self._running):
+            return None  # heavier than a running job's session: after it
         self._served[key[0]] = now
         return key, self._jobs[key].popleft()
 
@@ -137,8 +130,6 @@ class FairPool:
             self._pruned = now
             for k in [k for k in self._used if self._recent(k, now) < FORGOTTEN_S
                       and k not in self._jobs and k not in self._running]:
-                self._total_at, self._total = now, max(
-                    0.0, self._decayed_total(now) - self._recent(k, now))
                 del self._used[k]
             if len(self._served) > 4 * len(self._used) + 64:
                 live = {a for a, _ in self._used} | {a for a, _ in self._jobs}
@@ -168,7 +159,6 @@ class FairPool:
                     now = self._clock()
                     spent = time.thread_time() - began
                     self._used[key] = (self._recent(key, now) + spent, now)
-                    self._total_at, self._total = now, self._decayed_total(now) + spent
                     self._running.discard(key)
                     left = self._busy.pop(key[0]) - 1
                     if left:

@@ -122,9 +122,9 @@ def test_the_session_with_the_least_recent_work_goes_first():
 
 
 def test_a_heavy_session_waits_for_the_workers_to_be_free():
-    """Two workers: a session with more recent time on them than the average does not start
-    beside another session's job (it would share the interpreter's lock with it); a light
-    session's job does, on the worker left free; the heavy one runs once the workers are free."""
+    """Two workers: a session with more recent time on them than the running job's session
+    does not start beside it (it would share the interpreter's lock with it); a newcomer's job
+    does, on the worker left free; the heavy one runs once the lighter job has ended."""
     pool = FairPool(2, "test", heavy_alone=True)
     events: list[str] = []
     gate = threading.Event()
