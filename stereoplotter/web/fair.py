@@ -13,12 +13,12 @@ no job of a session that has had more of the workers lately, however many that s
 its address have sent; a class behind one address is served session by session like any
 other. With ``per_address``, an address never has more jobs running at once than that, so
 with more workers than that one client cannot occupy them all. With ``heavy_alone``, a job
-starts beside a running one only if its session has had no more of the workers lately than the
-running job's session: the server's actions hold the interpreter's lock, so a heavier
+does not start beside a running one whose session has had less than 1/:data:`HEAVIER` of its
+own session's time lately: the server's actions hold the interpreter's lock, so a much heavier
 session's action run beside a trainee's would take half of the trainee's share of it. A
 lighter session's job starts beside a heavier one's at once (it waits for no job of a heavier
-session); the heavier session's next job waits for the lighter one to end (a job's time,
-not a queue).
+session); the much heavier session's next job waits for the lighter one to end (a job's time,
+not a queue). Sessions within that factor of each other run side by side as before.
 
 :class:`FairCache` keeps values per owner within one budget, evicting from the owner that
 holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
@@ -35,13 +35,18 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
-__all__ = ["HALF_LIFE_S", "FairCache", "FairPool", "Holds"]
+__all__ = ["HALF_LIFE_S", "HEAVIER", "FairCache", "FairPool", "Holds"]
 
 
 #: Half-life of a session's recent time on the workers: the CPU time its jobs took is forgotten
 #: over a few seconds, so a trainee who drove hard a moment ago is soon served like the others
 #: (assumed: a page's burst of moves lasts a second or two). [s]
 HALF_LIFE_S = 1.0
+#: A session with more than this many times the recent time of a running job's session waits
+#: for that job to end (``heavy_alone``). Trainees at a similar pace run side by side (two of
+#: them waiting for each other would only lengthen their queue); a page turning a wheel at
+#: several times another's pace runs when that one's action has ended. [—]
+HEAVIER = 2.0
 #: A session whose recent time has decayed below this is forgotten: its next job is served as a
 #: newcomer's. [s]
 FORGOTTEN_S = 1e-4
@@ -50,8 +55,8 @@ FORGOTTEN_S = 1e-4
 class FairPool:
     """``workers`` threads serving the job of the session with the least recent time on them
     first; at most ``per_address`` jobs of one address running at once (None: no cap); with
-    ``heavy_alone``, a job beside a running one only if its session has had no more recent
-    time than the running job's."""
+    ``heavy_alone``, a job beside a running one only if its session has had at most
+    :data:`HEAVIER` times the running job's session's recent time."""
 
     def __init__(self, workers: int = 2, name: str = "fair", per_address: int | None = None,
                  heavy_alone: bool = False, clock: Callable[[], float] = time.monotonic):
@@ -116,8 +121,9 @@ class FairPool:
         if best is None:
             return None
         (recent, _, _), key = best
-        if self._heavy_alone and any(recent > self._recent(k, now) for k in self._running):
-            return None  # heavier than a running job's session: after it
+        if self._heavy_alone and any(recent > HEAVIER * self._recent(k, now)
+                                     for k in self._running):
+            return None  # much heavier than a running job's session: after it
         self._served[key[0]] = now
         return key, self._jobs[key].popleft()
 

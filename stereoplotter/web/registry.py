@@ -154,7 +154,7 @@ class Registry:
         #: Refused sockets waiting for their refusal (``sockets.REFUSAL_DELAY_S``).
         self.refusal_holds = Holds(*HELD_REFUSALS)
         #: The threads that carry out the sessions' actions (the session with the least recent
-        #: time on them first, and beside a running action only a session with no more: a
+        #: time on them first, and beside a running action no session with more than twice: a
         #: flood from one client does not queue the others behind it nor share the
         #: interpreter's lock with their actions), and render photo patches (at most
         #: PATCHES_AT_ONCE of one address at once; rendered in worker processes when

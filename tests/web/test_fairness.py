@@ -16,7 +16,7 @@ from starlette.websockets import WebSocketDisconnect
 
 from stereoplotter.web import registry, sockets
 from stereoplotter.web.app import create_app
-from stereoplotter.web.fair import FairPool
+from stereoplotter.web.fair import HEAVIER, FairPool
 from tests.web.conftest import PRACTICE, TOKEN, ask, make_test_client, open_socket, start
 
 
@@ -122,9 +122,10 @@ def test_the_session_with_the_least_recent_work_goes_first():
 
 
 def test_a_heavy_session_waits_for_the_workers_to_be_free():
-    """Two workers: a session with more recent time on them than the running job's session
-    does not start beside it (it would share the interpreter's lock with it); a newcomer's job
-    does, on the worker left free; the heavy one runs once the lighter job has ended."""
+    """Two workers: a session with more than ``HEAVIER`` times the recent time of the running
+    job's session does not start beside it (it would share the interpreter's lock with it); a
+    newcomer's job does, on the worker left free; the heavy one runs once the lighter job has
+    ended."""
     pool = FairPool(2, "test", heavy_alone=True)
     events: list[str] = []
     gate = threading.Event()
@@ -141,7 +142,7 @@ def test_a_heavy_session_waits_for_the_workers_to_be_free():
     try:
         pool.submit("10.0.0.66", "heavy", _run_for, 0.08).result(5)
         pool.submit("10.0.0.7", "light", _run_for, 0.001).result(5)
-        assert pool.recent("10.0.0.66", "heavy") > 2 * pool.recent("10.0.0.7", "light")
+        assert pool.recent("10.0.0.66", "heavy") > 4 * HEAVIER * pool.recent("10.0.0.7", "light")
         held = pool.submit("10.0.0.7", "light", job, "light", True)
         time.sleep(0.02)
         heavy = pool.submit("10.0.0.66", "heavy", job, "heavy")
