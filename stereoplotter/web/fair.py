@@ -67,8 +67,11 @@ class FairPool:
         self._busy: dict[str, int] = {}  # jobs running per address
         self._jobs: dict[tuple[str, str], deque] = {}  # queued: (future, fn, args, queued at)
         self._running: set[tuple[str, str]] = set()
-        #: each session's recent time on the workers [s] and when it was last brought up to date
-        self._used: dict[tuple[str, str], tuple[float, float]] = {}
+        #: each session's recent time on the workers, kept as [s] × 2^((t − epoch)/half-life) at
+        #: the time t it was charged: all decay alike, so these compare as the decayed values
+        #: do and choosing a job needs no power of two per session
+        self._used: dict[tuple[str, str], float] = {}
+        self._epoch = clock()
         self._served: dict[str, float] = {}  # when an address's job last started
         self._pruned = clock()
         self._closed = False
@@ -101,30 +104,38 @@ class FairPool:
         with self._cv:
             return self._recent((address, session), self._clock())
 
+    def _scale(self, now: float) -> float:
+        return 2.0 ** ((now - self._epoch) / HALF_LIFE_S)
+
     def _recent(self, key: tuple[str, str], now: float) -> float:
-        used, then = self._used.get(key, (0.0, now))
-        return used * 0.5 ** ((now - then) / HALF_LIFE_S)
+        return self._used.get(key, 0.0) / self._scale(now)
+
+    def _charge(self, key: tuple[str, str], spent: float, now: float) -> None:
+        """Add ``spent`` [s] to a session's recent time (lock held)."""
+        scale = self._scale(now)
+        if scale > 2.0**400:  # far from the epoch: a new one (the values stay finite)
+            self._used = {k: v / scale for k, v in self._used.items()}
+            self._epoch, scale = now, 1.0
+        self._used[key] = self._used.get(key, 0.0) + spent * scale
 
     def _next(self) -> tuple[tuple[str, str], Any] | None:
         """The next job (called with the lock held), or None."""
-        now = self._clock()
-        best = None
+        used, served, cap, busy = self._used, self._served, self._per_address, self._busy
+        best = best_rank = None
         for key, queue in self._jobs.items():
             if not queue or key in self._running:
                 continue
-            address = key[0]
-            if self._per_address is not None and self._busy.get(address, 0) >= self._per_address:
+            if cap is not None and busy.get(key[0], 0) >= cap:
                 continue
-            rank = (self._recent(key, now), self._served.get(address, -math.inf), queue[0][3])
-            if best is None or rank < best[0]:
-                best = (rank, key)
+            rank = (used.get(key, 0.0), served.get(key[0], -math.inf), queue[0][3])
+            if best is None or rank < best_rank:
+                best, best_rank = key, rank
         if best is None:
             return None
-        (recent, _, _), key = best
-        if self._heavy_alone and any(recent > HEAVIER * self._recent(k, now)
-                                     for k in self._running):
+        key, mine = best, best_rank[0]
+        if self._heavy_alone and any(mine > HEAVIER * used.get(k, 0.0) for k in self._running):
             return None  # much heavier than a running job's session: after it
-        self._served[key[0]] = now
+        served[key[0]] = self._clock()
         return key, self._jobs[key].popleft()
 
     def _forget(self, key: tuple[str, str], now: float) -> None:
@@ -134,7 +145,8 @@ class FairPool:
             self._jobs.pop(key, None)
         if now - self._pruned > HALF_LIFE_S:
             self._pruned = now
-            for k in [k for k in self._used if self._recent(k, now) < FORGOTTEN_S
+            floor = FORGOTTEN_S * self._scale(now)
+            for k in [k for k, v in self._used.items() if v < floor
                       and k not in self._jobs and k not in self._running]:
                 del self._used[k]
             if len(self._served) > 4 * len(self._used) + 64:
@@ -164,7 +176,7 @@ class FairPool:
                 with self._cv:
                     now = self._clock()
                     spent = time.thread_time() - began
-                    self._used[key] = (self._recent(key, now) + spent, now)
+                    self._charge(key, spent, now)
                     self._running.discard(key)
                     left = self._busy.pop(key[0]) - 1
                     if left:
