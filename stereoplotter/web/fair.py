@@ -18,7 +18,7 @@ own session's time lately: the server's actions hold the interpreter's lock, so 
 session's action run beside a trainee's would take half of the trainee's share of it. A
 lighter session's job starts beside a heavier one's at once (it waits for no job of a heavier
 session); the much heavier session's next job waits for the lighter one to end (a job's time,
-not a queue). Sessions within that factor of each other run side by side as before.
+not a queue). Sessions within that factor of each other run side by side.
 
 :class:`FairCache` keeps values per owner within one budget, evicting from the owner that
 holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
