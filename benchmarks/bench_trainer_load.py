@@ -30,9 +30,11 @@ otherwise). The honest trainees take what changed in the state after the first w
 the page does (``--whole-states``: the whole state each time). It also prints the CPU time of
 the two client processes (the honest trainees' in each phase, the abuser's): on the server's own
 machine their work takes the server's processors, which a class's clients on their own machines
-would not.
+would not. ``--server-probe`` also times, inside the server, each job on the actor threads: its
+wait in the queue, its run, and whether a job of the other kind (honest, abuser) ran beside it
+(a hook the script puts on the server's path; the server's code is unchanged).
 
-    PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20]
+    PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20] [--server-probe]
 
 ``--action-cost``: no server; the CPU time of one honest turn (action and reply JSON, with the
 whole state and with what changed in it) in this process, and the garbage collector's full pass
@@ -63,7 +65,81 @@ from stereoplotter.web.statepatch import apply_patch, state_patch
 TOKEN = "bench-token"
 
 
-def _start_server(data_dir: str) -> tuple[subprocess.Popen, str]:
+#: ``--server-probe``: loaded by the server as ``sitecustomize`` (its folder first on the
+#: server's path); appends one line a job run on the actor threads to the file named by
+#: ``STEREOPLOTTER_BENCH_PROBE``: address, queue wait [s], run [s], whether a job of the other
+#: kind (the abuser's address or not) ran at some moment of its run.
+PROBE = r"""
+import os, sys, threading, time
+OUT = os.environ.get("STEREOPLOTTER_BENCH_PROBE")
+if OUT and "trainer" in sys.argv:
+    import importlib.abc
+    rows, lock = [], threading.Lock()
+    running, started = {True: 0, False: 0}, {True: 0, False: 0}
+
+    def patch(mod):
+        submit = mod.FairPool.submit
+
+        def timed(self, address, session, fn, *args):
+            if not self._threads[0].name.startswith("trainer-actor"):
+                return submit(self, address, session, fn, *args)
+            queued, abuser = time.perf_counter(), address == ABUSER
+
+            def job(*a):
+                began = time.perf_counter()
+                with lock:
+                    beside, others = running[not abuser] > 0, started[not abuser]
+                    running[abuser] += 1
+                    started[abuser] += 1
+                try:
+                    return fn(*a)
+                finally:
+                    with lock:
+                        running[abuser] -= 1
+                        beside = beside or started[not abuser] != others
+                        rows.append((address, began - queued, time.perf_counter() - began,
+                                     int(beside)))
+            return submit(self, address, session, job, *args)
+        mod.FairPool.submit = timed
+
+    def write():
+        done = 0
+        with open(OUT, "w") as f:
+            while True:
+                time.sleep(0.5)
+                n = len(rows)
+                f.writelines(" ".join(map(str, r)) + "\n" for r in rows[done:n])
+                f.flush()
+                done = n
+    threading.Thread(target=write, daemon=True).start()
+
+    class Hook(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path, target=None):
+            if name != "stereoplotter.web.fair":
+                return None
+            sys.meta_path.remove(self)
+            import importlib.util
+            spec = importlib.util.find_spec(name)
+            run = spec.loader.exec_module
+
+            def exec_module(module):
+                run(module)
+                patch(module)
+            spec.loader.exec_module = exec_module
+            return spec
+    sys.meta_path.insert(0, Hook())
+"""
+
+
+def _start_server(data_dir: str, probe: str | None = None) -> tuple[subprocess.Popen, str]:
+    env = dict(os.environ)
+    if probe is not None:  # the probe's folder first on the server's path
+        folder = os.path.join(data_dir, "probe")
+        os.makedirs(folder)
+        with open(os.path.join(folder, "sitecustomize.py"), "w") as f:
+            f.write(PROBE.replace("ABUSER", repr(_local(250))))
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [folder, env.get("PYTHONPATH")]))
+        env["STEREOPLOTTER_BENCH_PROBE"] = probe
     proc = subprocess.Popen(
         [
             sys.executable,
@@ -77,7 +153,7 @@ def _start_server(data_dir: str) -> tuple[subprocess.Popen, str]:
         ],
         stdout=subprocess.PIPE,
         text=True,
-        env=dict(os.environ),
+        env=env,
     )
     line = proc.stdout.readline()  # "trainee page:    http://localhost:PORT/"
     port = line.rsplit(":", 1)[1].strip().rstrip("/")
@@ -345,6 +421,36 @@ def _abuser_process(host, stop_in, sockets, sessions, patchers, queue) -> None:
     queue.put(got)
 
 
+def _probe_summary(path: str) -> None:
+    """``--server-probe``: the actor threads' jobs of each phase's honest trainees (by their
+    addresses) and of the abuser: queue wait and run (median, p95), and the share of jobs with
+    a job of the other kind running beside them."""
+    groups: dict[str, list[tuple[float, float, int]]] = {"idle": [], "abuse": [], "abuser": []}
+    with open(path) as f:
+        for line in f:
+            address, wait, run, beside = line.split()
+            last = int(address.rsplit(".", 1)[1])
+            group = ("abuser" if last == 250 else "abuse" if last >= 110
+                     else "idle" if last >= 10 else None)
+            if group is None:  # the first view before the phases
+                continue
+            groups[group].append((float(wait) * 1e3, float(run) * 1e3, int(beside)))
+
+    def q(values: list[float], p: float) -> float:
+        values = sorted(values)
+        return values[int(p * (len(values) - 1))] if values else math.nan
+
+    for group, rows in groups.items():
+        if not rows:
+            continue
+        waits, runs = [r[0] for r in rows], [r[1] for r in rows]
+        who = "the abuser's" if group == "abuser" else f"honest ({group} phase)"
+        print(f"server probe, actor jobs of {who}: {len(rows)}; queue wait median "
+              f"{q(waits, 0.5):.2f} ms, p95 {q(waits, 0.95):.2f} ms; run median "
+              f"{q(runs, 0.5):.2f} ms, p95 {q(runs, 0.95):.2f} ms; with a job of the other kind "
+              f"beside them {sum(r[2] for r in rows) / len(rows):.0%}")
+
+
 def _summary(name: str, rtt: list[float], patches: list[float]) -> str:
     rtt = sorted(rtt)
     p95 = rtt[int(0.95 * (len(rtt) - 1))] if rtt else math.nan
@@ -357,7 +463,8 @@ async def abuse_async(args) -> None:
     import multiprocessing
 
     with tempfile.TemporaryDirectory() as data:
-        proc, host = _start_server(data)
+        probe = os.path.join(data, "probe.txt") if args.server_probe else None
+        proc, host = _start_server(data, probe)
         try:
             async with httpx.AsyncClient(base_url=f"http://{host}", timeout=900) as http:
                 t0 = time.perf_counter()  # the photos of every exercise built at start-up
@@ -397,6 +504,8 @@ async def abuse_async(args) -> None:
                 proc.wait(30)
             except subprocess.TimeoutExpired:
                 proc.kill()
+        if probe is not None:
+            _probe_summary(probe)
     a = results["abuser"]
     idle_patch = statistics.median(results["idle"][1] or [math.nan])
     abuse_patch = statistics.median(results["abuse"][1] or [math.nan])
@@ -560,6 +669,8 @@ def main() -> None:
     )
     ap.add_argument("--abuser", action="store_true",
                     help="fairness: honest trainees alone, then beside one abuser")
+    ap.add_argument("--server-probe", action="store_true",
+                    help="--abuser: time the server's actor jobs (queue wait, run, overlap)")
     ap.add_argument("--whole-states", action="store_true",
                     help="--abuser: the honest trainees take the whole state each turn")
     ap.add_argument("--abuse-sockets", type=int, default=100)

@@ -1,14 +1,24 @@
-"""A fair worker pool: jobs of many clients served round-robin, not first come, first served.
+"""A fair worker pool: the job of the session with the least recent work first, not first come,
+first served.
 
 The server's actions and photo patches run on worker threads. With one queue, a client that
 sends a hundred requests puts every other trainee's request behind them; here each job is
 queued under its owner (a client address, then a session of that address), and a free worker
-takes the next job of the next address in turn, and within the address of the next session in
-turn. A session never has two jobs running at once (its actions keep their order). So a
-trainee's request waits for at most one job of each other address with work queued, however
-many that address has sent. With ``per_address``, an address never has more jobs running at
-once than that, so with more workers than that one client cannot occupy them all: a newcomer's
-job starts on the worker left free.
+takes the queued job of the session that has had the least of the workers' time lately (the
+CPU time its jobs took on them, decayed with a half-life of :data:`HALF_LIFE_S`: CPU, not wall
+time, so a job slowed by others is not charged for them); between sessions with the
+same, the address served longest ago goes first, then the job queued first. A session never
+has two jobs running at once (its actions keep their order). So a trainee's request waits for
+no job of a session that has had more of the workers lately, however many that session or
+its address have sent; a class behind one address is served session by session like any
+other. With ``per_address``, an address never has more jobs running at once than that, so
+with more workers than that one client cannot occupy them all. With ``heavy_alone``, a job
+does not start beside a running one whose session has had less than 1/:data:`HEAVIER` of its
+own session's time lately: the server's actions hold the interpreter's lock, so a much heavier
+session's action run beside a trainee's would take half of the trainee's share of it. A
+lighter session's job starts beside a heavier one's at once (it waits for no job of a heavier
+session); the much heavier session's next job waits for the lighter one to end (a job's time,
+not a queue). Sessions within that factor of each other run side by side.
 
 :class:`FairCache` keeps values per owner within one budget, evicting from the owner that
 holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
@@ -17,27 +27,53 @@ retries at once waits for its refusal), with a bound per client and in all.
 
 from __future__ import annotations
 
+import math
 import threading
+import time
 from collections import OrderedDict, deque
 from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
-__all__ = ["FairCache", "FairPool", "Holds"]
+__all__ = ["HALF_LIFE_S", "HEAVIER", "FairCache", "FairPool", "Holds"]
+
+
+#: Half-life of a session's recent time on the workers: the CPU time its jobs took is forgotten
+#: over a few seconds, so a trainee who drove hard a moment ago is soon served like the others
+#: (assumed: a page's burst of moves lasts a second or two). [s]
+HALF_LIFE_S = 1.0
+#: A session with more than this many times the recent time of a running job's session waits
+#: for that job to end (``heavy_alone``). Trainees at a similar pace run side by side (two of
+#: them waiting for each other would only lengthen their queue); a page turning a wheel at
+#: several times another's pace runs when that one's action has ended. [—]
+HEAVIER = 2.0
+#: A session whose recent time has decayed below this is forgotten: its next job is served as a
+#: newcomer's. [s]
+FORGOTTEN_S = 1e-4
 
 
 class FairPool:
-    """``workers`` threads serving jobs round-robin by address, then by session; at most
-    ``per_address`` jobs of one address running at once (None: no cap)."""
+    """``workers`` threads serving the job of the session with the least recent time on them
+    first; at most ``per_address`` jobs of one address running at once (None: no cap); with
+    ``heavy_alone``, a job beside a running one only if its session has had at most
+    :data:`HEAVIER` times the running job's session's recent time."""
 
-    def __init__(self, workers: int = 2, name: str = "fair", per_address: int | None = None):
+    def __init__(self, workers: int = 2, name: str = "fair", per_address: int | None = None,
+                 heavy_alone: bool = False, clock: Callable[[], float] = time.monotonic):
         self._cv = threading.Condition()
         self._per_address = per_address
+        self._heavy_alone = heavy_alone
+        self._clock = clock
         self._busy: dict[str, int] = {}  # jobs running per address
-        self._jobs: dict[tuple[str, str], deque] = {}
-        self._addresses: deque[str] = deque()
-        self._sessions: dict[str, deque[str]] = {}
+        self._jobs: dict[tuple[str, str], deque] = {}  # queued: (future, fn, args, queued at)
         self._running: set[tuple[str, str]] = set()
+        #: each session's recent time on the workers, kept as [s] × 2^((t − epoch)/half-life) at
+        #: the time t it was charged: all decay alike, so these compare as the decayed values
+        #: do and choosing a job needs no power of two per session
+        self._used: dict[tuple[str, str], float] = {}
+        self._epoch = clock()
+        self._served: dict[str, float] = {}  # when an address's job last started
+        self._pruned = clock()
         self._closed = False
         self._threads = [
             threading.Thread(target=self._work, name=f"{name}-{i}", daemon=True)
@@ -53,14 +89,8 @@ class FairPool:
             if self._closed:
                 fut.set_exception(RuntimeError("the server is stopping"))
                 return fut
-            key = (address, session)
-            if key not in self._jobs:
-                self._jobs[key] = deque()
-                if address not in self._sessions:  # a newcomer is next in turn
-                    self._sessions[address] = deque()
-                    self._addresses.appendleft(address)
-                self._sessions[address].appendleft(session)
-            self._jobs[key].append((fut, fn, args))
+            self._jobs.setdefault((address, session), deque()).append(
+                (fut, fn, args, self._clock()))
             self._cv.notify()
         return fut
 
@@ -69,34 +99,59 @@ class FairPool:
         with self._cv:
             return sum(len(q) for q in self._jobs.values())
 
-    def _next(self) -> tuple[tuple[str, str], Any] | None:
-        """The next job in turn (called with the lock held), or None."""
-        for _ in range(len(self._addresses)):
-            address = self._addresses[0]
-            self._addresses.rotate(-1)
-            if self._per_address is not None and self._busy.get(address, 0) >= self._per_address:
-                continue
-            ring = self._sessions[address]
-            for _ in range(len(ring)):
-                session = ring[0]
-                ring.rotate(-1)
-                key = (address, session)
-                if key not in self._running and self._jobs[key]:
-                    return key, self._jobs[key].popleft()
-        return None
+    def recent(self, address: str, session: str) -> float:
+        """A session's recent time on the workers [s] (decayed with :data:`HALF_LIFE_S`)."""
+        with self._cv:
+            return self._recent((address, session), self._clock())
 
-    def _forget(self, key: tuple[str, str]) -> None:
-        """Drop an owner with nothing queued nor running (lock held)."""
-        if self._jobs.get(key) or key in self._running:
-            return
-        address, session = key
-        self._jobs.pop(key, None)
-        ring = self._sessions.get(address)
-        if ring is not None and session in ring:
-            ring.remove(session)
-            if not ring:
-                del self._sessions[address]
-                self._addresses.remove(address)
+    def _scale(self, now: float) -> float:
+        return 2.0 ** ((now - self._epoch) / HALF_LIFE_S)
+
+    def _recent(self, key: tuple[str, str], now: float) -> float:
+        return self._used.get(key, 0.0) / self._scale(now)
+
+    def _charge(self, key: tuple[str, str], spent: float, now: float) -> None:
+        """Add ``spent`` [s] to a session's recent time (lock held)."""
+        scale = self._scale(now)
+        if scale > 2.0**400:  # far from the epoch: a new one (the values stay finite)
+            self._used = {k: v / scale for k, v in self._used.items()}
+            self._epoch, scale = now, 1.0
+        self._used[key] = self._used.get(key, 0.0) + spent * scale
+
+    def _next(self) -> tuple[tuple[str, str], Any] | None:
+        """The next job (called with the lock held), or None."""
+        used, served, cap, busy = self._used, self._served, self._per_address, self._busy
+        best = best_rank = None
+        for key, queue in self._jobs.items():
+            if not queue or key in self._running:
+                continue
+            if cap is not None and busy.get(key[0], 0) >= cap:
+                continue
+            rank = (used.get(key, 0.0), served.get(key[0], -math.inf), queue[0][3])
+            if best is None or rank < best_rank:
+                best, best_rank = key, rank
+        if best is None:
+            return None
+        key, mine = best, best_rank[0]
+        if self._heavy_alone and any(mine > HEAVIER * used.get(k, 0.0) for k in self._running):
+            return None  # much heavier than a running job's session: after it
+        served[key[0]] = self._clock()
+        return key, self._jobs[key].popleft()
+
+    def _forget(self, key: tuple[str, str], now: float) -> None:
+        """Drop an owner with nothing queued nor running (lock held), and the recent time of
+        sessions long idle."""
+        if not self._jobs.get(key) and key not in self._running:
+            self._jobs.pop(key, None)
+        if now - self._pruned > HALF_LIFE_S:
+            self._pruned = now
+            floor = FORGOTTEN_S * self._scale(now)
+            for k in [k for k, v in self._used.items() if v < floor
+                      and k not in self._jobs and k not in self._running]:
+                del self._used[k]
+            if len(self._served) > 4 * len(self._used) + 64:
+                live = {a for a, _ in self._used} | {a for a, _ in self._jobs}
+                self._served = {a: t for a, t in self._served.items() if a in live}
 
     def _work(self) -> None:
         while True:
@@ -107,9 +162,10 @@ class FairPool:
                         return
                     self._cv.wait()
                     got = self._next()
-                key, (fut, fn, args) = got
+                key, (fut, fn, args, _) = got
                 self._running.add(key)
                 self._busy[key[0]] = self._busy.get(key[0], 0) + 1
+            began = time.thread_time()
             try:
                 if fut.set_running_or_notify_cancel():
                     try:
@@ -118,11 +174,14 @@ class FairPool:
                         fut.set_exception(exc)
             finally:
                 with self._cv:
+                    now = self._clock()
+                    spent = time.thread_time() - began
+                    self._charge(key, spent, now)
                     self._running.discard(key)
                     left = self._busy.pop(key[0]) - 1
                     if left:
                         self._busy[key[0]] = left
-                    self._forget(key)
+                    self._forget(key, now)
                     self._cv.notify_all()
 
     def shutdown(self, wait: bool = True) -> None:
@@ -130,7 +189,7 @@ class FairPool:
         with self._cv:
             self._closed = True
             for q in self._jobs.values():
-                for fut, _, _ in q:
+                for fut, _, _, _ in q:
                     fut.cancel()
                 q.clear()
             self._cv.notify_all()

@@ -153,11 +153,14 @@ class Registry:
         self.connect_limits: dict[str, RateLimit] = {}
         #: Refused sockets waiting for their refusal (``sockets.REFUSAL_DELAY_S``).
         self.refusal_holds = Holds(*HELD_REFUSALS)
-        #: The threads that carry out the sessions' actions (round-robin by client address and
-        #: session: a flood from one client does not queue the others behind it), and render
-        #: photo patches (at most PATCHES_AT_ONCE of one address at once; rendered in worker
-        #: processes when ``renderers`` has them).
-        self.actor = FairPool(ACTORS, "trainer-actor", per_address=ACTIONS_AT_ONCE)
+        #: The threads that carry out the sessions' actions (the session with the least recent
+        #: time on them first, and beside a running action no session with more than twice: a
+        #: flood from one client does not queue the others behind it nor share the
+        #: interpreter's lock with their actions), and render photo patches (at most
+        #: PATCHES_AT_ONCE of one address at once; rendered in worker processes when
+        #: ``renderers`` has them).
+        self.actor = FairPool(ACTORS, "trainer-actor", per_address=ACTIONS_AT_ONCE,
+                              heavy_alone=True)
         self.patcher = FairPool(PATCHERS, "trainer-patch", per_address=PATCHES_AT_ONCE)
         self.renderers = renderers if renderers is not None else Renderers(PATCHERS, False)
         self._seed_key = store.server_key(SEED_KEY)

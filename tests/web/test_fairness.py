@@ -1,5 +1,6 @@
 """Fair under abuse: one live socket per session, message limits per session and per address,
-work served round-robin by client (a flood waits behind itself), photo patches rendered
+work served to the session with the least recent work first (a flood waits behind itself; a
+heavy session's action never runs beside another's), photo patches rendered
 without one shared lock and limited per session. Speeds are measured in
 ``benchmarks/bench_trainer_load.py``; here the rules themselves are tried."""
 
@@ -15,7 +16,7 @@ from starlette.websockets import WebSocketDisconnect
 
 from stereoplotter.web import registry, sockets
 from stereoplotter.web.app import create_app
-from stereoplotter.web.fair import FairPool
+from stereoplotter.web.fair import HEAVIER, FairPool
 from tests.web.conftest import PRACTICE, TOKEN, ask, make_test_client, open_socket, start
 
 
@@ -88,6 +89,73 @@ def test_work_is_served_round_robin_by_address():
     for s in range(10):
         mine = [k for k in abuse if k % 10 == s]
         assert mine == sorted(mine)
+
+
+def _run_for(seconds: float) -> None:
+    """Compute for ``seconds`` of this thread's CPU time (what the pool charges)."""
+    began = time.thread_time()
+    while time.thread_time() - began < seconds:
+        pass
+
+
+def test_the_session_with_the_least_recent_work_goes_first():
+    """One worker, one client address (a class behind a proxy): a session that has just had
+    60 ms of the worker's CPU time queues a job before a quiet session of the same address does;
+    the quiet session's job runs first."""
+    pool = FairPool(1, "test")
+    order: list[str] = []
+    gate = threading.Event()
+    try:
+        pool.submit("10.0.0.1", "busy", _run_for, 0.06).result(5)
+        assert pool.recent("10.0.0.1", "busy") >= 0.05
+        assert pool.recent("10.0.0.1", "quiet") == 0.0
+        blocker = pool.submit("10.0.0.9", "other", gate.wait, 5)
+        time.sleep(0.02)  # the blocker holds the worker
+        busy = pool.submit("10.0.0.1", "busy", order.append, "busy")
+        quiet = pool.submit("10.0.0.1", "quiet", order.append, "quiet")
+        gate.set()
+        for f in (blocker, busy, quiet):
+            f.result(5)
+    finally:
+        pool.shutdown()
+    assert order == ["quiet", "busy"]
+
+
+def test_a_heavy_session_waits_for_the_workers_to_be_free():
+    """Two workers: a session with more than ``HEAVIER`` times the recent time of the running
+    job's session does not start beside it (it would share the interpreter's lock with it); a
+    newcomer's job does, on the worker left free; the heavy one runs once the lighter job has
+    ended."""
+    pool = FairPool(2, "test", heavy_alone=True)
+    events: list[str] = []
+    gate = threading.Event()
+    lock = threading.Lock()
+
+    def job(name: str, wait: bool = False) -> None:
+        with lock:
+            events.append(f"start {name}")
+        if wait:
+            gate.wait(5)
+        with lock:
+            events.append(f"end {name}")
+
+    try:
+        pool.submit("10.0.0.66", "heavy", _run_for, 0.08).result(5)
+        pool.submit("10.0.0.7", "light", _run_for, 0.001).result(5)
+        assert pool.recent("10.0.0.66", "heavy") > 4 * HEAVIER * pool.recent("10.0.0.7", "light")
+        held = pool.submit("10.0.0.7", "light", job, "light", True)
+        time.sleep(0.02)
+        heavy = pool.submit("10.0.0.66", "heavy", job, "heavy")
+        newcomer = pool.submit("10.0.0.8", "new", job, "new")
+        newcomer.result(5)  # a light job starts beside the running one
+        time.sleep(0.05)
+        assert "start heavy" not in events, events
+        gate.set()
+        held.result(5)
+        heavy.result(5)
+    finally:
+        pool.shutdown()
+    assert events.index("start heavy") > events.index("end light"), events
 
 
 def test_patches_render_in_parallel_and_are_limited_per_session(tmp_path, monkeypatch):
