@@ -676,10 +676,7 @@ def parallaxes_at_marks(
     >>> bool(dp == (pl - p0l)[0] - (pr - p0r)[0] and q == (pl - p0l)[1] - (pr - p0r)[1])
     True
     """
-    sides = []
-    for side, unit in (("left", left), ("right", right)):
-        sx, sy, sz = setting.pivot(side)
-        sides.append((sx, sy, sz, *_map_fields(UnitMap(unit))))
+    sides = _pivots_and_fields(setting, left, right)
     pl, pr = _a(photo_left_mm), _a(photo_right_mm)
     args = (
         _a(x_mm),
@@ -718,10 +715,7 @@ def x_parallaxes_at_marks(
     >>> bool(x_parallaxes_at_marks(40.0, 7.0, 125.0, setting, unit, unit, 30.0, -40.0) == dp)
     True
     """
-    sides = []
-    for side, unit in (("left", left), ("right", right)):
-        sx, sy, sz = setting.pivot(side)
-        sides.append((sx, sy, sz, *_map_fields(UnitMap(unit))))
+    sides = _pivots_and_fields(setting, left, right)
     args = (
         _a(x_mm),
         _a(y_mm),
@@ -754,6 +748,17 @@ def _parallaxes_of_counters(x, y, depth, f_instrument, x0l, y0l, x0r, y0r, *fiel
     xl, yl = _photo_of_counters(x, y, depth, *fields[:3], f_instrument, *fields[3:15])
     xr, yr = _photo_of_counters(x, y, depth, *fields[15:18], f_instrument, *fields[18:])
     return (xl - x0l) - (xr - x0r), (yl - y0l) - (yr - y0r)
+
+
+def _pivots_and_fields(
+    setting: InstrumentSetting, left: CorrectionUnit, right: CorrectionUnit
+) -> tuple[tuple[Any, ...], ...]:
+    """Per side, its pivot (S_x, S_y, S_z) and its map's fields (:func:`_map_fields`): the 15
+    arguments a side of :func:`_parallaxes_of_counters` and :func:`_x_parallax_of_counters`."""
+    return tuple(
+        (*setting.pivot(side), *_map_fields(UnitMap(unit)))
+        for side, unit in (("left", left), ("right", right))
+    )
 
 
 def _map_fields(m: UnitMap) -> tuple[Any, ...]:

@@ -256,6 +256,14 @@ def _standard_points(
     return local, instrument_frame_m(local, origin, frame_rotation)
 
 
+def _counters_at_ideal(model_mm: ArrayLike, setting: InstrumentSetting) -> tuple[_F, _F, _F]:
+    """The X, Y and D counters on ideal model points (X − MO_X, Y − MO_Y, D). [mm]"""
+    m = np.asarray(model_mm, float)
+    x = np.asarray(setting.model_origin_x_mm, float) + m[..., 0]
+    y = np.asarray(setting.model_origin_y_mm, float) + m[..., 1]
+    return x, y, m[..., 2]
+
+
 def parallax_errors_at_ideal(
     model_mm: ArrayLike,
     photo_left_mm: ArrayLike,
@@ -298,10 +306,8 @@ def parallax_errors_at_ideal(
     >>> float(dp), float(q)
     (0.0, 0.0)
     """
-    m = np.asarray(model_mm, float)
-    x = np.asarray(setting.model_origin_x_mm, float) + m[..., 0]
-    y = np.asarray(setting.model_origin_y_mm, float) + m[..., 1]
-    return parallaxes_at_marks(x, y, m[..., 2], setting, left, right, photo_left_mm, photo_right_mm)
+    x, y, depth = _counters_at_ideal(model_mm, setting)
+    return parallaxes_at_marks(x, y, depth, setting, left, right, photo_left_mm, photo_right_mm)
 
 
 def x_parallax_errors_at_ideal(
@@ -322,11 +328,9 @@ def x_parallax_errors_at_ideal(
     >>> bool(x_parallax_errors_at_ideal(*args) == parallax_errors_at_ideal(*args)[0])
     True
     """
-    m = np.asarray(model_mm, float)
-    x = np.asarray(setting.model_origin_x_mm, float) + m[..., 0]
-    y = np.asarray(setting.model_origin_y_mm, float) + m[..., 1]
+    x, y, depth = _counters_at_ideal(model_mm, setting)
     pl, pr = np.asarray(photo_left_mm, float), np.asarray(photo_right_mm, float)
-    return x_parallaxes_at_marks(x, y, m[..., 2], setting, left, right, pl[..., 0], pr[..., 0])
+    return x_parallaxes_at_marks(x, y, depth, setting, left, right, pl[..., 0], pr[..., 0])
 
 
 def plane_residuals(
