@@ -1,4 +1,5 @@
-"""Domain exceptions (all subclass :class:`ValueError`) and the helpers of their messages."""
+"""Domain exceptions (all subclass :class:`ValueError`), the helpers of their messages, and the
+SIGTERM handler that ends a run as Ctrl-C does."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ __all__ = [
     "TrainerError",
     "describe_value",
     "did_you_mean",
+    "raise_keyboard_interrupt",
 ]
 
 #: Control characters and line breaks: a message quoting user text stays one printable line.
@@ -99,3 +101,9 @@ def describe_value(value: Any) -> str:
     if isinstance(value, str):
         return f"the text {value!r}"
     return repr(value)
+
+
+def raise_keyboard_interrupt(signum: int, frame: object) -> None:
+    """A SIGTERM handler: a termination ends the run as Ctrl-C does (the command's one line,
+    its exit code, and whatever the interpreter does at a normal exit)."""
+    raise KeyboardInterrupt

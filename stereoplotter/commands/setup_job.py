@@ -20,7 +20,7 @@ import sys
 import threading
 from pathlib import Path
 
-from stereoplotter.errors import ConfigError, StereoplotterError
+from stereoplotter.errors import ConfigError, StereoplotterError, raise_keyboard_interrupt
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.job_file import Job, load_job
 from stereoplotter.io.job_measured import MeasuredPair, measured_pairs
@@ -31,7 +31,7 @@ from stereoplotter.setup.records import SetupOptions, SetupRefusal
 from stereoplotter.setup.sheet import deferred_sheets
 from stereoplotter.spec.instrument_spec import InstrumentSpec
 
-__all__ = ["compute_job", "raise_keyboard_interrupt", "run", "write_job"]
+__all__ = ["compute_job", "run", "write_job"]
 
 
 def _instrument(job: Job) -> InstrumentSpec:
@@ -122,11 +122,6 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGTERM, previous)
-
-
-def raise_keyboard_interrupt(signum: int, frame: object) -> None:
-    """The SIGTERM handler of :func:`run`: a termination ends the run as Ctrl-C does."""
-    raise KeyboardInterrupt
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import signal
 import socket
 import sqlite3
 import sys
@@ -10,6 +11,7 @@ from pathlib import Path
 
 import uvicorn
 
+from stereoplotter.errors import raise_keyboard_interrupt
 from stereoplotter.io.session_store import SessionStore, default_data_dir
 from stereoplotter.web.app import create_app
 from stereoplotter.web.guard import public_origin
@@ -104,6 +106,11 @@ def serve(host: str = "127.0.0.1", port: int = 0, token: str | None = None,
     gc.freeze()
     gc.set_threshold(*GC_THRESHOLDS)
     sys.setswitchinterval(SWITCH_INTERVAL_S)
+    # SIGTERM (a service manager's stop) ends the server as Ctrl-C does: uvicorn shuts down
+    # gracefully, then raises the signal again, and this handler turns it into the interrupt
+    # the command answers in one line, so the worker pools are shut down at exit (with the
+    # default handler the process died there and left the pools' semaphores behind)
+    signal.signal(signal.SIGTERM, raise_keyboard_interrupt)
     uvicorn.Server(uvicorn_config(app, public_url, trusted_proxies)).run(sockets=[sock])
 
 

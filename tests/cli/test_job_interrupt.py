@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 from stereoplotter.cli import main
-from stereoplotter.commands import setup_job
 from stereoplotter.commands.setup_job import compute_job
+from stereoplotter.errors import raise_keyboard_interrupt
 from stereoplotter.io import atomic_write, output_folder
 from stereoplotter.io.job_file import load_job
 from stereoplotter.io.output_folder import write_outputs
@@ -79,7 +79,7 @@ def test_an_interrupt_after_any_write_leaves_the_old_or_the_new_run(runs, tmp_pa
     old, new, files, about = runs
     states = {"old": _snapshot(old), "new": _snapshot(new)}
     assert states["old"] != states["new"] and "notes.txt" in states["new"]
-    previous = signal.signal(signal.SIGTERM, setup_job.raise_keyboard_interrupt)
+    previous = signal.signal(signal.SIGTERM, raise_keyboard_interrupt)
     seen = []
     try:
         k, writes = 1, len(files) + 1 + 1  # the files, the manifest, one past the last
