@@ -418,8 +418,7 @@ class UnitMap:
 
     def photo_xy(self, xi: ArrayLike, eta: ArrayLike) -> tuple[NDArray, NDArray]:
         """:func:`photo_from_rod` on separate ξ, η arrays, returning (x, y) separately."""
-        args = (xi, eta, self.f, self.ta, self.to, self.kx, self.ky, self.num, self.mech)
-        args = (*args, self.ex, self.ey, self.c, self.s, self.ms)
+        args = (xi, eta, *_map_fields(self))
         if ndim(xi) < 2 and ndim(self.c) < 2:  # no (trials × points) grid: at once
             return _photo_xy(*args)
         return rowwise(_photo_xy, args, 2)
@@ -431,8 +430,7 @@ class UnitMap:
 
     def rod_xy(self, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """:func:`rod_from_photo` on separate x, y arrays, returning (ξ, η) separately."""
-        args = (x, y, self.c, self.s, self.ex, self.ey, self.mech, self.f, self.ta, self.to)
-        args = (*args, self.kx, self.ky, self.num)
+        args = (x, y, *_rod_fields(self))
         if ndim(x) < 2 and ndim(self.c) < 2:  # no (trials × points) grid: at once
             return _rod_xy(*args)
         return rowwise(_rod_xy, args, 2)
@@ -735,8 +733,7 @@ def _x_parallax_of_counters(x, y, depth, f_instrument, x0l, x0r, *fields):
     xs = []
     for side in (fields[:15], fields[15:]):
         sx, sy, sz, *m = side
-        n = (depth + sz) / f_instrument
-        u, v = _photo_uv((x - sx) / n, (y - sy) / n, *m[:9])
+        u, v = _photo_uv(*_rod_of_counters(x, y, depth, sx, sy, sz, f_instrument), *m[:9])
         c, s = m[9], m[10]
         xs.append(c * u + s * v)
     return ((xs[0] - x0l) - (xs[1] - x0r),)
@@ -766,10 +763,15 @@ def _map_fields(m: UnitMap) -> tuple[Any, ...]:
     return (m.f, m.ta, m.to, m.kx, m.ky, m.num, m.mech, m.ex, m.ey, m.c, m.s, m.ms)
 
 
-def _photo_of_counters(x, y, depth, sx, sy, sz, f_instrument, *fields):
-    """:func:`rod_frame`'s ξ, η of counters, then :func:`_photo_xy` (one side)."""
+def _rod_of_counters(x, y, depth, sx, sy, sz, f_instrument):
+    """:func:`rod_frame`'s ξ, η of counters (one side, its pivot S_x, S_y, S_z)."""
     n = (depth + sz) / f_instrument
-    return _photo_xy((x - sx) / n, (y - sy) / n, *fields)
+    return (x - sx) / n, (y - sy) / n
+
+
+def _photo_of_counters(x, y, depth, sx, sy, sz, f_instrument, *fields):
+    """:func:`_rod_of_counters`, then :func:`_photo_xy` (one side)."""
+    return _photo_xy(*_rod_of_counters(x, y, depth, sx, sy, sz, f_instrument), *fields)
 
 
 def rods_intersection(
