@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import itertools
 import json
 import math
 import os
@@ -73,8 +74,10 @@ PROBE = r"""
 import os, sys, threading, time
 OUT = os.environ.get("STEREOPLOTTER_BENCH_PROBE")
 if OUT and "trainer" in sys.argv:
+    import contextvars
     import importlib.abc
-    rows, lock = [], threading.Lock()
+    rows, lock, turns, answered = [], threading.Lock(), [], {}
+    TURN = contextvars.ContextVar("turn", default=None)  # the message being answered
     running, started = {True: 0, False: 0}, {True: 0, False: 0}
 
     def patch(mod):
@@ -84,6 +87,9 @@ if OUT and "trainer" in sys.argv:
             if not self._threads[0].name.startswith("trainer-actor"):
                 return submit(self, address, session, fn, *args)
             queued, abuser = time.perf_counter(), address == ABUSER
+            turn = TURN.get()
+            if turn is not None:
+                turn["queued"] = queued
 
             def job(*a):
                 began = time.perf_counter()
@@ -97,8 +103,10 @@ if OUT and "trainer" in sys.argv:
                     with lock:
                         running[abuser] -= 1
                         beside = beside or started[not abuser] != others
-                        rows.append((address, began - queued, time.perf_counter() - began,
-                                     int(beside)))
+                        ended = time.perf_counter()
+                        rows.append((address, began - queued, ended - began, int(beside)))
+                        if turn is not None:
+                            turn.update(began=began, ended=ended, beside=beside)
             return submit(self, address, session, job, *args)
         mod.FairPool.submit = timed
 
@@ -113,18 +121,62 @@ if OUT and "trainer" in sys.argv:
                 done = n
     threading.Thread(target=write, daemon=True).start()
 
+    def patch_sockets(mod):
+        answer, dump = mod._answer, mod._dump
+
+        async def timed(reg, live, message, *args):
+            row = {"in": time.perf_counter()}
+            token = TURN.set(row)
+            try:
+                reply = await answer(reg, live, message, *args)
+            finally:
+                TURN.reset(token)
+            row["out"] = time.perf_counter()
+            if isinstance(reply.get("seq"), int) and "began" in row:
+                row["address"], row["seq"] = live.address, reply["seq"]
+                answered[id(reply)] = row
+            return reply
+
+        def dumped(body):
+            text = dump(body)
+            row = answered.pop(id(body), None)
+            if row is not None:
+                turns.append((row["address"], row["seq"], row["in"], row["queued"],
+                              row["began"], row["ended"], row["out"], time.perf_counter(),
+                              int(row["beside"])))
+            return text
+        mod._answer, mod._dump = timed, dumped
+
+    def write_turns():
+        done = 0
+        with open(OUT + ".turns", "w") as f:
+            while True:
+                time.sleep(0.5)
+                n = len(turns)
+                f.writelines(" ".join(map(str, r)) + "\n" for r in turns[done:n])
+                f.flush()
+                done = n
+    threading.Thread(target=write_turns, daemon=True).start()
+
+    hooked = {"stereoplotter.web.fair": patch, "stereoplotter.web.sockets": patch_sockets}
+
     class Hook(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path, target=None):
-            if name != "stereoplotter.web.fair":
+            if name not in hooked:
                 return None
-            sys.meta_path.remove(self)
+            then = hooked.pop(name)
             import importlib.util
-            spec = importlib.util.find_spec(name)
+            sys.meta_path.remove(self)
+            try:
+                spec = importlib.util.find_spec(name)
+            finally:
+                if hooked:
+                    sys.meta_path.insert(0, self)
             run = spec.loader.exec_module
 
             def exec_module(module):
                 run(module)
-                patch(module)
+                then(module)
             spec.loader.exec_module = exec_module
             return spec
     sys.meta_path.insert(0, Hook())
@@ -305,9 +357,10 @@ async def _open_from(host: str, sid: str, secret: str, address: str, patches: bo
 
 
 async def honest(host, n: int, stop: float, rtt: list, patches: list | None, pause: float,
-                 whole: bool = False):
+                 whole: bool = False, trace: list | None = None):
     """A trainee turning a wheel; like the page, it takes what changed in the state after the
-    first (``whole``: the whole state each time)."""
+    first (``whole``: the whole state each time). ``trace``: each answered turn's address, seq,
+    and the clock when it was sent and its answer received."""
     address = _local(10 + n)
     transport = httpx.AsyncHTTPTransport(local_address=address)
     async with httpx.AsyncClient(base_url=f"http://{host}", transport=transport,
@@ -340,7 +393,10 @@ async def honest(host, n: int, stop: float, rtt: list, patches: list | None, pau
             reply = await _ask(ws, {"action": {"kind": "turn", "control": "X",
                                                "delta": 0.05 if i % 2 else -0.05}, "seq": i})
             if reply.get("error") is None:
-                rtt.append((time.perf_counter() - t0) * 1e3)
+                t1 = time.perf_counter()
+                rtt.append((t1 - t0) * 1e3)
+                if trace is not None:
+                    trace.append((address, i, t0, t1))
             if "patch" in reply:  # what the page does with it
                 held = apply_patch(held, reply["patch"])
             i += 1
@@ -451,6 +507,43 @@ def _probe_summary(path: str) -> None:
               f"beside them {sum(r[2] for r in rows) / len(rows):.0%}")
 
 
+#: The parts of an honest turn's round trip ``_turns_summary`` names, between the clocks of
+#: the client (sent, received) and of the server (the message handed to the answer, the job
+#: queued, begun and ended on an actor thread, the answer back on the event loop, its JSON
+#: made to be sent).
+TURN_PARTS = ("to the server's answer (client send, network, event loop)",
+              "event loop before the queue", "queue wait", "run", "event loop after the run",
+              "answer made", "to the client (send, network, client loop)")
+
+
+def _turns_summary(path: str, trace: list) -> None:
+    """``--server-probe``: where the time of the honest trainees' turns under abuse goes, for
+    all of them and for the slowest 5 % (the client's and the server's clocks are the same
+    monotonic clock of the machine)."""
+    server = {}
+    with open(path) as f:
+        for line in f:
+            address, seq, *times, beside = line.split()
+            server[(address, int(seq))] = ([float(t) for t in times], int(beside))
+    rows = []
+    for address, seq, sent, got in trace:
+        if int(address.rsplit(".", 1)[1]) < 110 or (address, seq) not in server:
+            continue
+        times, beside = server[(address, seq)]
+        clock = [sent, *times, got]
+        rows.append((got - sent, [(b - a) * 1e3 for a, b in itertools.pairwise(clock)], beside))
+    if not rows:
+        return
+    rows.sort(key=lambda r: r[0])
+    tail = rows[int(0.95 * (len(rows) - 1)):]
+    for name, group in (("all", rows), ("slowest 5 %", tail)):
+        parts = [statistics.mean(r[1][k] for r in group) for k in range(len(TURN_PARTS))]
+        print(f"server probe, honest turns under abuse, {name} ({len(group)}, round trip mean "
+              f"{statistics.mean(r[0] for r in group) * 1e3:.1f} ms; with an abuser's job "
+              f"beside {sum(r[2] for r in group) / len(group):.0%}), mean ms: "
+              + "; ".join(f"{p} {v:.1f}" for p, v in zip(TURN_PARTS, parts, strict=True)))
+
+
 def _summary(name: str, rtt: list[float], patches: list[float]) -> str:
     rtt = sorted(rtt)
     p95 = rtt[int(0.95 * (len(rtt) - 1))] if rtt else math.nan
@@ -464,6 +557,7 @@ async def abuse_async(args) -> None:
 
     with tempfile.TemporaryDirectory() as data:
         probe = os.path.join(data, "probe.txt") if args.server_probe else None
+        trace: list | None = [] if args.server_probe else None
         proc, host = _start_server(data, probe)
         try:
             async with httpx.AsyncClient(base_url=f"http://{host}", timeout=900) as http:
@@ -489,7 +583,8 @@ async def abuse_async(args) -> None:
                 cpu = time.process_time()
                 await asyncio.gather(*(
                     honest(host, n + (100 if phase == "abuse" else 0), stop, rtt,
-                           patches if n == 0 else None, 1 / args.rate, args.whole_states)
+                           patches if n == 0 else None, 1 / args.rate, args.whole_states,
+                           trace)
                     for n in range(args.trainees)))
                 cpu = time.process_time() - cpu  # the honest clients' own CPU in the phase
                 if abuser is not None:
@@ -506,6 +601,7 @@ async def abuse_async(args) -> None:
                 proc.kill()
         if probe is not None:
             _probe_summary(probe)
+            _turns_summary(probe + ".turns", trace)
     a = results["abuser"]
     idle_patch = statistics.median(results["idle"][1] or [math.nan])
     abuse_patch = statistics.median(results["abuse"][1] or [math.nan])

@@ -20,6 +20,16 @@ lighter session's job starts beside a heavier one's at once (it waits for no job
 session); the much heavier session's next job waits for the lighter one to end (a job's time,
 not a queue). Sessions within that factor of each other run side by side.
 
+An address held to its share (:meth:`FairPool.hold_to_share`: the server does so for a while
+after it refused one of the address's requests for a limit) gets no more than an even share of
+the workers' time while other addresses have had work lately: when its recent time exceeds
+its share of one worker (1/n of it, n the addresses whose jobs started within
+:data:`ACTIVE_S`, kept over the half-life's span) its next job waits, even with a worker free,
+until its recent time has decayed below that. Otherwise the pool gives a flooding address
+whatever the others leave, and its jobs, however well ordered, keep the workers and the
+interpreter's lock busy beside theirs. Addresses not held are never paced (a class behind one
+address may use the workers as far as they are free).
+
 :class:`FairCache` keeps values per owner within one budget, evicting from the owner that
 holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
 retries at once waits for its refusal), with a bound per client and in all.
@@ -35,7 +45,7 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
-__all__ = ["HALF_LIFE_S", "HEAVIER", "FairCache", "FairPool", "Holds"]
+__all__ = ["ACTIVE_S", "HALF_LIFE_S", "HEAVIER", "FairCache", "FairPool", "Holds"]
 
 
 #: Half-life of a session's recent time on the workers: the CPU time its jobs took is forgotten
@@ -50,6 +60,12 @@ HEAVIER = 2.0
 #: A session whose recent time has decayed below this is forgotten: its next job is served as a
 #: newcomer's. [s]
 FORGOTTEN_S = 1e-4
+#: An address whose job started within this span counts among those sharing the workers (an
+#: address held to its share gets 1/n of one worker's time, n those addresses). [s]
+ACTIVE_S = 1.0
+#: The decayed sum of a steady use of 1 s a second: what a share of one worker's time amounts
+#: to in the pool's recent time (the integral of 2^(−t/half-life) over the past). [s]
+_STEADY = HALF_LIFE_S / math.log(2.0)
 
 
 class FairPool:
@@ -73,6 +89,11 @@ class FairPool:
         self._used: dict[tuple[str, str], float] = {}
         self._epoch = clock()
         self._served: dict[str, float] = {}  # when an address's job last started
+        #: each address's recent time, scaled as ``_used``; and the addresses held to their
+        #: share, until when
+        self._address_used: dict[str, float] = {}
+        self._held: dict[str, float] = {}
+        self._wake: float | None = None  # when a job held to its share may start
         self._pruned = clock()
         self._closed = False
         self._threads = [
@@ -94,6 +115,21 @@ class FairPool:
             self._cv.notify()
         return fut
 
+    def hold_to_share(self, address: str, seconds: float) -> None:
+        """Hold ``address`` to an even share of the workers' time for ``seconds`` from now (a
+        later call extends it)."""
+        with self._cv:
+            self._held[address] = max(self._held.get(address, -math.inf),
+                                      self._clock() + seconds)
+            if len(self._held) > 10_000:  # forget the expired ones rather than grow
+                now = self._clock()
+                self._held = {a: t for a, t in self._held.items() if t > now}
+
+    def held_to_share(self, address: str) -> bool:
+        """Whether ``address`` is held to its share now."""
+        with self._cv:
+            return self._held.get(address, -math.inf) > self._clock()
+
     def pending(self) -> int:
         """Jobs queued and not yet started."""
         with self._cv:
@@ -111,22 +147,53 @@ class FairPool:
         return self._used.get(key, 0.0) / self._scale(now)
 
     def _charge(self, key: tuple[str, str], spent: float, now: float) -> None:
-        """Add ``spent`` [s] to a session's recent time (lock held)."""
+        """Add ``spent`` [s] to a session's and its address's recent time (lock held)."""
         scale = self._scale(now)
         if scale > 2.0**400:  # far from the epoch: a new one (the values stay finite)
             self._used = {k: v / scale for k, v in self._used.items()}
+            self._address_used = {a: v / scale for a, v in self._address_used.items()}
             self._epoch, scale = now, 1.0
         self._used[key] = self._used.get(key, 0.0) + spent * scale
+        address = key[0]
+        self._address_used[address] = self._address_used.get(address, 0.0) + spent * scale
+
+    def _over_share(self, address: str, now: float, active: list[int]) -> float | None:
+        """For an address held to its share whose recent time exceeds it while another
+        address has had work lately: the seconds until it falls within (lock held); else
+        None. ``active``: [the addresses whose job started within ACTIVE_S], or [-1] not yet
+        counted (counted here once for all calls of one choice)."""
+        until = self._held.get(address)
+        if until is None or until <= now:
+            return None
+        if active[0] < 0:
+            active[0] = sum(1 for t in self._served.values() if now - t < ACTIVE_S)
+        others = active[0] - (now - self._served.get(address, -math.inf) < ACTIVE_S)
+        if others < 1 and not any(a != address for a, _ in self._running):
+            return None  # alone: nothing to share
+        allowed = _STEADY / max(others + 1, 2) * self._scale(now)
+        mine = self._address_used.get(address, 0.0)
+        if mine <= allowed:
+            return None
+        return HALF_LIFE_S * math.log2(mine / allowed)
 
     def _next(self) -> tuple[tuple[str, str], Any] | None:
         """The next job (called with the lock held), or None."""
         used, served, cap, busy = self._used, self._served, self._per_address, self._busy
         best = best_rank = None
+        now = self._clock() if self._held else 0.0
+        active = [-1]
+        self._wake = None
         for key, queue in self._jobs.items():
             if not queue or key in self._running:
                 continue
             if cap is not None and busy.get(key[0], 0) >= cap:
                 continue
+            if self._held:
+                wait = self._over_share(key[0], now, active)
+                if wait is not None:  # beyond its share: not before it has decayed
+                    wake = now + max(wait, 1e-3)
+                    self._wake = wake if self._wake is None else min(self._wake, wake)
+                    continue
             rank = (used.get(key, 0.0), served.get(key[0], -math.inf), queue[0][3])
             if best is None or rank < best_rank:
                 best, best_rank = key, rank
@@ -149,6 +216,10 @@ class FairPool:
             for k in [k for k, v in self._used.items() if v < floor
                       and k not in self._jobs and k not in self._running]:
                 del self._used[k]
+            busy = {a for a, _ in self._jobs} | {a for a, _ in self._running}
+            for a in [a for a, v in self._address_used.items() if v < floor and a not in busy]:
+                del self._address_used[a]
+            self._held = {a: t for a, t in self._held.items() if t > now}
             if len(self._served) > 4 * len(self._used) + 64:
                 live = {a for a, _ in self._used} | {a for a, _ in self._jobs}
                 self._served = {a: t for a, t in self._served.items() if a in live}
@@ -160,7 +231,8 @@ class FairPool:
                 while got is None:
                     if self._closed:
                         return
-                    self._cv.wait()
+                    wake = self._wake
+                    self._cv.wait(None if wake is None else max(wake - self._clock(), 1e-3))
                     got = self._next()
                 key, (fut, fn, args, _) = got
                 self._running.add(key)

@@ -74,6 +74,13 @@ PATCHES_AT_ONCE = 1
 #: the honest trainees' p95 under abuse was 149 ms without this cap and 112 ms, 90 ms with it
 #: (single runs). [actions]
 ACTIONS_AT_ONCE = 1
+#: How long a client address refused for any of its limits (messages, sockets, patches) is
+#: held to an even share of the actor threads' time (``fair.FairPool.hold_to_share``: while
+#: other addresses have had actions lately, 1/n of one thread, n those addresses); each
+#: refusal extends it. A class behind one address within its limits is never held; a
+#: client that keeps hitting them is, as long as it does (assumed: a page's own refusals, a
+#: reconnect storm after a restart, pass within seconds). [s]
+REFUSED_HOLD_S = 10.0
 #: Sockets a session may open (a page reconnects after a dropped network or a reload): a rate
 #: and a burst; beyond, a socket is closed (4429) before any work is done for it. [1/s], [—]
 CONNECT_LIMIT = (1.0, 5)
@@ -202,14 +209,25 @@ class Registry:
             self.patch_limits.clear()
         mine = self.patch_limits.setdefault(("s", sid), RateLimit(*PATCH_LIMIT))
         theirs = self.patch_limits.setdefault(("a", address), RateLimit(*PATCH_ADDRESS_LIMIT))
-        return mine.allow() and theirs.allow()
+        if mine.allow() and theirs.allow():
+            return True
+        self.refused(address)
+        return False
 
     def connect_allowed(self, address: str) -> bool:
         """Whether a client address may open another socket now (``ADDRESS_CONNECT_LIMIT``)."""
         if len(self.connect_limits) > 10_000:
             self.connect_limits.clear()
         bucket = self.connect_limits.setdefault(address, RateLimit(*ADDRESS_CONNECT_LIMIT))
-        return bucket.allow()
+        if bucket.allow():
+            return True
+        self.refused(address)
+        return False
+
+    def refused(self, address: str) -> None:
+        """A request of ``address`` was refused for a limit: its actions are held to an even
+        share of the actor threads for :data:`REFUSED_HOLD_S`."""
+        self.actor.hold_to_share(address, REFUSED_HOLD_S)
 
     def run(self, pool: FairPool, address: str, session: str, fn, *args) -> Future:
         """``fn(*args)`` on a fair pool, queued under the client address and the session."""

@@ -141,6 +141,7 @@ def _start_allowed(request: Request) -> None:
         web.starts.clear()
     addr = address_of(request)
     if not web.starts.setdefault(addr, RateLimit(*web.start_limit)).allow():
+        web.reg.refused(addr)
         raise Refused(429, "too many sessions started from this address: wait a moment")
 
 

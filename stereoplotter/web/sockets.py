@@ -169,6 +169,7 @@ async def trainee_socket(websocket: WebSocket, reg: Registry) -> None:
     if live.connects is None:
         live.connects = RateLimit(*CONNECT_LIMIT)
     if not live.connects.allow():
+        reg.refused(address_of(websocket))
         await _held(reg, address_of(websocket))
         return await _refuse(websocket, "too many connections of this session: wait a moment",
                              4429)
@@ -248,10 +249,12 @@ async def _answer(reg: Registry, live, message: dict[str, Any], limits,
     try:
         session_limit, address_limit_ = limits
         if not session_limit.allow():
+            reg.refused(live.address)
             raise Refused(
                 429, f"{_TOO_MANY}: at most {session_limit.rate:g} a second a session"
             )
         if not address_limit_.allow():
+            reg.refused(live.address)
             raise Refused(429, f"{_TOO_MANY} from this address: wait a moment")
         msg = parse_message(message.get("text"))
         seq = msg.get("seq")

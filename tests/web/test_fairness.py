@@ -158,6 +158,55 @@ def test_a_heavy_session_waits_for_the_workers_to_be_free():
     assert events.index("start heavy") > events.index("end light"), events
 
 
+def test_an_address_held_to_its_share_waits_while_others_act():
+    """One worker; ten addresses have acted lately. An address held to its share (a tenth of
+    the worker's time) that has just had more than that waits, even with the worker free,
+    while the others act; an address as busy but not held does not; the held one's job runs
+    once its recent time has decayed (the pool's clock moved on)."""
+    now = [1000.0]
+    pool = FairPool(1, "test", clock=lambda: now[0])
+    order: list[str] = []
+    try:
+        for i in range(8):
+            pool.submit(f"10.0.1.{i}", "s", order.append, "light").result(5)
+        pool.hold_to_share("10.0.0.66", 60.0)
+        assert pool.held_to_share("10.0.0.66") and not pool.held_to_share("10.0.0.77")
+        # a tenth of one worker, as recent time: 0.1 × HALF_LIFE_S / ln 2 ≈ 0.144 s
+        pool.submit("10.0.0.66", "flood", _run_for, 0.2).result(5)  # within it until now
+        pool.submit("10.0.0.77", "class", _run_for, 0.2).result(5)
+        order.clear()
+        held = pool.submit("10.0.0.66", "flood", order.append, "held")
+        pool.submit("10.0.0.77", "class", order.append, "not held").result(5)
+        pool.submit("10.0.1.0", "s", order.append, "light").result(5)
+        time.sleep(0.1)
+        assert not held.done() and order == ["not held", "light"], order
+        now[0] += 5.0  # the others quiet, its recent time decayed 32-fold
+        held.result(5)
+    finally:
+        pool.shutdown()
+    assert order == ["not held", "light", "held"]
+
+
+def test_a_client_refused_for_a_limit_is_held_to_its_share(tmp_path, monkeypatch):
+    """A client opening sockets beyond its address's limit is held to an even share of the
+    actor threads; another address is not."""
+    monkeypatch.setattr(registry, "ADDRESS_CONNECT_LIMIT", (0.01, 2))
+    monkeypatch.setattr(sockets, "REFUSAL_DELAY_S", 0.01)
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        sid, secret = start(c, PRACTICE, trainee="churn")
+        actor = c.app.state.registry.actor
+        for _ in range(2):
+            ws, _, hello = open_socket(c, sid, secret)
+            ws.__exit__(None, None, None)
+            assert "hello" in hello
+        assert not actor.held_to_share("testclient")
+        with pytest.raises(WebSocketDisconnect):
+            with c.websocket_connect(f"/ws/{sid}") as conn:
+                conn.receive_text()
+        assert actor.held_to_share("testclient")
+        assert not actor.held_to_share("10.0.0.7")
+
+
 def test_patches_render_in_parallel_and_are_limited_per_session(tmp_path, monkeypatch):
     monkeypatch.setattr(registry, "PATCH_LIMIT", (0.01, 5))  # a slow machine refills no token
     with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
