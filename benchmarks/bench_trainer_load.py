@@ -147,15 +147,27 @@ if OUT and "trainer" in sys.argv:
             return text
         mod._answer, mod._dump = timed, dumped
 
+    import gc
+    passes, began = [], [0.0]
+
+    def collected(phase, info):  # the garbage collector's passes: generation, start, end
+        if phase == "start":
+            began[0] = time.perf_counter()
+        else:
+            passes.append((info["generation"], began[0], time.perf_counter()))
+    gc.callbacks.append(collected)
+
     def write_turns():
-        done = 0
-        with open(OUT + ".turns", "w") as f:
+        done, done_gc = 0, 0
+        with open(OUT + ".turns", "w") as f, open(OUT + ".gc", "w") as g:
             while True:
                 time.sleep(0.5)
-                n = len(turns)
+                n, m = len(turns), len(passes)
                 f.writelines(" ".join(map(str, r)) + "\n" for r in turns[done:n])
+                g.writelines(" ".join(map(str, r)) + "\n" for r in passes[done_gc:m])
                 f.flush()
-                done = n
+                g.flush()
+                done, done_gc = n, m
     threading.Thread(target=write_turns, daemon=True).start()
 
     hooked = {"stereoplotter.web.fair": patch, "stereoplotter.web.sockets": patch_sockets}
@@ -531,11 +543,33 @@ def _turns_summary(path: str, trace: list) -> None:
             continue
         times, beside = server[(address, seq)]
         clock = [sent, *times, got]
-        rows.append((got - sent, [(b - a) * 1e3 for a, b in itertools.pairwise(clock)], beside))
+        rows.append((got - sent, [(b - a) * 1e3 for a, b in itertools.pairwise(clock)], beside,
+                     sent))
     if not rows:
         return
     rows.sort(key=lambda r: r[0])
     tail = rows[int(0.95 * (len(rows) - 1)):]
+    began = min(r[3] for r in rows)
+    windows: dict[int, int] = {}
+    for r in tail:
+        k = int((r[3] - began) / 0.25)
+        windows[k] = windows.get(k, 0) + 1
+    busiest = sorted(windows.items(), key=lambda kv: -kv[1])[:8]
+    ended = max(r[3] for r in rows)
+    with open(path[:-len(".turns")] + ".gc") as f:
+        passes = [(int(g), float(a), float(b)) for g, a, b in (line.split() for line in f)]
+    passes = [(g, a - began, (b - a) * 1e3) for g, a, b in passes if began <= a <= ended]
+    for gen in (0, 1, 2):
+        mine = [ms for g, _, ms in passes if g == gen]
+        if mine:
+            print(f"server probe, the collector's generation-{gen} passes in the abuse phase: "
+                  f"{len(mine)}, {sum(mine):.0f} ms in all, longest {max(mine):.1f} ms"
+                  + ("" if gen < 1 else "; at (s into the phase: ms) " + ", ".join(
+                      f"{a:.2f}: {ms:.0f}" for g, a, ms in passes if g == gen and ms > 5)))
+    print(f"server probe, the slowest 5 % of the honest turns under abuse were sent in "
+          f"{len(windows)} quarter-seconds of the phase's "
+          f"{int((max(r[3] for r in rows) - began) / 0.25) + 1}; the busiest (s into the "
+          f"phase: turns): " + ", ".join(f"{k * 0.25:.2f}: {n}" for k, n in busiest))
     for name, group in (("all", rows), ("slowest 5 %", tail)):
         parts = [statistics.mean(r[1][k] for r in group) for k in range(len(TURN_PARTS))]
         print(f"server probe, honest turns under abuse, {name} ({len(group)}, round trip mean "

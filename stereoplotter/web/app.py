@@ -175,6 +175,7 @@ def create_app(
             for proc in workers:
                 proc.terminate()
         reg.actor.shutdown(wait=True)
+        reg.starter.shutdown(wait=True)
         reg.patcher.shutdown(wait=True)
         reg.renderers.shutdown()
         store.close()

@@ -64,6 +64,13 @@ PATCH_ADDRESS_LIMIT = (200.0, 400)
 #: interpreter's lock for most of its 0.1–0.3 s, which in the server would stall the event loop
 #: and the actors). [threads]
 ACTORS, PATCHERS = 2, 2
+#: Worker threads that start sessions (``start``: the exercise's setup and the simulated
+#: operator's targets, tens of ms of Python a session), a fair pool of their own. With every
+#: start on a thread of its own (a class starting at once), each holds the interpreter's lock
+#: in turn with the event loop and the actors, and a trainee already turning a wheel waits for
+#: all of them at each of its message's hand-overs; on one thread a start waits for the starts
+#: before it instead (a class of 40 at once: about a second for the last). [threads]
+STARTERS = 1
 #: Photo patches of one client address rendered at once: with PATCHERS above it, a client
 #: asking for patches without pause leaves a worker free for the others. [patches]
 PATCHES_AT_ONCE = 1
@@ -169,6 +176,9 @@ class Registry:
         self.actor = FairPool(ACTORS, "trainer-actor", per_address=ACTIONS_AT_ONCE,
                               heavy_alone=True)
         self.patcher = FairPool(PATCHERS, "trainer-patch", per_address=PATCHES_AT_ONCE)
+        #: The thread that starts sessions (``STARTERS``), the address started least lately
+        #: first.
+        self.starter = FairPool(STARTERS, "trainer-start")
         self.renderers = renderers if renderers is not None else Renderers(PATCHERS, False)
         self._seed_key = store.server_key(SEED_KEY)
         self.rows: dict[str, dict[str, Any]] = {r["id"]: r for r in store.sessions()}

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import asyncio
 import csv
+import functools
 import io
 import json
 import math
@@ -171,9 +172,10 @@ async def new_session(request: Request) -> Response:
     demo = body.get("demonstration", False)
     if not isinstance(demo, bool):
         raise Refused(400, "demonstration: expected true or false")
-    live, secret = await run_in_threadpool(
-        web_of(request).reg.start, exercise, trainee, seed=seed, demonstration=demo
-    )
+    reg = web_of(request).reg
+    live, secret = await asyncio.wrap_future(reg.run(
+        reg.starter, address_of(request), "start", functools.partial(
+            reg.start, exercise, trainee, seed=seed, demonstration=demo)))
     return JSONResponse({"id": live.id, "secret": secret}, headers=_NO_STORE)
 
 
