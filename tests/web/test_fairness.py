@@ -207,6 +207,34 @@ def test_a_client_refused_for_a_limit_is_held_to_its_share(tmp_path, monkeypatch
         assert not actor.held_to_share("10.0.0.7")
 
 
+def test_sessions_start_one_at_a_time_on_their_own_thread(tmp_path, monkeypatch):
+    """Many session starts at once (a class, or a client starting sessions in a loop) run one
+    after the other on the starting thread, not each on a thread of its own beside the event
+    loop and the actors."""
+    threads: list[str] = []
+    begun = registry.core.start
+
+    def start_here(*args):
+        threads.append(threading.current_thread().name)
+        return begun(*args)
+
+    monkeypatch.setattr(registry.core, "start", start_here)
+    with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
+        answers: list[int] = []
+
+        def post(k: int) -> None:
+            r = c.post("/api/sessions", json={"exercise": PRACTICE, "trainee": f"t{k}"})
+            answers.append(r.status_code)
+
+        posts = [threading.Thread(target=post, args=(k,)) for k in range(6)]
+        for t in posts:
+            t.start()
+        for t in posts:
+            t.join()
+    assert answers == [200] * 6
+    assert threads == ["trainer-start-0"] * 6
+
+
 def test_patches_render_in_parallel_and_are_limited_per_session(tmp_path, monkeypatch):
     monkeypatch.setattr(registry, "PATCH_LIMIT", (0.01, 5))  # a slow machine refills no token
     with make_test_client(create_app(TOKEN, tmp_path, hosts=("testserver",))) as c:
