@@ -32,7 +32,13 @@ the two client processes (the honest trainees' in each phase, the abuser's): on 
 machine their work takes the server's processors, which a class's clients on their own machines
 would not. ``--server-probe`` also times, inside the server, each job on the actor threads: its
 wait in the queue, its run, and whether a job of the other kind (honest, abuser) ran beside it
-(a hook the script puts on the server's path; the server's code is unchanged).
+(a hook the script puts on the server's path; the server's code is unchanged); where each
+honest turn's round trip under abuse went, on the machine's one monotonic clock (from the
+client's send to the server's answer beginning, the event loop before the queue, the queue
+wait, the run, the event loop after it, the answer's JSON, back to the client), as means over
+all turns and over the slowest 5 %; in which quarter-seconds of the phase the slowest 5 % were
+sent (a stall of the whole server holds every trainee's turn in one); and the garbage
+collector's passes in the phase (``gc.callbacks``).
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20] [--server-probe]
 
@@ -69,7 +75,10 @@ TOKEN = "bench-token"
 #: ``--server-probe``: loaded by the server as ``sitecustomize`` (its folder first on the
 #: server's path); appends one line a job run on the actor threads to the file named by
 #: ``STEREOPLOTTER_BENCH_PROBE``: address, queue wait [s], run [s], whether a job of the other
-#: kind (the abuser's address or not) ran at some moment of its run.
+#: kind (the abuser's address or not) ran at some moment of its run; to that name + ``.turns``
+#: one line an answered message with a ``seq``: address, seq, and the clock when the answer
+#: began, the job was queued, began and ended, the answer was back on the event loop and its
+#: JSON made, and whether an abuser's job ran beside it; to ``.gc`` one line a collector pass.
 PROBE = r"""
 import os, sys, threading, time
 OUT = os.environ.get("STEREOPLOTTER_BENCH_PROBE")
