@@ -38,7 +38,7 @@ client's send to the server's answer beginning, the event loop before the queue,
 wait, the run, the event loop after it, the answer's JSON, back to the client), as means over
 all turns and over the slowest 5 %; in which quarter-seconds of the phase the slowest 5 % were
 sent (a stall of the whole server holds every trainee's turn in one); and the garbage
-collector's passes in the phase (``gc.callbacks``).
+collector's passes and the actions' writes to the store in the phase.
 
     PYTHONPATH=. python benchmarks/bench_trainer_load.py --abuser [--seconds 20] [--server-probe]
 
@@ -78,7 +78,8 @@ TOKEN = "bench-token"
 #: kind (the abuser's address or not) ran at some moment of its run; to that name + ``.turns``
 #: one line an answered message with a ``seq``: address, seq, and the clock when the answer
 #: began, the job was queued, began and ended, the answer was back on the event loop and its
-#: JSON made, and whether an abuser's job ran beside it; to ``.gc`` one line a collector pass.
+#: JSON made, and whether an abuser's job ran beside it; to ``.gc`` one line a collector pass
+#: (generation, start, end) or an action's write to the store (−1, start, end).
 PROBE = r"""
 import os, sys, threading, time
 OUT = os.environ.get("STEREOPLOTTER_BENCH_PROBE")
@@ -179,7 +180,19 @@ if OUT and "trainer" in sys.argv:
                 done, done_gc = n, m
     threading.Thread(target=write_turns, daemon=True).start()
 
-    hooked = {"stereoplotter.web.fair": patch, "stereoplotter.web.sockets": patch_sockets}
+    def patch_store(mod):  # an action's record written: when, how long (the store's lock held)
+        append = mod.SessionStore.append_action
+
+        def timed(self, *args):
+            began = time.perf_counter()
+            try:
+                return append(self, *args)
+            finally:
+                passes.append((-1, began, time.perf_counter()))
+        mod.SessionStore.append_action = timed
+
+    hooked = {"stereoplotter.web.fair": patch, "stereoplotter.web.sockets": patch_sockets,
+              "stereoplotter.io.session_store": patch_store}
 
     class Hook(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path, target=None):
@@ -568,6 +581,12 @@ def _turns_summary(path: str, trace: list) -> None:
     with open(path[:-len(".turns")] + ".gc") as f:
         passes = [(int(g), float(a), float(b)) for g, a, b in (line.split() for line in f)]
     passes = [(g, a - began, (b - a) * 1e3) for g, a, b in passes if began <= a <= ended]
+    writes = sorted(ms for g, _, ms in passes if g == -1)
+    if writes:
+        print(f"server probe, actions written to the store in the abuse phase: {len(writes)}, "
+              f"median {writes[len(writes) // 2]:.2f} ms, longest {writes[-1]:.1f} ms; over "
+              f"20 ms at (s into the phase: ms) " + ", ".join(
+                  f"{a:.2f}: {ms:.0f}" for g, a, ms in passes if g == -1 and ms > 20))
     for gen in (0, 1, 2):
         mine = [ms for g, _, ms in passes if g == gen]
         if mine:
