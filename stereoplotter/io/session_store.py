@@ -38,6 +38,9 @@ __all__ = [
 
 #: The database file inside the data folder.
 DB_NAME = "trainer.sqlite3"
+#: How often the write-ahead log is copied into the store's file, off the writers' path
+#: (SQLite's own default copies it within a write once the log holds 1 000 pages). [s]
+CHECKPOINT_S = 1.0
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS sessions (
@@ -141,10 +144,37 @@ class SessionStore:
         self._db.execute("PRAGMA journal_mode=WAL")
         self._db.execute("PRAGMA synchronous=NORMAL")
         self._db.executescript(_SCHEMA)
+        self._stop = threading.Event()
+        self._checkpointer: threading.Thread | None = None
+        if self.path is not None:
+            # the log's pages are copied into the file (and the file synced to the disk) by a
+            # thread of its own on its own connection, not by the write that fills the WAL
+            # with the store's lock held: a sync of a busy disk took up to 180 ms there, and
+            # every write and check waited for it
+            self._db.execute("PRAGMA wal_autocheckpoint=0")
+            self._checkpointer = threading.Thread(
+                target=self._checkpoints, args=(target,), name="store-checkpoint", daemon=True)
+            self._checkpointer.start()
+
+    def _checkpoints(self, target: str) -> None:
+        """Copy the write-ahead log into the file every :data:`CHECKPOINT_S` (SQLite's passive
+        checkpoint: writers are never blocked, readers keep their snapshot)."""
+        db = sqlite3.connect(target, check_same_thread=False, isolation_level=None)
+        try:
+            while not self._stop.wait(CHECKPOINT_S):
+                try:
+                    db.execute("PRAGMA wal_checkpoint(PASSIVE)")
+                except sqlite3.Error:  # busy or failing now: the next round tries again
+                    pass
+        finally:
+            db.close()
 
     def close(self) -> None:
+        self._stop.set()
+        if self._checkpointer is not None:
+            self._checkpointer.join(10)
         with self._lock:
-            self._db.close()
+            self._db.close()  # the last connection: SQLite copies the log into the file
 
     def _run(self, sql: str, args: tuple = ()) -> list[tuple]:
         with self._lock:
