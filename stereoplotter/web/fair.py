@@ -22,12 +22,12 @@ not a queue). Sessions within that factor of each other run side by side.
 
 An address held to its share (:meth:`FairPool.hold_to_share`: the server does so for a while
 after it refused one of the address's requests for a limit) gets no more than an even share of
-the workers' time while other addresses have had work lately: when its recent time exceeds
-its share of one worker (1/n of it, n the addresses whose jobs started within
-:data:`ACTIVE_S`, kept over the half-life's span) its next job waits, even with a worker free,
-until its recent time has decayed below that. Otherwise the pool gives a flooding address
-whatever the others leave, and its jobs, however well ordered, keep the workers and the
-interpreter's lock busy beside theirs. Addresses not held are never paced (a class behind one
+the workers' time while other addresses have had work lately: when its recent time (its
+sessions' together, decayed alike) exceeds what a steady 1/n of one worker's time amounts to,
+n the addresses whose jobs started within :data:`ACTIVE_S`, its next job waits, even with a
+worker free, until its recent time has decayed below that. Otherwise the pool gives a
+flooding address whatever the others leave, and its jobs, however well ordered, keep the
+workers and the interpreter's lock busy beside theirs. Addresses not held are never paced (a class behind one
 address may use the workers as far as they are free).
 
 :class:`FairCache` keeps values per owner within one budget, evicting from the owner that
