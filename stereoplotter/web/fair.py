@@ -27,8 +27,8 @@ sessions' together, decayed alike) exceeds what a steady 1/n of one worker's tim
 n the addresses whose jobs started within :data:`ACTIVE_S`, its next job waits, even with a
 worker free, until its recent time has decayed below that. Otherwise the pool gives a
 flooding address whatever the others leave, and its jobs, however well ordered, keep the
-workers and the interpreter's lock busy beside theirs. Addresses not held are never paced (a class behind one
-address may use the workers as far as they are free).
+workers and the interpreter's lock busy beside theirs. Addresses not held are never paced
+(a class behind one address may use the workers as far as they are free).
 
 :class:`FairCache` keeps values per owner within one budget, evicting from the owner that
 holds the most. :class:`Holds` counts refusals held back before they are sent (a client that
