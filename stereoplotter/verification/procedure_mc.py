@@ -296,6 +296,10 @@ class ProcedureOptions:
         The estimator with the linear control variate
         (:mod:`~stereoplotter.verification.control_variate`; unbiased, its CI ≈ 10–40×
         narrower); False: the plain mean.
+    decompose : bool
+        Setup methods: each reading's ``decomposition`` (:mod:`.decomposition`); False: None
+        (a run read only for its value or its per-trial mean squares skips its first-order
+        fields).
     passes : int or None
         Every loop makes this many passes (no check ever passes); None: as ``fidelity`` says.
     linkage : {"drag", "independent"} or None
@@ -317,6 +321,7 @@ class ProcedureOptions:
     control: str = "exact"
     instrument: bool = False
     control_variate: bool = True
+    decompose: bool = True
     passes: int | None = None
     linkage: str | None = None
     fidelity: Fidelity | None = None
@@ -539,6 +544,7 @@ def run_configuration(
         standard_points_at_a=method == "conventional" and options.standard_points == "book",
         sigma_control_mm=sigma_control,
         sources_off=sources_off,
+        decompose=options.decompose,
     )
     ms = mean_squares(run)
     return ConfigurationRun(ms.plain, ms.controlled, ms.error_free_dp, units)
@@ -576,13 +582,16 @@ def _extras(
     ):
         cf, h = rms_ci(best[key], units[key])
         ref = _formulas(m, scenario, spec, g, o.sources, c)["rigorous"]
-        ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
+        decomposition = None
+        if o.decompose:
+            ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
+            decomposition = dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key])
         fields[key] = {
             "coefficient": cf,
             "ci": h,
             "plain": rms_ci(plain[key], units[key]),
             "formula": ref,
-            "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
+            "decomposition": decomposition,
             "mean_squares": plain[key],  # per trial, photo mm² (paired switch steps)
             "unit": units[key],
         }

@@ -164,6 +164,9 @@ class ProcedureRun:
     sources_off : mapping or None
         Key prefix → (trials,) mask of the trials whose acts of that prefix draw 0
         (:func:`conventional_sources_mc`); None: every act drawn on every trial.
+    decompose : bool
+        Setup methods: also the first-order fields of the decomposition (:mod:`.decomposition`)
+        of each reading; False: only the readings and the elements' errors.
     """
 
     scenario: Scenario
@@ -181,6 +184,7 @@ class ProcedureRun:
     standard_points_at_a: bool = False
     sigma_control_mm: float = 0.0
     sources_off: Mapping[str, NDArray[np.bool_]] | None = None
+    decompose: bool = True
 
     @property
     def procedure(self) -> str:
@@ -263,23 +267,27 @@ def _setup_fields(run: ProcedureRun, zero_run: SimulationResult) -> tuple[FieldM
 
     units0 = zero_run.instrument.state()["units"]
     state0 = (zero_run.instrument.setting, {s: units0[s] for s in ("left", "right")})
-    jac = dc.state_jacobian(*state0, dp_function(sc, sheet, allp))
+    jac = dc.state_jacobian(*state0, dp_function(sc, sheet, allp)) if run.decompose else None
 
     def decompose(
         result: SimulationResult, main: dict[str, FloatArray]
     ) -> dict[FieldKey, FloatArray]:
         """Per-trial mean squares of the first-order fields of the decomposition
-        (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²]."""
+        (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²], and
+        each (6.22) element's squared error ("element", name); the elements' only without
+        ``run.decompose``."""
         units = result.instrument.state()["units"]
         trials = len(next(iter(main.values())))
         deltas = dc.state_deltas(
             result.instrument.setting, {s: units[s] for s in ("left", "right")}, *state0, trials
         )
-        noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
         # each (6.22) element's error (instrument units: mm, tangent, rad), squared per trial
         out: dict[FieldKey, FloatArray] = {
             ("element", f"{o}.{f}"): deltas[i] ** 2 for i, (o, f) in enumerate(dc.ELEMENTS)
         }
+        if jac is None:
+            return out
+        noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
         for step, d in dc.linear_fields(jac, deltas):
             r = readings(d)
             r["observed"] = r["levelled"] + noise

@@ -125,8 +125,11 @@ PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this
 class ProcedureConfig:
     """A configuration of the procedure MC: its ``method`` and the options of its runs (the
     fields of :class:`~stereoplotter.verification.procedure_mc.ProcedureOptions` it sets:
-    ``grid``, ``passes``, ``sources``, ``fidelity``); ``idealised``: run on the scenario with
-    vertical photos over flat terrain (:func:`idealised_geometry`)."""
+    ``grid``, ``passes``, ``sources``, ``fidelity``, ``control_variate``, ``decompose``);
+    ``idealised``: run on the scenario with vertical photos over flat terrain
+    (:func:`idealised_geometry`). A run the table reads only for its value skips the
+    decomposition, one read only for its plain per-trial mean squares (a switch step) also the
+    control variate: the values read are the same."""
 
     method: str
     grid: tuple[int, int] = (16, 32)
@@ -134,6 +137,8 @@ class ProcedureConfig:
     sources: str = "both"
     fidelity: Fidelity | None = None
     idealised: bool = False
+    control_variate: bool = True
+    decompose: bool = True
 
     def options(self) -> dict[str, Any]:
         """The :func:`procedure_mc` keyword arguments of a run of this configuration."""
@@ -143,6 +148,8 @@ class ProcedureConfig:
             "passes": self.passes,
             "sources": self.sources,
             "fidelity": self.fidelity,
+            "control_variate": self.control_variate,
+            "decompose": self.decompose,
         }
 
 
@@ -330,6 +337,9 @@ def run_procedure_job(job: ProcedureJob) -> dict[str, RunResult]:
         scenario = job.scenario
         if run.idealised:  # vertical photos over flat terrain
             scenario = idealised_geometry(scenario)
+        options = run.options()
+        if job.instrument_errors:  # read for its value only (``mc_procedure_instrument``)
+            options["decompose"] = False
         res = procedure_mc(
             scenario,
             spec=job.spec,
@@ -337,7 +347,7 @@ def run_procedure_job(job: ProcedureJob) -> dict[str, RunResult]:
             seed=job.seed,
             instrument=job.instrument_errors,
             linkage=job.linkage,
-            **run.options(),
+            **options,
         )
         return {config: res}
     (passes,) = {job.options[c].passes for c in job.configs}  # the shared run: one number
@@ -373,8 +383,11 @@ def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ProcedureCo
     base = PROCEDURE_CONFIGS["setup"]
     out = {**PROCEDURE_CONFIGS, "setup": replace(base, fidelity=f)}
     formula = Fidelity.as_formula()
-    out["setup_formula"] = replace(base, fidelity=formula)
-    out["setup_formula_flat"] = replace(base, fidelity=formula, idealised=True)
+    # the as-formula runs are read for their values (control variate), the steps for their
+    # plain per-trial mean squares (:func:`switch_decomposition`): neither for a decomposition
+    read = replace(base, decompose=False)
+    out["setup_formula"] = replace(read, fidelity=formula)
+    out["setup_formula_flat"] = replace(read, fidelity=formula, idealised=True)
     chain = switch_chain(f)
     step = formula
     for i, name in enumerate(chain[:-1], 1):
@@ -383,7 +396,7 @@ def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ProcedureCo
         step = replace(step, **change)
         if name == "linkage" and value is None:
             step = replace(step, linkage=None)
-        out[f"setup_step_{i}"] = replace(base, fidelity=step)
+        out[f"setup_step_{i}"] = replace(read, fidelity=step, control_variate=False)
     return out
 
 
