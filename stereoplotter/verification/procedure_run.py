@@ -288,10 +288,15 @@ def _setup_fields(run: ProcedureRun, zero_run: SimulationResult) -> tuple[FieldM
         if jac is None:
             return out
         noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
+        blocks = cvar.row_blocks(trials)
         for step, d in dc.linear_fields(jac, deltas):
-            r = readings(d)
-            r["observed"] = r["levelled"] + noise
-            out.update({(key, step): np.mean(v**2, axis=-1) for key, v in r.items()})
+            ms = {(key, step): np.empty(trials) for key in ("parallax", "levelled", "observed")}
+            for s, e in blocks:  # a trial's readings are its own row's
+                r = readings(d[s:e])
+                r["observed"] = r["levelled"] + noise[s:e]
+                for key, v in r.items():
+                    ms[key, step][s:e] = np.mean(v**2, axis=-1)
+            out.update(ms)
         return out
 
     return FieldMaker(fields, decompose), zero[:n]
@@ -416,9 +421,11 @@ def _chunk_mean_squares(
     if lin:
         on = _inputs_on(lin, part, trials) if off else None
         controlled = cvar.per_trial_controlled(fs, lin, noise, dict(injected), model, on)
-    plain: dict[FieldKey, FloatArray] = {
-        name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()
-    }
+    plain: dict[FieldKey, FloatArray] = {}
+    for name, v in fs.items():
+        ms = plain[name] = np.empty(trials)
+        for s, e in cvar.row_blocks(trials):  # each trial's own row
+            ms[s:e] = np.mean(np.asarray(v[s:e]) ** 2, axis=-1)
     if maker.decompose is not None:  # already mean squares
         plain.update(maker.decompose(result, fs))
     return plain, controlled
