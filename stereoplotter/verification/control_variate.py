@@ -37,10 +37,14 @@ from stereoplotter.procedure.operator import Noise
 __all__ = [
     "BLOCK_TRIALS",
     "STEP",
+    "Design",
     "DesignNoise",
     "LinearControl",
     "RecordingNoise",
     "SourceNoise",
+    "StackedNoise",
+    "control_from",
+    "design",
     "design_inputs",
     "linear_control",
     "per_trial_controlled",
@@ -155,14 +159,31 @@ def design_inputs(model: ErrorModel | None, trials: int) -> dict[str, object]:
     return out
 
 
-def linear_control(
-    run: Callable[[dict[str, object], Noise, int], dict[str, NDArray[np.float64]]],
-    model: ErrorModel | None,
-) -> LinearControl:
-    """Linearise the fields of ``run(injected, noise, trials) -> {name: (T, P)}`` about the run
-    with every random input 0: a discovery run (1 trial) lists the acts, then one designed run
-    of 1 + 2K trials steps each input by ±:data:`STEP`. ``model``: the instrument's error model
-    (None: no instrument errors)."""
+@dataclass(frozen=True)
+class Design:
+    """The designed run of a linearisation (:func:`design`): its ``inputs`` ("noise:<key>" or
+    "instrument:<term>"), ``trials`` (1 + 2K: the centre, then each input stepped by +STEP and
+    −STEP), the injected errors and the judgment steps of every trial, and var(uₖ)."""
+
+    inputs: tuple[str, ...]
+    trials: int
+    injected: dict[str, object]
+    steps: dict[str, NDArray[np.float64]]
+    variance: NDArray[np.float64]
+
+    def noise(self) -> DesignNoise:
+        """The judgments of the designed run."""
+        return DesignNoise(self.trials, self.steps)
+
+
+#: A run of the fields to linearise: (injected, noise, trials) → {name: (T, P)}.
+FieldRun = Callable[[dict[str, object], Noise, int], dict[str, NDArray[np.float64]]]
+
+
+def design(run: FieldRun, model: ErrorModel | None) -> Design:
+    """The designed run of :func:`linear_control`: a discovery run of ``run`` (1 trial) lists
+    the acts with σ > 0 in order of first use; each of them and each random instrument error
+    term of ``model`` (None: none) is an input."""
     keys: list[str] = []
     run(design_inputs(model, 1), DesignNoise(1, {}, keys), 1)
     terms = _random_terms(model)
@@ -178,16 +199,44 @@ def linear_control(
             steps[key] = s
         else:
             injected[key] = s * _scale(model, key)
-    fields = run(injected, DesignNoise(trials, steps), trials)
     variance = np.array([1.0] * len(keys) + [_VARIANCE[t.distribution] for t in terms], float)
+    return Design(tuple(names), trials, injected, steps, variance)
+
+
+def control_from(d: Design, fields: dict[str, NDArray[np.float64]]) -> LinearControl:
+    """The linear control from the ``fields`` of the designed run ``d`` (its trials' rows)."""
     center, gradient, expectation, gms = {}, {}, {}, {}
     for name, v in fields.items():
-        v = np.asarray(v, float).reshape(trials, -1)
+        v = np.asarray(v, float).reshape(d.trials, -1)
         b = v[0]
         g = (v[1::2] - v[2::2]) / (2.0 * STEP)
         center[name], gradient[name], gms[name] = b, g, np.mean(g**2, axis=1)
-        expectation[name] = float(np.mean(b**2) + variance @ gms[name])
-    return LinearControl(tuple(names), center, gradient, expectation, variance, gms)
+        expectation[name] = float(np.mean(b**2) + d.variance @ gms[name])
+    return LinearControl(d.inputs, center, gradient, expectation, d.variance, gms)
+
+
+def linear_control(run: FieldRun, model: ErrorModel | None) -> LinearControl:
+    """Linearise the fields of ``run(injected, noise, trials) -> {name: (T, P)}`` about the run
+    with every random input 0: a discovery run (1 trial) lists the acts, then one designed run
+    of 1 + 2K trials steps each input by ±:data:`STEP` (:func:`design`, :func:`control_from`).
+    ``model``: the instrument's error model (None: no instrument errors)."""
+    d = design(run, model)
+    return control_from(d, run(d.injected, d.noise(), d.trials))
+
+
+class StackedNoise(Noise):
+    """The trials of a designed run (:class:`DesignNoise`) followed by those of a chunk
+    (:class:`RecordingNoise`), for one run of both: each act draws the design's values, then
+    the chunk's (recorded by it as ever). The procedure treats every trial alone, so each
+    trial's result is the one it has in a run of its own part."""
+
+    def __init__(self, designed: DesignNoise, recorded: RecordingNoise):
+        trials = designed.design_trials + (recorded.trials or 1)
+        super().__init__(recorded.seed, trials, None, recorded.first_trial)
+        self.designed, self.recorded = designed, recorded
+
+    def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
+        return np.concatenate([self.designed.normal(key, sigma), self.recorded.normal(key, sigma)])
 
 
 def per_trial_controlled(

@@ -112,8 +112,9 @@ def method_operator(
 FieldKey = str | tuple[str, str]
 #: A run's fields: (result, noise) → field name → per-trial values over the domain, (T, n).
 Fields = Callable[[SimulationResult, Noise], dict[str, FloatArray]]
-#: The decomposition's mean squares: (result, the run's fields) → (reading, level) → (T,).
-Decompose = Callable[[SimulationResult, dict[str, FloatArray]], dict[FieldKey, FloatArray]]
+#: The decomposition's mean squares: (result, the run's fields, the rows of the result's trials
+#: they are) → (reading, level) → (T,).
+Decompose = Callable[[SimulationResult, dict[str, FloatArray], slice], dict[FieldKey, FloatArray]]
 
 
 @dataclass(frozen=True)
@@ -270,7 +271,7 @@ def _setup_fields(run: ProcedureRun, zero_run: SimulationResult) -> tuple[FieldM
     jac = dc.state_jacobian(*state0, dp_function(sc, sheet, allp)) if run.decompose else None
 
     def decompose(
-        result: SimulationResult, main: dict[str, FloatArray]
+        result: SimulationResult, main: dict[str, FloatArray], rows: slice
     ) -> dict[FieldKey, FloatArray]:
         """Per-trial mean squares of the first-order fields of the decomposition
         (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²], and
@@ -279,7 +280,11 @@ def _setup_fields(run: ProcedureRun, zero_run: SimulationResult) -> tuple[FieldM
         units = result.instrument.state()["units"]
         trials = len(next(iter(main.values())))
         deltas = dc.state_deltas(
-            result.instrument.setting, {s: units[s] for s in ("left", "right")}, *state0, trials
+            result.instrument.setting,
+            {s: units[s] for s in ("left", "right")},
+            *state0,
+            trials,
+            rows,
         )
         # each (6.22) element's error (instrument units: mm, tangent, rad), squared per trial
         out: dict[FieldKey, FloatArray] = {
@@ -290,7 +295,9 @@ def _setup_fields(run: ProcedureRun, zero_run: SimulationResult) -> tuple[FieldM
         noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
         blocks = cvar.row_blocks(trials)
         for step, d in dc.linear_fields(jac, deltas):
-            ms = {(key, step): np.empty(trials) for key in ("parallax", "levelled", "observed")}
+            ms: dict[FieldKey, FloatArray] = {
+                (key, step): np.empty(trials) for key in ("parallax", "levelled", "observed")
+            }
             for s, e in blocks:  # a trial's readings are its own row's
                 r = readings(d[s:e])
                 r["observed"] = r["levelled"] + noise[s:e]
@@ -353,8 +360,10 @@ def mean_squares(run: ProcedureRun) -> MeanSquares:
     :func:`_conventional_fields`), plain and with the linear control variate
     (:mod:`~stereoplotter.verification.control_variate`), and the error-free run's δp.
 
-    The error-free run once; the linearisation once; the noisy trials in chunks under the memory
-    budget (the random draws are keyed by trial, so the chunk size changes no result).
+    The error-free run once; the linearisation once, its designed run in one run with the first
+    chunk on the ideal instrument (the procedure's per-act work paid once for both); the noisy
+    trials in chunks under the memory budget (the random draws are keyed by trial, so the chunk
+    size changes no result).
     """
 
     zero_prep = run.prepared(run.operator.error_free, "zero")
@@ -364,13 +373,21 @@ def mean_squares(run: ProcedureRun) -> MeanSquares:
     else:
         maker, d_zero = _conventional_fields(run, zero_prep, zero_run)
     prep = run.prepared(run.operator.noisy, None if run.instrument_errors else "zero")
-    lin = _linearisation(prep, maker) if run.control_variate else None
+    design = _design(prep, maker) if run.control_variate else None
+    lin: cvar.LinearControl | None = None
     chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, run.procedure)
     plain: dict[FieldKey, FloatArray] = {}
     controlled: dict[FieldKey, FloatArray] = {}
     for first in range(0, run.trials, chunk):
         m = min(chunk, run.trials - first)
-        part_plain, part_controlled = _chunk_mean_squares(run, prep, maker, lin, first, m)
+        # with the real mechanics (instrument errors) a trial's last bits depend on the trials
+        # run beside it (1e-14 relative, measured): the designed run goes alone there
+        with_design = design if first == 0 and not run.instrument_errors else None
+        if design is not None and lin is None and with_design is None:
+            lin = _linearised(prep, maker, design)
+        part_plain, part_controlled, lin = _chunk_mean_squares(
+            run, prep, maker, lin, first, m, with_design
+        )
         for name, v in part_plain.items():
             plain.setdefault(name, np.empty(run.trials))[first : first + m] = v
             if name in part_controlled:
@@ -380,9 +397,10 @@ def mean_squares(run: ProcedureRun) -> MeanSquares:
     return MeanSquares(plain, controlled, d_zero)
 
 
-def _linearisation(prep: PreparedRun, maker: FieldMaker) -> cvar.LinearControl:
-    """The linear control variate of ``maker``'s fields about the run with every random input 0
-    (:func:`~stereoplotter.verification.control_variate.linear_control`)."""
+def _design(prep: PreparedRun, maker: FieldMaker) -> cvar.Design:
+    """The designed run of the linear control variate of ``maker``'s fields about the run with
+    every random input 0 (:func:`~stereoplotter.verification.control_variate.design`: its
+    discovery run made here)."""
 
     def fields_of(injected: dict[str, Any], noise: Noise, trials: int) -> dict[str, FloatArray]:
         result = run_trials_chunk(
@@ -390,7 +408,17 @@ def _linearisation(prep: PreparedRun, maker: FieldMaker) -> cvar.LinearControl:
         )
         return maker.fields(result, noise)
 
-    return cvar.linear_control(fields_of, prep.model)
+    return cvar.design(fields_of, prep.model)
+
+
+def _linearised(prep: PreparedRun, maker: FieldMaker, design: cvar.Design) -> cvar.LinearControl:
+    """The linear control from ``design``'s run made alone."""
+    noise = design.noise()
+    result = run_trials_chunk(
+        prep, 0, design.trials, evaluate=False, transcript=False, injected=design.injected,
+        noise=noise,
+    )  # fmt: skip
+    return cvar.control_from(design, maker.fields(result, noise))
 
 
 def _chunk_mean_squares(
@@ -400,9 +428,12 @@ def _chunk_mean_squares(
     lin: cvar.LinearControl | None,
     first: int,
     trials: int,
-) -> tuple[dict[FieldKey, FloatArray], dict[str, FloatArray]]:
+    design: cvar.Design | None = None,
+) -> tuple[dict[FieldKey, FloatArray], dict[str, FloatArray], cvar.LinearControl | None]:
     """Per-trial mean squares of trials ``first … first + trials − 1``: plain (with the
-    decomposition's) and controlled (empty without ``lin``)."""
+    decomposition's) and controlled (empty without a linear control); and the linear control.
+    With ``design`` its designed run goes before the trials in the same run, and the linear
+    control is built from it (else ``lin``, None: none)."""
     model = prep.model
     injected = model.draw_keyed(prep.seed, first, first + trials)
     off = run.sources_off
@@ -413,10 +444,26 @@ def _chunk_mean_squares(
         noise = cvar.SourceNoise(prep.seed, trials, first, part)
     else:
         noise = cvar.RecordingNoise(prep.seed, trials, first)
-    result = run_trials_chunk(
-        prep, first, trials, evaluate=False, transcript=False, injected=injected, noise=noise
-    )
-    fs = maker.fields(result, noise)
+    if design is None:
+        result = run_trials_chunk(
+            prep, first, trials, evaluate=False, transcript=False, injected=injected, noise=noise
+        )
+        fs = maker.fields(result, noise)
+        rows = slice(0, trials)
+    else:  # the designed trials, then the chunk's, in one run
+        d = design.trials
+        stacked = cvar.StackedNoise(design.noise(), noise)
+        both = {
+            k: np.concatenate([np.broadcast_to(np.asarray(design.injected[k], float), (d,)), v])
+            for k, v in injected.items()
+        }
+        result = run_trials_chunk(
+            prep, first, d + trials, evaluate=False, transcript=False, injected=both, noise=stacked
+        )
+        every = maker.fields(result, stacked)
+        lin = cvar.control_from(design, {k: v[:d] for k, v in every.items()})
+        fs = {k: v[d:] for k, v in every.items()}
+        rows = slice(d, d + trials)
     controlled: dict[str, FloatArray] = {}
     if lin:
         on = _inputs_on(lin, part, trials) if off else None
@@ -427,8 +474,8 @@ def _chunk_mean_squares(
         for s, e in cvar.row_blocks(trials):  # each trial's own row
             ms[s:e] = np.mean(np.asarray(v[s:e]) ** 2, axis=-1)
     if maker.decompose is not None:  # already mean squares
-        plain.update(maker.decompose(result, fs))
-    return plain, controlled
+        plain.update(maker.decompose(result, fs, rows))
+    return plain, controlled, lin
 
 
 def _inputs_on(
