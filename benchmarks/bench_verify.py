@@ -4,6 +4,7 @@ parts.
 python benchmarks/bench_verify.py [--trials T] [--repeat R]
 python benchmarks/bench_verify.py --jobs     # CPU seconds of each procedure-MC job, serially
 python benchmarks/bench_verify.py --phases   # and each job's CPU split into its parts
+python benchmarks/bench_verify.py --timeline # `verify --json -q` as the CLI runs it, on a clock
 
 ``--jobs`` runs the default ``verify``'s procedure-MC jobs one after another in this process
 (one BLAS thread, as in a worker) and prints each job's CPU seconds (user + system), their sum
@@ -15,7 +16,14 @@ job pays once — the run preparation (``ProcedureRun.prepared``, twice), the er
 fields' set-up, the linearisation's discovery run (1 trial) and its designed run (1 + 2K
 trials) — and what grows with its trials: the noisy trials' procedure, the control variate
 (``control_variate.per_trial_controlled``) and the rest (the fields δp, the levelling and the
-decomposition), as a Markdown table.
+decomposition), as a Markdown table. On the ideal instrument the designed run goes in one run
+with the first chunk of trials (``procedure_run.mean_squares``): its time is then under
+"trials", and "design" holds only the runs with instrument errors.
+
+``--timeline`` runs ``stereoplotter verify --json -q`` in this process exactly as the command
+line does (the same worker processes) and prints when each part of the main process ended and
+when each procedure-MC job started and ended in which worker, seconds from this process's start
+(with its CPU seconds): where the two cores sit idle, and the critical path.
 """
 
 import argparse
@@ -36,7 +44,11 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--jobs", action="store_true", help="CPU seconds of each procedure-MC job")
     ap.add_argument("--phases", action="store_true", help="each job's CPU split into its parts")
+    ap.add_argument("--timeline", action="store_true", help="verify --json -q on a clock")
     a = ap.parse_args()
+    if a.timeline:
+        timeline()
+        return
     if a.phases:
         jobs_phases()
         return
@@ -150,6 +162,78 @@ def jobs_phases():
             print(f"| {name} | {sum(job.trials.values())} | {cpu:.3f} | {parts} | {rest:.3f} |")
     parts = " | ".join(f"{totals[k]:.2f}" for k in (*PHASES, "rest"))
     print(f"| **all** | | **{totals['CPU']:.2f}** | {parts} |")
+
+
+def _since_start():
+    """Seconds since this process (the parent of the workers) started: Linux's boot-time clock
+    against the start in ``/proc/self/stat`` (clock ticks, 10 ms)."""
+    return time.clock_gettime(time.CLOCK_BOOTTIME) - _START
+
+
+def _process_start():
+    with open("/proc/self/stat") as f:
+        fields = f.read().rpartition(")")[2].split()
+    return int(fields[19]) / os.sysconf("SC_CLK_TCK")  # field 22, starttime
+
+
+_START = _process_start()
+
+
+def timeline():
+    """``verify --json -q`` as the CLI runs it, with the end of each part of the main process
+    and the start and end of each procedure-MC job in its worker (seconds since this process
+    started, CPU seconds of the main process so far or of the job), as a Markdown table."""
+    import contextlib
+    import io
+    import sys
+
+    import stereoplotter.commands.verification as command
+    from stereoplotter.cli import main as cli
+
+    log = []
+
+    def mark(what):
+        log.append(("main", what, "", _since_start(), time.process_time()))
+
+    mark("imports (this script's)")
+    job_at = v._job_at
+
+    def timed_job(i):
+        start, cpu = _since_start(), time.process_time()
+        out = job_at(i)
+        job = v._JOBS[i]
+        name = " ".join(job.configs) + (" instrument" if job.instrument_errors else "")
+        return out, (os.getpid(), name, start, _since_start(), time.process_time() - cpu)
+
+    keyed = v.PendingProcedureMC._keyed
+
+    def keyed_logged(self, i, results):
+        if isinstance(results, tuple):
+            results, (pid, name, start, end, cpu) = results
+            log.append((f"worker {pid}", name, f"{start:.2f}", end, cpu))
+        return keyed(self, i, results)
+
+    def wrapped(name):
+        fn = getattr(command, name)
+
+        def run(*args, **kwargs):
+            out = fn(*args, **kwargs)
+            mark(name)
+            return out
+
+        setattr(command, name, run)
+
+    v._job_at, v.PendingProcedureMC._keyed = timed_job, keyed_logged
+    for name in ("start_book_procedure_mc", "verify", "attach_procedure_mc", "json_text"):
+        wrapped(name)
+    sys.argv = ["stereoplotter", "verify", "--json", "-q"]
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):
+        cli()
+    mark("done")
+    print("| process | part | start | end | CPU |")
+    print("|---|---|---:|---:|---:|")
+    for who, what, start, end, cpu in log:
+        print(f"| {who} | {what} | {start} | {end:.2f} | {cpu:.2f} |")
 
 
 def _linear(entry, trials):
