@@ -177,6 +177,17 @@ def _process_start():
 
 
 _START = _process_start()
+#: The worker's job function of ``verify`` (:func:`timeline` replaces it by :func:`_timed_job`).
+_JOB_AT = []
+
+
+def _timed_job(i):
+    """Job i in a worker, with its start, end (:func:`_since_start`) and CPU seconds."""
+    start, cpu = _since_start(), time.process_time()
+    out = _JOB_AT[0](i)
+    job = v._JOBS[i]
+    name = " ".join(job.configs) + (" instrument" if job.instrument_errors else "")
+    return out, (os.getpid(), name, start, _since_start(), time.process_time() - cpu)
 
 
 def timeline():
@@ -196,15 +207,6 @@ def timeline():
         log.append(("main", what, "", _since_start(), time.process_time()))
 
     mark("imports (this script's)")
-    job_at = v._job_at
-
-    def timed_job(i):
-        start, cpu = _since_start(), time.process_time()
-        out = job_at(i)
-        job = v._JOBS[i]
-        name = " ".join(job.configs) + (" instrument" if job.instrument_errors else "")
-        return out, (os.getpid(), name, start, _since_start(), time.process_time() - cpu)
-
     keyed = v.PendingProcedureMC._keyed
 
     def keyed_logged(self, i, results):
@@ -223,7 +225,8 @@ def timeline():
 
         setattr(command, name, run)
 
-    v._job_at, v.PendingProcedureMC._keyed = timed_job, keyed_logged
+    _JOB_AT.append(v._job_at)
+    v._job_at, v.PendingProcedureMC._keyed = _timed_job, keyed_logged
     for name in ("start_book_procedure_mc", "verify", "attach_procedure_mc", "json_text"):
         wrapped(name)
     sys.argv = ["stereoplotter", "verify", "--json", "-q"]
