@@ -168,6 +168,9 @@ class ProcedureRun:
     decompose : bool
         Setup methods: also the first-order fields of the decomposition (:mod:`.decomposition`)
         of each reading; False: only the readings and the elements' errors.
+    measure : tuple of str or None
+        Conventional method: the readings measured (of "parallax", "slip", "plane", "book");
+        None: every one.
     """
 
     scenario: Scenario
@@ -186,6 +189,7 @@ class ProcedureRun:
     sigma_control_mm: float = 0.0
     sources_off: Mapping[str, NDArray[np.bool_]] | None = None
     decompose: bool = True
+    measure: tuple[str, ...] | None = None
 
     @property
     def procedure(self) -> str:
@@ -336,21 +340,25 @@ def _conventional_fields(
         levelling_design(book[:, 0], book[:, 1])
     )
 
+    measure = run.measure or ("parallax", "slip", "plane", "book")  # None: every reading
+
     def fields(result: SimulationResult, noise: Noise) -> dict[str, FloatArray]:
-        d = dp_at(sc, result.sheet, result.instrument, pts) - d_zero
         e = (height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
-        obs = e[:, n : n + nl] + np.stack(
-            [noise.normal(f"mc/datum/{i}", sigma_p) for i in range(nl)], -1
-        )
-        ctl = e[:, n + nl :] + np.stack(
-            [noise.normal(f"mc/book/{i}", sigma_p) for i in range(len(book))], -1
-        )
-        return {
-            "parallax": d,
-            "slip": e[:, :n],
-            "plane": e[:, :n] - np.mean(obs, axis=-1, keepdims=True),
-            "book": e[:, :n] - ctl @ refit.T,
-        }
+        # every observation drawn, measured or not: the same acts in the linear control
+        datum = np.stack([noise.normal(f"mc/datum/{i}", sigma_p) for i in range(nl)], -1)
+        control = np.stack([noise.normal(f"mc/book/{i}", sigma_p) for i in range(len(book))], -1)
+        out: dict[str, FloatArray] = {}
+        if "parallax" in measure:
+            out["parallax"] = dp_at(sc, result.sheet, result.instrument, pts) - d_zero
+        if "slip" in measure:
+            out["slip"] = e[:, :n]
+        if "plane" in measure:
+            obs = e[:, n : n + nl] + datum
+            out["plane"] = e[:, :n] - np.mean(obs, axis=-1, keepdims=True)
+        if "book" in measure:
+            ctl = e[:, n + nl :] + control
+            out["book"] = e[:, :n] - ctl @ refit.T
+        return out
 
     return FieldMaker(fields), d_zero
 

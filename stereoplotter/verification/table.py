@@ -125,7 +125,8 @@ PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this
 class ProcedureConfig:
     """A configuration of the procedure MC: its ``method`` and the options of its runs (the
     fields of :class:`~stereoplotter.verification.procedure_mc.ProcedureOptions` it sets:
-    ``grid``, ``passes``, ``sources``, ``fidelity``, ``control_variate``, ``decompose``);
+    ``grid``, ``passes``, ``sources``, ``fidelity``, ``control_variate``, ``decompose``,
+    ``measure``);
     ``idealised``: run on the scenario with vertical photos over flat terrain
     (:func:`idealised_geometry`). A run the table reads only for its value skips the
     decomposition, one read only for its plain per-trial mean squares (a switch step) also the
@@ -139,6 +140,7 @@ class ProcedureConfig:
     idealised: bool = False
     control_variate: bool = True
     decompose: bool = True
+    measure: tuple[str, ...] | None = None
 
     def options(self) -> dict[str, Any]:
         """The :func:`procedure_mc` keyword arguments of a run of this configuration."""
@@ -150,6 +152,7 @@ class ProcedureConfig:
             "fidelity": self.fidelity,
             "control_variate": self.control_variate,
             "decompose": self.decompose,
+            "measure": self.measure,
         }
 
 
@@ -161,12 +164,13 @@ class ProcedureConfig:
 #: (5.54)/(5.55) do not model; it makes the run smooth enough for the control variate). The
 #: setup run's statistic is the mean over a midpoint grid of 8 × 16 (not 16 × 32): half the
 #: time, values within 0.3 % of the finer grid on the same 4 000 trials (pair60 levelled
-#: 0.1298 / 0.1302, observed 0.6696 / 0.6707; parallax within 0.02 %).
+#: 0.1298 / 0.1302, observed 0.6696 / 0.6707; parallax within 0.02 %). A conventional run
+#: measures only its statistic's reading (``measure=()``: the table reads no other datum).
 PROCEDURE_CONFIGS = {
     "setup": ProcedureConfig("setup", grid=(8, 16)),
-    "conventional": ProcedureConfig("conventional", passes=3),
-    "y_parallax": ProcedureConfig("conventional", passes=3, sources="y_parallax"),
-    "stereo": ProcedureConfig("conventional", passes=3, sources="stereo"),
+    "conventional": ProcedureConfig("conventional", passes=3, measure=()),
+    "y_parallax": ProcedureConfig("conventional", passes=3, sources="y_parallax", measure=()),
+    "stereo": ProcedureConfig("conventional", passes=3, sources="stereo", measure=()),
 }
 #: The seed stream of each configuration's runs, declared (not its place in
 #: :data:`PROCEDURE_CONFIGS`): a run of configuration c at overlap slot s takes the seed
@@ -351,6 +355,7 @@ def run_procedure_job(job: ProcedureJob) -> dict[str, RunResult]:
         )
         return {config: res}
     (passes,) = {job.options[c].passes for c in job.configs}  # the shared run: one number
+    (measure,) = {job.options[c].measure for c in job.configs}
     by_source = {job.options[c].sources: c for c in job.configs}
     out = conventional_sources_mc(
         job.scenario,
@@ -360,6 +365,7 @@ def run_procedure_job(job: ProcedureJob) -> dict[str, RunResult]:
         instrument=job.instrument_errors,
         linkage=job.linkage,
         passes=passes,
+        measure=measure,
     )
     return {by_source[k]: r for k, r in out.items()}
 
