@@ -5,6 +5,7 @@ python benchmarks/bench_verify.py [--trials T] [--repeat R]
 python benchmarks/bench_verify.py --jobs     # CPU seconds of each procedure-MC job, serially
 python benchmarks/bench_verify.py --phases   # and each job's CPU split into its parts
 python benchmarks/bench_verify.py --timeline # `verify --json -q` as the CLI runs it, on a clock
+python benchmarks/bench_verify.py --variance [--trials T]   # regression control variates, setup
 
 ``--jobs`` runs the default ``verify``'s procedure-MC jobs one after another in this process
 (one BLAS thread, as in a worker) and prints each job's CPU seconds (user + system), their sum
@@ -24,6 +25,13 @@ with the first chunk of trials (``procedure_run.mean_squares``): its time is the
 line does (the same worker processes) and prints when each part of the main process ended and
 when each procedure-MC job started and ended in which worker, seconds from this process's start
 (with its CPU seconds): where the two cores sit idle, and the critical path.
+
+``--variance`` runs the 60 % setup job (its first T trials, default 16 000) and asks how much
+a richer control variate would narrow each reading's CI: the per-trial variance of today's
+estimator (mean_p v² − L + E[L]) against a fitted control coefficient of L, and a regression on
+L and the active inputs' draws u (linear; + u² − 1; + the products uₖuₗ: every control of
+known mean 0, the draws being independent standard normals), in-sample. The variance ratio is
+the ratio of trials for the same CI. Nothing of ``verify`` changes.
 """
 
 import argparse
@@ -45,7 +53,11 @@ def main():
     ap.add_argument("--jobs", action="store_true", help="CPU seconds of each procedure-MC job")
     ap.add_argument("--phases", action="store_true", help="each job's CPU split into its parts")
     ap.add_argument("--timeline", action="store_true", help="verify --json -q on a clock")
+    ap.add_argument("--variance", action="store_true", help="richer control variates, setup")
     a = ap.parse_args()
+    if a.variance:
+        variance(16000 if a.trials == 60000 else a.trials)
+        return
     if a.timeline:
         timeline()
         return
@@ -237,6 +249,60 @@ def timeline():
     print("|---|---|---:|---:|---:|")
     for who, what, start, end, cpu in log:
         print(f"| {who} | {what} | {start} | {end:.2f} | {cpu:.2f} |")
+
+
+def variance(trials):
+    """The variance of today's controlled per-trial values of the 60 % setup job's readings
+    against richer control variates (module docstring), printed per reading."""
+    from stereoplotter.verification import control_variate as cv
+
+    caught = {}
+    controlled = cv.per_trial_controlled
+
+    def catch(fields, lin, noise, injected, model, on=None):
+        out = controlled(fields, lin, noise, injected, model, on)
+        n = next(iter(fields.values())).shape[0]
+        for name, field in fields.items():
+            active = np.flatnonzero(np.any(lin.gradient[name] != 0.0, axis=1))
+            u = np.zeros((len(active), n))
+            for row, j in enumerate(active):
+                kind, _, key = lin.inputs[j].partition(":")
+                z = noise.z.get(key) if kind == "noise" else None
+                if z is not None:
+                    u[row] = z
+            plain = np.mean(np.asarray(field) ** 2, axis=-1)
+            caught.setdefault(name, []).append((plain, out[name], u))
+        return out
+
+    cv.per_trial_controlled = catch
+    pending = v.start_procedure_mc(
+        None, 20240601, book_scenarios(), instrument=book_instrument(), workers=1
+    )
+    job = next(j for j in pending.jobs if j.configs == ("setup",) and not j.instrument_errors)
+    job = type(job)(**{**job.__dict__, "trials": {k: trials for k in job.trials}})
+    with threadpool_limits(limits=1, user_api="blas"):
+        v.run_procedure_job(job)
+    print(f"60 % setup, {trials} trials: variance / today's controlled (= trials for one CI)")
+    print("| reading | active inputs | plain | fitted β | + u | + u² − 1 | + uₖuₗ |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    for name, parts in caught.items():
+        y, c, u = (np.concatenate([p[i] for p in parts], axis=-1) for i in range(3))
+        lin = y - c  # L − E[L]
+        beta = np.cov(y, lin)[0, 1] / np.var(lin)
+        pairs = np.triu_indices(len(u), 1)
+        sets = (u.T, np.column_stack([u.T, (u**2 - 1).T]))
+        sets += (np.column_stack([sets[1], (u[pairs[0]] * u[pairs[1]]).T]),)
+        ratios = []
+        for x in sets:
+            x = np.column_stack([x, lin])
+            x = x - x.mean(0)
+            coef, *_ = np.linalg.lstsq(x, y - y.mean(), rcond=None)
+            ratios.append(np.var(y - x @ coef) / np.var(c))
+        cells = " | ".join(f"{r:.3f}" for r in ratios)
+        print(
+            f"| {name} | {len(u)} | {np.var(y) / np.var(c):.2f} | "
+            f"{np.var(y - beta * lin) / np.var(c):.3f} | {cells} |"
+        )
 
 
 def _linear(entry, trials):
