@@ -189,17 +189,22 @@ def _process_start():
 
 
 _START = _process_start()
-#: The worker's job function of ``verify`` (:func:`timeline` replaces it by :func:`_timed_job`).
-_JOB_AT = []
+#: Where the forked workers of :func:`timeline` write one line a job (set by it).
+_JOB_LOG = []
 
 
-def _timed_job(i):
-    """Job i in a worker, with its start, end (:func:`_since_start`) and CPU seconds."""
+def _timed_job(job, run=v.run_procedure_job):
+    """:func:`~stereoplotter.verification.table.run_procedure_job` with its start, end
+    (:func:`_since_start`) and CPU seconds appended to the file :data:`_JOB_LOG` names."""
     start, cpu = _since_start(), time.process_time()
-    out = _JOB_AT[0](i)
-    job = v._JOBS[i]
+    out = run(job)
     name = " ".join(job.configs) + (" instrument" if job.instrument_errors else "")
-    return out, (os.getpid(), name, start, _since_start(), time.process_time() - cpu)
+    line = (
+        f"{os.getpid()}\t{name}\t{start:.2f}\t{_since_start():.2f}\t{time.process_time() - cpu:.2f}"
+    )
+    with open(_JOB_LOG[0], "a") as f:
+        f.write(line + "\n")
+    return out
 
 
 def timeline():
@@ -209,6 +214,7 @@ def timeline():
     import contextlib
     import io
     import sys
+    import tempfile
 
     import stereoplotter.commands.verification as command
     from stereoplotter.cli import main as cli
@@ -216,16 +222,9 @@ def timeline():
     log = []
 
     def mark(what):
-        log.append(("main", what, "", _since_start(), time.process_time()))
+        log.append(("main", what, "", f"{_since_start():.2f}", f"{time.process_time():.2f}"))
 
     mark("imports (this script's)")
-    keyed = v.PendingProcedureMC._keyed
-
-    def keyed_logged(self, i, results):
-        if isinstance(results, tuple):
-            results, (pid, name, start, end, cpu) = results
-            log.append((f"worker {pid}", name, f"{start:.2f}", end, cpu))
-        return keyed(self, i, results)
 
     def wrapped(name):
         fn = getattr(command, name)
@@ -237,18 +236,23 @@ def timeline():
 
         setattr(command, name, run)
 
-    _JOB_AT.append(v._job_at)
-    v._job_at, v.PendingProcedureMC._keyed = _timed_job, keyed_logged
     for name in ("start_book_procedure_mc", "verify", "attach_procedure_mc", "json_text"):
         wrapped(name)
+    v.run_procedure_job = _timed_job  # looked up by the workers' job function when it runs
     sys.argv = ["stereoplotter", "verify", "--json", "-q"]
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):
-        cli()
-    mark("done")
+    with tempfile.TemporaryDirectory() as tmp:
+        _JOB_LOG.append(os.path.join(tmp, "jobs.tsv"))
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):
+            cli()
+        mark("done")
+        with open(_JOB_LOG[0]) as f:
+            jobs = [line.rstrip("\n").split("\t") for line in f]
+    jobs.sort(key=lambda j: float(j[3]))
+    rows = log[:-3] + [(f"worker {pid}", *rest) for pid, *rest in jobs] + log[-3:]
     print("| process | part | start | end | CPU |")
     print("|---|---|---:|---:|---:|")
-    for who, what, start, end, cpu in log:
-        print(f"| {who} | {what} | {start} | {end:.2f} | {cpu:.2f} |")
+    for row in rows:
+        print("| " + " | ".join(row) + " |")
 
 
 def variance(trials):
