@@ -35,19 +35,30 @@ from stereoplotter.instrument.error_model import ErrorModel, ErrorTerm
 from stereoplotter.procedure.operator import Noise
 
 __all__ = [
+    "BLOCK_TRIALS",
     "STEP",
+    "Design",
     "DesignNoise",
     "LinearControl",
     "RecordingNoise",
     "SourceNoise",
+    "StackedNoise",
+    "control_from",
+    "design",
     "design_inputs",
     "linear_control",
     "per_trial_controlled",
+    "row_blocks",
 ]
 
 #: Step of the central differences, in units of the draw (σ of a normal, half-width of a
 #: uniform). [—]
 STEP = 0.1
+
+#: Trials whose per-trial reductions are computed at once: a block's arrays (≈ 0.5–2 MB) stay
+#: in the processor's cache, where a chunk's (tens of MB) would stream through memory several
+#: times. Each trial's row is computed alone, so the block changes no value.
+BLOCK_TRIALS = 512
 
 #: Variance of the standardised draw of a distribution.
 _VARIANCE = {"normal": 1.0, "uniform": 1.0 / 3.0}
@@ -148,14 +159,31 @@ def design_inputs(model: ErrorModel | None, trials: int) -> dict[str, object]:
     return out
 
 
-def linear_control(
-    run: Callable[[dict[str, object], Noise, int], dict[str, NDArray[np.float64]]],
-    model: ErrorModel | None,
-) -> LinearControl:
-    """Linearise the fields of ``run(injected, noise, trials) -> {name: (T, P)}`` about the run
-    with every random input 0: a discovery run (1 trial) lists the acts, then one designed run
-    of 1 + 2K trials steps each input by ±:data:`STEP`. ``model``: the instrument's error model
-    (None: no instrument errors)."""
+@dataclass(frozen=True)
+class Design:
+    """The designed run of a linearisation (:func:`design`): its ``inputs`` ("noise:<key>" or
+    "instrument:<term>"), ``trials`` (1 + 2K: the centre, then each input stepped by +STEP and
+    −STEP), the injected errors and the judgment steps of every trial, and var(uₖ)."""
+
+    inputs: tuple[str, ...]
+    trials: int
+    injected: dict[str, object]
+    steps: dict[str, NDArray[np.float64]]
+    variance: NDArray[np.float64]
+
+    def noise(self) -> DesignNoise:
+        """The judgments of the designed run."""
+        return DesignNoise(self.trials, self.steps)
+
+
+#: A run of the fields to linearise: (injected, noise, trials) → {name: (T, P)}.
+FieldRun = Callable[[dict[str, object], Noise, int], dict[str, NDArray[np.float64]]]
+
+
+def design(run: FieldRun, model: ErrorModel | None) -> Design:
+    """The designed run of :func:`linear_control`: a discovery run of ``run`` (1 trial) lists
+    the acts with σ > 0 in order of first use; each of them and each random instrument error
+    term of ``model`` (None: none) is an input."""
     keys: list[str] = []
     run(design_inputs(model, 1), DesignNoise(1, {}, keys), 1)
     terms = _random_terms(model)
@@ -171,16 +199,44 @@ def linear_control(
             steps[key] = s
         else:
             injected[key] = s * _scale(model, key)
-    fields = run(injected, DesignNoise(trials, steps), trials)
     variance = np.array([1.0] * len(keys) + [_VARIANCE[t.distribution] for t in terms], float)
+    return Design(tuple(names), trials, injected, steps, variance)
+
+
+def control_from(d: Design, fields: dict[str, NDArray[np.float64]]) -> LinearControl:
+    """The linear control from the ``fields`` of the designed run ``d`` (its trials' rows)."""
     center, gradient, expectation, gms = {}, {}, {}, {}
     for name, v in fields.items():
-        v = np.asarray(v, float).reshape(trials, -1)
+        v = np.asarray(v, float).reshape(d.trials, -1)
         b = v[0]
         g = (v[1::2] - v[2::2]) / (2.0 * STEP)
         center[name], gradient[name], gms[name] = b, g, np.mean(g**2, axis=1)
-        expectation[name] = float(np.mean(b**2) + variance @ gms[name])
-    return LinearControl(tuple(names), center, gradient, expectation, variance, gms)
+        expectation[name] = float(np.mean(b**2) + d.variance @ gms[name])
+    return LinearControl(d.inputs, center, gradient, expectation, d.variance, gms)
+
+
+def linear_control(run: FieldRun, model: ErrorModel | None) -> LinearControl:
+    """Linearise the fields of ``run(injected, noise, trials) -> {name: (T, P)}`` about the run
+    with every random input 0: a discovery run (1 trial) lists the acts, then one designed run
+    of 1 + 2K trials steps each input by ±:data:`STEP` (:func:`design`, :func:`control_from`).
+    ``model``: the instrument's error model (None: no instrument errors)."""
+    d = design(run, model)
+    return control_from(d, run(d.injected, d.noise(), d.trials))
+
+
+class StackedNoise(Noise):
+    """The trials of a designed run (:class:`DesignNoise`) followed by those of a chunk
+    (:class:`RecordingNoise`), for one run of both: each act draws the design's values, then
+    the chunk's (recorded by it as ever). The procedure treats every trial alone, so each
+    trial's result is the one it has in a run of its own part."""
+
+    def __init__(self, designed: DesignNoise, recorded: RecordingNoise):
+        trials = designed.design_trials + (recorded.trials or 1)
+        super().__init__(recorded.seed, trials, None, recorded.first_trial)
+        self.designed, self.recorded = designed, recorded
+
+    def normal(self, key: str, sigma: float) -> NDArray[np.float64]:
+        return np.concatenate([self.designed.normal(key, sigma), self.recorded.normal(key, sigma)])
 
 
 def per_trial_controlled(
@@ -208,9 +264,6 @@ def per_trial_controlled(
     out = {}
     for name, v in fields.items():
         v = np.asarray(v, float).reshape(trials, -1)
-        lin_v = u.T @ lin.gradient[name]
-        lin_v += lin.center[name][None, :]
-        lin_ms = np.einsum("tp,tp->t", lin_v, lin_v) / lin_v.shape[1]
         expect: float | NDArray[np.float64]
         if on is None:
             expect = lin.expectation[name]
@@ -219,5 +272,19 @@ def per_trial_controlled(
                 raise ValueError("on: the linearisation holds no input variances")
             b2 = float(np.mean(lin.center[name] ** 2))
             expect = b2 + (lin.variance * lin.gradient_ms[name]) @ on
-        out[name] = np.einsum("tp,tp->t", v, v) / v.shape[1] - lin_ms + expect
+        res = np.empty(trials)
+        for s, e in row_blocks(trials):  # each trial's values depend on its own row only
+            lin_v = u[:, s:e].T @ lin.gradient[name]
+            lin_v += lin.center[name][None, :]
+            lin_ms = np.einsum("tp,tp->t", lin_v, lin_v) / lin_v.shape[1]
+            vb = v[s:e]
+            res[s:e] = np.einsum("tp,tp->t", vb, vb) / vb.shape[1] - lin_ms
+        out[name] = res + expect
     return out
+
+
+def row_blocks(trials: int, block: int | None = None) -> list[tuple[int, int]]:
+    """(start, end) of consecutive blocks of ``block`` trials (default :data:`BLOCK_TRIALS`)
+    covering 0 … trials − 1."""
+    b = BLOCK_TRIALS if block is None else block
+    return [(s, min(s + b, trials)) for s in range(0, trials, b)]

@@ -147,13 +147,17 @@ def state_deltas(
     zero_setting: InstrumentSetting,
     zero_units: Mapping[str, CorrectionUnit],
     trials: int,
+    rows: slice | None = None,
 ) -> FloatArray:
-    """Each trial's state minus the error-free state, (len(STATE), T)."""
+    """Each trial's state minus the error-free state, (len(STATE), T); ``rows``: the trials'
+    rows of a state of more trials (None: all of it)."""
     units = {k: _resolved(u) for k, u in units.items()}
     zero_units = {k: _resolved(u) for k, u in zero_units.items()}
     out = np.empty((len(STATE), trials))
     for i, key in enumerate(STATE):
         v = _get(setting, units, key)
+        if rows is not None and v.ndim:
+            v = v[rows]
         z = float(np.ravel(_get(zero_setting, zero_units, key))[0])
         out[i] = np.broadcast_to(v - z, (trials,))
     return out

@@ -99,6 +99,7 @@ if TYPE_CHECKING:
     from stereoplotter.spec.instrument_spec import InstrumentSpec
 
 __all__ = [
+    "CONVENTIONAL_READINGS",
     "LINKAGE_VARIANTS",
     "METHODS",
     "SOURCES",
@@ -115,6 +116,8 @@ __all__ = [
 ]
 
 
+#: The readings of a conventional run (``by_datum``; ``procedure_mc(measure=…)``).
+CONVENTIONAL_READINGS = ("parallax", "slip", "plane", "book")
 #: ``procedure_mc(sources=…)`` of the conventional method: which judgment errors are on.
 SOURCES = ("both", "y_parallax", "stereo")
 
@@ -296,6 +299,13 @@ class ProcedureOptions:
         The estimator with the linear control variate
         (:mod:`~stereoplotter.verification.control_variate`; unbiased, its CI ≈ 10–40×
         narrower); False: the plain mean.
+    decompose : bool
+        Setup methods: each reading's ``decomposition`` (:mod:`.decomposition`); False: None
+        (a run read only for its value or its per-trial mean squares skips its first-order
+        fields).
+    measure : tuple of str or None
+        Conventional only: the readings measured, of "parallax", "slip", "plane" and "book"
+        (``by_datum`` holds these; the statistic's own is always measured); None: every one.
     passes : int or None
         Every loop makes this many passes (no check ever passes); None: as ``fidelity`` says.
     linkage : {"drag", "independent"} or None
@@ -317,6 +327,8 @@ class ProcedureOptions:
     control: str = "exact"
     instrument: bool = False
     control_variate: bool = True
+    decompose: bool = True
+    measure: tuple[str, ...] | None = None
     passes: int | None = None
     linkage: str | None = None
     fidelity: Fidelity | None = None
@@ -517,9 +529,20 @@ def run_configuration(
     c, p, n = geometry["c"], geometry["p"], geometry["n"]
     operator = method_operator(method, options.sigma_mm, c, p, n, sources)
     unit = operator.unit_mm
+    measure = None
     if method == "conventional":
-        units = dict.fromkeys(("parallax", "slip", "plane", "book"), unit)
+        units = dict.fromkeys(CONVENTIONAL_READINGS, unit)
         sigma_control = 0.0
+        if options.measure is not None:
+            unknown = set(options.measure) - set(CONVENTIONAL_READINGS)
+            if unknown:
+                raise ValueError(
+                    f"measure: expected readings among {CONVENTIONAL_READINGS}, "
+                    f"found {sorted(unknown)}"
+                )
+            o = options
+            statistic = _field_name(method, o.quantity, o.levelling, o.datum, o.control)
+            measure = tuple(dict.fromkeys((*options.measure, statistic)))
     else:  # m_p = m_xy/√2 of the observed control parallaxes
         units = {"parallax": unit, "levelled": unit, "observed": unit / math.sqrt(2.0)}
         sigma_control = units["observed"]
@@ -539,6 +562,8 @@ def run_configuration(
         standard_points_at_a=method == "conventional" and options.standard_points == "book",
         sigma_control_mm=sigma_control,
         sources_off=sources_off,
+        decompose=options.decompose,
+        measure=measure,
     )
     ms = mean_squares(run)
     return ConfigurationRun(ms.plain, ms.controlled, ms.error_free_dp, units)
@@ -563,8 +588,9 @@ def _extras(
     decompositions, or the conventional run's readings by datum and its options."""
     if method == "conventional":
         unit = units["plane"]
+        datums = [k for k in CONVENTIONAL_READINGS if k in best]
         return {
-            "by_datum": {k: rms_ci(best[k], unit) for k in ("parallax", "slip", "plane", "book")},
+            "by_datum": {k: rms_ci(best[k], unit) for k in datums},
             **{k: getattr(o, k) for k in ("quantity", "standard_points", "datum", "levelling")},
             "sources": o.sources,
         }
@@ -576,13 +602,16 @@ def _extras(
     ):
         cf, h = rms_ci(best[key], units[key])
         ref = _formulas(m, scenario, spec, g, o.sources, c)["rigorous"]
-        ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
+        decomposition = None
+        if o.decompose:
+            ms = {s: plain[(key, s)] for s, _ in dc.LEVELS}
+            decomposition = dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key])
         fields[key] = {
             "coefficient": cf,
             "ci": h,
             "plain": rms_ci(plain[key], units[key]),
             "formula": ref,
-            "decomposition": dc.rms_steps(ref, {**ms, "procedure": plain[key]}, units[key]),
+            "decomposition": decomposition,
             "mean_squares": plain[key],  # per trial, photo mm² (paired switch steps)
             "unit": units[key],
         }

@@ -112,8 +112,9 @@ def method_operator(
 FieldKey = str | tuple[str, str]
 #: A run's fields: (result, noise) → field name → per-trial values over the domain, (T, n).
 Fields = Callable[[SimulationResult, Noise], dict[str, FloatArray]]
-#: The decomposition's mean squares: (result, the run's fields) → (reading, level) → (T,).
-Decompose = Callable[[SimulationResult, dict[str, FloatArray]], dict[FieldKey, FloatArray]]
+#: The decomposition's mean squares: (result, the run's fields, the rows of the result's trials
+#: they are) → (reading, level) → (T,).
+Decompose = Callable[[SimulationResult, dict[str, FloatArray], slice], dict[FieldKey, FloatArray]]
 
 
 @dataclass(frozen=True)
@@ -164,6 +165,12 @@ class ProcedureRun:
     sources_off : mapping or None
         Key prefix → (trials,) mask of the trials whose acts of that prefix draw 0
         (:func:`conventional_sources_mc`); None: every act drawn on every trial.
+    decompose : bool
+        Setup methods: also the first-order fields of the decomposition (:mod:`.decomposition`)
+        of each reading; False: only the readings and the elements' errors.
+    measure : tuple of str or None
+        Conventional method: the readings measured (of "parallax", "slip", "plane", "book");
+        None: every one.
     """
 
     scenario: Scenario
@@ -181,6 +188,8 @@ class ProcedureRun:
     standard_points_at_a: bool = False
     sigma_control_mm: float = 0.0
     sources_off: Mapping[str, NDArray[np.bool_]] | None = None
+    decompose: bool = True
+    measure: tuple[str, ...] | None = None
 
     @property
     def procedure(self) -> str:
@@ -263,27 +272,42 @@ def _setup_fields(run: ProcedureRun, zero_run: SimulationResult) -> tuple[FieldM
 
     units0 = zero_run.instrument.state()["units"]
     state0 = (zero_run.instrument.setting, {s: units0[s] for s in ("left", "right")})
-    jac = dc.state_jacobian(*state0, dp_function(sc, sheet, allp))
+    jac = dc.state_jacobian(*state0, dp_function(sc, sheet, allp)) if run.decompose else None
 
     def decompose(
-        result: SimulationResult, main: dict[str, FloatArray]
+        result: SimulationResult, main: dict[str, FloatArray], rows: slice
     ) -> dict[FieldKey, FloatArray]:
         """Per-trial mean squares of the first-order fields of the decomposition
-        (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²]."""
+        (:mod:`.decomposition`) of each reading, (reading, level) → (T,) [photo mm²], and
+        each (6.22) element's squared error ("element", name); the elements' only without
+        ``run.decompose``."""
         units = result.instrument.state()["units"]
         trials = len(next(iter(main.values())))
         deltas = dc.state_deltas(
-            result.instrument.setting, {s: units[s] for s in ("left", "right")}, *state0, trials
+            result.instrument.setting,
+            {s: units[s] for s in ("left", "right")},
+            *state0,
+            trials,
+            rows,
         )
-        noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
         # each (6.22) element's error (instrument units: mm, tangent, rad), squared per trial
         out: dict[FieldKey, FloatArray] = {
             ("element", f"{o}.{f}"): deltas[i] ** 2 for i, (o, f) in enumerate(dc.ELEMENTS)
         }
+        if jac is None:
+            return out
+        noise = main["observed"] - main["levelled"]  # the observed control parallaxes' part
+        blocks = cvar.row_blocks(trials)
         for step, d in dc.linear_fields(jac, deltas):
-            r = readings(d)
-            r["observed"] = r["levelled"] + noise
-            out.update({(key, step): np.mean(v**2, axis=-1) for key, v in r.items()})
+            ms: dict[FieldKey, FloatArray] = {
+                (key, step): np.empty(trials) for key in ("parallax", "levelled", "observed")
+            }
+            for s, e in blocks:  # a trial's readings are its own row's
+                r = readings(d[s:e])
+                r["observed"] = r["levelled"] + noise[s:e]
+                for key, v in r.items():
+                    ms[key, step][s:e] = np.mean(v**2, axis=-1)
+            out.update(ms)
         return out
 
     return FieldMaker(fields, decompose), zero[:n]
@@ -316,21 +340,25 @@ def _conventional_fields(
         levelling_design(book[:, 0], book[:, 1])
     )
 
+    measure = run.measure or ("parallax", "slip", "plane", "book")  # None: every reading
+
     def fields(result: SimulationResult, noise: Noise) -> dict[str, FloatArray]:
-        d = dp_at(sc, result.sheet, result.instrument, pts) - d_zero
         e = (height_errors_parallax(sc, result.sheet, result.instrument, allp) - h_zero) * k
-        obs = e[:, n : n + nl] + np.stack(
-            [noise.normal(f"mc/datum/{i}", sigma_p) for i in range(nl)], -1
-        )
-        ctl = e[:, n + nl :] + np.stack(
-            [noise.normal(f"mc/book/{i}", sigma_p) for i in range(len(book))], -1
-        )
-        return {
-            "parallax": d,
-            "slip": e[:, :n],
-            "plane": e[:, :n] - np.mean(obs, axis=-1, keepdims=True),
-            "book": e[:, :n] - ctl @ refit.T,
-        }
+        # every observation drawn, measured or not: the same acts in the linear control
+        datum = np.stack([noise.normal(f"mc/datum/{i}", sigma_p) for i in range(nl)], -1)
+        control = np.stack([noise.normal(f"mc/book/{i}", sigma_p) for i in range(len(book))], -1)
+        out: dict[str, FloatArray] = {}
+        if "parallax" in measure:
+            out["parallax"] = dp_at(sc, result.sheet, result.instrument, pts) - d_zero
+        if "slip" in measure:
+            out["slip"] = e[:, :n]
+        if "plane" in measure:
+            obs = e[:, n : n + nl] + datum
+            out["plane"] = e[:, :n] - np.mean(obs, axis=-1, keepdims=True)
+        if "book" in measure:
+            ctl = e[:, n + nl :] + control
+            out["book"] = e[:, :n] - ctl @ refit.T
+        return out
 
     return FieldMaker(fields), d_zero
 
@@ -340,8 +368,10 @@ def mean_squares(run: ProcedureRun) -> MeanSquares:
     :func:`_conventional_fields`), plain and with the linear control variate
     (:mod:`~stereoplotter.verification.control_variate`), and the error-free run's δp.
 
-    The error-free run once; the linearisation once; the noisy trials in chunks under the memory
-    budget (the random draws are keyed by trial, so the chunk size changes no result).
+    The error-free run once; the linearisation once, its designed run in one run with the first
+    chunk on the ideal instrument (the procedure's per-act work paid once for both); the noisy
+    trials in chunks under the memory budget (the random draws are keyed by trial, so the chunk
+    size changes no result).
     """
 
     zero_prep = run.prepared(run.operator.error_free, "zero")
@@ -351,13 +381,21 @@ def mean_squares(run: ProcedureRun) -> MeanSquares:
     else:
         maker, d_zero = _conventional_fields(run, zero_prep, zero_run)
     prep = run.prepared(run.operator.noisy, None if run.instrument_errors else "zero")
-    lin = _linearisation(prep, maker) if run.control_variate else None
+    design = _design(prep, maker) if run.control_variate else None
+    lin: cvar.LinearControl | None = None
     chunk = chunk_trials_for(DEFAULT_MEMORY_BUDGET_MB, run.procedure)
     plain: dict[FieldKey, FloatArray] = {}
     controlled: dict[FieldKey, FloatArray] = {}
     for first in range(0, run.trials, chunk):
         m = min(chunk, run.trials - first)
-        part_plain, part_controlled = _chunk_mean_squares(run, prep, maker, lin, first, m)
+        # with the real mechanics (instrument errors) a trial's last bits depend on the trials
+        # run beside it (1e-14 relative, measured): the designed run goes alone there
+        with_design = design if first == 0 and not run.instrument_errors else None
+        if design is not None and lin is None and with_design is None:
+            lin = _linearised(prep, maker, design)
+        part_plain, part_controlled, lin = _chunk_mean_squares(
+            run, prep, maker, lin, first, m, with_design
+        )
         for name, v in part_plain.items():
             plain.setdefault(name, np.empty(run.trials))[first : first + m] = v
             if name in part_controlled:
@@ -367,9 +405,10 @@ def mean_squares(run: ProcedureRun) -> MeanSquares:
     return MeanSquares(plain, controlled, d_zero)
 
 
-def _linearisation(prep: PreparedRun, maker: FieldMaker) -> cvar.LinearControl:
-    """The linear control variate of ``maker``'s fields about the run with every random input 0
-    (:func:`~stereoplotter.verification.control_variate.linear_control`)."""
+def _design(prep: PreparedRun, maker: FieldMaker) -> cvar.Design:
+    """The designed run of the linear control variate of ``maker``'s fields about the run with
+    every random input 0 (:func:`~stereoplotter.verification.control_variate.design`: its
+    discovery run made here)."""
 
     def fields_of(injected: dict[str, Any], noise: Noise, trials: int) -> dict[str, FloatArray]:
         result = run_trials_chunk(
@@ -377,7 +416,17 @@ def _linearisation(prep: PreparedRun, maker: FieldMaker) -> cvar.LinearControl:
         )
         return maker.fields(result, noise)
 
-    return cvar.linear_control(fields_of, prep.model)
+    return cvar.design(fields_of, prep.model)
+
+
+def _linearised(prep: PreparedRun, maker: FieldMaker, design: cvar.Design) -> cvar.LinearControl:
+    """The linear control from ``design``'s run made alone."""
+    noise = design.noise()
+    result = run_trials_chunk(
+        prep, 0, design.trials, evaluate=False, transcript=False, injected=design.injected,
+        noise=noise,
+    )  # fmt: skip
+    return cvar.control_from(design, maker.fields(result, noise))
 
 
 def _chunk_mean_squares(
@@ -387,9 +436,12 @@ def _chunk_mean_squares(
     lin: cvar.LinearControl | None,
     first: int,
     trials: int,
-) -> tuple[dict[FieldKey, FloatArray], dict[str, FloatArray]]:
+    design: cvar.Design | None = None,
+) -> tuple[dict[FieldKey, FloatArray], dict[str, FloatArray], cvar.LinearControl | None]:
     """Per-trial mean squares of trials ``first … first + trials − 1``: plain (with the
-    decomposition's) and controlled (empty without ``lin``)."""
+    decomposition's) and controlled (empty without a linear control); and the linear control.
+    With ``design`` its designed run goes before the trials in the same run, and the linear
+    control is built from it (else ``lin``, None: none)."""
     model = prep.model
     injected = model.draw_keyed(prep.seed, first, first + trials)
     off = run.sources_off
@@ -400,20 +452,38 @@ def _chunk_mean_squares(
         noise = cvar.SourceNoise(prep.seed, trials, first, part)
     else:
         noise = cvar.RecordingNoise(prep.seed, trials, first)
-    result = run_trials_chunk(
-        prep, first, trials, evaluate=False, transcript=False, injected=injected, noise=noise
-    )
-    fs = maker.fields(result, noise)
+    if design is None:
+        result = run_trials_chunk(
+            prep, first, trials, evaluate=False, transcript=False, injected=injected, noise=noise
+        )
+        fs = maker.fields(result, noise)
+        rows = slice(0, trials)
+    else:  # the designed trials, then the chunk's, in one run
+        d = design.trials
+        stacked = cvar.StackedNoise(design.noise(), noise)
+        both = {
+            k: np.concatenate([np.broadcast_to(np.asarray(design.injected[k], float), (d,)), v])
+            for k, v in injected.items()
+        }
+        result = run_trials_chunk(
+            prep, first, d + trials, evaluate=False, transcript=False, injected=both, noise=stacked
+        )
+        every = maker.fields(result, stacked)
+        lin = cvar.control_from(design, {k: v[:d] for k, v in every.items()})
+        fs = {k: v[d:] for k, v in every.items()}
+        rows = slice(d, d + trials)
     controlled: dict[str, FloatArray] = {}
     if lin:
         on = _inputs_on(lin, part, trials) if off else None
         controlled = cvar.per_trial_controlled(fs, lin, noise, dict(injected), model, on)
-    plain: dict[FieldKey, FloatArray] = {
-        name: np.mean(np.asarray(v) ** 2, axis=-1) for name, v in fs.items()
-    }
+    plain: dict[FieldKey, FloatArray] = {}
+    for name, v in fs.items():
+        ms = plain[name] = np.empty(trials)
+        for s, e in cvar.row_blocks(trials):  # each trial's own row
+            ms[s:e] = np.mean(np.asarray(v[s:e]) ** 2, axis=-1)
     if maker.decompose is not None:  # already mean squares
-        plain.update(maker.decompose(result, fs))
-    return plain, controlled
+        plain.update(maker.decompose(result, fs, rows))
+    return plain, controlled, lin
 
 
 def _inputs_on(

@@ -125,8 +125,12 @@ PROCEDURE_NOTE = "no procedure MC (the simulated procedure does not measure this
 class ProcedureConfig:
     """A configuration of the procedure MC: its ``method`` and the options of its runs (the
     fields of :class:`~stereoplotter.verification.procedure_mc.ProcedureOptions` it sets:
-    ``grid``, ``passes``, ``sources``, ``fidelity``); ``idealised``: run on the scenario with
-    vertical photos over flat terrain (:func:`idealised_geometry`)."""
+    ``grid``, ``passes``, ``sources``, ``fidelity``, ``control_variate``, ``decompose``,
+    ``measure``);
+    ``idealised``: run on the scenario with vertical photos over flat terrain
+    (:func:`idealised_geometry`). A run the table reads only for its value skips the
+    decomposition, one read only for its plain per-trial mean squares (a switch step) also the
+    control variate: the values read are the same."""
 
     method: str
     grid: tuple[int, int] = (16, 32)
@@ -134,6 +138,9 @@ class ProcedureConfig:
     sources: str = "both"
     fidelity: Fidelity | None = None
     idealised: bool = False
+    control_variate: bool = True
+    decompose: bool = True
+    measure: tuple[str, ...] | None = None
 
     def options(self) -> dict[str, Any]:
         """The :func:`procedure_mc` keyword arguments of a run of this configuration."""
@@ -143,6 +150,9 @@ class ProcedureConfig:
             "passes": self.passes,
             "sources": self.sources,
             "fidelity": self.fidelity,
+            "control_variate": self.control_variate,
+            "decompose": self.decompose,
+            "measure": self.measure,
         }
 
 
@@ -154,12 +164,13 @@ class ProcedureConfig:
 #: (5.54)/(5.55) do not model; it makes the run smooth enough for the control variate). The
 #: setup run's statistic is the mean over a midpoint grid of 8 × 16 (not 16 × 32): half the
 #: time, values within 0.3 % of the finer grid on the same 4 000 trials (pair60 levelled
-#: 0.1298 / 0.1302, observed 0.6696 / 0.6707; parallax within 0.02 %).
+#: 0.1298 / 0.1302, observed 0.6696 / 0.6707; parallax within 0.02 %). A conventional run
+#: measures only its statistic's reading (``measure=()``: the table reads no other datum).
 PROCEDURE_CONFIGS = {
     "setup": ProcedureConfig("setup", grid=(8, 16)),
-    "conventional": ProcedureConfig("conventional", passes=3),
-    "y_parallax": ProcedureConfig("conventional", passes=3, sources="y_parallax"),
-    "stereo": ProcedureConfig("conventional", passes=3, sources="stereo"),
+    "conventional": ProcedureConfig("conventional", passes=3, measure=()),
+    "y_parallax": ProcedureConfig("conventional", passes=3, sources="y_parallax", measure=()),
+    "stereo": ProcedureConfig("conventional", passes=3, sources="stereo", measure=()),
 }
 #: The seed stream of each configuration's runs, declared (not its place in
 #: :data:`PROCEDURE_CONFIGS`): a run of configuration c at overlap slot s takes the seed
@@ -330,6 +341,9 @@ def run_procedure_job(job: ProcedureJob) -> dict[str, RunResult]:
         scenario = job.scenario
         if run.idealised:  # vertical photos over flat terrain
             scenario = idealised_geometry(scenario)
+        options = run.options()
+        if job.instrument_errors:  # read for its value only (``mc_procedure_instrument``)
+            options["decompose"] = False
         res = procedure_mc(
             scenario,
             spec=job.spec,
@@ -337,10 +351,11 @@ def run_procedure_job(job: ProcedureJob) -> dict[str, RunResult]:
             seed=job.seed,
             instrument=job.instrument_errors,
             linkage=job.linkage,
-            **run.options(),
+            **options,
         )
         return {config: res}
     (passes,) = {job.options[c].passes for c in job.configs}  # the shared run: one number
+    (measure,) = {job.options[c].measure for c in job.configs}
     by_source = {job.options[c].sources: c for c in job.configs}
     out = conventional_sources_mc(
         job.scenario,
@@ -350,6 +365,7 @@ def run_procedure_job(job: ProcedureJob) -> dict[str, RunResult]:
         instrument=job.instrument_errors,
         linkage=job.linkage,
         passes=passes,
+        measure=measure,
     )
     return {by_source[k]: r for k, r in out.items()}
 
@@ -373,8 +389,11 @@ def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ProcedureCo
     base = PROCEDURE_CONFIGS["setup"]
     out = {**PROCEDURE_CONFIGS, "setup": replace(base, fidelity=f)}
     formula = Fidelity.as_formula()
-    out["setup_formula"] = replace(base, fidelity=formula)
-    out["setup_formula_flat"] = replace(base, fidelity=formula, idealised=True)
+    # the as-formula runs are read for their values (control variate), the steps for their
+    # plain per-trial mean squares (:func:`switch_decomposition`): neither for a decomposition
+    read = replace(base, decompose=False)
+    out["setup_formula"] = replace(read, fidelity=formula)
+    out["setup_formula_flat"] = replace(read, fidelity=formula, idealised=True)
     chain = switch_chain(f)
     step = formula
     for i, name in enumerate(chain[:-1], 1):
@@ -383,7 +402,7 @@ def procedure_configs(fidelity: Fidelity | None = None) -> dict[str, ProcedureCo
         step = replace(step, **change)
         if name == "linkage" and value is None:
             step = replace(step, linkage=None)
-        out[f"setup_step_{i}"] = replace(base, fidelity=step)
+        out[f"setup_step_{i}"] = replace(read, fidelity=step, control_variate=False)
     return out
 
 

@@ -99,3 +99,63 @@ def test_source_noise_masks_only_its_sources():
     np.testing.assert_array_equal(q, np.where(off["q/"], 0.0, q0))
     np.testing.assert_array_equal(s, s0)
     np.testing.assert_array_equal(noise.z["q/1"], q / 0.5)
+
+
+def test_designed_run_beside_a_chunk_leaves_each_trial_its_own_state(book80):
+    """The linearisation's designed run in one run with a chunk of trials
+    (:class:`StackedNoise`, as ``procedure_run.mean_squares`` runs them on the ideal
+    instrument): every trial's instrument state is bit for bit the one of its part run alone —
+    the designed trials, and trials 7 … 16 of the seed — and the chunk's recorded draws are
+    those of its own run: the procedure treats every trial alone."""
+    from dataclasses import replace
+
+    from stereoplotter.procedure.operator import OperatorModel
+    from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
+    from stereoplotter.verification import decomposition as dc
+
+    sc, spec = book80
+    op = replace(OperatorModel().zero(), monocular_sigma_mm=0.01)
+    prep = prepare_run(sc, spec, "setup", "zero", 5, operator=op, ideal_mechanics=True)
+
+    def run(injected, noise, trials):
+        return run_trials_chunk(
+            prep, 0, trials, evaluate=False, transcript=False, injected=injected, noise=noise
+        )
+
+    design = cvar.design(lambda inj, noise, n: (run(inj, noise, n), {})[1], prep.model)
+    assert design.trials > 1
+    first, t = 7, 10
+    injected = prep.model.draw_keyed(prep.seed, first, first + t)
+    alone_noise = cvar.RecordingNoise(prep.seed, t, first)
+    alone = run_trials_chunk(
+        prep, first, t, evaluate=False, transcript=False, injected=injected, noise=alone_noise
+    )
+    alone_design = run(design.injected, design.noise(), design.trials)
+    recorded = cvar.RecordingNoise(prep.seed, t, first)
+    d = design.trials
+    both_injected = {
+        k: np.concatenate([np.broadcast_to(np.asarray(design.injected[k], float), (d,)), v])
+        for k, v in injected.items()
+    }
+    both = run_trials_chunk(
+        prep,
+        first,
+        d + t,
+        evaluate=False,
+        transcript=False,
+        injected=both_injected,
+        noise=cvar.StackedNoise(design.noise(), recorded),
+    )
+
+    def state(result):
+        units = result.instrument.state()["units"]
+        objects = {"setting": result.instrument.setting, **units}
+        return {key: np.asarray(getattr(objects[key[0]], key[1]), float) for key in dc.STATE}
+
+    s_both, s_design, s_alone = state(both), state(alone_design), state(alone)
+    for key in dc.STATE:
+        np.testing.assert_array_equal(np.broadcast_to(s_both[key], (d + t,))[:d], s_design[key])
+        np.testing.assert_array_equal(np.broadcast_to(s_both[key], (d + t,))[d:], s_alone[key])
+    assert recorded.z.keys() == alone_noise.z.keys()
+    for key, z in alone_noise.z.items():
+        np.testing.assert_array_equal(recorded.z[key], z)
