@@ -203,11 +203,15 @@ def iter_chunk_columns(
     With ``workers`` > 1 the chunks after the first run in that many forked processes, each
     given the next task of :func:`worker_tasks` in trial order and at most
     :data:`QUEUED_PER_WORKER` ahead of the one yielded, while this process runs the first and
-    then only collects: it holds the columns of a fixed number of tasks, never a share of the
+    then collects: it holds the columns of a fixed number of tasks, never a share of the
     run, so its memory does not grow with the trials (the forked processes keep the cores
-    busy). ``progress`` counts each chunk when it
-    is yielded. Every draw is keyed by the trial, so the columns are the same whatever the
-    workers and the chunks.
+    busy). Where each task is one chunk on whole keyed blocks, this process also runs the next
+    task not yet given whenever the chunk it is to yield is still running: the last chunks are
+    then shared by three processes instead of two (at 10⁵ trials of the conventional method,
+    nine chunks, the last a short one, one worker no longer runs two chunks after the other
+    has stopped). Chunks that start inside a block are not taken: one run here would draw its
+    first block's prefix again. ``progress`` counts each chunk when it is yielded. Every draw
+    is keyed by the trial, so the columns are the same whatever the workers and the chunks.
     """
     if trials < 1:
         raise ValueError(f"trials: expected ≥ 1, found {trials}")
@@ -218,6 +222,7 @@ def iter_chunk_columns(
     count = len(starts)
     pool = None
     tasks: list[list[int]] = []
+    steal = False
     if workers > 1 and count > 1 and "fork" in multiprocessing.get_all_start_methods():
         _PREPARED[:] = [(prep, evaluate)]  # inherited by the forked workers
         context = multiprocessing.get_context("fork")
@@ -225,6 +230,7 @@ def iter_chunk_columns(
         pool = ProcessPoolExecutor(max_workers=processes, mp_context=context)
         depth = QUEUED_PER_WORKER * processes
         tasks = worker_tasks(count, chunk_trials, processes)
+        steal = chunk_trials % BLOCK == 0  # a chunk a task, none drawing a block's prefix
     task_of = {k: j for j, task in enumerate(tasks) for k in task}
     given: dict[int, Future[Any]] = {}  # each task given to a process: its chunks' columns
     done: dict[int, dict[str, NDArray[Any]]] = {}  # columns of a finished task, not yet yielded
@@ -252,6 +258,11 @@ def iter_chunk_columns(
                 if k not in done:
                     j = task_of[k]
                     give_workers(j)
+                    while steal and not given[j].done() and given_next < len(tasks):
+                        # the workers are busy and a task is not given yet: it runs here
+                        mine, given_next = tasks[given_next], given_next + 1
+                        for c in mine:
+                            done[c] = _columns_here(prep, starts[c], sizes[c], evaluate)
                     done.update(zip(tasks[j], given.pop(j).result(), strict=True))
                 columns = done.pop(k)
             yield None, columns
