@@ -11,6 +11,7 @@ import zlib
 import numpy as np
 import pytest
 
+from stereoplotter import random_streams
 from stereoplotter.cli import main
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
@@ -57,6 +58,33 @@ def test_keyed_normals_go_on_from_where_a_range_stopped():
     for order in (ranges, ranges[::-1], [*ranges, *ranges]):
         for a, b in order:
             assert np.array_equal(keyed_standard_normal(11, "k/n", a, b), whole[a:b]), (a, b)
+
+
+def test_keyed_normals_of_known_keys_from_states_seeded_together():
+    """The keys drawn before in this process have their blocks' generator states computed all
+    at once for a new range (``random_streams.seeded_states``); their numbers, and those of a
+    block going on from a kept state, are those of the block drawn whole by a generator of its
+    own."""
+    keys = [f"k/together/{i}" for i in range(5)]
+    whole = {k: keyed_draws(2**32 - 1, k, 0, 3 * BLOCK, _normal) for k in keys}
+    cuts = [0, 5, BLOCK + 7, 2 * BLOCK + 100, 2 * BLOCK + 101, 3 * BLOCK]
+    for a, b in itertools.pairwise(cuts):
+        for k in keys:
+            got = keyed_standard_normal(2**32 - 1, k, a, b)
+            assert np.array_equal(got, whole[k][a:b]), (k, a, b)
+
+
+def test_block_states_seeded_together_are_numpys():
+    rng = np.random.default_rng(4)
+    codes = rng.integers(0, 2**32, 200).astype(np.uint32)
+    blocks = rng.integers(0, 60, 200).astype(np.uint32)
+    blocks[:20] = 0
+    for seed in (0, 1, 2**32 - 1):
+        got = random_streams.seeded_states(seed, codes, blocks)
+        for c, b, state in zip(codes.tolist(), blocks.tolist(), got, strict=True):
+            entropy = [seed, c] if b == 0 else [seed, c, b]
+            want = np.random.default_rng(entropy).bit_generator.state["state"]
+            assert state == (want["state"], want["inc"]), (seed, c, b)
 
 
 @pytest.mark.parametrize("method", ["setup", "conventional"])
