@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M, UM_PER_MM
+from stereoplotter.procedure.arrays import max_abs_last
 from stereoplotter.procedure.run import PreparedRun
 from stereoplotter.procedure.simulate import SimulationResult, run_trials_chunk
 from stereoplotter.random_streams import BLOCK
@@ -316,13 +317,13 @@ def trial_columns(result: SimulationResult) -> dict[str, NDArray[Any]]:
         cols[f"iterations/{name}"] = _full(v, t)
     for name, v in result.zero_readings.items():
         cols[f"zero_reading/{name}"] = _full(v, t)
-    q_std = np.abs(np.asarray(result.q_standard_mm, float)).reshape(t, -1)
+    q_std = np.asarray(result.q_standard_mm, float).reshape(t, -1)
     q_grid = np.asarray(result.q_grid_mm, float).reshape(t, -1)
-    cols["residual_y_parallax/standard_points_max_um"] = np.max(q_std, axis=1) * UM_PER_MM
+    cols["residual_y_parallax/standard_points_max_um"] = max_abs_last(q_std) * UM_PER_MM
     cols["residual_y_parallax/grid_max_um"] = np.max(np.abs(q_grid), axis=1) * UM_PER_MM
     cols["residual_y_parallax/grid_rms_um"] = np.sqrt(np.mean(q_grid**2, axis=1)) * UM_PER_MM
     if result.evaluation is not None:
-        for set_name, measures in result.evaluation.summary().items():
+        for set_name, measures in result.evaluation.summary(permille=False).items():
             for key, v in measures.items():
                 if key == "n_points" or not key.endswith(_BASE_UNITS):
                     continue

@@ -17,6 +17,7 @@ from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.trial_store import TrialStore
 from stereoplotter.procedure import trials
+from stereoplotter.procedure.arrays import max_abs_last
 from stereoplotter.procedure.simulate import prepare_run, simulate
 from stereoplotter.procedure.trials import (
     chunk_trials_for,
@@ -72,6 +73,19 @@ def test_keyed_normals_of_known_keys_from_states_seeded_together():
         for k in keys:
             got = keyed_standard_normal(2**32 - 1, k, a, b)
             assert np.array_equal(got, whole[k][a:b]), (k, a, b)
+
+
+def test_largest_absolute_value_of_rows_by_columns_is_numpys():
+    rng = np.random.default_rng(5)
+    for n in (1, 2, 6, 16, 17, 81):
+        v = rng.normal(size=(300, n))
+        v[rng.random(v.shape) < 0.05] = -0.0
+        v[rng.random(v.shape) < 0.05] = 0.0
+        v[rng.random(v.shape) < 0.01] = np.nan
+        v[7] = -0.0  # a row of zeros of either sign
+        got, want = max_abs_last(v), np.max(np.abs(v), axis=-1)
+        np.testing.assert_array_equal(got, want, err_msg=str(n))
+        assert not np.signbit(got).any()
 
 
 def test_block_states_seeded_together_are_numpys():
