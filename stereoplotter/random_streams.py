@@ -147,8 +147,13 @@ def _block_generator(
     ``start … stop−1`` that needs it: this thread's scratch generator set to the block's state
     where the state was computed with those of the other keys (:func:`_states_for_range`), else
     :func:`_generator`. The scratch generator is good until the next call."""
-    codes = _CODES.setdefault(seed, {})
-    codes[code] = None
+    codes = _CODES.get(seed)
+    if codes is None:
+        if len(_CODES) >= _CODES_SEEDS:
+            _CODES.clear()
+        codes = _CODES[seed] = {}
+    if len(codes) < _CODES_MAX:
+        codes[code] = None
     state = _STATES.pop((seed, code, block), None)
     if state is None and (seed, start, stop) != _STATES_RANGE[0] and 0 <= seed < 2**32:
         _states_for_range(seed, start, stop, list(codes))
@@ -168,6 +173,10 @@ def _block_generator(
 #: Per seed, the key codes drawn in this process, in their first order (the keys a chunk of a
 #: run draws are nearly all those the chunk before drew).
 _CODES: dict[int, dict[int, None]] = {}
+#: At most this many seeds' codes kept (all dropped when full), and this many codes a seed (a
+#: convention: a run of pair60 draws ≈ 1 700 keys with the setup method, ≈ 4 000 with the
+#: conventional one; a long-lived process, the trainer's server, sees many seeds).
+_CODES_SEEDS, _CODES_MAX = 8, 1 << 14
 #: PCG64 (state, increment) of blocks of the known keys, by (seed, code, block): those of the
 #: range of :data:`_STATES_RANGE`, each taken once.
 _STATES: dict[tuple[int, int, int], tuple[int, int]] = {}

@@ -204,15 +204,11 @@ def iter_chunk_columns(
     With ``workers`` > 1 the chunks after the first run in that many forked processes, each
     given the next task of :func:`worker_tasks` in trial order and at most
     :data:`QUEUED_PER_WORKER` ahead of the one yielded, while this process runs the first and
-    then collects: it holds the columns of a fixed number of tasks, never a share of the
-    run, so its memory does not grow with the trials (the forked processes keep the cores
-    busy). Where each task is one chunk on whole keyed blocks, this process also runs the next
-    task not yet given whenever the chunk it is to yield is still running: the last chunks are
-    then shared by three processes instead of two (at 10⁵ trials of the conventional method,
-    nine chunks, the last a short one, one worker no longer runs two chunks after the other
-    has stopped). Chunks that start inside a block are not taken: one run here would draw its
-    first block's prefix again. ``progress`` counts each chunk when it is yielded. Every draw
-    is keyed by the trial, so the columns are the same whatever the workers and the chunks.
+    collects (the columns of a fixed number of tasks: its memory does not grow with the trials)
+    and, where each task is one chunk on whole keyed blocks, runs the next task not yet given
+    whenever the chunk to yield still runs (the last chunks shared by three processes; a chunk
+    starting inside a block would draw its prefix again here). ``progress`` counts each chunk
+    when it is yielded; every draw is keyed by the trial: no column depends on the workers.
     """
     if trials < 1:
         raise ValueError(f"trials: expected ≥ 1, found {trials}")
@@ -260,10 +256,8 @@ def iter_chunk_columns(
                     j = task_of[k]
                     give_workers(j)
                     while steal and not given[j].done() and given_next < len(tasks):
-                        # the workers are busy and a task is not given yet: it runs here
-                        mine, given_next = tasks[given_next], given_next + 1
-                        for c in mine:
-                            done[c] = _columns_here(prep, starts[c], sizes[c], evaluate)
+                        mine, given_next = tasks[given_next], given_next + 1  # run here
+                        done.update(_task_here(prep, mine, starts, sizes, evaluate))
                     done.update(zip(tasks[j], given.pop(j).result(), strict=True))
                 columns = done.pop(k)
             yield None, columns
@@ -274,6 +268,12 @@ def iter_chunk_columns(
         if pool is not None:
             pool.shutdown(cancel_futures=True)
             _PREPARED.clear()
+
+
+def _task_here(
+    prep: PreparedRun, task: list[int], starts: list[int], sizes: list[int], evaluate: bool
+) -> dict[int, dict[str, NDArray[Any]]]:
+    return {k: _columns_here(prep, starts[k], sizes[k], evaluate) for k in task}
 
 
 def _columns_here(prep: PreparedRun, first: int, n: int, evaluate: bool) -> dict[str, NDArray[Any]]:

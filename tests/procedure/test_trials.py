@@ -225,18 +225,18 @@ def test_chunks_this_process_takes_from_the_workers_give_the_columns_of_one_proc
     prep = prepare_run(sc, load_instrument("sc1"), "setup", seed=3)
     one = list(iter_chunk_columns(prep, 27, 3, workers=1, evaluate=False))
     here = []
-    columns_here = trials._columns_here
+    run_chunk = trials.run_trials_chunk
 
-    def counted(prep, first, n, evaluate):
+    def counted(prep, first, n, **kwargs):
         here.append(first)
-        return columns_here(prep, first, n, evaluate)
+        return run_chunk(prep, first, n, **kwargs)
 
     monkeypatch.setattr(trials, "BLOCK", 1)
-    monkeypatch.setattr(trials, "_columns_here", counted)
+    monkeypatch.setattr(trials, "run_trials_chunk", counted)
     assert trials.worker_tasks(9, 3, 2) == [[k] for k in range(1, 9)]
     two = list(iter_chunk_columns(prep, 27, 3, workers=2, evaluate=False))
     assert len(two) == 9
-    assert len(here) == len(set(here)) and 0 not in here  # run here: chunks after the first
+    assert here[0] == 0 and len(here) == len(set(here))  # the first, and any taken here
     for (_, a), (_, b) in zip(one, two, strict=True):
         for name in a:
             np.testing.assert_array_equal(a[name], b[name], err_msg=name)
