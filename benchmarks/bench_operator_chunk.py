@@ -15,6 +15,11 @@ a change of the operator's arithmetic, measured here and not in the package):
 
 ``--draws``: the share of the chunk's CPU in the keyed normal draws (``Noise.normal``), and
 the number of keys drawn.
+
+``--task N``: N consecutive chunks of ``--trials`` in one process (trials 0 …), as a worker
+runs a task, with no variant: the process CPU of each chunk and of those after the first (the
+first chunk of a process draws its keys' blocks without the states seeded together,
+``random_streams._states_for_range``). Run it with each checkout on ``PYTHONPATH`` in turn.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.paths import resolve_data_file
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.procedure.simulate import prepare_run, run_trials_chunk
+from stereoplotter.procedure.trials import trial_columns
 
 VARIANTS = {
     "today": {},
@@ -75,9 +81,13 @@ def main() -> None:
     p.add_argument("--trials", type=int, default=5000)
     p.add_argument("--runs", type=int, default=5)
     p.add_argument("--draws", action="store_true", help="the keyed draws' share only")
+    p.add_argument("--task", type=int, default=0, help="N consecutive chunks in one process")
     args = p.parse_args()
     scenario = load_scenario(resolve_data_file("scenarios", "pair60"))
     prep = prepare_run(scenario, load_instrument("sc1"), args.method, seed=scenario.seed)
+    if args.task:
+        _task(prep, args)
+        return
     run_trials_chunk(prep, 0, 16)  # warm: caches, first calls
     if args.draws:
         _draws(prep, args)
@@ -101,6 +111,17 @@ def main() -> None:
             f"{args.method} {name}: CPU median {med:.3f} s, {med / today:.3f}× today, "
             f"bit-identical: {same}"
         )
+
+
+def _task(prep: Any, args: argparse.Namespace) -> None:
+    cpu = []
+    for k in range(args.task):
+        t = time.process_time()
+        trial_columns(run_trials_chunk(prep, k * args.trials, args.trials, transcript=False))
+        cpu.append(time.process_time() - t)
+    chunks = " ".join(f"{c:.3f}" for c in cpu)
+    rest = sum(cpu[1:])
+    print(f"{args.method} chunks of {args.trials}: CPU {chunks} s; after the first {rest:.3f} s")
 
 
 def _draws(prep: Any, args: argparse.Namespace) -> None:

@@ -13,9 +13,11 @@ A single run (no trial axis) is trial 0 of the same streams.
 
 from __future__ import annotations
 
+import threading
 import zlib
 from collections.abc import Callable, Iterable, Iterator
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -95,24 +97,30 @@ def keyed_standard_normal(seed: int, key: str, start: int, stop: int) -> NDArray
     seed, code = int(seed), key_code(key)
     out = np.empty(stop - start)
     for block, skip, at, n in _blocks(start, stop):
-        rng = _RESUME.pop((seed, key, start + at), None) if skip else None
-        if rng is not None:
+        kept = _RESUME.pop((seed, key, start + at), None) if skip else None
+        if kept is not None:
+            rng = _scratch(kept) if isinstance(kept, dict) else kept
             rng.standard_normal(n - skip, out=out[at : at + n - skip])
         else:
-            rng = _generator(seed, code, block)
+            rng = _block_generator(seed, code, block, start, stop)
             if skip:
                 out[at : at + n - skip] = rng.standard_normal(n)[skip:]
             else:
                 rng.standard_normal(n, out=out[at : at + n])
-        if n < BLOCK:  # the block goes on after this range: keep its generator there
+        if n < BLOCK:  # the block goes on after this range: keep its generator (or state) there
             if len(_RESUME) >= _RESUME_MAX:
                 _RESUME.clear()
-            _RESUME[(seed, key, start + at + n - skip)] = rng
+            scratch = rng is _SCRATCH.__dict__.get("rng")
+            keep: np.random.Generator | dict[str, Any] = (
+                dict(rng.bit_generator.state) if scratch else rng
+            )
+            _RESUME[(seed, key, start + at + n - skip)] = keep
     return out
 
 
-#: Generators of blocks a range left unfinished, by (seed, key, the trial they would draw next).
-_RESUME: dict[tuple[int, str, int], np.random.Generator] = {}
+#: Generators (or the states of this thread's scratch generator) of blocks a range left
+#: unfinished, by (seed, key, the trial they would draw next).
+_RESUME: dict[tuple[int, str, int], np.random.Generator | dict[str, Any]] = {}
 #: At most this many kept (a convention: above the keys of one chunk of either method on pair60,
 #: 1 666 and 3 505; ≈ 1.3 kB each, so ≤ ≈ 10 MB), all dropped when full.
 _RESUME_MAX = 8192
@@ -130,6 +138,144 @@ def _blocks(start: int, stop: int) -> Iterator[tuple[int, int, int, int]]:
         end = min(stop, first + BLOCK)
         yield block, t - first, t - start, end - first
         t = end
+
+
+def _block_generator(
+    seed: int, code: int, block: int, start: int, stop: int
+) -> np.random.Generator:
+    """The generator of block ``block`` of the stream (seed, key code) at its start, for a range
+    ``start … stop−1`` that needs it: this thread's scratch generator set to the block's state
+    where the state was computed with those of the other keys (:func:`_states_for_range`), else
+    :func:`_generator`. The scratch generator is good until the next call."""
+    codes = _CODES.get(seed)
+    if codes is None:
+        if len(_CODES) >= _CODES_SEEDS:
+            _CODES.clear()
+        codes = _CODES[seed] = {}
+    if len(codes) < _CODES_MAX:
+        codes[code] = None
+    state = _STATES.pop((seed, code, block), None)
+    if state is None and (seed, start, stop) != _STATES_RANGE[0] and 0 <= seed < 2**32:
+        _states_for_range(seed, start, stop, list(codes))
+        state = _STATES.pop((seed, code, block), None)
+    if state is None:
+        return _generator(seed, code, block)
+    return _scratch(
+        {
+            "bit_generator": "PCG64",
+            "state": {"state": state[0], "inc": state[1]},
+            "has_uint32": 0,
+            "uinteger": 0,
+        }
+    )
+
+
+#: Per seed, the key codes drawn in this process, in their first order (the keys a chunk of a
+#: run draws are nearly all those the chunk before drew).
+_CODES: dict[int, dict[int, None]] = {}
+#: At most this many seeds' codes kept (all dropped when full), and this many codes a seed (a
+#: convention: a run of pair60 draws ≈ 1 700 keys with the setup method, ≈ 4 000 with the
+#: conventional one; a long-lived process, the trainer's server, sees many seeds).
+_CODES_SEEDS, _CODES_MAX = 8, 1 << 14
+#: PCG64 (state, increment) of blocks of the known keys, by (seed, code, block): those of the
+#: range of :data:`_STATES_RANGE`, each taken once.
+_STATES: dict[tuple[int, int, int], tuple[int, int]] = {}
+#: The (seed, start, stop) whose blocks' states :data:`_STATES` holds.
+_STATES_RANGE: list[tuple[int, int, int] | None] = [None]
+#: This thread's scratch generator (``rng``), its state set for each block it draws.
+_SCRATCH = threading.local()
+
+
+def _scratch(state: dict[str, Any]) -> np.random.Generator:
+    rng: np.random.Generator | None = _SCRATCH.__dict__.get("rng")
+    if rng is None:
+        rng = _SCRATCH.rng = np.random.Generator(np.random.PCG64(0))
+    rng.bit_generator.state = state
+    return rng
+
+
+def _states_for_range(seed: int, start: int, stop: int, codes: list[int]) -> None:
+    """The states of the blocks of ``start … stop−1`` of every key code in ``codes``
+    (:func:`seeded_states`) into :data:`_STATES`, those of an earlier range dropped."""
+    first, last = start // BLOCK, (stop - 1) // BLOCK
+    blocks = np.arange(first, last + 1, dtype=np.uint32)
+    code_of = np.repeat(np.asarray(codes, np.uint32), blocks.size)
+    block_of = np.tile(blocks, len(codes))
+    _STATES.clear()
+    _STATES_RANGE[0] = (seed, start, stop)
+    states = seeded_states(seed, code_of, block_of)
+    keys = [(seed, c, b) for c, b in zip(code_of.tolist(), block_of.tolist(), strict=True)]
+    _STATES.update(zip(keys, states, strict=True))
+
+
+#: numpy's ``SeedSequence`` constants (hash multipliers and mixing; its pool of 4 words).
+_INIT_A, _MULT_A, _INIT_B, _MULT_B = 0x43B0D7E5, 0x931E8875, 0x8B51F9DD, 0x58F38DED
+_MIX_L, _MIX_R = 0xCA01F9DD, 0x4973F715
+#: PCG64's 128-bit LCG multiplier.
+_PCG_MULT = (2549297995355413924 << 64) + 4865540595714422341
+_M128 = (1 << 128) - 1
+
+
+def _hash_consts(init: int, mult: int, count: int) -> list[int]:
+    out = [init]
+    for _ in range(count):
+        out.append(out[-1] * mult & 0xFFFFFFFF)
+    return out
+
+
+_HASH_A = _hash_consts(_INIT_A, _MULT_A, 16)
+_HASH_B = _hash_consts(_INIT_B, _MULT_B, 8)
+
+
+def seeded_states(
+    seed: int, codes: NDArray[np.uint32], blocks: NDArray[np.uint32]
+) -> list[tuple[int, int]]:
+    """PCG64's (state, increment) of ``default_rng([seed, code(, block)])`` for each (code,
+    block), the blocks' seeding of :func:`_generator`, computed for all at once: numpy's
+    ``SeedSequence`` (entropy [seed, code, block, 0] in a pool of four 32-bit words, block 0's
+    [seed, code] hashed alike: a missing word is hashed as 0) on uint32 arrays, whose products
+    wrap as its C arithmetic does, then PCG64's seeding (state 0, increment 2·seq + 1, a step,
+    the state word added, a step) on Python integers. 0 ≤ seed < 2³².
+
+    Examples
+    --------
+    >>> codes, blocks = np.array([7, 7], np.uint32), np.array([0, 3], np.uint32)
+    >>> got = seeded_states(5, codes, blocks)
+    >>> want = [np.random.default_rng(e).bit_generator.state["state"] for e in ([5, 7], [5, 7, 3])]
+    >>> got == [(w["state"], w["inc"]) for w in want]
+    True
+    """
+    u32 = np.uint32
+    n = codes.size
+    calls = iter(range(len(_HASH_A) - 1))
+
+    def hashmix(value: NDArray[np.uint32]) -> NDArray[np.uint32]:
+        i = next(calls)
+        v = (value ^ u32(_HASH_A[i])) * u32(_HASH_A[i + 1])
+        out: NDArray[np.uint32] = v ^ (v >> u32(16))
+        return out
+
+    def mix(x: NDArray[np.uint32], y: NDArray[np.uint32]) -> NDArray[np.uint32]:
+        r = x * u32(_MIX_L) - y * u32(_MIX_R)
+        out: NDArray[np.uint32] = r ^ (r >> u32(16))
+        return out
+
+    entropy = (np.full(n, seed, u32), codes.astype(u32), blocks.astype(u32), np.zeros(n, u32))
+    pool = [hashmix(e) for e in entropy]
+    for src in range(4):
+        for dst in range(4):
+            if src != dst:
+                pool[dst] = mix(pool[dst], hashmix(pool[src]))
+    words = []
+    for i in range(8):  # generate_state(4, uint64): eight 32-bit words, two to a 64-bit word
+        v = (pool[i % 4] ^ u32(_HASH_B[i])) * u32(_HASH_B[i + 1])
+        words.append((v ^ (v >> u32(16))).astype(np.uint64))
+    w64 = [(words[2 * k] | (words[2 * k + 1] << np.uint64(32))).tolist() for k in range(4)]
+    out = []
+    for s_hi, s_lo, q_hi, q_lo in zip(*w64, strict=True):
+        inc = ((((q_hi << 64) | q_lo) << 1) | 1) & _M128
+        out.append((((inc + ((s_hi << 64) | s_lo)) * _PCG_MULT + inc) & _M128, inc))
+    return out
 
 
 def _generator(seed: int, code: int, block: int) -> np.random.Generator:

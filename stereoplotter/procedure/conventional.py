@@ -41,7 +41,7 @@ from stereoplotter.instrument.virtual import (
     KnobName,
     control_kind,
 )
-from stereoplotter.procedure.arrays import Active, Floats, Mask, Value
+from stereoplotter.procedure.arrays import Active, Floats, Mask, Value, max_abs_last
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.conventional_calibration import (
     ELEMENTS,
@@ -175,8 +175,7 @@ _SIX_Q = "standard point {i}: fuse, judge the y-parallax"
 
 
 def _worst(values: Sequence[Value]) -> NDArray[np.float64]:
-    worst: Floats = np.max(np.abs(np.stack(values, axis=-1)), axis=-1)
-    return worst
+    return max_abs_last(np.asarray(np.stack(values, axis=-1), float))
 
 
 def _rms(values: Sequence[Value]) -> NDArray[np.float64]:

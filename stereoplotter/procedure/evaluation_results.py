@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stereoplotter.constants import MM_PER_M
+from stereoplotter.procedure.arrays import max_abs_last
 
 __all__ = ["ModelEvaluation", "PointSetEvaluation"]
 
@@ -26,8 +27,7 @@ def _rms(v: _F) -> _F:
 
 
 def _max_abs(v: _F) -> _F:
-    worst: _F = np.max(np.abs(v), axis=-1)
-    return worst
+    return max_abs_last(np.asarray(v, float))
 
 
 def _plain(v: Any) -> Any:
@@ -91,12 +91,17 @@ class PointSetEvaluation:
         return np.hypot(self.x_error_m, self.y_error_m)
 
     def summary(
-        self, flying_height_m: float, map_scale_denominator: int | None, trials: int | None
+        self,
+        flying_height_m: float,
+        map_scale_denominator: int | None,
+        trials: int | None,
+        permille: bool = True,
     ) -> dict[str, Any]:
         """Max |·| and RMS over the points of every error (floats, or arrays (T,) for T trials).
 
         Keys end in their unit: ``_mm`` photo mm (parallaxes), ``_m`` ground metres,
-        ``_map_mm`` mm on the map, ``_permille`` ‰ of the mean flying height H̄.
+        ``_map_mm`` mm on the map, ``_permille`` ‰ of the mean flying height H̄ (left out
+        unless ``permille``).
         """
         if not self.ids:
             return {}
@@ -117,10 +122,13 @@ class PointSetEvaluation:
         if map_scale_denominator:
             put("plan_error", plan * MM_PER_M / map_scale_denominator, "map_mm")
         put("height_error", self.height_error_m, "m")
-        put("height_error", self.height_error_m * per_h, "permille")
+        if permille:
+            put("height_error", self.height_error_m * per_h, "permille")
         if self.height_error_after_plane_m is not None:
             put("height_error_after_plane", self.height_error_after_plane_m, "m")
-            put("height_error_after_plane", self.height_error_after_plane_m * per_h, "permille")
+            if permille:
+                after = self.height_error_after_plane_m * per_h
+                put("height_error_after_plane", after, "permille")
         return out
 
     def per_point(
@@ -207,10 +215,10 @@ class ModelEvaluation:
             "check": self.check,
         }
 
-    def summary(self) -> dict[str, dict[str, Any]]:
+    def summary(self, permille: bool = True) -> dict[str, dict[str, Any]]:
         """Max |·| and RMS per point set (see :meth:`PointSetEvaluation.summary`)."""
         return {
-            name: s.summary(self.flying_height_m, self.map_scale_denominator, self.trials)
+            name: s.summary(self.flying_height_m, self.map_scale_denominator, self.trials, permille)
             for name, s in self.sets().items()
         }
 

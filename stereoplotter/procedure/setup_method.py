@@ -34,7 +34,7 @@ from stereoplotter.instrument.virtual import (
     control_kind,
 )
 from stereoplotter.procedure import steps
-from stereoplotter.procedure.arrays import Floats, Mask, Value
+from stereoplotter.procedure.arrays import Floats, Mask, Value, max_abs_last
 from stereoplotter.procedure.compaction import compacted
 from stereoplotter.procedure.control_names import CASSETTE, DECENTRATION, KNOB, Tilt
 from stereoplotter.procedure.floor import ControlHeights
@@ -575,7 +575,7 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     operator's practice, remedy R2 where it exceeds ¼ mark."""
     tol = run.sheet.tolerances["residual_y_parallax_mm"]
     seen = np.stack(steps.judge_standard_points(run, stage, NoiseKey(stage).at("std")), axis=-1)
-    worst = np.max(np.abs(seen), axis=-1)
+    worst = max_abs_last(seen)
     name = f"stage {stage}: residual y-parallax (6 points)"
     if run.remedial:
         failed = worst > tol
@@ -584,7 +584,7 @@ def check_standard_points(run: Run, stage: str) -> NDArray[np.float64]:
     if run.remedial:
         remedy = f"R2 stage {stage}: refine the relative orientation"
         run.record_remedy(remedy, name, failed, rounds)
-    return cast(Floats, worst)
+    return worst
 
 
 def _q_jacobian(run: Run, imgs: tuple[Floats, Floats]) -> NDArray[np.float64]:
@@ -623,7 +623,7 @@ def refine_relative_orientation(
     remedy = "R2 refine the relative orientation"
     active = op.v(failed).astype(bool)
     rounds = np.zeros(np.shape(active), int)
-    worst = np.max(np.abs(seen), axis=-1)
+    worst = max_abs_last(seen)
     for it in range(1, op.model.max_iterations + 1):
         if not np.any(active):
             break
@@ -631,7 +631,7 @@ def refine_relative_orientation(
         with compacted(run, active) as cut:  # the round on the trials still failing only
             new = _r2_round(cut.run, stage, it, cut.take(seen), cut.active, remedy)
         seen = cut.put(seen, new)
-        worst = cut.put(worst, np.max(np.abs(new), axis=-1))
+        worst = cut.put(worst, max_abs_last(new))
         active = active & (worst > tol)
     return rounds, worst
 

@@ -11,10 +11,13 @@ import zlib
 import numpy as np
 import pytest
 
+from stereoplotter import random_streams
 from stereoplotter.cli import main
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.trial_store import TrialStore
+from stereoplotter.procedure import trials
+from stereoplotter.procedure.arrays import max_abs_last
 from stereoplotter.procedure.simulate import prepare_run, simulate
 from stereoplotter.procedure.trials import (
     chunk_trials_for,
@@ -56,6 +59,46 @@ def test_keyed_normals_go_on_from_where_a_range_stopped():
     for order in (ranges, ranges[::-1], [*ranges, *ranges]):
         for a, b in order:
             assert np.array_equal(keyed_standard_normal(11, "k/n", a, b), whole[a:b]), (a, b)
+
+
+def test_keyed_normals_of_known_keys_from_states_seeded_together():
+    """The keys drawn before in this process have their blocks' generator states computed all
+    at once for a new range (``random_streams.seeded_states``); their numbers, and those of a
+    block going on from a kept state, are those of the block drawn whole by a generator of its
+    own."""
+    keys = [f"k/together/{i}" for i in range(5)]
+    whole = {k: keyed_draws(2**32 - 1, k, 0, 3 * BLOCK, _normal) for k in keys}
+    cuts = [0, 5, BLOCK + 7, 2 * BLOCK + 100, 2 * BLOCK + 101, 3 * BLOCK]
+    for a, b in itertools.pairwise(cuts):
+        for k in keys:
+            got = keyed_standard_normal(2**32 - 1, k, a, b)
+            assert np.array_equal(got, whole[k][a:b]), (k, a, b)
+
+
+def test_largest_absolute_value_of_rows_by_columns_is_numpys():
+    rng = np.random.default_rng(5)
+    for n in (1, 2, 6, 16, 17, 81):
+        v = rng.normal(size=(300, n))
+        v[rng.random(v.shape) < 0.05] = -0.0
+        v[rng.random(v.shape) < 0.05] = 0.0
+        v[rng.random(v.shape) < 0.01] = np.nan
+        v[7] = -0.0  # a row of zeros of either sign
+        got, want = max_abs_last(v), np.max(np.abs(v), axis=-1)
+        np.testing.assert_array_equal(got, want, err_msg=str(n))
+        assert not np.signbit(got).any()
+
+
+def test_block_states_seeded_together_are_numpys():
+    rng = np.random.default_rng(4)
+    codes = rng.integers(0, 2**32, 200).astype(np.uint32)
+    blocks = rng.integers(0, 60, 200).astype(np.uint32)
+    blocks[:20] = 0
+    for seed in (0, 1, 2**32 - 1):
+        got = random_streams.seeded_states(seed, codes, blocks)
+        for c, b, state in zip(codes.tolist(), blocks.tolist(), got, strict=True):
+            entropy = [seed, c] if b == 0 else [seed, c, b]
+            want = np.random.default_rng(entropy).bit_generator.state["state"]
+            assert state == (want["state"], want["inc"]), (seed, c, b)
 
 
 @pytest.mark.parametrize("method", ["setup", "conventional"])
@@ -169,6 +212,31 @@ def test_many_chunks_on_workers_give_the_columns_of_one_process():
     one = list(iter_chunk_columns(prep, 27, 3, workers=1, evaluate=False))
     two = list(iter_chunk_columns(prep, 27, 3, workers=2, evaluate=False))
     assert len(one) == len(two) == 9
+    for (_, a), (_, b) in zip(one, two, strict=True):
+        for name in a:
+            np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+
+
+def test_chunks_this_process_takes_from_the_workers_give_the_columns_of_one_process(monkeypatch):
+    """Chunks on whole keyed blocks (the block taken as one trial here): the main process runs
+    the tasks not yet given while it waits for the workers; every chunk is yielded once, in
+    order, with the columns one process computes."""
+    sc = load_scenario("pair60")
+    prep = prepare_run(sc, load_instrument("sc1"), "setup", seed=3)
+    one = list(iter_chunk_columns(prep, 27, 3, workers=1, evaluate=False))
+    here = []
+    run_chunk = trials.run_trials_chunk
+
+    def counted(prep, first, n, **kwargs):
+        here.append(first)
+        return run_chunk(prep, first, n, **kwargs)
+
+    monkeypatch.setattr(trials, "BLOCK", 1)
+    monkeypatch.setattr(trials, "run_trials_chunk", counted)
+    assert trials.worker_tasks(9, 3, 2) == [[k] for k in range(1, 9)]
+    two = list(iter_chunk_columns(prep, 27, 3, workers=2, evaluate=False))
+    assert len(two) == 9
+    assert here[0] == 0 and len(here) == len(set(here))  # the first, and any taken here
     for (_, a), (_, b) in zip(one, two, strict=True):
         for name in a:
             np.testing.assert_array_equal(a[name], b[name], err_msg=name)
