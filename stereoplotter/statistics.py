@@ -31,15 +31,33 @@ QUANTILES = (0.05, 0.5, 0.95)
 Z95 = 1.959963984540054
 
 
-def _quantile_ci(sorted_values: np.ndarray, p: float) -> dict[str, Any]:
-    n = len(sorted_values)
-    value = float(np.quantile(sorted_values, p, method="linear"))
+def _ci_ranks(n: int, p: float) -> tuple[int, int]:
+    """The order statistics (0-based ranks) that bound the 95 % confidence interval of q_p."""
     half = Z95 * math.sqrt(n * p * (1.0 - p))
-    lo = math.floor(n * p - half)
-    hi = math.ceil(n * p + half)
+    return math.floor(n * p - half), math.ceil(n * p + half)
+
+
+def _ranks_read(n: int) -> list[int]:
+    """Every rank :func:`_quantile_ci` reads of ``n`` values: the two neighbours of each
+    quantile's position (n − 1)·p that ``np.quantile``'s linear method interpolates between,
+    and the ranks of its confidence interval."""
+    ranks: set[int] = set()
+    for p in QUANTILES:
+        below = math.floor((n - 1) * p)
+        ranks.update((below, min(below + 1, n - 1)))
+        ranks.update(r for r in _ci_ranks(n, p) if 0 <= r <= n - 1)
+    return sorted(ranks)
+
+
+def _quantile_ci(ranked: np.ndarray, p: float) -> dict[str, Any]:
+    """q_p and its confidence interval from ``ranked``: the values with every rank of
+    :func:`_ranks_read` in its sorted place (``np.partition``; a sorted array also serves)."""
+    n = len(ranked)
+    value = float(np.quantile(ranked, p, method="linear"))
+    lo, hi = _ci_ranks(n, p)
     ci = None
     if n >= 2 and lo >= 0 and hi <= n - 1:
-        ci = [float(sorted_values[lo]), float(sorted_values[hi])]
+        ci = [float(ranked[lo]), float(ranked[hi])]
     return {"value": value, "ci95": ci}
 
 
@@ -79,8 +97,9 @@ def summarise_values(values: ArrayLike) -> dict[str, Any]:
         min=float(np.min(x)),
         max=float(np.max(x)),
     )
-    s = np.sort(x)
-    out["quantiles"] = {f"p{round(100 * p):02d}": _quantile_ci(s, p) for p in QUANTILES}
+    # the few order statistics the quantiles read put in their places (O(n)), not a full sort
+    ranked = np.partition(x, _ranks_read(n))
+    out["quantiles"] = {f"p{round(100 * p):02d}": _quantile_ci(ranked, p) for p in QUANTILES}
     return out
 
 

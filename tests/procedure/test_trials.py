@@ -151,6 +151,27 @@ def test_mean_and_rms_standard_errors_match_their_spread():
     assert np.mean(covered) == pytest.approx(0.95, abs=3 * math.sqrt(0.95 * 0.05 / 400))
 
 
+@pytest.mark.parametrize("n", [2, 3, 19, 20, 21, 400, 4001])
+def test_quantiles_are_the_order_statistics_of_the_sorted_values(n):
+    """Each quantile and its interval as from the whole sample sorted (``np.quantile`` on it,
+    ranks k = T·p ± 1.96·√(T·p(1−p))), also with ties."""
+    rng = np.random.default_rng(n)
+    for x in (rng.exponential(size=n), rng.integers(0, 4, size=n).astype(float)):
+        if np.all(x == x[0]):
+            continue
+        s = np.sort(x)
+        got = summarise_values(x)["quantiles"]
+        for p in (0.05, 0.5, 0.95):
+            q = got[f"p{round(100 * p):02d}"]
+            assert q["value"] == np.quantile(s, p)
+            lo = math.floor(n * p - 1.959963984540054 * math.sqrt(n * p * (1 - p)))
+            hi = math.ceil(n * p + 1.959963984540054 * math.sqrt(n * p * (1 - p)))
+            if 0 <= lo and hi <= n - 1:
+                assert q["ci95"] == [s[lo], s[hi]]
+            else:
+                assert q["ci95"] is None
+
+
 def test_pass_rate_and_unit_change():
     assert summarise_flags([True] * 3 + [False])["rate"] == 0.75
     s = summarise_values([1.0, 2.0, np.nan, 4.0])
