@@ -204,11 +204,10 @@ def iter_chunk_columns(
     With ``workers`` > 1 the chunks after the first run in that many forked processes, each
     given the next task of :func:`worker_tasks` in trial order and at most
     :data:`QUEUED_PER_WORKER` ahead of the one yielded, while this process runs the first and
-    collects (the columns of a fixed number of tasks: its memory does not grow with the trials)
-    and, where each task is one chunk on whole keyed blocks, runs the next task not yet given
-    whenever the chunk to yield still runs (the last chunks shared by three processes; a chunk
-    starting inside a block would draw its prefix again here). ``progress`` counts each chunk
-    when it is yielded; every draw is keyed by the trial: no column depends on the workers.
+    then only collects: it holds the columns of a fixed number of tasks, never a share of the
+    run, so its memory does not grow with the trials (the forked processes keep the cores
+    busy). ``progress`` counts each chunk when it is yielded. Every draw is keyed by the trial,
+    so the columns are the same whatever the workers and the chunks.
     """
     if trials < 1:
         raise ValueError(f"trials: expected ≥ 1, found {trials}")
@@ -219,7 +218,6 @@ def iter_chunk_columns(
     count = len(starts)
     pool = None
     tasks: list[list[int]] = []
-    steal = False
     if workers > 1 and count > 1 and "fork" in multiprocessing.get_all_start_methods():
         _PREPARED[:] = [(prep, evaluate)]  # inherited by the forked workers
         context = multiprocessing.get_context("fork")
@@ -227,7 +225,6 @@ def iter_chunk_columns(
         pool = ProcessPoolExecutor(max_workers=processes, mp_context=context)
         depth = QUEUED_PER_WORKER * processes
         tasks = worker_tasks(count, chunk_trials, processes)
-        steal = chunk_trials % BLOCK == 0  # a chunk a task, none drawing a block's prefix
     task_of = {k: j for j, task in enumerate(tasks) for k in task}
     given: dict[int, Future[Any]] = {}  # each task given to a process: its chunks' columns
     done: dict[int, dict[str, NDArray[Any]]] = {}  # columns of a finished task, not yet yielded
@@ -255,9 +252,6 @@ def iter_chunk_columns(
                 if k not in done:
                     j = task_of[k]
                     give_workers(j)
-                    while steal and not given[j].done() and given_next < len(tasks):
-                        mine, given_next = tasks[given_next], given_next + 1  # run here
-                        done.update(_task_here(prep, mine, starts, sizes, evaluate))
                     done.update(zip(tasks[j], given.pop(j).result(), strict=True))
                 columns = done.pop(k)
             yield None, columns
@@ -268,12 +262,6 @@ def iter_chunk_columns(
         if pool is not None:
             pool.shutdown(cancel_futures=True)
             _PREPARED.clear()
-
-
-def _task_here(
-    prep: PreparedRun, task: list[int], starts: list[int], sizes: list[int], evaluate: bool
-) -> dict[int, dict[str, NDArray[Any]]]:
-    return {k: _columns_here(prep, starts[k], sizes[k], evaluate) for k in task}
 
 
 def _columns_here(prep: PreparedRun, first: int, n: int, evaluate: bool) -> dict[str, NDArray[Any]]:

@@ -16,7 +16,6 @@ from stereoplotter.cli import main
 from stereoplotter.io.instrument_file import load_instrument
 from stereoplotter.io.scenario_file import load_scenario
 from stereoplotter.io.trial_store import TrialStore
-from stereoplotter.procedure import trials
 from stereoplotter.procedure.arrays import max_abs_last
 from stereoplotter.procedure.simulate import prepare_run, simulate
 from stereoplotter.procedure.trials import (
@@ -233,31 +232,6 @@ def test_many_chunks_on_workers_give_the_columns_of_one_process():
     one = list(iter_chunk_columns(prep, 27, 3, workers=1, evaluate=False))
     two = list(iter_chunk_columns(prep, 27, 3, workers=2, evaluate=False))
     assert len(one) == len(two) == 9
-    for (_, a), (_, b) in zip(one, two, strict=True):
-        for name in a:
-            np.testing.assert_array_equal(a[name], b[name], err_msg=name)
-
-
-def test_chunks_this_process_takes_from_the_workers_give_the_columns_of_one_process(monkeypatch):
-    """Chunks on whole keyed blocks (the block taken as one trial here): the main process runs
-    the tasks not yet given while it waits for the workers; every chunk is yielded once, in
-    order, with the columns one process computes."""
-    sc = load_scenario("pair60")
-    prep = prepare_run(sc, load_instrument("sc1"), "setup", seed=3)
-    one = list(iter_chunk_columns(prep, 27, 3, workers=1, evaluate=False))
-    here = []
-    run_chunk = trials.run_trials_chunk
-
-    def counted(prep, first, n, **kwargs):
-        here.append(first)
-        return run_chunk(prep, first, n, **kwargs)
-
-    monkeypatch.setattr(trials, "BLOCK", 1)
-    monkeypatch.setattr(trials, "run_trials_chunk", counted)
-    assert trials.worker_tasks(9, 3, 2) == [[k] for k in range(1, 9)]
-    two = list(iter_chunk_columns(prep, 27, 3, workers=2, evaluate=False))
-    assert len(two) == 9
-    assert here[0] == 0 and len(here) == len(set(here))  # the first, and any taken here
     for (_, a), (_, b) in zip(one, two, strict=True):
         for name in a:
             np.testing.assert_array_equal(a[name], b[name], err_msg=name)
