@@ -156,21 +156,29 @@ def test_instrument_test_cli(capsys):
 
 
 @pytest.fixture(scope="module")
-def verify_rows():
-    """The rows of ``verify --trials 2000 --json``: the procedure MC and the as-formula runs
-    take their own trials and seeds, only the linear MC follows --trials (the as_formula blocks,
-    mc_procedure and its CI of every row were compared with the default run's: identical)."""
+def verify_run(tmp_path_factory):
+    """``verify --trials 2000 -o DIR``: (its printed text, DIR). The procedure MC and the
+    as-formula runs take their own trials and seeds, only the linear MC follows --trials (the
+    as_formula blocks, mc_procedure and its CI of every row were compared with the default
+    run's: identical)."""
+    out = tmp_path_factory.mktemp("verify")
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):
-        assert main(["verify", "--trials", "2000", "--json"]) == 0
-    return json.loads(buf.getvalue())
+        assert main(["verify", "--trials", "2000", "-o", str(out)]) == 0
+    return buf.getvalue(), out
 
 
-def test_verify_cli(tmp_path, capsys, verify_rows):
-    assert main(["verify", "--trials", "2000", "-o", str(tmp_path)]) == 0
-    out = capsys.readouterr().out
+@pytest.fixture(scope="module")
+def verify_rows(verify_run):
+    """The rows of that run as ``verify --json`` prints them: its ``verification.json`` holds
+    the same rows (plain JSON both)."""
+    return json.loads((verify_run[1] / "verification.json").read_text(encoding="utf-8"))
+
+
+def test_verify_cli(verify_run, verify_rows):
+    out, folder = verify_run
     assert "(6.43)" in out and "verdict" in out
-    names = {p.name for p in tmp_path.iterdir()}
+    names = {p.name for p in folder.iterdir()}
     assert {
         "verification.md",
         "verification.csv",
