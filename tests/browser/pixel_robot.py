@@ -408,6 +408,13 @@ FUSED_PX, UNFUSED_PX = 3.0, 10.0
 MARK_STEP_MM, DITHER, DITHER_RADIUS_PX = 0.01, 4, 4.0
 #: Steps of the search by Z, in :data:`Z_SEARCH_UM`. [—]
 Z_STEPS = (1, -1, 2, -2)
+#: The search beyond the finding field (:meth:`Robot.far`): b_y's probe [mm]; the y-parallax
+#: one step of b_y adds (under the ×2 search's reach, ±5 mm of photo, so that the steps'
+#: reaches overlap) [µm]; the steps, in those units (b_y's range on the SD-3 is ±20 mm) [—].
+BY_PROBE_MM, FAR_STEP_UM, FAR_STEPS = 1.0, 4000.0, (1, -1, 2, -2, 3, -3, 4, -4, 5, -5)
+#: With the search beyond the field: the largest turn of one conventional clearing (κ up to
+#: 0.15 rad clears 8 mm of y-parallax 60 mm from the other photo's centre), and its cycles.
+WIDE_MAX_TURN, WIDE_CYCLES = 0.15, 6
 
 
 class Robot:
@@ -416,8 +423,17 @@ class Robot:
     fused Z is kept and set again when the robot comes back to it."""
 
     def __init__(self, eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6),
-                 observer=None):
+                 observer=None, substitutes: dict[int, tuple[float, float]] | None = None,
+                 wide: bool = False):
         self.eyes = eyes
+        #: Standard point → the offset of its substitute from it on the left photo (x, y up):
+        #: the marks go to the point, then on by this offset. [mm]
+        self.substitutes = dict(substitutes or {})
+        #: Whether a detail outside the finding field is searched for by b_y
+        #: (:meth:`far`), and the conventional clearing turns further (:data:`WIDE_MAX_TURN`).
+        self.wide = wide
+        self.by_base: float | None = None  # b_y as the robot found it (its setting)
+        self.q_per_by: float | None = None  # µm of y-parallax seen per mm of b_y
         #: Called with the record after each pass (a benchmark's diagnostics; the robot never
         #: reads what it does).
         self.observer = observer
@@ -443,10 +459,66 @@ class Robot:
         self.px_per_xy = np.array(cols).T
         self.rec.notes.append(f"px per X, Y: {self.px_per_xy.tolist()}")
 
+    def arrive(self, n: int) -> None:
+        """Go to standard point ``n`` (its go-to), and on to its substitute where it has one
+        (X and Y turned by the offset, through the learnt effect of X and Y on the view)."""
+        self.eyes.go_to(n)
+        if n not in self.substitutes or self.px_per_xy is None:
+            return
+        dx_mm, dy_mm = self.substitutes[n]
+        px = np.array([dx_mm, -dy_mm]) / (SCREEN_PIXEL_MM / FIND_MAG)
+        turns = np.linalg.solve(self.px_per_xy, px)
+        for axis, d in zip(("X", "Y"), turns, strict=True):
+            self.eyes.turn(axis, round(float(d), 3))
+
+    def set_by(self, value: float) -> float:
+        """b_y set (a setting past a stop is refused: the wheel then stays); its value."""
+        self.eyes.set("by", round(value, 3))
+        return self.eyes.wheel("by")
+
+    def learn_by(self) -> None:
+        """How a turn of b_y moves the right view (a probe of :data:`BY_PROBE_MM`, the right
+        view before and after matched on itself): the y-parallax it adds a mm."""
+        self.by_base = self.eyes.wheel("by")
+        before = view(self.eyes, FIND_MAG)[1]
+        now = self.set_by(self.by_base + BY_PROBE_MM)
+        after = view(self.eyes, FIND_MAG)[1]
+        self.set_by(self.by_base)
+        m = match(before, after, FIND_MAG)
+        if m is None or abs(now - self.by_base) < 0.5 * BY_PROBE_MM:
+            self.rec.notes.append(f"b_y probe: {m}, b_y {now}")
+            return
+        self.q_per_by = m.q_um / (now - self.by_base)
+        self.rec.notes.append(f"q per b_y: {self.q_per_by:.0f} µm/mm")
+
+    def far(self, n: int) -> tuple[Match, float] | None:
+        """A detail outside the finding field searched for by b_y: b_y set by steps of about
+        :data:`FAR_STEP_UM` of y-parallax each way (:data:`FAR_STEPS`), the detail looked for
+        at each (and by Z, :meth:`coarse`); the match and the y-parallax the shift of b_y
+        added (b_y left where the detail was found; :meth:`by_back` sets it back). [µm]"""
+        if self.q_per_by is None or self.by_base is None:
+            return None
+        for k in FAR_STEPS:
+            now = self.set_by(self.by_base + k * FAR_STEP_UM / abs(self.q_per_by))
+            if abs(now - self.by_base) < 1e-6:
+                continue
+            m = self.coarse(n)
+            if m is not None:
+                added = (now - self.by_base) * self.q_per_by
+                self.rec.notes.append(f"far {n}: b_y {now} ({added:.0f} µm): {m}")
+                return m, added
+        self.set_by(self.by_base)
+        self.rec.notes.append(f"far {n}: not found")
+        return None
+
+    def by_back(self) -> None:
+        if self.by_base is not None and self.eyes.wheel("by") != self.by_base:
+            self.set_by(self.by_base)
+
     def go_to(self, n: int) -> None:
         """Go to point ``n`` and on to its detail (:func:`textured_spot`), chosen the first
         time from the ×2 view."""
-        self.eyes.go_to(n)
+        self.arrive(n)
         if self.px_per_xy is None:
             return
         if n not in self.spot_at:
@@ -618,21 +690,31 @@ class Robot:
         """At point ``n``: the detail found, ``control`` turned by a probe step to learn its
         effect on the y-parallax, then turned to clear it (a step of the conventional method,
         by the eye)."""
-        self.eyes.go_to(n)
+        self.arrive(n)
         m = self.coarse(n)
+        added = 0.0  # the y-parallax a shifted b_y adds to what is seen [µm]
+        if m is None and self.wide:
+            found = self.far(n)
+            if found is not None:
+                m, added = found
         if m is None:
             return False
-        if abs(m.q_um) < CLASSIC_DONE_UM:
+        if abs(m.q_um - added) < CLASSIC_DONE_UM:
+            self.by_back()
             return True
         self.eyes.turn(control, PROBE[control])
         moved = self.look((m.dx_px, m.dy_px), 40.0)
         if moved is None or abs(moved.q_um - m.q_um) < 20.0:
             self.eyes.turn(control, -PROBE[control])
+            self.by_back()
             return False
         per = (moved.q_um - m.q_um) / PROBE[control]
-        d = float(np.clip(-moved.q_um / per, -CLASSIC_MAX_TURN, CLASSIC_MAX_TURN))
+        most = WIDE_MAX_TURN if self.wide else CLASSIC_MAX_TURN
+        d = float(np.clip(-(moved.q_um - added) / per, -most, most))
         self.eyes.turn(control, d)
-        self.rec.notes.append(f"classic {n} {control}: q {moved.q_um:.0f} µm, turned {d:.5f}")
+        self.by_back()
+        self.rec.notes.append(f"classic {n} {control}: q {moved.q_um - added:.0f} µm, "
+                              f"turned {d:.5f}")
         return True
 
     def learn_z(self, m: Match) -> Match:
@@ -664,6 +746,12 @@ class Robot:
         n = self.rec.points[0]
         self.eyes.go_to(n)
         self.z = self.eyes.wheel("Z")
+        if self.wide or self.substitutes:
+            # the effects of X, Y (for the substitutes) and of b_y (for the search beyond
+            # the field) learnt first: each from one view matched on itself
+            self.learn_xy()
+            if self.wide:
+                self.learn_by()
         m = self.look()
         for d in COMMON_SEARCH:
             if m is not None:
@@ -672,15 +760,20 @@ class Robot:
             m = self.look()
             if m is None:
                 self.eyes.turn("kappa_right", -d)
+        if m is None and self.wide:
+            found = self.far(n)
+            m = None if found is None else found[0]
         if m is None:
             return
         self.learn_z(m)
-        for _ in range(CLASSIC_CYCLES):
+        self.by_back()
+        for _ in range(WIDE_CYCLES if self.wide else CLASSIC_CYCLES):
             ok = [self.clear_with(p, c) for p, c in CLASSIC if p in self.rec.points]
             if all(ok):
                 break
         self.eyes.go_to(n)
-        self.learn_xy()
+        if self.px_per_xy is None:
+            self.learn_xy()
 
     def predict(self, q_um: dict[int, float], p_um: dict[int, float],
                 step: dict[str, float]) -> dict[int, tuple[float, float]]:
@@ -724,6 +817,12 @@ class Robot:
             m = self.fine(n, m)
         if m.magnification != FINE_MAGS[0]:
             m = self.fine_spot(n, m)
+        if (m.magnification == FIND_MAG and rec.x_per_z is not None
+                and abs(m.dx_px) > UNFUSED_PX):
+            # a ×2 match whose x-parallax Z could not clear (each fusing look lost it): not
+            # taken as a reading, as an unfused ×20 match is not (:meth:`fused_or`)
+            rec.notes.append(f"unfused ×{FIND_MAG} at {n}: {m}: not read")
+            return None
         return self.steady(m)
 
     def probe_row(self, n: int) -> None:
@@ -833,9 +932,25 @@ def _worse(q_um: dict[int, float], mag: dict[int, int], last_q: dict[int, float]
         WORSE_FACTOR * max(abs(last_q[n]) for n in common) + WORSE_UM)
 
 
+#: How far a substitute for an unusable standard point is put from it, towards the middle
+#: of the other points (the grade takes one within 0.2·c of the point, 14 mm for c = 70 mm;
+#: the ×2 field's half is 6.4 mm). [mm]
+SUBSTITUTE_MM = 10.0
+
+
+def substitute_offset(points: dict[int, tuple[float, float]], n: int) -> tuple[float, float]:
+    """Where to look instead of the unusable standard point ``n`` (``points``: the standard
+    points on the left photo, as the overview draws them): :data:`SUBSTITUTE_MM` from it
+    towards the mean of the others, as the offset from it (x, y up). [mm]"""
+    here = np.array(points[n], float)
+    rest = np.mean([xy for k, xy in points.items() if k != n], axis=0)
+    way = (rest - here) / np.linalg.norm(rest - here)
+    return float(round(way[0] * SUBSTITUTE_MM, 3)), float(round(way[1] * SUBSTITUTE_MM, 3))
+
+
 def relative_orientation(eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6),
-                         observer=None) -> Orientation:
+                         observer=None, substitutes=None, wide: bool = False) -> Orientation:
     """Clear the y-parallax at the standard ``points`` by least squares on the measured
     parallaxes (module docstring); returns the record (the last measured q at each point).
     ``observer`` (diagnostics only) is called with the record after each pass."""
-    return Robot(eyes, tolerance_um, points, observer).run()
+    return Robot(eyes, tolerance_um, points, observer, substitutes, wide).run()
