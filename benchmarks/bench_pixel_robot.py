@@ -61,6 +61,14 @@ def _observer(app, sid: str, eyes):
     return show
 
 
+class _Echo(list):
+    """The robot's notes, printed as they are made (``--verbose``)."""
+
+    def append(self, note) -> None:
+        print("   ", note, flush=True)
+        super().append(note)
+
+
 def _stage(page) -> str:
     return page.inner_text("#stage")
 
@@ -92,10 +100,8 @@ def _e12(page, base, app, sid, eyes, observer, trainee, t0, verbose) -> None:
     print(f"  substitutes (offset from the point, mm): {subs}; true q after C1 "
           f"{_true_q_um(app, sid)} µm", flush=True)
     rec = relative_orientation(eyes, pixel_page.tolerance_um(page), observer=observer,
-                               substitutes=subs, wide=True)
-    if verbose:
-        for note in rec.notes:
-            print("   ", note)
+                               substitutes=subs, wide=True,
+                               notes=_Echo() if verbose else None)
     eyes.claim()
     seen = {n: f"{q:.1f} (×{rec.mag[n]})" for n, q in sorted(rec.q_um.items())}
     print(f"{trainee}: C2 claimed; true q {_true_q_um(app, sid)} µm; {measures('C2')}; "

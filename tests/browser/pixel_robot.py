@@ -253,12 +253,13 @@ def _vertex(c_m: float, c_0: float, c_p: float) -> float:
 def match(
     left: np.ndarray, right: np.ndarray, magnification: int,
     predict_px: tuple[float, float] | None = None, radius_px: float | None = None,
-    strict: bool = True,
+    strict: bool = True, reach_px: float = SEARCH_PX,
 ) -> Match | None:
     """The left eyepiece's centre found in the right eyepiece (see the module docstring), or
     None where the match is weak or ambiguous. ``predict_px``, ``radius_px``: search only
     offsets within ``radius_px`` of ``predict_px``; the peak's lead is then taken over the
-    peaks within :data:`LOCAL_RIVAL` radii of the prediction."""
+    peaks within :data:`LOCAL_RIVAL` radii of the prediction. ``reach_px``: the largest
+    offset searched on each axis (a match at it is refused: the detail may lie beyond)."""
     gl, ml = grey_and_mask(left)
     gr, mr = grey_and_mask(right)
     h, w = gl.shape
@@ -270,7 +271,7 @@ def match(
     oy, ox = np.mgrid[0:ncc.shape[0], 0:ncc.shape[1]]
     # offsets of the template from its place in the left view
     oy, ox = oy - (size - 1) - c0[0], ox - (size - 1) - c0[1]
-    allowed = (np.abs(oy) <= SEARCH_PX) & (np.abs(ox) <= SEARCH_PX)
+    allowed = (np.abs(oy) <= reach_px) & (np.abs(ox) <= reach_px)
     if predict_px is not None and radius_px is not None:
         allowed &= np.hypot(ox - predict_px[0], oy - predict_px[1]) <= radius_px
     if not allowed.any():
@@ -287,7 +288,7 @@ def match(
     margin = peak - second
     if strict and (peak < MIN_PEAK or margin < MIN_MARGIN):
         return None
-    if max(abs(oy[i, j]), abs(ox[i, j])) >= SEARCH_PX:  # at the search's edge: beyond it
+    if max(abs(oy[i, j]), abs(ox[i, j])) >= reach_px:  # at the search's edge: beyond it
         return None
     di = _vertex(ncc[i - 1, j], ncc[i, j], ncc[i + 1, j])
     dj = _vertex(ncc[i, j - 1], ncc[i, j], ncc[i, j + 1])
@@ -415,6 +416,15 @@ BY_PROBE_MM, FAR_STEP_UM, FAR_STEPS = 1.0, 4000.0, (1, -1, 2, -2, 3, -3, 4, -4, 
 #: With the search beyond the field: the largest turn of one conventional clearing (κ up to
 #: 0.15 rad clears 8 mm of y-parallax 60 mm from the other photo's centre), and its cycles.
 WIDE_MAX_TURN, WIDE_CYCLES = 0.15, 6
+#: Halvings of a clearing turn that the stop refused (the knobs stop at tan 3°). [—]
+WIDE_STOP_TRIES = 4
+#: The search by Z with the search beyond the field, in :data:`Z_SEARCH_UM` (in mountains a
+#: detail's x-parallax at another point's Z reaches well over the ±7 mm of :data:`Z_STEPS`:
+#: e12, point 5 at 0.7 mm of y-parallax not found by them). [—]
+WIDE_Z_STEPS = (1, -1, 2, -2, 3, -3, 4, -4, 5, -5)
+#: The reach of a ×2 search beyond the field, on each axis (the steps of Z and b_y move the
+#: detail by 70–80 ×2 pixels, so the reaches still overlap). [px]
+WIDE_REACH_PX = 85.0
 
 
 class Robot:
@@ -433,6 +443,8 @@ class Robot:
         #: (:meth:`far`), and the conventional clearing turns further (:data:`WIDE_MAX_TURN`).
         self.wide = wide
         self.by_base: float | None = None  # b_y as the robot found it (its setting)
+        #: The point the marks were last sent to, and whether on to its detail spot.
+        self.here: tuple[int, bool] | None = None
         self.q_per_by: float | None = None  # µm of y-parallax seen per mm of b_y
         #: Called with the record after each pass (a benchmark's diagnostics; the robot never
         #: reads what it does).
@@ -463,6 +475,7 @@ class Robot:
         """Go to standard point ``n`` (its go-to), and on to its substitute where it has one
         (X and Y turned by the offset, through the learnt effect of X and Y on the view)."""
         self.eyes.go_to(n)
+        self.here = (n, False)
         if n not in self.substitutes or self.px_per_xy is None:
             return
         dx_mm, dy_mm = self.substitutes[n]
@@ -499,9 +512,10 @@ class Robot:
         if self.q_per_by is None or self.by_base is None:
             return None
         for k in FAR_STEPS:
-            now = self.set_by(self.by_base + k * FAR_STEP_UM / abs(self.q_per_by))
-            if abs(now - self.by_base) < 1e-6:
-                continue
+            target = self.by_base + k * FAR_STEP_UM / abs(self.q_per_by)
+            now = self.set_by(target)
+            if abs(now - target) > 0.015:
+                continue  # past b_y's stop: refused
             m = self.coarse(n)
             if m is not None:
                 added = (now - self.by_base) * self.q_per_by
@@ -519,6 +533,7 @@ class Robot:
         """Go to point ``n`` and on to its detail (:func:`textured_spot`), chosen the first
         time from the ×2 view."""
         self.arrive(n)
+        self.here = (n, True)
         if self.px_per_xy is None:
             return
         if n not in self.spot_at:
@@ -531,8 +546,15 @@ class Robot:
                 self.eyes.turn(axis, d)
 
     def set_z(self, value: float) -> None:
+        before = self.z
         self.eyes.set("Z", round(value, 3))
         self.z = self.eyes.wheel("Z")  # at a stop the carriage stays there
+        if self.wide and self.here is not None and self.z != before:
+            # Z moves the model point the marks are on, and so the left mark off the point
+            # (SD-3, e12: 50 mm of Z moved it 28 mm, off the photo at point 2): the marks
+            # brought back onto the point at the new Z, as a go-to puts them
+            n, spot = self.here
+            self.go_to(n) if spot else self.arrive(n)
 
     def fine_spot(self, n: int, m: Match) -> Match:
         """Where ×20 finds nothing sure at point ``n``'s detail (a striped field, a plain one),
@@ -640,8 +662,8 @@ class Robot:
             return m
         return again
 
-    def look(self, predict=None, radius=None) -> Match | None:
-        return match(*view(self.eyes, FIND_MAG), FIND_MAG, predict, radius)
+    def look(self, predict=None, radius=None, reach=SEARCH_PX) -> Match | None:
+        return match(*view(self.eyes, FIND_MAG), FIND_MAG, predict, radius, reach_px=reach)
 
     def clear_x(self, m: Match) -> Match:
         """Z set to clear the x-parallax of a found detail (up to three settings, the detail
@@ -666,6 +688,8 @@ class Robot:
         rec = self.rec
         if n in self.z_at and self.z != self.z_at[n]:
             self.set_z(self.z_at[n])
+        if self.wide:
+            return self.coarse_wide(n)
         m = self.look()
         if m is None and rec.x_per_z is not None:
             start = self.z
@@ -685,6 +709,36 @@ class Robot:
         self.z_at[n] = self.z
         rec.notes.append(f"coarse {n}: {m}")
         return m
+
+    def coarse_wide(self, n: int) -> Match | None:
+        """:meth:`coarse` with the search beyond the field: Z set by :data:`WIDE_Z_STEPS`, the
+        detail looked for within :data:`WIDE_REACH_PX` (a match farther out was, in e12's
+        first runs, a weak false one at the search's edge), and a match taken only where Z
+        then fuses it (its x-parallax cleared to :data:`UNFUSED_PX`): a match Z cannot fuse
+        is not the detail, and the search goes on."""
+        rec = self.rec
+        start = self.z
+        settings = [0.0]
+        if rec.x_per_z is not None:
+            settings += [k * Z_SEARCH_UM / abs(rec.x_per_z) for k in WIDE_Z_STEPS]
+        for dz in settings:
+            if dz:
+                self.set_z(start + dz)
+            m = self.look(reach=WIDE_REACH_PX)
+            if m is None:
+                continue
+            if rec.x_per_z is None:
+                m = self.learn_z(m)
+            m = self.clear_x(m)
+            if rec.x_per_z is not None and abs(m.dx_px) > UNFUSED_PX:
+                rec.notes.append(f"coarse {n}: not fused, refused: {m}")
+                continue
+            self.z_at[n] = self.z
+            rec.notes.append(f"coarse {n}: {m} (Z {self.z})")
+            return m
+        self.set_z(start)
+        rec.notes.append(f"coarse {n}: not found")
+        return None
 
     def clear_with(self, n: int, control: str) -> bool:
         """At point ``n``: the detail found, ``control`` turned by a probe step to learn its
@@ -711,7 +765,13 @@ class Robot:
         per = (moved.q_um - m.q_um) / PROBE[control]
         most = WIDE_MAX_TURN if self.wide else CLASSIC_MAX_TURN
         d = float(np.clip(-(moved.q_um - added) / per, -most, most))
+        was = self.eyes.wheel(control) if self.wide else None
         self.eyes.turn(control, d)
+        for _ in range(WIDE_STOP_TRIES if self.wide else 0):
+            if self.eyes.wheel(control) != was:
+                break
+            d /= 2  # a turn past the stop is refused: a shorter one
+            self.eyes.turn(control, d)
         self.by_back()
         self.rec.notes.append(f"classic {n} {control}: q {moved.q_um - added:.0f} µm, "
                               f"turned {d:.5f}")
@@ -744,7 +804,7 @@ class Robot:
         the eye, each element's effect learnt by a probe turn) until every detail is found near
         the mark."""
         n = self.rec.points[0]
-        self.eyes.go_to(n)
+        self.arrive(n)
         self.z = self.eyes.wheel("Z")
         if self.wide or self.substitutes:
             # the effects of X, Y (for the substitutes) and of b_y (for the search beyond
@@ -949,8 +1009,15 @@ def substitute_offset(points: dict[int, tuple[float, float]], n: int) -> tuple[f
 
 
 def relative_orientation(eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6),
-                         observer=None, substitutes=None, wide: bool = False) -> Orientation:
+                         observer=None, substitutes=None, wide: bool = False,
+                         notes: list | None = None) -> Orientation:
     """Clear the y-parallax at the standard ``points`` by least squares on the measured
     parallaxes (module docstring); returns the record (the last measured q at each point).
-    ``observer`` (diagnostics only) is called with the record after each pass."""
-    return Robot(eyes, tolerance_um, points, observer, substitutes, wide).run()
+    ``observer`` (diagnostics only) is called with the record after each pass; ``notes``
+    (diagnostics only) is the list the robot's notes are appended to as they are made.
+    ``substitutes``: standard point → the offset of its substitute on the left photo (mm,
+    :func:`substitute_offset`); ``wide``: search beyond the finding field by b_y."""
+    robot = Robot(eyes, tolerance_um, points, observer, substitutes, wide)
+    if notes is not None:
+        robot.rec.notes = notes
+    return robot.run()
