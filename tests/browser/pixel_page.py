@@ -1,7 +1,9 @@
 """The pixel robot's hands and eyes on the instrument page (``tests/browser/pixel_robot.py``
 decides): the go-to buttons, turns typed into the keyboard box, the magnification box, and the
 two eyepiece canvases as the page draws them (read back as PNG). Nothing else of the page is
-read: no parallax read-out (an exam has none), no state, no core.
+read: no parallax read-out (an exam has none), no state, no core. For the shipped exam e12
+also the setup sheet panel (C1's values, :func:`interior`), the counters' *read*, the gear and
+record forms, and the overview's standard points and its list of unusable ones.
 """
 
 from __future__ import annotations

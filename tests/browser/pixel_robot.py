@@ -37,6 +37,15 @@ solved from the ×20 readings alone (averaging the readings' scatter over the pa
 that loses a point is turned back whole, the points measured again there, and a shorter one
 (:data:`LOST_SHARE`) taken; a step that leaves the parallaxes worse is halved (half of it
 turned back) and the points measured again, or turned back whole after the last pass.
+
+**Beyond the field** (``wide``, the mountain exam e12 on the SD-3): a point whose detail the
+×2 field does not show is searched for by b_y (:meth:`Robot.far`: b_y's effect on the right
+view learnt by a probe, then steps of about 4 mm of y-parallax each way, the y-parallax the
+shift added counted in and b_y set back after the clearing turn) and by Z over ±60 mm (the
+marks put back on the point after each setting of Z: on the SD-3 Z moves the left mark off
+it), a match taken only where Z then fuses it (:meth:`Robot.coarse_wide`). An unusable
+standard point is measured at its substitute (``substitutes``: the marks go to the point, then
+on by the offset, :func:`substitute_offset`).
 """
 
 from __future__ import annotations
