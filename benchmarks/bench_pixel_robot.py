@@ -35,7 +35,7 @@ from stereoplotter.web.browser_setup import chromium_path
 from stereoplotter.web.registry import SEED_KEY
 from tests.browser import pixel_page
 from tests.browser.conftest import FLAGS, _free_port
-from tests.browser.pixel_robot import relative_orientation
+from tests.browser.pixel_robot import relative_orientation, substitute_offset
 
 TOKEN = "bench-token"
 
@@ -61,6 +61,55 @@ def _observer(app, sid: str, eyes):
     return show
 
 
+class _Echo(list):
+    """The robot's notes, printed as they are made (``--verbose``)."""
+
+    def append(self, note) -> None:
+        print("   ", note, flush=True)
+        super().append(note)
+
+
+def _stage(page) -> str:
+    return page.inner_text("#stage")
+
+
+def _e12(page, base, app, sid, eyes, observer, trainee, t0, verbose) -> None:
+    """e12 as far as the robot goes: C1 from the sheet (claimed), the substitute recorded, C2
+    by the robot (claimed); prints the stage reached and the true residuals at each claim."""
+    from stereoplotter.trainer.outcome import stage_measures
+
+    session = app.state.registry.live[sid].session
+
+    def measures(stage: str) -> str:
+        inst = session.at_claim.get(stage, session.inst)
+        return "; ".join(f"{m.name} {float(np.max(m.value)):.4g} {m.unit} (tol "
+                         f"{m.tolerance:.4g})"
+                         for m in stage_measures(inst, session.prep, stage,
+                                                 session.exercise.unusable_points))
+
+    sheet = pixel_page.sheet_values(page)
+    pixel_page.interior(eyes, sheet)
+    eyes.claim()
+    print(f"{trainee}: C1 claimed ({eyes.sent} actions): {measures('C1')}; now "
+          f"{_stage(page)!r}", flush=True)
+    points = eyes.standard_points()
+    subs = {n: substitute_offset(points, n) for n in eyes.unusable()}
+    for n, (dx, dy) in subs.items():
+        x, y = points[n][0] + dx, points[n][1] + dy
+        eyes.record(f"substitute {n}", f"{x:.3f}, {y:.3f}")
+    print(f"  substitutes (offset from the point, mm): {subs}; true q after C1 "
+          f"{_true_q_um(app, sid)} µm", flush=True)
+    rec = relative_orientation(eyes, pixel_page.tolerance_um(page), observer=observer,
+                               substitutes=subs, wide=True,
+                               notes=_Echo() if verbose else None)
+    eyes.claim()
+    seen = {n: f"{q:.1f} (×{rec.mag[n]})" for n, q in sorted(rec.q_um.items())}
+    print(f"{trainee}: C2 claimed; true q {_true_q_um(app, sid)} µm; {measures('C2')}; "
+          f"last read q {seen}; passes {rec.passes}; {eyes.sent} actions, {eyes.looks} looks, "
+          f"{time.perf_counter() - t0:.0f} s; now {_stage(page)!r} (C3, C4 not attempted)",
+          flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=10)
@@ -68,6 +117,11 @@ def main() -> None:
     ap.add_argument("--practice-seed", type=int, default=None,
                     help="run the fixed-seed practice exercise of "
                     "tests/browser/test_pixel_robot.py with this seed, for its trainee")
+    ap.add_argument("--exercise", choices=("c2", "e12"), default="c2",
+                    help="c2: C2 of e05 as an exam (the default); e12: the shipped conventional "
+                    "exam e12 (SD-3, mountains): C1 from the sheet, C2 with a substitute for "
+                    "the unusable point and the search beyond the field; C3 and C4 are not "
+                    "attempted")
     ap.add_argument("--verbose", action="store_true",
                     help="diagnostics: the robot's notes, and after each pass the true q and Z "
                     "read from the server's session (never shown to the robot)")
@@ -98,7 +152,9 @@ def main() -> None:
         page = ctx.new_page()
         page.goto(base + "/")
         name = pixel_page.EXAM_NAME
-        if args.practice_seed is None:
+        if args.exercise == "e12":
+            name = pixel_page.E12_NAME
+        elif args.practice_seed is None:
             pixel_page.upload_exam(page, base, TOKEN)
         else:
             name = f"c2-by-eye-{args.practice_seed}"
@@ -110,6 +166,9 @@ def main() -> None:
             sid = pixel_page.start(page, base, trainee, name)
             eyes = pixel_page.PageEyes(page)
             observer = _observer(app, sid, eyes) if args.verbose else None
+            if args.exercise == "e12":
+                _e12(page, base, app, sid, eyes, observer, trainee, t0, args.verbose)
+                continue
             rec = relative_orientation(eyes, pixel_page.tolerance_um(page), observer=observer)
             if args.verbose:
                 for note in rec.notes:

@@ -1,7 +1,9 @@
 """The pixel robot's hands and eyes on the instrument page (``tests/browser/pixel_robot.py``
 decides): the go-to buttons, turns typed into the keyboard box, the magnification box, and the
 two eyepiece canvases as the page draws them (read back as PNG). Nothing else of the page is
-read: no parallax read-out (an exam has none), no state, no core.
+read: no parallax read-out (an exam has none), no state, no core. For the shipped exam e12
+also the setup sheet panel (C1's values, :func:`interior`), the counters' *read*, the gear and
+record forms, and the overview's standard points and its list of unusable ones.
 """
 
 from __future__ import annotations
@@ -70,6 +72,46 @@ class PageEyes:
         its old value in 3 of 30 sessions)."""
         text = self.page.evaluate(_WHEEL, f".wheel[data-control='{control}'] .value")
         return float(text.split()[0].replace("−", "-"))
+
+    def gear(self, value: int) -> None:
+        """Gear the height counter (the gear form)."""
+        t0 = time.monotonic()
+        self.page.fill("#act-gear-value", str(int(value)))
+        self.page.click("#act-gear")
+        self.page.wait_for_function(f"() => window.__n >= {self.sent + 1}", timeout=60_000)
+        self.settle()
+        self.act_s += time.monotonic() - t0
+
+    def read(self, counter: str) -> float:
+        """A counter read by its *read* button: the value the result line shows."""
+        import re
+
+        t0 = time.monotonic()
+        self.page.click(f"#counters tr[data-counter='{counter}'] .read")
+        self.page.wait_for_function(f"() => window.__n >= {self.sent + 1}", timeout=60_000)
+        self.settle()
+        self.act_s += time.monotonic() - t0
+        return float(re.search(r"reads (-?[\d.]+)", self.page.inner_text("#result")).group(1))
+
+    def record(self, name: str, value: str) -> None:
+        """Write a value on the sheet (the record form): e.g. ``substitute 3``, ``"x, y"``."""
+        self.page.fill("#act-record-name", name)
+        self.page.fill("#act-record-value", value)
+        self.page.click("#act-record")
+        self.page.wait_for_function(f"() => window.__n >= {self.sent + 1}", timeout=60_000)
+        self.settle()
+
+    def standard_points(self) -> dict[int, tuple[float, float]]:
+        """The standard points where the overview draws them on the left photo. [mm]"""
+        out = {}
+        for g in self.page.locator("#overview-svg g.ov-standard[data-left-xy]").all():
+            x, y = (float(v) for v in g.get_attribute("data-left-xy").split(","))
+            out[int(g.get_attribute("data-point"))] = (x, y)
+        return out
+
+    def unusable(self) -> list[int]:
+        """The standard points the overview calls unusable (its substitute list)."""
+        return [int(v) for v in self.page.locator("#substitute-for option").all_inner_texts()]
 
     def claim(self) -> None:
         before = self.sent
@@ -152,6 +194,62 @@ def start(page, server: str, trainee: str, name: str = EXAM_NAME) -> str:
     page.wait_for_selector("body[data-ready='1']")
     page.wait_for_selector("body[data-overview='1']")
     return page.url.rsplit("/", 1)[1]
+
+
+#: The shipped conventional exam (SD-3, mountains, C1–C4, standard point 3 unusable).
+E12_NAME = "e12-conventional-exam"
+#: The places of zero of the counters a C1 sets from (the instrument's own, known to its
+#: operator: b_x 0, b_y and b_z′ 50, the decentrations 20 mm; the decentration counter's
+#: caption on the page says so for dx, dy). [mm]
+ZERO_PLACES = {"bx": 0.0, "by": 50.0, "bz": 50.0, "dx_left": 20.0, "dy_left": 20.0,
+               "dx_right": 20.0, "dy_right": 20.0}
+
+
+def sheet_values(page) -> dict[str, float]:
+    """The numeric rows of the setup sheet panel (``f instrument mm`` → 111.987527, …)."""
+    page.click("#sheet-btn")
+    page.wait_for_function("() => /f instrument/.test(document.querySelector('#sheet-body')"
+                           ".innerText)", timeout=60_000)
+    out = {}
+    for line in page.inner_text("#sheet-body").splitlines():
+        parts = line.split("\t")
+        if len(parts) == 2:
+            try:
+                out[parts[0].strip()] = float(parts[1])
+            except ValueError:
+                pass
+    page.click("#sheet-close")
+    return out
+
+
+def interior(eyes: PageEyes, sheet: dict[str, float]) -> None:
+    """C1 of the conventional method from the setup sheet, as its steps name it: the height
+    counter geared to 1:M_в, f_пр, the cassettes at κ = 0, the correction knobs at 0 and the
+    decentrations at their places of zero, b_x = MO_bx + b_x (MO_bx read at the place of
+    zero), b_z′ = 0, D = n_л·f_пр (Z, to its upper stop where beyond). MO_by, MO_X, MO_Y need
+    the cassette centres, which the exam's page does not caption: b_y is left at its place of
+    zero (the relative orientation takes up a common y-shift with the two κ)."""
+    eyes.gear(int(sheet["scale vertical"]))
+    f = sheet["f instrument mm"]
+    eyes.set("f_instrument", f)
+    for control in ("kappa_left", "kappa_right", "k_alpha_left", "k_omega_left",
+                    "k_alpha_right", "k_omega_right"):
+        eyes.set(control, 0.0)
+    for control in ("dx_left", "dy_left", "dx_right", "dy_right", "by"):
+        eyes.set(control, ZERO_PLACES[control])
+    eyes.set("bx", ZERO_PLACES["bx"])
+    mo_bx = eyes.read("bx")
+    eyes.set("bx", round(mo_bx + sheet["b x mm"], 3))
+    eyes.set("bz", ZERO_PLACES["bz"])
+    d = sheet["n left"] * f
+    for below in Z_BACK_OFF:  # a setting past the stop is refused: a little lower each time
+        eyes.set("Z", round(d - below, 3))
+        if abs(eyes.wheel("Z") - (d - below)) < 0.011:
+            break
+
+
+#: How far under D = n_л·f_пр C1 tries Z where the setting is refused (past the stop). [mm]
+Z_BACK_OFF = (0.0, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0)
 
 
 def grade_after_claim(page, server: str, sid: str) -> dict:

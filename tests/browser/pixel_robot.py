@@ -37,6 +37,15 @@ solved from the ×20 readings alone (averaging the readings' scatter over the pa
 that loses a point is turned back whole, the points measured again there, and a shorter one
 (:data:`LOST_SHARE`) taken; a step that leaves the parallaxes worse is halved (half of it
 turned back) and the points measured again, or turned back whole after the last pass.
+
+**Beyond the field** (``wide``, the mountain exam e12 on the SD-3): a point whose detail the
+×2 field does not show is searched for by b_y (:meth:`Robot.far`: b_y's effect on the right
+view learnt by a probe, then steps of about 4 mm of y-parallax each way, the y-parallax the
+shift added counted in and b_y set back after the clearing turn) and by Z over ±60 mm (the
+marks put back on the point after each setting of Z: on the SD-3 Z moves the left mark off
+it), a match taken only where Z then fuses it (:meth:`Robot.coarse_wide`). An unusable
+standard point is measured at its substitute (``substitutes``: the marks go to the point, then
+on by the offset, :func:`substitute_offset`).
 """
 
 from __future__ import annotations
@@ -253,12 +262,13 @@ def _vertex(c_m: float, c_0: float, c_p: float) -> float:
 def match(
     left: np.ndarray, right: np.ndarray, magnification: int,
     predict_px: tuple[float, float] | None = None, radius_px: float | None = None,
-    strict: bool = True,
+    strict: bool = True, reach_px: float = SEARCH_PX,
 ) -> Match | None:
     """The left eyepiece's centre found in the right eyepiece (see the module docstring), or
     None where the match is weak or ambiguous. ``predict_px``, ``radius_px``: search only
     offsets within ``radius_px`` of ``predict_px``; the peak's lead is then taken over the
-    peaks within :data:`LOCAL_RIVAL` radii of the prediction."""
+    peaks within :data:`LOCAL_RIVAL` radii of the prediction. ``reach_px``: the largest
+    offset searched on each axis (a match at it is refused: the detail may lie beyond)."""
     gl, ml = grey_and_mask(left)
     gr, mr = grey_and_mask(right)
     h, w = gl.shape
@@ -270,7 +280,7 @@ def match(
     oy, ox = np.mgrid[0:ncc.shape[0], 0:ncc.shape[1]]
     # offsets of the template from its place in the left view
     oy, ox = oy - (size - 1) - c0[0], ox - (size - 1) - c0[1]
-    allowed = (np.abs(oy) <= SEARCH_PX) & (np.abs(ox) <= SEARCH_PX)
+    allowed = (np.abs(oy) <= reach_px) & (np.abs(ox) <= reach_px)
     if predict_px is not None and radius_px is not None:
         allowed &= np.hypot(ox - predict_px[0], oy - predict_px[1]) <= radius_px
     if not allowed.any():
@@ -287,7 +297,7 @@ def match(
     margin = peak - second
     if strict and (peak < MIN_PEAK or margin < MIN_MARGIN):
         return None
-    if max(abs(oy[i, j]), abs(ox[i, j])) >= SEARCH_PX:  # at the search's edge: beyond it
+    if max(abs(oy[i, j]), abs(ox[i, j])) >= reach_px:  # at the search's edge: beyond it
         return None
     di = _vertex(ncc[i - 1, j], ncc[i, j], ncc[i + 1, j])
     dj = _vertex(ncc[i, j - 1], ncc[i, j], ncc[i, j + 1])
@@ -408,6 +418,22 @@ FUSED_PX, UNFUSED_PX = 3.0, 10.0
 MARK_STEP_MM, DITHER, DITHER_RADIUS_PX = 0.01, 4, 4.0
 #: Steps of the search by Z, in :data:`Z_SEARCH_UM`. [—]
 Z_STEPS = (1, -1, 2, -2)
+#: The search beyond the finding field (:meth:`Robot.far`): b_y's probe [mm]; the y-parallax
+#: one step of b_y adds (under the ×2 search's reach, ±5 mm of photo, so that the steps'
+#: reaches overlap) [µm]; the steps, in those units (b_y's range on the SD-3 is ±20 mm) [—].
+BY_PROBE_MM, FAR_STEP_UM, FAR_STEPS = 1.0, 4000.0, (1, -1, 2, -2, 3, -3, 4, -4, 5, -5)
+#: With the search beyond the field: the largest turn of one conventional clearing (κ up to
+#: 0.15 rad clears 8 mm of y-parallax 60 mm from the other photo's centre), and its cycles.
+WIDE_MAX_TURN, WIDE_CYCLES = 0.15, 6
+#: Halvings of a clearing turn that the stop refused (the knobs stop at tan 3°). [—]
+WIDE_STOP_TRIES = 4
+#: The search by Z with the search beyond the field, in :data:`Z_SEARCH_UM` (in mountains a
+#: detail's x-parallax at another point's Z reaches well over the ±7 mm of :data:`Z_STEPS`:
+#: e12, point 5 at 0.7 mm of y-parallax not found by them). [—]
+WIDE_Z_STEPS = (1, -1, 2, -2, 3, -3, 4, -4, 5, -5)
+#: The reach of a ×2 search beyond the field, on each axis (the steps of Z and b_y move the
+#: detail by 70–80 ×2 pixels, so the reaches still overlap). [px]
+WIDE_REACH_PX = 85.0
 
 
 class Robot:
@@ -416,8 +442,19 @@ class Robot:
     fused Z is kept and set again when the robot comes back to it."""
 
     def __init__(self, eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6),
-                 observer=None):
+                 observer=None, substitutes: dict[int, tuple[float, float]] | None = None,
+                 wide: bool = False):
         self.eyes = eyes
+        #: Standard point → the offset of its substitute from it on the left photo (x, y up):
+        #: the marks go to the point, then on by this offset. [mm]
+        self.substitutes = dict(substitutes or {})
+        #: Whether a detail outside the finding field is searched for by b_y
+        #: (:meth:`far`), and the conventional clearing turns further (:data:`WIDE_MAX_TURN`).
+        self.wide = wide
+        self.by_base: float | None = None  # b_y as the robot found it (its setting)
+        #: The point the marks were last sent to, and whether on to its detail spot.
+        self.here: tuple[int, bool] | None = None
+        self.q_per_by: float | None = None  # µm of y-parallax seen per mm of b_y
         #: Called with the record after each pass (a benchmark's diagnostics; the robot never
         #: reads what it does).
         self.observer = observer
@@ -443,10 +480,69 @@ class Robot:
         self.px_per_xy = np.array(cols).T
         self.rec.notes.append(f"px per X, Y: {self.px_per_xy.tolist()}")
 
+    def arrive(self, n: int) -> None:
+        """Go to standard point ``n`` (its go-to), and on to its substitute where it has one
+        (X and Y turned by the offset, through the learnt effect of X and Y on the view)."""
+        self.eyes.go_to(n)
+        self.here = (n, False)
+        if n not in self.substitutes or self.px_per_xy is None:
+            return
+        dx_mm, dy_mm = self.substitutes[n]
+        px = np.array([dx_mm, -dy_mm]) / (SCREEN_PIXEL_MM / FIND_MAG)
+        turns = np.linalg.solve(self.px_per_xy, px)
+        for axis, d in zip(("X", "Y"), turns, strict=True):
+            self.eyes.turn(axis, round(float(d), 3))
+
+    def set_by(self, value: float) -> float:
+        """b_y set (a setting past a stop is refused: the wheel then stays); its value."""
+        self.eyes.set("by", round(value, 3))
+        return self.eyes.wheel("by")
+
+    def learn_by(self) -> None:
+        """How a turn of b_y moves the right view (a probe of :data:`BY_PROBE_MM`, the right
+        view before and after matched on itself): the y-parallax it adds a mm."""
+        self.by_base = self.eyes.wheel("by")
+        before = view(self.eyes, FIND_MAG)[1]
+        now = self.set_by(self.by_base + BY_PROBE_MM)
+        after = view(self.eyes, FIND_MAG)[1]
+        self.set_by(self.by_base)
+        m = match(before, after, FIND_MAG)
+        if m is None or abs(now - self.by_base) < 0.5 * BY_PROBE_MM:
+            self.rec.notes.append(f"b_y probe: {m}, b_y {now}")
+            return
+        self.q_per_by = m.q_um / (now - self.by_base)
+        self.rec.notes.append(f"q per b_y: {self.q_per_by:.0f} µm/mm")
+
+    def far(self, n: int) -> tuple[Match, float] | None:
+        """A detail outside the finding field searched for by b_y: b_y set by steps of about
+        :data:`FAR_STEP_UM` of y-parallax each way (:data:`FAR_STEPS`), the detail looked for
+        at each (and by Z, :meth:`coarse`); the match and the y-parallax the shift of b_y
+        added (b_y left where the detail was found; :meth:`by_back` sets it back). [µm]"""
+        if self.q_per_by is None or self.by_base is None:
+            return None
+        for k in FAR_STEPS:
+            target = self.by_base + k * FAR_STEP_UM / abs(self.q_per_by)
+            now = self.set_by(target)
+            if abs(now - target) > 0.015:
+                continue  # past b_y's stop: refused
+            m = self.coarse(n)
+            if m is not None:
+                added = (now - self.by_base) * self.q_per_by
+                self.rec.notes.append(f"far {n}: b_y {now} ({added:.0f} µm): {m}")
+                return m, added
+        self.set_by(self.by_base)
+        self.rec.notes.append(f"far {n}: not found")
+        return None
+
+    def by_back(self) -> None:
+        if self.by_base is not None and self.eyes.wheel("by") != self.by_base:
+            self.set_by(self.by_base)
+
     def go_to(self, n: int) -> None:
         """Go to point ``n`` and on to its detail (:func:`textured_spot`), chosen the first
         time from the ×2 view."""
-        self.eyes.go_to(n)
+        self.arrive(n)
+        self.here = (n, True)
         if self.px_per_xy is None:
             return
         if n not in self.spot_at:
@@ -459,8 +555,15 @@ class Robot:
                 self.eyes.turn(axis, d)
 
     def set_z(self, value: float) -> None:
+        before = self.z
         self.eyes.set("Z", round(value, 3))
         self.z = self.eyes.wheel("Z")  # at a stop the carriage stays there
+        if self.wide and self.here is not None and self.z != before:
+            # Z moves the model point the marks are on, and so the left mark off the point
+            # (SD-3, e12: 50 mm of Z moved it 28 mm, off the photo at point 2): the marks
+            # brought back onto the point at the new Z, as a go-to puts them
+            n, spot = self.here
+            self.go_to(n) if spot else self.arrive(n)
 
     def fine_spot(self, n: int, m: Match) -> Match:
         """Where ×20 finds nothing sure at point ``n``'s detail (a striped field, a plain one),
@@ -568,8 +671,8 @@ class Robot:
             return m
         return again
 
-    def look(self, predict=None, radius=None) -> Match | None:
-        return match(*view(self.eyes, FIND_MAG), FIND_MAG, predict, radius)
+    def look(self, predict=None, radius=None, reach=SEARCH_PX) -> Match | None:
+        return match(*view(self.eyes, FIND_MAG), FIND_MAG, predict, radius, reach_px=reach)
 
     def clear_x(self, m: Match) -> Match:
         """Z set to clear the x-parallax of a found detail (up to three settings, the detail
@@ -594,6 +697,8 @@ class Robot:
         rec = self.rec
         if n in self.z_at and self.z != self.z_at[n]:
             self.set_z(self.z_at[n])
+        if self.wide:
+            return self.coarse_wide(n)
         m = self.look()
         if m is None and rec.x_per_z is not None:
             start = self.z
@@ -614,25 +719,71 @@ class Robot:
         rec.notes.append(f"coarse {n}: {m}")
         return m
 
+    def coarse_wide(self, n: int) -> Match | None:
+        """:meth:`coarse` with the search beyond the field: Z set by :data:`WIDE_Z_STEPS`, the
+        detail looked for within :data:`WIDE_REACH_PX` (a match farther out was, in e12's
+        first runs, a weak false one at the search's edge), and a match taken only where Z
+        then fuses it (its x-parallax cleared to :data:`UNFUSED_PX`): a match Z cannot fuse
+        is not the detail, and the search goes on."""
+        rec = self.rec
+        start = self.z
+        settings = [0.0]
+        if rec.x_per_z is not None:
+            settings += [k * Z_SEARCH_UM / abs(rec.x_per_z) for k in WIDE_Z_STEPS]
+        for dz in settings:
+            if dz:
+                self.set_z(start + dz)
+            m = self.look(reach=WIDE_REACH_PX)
+            if m is None:
+                continue
+            if rec.x_per_z is None:
+                m = self.learn_z(m)
+            m = self.clear_x(m)
+            if rec.x_per_z is not None and abs(m.dx_px) > UNFUSED_PX:
+                rec.notes.append(f"coarse {n}: not fused, refused: {m}")
+                continue
+            self.z_at[n] = self.z
+            rec.notes.append(f"coarse {n}: {m} (Z {self.z})")
+            return m
+        self.set_z(start)
+        rec.notes.append(f"coarse {n}: not found")
+        return None
+
     def clear_with(self, n: int, control: str) -> bool:
         """At point ``n``: the detail found, ``control`` turned by a probe step to learn its
         effect on the y-parallax, then turned to clear it (a step of the conventional method,
         by the eye)."""
-        self.eyes.go_to(n)
+        self.arrive(n)
         m = self.coarse(n)
+        added = 0.0  # the y-parallax a shifted b_y adds to what is seen [µm]
+        if m is None and self.wide:
+            found = self.far(n)
+            if found is not None:
+                m, added = found
         if m is None:
             return False
-        if abs(m.q_um) < CLASSIC_DONE_UM:
+        if abs(m.q_um - added) < CLASSIC_DONE_UM:
+            self.by_back()
             return True
         self.eyes.turn(control, PROBE[control])
         moved = self.look((m.dx_px, m.dy_px), 40.0)
         if moved is None or abs(moved.q_um - m.q_um) < 20.0:
             self.eyes.turn(control, -PROBE[control])
+            self.by_back()
             return False
         per = (moved.q_um - m.q_um) / PROBE[control]
-        d = float(np.clip(-moved.q_um / per, -CLASSIC_MAX_TURN, CLASSIC_MAX_TURN))
+        most = WIDE_MAX_TURN if self.wide else CLASSIC_MAX_TURN
+        d = float(np.clip(-(moved.q_um - added) / per, -most, most))
+        was = self.eyes.wheel(control) if self.wide else None
         self.eyes.turn(control, d)
-        self.rec.notes.append(f"classic {n} {control}: q {moved.q_um:.0f} µm, turned {d:.5f}")
+        for _ in range(WIDE_STOP_TRIES if self.wide else 0):
+            if self.eyes.wheel(control) != was:
+                break
+            d /= 2  # a turn past the stop is refused: a shorter one
+            self.eyes.turn(control, d)
+        self.by_back()
+        self.rec.notes.append(f"classic {n} {control}: q {moved.q_um - added:.0f} µm, "
+                              f"turned {d:.5f}")
         return True
 
     def learn_z(self, m: Match) -> Match:
@@ -662,8 +813,14 @@ class Robot:
         the eye, each element's effect learnt by a probe turn) until every detail is found near
         the mark."""
         n = self.rec.points[0]
-        self.eyes.go_to(n)
+        self.arrive(n)
         self.z = self.eyes.wheel("Z")
+        if self.wide or self.substitutes:
+            # the effects of X, Y (for the substitutes) and of b_y (for the search beyond
+            # the field) learnt first: each from one view matched on itself
+            self.learn_xy()
+            if self.wide:
+                self.learn_by()
         m = self.look()
         for d in COMMON_SEARCH:
             if m is not None:
@@ -672,15 +829,20 @@ class Robot:
             m = self.look()
             if m is None:
                 self.eyes.turn("kappa_right", -d)
+        if m is None and self.wide:
+            found = self.far(n)
+            m = None if found is None else found[0]
         if m is None:
             return
         self.learn_z(m)
-        for _ in range(CLASSIC_CYCLES):
+        self.by_back()
+        for _ in range(WIDE_CYCLES if self.wide else CLASSIC_CYCLES):
             ok = [self.clear_with(p, c) for p, c in CLASSIC if p in self.rec.points]
             if all(ok):
                 break
         self.eyes.go_to(n)
-        self.learn_xy()
+        if self.px_per_xy is None:
+            self.learn_xy()
 
     def predict(self, q_um: dict[int, float], p_um: dict[int, float],
                 step: dict[str, float]) -> dict[int, tuple[float, float]]:
@@ -724,6 +886,12 @@ class Robot:
             m = self.fine(n, m)
         if m.magnification != FINE_MAGS[0]:
             m = self.fine_spot(n, m)
+        if (m.magnification == FIND_MAG and rec.x_per_z is not None
+                and abs(m.dx_px) > UNFUSED_PX):
+            # a ×2 match whose x-parallax Z could not clear (each fusing look lost it): not
+            # taken as a reading, as an unfused ×20 match is not (:meth:`fused_or`)
+            rec.notes.append(f"unfused ×{FIND_MAG} at {n}: {m}: not read")
+            return None
         return self.steady(m)
 
     def probe_row(self, n: int) -> None:
@@ -833,9 +1001,32 @@ def _worse(q_um: dict[int, float], mag: dict[int, int], last_q: dict[int, float]
         WORSE_FACTOR * max(abs(last_q[n]) for n in common) + WORSE_UM)
 
 
+#: How far a substitute for an unusable standard point is put from it, towards the middle
+#: of the other points (the grade takes one within 0.2·c of the point, 14 mm for c = 70 mm;
+#: the ×2 field's half is 6.4 mm). [mm]
+SUBSTITUTE_MM = 10.0
+
+
+def substitute_offset(points: dict[int, tuple[float, float]], n: int) -> tuple[float, float]:
+    """Where to look instead of the unusable standard point ``n`` (``points``: the standard
+    points on the left photo, as the overview draws them): :data:`SUBSTITUTE_MM` from it
+    towards the mean of the others, as the offset from it (x, y up). [mm]"""
+    here = np.array(points[n], float)
+    rest = np.mean([xy for k, xy in points.items() if k != n], axis=0)
+    way = (rest - here) / np.linalg.norm(rest - here)
+    return float(round(way[0] * SUBSTITUTE_MM, 3)), float(round(way[1] * SUBSTITUTE_MM, 3))
+
+
 def relative_orientation(eyes: Eyes, tolerance_um: float, points=(1, 2, 3, 4, 5, 6),
-                         observer=None) -> Orientation:
+                         observer=None, substitutes=None, wide: bool = False,
+                         notes: list | None = None) -> Orientation:
     """Clear the y-parallax at the standard ``points`` by least squares on the measured
     parallaxes (module docstring); returns the record (the last measured q at each point).
-    ``observer`` (diagnostics only) is called with the record after each pass."""
-    return Robot(eyes, tolerance_um, points, observer).run()
+    ``observer`` (diagnostics only) is called with the record after each pass; ``notes``
+    (diagnostics only) is the list the robot's notes are appended to as they are made.
+    ``substitutes``: standard point → the offset of its substitute on the left photo (mm,
+    :func:`substitute_offset`); ``wide``: search beyond the finding field by b_y."""
+    robot = Robot(eyes, tolerance_um, points, observer, substitutes, wide)
+    if notes is not None:
+        robot.rec.notes = notes
+    return robot.run()

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.ndimage import gaussian_filter, shift
 
-from tests.browser.pixel_robot import match
+from tests.browser.pixel_robot import match, substitute_offset
 
 SIZE = 256
 
@@ -55,3 +55,27 @@ def test_stripes_along_one_direction_are_rejected_as_ambiguous():
     stripes = 128 + 30 * np.sin(2 * np.pi * (xx + 0.3 * yy) / 9.0)
     m = match(_eyepiece(stripes), _eyepiece(np.roll(stripes, 5, axis=1)), 20)
     assert m is None, m
+
+
+def test_a_match_beyond_the_reach_is_refused():
+    """An offset of 90 px is found within the full search (100 px) and refused with a reach
+    of 85 px (the search beyond the field then moves b_y or Z on)."""
+    field = _texture(3)
+    left = field[32:32 + SIZE, 32:32 + SIZE]
+    right = shift(field, (0.0, -90.0), order=3, mode="nearest")[32:32 + SIZE, 32:32 + SIZE]
+    m = match(_eyepiece(left), _eyepiece(right), 2)
+    assert m is not None and abs(m.dx_px + 90.0) < 0.2 and abs(m.dy_px) < 0.2, m
+    assert match(_eyepiece(left), _eyepiece(right), 2, reach_px=85.0) is None
+
+
+def test_a_substitute_lies_within_the_grades_reach_towards_the_others():
+    """e12's point 3 near the top edge of the left photo (the overview's places for one
+    trainee): the substitute 10 mm from it, inside 0.2·c = 14 mm (c = 70 mm), and nearer the
+    others' mean than the point."""
+    points = {1: (-2.5282, 3.1462), 2: (72.5923, 1.776), 3: (-1.1502, 86.1315),
+              4: (74.3791, 83.6101), 5: (-3.7574, -70.876), 6: (63.9533, -71.4277)}
+    dx, dy = substitute_offset(points, 3)
+    assert abs(np.hypot(dx, dy) - 10.0) < 1e-3 and np.hypot(dx, dy) <= 0.2 * 70.0
+    mean = np.mean([points[k] for k in (1, 2, 4, 5, 6)], axis=0)
+    sub = np.array(points[3]) + (dx, dy)
+    assert np.hypot(*(sub - mean)) < np.hypot(*(np.array(points[3]) - mean)) - 9.0
